@@ -1,0 +1,62 @@
+//! Rust mirrors of the structs in `shaders/common.glsl`. Field names equal the GLSL member
+//! names so that the `gpu_layout` test can match them against SPIR-V reflection.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Where each field of a mirrored struct starts, for the layout test.
+pub trait GpuLayout {
+    /// The GLSL struct name.
+    const GLSL_NAME: &'static str;
+    /// (member name, byte offset) in declaration order.
+    fn field_offsets() -> Vec<(&'static str, usize)>;
+}
+
+macro_rules! gpu_struct {
+    ($(#[$meta:meta])* $name:ident { $($(#[$fmeta:meta])* $field:ident : $ty:ty,)* }) => {
+        $(#[$meta])*
+        #[repr(C)]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+        pub struct $name { $($(#[$fmeta])* pub $field: $ty,)* }
+        impl GpuLayout for $name {
+            const GLSL_NAME: &'static str = stringify!($name);
+            fn field_offsets() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($field), std::mem::offset_of!($name, $field)),)*]
+            }
+        }
+    };
+}
+
+/// `SHADING_SEED` in common.glsl.
+pub const SHADING_SEED: u32 = 0;
+
+gpu_struct!(
+    /// Per-frame uniforms (std140; every member 16-byte friendly).
+    FrameUniforms {
+        view: [[f32; 4]; 4],
+        proj: [[f32; 4]; 4],
+        camera_pos: [f32; 4],
+        light_count: u32,
+        ambient: f32,
+        shading_model: u32,
+        _pad0: u32,
+    }
+);
+
+gpu_struct!(
+    /// One radius-limited point light (std430 array element, 32 bytes).
+    PointLight {
+        /// xyz world position, w radius.
+        position_radius: [f32; 4],
+        /// rgb linear colour.
+        color: [f32; 4],
+    }
+);
+
+gpu_struct!(
+    /// Per-draw push constants.
+    ObjectPush {
+        position_scale: [f32; 4],
+        albedo_roughness: [f32; 4],
+        material: [f32; 4],
+    }
+);

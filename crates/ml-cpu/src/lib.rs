@@ -1,0 +1,15 @@
+//! The CPU half of manylights: everything that needs no GPU. Scene data (meshes, materials,
+//! lights, camera), the structs shared with the shaders, and the CPU reference of each
+//! shading model that the image tests compare the GPU against.
+
+pub mod camera;
+pub mod error;
+pub mod gpu_types;
+pub mod lights;
+pub mod material;
+pub mod mesh;
+pub mod scene;
+pub mod shading;
+mod teapot;
+
+pub use error::SceneError;

@@ -1,0 +1,70 @@
+//! Scenes: objects with a mesh kind, position, scale and material; lights; a camera.
+
+use crate::camera::Camera;
+use crate::gpu_types::PointLight;
+use crate::lights::LightParams;
+use crate::material::Material;
+use crate::mesh::MeshKind;
+use crate::SceneError;
+use glam::Vec3;
+
+/// The seed's ambient factor: colour = albedo · 0.02 + Lo.
+pub const SEED_AMBIENT: f32 = 0.02;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Object {
+    pub mesh: MeshKind,
+    pub position: Vec3,
+    pub scale: f32,
+    pub material: Material,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub objects: Vec<Object>,
+    /// Lights at rest; the renderer animates them per frame.
+    pub lights: Vec<PointLight>,
+    pub camera: Camera,
+    pub ambient: f32,
+}
+
+impl Scene {
+    /// The built-in `seed` scene (SPEC §1): a 7×7 grid of one object kind at
+    /// x,z = (i − 3.5)·2.5, y = 0, in one material.
+    pub fn seed(mesh: MeshKind, material: Material, lights: &LightParams) -> Result<Scene, SceneError> {
+        let mut objects = Vec::with_capacity(49);
+        for i in 0..7 {
+            for j in 0..7 {
+                let at = |k: i32| (k as f32 - 3.5) * 2.5;
+                objects.push(Object { mesh, position: Vec3::new(at(i), 0.0, at(j)), scale: 1.0, material });
+            }
+        }
+        Ok(Scene { objects, lights: lights.build()?, camera: Camera::seed(), ambient: SEED_AMBIENT })
+    }
+
+    /// The distinct meshes this scene draws, in first-use order.
+    pub fn mesh_kinds(&self) -> Vec<MeshKind> {
+        let mut kinds: Vec<MeshKind> = Vec::new();
+        for o in &self.objects {
+            if !kinds.contains(&o.mesh) {
+                kinds.push(o.mesh);
+            }
+        }
+        kinds
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seed_scene_is_a_7x7_grid() {
+        let s = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
+        assert_eq!(s.objects.len(), 49);
+        assert_eq!(s.objects[0].position, Vec3::new(-8.75, 0.0, -8.75));
+        assert_eq!(s.objects[48].position, Vec3::new(6.25, 0.0, 6.25));
+        assert_eq!(s.mesh_kinds(), vec![MeshKind::Sphere]);
+        assert_eq!(s.lights.len(), 64);
+    }
+}

@@ -1,0 +1,36 @@
+// Every struct that Rust mirrors lives here (crates/ml-cpu/src/gpu_types.rs).
+// Keep in sync: the test `gpu_layout` compares each Rust field offset and struct size with
+// what SPIR-V reflection of the compiled shaders reports, so a moved field fails CI.
+// Storage buffers are std430 (no 16-byte padding of scalars in arrays, no 64 KiB uniform cap:
+// seed mistake 5); the one uniform block is std140, so it holds only vec4-aligned members.
+
+#ifndef MANYLIGHTS_COMMON_GLSL
+#define MANYLIGHTS_COMMON_GLSL
+
+#define SHADING_SEED 0u
+
+// Per frame, one uniform buffer per frame in flight (set 0, binding 0).
+struct FrameUniforms {
+    mat4 view;
+    mat4 proj;           // Vulkan clip space: Y flipped, depth 0..1
+    vec4 camera_pos;     // xyz: world position of the eye
+    uint light_count;
+    float ambient;       // seed: colour = albedo * ambient + Lo
+    uint shading_model;  // SHADING_*
+    uint _pad0;
+};
+
+// A radius-limited point light (set 0, binding 1, std430 array).
+struct PointLight {
+    vec4 position_radius; // xyz: world position, w: radius (no light at all beyond it)
+    vec4 color;           // rgb: linear colour; a unused
+};
+
+// Per draw, by push constants as in seed 000.
+struct ObjectPush {
+    vec4 position_scale;   // xyz: world translation, w: uniform scale
+    vec4 albedo_roughness; // rgb: albedo, a: roughness
+    vec4 material;         // x: metallic; yzw unused
+};
+
+#endif

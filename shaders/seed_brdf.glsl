@@ -1,0 +1,55 @@
+// The `seed` shading model of SPEC §2 (seed 000): specular-only Cook-Torrance.
+// Mirrored on the CPU by crates/ml-cpu/src/shading.rs (keep in sync; tests compare them).
+
+#ifndef MANYLIGHTS_SEED_BRDF_GLSL
+#define MANYLIGHTS_SEED_BRDF_GLSL
+
+const float PI = 3.14159265358979;
+
+float d_ggx(float n_dot_h, float roughness) {
+    float alpha = roughness * roughness;
+    float alpha2 = alpha * alpha;
+    float denom = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;
+    return alpha2 / (PI * denom * denom);
+}
+
+// Schlick-Smith G divided by (4 NdotL NdotV). The seed computes G and then divides by
+// 4 NdotL NdotV, which is 0/0 at grazing view; the quotient is the same number without the NaN.
+float g_schlick_smith_over_4nlnv(float n_dot_l, float n_dot_v, float roughness) {
+    float r = roughness + 1.0;
+    float k = (r * r) / 8.0;
+    return 0.25 / ((n_dot_l * (1.0 - k) + k) * (n_dot_v * (1.0 - k) + k));
+}
+
+vec3 f_schlick(float cos_theta, vec3 albedo, float metallic) {
+    vec3 f0 = mix(vec3(0.04), albedo, metallic);
+    return f0 + (1.0 - f0) * pow(1.0 - cos_theta, 5.0);
+}
+
+// Light reflected towards V by one point light; exactly zero beyond the light's radius.
+vec3 seed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v,
+                      vec3 albedo, float roughness, float metallic) {
+    vec3 light_vec = light.position_radius.xyz - world_pos;
+    float dist = length(light_vec);
+    float radius = light.position_radius.w;
+    if (dist > radius) {
+        return vec3(0.0);
+    }
+    vec3 l = light_vec / dist;
+    vec3 h = normalize(v + l);
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    float n_dot_l = clamp(dot(n, l), 0.0, 1.0);
+    float n_dot_h = clamp(dot(n, h), 0.0, 1.0);
+    if (n_dot_l <= 0.0) {
+        return vec3(0.0);
+    }
+    float atten = clamp(1.0 - dist / radius, 0.0, 1.0);
+    float radiance = atten * atten * n_dot_l;
+    float d = d_ggx(n_dot_h, roughness);
+    float g = g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, roughness));
+    vec3 f = f_schlick(n_dot_v, albedo, metallic);
+    vec3 spec = d * f * g;
+    return spec * n_dot_l * light.color.rgb * radiance;
+}
+
+#endif
