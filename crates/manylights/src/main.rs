@@ -1,1 +1,200 @@
-fn main() {}
+//! `manylights`: the command line. Parses arguments and calls the library; every failure
+//! ends as one `error: …` line on stderr and a non-zero exit.
+
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, Parser, Subcommand};
+use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
+use ml_cpu::material::Material;
+use ml_cpu::mesh::MeshKind;
+use ml_cpu::scene::Scene;
+use ml_render::report::table;
+use ml_render::{HeadlessRenderer, RenderSettings, Technique};
+use ml_vk::{Context, ContextDesc};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::Ordering;
+
+#[derive(Parser)]
+#[command(name = "manylights", version, about = "A Vulkan renderer for scenes lit by many lights")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene headless (no window system) to a PNG and print a timing table.
+    Render(RenderArgs),
+    /// List Vulkan devices, drivers, versions and the limits manylights depends on.
+    Info,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// Scene to render (built in: seed).
+    #[arg(long, default_value = "seed")]
+    scene: String,
+    /// Lighting technique: forward.
+    #[arg(long, default_value = "forward")]
+    technique: String,
+    /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc.
+    #[arg(long, default_value = "sphere")]
+    object: String,
+    /// Material: gold, copper, chromium, nickel, titanium, cobalt, platinum, white, red, blue, black.
+    #[arg(long, default_value = "gold")]
+    material: String,
+    /// Number of point lights.
+    #[arg(long, default_value_t = 64)]
+    lights: u64,
+    /// Light placement: grid (the seed's) or random (uniform in x,z ∈ [−20,20], y ∈ [−2,12]).
+    #[arg(long, default_value = "grid")]
+    light_layout: String,
+    /// Seed of the random layout (and of random radii).
+    #[arg(long, default_value_t = 1)]
+    light_seed: u64,
+    /// Light radius R, or MIN..MAX for radii drawn per light.
+    #[arg(long, default_value = "15")]
+    light_radius: String,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Fix the animation clock at T (otherwise it advances 1/60 s per frame from 0).
+    #[arg(long)]
+    time: Option<f32>,
+    /// Frames to render; timings are averaged over them, the image is the last one.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    /// Enable the Khronos validation layer with synchronization validation; any message
+    /// makes the run fail.
+    #[arg(long)]
+    validation: bool,
+    /// Vulkan device index (see `manylights info`); default: the best one (discrete first).
+    #[arg(long)]
+    device: Option<usize>,
+    /// Output PNG file.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help, --version
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+            eprintln!("error: {first} (see `manylights --help`)");
+            return ExitCode::from(2);
+        }
+    };
+    let result = match cli.command {
+        Command::Render(args) => render(&args),
+        Command::Info => info(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", format!("{e:#}").replace('\n', " "));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn build_scene(args: &RenderArgs) -> Result<Scene> {
+    if args.scene != "seed" {
+        bail!("unknown scene '{}': expected seed", args.scene);
+    }
+    let lights = LightParams {
+        count: LightParams::check_count(args.lights)?,
+        layout: LightLayout::from_name(&args.light_layout)?,
+        seed: args.light_seed,
+        radius: RadiusRange::parse(&args.light_radius)?,
+    };
+    Ok(Scene::seed(MeshKind::from_name(&args.object)?, Material::named(&args.material)?, &lights)?)
+}
+
+/// Fail before rendering if the PNG could not be written: nothing is computed for nothing.
+fn check_output(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        bail!("cannot write '{}': it is a directory", path.display());
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        bail!("cannot write '{}': folder '{}' does not exist", path.display(), parent.display());
+    }
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .with_context(|| format!("cannot write '{}'", path.display()))?;
+    if !existed {
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(())
+}
+
+fn render(args: &RenderArgs) -> Result<()> {
+    let technique = Technique::from_name(&args.technique)?;
+    let scene = build_scene(args)?;
+    check_output(&args.out)?;
+    let settings = RenderSettings { technique, width: args.width, height: args.height, frames: args.frames, time: args.time };
+    let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device })?;
+    let messages = ctx.validation_counter();
+    let light_count = scene.lights.len();
+    let result = HeadlessRenderer::new(&ctx, scene, settings).and_then(|mut r| r.render());
+    let device = format!("{} ({}, {} {})", ctx.info.name, ctx.info.type_name(), ctx.info.driver_name, ctx.info.driver_info);
+    drop(ctx);
+    let output = result?;
+    image::save_buffer_with_format(&args.out, &output.rgba, output.width, output.height, image::ColorType::Rgba8, image::ImageFormat::Png)
+        .with_context(|| format!("cannot write '{}'", args.out.display()))?;
+    let stats = &output.stats;
+    let mut rows = vec![
+        ("device", device),
+        ("resolution", format!("{}x{}", output.width, output.height)),
+        ("technique", technique.name().to_owned()),
+        ("lights", light_count.to_string()),
+        ("frames", stats.frames.to_string()),
+    ];
+    match stats.gpu_ms() {
+        Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
+        None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
+    }
+    rows.push(("cpu ms/frame", format!("{:.3}  (update + record + submit)", stats.cpu_ms())));
+    rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
+    rows.push(("output", args.out.display().to_string()));
+    print!("{}", table(&rows));
+    let count = messages.load(Ordering::SeqCst);
+    if count > 0 {
+        bail!("the validation layer reported {count} message(s) (printed above)");
+    }
+    Ok(())
+}
+
+fn info() -> Result<()> {
+    let devices = ml_vk::context::list_devices()?;
+    for d in devices {
+        let l = &d.limits;
+        let rows = vec![
+            ("device", format!("{}: {} ({})", d.index, d.name, d.type_name())),
+            ("vulkan", d.api_version_string()),
+            ("driver", format!("{} {}", d.driver_name, d.driver_info)),
+            ("usable", if d.suitable { "yes".into() } else { "no (needs Vulkan 1.2 and a graphics queue)".to_string() }),
+            ("maxImageDimension2D", l.max_image_dimension2_d.to_string()),
+            ("maxStorageBufferRange", l.max_storage_buffer_range.to_string()),
+            ("maxUniformBufferRange", l.max_uniform_buffer_range.to_string()),
+            ("maxPushConstantsSize", l.max_push_constants_size.to_string()),
+            ("maxComputeWorkGroupInvocations", l.max_compute_work_group_invocations.to_string()),
+            ("maxComputeSharedMemorySize", l.max_compute_shared_memory_size.to_string()),
+            ("timestampPeriod (ns)", l.timestamp_period.to_string()),
+            ("timestampComputeAndGraphics", (l.timestamp_compute_and_graphics != 0).to_string()),
+        ];
+        println!("{}", table(&rows));
+    }
+    Ok(())
+}

@@ -16,9 +16,12 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// The seed's first-person camera: from (10, 13, 1.8), 62.5° down, facing −X (the grid).
+    /// The seed's first-person camera, 62.5° down towards the grid. Seed 000 calls
+    /// `setPosition(10, 13, 1.8)`, but its framework stores the negated eye position
+    /// (`camPos = camera.position * -1`) in a Y-down world; in our +Y-up world the eye is at
+    /// (−10, 13, −1.8), facing +X.
     pub fn seed() -> Camera {
-        Camera { position: Vec3::new(10.0, 13.0, 1.8), pitch_deg: -62.5, yaw_deg: 180.0, fov_y_deg: 60.0, near: 0.1, far: 256.0 }
+        Camera { position: Vec3::new(-10.0, 13.0, -1.8), pitch_deg: -62.5, yaw_deg: 0.0, fov_y_deg: 60.0, near: 0.1, far: 256.0 }
     }
 
     /// A camera at `position` looking at `target`.

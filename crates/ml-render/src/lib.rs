@@ -1,0 +1,15 @@
+//! manylights techniques and passes: what is drawn and how, on top of the Vulkan plumbing
+//! (ml-vk) and the CPU scene (ml-cpu).
+
+pub mod error;
+pub mod forward;
+pub mod frame;
+pub mod gpu_mesh;
+pub mod headless;
+pub mod report;
+pub mod settings;
+pub mod targets;
+
+pub use error::RenderError;
+pub use headless::{HeadlessRenderer, RenderOutput};
+pub use settings::{RenderSettings, Technique};

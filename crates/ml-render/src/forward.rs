@@ -1,0 +1,269 @@
+//! Technique `forward` (SPEC §3): one render pass, one subpass; every fragment loops over
+//! every light in a std430 storage buffer.
+
+use crate::gpu_mesh::GpuMesh;
+use crate::targets::COLOR_FORMAT;
+use ml_cpu::gpu_types::ObjectPush;
+use ml_cpu::mesh::Vertex;
+use ml_cpu::scene::Object;
+use ml_vk::{shader, vk, Context, VkError, VkResultExt};
+
+/// Binding numbers of set 0 (see the shaders).
+pub const BINDING_FRAME: u32 = 0;
+pub const BINDING_LIGHTS: u32 = 1;
+
+/// Background of pixels no object covers (linear, before the UNORM store).
+pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
+
+pub struct ForwardPass {
+    pub render_pass: vk::RenderPass,
+    pub set_layout: vk::DescriptorSetLayout,
+    pub pipeline_layout: vk::PipelineLayout,
+    pub pipeline: vk::Pipeline,
+}
+
+impl ForwardPass {
+    pub fn new(ctx: &Context, depth_format: vk::Format) -> Result<ForwardPass, VkError> {
+        let mut pass = ForwardPass {
+            render_pass: vk::RenderPass::null(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            pipeline_layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+        };
+        // On failure, destroy what was made (null handles are ignored by vkDestroy*).
+        match pass.create(ctx, depth_format) {
+            Ok(()) => Ok(pass),
+            Err(e) => {
+                pass.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn create(&mut self, ctx: &Context, depth_format: vk::Format) -> Result<(), VkError> {
+        let d = &ctx.device;
+        self.render_pass = create_render_pass(ctx, depth_format)?;
+        let bindings = [
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(BINDING_FRAME)
+                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT),
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(BINDING_LIGHTS)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+        ];
+        // SAFETY: valid device and create infos throughout.
+        self.set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
+            .ctx("vkCreateDescriptorSetLayout")?;
+        let push = [vk::PushConstantRange::default()
+            .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+            .size(std::mem::size_of::<ObjectPush>() as u32)];
+        let layouts = [self.set_layout];
+        let layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push);
+        // SAFETY: as above.
+        self.pipeline_layout = unsafe { d.create_pipeline_layout(&layout_info, None) }.ctx("vkCreatePipelineLayout")?;
+        self.pipeline = self.create_pipeline(ctx)?;
+        Ok(())
+    }
+
+    fn create_pipeline(&self, ctx: &Context) -> Result<vk::Pipeline, VkError> {
+        let vert = shader::module(ctx, ml_shaders::FORWARD_VERT)?;
+        let frag = match shader::module(ctx, ml_shaders::FORWARD_FRAG) {
+            Ok(f) => f,
+            Err(e) => {
+                // SAFETY: unused module.
+                unsafe { ctx.device.destroy_shader_module(vert, None) };
+                return Err(e);
+            }
+        };
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(frag).name(c"main"),
+        ];
+        let vertex_bindings = [vk::VertexInputBindingDescription::default()
+            .binding(0)
+            .stride(std::mem::size_of::<Vertex>() as u32)
+            .input_rate(vk::VertexInputRate::VERTEX)];
+        let vertex_attributes = [
+            vk::VertexInputAttributeDescription::default()
+                .location(0)
+                .binding(0)
+                .format(vk::Format::R32G32B32_SFLOAT)
+                .offset(std::mem::offset_of!(Vertex, position) as u32),
+            vk::VertexInputAttributeDescription::default()
+                .location(1)
+                .binding(0)
+                .format(vk::Format::R32G32B32_SFLOAT)
+                .offset(std::mem::offset_of!(Vertex, normal) as u32),
+        ];
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&vertex_bindings)
+            .vertex_attribute_descriptions(&vertex_attributes);
+        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+        // Meshes wind counter-clockwise seen from outside; the Y-flipped projection keeps that
+        // counter-clockwise in Vulkan's framebuffer convention.
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(vk::CullModeFlags::BACK)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(true)
+            .depth_write_enable(true)
+            .depth_compare_op(vk::CompareOp::LESS);
+        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let info = [vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&input_assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(self.pipeline_layout)
+            .render_pass(self.render_pass)
+            .subpass(0)];
+        // SAFETY: every referenced object is alive.
+        let result = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None) };
+        // SAFETY: modules are no longer needed once the pipeline exists (or failed).
+        unsafe {
+            ctx.device.destroy_shader_module(vert, None);
+            ctx.device.destroy_shader_module(frag, None);
+        }
+        result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")
+    }
+
+    /// Record the whole pass: clear, draw every object with its push constants, and leave the
+    /// colour target in TRANSFER_SRC_OPTIMAL for a read-back.
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        framebuffer: vk::Framebuffer,
+        extent: vk::Extent2D,
+        set: vk::DescriptorSet,
+        meshes: &[GpuMesh],
+        objects: &[Object],
+    ) {
+        let d = &ctx.device;
+        let clear = [
+            vk::ClearValue { color: vk::ClearColorValue { float32: CLEAR_COLOR } },
+            vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } },
+        ];
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(self.render_pass)
+            .framebuffer(framebuffer)
+            .render_area(area)
+            .clear_values(&clear);
+        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+        // SAFETY: recording state; every handle is alive until the frame's fence signals.
+        unsafe {
+            d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_set_viewport(cmd, 0, &[viewport]);
+            d.cmd_set_scissor(cmd, 0, &[area]);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[set], &[]);
+            for mesh in meshes {
+                d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
+                d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
+                for object in objects.iter().filter(|o| o.mesh == mesh.kind) {
+                    let push = object_push(object);
+                    d.cmd_push_constants(
+                        cmd,
+                        self.pipeline_layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&push),
+                    );
+                    d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
+                }
+            }
+            d.cmd_end_render_pass(cmd);
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: no pending work uses these objects; null handles are ignored.
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+            ctx.device.destroy_render_pass(self.render_pass, None);
+        }
+    }
+}
+
+pub fn object_push(o: &Object) -> ObjectPush {
+    let m = &o.material;
+    ObjectPush {
+        position_scale: [o.position.x, o.position.y, o.position.z, o.scale],
+        albedo_roughness: [m.albedo.x, m.albedo.y, m.albedo.z, m.roughness],
+        material: [m.metallic, 0.0, 0.0, 0.0],
+    }
+}
+
+fn create_render_pass(ctx: &Context, depth_format: vk::Format) -> Result<vk::RenderPass, VkError> {
+    let attachments = [
+        vk::AttachmentDescription::default()
+            .format(COLOR_FORMAT)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .initial_layout(vk::ImageLayout::UNDEFINED)
+            .final_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+        vk::AttachmentDescription::default()
+            .format(depth_format)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .initial_layout(vk::ImageLayout::UNDEFINED)
+            .final_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
+    ];
+    let color_ref = [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }];
+    let depth_ref = vk::AttachmentReference { attachment: 1, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
+    let subpasses = [vk::SubpassDescription::default()
+        .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+        .color_attachments(&color_ref)
+        .depth_stencil_attachment(&depth_ref)];
+    let attachment_stages = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
+        | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
+        | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
+    let attachment_writes = vk::AccessFlags::COLOR_ATTACHMENT_WRITE | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
+    let dependencies = [
+        // The targets are reused every other frame: wait for the earlier frame's attachment
+        // writes and its read-back copy before clearing them again.
+        vk::SubpassDependency::default()
+            .src_subpass(vk::SUBPASS_EXTERNAL)
+            .dst_subpass(0)
+            .src_stage_mask(attachment_stages | vk::PipelineStageFlags::TRANSFER)
+            .src_access_mask(attachment_writes)
+            .dst_stage_mask(attachment_stages)
+            .dst_access_mask(attachment_writes | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
+        // The colour result is copied out afterwards.
+        vk::SubpassDependency::default()
+            .src_subpass(0)
+            .dst_subpass(vk::SUBPASS_EXTERNAL)
+            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
+            .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags::TRANSFER)
+            .dst_access_mask(vk::AccessFlags::TRANSFER_READ),
+    ];
+    let info = vk::RenderPassCreateInfo::default().attachments(&attachments).subpasses(&subpasses).dependencies(&dependencies);
+    // SAFETY: valid device and create info.
+    unsafe { ctx.device.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")
+}

@@ -1,0 +1,79 @@
+//! What a render is asked to do, checked against the device before anything is allocated.
+
+use crate::error::RenderError;
+use ml_vk::Context;
+
+/// Lighting techniques (SPEC §3). Each must give the same image as `Forward`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Technique {
+    /// Brute force: every fragment loops over every light.
+    Forward,
+}
+
+impl Technique {
+    pub const ALL: [Technique; 1] = [Technique::Forward];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::Forward => "forward",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<Technique, RenderError> {
+        Technique::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| {
+            let expected = Technique::ALL.map(|t| t.name()).join(", ");
+            RenderError::Invalid(format!("unknown technique '{name}': expected one of {expected}"))
+        })
+    }
+}
+
+/// Size of the biggest image we agree to render, whatever the device allows: 16384² RGBA8 is
+/// 1 GiB of colour alone, per frame in flight.
+pub const MAX_DIMENSION: u32 = 16384;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub technique: Technique,
+    pub width: u32,
+    pub height: u32,
+    /// Frames to render; the image is the last one's, timings are averaged over all.
+    pub frames: u32,
+    /// Fixed animation clock; None advances it by 1/60 s per frame from 0 (deterministic).
+    pub time: Option<f32>,
+}
+
+/// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
+pub const TIMER_SPEED: f32 = 0.25;
+pub const FRAME_SECONDS: f32 = 1.0 / 60.0;
+
+impl RenderSettings {
+    /// Animation clock of frame `i`.
+    pub fn clock(&self, i: u32) -> f32 {
+        self.time.unwrap_or(i as f32 * FRAME_SECONDS * TIMER_SPEED)
+    }
+
+    /// Reject sizes and counts the device (or common sense) cannot take, before allocating.
+    pub fn check(&self, ctx: &Context, lights: usize) -> Result<(), RenderError> {
+        let limits = &ctx.info.limits;
+        let max_dim = limits.max_image_dimension2_d.min(MAX_DIMENSION);
+        for (what, v) in [("--width", self.width), ("--height", self.height)] {
+            if v == 0 || v > max_dim {
+                return Err(RenderError::Invalid(format!("{what} {v} is out of range: use 1 to {max_dim}")));
+            }
+        }
+        if self.frames == 0 {
+            return Err(RenderError::Invalid("--frames must be at least 1".into()));
+        }
+        if let Some(t) = self.time.filter(|t| !t.is_finite()) {
+            return Err(RenderError::Invalid(format!("--time {t} is not a finite number")));
+        }
+        let bytes = lights as u64 * std::mem::size_of::<ml_cpu::gpu_types::PointLight>() as u64;
+        if bytes > limits.max_storage_buffer_range as u64 {
+            return Err(RenderError::Invalid(format!(
+                "{lights} lights need {bytes} bytes of light buffer but '{}' allows {} bytes per storage buffer",
+                ctx.info.name, limits.max_storage_buffer_range
+            )));
+        }
+        Ok(())
+    }
+}

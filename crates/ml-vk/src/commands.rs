@@ -1,0 +1,47 @@
+//! One-shot command buffers for setup work (uploads, read-backs), waited on with a fence.
+
+use crate::context::Context;
+use crate::error::{Result, VkResultExt};
+use ash::vk;
+
+/// Record `record` into a fresh command buffer, submit it and wait until the GPU is done.
+pub fn one_shot(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+    let alloc = vk::CommandBufferAllocateInfo::default()
+        .command_pool(ctx.transient_pool)
+        .level(vk::CommandBufferLevel::PRIMARY)
+        .command_buffer_count(1);
+    // SAFETY: valid pool on this device.
+    let cmd = unsafe { ctx.device.allocate_command_buffers(&alloc) }.ctx("vkAllocateCommandBuffers")?[0];
+    // SAFETY: valid device.
+    let fence = match unsafe { ctx.device.create_fence(&vk::FenceCreateInfo::default(), None) }.ctx("vkCreateFence") {
+        Ok(f) => f,
+        Err(e) => {
+            // SAFETY: never submitted.
+            unsafe { ctx.device.free_command_buffers(ctx.transient_pool, &[cmd]) };
+            return Err(e);
+        }
+    };
+    let result = (|| {
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: fresh command buffer.
+        unsafe { ctx.device.begin_command_buffer(cmd, &begin) }.ctx("vkBeginCommandBuffer")?;
+        record(cmd);
+        // SAFETY: recording state.
+        unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")?;
+        let cmds = [cmd];
+        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        // SAFETY: executable command buffer; the fence is unsignalled.
+        unsafe { ctx.device.queue_submit(ctx.queue, &submit, fence) }.ctx("vkQueueSubmit")?;
+        // SAFETY: the fence belongs to this device.
+        unsafe { ctx.device.wait_for_fences(&[fence], true, u64::MAX) }.ctx("vkWaitForFences")
+    })();
+    // SAFETY: on success the GPU is done with both; on failure wait for whatever was submitted.
+    unsafe {
+        if result.is_err() {
+            let _ = ctx.device.device_wait_idle();
+        }
+        ctx.device.destroy_fence(fence, None);
+        ctx.device.free_command_buffers(ctx.transient_pool, &[cmd]);
+    }
+    result
+}

@@ -1,0 +1,352 @@
+//! Instance (with optional validation + synchronization validation and a debug messenger
+//! that counts messages), physical-device choice, logical device, one graphics queue, and
+//! the memory allocator.
+
+use crate::error::{Result, VkError, VkResultExt};
+use ash::{ext::debug_utils, vk};
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::{c_void, CStr};
+use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+/// The lowest Vulkan version we run on (SPEC §5: any Vulkan 1.2+ device).
+pub const MIN_API: u32 = vk::API_VERSION_1_2;
+
+#[derive(Clone, Debug, Default)]
+pub struct ContextDesc {
+    /// Enable the Khronos validation layer with synchronization validation.
+    pub validation: bool,
+    /// Pick this device (index in `manylights info`) instead of the best one.
+    pub device_index: Option<usize>,
+}
+
+/// What `info` prints about a device and what the renderer checks against.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    pub index: usize,
+    pub name: String,
+    pub device_type: vk::PhysicalDeviceType,
+    pub api_version: u32,
+    pub driver_name: String,
+    pub driver_info: String,
+    pub limits: vk::PhysicalDeviceLimits,
+    /// Whether it has a graphics queue and Vulkan ≥ 1.2.
+    pub suitable: bool,
+}
+
+impl DeviceInfo {
+    pub fn api_version_string(&self) -> String {
+        let v = self.api_version;
+        format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
+    }
+
+    pub fn type_name(&self) -> &'static str {
+        match self.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
+            vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
+            vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
+            vk::PhysicalDeviceType::CPU => "CPU",
+            _ => "other",
+        }
+    }
+
+    fn preference(&self) -> u32 {
+        match self.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+            vk::PhysicalDeviceType::CPU => 3,
+            _ => 4,
+        }
+    }
+}
+
+/// Instance-level state shared by `Context` and `list_devices`.
+struct InstanceParts {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    messages: Arc<AtomicU32>,
+}
+
+impl InstanceParts {
+    fn new(validation: bool) -> Result<InstanceParts> {
+        // SAFETY: loading the system Vulkan loader; its symbols are used through ash only.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))?;
+        let mut layers = Vec::new();
+        let mut extensions = Vec::new();
+        if validation {
+            // SAFETY: plain enumeration.
+            let available = unsafe { entry.enumerate_instance_layer_properties() }.ctx("vkEnumerateInstanceLayerProperties")?;
+            if !available.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)) {
+                return Err(VkError::NoValidationLayer);
+            }
+            layers.push(VALIDATION_LAYER.as_ptr());
+            extensions.push(debug_utils::NAME.as_ptr());
+        }
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"manylights")
+            .engine_name(c"manylights")
+            .api_version(MIN_API);
+        let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled);
+        let messages = Arc::new(AtomicU32::new(0));
+        let messenger_info = || vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(Arc::as_ptr(&messages) as *mut c_void);
+        let mut instance_messenger = messenger_info();
+        let mut info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions);
+        if validation {
+            // Chained so that instance creation and destruction are validated too.
+            info = info.push_next(&mut features).push_next(&mut instance_messenger);
+        }
+        // SAFETY: all pointers in `info` outlive the call.
+        let instance = match unsafe { entry.create_instance(&info, None) } {
+            Ok(i) => i,
+            Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => return Err(VkError::NoDriver),
+            Err(e) => return Err(VkError::Call { what: "vkCreateInstance", result: e }),
+        };
+        let debug = if validation {
+            let loader = debug_utils::Instance::new(&entry, &instance);
+            // SAFETY: `messages` outlives the messenger (both dropped in `Drop`, messenger first).
+            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info(), None) };
+            match messenger {
+                Ok(m) => Some((loader, m)),
+                Err(e) => {
+                    // SAFETY: nothing else was created from the instance yet.
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(VkError::Call { what: "vkCreateDebugUtilsMessengerEXT", result: e });
+                }
+            }
+        } else {
+            None
+        };
+        Ok(InstanceParts { entry, instance, debug, messages })
+    }
+
+    fn devices(&self) -> Result<Vec<(vk::PhysicalDevice, DeviceInfo)>> {
+        // SAFETY: plain enumeration on a live instance.
+        let physical = unsafe { self.instance.enumerate_physical_devices() }.ctx("vkEnumeratePhysicalDevices")?;
+        if physical.is_empty() {
+            return Err(VkError::NoDriver);
+        }
+        Ok(physical.into_iter().enumerate().map(|(index, pd)| (pd, self.describe(index, pd))).collect())
+    }
+
+    fn describe(&self, index: usize, pd: vk::PhysicalDevice) -> DeviceInfo {
+        // SAFETY: queries on a physical device of this instance.
+        let props = unsafe { self.instance.get_physical_device_properties(pd) };
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        if props.api_version >= MIN_API {
+            let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+            // SAFETY: core in 1.1+, and the device reports 1.2+.
+            unsafe { self.instance.get_physical_device_properties2(pd, &mut props2) };
+        }
+        let name = c_text(props.device_name_as_c_str());
+        DeviceInfo {
+            index,
+            name,
+            device_type: props.device_type,
+            api_version: props.api_version,
+            driver_name: c_text(driver.driver_name_as_c_str()),
+            driver_info: c_text(driver.driver_info_as_c_str()),
+            limits: props.limits,
+            suitable: props.api_version >= MIN_API && graphics_queue_family(&self.instance, pd).is_some(),
+        }
+    }
+
+    fn destroy(&mut self) {
+        // SAFETY: called once, after every child object is gone.
+        unsafe {
+            if let Some((loader, m)) = self.debug.take() {
+                loader.destroy_debug_utils_messenger(m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+fn c_text(text: std::result::Result<&CStr, std::ffi::FromBytesUntilNulError>) -> String {
+    text.map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
+fn graphics_queue_family(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Option<(u32, vk::QueueFamilyProperties)> {
+    // SAFETY: query on a valid physical device.
+    let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+    families
+        .into_iter()
+        .enumerate()
+        .find(|(_, f)| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
+        .map(|(i, f)| (i as u32, f))
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // SAFETY: `user` is the AtomicU32 inside the Arc that the Context keeps alive; `data` is
+    // valid for the duration of the callback per the Vulkan spec.
+    unsafe {
+        (*(user as *const AtomicU32)).fetch_add(1, Ordering::SeqCst);
+        let message = if data.is_null() || (*data).p_message.is_null() {
+            std::borrow::Cow::Borrowed("(no message)")
+        } else {
+            CStr::from_ptr((*data).p_message).to_string_lossy()
+        };
+        eprintln!("vulkan {severity:?} {kind:?}: {message}");
+    }
+    vk::FALSE
+}
+
+/// The device everything renders with.
+pub struct Context {
+    parts: InstanceParts,
+    pub physical_device: vk::PhysicalDevice,
+    pub info: DeviceInfo,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+    /// Bits of a timestamp that are valid on our queue (0: no GPU timing).
+    pub timestamp_valid_bits: u32,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub(crate) transient_pool: vk::CommandPool,
+}
+
+/// Describe every Vulkan device (for `manylights info`).
+pub fn list_devices() -> Result<Vec<DeviceInfo>> {
+    let mut parts = InstanceParts::new(false)?;
+    let devices = parts.devices().map(|d| d.into_iter().map(|(_, info)| info).collect());
+    parts.destroy();
+    devices
+}
+
+impl Context {
+    pub fn new(desc: &ContextDesc) -> Result<Context> {
+        let mut parts = InstanceParts::new(desc.validation)?;
+        match Self::with_instance(&parts, desc) {
+            Ok((physical_device, info, device, queue_family, timestamp_valid_bits)) => {
+                // SAFETY: the device was created with one queue in this family.
+                let queue = unsafe { device.get_device_queue(queue_family, 0) };
+                let allocator = Allocator::new(&AllocatorCreateDesc {
+                    instance: parts.instance.clone(),
+                    device: device.clone(),
+                    physical_device,
+                    debug_settings: Default::default(),
+                    buffer_device_address: false,
+                    allocation_sizes: Default::default(),
+                })
+                .map_err(|source| VkError::Alloc { what: "the allocator".into(), source })?;
+                let pool_info = vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(queue_family)
+                    .flags(vk::CommandPoolCreateFlags::TRANSIENT | vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+                // SAFETY: valid device and create info.
+                let transient_pool = unsafe { device.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
+                Ok(Context {
+                    parts,
+                    physical_device,
+                    info,
+                    device,
+                    queue,
+                    queue_family,
+                    timestamp_valid_bits,
+                    allocator: ManuallyDrop::new(Mutex::new(allocator)),
+                    transient_pool,
+                })
+            }
+            Err(e) => {
+                parts.destroy();
+                Err(e)
+            }
+        }
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn with_instance(parts: &InstanceParts, desc: &ContextDesc) -> Result<(vk::PhysicalDevice, DeviceInfo, ash::Device, u32, u32)> {
+        let devices = parts.devices()?;
+        let (pd, info) = match desc.device_index {
+            Some(index) => {
+                let count = devices.len();
+                let (pd, info) = devices.into_iter().nth(index).ok_or(VkError::DeviceIndex { index, count })?;
+                if !info.suitable {
+                    return Err(VkError::NoSuitableDevice(format!(": device {index} '{}' is not", info.name)));
+                }
+                (pd, info)
+            }
+            None => devices
+                .into_iter()
+                .filter(|(_, i)| i.suitable)
+                .min_by_key(|(_, i)| i.preference())
+                .ok_or(VkError::NoSuitableDevice(String::new()))?,
+        };
+        let (family, family_props) = graphics_queue_family(&parts.instance, pd).expect("checked by `suitable`");
+        let priorities = [1.0];
+        let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
+        let info_create = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
+        // SAFETY: valid physical device and create info.
+        let device = unsafe { parts.instance.create_device(pd, &info_create, None) }.ctx("vkCreateDevice")?;
+        Ok((pd, info, device, family, family_props.timestamp_valid_bits))
+    }
+
+    pub fn instance(&self) -> &ash::Instance {
+        &self.parts.instance
+    }
+
+    pub fn entry(&self) -> &ash::Entry {
+        &self.parts.entry
+    }
+
+    /// Validation messages (warnings and errors) reported so far; 0 without validation.
+    pub fn validation_messages(&self) -> u32 {
+        self.parts.messages.load(Ordering::SeqCst)
+    }
+
+    /// Shared handle to the message counter, readable after the context is gone (the layer
+    /// reports leaked objects while the device and instance are destroyed).
+    pub fn validation_counter(&self) -> Arc<AtomicU32> {
+        self.parts.messages.clone()
+    }
+
+    pub fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
+        // A poisoned lock only means another thread panicked mid-allocation; the allocator's
+        // own state is still consistent for freeing.
+        self.allocator.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub fn format_supports(&self, format: vk::Format, features: vk::FormatFeatureFlags) -> bool {
+        // SAFETY: query on our physical device.
+        let props = unsafe { self.parts.instance.get_physical_device_format_properties(self.physical_device, format) };
+        props.optimal_tiling_features.contains(features)
+    }
+
+    pub fn wait_idle(&self) -> Result<()> {
+        // SAFETY: valid device.
+        unsafe { self.device.device_wait_idle() }.ctx("vkDeviceWaitIdle")
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        // SAFETY: the owner has destroyed every resource; waiting first makes that safe even on
+        // an error path that left work in flight.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.transient_pool, None);
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_device(None);
+        }
+        self.parts.destroy();
+    }
+}
