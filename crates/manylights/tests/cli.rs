@@ -1,0 +1,103 @@
+//! The command line: a good render prints its table and writes its PNG; bad input gets one
+//! clear error line and a non-zero exit, never a panic.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn manylights(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_manylights"));
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("run manylights")
+}
+
+fn temp_png(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("manylights-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Fails unless the run failed with exactly one `error:` line mentioning every `needle`.
+fn assert_one_line_error(out: &Output, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "should fail; stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "expected one line, got: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "'{n}' missing from: {stderr}");
+    }
+}
+
+#[test]
+fn renders_a_png_and_prints_the_table() {
+    let png = temp_png("ok.png");
+    let out = manylights(&["render", "--validation", "--width", "64", "--height", "36", "--time", "0", "--out", png.to_str().unwrap()], &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    for key in ["device", "resolution", "64x36", "lights", "gpu ms", "cpu ms/frame"] {
+        assert!(stdout.contains(key), "'{key}' missing from:\n{stdout}");
+    }
+    let img = image::open(&png).expect("a PNG").to_rgba8();
+    assert_eq!(img.dimensions(), (64, 36));
+}
+
+#[test]
+fn info_lists_a_device() {
+    let out = manylights(&["info"], &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(stdout.contains("device") && stdout.contains("maxStorageBufferRange"), "{stdout}");
+}
+
+#[test]
+fn bad_names_are_refused_with_the_choices() {
+    let png = temp_png("never.png");
+    let p = png.to_str().unwrap();
+    assert_one_line_error(&manylights(&["render", "--technique", "raytraced", "--out", p], &[]), &["raytraced", "forward"]);
+    assert_one_line_error(&manylights(&["render", "--object", "venus", "--out", p], &[]), &["venus", "teapot"]);
+    assert_one_line_error(&manylights(&["render", "--material", "mithril", "--out", p], &[]), &["mithril", "gold"]);
+    assert_one_line_error(&manylights(&["render", "--light-layout", "spiral", "--out", p], &[]), &["spiral", "grid"]);
+    assert_one_line_error(&manylights(&["render", "--light-radius", "3..1", "--out", p], &[]), &["3..1"]);
+    assert_one_line_error(&manylights(&["render", "--scene", "nope", "--out", p], &[]), &["nope"]);
+    assert_one_line_error(&manylights(&["render", "--width", "wide", "--out", p], &[]), &["wide"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn absurd_sizes_and_counts_are_refused() {
+    let png = temp_png("never2.png");
+    let p = png.to_str().unwrap();
+    assert_one_line_error(&manylights(&["render", "--lights", "0", "--out", p], &[]), &["--lights 0"]);
+    assert_one_line_error(&manylights(&["render", "--lights", "100000000", "--out", p], &[]), &["--lights 100000000", "16777216"]);
+    assert_one_line_error(&manylights(&["render", "--width", "0", "--out", p], &[]), &["--width 0"]);
+    assert_one_line_error(&manylights(&["render", "--height", "100000", "--out", p], &[]), &["--height 100000"]);
+    assert_one_line_error(&manylights(&["render", "--frames", "0", "--out", p], &[]), &["--frames"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn unwritable_output_is_refused_before_rendering() {
+    let missing = std::env::temp_dir().join("manylights-no-such-folder/a.png");
+    assert_one_line_error(&manylights(&["render", "--out", missing.to_str().unwrap()], &[]), &["does not exist"]);
+    let dir = std::env::temp_dir();
+    assert_one_line_error(&manylights(&["render", "--out", dir.to_str().unwrap()], &[]), &["directory"]);
+}
+
+#[test]
+fn no_vulkan_driver_names_what_to_install() {
+    let png = temp_png("never3.png");
+    let out = manylights(&["render", "--out", png.to_str().unwrap()], &[("VK_DRIVER_FILES", "/nonexistent"), ("VK_ICD_FILENAMES", "/nonexistent")]);
+    assert_one_line_error(&out, &["no Vulkan driver", "mesa-vulkan-drivers"]);
+    let out = manylights(&["info"], &[("VK_DRIVER_FILES", "/nonexistent"), ("VK_ICD_FILENAMES", "/nonexistent")]);
+    assert_one_line_error(&out, &["no Vulkan driver"]);
+}
+
+#[test]
+fn missing_device_index_is_refused() {
+    let png = temp_png("never4.png");
+    assert_one_line_error(&manylights(&["render", "--device", "99", "--out", png.to_str().unwrap()], &[]), &["--device 99"]);
+}
