@@ -39,6 +39,12 @@ gpu_struct!(
         ambient: f32,
         shading_model: u32,
         _pad0: u32,
+        /// xyz: cluster grid size; w: debug view (DEBUG_VIEW_*).
+        cluster_dims: [u32; 4],
+        /// xy: image size in pixels.
+        viewport: [u32; 4],
+        /// x, y: slice = ⌊ln(depth)·x + y⌋; z: lights per cluster at the top of the heat map.
+        cluster_slices: [f32; 4],
     }
 );
 
@@ -51,6 +57,18 @@ gpu_struct!(
         color: [f32; 4],
     }
 );
+
+gpu_struct!(
+    /// Where a cluster's lights are in the light-index list (std430, 8 bytes).
+    ClusterRange {
+        offset: u32,
+        count: u32,
+    }
+);
+
+/// `DEBUG_VIEW_*` in common.glsl.
+pub const DEBUG_VIEW_NONE: u32 = 0;
+pub const DEBUG_VIEW_CLUSTER_HEAT: u32 = 1;
 
 gpu_struct!(
     /// Per-draw push constants.

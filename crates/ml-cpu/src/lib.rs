@@ -3,6 +3,7 @@
 //! shading model that the image tests compare the GPU against.
 
 pub mod camera;
+pub mod cluster;
 pub mod error;
 pub mod gpu_types;
 pub mod lights;

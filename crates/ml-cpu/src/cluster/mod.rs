@@ -1,0 +1,12 @@
+//! Clustered light assignment (SPEC §3 `clustered-cpu`): the view frustum split into X×Y
+//! screen tiles and Z exponential depth slices; for every cluster, the lights whose sphere
+//! can reach a point inside it.
+
+mod assign;
+mod grid;
+
+pub use assign::{ClusterAssigner, ClusterLists, ClusterStats};
+pub use grid::{Aabb, ClusterDims, ClusterGrid};
+
+#[cfg(test)]
+mod tests;
