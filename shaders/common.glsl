@@ -9,6 +9,9 @@
 
 #define SHADING_SEED 0u
 
+#define DEBUG_VIEW_NONE 0u
+#define DEBUG_VIEW_CLUSTER_HEAT 1u
+
 // Per frame, one uniform buffer per frame in flight (set 0, binding 0).
 struct FrameUniforms {
     mat4 view;
@@ -18,12 +21,21 @@ struct FrameUniforms {
     float ambient;       // seed: colour = albedo * ambient + Lo
     uint shading_model;  // SHADING_*
     uint _pad0;
+    uvec4 cluster_dims;  // xyz: cluster grid size; w: debug view (DEBUG_VIEW_*)
+    uvec4 viewport;      // xy: image size in pixels
+    vec4 cluster_slices; // x, y: slice = floor(log(depth) * x + y); z: heat-map top (lights)
 };
 
 // A radius-limited point light (set 0, binding 1, std430 array).
 struct PointLight {
     vec4 position_radius; // xyz: world position, w: radius (no light at all beyond it)
     vec4 color;           // rgb: linear colour; a unused
+};
+
+// Where a cluster's lights are in the light-index list (set 0, binding 2, std430 array).
+struct ClusterRange {
+    uint offset;
+    uint count;
 };
 
 // Per draw, by push constants as in seed 000.

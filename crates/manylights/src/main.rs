@@ -8,7 +8,8 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::report::table;
-use ml_render::{HeadlessRenderer, RenderSettings, Technique};
+use ml_cpu::cluster::ClusterDims;
+use ml_render::{DebugView, HeadlessRenderer, RenderSettings, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -34,9 +35,15 @@ struct RenderArgs {
     /// Scene to render (built in: seed).
     #[arg(long, default_value = "seed")]
     scene: String,
-    /// Lighting technique: forward.
+    /// Lighting technique: forward, clustered-cpu.
     #[arg(long, default_value = "forward")]
     technique: String,
+    /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).
+    #[arg(long, default_value = "16x9x24")]
+    clusters: String,
+    /// Debug view: none, cluster-heat (lights per cluster; clustered techniques).
+    #[arg(long, default_value = "none")]
+    debug_view: String,
     /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc.
     #[arg(long, default_value = "sphere")]
     object: String,
@@ -143,7 +150,15 @@ fn render(args: &RenderArgs) -> Result<()> {
     let technique = Technique::from_name(&args.technique)?;
     let scene = build_scene(args)?;
     check_output(&args.out)?;
-    let settings = RenderSettings { technique, width: args.width, height: args.height, frames: args.frames, time: args.time };
+    let settings = RenderSettings {
+        technique,
+        clusters: ClusterDims::parse(&args.clusters)?,
+        debug_view: DebugView::from_name(&args.debug_view)?,
+        width: args.width,
+        height: args.height,
+        frames: args.frames,
+        time: args.time,
+    };
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device })?;
     let messages = ctx.validation_counter();
     let light_count = scene.lights.len();
@@ -165,7 +180,20 @@ fn render(args: &RenderArgs) -> Result<()> {
         Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
         None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
     }
-    rows.push(("cpu ms/frame", format!("{:.3}  (update + record + submit)", stats.cpu_ms())));
+    if let Some(ms) = stats.assign_ms() {
+        rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
+    }
+    if let Some(c) = stats.clusters {
+        let d = settings.clusters;
+        rows.push(("clusters", format!("{}x{}x{} = {}", d.x, d.y, d.z, d.count())));
+        rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
+        rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
+    }
+    if settings.debug_view == DebugView::ClusterHeat {
+        let top = stats.clusters.map_or(1, |c| c.max_lights.max(1));
+        rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights per cluster")));
+    }
+    rows.push(("cpu ms/frame", format!("{:.3}  (update + assign + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
     rows.push(("output", args.out.display().to_string()));
     print!("{}", table(&rows));

@@ -9,6 +9,7 @@ pub mod gpu_types;
 pub mod lights;
 pub mod material;
 pub mod mesh;
+pub mod random_scene;
 pub mod scene;
 pub mod shading;
 mod teapot;

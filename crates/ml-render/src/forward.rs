@@ -1,7 +1,9 @@
-//! Technique `forward` (SPEC §3): one render pass, one subpass; every fragment loops over
-//! every light in a std430 storage buffer.
+//! The forward render pass (SPEC §3): one render pass, one subpass. Technique `forward`
+//! loops every fragment over every light in a std430 storage buffer; `clustered-*` over the
+//! lights of the fragment's cluster (same pass, another fragment shader).
 
 use crate::gpu_mesh::GpuMesh;
+use crate::settings::Technique;
 use crate::targets::COLOR_FORMAT;
 use ml_cpu::gpu_types::ObjectPush;
 use ml_cpu::mesh::Vertex;
@@ -11,6 +13,8 @@ use ml_vk::{shader, vk, Context, VkError, VkResultExt};
 /// Binding numbers of set 0 (see the shaders).
 pub const BINDING_FRAME: u32 = 0;
 pub const BINDING_LIGHTS: u32 = 1;
+pub const BINDING_CLUSTER_RANGES: u32 = 2;
+pub const BINDING_LIGHT_INDICES: u32 = 3;
 
 /// Background of pixels no object covers (linear, before the UNORM store).
 pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
@@ -23,7 +27,7 @@ pub struct ForwardPass {
 }
 
 impl ForwardPass {
-    pub fn new(ctx: &Context, depth_format: vk::Format) -> Result<ForwardPass, VkError> {
+    pub fn new(ctx: &Context, depth_format: vk::Format, technique: Technique) -> Result<ForwardPass, VkError> {
         let mut pass = ForwardPass {
             render_pass: vk::RenderPass::null(),
             set_layout: vk::DescriptorSetLayout::null(),
@@ -31,7 +35,8 @@ impl ForwardPass {
             pipeline: vk::Pipeline::null(),
         };
         // On failure, destroy what was made (null handles are ignored by vkDestroy*).
-        match pass.create(ctx, depth_format) {
+        let fragment = if technique.is_clustered() { ml_shaders::CLUSTERED_FRAG } else { ml_shaders::FORWARD_FRAG };
+        match pass.create(ctx, depth_format, fragment) {
             Ok(()) => Ok(pass),
             Err(e) => {
                 pass.destroy(ctx);
@@ -40,24 +45,20 @@ impl ForwardPass {
         }
     }
 
-    fn create(&mut self, ctx: &Context, depth_format: vk::Format) -> Result<(), VkError> {
+    fn create(&mut self, ctx: &Context, depth_format: vk::Format, fragment: &[u8]) -> Result<(), VkError> {
         let d = &ctx.device;
         self.render_pass = create_render_pass(ctx, depth_format)?;
-        let bindings = [
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(BINDING_FRAME)
-                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
-                .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT),
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(BINDING_LIGHTS)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::FRAGMENT),
-        ];
-        // SAFETY: valid device and create infos throughout.
-        self.set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
-            .ctx("vkCreateDescriptorSetLayout")?;
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        self.set_layout = shader::set_layout(
+            ctx,
+            &[
+                (BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER),
+                (BINDING_LIGHTS, storage),
+                (BINDING_CLUSTER_RANGES, storage),
+                (BINDING_LIGHT_INDICES, storage),
+            ],
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+        )?;
         let push = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             .size(std::mem::size_of::<ObjectPush>() as u32)];
@@ -65,13 +66,13 @@ impl ForwardPass {
         let layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push);
         // SAFETY: as above.
         self.pipeline_layout = unsafe { d.create_pipeline_layout(&layout_info, None) }.ctx("vkCreatePipelineLayout")?;
-        self.pipeline = self.create_pipeline(ctx)?;
+        self.pipeline = self.create_pipeline(ctx, fragment)?;
         Ok(())
     }
 
-    fn create_pipeline(&self, ctx: &Context) -> Result<vk::Pipeline, VkError> {
+    fn create_pipeline(&self, ctx: &Context, fragment: &[u8]) -> Result<vk::Pipeline, VkError> {
         let vert = shader::module(ctx, ml_shaders::FORWARD_VERT)?;
-        let frag = match shader::module(ctx, ml_shaders::FORWARD_FRAG) {
+        let frag = match shader::module(ctx, fragment) {
             Ok(f) => f,
             Err(e) => {
                 // SAFETY: unused module.

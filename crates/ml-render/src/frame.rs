@@ -1,22 +1,30 @@
 //! One frame in flight (SPEC §6: two of them): its command buffer and fence, its own
-//! persistently mapped uniform and light buffers and descriptor set (seeds 001/004), its
-//! timer and its render targets.
+//! persistently mapped uniform, light and cluster buffers and descriptor set (seeds 001/004),
+//! its timer and its render targets. Cluster buffers grow when a frame needs more; nothing
+//! is ever dropped.
 
-use crate::forward::{BINDING_FRAME, BINDING_LIGHTS};
+use crate::forward::{BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
 use crate::targets::Targets;
-use ml_cpu::gpu_types::{FrameUniforms, PointLight};
+use gpu_allocator::MemoryLocation;
+use ml_cpu::cluster::ClusterLists;
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
 use ml_vk::{vk, Buffer, Context, GpuTimer, VkError, VkResultExt};
 
 pub const FRAMES_IN_FLIGHT: usize = 2;
+
+/// Light-index capacity a frame starts with, per light (grows on demand).
+const INITIAL_INDICES_PER_LIGHT: usize = 4;
 
 pub struct FrameInFlight {
     pub cmd: vk::CommandBuffer,
     pub fence: vk::Fence,
     pub uniforms: Buffer,
     pub lights: Buffer,
+    pub cluster_ranges: Buffer,
+    pub light_indices: Buffer,
     pub set: vk::DescriptorSet,
     pub timer: GpuTimer,
-    pub targets: Targets,
+    pub targets: Option<Targets>,
 }
 
 /// Everything `FrameInFlight::new` needs from the renderer.
@@ -25,88 +33,103 @@ pub struct FrameSetup<'a> {
     pub descriptor_pool: vk::DescriptorPool,
     pub set_layout: vk::DescriptorSetLayout,
     pub light_count: usize,
+    pub cluster_count: usize,
+    pub passes: u32,
     pub make_targets: &'a dyn Fn() -> Result<Targets, VkError>,
 }
 
+fn host_buffer(ctx: &Context, name: &str, bytes: usize, usage: vk::BufferUsageFlags) -> Result<Buffer, VkError> {
+    Buffer::new(ctx, name, bytes as u64, usage, MemoryLocation::CpuToGpu)
+}
+
 impl FrameInFlight {
-    /// Builds into `out` piece by piece so that a failure leaves only objects that
-    /// `destroy_partial` can release.
     pub fn new(ctx: &Context, setup: &FrameSetup) -> Result<FrameInFlight, VkError> {
+        let mut frame = FrameInFlight {
+            cmd: vk::CommandBuffer::null(),
+            fence: vk::Fence::null(),
+            uniforms: Buffer::null(),
+            lights: Buffer::null(),
+            cluster_ranges: Buffer::null(),
+            light_indices: Buffer::null(),
+            set: vk::DescriptorSet::null(),
+            timer: GpuTimer::null(),
+            targets: None,
+        };
+        // On failure everything made so far is released (null parts are skipped).
+        match frame.create(ctx, setup) {
+            Ok(()) => Ok(frame),
+            Err(e) => {
+                frame.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn create(&mut self, ctx: &Context, setup: &FrameSetup) -> Result<(), VkError> {
         let d = &ctx.device;
         let alloc = vk::CommandBufferAllocateInfo::default().command_pool(setup.pool).command_buffer_count(1);
-        // SAFETY: valid pool; everything below uses valid create infos on this device.
-        let cmd = unsafe { d.allocate_command_buffers(&alloc) }.ctx("vkAllocateCommandBuffers")?[0];
-        let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }
+        // SAFETY: valid pool and create infos on this device.
+        self.cmd = unsafe { d.allocate_command_buffers(&alloc) }.ctx("vkAllocateCommandBuffers")?[0];
+        // SAFETY: as above.
+        self.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }
             .ctx("vkCreateFence")?;
-        let mut uniforms = Buffer::new(
-            ctx,
-            "frame uniforms",
-            std::mem::size_of::<FrameUniforms>() as u64,
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-            gpu_allocator::MemoryLocation::CpuToGpu,
-        )
-        .inspect_err(|_| unsafe { d.destroy_fence(fence, None) })?;
-        let light_bytes = (setup.light_count * std::mem::size_of::<PointLight>()) as u64;
-        let mut lights = Buffer::new(ctx, "lights", light_bytes, vk::BufferUsageFlags::STORAGE_BUFFER, gpu_allocator::MemoryLocation::CpuToGpu)
-            .inspect_err(|_| {
-                uniforms.destroy(ctx);
-                unsafe { d.destroy_fence(fence, None) }
-            })?;
-        let cleanup = |uniforms: &mut Buffer, lights: &mut Buffer| {
-            uniforms.destroy(ctx);
-            lights.destroy(ctx);
-            // SAFETY: never submitted.
-            unsafe { d.destroy_fence(fence, None) };
-        };
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        self.uniforms = host_buffer(ctx, "frame uniforms", size_of::<FrameUniforms>(), vk::BufferUsageFlags::UNIFORM_BUFFER)?;
+        self.lights = host_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>(), storage)?;
+        self.cluster_ranges = host_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>(), storage)?;
+        self.light_indices = host_buffer(ctx, "light indices", setup.light_count * INITIAL_INDICES_PER_LIGHT * 4, storage)?;
         let layouts = [setup.set_layout];
         let set_info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(setup.descriptor_pool).set_layouts(&layouts);
-        let set = match unsafe { d.allocate_descriptor_sets(&set_info) }.ctx("vkAllocateDescriptorSets") {
-            Ok(s) => s[0],
-            Err(e) => {
-                cleanup(&mut uniforms, &mut lights);
-                return Err(e);
-            }
-        };
-        let ubo = [vk::DescriptorBufferInfo::default().buffer(uniforms.raw).range(vk::WHOLE_SIZE)];
-        let ssbo = [vk::DescriptorBufferInfo::default().buffer(lights.raw).range(vk::WHOLE_SIZE)];
-        let writes = [
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(BINDING_FRAME)
-                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
-                .buffer_info(&ubo),
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(BINDING_LIGHTS)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .buffer_info(&ssbo),
-        ];
-        // SAFETY: the set and buffers are alive and unused.
-        unsafe { d.update_descriptor_sets(&writes, &[]) };
-        let mut timer = match GpuTimer::new(ctx, 1) {
-            Ok(t) => t,
-            Err(e) => {
-                cleanup(&mut uniforms, &mut lights);
-                return Err(e);
-            }
-        };
-        let targets = match (setup.make_targets)() {
-            Ok(t) => t,
-            Err(e) => {
-                timer.destroy(ctx);
-                cleanup(&mut uniforms, &mut lights);
-                return Err(e);
-            }
-        };
-        Ok(FrameInFlight { cmd, fence, uniforms, lights, set, timer, targets })
+        // SAFETY: the pool has room for one set per frame in flight.
+        self.set = unsafe { d.allocate_descriptor_sets(&set_info) }.ctx("vkAllocateDescriptorSets")?[0];
+        self.bind(ctx, BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
+        for (binding, buffer) in [
+            (BINDING_LIGHTS, self.lights.raw),
+            (BINDING_CLUSTER_RANGES, self.cluster_ranges.raw),
+            (BINDING_LIGHT_INDICES, self.light_indices.raw),
+        ] {
+            self.bind(ctx, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
+        }
+        self.timer = GpuTimer::new(ctx, setup.passes)?;
+        self.targets = Some((setup.make_targets)()?);
+        Ok(())
+    }
+
+    /// Point `binding` of this frame's set at `buffer`. Only while the frame is not in flight.
+    fn bind(&self, ctx: &Context, binding: u32, ty: vk::DescriptorType, buffer: vk::Buffer) {
+        let info = [vk::DescriptorBufferInfo::default().buffer(buffer).range(vk::WHOLE_SIZE)];
+        let write = [vk::WriteDescriptorSet::default().dst_set(self.set).dst_binding(binding).descriptor_type(ty).buffer_info(&info)];
+        // SAFETY: the set and buffer are alive and the set is not in use by pending work.
+        unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
+    }
+
+    /// Copy the cluster lists into this frame's buffers, growing the index buffer (to 1.5×
+    /// what is needed) when it is too small. Returns whether it grew. Call only after the
+    /// frame's fence has signalled.
+    pub fn upload_clusters(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<bool, VkError> {
+        let needed = std::mem::size_of_val(&lists.indices[..]);
+        let grew = needed as u64 > self.light_indices.size;
+        if grew {
+            let bigger = host_buffer(ctx, "light indices", needed + needed / 2, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+            let mut old = std::mem::replace(&mut self.light_indices, bigger);
+            old.destroy(ctx);
+            self.bind(ctx, BINDING_LIGHT_INDICES, vk::DescriptorType::STORAGE_BUFFER, self.light_indices.raw);
+        }
+        self.cluster_ranges.write(0, &lists.ranges);
+        self.light_indices.write(0, &lists.indices);
+        Ok(grew)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        self.targets.destroy(ctx);
+        if let Some(mut t) = self.targets.take() {
+            t.destroy(ctx);
+        }
         self.timer.destroy(ctx);
-        self.uniforms.destroy(ctx);
-        self.lights.destroy(ctx);
-        // SAFETY: the caller waited for the device to be idle.
+        for b in [&mut self.uniforms, &mut self.lights, &mut self.cluster_ranges, &mut self.light_indices] {
+            b.destroy(ctx);
+        }
+        // SAFETY: the caller waited for the device to be idle; a null fence is ignored.
         unsafe { ctx.device.destroy_fence(self.fence, None) };
+        self.fence = vk::Fence::null();
     }
 }

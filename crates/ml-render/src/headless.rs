@@ -8,14 +8,21 @@ use crate::gpu_mesh::GpuMesh;
 use crate::report::FrameStats;
 use crate::settings::RenderSettings;
 use crate::targets::{depth_format, Targets};
-use ml_cpu::gpu_types::{FrameUniforms, PointLight, SHADING_SEED};
+use crate::settings::DebugView;
+use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists};
+use ml_cpu::gpu_types::{FrameUniforms, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
 use ml_cpu::lights::animate_into;
 use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
 use std::time::Instant;
 
-/// The passes the timer reports, in order.
-pub const PASS_NAMES: [&str; 1] = ["forward"];
+/// CPU-side cluster state of `clustered-cpu`: the grid (rebuilt when camera or size change;
+/// fixed in headless rendering), the assigner and this frame's lists.
+struct CpuClusters {
+    grid: ClusterGrid,
+    assigner: ClusterAssigner,
+    lists: ClusterLists,
+}
 
 /// A rendered image (tightly packed RGBA8, row 0 at the top) and its measurements.
 pub struct RenderOutput {
@@ -38,6 +45,9 @@ pub struct HeadlessRenderer<'a> {
     readback: Option<Buffer>,
     /// Lights of the current frame (animated copy of the scene's).
     animated: Vec<PointLight>,
+    clusters: Option<CpuClusters>,
+    /// The cluster grid's shader parameters (also set for `forward`, which ignores them).
+    grid: ClusterGrid,
 }
 
 impl<'a> HeadlessRenderer<'a> {
@@ -46,18 +56,26 @@ impl<'a> HeadlessRenderer<'a> {
         let depth = depth_format(ctx)?;
         let extent = vk::Extent2D { width: settings.width, height: settings.height };
         let animated = scene.lights.clone();
+        let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
+        let clusters = settings.technique.is_clustered().then(|| CpuClusters {
+            grid: grid.clone(),
+            assigner: ClusterAssigner::new(),
+            lists: ClusterLists::default(),
+        });
         let mut r = HeadlessRenderer {
             ctx,
             scene,
             settings,
             extent,
-            pass: ForwardPass::new(ctx, depth)?,
+            pass: ForwardPass::new(ctx, depth, settings.technique)?,
             meshes: Vec::new(),
             command_pool: vk::CommandPool::null(),
             descriptor_pool: vk::DescriptorPool::null(),
             frames: Vec::new(),
             readback: None,
             animated,
+            clusters,
+            grid,
         };
         // Anything made before a failure is released by Drop.
         r.create_resources(depth)?;
@@ -77,7 +95,7 @@ impl<'a> HeadlessRenderer<'a> {
         let n = FRAMES_IN_FLIGHT as u32;
         let sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 3 * n },
         ];
         let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&sizes);
         // SAFETY: as above.
@@ -90,6 +108,8 @@ impl<'a> HeadlessRenderer<'a> {
             descriptor_pool: self.descriptor_pool,
             set_layout: self.pass.set_layout,
             light_count: self.scene.lights.len(),
+            cluster_count: self.settings.clusters.count(),
+            passes: 1,
             make_targets: &make_targets,
         };
         for _ in 0..FRAMES_IN_FLIGHT {
@@ -107,7 +127,7 @@ impl<'a> HeadlessRenderer<'a> {
     /// Render `settings.frames` frames, two in flight, and read back the last one.
     pub fn render(&mut self) -> Result<RenderOutput, RenderError> {
         let ctx = self.ctx;
-        let mut stats = FrameStats::new(&PASS_NAMES);
+        let mut stats = FrameStats::new(&[self.settings.technique.name()]);
         let start = Instant::now();
         let mut last = 0;
         for i in 0..self.settings.frames {
@@ -119,7 +139,7 @@ impl<'a> HeadlessRenderer<'a> {
                 stats.add_gpu(&ms);
             }
             let cpu = Instant::now();
-            self.update_frame(f, self.settings.clock(i));
+            self.update_frame(f, self.settings.clock(i), &mut stats)?;
             self.record(f)?;
             // SAFETY: the fence was waited on above and the command buffer is executable.
             unsafe {
@@ -144,8 +164,25 @@ impl<'a> HeadlessRenderer<'a> {
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
     }
 
-    fn update_frame(&mut self, f: usize, t: f32) {
+    fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<(), VkError> {
         animate_into(&self.scene.lights, t, &mut self.animated);
+        let mut heat_top = 1.0;
+        if let Some(c) = &mut self.clusters {
+            let start = Instant::now();
+            c.assigner.assign(&c.grid, &self.animated, &mut c.lists);
+            stats.add_assign_ms(start.elapsed().as_secs_f64() * 1e3);
+            let cluster_stats = c.lists.stats();
+            heat_top = cluster_stats.max_lights.max(1) as f32;
+            stats.clusters = Some(cluster_stats);
+            if self.frames[f].upload_clusters(self.ctx, &c.lists)? {
+                stats.index_growths += 1;
+            }
+        }
+        let g = &self.grid;
+        let debug_view = match self.settings.debug_view {
+            DebugView::None => DEBUG_VIEW_NONE,
+            DebugView::ClusterHeat => DEBUG_VIEW_CLUSTER_HEAT,
+        };
         let cam = &self.scene.camera;
         let uniforms = FrameUniforms {
             view: cam.view().to_cols_array_2d(),
@@ -155,10 +192,14 @@ impl<'a> HeadlessRenderer<'a> {
             ambient: self.scene.ambient,
             shading_model: SHADING_SEED,
             _pad0: 0,
+            cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
+            viewport: [self.extent.width, self.extent.height, 0, 0],
+            cluster_slices: [g.log_scale, g.log_bias, heat_top, 0.0],
         };
         let frame = &mut self.frames[f];
         frame.uniforms.write(0, &[uniforms]);
         frame.lights.write(0, &self.animated);
+        Ok(())
     }
 
     fn record(&mut self, f: usize) -> Result<(), VkError> {
@@ -173,7 +214,8 @@ impl<'a> HeadlessRenderer<'a> {
         }
         frame.timer.reset(ctx, cmd);
         frame.timer.begin(ctx, cmd, 0);
-        self.pass.record(ctx, cmd, frame.targets.framebuffer, self.extent, frame.set, &self.meshes, &self.scene.objects);
+        let framebuffer = frame.targets.as_ref().expect("made with the frame").framebuffer;
+        self.pass.record(ctx, cmd, framebuffer, self.extent, frame.set, &self.meshes, &self.scene.objects);
         frame.timer.end(ctx, cmd, 0);
         // SAFETY: recording state.
         unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")
@@ -183,7 +225,7 @@ impl<'a> HeadlessRenderer<'a> {
     /// outgoing dependency orders this copy after the colour writes) into host memory.
     fn read_back(&mut self, f: usize) -> Result<Vec<u8>, VkError> {
         let ctx = self.ctx;
-        let image = self.frames[f].targets.color.raw;
+        let image = self.frames[f].targets.as_ref().expect("made with the frame").color.raw;
         let buffer = self.readback.as_ref().expect("created with the renderer");
         let extent = self.extent;
         commands::one_shot(ctx, |cmd| {

@@ -12,4 +12,4 @@ pub mod targets;
 
 pub use error::RenderError;
 pub use headless::{HeadlessRenderer, RenderOutput};
-pub use settings::{RenderSettings, Technique};
+pub use settings::{DebugView, RenderSettings, Technique};

@@ -7,8 +7,14 @@ pub struct FrameStats {
     gpu_sum_ms: Vec<f64>,
     gpu_frames: u32,
     cpu_sum_ms: f64,
+    assign_sum_ms: f64,
+    assign_frames: u32,
     pub frames: u32,
     pub wall_ms: f64,
+    /// Cluster statistics of the last frame (clustered techniques).
+    pub clusters: Option<ml_cpu::cluster::ClusterStats>,
+    /// How often a frame's light-index buffer had to grow.
+    pub index_growths: u32,
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -21,8 +27,12 @@ impl FrameStats {
             gpu_sum_ms: vec![0.0; pass_names.len()],
             gpu_frames: 0,
             cpu_sum_ms: 0.0,
+            assign_sum_ms: 0.0,
+            assign_frames: 0,
             frames: 0,
             wall_ms: 0.0,
+            clusters: None,
+            index_growths: 0,
         }
     }
 
@@ -31,6 +41,16 @@ impl FrameStats {
             *sum += v;
         }
         self.gpu_frames += 1;
+    }
+
+    pub fn add_assign_ms(&mut self, ms: f64) {
+        self.assign_sum_ms += ms;
+        self.assign_frames += 1;
+    }
+
+    /// Mean CPU light-assignment time (clustered-cpu).
+    pub fn assign_ms(&self) -> Option<f64> {
+        (self.assign_frames > 0).then(|| self.assign_sum_ms / self.assign_frames as f64)
     }
 
     pub fn add_cpu_ms(&mut self, ms: f64) {

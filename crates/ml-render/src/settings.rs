@@ -1,6 +1,7 @@
 //! What a render is asked to do, checked against the device before anything is allocated.
 
 use crate::error::RenderError;
+use ml_cpu::cluster::ClusterDims;
 use ml_vk::Context;
 
 /// Lighting techniques (SPEC §3). Each must give the same image as `Forward`.
@@ -8,15 +9,22 @@ use ml_vk::Context;
 pub enum Technique {
     /// Brute force: every fragment loops over every light.
     Forward,
+    /// Cluster grid with lights assigned on the CPU every frame.
+    ClusteredCpu,
 }
 
 impl Technique {
-    pub const ALL: [Technique; 1] = [Technique::Forward];
+    pub const ALL: [Technique; 2] = [Technique::Forward, Technique::ClusteredCpu];
 
     pub fn name(self) -> &'static str {
         match self {
             Technique::Forward => "forward",
+            Technique::ClusteredCpu => "clustered-cpu",
         }
+    }
+
+    pub fn is_clustered(self) -> bool {
+        matches!(self, Technique::ClusteredCpu)
     }
 
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {
@@ -27,6 +35,24 @@ impl Technique {
     }
 }
 
+/// What the image shows instead of the shaded scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DebugView {
+    None,
+    /// Lights per cluster as a heat map (clustered techniques).
+    ClusterHeat,
+}
+
+impl DebugView {
+    pub fn from_name(name: &str) -> Result<DebugView, RenderError> {
+        match name {
+            "none" => Ok(DebugView::None),
+            "cluster-heat" => Ok(DebugView::ClusterHeat),
+            _ => Err(RenderError::Invalid(format!("unknown debug view '{name}': expected one of none, cluster-heat"))),
+        }
+    }
+}
+
 /// Size of the biggest image we agree to render, whatever the device allows: 16384² RGBA8 is
 /// 1 GiB of colour alone, per frame in flight.
 pub const MAX_DIMENSION: u32 = 16384;
@@ -34,6 +60,9 @@ pub const MAX_DIMENSION: u32 = 16384;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     pub technique: Technique,
+    /// Cluster grid of the clustered techniques.
+    pub clusters: ClusterDims,
+    pub debug_view: DebugView,
     pub width: u32,
     pub height: u32,
     /// Frames to render; the image is the last one's, timings are averaged over all.
@@ -47,6 +76,11 @@ pub const TIMER_SPEED: f32 = 0.25;
 pub const FRAME_SECONDS: f32 = 1.0 / 60.0;
 
 impl RenderSettings {
+    /// Defaults for everything but size: forward, 16×9×24 clusters, one frame at time 0.
+    pub fn new(technique: Technique, width: u32, height: u32) -> RenderSettings {
+        RenderSettings { technique, clusters: ClusterDims::DEFAULT, debug_view: DebugView::None, width, height, frames: 1, time: Some(0.0) }
+    }
+
     /// Animation clock of frame `i`.
     pub fn clock(&self, i: u32) -> f32 {
         self.time.unwrap_or(i as f32 * FRAME_SECONDS * TIMER_SPEED)
@@ -60,6 +94,9 @@ impl RenderSettings {
             if v == 0 || v > max_dim {
                 return Err(RenderError::Invalid(format!("{what} {v} is out of range: use 1 to {max_dim}")));
             }
+        }
+        if self.debug_view == DebugView::ClusterHeat && !self.technique.is_clustered() {
+            return Err(RenderError::Invalid(format!("--debug-view cluster-heat needs a clustered technique, not {}", self.technique.name())));
         }
         if self.frames == 0 {
             return Err(RenderError::Invalid("--frames must be at least 1".into()));

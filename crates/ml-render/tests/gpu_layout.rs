@@ -2,7 +2,7 @@
 //! reflection of the compiled shaders reports (seed mistake 5: the std140 trap). A field
 //! moved on either side fails here.
 
-use ml_cpu::gpu_types::{FrameUniforms, GpuLayout, ObjectPush, PointLight};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, GpuLayout, ObjectPush, PointLight};
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
 use std::collections::HashMap;
@@ -58,11 +58,21 @@ fn reflect_all() -> HashMap<String, Reflected> {
     structs
 }
 
-fn check<T: GpuLayout>(structs: &HashMap<String, Reflected>) {
-    let reflected = structs.get(T::GLSL_NAME).unwrap_or_else(|| panic!("no shader uses struct {}", T::GLSL_NAME));
+/// How the Rust struct differs from the shaders' layout, if it does.
+fn mismatch<T: GpuLayout>(structs: &HashMap<String, Reflected>) -> Option<String> {
+    let Some(reflected) = structs.get(T::GLSL_NAME) else { return Some(format!("no shader uses struct {}", T::GLSL_NAME)) };
     let rust: Vec<(String, usize)> = T::field_offsets().into_iter().map(|(n, o)| (n.to_owned(), o)).collect();
-    assert_eq!(rust, reflected.members, "{}: Rust field offsets differ from the shader's", T::GLSL_NAME);
-    assert_eq!(std::mem::size_of::<T>(), reflected.size, "{}: Rust size differs from the shader's", T::GLSL_NAME);
+    if rust != reflected.members {
+        return Some(format!("{}: Rust field offsets {rust:?}, shaders {:?}", T::GLSL_NAME, reflected.members));
+    }
+    let size = std::mem::size_of::<T>();
+    (size != reflected.size).then(|| format!("{}: Rust size {size}, shaders {}", T::GLSL_NAME, reflected.size))
+}
+
+fn check<T: GpuLayout>(structs: &HashMap<String, Reflected>) {
+    if let Some(problem) = mismatch::<T>(structs) {
+        panic!("{problem}");
+    }
 }
 
 #[test]
@@ -71,6 +81,28 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<FrameUniforms>(&structs);
     check::<PointLight>(&structs);
     check::<ObjectPush>(&structs);
+    check::<ClusterRange>(&structs);
+}
+
+/// Seed mistake 5: its index list was a std140 uint array, 16 bytes per index. Ours is a
+/// std430 uint array: stride 4, as the Rust side uploads it (`Vec<u32>`).
+#[test]
+fn light_index_list_is_packed() {
+    let mut stride = None;
+    for (_, spirv) in ml_shaders::ALL {
+        let words: Vec<u32> = spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+        for entry in ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().unwrap() {
+            for var in &entry.vars {
+                if let Type::Struct(s) = var.ty() {
+                    for m in s.members.iter().filter(|m| m.name.as_deref() == Some("light_indices")) {
+                        let Type::Array(a) = &m.ty else { panic!("light_indices is not an array") };
+                        stride = a.stride;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(stride, Some(4), "light_indices must be a tightly packed uint array");
 }
 
 #[test]
@@ -87,6 +119,6 @@ fn the_check_catches_a_moved_field() {
             vec![("color", std::mem::offset_of!(Swapped, color)), ("position_radius", std::mem::offset_of!(Swapped, position_radius))]
         }
     }
-    let structs = reflect_all();
-    assert!(std::panic::catch_unwind(|| check::<Swapped>(&structs)).is_err());
+    let problem = mismatch::<Swapped>(&reflect_all()).expect("a swapped field must be reported");
+    assert!(problem.contains("PointLight"), "{problem}");
 }

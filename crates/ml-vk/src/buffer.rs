@@ -15,6 +15,12 @@ pub struct Buffer {
 }
 
 impl Buffer {
+    /// A buffer that owns nothing (destroying it does nothing): a placeholder while a larger
+    /// object is being built.
+    pub fn null() -> Buffer {
+        Buffer { raw: vk::Buffer::null(), size: 0, allocation: None }
+    }
+
     pub fn new(ctx: &Context, name: &str, size: vk::DeviceSize, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
         let info = vk::BufferCreateInfo::default().size(size.max(4)).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device and create info.

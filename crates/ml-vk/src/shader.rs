@@ -10,3 +10,26 @@ pub fn module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
     // SAFETY: valid SPIR-V words from our build.
     unsafe { ctx.device.create_shader_module(&info, None) }.ctx("vkCreateShaderModule")
 }
+
+/// A compute pipeline running `main` of the given SPIR-V with `layout`.
+pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout) -> Result<vk::Pipeline> {
+    let module = module(ctx, spirv)?;
+    let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(c"main");
+    let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
+    // SAFETY: valid module and layout.
+    let result = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
+    // SAFETY: the module is not needed once the pipeline exists (or failed).
+    unsafe { ctx.device.destroy_shader_module(module, None) };
+    result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateComputePipelines")
+}
+
+/// A descriptor set layout of `bindings` (binding number, type), all visible to `stages`.
+pub fn set_layout(ctx: &Context, bindings: &[(u32, vk::DescriptorType)], stages: vk::ShaderStageFlags) -> Result<vk::DescriptorSetLayout> {
+    let bindings: Vec<vk::DescriptorSetLayoutBinding> = bindings
+        .iter()
+        .map(|&(b, ty)| vk::DescriptorSetLayoutBinding::default().binding(b).descriptor_type(ty).descriptor_count(1).stage_flags(stages))
+        .collect();
+    // SAFETY: valid device and create info.
+    unsafe { ctx.device.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
+        .ctx("vkCreateDescriptorSetLayout")
+}

@@ -21,6 +21,11 @@ impl GpuTimer {
         Ok(GpuTimer { pool, passes, period_ns, written: false })
     }
 
+    /// A timer that owns nothing (a placeholder while a larger object is being built).
+    pub fn null() -> GpuTimer {
+        GpuTimer { pool: vk::QueryPool::null(), passes: 0, period_ns: None, written: false }
+    }
+
     /// Reset all queries; record outside a render pass before the first `begin`.
     pub fn reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         // SAFETY: recording state, outside a render pass.

@@ -1,7 +1,8 @@
 use super::*;
 use crate::camera::Camera;
 use crate::gpu_types::PointLight;
-use crate::lights::{LightLayout, LightParams, RadiusRange};
+use crate::lights::LightParams;
+use crate::random_scene::{hostile_lights, random_camera};
 use glam::{Vec3, Vec4, Vec4Swizzles};
 use rand::{Rng, SeedableRng};
 
@@ -65,32 +66,6 @@ fn cluster_dims_parse() {
     for bad in ["", "16x9", "0x9x24", "16x9x24x2", "axbxc", "2000x2000x2000"] {
         assert!(ClusterDims::parse(bad).is_err(), "{bad}");
     }
-}
-
-/// A random camera somewhere in the light box, looking at a random point near the ground.
-fn random_camera(rng: &mut impl Rng) -> Camera {
-    let eye = Vec3::new(rng.random_range(-18.0..18.0), rng.random_range(0.5..14.0), rng.random_range(-18.0..18.0));
-    let target = Vec3::new(rng.random_range(-10.0..10.0), rng.random_range(-2.0..2.0), rng.random_range(-10.0..10.0));
-    Camera::looking_at(eye, target, rng.random_range(40.0..90.0), 0.1, 256.0)
-}
-
-/// Lights that stress the edge cases: random in the box with radii 0.2–40, plus lights
-/// behind the camera whose sphere reaches in front, straddling the near plane, and around
-/// the eye.
-fn hostile_lights(rng: &mut impl Rng, camera: &Camera, count: u32) -> Vec<PointLight> {
-    let params = LightParams { count, layout: LightLayout::Random, seed: rng.random(), radius: RadiusRange { min: 0.2, max: 40.0 } };
-    let mut lights = params.build().unwrap();
-    let f = camera.forward();
-    for i in 0..12 {
-        let r = rng.random_range(0.3..6.0);
-        let at = match i % 3 {
-            0 => camera.position - f * (r * 0.7),        // behind, reaching in front
-            1 => camera.position + f * camera.near,       // straddling the near plane
-            _ => camera.position + Vec3::new(rng.random_range(-0.2..0.2), 0.1, 0.0), // around the eye
-        };
-        lights.push(light(at, r));
-    }
-    lights
 }
 
 /// Every (light, point) pair with distance < radius is in that point's cluster list, for

@@ -10,21 +10,43 @@ use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
 pub fn settings(width: u32, height: u32) -> RenderSettings {
-    RenderSettings { technique: Technique::Forward, width, height, frames: 1, time: Some(0.0) }
+    RenderSettings::new(Technique::Forward, width, height)
 }
 
 /// Render on a fresh validated context and check the layer said nothing.
 pub fn render(scene: Scene, settings: RenderSettings) -> RenderOutput {
+    render_each(&scene, &[settings]).pop().expect("one output")
+}
+
+/// Render the scene once per settings on one validated context; no validation message allowed.
+pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutput> {
     let ctx = Context::new(&ContextDesc { validation: true, device_index: None })
         .expect("a Vulkan device with the validation layer (CI installs lavapipe and vulkan-validationlayers)");
     let counter = ctx.validation_counter();
-    let output = {
-        let mut renderer = HeadlessRenderer::new(&ctx, scene, settings).expect("renderer");
-        renderer.render().expect("render")
-    };
+    let outputs = settings
+        .iter()
+        .map(|s| {
+            let mut renderer = HeadlessRenderer::new(&ctx, scene.clone(), *s).expect("renderer");
+            renderer.render().expect("render")
+        })
+        .collect();
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
-    output
+    outputs
+}
+
+/// Largest per-channel difference between two images of the same size, and how many
+/// pixels differ at all.
+pub fn max_difference(a: &RenderOutput, b: &RenderOutput) -> (u8, usize) {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut worst = 0;
+    let mut pixels = 0;
+    for (pa, pb) in a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)) {
+        let d = pa.iter().zip(pb).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+        worst = worst.max(d);
+        pixels += (d > 0) as usize;
+    }
+    (worst, pixels)
 }
 
 pub fn pixel(out: &RenderOutput, x: u32, y: u32) -> [u8; 3] {

@@ -1,0 +1,115 @@
+//! The slice formula is written once in Rust (`ClusterGrid::slice`) and once in GLSL
+//! (`cluster_slice` in shaders/cluster.glsl). On 10⁵ random depths the GPU's slices must equal
+//! the CPU's, except for depths within 1e-4 slices of a boundary, where f32 `log` may round
+//! either way — and there they may differ by one slice only (the cluster boxes carry slack
+//! for exactly that).
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use ml_cpu::camera::Camera;
+use ml_cpu::cluster::{ClusterDims, ClusterGrid};
+use ml_cpu::gpu_types::FrameUniforms;
+use ml_vk::{commands, shader, Buffer, Context, ContextDesc};
+use rand::{Rng, SeedableRng};
+use std::sync::atomic::Ordering;
+
+const COUNT: usize = 100_000;
+
+fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
+    let storage = vk::DescriptorType::STORAGE_BUFFER;
+    let layout = shader::set_layout(ctx, &[(0, vk::DescriptorType::UNIFORM_BUFFER), (1, storage), (2, storage)], vk::ShaderStageFlags::COMPUTE)
+        .unwrap();
+    let layouts = [layout];
+    // SAFETY: valid device and create infos; everything is destroyed below after the wait.
+    let pipeline_layout =
+        unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }.unwrap();
+    let pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SLICE_PROBE_COMP, pipeline_layout).unwrap();
+    let sizes = [
+        vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
+        vk::DescriptorPoolSize { ty: storage, descriptor_count: 2 },
+    ];
+    // SAFETY: as above.
+    let pool = unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }.unwrap();
+    // SAFETY: as above.
+    let set = unsafe { ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts)) }
+        .unwrap()[0];
+
+    let frame = FrameUniforms {
+        cluster_dims: [grid.dims.x, grid.dims.y, grid.dims.z, 0],
+        viewport: [grid.width, grid.height, 0, 0],
+        cluster_slices: [grid.log_scale, grid.log_bias, 1.0, 0.0],
+        ..Default::default()
+    };
+    let mut uniforms = Buffer::new(ctx, "uniforms", size_of::<FrameUniforms>() as u64, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu).unwrap();
+    uniforms.write(0, &[frame]);
+    let mut input = Buffer::new(ctx, "depths", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu).unwrap();
+    input.write(0, depths);
+    let mut output = Buffer::new(ctx, "slices", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
+    let infos = [uniforms.raw, input.raw, output.raw].map(|b| [vk::DescriptorBufferInfo::default().buffer(b).range(vk::WHOLE_SIZE)]);
+    let writes: Vec<vk::WriteDescriptorSet> = infos
+        .iter()
+        .enumerate()
+        .map(|(i, info)| {
+            let ty = if i == 0 { vk::DescriptorType::UNIFORM_BUFFER } else { storage };
+            vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(ty).buffer_info(info)
+        })
+        .collect();
+    // SAFETY: the set and buffers are alive and unused.
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    commands::one_shot(ctx, |cmd| {
+        let to_host = [vk::MemoryBarrier::default().src_access_mask(vk::AccessFlags::SHADER_WRITE).dst_access_mask(vk::AccessFlags::HOST_READ)];
+        // SAFETY: recording state; all bound objects are alive.
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, pipeline_layout, 0, &[set], &[]);
+            ctx.device.cmd_dispatch(cmd, depths.len().div_ceil(64) as u32, 1, 1);
+            ctx.device.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::PipelineStageFlags::HOST,
+                vk::DependencyFlags::empty(),
+                &to_host,
+                &[],
+                &[],
+            );
+        }
+    })
+    .expect("probe dispatch");
+    let slices: Vec<u32> = bytemuck::cast_slice(output.mapped()).to_vec();
+    for b in [&mut uniforms, &mut input, &mut output] {
+        b.destroy(ctx);
+    }
+    // SAFETY: the GPU is idle (one_shot waited).
+    unsafe {
+        ctx.device.destroy_descriptor_pool(pool, None);
+        ctx.device.destroy_pipeline(pipeline, None);
+        ctx.device.destroy_pipeline_layout(pipeline_layout, None);
+        ctx.device.destroy_descriptor_set_layout(layout, None);
+    }
+    slices
+}
+
+#[test]
+fn glsl_and_rust_slices_agree_on_random_depths() {
+    let ctx = Context::new(&ContextDesc { validation: true, device_index: None }).expect("Vulkan with validation");
+    let counter = ctx.validation_counter();
+    let grid = ClusterGrid::new(ClusterDims::DEFAULT, 1920, 1080, &Camera::seed());
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    // Uniform in log depth (like the slices), plus some out of [near, far].
+    let depths: Vec<f32> = (0..COUNT).map(|_| grid.near * (grid.far / grid.near).powf(rng.random_range(-0.05..1.05))).collect();
+    let gpu = gpu_slices(&ctx, &grid, &depths);
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages");
+    let (mut boundary, mut differ) = (0, 0);
+    for (d, g) in depths.iter().zip(&gpu) {
+        let cpu = grid.slice(*d);
+        let s = d.ln() as f64 * grid.log_scale as f64 + grid.log_bias as f64;
+        let near_boundary = (s - s.round()).abs() < 1e-4;
+        boundary += near_boundary as u32;
+        if cpu != *g {
+            differ += 1;
+            assert!(near_boundary && cpu.abs_diff(*g) == 1, "depth {d}: CPU slice {cpu}, GPU slice {g}");
+        }
+    }
+    println!("{COUNT} depths: {differ} differ by one slice, all within 1e-4 slices of a boundary ({boundary} such depths)");
+}
