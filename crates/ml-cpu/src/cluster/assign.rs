@@ -12,7 +12,7 @@
 
 use super::grid::ClusterGrid;
 use crate::gpu_types::{ClusterRange, PointLight};
-use glam::{Vec3, Vec4Swizzles};
+use glam::Vec4Swizzles;
 use rayon::prelude::*;
 
 /// Result of one assignment: per cluster (offset, count) into `indices`.
@@ -43,14 +43,27 @@ impl ClusterLists {
     }
 }
 
-/// Lights per rayon task: big enough to amortise the task, small enough to balance 2–16 cores.
-const CHUNK: usize = 512;
+/// Fewest lights per rayon task: below this a task costs more than it saves.
+const MIN_CHUNK: usize = 256;
 
-/// Reusable assignment state (per-chunk pair lists keep their allocations across frames).
+/// One task's share: its (cluster, light) pairs and per-cluster counts, which the prefix sum
+/// turns into the task's write cursors.
+#[derive(Default)]
+struct Chunk {
+    pairs: Vec<(u32, u32)>,
+    counts: Vec<u32>,
+}
+
+/// Reusable assignment state (per-task buffers keep their allocations across frames).
 #[derive(Default)]
 pub struct ClusterAssigner {
-    chunk_pairs: Vec<Vec<(u32, u32)>>,
+    chunks: Vec<Chunk>,
 }
+
+/// The index list, shared by tasks that write disjoint positions of it.
+struct Disjoint(*mut u32);
+// SAFETY: tasks only write positions their own cursors own (see `assign`).
+unsafe impl Sync for Disjoint {}
 
 impl ClusterAssigner {
     pub fn new() -> ClusterAssigner {
@@ -59,43 +72,64 @@ impl ClusterAssigner {
 
     /// Assign `lights` (world space) to the clusters of `grid`, into `out`.
     pub fn assign(&mut self, grid: &ClusterGrid, lights: &[PointLight], out: &mut ClusterLists) {
-        let chunks = lights.len().div_ceil(CHUNK);
-        self.chunk_pairs.resize_with(chunks, Vec::new);
-        self.chunk_pairs.par_iter_mut().enumerate().for_each(|(c, pairs)| {
-            pairs.clear();
-            let first = c * CHUNK;
-            for (i, light) in lights[first..(first + CHUNK).min(lights.len())].iter().enumerate() {
-                light_clusters(grid, light, |cluster| pairs.push((cluster, (first + i) as u32)));
+        let clusters = grid.dims.count();
+        // A few tasks per thread balance the load; more only add prefix-sum work.
+        let tasks = lights.len().div_ceil(MIN_CHUNK).clamp(1, rayon::current_num_threads() * 4);
+        let per_task = lights.len().div_ceil(tasks).max(1);
+        self.chunks.resize_with(tasks, Chunk::default);
+        // 1. Each task lists its lights' clusters and counts them per cluster.
+        self.chunks.par_iter_mut().enumerate().for_each(|(t, chunk)| {
+            chunk.pairs.clear();
+            chunk.counts.clear();
+            chunk.counts.resize(clusters, 0);
+            let first = (t * per_task).min(lights.len());
+            for (i, light) in lights[first..(first + per_task).min(lights.len())].iter().enumerate() {
+                light_clusters(grid, light, |cluster| {
+                    chunk.pairs.push((cluster, (first + i) as u32));
+                    chunk.counts[cluster as usize] += 1;
+                });
             }
         });
-        // Count, prefix sum, fill. Chunks and lights are visited in order, so every cluster's
-        // list is sorted by light index: the shader then sums in the same order as `forward`.
+        // 2. Prefix sum over clusters, and within a cluster over tasks in light order, so every
+        //    cluster's list comes out sorted by light index: the shader then sums in the same
+        //    order as `forward`. Counts become each task's write cursors.
         out.ranges.clear();
-        out.ranges.resize(grid.dims.count(), ClusterRange::default());
-        for pairs in &self.chunk_pairs {
-            for &(cluster, _) in pairs {
-                out.ranges[cluster as usize].count += 1;
-            }
-        }
+        out.ranges.resize(clusters, ClusterRange::default());
         let mut offset = 0u32;
-        for r in &mut out.ranges {
-            r.offset = offset;
-            offset += r.count;
+        for (cluster, range) in out.ranges.iter_mut().enumerate() {
+            range.offset = offset;
+            for chunk in &mut self.chunks {
+                let count = chunk.counts[cluster];
+                chunk.counts[cluster] = offset;
+                offset += count;
+            }
+            range.count = offset - range.offset;
         }
+        // 3. Tasks write their pairs at their cursors: disjoint positions, in parallel.
         out.indices.clear();
         out.indices.resize(offset as usize, 0);
-        let mut cursor: Vec<u32> = out.ranges.iter().map(|r| r.offset).collect();
-        for pairs in &self.chunk_pairs {
-            for &(cluster, light) in pairs {
-                let c = &mut cursor[cluster as usize];
-                out.indices[*c as usize] = light;
-                *c += 1;
+        let indices = Disjoint(out.indices.as_mut_ptr());
+        let indices = &indices;
+        self.chunks.par_iter_mut().for_each(|chunk| {
+            for &(cluster, light) in &chunk.pairs {
+                let cursor = &mut chunk.counts[cluster as usize];
+                // SAFETY: cursors of different (task, cluster) pairs cover disjoint ranges of
+                // `out.indices` (step 2), each within its length; `out.indices` is not resized
+                // or read until every task is done.
+                unsafe { *indices.0.add(*cursor as usize) = light };
+                *cursor += 1;
             }
-        }
+        });
     }
 }
 
 /// Call `emit` with every cluster whose box the light's sphere touches.
+///
+/// Per depth slice the sphere is cut to the slab the slice spans (its cross-section there is
+/// narrower than the sphere: "iterative sphere refinement"), the slab's box is projected to a
+/// pixel rectangle, and the tiles under it are tested box against sphere. The slab never
+/// reaches in front of the near plane, so nothing is projected through w ≤ 0, also for
+/// lights whose centre is behind the camera.
 pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: impl FnMut(u32)) {
     let p = light.position_radius;
     let r = p[3];
@@ -105,41 +139,27 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
     if dmax < grid.near || dmin > grid.far {
         return;
     }
-    let k0 = grid.slice(dmin.max(grid.near));
-    let k1 = grid.slice(dmax.min(grid.far));
-    let d = grid.dims;
-    let (mut x0, mut x1, mut y0, mut y1) = (0, d.x - 1, 0, d.y - 1);
-    // Only a box wholly in front of the eye projects to a bounded rectangle; otherwise
-    // every tile is a candidate and the box test decides.
-    if dmin > grid.near * 0.5 {
-        let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
-        for corner in 0..8 {
-            let s = Vec3::new(
-                if corner & 1 == 0 { -r } else { r },
-                if corner & 2 == 0 { -r } else { r },
-                if corner & 4 == 0 { -r } else { r },
-            );
-            let clip = grid.projection * (c + s).extend(1.0);
-            let ndc = clip.xy() / clip.w;
-            lo = lo.min(ndc);
-            hi = hi.max(ndc);
-        }
-        let to_px = |ndc: f32, size: u32| (ndc + 1.0) * 0.5 * size as f32;
-        let (px0, px1) = (to_px(lo.x, grid.width), to_px(hi.x, grid.width));
-        let (py0, py1) = (to_px(lo.y, grid.height), to_px(hi.y, grid.height));
-        if px1 < -1.0 || py1 < -1.0 || px0 > grid.width as f32 + 1.0 || py0 > grid.height as f32 + 1.0 {
-            return;
-        }
-        // A shaded point projects to its pixel's centre, so pixels within a pixel of the
-        // rectangle cover it (the extra pixel absorbs rounding).
-        let pixel = |v: f32, size: u32| (v.floor().max(0.0) as u32).min(size - 1);
-        x0 = grid.tile_x(pixel(px0 - 1.0, grid.width));
-        x1 = grid.tile_x(pixel(px1 + 1.0, grid.width));
-        y0 = grid.tile_y(pixel(py0 - 1.0, grid.height));
-        y1 = grid.tile_y(pixel(py1 + 1.0, grid.height));
+    // Off screen as a whole? (Most lights of a large scene are; one projection rejects them.)
+    let d0 = dmin.max(grid.near);
+    let inv = (1.0 / d0, 1.0 / dmax);
+    if grid.tile_span_x(c.x - r, c.x + r, inv).is_none() || grid.tile_span_y(c.y - r, c.y + r, inv).is_none() {
+        return;
     }
+    let k0 = grid.slice(d0);
+    let k1 = grid.slice(dmax.min(grid.far));
     let r2 = r * r;
     for z in k0..=k1 {
+        // The part of the sphere in this slice's depth range.
+        let (s0, s1) = grid.slice_depths(z);
+        let (s0, s1) = (s0.max(dmin).max(grid.near), s1.min(dmax));
+        if s0 > s1 {
+            continue;
+        }
+        let closest = depth.clamp(s0, s1);
+        let rr = (r2 - (closest - depth) * (closest - depth)).max(0.0).sqrt();
+        let inv = (1.0 / s0, 1.0 / s1);
+        let Some((x0, x1)) = grid.tile_span_x(c.x - rr, c.x + rr, inv) else { continue };
+        let Some((y0, y1)) = grid.tile_span_y(c.y - rr, c.y + rr, inv) else { continue };
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let index = grid.index(x, y, z);

@@ -58,6 +58,24 @@ impl Aabb {
     }
 }
 
+/// NDC range of scale·v/d over v ∈ [va, vb], d ∈ [d0, d1] with d > 0 (given as 1/d0, 1/d1):
+/// the extremes are at the corners, and v/d is monotonic in each.
+fn projected_span(scale: f32, va: f32, vb: f32, (inv0, inv1): (f32, f32)) -> (f32, f32) {
+    let corners = [va * inv0, va * inv1, vb * inv0, vb * inv1].map(|t| t * scale);
+    (corners.iter().copied().fold(f32::MAX, f32::min), corners.iter().copied().fold(f32::MIN, f32::max))
+}
+
+/// Pixels whose centres may lie in NDC [lo, hi] (one pixel of margin), clamped to the image;
+/// None when the span is off screen.
+fn pixel_span(lo: f32, hi: f32, size: u32) -> Option<(u32, u32)> {
+    let to_px = |ndc: f32| (ndc + 1.0) * 0.5 * size as f32;
+    let (a, b) = (to_px(lo) - 1.0, to_px(hi) + 1.0);
+    if b < 0.0 || a >= size as f32 {
+        return None;
+    }
+    Some((a.max(0.0) as u32, (b.min(size as f32 - 1.0)) as u32))
+}
+
 /// The grid for one camera and image size.
 #[derive(Clone, Debug)]
 pub struct ClusterGrid {
@@ -73,6 +91,8 @@ pub struct ClusterGrid {
     pub projection: Mat4,
     /// View-space bounds of every cluster, index = (z·Y + y)·X + x.
     pub bounds: Vec<Aabb>,
+    /// Depth where each slice starts, with slack (Z + 1 entries; the last is far).
+    slice_starts: Vec<f32>,
 }
 
 /// Relative slack added to every cluster's box so that a fragment whose slice or tile was
@@ -98,7 +118,13 @@ impl ClusterGrid {
             view: camera.view(),
             projection,
             bounds: Vec::with_capacity(dims.count()),
+            slice_starts: Vec::new(),
         };
+        // The tile spans below project with x_clip = p00·x, y_clip = p11·y, w = −z: a symmetric
+        // perspective, which is what `Camera::projection` makes.
+        let p = grid.projection;
+        debug_assert!(p.z_axis.x == 0.0 && p.z_axis.y == 0.0 && p.z_axis.w == -1.0 && p.w_axis.w == 0.0);
+        grid.slice_starts = (0..=dims.z).map(|k| grid.slice_start(k)).collect();
         grid.bounds = grid.compute_bounds();
         grid
     }
@@ -112,6 +138,25 @@ impl ClusterGrid {
     /// Depth where slice `k` starts (k = Z gives far).
     pub fn slice_start(&self, k: u32) -> f32 {
         self.near * (self.far / self.near).powf(k as f32 / self.dims.z as f32)
+    }
+
+    /// Depth range of slice `k`, widened by the slack the cluster boxes carry.
+    pub fn slice_depths(&self, k: u32) -> (f32, f32) {
+        (self.slice_starts[k as usize] * (1.0 - SLACK), self.slice_starts[k as usize + 1] * (1.0 + SLACK))
+    }
+
+    /// Tiles in x under the view-space box x ∈ [xa, xb], depth ∈ [d0, d1] (0 < d0 ≤ d1),
+    /// given as `inv_depths` = (1/d0, 1/d1); None when the box is off screen. A shaded point
+    /// projects to its pixel's centre, so a pixel of margin absorbs rounding.
+    pub fn tile_span_x(&self, xa: f32, xb: f32, inv_depths: (f32, f32)) -> Option<(u32, u32)> {
+        let (lo, hi) = projected_span(self.projection.x_axis.x, xa, xb, inv_depths);
+        pixel_span(lo, hi, self.width).map(|(a, b)| (self.tile_x(a), self.tile_x(b)))
+    }
+
+    /// As `tile_span_x` for rows (Vulkan: row 0 at the top, the projection flips y).
+    pub fn tile_span_y(&self, ya: f32, yb: f32, inv_depths: (f32, f32)) -> Option<(u32, u32)> {
+        let (lo, hi) = projected_span(self.projection.y_axis.y, ya, yb, inv_depths);
+        pixel_span(lo, hi, self.height).map(|(a, b)| (self.tile_y(a), self.tile_y(b)))
     }
 
     /// Tile of pixel column/row (integer arithmetic, as in the shader).
