@@ -46,6 +46,20 @@ fn renders_a_png_and_prints_the_table() {
 }
 
 #[test]
+fn clustered_render_reports_its_clusters() {
+    let png = temp_png("clustered.png");
+    let out = manylights(
+        &["render", "--validation", "--technique", "clustered-cpu", "--clusters", "4x4x2", "--width", "64", "--height", "36", "--out", png.to_str().unwrap()],
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    for key in ["clustered-cpu", "cpu assign ms", "4x4x2 = 32", "lights/cluster", "index list"] {
+        assert!(stdout.contains(key), "'{key}' missing from:\n{stdout}");
+    }
+}
+
+#[test]
 fn info_lists_a_device() {
     let out = manylights(&["info"], &[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -64,6 +78,10 @@ fn bad_names_are_refused_with_the_choices() {
     assert_one_line_error(&manylights(&["render", "--light-radius", "3..1", "--out", p], &[]), &["3..1"]);
     assert_one_line_error(&manylights(&["render", "--scene", "nope", "--out", p], &[]), &["nope"]);
     assert_one_line_error(&manylights(&["render", "--width", "wide", "--out", p], &[]), &["wide"]);
+    assert_one_line_error(&manylights(&["render", "--clusters", "16x9", "--out", p], &[]), &["--clusters 16x9"]);
+    assert_one_line_error(&manylights(&["render", "--clusters", "0x9x24", "--out", p], &[]), &["--clusters 0x9x24"]);
+    assert_one_line_error(&manylights(&["render", "--debug-view", "xray", "--out", p], &[]), &["xray", "cluster-heat"]);
+    assert_one_line_error(&manylights(&["render", "--debug-view", "cluster-heat", "--out", p], &[]), &["clustered technique"]);
     assert!(!png.exists());
 }
 

@@ -24,6 +24,17 @@ pub struct ForwardPass {
     pub set_layout: vk::DescriptorSetLayout,
     pub pipeline_layout: vk::PipelineLayout,
     pub pipeline: vk::Pipeline,
+    /// Draws the cluster-heat legend over the image (no depth, no vertex buffer).
+    pub legend_pipeline: vk::Pipeline,
+}
+
+/// The two kinds of draw in the pass.
+#[derive(Clone, Copy, PartialEq)]
+enum Draw {
+    /// Scene meshes: vertex buffer, depth test, back-face culling.
+    Mesh,
+    /// Screen-space overlay made from the vertex index, drawn over everything.
+    Overlay,
 }
 
 impl ForwardPass {
@@ -33,6 +44,7 @@ impl ForwardPass {
             set_layout: vk::DescriptorSetLayout::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            legend_pipeline: vk::Pipeline::null(),
         };
         // On failure, destroy what was made (null handles are ignored by vkDestroy*).
         let fragment = if technique.is_clustered() { ml_shaders::CLUSTERED_FRAG } else { ml_shaders::FORWARD_FRAG };
@@ -66,12 +78,13 @@ impl ForwardPass {
         let layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push);
         // SAFETY: as above.
         self.pipeline_layout = unsafe { d.create_pipeline_layout(&layout_info, None) }.ctx("vkCreatePipelineLayout")?;
-        self.pipeline = self.create_pipeline(ctx, fragment)?;
+        self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh)?;
+        self.legend_pipeline = self.create_pipeline(ctx, ml_shaders::HEAT_LEGEND_VERT, ml_shaders::HEAT_LEGEND_FRAG, Draw::Overlay)?;
         Ok(())
     }
 
-    fn create_pipeline(&self, ctx: &Context, fragment: &[u8]) -> Result<vk::Pipeline, VkError> {
-        let vert = shader::module(ctx, ml_shaders::FORWARD_VERT)?;
+    fn create_pipeline(&self, ctx: &Context, vertex: &[u8], fragment: &[u8], draw: Draw) -> Result<vk::Pipeline, VkError> {
+        let vert = shader::module(ctx, vertex)?;
         let frag = match shader::module(ctx, fragment) {
             Ok(f) => f,
             Err(e) => {
@@ -100,22 +113,25 @@ impl ForwardPass {
                 .format(vk::Format::R32G32B32_SFLOAT)
                 .offset(std::mem::offset_of!(Vertex, normal) as u32),
         ];
-        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-            .vertex_binding_descriptions(&vertex_bindings)
-            .vertex_attribute_descriptions(&vertex_attributes);
+        let vertex_input = match draw {
+            Draw::Mesh => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&vertex_bindings)
+                .vertex_attribute_descriptions(&vertex_attributes),
+            Draw::Overlay => vk::PipelineVertexInputStateCreateInfo::default(),
+        };
         let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         // Meshes wind counter-clockwise seen from outside; the Y-flipped projection keeps that
         // counter-clockwise in Vulkan's framebuffer convention.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(vk::CullModeFlags::BACK)
+            .cull_mode(if draw == Draw::Mesh { vk::CullModeFlags::BACK } else { vk::CullModeFlags::NONE })
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(true)
-            .depth_write_enable(true)
+            .depth_test_enable(draw == Draw::Mesh)
+            .depth_write_enable(draw == Draw::Mesh)
             .depth_compare_op(vk::CompareOp::LESS);
         let blend_attachments = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
@@ -144,8 +160,9 @@ impl ForwardPass {
         result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")
     }
 
-    /// Record the whole pass: clear, draw every object with its push constants, and leave the
-    /// colour target in TRANSFER_SRC_OPTIMAL for a read-back.
+    /// Record the whole pass: clear, draw every object with its push constants (and the
+    /// heat-map legend when asked), and leave the colour target in TRANSFER_SRC_OPTIMAL for a
+    /// read-back.
     pub fn record(
         &self,
         ctx: &Context,
@@ -155,6 +172,7 @@ impl ForwardPass {
         set: vk::DescriptorSet,
         meshes: &[GpuMesh],
         objects: &[Object],
+        legend: bool,
     ) {
         let d = &ctx.device;
         let clear = [
@@ -190,6 +208,10 @@ impl ForwardPass {
                     d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
                 }
             }
+            if legend {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.legend_pipeline);
+                d.cmd_draw(cmd, 6, 1, 0, 0);
+            }
             d.cmd_end_render_pass(cmd);
         }
     }
@@ -198,6 +220,7 @@ impl ForwardPass {
         // SAFETY: no pending work uses these objects; null handles are ignored.
         unsafe {
             ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline(self.legend_pipeline, None);
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
             ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
             ctx.device.destroy_render_pass(self.render_pass, None);

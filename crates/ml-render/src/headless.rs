@@ -215,7 +215,8 @@ impl<'a> HeadlessRenderer<'a> {
         frame.timer.reset(ctx, cmd);
         frame.timer.begin(ctx, cmd, 0);
         let framebuffer = frame.targets.as_ref().expect("made with the frame").framebuffer;
-        self.pass.record(ctx, cmd, framebuffer, self.extent, frame.set, &self.meshes, &self.scene.objects);
+        let legend = self.settings.debug_view == DebugView::ClusterHeat;
+        self.pass.record(ctx, cmd, framebuffer, self.extent, frame.set, &self.meshes, &self.scene.objects, legend);
         frame.timer.end(ctx, cmd, 0);
         // SAFETY: recording state.
         unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")

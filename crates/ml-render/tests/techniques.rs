@@ -61,3 +61,21 @@ fn clustered_cpu_equals_forward_on_the_seed_scene() {
         assert_matches_forward(&format!("seed scene ({}), seed grid", object.name()), &scene, ClusterDims { x: 4, y: 4, z: 2 });
     }
 }
+
+#[test]
+fn cluster_heat_view_paints_counts_and_a_legend() {
+    let scene = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
+    let mut settings = RenderSettings::new(Technique::ClusteredCpu, 320, 180);
+    settings.debug_view = ml_render::DebugView::ClusterHeat;
+    let heat = common::render(scene.clone(), settings);
+    // The legend's ramp spans x ∈ [2%, 35%] of the width near the bottom: black → red.
+    let y = (180.0 * 0.915) as u32;
+    let [r0, g0, b0] = common::pixel(&heat, (320.0 * 0.025) as u32, y);
+    let [r1, g1, _] = common::pixel(&heat, (320.0 * 0.34) as u32, y);
+    assert!(r0.max(g0).max(b0) < 40, "ramp should start black: {:?}", [r0, g0, b0]);
+    assert!(r1 > 200 && g1 < 60, "ramp should end red: {:?}", [r1, g1]);
+    // The objects show heat colours, not the shaded image.
+    let shaded = common::render(scene, RenderSettings::new(Technique::ClusteredCpu, 320, 180));
+    let (diff, pixels) = common::max_difference(&heat, &shaded);
+    assert!(diff > 100 && pixels > 5000, "heat view looks like the shaded image ({pixels} pixels differ)");
+}
