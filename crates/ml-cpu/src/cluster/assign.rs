@@ -148,6 +148,7 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
     let k0 = grid.slice(d0);
     let k1 = grid.slice(dmax.min(grid.far));
     let r2 = r * r;
+    let centre = glam::Vec3A::from(c);
     for z in k0..=k1 {
         // The part of the sphere in this slice's depth range.
         let (s0, s1) = grid.slice_depths(z);
@@ -163,7 +164,7 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let index = grid.index(x, y, z);
-                if grid.bounds[index as usize].distance_squared(c) <= r2 {
+                if grid.bounds[index as usize].distance_squared(centre) <= r2 {
                     emit(index);
                 }
             }

@@ -10,7 +10,7 @@
 //! perspective projection crowds almost every depth into the last few slices.
 
 use crate::camera::Camera;
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3, Vec3A, Vec4};
 
 /// Grid size X×Y×Z.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,17 +43,17 @@ impl ClusterDims {
     }
 }
 
-/// Axis-aligned box in view space.
+/// Axis-aligned box in view space (16-byte lanes: the test below is a few SIMD operations).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
-    pub min: Vec3,
-    pub max: Vec3,
+    pub min: Vec3A,
+    pub max: Vec3A,
 }
 
 impl Aabb {
     /// Squared distance from `p` to the box (0 inside).
-    pub fn distance_squared(&self, p: Vec3) -> f32 {
-        let d = (self.min - p).max(p - self.max).max(Vec3::ZERO);
+    pub fn distance_squared(&self, p: Vec3A) -> f32 {
+        let d = (self.min - p).max(p - self.max).max(Vec3A::ZERO);
         d.length_squared()
     }
 }
@@ -203,17 +203,17 @@ impl ClusterGrid {
                 let (y0, y1) = Self::tile_centres(y, d.y, self.height);
                 for x in 0..d.x {
                     let (x0, x1) = Self::tile_centres(x, d.x, self.width);
-                    let mut b = Aabb { min: Vec3::splat(f32::MAX), max: Vec3::splat(f32::MIN) };
+                    let (mut b_min, mut b_max) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
                     for (px, py) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
                         let dir = ray(px, py);
                         for depth in [z0, z1] {
                             let p = dir * depth;
-                            b.min = b.min.min(p);
-                            b.max = b.max.max(p);
+                            b_min = b_min.min(p);
+                            b_max = b_max.max(p);
                         }
                     }
-                    let pad = (b.max - b.min).max(Vec3::splat(z1 - z0)) * SLACK;
-                    bounds.push(Aabb { min: b.min - pad, max: b.max + pad });
+                    let pad = (b_max - b_min).max(Vec3::splat(z1 - z0)) * SLACK;
+                    bounds.push(Aabb { min: (b_min - pad).into(), max: (b_max + pad).into() });
                 }
             }
         }
