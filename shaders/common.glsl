@@ -24,6 +24,9 @@ struct FrameUniforms {
     uvec4 cluster_dims;  // xyz: cluster grid size; w: debug view (DEBUG_VIEW_*)
     uvec4 viewport;      // xy: image size in pixels
     vec4 cluster_slices; // x, y: slice = floor(log(depth) * x + y); z: heat-map top (lights)
+    vec4 cluster_frustum; // x: near, y: far, z: proj[0][0], w: proj[1][1] (symmetric perspective)
+    vec4 light_animation; // xyz: offset every light moves by this frame (the seed's animation)
+    uvec4 cluster_build;  // x: light-index capacity (entries) of this frame's list
 };
 
 // A radius-limited point light (set 0, binding 1, std430 array).
@@ -36,6 +39,20 @@ struct PointLight {
 struct ClusterRange {
     uint offset;
     uint count;
+};
+
+// A cluster's view-space bounding box (clustered-gpu; w unused).
+struct ClusterBounds {
+    vec4 min_corner;
+    vec4 max_corner;
+};
+
+// What the GPU cluster build tells the CPU after the frame (host-visible).
+struct ClusterFeedback {
+    uint needed;     // light-index entries this frame needed
+    uint overflowed; // 1 when needed > capacity: the frame's lists were cut short
+    uint max_count;  // most lights in one cluster
+    uint _pad0;
 };
 
 // Per draw, by push constants as in seed 000.

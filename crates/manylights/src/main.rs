@@ -35,7 +35,7 @@ struct RenderArgs {
     /// Scene to render (built in: seed).
     #[arg(long, default_value = "seed")]
     scene: String,
-    /// Lighting technique: forward, clustered-cpu.
+    /// Lighting technique: forward, clustered-cpu, clustered-gpu.
     #[arg(long, default_value = "forward")]
     technique: String,
     /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).
@@ -188,6 +188,12 @@ fn render(args: &RenderArgs) -> Result<()> {
         rows.push(("clusters", format!("{}x{}x{} = {}", d.x, d.y, d.z, d.count())));
         rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
         rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
+    }
+    if stats.overflowed_frames > 0 {
+        rows.push((
+            "overflows",
+            format!("{} frame(s) outgrew their light lists; {} re-rendered at the grown size", stats.overflowed_frames, stats.rerendered_frames),
+        ));
     }
     if settings.debug_view == DebugView::ClusterHeat {
         let top = stats.clusters.map_or(1, |c| c.max_lights.max(1));

@@ -45,6 +45,12 @@ gpu_struct!(
         viewport: [u32; 4],
         /// x, y: slice = ⌊ln(depth)·x + y⌋; z: lights per cluster at the top of the heat map.
         cluster_slices: [f32; 4],
+        /// near, far, projection[0][0], projection[1][1].
+        cluster_frustum: [f32; 4],
+        /// xyz: the offset every light moves by this frame (animated on the GPU by clustered-gpu).
+        light_animation: [f32; 4],
+        /// x: light-index capacity (entries) of this frame's list (clustered-gpu).
+        cluster_build: [u32; 4],
     }
 );
 
@@ -63,6 +69,24 @@ gpu_struct!(
     ClusterRange {
         offset: u32,
         count: u32,
+    }
+);
+
+gpu_struct!(
+    /// A cluster's view-space box as the GPU builds it (clustered-gpu).
+    ClusterBounds {
+        min_corner: [f32; 4],
+        max_corner: [f32; 4],
+    }
+);
+
+gpu_struct!(
+    /// What the GPU cluster build reports back after a frame.
+    ClusterFeedback {
+        needed: u32,
+        overflowed: u32,
+        max_count: u32,
+        _pad0: u32,
     }
 );
 

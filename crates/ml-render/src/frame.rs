@@ -3,6 +3,7 @@
 //! its timer and its render targets. Cluster buffers grow when a frame needs more; nothing
 //! is ever dropped.
 
+use crate::cluster_build::{self as build, GpuClusterBuilder, GpuClusterFrame};
 use crate::forward::{BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
@@ -13,7 +14,7 @@ use ml_vk::{vk, Buffer, Context, GpuTimer, VkError, VkResultExt};
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
 /// Light-index capacity a frame starts with, per light (grows on demand).
-const INITIAL_INDICES_PER_LIGHT: usize = 4;
+const INITIAL_INDICES_PER_LIGHT: usize = 16;
 
 pub struct FrameInFlight {
     pub cmd: vk::CommandBuffer,
@@ -25,6 +26,11 @@ pub struct FrameInFlight {
     pub set: vk::DescriptorSet,
     pub timer: GpuTimer,
     pub targets: Option<Targets>,
+    /// The GPU cluster build's per-frame part (clustered-gpu only).
+    pub gpu: Option<GpuClusterFrame>,
+    /// Where lights and cluster lists live: host-visible (written by the CPU) or device-local
+    /// (written by the GPU build).
+    location: MemoryLocation,
 }
 
 /// Everything `FrameInFlight::new` needs from the renderer.
@@ -36,10 +42,15 @@ pub struct FrameSetup<'a> {
     pub cluster_count: usize,
     pub passes: u32,
     pub make_targets: &'a dyn Fn() -> Result<Targets, VkError>,
+    /// Set for clustered-gpu: the GPU writes lights and lists.
+    pub builder: Option<&'a GpuClusterBuilder>,
 }
 
-fn host_buffer(ctx: &Context, name: &str, bytes: usize, usage: vk::BufferUsageFlags) -> Result<Buffer, VkError> {
-    Buffer::new(ctx, name, bytes as u64, usage, MemoryLocation::CpuToGpu)
+/// Storage buffer for lights or cluster lists. Device-local ones can also be copied out
+/// (tests read the GPU's lists back).
+fn list_buffer(ctx: &Context, name: &str, bytes: usize, location: MemoryLocation) -> Result<Buffer, VkError> {
+    let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC;
+    Buffer::new(ctx, name, bytes as u64, usage, location)
 }
 
 impl FrameInFlight {
@@ -54,6 +65,8 @@ impl FrameInFlight {
             set: vk::DescriptorSet::null(),
             timer: GpuTimer::null(),
             targets: None,
+            gpu: None,
+            location: if setup.builder.is_some() { MemoryLocation::GpuOnly } else { MemoryLocation::CpuToGpu },
         };
         // On failure everything made so far is released (null parts are skipped).
         match frame.create(ctx, setup) {
@@ -73,11 +86,12 @@ impl FrameInFlight {
         // SAFETY: as above.
         self.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }
             .ctx("vkCreateFence")?;
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        self.uniforms = host_buffer(ctx, "frame uniforms", size_of::<FrameUniforms>(), vk::BufferUsageFlags::UNIFORM_BUFFER)?;
-        self.lights = host_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>(), storage)?;
-        self.cluster_ranges = host_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>(), storage)?;
-        self.light_indices = host_buffer(ctx, "light indices", setup.light_count * INITIAL_INDICES_PER_LIGHT * 4, storage)?;
+        let at = self.location;
+        let uniform_bytes = size_of::<FrameUniforms>() as u64;
+        self.uniforms = Buffer::new(ctx, "frame uniforms", uniform_bytes, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;
+        self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>(), at)?;
+        self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>(), at)?;
+        self.light_indices = list_buffer(ctx, "light indices", setup.light_count * INITIAL_INDICES_PER_LIGHT * 4, at)?;
         let layouts = [setup.set_layout];
         let set_info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(setup.descriptor_pool).set_layouts(&layouts);
         // SAFETY: the pool has room for one set per frame in flight.
@@ -92,35 +106,69 @@ impl FrameInFlight {
         }
         self.timer = GpuTimer::new(ctx, setup.passes)?;
         self.targets = Some((setup.make_targets)()?);
+        if let Some(builder) = setup.builder {
+            let gpu = builder.frame_resources(ctx, setup.descriptor_pool)?;
+            let set = gpu.set;
+            let (counters, feedback) = (gpu.counters.raw, gpu.feedback.raw);
+            self.gpu = Some(gpu);
+            write_set(ctx, set, build::BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
+            for (binding, buffer) in [
+                (build::BINDING_REST_LIGHTS, builder.rest_lights.raw),
+                (build::BINDING_LIGHTS, self.lights.raw),
+                (build::BINDING_BOUNDS, builder.bounds.raw),
+                (build::BINDING_COUNTERS, counters),
+                (build::BINDING_RANGES, self.cluster_ranges.raw),
+                (build::BINDING_INDICES, self.light_indices.raw),
+                (build::BINDING_FEEDBACK, feedback),
+            ] {
+                write_set(ctx, set, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
+            }
+        }
         Ok(())
     }
 
-    /// Point `binding` of this frame's set at `buffer`. Only while the frame is not in flight.
+    /// Point `binding` of this frame's shading set at `buffer`. Only while not in flight.
     fn bind(&self, ctx: &Context, binding: u32, ty: vk::DescriptorType, buffer: vk::Buffer) {
-        let info = [vk::DescriptorBufferInfo::default().buffer(buffer).range(vk::WHOLE_SIZE)];
-        let write = [vk::WriteDescriptorSet::default().dst_set(self.set).dst_binding(binding).descriptor_type(ty).buffer_info(&info)];
-        // SAFETY: the set and buffer are alive and the set is not in use by pending work.
-        unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
+        write_set(ctx, self.set, binding, ty, buffer);
+    }
+
+    /// Entries the light-index list holds.
+    pub fn index_capacity(&self) -> usize {
+        (self.light_indices.size / 4) as usize
+    }
+
+    /// Grow the light-index list to hold at least `entries` (nothing if it already does).
+    /// Returns whether it grew. Call only after the frame's fence has signalled.
+    pub fn ensure_index_capacity(&mut self, ctx: &Context, entries: usize) -> Result<bool, VkError> {
+        if entries <= self.index_capacity() {
+            return Ok(false);
+        }
+        let bigger = list_buffer(ctx, "light indices", entries * 4, self.location)?;
+        let mut old = std::mem::replace(&mut self.light_indices, bigger);
+        old.destroy(ctx);
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        self.bind(ctx, BINDING_LIGHT_INDICES, storage, self.light_indices.raw);
+        if let Some(gpu) = &self.gpu {
+            write_set(ctx, gpu.set, build::BINDING_INDICES, storage, self.light_indices.raw);
+        }
+        Ok(true)
     }
 
     /// Copy the cluster lists into this frame's buffers, growing the index buffer (to 1.5×
     /// what is needed) when it is too small. Returns whether it grew. Call only after the
     /// frame's fence has signalled.
     pub fn upload_clusters(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<bool, VkError> {
-        let needed = std::mem::size_of_val(&lists.indices[..]);
-        let grew = needed as u64 > self.light_indices.size;
-        if grew {
-            let bigger = host_buffer(ctx, "light indices", needed + needed / 2, vk::BufferUsageFlags::STORAGE_BUFFER)?;
-            let mut old = std::mem::replace(&mut self.light_indices, bigger);
-            old.destroy(ctx);
-            self.bind(ctx, BINDING_LIGHT_INDICES, vk::DescriptorType::STORAGE_BUFFER, self.light_indices.raw);
-        }
+        let needed = lists.indices.len();
+        let grew = needed > self.index_capacity() && self.ensure_index_capacity(ctx, needed + needed / 2)?;
         self.cluster_ranges.write(0, &lists.ranges);
         self.light_indices.write(0, &lists.indices);
         Ok(grew)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
+        if let Some(mut gpu) = self.gpu.take() {
+            gpu.destroy(ctx);
+        }
         if let Some(mut t) = self.targets.take() {
             t.destroy(ctx);
         }
@@ -132,4 +180,12 @@ impl FrameInFlight {
         unsafe { ctx.device.destroy_fence(self.fence, None) };
         self.fence = vk::Fence::null();
     }
+}
+
+/// Point `binding` of `set` at the whole of `buffer`. Only while the set is not in use.
+fn write_set(ctx: &Context, set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, buffer: vk::Buffer) {
+    let info = [vk::DescriptorBufferInfo::default().buffer(buffer).range(vk::WHOLE_SIZE)];
+    let write = [vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).buffer_info(&info)];
+    // SAFETY: the set and buffer are alive and the set is not in use by pending work.
+    unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
 }

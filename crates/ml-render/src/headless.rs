@@ -9,9 +9,11 @@ use crate::report::FrameStats;
 use crate::settings::RenderSettings;
 use crate::targets::{depth_format, Targets};
 use crate::settings::DebugView;
-use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists};
-use ml_cpu::gpu_types::{FrameUniforms, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
-use ml_cpu::lights::animate_into;
+use crate::cluster_build::GpuClusterBuilder;
+use crate::settings::Technique;
+use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
+use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
 use std::time::Instant;
@@ -48,7 +50,26 @@ pub struct HeadlessRenderer<'a> {
     clusters: Option<CpuClusters>,
     /// The cluster grid's shader parameters (also set for `forward`, which ignores them).
     grid: ClusterGrid,
+    /// clustered-gpu: the compute passes and their shared buffers.
+    builder: Option<GpuClusterBuilder>,
+    /// clustered-gpu: light-index entries every frame recorded from now on must hold (grows
+    /// when a frame reports it needed more).
+    required_indices: usize,
+    /// Per frame slot: whether the frame it last ran overflowed its light-index list.
+    overflowed: Vec<bool>,
+    /// Per frame slot: whether it has been submitted since its results were last collected.
+    pending: Vec<bool>,
+    /// Top of the heat-map scale (lights per cluster), from the newest known frame.
+    heat_top: f32,
+    /// Slot of the frame that was read back last.
+    last_frame: usize,
 }
+
+/// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
+const DEFAULT_HEAT_TOP: f32 = 64.0;
+/// clustered-gpu re-renders a final frame whose lists overflowed (after growing them); if it
+/// still overflows this often something is wrong, and the render fails instead of lying.
+const MAX_RERENDERS: u32 = 2;
 
 impl<'a> HeadlessRenderer<'a> {
     pub fn new(ctx: &'a Context, scene: Scene, settings: RenderSettings) -> Result<HeadlessRenderer<'a>, RenderError> {
@@ -57,7 +78,7 @@ impl<'a> HeadlessRenderer<'a> {
         let extent = vk::Extent2D { width: settings.width, height: settings.height };
         let animated = scene.lights.clone();
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
-        let clusters = settings.technique.is_clustered().then(|| CpuClusters {
+        let clusters = (settings.technique == Technique::ClusteredCpu).then(|| CpuClusters {
             grid: grid.clone(),
             assigner: ClusterAssigner::new(),
             lists: ClusterLists::default(),
@@ -76,6 +97,12 @@ impl<'a> HeadlessRenderer<'a> {
             animated,
             clusters,
             grid,
+            builder: None,
+            required_indices: 0,
+            overflowed: vec![false; FRAMES_IN_FLIGHT],
+            pending: vec![false; FRAMES_IN_FLIGHT],
+            heat_top: DEFAULT_HEAT_TOP,
+            last_frame: 0,
         };
         // Anything made before a failure is released by Drop.
         r.create_resources(depth)?;
@@ -92,12 +119,17 @@ impl<'a> HeadlessRenderer<'a> {
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         // SAFETY: valid device and create infos.
         self.command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
+        if self.settings.technique.is_gpu_built() {
+            self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
+        }
+        // Per frame: the shading set (1 uniform + 3 storage) and, for clustered-gpu, the build
+        // set (1 uniform + 7 storage).
         let n = FRAMES_IN_FLIGHT as u32;
         let sizes = [
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 3 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 2 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 10 * n },
         ];
-        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&sizes);
+        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(2 * n).pool_sizes(&sizes);
         // SAFETY: as above.
         self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
         let render_pass = self.pass.render_pass;
@@ -109,11 +141,18 @@ impl<'a> HeadlessRenderer<'a> {
             set_layout: self.pass.set_layout,
             light_count: self.scene.lights.len(),
             cluster_count: self.settings.clusters.count(),
-            passes: 1,
+            passes: self.pass_names().len() as u32,
             make_targets: &make_targets,
+            builder: self.builder.as_ref(),
         };
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
+        }
+        if self.builder.is_some() {
+            // The boxes depend on projection and size only: once here.
+            self.write_uniforms(0, 0.0);
+            let set = self.frames[0].gpu.as_ref().expect("made with the builder").set;
+            self.builder.as_ref().expect("checked").compute_bounds(ctx, set)?;
         }
         let bytes = extent.width as u64 * extent.height as u64 * 4;
         self.readback = Some(Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
@@ -124,82 +163,155 @@ impl<'a> HeadlessRenderer<'a> {
         &self.scene
     }
 
-    /// Render `settings.frames` frames, two in flight, and read back the last one.
+    /// The passes the timer reports, in order.
+    fn pass_names(&self) -> Vec<&'static str> {
+        let shading = self.settings.technique.name();
+        if self.settings.technique.is_gpu_built() {
+            vec!["cluster build", shading]
+        } else {
+            vec![shading]
+        }
+    }
+
+    /// Render `settings.frames` frames, two in flight, and read back the last one. With
+    /// clustered-gpu, a last frame whose light lists overflowed is rendered again once the
+    /// lists have grown, so the image is never one with lights missing.
     pub fn render(&mut self) -> Result<RenderOutput, RenderError> {
-        let ctx = self.ctx;
-        let mut stats = FrameStats::new(&[self.settings.technique.name()]);
+        let mut stats = FrameStats::new(&self.pass_names());
         let start = Instant::now();
         let mut last = 0;
         for i in 0..self.settings.frames {
-            let f = i as usize % FRAMES_IN_FLIGHT;
-            let fence = self.frames[f].fence;
-            // SAFETY: the fence belongs to this device.
-            unsafe { ctx.device.wait_for_fences(&[fence], true, u64::MAX) }.ctx("vkWaitForFences")?;
-            if let Some(ms) = self.frames[f].timer.read_ms(ctx)? {
-                stats.add_gpu(&ms);
-            }
-            let cpu = Instant::now();
-            self.update_frame(f, self.settings.clock(i), &mut stats)?;
-            self.record(f)?;
-            // SAFETY: the fence was waited on above and the command buffer is executable.
-            unsafe {
-                ctx.device.reset_fences(&[fence]).ctx("vkResetFences")?;
-                let cmds = [self.frames[f].cmd];
-                let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-                ctx.device.queue_submit(ctx.queue, &submit, fence).ctx("vkQueueSubmit")?;
-            }
-            stats.add_cpu_ms(cpu.elapsed().as_secs_f64() * 1e3);
-            last = f;
+            last = i as usize % FRAMES_IN_FLIGHT;
+            self.run_frame(last, self.settings.clock(i), &mut stats)?;
         }
-        for f in 0..FRAMES_IN_FLIGHT {
-            // SAFETY: as above.
-            unsafe { ctx.device.wait_for_fences(&[self.frames[f].fence], true, u64::MAX) }.ctx("vkWaitForFences")?;
-            if let Some(ms) = self.frames[f].timer.read_ms(ctx)? {
-                stats.add_gpu(&ms);
+        self.collect_all(&mut stats)?;
+        let mut rerenders = 0;
+        while self.overflowed[last] {
+            if rerenders == MAX_RERENDERS {
+                return Err(RenderError::Invalid(format!(
+                    "clustered-gpu: the light lists still overflowed after {MAX_RERENDERS} re-renders ({} entries needed)",
+                    self.required_indices
+                )));
             }
+            rerenders += 1;
+            stats.rerendered_frames += 1;
+            last = (last + 1) % FRAMES_IN_FLIGHT;
+            self.run_frame(last, self.settings.clock(self.settings.frames - 1), &mut stats)?;
+            self.collect_all(&mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         stats.frames = self.settings.frames;
+        self.last_frame = last;
         let rgba = self.read_back(last)?;
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
     }
 
+    /// Wait for slot `f`, collect its results, update, record and submit a frame at clock `t`.
+    fn run_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<(), RenderError> {
+        let ctx = self.ctx;
+        let fence = self.frames[f].fence;
+        self.collect(f, stats)?;
+        let cpu = Instant::now();
+        self.update_frame(f, t, stats)?;
+        self.record(f)?;
+        // SAFETY: the fence was waited on in `collect` and the command buffer is executable.
+        unsafe {
+            ctx.device.reset_fences(&[fence]).ctx("vkResetFences")?;
+            let cmds = [self.frames[f].cmd];
+            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+            ctx.device.queue_submit(ctx.queue, &submit, fence).ctx("vkQueueSubmit")?;
+        }
+        self.pending[f] = true;
+        stats.add_cpu_ms(cpu.elapsed().as_secs_f64() * 1e3);
+        Ok(())
+    }
+
+    /// Wait for slot `f`'s last frame and take in what it measured and reported.
+    fn collect(&mut self, f: usize, stats: &mut FrameStats) -> Result<(), VkError> {
+        let ctx = self.ctx;
+        // SAFETY: the fence belongs to this device.
+        unsafe { ctx.device.wait_for_fences(&[self.frames[f].fence], true, u64::MAX) }.ctx("vkWaitForFences")?;
+        if !std::mem::take(&mut self.pending[f]) {
+            return Ok(());
+        }
+        if let Some(ms) = self.frames[f].timer.read_ms(ctx)? {
+            stats.add_gpu(&ms);
+        }
+        if let Some(gpu) = &self.frames[f].gpu {
+            let feedback = gpu.feedback();
+            let needed = feedback.needed as usize;
+            let clusters = self.settings.clusters.count();
+            stats.clusters = Some(ClusterStats {
+                mean_lights: needed as f64 / clusters as f64,
+                max_lights: feedback.max_count,
+                index_len: needed,
+            });
+            self.heat_top = feedback.max_count.max(1) as f32;
+            self.overflowed[f] = feedback.overflowed != 0;
+            if self.overflowed[f] {
+                stats.overflowed_frames += 1;
+                eprintln!(
+                    "clustered-gpu: a frame needed {needed} light-index entries but its list held {}; growing the lists (that frame is re-rendered if it is the last)",
+                    self.frames[f].index_capacity()
+                );
+                self.required_indices = self.required_indices.max(needed + needed / 2);
+            }
+        }
+        Ok(())
+    }
+
+    fn collect_all(&mut self, stats: &mut FrameStats) -> Result<(), VkError> {
+        (0..FRAMES_IN_FLIGHT).try_for_each(|f| self.collect(f, stats))
+    }
+
     fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<(), VkError> {
-        animate_into(&self.scene.lights, t, &mut self.animated);
-        let mut heat_top = 1.0;
+        if self.builder.is_some() {
+            if self.frames[f].ensure_index_capacity(self.ctx, self.required_indices)? {
+                stats.index_growths += 1;
+            }
+        } else {
+            animate_into(&self.scene.lights, t, &mut self.animated);
+            self.frames[f].lights.write(0, &self.animated);
+        }
         if let Some(c) = &mut self.clusters {
             let start = Instant::now();
             c.assigner.assign(&c.grid, &self.animated, &mut c.lists);
             stats.add_assign_ms(start.elapsed().as_secs_f64() * 1e3);
             let cluster_stats = c.lists.stats();
-            heat_top = cluster_stats.max_lights.max(1) as f32;
+            self.heat_top = cluster_stats.max_lights.max(1) as f32;
             stats.clusters = Some(cluster_stats);
             if self.frames[f].upload_clusters(self.ctx, &c.lists)? {
                 stats.index_growths += 1;
             }
         }
+        self.write_uniforms(f, t);
+        Ok(())
+    }
+
+    fn write_uniforms(&mut self, f: usize, t: f32) {
         let g = &self.grid;
         let debug_view = match self.settings.debug_view {
             DebugView::None => DEBUG_VIEW_NONE,
             DebugView::ClusterHeat => DEBUG_VIEW_CLUSTER_HEAT,
         };
         let cam = &self.scene.camera;
+        let frame = &mut self.frames[f];
         let uniforms = FrameUniforms {
-            view: cam.view().to_cols_array_2d(),
-            proj: cam.projection(self.extent.width as f32 / self.extent.height as f32).to_cols_array_2d(),
+            view: g.view.to_cols_array_2d(),
+            proj: g.projection.to_cols_array_2d(),
             camera_pos: cam.position.extend(1.0).to_array(),
-            light_count: self.animated.len() as u32,
+            light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
             shading_model: SHADING_SEED,
             _pad0: 0,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
             viewport: [self.extent.width, self.extent.height, 0, 0],
-            cluster_slices: [g.log_scale, g.log_bias, heat_top, 0.0],
+            cluster_slices: [g.log_scale, g.log_bias, self.heat_top, 0.0],
+            cluster_frustum: [g.near, g.far, g.projection.x_axis.x, g.projection.y_axis.y],
+            light_animation: animation_offset(t).extend(0.0).to_array(),
+            cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
         };
-        let frame = &mut self.frames[f];
         frame.uniforms.write(0, &[uniforms]);
-        frame.lights.write(0, &self.animated);
-        Ok(())
     }
 
     fn record(&mut self, f: usize) -> Result<(), VkError> {
@@ -213,13 +325,60 @@ impl<'a> HeadlessRenderer<'a> {
             ctx.device.begin_command_buffer(cmd, &begin).ctx("vkBeginCommandBuffer")?;
         }
         frame.timer.reset(ctx, cmd);
-        frame.timer.begin(ctx, cmd, 0);
+        let mut pass = 0;
+        if let (Some(builder), Some(gpu)) = (&self.builder, &frame.gpu) {
+            frame.timer.begin(ctx, cmd, pass);
+            builder.record(ctx, cmd, gpu);
+            frame.timer.end(ctx, cmd, pass);
+            pass += 1;
+        }
+        frame.timer.begin(ctx, cmd, pass);
         let framebuffer = frame.targets.as_ref().expect("made with the frame").framebuffer;
         let legend = self.settings.debug_view == DebugView::ClusterHeat;
         self.pass.record(ctx, cmd, framebuffer, self.extent, frame.set, &self.meshes, &self.scene.objects, legend);
-        frame.timer.end(ctx, cmd, 0);
+        frame.timer.end(ctx, cmd, pass);
         // SAFETY: recording state.
         unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")
+    }
+
+    /// The cluster lists the GPU built for the frame `render` returned (clustered-gpu; None
+    /// otherwise), copied to the host. Lists are sorted per cluster (the GPU's order is not
+    /// deterministic); for tests and tools, not the frame loop.
+    pub fn gpu_cluster_lists(&self) -> Result<Option<ClusterLists>, VkError> {
+        if self.builder.is_none() {
+            return Ok(None);
+        }
+        let ctx = self.ctx;
+        let frame = &self.frames[self.last_frame];
+        let needed = frame.gpu.as_ref().expect("clustered-gpu frame").feedback().needed as u64;
+        let copies = [(&frame.cluster_ranges, frame.cluster_ranges.size), (&frame.light_indices, (needed * 4).max(4))];
+        let mut host = Vec::new();
+        for (_, size) in copies {
+            host.push(Buffer::new(ctx, "cluster read-back", size, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
+        }
+        let copied = commands::one_shot(ctx, |cmd| {
+            for ((src, size), dst) in copies.iter().zip(&host) {
+                // SAFETY: recording state; both buffers are alive and large enough. The frame's
+                // build ended with a barrier making its writes visible to transfers.
+                unsafe { ctx.device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[vk::BufferCopy::default().size(*size)]) };
+            }
+            crate::cluster_build::barrier(ctx, cmd, vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE, vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ);
+        });
+        let lists = copied.map(|()| {
+            let ranges: Vec<ClusterRange> = bytemuck::pod_collect_to_vec(host[0].mapped());
+            let all: Vec<u32> = bytemuck::pod_collect_to_vec(host[1].mapped());
+            let mut indices = Vec::with_capacity(needed as usize);
+            for r in &ranges {
+                let mut list = all[r.offset as usize..(r.offset + r.count) as usize].to_vec();
+                list.sort_unstable();
+                indices.extend(list);
+            }
+            ClusterLists { ranges, indices }
+        });
+        for mut b in host {
+            b.destroy(ctx);
+        }
+        lists.map(Some)
     }
 
     /// Copy frame `f`'s colour target (left in TRANSFER_SRC_OPTIMAL by the render pass, whose
@@ -266,6 +425,9 @@ impl Drop for HeadlessRenderer<'_> {
             frame.destroy(ctx);
         }
         if let Some(mut b) = self.readback.take() {
+            b.destroy(ctx);
+        }
+        if let Some(mut b) = self.builder.take() {
             b.destroy(ctx);
         }
         for mesh in &mut self.meshes {

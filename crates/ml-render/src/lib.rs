@@ -1,6 +1,7 @@
 //! manylights techniques and passes: what is drawn and how, on top of the Vulkan plumbing
 //! (ml-vk) and the CPU scene (ml-cpu).
 
+pub mod cluster_build;
 pub mod error;
 pub mod forward;
 pub mod frame;

@@ -15,6 +15,10 @@ pub struct FrameStats {
     pub clusters: Option<ml_cpu::cluster::ClusterStats>,
     /// How often a frame's light-index buffer had to grow.
     pub index_growths: u32,
+    /// clustered-gpu: frames whose light lists overflowed (reported, never shown as final).
+    pub overflowed_frames: u32,
+    /// clustered-gpu: extra frames rendered because the last one overflowed.
+    pub rerendered_frames: u32,
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -33,6 +37,8 @@ impl FrameStats {
             wall_ms: 0.0,
             clusters: None,
             index_growths: 0,
+            overflowed_frames: 0,
+            rerendered_frames: 0,
         }
     }
 

@@ -11,20 +11,28 @@ pub enum Technique {
     Forward,
     /// Cluster grid with lights assigned on the CPU every frame.
     ClusteredCpu,
+    /// Cluster grid built by compute shaders every frame; lights animated on the GPU.
+    ClusteredGpu,
 }
 
 impl Technique {
-    pub const ALL: [Technique; 2] = [Technique::Forward, Technique::ClusteredCpu];
+    pub const ALL: [Technique; 3] = [Technique::Forward, Technique::ClusteredCpu, Technique::ClusteredGpu];
 
     pub fn name(self) -> &'static str {
         match self {
             Technique::Forward => "forward",
             Technique::ClusteredCpu => "clustered-cpu",
+            Technique::ClusteredGpu => "clustered-gpu",
         }
     }
 
     pub fn is_clustered(self) -> bool {
-        matches!(self, Technique::ClusteredCpu)
+        matches!(self, Technique::ClusteredCpu | Technique::ClusteredGpu)
+    }
+
+    /// Whether the GPU builds the clusters (and animates the lights).
+    pub fn is_gpu_built(self) -> bool {
+        matches!(self, Technique::ClusteredGpu)
     }
 
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {

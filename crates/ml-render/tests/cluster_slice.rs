@@ -23,7 +23,7 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     // SAFETY: valid device and create infos; everything is destroyed below after the wait.
     let pipeline_layout =
         unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }.unwrap();
-    let pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SLICE_PROBE_COMP, pipeline_layout).unwrap();
+    let pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SLICE_PROBE_COMP, pipeline_layout, &[]).unwrap();
     let sizes = [
         vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
         vk::DescriptorPoolSize { ty: storage, descriptor_count: 2 },

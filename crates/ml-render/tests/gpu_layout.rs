@@ -2,7 +2,7 @@
 //! reflection of the compiled shaders reports (seed mistake 5: the std140 trap). A field
 //! moved on either side fails here.
 
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, GpuLayout, ObjectPush, PointLight};
+use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectPush, PointLight};
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
 use std::collections::HashMap;
@@ -82,6 +82,8 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<PointLight>(&structs);
     check::<ObjectPush>(&structs);
     check::<ClusterRange>(&structs);
+    check::<ClusterBounds>(&structs);
+    check::<ClusterFeedback>(&structs);
 }
 
 /// Seed mistake 5: its index list was a std140 uint array, 16 bytes per index. Ours is a

@@ -11,10 +11,22 @@ pub fn module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
     unsafe { ctx.device.create_shader_module(&info, None) }.ctx("vkCreateShaderModule")
 }
 
-/// A compute pipeline running `main` of the given SPIR-V with `layout`.
-pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout) -> Result<vk::Pipeline> {
+/// A compute pipeline running `main` of the given SPIR-V with `layout`; `constants` sets
+/// 32-bit specialization constants (id, value; a GLSL bool is 0 or 1).
+pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout, constants: &[(u32, u32)]) -> Result<vk::Pipeline> {
     let module = module(ctx, spirv)?;
-    let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(c"main");
+    let entries: Vec<vk::SpecializationMapEntry> = constants
+        .iter()
+        .enumerate()
+        .map(|(i, &(id, _))| vk::SpecializationMapEntry { constant_id: id, offset: (i * 4) as u32, size: 4 })
+        .collect();
+    let data: Vec<u8> = constants.iter().flat_map(|&(_, v)| v.to_ne_bytes()).collect();
+    let spec = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
+    let stage = vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::COMPUTE)
+        .module(module)
+        .name(c"main")
+        .specialization_info(&spec);
     let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
     // SAFETY: valid module and layout.
     let result = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };

@@ -10,7 +10,7 @@
 //! perspective projection crowds almost every depth into the last few slices.
 
 use crate::camera::Camera;
-use glam::{Mat4, Vec3, Vec3A, Vec4};
+use glam::{Mat4, Vec3, Vec3A};
 
 /// Grid size X×Y×Z.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,6 +95,7 @@ pub struct ClusterGrid {
     slice_starts: Vec<f32>,
 }
 
+/// Keep in sync with `CLUSTER_SLACK` in cluster.glsl.
 /// Relative slack added to every cluster's box so that a fragment whose slice or tile was
 /// rounded into a neighbour (f32 `log`, interpolation) is still covered. It only ever adds
 /// lights whose contribution at the fragment is below (slack)²·(radius terms), i.e. nothing.
@@ -186,13 +187,12 @@ impl ClusterGrid {
     }
 
     fn compute_bounds(&self) -> Vec<Aabb> {
-        let inv_proj = self.projection.inverse();
-        // View-space direction through a pixel position, scaled to depth 1 (z = −1).
+        // View-space direction through a pixel position, scaled to depth 1 (z = −1); for the
+        // symmetric perspective ndc = p·v/(−z). Keep in sync with cluster_bounds.comp.
+        let (p00, p11) = (self.projection.x_axis.x, self.projection.y_axis.y);
         let ray = |px: f32, py: f32| {
-            let ndc = Vec4::new(px / self.width as f32 * 2.0 - 1.0, py / self.height as f32 * 2.0 - 1.0, 1.0, 1.0);
-            let v = inv_proj * ndc;
-            let v = v.truncate() / v.w;
-            v / -v.z
+            let ndc = (px / self.width as f32 * 2.0 - 1.0, py / self.height as f32 * 2.0 - 1.0);
+            Vec3::new(ndc.0 / p00, ndc.1 / p11, -1.0)
         };
         let d = self.dims;
         let mut bounds = Vec::with_capacity(d.count());

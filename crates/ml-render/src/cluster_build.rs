@@ -1,0 +1,223 @@
+//! Technique `clustered-gpu` (SPEC §3): the cluster grid built by compute shaders every frame
+//! from the light buffer, with no per-light CPU work and no read-back in the frame.
+//!
+//! Per frame: clear the counters → COUNT (one invocation per light: animate it, write it for
+//! shading, count it into every cluster its sphere touches) → SCAN (one workgroup: prefix sum
+//! into (offset, count) ranges, counters become cursors, report the entries needed) → FILL
+//! (each light writes its index at its clusters' cursors) → the shading pass reads the lists.
+//! Lights only visit the clusters under their own projected slab rectangles, so the cost
+//! follows the (light, cluster) pairs, not lights × clusters.
+//! Capacity: the index list has a size; the SCAN pass reports what the frame needed and cuts
+//! ranges to fit when it was too small; the CPU reads that after the frame's fence and grows
+//! the list for every later frame (see `headless.rs`).
+
+use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
+use ml_vk::{shader, vk, Buffer, Context, VkError, VkResultExt};
+
+/// Bindings of the build's descriptor set (see the shaders).
+pub const BINDING_FRAME: u32 = 0;
+pub const BINDING_REST_LIGHTS: u32 = 1;
+pub const BINDING_LIGHTS: u32 = 2;
+pub const BINDING_BOUNDS: u32 = 3;
+pub const BINDING_COUNTERS: u32 = 4;
+pub const BINDING_RANGES: u32 = 5;
+pub const BINDING_INDICES: u32 = 6;
+pub const BINDING_FEEDBACK: u32 = 7;
+
+const BUILD_GROUP: u32 = 128;
+const BOUNDS_GROUP: u32 = 64;
+
+pub struct GpuClusterBuilder {
+    pub set_layout: vk::DescriptorSetLayout,
+    pipeline_layout: vk::PipelineLayout,
+    bounds_pipeline: vk::Pipeline,
+    count_pipeline: vk::Pipeline,
+    scan_pipeline: vk::Pipeline,
+    fill_pipeline: vk::Pipeline,
+    /// Lights at rest, uploaded once (device-local); the COUNT pass animates them.
+    pub rest_lights: Buffer,
+    /// Every cluster's view-space box, rebuilt by `compute_bounds`.
+    pub bounds: Buffer,
+    light_count: u32,
+    cluster_count: u32,
+}
+
+/// Per frame in flight: the counters/cursors, the feedback the CPU reads, the build's set.
+pub struct GpuClusterFrame {
+    pub counters: Buffer,
+    pub feedback: Buffer,
+    pub set: vk::DescriptorSet,
+}
+
+impl GpuClusterFrame {
+    pub fn feedback(&self) -> ClusterFeedback {
+        bytemuck::pod_read_unaligned(&self.feedback.mapped()[..size_of::<ClusterFeedback>()])
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.counters.destroy(ctx);
+        self.feedback.destroy(ctx);
+    }
+}
+
+impl GpuClusterBuilder {
+    pub fn new(ctx: &Context, rest_lights: &[PointLight], cluster_count: usize) -> Result<GpuClusterBuilder, VkError> {
+        let mut b = GpuClusterBuilder {
+            set_layout: vk::DescriptorSetLayout::null(),
+            pipeline_layout: vk::PipelineLayout::null(),
+            bounds_pipeline: vk::Pipeline::null(),
+            count_pipeline: vk::Pipeline::null(),
+            scan_pipeline: vk::Pipeline::null(),
+            fill_pipeline: vk::Pipeline::null(),
+            rest_lights: Buffer::null(),
+            bounds: Buffer::null(),
+            light_count: rest_lights.len() as u32,
+            cluster_count: cluster_count as u32,
+        };
+        match b.create(ctx, rest_lights) {
+            Ok(()) => Ok(b),
+            Err(e) => {
+                b.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn create(&mut self, ctx: &Context, rest_lights: &[PointLight]) -> Result<(), VkError> {
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        let mut bindings = vec![(BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER)];
+        bindings.extend([BINDING_REST_LIGHTS, BINDING_LIGHTS, BINDING_BOUNDS, BINDING_COUNTERS, BINDING_RANGES, BINDING_INDICES, BINDING_FEEDBACK].map(|b| (b, storage)));
+        self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::COMPUTE)?;
+        let layouts = [self.set_layout];
+        // SAFETY: valid device and create info.
+        self.pipeline_layout = unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }
+            .ctx("vkCreatePipelineLayout")?;
+        self.bounds_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BOUNDS_COMP, self.pipeline_layout, &[])?;
+        self.count_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 0)])?;
+        self.fill_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 1)])?;
+        self.scan_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SCAN_COMP, self.pipeline_layout, &[])?;
+        self.rest_lights = Buffer::device_local_with(ctx, "lights at rest", bytemuck::cast_slice(rest_lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        self.bounds = Buffer::new(
+            ctx,
+            "cluster bounds",
+            (self.cluster_count as usize * size_of::<ClusterBounds>()) as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            gpu_allocator::MemoryLocation::GpuOnly,
+        )?;
+        Ok(())
+    }
+
+    /// Rebuild every cluster's box (when projection or image size change) with the grid in
+    /// `set`'s uniforms, and wait for it.
+    pub fn compute_bounds(&self, ctx: &Context, set: vk::DescriptorSet) -> Result<(), VkError> {
+        ml_vk::commands::one_shot(ctx, |cmd| {
+            // SAFETY: recording state; all bound objects are alive.
+            unsafe {
+                ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.bounds_pipeline);
+                ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
+                ctx.device.cmd_dispatch(cmd, self.cluster_count.div_ceil(BOUNDS_GROUP), 1, 1);
+            }
+            barrier(ctx, cmd, vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE, vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
+        })
+    }
+
+    /// Record the frame's build. Afterwards the lights, ranges and index list are visible to
+    /// fragment shaders and the feedback to the host.
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: &GpuClusterFrame) {
+        let d = &ctx.device;
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        // This frame's buffers were last used two submissions ago (shading reads, build writes).
+        barrier(
+            ctx,
+            cmd,
+            compute | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+            compute | vk::PipelineStageFlags::TRANSFER,
+            rw | vk::AccessFlags::TRANSFER_WRITE,
+        );
+        let lights = self.light_count.div_ceil(BUILD_GROUP);
+        // SAFETY: recording state outside a render pass; all bound objects are alive.
+        unsafe {
+            d.cmd_fill_buffer(cmd, frame.counters.raw, 0, vk::WHOLE_SIZE, 0);
+            barrier(ctx, cmd, vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE, compute, rw);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[frame.set], &[]);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.count_pipeline);
+            d.cmd_dispatch(cmd, lights, 1, 1);
+            barrier(ctx, cmd, compute, vk::AccessFlags::SHADER_WRITE, compute, rw);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.scan_pipeline);
+            d.cmd_dispatch(cmd, 1, 1, 1);
+            barrier(ctx, cmd, compute, vk::AccessFlags::SHADER_WRITE, compute, rw);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.fill_pipeline);
+            d.cmd_dispatch(cmd, lights, 1, 1);
+        }
+        barrier(
+            ctx,
+            cmd,
+            compute,
+            vk::AccessFlags::SHADER_WRITE,
+            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST | vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::SHADER_READ | vk::AccessFlags::HOST_READ | vk::AccessFlags::TRANSFER_READ,
+        );
+    }
+
+    /// This frame's build resources (its set is written by the caller, see `frame.rs`).
+    pub fn frame_resources(&self, ctx: &Context, pool: vk::DescriptorPool) -> Result<GpuClusterFrame, VkError> {
+        let mut frame = GpuClusterFrame { counters: Buffer::null(), feedback: Buffer::null(), set: vk::DescriptorSet::null() };
+        let result = (|| {
+            frame.counters = Buffer::new(
+                ctx,
+                "cluster counters",
+                self.cluster_count as u64 * 4,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                gpu_allocator::MemoryLocation::GpuOnly,
+            )?;
+            frame.feedback = Buffer::new(
+                ctx,
+                "cluster feedback",
+                size_of::<ClusterFeedback>() as u64,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                gpu_allocator::MemoryLocation::GpuToCpu,
+            )?;
+            let layouts = [self.set_layout];
+            // SAFETY: the pool has room for the build sets.
+            frame.set = unsafe { ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts)) }
+                .ctx("vkAllocateDescriptorSets")?[0];
+            Ok(())
+        })();
+        match result {
+            Ok(()) => Ok(frame),
+            Err(e) => {
+                frame.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.rest_lights.destroy(ctx);
+        self.bounds.destroy(ctx);
+        // SAFETY: the device is idle; null handles are ignored.
+        unsafe {
+            for p in [self.bounds_pipeline, self.count_pipeline, self.scan_pipeline, self.fill_pipeline] {
+                ctx.device.destroy_pipeline(p, None);
+            }
+            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// A global memory barrier.
+pub fn barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    src_stage: vk::PipelineStageFlags,
+    src_access: vk::AccessFlags,
+    dst_stage: vk::PipelineStageFlags,
+    dst_access: vk::AccessFlags,
+) {
+    let b = [vk::MemoryBarrier::default().src_access_mask(src_access).dst_access_mask(dst_access)];
+    // SAFETY: recording state, outside a render pass.
+    unsafe { ctx.device.cmd_pipeline_barrier(cmd, src_stage, dst_stage, vk::DependencyFlags::empty(), &b, &[], &[]) };
+}
