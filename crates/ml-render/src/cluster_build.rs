@@ -12,6 +12,7 @@
 //! the list for every later frame (see `headless.rs`).
 
 use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
+use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError, VkResultExt};
 
 /// Bindings of the build's descriptor set (see the shaders).
@@ -117,7 +118,8 @@ impl GpuClusterBuilder {
                 ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
                 ctx.device.cmd_dispatch(cmd, self.cluster_count.div_ceil(BOUNDS_GROUP), 1, 1);
             }
-            barrier(ctx, cmd, vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE, vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
+            let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
         })
     }
 
@@ -128,36 +130,35 @@ impl GpuClusterBuilder {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         // This frame's buffers were last used two submissions ago (shading reads, build writes).
-        barrier(
+        memory_barrier(
             ctx,
             cmd,
-            compute | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-            compute | vk::PipelineStageFlags::TRANSFER,
-            rw | vk::AccessFlags::TRANSFER_WRITE,
+            (compute | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE),
+            (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE),
         );
         let lights = self.light_count.div_ceil(BUILD_GROUP);
         // SAFETY: recording state outside a render pass; all bound objects are alive.
         unsafe {
             d.cmd_fill_buffer(cmd, frame.counters.raw, 0, vk::WHOLE_SIZE, 0);
-            barrier(ctx, cmd, vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE, compute, rw);
+            memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[frame.set], &[]);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.count_pipeline);
             d.cmd_dispatch(cmd, lights, 1, 1);
-            barrier(ctx, cmd, compute, vk::AccessFlags::SHADER_WRITE, compute, rw);
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.scan_pipeline);
             d.cmd_dispatch(cmd, 1, 1, 1);
-            barrier(ctx, cmd, compute, vk::AccessFlags::SHADER_WRITE, compute, rw);
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.fill_pipeline);
             d.cmd_dispatch(cmd, lights, 1, 1);
         }
-        barrier(
+        memory_barrier(
             ctx,
             cmd,
-            compute,
-            vk::AccessFlags::SHADER_WRITE,
-            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST | vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::SHADER_READ | vk::AccessFlags::HOST_READ | vk::AccessFlags::TRANSFER_READ,
+            (compute, vk::AccessFlags::SHADER_WRITE),
+            (
+                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST | vk::PipelineStageFlags::TRANSFER,
+                vk::AccessFlags::SHADER_READ | vk::AccessFlags::HOST_READ | vk::AccessFlags::TRANSFER_READ,
+            ),
         );
     }
 
@@ -206,18 +207,4 @@ impl GpuClusterBuilder {
             ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
-}
-
-/// A global memory barrier.
-pub fn barrier(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    src_stage: vk::PipelineStageFlags,
-    src_access: vk::AccessFlags,
-    dst_stage: vk::PipelineStageFlags,
-    dst_access: vk::AccessFlags,
-) {
-    let b = [vk::MemoryBarrier::default().src_access_mask(src_access).dst_access_mask(dst_access)];
-    // SAFETY: recording state, outside a render pass.
-    unsafe { ctx.device.cmd_pipeline_barrier(cmd, src_stage, dst_stage, vk::DependencyFlags::empty(), &b, &[], &[]) };
 }

@@ -13,9 +13,6 @@ use ml_vk::{vk, Buffer, Context, GpuTimer, VkError, VkResultExt};
 
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
-/// Light-index capacity a frame starts with, per light (grows on demand).
-const INITIAL_INDICES_PER_LIGHT: usize = 16;
-
 pub struct FrameInFlight {
     pub cmd: vk::CommandBuffer,
     pub fence: vk::Fence,
@@ -40,6 +37,8 @@ pub struct FrameSetup<'a> {
     pub set_layout: vk::DescriptorSetLayout,
     pub light_count: usize,
     pub cluster_count: usize,
+    /// Light-index entries the list starts with (it grows on demand).
+    pub initial_indices: usize,
     pub passes: u32,
     pub make_targets: &'a dyn Fn() -> Result<Targets, VkError>,
     /// Set for clustered-gpu: the GPU writes lights and lists.
@@ -91,7 +90,7 @@ impl FrameInFlight {
         self.uniforms = Buffer::new(ctx, "frame uniforms", uniform_bytes, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;
         self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>(), at)?;
         self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>(), at)?;
-        self.light_indices = list_buffer(ctx, "light indices", setup.light_count * INITIAL_INDICES_PER_LIGHT * 4, at)?;
+        self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.max(1) * 4, at)?;
         let layouts = [setup.set_layout];
         let set_info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(setup.descriptor_pool).set_layouts(&layouts);
         // SAFETY: the pool has room for one set per frame in flight.

@@ -18,10 +18,8 @@ use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
 use std::time::Instant;
 
-/// CPU-side cluster state of `clustered-cpu`: the grid (rebuilt when camera or size change;
-/// fixed in headless rendering), the assigner and this frame's lists.
+/// CPU-side cluster state of `clustered-cpu`: the assigner and this frame's lists.
 struct CpuClusters {
-    grid: ClusterGrid,
     assigner: ClusterAssigner,
     lists: ClusterLists,
 }
@@ -48,7 +46,8 @@ pub struct HeadlessRenderer<'a> {
     /// Lights of the current frame (animated copy of the scene's).
     animated: Vec<PointLight>,
     clusters: Option<CpuClusters>,
-    /// The cluster grid's shader parameters (also set for `forward`, which ignores them).
+    /// The cluster grid (fixed: headless rendering keeps camera and size; its shader
+    /// parameters are also set for `forward`, which ignores them).
     grid: ClusterGrid,
     /// clustered-gpu: the compute passes and their shared buffers.
     builder: Option<GpuClusterBuilder>,
@@ -65,6 +64,10 @@ pub struct HeadlessRenderer<'a> {
     last_frame: usize,
 }
 
+/// Copies into host-visible buffers, then read by the CPU.
+const TRANSFER_TO_HOST: ((vk::PipelineStageFlags, vk::AccessFlags), (vk::PipelineStageFlags, vk::AccessFlags)) =
+    ((vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));
+
 /// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
 const DEFAULT_HEAT_TOP: f32 = 64.0;
 /// clustered-gpu re-renders a final frame whose lists overflowed (after growing them); if it
@@ -78,11 +81,8 @@ impl<'a> HeadlessRenderer<'a> {
         let extent = vk::Extent2D { width: settings.width, height: settings.height };
         let animated = scene.lights.clone();
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
-        let clusters = (settings.technique == Technique::ClusteredCpu).then(|| CpuClusters {
-            grid: grid.clone(),
-            assigner: ClusterAssigner::new(),
-            lists: ClusterLists::default(),
-        });
+        let clusters = (settings.technique == Technique::ClusteredCpu)
+            .then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
         let mut r = HeadlessRenderer {
             ctx,
             scene,
@@ -141,6 +141,9 @@ impl<'a> HeadlessRenderer<'a> {
             set_layout: self.pass.set_layout,
             light_count: self.scene.lights.len(),
             cluster_count: self.settings.clusters.count(),
+            // Clustered techniques start with room for 16 entries per light (grown on demand);
+            // forward never reads the list.
+            initial_indices: if self.settings.technique.is_clustered() { self.scene.lights.len() * 16 } else { 1 },
             passes: self.pass_names().len() as u32,
             make_targets: &make_targets,
             builder: self.builder.as_ref(),
@@ -275,7 +278,7 @@ impl<'a> HeadlessRenderer<'a> {
         }
         if let Some(c) = &mut self.clusters {
             let start = Instant::now();
-            c.assigner.assign(&c.grid, &self.animated, &mut c.lists);
+            c.assigner.assign(&self.grid, &self.animated, &mut c.lists);
             stats.add_assign_ms(start.elapsed().as_secs_f64() * 1e3);
             let cluster_stats = c.lists.stats();
             self.heat_top = cluster_stats.max_lights.max(1) as f32;
@@ -362,7 +365,7 @@ impl<'a> HeadlessRenderer<'a> {
                 // build ended with a barrier making its writes visible to transfers.
                 unsafe { ctx.device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[vk::BufferCopy::default().size(*size)]) };
             }
-            crate::cluster_build::barrier(ctx, cmd, vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE, vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ);
+            commands::memory_barrier(ctx, cmd, TRANSFER_TO_HOST.0, TRANSFER_TO_HOST.1);
         });
         let lists = copied.map(|()| {
             let ranges: Vec<ClusterRange> = bytemuck::pod_collect_to_vec(host[0].mapped());
@@ -392,26 +395,9 @@ impl<'a> HeadlessRenderer<'a> {
             let region = [vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1))
                 .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })];
-            let to_host = [vk::BufferMemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                .dst_access_mask(vk::AccessFlags::HOST_READ)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(buffer.raw)
-                .size(vk::WHOLE_SIZE)];
             // SAFETY: recording state; image and buffer are alive and large enough.
-            unsafe {
-                ctx.device.cmd_copy_image_to_buffer(cmd, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &region);
-                ctx.device.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::HOST,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &to_host,
-                    &[],
-                );
-            }
+            unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &region) };
+            commands::memory_barrier(ctx, cmd, TRANSFER_TO_HOST.0, TRANSFER_TO_HOST.1);
         })?;
         Ok(buffer.mapped().to_vec())
     }

@@ -57,22 +57,18 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     // SAFETY: the set and buffers are alive and unused.
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
     commands::one_shot(ctx, |cmd| {
-        let to_host = [vk::MemoryBarrier::default().src_access_mask(vk::AccessFlags::SHADER_WRITE).dst_access_mask(vk::AccessFlags::HOST_READ)];
         // SAFETY: recording state; all bound objects are alive.
         unsafe {
             ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
             ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, pipeline_layout, 0, &[set], &[]);
             ctx.device.cmd_dispatch(cmd, depths.len().div_ceil(64) as u32, 1, 1);
-            ctx.device.cmd_pipeline_barrier(
-                cmd,
-                vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::PipelineStageFlags::HOST,
-                vk::DependencyFlags::empty(),
-                &to_host,
-                &[],
-                &[],
-            );
         }
+        commands::memory_barrier(
+            ctx,
+            cmd,
+            (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE),
+            (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+        );
     })
     .expect("probe dispatch");
     let slices: Vec<u32> = bytemuck::cast_slice(output.mapped()).to_vec();

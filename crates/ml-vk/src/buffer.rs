@@ -79,21 +79,12 @@ impl Buffer {
                     // SAFETY: both buffers are alive and large enough.
                     unsafe { ctx.device.cmd_copy_buffer(cmd, staging.raw, buffer.raw, &region) };
                     // Make the copy visible to every later use (vertex input, shaders).
-                    let barrier = [vk::MemoryBarrier::default()
-                        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                        .dst_access_mask(vk::AccessFlags::MEMORY_READ)];
-                    // SAFETY: recording state.
-                    unsafe {
-                        ctx.device.cmd_pipeline_barrier(
-                            cmd,
-                            vk::PipelineStageFlags::TRANSFER,
-                            vk::PipelineStageFlags::ALL_COMMANDS,
-                            vk::DependencyFlags::empty(),
-                            &barrier,
-                            &[],
-                            &[],
-                        )
-                    };
+                    crate::commands::memory_barrier(
+                        ctx,
+                        cmd,
+                        (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
+                        (vk::PipelineStageFlags::ALL_COMMANDS, vk::AccessFlags::MEMORY_READ),
+                    );
                 });
                 match copied {
                     Ok(()) => Ok(buffer),

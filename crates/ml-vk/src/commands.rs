@@ -45,3 +45,15 @@ pub fn one_shot(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Result
     }
     result
 }
+
+/// A global memory barrier: `src` (stages, accesses) before `dst` (stages, accesses).
+pub fn memory_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    src: (vk::PipelineStageFlags, vk::AccessFlags),
+    dst: (vk::PipelineStageFlags, vk::AccessFlags),
+) {
+    let b = [vk::MemoryBarrier::default().src_access_mask(src.1).dst_access_mask(dst.1)];
+    // SAFETY: recording state, outside a render pass.
+    unsafe { ctx.device.cmd_pipeline_barrier(cmd, src.0, dst.0, vk::DependencyFlags::empty(), &b, &[], &[]) };
+}
