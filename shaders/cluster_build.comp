@@ -10,6 +10,9 @@
 
 layout(local_size_x = 128) in;
 layout(constant_id = 0) const bool FILL = false;
+// Invocations per light. Few lights are big and many small: with few lights each gets up to
+// 64 invocations that share its candidate tiles, so the GPU stays busy; with many, one.
+layout(constant_id = 1) const uint LANES = 1u;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 layout(std430, set = 0, binding = 1) readonly buffer RestLightBuffer { PointLight rest_lights[]; };
@@ -31,7 +34,8 @@ void touch(uint cluster, uint light) {
 }
 
 void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = gl_GlobalInvocationID.x / LANES;
+    uint lane = gl_GlobalInvocationID.x % LANES;
     if (i >= frame.light_count) {
         return;
     }
@@ -39,7 +43,7 @@ void main() {
     light.position_radius.xyz += frame.light_animation.xyz;
     // (Written as if/else: reflection tools cannot fold a specialization-constant `!`.)
     if (FILL) {
-    } else {
+    } else if (lane == 0u) {
         lights[i] = light;
     }
     float r = light.position_radius.w;
@@ -78,14 +82,14 @@ void main() {
             || !cluster_tile_span(frame.cluster_frustum.w, c.y - rr, c.y + rr, slab, size.y, d.y, ys)) {
             continue;
         }
-        for (uint y = ys.x; y <= ys.y; ++y) {
-            for (uint x = xs.x; x <= xs.y; ++x) {
-                uint index = (z * d.y + y) * d.x + x;
-                ClusterBounds b = bounds[index];
-                vec3 e = max(max(b.min_corner.xyz - c, c - b.max_corner.xyz), vec3(0.0));
-                if (dot(e, e) <= r2) {
-                    touch(index, i);
-                }
+        uint w = xs.y - xs.x + 1u;
+        uint cells = w * (ys.y - ys.x + 1u);
+        for (uint k = lane; k < cells; k += LANES) {
+            uint index = (z * d.y + ys.x + k / w) * d.x + xs.x + k % w;
+            ClusterBounds b = bounds[index];
+            vec3 e = max(max(b.min_corner.xyz - c, c - b.max_corner.xyz), vec3(0.0));
+            if (dot(e, e) <= r2) {
+                touch(index, i);
             }
         }
     }

@@ -17,7 +17,7 @@ fn assign(c: &mut Criterion) {
         let mut assigner = ClusterAssigner::new();
         let mut lists = ClusterLists::default();
         group.bench_with_input(BenchmarkId::from_parameter(count), &lights, |b, lights| {
-            b.iter(|| assigner.assign(&grid, lights, &mut lists));
+            b.iter(|| assigner.assign(&grid, lights, &mut lists, usize::MAX).expect("no limit"));
         });
         let s = lists.stats();
         println!("{count} lights: lights/cluster mean {:.2} max {}, index list {}", s.mean_lights, s.max_lights, s.index_len);

@@ -1,10 +1,10 @@
 //! Technique `clustered-gpu` (SPEC §3): the cluster grid built by compute shaders every frame
 //! from the light buffer, with no per-light CPU work and no read-back in the frame.
 //!
-//! Per frame: clear the counters → COUNT (one invocation per light: animate it, write it for
-//! shading, count it into every cluster its sphere touches) → SCAN (one workgroup: prefix sum
-//! into (offset, count) ranges, counters become cursors, report the entries needed) → FILL
-//! (each light writes its index at its clusters' cursors) → the shading pass reads the lists.
+//! Per frame: clear the counters → COUNT (1–64 invocations per light: animate it, write it for
+//! shading, count it into every cluster its sphere touches) → SCAN (three steps: per-block
+//! prefix sums, block totals, apply; counters become cursors; reports the entries needed) →
+//! FILL (each light writes its index at its clusters' cursors) → the shading pass reads them.
 //! Lights only visit the clusters under their own projected slab rectangles, so the cost
 //! follows the (light, cluster) pairs, not lights × clusters.
 //! Capacity: the index list has a size; the SCAN pass reports what the frame needed and cuts
@@ -24,17 +24,29 @@ pub const BINDING_COUNTERS: u32 = 4;
 pub const BINDING_RANGES: u32 = 5;
 pub const BINDING_INDICES: u32 = 6;
 pub const BINDING_FEEDBACK: u32 = 7;
+pub const BINDING_SCAN_BLOCKS: u32 = 8;
 
 const BUILD_GROUP: u32 = 128;
 const BOUNDS_GROUP: u32 = 64;
+/// Clusters per scan block (cluster_scan.comp); ClusterDims::MAX_CLUSTERS = SCAN_BLOCK² so the
+/// block totals fit one workgroup.
+const SCAN_BLOCK: u32 = 1024;
+
+/// Invocations per light in COUNT/FILL: enough that even a few (big) lights keep ~64k
+/// invocations busy, at most 64; a power of two.
+fn lanes_per_light(lights: u32) -> u32 {
+    (65_536 / lights.max(1)).clamp(1, 64).next_power_of_two().min(64)
+}
 
 pub struct GpuClusterBuilder {
     pub set_layout: vk::DescriptorSetLayout,
     pipeline_layout: vk::PipelineLayout,
     bounds_pipeline: vk::Pipeline,
     count_pipeline: vk::Pipeline,
-    scan_pipeline: vk::Pipeline,
+    /// The three steps of the prefix sum (block scans, block totals, apply).
+    scan_pipelines: [vk::Pipeline; 3],
     fill_pipeline: vk::Pipeline,
+    lanes: u32,
     /// Lights at rest, uploaded once (device-local); the COUNT pass animates them.
     pub rest_lights: Buffer,
     /// Every cluster's view-space box, rebuilt by `compute_bounds`.
@@ -47,6 +59,8 @@ pub struct GpuClusterBuilder {
 pub struct GpuClusterFrame {
     pub counters: Buffer,
     pub feedback: Buffer,
+    /// Per scan block: its total and largest count, then its offset.
+    pub scan_blocks: Buffer,
     pub set: vk::DescriptorSet,
 }
 
@@ -58,6 +72,7 @@ impl GpuClusterFrame {
     pub fn destroy(&mut self, ctx: &Context) {
         self.counters.destroy(ctx);
         self.feedback.destroy(ctx);
+        self.scan_blocks.destroy(ctx);
     }
 }
 
@@ -68,8 +83,9 @@ impl GpuClusterBuilder {
             pipeline_layout: vk::PipelineLayout::null(),
             bounds_pipeline: vk::Pipeline::null(),
             count_pipeline: vk::Pipeline::null(),
-            scan_pipeline: vk::Pipeline::null(),
+            scan_pipelines: [vk::Pipeline::null(); 3],
             fill_pipeline: vk::Pipeline::null(),
+            lanes: lanes_per_light(rest_lights.len() as u32),
             rest_lights: Buffer::null(),
             bounds: Buffer::null(),
             light_count: rest_lights.len() as u32,
@@ -87,16 +103,22 @@ impl GpuClusterBuilder {
     fn create(&mut self, ctx: &Context, rest_lights: &[PointLight]) -> Result<(), VkError> {
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         let mut bindings = vec![(BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER)];
-        bindings.extend([BINDING_REST_LIGHTS, BINDING_LIGHTS, BINDING_BOUNDS, BINDING_COUNTERS, BINDING_RANGES, BINDING_INDICES, BINDING_FEEDBACK].map(|b| (b, storage)));
+        bindings.extend(
+            [BINDING_REST_LIGHTS, BINDING_LIGHTS, BINDING_BOUNDS, BINDING_COUNTERS, BINDING_RANGES, BINDING_INDICES, BINDING_FEEDBACK, BINDING_SCAN_BLOCKS]
+                .map(|b| (b, storage)),
+        );
         self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::COMPUTE)?;
         let layouts = [self.set_layout];
         // SAFETY: valid device and create info.
         self.pipeline_layout = unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }
             .ctx("vkCreatePipelineLayout")?;
         self.bounds_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BOUNDS_COMP, self.pipeline_layout, &[])?;
-        self.count_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 0)])?;
-        self.fill_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 1)])?;
-        self.scan_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SCAN_COMP, self.pipeline_layout, &[])?;
+        // Specialization constants: 0 = FILL, 1 = LANES (cluster_build.comp); 0 = STEP (scan).
+        self.count_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 0), (1, self.lanes)])?;
+        self.fill_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 1), (1, self.lanes)])?;
+        for (step, pipeline) in self.scan_pipelines.iter_mut().enumerate() {
+            *pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SCAN_COMP, self.pipeline_layout, &[(0, step as u32)])?;
+        }
         self.rest_lights = Buffer::device_local_with(ctx, "lights at rest", bytemuck::cast_slice(rest_lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         self.bounds = Buffer::new(
             ctx,
@@ -136,20 +158,27 @@ impl GpuClusterBuilder {
             (compute | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE),
             (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE),
         );
-        let lights = self.light_count.div_ceil(BUILD_GROUP);
+        let light_groups = (self.light_count as u64 * self.lanes as u64).div_ceil(BUILD_GROUP as u64) as u32;
+        let blocks = self.cluster_count.div_ceil(SCAN_BLOCK);
+        let steps = [
+            (self.count_pipeline, light_groups),
+            (self.scan_pipelines[0], blocks),
+            (self.scan_pipelines[1], 1),
+            (self.scan_pipelines[2], blocks),
+            (self.fill_pipeline, light_groups),
+        ];
         // SAFETY: recording state outside a render pass; all bound objects are alive.
         unsafe {
             d.cmd_fill_buffer(cmd, frame.counters.raw, 0, vk::WHOLE_SIZE, 0);
             memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[frame.set], &[]);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.count_pipeline);
-            d.cmd_dispatch(cmd, lights, 1, 1);
-            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.scan_pipeline);
-            d.cmd_dispatch(cmd, 1, 1, 1);
-            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.fill_pipeline);
-            d.cmd_dispatch(cmd, lights, 1, 1);
+            for (i, (pipeline, groups)) in steps.into_iter().enumerate() {
+                if i > 0 {
+                    memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
+                }
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+                d.cmd_dispatch(cmd, groups, 1, 1);
+            }
         }
         memory_barrier(
             ctx,
@@ -164,7 +193,7 @@ impl GpuClusterBuilder {
 
     /// This frame's build resources (its set is written by the caller, see `frame.rs`).
     pub fn frame_resources(&self, ctx: &Context, pool: vk::DescriptorPool) -> Result<GpuClusterFrame, VkError> {
-        let mut frame = GpuClusterFrame { counters: Buffer::null(), feedback: Buffer::null(), set: vk::DescriptorSet::null() };
+        let mut frame = GpuClusterFrame { counters: Buffer::null(), feedback: Buffer::null(), scan_blocks: Buffer::null(), set: vk::DescriptorSet::null() };
         let result = (|| {
             frame.counters = Buffer::new(
                 ctx,
@@ -179,6 +208,13 @@ impl GpuClusterBuilder {
                 size_of::<ClusterFeedback>() as u64,
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 gpu_allocator::MemoryLocation::GpuToCpu,
+            )?;
+            frame.scan_blocks = Buffer::new(
+                ctx,
+                "cluster scan blocks",
+                self.cluster_count.div_ceil(SCAN_BLOCK) as u64 * 8,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                gpu_allocator::MemoryLocation::GpuOnly,
             )?;
             let layouts = [self.set_layout];
             // SAFETY: the pool has room for the build sets.
@@ -200,7 +236,7 @@ impl GpuClusterBuilder {
         self.bounds.destroy(ctx);
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
-            for p in [self.bounds_pipeline, self.count_pipeline, self.scan_pipeline, self.fill_pipeline] {
+            for p in [self.bounds_pipeline, self.count_pipeline, self.fill_pipeline].into_iter().chain(self.scan_pipelines) {
                 ctx.device.destroy_pipeline(p, None);
             }
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);

@@ -108,7 +108,7 @@ impl FrameInFlight {
         if let Some(builder) = setup.builder {
             let gpu = builder.frame_resources(ctx, setup.descriptor_pool)?;
             let set = gpu.set;
-            let (counters, feedback) = (gpu.counters.raw, gpu.feedback.raw);
+            let (counters, feedback, blocks) = (gpu.counters.raw, gpu.feedback.raw, gpu.scan_blocks.raw);
             self.gpu = Some(gpu);
             write_set(ctx, set, build::BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
             for (binding, buffer) in [
@@ -119,6 +119,7 @@ impl FrameInFlight {
                 (build::BINDING_RANGES, self.cluster_ranges.raw),
                 (build::BINDING_INDICES, self.light_indices.raw),
                 (build::BINDING_FEEDBACK, feedback),
+                (build::BINDING_SCAN_BLOCKS, blocks),
             ] {
                 write_set(ctx, set, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
             }
@@ -136,12 +137,19 @@ impl FrameInFlight {
         (self.light_indices.size / 4) as usize
     }
 
-    /// Grow the light-index list to hold at least `entries` (nothing if it already does).
-    /// Returns whether it grew. Call only after the frame's fence has signalled.
-    pub fn ensure_index_capacity(&mut self, ctx: &Context, entries: usize) -> Result<bool, VkError> {
-        if entries <= self.index_capacity() {
+    /// Grow the light-index list to hold at least `needed` entries, with room to spare (1.5×)
+    /// where the device allows it; nothing if it already does. A list the device cannot bind
+    /// (maxStorageBufferRange) is an error, never a silently shortened list. Returns whether
+    /// it grew. Call only after the frame's fence has signalled.
+    pub fn ensure_index_capacity(&mut self, ctx: &Context, needed: usize) -> Result<bool, VkError> {
+        if needed <= self.index_capacity() {
             return Ok(false);
         }
+        let limit = max_index_entries(ctx);
+        if needed > limit {
+            return Err(lists_too_long(needed, limit, &format!("'{}' binds as one storage buffer", ctx.info.name)));
+        }
+        let entries = (needed + needed / 2).min(limit);
         let bigger = list_buffer(ctx, "light indices", entries * 4, self.location)?;
         let mut old = std::mem::replace(&mut self.light_indices, bigger);
         old.destroy(ctx);
@@ -153,12 +161,10 @@ impl FrameInFlight {
         Ok(true)
     }
 
-    /// Copy the cluster lists into this frame's buffers, growing the index buffer (to 1.5×
-    /// what is needed) when it is too small. Returns whether it grew. Call only after the
-    /// frame's fence has signalled.
+    /// Copy the cluster lists into this frame's buffers, growing the index buffer when it is
+    /// too small. Returns whether it grew. Call only after the frame's fence has signalled.
     pub fn upload_clusters(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<bool, VkError> {
-        let needed = lists.indices.len();
-        let grew = needed > self.index_capacity() && self.ensure_index_capacity(ctx, needed + needed / 2)?;
+        let grew = self.ensure_index_capacity(ctx, lists.indices.len())?;
         self.cluster_ranges.write(0, &lists.ranges);
         self.light_indices.write(0, &lists.indices);
         Ok(grew)
@@ -187,4 +193,18 @@ fn write_set(ctx: &Context, set: vk::DescriptorSet, binding: u32, ty: vk::Descri
     let write = [vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).buffer_info(&info)];
     // SAFETY: the set and buffer are alive and the set is not in use by pending work.
     unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
+}
+
+/// The most light-index entries one list may hold: what the device binds as one storage buffer.
+pub fn max_index_entries(ctx: &Context) -> usize {
+    ctx.info.limits.max_storage_buffer_range as usize / 4
+}
+
+/// The error for light lists longer than `limit` entries, which is what `holder` can take.
+pub fn lists_too_long(needed: usize, limit: usize, holder: &str) -> VkError {
+    VkError::Limit(format!(
+        "the cluster light lists need at least {needed} entries ({} MiB), more than the {} MiB {holder}: use fewer or smaller lights, or a coarser --clusters grid",
+        (needed as u64 * 4) >> 20,
+        (limit as u64 * 4) >> 20
+    ))
 }

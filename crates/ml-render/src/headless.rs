@@ -3,7 +3,7 @@
 
 use crate::error::RenderError;
 use crate::forward::ForwardPass;
-use crate::frame::{FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
+use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
 use crate::report::FrameStats;
 use crate::settings::RenderSettings;
@@ -68,6 +68,10 @@ pub struct HeadlessRenderer<'a> {
 const TRANSFER_TO_HOST: ((vk::PipelineStageFlags, vk::AccessFlags), (vk::PipelineStageFlags, vk::AccessFlags)) =
     ((vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));
 
+/// Most light-index entries clustered-cpu builds (512 MiB of indices, twice that while
+/// assigning); beyond it the render fails with a clear message.
+const MAX_CPU_LIST_ENTRIES: usize = 1 << 27;
+
 /// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
 const DEFAULT_HEAT_TOP: f32 = 64.0;
 /// clustered-gpu re-renders a final frame whose lists overflowed (after growing them); if it
@@ -123,11 +127,11 @@ impl<'a> HeadlessRenderer<'a> {
             self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
         }
         // Per frame: the shading set (1 uniform + 3 storage) and, for clustered-gpu, the build
-        // set (1 uniform + 7 storage).
+        // set (1 uniform + 8 storage).
         let n = FRAMES_IN_FLIGHT as u32;
         let sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 2 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 10 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 11 * n },
         ];
         let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(2 * n).pool_sizes(&sizes);
         // SAFETY: as above.
@@ -257,7 +261,7 @@ impl<'a> HeadlessRenderer<'a> {
                     "clustered-gpu: a frame needed {needed} light-index entries but its list held {}; growing the lists (that frame is re-rendered if it is the last)",
                     self.frames[f].index_capacity()
                 );
-                self.required_indices = self.required_indices.max(needed + needed / 2);
+                self.required_indices = self.required_indices.max(needed);
             }
         }
         Ok(())
@@ -278,7 +282,11 @@ impl<'a> HeadlessRenderer<'a> {
         }
         if let Some(c) = &mut self.clusters {
             let start = Instant::now();
-            c.assigner.assign(&self.grid, &self.animated, &mut c.lists);
+            // The CPU also holds the lists (and their pairs) in memory: cap what it builds.
+            let limit = frame::max_index_entries(self.ctx).min(MAX_CPU_LIST_ENTRIES);
+            c.assigner
+                .assign(&self.grid, &self.animated, &mut c.lists, limit)
+                .map_err(|e| frame::lists_too_long(e.at_least, limit, "clustered-cpu builds (or the device binds)"))?;
             stats.add_assign_ms(start.elapsed().as_secs_f64() * 1e3);
             let cluster_stats = c.lists.stats();
             self.heat_top = cluster_stats.max_lights.max(1) as f32;

@@ -30,8 +30,14 @@ fn gpu_lists_equal_the_cpu_assignment_on_random_scenes() {
     let counter = ctx.validation_counter();
     let (mut pairs, mut borderline) = (0usize, 0usize);
     for seed in 0..20 {
-        let scene = random_scene(3000 + seed, 5000);
-        let dims = if seed % 5 == 4 { ClusterDims { x: 4, y: 4, z: 2 } } else { ClusterDims::DEFAULT };
+        // The seed's tiny grid, the default, and a fine one whose scan spans 72 blocks (with
+        // fewer lights there: radii up to 40 on 74k clusters would outgrow a storage buffer).
+        let (dims, max_lights) = match seed % 5 {
+            4 => (ClusterDims { x: 4, y: 4, z: 2 }, 5000),
+            2 => (ClusterDims { x: 64, y: 36, z: 32 }, 200),
+            _ => (ClusterDims::DEFAULT, 5000),
+        };
+        let scene = random_scene(3000 + seed, max_lights);
         let mut settings = RenderSettings::new(Technique::ClusteredGpu, W, H);
         settings.clusters = dims;
         settings.frames = 2;
@@ -44,7 +50,7 @@ fn gpu_lists_equal_the_cpu_assignment_on_random_scenes() {
         let mut lights = scene.lights.clone();
         animate_into(&scene.lights, settings.clock(settings.frames - 1), &mut lights);
         let mut cpu = ClusterLists::default();
-        ClusterAssigner::new().assign(&grid, &lights, &mut cpu);
+        ClusterAssigner::new().assign(&grid, &lights, &mut cpu, usize::MAX).expect("no limit");
 
         for cluster in 0..dims.count() as u32 {
             let (g, c) = (gpu.lists_of_sorted(cluster), cpu.lights_of(cluster));
@@ -98,4 +104,33 @@ fn a_hundred_thousand_lights_render_cleanly() {
     let c = out.stats.clusters.expect("cluster stats");
     println!("100k lights: {} list entries, max {} per cluster", c.index_len, c.max_lights);
     assert!(c.index_len > 100_000, "the lights should land in many clusters");
+}
+
+#[test]
+fn lists_larger_than_a_storage_buffer_fail_loudly() {
+    // 1,000 lights of radius 40 on a fine grid need ~240 MiB of list: more than lavapipe
+    // binds (128 MiB). Both builders must say so, not render short lists.
+    let lights = LightParams { count: 1000, layout: LightLayout::Random, seed: 3, radius: RadiusRange::fixed(40.0) };
+    let scene = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &lights).unwrap();
+    let ctx = Context::new(&ContextDesc { validation: true, device_index: None }).expect("Vulkan with validation");
+    let counter = ctx.validation_counter();
+    let limit = ctx.info.limits.max_storage_buffer_range as u64;
+    for technique in [Technique::ClusteredCpu, Technique::ClusteredGpu] {
+        let mut settings = RenderSettings::new(technique, 64, 36);
+        settings.clusters = ClusterDims { x: 64, y: 36, z: 32 };
+        let result = HeadlessRenderer::new(&ctx, scene.clone(), settings).and_then(|mut r| r.render());
+        match result {
+            Err(e) => {
+                let text = e.to_string();
+                assert!(text.contains("light lists need") && text.contains("--clusters"), "{}: {text}", technique.name());
+            }
+            Ok(out) => {
+                // Only a device that binds enough may succeed, and then with every entry.
+                let c = out.stats.clusters.expect("stats");
+                assert!(c.index_len as u64 * 4 <= limit, "{}: {} entries rendered past the limit", technique.name(), c.index_len);
+            }
+        }
+    }
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages");
 }

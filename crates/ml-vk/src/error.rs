@@ -14,6 +14,8 @@ pub enum VkError {
     DeviceIndex { index: usize, count: usize },
     #[error("validation was requested but the layer VK_LAYER_KHRONOS_validation is not installed: `apt-get install vulkan-validationlayers`")]
     NoValidationLayer,
+    #[error("{0}")]
+    Limit(String),
     #[error("device '{device}' lacks {what}")]
     Unsupported { device: String, what: String },
     #[error("{what} failed: {result}")]

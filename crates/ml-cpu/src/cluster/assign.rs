@@ -14,6 +14,7 @@ use super::grid::ClusterGrid;
 use crate::gpu_types::{ClusterRange, PointLight};
 use glam::Vec4Swizzles;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Result of one assignment: per cluster (offset, count) into `indices`.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -70,9 +71,12 @@ impl ClusterAssigner {
         ClusterAssigner::default()
     }
 
-    /// Assign `lights` (world space) to the clusters of `grid`, into `out`.
-    pub fn assign(&mut self, grid: &ClusterGrid, lights: &[PointLight], out: &mut ClusterLists) {
+    /// Assign `lights` (world space) to the clusters of `grid`, into `out`. Stops early, with
+    /// a lower bound of what was needed, when the lists would exceed `max_entries` (what the
+    /// GPU can bind): huge lights on a fine grid must fail, not exhaust memory.
+    pub fn assign(&mut self, grid: &ClusterGrid, lights: &[PointLight], out: &mut ClusterLists, max_entries: usize) -> Result<(), ListsTooLong> {
         let clusters = grid.dims.count();
+        let emitted = AtomicUsize::new(0);
         // A few tasks per thread balance the load; more only add prefix-sum work.
         let tasks = lights.len().div_ceil(MIN_CHUNK).clamp(1, rayon::current_num_threads() * 4);
         let per_task = lights.len().div_ceil(tasks).max(1);
@@ -84,12 +88,23 @@ impl ClusterAssigner {
             chunk.counts.resize(clusters, 0);
             let first = (t * per_task).min(lights.len());
             for (i, light) in lights[first..(first + per_task).min(lights.len())].iter().enumerate() {
+                let before = chunk.pairs.len();
                 light_clusters(grid, light, |cluster| {
                     chunk.pairs.push((cluster, (first + i) as u32));
                     chunk.counts[cluster as usize] += 1;
                 });
+                if emitted.fetch_add(chunk.pairs.len() - before, Ordering::Relaxed) > max_entries {
+                    return;
+                }
             }
         });
+        let total = emitted.load(Ordering::Relaxed);
+        if total > max_entries {
+            for chunk in &mut self.chunks {
+                chunk.pairs = Vec::new(); // give the memory back
+            }
+            return Err(ListsTooLong { at_least: total });
+        }
         // 2. Prefix sum over clusters, and within a cluster over tasks in light order, so every
         //    cluster's list comes out sorted by light index: the shader then sums in the same
         //    order as `forward`. Counts become each task's write cursors.
@@ -120,7 +135,14 @@ impl ClusterAssigner {
                 *cursor += 1;
             }
         });
+        Ok(())
     }
+}
+
+/// The lists would be longer than allowed; at least this many entries were needed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ListsTooLong {
+    pub at_least: usize,
 }
 
 /// Call `emit` with every cluster whose box the light's sphere touches.

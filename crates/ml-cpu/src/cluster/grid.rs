@@ -23,7 +23,8 @@ pub struct ClusterDims {
 impl ClusterDims {
     /// The default: 16×9 tiles (16:9 screens get square-ish tiles), 24 slices.
     pub const DEFAULT: ClusterDims = ClusterDims { x: 16, y: 9, z: 24 };
-    /// The largest grid we accept (a million clusters).
+    /// The largest grid we accept (a million clusters; the GPU scan handles 1024 blocks of
+    /// 1024, see cluster_scan.comp).
     pub const MAX_CLUSTERS: u64 = 1 << 20;
 
     /// Parse `XxYxZ`, e.g. `16x9x24`.

@@ -15,7 +15,7 @@ fn light(p: Vec3, r: f32) -> PointLight {
 
 fn assign(grid: &ClusterGrid, lights: &[PointLight]) -> ClusterLists {
     let mut out = ClusterLists::default();
-    ClusterAssigner::new().assign(grid, lights, &mut out);
+    ClusterAssigner::new().assign(grid, lights, &mut out, usize::MAX).expect("no limit");
     out
 }
 
@@ -214,4 +214,15 @@ fn mistake_5_gpu_structs_have_no_std140_padding() {
     assert_eq!(std::mem::size_of::<crate::gpu_types::ClusterRange>(), 8);
     let lists = assign(&seed_camera_grid(ClusterDims::DEFAULT), &LightParams::seed_default().build().unwrap());
     assert_eq!(std::mem::size_of_val(&lists.indices[..]), lists.indices.len() * 4);
+}
+
+#[test]
+fn assignment_stops_at_its_limit_instead_of_exhausting_memory() {
+    let grid = seed_camera_grid(ClusterDims::DEFAULT);
+    let lights: Vec<PointLight> = (0..2000).map(|i| light(Vec3::new(0.0, i as f32 * 1e-3, 0.0), 40.0)).collect();
+    let mut out = ClusterLists::default();
+    let err = ClusterAssigner::new().assign(&grid, &lights, &mut out, 10_000).unwrap_err();
+    assert!(err.at_least > 10_000);
+    // Within the limit it succeeds.
+    ClusterAssigner::new().assign(&grid, &lights[..2], &mut out, 10_000).unwrap();
 }
