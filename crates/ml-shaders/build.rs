@@ -4,21 +4,14 @@
 
 use glslang::{
     include::{IncludeHandler, IncludeResult, IncludeType},
-    Compiler, CompilerOptions, ShaderInput,
-    ShaderSource, ShaderStage, SpirvVersion, Target, VulkanVersion,
+    Compiler, CompilerOptions, ShaderInput, ShaderSource, ShaderStage, SpirvVersion, Target, VulkanVersion,
 };
 use std::path::{Path, PathBuf};
 
 struct FolderIncludes(PathBuf);
 
 impl IncludeHandler for FolderIncludes {
-    fn include(
-        &mut self,
-        _ty: IncludeType,
-        header_name: &str,
-        _includer_name: &str,
-        _include_depth: usize,
-    ) -> Option<IncludeResult> {
+    fn include(&mut self, _ty: IncludeType, header_name: &str, _includer_name: &str, _include_depth: usize) -> Option<IncludeResult> {
         let path = self.0.join(header_name);
         let data = std::fs::read_to_string(&path).ok()?;
         Some(IncludeResult { name: path.display().to_string(), data })
@@ -45,10 +38,7 @@ fn main() {
         target: Target::Vulkan { version: VulkanVersion::Vulkan1_2, spirv_version: SpirvVersion::SPIRV1_5 },
         ..CompilerOptions::default()
     };
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(&shader_dir)
-        .expect("read shaders/")
-        .map(|e| e.unwrap().path())
-        .collect();
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(&shader_dir).expect("read shaders/").map(|e| e.unwrap().path()).collect();
     entries.sort();
     let mut index = String::new();
     let mut all = String::from("/// Every compiled shader by file name, for reflection tests.\npub const ALL: &[(&str, &[u8])] = &[\n");
@@ -60,9 +50,7 @@ fn main() {
         let mut includes = FolderIncludes(shader_dir.clone());
         let input = ShaderInput::new(&source, stage, &options, None::<&[(&str, Option<&str>)]>, Some(&mut includes))
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let shader = glslang::Shader::new(compiler, input)
-            .parse()
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let shader = glslang::Shader::new(compiler, input).parse().unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let words = shader.compile().unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let file_name = path.file_name().unwrap().to_str().unwrap().to_owned();
         let spv_name = format!("{file_name}.spv");

@@ -3,12 +3,12 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser, Subcommand};
+use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::report::table;
-use ml_cpu::cluster::ClusterDims;
 use ml_render::{DebugView, HeadlessRenderer, RenderSettings, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
@@ -135,11 +135,7 @@ fn check_output(path: &Path) -> Result<()> {
         bail!("cannot write '{}': folder '{}' does not exist", path.display(), parent.display());
     }
     let existed = path.exists();
-    std::fs::OpenOptions::new()
-        .append(true)
-        .create(true)
-        .open(path)
-        .with_context(|| format!("cannot write '{}'", path.display()))?;
+    std::fs::OpenOptions::new().append(true).create(true).open(path).with_context(|| format!("cannot write '{}'", path.display()))?;
     if !existed {
         let _ = std::fs::remove_file(path);
     }
@@ -192,7 +188,10 @@ fn render(args: &RenderArgs) -> Result<()> {
     if stats.overflowed_frames > 0 {
         rows.push((
             "overflows",
-            format!("{} frame(s) outgrew their light lists; {} re-rendered at the grown size", stats.overflowed_frames, stats.rerendered_frames),
+            format!(
+                "{} frame(s) outgrew their light lists; {} re-rendered at the grown size",
+                stats.overflowed_frames, stats.rerendered_frames
+            ),
         ));
     }
     if settings.debug_view == DebugView::ClusterHeat {

@@ -35,7 +35,8 @@ fn assert_one_line_error(out: &Output, needles: &[&str]) {
 #[test]
 fn renders_a_png_and_prints_the_table() {
     let png = temp_png("ok.png");
-    let out = manylights(&["render", "--validation", "--width", "64", "--height", "36", "--time", "0", "--out", png.to_str().unwrap()], &[]);
+    let out =
+        manylights(&["render", "--validation", "--width", "64", "--height", "36", "--time", "0", "--out", png.to_str().unwrap()], &[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
     for key in ["device", "resolution", "64x36", "lights", "gpu ms", "cpu ms/frame"] {
@@ -49,7 +50,20 @@ fn renders_a_png_and_prints_the_table() {
 fn clustered_render_reports_its_clusters() {
     let png = temp_png("clustered.png");
     let out = manylights(
-        &["render", "--validation", "--technique", "clustered-cpu", "--clusters", "4x4x2", "--width", "64", "--height", "36", "--out", png.to_str().unwrap()],
+        &[
+            "render",
+            "--validation",
+            "--technique",
+            "clustered-cpu",
+            "--clusters",
+            "4x4x2",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--out",
+            png.to_str().unwrap(),
+        ],
         &[],
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -108,7 +122,10 @@ fn unwritable_output_is_refused_before_rendering() {
 #[test]
 fn no_vulkan_driver_names_what_to_install() {
     let png = temp_png("never3.png");
-    let out = manylights(&["render", "--out", png.to_str().unwrap()], &[("VK_DRIVER_FILES", "/nonexistent"), ("VK_ICD_FILENAMES", "/nonexistent")]);
+    let out = manylights(
+        &["render", "--out", png.to_str().unwrap()],
+        &[("VK_DRIVER_FILES", "/nonexistent"), ("VK_ICD_FILENAMES", "/nonexistent")],
+    );
     assert_one_line_error(&out, &["no Vulkan driver", "mesa-vulkan-drivers"]);
     let out = manylights(&["info"], &[("VK_DRIVER_FILES", "/nonexistent"), ("VK_ICD_FILENAMES", "/nonexistent")]);
     assert_one_line_error(&out, &["no Vulkan driver"]);

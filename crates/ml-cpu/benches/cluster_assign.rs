@@ -11,9 +11,8 @@ fn assign(c: &mut Criterion) {
     let grid = ClusterGrid::new(ClusterDims::DEFAULT, 1920, 1080, &Camera::seed());
     let mut group = c.benchmark_group("cluster_assign_16x9x24_1080p");
     for count in [1_000u32, 10_000, 100_000] {
-        let lights = LightParams { count, layout: LightLayout::Random, seed: 1, radius: RadiusRange { min: 1.0, max: 3.0 } }
-            .build()
-            .unwrap();
+        let lights =
+            LightParams { count, layout: LightLayout::Random, seed: 1, radius: RadiusRange { min: 1.0, max: 3.0 } }.build().unwrap();
         let mut assigner = ClusterAssigner::new();
         let mut lists = ClusterLists::default();
         group.bench_with_input(BenchmarkId::from_parameter(count), &lights, |b, lights| {

@@ -27,14 +27,7 @@ impl Camera {
     /// A camera at `position` looking at `target`.
     pub fn looking_at(position: Vec3, target: Vec3, fov_y_deg: f32, near: f32, far: f32) -> Camera {
         let d = (target - position).normalize();
-        Camera {
-            position,
-            pitch_deg: d.y.asin().to_degrees(),
-            yaw_deg: d.z.atan2(d.x).to_degrees(),
-            fov_y_deg,
-            near,
-            far,
-        }
+        Camera { position, pitch_deg: d.y.asin().to_degrees(), yaw_deg: d.z.atan2(d.x).to_degrees(), fov_y_deg, near, far }
     }
 
     pub fn forward(&self) -> Vec3 {

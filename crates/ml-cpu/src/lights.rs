@@ -116,10 +116,7 @@ impl LightParams {
             };
             let radius = self.radius.sample(&mut rng);
             let c = SEED_COLORS[i % SEED_COLORS.len()];
-            lights.push(PointLight {
-                position_radius: [position.x, position.y, position.z, radius],
-                color: [c[0], c[1], c[2], 0.0],
-            });
+            lights.push(PointLight { position_radius: [position.x, position.y, position.z, radius], color: [c[0], c[1], c[2], 0.0] });
         }
         Ok(lights)
     }

@@ -31,8 +31,7 @@ pub enum MeshKind {
 }
 
 impl MeshKind {
-    pub const ALL: [MeshKind; 5] =
-        [MeshKind::Sphere, MeshKind::Teapot, MeshKind::TorusKnot, MeshKind::Plane, MeshKind::Disc];
+    pub const ALL: [MeshKind; 5] = [MeshKind::Sphere, MeshKind::Teapot, MeshKind::TorusKnot, MeshKind::Plane, MeshKind::Disc];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -107,9 +106,7 @@ pub fn uv_sphere(stacks: u32, slices: u32) -> Mesh {
 /// Square of half-size 1 in y = 0, facing +Y.
 pub fn plane() -> Mesh {
     let n = Vec3::Y;
-    let vertices = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
-        .map(|(x, z)| vertex(Vec3::new(x, 0.0, z), n))
-        .to_vec();
+    let vertices = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(x, z)| vertex(Vec3::new(x, 0.0, z), n)).to_vec();
     // Seen from +Y (looking down, x right, z towards the viewer) 0 → 2 → 1 is counter-clockwise.
     Mesh { vertices, indices: vec![0, 2, 1, 1, 2, 3] }
 }

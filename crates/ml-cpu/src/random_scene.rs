@@ -27,7 +27,7 @@ pub fn hostile_lights(rng: &mut impl Rng, camera: &Camera, count: u32) -> Vec<Po
     for i in 0..12 {
         let r = rng.random_range(0.3..6.0);
         let at = match i % 3 {
-            0 => camera.position - f * (r * 0.7),  // centre behind the eye, sphere reaches in front
+            0 => camera.position - f * (r * 0.7),   // centre behind the eye, sphere reaches in front
             1 => camera.position + f * camera.near, // straddling the near plane
             _ => camera.position + Vec3::new(rng.random_range(-0.2..0.2), 0.1, 0.0), // around the eye
         };
@@ -52,7 +52,11 @@ pub fn random_scene(seed: u64, max_lights: u32) -> Scene {
                 mesh: MeshKind::ALL[rng.random_range(0..MeshKind::ALL.len())],
                 position: Vec3::new(at(i / 7), 0.0, at(i % 7)),
                 scale: 1.0,
-                material: Material { albedo: Vec3::from(albedo), roughness: rng.random_range(0.1..0.9), metallic: rng.random_range(0.0..1.0) },
+                material: Material {
+                    albedo: Vec3::from(albedo),
+                    roughness: rng.random_range(0.1..0.9),
+                    metallic: rng.random_range(0.0..1.0),
+                },
             }
         })
         .collect();

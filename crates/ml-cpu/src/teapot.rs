@@ -110,10 +110,8 @@ pub(crate) fn teapot(steps: u32) -> Mesh {
                         let nudge = |t: f32| t + (0.5 - t) * 1e-3;
                         n = eval(&cp, nudge(u), nudge(v)).1;
                     }
-                    mesh.vertices.push(Vertex {
-                        position: (to_y_up * p).to_array(),
-                        normal: (to_y_up * (sign * n)).normalize().to_array(),
-                    });
+                    mesh.vertices
+                        .push(Vertex { position: (to_y_up * p).to_array(), normal: (to_y_up * (sign * n)).normalize().to_array() });
                 }
             }
             grid_indices(base, steps, steps, &mut mesh.indices);

@@ -104,22 +104,35 @@ impl GpuClusterBuilder {
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         let mut bindings = vec![(BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER)];
         bindings.extend(
-            [BINDING_REST_LIGHTS, BINDING_LIGHTS, BINDING_BOUNDS, BINDING_COUNTERS, BINDING_RANGES, BINDING_INDICES, BINDING_FEEDBACK, BINDING_SCAN_BLOCKS]
-                .map(|b| (b, storage)),
+            [
+                BINDING_REST_LIGHTS,
+                BINDING_LIGHTS,
+                BINDING_BOUNDS,
+                BINDING_COUNTERS,
+                BINDING_RANGES,
+                BINDING_INDICES,
+                BINDING_FEEDBACK,
+                BINDING_SCAN_BLOCKS,
+            ]
+            .map(|b| (b, storage)),
         );
         self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::COMPUTE)?;
         let layouts = [self.set_layout];
         // SAFETY: valid device and create info.
-        self.pipeline_layout = unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }
-            .ctx("vkCreatePipelineLayout")?;
+        self.pipeline_layout =
+            unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }
+                .ctx("vkCreatePipelineLayout")?;
         self.bounds_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BOUNDS_COMP, self.pipeline_layout, &[])?;
         // Specialization constants: 0 = FILL, 1 = LANES (cluster_build.comp); 0 = STEP (scan).
-        self.count_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 0), (1, self.lanes)])?;
-        self.fill_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 1), (1, self.lanes)])?;
+        self.count_pipeline =
+            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 0), (1, self.lanes)])?;
+        self.fill_pipeline =
+            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 1), (1, self.lanes)])?;
         for (step, pipeline) in self.scan_pipelines.iter_mut().enumerate() {
             *pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SCAN_COMP, self.pipeline_layout, &[(0, step as u32)])?;
         }
-        self.rest_lights = Buffer::device_local_with(ctx, "lights at rest", bytemuck::cast_slice(rest_lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        self.rest_lights =
+            Buffer::device_local_with(ctx, "lights at rest", bytemuck::cast_slice(rest_lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         self.bounds = Buffer::new(
             ctx,
             "cluster bounds",
@@ -155,7 +168,10 @@ impl GpuClusterBuilder {
         memory_barrier(
             ctx,
             cmd,
-            (compute | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE),
+            (
+                compute | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER,
+                vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+            ),
             (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE),
         );
         let light_groups = (self.light_count as u64 * self.lanes as u64).div_ceil(BUILD_GROUP as u64) as u32;
@@ -193,7 +209,12 @@ impl GpuClusterBuilder {
 
     /// This frame's build resources (its set is written by the caller, see `frame.rs`).
     pub fn frame_resources(&self, ctx: &Context, pool: vk::DescriptorPool) -> Result<GpuClusterFrame, VkError> {
-        let mut frame = GpuClusterFrame { counters: Buffer::null(), feedback: Buffer::null(), scan_blocks: Buffer::null(), set: vk::DescriptorSet::null() };
+        let mut frame = GpuClusterFrame {
+            counters: Buffer::null(),
+            feedback: Buffer::null(),
+            scan_blocks: Buffer::null(),
+            set: vk::DescriptorSet::null(),
+        };
         let result = (|| {
             frame.counters = Buffer::new(
                 ctx,
@@ -218,8 +239,10 @@ impl GpuClusterBuilder {
             )?;
             let layouts = [self.set_layout];
             // SAFETY: the pool has room for the build sets.
-            frame.set = unsafe { ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts)) }
-                .ctx("vkAllocateDescriptorSets")?[0];
+            frame.set = unsafe {
+                ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+            }
+            .ctx("vkAllocateDescriptorSets")?[0];
             Ok(())
         })();
         match result {

@@ -185,7 +185,8 @@ impl ForwardPass {
             .framebuffer(framebuffer)
             .render_area(area)
             .clear_values(&clear);
-        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+        let viewport =
+            vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
         // SAFETY: recording state; every handle is alive until the frame's fence signals.
         unsafe {
             d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);

@@ -83,8 +83,8 @@ impl FrameInFlight {
         // SAFETY: valid pool and create infos on this device.
         self.cmd = unsafe { d.allocate_command_buffers(&alloc) }.ctx("vkAllocateCommandBuffers")?[0];
         // SAFETY: as above.
-        self.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }
-            .ctx("vkCreateFence")?;
+        self.fence =
+            unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }.ctx("vkCreateFence")?;
         let at = self.location;
         let uniform_bytes = size_of::<FrameUniforms>() as u64;
         self.uniforms = Buffer::new(ctx, "frame uniforms", uniform_bytes, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;

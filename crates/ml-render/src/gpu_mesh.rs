@@ -12,7 +12,8 @@ pub struct GpuMesh {
 
 impl GpuMesh {
     pub fn upload(ctx: &Context, kind: MeshKind, mesh: &Mesh) -> Result<GpuMesh, VkError> {
-        let mut vertices = Buffer::device_local_with(ctx, "vertices", bytemuck::cast_slice(&mesh.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+        let mut vertices =
+            Buffer::device_local_with(ctx, "vertices", bytemuck::cast_slice(&mesh.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
         match Buffer::device_local_with(ctx, "indices", bytemuck::cast_slice(&mesh.indices), vk::BufferUsageFlags::INDEX_BUFFER) {
             Ok(indices) => Ok(GpuMesh { kind, vertices, indices, index_count: mesh.indices.len() as u32 }),
             Err(e) => {

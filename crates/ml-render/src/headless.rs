@@ -1,16 +1,14 @@
 //! Headless rendering (SPEC §5): offscreen targets, frames in flight, a read-back of the
 //! last frame into host memory. No window system needed.
 
+use crate::cluster_build::GpuClusterBuilder;
 use crate::error::RenderError;
 use crate::forward::ForwardPass;
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
 use crate::report::FrameStats;
-use crate::settings::RenderSettings;
+use crate::settings::{DebugView, RenderSettings, Technique};
 use crate::targets::{depth_format, Targets};
-use crate::settings::DebugView;
-use crate::cluster_build::GpuClusterBuilder;
-use crate::settings::Technique;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
 use ml_cpu::lights::{animate_into, animation_offset};
@@ -83,7 +81,8 @@ impl<'a> HeadlessRenderer<'a> {
         settings.check(ctx, scene.lights.len())?;
         let depth = depth_format(ctx)?;
         let extent = vk::Extent2D { width: settings.width, height: settings.height };
-        let animated = scene.lights.clone();
+        // clustered-gpu animates on the GPU; the others keep an animated copy on the CPU.
+        let animated = if settings.technique.is_gpu_built() { Vec::new() } else { scene.lights.clone() };
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
         let clusters = (settings.technique == Technique::ClusteredCpu)
             .then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
@@ -162,7 +161,8 @@ impl<'a> HeadlessRenderer<'a> {
             self.builder.as_ref().expect("checked").compute_bounds(ctx, set)?;
         }
         let bytes = extent.width as u64 * extent.height as u64 * 4;
-        self.readback = Some(Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
+        self.readback =
+            Some(Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
         Ok(())
     }
 
@@ -248,11 +248,8 @@ impl<'a> HeadlessRenderer<'a> {
             let feedback = gpu.feedback();
             let needed = feedback.needed as usize;
             let clusters = self.settings.clusters.count();
-            stats.clusters = Some(ClusterStats {
-                mean_lights: needed as f64 / clusters as f64,
-                max_lights: feedback.max_count,
-                index_len: needed,
-            });
+            stats.clusters =
+                Some(ClusterStats { mean_lights: needed as f64 / clusters as f64, max_lights: feedback.max_count, index_len: needed });
             self.heat_top = feedback.max_count.max(1) as f32;
             self.overflowed[f] = feedback.overflowed != 0;
             if self.overflowed[f] {
@@ -365,7 +362,13 @@ impl<'a> HeadlessRenderer<'a> {
         let copies = [(&frame.cluster_ranges, frame.cluster_ranges.size), (&frame.light_indices, (needed * 4).max(4))];
         let mut host = Vec::new();
         for (_, size) in copies {
-            host.push(Buffer::new(ctx, "cluster read-back", size, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
+            host.push(Buffer::new(
+                ctx,
+                "cluster read-back",
+                size,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                gpu_allocator::MemoryLocation::GpuToCpu,
+            )?);
         }
         let copied = commands::one_shot(ctx, |cmd| {
             for ((src, size), dst) in copies.iter().zip(&host) {

@@ -64,9 +64,7 @@ impl FrameStats {
     }
 
     pub fn gpu_ms(&self) -> PassTimes {
-        (self.gpu_frames > 0).then(|| {
-            self.pass_names.iter().zip(&self.gpu_sum_ms).map(|(n, s)| (*n, s / self.gpu_frames as f64)).collect()
-        })
+        (self.gpu_frames > 0).then(|| self.pass_names.iter().zip(&self.gpu_sum_ms).map(|(n, s)| (*n, s / self.gpu_frames as f64)).collect())
     }
 
     /// CPU time to update, record and submit one frame.

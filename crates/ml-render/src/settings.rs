@@ -104,7 +104,10 @@ impl RenderSettings {
             }
         }
         if self.debug_view == DebugView::ClusterHeat && !self.technique.is_clustered() {
-            return Err(RenderError::Invalid(format!("--debug-view cluster-heat needs a clustered technique, not {}", self.technique.name())));
+            return Err(RenderError::Invalid(format!(
+                "--debug-view cluster-heat needs a clustered technique, not {}",
+                self.technique.name()
+            )));
         }
         if self.frames == 0 {
             return Err(RenderError::Invalid("--frames must be at least 1".into()));

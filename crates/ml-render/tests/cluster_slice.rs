@@ -17,8 +17,9 @@ const COUNT: usize = 100_000;
 
 fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     let storage = vk::DescriptorType::STORAGE_BUFFER;
-    let layout = shader::set_layout(ctx, &[(0, vk::DescriptorType::UNIFORM_BUFFER), (1, storage), (2, storage)], vk::ShaderStageFlags::COMPUTE)
-        .unwrap();
+    let layout =
+        shader::set_layout(ctx, &[(0, vk::DescriptorType::UNIFORM_BUFFER), (1, storage), (2, storage)], vk::ShaderStageFlags::COMPUTE)
+            .unwrap();
     let layouts = [layout];
     // SAFETY: valid device and create infos; everything is destroyed below after the wait.
     let pipeline_layout =
@@ -29,10 +30,13 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
         vk::DescriptorPoolSize { ty: storage, descriptor_count: 2 },
     ];
     // SAFETY: as above.
-    let pool = unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }.unwrap();
+    let pool = unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
+        .unwrap();
     // SAFETY: as above.
-    let set = unsafe { ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts)) }
-        .unwrap()[0];
+    let set = unsafe {
+        ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+    }
+    .unwrap()[0];
 
     let frame = FrameUniforms {
         cluster_dims: [grid.dims.x, grid.dims.y, grid.dims.z, 0],
@@ -40,11 +44,15 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
         cluster_slices: [grid.log_scale, grid.log_bias, 1.0, 0.0],
         ..Default::default()
     };
-    let mut uniforms = Buffer::new(ctx, "uniforms", size_of::<FrameUniforms>() as u64, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu).unwrap();
+    let mut uniforms =
+        Buffer::new(ctx, "uniforms", size_of::<FrameUniforms>() as u64, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)
+            .unwrap();
     uniforms.write(0, &[frame]);
-    let mut input = Buffer::new(ctx, "depths", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu).unwrap();
+    let mut input =
+        Buffer::new(ctx, "depths", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu).unwrap();
     input.write(0, depths);
-    let mut output = Buffer::new(ctx, "slices", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
+    let mut output =
+        Buffer::new(ctx, "slices", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
     let infos = [uniforms.raw, input.raw, output.raw].map(|b| [vk::DescriptorBufferInfo::default().buffer(b).range(vk::WHOLE_SIZE)]);
     let writes: Vec<vk::WriteDescriptorSet> = infos
         .iter()

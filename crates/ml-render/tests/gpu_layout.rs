@@ -44,11 +44,7 @@ fn reflect_all() -> HashMap<String, Reflected> {
     let mut structs = HashMap::new();
     for (file, spirv) in ml_shaders::ALL {
         let words: Vec<u32> = spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-        let entries = ReflectConfig::new()
-            .spv(words)
-            .ref_all_rscs(true)
-            .reflect()
-            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        let entries = ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().unwrap_or_else(|e| panic!("{file}: {e}"));
         for entry in entries {
             for var in &entry.vars {
                 collect(var.ty(), None, &mut structs);

@@ -72,8 +72,8 @@ impl Buffer {
         let size = data.len() as vk::DeviceSize;
         let mut staging = Buffer::new(ctx, "staging", size, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
         staging.write(0, data);
-        let result = Buffer::new(ctx, name, size, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly)
-            .and_then(|mut buffer| {
+        let result =
+            Buffer::new(ctx, name, size, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly).and_then(|mut buffer| {
                 let copied = crate::commands::one_shot(ctx, |cmd| {
                     let region = [vk::BufferCopy::default().size(size)];
                     // SAFETY: both buffers are alive and large enough.

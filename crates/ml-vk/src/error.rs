@@ -12,7 +12,9 @@ pub enum VkError {
     NoSuitableDevice(String),
     #[error("--device {index} does not exist: {count} Vulkan device(s) found (see `manylights info`)")]
     DeviceIndex { index: usize, count: usize },
-    #[error("validation was requested but the layer VK_LAYER_KHRONOS_validation is not installed: `apt-get install vulkan-validationlayers`")]
+    #[error(
+        "validation was requested but the layer VK_LAYER_KHRONOS_validation is not installed: `apt-get install vulkan-validationlayers`"
+    )]
     NoValidationLayer,
     #[error("{0}")]
     Limit(String),

@@ -74,7 +74,13 @@ impl ClusterAssigner {
     /// Assign `lights` (world space) to the clusters of `grid`, into `out`. Stops early, with
     /// a lower bound of what was needed, when the lists would exceed `max_entries` (what the
     /// GPU can bind): huge lights on a fine grid must fail, not exhaust memory.
-    pub fn assign(&mut self, grid: &ClusterGrid, lights: &[PointLight], out: &mut ClusterLists, max_entries: usize) -> Result<(), ListsTooLong> {
+    pub fn assign(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[PointLight],
+        out: &mut ClusterLists,
+        max_entries: usize,
+    ) -> Result<(), ListsTooLong> {
         let clusters = grid.dims.count();
         let emitted = AtomicUsize::new(0);
         // A few tasks per thread balance the load; more only add prefix-sum work.

@@ -77,6 +77,12 @@ fn pixel_span(lo: f32, hi: f32, size: u32) -> Option<(u32, u32)> {
     Some((a.max(0.0) as u32, (b.min(size as f32 - 1.0)) as u32))
 }
 
+/// Tile of pixel `p` along an axis of `size` pixels split into `tiles`: ⌊p·tiles/size⌋, in
+/// integer arithmetic as in the shader.
+fn tile_of(p: u32, tiles: u32, size: u32) -> u32 {
+    ((p as u64 * tiles as u64) / size as u64) as u32
+}
+
 /// The grid for one camera and image size.
 #[derive(Clone, Debug)]
 pub struct ClusterGrid {
@@ -94,6 +100,10 @@ pub struct ClusterGrid {
     pub bounds: Vec<Aabb>,
     /// Depth where each slice starts, with slack (Z + 1 entries; the last is far).
     slice_starts: Vec<f32>,
+    /// Tile of every pixel column and row (the assignment looks tiles up per light and slice;
+    /// a table is much cheaper than the division).
+    tile_of_column: Vec<u32>,
+    tile_of_row: Vec<u32>,
 }
 
 /// Keep in sync with `CLUSTER_SLACK` in cluster.glsl.
@@ -121,12 +131,16 @@ impl ClusterGrid {
             projection,
             bounds: Vec::with_capacity(dims.count()),
             slice_starts: Vec::new(),
+            tile_of_column: Vec::new(),
+            tile_of_row: Vec::new(),
         };
         // The tile spans below project with x_clip = p00·x, y_clip = p11·y, w = −z: a symmetric
         // perspective, which is what `Camera::projection` makes.
         let p = grid.projection;
         debug_assert!(p.z_axis.x == 0.0 && p.z_axis.y == 0.0 && p.z_axis.w == -1.0 && p.w_axis.w == 0.0);
         grid.slice_starts = (0..=dims.z).map(|k| grid.slice_start(k)).collect();
+        grid.tile_of_column = (0..width).map(|px| tile_of(px, dims.x, width)).collect();
+        grid.tile_of_row = (0..height).map(|py| tile_of(py, dims.y, height)).collect();
         grid.bounds = grid.compute_bounds();
         grid
     }
@@ -163,11 +177,11 @@ impl ClusterGrid {
 
     /// Tile of pixel column/row (integer arithmetic, as in the shader).
     pub fn tile_x(&self, px: u32) -> u32 {
-        ((px as u64 * self.dims.x as u64) / self.width as u64) as u32
+        self.tile_of_column[px as usize]
     }
 
     pub fn tile_y(&self, py: u32) -> u32 {
-        ((py as u64 * self.dims.y as u64) / self.height as u64) as u32
+        self.tile_of_row[py as usize]
     }
 
     pub fn index(&self, x: u32, y: u32, z: u32) -> u32 {

@@ -90,7 +90,8 @@ fn no_light_that_reaches_a_point_is_missing_from_its_cluster() {
             samples.push((rng.random_range(0..W), rng.random_range(0..H), depth));
             // Near the rim of a light's sphere, where a too-tight tile or slice range shows.
             let l = &lights[rng.random_range(0..lights.len())];
-            let dir = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize_or(Vec3::X);
+            let dir =
+                Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize_or(Vec3::X);
             let q = Vec3::from_slice(&l.position_radius[..3]) + dir * l.position_radius[3] * rng.random_range(0.9..1.0);
             let clip = view_proj * q.extend(1.0);
             let (depth, ndc) = (clip.w, clip.xyz() / clip.w);
@@ -108,7 +109,10 @@ fn no_light_that_reaches_a_point_is_missing_from_its_cluster() {
                 let centre = Vec3::from_slice(&l.position_radius[..3]);
                 if centre.distance(p) < l.position_radius[3] {
                     reaching += 1;
-                    assert!(cluster.binary_search(&(i as u32)).is_ok(), "scene {scene}: light {i} reaches pixel ({px},{py}) at depth {depth} but is not in its cluster");
+                    assert!(
+                        cluster.binary_search(&(i as u32)).is_ok(),
+                        "scene {scene}: light {i} reaches pixel ({px},{py}) at depth {depth} but is not in its cluster"
+                    );
                 }
             }
         }
