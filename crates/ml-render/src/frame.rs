@@ -90,7 +90,7 @@ impl FrameInFlight {
         self.uniforms = Buffer::new(ctx, "frame uniforms", uniform_bytes, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;
         self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>(), at)?;
         self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>(), at)?;
-        self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.max(1) * 4, at)?;
+        self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.clamp(1, max_index_entries(ctx)) * 4, at)?;
         let layouts = [setup.set_layout];
         let set_info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(setup.descriptor_pool).set_layouts(&layouts);
         // SAFETY: the pool has room for one set per frame in flight.
