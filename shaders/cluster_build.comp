@@ -56,6 +56,12 @@ void main() {
     if (dmax < near || dmin > far) {
         return;
     }
+    // Wholly outside a side plane of the frustum (grid.rs outside_side_planes)?
+    float p00 = frame.cluster_frustum.z;
+    float p11 = abs(frame.cluster_frustum.w);
+    if (p00 * abs(c.x) - depth > r * sqrt(p00 * p00 + 1.0) || p11 * abs(c.y) - depth > r * sqrt(p11 * p11 + 1.0)) {
+        return;
+    }
     uvec3 d = frame.cluster_dims.xyz;
     uvec2 size = frame.viewport.xy;
     float d0 = max(dmin, near);

@@ -167,7 +167,12 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
     if dmax < grid.near || dmin > grid.far {
         return;
     }
-    // Off screen as a whole? (Most lights of a large scene are; one projection rejects them.)
+    // Outside a side plane of the view frustum? For the symmetric perspective the planes are
+    // p00·x = ±depth and p11·y = ±depth; most lights of a large scene fail here, cheaply.
+    if grid.outside_side_planes(c, r) {
+        return;
+    }
+    // Off screen as a whole? (The projected box also catches what the planes let through.)
     let d0 = dmin.max(grid.near);
     let inv = (1.0 / d0, 1.0 / dmax);
     if grid.tile_span_x(c.x - r, c.x + r, inv).is_none() || grid.tile_span_y(c.y - r, c.y + r, inv).is_none() {

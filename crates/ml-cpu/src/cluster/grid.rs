@@ -156,6 +156,16 @@ impl ClusterGrid {
         self.near * (self.far / self.near).powf(k as f32 / self.dims.z as f32)
     }
 
+    /// Whether a view-space sphere lies wholly outside one of the four side planes of the view
+    /// frustum (so no pixel can see any of it).
+    pub fn outside_side_planes(&self, centre: Vec3, radius: f32) -> bool {
+        let depth = -centre.z;
+        let (p00, p11) = (self.projection.x_axis.x, self.projection.y_axis.y.abs());
+        // Signed distance to the plane p·v = depth (outward positive) is (p·v − depth)/√(p²+1).
+        let outside = |p: f32, v: f32| (p * v.abs() - depth) > radius * (p * p + 1.0).sqrt();
+        outside(p00, centre.x) || outside(p11, centre.y)
+    }
+
     /// Depth range of slice `k`, widened by the slack the cluster boxes carry.
     pub fn slice_depths(&self, k: u32) -> (f32, f32) {
         (self.slice_starts[k as usize] * (1.0 - SLACK), self.slice_starts[k as usize + 1] * (1.0 + SLACK))
