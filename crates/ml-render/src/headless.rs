@@ -166,10 +166,6 @@ impl<'a> HeadlessRenderer<'a> {
         Ok(())
     }
 
-    pub fn scene(&self) -> &Scene {
-        &self.scene
-    }
-
     /// The passes the timer reports, in order.
     fn pass_names(&self) -> Vec<&'static str> {
         let shading = self.settings.technique.name();
@@ -207,7 +203,8 @@ impl<'a> HeadlessRenderer<'a> {
             self.collect_all(&mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        stats.frames = self.settings.frames;
+        // Averages are over every frame rendered, re-renders included.
+        stats.frames = self.settings.frames + stats.rerendered_frames;
         self.last_frame = last;
         let rgba = self.read_back(last)?;
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
