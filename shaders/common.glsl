@@ -16,6 +16,7 @@
 struct FrameUniforms {
     mat4 view;
     mat4 proj;           // Vulkan clip space: Y flipped, depth 0..1
+    mat4 inv_view_proj;  // clip → world (deferred-compute rebuilds positions from depth)
     vec4 camera_pos;     // xyz: world position of the eye
     uint light_count;
     float ambient;       // seed: colour = albedo * ambient + Lo
@@ -60,6 +61,25 @@ struct ObjectPush {
     vec4 position_scale;   // xyz: world translation, w: uniform scale
     vec4 albedo_roughness; // rgb: albedo, a: roughness
     vec4 material;         // x: metallic; yzw unused
+    uvec4 ids;             // x: index of the object in the scene's object buffer
 };
+
+// Octahedral encoding of a unit normal into [-1, 1]² (the G-buffer keeps it in 2 floats).
+vec2 oct_encode(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 p = n.xy;
+    if (n.z < 0.0) {
+        p = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    }
+    return p;
+}
+
+vec3 oct_decode(vec2 p) {
+    vec3 n = vec3(p, 1.0 - abs(p.x) - abs(p.y));
+    if (n.z < 0.0) {
+        n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    }
+    return normalize(n);
+}
 
 #endif

@@ -35,7 +35,7 @@ struct RenderArgs {
     /// Scene to render (built in: seed).
     #[arg(long, default_value = "seed")]
     scene: String,
-    /// Lighting technique: forward, clustered-cpu, clustered-gpu.
+    /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred-compute.
     #[arg(long, default_value = "forward")]
     technique: String,
     /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).

@@ -95,7 +95,7 @@ fn bad_names_are_refused_with_the_choices() {
     assert_one_line_error(&manylights(&["render", "--clusters", "16x9", "--out", p], &[]), &["--clusters 16x9"]);
     assert_one_line_error(&manylights(&["render", "--clusters", "0x9x24", "--out", p], &[]), &["--clusters 0x9x24"]);
     assert_one_line_error(&manylights(&["render", "--debug-view", "xray", "--out", p], &[]), &["xray", "cluster-heat"]);
-    assert_one_line_error(&manylights(&["render", "--debug-view", "cluster-heat", "--out", p], &[]), &["clustered technique"]);
+    assert_one_line_error(&manylights(&["render", "--debug-view", "cluster-heat", "--out", p], &[]), &["clustered forward technique"]);
     assert!(!png.exists());
 }
 

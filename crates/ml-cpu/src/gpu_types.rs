@@ -34,6 +34,7 @@ gpu_struct!(
     FrameUniforms {
         view: [[f32; 4]; 4],
         proj: [[f32; 4]; 4],
+        inv_view_proj: [[f32; 4]; 4],
         camera_pos: [f32; 4],
         light_count: u32,
         ambient: f32,
@@ -100,5 +101,7 @@ gpu_struct!(
         position_scale: [f32; 4],
         albedo_roughness: [f32; 4],
         material: [f32; 4],
+        /// x: index of the object in the scene's object buffer (deferred-compute).
+        ids: [u32; 4],
     }
 );

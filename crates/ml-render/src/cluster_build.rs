@@ -159,7 +159,7 @@ impl GpuClusterBuilder {
     }
 
     /// Record the frame's build. Afterwards the lights, ranges and index list are visible to
-    /// fragment shaders and the feedback to the host.
+    /// fragment and compute shaders and the feedback to the host.
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: &GpuClusterFrame) {
         let d = &ctx.device;
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
@@ -201,7 +201,7 @@ impl GpuClusterBuilder {
             cmd,
             (compute, vk::AccessFlags::SHADER_WRITE),
             (
-                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST | vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::FRAGMENT_SHADER | compute | vk::PipelineStageFlags::HOST | vk::PipelineStageFlags::TRANSFER,
                 vk::AccessFlags::SHADER_READ | vk::AccessFlags::HOST_READ | vk::AccessFlags::TRANSFER_READ,
             ),
         );

@@ -1,10 +1,11 @@
-//! The forward render pass (SPEC §3): one render pass, one subpass. Technique `forward`
-//! loops every fragment over every light in a std430 storage buffer; `clustered-*` over the
-//! lights of the fragment's cluster (same pass, another fragment shader).
+//! The raster pass (SPEC §3): one render pass, one subpass. Technique `forward` loops every
+//! fragment over every light in a std430 storage buffer; `clustered-*` over the lights of the
+//! fragment's cluster (same pass, another fragment shader); `deferred-compute` writes a
+//! G-buffer here instead and lights it in a compute pass (deferred.rs).
 
 use crate::gpu_mesh::GpuMesh;
 use crate::settings::Technique;
-use crate::targets::COLOR_FORMAT;
+use crate::targets::{Output, COLOR_FORMAT, GBUFFER_NORMAL_FORMAT, GBUFFER_OBJECT_FORMAT};
 use ml_cpu::gpu_types::ObjectPush;
 use ml_cpu::mesh::Vertex;
 use ml_cpu::scene::Object;
@@ -24,8 +25,9 @@ pub struct ForwardPass {
     pub set_layout: vk::DescriptorSetLayout,
     pub pipeline_layout: vk::PipelineLayout,
     pub pipeline: vk::Pipeline,
-    /// Draws the cluster-heat legend over the image (no depth, no vertex buffer).
+    /// Draws the cluster-heat legend over the image (no depth, no vertex buffer; colour only).
     pub legend_pipeline: vk::Pipeline,
+    pub output: Output,
 }
 
 /// The two kinds of draw in the pass.
@@ -39,16 +41,22 @@ enum Draw {
 
 impl ForwardPass {
     pub fn new(ctx: &Context, depth_format: vk::Format, technique: Technique) -> Result<ForwardPass, VkError> {
+        let output = Output::of(technique);
         let mut pass = ForwardPass {
             render_pass: vk::RenderPass::null(),
             set_layout: vk::DescriptorSetLayout::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             legend_pipeline: vk::Pipeline::null(),
+            output,
         };
         // On failure, destroy what was made (null handles are ignored by vkDestroy*).
-        let fragment = if technique.is_clustered() { ml_shaders::CLUSTERED_FRAG } else { ml_shaders::FORWARD_FRAG };
-        match pass.create(ctx, depth_format, fragment) {
+        let fragment = match (output, technique.is_clustered()) {
+            (Output::GBuffer, _) => ml_shaders::GBUFFER_FRAG,
+            (Output::Color, true) => ml_shaders::CLUSTERED_FRAG,
+            (Output::Color, false) => ml_shaders::FORWARD_FRAG,
+        };
+        match pass.create(ctx, depth_format, fragment, output) {
             Ok(()) => Ok(pass),
             Err(e) => {
                 pass.destroy(ctx);
@@ -57,9 +65,9 @@ impl ForwardPass {
         }
     }
 
-    fn create(&mut self, ctx: &Context, depth_format: vk::Format, fragment: &[u8]) -> Result<(), VkError> {
+    fn create(&mut self, ctx: &Context, depth_format: vk::Format, fragment: &[u8], output: Output) -> Result<(), VkError> {
         let d = &ctx.device;
-        self.render_pass = create_render_pass(ctx, depth_format)?;
+        self.render_pass = create_render_pass(ctx, depth_format, output)?;
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         self.set_layout = shader::set_layout(
             ctx,
@@ -78,12 +86,16 @@ impl ForwardPass {
         let layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push);
         // SAFETY: as above.
         self.pipeline_layout = unsafe { d.create_pipeline_layout(&layout_info, None) }.ctx("vkCreatePipelineLayout")?;
-        self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh)?;
-        self.legend_pipeline = self.create_pipeline(ctx, ml_shaders::HEAT_LEGEND_VERT, ml_shaders::HEAT_LEGEND_FRAG, Draw::Overlay)?;
+        let colour_attachments = output.colour_attachments();
+        self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh, colour_attachments)?;
+        if output == Output::Color {
+            self.legend_pipeline =
+                self.create_pipeline(ctx, ml_shaders::HEAT_LEGEND_VERT, ml_shaders::HEAT_LEGEND_FRAG, Draw::Overlay, colour_attachments)?;
+        }
         Ok(())
     }
 
-    fn create_pipeline(&self, ctx: &Context, vertex: &[u8], fragment: &[u8], draw: Draw) -> Result<vk::Pipeline, VkError> {
+    fn create_pipeline(&self, ctx: &Context, vertex: &[u8], fragment: &[u8], draw: Draw, colour_attachments: usize) -> Result<vk::Pipeline, VkError> {
         let vert = shader::module(ctx, vertex)?;
         let frag = match shader::module(ctx, fragment) {
             Ok(f) => f,
@@ -133,7 +145,8 @@ impl ForwardPass {
             .depth_test_enable(draw == Draw::Mesh)
             .depth_write_enable(draw == Draw::Mesh)
             .depth_compare_op(vk::CompareOp::LESS);
-        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let blend_attachments =
+            vec![vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA); colour_attachments];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
@@ -175,10 +188,12 @@ impl ForwardPass {
         legend: bool,
     ) {
         let d = &ctx.device;
-        let clear = [
-            vk::ClearValue { color: vk::ClearColorValue { float32: CLEAR_COLOR } },
-            vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } },
-        ];
+        // Colour attachments clear to the background (G-buffer: zeros), depth to the far plane.
+        let colour = vk::ClearValue { color: vk::ClearColorValue { float32: CLEAR_COLOR } };
+        let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
+        let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
+        let clear: Vec<vk::ClearValue> =
+            if self.output == Output::Color { vec![colour, depth] } else { vec![zero, zero, depth] };
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
         let begin = vk::RenderPassBeginInfo::default()
             .render_pass(self.render_pass)
@@ -197,8 +212,8 @@ impl ForwardPass {
             for mesh in meshes {
                 d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
                 d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
-                for object in objects.iter().filter(|o| o.mesh == mesh.kind) {
-                    let push = object_push(object);
+                for (index, object) in objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
+                    let push = object_push(object, index as u32);
                     d.cmd_push_constants(
                         cmd,
                         self.pipeline_layout,
@@ -229,64 +244,78 @@ impl ForwardPass {
     }
 }
 
-pub fn object_push(o: &Object) -> ObjectPush {
+/// What a draw of object `index` pushes (also the object buffer's entry for deferred-compute).
+pub fn object_push(o: &Object, index: u32) -> ObjectPush {
     let m = &o.material;
     ObjectPush {
         position_scale: [o.position.x, o.position.y, o.position.z, o.scale],
         albedo_roughness: [m.albedo.x, m.albedo.y, m.albedo.z, m.roughness],
         material: [m.metallic, 0.0, 0.0, 0.0],
+        ids: [index, 0, 0, 0],
     }
 }
 
-fn create_render_pass(ctx: &Context, depth_format: vk::Format) -> Result<vk::RenderPass, VkError> {
-    let attachments = [
-        vk::AttachmentDescription::default()
-            .format(COLOR_FORMAT)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-            .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-            .initial_layout(vk::ImageLayout::UNDEFINED)
-            .final_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-        vk::AttachmentDescription::default()
-            .format(depth_format)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::DONT_CARE)
-            .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-            .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-            .initial_layout(vk::ImageLayout::UNDEFINED)
-            .final_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
-    ];
-    let color_ref = [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }];
-    let depth_ref = vk::AttachmentReference { attachment: 1, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
+fn attachment(format: vk::Format, store: bool, final_layout: vk::ImageLayout) -> vk::AttachmentDescription {
+    vk::AttachmentDescription::default()
+        .format(format)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(if store { vk::AttachmentStoreOp::STORE } else { vk::AttachmentStoreOp::DONT_CARE })
+        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .final_layout(final_layout)
+}
+
+fn create_render_pass(ctx: &Context, depth_format: vk::Format, output: Output) -> Result<vk::RenderPass, VkError> {
+    let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+    let attachments: Vec<vk::AttachmentDescription> = match output {
+        // The colour result is copied out; depth is not needed afterwards.
+        Output::Color => vec![
+            attachment(COLOR_FORMAT, true, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+            attachment(depth_format, false, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
+        ],
+        // Everything is read by the lighting compute pass.
+        Output::GBuffer => vec![
+            attachment(GBUFFER_NORMAL_FORMAT, true, read_only),
+            attachment(GBUFFER_OBJECT_FORMAT, true, read_only),
+            attachment(depth_format, true, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+        ],
+    };
+    let colour_count = output.colour_attachments() as u32;
+    let color_refs: Vec<vk::AttachmentReference> =
+        (0..colour_count).map(|attachment| vk::AttachmentReference { attachment, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }).collect();
+    let depth_ref = vk::AttachmentReference { attachment: colour_count, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
     let subpasses = [vk::SubpassDescription::default()
         .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
-        .color_attachments(&color_ref)
+        .color_attachments(&color_refs)
         .depth_stencil_attachment(&depth_ref)];
     let attachment_stages = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
         | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
         | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
     let attachment_writes = vk::AccessFlags::COLOR_ATTACHMENT_WRITE | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
+    // Who uses the attachments after the pass: the read-back copy, or the lighting compute pass.
+    let (after_stage, after_access) = match output {
+        Output::Color => (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
+        Output::GBuffer => (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ),
+    };
     let dependencies = [
         // The targets are reused every other frame: wait for the earlier frame's attachment
-        // writes and its read-back copy before clearing them again.
+        // writes and its readers before clearing them again.
         vk::SubpassDependency::default()
             .src_subpass(vk::SUBPASS_EXTERNAL)
             .dst_subpass(0)
-            .src_stage_mask(attachment_stages | vk::PipelineStageFlags::TRANSFER)
+            .src_stage_mask(attachment_stages | after_stage)
             .src_access_mask(attachment_writes)
             .dst_stage_mask(attachment_stages)
             .dst_access_mask(attachment_writes | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
-        // The colour result is copied out afterwards.
         vk::SubpassDependency::default()
             .src_subpass(0)
             .dst_subpass(vk::SUBPASS_EXTERNAL)
-            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
-            .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags::TRANSFER)
-            .dst_access_mask(vk::AccessFlags::TRANSFER_READ),
+            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS)
+            .src_access_mask(attachment_writes)
+            .dst_stage_mask(after_stage)
+            .dst_access_mask(after_access),
     ];
     let info = vk::RenderPassCreateInfo::default().attachments(&attachments).subpasses(&subpasses).dependencies(&dependencies);
     // SAFETY: valid device and create info.

@@ -4,6 +4,7 @@
 //! is ever dropped.
 
 use crate::cluster_build::{self as build, GpuClusterBuilder, GpuClusterFrame};
+use crate::deferred::{self, ComputeLighting, LightingInputs};
 use crate::forward::{BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
@@ -23,8 +24,10 @@ pub struct FrameInFlight {
     pub set: vk::DescriptorSet,
     pub timer: GpuTimer,
     pub targets: Option<Targets>,
-    /// The GPU cluster build's per-frame part (clustered-gpu only).
+    /// The GPU cluster build's per-frame part (clustered-gpu, deferred-compute).
     pub gpu: Option<GpuClusterFrame>,
+    /// deferred-compute: the lighting pass's set (null otherwise).
+    pub lighting_set: vk::DescriptorSet,
     /// Where lights and cluster lists live: host-visible (written by the CPU) or device-local
     /// (written by the GPU build).
     location: MemoryLocation,
@@ -41,8 +44,10 @@ pub struct FrameSetup<'a> {
     pub initial_indices: usize,
     pub passes: u32,
     pub make_targets: &'a dyn Fn() -> Result<Targets, VkError>,
-    /// Set for clustered-gpu: the GPU writes lights and lists.
+    /// Set for clustered-gpu and deferred-compute: the GPU writes lights and lists.
     pub builder: Option<&'a GpuClusterBuilder>,
+    /// Set for deferred-compute: the lighting pass that reads them.
+    pub lighting: Option<&'a ComputeLighting>,
 }
 
 /// Storage buffer for lights or cluster lists. Device-local ones can also be copied out
@@ -65,6 +70,7 @@ impl FrameInFlight {
             timer: GpuTimer::null(),
             targets: None,
             gpu: None,
+            lighting_set: vk::DescriptorSet::null(),
             location: if setup.builder.is_some() { MemoryLocation::GpuOnly } else { MemoryLocation::CpuToGpu },
         };
         // On failure everything made so far is released (null parts are skipped).
@@ -124,6 +130,16 @@ impl FrameInFlight {
                 write_set(ctx, set, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
             }
         }
+        if let Some(lighting) = setup.lighting {
+            let inputs = LightingInputs {
+                uniforms: self.uniforms.raw,
+                lights: self.lights.raw,
+                ranges: self.cluster_ranges.raw,
+                indices: self.light_indices.raw,
+                targets: self.targets.as_ref().expect("made above"),
+            };
+            self.lighting_set = lighting.frame_set(ctx, setup.descriptor_pool, &inputs)?;
+        }
         Ok(())
     }
 
@@ -157,6 +173,9 @@ impl FrameInFlight {
         self.bind(ctx, BINDING_LIGHT_INDICES, storage, self.light_indices.raw);
         if let Some(gpu) = &self.gpu {
             write_set(ctx, gpu.set, build::BINDING_INDICES, storage, self.light_indices.raw);
+        }
+        if self.lighting_set != vk::DescriptorSet::null() {
+            write_set(ctx, self.lighting_set, deferred::BINDING_INDICES, storage, self.light_indices.raw);
         }
         Ok(true)
     }

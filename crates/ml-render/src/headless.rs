@@ -2,15 +2,16 @@
 //! last frame into host memory. No window system needed.
 
 use crate::cluster_build::GpuClusterBuilder;
+use crate::deferred::ComputeLighting;
 use crate::error::RenderError;
-use crate::forward::ForwardPass;
+use crate::forward::{object_push, ForwardPass};
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
 use crate::report::FrameStats;
 use crate::settings::{DebugView, RenderSettings, Technique};
-use crate::targets::{depth_format, Targets};
+use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
@@ -47,8 +48,10 @@ pub struct HeadlessRenderer<'a> {
     /// The cluster grid (fixed: headless rendering keeps camera and size; its shader
     /// parameters are also set for `forward`, which ignores them).
     grid: ClusterGrid,
-    /// clustered-gpu: the compute passes and their shared buffers.
+    /// clustered-gpu, deferred-compute: the compute passes and their shared buffers.
     builder: Option<GpuClusterBuilder>,
+    /// deferred-compute: the lighting compute pass.
+    lighting: Option<ComputeLighting>,
     /// clustered-gpu: light-index entries every frame recorded from now on must hold (grows
     /// when a frame reports it needed more).
     required_indices: usize,
@@ -79,7 +82,7 @@ const MAX_RERENDERS: u32 = 2;
 impl<'a> HeadlessRenderer<'a> {
     pub fn new(ctx: &'a Context, scene: Scene, settings: RenderSettings) -> Result<HeadlessRenderer<'a>, RenderError> {
         settings.check(ctx, scene.lights.len())?;
-        let depth = depth_format(ctx)?;
+        let depth = depth_format(ctx, Output::of(settings.technique))?;
         let extent = vk::Extent2D { width: settings.width, height: settings.height };
         // clustered-gpu animates on the GPU; the others keep an animated copy on the CPU.
         let animated = if settings.technique.is_gpu_built() { Vec::new() } else { scene.lights.clone() };
@@ -101,6 +104,7 @@ impl<'a> HeadlessRenderer<'a> {
             clusters,
             grid,
             builder: None,
+            lighting: None,
             required_indices: 0,
             overflowed: vec![false; FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
@@ -125,19 +129,26 @@ impl<'a> HeadlessRenderer<'a> {
         if self.settings.technique.is_gpu_built() {
             self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
         }
-        // Per frame: the shading set (1 uniform + 3 storage) and, for clustered-gpu, the build
-        // set (1 uniform + 8 storage).
+        if self.settings.technique.lights_in_compute() {
+            let objects: Vec<ObjectPush> = self.scene.objects.iter().enumerate().map(|(i, o)| object_push(o, i as u32)).collect();
+            self.lighting = Some(ComputeLighting::new(ctx, &objects)?);
+        }
+        // Per frame: the shading set (1 uniform + 3 storage), the build set (1 uniform + 8
+        // storage) and the lighting set (1 uniform, 4 storage, 3 sampled images, 1 storage image).
         let n = FRAMES_IN_FLIGHT as u32;
         let sizes = [
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 2 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 11 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 3 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 15 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 3 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: n },
         ];
-        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(2 * n).pool_sizes(&sizes);
+        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(3 * n).pool_sizes(&sizes);
         // SAFETY: as above.
         self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
         let render_pass = self.pass.render_pass;
         let extent = self.extent;
-        let make_targets = || Targets::new(ctx, render_pass, extent, depth);
+        let output = self.pass.output;
+        let make_targets = || Targets::new(ctx, render_pass, extent, depth, output);
         let setup = FrameSetup {
             pool: self.command_pool,
             descriptor_pool: self.descriptor_pool,
@@ -150,6 +161,7 @@ impl<'a> HeadlessRenderer<'a> {
             passes: self.pass_names().len() as u32,
             make_targets: &make_targets,
             builder: self.builder.as_ref(),
+            lighting: self.lighting.as_ref(),
         };
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
@@ -168,11 +180,13 @@ impl<'a> HeadlessRenderer<'a> {
 
     /// The passes the timer reports, in order.
     fn pass_names(&self) -> Vec<&'static str> {
-        let shading = self.settings.technique.name();
-        if self.settings.technique.is_gpu_built() {
-            vec!["cluster build", shading]
+        let t = self.settings.technique;
+        if t.lights_in_compute() {
+            vec!["cluster build", "g-buffer", "lighting"]
+        } else if t.is_gpu_built() {
+            vec!["cluster build", t.name()]
         } else {
-            vec![shading]
+            vec![t.name()]
         }
     }
 
@@ -304,6 +318,7 @@ impl<'a> HeadlessRenderer<'a> {
         let uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),
             proj: g.projection.to_cols_array_2d(),
+            inv_view_proj: (g.projection * g.view).inverse().to_cols_array_2d(),
             camera_pos: cam.position.extend(1.0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
@@ -342,6 +357,12 @@ impl<'a> HeadlessRenderer<'a> {
         let legend = self.settings.debug_view == DebugView::ClusterHeat;
         self.pass.record(ctx, cmd, framebuffer, self.extent, frame.set, &self.meshes, &self.scene.objects, legend);
         frame.timer.end(ctx, cmd, pass);
+        if let Some(lighting) = &self.lighting {
+            pass += 1;
+            frame.timer.begin(ctx, cmd, pass);
+            lighting.record(ctx, cmd, frame.lighting_set, frame.targets.as_ref().expect("made with the frame"), self.extent);
+            frame.timer.end(ctx, cmd, pass);
+        }
         // SAFETY: recording state.
         unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")
     }
@@ -423,6 +444,9 @@ impl Drop for HeadlessRenderer<'_> {
         }
         if let Some(mut b) = self.builder.take() {
             b.destroy(ctx);
+        }
+        if let Some(mut l) = self.lighting.take() {
+            l.destroy(ctx);
         }
         for mesh in &mut self.meshes {
             mesh.destroy(ctx);

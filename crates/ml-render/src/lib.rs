@@ -2,6 +2,7 @@
 //! (ml-vk) and the CPU scene (ml-cpu).
 
 pub mod cluster_build;
+pub mod deferred;
 pub mod error;
 pub mod forward;
 pub mod frame;

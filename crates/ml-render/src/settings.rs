@@ -13,26 +13,34 @@ pub enum Technique {
     ClusteredCpu,
     /// Cluster grid built by compute shaders every frame; lights animated on the GPU.
     ClusteredGpu,
+    /// clustered-gpu's lists, with the lighting as a compute pass over a G-buffer.
+    DeferredCompute,
 }
 
 impl Technique {
-    pub const ALL: [Technique; 3] = [Technique::Forward, Technique::ClusteredCpu, Technique::ClusteredGpu];
+    pub const ALL: [Technique; 4] = [Technique::Forward, Technique::ClusteredCpu, Technique::ClusteredGpu, Technique::DeferredCompute];
 
     pub fn name(self) -> &'static str {
         match self {
             Technique::Forward => "forward",
             Technique::ClusteredCpu => "clustered-cpu",
             Technique::ClusteredGpu => "clustered-gpu",
+            Technique::DeferredCompute => "deferred-compute",
         }
     }
 
     pub fn is_clustered(self) -> bool {
-        matches!(self, Technique::ClusteredCpu | Technique::ClusteredGpu)
+        matches!(self, Technique::ClusteredCpu | Technique::ClusteredGpu | Technique::DeferredCompute)
+    }
+
+    /// Whether the lighting runs as a compute pass over a G-buffer.
+    pub fn lights_in_compute(self) -> bool {
+        matches!(self, Technique::DeferredCompute)
     }
 
     /// Whether the GPU builds the clusters (and animates the lights).
     pub fn is_gpu_built(self) -> bool {
-        matches!(self, Technique::ClusteredGpu)
+        matches!(self, Technique::ClusteredGpu | Technique::DeferredCompute)
     }
 
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {

@@ -1,49 +1,99 @@
-//! Offscreen render targets (colour + depth + framebuffer) for headless rendering.
+//! Offscreen render targets for headless rendering: the colour image that is read back, the
+//! depth buffer, the G-buffer of deferred-compute, and the framebuffer of the raster pass.
 
+use crate::settings::Technique;
 use ml_vk::{vk, Context, Image, VkError, VkResultExt};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+/// G-buffer: octahedral normal in two floats (8 B) — half floats would move the seed's sharp
+/// highlights by several 8-bit steps — and the object index (4 B); 12 B/pixel besides depth.
+pub const GBUFFER_NORMAL_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
+pub const GBUFFER_OBJECT_FORMAT: vk::Format = vk::Format::R32_UINT;
 
-/// The first depth format the device can render to (one of these two is guaranteed).
-pub fn depth_format(ctx: &Context) -> Result<vk::Format, VkError> {
+/// What the raster pass writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// The shaded colour (forward techniques).
+    Color,
+    /// A G-buffer that a compute pass lights (deferred-compute).
+    GBuffer,
+}
+
+impl Output {
+    pub fn of(technique: Technique) -> Output {
+        if technique.lights_in_compute() {
+            Output::GBuffer
+        } else {
+            Output::Color
+        }
+    }
+
+    pub fn colour_attachments(self) -> usize {
+        match self {
+            Output::Color => 1,
+            Output::GBuffer => 2,
+        }
+    }
+}
+
+/// The first depth format the device can render to (and, for a G-buffer, sample).
+pub fn depth_format(ctx: &Context, output: Output) -> Result<vk::Format, VkError> {
+    let mut needs = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT;
+    if output == Output::GBuffer {
+        needs |= vk::FormatFeatureFlags::SAMPLED_IMAGE;
+    }
     [vk::Format::D32_SFLOAT, vk::Format::X8_D24_UNORM_PACK32]
         .into_iter()
-        .find(|&f| ctx.format_supports(f, vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT))
-        .ok_or_else(|| VkError::Unsupported { device: ctx.info.name.clone(), what: "a depth attachment format".into() })
+        .find(|&f| ctx.format_supports(f, needs))
+        .ok_or_else(|| VkError::Unsupported { device: ctx.info.name.clone(), what: format!("a depth format with {needs:?}") })
 }
 
 pub struct Targets {
+    /// The image that is read back (a colour attachment, or a storage image the lighting
+    /// compute pass writes).
     pub color: Image,
     pub depth: Image,
+    /// deferred-compute: normal and object-index images (empty otherwise).
+    pub gbuffer: Vec<Image>,
     pub framebuffer: vk::Framebuffer,
 }
 
 impl Targets {
-    pub fn new(ctx: &Context, render_pass: vk::RenderPass, extent: vk::Extent2D, depth_format: vk::Format) -> Result<Targets, VkError> {
-        let mut color = Image::new_2d(
-            ctx,
-            "colour target",
-            extent,
-            COLOR_FORMAT,
-            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-            vk::ImageAspectFlags::COLOR,
-        )?;
-        let mut depth = match Image::new_2d(
-            ctx,
-            "depth target",
-            extent,
-            depth_format,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-            vk::ImageAspectFlags::DEPTH,
-        ) {
-            Ok(d) => d,
-            Err(e) => {
-                color.destroy(ctx);
-                return Err(e);
-            }
+    pub fn new(ctx: &Context, render_pass: vk::RenderPass, extent: vk::Extent2D, depth_format: vk::Format, output: Output) -> Result<Targets, VkError> {
+        let mut t = Targets {
+            color: Image::null(),
+            depth: Image::null(),
+            gbuffer: Vec::new(),
+            framebuffer: vk::Framebuffer::null(),
         };
-        let views = [color.view, depth.view];
+        match t.create(ctx, render_pass, extent, depth_format, output) {
+            Ok(()) => Ok(t),
+            Err(e) => {
+                t.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn create(&mut self, ctx: &Context, render_pass: vk::RenderPass, extent: vk::Extent2D, depth_format: vk::Format, output: Output) -> Result<(), VkError> {
+        use vk::ImageUsageFlags as U;
+        let colour = vk::ImageAspectFlags::COLOR;
+        let (color_usage, depth_usage) = match output {
+            Output::Color => (U::COLOR_ATTACHMENT | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT),
+            Output::GBuffer => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED),
+        };
+        self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
+        self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
+        if output == Output::GBuffer {
+            for (name, format) in [("g-buffer normal", GBUFFER_NORMAL_FORMAT), ("g-buffer object", GBUFFER_OBJECT_FORMAT)] {
+                self.gbuffer.push(Image::new_2d(ctx, name, extent, format, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?);
+            }
+        }
+        let views: Vec<vk::ImageView> = match output {
+            Output::Color => vec![self.color.view, self.depth.view],
+            Output::GBuffer => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.depth.view],
+        };
         let info = vk::FramebufferCreateInfo::default()
             .render_pass(render_pass)
             .attachments(&views)
@@ -51,20 +101,18 @@ impl Targets {
             .height(extent.height)
             .layers(1);
         // SAFETY: views and render pass are compatible and alive.
-        match unsafe { ctx.device.create_framebuffer(&info, None) }.ctx("vkCreateFramebuffer") {
-            Ok(framebuffer) => Ok(Targets { color, depth, framebuffer }),
-            Err(e) => {
-                color.destroy(ctx);
-                depth.destroy(ctx);
-                Err(e)
-            }
-        }
+        self.framebuffer = unsafe { ctx.device.create_framebuffer(&info, None) }.ctx("vkCreateFramebuffer")?;
+        Ok(())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: no pending work uses the framebuffer.
+        // SAFETY: no pending work uses the framebuffer; a null handle is ignored.
         unsafe { ctx.device.destroy_framebuffer(self.framebuffer, None) };
+        self.framebuffer = vk::Framebuffer::null();
         self.color.destroy(ctx);
         self.depth.destroy(ctx);
+        for image in &mut self.gbuffer {
+            image.destroy(ctx);
+        }
     }
 }

@@ -3,7 +3,8 @@
 //! straddling the near plane, around the eye, radii 0.2–40 (cameras inside light spheres)
 //! and 1–5,000 lights, plus the seed scene; max channel difference ≤ 1/255.
 //! clustered-gpu fills its lists with atomics, so a cluster's lights come in any order and the
-//! float sum may round differently: that is what the 1/255 is for.
+//! float sum may round differently: that is what the 1/255 is for. deferred-compute (the same
+//! lists, lit in a compute pass over a G-buffer) is allowed 2/255, see MAX_DIFF_DEFERRED.
 //!
 //! Both shaders sum the same lights in the same (ascending) order, so in practice the
 //! images are identical; the 1/255 allowance covers compilers contracting the two loops'
@@ -22,8 +23,12 @@ use ml_render::{RenderSettings, Technique};
 const W: u32 = 160;
 const H: u32 = 90;
 const MAX_DIFF: u8 = 1;
+/// deferred-compute rebuilds the position from the depth buffer (instead of interpolating it)
+/// and stores the normal octahedrally in two floats: both move sharp highlights by a few
+/// 1e-5, which at roughness 0.1 turns into at most 2/255 on a few pixels per image.
+const MAX_DIFF_DEFERRED: u8 = 2;
 
-const CLUSTERED: [Technique; 2] = [Technique::ClusteredCpu, Technique::ClusteredGpu];
+const CLUSTERED: [Technique; 3] = [Technique::ClusteredCpu, Technique::ClusteredGpu, Technique::DeferredCompute];
 
 /// What a comparison saw, summed over scenes.
 #[derive(Default)]
@@ -51,7 +56,8 @@ fn assert_matches_forward(name: &str, scene: &Scene, clusters: ClusterDims) -> S
             "{name} {}: {} lights, clusters {}x{}x{}: max diff {worst}/255 in {pixels} pixels; lights/cluster mean {:.1} max {}; index growths {}, overflowed frames {}",
             t.name(), scene.lights.len(), clusters.x, clusters.y, clusters.z, c.mean_lights, c.max_lights, o.stats.index_growths, o.stats.overflowed_frames
         );
-        assert!(worst <= MAX_DIFF, "{name}: {} differs from forward by {worst}/255", t.name());
+        let allowed = if t.lights_in_compute() { MAX_DIFF_DEFERRED } else { MAX_DIFF };
+        assert!(worst <= allowed, "{name}: {} differs from forward by {worst}/255", t.name());
         seen.growths += o.stats.index_growths;
         seen.overflows += o.stats.overflowed_frames;
     }
