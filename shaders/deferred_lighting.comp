@@ -19,7 +19,7 @@ layout(set = 0, binding = 6) uniform sampler2D normal_image;
 layout(set = 0, binding = 7) uniform usampler2D object_image;
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 
-// Keep in sync with forward.rs CLEAR_COLOR.
+// Keep in sync with raster.rs CLEAR_COLOR.
 const vec4 CLEAR_COLOR = vec4(0.02, 0.02, 0.02, 1.0);
 
 void main() {

@@ -1,4 +1,4 @@
-//! Technique `deferred-compute`: the raster pass writes a G-buffer (forward.rs, Output::GBuffer)
+//! Technique `deferred-compute`: the raster pass writes a G-buffer (raster.rs, Output::GBuffer)
 //! and this compute pass lights it through the clustered-gpu lists — the same BRDF, cluster
 //! lookup and light order as the fragment path, on every SM (H100/H200 give graphics work 4 of
 //! 132). Its output is the colour target, left in TRANSFER_SRC_OPTIMAL like the forward pass's.
@@ -98,8 +98,10 @@ impl ComputeLighting {
     pub fn frame_set(&self, ctx: &Context, pool: vk::DescriptorPool, inputs: &LightingInputs) -> Result<vk::DescriptorSet, VkError> {
         let layouts = [self.set_layout];
         // SAFETY: the pool has room for one lighting set per frame.
-        let set = unsafe { ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts)) }
-            .ctx("vkAllocateDescriptorSets")?[0];
+        let set = unsafe {
+            ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+        }
+        .ctx("vkAllocateDescriptorSets")?[0];
         let buffer = |b: vk::Buffer| [vk::DescriptorBufferInfo::default().buffer(b).range(vk::WHOLE_SIZE)];
         let buffers = [
             (BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, buffer(inputs.uniforms)),
@@ -114,7 +116,11 @@ impl ComputeLighting {
             [vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(view).image_layout(layout)]
         };
         let images = [
-            (BINDING_DEPTH, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, sampled(t.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)),
+            (
+                BINDING_DEPTH,
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                sampled(t.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            ),
             (BINDING_NORMAL, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, sampled(t.gbuffer[0].view, read_only)),
             (BINDING_OBJECT_ID, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, sampled(t.gbuffer[1].view, read_only)),
             (
@@ -128,7 +134,9 @@ impl ComputeLighting {
             .map(|(b, ty, info)| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(*b).descriptor_type(*ty).buffer_info(info))
             .collect();
         writes.extend(
-            images.iter().map(|(b, ty, info)| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(*b).descriptor_type(*ty).image_info(info)),
+            images
+                .iter()
+                .map(|(b, ty, info)| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(*b).descriptor_type(*ty).image_info(info)),
         );
         // SAFETY: the set and everything it points at are alive and unused.
         unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };

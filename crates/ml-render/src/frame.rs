@@ -5,7 +5,7 @@
 
 use crate::cluster_build::{self as build, GpuClusterBuilder, GpuClusterFrame};
 use crate::deferred::{self, ComputeLighting, LightingInputs};
-use crate::forward::{BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
+use crate::raster::{BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::cluster::ClusterLists;

@@ -4,9 +4,9 @@
 use crate::cluster_build::GpuClusterBuilder;
 use crate::deferred::ComputeLighting;
 use crate::error::RenderError;
-use crate::forward::{object_push, ForwardPass};
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
+use crate::raster::{object_push, RasterPass};
 use crate::report::FrameStats;
 use crate::settings::{DebugView, RenderSettings, Technique};
 use crate::targets::{depth_format, Output, Targets};
@@ -36,7 +36,7 @@ pub struct HeadlessRenderer<'a> {
     scene: Scene,
     settings: RenderSettings,
     extent: vk::Extent2D,
-    pass: ForwardPass,
+    pass: RasterPass,
     meshes: Vec<GpuMesh>,
     command_pool: vk::CommandPool,
     descriptor_pool: vk::DescriptorPool,
@@ -94,7 +94,7 @@ impl<'a> HeadlessRenderer<'a> {
             scene,
             settings,
             extent,
-            pass: ForwardPass::new(ctx, depth, settings.technique)?,
+            pass: RasterPass::new(ctx, depth, settings.technique)?,
             meshes: Vec::new(),
             command_pool: vk::CommandPool::null(),
             descriptor_pool: vk::DescriptorPool::null(),

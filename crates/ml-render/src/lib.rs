@@ -4,10 +4,10 @@
 pub mod cluster_build;
 pub mod deferred;
 pub mod error;
-pub mod forward;
 pub mod frame;
 pub mod gpu_mesh;
 pub mod headless;
+pub mod raster;
 pub mod report;
 pub mod settings;
 pub mod targets;

@@ -60,13 +60,14 @@ pub struct Targets {
 }
 
 impl Targets {
-    pub fn new(ctx: &Context, render_pass: vk::RenderPass, extent: vk::Extent2D, depth_format: vk::Format, output: Output) -> Result<Targets, VkError> {
-        let mut t = Targets {
-            color: Image::null(),
-            depth: Image::null(),
-            gbuffer: Vec::new(),
-            framebuffer: vk::Framebuffer::null(),
-        };
+    pub fn new(
+        ctx: &Context,
+        render_pass: vk::RenderPass,
+        extent: vk::Extent2D,
+        depth_format: vk::Format,
+        output: Output,
+    ) -> Result<Targets, VkError> {
+        let mut t = Targets { color: Image::null(), depth: Image::null(), gbuffer: Vec::new(), framebuffer: vk::Framebuffer::null() };
         match t.create(ctx, render_pass, extent, depth_format, output) {
             Ok(()) => Ok(t),
             Err(e) => {
@@ -76,7 +77,14 @@ impl Targets {
         }
     }
 
-    fn create(&mut self, ctx: &Context, render_pass: vk::RenderPass, extent: vk::Extent2D, depth_format: vk::Format, output: Output) -> Result<(), VkError> {
+    fn create(
+        &mut self,
+        ctx: &Context,
+        render_pass: vk::RenderPass,
+        extent: vk::Extent2D,
+        depth_format: vk::Format,
+        output: Output,
+    ) -> Result<(), VkError> {
         use vk::ImageUsageFlags as U;
         let colour = vk::ImageAspectFlags::COLOR;
         let (color_usage, depth_usage) = match output {

@@ -18,7 +18,13 @@ impl Image {
     /// An image that owns nothing (destroying it does nothing): a placeholder while a larger
     /// object is being built.
     pub fn null() -> Image {
-        Image { raw: vk::Image::null(), view: vk::ImageView::null(), format: vk::Format::UNDEFINED, extent: vk::Extent2D::default(), allocation: None }
+        Image {
+            raw: vk::Image::null(),
+            view: vk::ImageView::null(),
+            format: vk::Format::UNDEFINED,
+            extent: vk::Extent2D::default(),
+            allocation: None,
+        }
     }
 
     pub fn new_2d(

@@ -20,7 +20,7 @@ pub const BINDING_LIGHT_INDICES: u32 = 3;
 /// Background of pixels no object covers (linear, before the UNORM store).
 pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
 
-pub struct ForwardPass {
+pub struct RasterPass {
     pub render_pass: vk::RenderPass,
     pub set_layout: vk::DescriptorSetLayout,
     pub pipeline_layout: vk::PipelineLayout,
@@ -39,10 +39,10 @@ enum Draw {
     Overlay,
 }
 
-impl ForwardPass {
-    pub fn new(ctx: &Context, depth_format: vk::Format, technique: Technique) -> Result<ForwardPass, VkError> {
+impl RasterPass {
+    pub fn new(ctx: &Context, depth_format: vk::Format, technique: Technique) -> Result<RasterPass, VkError> {
         let output = Output::of(technique);
-        let mut pass = ForwardPass {
+        let mut pass = RasterPass {
             render_pass: vk::RenderPass::null(),
             set_layout: vk::DescriptorSetLayout::null(),
             pipeline_layout: vk::PipelineLayout::null(),
@@ -95,7 +95,14 @@ impl ForwardPass {
         Ok(())
     }
 
-    fn create_pipeline(&self, ctx: &Context, vertex: &[u8], fragment: &[u8], draw: Draw, colour_attachments: usize) -> Result<vk::Pipeline, VkError> {
+    fn create_pipeline(
+        &self,
+        ctx: &Context,
+        vertex: &[u8],
+        fragment: &[u8],
+        draw: Draw,
+        colour_attachments: usize,
+    ) -> Result<vk::Pipeline, VkError> {
         let vert = shader::module(ctx, vertex)?;
         let frag = match shader::module(ctx, fragment) {
             Ok(f) => f,
@@ -192,8 +199,7 @@ impl ForwardPass {
         let colour = vk::ClearValue { color: vk::ClearColorValue { float32: CLEAR_COLOR } };
         let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
-        let clear: Vec<vk::ClearValue> =
-            if self.output == Output::Color { vec![colour, depth] } else { vec![zero, zero, depth] };
+        let clear: Vec<vk::ClearValue> = if self.output == Output::Color { vec![colour, depth] } else { vec![zero, zero, depth] };
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
         let begin = vk::RenderPassBeginInfo::default()
             .render_pass(self.render_pass)
@@ -283,8 +289,9 @@ fn create_render_pass(ctx: &Context, depth_format: vk::Format, output: Output) -
         ],
     };
     let colour_count = output.colour_attachments() as u32;
-    let color_refs: Vec<vk::AttachmentReference> =
-        (0..colour_count).map(|attachment| vk::AttachmentReference { attachment, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }).collect();
+    let color_refs: Vec<vk::AttachmentReference> = (0..colour_count)
+        .map(|attachment| vk::AttachmentReference { attachment, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL })
+        .collect();
     let depth_ref = vk::AttachmentReference { attachment: colour_count, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
     let subpasses = [vk::SubpassDescription::default()
         .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
