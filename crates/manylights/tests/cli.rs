@@ -96,6 +96,10 @@ fn bad_names_are_refused_with_the_choices() {
     assert_one_line_error(&manylights(&["render", "--clusters", "0x9x24", "--out", p], &[]), &["--clusters 0x9x24"]);
     assert_one_line_error(&manylights(&["render", "--debug-view", "xray", "--out", p], &[]), &["xray", "cluster-heat"]);
     assert_one_line_error(&manylights(&["render", "--debug-view", "cluster-heat", "--out", p], &[]), &["clustered forward technique"]);
+    assert_one_line_error(
+        &manylights(&["render", "--technique", "deferred-compute", "--debug-view", "cluster-heat", "--out", p], &[]),
+        &["clustered forward technique"],
+    );
     assert!(!png.exists());
 }
 

@@ -78,7 +78,7 @@ impl GpuClusterFrame {
 
 impl GpuClusterBuilder {
     pub fn new(ctx: &Context, rest_lights: &[PointLight], cluster_count: usize) -> Result<GpuClusterBuilder, VkError> {
-        let mut b = GpuClusterBuilder {
+        let b = GpuClusterBuilder {
             set_layout: vk::DescriptorSetLayout::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             bounds_pipeline: vk::Pipeline::null(),
@@ -91,13 +91,7 @@ impl GpuClusterBuilder {
             light_count: rest_lights.len() as u32,
             cluster_count: cluster_count as u32,
         };
-        match b.create(ctx, rest_lights) {
-            Ok(()) => Ok(b),
-            Err(e) => {
-                b.destroy(ctx);
-                Err(e)
-            }
-        }
+        ml_vk::build(ctx, b, |b| b.create(ctx, rest_lights))
     }
 
     fn create(&mut self, ctx: &Context, rest_lights: &[PointLight]) -> Result<(), VkError> {
@@ -117,11 +111,7 @@ impl GpuClusterBuilder {
             .map(|b| (b, storage)),
         );
         self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::COMPUTE)?;
-        let layouts = [self.set_layout];
-        // SAFETY: valid device and create info.
-        self.pipeline_layout =
-            unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }
-                .ctx("vkCreatePipelineLayout")?;
+        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout], &[])?;
         self.bounds_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BOUNDS_COMP, self.pipeline_layout, &[])?;
         // Specialization constants: 0 = FILL, 1 = LANES (cluster_build.comp); 0 = STEP (scan).
         self.count_pipeline =
@@ -209,13 +199,13 @@ impl GpuClusterBuilder {
 
     /// This frame's build resources (its set is written by the caller, see `frame.rs`).
     pub fn frame_resources(&self, ctx: &Context, pool: vk::DescriptorPool) -> Result<GpuClusterFrame, VkError> {
-        let mut frame = GpuClusterFrame {
+        let frame = GpuClusterFrame {
             counters: Buffer::null(),
             feedback: Buffer::null(),
             scan_blocks: Buffer::null(),
             set: vk::DescriptorSet::null(),
         };
-        let result = (|| {
+        ml_vk::build(ctx, frame, |frame| {
             frame.counters = Buffer::new(
                 ctx,
                 "cluster counters",
@@ -244,14 +234,7 @@ impl GpuClusterBuilder {
             }
             .ctx("vkAllocateDescriptorSets")?[0];
             Ok(())
-        })();
-        match result {
-            Ok(()) => Ok(frame),
-            Err(e) => {
-                frame.destroy(ctx);
-                Err(e)
-            }
-        }
+        })
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -265,5 +248,17 @@ impl GpuClusterBuilder {
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
             ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
+    }
+}
+
+impl ml_vk::Release for GpuClusterBuilder {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for GpuClusterFrame {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
     }
 }

@@ -40,20 +40,14 @@ pub struct LightingInputs<'a> {
 
 impl ComputeLighting {
     pub fn new(ctx: &Context, objects: &[ObjectPush]) -> Result<ComputeLighting, VkError> {
-        let mut l = ComputeLighting {
+        let l = ComputeLighting {
             set_layout: vk::DescriptorSetLayout::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             sampler: vk::Sampler::null(),
             objects: Buffer::null(),
         };
-        match l.create(ctx, objects) {
-            Ok(()) => Ok(l),
-            Err(e) => {
-                l.destroy(ctx);
-                Err(e)
-            }
-        }
+        ml_vk::build(ctx, l, |l| l.create(ctx, objects))
     }
 
     fn create(&mut self, ctx: &Context, objects: &[ObjectPush]) -> Result<(), VkError> {
@@ -75,11 +69,7 @@ impl ComputeLighting {
             ],
             vk::ShaderStageFlags::COMPUTE,
         )?;
-        let layouts = [self.set_layout];
-        // SAFETY: valid device and create infos.
-        self.pipeline_layout =
-            unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }
-                .ctx("vkCreatePipelineLayout")?;
+        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout], &[])?;
         self.pipeline = shader::compute_pipeline(ctx, ml_shaders::DEFERRED_LIGHTING_COMP, self.pipeline_layout, &[])?;
         // texelFetch ignores filtering; the sampler only has to exist.
         let sampler_info = vk::SamplerCreateInfo::default()
@@ -186,5 +176,11 @@ impl ComputeLighting {
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
             ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
+    }
+}
+
+impl ml_vk::Release for ComputeLighting {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
     }
 }

@@ -59,7 +59,7 @@ fn list_buffer(ctx: &Context, name: &str, bytes: usize, location: MemoryLocation
 
 impl FrameInFlight {
     pub fn new(ctx: &Context, setup: &FrameSetup) -> Result<FrameInFlight, VkError> {
-        let mut frame = FrameInFlight {
+        let frame = FrameInFlight {
             cmd: vk::CommandBuffer::null(),
             fence: vk::Fence::null(),
             uniforms: Buffer::null(),
@@ -74,13 +74,7 @@ impl FrameInFlight {
             location: if setup.builder.is_some() { MemoryLocation::GpuOnly } else { MemoryLocation::CpuToGpu },
         };
         // On failure everything made so far is released (null parts are skipped).
-        match frame.create(ctx, setup) {
-            Ok(()) => Ok(frame),
-            Err(e) => {
-                frame.destroy(ctx);
-                Err(e)
-            }
-        }
+        ml_vk::build(ctx, frame, |f| f.create(ctx, setup))
     }
 
     fn create(&mut self, ctx: &Context, setup: &FrameSetup) -> Result<(), VkError> {
@@ -226,4 +220,10 @@ pub fn lists_too_long(needed: usize, limit: usize, holder: &str) -> VkError {
         (needed as u64 * 4) >> 20,
         (limit as u64 * 4) >> 20
     ))
+}
+
+impl ml_vk::Release for FrameInFlight {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
 }

@@ -42,7 +42,7 @@ enum Draw {
 impl RasterPass {
     pub fn new(ctx: &Context, depth_format: vk::Format, technique: Technique) -> Result<RasterPass, VkError> {
         let output = Output::of(technique);
-        let mut pass = RasterPass {
+        let pass = RasterPass {
             render_pass: vk::RenderPass::null(),
             set_layout: vk::DescriptorSetLayout::null(),
             pipeline_layout: vk::PipelineLayout::null(),
@@ -56,17 +56,10 @@ impl RasterPass {
             (Output::Color, true) => ml_shaders::CLUSTERED_FRAG,
             (Output::Color, false) => ml_shaders::FORWARD_FRAG,
         };
-        match pass.create(ctx, depth_format, fragment, output) {
-            Ok(()) => Ok(pass),
-            Err(e) => {
-                pass.destroy(ctx);
-                Err(e)
-            }
-        }
+        ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, fragment, output))
     }
 
     fn create(&mut self, ctx: &Context, depth_format: vk::Format, fragment: &[u8], output: Output) -> Result<(), VkError> {
-        let d = &ctx.device;
         self.render_pass = create_render_pass(ctx, depth_format, output)?;
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         self.set_layout = shader::set_layout(
@@ -82,10 +75,7 @@ impl RasterPass {
         let push = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             .size(std::mem::size_of::<ObjectPush>() as u32)];
-        let layouts = [self.set_layout];
-        let layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push);
-        // SAFETY: as above.
-        self.pipeline_layout = unsafe { d.create_pipeline_layout(&layout_info, None) }.ctx("vkCreatePipelineLayout")?;
+        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout], &push)?;
         let colour_attachments = output.colour_attachments();
         self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh, colour_attachments)?;
         if output == Output::Color {
@@ -327,4 +317,10 @@ fn create_render_pass(ctx: &Context, depth_format: vk::Format, output: Output) -
     let info = vk::RenderPassCreateInfo::default().attachments(&attachments).subpasses(&subpasses).dependencies(&dependencies);
     // SAFETY: valid device and create info.
     unsafe { ctx.device.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")
+}
+
+impl ml_vk::Release for RasterPass {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
 }

@@ -111,9 +111,10 @@ impl RenderSettings {
                 return Err(RenderError::Invalid(format!("{what} {v} is out of range: use 1 to {max_dim}")));
             }
         }
-        if self.debug_view == DebugView::ClusterHeat && !self.technique.is_clustered() {
+        // The heat view is drawn by the clustered fragment shader (deferred-compute has none).
+        if self.debug_view == DebugView::ClusterHeat && (!self.technique.is_clustered() || self.technique.lights_in_compute()) {
             return Err(RenderError::Invalid(format!(
-                "--debug-view cluster-heat needs a clustered technique, not {}",
+                "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}",
                 self.technique.name()
             )));
         }

@@ -67,14 +67,8 @@ impl Targets {
         depth_format: vk::Format,
         output: Output,
     ) -> Result<Targets, VkError> {
-        let mut t = Targets { color: Image::null(), depth: Image::null(), gbuffer: Vec::new(), framebuffer: vk::Framebuffer::null() };
-        match t.create(ctx, render_pass, extent, depth_format, output) {
-            Ok(()) => Ok(t),
-            Err(e) => {
-                t.destroy(ctx);
-                Err(e)
-            }
-        }
+        let t = Targets { color: Image::null(), depth: Image::null(), gbuffer: Vec::new(), framebuffer: vk::Framebuffer::null() };
+        ml_vk::build(ctx, t, |t| t.create(ctx, render_pass, extent, depth_format, output))
     }
 
     fn create(
@@ -122,5 +116,11 @@ impl Targets {
         for image in &mut self.gbuffer {
             image.destroy(ctx);
         }
+    }
+}
+
+impl ml_vk::Release for Targets {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
     }
 }

@@ -21,9 +21,7 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
         shader::set_layout(ctx, &[(0, vk::DescriptorType::UNIFORM_BUFFER), (1, storage), (2, storage)], vk::ShaderStageFlags::COMPUTE)
             .unwrap();
     let layouts = [layout];
-    // SAFETY: valid device and create infos; everything is destroyed below after the wait.
-    let pipeline_layout =
-        unsafe { ctx.device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None) }.unwrap();
+    let pipeline_layout = shader::pipeline_layout(ctx, &layouts, &[]).unwrap();
     let pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SLICE_PROBE_COMP, pipeline_layout, &[]).unwrap();
     let sizes = [
         vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },

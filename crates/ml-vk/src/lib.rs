@@ -17,3 +17,20 @@ pub use context::{Context, ContextDesc, DeviceInfo};
 pub use error::{VkError, VkResultExt};
 pub use image::Image;
 pub use timing::GpuTimer;
+
+/// Objects made of several Vulkan objects release them all, skipping parts never made (null).
+pub trait Release {
+    fn release(&mut self, ctx: &Context);
+}
+
+/// Finish building `value` (which starts with null parts) with `create`; if that fails,
+/// release whatever it made before returning the error.
+pub fn build<T: Release, E>(ctx: &Context, mut value: T, create: impl FnOnce(&mut T) -> Result<(), E>) -> Result<T, E> {
+    match create(&mut value) {
+        Ok(()) => Ok(value),
+        Err(e) => {
+            value.release(ctx);
+            Err(e)
+        }
+    }
+}

@@ -45,3 +45,14 @@ pub fn set_layout(ctx: &Context, bindings: &[(u32, vk::DescriptorType)], stages:
     unsafe { ctx.device.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
         .ctx("vkCreateDescriptorSetLayout")
 }
+
+/// A pipeline layout of `set_layouts` and `push_constants`.
+pub fn pipeline_layout(
+    ctx: &Context,
+    set_layouts: &[vk::DescriptorSetLayout],
+    push_constants: &[vk::PushConstantRange],
+) -> Result<vk::PipelineLayout> {
+    let info = vk::PipelineLayoutCreateInfo::default().set_layouts(set_layouts).push_constant_ranges(push_constants);
+    // SAFETY: valid device and create info.
+    unsafe { ctx.device.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")
+}
