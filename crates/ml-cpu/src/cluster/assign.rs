@@ -181,8 +181,17 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
     let k0 = grid.slice(d0);
     let k1 = grid.slice(dmax.min(grid.far));
     let r2 = r * r;
-    let centre = glam::Vec3A::from(c);
+    // Squared distance from v to [lo, hi] along one axis.
+    let gap2 = |v: f32, (lo, hi): (f32, f32)| {
+        let g = (lo - v).max(v - hi).max(0.0);
+        g * g
+    };
     for z in k0..=k1 {
+        // The box test is separable (grid.rs x/y/z_extents): reject whole slices and rows.
+        let dz2 = gap2(c.z, grid.z_extents[z as usize]);
+        if dz2 > r2 {
+            continue;
+        }
         // The part of the sphere in this slice's depth range.
         let (s0, s1) = grid.slice_depths(z);
         let (s0, s1) = (s0.max(dmin).max(grid.near), s1.min(dmax));
@@ -194,11 +203,16 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
         let inv = (1.0 / s0, 1.0 / s1);
         let Some((x0, x1)) = grid.tile_span_x(c.x - rr, c.x + rr, inv) else { continue };
         let Some((y0, y1)) = grid.tile_span_y(c.y - rr, c.y + rr, inv) else { continue };
+        let xs = &grid.x_extents[(z * grid.dims.x) as usize..][..grid.dims.x as usize];
         for y in y0..=y1 {
+            let dzy2 = dz2 + gap2(c.y, grid.y_extents[(z * grid.dims.y + y) as usize]);
+            if dzy2 > r2 {
+                continue;
+            }
+            let row = grid.index(0, y, z);
             for x in x0..=x1 {
-                let index = grid.index(x, y, z);
-                if grid.bounds[index as usize].distance_squared(centre) <= r2 {
-                    emit(index);
+                if dzy2 + gap2(c.x, xs[x as usize]) <= r2 {
+                    emit(row + x);
                 }
             }
         }

@@ -98,6 +98,12 @@ pub struct ClusterGrid {
     pub projection: Mat4,
     /// View-space bounds of every cluster, index = (z·Y + y)·X + x.
     pub bounds: Vec<Aabb>,
+    /// The same boxes by axis: a cluster's x extent depends only on its tile column and
+    /// slice, y only on row and slice, z only on slice (corners are tile rays × slice depths).
+    /// Index z·X + x, z·Y + y and z.
+    pub x_extents: Vec<(f32, f32)>,
+    pub y_extents: Vec<(f32, f32)>,
+    pub z_extents: Vec<(f32, f32)>,
     /// Depth where each slice starts, with slack (Z + 1 entries; the last is far).
     slice_starts: Vec<f32>,
     /// Tile of every pixel column and row (the assignment looks tiles up per light and slice;
@@ -133,6 +139,9 @@ impl ClusterGrid {
             slice_starts: Vec::new(),
             tile_of_column: Vec::new(),
             tile_of_row: Vec::new(),
+            x_extents: Vec::new(),
+            y_extents: Vec::new(),
+            z_extents: Vec::new(),
         };
         // The tile spans below project with x_clip = p00·x, y_clip = p11·y, w = −z: a symmetric
         // perspective, which is what `Camera::projection` makes.
@@ -142,6 +151,8 @@ impl ClusterGrid {
         grid.tile_of_column = (0..width).map(|px| tile_of(px, dims.x, width)).collect();
         grid.tile_of_row = (0..height).map(|py| tile_of(py, dims.y, height)).collect();
         grid.bounds = grid.compute_bounds();
+        let (x_extents, y_extents, z_extents) = grid.axis_extents();
+        (grid.x_extents, grid.y_extents, grid.z_extents) = (x_extents, y_extents, z_extents);
         grid
     }
 
@@ -209,6 +220,17 @@ impl ClusterGrid {
         let first = (t as u64 * size as u64).div_ceil(tiles as u64);
         let last = ((t as u64 + 1) * size as u64).div_ceil(tiles as u64) - 1;
         (first as f32 + 0.5, last as f32 + 0.5)
+    }
+
+    /// The boxes' extents per axis (see `x_extents`), read off the boxes.
+    #[allow(clippy::type_complexity)]
+    fn axis_extents(&self) -> (Vec<(f32, f32)>, Vec<(f32, f32)>, Vec<(f32, f32)>) {
+        let d = self.dims;
+        let b = |x: u32, y: u32, z: u32| self.bounds[self.index(x, y, z) as usize];
+        let xs = (0..d.z).flat_map(|z| (0..d.x).map(move |x| (x, z))).map(|(x, z)| (b(x, 0, z).min.x, b(x, 0, z).max.x)).collect();
+        let ys = (0..d.z).flat_map(|z| (0..d.y).map(move |y| (y, z))).map(|(y, z)| (b(0, y, z).min.y, b(0, y, z).max.y)).collect();
+        let zs = (0..d.z).map(|z| (b(0, 0, z).min.z, b(0, 0, z).max.z)).collect();
+        (xs, ys, zs)
     }
 
     fn compute_bounds(&self) -> Vec<Aabb> {

@@ -230,3 +230,22 @@ fn assignment_stops_at_its_limit_instead_of_exhausting_memory() {
     // Within the limit it succeeds.
     ClusterAssigner::new().assign(&grid, &lights[..2], &mut out, 10_000).unwrap();
 }
+
+#[test]
+fn cluster_boxes_are_separable_by_axis() {
+    // The assignment tests x, y and z extents separately; that is the box test only if every
+    // box is the product of its column's, row's and slice's extents.
+    for dims in [ClusterDims::DEFAULT, ClusterDims { x: 4, y: 4, z: 2 }, ClusterDims { x: 7, y: 5, z: 3 }] {
+        let grid = seed_camera_grid(dims);
+        for z in 0..dims.z {
+            for y in 0..dims.y {
+                for x in 0..dims.x {
+                    let b = grid.bounds[grid.index(x, y, z) as usize];
+                    assert_eq!((b.min.x, b.max.x), grid.x_extents[(z * dims.x + x) as usize]);
+                    assert_eq!((b.min.y, b.max.y), grid.y_extents[(z * dims.y + y) as usize]);
+                    assert_eq!((b.min.z, b.max.z), grid.z_extents[z as usize]);
+                }
+            }
+        }
+    }
+}
