@@ -81,12 +81,15 @@ void main() {
         if (s0 > s1) {
             continue;
         }
-        float closest = clamp(depth, s0, s1);
-        float rr = sqrt(max(r2 - (closest - depth) * (closest - depth), 0.0));
-        vec2 slab = vec2(1.0 / s0, 1.0 / s1);
-        if (!cluster_tile_span(frame.cluster_frustum.z, c.x - rr, c.x + rr, slab, size.x, d.x, xs)
-            || !cluster_tile_span(frame.cluster_frustum.w, c.y - rr, c.y + rr, slab, size.y, d.y, ys)) {
-            continue;
+        // A light within one slice keeps its whole rectangle (as assign.rs does).
+        if (k0 != k1) {
+            float closest = clamp(depth, s0, s1);
+            float rr = sqrt(max(r2 - (closest - depth) * (closest - depth), 0.0));
+            vec2 slab = vec2(1.0 / s0, 1.0 / s1);
+            if (!cluster_tile_span(frame.cluster_frustum.z, c.x - rr, c.x + rr, slab, size.x, d.x, xs)
+                || !cluster_tile_span(frame.cluster_frustum.w, c.y - rr, c.y + rr, slab, size.y, d.y, ys)) {
+                continue;
+            }
         }
         uint w = xs.y - xs.x + 1u;
         uint cells = w * (ys.y - ys.x + 1u);

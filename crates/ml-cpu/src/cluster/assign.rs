@@ -47,11 +47,11 @@ impl ClusterLists {
 /// Fewest lights per rayon task: below this a task costs more than it saves.
 const MIN_CHUNK: usize = 256;
 
-/// One task's share: its (cluster, light) pairs and per-cluster counts, which the prefix sum
-/// turns into the task's write cursors.
+/// One task's share: its lights' runs of clusters (first cluster, count, light) and
+/// per-cluster counts, which the prefix sum turns into the task's write cursors.
 #[derive(Default)]
 struct Chunk {
-    pairs: Vec<(u32, u32)>,
+    runs: Vec<(u32, u32, u32)>,
     counts: Vec<u32>,
 }
 
@@ -89,17 +89,20 @@ impl ClusterAssigner {
         self.chunks.resize_with(tasks, Chunk::default);
         // 1. Each task lists its lights' clusters and counts them per cluster.
         self.chunks.par_iter_mut().enumerate().for_each(|(t, chunk)| {
-            chunk.pairs.clear();
+            chunk.runs.clear();
             chunk.counts.clear();
             chunk.counts.resize(clusters, 0);
             let first = (t * per_task).min(lights.len());
             for (i, light) in lights[first..(first + per_task).min(lights.len())].iter().enumerate() {
-                let before = chunk.pairs.len();
-                light_clusters(grid, light, |cluster| {
-                    chunk.pairs.push((cluster, (first + i) as u32));
-                    chunk.counts[cluster as usize] += 1;
+                let mut entries = 0;
+                light_cluster_runs(grid, light, |start, count| {
+                    chunk.runs.push((start, count, (first + i) as u32));
+                    for c in &mut chunk.counts[start as usize..(start + count) as usize] {
+                        *c += 1;
+                    }
+                    entries += count as usize;
                 });
-                if emitted.fetch_add(chunk.pairs.len() - before, Ordering::Relaxed) > max_entries {
+                if emitted.fetch_add(entries, Ordering::Relaxed) > max_entries {
                     return;
                 }
             }
@@ -107,7 +110,7 @@ impl ClusterAssigner {
         let total = emitted.load(Ordering::Relaxed);
         if total > max_entries {
             for chunk in &mut self.chunks {
-                chunk.pairs = Vec::new(); // give the memory back
+                chunk.runs = Vec::new(); // give the memory back
             }
             return Err(ListsTooLong { at_least: total });
         }
@@ -126,19 +129,20 @@ impl ClusterAssigner {
             }
             range.count = offset - range.offset;
         }
-        // 3. Tasks write their pairs at their cursors: disjoint positions, in parallel.
+        // 3. Tasks write their lights at their cursors: disjoint positions, in parallel.
         out.indices.clear();
         out.indices.resize(offset as usize, 0);
         let indices = Disjoint(out.indices.as_mut_ptr());
         let indices = &indices;
         self.chunks.par_iter_mut().for_each(|chunk| {
-            for &(cluster, light) in &chunk.pairs {
-                let cursor = &mut chunk.counts[cluster as usize];
-                // SAFETY: cursors of different (task, cluster) pairs cover disjoint ranges of
-                // `out.indices` (step 2), each within its length; `out.indices` is not resized
-                // or read until every task is done.
-                unsafe { *indices.0.add(*cursor as usize) = light };
-                *cursor += 1;
+            for &(start, count, light) in &chunk.runs {
+                for cursor in &mut chunk.counts[start as usize..(start + count) as usize] {
+                    // SAFETY: cursors of different (task, cluster) pairs cover disjoint ranges
+                    // of `out.indices` (step 2), each within its length; `out.indices` is not
+                    // resized or read until every task is done.
+                    unsafe { *indices.0.add(*cursor as usize) = light };
+                    *cursor += 1;
+                }
             }
         });
         Ok(())
@@ -152,13 +156,20 @@ pub struct ListsTooLong {
 }
 
 /// Call `emit` with every cluster whose box the light's sphere touches.
+#[cfg(test)]
+pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: impl FnMut(u32)) {
+    light_cluster_runs(grid, light, |start, count| (start..start + count).for_each(&mut emit));
+}
+
+/// Call `emit(first, count)` with every run of consecutive clusters (along a tile row) whose
+/// boxes the light's sphere touches.
 ///
 /// Per depth slice the sphere is cut to the slab the slice spans (its cross-section there is
 /// narrower than the sphere: "iterative sphere refinement"), the slab's box is projected to a
 /// pixel rectangle, and the tiles under it are tested box against sphere. The slab never
 /// reaches in front of the near plane, so nothing is projected through w ≤ 0, also for
 /// lights whose centre is behind the camera.
-pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: impl FnMut(u32)) {
+fn light_cluster_runs(grid: &ClusterGrid, light: &PointLight, mut emit: impl FnMut(u32, u32)) {
     let p = light.position_radius;
     let r = p[3];
     let c = (grid.view * glam::Vec4::new(p[0], p[1], p[2], 1.0)).xyz();
@@ -175,9 +186,9 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
     // Off screen as a whole? (The projected box also catches what the planes let through.)
     let d0 = dmin.max(grid.near);
     let inv = (1.0 / d0, 1.0 / dmax);
-    if grid.tile_span_x(c.x - r, c.x + r, inv).is_none() || grid.tile_span_y(c.y - r, c.y + r, inv).is_none() {
+    let (Some(whole_x), Some(whole_y)) = (grid.tile_span_x(c.x - r, c.x + r, inv), grid.tile_span_y(c.y - r, c.y + r, inv)) else {
         return;
-    }
+    };
     let k0 = grid.slice(d0);
     let k1 = grid.slice(dmax.min(grid.far));
     let r2 = r * r;
@@ -198,23 +209,29 @@ pub(crate) fn light_clusters(grid: &ClusterGrid, light: &PointLight, mut emit: i
         if s0 > s1 {
             continue;
         }
-        let closest = depth.clamp(s0, s1);
-        let rr = (r2 - (closest - depth) * (closest - depth)).max(0.0).sqrt();
-        let inv = (1.0 / s0, 1.0 / s1);
-        let Some((x0, x1)) = grid.tile_span_x(c.x - rr, c.x + rr, inv) else { continue };
-        let Some((y0, y1)) = grid.tile_span_y(c.y - rr, c.y + rr, inv) else { continue };
+        // A light within one slice: its slab is (nearly) all of it, so its whole rectangle
+        // serves (cluster_build.comp does the same).
+        let ((x0, x1), (y0, y1)) = if k0 == k1 {
+            (whole_x, whole_y)
+        } else {
+            let closest = depth.clamp(s0, s1);
+            let rr = (r2 - (closest - depth) * (closest - depth)).max(0.0).sqrt();
+            let inv = (1.0 / s0, 1.0 / s1);
+            let Some(xs) = grid.tile_span_x(c.x - rr, c.x + rr, inv) else { continue };
+            let Some(ys) = grid.tile_span_y(c.y - rr, c.y + rr, inv) else { continue };
+            (xs, ys)
+        };
         let xs = &grid.x_extents[(z * grid.dims.x) as usize..][..grid.dims.x as usize];
         for y in y0..=y1 {
             let dzy2 = dz2 + gap2(c.y, grid.y_extents[(z * grid.dims.y + y) as usize]);
             if dzy2 > r2 {
                 continue;
             }
-            let row = grid.index(0, y, z);
-            for x in x0..=x1 {
-                if dzy2 + gap2(c.x, xs[x as usize]) <= r2 {
-                    emit(row + x);
-                }
-            }
+            // Column boxes move right with x, so the columns in reach form one run.
+            let hits = |x: &u32| dzy2 + gap2(c.x, xs[*x as usize]) <= r2;
+            let Some(first) = (x0..=x1).find(hits) else { continue };
+            let last = (first..=x1).rev().find(hits).expect("`first` hits");
+            emit(grid.index(first, y, z), last - first + 1);
         }
     }
 }
