@@ -5,7 +5,8 @@
 
 use crate::targets::Targets;
 use ml_cpu::gpu_types::ObjectPush;
-use ml_vk::{image, shader, vk, Buffer, Context, VkError, VkResultExt};
+use ml_vk::commands::image_transition;
+use ml_vk::{shader, vk, Buffer, Context, VkError, VkResultExt};
 
 /// Bindings of the lighting set (deferred_lighting.comp).
 pub const BINDING_FRAME: u32 = 0;
@@ -135,36 +136,26 @@ impl ComputeLighting {
 
     /// Record the lighting of `targets` (after the raster pass and the cluster build).
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, set: vk::DescriptorSet, targets: &Targets, extent: vk::Extent2D) {
-        let colour = image::full_range(vk::ImageAspectFlags::COLOR);
-        let to_storage = [vk::ImageMemoryBarrier::default()
-            .src_access_mask(vk::AccessFlags::empty())
-            .dst_access_mask(vk::AccessFlags::SHADER_WRITE)
-            .old_layout(vk::ImageLayout::UNDEFINED)
-            .new_layout(vk::ImageLayout::GENERAL)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(targets.color.raw)
-            .subresource_range(colour)];
-        let to_transfer = [vk::ImageMemoryBarrier::default()
-            .src_access_mask(vk::AccessFlags::SHADER_WRITE)
-            .dst_access_mask(vk::AccessFlags::TRANSFER_READ)
-            .old_layout(vk::ImageLayout::GENERAL)
-            .new_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(targets.color.raw)
-            .subresource_range(colour)];
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
         let d = &ctx.device;
+        // The colour image was last read by a copy two frames ago (same queue).
+        let storage = (compute, vk::AccessFlags::SHADER_WRITE, vk::ImageLayout::GENERAL);
+        image_transition(ctx, cmd, targets.color.raw, (transfer, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), storage);
         // SAFETY: recording state outside a render pass; everything bound is alive.
         unsafe {
-            // The colour image was last read by a copy two frames ago (same queue).
-            d.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::TRANSFER, compute, vk::DependencyFlags::empty(), &[], &[], &to_storage);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
             d.cmd_dispatch(cmd, extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP), 1);
-            d.cmd_pipeline_barrier(cmd, compute, vk::PipelineStageFlags::TRANSFER, vk::DependencyFlags::empty(), &[], &[], &to_transfer);
         }
+        // Left like the forward pass leaves its colour target: ready for the read-back copy.
+        image_transition(
+            ctx,
+            cmd,
+            targets.color.raw,
+            storage,
+            (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+        );
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -57,3 +57,24 @@ pub fn memory_barrier(
     // SAFETY: recording state, outside a render pass.
     unsafe { ctx.device.cmd_pipeline_barrier(cmd, src.0, dst.0, vk::DependencyFlags::empty(), &b, &[], &[]) };
 }
+
+/// A colour image's layout transition: `from` (stage, access, layout) before `to`.
+pub fn image_transition(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    from: (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout),
+    to: (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout),
+) {
+    let b = [vk::ImageMemoryBarrier::default()
+        .src_access_mask(from.1)
+        .dst_access_mask(to.1)
+        .old_layout(from.2)
+        .new_layout(to.2)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(crate::image::full_range(vk::ImageAspectFlags::COLOR))];
+    // SAFETY: recording state, outside a render pass.
+    unsafe { ctx.device.cmd_pipeline_barrier(cmd, from.0, to.0, vk::DependencyFlags::empty(), &[], &[], &b) };
+}
