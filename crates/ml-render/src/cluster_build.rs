@@ -13,7 +13,8 @@
 
 use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
 use ml_vk::commands::memory_barrier;
-use ml_vk::{shader, vk, Buffer, Context, VkError, VkResultExt};
+use ml_vk::descriptors::allocate_set;
+use ml_vk::{shader, vk, Buffer, Context, VkError};
 
 /// Bindings of the build's descriptor set (see the shaders).
 pub const BINDING_FRAME: u32 = 0;
@@ -227,12 +228,7 @@ impl GpuClusterBuilder {
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 gpu_allocator::MemoryLocation::GpuOnly,
             )?;
-            let layouts = [self.set_layout];
-            // SAFETY: the pool has room for the build sets.
-            frame.set = unsafe {
-                ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
-            }
-            .ctx("vkAllocateDescriptorSets")?[0];
+            frame.set = allocate_set(ctx, pool, self.set_layout)?;
             Ok(())
         })
     }

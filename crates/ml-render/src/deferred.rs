@@ -6,6 +6,7 @@
 use crate::targets::Targets;
 use ml_cpu::gpu_types::ObjectPush;
 use ml_vk::commands::image_transition;
+use ml_vk::descriptors::{allocate_set, write_buffer};
 use ml_vk::{shader, vk, Buffer, Context, VkError, VkResultExt};
 
 /// Bindings of the lighting set (deferred_lighting.comp).
@@ -87,20 +88,16 @@ impl ComputeLighting {
 
     /// Allocate and fill a frame's lighting set.
     pub fn frame_set(&self, ctx: &Context, pool: vk::DescriptorPool, inputs: &LightingInputs) -> Result<vk::DescriptorSet, VkError> {
-        let layouts = [self.set_layout];
-        // SAFETY: the pool has room for one lighting set per frame.
-        let set = unsafe {
-            ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+        let set = allocate_set(ctx, pool, self.set_layout)?;
+        write_buffer(ctx, set, BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, inputs.uniforms);
+        for (binding, buffer) in [
+            (BINDING_LIGHTS, inputs.lights),
+            (BINDING_RANGES, inputs.ranges),
+            (BINDING_INDICES, inputs.indices),
+            (BINDING_OBJECTS, self.objects.raw),
+        ] {
+            write_buffer(ctx, set, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
         }
-        .ctx("vkAllocateDescriptorSets")?[0];
-        let buffer = |b: vk::Buffer| [vk::DescriptorBufferInfo::default().buffer(b).range(vk::WHOLE_SIZE)];
-        let buffers = [
-            (BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, buffer(inputs.uniforms)),
-            (BINDING_LIGHTS, vk::DescriptorType::STORAGE_BUFFER, buffer(inputs.lights)),
-            (BINDING_RANGES, vk::DescriptorType::STORAGE_BUFFER, buffer(inputs.ranges)),
-            (BINDING_INDICES, vk::DescriptorType::STORAGE_BUFFER, buffer(inputs.indices)),
-            (BINDING_OBJECTS, vk::DescriptorType::STORAGE_BUFFER, buffer(self.objects.raw)),
-        ];
         let t = inputs.targets;
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         let sampled = |view: vk::ImageView, layout: vk::ImageLayout| {
@@ -120,15 +117,10 @@ impl ComputeLighting {
                 [vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL)],
             ),
         ];
-        let mut writes: Vec<vk::WriteDescriptorSet> = buffers
+        let writes: Vec<vk::WriteDescriptorSet> = images
             .iter()
-            .map(|(b, ty, info)| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(*b).descriptor_type(*ty).buffer_info(info))
+            .map(|(b, ty, info)| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(*b).descriptor_type(*ty).image_info(info))
             .collect();
-        writes.extend(
-            images
-                .iter()
-                .map(|(b, ty, info)| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(*b).descriptor_type(*ty).image_info(info)),
-        );
         // SAFETY: the set and everything it points at are alive and unused.
         unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
         Ok(set)

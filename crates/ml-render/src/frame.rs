@@ -10,6 +10,7 @@ use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::cluster::ClusterLists;
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
+use ml_vk::descriptors::{allocate_set, write_buffer};
 use ml_vk::{vk, Buffer, Context, GpuTimer, VkError, VkResultExt};
 
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -91,10 +92,7 @@ impl FrameInFlight {
         self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>(), at)?;
         self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>(), at)?;
         self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.clamp(1, max_index_entries(ctx)) * 4, at)?;
-        let layouts = [setup.set_layout];
-        let set_info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(setup.descriptor_pool).set_layouts(&layouts);
-        // SAFETY: the pool has room for one set per frame in flight.
-        self.set = unsafe { d.allocate_descriptor_sets(&set_info) }.ctx("vkAllocateDescriptorSets")?[0];
+        self.set = allocate_set(ctx, setup.descriptor_pool, setup.set_layout)?;
         self.bind(ctx, BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
         for (binding, buffer) in [
             (BINDING_LIGHTS, self.lights.raw),
@@ -110,7 +108,7 @@ impl FrameInFlight {
             let set = gpu.set;
             let (counters, feedback, blocks) = (gpu.counters.raw, gpu.feedback.raw, gpu.scan_blocks.raw);
             self.gpu = Some(gpu);
-            write_set(ctx, set, build::BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
+            write_buffer(ctx, set, build::BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
             for (binding, buffer) in [
                 (build::BINDING_REST_LIGHTS, builder.rest_lights.raw),
                 (build::BINDING_LIGHTS, self.lights.raw),
@@ -121,7 +119,7 @@ impl FrameInFlight {
                 (build::BINDING_FEEDBACK, feedback),
                 (build::BINDING_SCAN_BLOCKS, blocks),
             ] {
-                write_set(ctx, set, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
+                write_buffer(ctx, set, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
             }
         }
         if let Some(lighting) = setup.lighting {
@@ -139,7 +137,7 @@ impl FrameInFlight {
 
     /// Point `binding` of this frame's shading set at `buffer`. Only while not in flight.
     fn bind(&self, ctx: &Context, binding: u32, ty: vk::DescriptorType, buffer: vk::Buffer) {
-        write_set(ctx, self.set, binding, ty, buffer);
+        write_buffer(ctx, self.set, binding, ty, buffer);
     }
 
     /// Entries the light-index list holds.
@@ -166,10 +164,10 @@ impl FrameInFlight {
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         self.bind(ctx, BINDING_LIGHT_INDICES, storage, self.light_indices.raw);
         if let Some(gpu) = &self.gpu {
-            write_set(ctx, gpu.set, build::BINDING_INDICES, storage, self.light_indices.raw);
+            write_buffer(ctx, gpu.set, build::BINDING_INDICES, storage, self.light_indices.raw);
         }
         if self.lighting_set != vk::DescriptorSet::null() {
-            write_set(ctx, self.lighting_set, deferred::BINDING_INDICES, storage, self.light_indices.raw);
+            write_buffer(ctx, self.lighting_set, deferred::BINDING_INDICES, storage, self.light_indices.raw);
         }
         Ok(true)
     }
@@ -198,14 +196,6 @@ impl FrameInFlight {
         unsafe { ctx.device.destroy_fence(self.fence, None) };
         self.fence = vk::Fence::null();
     }
-}
-
-/// Point `binding` of `set` at the whole of `buffer`. Only while the set is not in use.
-fn write_set(ctx: &Context, set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, buffer: vk::Buffer) {
-    let info = [vk::DescriptorBufferInfo::default().buffer(buffer).range(vk::WHOLE_SIZE)];
-    let write = [vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).buffer_info(&info)];
-    // SAFETY: the set and buffer are alive and the set is not in use by pending work.
-    unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
 }
 
 /// The most light-index entries one list may hold: what the device binds as one storage buffer.

@@ -9,7 +9,7 @@ use gpu_allocator::MemoryLocation;
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterDims, ClusterGrid};
 use ml_cpu::gpu_types::FrameUniforms;
-use ml_vk::{commands, shader, Buffer, Context, ContextDesc};
+use ml_vk::{commands, descriptors, shader, Buffer, Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
 
@@ -30,11 +30,7 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     // SAFETY: as above.
     let pool = unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
         .unwrap();
-    // SAFETY: as above.
-    let set = unsafe {
-        ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
-    }
-    .unwrap()[0];
+    let set = descriptors::allocate_set(ctx, pool, layout).unwrap();
 
     let frame = FrameUniforms {
         cluster_dims: [grid.dims.x, grid.dims.y, grid.dims.z, 0],
@@ -51,17 +47,9 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     input.write(0, depths);
     let mut output =
         Buffer::new(ctx, "slices", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
-    let infos = [uniforms.raw, input.raw, output.raw].map(|b| [vk::DescriptorBufferInfo::default().buffer(b).range(vk::WHOLE_SIZE)]);
-    let writes: Vec<vk::WriteDescriptorSet> = infos
-        .iter()
-        .enumerate()
-        .map(|(i, info)| {
-            let ty = if i == 0 { vk::DescriptorType::UNIFORM_BUFFER } else { storage };
-            vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(ty).buffer_info(info)
-        })
-        .collect();
-    // SAFETY: the set and buffers are alive and unused.
-    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    descriptors::write_buffer(ctx, set, 0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.raw);
+    descriptors::write_buffer(ctx, set, 1, storage, input.raw);
+    descriptors::write_buffer(ctx, set, 2, storage, output.raw);
     commands::one_shot(ctx, |cmd| {
         // SAFETY: recording state; all bound objects are alive.
         unsafe {

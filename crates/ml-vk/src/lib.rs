@@ -6,6 +6,7 @@
 pub mod buffer;
 pub mod commands;
 pub mod context;
+pub mod descriptors;
 pub mod error;
 pub mod image;
 pub mod shader;
