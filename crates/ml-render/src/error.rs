@@ -8,6 +8,4 @@ pub enum RenderError {
     Scene(#[from] ml_cpu::SceneError),
     #[error("{0}")]
     Invalid(String),
-    #[error("cannot write '{path}': {reason}")]
-    Output { path: String, reason: String },
 }

@@ -305,13 +305,9 @@ impl Context {
         &self.parts.entry
     }
 
-    /// Validation messages (warnings and errors) reported so far; 0 without validation.
-    pub fn validation_messages(&self) -> u32 {
-        self.parts.messages.load(Ordering::SeqCst)
-    }
-
-    /// Shared handle to the message counter, readable after the context is gone (the layer
-    /// reports leaked objects while the device and instance are destroyed).
+    /// Validation messages (warnings and errors) so far, through a handle that stays readable
+    /// after the context is gone (the layer reports leaked objects while the device and
+    /// instance are destroyed); 0 without validation.
     pub fn validation_counter(&self) -> Arc<AtomicU32> {
         self.parts.messages.clone()
     }
