@@ -59,22 +59,49 @@ impl Aabb {
     }
 }
 
+/// max and min without f32::max's NaN rules, which cost a compare and a blend per call on
+/// x86 (~10 % of the assignment): one `maxss`/`minss` each. Inputs are never NaN here.
+#[inline]
+pub(super) fn max(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+#[inline]
+pub(super) fn min(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
 /// NDC range of scale·v/d over v ∈ [va, vb], d ∈ [d0, d1] with d > 0 (given as 1/d0, 1/d1):
 /// the extremes are at the corners, and v/d is monotonic in each.
+/// With va ≤ vb the least v/d is at va and the greatest at vb (either depth).
+#[inline]
 fn projected_span(scale: f32, va: f32, vb: f32, (inv0, inv1): (f32, f32)) -> (f32, f32) {
-    let corners = [va * inv0, va * inv1, vb * inv0, vb * inv1].map(|t| t * scale);
-    (corners.iter().copied().fold(f32::MAX, f32::min), corners.iter().copied().fold(f32::MIN, f32::max))
+    let (lo, hi) = (min(va * inv0, va * inv1), max(vb * inv0, vb * inv1));
+    if scale >= 0.0 {
+        (lo * scale, hi * scale)
+    } else {
+        (hi * scale, lo * scale)
+    }
 }
 
 /// Pixels whose centres may lie in NDC [lo, hi] (one pixel of margin), clamped to the image;
 /// None when the span is off screen.
+#[inline]
 fn pixel_span(lo: f32, hi: f32, size: u32) -> Option<(u32, u32)> {
     let to_px = |ndc: f32| (ndc + 1.0) * 0.5 * size as f32;
     let (a, b) = (to_px(lo) - 1.0, to_px(hi) + 1.0);
     if b < 0.0 || a >= size as f32 {
         return None;
     }
-    Some((a.max(0.0) as u32, (b.min(size as f32 - 1.0)) as u32))
+    Some((max(a, 0.0) as u32, min(b, size as f32 - 1.0) as u32))
 }
 
 /// Tile of pixel `p` along an axis of `size` pixels split into `tiles`: ⌊p·tiles/size⌋, in
@@ -185,12 +212,14 @@ impl ClusterGrid {
     /// Tiles in x under the view-space box x ∈ [xa, xb], depth ∈ [d0, d1] (0 < d0 ≤ d1),
     /// given as `inv_depths` = (1/d0, 1/d1); None when the box is off screen. A shaded point
     /// projects to its pixel's centre, so a pixel of margin absorbs rounding.
+    #[inline]
     pub fn tile_span_x(&self, xa: f32, xb: f32, inv_depths: (f32, f32)) -> Option<(u32, u32)> {
         let (lo, hi) = projected_span(self.projection.x_axis.x, xa, xb, inv_depths);
         pixel_span(lo, hi, self.width).map(|(a, b)| (self.tile_x(a), self.tile_x(b)))
     }
 
     /// As `tile_span_x` for rows (Vulkan: row 0 at the top, the projection flips y).
+    #[inline]
     pub fn tile_span_y(&self, ya: f32, yb: f32, inv_depths: (f32, f32)) -> Option<(u32, u32)> {
         let (lo, hi) = projected_span(self.projection.y_axis.y, ya, yb, inv_depths);
         pixel_span(lo, hi, self.height).map(|(a, b)| (self.tile_y(a), self.tile_y(b)))
