@@ -122,10 +122,10 @@ impl ClusterAssigner {
                     chunk.counts[(start + count) as usize] = chunk.counts[(start + count) as usize].wrapping_sub(1);
                     pending += count as usize;
                 });
-                if pending >= LOOK_EVERY || pending > max_entries {
-                    if emitted.fetch_add(std::mem::take(&mut pending), Ordering::Relaxed) > max_entries {
-                        return;
-                    }
+                if (pending >= LOOK_EVERY || pending > max_entries)
+                    && emitted.fetch_add(std::mem::take(&mut pending), Ordering::Relaxed) > max_entries
+                {
+                    return;
                 }
             }
             emitted.fetch_add(pending, Ordering::Relaxed);
