@@ -64,6 +64,15 @@ struct ObjectPush {
     uvec4 ids;             // x: index of the object in the scene's object buffer
 };
 
+// Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with
+// raster.rs CLEAR_COLOR.
+const vec4 CLEAR_COLOR = vec4(0.02, 0.02, 0.02, 1.0);
+
+// Linear colour → what the 8-bit target stores: the seed's gamma 1/2.2 (values above 1 clip).
+vec3 encode_output(vec3 linear) {
+    return pow(linear, vec3(1.0 / 2.2));
+}
+
 // Octahedral encoding of a unit normal into [-1, 1]² (the G-buffer keeps it in 2 floats).
 vec2 oct_encode(vec3 n) {
     n /= abs(n.x) + abs(n.y) + abs(n.z);

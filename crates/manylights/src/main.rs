@@ -9,6 +9,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::report::table;
+use ml_render::targets::gbuffer_bytes_per_pixel;
 use ml_render::{DebugView, HeadlessRenderer, RenderSettings, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
@@ -25,7 +26,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene headless (no window system) to a PNG and print a timing table.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// List Vulkan devices, drivers, versions and the limits manylights depends on.
     Info,
 }
@@ -35,13 +36,14 @@ struct RenderArgs {
     /// Scene to render (built in: seed).
     #[arg(long, default_value = "seed")]
     scene: String,
-    /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred-compute.
+    /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
+    /// deferred-compute.
     #[arg(long, default_value = "forward")]
     technique: String,
     /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).
     #[arg(long, default_value = "16x9x24")]
     clusters: String,
-    /// Debug view: none, cluster-heat (lights per cluster; clustered techniques).
+    /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu).
     #[arg(long, default_value = "none")]
     debug_view: String,
     /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc.
@@ -175,6 +177,9 @@ fn render(args: &RenderArgs) -> Result<()> {
     match stats.gpu_ms() {
         Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
         None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
+    }
+    if technique.lights_in_subpass() || technique.lights_in_compute() {
+        rows.push(("g-buffer", format!("{} bytes/pixel + depth (octahedral normal 2×f32, object index u32)", gbuffer_bytes_per_pixel())));
     }
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));

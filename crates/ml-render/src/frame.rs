@@ -5,8 +5,9 @@
 
 use crate::cluster_build::{self as build, GpuClusterBuilder, GpuClusterFrame};
 use crate::deferred::{self, ComputeLighting, LightingInputs};
-use crate::raster::{BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
+use crate::raster::{RasterPass, BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
 use crate::targets::Targets;
+use crate::tonemap::ToneMap;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::cluster::ClusterLists;
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
@@ -29,6 +30,10 @@ pub struct FrameInFlight {
     pub gpu: Option<GpuClusterFrame>,
     /// deferred-compute: the lighting pass's set (null otherwise).
     pub lighting_set: vk::DescriptorSet,
+    /// deferred, deferred-clustered: set 1 of the lighting subpass and the tone map's set
+    /// (null otherwise).
+    pub input_set: vk::DescriptorSet,
+    pub tonemap_set: vk::DescriptorSet,
     /// Where lights and cluster lists live: host-visible (written by the CPU) or device-local
     /// (written by the GPU build).
     location: MemoryLocation,
@@ -49,6 +54,11 @@ pub struct FrameSetup<'a> {
     pub builder: Option<&'a GpuClusterBuilder>,
     /// Set for deferred-compute: the lighting pass that reads them.
     pub lighting: Option<&'a ComputeLighting>,
+    /// Set for deferred, deferred-clustered: the pass whose lighting subpass reads the
+    /// G-buffer, and the tone map after it.
+    pub subpasses: Option<(&'a RasterPass, &'a ToneMap)>,
+    /// Every object's material, for the deferred techniques (null otherwise).
+    pub objects: vk::Buffer,
 }
 
 /// Storage buffer for lights or cluster lists. Device-local ones can also be copied out
@@ -72,6 +82,8 @@ impl FrameInFlight {
             targets: None,
             gpu: None,
             lighting_set: vk::DescriptorSet::null(),
+            input_set: vk::DescriptorSet::null(),
+            tonemap_set: vk::DescriptorSet::null(),
             location: if setup.builder.is_some() { MemoryLocation::GpuOnly } else { MemoryLocation::CpuToGpu },
         };
         // On failure everything made so far is released (null parts are skipped).
@@ -128,9 +140,15 @@ impl FrameInFlight {
                 lights: self.lights.raw,
                 ranges: self.cluster_ranges.raw,
                 indices: self.light_indices.raw,
+                objects: setup.objects,
                 targets: self.targets.as_ref().expect("made above"),
             };
             self.lighting_set = lighting.frame_set(ctx, setup.descriptor_pool, &inputs)?;
+        }
+        if let Some((pass, tonemap)) = setup.subpasses {
+            let targets = self.targets.as_ref().expect("made above");
+            self.input_set = pass.input_set(ctx, setup.descriptor_pool, targets, setup.objects)?;
+            self.tonemap_set = tonemap.frame_set(ctx, setup.descriptor_pool, targets)?;
         }
         Ok(())
     }

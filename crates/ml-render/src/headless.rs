@@ -6,10 +6,11 @@ use crate::deferred::ComputeLighting;
 use crate::error::RenderError;
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
-use crate::raster::{object_push, RasterPass};
+use crate::raster::{object_push, DrawList, PassFrame, RasterPass};
 use crate::report::FrameStats;
-use crate::settings::{DebugView, RenderSettings, Technique};
+use crate::settings::{DebugView, RenderSettings};
 use crate::targets::{depth_format, Output, Targets};
+use crate::tonemap::ToneMap;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
 use ml_cpu::lights::{animate_into, animation_offset};
@@ -52,6 +53,10 @@ pub struct HeadlessRenderer<'a> {
     builder: Option<GpuClusterBuilder>,
     /// deferred-compute: the lighting compute pass.
     lighting: Option<ComputeLighting>,
+    /// deferred, deferred-clustered: the tone map after the render pass.
+    tonemap: Option<ToneMap>,
+    /// Deferred techniques: every object's material, indexed by the G-buffer's object ids.
+    objects: Option<Buffer>,
     /// clustered-gpu: light-index entries every frame recorded from now on must hold (grows
     /// when a frame reports it needed more).
     required_indices: usize,
@@ -87,8 +92,8 @@ impl<'a> HeadlessRenderer<'a> {
         // clustered-gpu animates on the GPU; the others keep an animated copy on the CPU.
         let animated = if settings.technique.is_gpu_built() { Vec::new() } else { scene.lights.clone() };
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
-        let clusters = (settings.technique == Technique::ClusteredCpu)
-            .then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
+        let clusters =
+            settings.technique.is_cpu_built().then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
         let mut r = HeadlessRenderer {
             ctx,
             scene,
@@ -105,6 +110,8 @@ impl<'a> HeadlessRenderer<'a> {
             grid,
             builder: None,
             lighting: None,
+            tonemap: None,
+            objects: None,
             required_indices: 0,
             overflowed: vec![false; FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
@@ -129,20 +136,30 @@ impl<'a> HeadlessRenderer<'a> {
         if self.settings.technique.is_gpu_built() {
             self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
         }
-        if self.settings.technique.lights_in_compute() {
+        if self.pass.output != Output::Color {
             let objects: Vec<ObjectPush> = self.scene.objects.iter().enumerate().map(|(i, o)| object_push(o, i as u32)).collect();
-            self.lighting = Some(ComputeLighting::new(ctx, &objects)?);
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         }
-        // Per frame: the shading set (1 uniform + 3 storage), the build set (1 uniform + 8
-        // storage) and the lighting set (1 uniform, 4 storage, 3 sampled images, 1 storage image).
+        if self.settings.technique.lights_in_compute() {
+            self.lighting = Some(ComputeLighting::new(ctx)?);
+        }
+        if self.settings.technique.lights_in_subpass() {
+            self.tonemap = Some(ToneMap::new(ctx)?);
+        }
+        // Per frame at most: the shading set (1 uniform + 3 storage), the build set (1 uniform
+        // + 8 storage), the lighting set (1 uniform, 4 storage, 3 sampled images, 1 storage
+        // image), the subpass input set (1 storage, 3 input attachments) and the tone map's set
+        // (1 sampled image, 1 storage image).
         let n = FRAMES_IN_FLIGHT as u32;
         let sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 3 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 15 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 3 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 16 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 4 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: 2 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::INPUT_ATTACHMENT, descriptor_count: 3 * n },
         ];
-        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(3 * n).pool_sizes(&sizes);
+        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(5 * n).pool_sizes(&sizes);
         // SAFETY: as above.
         self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
         let render_pass = self.pass.render_pass;
@@ -162,6 +179,8 @@ impl<'a> HeadlessRenderer<'a> {
             make_targets: &make_targets,
             builder: self.builder.as_ref(),
             lighting: self.lighting.as_ref(),
+            subpasses: self.tonemap.as_ref().map(|t| (&self.pass, t)),
+            objects: self.objects.as_ref().map_or(vk::Buffer::null(), |b| b.raw),
         };
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
@@ -183,6 +202,8 @@ impl<'a> HeadlessRenderer<'a> {
         let t = self.settings.technique;
         if t.lights_in_compute() {
             vec!["cluster build", "g-buffer", "lighting"]
+        } else if t.lights_in_subpass() {
+            vec!["g-buffer + lighting", "tone map"]
         } else if t.is_gpu_built() {
             vec!["cluster build", t.name()]
         } else {
@@ -353,14 +374,21 @@ impl<'a> HeadlessRenderer<'a> {
             pass += 1;
         }
         frame.timer.begin(ctx, cmd, pass);
-        let framebuffer = frame.targets.as_ref().expect("made with the frame").framebuffer;
+        let targets = frame.targets.as_ref().expect("made with the frame");
         let legend = self.settings.debug_view == DebugView::ClusterHeat;
-        self.pass.record(ctx, cmd, framebuffer, self.extent, frame.set, &self.meshes, &self.scene.objects, legend);
+        let pass_frame = PassFrame { framebuffer: targets.framebuffer, extent: self.extent, set: frame.set, input_set: frame.input_set };
+        self.pass.record(ctx, cmd, &pass_frame, &DrawList { meshes: &self.meshes, objects: &self.scene.objects }, legend);
         frame.timer.end(ctx, cmd, pass);
         if let Some(lighting) = &self.lighting {
             pass += 1;
             frame.timer.begin(ctx, cmd, pass);
-            lighting.record(ctx, cmd, frame.lighting_set, frame.targets.as_ref().expect("made with the frame"), self.extent);
+            lighting.record(ctx, cmd, frame.lighting_set, targets, self.extent);
+            frame.timer.end(ctx, cmd, pass);
+        }
+        if let Some(tonemap) = &self.tonemap {
+            pass += 1;
+            frame.timer.begin(ctx, cmd, pass);
+            tonemap.record(ctx, cmd, frame.tonemap_set, targets, self.extent);
             frame.timer.end(ctx, cmd, pass);
         }
         // SAFETY: recording state.
@@ -447,6 +475,12 @@ impl Drop for HeadlessRenderer<'_> {
         }
         if let Some(mut l) = self.lighting.take() {
             l.destroy(ctx);
+        }
+        if let Some(mut t) = self.tonemap.take() {
+            t.destroy(ctx);
+        }
+        if let Some(mut b) = self.objects.take() {
+            b.destroy(ctx);
         }
         for mesh in &mut self.meshes {
             mesh.destroy(ctx);

@@ -2,15 +2,18 @@
 //! (ml-vk) and the CPU scene (ml-cpu).
 
 pub mod cluster_build;
+pub mod compute_pass;
 pub mod deferred;
 pub mod error;
 pub mod frame;
 pub mod gpu_mesh;
 pub mod headless;
 pub mod raster;
+pub mod render_pass;
 pub mod report;
 pub mod settings;
 pub mod targets;
+pub mod tonemap;
 
 pub use error::RenderError;
 pub use headless::{HeadlessRenderer, RenderOutput};

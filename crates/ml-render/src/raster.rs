@@ -1,14 +1,18 @@
-//! The raster pass (SPEC §3): one render pass, one subpass. Technique `forward` loops every
-//! fragment over every light in a std430 storage buffer; `clustered-*` over the lights of the
-//! fragment's cluster (same pass, another fragment shader); `deferred-compute` writes a
-//! G-buffer here instead and lights it in a compute pass (deferred.rs).
+//! The raster pass (SPEC §3): one render pass. Technique `forward` loops every fragment over
+//! every light in a std430 storage buffer; `clustered-*` over the lights of the fragment's
+//! cluster (same pass, another fragment shader); `deferred-compute` writes a G-buffer here and
+//! lights it in a compute pass (deferred.rs); `deferred` and `deferred-clustered` are seed
+//! 002's pass with two subpasses: subpass 0 writes the G-buffer, subpass 1 reads it as input
+//! attachments and shades a full-screen triangle into an HDR target (tone-mapped after).
 
 use crate::gpu_mesh::GpuMesh;
+use crate::render_pass;
 use crate::settings::Technique;
-use crate::targets::{Output, COLOR_FORMAT, GBUFFER_NORMAL_FORMAT, GBUFFER_OBJECT_FORMAT};
+use crate::targets::{Output, Targets};
 use ml_cpu::gpu_types::ObjectPush;
 use ml_cpu::mesh::Vertex;
 use ml_cpu::scene::Object;
+use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
 use ml_vk::{shader, vk, Context, VkError, VkResultExt};
 
 /// Binding numbers of set 0 (see the shaders).
@@ -16,6 +20,11 @@ pub const BINDING_FRAME: u32 = 0;
 pub const BINDING_LIGHTS: u32 = 1;
 pub const BINDING_CLUSTER_RANGES: u32 = 2;
 pub const BINDING_LIGHT_INDICES: u32 = 3;
+/// Bindings of set 1, the lighting subpass's inputs (deferred_frag.glsl).
+pub const BINDING_INPUT_OBJECTS: u32 = 0;
+pub const BINDING_INPUT_DEPTH: u32 = 1;
+pub const BINDING_INPUT_NORMAL: u32 = 2;
+pub const BINDING_INPUT_OBJECT_ID: u32 = 3;
 
 /// Background of pixels no object covers (linear, before the UNORM store).
 pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
@@ -27,16 +36,39 @@ pub struct RasterPass {
     pub pipeline: vk::Pipeline,
     /// Draws the cluster-heat legend over the image (no depth, no vertex buffer; colour only).
     pub legend_pipeline: vk::Pipeline,
+    /// Output::Subpasses: the lighting subpass's pipeline, its layout (sets 0 and 1) and the
+    /// layout of set 1 (objects + input attachments); null otherwise.
+    pub lighting_pipeline: vk::Pipeline,
+    pub lighting_layout: vk::PipelineLayout,
+    pub input_set_layout: vk::DescriptorSetLayout,
     pub output: Output,
 }
 
-/// The two kinds of draw in the pass.
+/// The kinds of draw in the pass.
 #[derive(Clone, Copy, PartialEq)]
 enum Draw {
-    /// Scene meshes: vertex buffer, depth test, back-face culling.
+    /// Scene meshes: vertex buffer, depth test, back-face culling (subpass 0).
     Mesh,
-    /// Screen-space overlay made from the vertex index, drawn over everything.
+    /// Screen-space overlay made from the vertex index, drawn over everything (subpass 0).
     Overlay,
+    /// The full-screen lighting triangle of subpass 1, reading the G-buffer.
+    Lighting,
+}
+
+/// What one frame's pass draws into and reads.
+pub struct PassFrame {
+    pub framebuffer: vk::Framebuffer,
+    pub extent: vk::Extent2D,
+    /// Set 0: uniforms, lights, cluster lists.
+    pub set: vk::DescriptorSet,
+    /// Set 1 of the lighting subpass (null without one).
+    pub input_set: vk::DescriptorSet,
+}
+
+/// The scene's draws: meshes and the objects that use them.
+pub struct DrawList<'a> {
+    pub meshes: &'a [GpuMesh],
+    pub objects: &'a [Object],
 }
 
 impl RasterPass {
@@ -48,19 +80,24 @@ impl RasterPass {
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             legend_pipeline: vk::Pipeline::null(),
+            lighting_pipeline: vk::Pipeline::null(),
+            lighting_layout: vk::PipelineLayout::null(),
+            input_set_layout: vk::DescriptorSetLayout::null(),
             output,
         };
         // On failure, destroy what was made (null handles are ignored by vkDestroy*).
         let fragment = match (output, technique.is_clustered()) {
-            (Output::GBuffer, _) => ml_shaders::GBUFFER_FRAG,
+            (Output::GBuffer | Output::Subpasses, _) => ml_shaders::GBUFFER_FRAG,
             (Output::Color, true) => ml_shaders::CLUSTERED_FRAG,
             (Output::Color, false) => ml_shaders::FORWARD_FRAG,
         };
-        ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, fragment, output))
+        let lighting = if technique.is_clustered() { ml_shaders::DEFERRED_CLUSTERED_FRAG } else { ml_shaders::DEFERRED_FRAG };
+        ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, fragment, lighting))
     }
 
-    fn create(&mut self, ctx: &Context, depth_format: vk::Format, fragment: &[u8], output: Output) -> Result<(), VkError> {
-        self.render_pass = create_render_pass(ctx, depth_format, output)?;
+    fn create(&mut self, ctx: &Context, depth_format: vk::Format, fragment: &[u8], lighting: &[u8]) -> Result<(), VkError> {
+        let output = self.output;
+        self.render_pass = render_pass::describe(depth_format, output).create(ctx)?;
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         self.set_layout = shader::set_layout(
             ctx,
@@ -76,23 +113,55 @@ impl RasterPass {
             .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             .size(std::mem::size_of::<ObjectPush>() as u32)];
         self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout], &push)?;
-        let colour_attachments = output.colour_attachments();
-        self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh, colour_attachments)?;
+        self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh)?;
         if output == Output::Color {
-            self.legend_pipeline =
-                self.create_pipeline(ctx, ml_shaders::HEAT_LEGEND_VERT, ml_shaders::HEAT_LEGEND_FRAG, Draw::Overlay, colour_attachments)?;
+            self.legend_pipeline = self.create_pipeline(ctx, ml_shaders::HEAT_LEGEND_VERT, ml_shaders::HEAT_LEGEND_FRAG, Draw::Overlay)?;
+        }
+        if output == Output::Subpasses {
+            use vk::DescriptorType as T;
+            self.input_set_layout = shader::set_layout(
+                ctx,
+                &[
+                    (BINDING_INPUT_OBJECTS, T::STORAGE_BUFFER),
+                    (BINDING_INPUT_DEPTH, T::INPUT_ATTACHMENT),
+                    (BINDING_INPUT_NORMAL, T::INPUT_ATTACHMENT),
+                    (BINDING_INPUT_OBJECT_ID, T::INPUT_ATTACHMENT),
+                ],
+                vk::ShaderStageFlags::FRAGMENT,
+            )?;
+            self.lighting_layout = shader::pipeline_layout(ctx, &[self.set_layout, self.input_set_layout], &[])?;
+            self.lighting_pipeline = self.create_pipeline(ctx, ml_shaders::FULLSCREEN_VERT, lighting, Draw::Lighting)?;
         }
         Ok(())
     }
 
-    fn create_pipeline(
+    /// Set 1 of a frame's lighting subpass: the object buffer and its targets' G-buffer.
+    pub fn input_set(
         &self,
         ctx: &Context,
-        vertex: &[u8],
-        fragment: &[u8],
-        draw: Draw,
-        colour_attachments: usize,
-    ) -> Result<vk::Pipeline, VkError> {
+        pool: vk::DescriptorPool,
+        targets: &Targets,
+        objects: vk::Buffer,
+    ) -> Result<vk::DescriptorSet, VkError> {
+        let set = allocate_set(ctx, pool, self.input_set_layout)?;
+        write_buffer(ctx, set, BINDING_INPUT_OBJECTS, vk::DescriptorType::STORAGE_BUFFER, objects);
+        let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        for (binding, view, layout) in [
+            (BINDING_INPUT_DEPTH, targets.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            (BINDING_INPUT_NORMAL, targets.gbuffer[0].view, read_only),
+            (BINDING_INPUT_OBJECT_ID, targets.gbuffer[1].view, read_only),
+        ] {
+            let info = vk::DescriptorImageInfo::default().image_view(view).image_layout(layout);
+            write_image(ctx, set, binding, vk::DescriptorType::INPUT_ATTACHMENT, info);
+        }
+        Ok(set)
+    }
+
+    fn create_pipeline(&self, ctx: &Context, vertex: &[u8], fragment: &[u8], draw: Draw) -> Result<vk::Pipeline, VkError> {
+        let (layout, subpass, colour_attachments) = match draw {
+            Draw::Mesh | Draw::Overlay => (self.pipeline_layout, 0, self.output.colour_attachments()),
+            Draw::Lighting => (self.lighting_layout, 1, 1),
+        };
         let vert = shader::module(ctx, vertex)?;
         let frag = match shader::module(ctx, fragment) {
             Ok(f) => f,
@@ -126,7 +195,7 @@ impl RasterPass {
             Draw::Mesh => vk::PipelineVertexInputStateCreateInfo::default()
                 .vertex_binding_descriptions(&vertex_bindings)
                 .vertex_attribute_descriptions(&vertex_attributes),
-            Draw::Overlay => vk::PipelineVertexInputStateCreateInfo::default(),
+            Draw::Overlay | Draw::Lighting => vk::PipelineVertexInputStateCreateInfo::default(),
         };
         let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
@@ -157,9 +226,9 @@ impl RasterPass {
             .depth_stencil_state(&depth)
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
-            .layout(self.pipeline_layout)
+            .layout(layout)
             .render_pass(self.render_pass)
-            .subpass(0)];
+            .subpass(subpass)];
         // SAFETY: every referenced object is alive.
         let result = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None) };
         // SAFETY: modules are no longer needed once the pipeline exists (or failed).
@@ -171,29 +240,26 @@ impl RasterPass {
     }
 
     /// Record the whole pass: clear, draw every object with its push constants (and the
-    /// heat-map legend when asked), and leave the colour target in TRANSFER_SRC_OPTIMAL for a
-    /// read-back.
-    pub fn record(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        framebuffer: vk::Framebuffer,
-        extent: vk::Extent2D,
-        set: vk::DescriptorSet,
-        meshes: &[GpuMesh],
-        objects: &[Object],
-        legend: bool,
-    ) {
+    /// heat-map legend when asked), and — with two subpasses — light the G-buffer. Leaves the
+    /// colour target in TRANSFER_SRC_OPTIMAL for a read-back (Output::Color), or the G-buffer
+    /// / HDR image ready for the compute pass that follows.
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: &PassFrame, draws: &DrawList, legend: bool) {
         let d = &ctx.device;
-        // Colour attachments clear to the background (G-buffer: zeros), depth to the far plane.
+        // Colour clears to the background, the G-buffer to zeros, depth to the far plane, HDR
+        // to alpha 0 ("no object here", see tonemap.comp).
         let colour = vk::ClearValue { color: vk::ClearColorValue { float32: CLEAR_COLOR } };
         let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
-        let clear: Vec<vk::ClearValue> = if self.output == Output::Color { vec![colour, depth] } else { vec![zero, zero, depth] };
+        let clear: Vec<vk::ClearValue> = match self.output {
+            Output::Color => vec![colour, depth],
+            Output::GBuffer => vec![zero, zero, depth],
+            Output::Subpasses => vec![zero, zero, depth, zero],
+        };
+        let extent = frame.extent;
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
         let begin = vk::RenderPassBeginInfo::default()
             .render_pass(self.render_pass)
-            .framebuffer(framebuffer)
+            .framebuffer(frame.framebuffer)
             .render_area(area)
             .clear_values(&clear);
         let viewport =
@@ -204,11 +270,11 @@ impl RasterPass {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[area]);
-            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[set], &[]);
-            for mesh in meshes {
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[frame.set], &[]);
+            for mesh in draws.meshes {
                 d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
                 d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
-                for (index, object) in objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
+                for (index, object) in draws.objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
                     let push = object_push(object, index as u32);
                     d.cmd_push_constants(
                         cmd,
@@ -224,6 +290,13 @@ impl RasterPass {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.legend_pipeline);
                 d.cmd_draw(cmd, 6, 1, 0, 0);
             }
+            if self.output == Output::Subpasses {
+                d.cmd_next_subpass(cmd, vk::SubpassContents::INLINE);
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.lighting_pipeline);
+                let sets = [frame.set, frame.input_set];
+                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.lighting_layout, 0, &sets, &[]);
+                d.cmd_draw(cmd, 3, 1, 0, 0);
+            }
             d.cmd_end_render_pass(cmd);
         }
     }
@@ -233,8 +306,11 @@ impl RasterPass {
         unsafe {
             ctx.device.destroy_pipeline(self.pipeline, None);
             ctx.device.destroy_pipeline(self.legend_pipeline, None);
+            ctx.device.destroy_pipeline(self.lighting_pipeline, None);
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device.destroy_pipeline_layout(self.lighting_layout, None);
             ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+            ctx.device.destroy_descriptor_set_layout(self.input_set_layout, None);
             ctx.device.destroy_render_pass(self.render_pass, None);
         }
     }
@@ -249,74 +325,6 @@ pub fn object_push(o: &Object, index: u32) -> ObjectPush {
         material: [m.metallic, 0.0, 0.0, 0.0],
         ids: [index, 0, 0, 0],
     }
-}
-
-fn attachment(format: vk::Format, store: bool, final_layout: vk::ImageLayout) -> vk::AttachmentDescription {
-    vk::AttachmentDescription::default()
-        .format(format)
-        .samples(vk::SampleCountFlags::TYPE_1)
-        .load_op(vk::AttachmentLoadOp::CLEAR)
-        .store_op(if store { vk::AttachmentStoreOp::STORE } else { vk::AttachmentStoreOp::DONT_CARE })
-        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-        .initial_layout(vk::ImageLayout::UNDEFINED)
-        .final_layout(final_layout)
-}
-
-fn create_render_pass(ctx: &Context, depth_format: vk::Format, output: Output) -> Result<vk::RenderPass, VkError> {
-    let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-    let attachments: Vec<vk::AttachmentDescription> = match output {
-        // The colour result is copied out; depth is not needed afterwards.
-        Output::Color => vec![
-            attachment(COLOR_FORMAT, true, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-            attachment(depth_format, false, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
-        ],
-        // Everything is read by the lighting compute pass.
-        Output::GBuffer => vec![
-            attachment(GBUFFER_NORMAL_FORMAT, true, read_only),
-            attachment(GBUFFER_OBJECT_FORMAT, true, read_only),
-            attachment(depth_format, true, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-        ],
-    };
-    let colour_count = output.colour_attachments() as u32;
-    let color_refs: Vec<vk::AttachmentReference> = (0..colour_count)
-        .map(|attachment| vk::AttachmentReference { attachment, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL })
-        .collect();
-    let depth_ref = vk::AttachmentReference { attachment: colour_count, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
-    let subpasses = [vk::SubpassDescription::default()
-        .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
-        .color_attachments(&color_refs)
-        .depth_stencil_attachment(&depth_ref)];
-    let attachment_stages = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
-        | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
-        | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
-    let attachment_writes = vk::AccessFlags::COLOR_ATTACHMENT_WRITE | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
-    // Who uses the attachments after the pass: the read-back copy, or the lighting compute pass.
-    let (after_stage, after_access) = match output {
-        Output::Color => (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
-        Output::GBuffer => (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ),
-    };
-    let dependencies = [
-        // The targets are reused every other frame: wait for the earlier frame's attachment
-        // writes and its readers before clearing them again.
-        vk::SubpassDependency::default()
-            .src_subpass(vk::SUBPASS_EXTERNAL)
-            .dst_subpass(0)
-            .src_stage_mask(attachment_stages | after_stage)
-            .src_access_mask(attachment_writes)
-            .dst_stage_mask(attachment_stages)
-            .dst_access_mask(attachment_writes | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
-        vk::SubpassDependency::default()
-            .src_subpass(0)
-            .dst_subpass(vk::SUBPASS_EXTERNAL)
-            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS)
-            .src_access_mask(attachment_writes)
-            .dst_stage_mask(after_stage)
-            .dst_access_mask(after_access),
-    ];
-    let info = vk::RenderPassCreateInfo::default().attachments(&attachments).subpasses(&subpasses).dependencies(&dependencies);
-    // SAFETY: valid device and create info.
-    unsafe { ctx.device.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")
 }
 
 impl ml_vk::Release for RasterPass {

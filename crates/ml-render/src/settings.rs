@@ -13,24 +13,48 @@ pub enum Technique {
     ClusteredCpu,
     /// Cluster grid built by compute shaders every frame; lights animated on the GPU.
     ClusteredGpu,
+    /// Seed 002: one render pass, G-buffer subpass → lighting subpass (input attachments),
+    /// every light per pixel, into an HDR target; then a tone-map pass.
+    Deferred,
+    /// `Deferred` with the lighting subpass looping over its cluster's lights (CPU-assigned).
+    DeferredClustered,
     /// clustered-gpu's lists, with the lighting as a compute pass over a G-buffer.
     DeferredCompute,
 }
 
 impl Technique {
-    pub const ALL: [Technique; 4] = [Technique::Forward, Technique::ClusteredCpu, Technique::ClusteredGpu, Technique::DeferredCompute];
+    pub const ALL: [Technique; 6] = [
+        Technique::Forward,
+        Technique::ClusteredCpu,
+        Technique::ClusteredGpu,
+        Technique::Deferred,
+        Technique::DeferredClustered,
+        Technique::DeferredCompute,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             Technique::Forward => "forward",
             Technique::ClusteredCpu => "clustered-cpu",
             Technique::ClusteredGpu => "clustered-gpu",
+            Technique::Deferred => "deferred",
+            Technique::DeferredClustered => "deferred-clustered",
             Technique::DeferredCompute => "deferred-compute",
         }
     }
 
     pub fn is_clustered(self) -> bool {
-        matches!(self, Technique::ClusteredCpu | Technique::ClusteredGpu | Technique::DeferredCompute)
+        matches!(self, Technique::ClusteredCpu | Technique::ClusteredGpu | Technique::DeferredClustered | Technique::DeferredCompute)
+    }
+
+    /// Whether the CPU assigns lights to clusters every frame.
+    pub fn is_cpu_built(self) -> bool {
+        matches!(self, Technique::ClusteredCpu | Technique::DeferredClustered)
+    }
+
+    /// Whether the lighting runs in the second subpass of the raster pass (seed 002).
+    pub fn lights_in_subpass(self) -> bool {
+        matches!(self, Technique::Deferred | Technique::DeferredClustered)
     }
 
     /// Whether the lighting runs as a compute pass over a G-buffer.
@@ -111,8 +135,8 @@ impl RenderSettings {
                 return Err(RenderError::Invalid(format!("{what} {v} is out of range: use 1 to {max_dim}")));
             }
         }
-        // The heat view is drawn by the clustered fragment shader (deferred-compute has none).
-        if self.debug_view == DebugView::ClusterHeat && (!self.technique.is_clustered() || self.technique.lights_in_compute()) {
+        // The heat view is drawn by the clustered forward fragment shader.
+        if self.debug_view == DebugView::ClusterHeat && !matches!(self.technique, Technique::ClusteredCpu | Technique::ClusteredGpu) {
             return Err(RenderError::Invalid(format!(
                 "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}",
                 self.technique.name()

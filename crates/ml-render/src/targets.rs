@@ -6,6 +6,8 @@ use ml_vk::{vk, Context, Image, VkError, VkResultExt};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+/// What the deferred lighting subpass writes: linear HDR colour (seed 002), tone-mapped after.
+pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// G-buffer: octahedral normal in two floats (8 B) — half floats would move the seed's sharp
 /// highlights by several 8-bit steps — and the object index (4 B); 12 B/pixel besides depth.
 pub const GBUFFER_NORMAL_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
@@ -18,29 +20,41 @@ pub enum Output {
     Color,
     /// A G-buffer that a compute pass lights (deferred-compute).
     GBuffer,
+    /// A G-buffer that the pass's second subpass lights into an HDR image (deferred,
+    /// deferred-clustered); the G-buffer and depth live only inside the pass.
+    Subpasses,
 }
 
 impl Output {
     pub fn of(technique: Technique) -> Output {
         if technique.lights_in_compute() {
             Output::GBuffer
+        } else if technique.lights_in_subpass() {
+            Output::Subpasses
         } else {
             Output::Color
         }
     }
 
+    /// Colour attachments the meshes are drawn into (subpass 0).
     pub fn colour_attachments(self) -> usize {
         match self {
             Output::Color => 1,
-            Output::GBuffer => 2,
+            Output::GBuffer | Output::Subpasses => 2,
         }
     }
+}
+
+/// Bytes per pixel of the G-buffer, depth excluded (the figure `render` prints).
+pub fn gbuffer_bytes_per_pixel() -> u32 {
+    8 + 4
 }
 
 /// The first depth format the device can render to (and, for a G-buffer, sample).
 pub fn depth_format(ctx: &Context, output: Output) -> Result<vk::Format, VkError> {
     let mut needs = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT;
-    if output == Output::GBuffer {
+    if output != Output::Color {
+        // Read by the lighting pass (sampled, or loaded as an input attachment).
         needs |= vk::FormatFeatureFlags::SAMPLED_IMAGE;
     }
     [vk::Format::D32_SFLOAT, vk::Format::X8_D24_UNORM_PACK32]
@@ -51,11 +65,13 @@ pub fn depth_format(ctx: &Context, output: Output) -> Result<vk::Format, VkError
 
 pub struct Targets {
     /// The image that is read back (a colour attachment, or a storage image the lighting
-    /// compute pass writes).
+    /// compute pass or the tone map writes).
     pub color: Image,
     pub depth: Image,
-    /// deferred-compute: normal and object-index images (empty otherwise).
+    /// Deferred techniques: normal and object-index images (empty otherwise).
     pub gbuffer: Vec<Image>,
+    /// deferred, deferred-clustered: the lighting subpass's HDR output (null otherwise).
+    pub hdr: Image,
     pub framebuffer: vk::Framebuffer,
 }
 
@@ -67,7 +83,13 @@ impl Targets {
         depth_format: vk::Format,
         output: Output,
     ) -> Result<Targets, VkError> {
-        let t = Targets { color: Image::null(), depth: Image::null(), gbuffer: Vec::new(), framebuffer: vk::Framebuffer::null() };
+        let t = Targets {
+            color: Image::null(),
+            depth: Image::null(),
+            gbuffer: Vec::new(),
+            hdr: Image::null(),
+            framebuffer: vk::Framebuffer::null(),
+        };
         ml_vk::build(ctx, t, |t| t.create(ctx, render_pass, extent, depth_format, output))
     }
 
@@ -81,20 +103,31 @@ impl Targets {
     ) -> Result<(), VkError> {
         use vk::ImageUsageFlags as U;
         let colour = vk::ImageAspectFlags::COLOR;
-        let (color_usage, depth_usage) = match output {
-            Output::Color => (U::COLOR_ATTACHMENT | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT),
-            Output::GBuffer => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED),
+        // The subpass G-buffer never leaves the render pass: TRANSIENT lets a tiler keep it in
+        // tile memory (the device still backs it with ordinary memory where it has no lazy kind).
+        let inside_pass = U::INPUT_ATTACHMENT | U::TRANSIENT_ATTACHMENT;
+        let (color_usage, depth_usage, gbuffer_usage) = match output {
+            Output::Color => (U::COLOR_ATTACHMENT | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT, U::empty()),
+            Output::GBuffer => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::COLOR_ATTACHMENT | U::SAMPLED),
+            Output::Subpasses => {
+                (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | inside_pass, U::COLOR_ATTACHMENT | inside_pass)
+            }
         };
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
         self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
-        if output == Output::GBuffer {
+        if output != Output::Color {
             for (name, format) in [("g-buffer normal", GBUFFER_NORMAL_FORMAT), ("g-buffer object", GBUFFER_OBJECT_FORMAT)] {
-                self.gbuffer.push(Image::new_2d(ctx, name, extent, format, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?);
+                self.gbuffer.push(Image::new_2d(ctx, name, extent, format, gbuffer_usage, colour)?);
             }
         }
+        if output == Output::Subpasses {
+            self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
+        }
+        // Attachment order: see raster.rs create_render_pass.
         let views: Vec<vk::ImageView> = match output {
             Output::Color => vec![self.color.view, self.depth.view],
             Output::GBuffer => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.depth.view],
+            Output::Subpasses => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.depth.view, self.hdr.view],
         };
         let info = vk::FramebufferCreateInfo::default()
             .render_pass(render_pass)
@@ -116,6 +149,7 @@ impl Targets {
         for image in &mut self.gbuffer {
             image.destroy(ctx);
         }
+        self.hdr.destroy(ctx);
     }
 }
 

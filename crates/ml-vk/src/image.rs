@@ -108,3 +108,16 @@ impl Image {
 pub fn full_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(1).layer_count(1)
 }
+
+/// A sampler for `texelFetch`-only images: it ignores filtering, but a combined image sampler
+/// needs one.
+pub fn fetch_sampler(ctx: &Context) -> Result<vk::Sampler> {
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(vk::Filter::NEAREST)
+        .min_filter(vk::Filter::NEAREST)
+        .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+    // SAFETY: valid device and create info.
+    unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")
+}

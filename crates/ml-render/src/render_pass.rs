@@ -1,0 +1,180 @@
+//! The raster pass's VkRenderPass as plain data first (tests inspect it: SPEC §3 asks for seed
+//! 002's two subpasses with input attachments), then created from that data.
+//!
+//! Output::Color and Output::GBuffer: one subpass. Output::Subpasses (seed 002): attachments
+//! 0 normal, 1 object index, 2 depth — the G-buffer, written by subpass 0, read by subpass 1 as
+//! input attachments, never stored — and 3 HDR colour, written by subpass 1 and read by the
+//! tone-map compute pass.
+
+use crate::targets::{Output, COLOR_FORMAT, GBUFFER_NORMAL_FORMAT, GBUFFER_OBJECT_FORMAT, HDR_FORMAT};
+use ml_vk::{vk, Context, VkError, VkResultExt};
+
+/// One subpass: which attachments it writes and reads.
+#[derive(Clone, Debug, Default)]
+pub struct Subpass {
+    pub colour: Vec<vk::AttachmentReference>,
+    pub depth: Option<vk::AttachmentReference>,
+    /// Read with subpassLoad, in input_attachment_index order.
+    pub inputs: Vec<vk::AttachmentReference>,
+}
+
+#[derive(Clone, Debug)]
+pub struct RenderPassDesc {
+    pub attachments: Vec<vk::AttachmentDescription>,
+    pub subpasses: Vec<Subpass>,
+    pub dependencies: Vec<vk::SubpassDependency>,
+}
+
+fn attachment(format: vk::Format, store: bool, final_layout: vk::ImageLayout) -> vk::AttachmentDescription {
+    vk::AttachmentDescription::default()
+        .format(format)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(if store { vk::AttachmentStoreOp::STORE } else { vk::AttachmentStoreOp::DONT_CARE })
+        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .final_layout(final_layout)
+}
+
+fn reference(attachment: u32, layout: vk::ImageLayout) -> vk::AttachmentReference {
+    vk::AttachmentReference { attachment, layout }
+}
+
+const COLOUR_OUT: vk::PipelineStageFlags = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT;
+const FRAGMENT_TESTS: vk::PipelineStageFlags = vk::PipelineStageFlags::from_raw(
+    vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS.as_raw(),
+);
+const ATTACHMENT_WRITES: vk::AccessFlags =
+    vk::AccessFlags::from_raw(vk::AccessFlags::COLOR_ATTACHMENT_WRITE.as_raw() | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw());
+
+fn dependency(
+    src: (u32, vk::PipelineStageFlags, vk::AccessFlags),
+    dst: (u32, vk::PipelineStageFlags, vk::AccessFlags),
+) -> vk::SubpassDependency {
+    vk::SubpassDependency::default()
+        .src_subpass(src.0)
+        .src_stage_mask(src.1)
+        .src_access_mask(src.2)
+        .dst_subpass(dst.0)
+        .dst_stage_mask(dst.1)
+        .dst_access_mask(dst.2)
+}
+
+/// The render pass the raster pass uses for `output`.
+pub fn describe(depth_format: vk::Format, output: Output) -> RenderPassDesc {
+    match output {
+        Output::Color | Output::GBuffer => one_subpass(depth_format, output),
+        Output::Subpasses => two_subpasses(depth_format),
+    }
+}
+
+fn one_subpass(depth_format: vk::Format, output: Output) -> RenderPassDesc {
+    let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+    let attachments = match output {
+        // The colour result is copied out; depth is not needed afterwards.
+        Output::Color => vec![
+            attachment(COLOR_FORMAT, true, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+            attachment(depth_format, false, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
+        ],
+        // Everything is read by the lighting compute pass.
+        _ => vec![
+            attachment(GBUFFER_NORMAL_FORMAT, true, read_only),
+            attachment(GBUFFER_OBJECT_FORMAT, true, read_only),
+            attachment(depth_format, true, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+        ],
+    };
+    let colour_count = output.colour_attachments() as u32;
+    let subpass = Subpass {
+        colour: (0..colour_count).map(|a| reference(a, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)).collect(),
+        depth: Some(reference(colour_count, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
+        inputs: Vec::new(),
+    };
+    // Who uses the attachments after the pass: the read-back copy, or the lighting compute pass.
+    let after = match output {
+        Output::Color => (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
+        _ => (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ),
+    };
+    let dependencies = vec![
+        // The targets are reused every other frame: wait for the earlier frame's attachment
+        // writes and its readers before clearing them again.
+        dependency(
+            (vk::SUBPASS_EXTERNAL, COLOUR_OUT | FRAGMENT_TESTS | after.0, ATTACHMENT_WRITES),
+            (0, COLOUR_OUT | FRAGMENT_TESTS, ATTACHMENT_WRITES | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
+        ),
+        dependency(
+            (0, COLOUR_OUT | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS, ATTACHMENT_WRITES),
+            (vk::SUBPASS_EXTERNAL, after.0, after.1),
+        ),
+    ];
+    RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
+}
+
+fn two_subpasses(depth_format: vk::Format) -> RenderPassDesc {
+    let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+    let depth_read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+    let colour = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+    let attachments = vec![
+        attachment(GBUFFER_NORMAL_FORMAT, false, read_only),
+        attachment(GBUFFER_OBJECT_FORMAT, false, read_only),
+        attachment(depth_format, false, depth_read_only),
+        attachment(HDR_FORMAT, true, read_only),
+    ];
+    let subpasses = vec![
+        Subpass {
+            colour: vec![reference(0, colour), reference(1, colour)],
+            depth: Some(reference(2, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
+            inputs: Vec::new(),
+        },
+        // input_attachment_index 0, 1, 2 in deferred_frag.glsl.
+        Subpass {
+            colour: vec![reference(3, colour)],
+            depth: None,
+            inputs: vec![reference(2, depth_read_only), reference(0, read_only), reference(1, read_only)],
+        },
+    ];
+    let fragment = vk::PipelineStageFlags::FRAGMENT_SHADER;
+    let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+    let colour_write = vk::AccessFlags::COLOR_ATTACHMENT_WRITE;
+    let external = vk::SUBPASS_EXTERNAL;
+    let dependencies = vec![
+        // The targets are reused every other frame: the G-buffer was last written by that
+        // frame's subpass 0 and read by its subpass 1 ...
+        dependency(
+            (external, COLOUR_OUT | FRAGMENT_TESTS | fragment, ATTACHMENT_WRITES),
+            (0, COLOUR_OUT | FRAGMENT_TESTS, ATTACHMENT_WRITES | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
+        ),
+        // ... and the HDR image written by its subpass 1 and read by its tone map.
+        dependency((external, COLOUR_OUT | compute, colour_write), (1, COLOUR_OUT, colour_write)),
+        // Seed 002's dependency: G-buffer writes before the lighting subpass reads them, per
+        // pixel (BY_REGION: a tiler never leaves the tile).
+        dependency((0, COLOUR_OUT | FRAGMENT_TESTS, ATTACHMENT_WRITES), (1, fragment, vk::AccessFlags::INPUT_ATTACHMENT_READ))
+            .dependency_flags(vk::DependencyFlags::BY_REGION),
+        // HDR writes before the tone map reads them.
+        dependency((1, COLOUR_OUT, colour_write), (external, compute, vk::AccessFlags::SHADER_READ)),
+    ];
+    RenderPassDesc { attachments, subpasses, dependencies }
+}
+
+impl RenderPassDesc {
+    pub fn create(&self, ctx: &Context) -> Result<vk::RenderPass, VkError> {
+        let subpasses: Vec<vk::SubpassDescription> = self
+            .subpasses
+            .iter()
+            .map(|s| {
+                let d = vk::SubpassDescription::default()
+                    .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+                    .color_attachments(&s.colour)
+                    .input_attachments(&s.inputs);
+                match &s.depth {
+                    Some(depth) => d.depth_stencil_attachment(depth),
+                    None => d,
+                }
+            })
+            .collect();
+        let info =
+            vk::RenderPassCreateInfo::default().attachments(&self.attachments).subpasses(&subpasses).dependencies(&self.dependencies);
+        // SAFETY: valid device and create info; the referenced arrays outlive the call.
+        unsafe { ctx.device.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")
+    }
+}

@@ -1,0 +1,29 @@
+// Subpass 1 of the deferred render pass (seed 002): reads the G-buffer that subpass 0 wrote as
+// input attachments (this pixel only: subpassLoad), rebuilds the position from depth and
+// shades it with lighting.glsl into the HDR target. `deferred.frag` loops over every light,
+// `deferred_clustered.frag` over the fragment's cluster. Pixels no object covers keep the
+// clear value (alpha 0), which the tone-map pass turns into the background colour.
+
+#include "common.glsl"
+
+#include "scene_bindings.glsl"
+layout(std430, set = 1, binding = 0) readonly buffer ObjectBuffer { ObjectPush objects[]; };
+layout(input_attachment_index = 0, set = 1, binding = 1) uniform subpassInput depth_input;
+layout(input_attachment_index = 1, set = 1, binding = 2) uniform subpassInput normal_input;
+layout(input_attachment_index = 2, set = 1, binding = 3) uniform usubpassInput object_input;
+
+#include "lighting.glsl"
+
+layout(location = 0) out vec4 out_hdr;
+
+void main() {
+    float z = subpassLoad(depth_input).r;
+    if (z >= 1.0) {
+        discard;
+    }
+    vec3 world = world_from_depth(gl_FragCoord.xy, z);
+    vec3 n = oct_decode(subpassLoad(normal_input).xy);
+    ObjectPush object = objects[subpassLoad(object_input).r];
+    vec3 color = shade_point(world, n, object.albedo_roughness.rgb, object.albedo_roughness.a, object.material.x, gl_FragCoord.xy);
+    out_hdr = vec4(color, 1.0);
+}
