@@ -8,6 +8,7 @@
 #define MANYLIGHTS_COMMON_GLSL
 
 #define SHADING_SEED 0u
+#define SHADING_BLINN_PHONG 1u
 
 #define DEBUG_VIEW_NONE 0u
 #define DEBUG_VIEW_CLUSTER_HEAT 1u
@@ -28,6 +29,15 @@ struct FrameUniforms {
     vec4 cluster_frustum; // x: near, y: far, z: proj[0][0], w: proj[1][1] (symmetric perspective)
     vec4 light_animation; // xyz: offset every light moves by this frame (the seed's animation)
     uvec4 cluster_build;  // x: light-index capacity (entries) of this frame's list
+    // The blinn-phong model's other lights (seed 002); the seed model ignores them.
+    mat4 shadow_view_proj;     // world → the sun's shadow-map clip space (depth 0..1)
+    vec4 sun_direction;        // xyz: direction the sunlight travels; w: shadow-map texel (uv units)
+    vec4 sun_strength;         // rgb: colour × strength; w: shadow-map texel in world units
+    vec4 spot_position_range;  // xyz: position; w: range (no light beyond it)
+    vec4 spot_direction_power; // xyz: unit direction; w: cone exponent
+    vec4 spot_strength;        // rgb
+    vec4 ambient_light;        // rgb: ambient colour
+    vec4 texture_transform;    // the 2×2 transform of texture coordinates: columns xy and zw
 };
 
 // A radius-limited point light (set 0, binding 1, std430 array).

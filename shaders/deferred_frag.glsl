@@ -7,10 +7,12 @@
 #include "common.glsl"
 
 #include "scene_bindings.glsl"
-layout(std430, set = 1, binding = 0) readonly buffer ObjectBuffer { ObjectPush objects[]; };
-layout(input_attachment_index = 0, set = 1, binding = 1) uniform subpassInput depth_input;
-layout(input_attachment_index = 1, set = 1, binding = 2) uniform subpassInput normal_input;
-layout(input_attachment_index = 2, set = 1, binding = 3) uniform usubpassInput object_input;
+#include "textures.glsl"
+layout(std430, set = 2, binding = 0) readonly buffer ObjectBuffer { ObjectPush objects[]; };
+layout(input_attachment_index = 0, set = 2, binding = 1) uniform subpassInput depth_input;
+layout(input_attachment_index = 1, set = 2, binding = 2) uniform subpassInput normal_input;
+layout(input_attachment_index = 2, set = 2, binding = 3) uniform usubpassInput object_input;
+layout(input_attachment_index = 3, set = 2, binding = 4) uniform subpassInput albedo_input;
 
 #include "lighting.glsl"
 
@@ -24,6 +26,7 @@ void main() {
     vec3 world = world_from_depth(gl_FragCoord.xy, z);
     vec3 n = oct_decode(subpassLoad(normal_input).xy);
     ObjectPush object = objects[subpassLoad(object_input).r];
-    vec3 color = shade_point(world, n, object.albedo_roughness.rgb, object.albedo_roughness.a, object.material.x, gl_FragCoord.xy);
+    vec3 albedo = object.albedo_roughness.rgb * subpassLoad(albedo_input).rgb;
+    vec3 color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, gl_FragCoord.xy);
     out_hdr = vec4(color, 1.0);
 }

@@ -14,6 +14,8 @@ layout(set = 0, binding = 5) uniform sampler2D depth_image;
 layout(set = 0, binding = 6) uniform sampler2D normal_image;
 layout(set = 0, binding = 7) uniform usampler2D object_image;
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
+layout(set = 0, binding = 9) uniform sampler2D albedo_image;
+#include "textures.glsl"
 
 #include "lighting.glsl"
 
@@ -31,6 +33,7 @@ void main() {
     vec3 world = world_from_depth(frag_xy, z);
     vec3 n = oct_decode(texelFetch(normal_image, p, 0).xy);
     ObjectPush object = objects[texelFetch(object_image, p, 0).r];
-    vec3 color = shade_point(world, n, object.albedo_roughness.rgb, object.albedo_roughness.a, object.material.x, frag_xy);
+    vec3 albedo = object.albedo_roughness.rgb * texelFetch(albedo_image, p, 0).rgb;
+    vec3 color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, frag_xy);
     imageStore(out_image, p, vec4(encode_output(color), 1.0));
 }

@@ -7,10 +7,14 @@
 
 layout(location = 0) in vec3 in_world_pos;
 layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) in vec4 in_tangent;
 
 #include "scene_bindings.glsl"
 layout(push_constant) uniform PushBlock { ObjectPush object; };
 
+#include "textures.glsl"
+#include "surface.glsl"
 #include "lighting.glsl"
 
 layout(location = 0) out vec4 out_color;
@@ -25,7 +29,8 @@ void main() {
         return;
     }
 #endif
-    vec3 color = shade_point(in_world_pos, normalize(in_normal), object.albedo_roughness.rgb, object.albedo_roughness.a,
+    Surface s = surface_at(in_normal, in_tangent, in_uv);
+    vec3 color = shade_point(in_world_pos, s.normal, object.albedo_roughness.rgb * s.albedo_factor, object.albedo_roughness.a,
                              object.material.x, gl_FragCoord.xy);
     // The target is UNORM: the seed writes gamma-encoded values itself.
     out_color = vec4(encode_output(color), 1.0);

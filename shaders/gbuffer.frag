@@ -1,18 +1,28 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// G-buffer of deferred-compute: 12 bytes per pixel besides depth — the normal (octahedral, two
-// floats: exact enough that the seed's sharp highlights do not move) and the object's index
-// (its material comes from the object buffer at full precision). Position comes from depth.
+// G-buffer of the deferred techniques: 16 bytes per pixel besides depth — the normal
+// (octahedral, two floats: exact enough that the seed's sharp highlights do not move), the
+// object's index (its material comes from the object buffer at full precision) and the
+// surface's albedo factor (the blinn-phong texture; 1 for the seed model). Position comes
+// from depth.
 #include "common.glsl"
+#include "scene_bindings.glsl"
+#include "textures.glsl"
+#include "surface.glsl"
 
 layout(location = 0) in vec3 in_world_pos;
 layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) in vec4 in_tangent;
 layout(push_constant) uniform PushBlock { ObjectPush object; };
 
 layout(location = 0) out vec2 out_normal;
 layout(location = 1) out uint out_object;
+layout(location = 2) out vec4 out_albedo_factor;
 
 void main() {
-    out_normal = oct_encode(normalize(in_normal));
+    Surface s = surface_at(in_normal, in_tangent, in_uv);
+    out_normal = oct_encode(s.normal);
     out_object = object.ids.x;
+    out_albedo_factor = vec4(s.albedo_factor, 1.0);
 }

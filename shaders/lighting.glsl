@@ -2,16 +2,27 @@
 // deferred lighting subpass, the deferred-compute pass): one BRDF source, one summation order
 // (ascending light index), so culling and deferring change no pixel.
 //
-// The includer includes scene_bindings.glsl (`frame`, `lights[]`, with CLUSTERED the lists).
+// The includer includes scene_bindings.glsl (`frame`, `lights[]`, with CLUSTERED the lists)
+// and textures.glsl.
 
 #ifndef MANYLIGHTS_LIGHTING_GLSL
 #define MANYLIGHTS_LIGHTING_GLSL
 
 #include "seed_brdf.glsl"
+#include "blinn_phong.glsl"
 #include "cluster.glsl"
 
-// Linear colour of a surface point: ambient plus every light that reaches it. `frag_xy` is
-// the pixel centre (gl_FragCoord.xy), which picks the cluster.
+// One point light's contribution under the frame's shading model.
+vec3 point_light(PointLight light, vec3 world, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
+    if (frame.shading_model == SHADING_BLINN_PHONG) {
+        return bp_point_light(light, world, n, v, albedo, mix(vec3(0.04), albedo, metallic), 1.0 - roughness);
+    }
+    return seed_point_light(light, world, n, v, albedo, roughness, metallic);
+}
+
+// Linear colour of a surface point: every light that reaches it plus what the model adds
+// (seed: ambient; blinn-phong: ambient, sun, spot, reflection). `frag_xy` is the pixel
+// centre (gl_FragCoord.xy), which picks the cluster.
 vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, vec2 frag_xy) {
     vec3 v = normalize(frame.camera_pos.xyz - world);
     vec3 lo = vec3(0.0);
@@ -20,13 +31,16 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
     ClusterRange range = cluster_ranges[cluster_of(frame, frag_xy, depth)];
     for (uint k = 0u; k < range.count; ++k) {
         uint i = light_indices[range.offset + k];
-        lo += seed_point_light(lights[i], world, n, v, albedo, roughness, metallic);
+        lo += point_light(lights[i], world, n, v, albedo, roughness, metallic);
     }
 #else
     for (uint i = 0u; i < frame.light_count; ++i) {
-        lo += seed_point_light(lights[i], world, n, v, albedo, roughness, metallic);
+        lo += point_light(lights[i], world, n, v, albedo, roughness, metallic);
     }
 #endif
+    if (frame.shading_model == SHADING_BLINN_PHONG) {
+        return bp_scene_lights(world, n, v, albedo, mix(vec3(0.04), albedo, metallic), 1.0 - roughness) + lo;
+    }
     return albedo * frame.ambient + lo;
 }
 

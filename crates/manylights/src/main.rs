@@ -10,7 +10,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::report::table;
 use ml_render::targets::gbuffer_bytes_per_pixel;
-use ml_render::{DebugView, HeadlessRenderer, RenderSettings, Technique};
+use ml_render::{DebugView, HeadlessRenderer, RenderSettings, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -40,6 +40,10 @@ struct RenderArgs {
     /// deferred-compute.
     #[arg(long, default_value = "forward")]
     technique: String,
+    /// Shading model: seed (seed 000's Cook–Torrance) or blinn-phong (seed 002: shadowed sun,
+    /// spot light, textures, normal maps, sky reflections).
+    #[arg(long, default_value = "seed")]
+    shading: String,
     /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).
     #[arg(long, default_value = "16x9x24")]
     clusters: String,
@@ -124,7 +128,9 @@ fn build_scene(args: &RenderArgs) -> Result<Scene> {
         seed: args.light_seed,
         radius: RadiusRange::parse(&args.light_radius)?,
     };
-    Ok(Scene::seed(MeshKind::from_name(&args.object)?, Material::named(&args.material)?, &lights)?)
+    let scene = Scene::seed(MeshKind::from_name(&args.object)?, Material::named(&args.material)?, &lights)?;
+    // Seed 002's lighting wants something to cast shadows on.
+    Ok(if ShadingModel::from_name(&args.shading)? == ShadingModel::BlinnPhong { scene.with_floor() } else { scene })
 }
 
 /// Fail before rendering if the PNG could not be written: nothing is computed for nothing.
@@ -150,6 +156,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     check_output(&args.out)?;
     let settings = RenderSettings {
         technique,
+        shading: ShadingModel::from_name(&args.shading)?,
         clusters: ClusterDims::parse(&args.clusters)?,
         debug_view: DebugView::from_name(&args.debug_view)?,
         width: args.width,
@@ -171,6 +178,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         ("device", device),
         ("resolution", format!("{}x{}", output.width, output.height)),
         ("technique", technique.name().to_owned()),
+        ("shading", settings.shading.name().to_owned()),
         ("lights", light_count.to_string()),
         ("frames", stats.frames.to_string()),
     ];

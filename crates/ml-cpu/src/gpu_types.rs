@@ -26,8 +26,9 @@ macro_rules! gpu_struct {
     };
 }
 
-/// `SHADING_SEED` in common.glsl.
+/// `SHADING_*` in common.glsl.
 pub const SHADING_SEED: u32 = 0;
+pub const SHADING_BLINN_PHONG: u32 = 1;
 
 gpu_struct!(
     /// Per-frame uniforms (std140; every member 16-byte friendly).
@@ -52,6 +53,15 @@ gpu_struct!(
         light_animation: [f32; 4],
         /// x: light-index capacity (entries) of this frame's list (clustered-gpu).
         cluster_build: [u32; 4],
+        /// The blinn-phong model's other lights; see common.glsl.
+        shadow_view_proj: [[f32; 4]; 4],
+        sun_direction: [f32; 4],
+        sun_strength: [f32; 4],
+        spot_position_range: [f32; 4],
+        spot_direction_power: [f32; 4],
+        spot_strength: [f32; 4],
+        ambient_light: [f32; 4],
+        texture_transform: [f32; 4],
     }
 );
 

@@ -2,6 +2,7 @@
 //! lights, camera), the structs shared with the shaders, and the CPU reference of each
 //! shading model that the image tests compare the GPU against.
 
+pub mod blinn_phong;
 pub mod camera;
 pub mod cluster;
 pub mod error;
@@ -13,5 +14,6 @@ pub mod random_scene;
 pub mod scene;
 pub mod shading;
 mod teapot;
+pub mod textures;
 
 pub use error::SceneError;

@@ -12,6 +12,11 @@ use std::f32::consts::{PI, TAU};
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
+    /// Texture coordinates (the blinn-phong model's albedo and normal maps).
+    pub uv: [f32; 2],
+    /// xyz: tangent along +u, orthogonal to the normal; w: ±1, the bitangent's handedness
+    /// (bitangent = w · normal × tangent), for normal mapping.
+    pub tangent: [f32; 4],
 }
 
 #[derive(Clone, Debug, Default)]
@@ -52,13 +57,15 @@ impl MeshKind {
     }
 
     pub fn build(self) -> Mesh {
-        match self {
+        let mut mesh = match self {
             MeshKind::Sphere => uv_sphere(SPHERE_STACKS, SPHERE_SLICES),
             MeshKind::Teapot => fit_unit_cube(crate::teapot::teapot(TEAPOT_PATCH_STEPS)),
             MeshKind::TorusKnot => fit_unit_cube(torus_knot(2, 3, 256, 24, 0.45)),
             MeshKind::Plane => plane(),
             MeshKind::Disc => disc(64),
-        }
+        };
+        compute_tangents(&mut mesh);
+        mesh
     }
 }
 
@@ -68,8 +75,43 @@ pub const SPHERE_STACKS: u32 = 64;
 pub const SPHERE_SLICES: u32 = 128;
 const TEAPOT_PATCH_STEPS: u32 = 12;
 
-fn vertex(p: Vec3, n: Vec3) -> Vertex {
-    Vertex { position: p.to_array(), normal: n.normalize().to_array() }
+/// A vertex without its tangent (`compute_tangents` adds it once the mesh is complete).
+pub(crate) fn vertex_uv(p: Vec3, n: Vec3, uv: [f32; 2]) -> Vertex {
+    Vertex { position: p.to_array(), normal: n.normalize().to_array(), uv, tangent: [0.0; 4] }
+}
+
+/// Per-vertex tangent frames from the texture coordinates: each triangle's ∂p/∂u and ∂p/∂v
+/// summed at its vertices (weighted by area, which the unnormalised edge products carry),
+/// then made orthogonal to the normal (Gram–Schmidt); w records whether (T, B, N) is
+/// right-handed. Vertices where u does not change (poles, collapsed edges) get any tangent
+/// orthogonal to the normal.
+pub fn compute_tangents(mesh: &mut Mesh) {
+    let mut tu = vec![Vec3::ZERO; mesh.vertices.len()];
+    let mut tv = vec![Vec3::ZERO; mesh.vertices.len()];
+    for tri in mesh.indices.chunks_exact(3) {
+        let v = |k: usize| &mesh.vertices[tri[k] as usize];
+        let (e1, e2) = (Vec3::from(v(1).position) - Vec3::from(v(0).position), Vec3::from(v(2).position) - Vec3::from(v(0).position));
+        let (du1, dv1) = (v(1).uv[0] - v(0).uv[0], v(1).uv[1] - v(0).uv[1]);
+        let (du2, dv2) = (v(2).uv[0] - v(0).uv[0], v(2).uv[1] - v(0).uv[1]);
+        let det = du1 * dv2 - du2 * dv1;
+        if det.abs() < 1e-12 {
+            continue;
+        }
+        let (t, b) = ((e1 * dv2 - e2 * dv1) / det, (e2 * du1 - e1 * du2) / det);
+        for &i in tri {
+            tu[i as usize] += t;
+            tv[i as usize] += b;
+        }
+    }
+    for (v, (t, b)) in mesh.vertices.iter_mut().zip(tu.into_iter().zip(tv)) {
+        let n = Vec3::from(v.normal);
+        let mut tangent = (t - n * n.dot(t)).normalize_or_zero();
+        if tangent == Vec3::ZERO {
+            tangent = n.any_orthonormal_vector();
+        }
+        let w = if n.cross(tangent).dot(b) < 0.0 { -1.0 } else { 1.0 };
+        v.tangent = tangent.extend(w).to_array();
+    }
 }
 
 /// Indices of a (rows+1)×(cols+1) vertex grid as triangles, two per cell (winding is fixed
@@ -95,7 +137,7 @@ pub fn uv_sphere(stacks: u32, slices: u32) -> Mesh {
         for l in 0..=slices {
             let phi = TAU * l as f32 / slices as f32;
             let n = Vec3::new(theta.sin() * phi.sin(), theta.cos(), theta.sin() * phi.cos());
-            vertices.push(vertex(n, n));
+            vertices.push(vertex_uv(n, n, [l as f32 / slices as f32, s as f32 / stacks as f32]));
         }
     }
     let mut indices = Vec::new();
@@ -103,20 +145,26 @@ pub fn uv_sphere(stacks: u32, slices: u32) -> Mesh {
     orient_triangles_to_normals(&mut Mesh { vertices, indices })
 }
 
+/// Texture coordinates of the point (x, 0, z) of a plane or disc: the unit square over it.
+fn planar_uv(x: f32, z: f32) -> [f32; 2] {
+    [(x + 1.0) * 0.5, (z + 1.0) * 0.5]
+}
+
 /// Square of half-size 1 in y = 0, facing +Y.
 pub fn plane() -> Mesh {
     let n = Vec3::Y;
-    let vertices = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(x, z)| vertex(Vec3::new(x, 0.0, z), n)).to_vec();
+    let vertices =
+        [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(x, z)| vertex_uv(Vec3::new(x, 0.0, z), n, planar_uv(x, z))).to_vec();
     // Seen from +Y (looking down, x right, z towards the viewer) 0 → 2 → 1 is counter-clockwise.
     Mesh { vertices, indices: vec![0, 2, 1, 1, 2, 3] }
 }
 
 /// Disc of radius 1 in y = 0, facing +Y.
 pub fn disc(segments: u32) -> Mesh {
-    let mut vertices = vec![vertex(Vec3::ZERO, Vec3::Y)];
+    let mut vertices = vec![vertex_uv(Vec3::ZERO, Vec3::Y, planar_uv(0.0, 0.0))];
     for i in 0..segments {
         let a = TAU * i as f32 / segments as f32;
-        vertices.push(vertex(Vec3::new(a.cos(), 0.0, a.sin()), Vec3::Y));
+        vertices.push(vertex_uv(Vec3::new(a.cos(), 0.0, a.sin()), Vec3::Y, planar_uv(a.cos(), a.sin())));
     }
     let mut indices = Vec::new();
     for i in 0..segments {
@@ -146,7 +194,8 @@ pub fn torus_knot(p: u32, q: u32, steps: u32, sides: u32, tube: f32) -> Mesh {
         for k in 0..=sides {
             let a = TAU * k as f32 / sides as f32;
             let n = normal * a.cos() + binormal * a.sin();
-            vertices.push(vertex(c + tube * n, n));
+            // u runs along the knot (8 texture repeats), v around the tube.
+            vertices.push(vertex_uv(c + tube * n, n, [8.0 * s as f32 / steps as f32, k as f32 / sides as f32]));
         }
     }
     let mut indices = Vec::new();
@@ -241,6 +290,27 @@ mod tests {
             assert!(lo.min_element() >= -1.0 - 1e-5 && hi.max_element() <= 1.0 + 1e-5, "{kind:?} {lo} {hi}");
             assert!((hi - lo).max_element() > 1.99, "{kind:?} should span the cube: {lo} {hi}");
         }
+    }
+
+    #[test]
+    fn tangents_are_unit_orthogonal_and_follow_u() {
+        for kind in MeshKind::ALL {
+            let mesh = kind.build();
+            for v in &mesh.vertices {
+                let (t, n) = (Vec3::from_slice(&v.tangent[..3]), Vec3::from(v.normal));
+                assert!((t.length() - 1.0).abs() < 1e-4 && t.dot(n).abs() < 1e-4, "{kind:?}: {v:?}");
+                assert!(v.tangent[3].abs() == 1.0, "{kind:?}: handedness {}", v.tangent[3]);
+            }
+        }
+        // The plane: u grows with x, v with z; (T, B, N) = (+X, +Z, +Y) is left-handed.
+        let plane = MeshKind::Plane.build();
+        for v in &plane.vertices {
+            assert_eq!(v.tangent, [1.0, 0.0, 0.0, -1.0]);
+        }
+        // The sphere's equator: u runs with the longitude φ, towards +x at φ = 0 (+z).
+        let sphere = MeshKind::Sphere.build();
+        let v = sphere.vertices.iter().find(|v| v.position[1].abs() < 1e-6 && v.position[2] > 0.999 && v.uv[0] == 0.0).unwrap();
+        assert!(v.tangent[0] > 0.999, "{v:?}");
     }
 
     #[test]

@@ -60,5 +60,5 @@ pub fn random_scene(seed: u64, max_lights: u32) -> Scene {
             }
         })
         .collect();
-    Scene { objects, lights, camera, ambient: SEED_AMBIENT }
+    Scene { objects, lights, camera, ambient: SEED_AMBIENT, blinn_phong: Default::default() }
 }

@@ -1,5 +1,6 @@
 //! Scenes: objects with a mesh kind, position, scale and material; lights; a camera.
 
+use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
 use crate::gpu_types::PointLight;
 use crate::lights::LightParams;
@@ -26,6 +27,8 @@ pub struct Scene {
     pub lights: Vec<PointLight>,
     pub camera: Camera,
     pub ambient: f32,
+    /// The other lights of the blinn-phong model (the seed model ignores them).
+    pub blinn_phong: BlinnPhongLights,
 }
 
 impl Scene {
@@ -39,7 +42,31 @@ impl Scene {
                 objects.push(Object { mesh, position: Vec3::new(at(i), 0.0, at(j)), scale: 1.0, material });
             }
         }
-        Ok(Scene { objects, lights: lights.build()?, camera: Camera::seed(), ambient: SEED_AMBIENT })
+        Ok(Scene {
+            objects,
+            lights: lights.build()?,
+            camera: Camera::seed(),
+            ambient: SEED_AMBIENT,
+            blinn_phong: BlinnPhongLights::default(),
+        })
+    }
+
+    /// Seed 002's setting for the seed scene: the same grid standing on a floor (which
+    /// receives the sun's shadows), for the blinn-phong model.
+    pub fn with_floor(mut self) -> Scene {
+        let floor = Material { albedo: Vec3::splat(0.8), roughness: 0.7, metallic: 0.0 };
+        let (lo, hi) = self.bounds();
+        let centre = (lo + hi) * 0.5;
+        let half = (hi - lo).max_element() * 0.5 + 2.0;
+        self.objects.push(Object { mesh: MeshKind::Plane, position: Vec3::new(centre.x, lo.y, centre.z), scale: half, material: floor });
+        self
+    }
+
+    /// World box around every object (each mesh fits [−1, 1]³ before scale and translation).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.objects.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), o| {
+            (lo.min(o.position - Vec3::splat(o.scale)), hi.max(o.position + Vec3::splat(o.scale)))
+        })
     }
 
     /// The distinct meshes this scene draws, in first-use order.

@@ -2,7 +2,7 @@
 //! 10-patch form with mirror symmetry that GLUT popularised: 127 control points, z up.
 //! Tessellated here into 32 bicubic patches and turned to +Y up.
 
-use crate::mesh::{grid_indices, orient_triangles_to_normals, Mesh, Vertex};
+use crate::mesh::{grid_indices, orient_triangles_to_normals, vertex_uv, Mesh};
 use glam::{Mat3, Vec3};
 
 /// Control-point indices of the 10 source patches (rim, body ×2, lid ×2, bottom, handle ×2,
@@ -110,8 +110,7 @@ pub(crate) fn teapot(steps: u32) -> Mesh {
                         let nudge = |t: f32| t + (0.5 - t) * 1e-3;
                         n = eval(&cp, nudge(u), nudge(v)).1;
                     }
-                    mesh.vertices
-                        .push(Vertex { position: (to_y_up * p).to_array(), normal: (to_y_up * (sign * n)).normalize().to_array() });
+                    mesh.vertices.push(vertex_uv(to_y_up * p, to_y_up * (sign * n), [u, v]));
                 }
             }
             grid_indices(base, steps, steps, &mut mesh.indices);

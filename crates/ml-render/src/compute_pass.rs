@@ -16,8 +16,13 @@ pub struct ComputePass {
 }
 
 impl ComputePass {
-    /// The pass of `spirv` with one set of `bindings`.
-    pub fn new(ctx: &Context, bindings: &[(u32, vk::DescriptorType)], spirv: &[u8]) -> Result<ComputePass, VkError> {
+    /// The pass of `spirv` with set 0 of `bindings` and further sets of `more_sets`.
+    pub fn new(
+        ctx: &Context,
+        bindings: &[(u32, vk::DescriptorType)],
+        more_sets: &[vk::DescriptorSetLayout],
+        spirv: &[u8],
+    ) -> Result<ComputePass, VkError> {
         let p = ComputePass {
             set_layout: vk::DescriptorSetLayout::null(),
             sampler: vk::Sampler::null(),
@@ -26,20 +31,21 @@ impl ComputePass {
         };
         ml_vk::build(ctx, p, |p| {
             p.set_layout = shader::set_layout(ctx, bindings, vk::ShaderStageFlags::COMPUTE)?;
-            p.pipeline_layout = shader::pipeline_layout(ctx, &[p.set_layout], &[])?;
+            let layouts: Vec<vk::DescriptorSetLayout> = std::iter::once(p.set_layout).chain(more_sets.iter().copied()).collect();
+            p.pipeline_layout = shader::pipeline_layout(ctx, &layouts, &[])?;
             p.pipeline = shader::compute_pipeline(ctx, spirv, p.pipeline_layout, &[])?;
             p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })
     }
 
-    /// Run over `extent` with `set`, writing `color` as a storage image, and leave it as the
+    /// Run over `extent` with `sets` (from set 0), writing `color` as a storage image, and leave it as the
     /// forward pass leaves its own target: in TRANSFER_SRC_OPTIMAL, ready for the read-back.
     pub fn record_into_colour_target(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        set: vk::DescriptorSet,
+        sets: &[vk::DescriptorSet],
         color: vk::Image,
         extent: vk::Extent2D,
     ) {
@@ -52,7 +58,7 @@ impl ComputePass {
         // SAFETY: recording state outside a render pass; everything bound is alive.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, sets, &[]);
             d.cmd_dispatch(cmd, extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP), 1);
         }
         image_transition(ctx, cmd, color, storage, (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL));

@@ -18,6 +18,7 @@ pub const BINDING_DEPTH: u32 = 5;
 pub const BINDING_NORMAL: u32 = 6;
 pub const BINDING_OBJECT_ID: u32 = 7;
 pub const BINDING_OUTPUT: u32 = 8;
+pub const BINDING_ALBEDO: u32 = 9;
 
 pub struct ComputeLighting {
     pass: ComputePass,
@@ -35,7 +36,7 @@ pub struct LightingInputs<'a> {
 }
 
 impl ComputeLighting {
-    pub fn new(ctx: &Context) -> Result<ComputeLighting, VkError> {
+    pub fn new(ctx: &Context, textures_layout: vk::DescriptorSetLayout) -> Result<ComputeLighting, VkError> {
         use vk::DescriptorType as T;
         let storage = T::STORAGE_BUFFER;
         let image = T::COMBINED_IMAGE_SAMPLER;
@@ -49,8 +50,11 @@ impl ComputeLighting {
             (BINDING_NORMAL, image),
             (BINDING_OBJECT_ID, image),
             (BINDING_OUTPUT, T::STORAGE_IMAGE),
+            (BINDING_ALBEDO, image),
         ];
-        Ok(ComputeLighting { pass: ComputePass::new(ctx, &bindings, ml_shaders::DEFERRED_LIGHTING_COMP)? })
+        // Set 1: the scene's textures (blinn-phong's shadow map and sky).
+        let pass = ComputePass::new(ctx, &bindings, &[textures_layout], ml_shaders::DEFERRED_LIGHTING_COMP)?;
+        Ok(ComputeLighting { pass })
     }
 
     /// Allocate and fill a frame's lighting set.
@@ -74,14 +78,15 @@ impl ComputeLighting {
         write_image(ctx, set, BINDING_DEPTH, image, sampled(t.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
         write_image(ctx, set, BINDING_NORMAL, image, sampled(t.gbuffer[0].view, read_only));
         write_image(ctx, set, BINDING_OBJECT_ID, image, sampled(t.gbuffer[1].view, read_only));
+        write_image(ctx, set, BINDING_ALBEDO, image, sampled(t.gbuffer[2].view, read_only));
         let output = vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL);
         write_image(ctx, set, BINDING_OUTPUT, vk::DescriptorType::STORAGE_IMAGE, output);
         Ok(set)
     }
 
     /// Record the lighting of `targets` (after the raster pass and the cluster build).
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, set: vk::DescriptorSet, targets: &Targets, extent: vk::Extent2D) {
-        self.pass.record_into_colour_target(ctx, cmd, set, targets.color.raw, extent);
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, sets: [vk::DescriptorSet; 2], targets: &Targets, extent: vk::Extent2D) {
+        self.pass.record_into_colour_target(ctx, cmd, &sets, targets.color.raw, extent);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

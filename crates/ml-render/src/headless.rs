@@ -8,11 +8,16 @@ use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
 use crate::raster::{object_push, DrawList, PassFrame, RasterPass};
 use crate::report::FrameStats;
+use crate::scene_textures::{SceneTextures, ShadowInputs};
+use crate::settings::ShadingModel;
 use crate::settings::{DebugView, RenderSettings};
 use crate::targets::{depth_format, Output, Targets};
 use crate::tonemap::ToneMap;
+use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_SEED};
+use ml_cpu::gpu_types::{
+    ClusterRange, FrameUniforms, ObjectPush, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_BLINN_PHONG, SHADING_SEED,
+};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
@@ -38,6 +43,10 @@ pub struct HeadlessRenderer<'a> {
     settings: RenderSettings,
     extent: vk::Extent2D,
     pass: RasterPass,
+    /// Set 1 of every shading pipeline (blinn-phong's shadow map, sky, albedo and normal maps).
+    textures: SceneTextures,
+    /// The sun's shadow-map view-projection (blinn-phong).
+    shadow_view_proj: glam::Mat4,
     meshes: Vec<GpuMesh>,
     command_pool: vk::CommandPool,
     descriptor_pool: vk::DescriptorPool,
@@ -94,12 +103,26 @@ impl<'a> HeadlessRenderer<'a> {
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
         let clusters =
             settings.technique.is_cpu_built().then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
+        let blinn_phong = settings.shading == ShadingModel::BlinnPhong;
+        let textures = SceneTextures::new(ctx, blinn_phong, depth_format(ctx, Output::GBuffer)?)?;
+        let pass = match RasterPass::new(ctx, depth, settings.technique, textures.set_layout) {
+            Ok(p) => p,
+            Err(e) => {
+                let mut textures = textures;
+                textures.destroy(ctx);
+                return Err(e.into());
+            }
+        };
+        let (lo, hi) = scene.bounds();
+        let shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
         let mut r = HeadlessRenderer {
             ctx,
             scene,
             settings,
             extent,
-            pass: RasterPass::new(ctx, depth, settings.technique)?,
+            pass,
+            textures,
+            shadow_view_proj,
             meshes: Vec::new(),
             command_pool: vk::CommandPool::null(),
             descriptor_pool: vk::DescriptorPool::null(),
@@ -128,6 +151,10 @@ impl<'a> HeadlessRenderer<'a> {
         for kind in self.scene.mesh_kinds() {
             self.meshes.push(GpuMesh::upload(ctx, kind, &kind.build())?);
         }
+        if self.settings.shading == ShadingModel::BlinnPhong {
+            let inputs = ShadowInputs { scene: &self.scene, meshes: &self.meshes, view_proj: self.shadow_view_proj };
+            self.textures.render_shadow_map(ctx, &inputs)?;
+        }
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -142,7 +169,7 @@ impl<'a> HeadlessRenderer<'a> {
             self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         }
         if self.settings.technique.lights_in_compute() {
-            self.lighting = Some(ComputeLighting::new(ctx)?);
+            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout)?);
         }
         if self.settings.technique.lights_in_subpass() {
             self.tonemap = Some(ToneMap::new(ctx)?);
@@ -335,6 +362,14 @@ impl<'a> HeadlessRenderer<'a> {
             DebugView::ClusterHeat => DEBUG_VIEW_CLUSTER_HEAT,
         };
         let cam = &self.scene.camera;
+        let bp = &self.scene.blinn_phong;
+        // World size of a shadow-map texel: the orthographic projection's first row is the
+        // sun's x axis over the half-width it covers.
+        let shadow_texel_world = 2.0 / self.shadow_view_proj.row(0).truncate().length() / self.textures.shadow_size as f32;
+        let shading_model = match self.settings.shading {
+            ShadingModel::Seed => SHADING_SEED,
+            ShadingModel::BlinnPhong => SHADING_BLINN_PHONG,
+        };
         let frame = &mut self.frames[f];
         let uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),
@@ -343,7 +378,7 @@ impl<'a> HeadlessRenderer<'a> {
             camera_pos: cam.position.extend(1.0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
-            shading_model: SHADING_SEED,
+            shading_model,
             _pad0: 0,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
             viewport: [self.extent.width, self.extent.height, 0, 0],
@@ -351,6 +386,14 @@ impl<'a> HeadlessRenderer<'a> {
             cluster_frustum: [g.near, g.far, g.projection.x_axis.x, g.projection.y_axis.y],
             light_animation: animation_offset(t).extend(0.0).to_array(),
             cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
+            shadow_view_proj: self.shadow_view_proj.to_cols_array_2d(),
+            sun_direction: bp.sun_direction.extend(1.0 / self.textures.shadow_size as f32).to_array(),
+            sun_strength: bp.sun_strength.extend(shadow_texel_world).to_array(),
+            spot_position_range: bp.spot.position.extend(bp.spot.range).to_array(),
+            spot_direction_power: bp.spot.direction.extend(bp.spot.power).to_array(),
+            spot_strength: bp.spot.strength.extend(0.0).to_array(),
+            ambient_light: bp.ambient.extend(0.0).to_array(),
+            texture_transform: bp.texture_transform.to_cols_array(),
         };
         frame.uniforms.write(0, &[uniforms]);
     }
@@ -376,13 +419,19 @@ impl<'a> HeadlessRenderer<'a> {
         frame.timer.begin(ctx, cmd, pass);
         let targets = frame.targets.as_ref().expect("made with the frame");
         let legend = self.settings.debug_view == DebugView::ClusterHeat;
-        let pass_frame = PassFrame { framebuffer: targets.framebuffer, extent: self.extent, set: frame.set, input_set: frame.input_set };
+        let pass_frame = PassFrame {
+            framebuffer: targets.framebuffer,
+            extent: self.extent,
+            set: frame.set,
+            textures: self.textures.set,
+            input_set: frame.input_set,
+        };
         self.pass.record(ctx, cmd, &pass_frame, &DrawList { meshes: &self.meshes, objects: &self.scene.objects }, legend);
         frame.timer.end(ctx, cmd, pass);
         if let Some(lighting) = &self.lighting {
             pass += 1;
             frame.timer.begin(ctx, cmd, pass);
-            lighting.record(ctx, cmd, frame.lighting_set, targets, self.extent);
+            lighting.record(ctx, cmd, [frame.lighting_set, self.textures.set], targets, self.extent);
             frame.timer.end(ctx, cmd, pass);
         }
         if let Some(tonemap) = &self.tonemap {
@@ -491,5 +540,6 @@ impl Drop for HeadlessRenderer<'_> {
             ctx.device.destroy_command_pool(self.command_pool, None);
         }
         self.pass.destroy(ctx);
+        self.textures.destroy(ctx);
     }
 }

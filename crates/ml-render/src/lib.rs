@@ -11,10 +11,11 @@ pub mod headless;
 pub mod raster;
 pub mod render_pass;
 pub mod report;
+pub mod scene_textures;
 pub mod settings;
 pub mod targets;
 pub mod tonemap;
 
 pub use error::RenderError;
 pub use headless::{HeadlessRenderer, RenderOutput};
-pub use settings::{DebugView, RenderSettings, Technique};
+pub use settings::{DebugView, RenderSettings, ShadingModel, Technique};

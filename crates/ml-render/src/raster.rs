@@ -20,11 +20,13 @@ pub const BINDING_FRAME: u32 = 0;
 pub const BINDING_LIGHTS: u32 = 1;
 pub const BINDING_CLUSTER_RANGES: u32 = 2;
 pub const BINDING_LIGHT_INDICES: u32 = 3;
-/// Bindings of set 1, the lighting subpass's inputs (deferred_frag.glsl).
+/// Bindings of set 2, the lighting subpass's inputs (deferred_frag.glsl; set 1 holds the
+/// scene's textures in every pipeline of the pass).
 pub const BINDING_INPUT_OBJECTS: u32 = 0;
 pub const BINDING_INPUT_DEPTH: u32 = 1;
 pub const BINDING_INPUT_NORMAL: u32 = 2;
 pub const BINDING_INPUT_OBJECT_ID: u32 = 3;
+pub const BINDING_INPUT_ALBEDO: u32 = 4;
 
 /// Background of pixels no object covers (linear, before the UNORM store).
 pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
@@ -36,8 +38,8 @@ pub struct RasterPass {
     pub pipeline: vk::Pipeline,
     /// Draws the cluster-heat legend over the image (no depth, no vertex buffer; colour only).
     pub legend_pipeline: vk::Pipeline,
-    /// Output::Subpasses: the lighting subpass's pipeline, its layout (sets 0 and 1) and the
-    /// layout of set 1 (objects + input attachments); null otherwise.
+    /// Output::Subpasses: the lighting subpass's pipeline, its layout (sets 0, 1 and 2) and the
+    /// layout of set 2 (objects + input attachments); null otherwise.
     pub lighting_pipeline: vk::Pipeline,
     pub lighting_layout: vk::PipelineLayout,
     pub input_set_layout: vk::DescriptorSetLayout,
@@ -61,7 +63,9 @@ pub struct PassFrame {
     pub extent: vk::Extent2D,
     /// Set 0: uniforms, lights, cluster lists.
     pub set: vk::DescriptorSet,
-    /// Set 1 of the lighting subpass (null without one).
+    /// Set 1: the scene's textures.
+    pub textures: vk::DescriptorSet,
+    /// Set 2 of the lighting subpass (null without one).
     pub input_set: vk::DescriptorSet,
 }
 
@@ -72,7 +76,13 @@ pub struct DrawList<'a> {
 }
 
 impl RasterPass {
-    pub fn new(ctx: &Context, depth_format: vk::Format, technique: Technique) -> Result<RasterPass, VkError> {
+    /// The pass for `technique`; `textures_layout` is set 1 of every pipeline (scene_textures.rs).
+    pub fn new(
+        ctx: &Context,
+        depth_format: vk::Format,
+        technique: Technique,
+        textures_layout: vk::DescriptorSetLayout,
+    ) -> Result<RasterPass, VkError> {
         let output = Output::of(technique);
         let pass = RasterPass {
             render_pass: vk::RenderPass::null(),
@@ -92,10 +102,16 @@ impl RasterPass {
             (Output::Color, false) => ml_shaders::FORWARD_FRAG,
         };
         let lighting = if technique.is_clustered() { ml_shaders::DEFERRED_CLUSTERED_FRAG } else { ml_shaders::DEFERRED_FRAG };
-        ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, fragment, lighting))
+        ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, (fragment, lighting), textures_layout))
     }
 
-    fn create(&mut self, ctx: &Context, depth_format: vk::Format, fragment: &[u8], lighting: &[u8]) -> Result<(), VkError> {
+    fn create(
+        &mut self,
+        ctx: &Context,
+        depth_format: vk::Format,
+        (fragment, lighting): (&[u8], &[u8]),
+        textures_layout: vk::DescriptorSetLayout,
+    ) -> Result<(), VkError> {
         let output = self.output;
         self.render_pass = render_pass::describe(depth_format, output).create(ctx)?;
         let storage = vk::DescriptorType::STORAGE_BUFFER;
@@ -112,7 +128,7 @@ impl RasterPass {
         let push = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             .size(std::mem::size_of::<ObjectPush>() as u32)];
-        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout], &push)?;
+        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout, textures_layout], &push)?;
         self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh)?;
         if output == Output::Color {
             self.legend_pipeline = self.create_pipeline(ctx, ml_shaders::HEAT_LEGEND_VERT, ml_shaders::HEAT_LEGEND_FRAG, Draw::Overlay)?;
@@ -126,16 +142,17 @@ impl RasterPass {
                     (BINDING_INPUT_DEPTH, T::INPUT_ATTACHMENT),
                     (BINDING_INPUT_NORMAL, T::INPUT_ATTACHMENT),
                     (BINDING_INPUT_OBJECT_ID, T::INPUT_ATTACHMENT),
+                    (BINDING_INPUT_ALBEDO, T::INPUT_ATTACHMENT),
                 ],
                 vk::ShaderStageFlags::FRAGMENT,
             )?;
-            self.lighting_layout = shader::pipeline_layout(ctx, &[self.set_layout, self.input_set_layout], &[])?;
+            self.lighting_layout = shader::pipeline_layout(ctx, &[self.set_layout, textures_layout, self.input_set_layout], &[])?;
             self.lighting_pipeline = self.create_pipeline(ctx, ml_shaders::FULLSCREEN_VERT, lighting, Draw::Lighting)?;
         }
         Ok(())
     }
 
-    /// Set 1 of a frame's lighting subpass: the object buffer and its targets' G-buffer.
+    /// Set 2 of a frame's lighting subpass: the object buffer and its targets' G-buffer.
     pub fn input_set(
         &self,
         ctx: &Context,
@@ -150,6 +167,7 @@ impl RasterPass {
             (BINDING_INPUT_DEPTH, targets.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
             (BINDING_INPUT_NORMAL, targets.gbuffer[0].view, read_only),
             (BINDING_INPUT_OBJECT_ID, targets.gbuffer[1].view, read_only),
+            (BINDING_INPUT_ALBEDO, targets.gbuffer[2].view, read_only),
         ] {
             let info = vk::DescriptorImageInfo::default().image_view(view).image_layout(layout);
             write_image(ctx, set, binding, vk::DescriptorType::INPUT_ATTACHMENT, info);
@@ -190,6 +208,16 @@ impl RasterPass {
                 .binding(0)
                 .format(vk::Format::R32G32B32_SFLOAT)
                 .offset(std::mem::offset_of!(Vertex, normal) as u32),
+            vk::VertexInputAttributeDescription::default()
+                .location(2)
+                .binding(0)
+                .format(vk::Format::R32G32_SFLOAT)
+                .offset(std::mem::offset_of!(Vertex, uv) as u32),
+            vk::VertexInputAttributeDescription::default()
+                .location(3)
+                .binding(0)
+                .format(vk::Format::R32G32B32A32_SFLOAT)
+                .offset(std::mem::offset_of!(Vertex, tangent) as u32),
         ];
         let vertex_input = match draw {
             Draw::Mesh => vk::PipelineVertexInputStateCreateInfo::default()
@@ -252,8 +280,8 @@ impl RasterPass {
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
         let clear: Vec<vk::ClearValue> = match self.output {
             Output::Color => vec![colour, depth],
-            Output::GBuffer => vec![zero, zero, depth],
-            Output::Subpasses => vec![zero, zero, depth, zero],
+            Output::GBuffer => vec![zero, zero, zero, depth],
+            Output::Subpasses => vec![zero, zero, zero, depth, zero],
         };
         let extent = frame.extent;
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
@@ -270,7 +298,7 @@ impl RasterPass {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[area]);
-            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[frame.set], &[]);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[frame.set, frame.textures], &[]);
             for mesh in draws.meshes {
                 d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
                 d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
@@ -293,7 +321,7 @@ impl RasterPass {
             if self.output == Output::Subpasses {
                 d.cmd_next_subpass(cmd, vk::SubpassContents::INLINE);
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.lighting_pipeline);
-                let sets = [frame.set, frame.input_set];
+                let sets = [frame.set, frame.textures, frame.input_set];
                 d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.lighting_layout, 0, &sets, &[]);
                 d.cmd_draw(cmd, 3, 1, 0, 0);
             }

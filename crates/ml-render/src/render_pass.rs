@@ -2,11 +2,11 @@
 //! 002's two subpasses with input attachments), then created from that data.
 //!
 //! Output::Color and Output::GBuffer: one subpass. Output::Subpasses (seed 002): attachments
-//! 0 normal, 1 object index, 2 depth — the G-buffer, written by subpass 0, read by subpass 1 as
-//! input attachments, never stored — and 3 HDR colour, written by subpass 1 and read by the
-//! tone-map compute pass.
+//! 0 normal, 1 object index, 2 albedo, 3 depth — the G-buffer, written by subpass 0, read by
+//! subpass 1 as input attachments, never stored — and 4 HDR colour, written by subpass 1 and
+//! read by the tone-map compute pass.
 
-use crate::targets::{Output, COLOR_FORMAT, GBUFFER_NORMAL_FORMAT, GBUFFER_OBJECT_FORMAT, HDR_FORMAT};
+use crate::targets::{Output, COLOR_FORMAT, GBUFFER_ALBEDO_FORMAT, GBUFFER_NORMAL_FORMAT, GBUFFER_OBJECT_FORMAT, HDR_FORMAT};
 use ml_vk::{vk, Context, VkError, VkResultExt};
 
 /// One subpass: which attachments it writes and reads.
@@ -81,6 +81,7 @@ fn one_subpass(depth_format: vk::Format, output: Output) -> RenderPassDesc {
         _ => vec![
             attachment(GBUFFER_NORMAL_FORMAT, true, read_only),
             attachment(GBUFFER_OBJECT_FORMAT, true, read_only),
+            attachment(GBUFFER_ALBEDO_FORMAT, true, read_only),
             attachment(depth_format, true, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
         ],
     };
@@ -117,20 +118,21 @@ fn two_subpasses(depth_format: vk::Format) -> RenderPassDesc {
     let attachments = vec![
         attachment(GBUFFER_NORMAL_FORMAT, false, read_only),
         attachment(GBUFFER_OBJECT_FORMAT, false, read_only),
+        attachment(GBUFFER_ALBEDO_FORMAT, false, read_only),
         attachment(depth_format, false, depth_read_only),
         attachment(HDR_FORMAT, true, read_only),
     ];
     let subpasses = vec![
         Subpass {
-            colour: vec![reference(0, colour), reference(1, colour)],
-            depth: Some(reference(2, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
+            colour: vec![reference(0, colour), reference(1, colour), reference(2, colour)],
+            depth: Some(reference(3, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
             inputs: Vec::new(),
         },
-        // input_attachment_index 0, 1, 2 in deferred_frag.glsl.
+        // input_attachment_index 0, 1, 2, 3 in deferred_frag.glsl.
         Subpass {
-            colour: vec![reference(3, colour)],
+            colour: vec![reference(4, colour)],
             depth: None,
-            inputs: vec![reference(2, depth_read_only), reference(0, read_only), reference(1, read_only)],
+            inputs: vec![reference(3, depth_read_only), reference(0, read_only), reference(1, read_only), reference(2, read_only)],
         },
     ];
     let fragment = vk::PipelineStageFlags::FRAGMENT_SHADER;

@@ -75,6 +75,33 @@ impl Technique {
     }
 }
 
+/// Shading models (SPEC §2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadingModel {
+    /// Seed 000: specular-only Cook–Torrance, ambient factor, gamma.
+    Seed,
+    /// Seed 002: Blinn-Phong with a shadowed sun, a spot light, textures and reflections.
+    BlinnPhong,
+}
+
+impl ShadingModel {
+    pub const ALL: [ShadingModel; 2] = [ShadingModel::Seed, ShadingModel::BlinnPhong];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadingModel::Seed => "seed",
+            ShadingModel::BlinnPhong => "blinn-phong",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<ShadingModel, RenderError> {
+        ShadingModel::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
+            let expected = ShadingModel::ALL.map(|m| m.name()).join(", ");
+            RenderError::Invalid(format!("unknown shading model '{name}': expected one of {expected}"))
+        })
+    }
+}
+
 /// What the image shows instead of the shaded scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DebugView {
@@ -100,6 +127,7 @@ pub const MAX_DIMENSION: u32 = 16384;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     pub technique: Technique,
+    pub shading: ShadingModel,
     /// Cluster grid of the clustered techniques.
     pub clusters: ClusterDims,
     pub debug_view: DebugView,
@@ -116,9 +144,19 @@ pub const TIMER_SPEED: f32 = 0.25;
 pub const FRAME_SECONDS: f32 = 1.0 / 60.0;
 
 impl RenderSettings {
-    /// Defaults for everything but size: forward, 16×9×24 clusters, one frame at time 0.
+    /// Defaults for everything but technique and size: the seed model, 16×9×24 clusters, one
+    /// frame at time 0.
     pub fn new(technique: Technique, width: u32, height: u32) -> RenderSettings {
-        RenderSettings { technique, clusters: ClusterDims::DEFAULT, debug_view: DebugView::None, width, height, frames: 1, time: Some(0.0) }
+        RenderSettings {
+            technique,
+            shading: ShadingModel::Seed,
+            clusters: ClusterDims::DEFAULT,
+            debug_view: DebugView::None,
+            width,
+            height,
+            frames: 1,
+            time: Some(0.0),
+        }
     }
 
     /// Animation clock of frame `i`.

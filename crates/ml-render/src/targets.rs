@@ -9,9 +9,12 @@ pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// What the deferred lighting subpass writes: linear HDR colour (seed 002), tone-mapped after.
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// G-buffer: octahedral normal in two floats (8 B) — half floats would move the seed's sharp
-/// highlights by several 8-bit steps — and the object index (4 B); 12 B/pixel besides depth.
+/// highlights by several 8-bit steps — the object index (4 B) and the albedo factor (4 B);
+/// 16 B/pixel besides depth.
 pub const GBUFFER_NORMAL_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
 pub const GBUFFER_OBJECT_FORMAT: vk::Format = vk::Format::R32_UINT;
+/// The surface's albedo factor (blinn-phong's texture sample; 1 for the seed model).
+pub const GBUFFER_ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 
 /// What the raster pass writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,14 +43,14 @@ impl Output {
     pub fn colour_attachments(self) -> usize {
         match self {
             Output::Color => 1,
-            Output::GBuffer | Output::Subpasses => 2,
+            Output::GBuffer | Output::Subpasses => 3,
         }
     }
 }
 
 /// Bytes per pixel of the G-buffer, depth excluded (the figure `render` prints).
 pub fn gbuffer_bytes_per_pixel() -> u32 {
-    8 + 4
+    8 + 4 + 4
 }
 
 /// The first depth format the device can render to (and, for a G-buffer, sample).
@@ -68,7 +71,7 @@ pub struct Targets {
     /// compute pass or the tone map writes).
     pub color: Image,
     pub depth: Image,
-    /// Deferred techniques: normal and object-index images (empty otherwise).
+    /// Deferred techniques: normal, object-index and albedo images (empty otherwise).
     pub gbuffer: Vec<Image>,
     /// deferred, deferred-clustered: the lighting subpass's HDR output (null otherwise).
     pub hdr: Image,
@@ -116,7 +119,11 @@ impl Targets {
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
         self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
         if output != Output::Color {
-            for (name, format) in [("g-buffer normal", GBUFFER_NORMAL_FORMAT), ("g-buffer object", GBUFFER_OBJECT_FORMAT)] {
+            for (name, format) in [
+                ("g-buffer normal", GBUFFER_NORMAL_FORMAT),
+                ("g-buffer object", GBUFFER_OBJECT_FORMAT),
+                ("g-buffer albedo", GBUFFER_ALBEDO_FORMAT),
+            ] {
                 self.gbuffer.push(Image::new_2d(ctx, name, extent, format, gbuffer_usage, colour)?);
             }
         }
@@ -126,8 +133,8 @@ impl Targets {
         // Attachment order: see raster.rs create_render_pass.
         let views: Vec<vk::ImageView> = match output {
             Output::Color => vec![self.color.view, self.depth.view],
-            Output::GBuffer => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.depth.view],
-            Output::Subpasses => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.depth.view, self.hdr.view],
+            Output::GBuffer => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.gbuffer[2].view, self.depth.view],
+            Output::Subpasses => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.gbuffer[2].view, self.depth.view, self.hdr.view],
         };
         let info = vk::FramebufferCreateInfo::default()
             .render_pass(render_pass)

@@ -18,7 +18,7 @@ impl ToneMap {
     pub fn new(ctx: &Context) -> Result<ToneMap, VkError> {
         use vk::DescriptorType as T;
         let bindings = [(BINDING_HDR, T::COMBINED_IMAGE_SAMPLER), (BINDING_OUTPUT, T::STORAGE_IMAGE)];
-        Ok(ToneMap { pass: ComputePass::new(ctx, &bindings, ml_shaders::TONEMAP_COMP)? })
+        Ok(ToneMap { pass: ComputePass::new(ctx, &bindings, &[], ml_shaders::TONEMAP_COMP)? })
     }
 
     /// Allocate and fill a frame's set: its HDR image in, its colour target out.
@@ -37,7 +37,7 @@ impl ToneMap {
     /// Record the tone map of `targets` (after the render pass, whose outgoing dependency
     /// orders the HDR writes before this pass's reads).
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, set: vk::DescriptorSet, targets: &Targets, extent: vk::Extent2D) {
-        self.pass.record_into_colour_target(ctx, cmd, set, targets.color.raw, extent);
+        self.pass.record_into_colour_target(ctx, cmd, &[set], targets.color.raw, extent);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -20,7 +20,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::random_scene::random_scene;
 use ml_cpu::scene::Scene;
-use ml_render::{RenderSettings, Technique};
+use ml_render::{RenderSettings, ShadingModel, Technique};
 
 const W: u32 = 160;
 const H: u32 = 90;
@@ -30,6 +30,15 @@ const MAX_DIFF: u8 = 1;
 /// highlights by a few 1e-5, which at roughness 0.1 turns into at most 2/255 on a few pixels
 /// per image. (The HDR target's half floats add at most ~1e-5 after gamma.)
 const MAX_DIFF_DEFERRED: u8 = 2;
+
+/// blinn-phong's sun shadow: the deferred paths look the shadow map up from a position rebuilt
+/// from depth (off by ~1e-4 at 20 units with D32 and near 0.1), and a depth comparison near its
+/// threshold flips for such a move (it is not continuous in the reference depth, whatever the
+/// filter): measured, without the shadow lookup the same scenes differ by at most 1/255; with
+/// it, 2 of 14,400 pixels by 9–21/255. So: at most this many pixels beyond MAX_DIFF_DEFERRED
+/// per image, by at most MAX_DIFF_SHADOW_OUTLIER.
+const SHADOW_OUTLIERS: usize = 8;
+const MAX_DIFF_SHADOW_OUTLIER: u8 = 32;
 
 const OTHERS: [Technique; 5] =
     [Technique::ClusteredCpu, Technique::ClusteredGpu, Technique::Deferred, Technique::DeferredClustered, Technique::DeferredCompute];
@@ -44,9 +53,16 @@ struct Seen {
 /// Render with forward and each other technique (two frames, so both frames in flight build
 /// or upload their own cluster data) and compare.
 fn assert_matches_forward(name: &str, scene: &Scene, clusters: ClusterDims) -> Seen {
-    let mut settings = vec![RenderSettings::new(Technique::Forward, W, H)];
+    assert_matches_forward_shaded(name, scene, clusters, ShadingModel::Seed)
+}
+
+fn assert_matches_forward_shaded(name: &str, scene: &Scene, clusters: ClusterDims, shading: ShadingModel) -> Seen {
+    let mut forward = RenderSettings::new(Technique::Forward, W, H);
+    forward.shading = shading;
+    let mut settings = vec![forward];
     for t in OTHERS {
         let mut s = RenderSettings::new(t, W, H);
+        s.shading = shading;
         s.clusters = clusters;
         s.frames = 2;
         settings.push(s);
@@ -63,7 +79,15 @@ fn assert_matches_forward(name: &str, scene: &Scene, clusters: ClusterDims) -> S
         );
         let deferred = t.lights_in_compute() || t.lights_in_subpass();
         let allowed = if deferred { MAX_DIFF_DEFERRED } else { MAX_DIFF };
-        assert!(worst <= allowed, "{name}: {} differs from forward by {worst}/255", t.name());
+        if deferred && shading == ShadingModel::BlinnPhong {
+            // See SHADOW_OUTLIERS: a few pixels may differ more, none by more than a ninth of the sun.
+            let beyond = common::pixels_beyond(&out[0], o, allowed);
+            println!("{name} {}: {beyond} pixels beyond {allowed}/255", t.name());
+            assert!(beyond <= SHADOW_OUTLIERS, "{name}: {} differs from forward beyond {allowed}/255 in {beyond} pixels", t.name());
+            assert!(worst <= MAX_DIFF_SHADOW_OUTLIER, "{name}: {} differs from forward by {worst}/255", t.name());
+        } else {
+            assert!(worst <= allowed, "{name}: {} differs from forward by {worst}/255", t.name());
+        }
         seen.growths += o.stats.index_growths;
         seen.overflows += o.stats.overflowed_frames;
     }
@@ -94,6 +118,26 @@ fn every_technique_equals_forward_on_the_seed_scene() {
         let scene = Scene::seed(object, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
         assert_matches_forward(&format!("seed scene ({})", object.name()), &scene, ClusterDims::DEFAULT);
         assert_matches_forward(&format!("seed scene ({}), seed grid", object.name()), &scene, ClusterDims { x: 4, y: 4, z: 2 });
+    }
+}
+
+/// Seed 002's model: textures, normal maps, a shadowed sun, a spot light and reflections on
+/// top of the point lights, the same in every technique.
+#[test]
+fn every_technique_equals_forward_with_blinn_phong() {
+    let gold = Material::named("gold").unwrap();
+    for object in [MeshKind::Sphere, MeshKind::Teapot] {
+        let scene = Scene::seed(object, gold, &LightParams::seed_default()).unwrap().with_floor();
+        assert_matches_forward_shaded(
+            &format!("blinn-phong seed scene ({})", object.name()),
+            &scene,
+            ClusterDims::DEFAULT,
+            ShadingModel::BlinnPhong,
+        );
+    }
+    for seed in 0..4 {
+        let scene = random_scene(2000 + seed, 2000);
+        assert_matches_forward_shaded(&format!("blinn-phong random scene {seed}"), &scene, ClusterDims::DEFAULT, ShadingModel::BlinnPhong);
     }
 }
 

@@ -35,12 +35,27 @@ impl Image {
         usage: vk::ImageUsageFlags,
         aspect: vk::ImageAspectFlags,
     ) -> Result<Image> {
+        Image::new(ctx, name, ImageShape { extent, levels: 1, cube: false }, format, usage, aspect)
+    }
+
+    /// A 2D image (or a cubemap: six layers, a cube view) with `shape.levels` mip levels.
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        shape: ImageShape,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+    ) -> Result<Image> {
+        let extent = shape.extent;
+        let layers = if shape.cube { 6 } else { 1 };
         let info = vk::ImageCreateInfo::default()
+            .flags(if shape.cube { vk::ImageCreateFlags::CUBE_COMPATIBLE } else { vk::ImageCreateFlags::empty() })
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
             .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
-            .mip_levels(1)
-            .array_layers(1)
+            .mip_levels(shape.levels)
+            .array_layers(layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
@@ -73,7 +88,7 @@ impl Image {
         }
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
-            .view_type(vk::ImageViewType::TYPE_2D)
+            .view_type(if shape.cube { vk::ImageViewType::CUBE } else { vk::ImageViewType::TYPE_2D })
             .format(format)
             .subresource_range(full_range(aspect));
         // SAFETY: bound image.
@@ -105,8 +120,88 @@ impl Image {
     }
 }
 
+/// Size, mip levels and kind of an image.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageShape {
+    pub extent: vk::Extent2D,
+    pub levels: u32,
+    /// Six layers viewed as a cube.
+    pub cube: bool,
+}
+
+/// Every mip level and layer of an image.
 pub fn full_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
-    vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(1).layer_count(1)
+    vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(vk::REMAINING_MIP_LEVELS).layer_count(vk::REMAINING_ARRAY_LAYERS)
+}
+
+/// A sampled RGBA8 texture filled from `levels[level][layer]` (tightly packed texels; level
+/// 0 is `shape.extent`, each next level half the size) through a staging buffer, left in
+/// SHADER_READ_ONLY_OPTIMAL for fragment and compute shaders.
+pub fn texture_with(ctx: &Context, name: &str, shape: ImageShape, format: vk::Format, levels: &[Vec<&[u8]>]) -> Result<Image> {
+    let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
+    let image = Image::new(ctx, name, shape, format, usage, vk::ImageAspectFlags::COLOR)?;
+    let bytes: Vec<u8> = levels.iter().flatten().flat_map(|layer| layer.iter().copied()).collect();
+    let staging =
+        crate::Buffer::new(ctx, "texture staging", bytes.len() as u64, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu);
+    let mut staging = match staging {
+        Ok(b) => b,
+        Err(e) => {
+            let mut image = image;
+            image.destroy(ctx);
+            return Err(e);
+        }
+    };
+    staging.write(0, &bytes);
+    let mut regions = Vec::new();
+    let mut offset = 0u64;
+    for (level, layers) in levels.iter().enumerate() {
+        for (layer, data) in layers.iter().enumerate() {
+            let (w, h) = ((shape.extent.width >> level).max(1), (shape.extent.height >> level).max(1));
+            regions.push(
+                vk::BufferImageCopy::default()
+                    .buffer_offset(offset)
+                    .image_subresource(
+                        vk::ImageSubresourceLayers::default()
+                            .aspect_mask(vk::ImageAspectFlags::COLOR)
+                            .mip_level(level as u32)
+                            .base_array_layer(layer as u32)
+                            .layer_count(1),
+                    )
+                    .image_extent(vk::Extent3D { width: w, height: h, depth: 1 }),
+            );
+            offset += data.len() as u64;
+        }
+    }
+    let copied = crate::commands::one_shot(ctx, |cmd| {
+        let whole = vk::PipelineStageFlags::TRANSFER;
+        let to_transfer = (whole, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+        crate::commands::image_transition(
+            ctx,
+            cmd,
+            image.raw,
+            (vk::PipelineStageFlags::TOP_OF_PIPE, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED),
+            to_transfer,
+        );
+        // SAFETY: recording state; buffer and image are alive and the regions lie within them.
+        unsafe { ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, image.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &regions) };
+        let readers = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        crate::commands::image_transition(
+            ctx,
+            cmd,
+            image.raw,
+            to_transfer,
+            (readers, vk::AccessFlags::SHADER_READ, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+        );
+    });
+    staging.destroy(ctx);
+    match copied {
+        Ok(()) => Ok(image),
+        Err(e) => {
+            let mut image = image;
+            image.destroy(ctx);
+            Err(e)
+        }
+    }
 }
 
 /// A sampler for `texelFetch`-only images: it ignores filtering, but a combined image sampler

@@ -16,7 +16,7 @@ pub use ash::vk;
 pub use buffer::Buffer;
 pub use context::{Context, ContextDesc, DeviceInfo};
 pub use error::{VkError, VkResultExt};
-pub use image::Image;
+pub use image::{Image, ImageShape};
 pub use timing::GpuTimer;
 
 /// Objects made of several Vulkan objects release them all, skipping parts never made (null).

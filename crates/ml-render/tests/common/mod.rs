@@ -49,6 +49,12 @@ pub fn max_difference(a: &RenderOutput, b: &RenderOutput) -> (u8, usize) {
     (worst, pixels)
 }
 
+/// Pixels whose largest channel difference exceeds `limit`.
+#[allow(dead_code)] // not every test binary uses it
+pub fn pixels_beyond(a: &RenderOutput, b: &RenderOutput, limit: u8) -> usize {
+    a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)).filter(|(pa, pb)| pa.iter().zip(*pb).any(|(x, y)| x.abs_diff(*y) > limit)).count()
+}
+
 pub fn pixel(out: &RenderOutput, x: u32, y: u32) -> [u8; 3] {
     let i = ((y * out.width + x) * 4) as usize;
     [out.rgba[i], out.rgba[i + 1], out.rgba[i + 2]]

@@ -1,0 +1,325 @@
+//! Set 1 of every shading pipeline: the scene's textures. For the blinn-phong model (seed 002)
+//! the sun's shadow map, a sky cubemap for reflections, the albedo and normal maps (all made by
+//! our code: ml_cpu::textures); the seed model binds 1×1 stand-ins it never samples.
+//!
+//! The shadow map is rendered once, when the renderer is made: the sun and the objects do not
+//! move (only the point lights do, and they cast no shadows). Depth only, every object, an
+//! orthographic view along the sun fitted to the scene (ml_cpu::blinn_phong).
+
+use crate::gpu_mesh::GpuMesh;
+use crate::raster::object_push;
+use ml_cpu::mesh::Vertex;
+use ml_cpu::scene::Scene;
+use ml_cpu::textures;
+use ml_vk::descriptors::{allocate_set, write_image};
+use ml_vk::image::{texture_with, ImageShape};
+use ml_vk::{shader, vk, Context, Image, VkError, VkResultExt};
+
+/// Bindings of set 1 (textures.glsl).
+const BINDING_SHADOW: u32 = 0;
+const BINDING_SKY: u32 = 1;
+const BINDING_ALBEDO: u32 = 2;
+const BINDING_NORMAL: u32 = 3;
+
+/// Texels per side of the sun's shadow map (blinn-phong).
+pub const SHADOW_MAP_SIZE: u32 = 2048;
+const MATERIAL_MAP_SIZE: u32 = 256;
+const SKY_SIZE: u32 = 64;
+
+pub struct SceneTextures {
+    pub set_layout: vk::DescriptorSetLayout,
+    pub set: vk::DescriptorSet,
+    pool: vk::DescriptorPool,
+    images: Vec<Image>,
+    samplers: Vec<vk::Sampler>,
+    /// Texels per side of the shadow map (1 for the seed model).
+    pub shadow_size: u32,
+}
+
+/// What the sun's shadow pass draws.
+pub struct ShadowInputs<'a> {
+    pub scene: &'a Scene,
+    pub meshes: &'a [GpuMesh],
+    pub view_proj: glam::Mat4,
+}
+
+/// The shadow map's place in `SceneTextures::images`.
+const SHADOW_IMAGE: usize = 3;
+
+impl SceneTextures {
+    /// The textures: with `blinn_phong` the real maps and a shadow map (cleared: fill it with
+    /// `render_shadow_map` once the meshes are on the GPU), else 1×1 stand-ins. The shadow map
+    /// uses `depth_format`, which must be sampleable.
+    pub fn new(ctx: &Context, blinn_phong: bool, depth_format: vk::Format) -> Result<SceneTextures, VkError> {
+        let t = SceneTextures {
+            set_layout: vk::DescriptorSetLayout::null(),
+            set: vk::DescriptorSet::null(),
+            pool: vk::DescriptorPool::null(),
+            images: Vec::new(),
+            samplers: Vec::new(),
+            shadow_size: 1,
+        };
+        ml_vk::build(ctx, t, |t| t.create(ctx, blinn_phong, depth_format))
+    }
+
+    /// Draw every object of `inputs` into the shadow map, from the sun.
+    pub fn render_shadow_map(&self, ctx: &Context, inputs: &ShadowInputs) -> Result<(), VkError> {
+        render_shadow_map(ctx, &self.images[SHADOW_IMAGE], Some(inputs))
+    }
+
+    fn create(&mut self, ctx: &Context, real: bool, depth_format: vk::Format) -> Result<(), VkError> {
+        use vk::DescriptorType as T;
+        let sampled = T::COMBINED_IMAGE_SAMPLER;
+        let stages = vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
+        self.set_layout = shader::set_layout(
+            ctx,
+            &[(BINDING_SHADOW, sampled), (BINDING_SKY, sampled), (BINDING_ALBEDO, sampled), (BINDING_NORMAL, sampled)],
+            stages,
+        )?;
+        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: 4 }];
+        // SAFETY: valid device and create info.
+        self.pool =
+            unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
+                .ctx("vkCreateDescriptorPool")?;
+        self.set = allocate_set(ctx, self.pool, self.set_layout)?;
+
+        let rgba = vk::Format::R8G8B8A8_UNORM;
+        let flat = |size: u32| ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, cube: false };
+        let (albedo, normal, sky) = if real {
+            let a = textures::tiles_albedo(MATERIAL_MAP_SIZE);
+            let n = textures::bumps_normal_map(MATERIAL_MAP_SIZE);
+            let s = textures::sky_cube(SKY_SIZE);
+            let mips = |m: &textures::MipChain| ImageShape { levels: m.levels.len() as u32, ..flat(m.size) };
+            let albedo = texture_with(ctx, "albedo map", mips(&a), rgba, &a.levels.iter().map(|l| vec![l.as_slice()]).collect::<Vec<_>>())?;
+            self.images.push(albedo);
+            let normal = texture_with(ctx, "normal map", mips(&n), rgba, &n.levels.iter().map(|l| vec![l.as_slice()]).collect::<Vec<_>>())?;
+            self.images.push(normal);
+            let cube = ImageShape { cube: true, ..flat(SKY_SIZE) };
+            self.images.push(texture_with(ctx, "sky", cube, rgba, &[s.iter().map(|f| f.as_slice()).collect()])?);
+            (0, 1, 2)
+        } else {
+            let white = [255u8; 4];
+            let up = [128u8, 128, 255, 255];
+            self.images.push(texture_with(ctx, "albedo map", flat(1), rgba, &[vec![&white[..]]])?);
+            self.images.push(texture_with(ctx, "normal map", flat(1), rgba, &[vec![&up[..]]])?);
+            let cube = ImageShape { cube: true, ..flat(1) };
+            self.images.push(texture_with(ctx, "sky", cube, rgba, &[vec![&white[..]; 6]])?);
+            (0, 1, 2)
+        };
+        self.shadow_size = if real { SHADOW_MAP_SIZE } else { 1 };
+        let extent = vk::Extent2D { width: self.shadow_size, height: self.shadow_size };
+        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        self.images.push(Image::new_2d(ctx, "shadow map", extent, depth_format, usage, vk::ImageAspectFlags::DEPTH)?);
+        let shadow_image = SHADOW_IMAGE;
+        // Cleared to the far plane ("lit everywhere") until the objects are drawn into it.
+        render_shadow_map(ctx, &self.images[shadow_image], None)?;
+
+        let material_sampler = sampler(ctx, vk::SamplerAddressMode::REPEAT, vk::Filter::LINEAR, None)?;
+        self.samplers.push(material_sampler);
+        let sky_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE, vk::Filter::LINEAR, None)?;
+        self.samplers.push(sky_sampler);
+        // Outside the map is lit: the border is the far plane (1.0) and the test is ≤. Each
+        // tap filters four comparisons bilinearly (as the seed's DX12-book sampler does), so
+        // the lit fraction changes continuously with the position: a position rebuilt from
+        // depth (deferred) then moves it by as little as the position moved, where a nearest
+        // tap would jump by a ninth of the sun across a texel boundary.
+        let depth_filter = if ctx.format_supports(depth_format, vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR) {
+            vk::Filter::LINEAR
+        } else {
+            vk::Filter::NEAREST
+        };
+        let shadow_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_BORDER, depth_filter, Some(vk::CompareOp::LESS_OR_EQUAL))?;
+        self.samplers.push(shadow_sampler);
+        let info = |sampler: vk::Sampler, image: &Image, layout: vk::ImageLayout| {
+            vk::DescriptorImageInfo::default().sampler(sampler).image_view(image.view).image_layout(layout)
+        };
+        let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        let i = &self.images;
+        write_image(
+            ctx,
+            self.set,
+            BINDING_SHADOW,
+            sampled,
+            info(shadow_sampler, &i[shadow_image], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+        );
+        write_image(ctx, self.set, BINDING_SKY, sampled, info(sky_sampler, &i[sky], read_only));
+        write_image(ctx, self.set, BINDING_ALBEDO, sampled, info(material_sampler, &i[albedo], read_only));
+        write_image(ctx, self.set, BINDING_NORMAL, sampled, info(material_sampler, &i[normal], read_only));
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for image in &mut self.images {
+            image.destroy(ctx);
+        }
+        // SAFETY: the device is idle; null handles are ignored.
+        unsafe {
+            for s in self.samplers.drain(..) {
+                ctx.device.destroy_sampler(s, None);
+            }
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+        self.pool = vk::DescriptorPool::null();
+        self.set_layout = vk::DescriptorSetLayout::null();
+    }
+}
+
+impl ml_vk::Release for SceneTextures {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
+
+fn sampler(
+    ctx: &Context,
+    address: vk::SamplerAddressMode,
+    filter: vk::Filter,
+    compare: Option<vk::CompareOp>,
+) -> Result<vk::Sampler, VkError> {
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(filter)
+        .min_filter(filter)
+        .mipmap_mode(if filter == vk::Filter::LINEAR { vk::SamplerMipmapMode::LINEAR } else { vk::SamplerMipmapMode::NEAREST })
+        .address_mode_u(address)
+        .address_mode_v(address)
+        .address_mode_w(address)
+        .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE)
+        .compare_enable(compare.is_some())
+        .compare_op(compare.unwrap_or(vk::CompareOp::ALWAYS))
+        .max_lod(vk::LOD_CLAMP_NONE);
+    // SAFETY: valid device and create info.
+    unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")
+}
+
+/// Clear `target` to the far plane and, given inputs, draw every object into it from the sun;
+/// leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL for the shading passes.
+fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs>) -> Result<(), VkError> {
+    let d = &ctx.device;
+    let attachment = [vk::AttachmentDescription::default()
+        .format(target.format)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .final_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)];
+    let depth_ref = vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
+    let subpass =
+        [vk::SubpassDescription::default().pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS).depth_stencil_attachment(&depth_ref)];
+    let tests = vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
+    // The depth writes before every later shader read of the map (frames come after this
+    // submission in queue order).
+    let dependency = [vk::SubpassDependency::default()
+        .src_subpass(0)
+        .dst_subpass(vk::SUBPASS_EXTERNAL)
+        .src_stage_mask(tests)
+        .src_access_mask(vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER)
+        .dst_access_mask(vk::AccessFlags::SHADER_READ)];
+    let info = vk::RenderPassCreateInfo::default().attachments(&attachment).subpasses(&subpass).dependencies(&dependency);
+    // SAFETY: valid device and create info.
+    let render_pass = unsafe { d.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")?;
+    let views = [target.view];
+    let fb_info = vk::FramebufferCreateInfo::default()
+        .render_pass(render_pass)
+        .attachments(&views)
+        .width(target.extent.width)
+        .height(target.extent.height)
+        .layers(1);
+    let push_size = (std::mem::size_of::<ml_cpu::gpu_types::ObjectPush>() + 64) as u32;
+    let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::VERTEX).size(push_size)];
+    let mut framebuffer = vk::Framebuffer::null();
+    let mut layout = vk::PipelineLayout::null();
+    let mut pipeline = vk::Pipeline::null();
+    let result = (|| {
+        // SAFETY: as above.
+        framebuffer = unsafe { d.create_framebuffer(&fb_info, None) }.ctx("vkCreateFramebuffer")?;
+        layout = shader::pipeline_layout(ctx, &[], &push)?;
+        pipeline = shadow_pipeline(ctx, render_pass, layout)?;
+        let extent = target.extent;
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
+        let clear = [vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } }];
+        ml_vk::commands::one_shot(ctx, |cmd| {
+            let begin =
+                vk::RenderPassBeginInfo::default().render_pass(render_pass).framebuffer(framebuffer).render_area(area).clear_values(&clear);
+            let viewport =
+                vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+            // SAFETY: recording state; everything used is alive until the wait in one_shot.
+            unsafe {
+                d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+                if let Some(s) = inputs {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                    d.cmd_set_viewport(cmd, 0, &[viewport]);
+                    d.cmd_set_scissor(cmd, 0, &[area]);
+                    for mesh in s.meshes {
+                        d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
+                        d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
+                        for (index, object) in s.scene.objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
+                            let mut bytes = bytemuck::bytes_of(&object_push(object, index as u32)).to_vec();
+                            bytes.extend_from_slice(bytemuck::bytes_of(&s.view_proj.to_cols_array()));
+                            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, &bytes);
+                            d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
+                        }
+                    }
+                }
+                d.cmd_end_render_pass(cmd);
+            }
+        })
+    })();
+    // SAFETY: one_shot waited for the GPU (or nothing was submitted); null handles are ignored.
+    unsafe {
+        d.destroy_pipeline(pipeline, None);
+        d.destroy_pipeline_layout(layout, None);
+        d.destroy_framebuffer(framebuffer, None);
+        d.destroy_render_pass(render_pass, None);
+    }
+    result
+}
+
+/// Depth-only pipeline of the shadow pass: positions only, no fragment shader, both faces.
+fn shadow_pipeline(ctx: &Context, render_pass: vk::RenderPass, layout: vk::PipelineLayout) -> Result<vk::Pipeline, VkError> {
+    let vert = shader::module(ctx, ml_shaders::SHADOW_VERT)?;
+    let stages = [vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main")];
+    let bindings = [vk::VertexInputBindingDescription::default().binding(0).stride(std::mem::size_of::<Vertex>() as u32)];
+    let attributes = [vk::VertexInputAttributeDescription::default()
+        .location(0)
+        .binding(0)
+        .format(vk::Format::R32G32B32_SFLOAT)
+        .offset(std::mem::offset_of!(Vertex, position) as u32)];
+    let vertex_input =
+        vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&bindings).vertex_attribute_descriptions(&attributes);
+    let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .line_width(1.0);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(true)
+        .depth_write_enable(true)
+        .depth_compare_op(vk::CompareOp::LESS);
+    let blend = vk::PipelineColorBlendStateCreateInfo::default();
+    let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+    let info = [vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&input_assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&depth)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .render_pass(render_pass)
+        .subpass(0)];
+    // SAFETY: every referenced object is alive.
+    let result = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None) };
+    // SAFETY: the module is not needed once the pipeline exists (or failed).
+    unsafe { ctx.device.destroy_shader_module(vert, None) };
+    result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")
+}

@@ -1,0 +1,12 @@
+// Set 1 of every shading path: the scene's textures (scene_textures.rs). The seed model
+// binds them too but never samples them.
+
+#ifndef MANYLIGHTS_TEXTURES_GLSL
+#define MANYLIGHTS_TEXTURES_GLSL
+
+layout(set = 1, binding = 0) uniform sampler2DShadow shadow_map; // the sun's depth, compared
+layout(set = 1, binding = 1) uniform samplerCube sky;            // environment for reflections
+layout(set = 1, binding = 2) uniform sampler2D albedo_map;
+layout(set = 1, binding = 3) uniform sampler2D normal_map;       // tangent space, n·0.5 + 0.5
+
+#endif
