@@ -3,7 +3,8 @@
 # 4,096 / 65,536 random lights of radius 1–3; GPU ms per pass of every forward and deferred
 # technique. Usage: scripts/bench_deferred.sh [BINARY] [OUTDIR] [FRAMES_FAST] [FRAMES_SLOW]
 # MAX_BRUTE=N skips forward and deferred (every light at every pixel) above N lights: on
-# lavapipe one 65,536-light frame of those takes a quarter of an hour.
+# lavapipe one 65,536-light frame of those takes a quarter of an hour. SHADING=blinn-phong
+# measures seed 002's model instead of the seed's.
 set -euo pipefail
 bin=${1:-target/release/manylights}
 out=${2:-bench-deferred}
@@ -21,6 +22,6 @@ for lights in 64 4096 65536; do
     if [ "$lights" -ge 4096 ] && { [ "$t" = forward ] || [ "$t" = deferred ]; }; then frames=$slow; fi
     echo "== $t, $lights lights, $frames frames"
     "$bin" render --technique "$t" --lights "$lights" "${layout[@]}" --width 1920 --height 1080 \
-      --frames "$frames" --out "$out/$t-$lights.png" | grep -E "gpu ms|cpu assign|g-buffer|lights/cluster|device"
+      --shading "${SHADING:-seed}" --frames "$frames" --out "$out/$t-$lights.png" | grep -E "gpu ms|cpu assign|g-buffer|lights/cluster|device"
   done
 done

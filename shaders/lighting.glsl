@@ -12,13 +12,25 @@
 #include "blinn_phong.glsl"
 #include "cluster.glsl"
 
-// One point light's contribution under the frame's shading model.
-vec3 point_light(PointLight light, vec3 world, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
-    if (frame.shading_model == SHADING_BLINN_PHONG) {
-        return bp_point_light(light, world, n, v, albedo, mix(vec3(0.04), albedo, metallic), 1.0 - roughness);
+// Sum LIGHT(light) over every light that may reach the point: the cluster's lights in
+// ascending index order, or all of them. A macro, so that each shading model gets its own
+// loop: a model switch inside the loop made the seed model's fragment shader 1.4–1.8× slower
+// on the H100 (measured).
+#ifdef CLUSTERED
+#define SUM_LIGHTS(sum, LIGHT)                                                   \
+    {                                                                            \
+        float depth_ = -(frame.view * vec4(world, 1.0)).z;                       \
+        ClusterRange range_ = cluster_ranges[cluster_of(frame, frag_xy, depth_)]; \
+        for (uint k_ = 0u; k_ < range_.count; ++k_) {                           \
+            sum += LIGHT(lights[light_indices[range_.offset + k_]]);             \
+        }                                                                        \
     }
-    return seed_point_light(light, world, n, v, albedo, roughness, metallic);
-}
+#else
+#define SUM_LIGHTS(sum, LIGHT)                           \
+    for (uint i_ = 0u; i_ < frame.light_count; ++i_) { \
+        sum += LIGHT(lights[i_]);                        \
+    }
+#endif
 
 // Linear colour of a surface point: every light that reaches it plus what the model adds
 // (seed: ambient; blinn-phong: ambient, sun, spot, reflection). `frag_xy` is the pixel
@@ -26,21 +38,15 @@ vec3 point_light(PointLight light, vec3 world, vec3 n, vec3 v, vec3 albedo, floa
 vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, vec2 frag_xy) {
     vec3 v = normalize(frame.camera_pos.xyz - world);
     vec3 lo = vec3(0.0);
-#ifdef CLUSTERED
-    float depth = -(frame.view * vec4(world, 1.0)).z;
-    ClusterRange range = cluster_ranges[cluster_of(frame, frag_xy, depth)];
-    for (uint k = 0u; k < range.count; ++k) {
-        uint i = light_indices[range.offset + k];
-        lo += point_light(lights[i], world, n, v, albedo, roughness, metallic);
-    }
-#else
-    for (uint i = 0u; i < frame.light_count; ++i) {
-        lo += point_light(lights[i], world, n, v, albedo, roughness, metallic);
-    }
-#endif
     if (frame.shading_model == SHADING_BLINN_PHONG) {
-        return bp_scene_lights(world, n, v, albedo, mix(vec3(0.04), albedo, metallic), 1.0 - roughness) + lo;
+        vec3 r0 = mix(vec3(0.04), albedo, metallic);
+        float shininess = 1.0 - roughness;
+#define BP_LIGHT(l) bp_point_light(l, world, n, v, albedo, r0, shininess)
+        SUM_LIGHTS(lo, BP_LIGHT)
+        return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo;
     }
+#define SEED_LIGHT(l) seed_point_light(l, world, n, v, albedo, roughness, metallic)
+    SUM_LIGHTS(lo, SEED_LIGHT)
     return albedo * frame.ambient + lo;
 }
 
