@@ -74,6 +74,12 @@ struct ObjectPush {
     uvec4 ids;             // x: index of the object in the scene's object buffer
 };
 
+// Push constants of the sun's shadow pass (blinn-phong): the object and the light's matrix.
+struct ShadowPush {
+    ObjectPush object;
+    mat4 light_view_proj;
+};
+
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with
 // raster.rs CLEAR_COLOR.
 const vec4 CLEAR_COLOR = vec4(0.02, 0.02, 0.02, 1.0);

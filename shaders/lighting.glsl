@@ -8,6 +8,7 @@
 #ifndef MANYLIGHTS_LIGHTING_GLSL
 #define MANYLIGHTS_LIGHTING_GLSL
 
+#include "shading_model.glsl"
 #include "seed_brdf.glsl"
 #include "blinn_phong.glsl"
 #include "cluster.glsl"
@@ -38,7 +39,7 @@
 vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, vec2 frag_xy) {
     vec3 v = normalize(frame.camera_pos.xyz - world);
     vec3 lo = vec3(0.0);
-    if (frame.shading_model == SHADING_BLINN_PHONG) {
+    if (MODEL_BLINN_PHONG) {
         vec3 r0 = mix(vec3(0.04), albedo, metallic);
         float shininess = 1.0 - roughness;
 #define BP_LIGHT(l) bp_point_light(l, world, n, v, albedo, r0, shininess)

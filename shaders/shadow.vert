@@ -5,12 +5,9 @@
 
 layout(location = 0) in vec3 in_position;
 
-layout(push_constant) uniform PushBlock {
-    ObjectPush object;
-    mat4 light_view_proj;
-};
+layout(push_constant) uniform ShadowPushBlock { ShadowPush shadow; };
 
 void main() {
-    vec3 world = in_position * object.position_scale.w + object.position_scale.xyz;
-    gl_Position = light_view_proj * vec4(world, 1.0);
+    vec3 world = in_position * shadow.object.position_scale.w + shadow.object.position_scale.xyz;
+    gl_Position = shadow.light_view_proj * vec4(world, 1.0);
 }

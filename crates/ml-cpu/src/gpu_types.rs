@@ -115,3 +115,11 @@ gpu_struct!(
         ids: [u32; 4],
     }
 );
+
+gpu_struct!(
+    /// Push constants of the sun's shadow pass (blinn-phong).
+    ShadowPush {
+        object: ObjectPush,
+        light_view_proj: [[f32; 4]; 4],
+    }
+);

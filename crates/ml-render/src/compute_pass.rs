@@ -16,12 +16,13 @@ pub struct ComputePass {
 }
 
 impl ComputePass {
-    /// The pass of `spirv` with set 0 of `bindings` and further sets of `more_sets`.
+    /// The pass of `spirv` (with specialization `constants`: id, value) with set 0 of
+    /// `bindings` and further sets of `more_sets`.
     pub fn new(
         ctx: &Context,
         bindings: &[(u32, vk::DescriptorType)],
         more_sets: &[vk::DescriptorSetLayout],
-        spirv: &[u8],
+        (spirv, constants): (&[u8], &[(u32, u32)]),
     ) -> Result<ComputePass, VkError> {
         let p = ComputePass {
             set_layout: vk::DescriptorSetLayout::null(),
@@ -33,7 +34,7 @@ impl ComputePass {
             p.set_layout = shader::set_layout(ctx, bindings, vk::ShaderStageFlags::COMPUTE)?;
             let layouts: Vec<vk::DescriptorSetLayout> = std::iter::once(p.set_layout).chain(more_sets.iter().copied()).collect();
             p.pipeline_layout = shader::pipeline_layout(ctx, &layouts, &[])?;
-            p.pipeline = shader::compute_pipeline(ctx, spirv, p.pipeline_layout, &[])?;
+            p.pipeline = shader::compute_pipeline(ctx, spirv, p.pipeline_layout, constants)?;
             p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })

@@ -4,6 +4,8 @@
 //! 132). Its output is the colour target, left in TRANSFER_SRC_OPTIMAL like the forward pass's.
 
 use crate::compute_pass::ComputePass;
+use crate::raster::SPEC_BLINN_PHONG;
+use crate::settings::ShadingModel;
 use crate::targets::Targets;
 use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
 use ml_vk::{vk, Context, VkError};
@@ -36,7 +38,7 @@ pub struct LightingInputs<'a> {
 }
 
 impl ComputeLighting {
-    pub fn new(ctx: &Context, textures_layout: vk::DescriptorSetLayout) -> Result<ComputeLighting, VkError> {
+    pub fn new(ctx: &Context, textures_layout: vk::DescriptorSetLayout, shading: ShadingModel) -> Result<ComputeLighting, VkError> {
         use vk::DescriptorType as T;
         let storage = T::STORAGE_BUFFER;
         let image = T::COMBINED_IMAGE_SAMPLER;
@@ -53,7 +55,8 @@ impl ComputeLighting {
             (BINDING_ALBEDO, image),
         ];
         // Set 1: the scene's textures (blinn-phong's shadow map and sky).
-        let pass = ComputePass::new(ctx, &bindings, &[textures_layout], ml_shaders::DEFERRED_LIGHTING_COMP)?;
+        let model = [(SPEC_BLINN_PHONG, u32::from(shading == ShadingModel::BlinnPhong))];
+        let pass = ComputePass::new(ctx, &bindings, &[textures_layout], (ml_shaders::DEFERRED_LIGHTING_COMP, &model))?;
         Ok(ComputeLighting { pass })
     }
 

@@ -105,7 +105,7 @@ impl<'a> HeadlessRenderer<'a> {
             settings.technique.is_cpu_built().then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
         let blinn_phong = settings.shading == ShadingModel::BlinnPhong;
         let textures = SceneTextures::new(ctx, blinn_phong, depth_format(ctx, Output::GBuffer)?)?;
-        let pass = match RasterPass::new(ctx, depth, settings.technique, textures.set_layout) {
+        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.shading), textures.set_layout) {
             Ok(p) => p,
             Err(e) => {
                 let mut textures = textures;
@@ -169,7 +169,7 @@ impl<'a> HeadlessRenderer<'a> {
             self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         }
         if self.settings.technique.lights_in_compute() {
-            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout)?);
+            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.shading)?);
         }
         if self.settings.technique.lights_in_subpass() {
             self.tonemap = Some(ToneMap::new(ctx)?);

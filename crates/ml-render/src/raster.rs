@@ -7,7 +7,7 @@
 
 use crate::gpu_mesh::GpuMesh;
 use crate::render_pass;
-use crate::settings::Technique;
+use crate::settings::{ShadingModel, Technique};
 use crate::targets::{Output, Targets};
 use ml_cpu::gpu_types::ObjectPush;
 use ml_cpu::mesh::Vertex;
@@ -44,7 +44,11 @@ pub struct RasterPass {
     pub lighting_layout: vk::PipelineLayout,
     pub input_set_layout: vk::DescriptorSetLayout,
     pub output: Output,
+    shading: ShadingModel,
 }
+
+/// constant_id of `MODEL_BLINN_PHONG` in shading_model.glsl.
+pub const SPEC_BLINN_PHONG: u32 = 10;
 
 /// The kinds of draw in the pass.
 #[derive(Clone, Copy, PartialEq)]
@@ -76,11 +80,12 @@ pub struct DrawList<'a> {
 }
 
 impl RasterPass {
-    /// The pass for `technique`; `textures_layout` is set 1 of every pipeline (scene_textures.rs).
+    /// The pass for a technique and shading model; `textures_layout` is set 1 of every
+    /// pipeline (scene_textures.rs).
     pub fn new(
         ctx: &Context,
         depth_format: vk::Format,
-        technique: Technique,
+        (technique, shading): (Technique, ShadingModel),
         textures_layout: vk::DescriptorSetLayout,
     ) -> Result<RasterPass, VkError> {
         let output = Output::of(technique);
@@ -94,6 +99,7 @@ impl RasterPass {
             lighting_layout: vk::PipelineLayout::null(),
             input_set_layout: vk::DescriptorSetLayout::null(),
             output,
+            shading,
         };
         // On failure, destroy what was made (null handles are ignored by vkDestroy*).
         let fragment = match (output, technique.is_clustered()) {
@@ -189,9 +195,17 @@ impl RasterPass {
                 return Err(e);
             }
         };
+        // The shading model, compiled in (shading_model.glsl); the legend ignores it.
+        let model = [vk::SpecializationMapEntry { constant_id: SPEC_BLINN_PHONG, offset: 0, size: 4 }];
+        let model_data = u32::from(self.shading == ShadingModel::BlinnPhong).to_ne_bytes();
+        let spec = vk::SpecializationInfo::default().map_entries(&model).data(&model_data);
         let stages = [
             vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(frag).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(frag)
+                .name(c"main")
+                .specialization_info(&spec),
         ];
         let vertex_bindings = [vk::VertexInputBindingDescription::default()
             .binding(0)

@@ -8,6 +8,7 @@
 
 use crate::gpu_mesh::GpuMesh;
 use crate::raster::object_push;
+use ml_cpu::gpu_types::ShadowPush;
 use ml_cpu::mesh::Vertex;
 use ml_cpu::scene::Scene;
 use ml_cpu::textures;
@@ -228,7 +229,7 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
         .width(target.extent.width)
         .height(target.extent.height)
         .layers(1);
-    let push_size = (std::mem::size_of::<ml_cpu::gpu_types::ObjectPush>() + 64) as u32;
+    let push_size = std::mem::size_of::<ShadowPush>() as u32;
     let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::VERTEX).size(push_size)];
     let mut framebuffer = vk::Framebuffer::null();
     let mut layout = vk::PipelineLayout::null();
@@ -257,9 +258,9 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
                         d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
                         d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
                         for (index, object) in s.scene.objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
-                            let mut bytes = bytemuck::bytes_of(&object_push(object, index as u32)).to_vec();
-                            bytes.extend_from_slice(bytemuck::bytes_of(&s.view_proj.to_cols_array()));
-                            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, &bytes);
+                            let push =
+                                ShadowPush { object: object_push(object, index as u32), light_view_proj: s.view_proj.to_cols_array_2d() };
+                            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
                             d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
                         }
                     }

@@ -18,7 +18,7 @@ impl ToneMap {
     pub fn new(ctx: &Context) -> Result<ToneMap, VkError> {
         use vk::DescriptorType as T;
         let bindings = [(BINDING_HDR, T::COMBINED_IMAGE_SAMPLER), (BINDING_OUTPUT, T::STORAGE_IMAGE)];
-        Ok(ToneMap { pass: ComputePass::new(ctx, &bindings, &[], ml_shaders::TONEMAP_COMP)? })
+        Ok(ToneMap { pass: ComputePass::new(ctx, &bindings, &[], (ml_shaders::TONEMAP_COMP, &[]))? })
     }
 
     /// Allocate and fill a frame's set: its HDR image in, its colour target out.
