@@ -12,6 +12,11 @@
 
 #define DEBUG_VIEW_NONE 0u
 #define DEBUG_VIEW_CLUSTER_HEAT 1u
+#define DEBUG_VIEW_GBUFFER_ALBEDO 2u
+#define DEBUG_VIEW_GBUFFER_NORMAL 3u
+#define DEBUG_VIEW_GBUFFER_MATERIAL 4u
+#define DEBUG_VIEW_DEPTH 5u
+#define DEBUG_VIEW_SHADOW_MAP 6u
 
 // Per frame, one uniform buffer per frame in flight (set 0, binding 0).
 struct FrameUniforms {

@@ -27,6 +27,9 @@ void main() {
     vec3 n = oct_decode(subpassLoad(normal_input).xy);
     ObjectPush object = objects[subpassLoad(object_input).r];
     vec3 albedo = object.albedo_roughness.rgb * subpassLoad(albedo_input).rgb;
-    vec3 color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, gl_FragCoord.xy);
+    vec3 color;
+    if (!debug_surface(world, n, albedo, object.albedo_roughness.a, object.material.x, color)) {
+        color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, gl_FragCoord.xy);
+    }
     out_hdr = vec4(color, 1.0);
 }

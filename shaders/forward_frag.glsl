@@ -30,8 +30,13 @@ void main() {
     }
 #endif
     Surface s = surface_at(in_normal, in_tangent, in_uv);
-    vec3 color = shade_point(in_world_pos, s.normal, object.albedo_roughness.rgb * s.albedo_factor, object.albedo_roughness.a,
-                             object.material.x, gl_FragCoord.xy);
+    vec3 albedo = object.albedo_roughness.rgb * s.albedo_factor;
+    float roughness = object.albedo_roughness.a;
+    float metallic = object.material.x;
+    vec3 color;
+    if (!debug_surface(in_world_pos, s.normal, albedo, roughness, metallic, color)) {
+        color = shade_point(in_world_pos, s.normal, albedo, roughness, metallic, gl_FragCoord.xy);
+    }
     // The target is UNORM: the seed writes gamma-encoded values itself.
     out_color = vec4(encode_output(color), 1.0);
 }

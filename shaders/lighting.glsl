@@ -51,6 +51,30 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
     return albedo * frame.ambient + lo;
 }
 
+// The surface debug views (G-buffer channels, depth): what the view shows at a surface point
+// as linear colour, which encode_output turns into the promised display values — albedo as
+// it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
+// False for any other view. Every shading path calls it with the values it would shade with.
+bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, out vec3 color) {
+    uint view = frame.cluster_dims.w;
+    vec3 display;
+    if (view == DEBUG_VIEW_GBUFFER_ALBEDO) {
+        color = albedo;
+        return true;
+    } else if (view == DEBUG_VIEW_GBUFFER_NORMAL) {
+        display = n * 0.5 + 0.5;
+    } else if (view == DEBUG_VIEW_GBUFFER_MATERIAL) {
+        display = vec3(roughness, metallic, 0.0);
+    } else if (view == DEBUG_VIEW_DEPTH) {
+        float depth = -(frame.view * vec4(world, 1.0)).z;
+        display = vec3(log(depth / frame.cluster_frustum.x) / log(frame.cluster_frustum.y / frame.cluster_frustum.x));
+    } else {
+        return false;
+    }
+    color = pow(clamp(display, 0.0, 1.0), vec3(2.2));
+    return true;
+}
+
 // Lights in the fragment's cluster (the cluster-heat debug view).
 #ifdef CLUSTERED
 uint cluster_light_count(vec3 world, vec2 frag_xy) {

@@ -8,5 +8,6 @@ layout(set = 1, binding = 0) uniform sampler2DShadow shadow_map; // the sun's de
 layout(set = 1, binding = 1) uniform samplerCube sky;            // environment for reflections
 layout(set = 1, binding = 2) uniform sampler2D albedo_map;
 layout(set = 1, binding = 3) uniform sampler2D normal_map;       // tangent space, n·0.5 + 0.5
+layout(set = 1, binding = 4) uniform sampler2D shadow_depth;     // the shadow map's depths (debug view)
 
 #endif

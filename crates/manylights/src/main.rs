@@ -47,7 +47,8 @@ struct RenderArgs {
     /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).
     #[arg(long, default_value = "16x9x24")]
     clusters: String,
-    /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu).
+    /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu),
+    /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (blinn-phong).
     #[arg(long, default_value = "none")]
     debug_view: String,
     /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc.

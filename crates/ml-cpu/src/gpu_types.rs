@@ -104,6 +104,11 @@ gpu_struct!(
 /// `DEBUG_VIEW_*` in common.glsl.
 pub const DEBUG_VIEW_NONE: u32 = 0;
 pub const DEBUG_VIEW_CLUSTER_HEAT: u32 = 1;
+pub const DEBUG_VIEW_GBUFFER_ALBEDO: u32 = 2;
+pub const DEBUG_VIEW_GBUFFER_NORMAL: u32 = 3;
+pub const DEBUG_VIEW_GBUFFER_MATERIAL: u32 = 4;
+pub const DEBUG_VIEW_DEPTH: u32 = 5;
+pub const DEBUG_VIEW_SHADOW_MAP: u32 = 6;
 
 gpu_struct!(
     /// Per-draw push constants.

@@ -2,6 +2,7 @@
 //! last frame into host memory. No window system needed.
 
 use crate::cluster_build::GpuClusterBuilder;
+use crate::compute_pass::ComputePass;
 use crate::deferred::ComputeLighting;
 use crate::error::RenderError;
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
@@ -15,11 +16,10 @@ use crate::targets::{depth_format, Output, Targets};
 use crate::tonemap::ToneMap;
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{
-    ClusterRange, FrameUniforms, ObjectPush, PointLight, DEBUG_VIEW_CLUSTER_HEAT, DEBUG_VIEW_NONE, SHADING_BLINN_PHONG, SHADING_SEED,
-};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight, SHADING_BLINN_PHONG, SHADING_SEED};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::scene::Scene;
+use ml_vk::descriptors::{allocate_set, write_image};
 use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
 use std::time::Instant;
 
@@ -66,6 +66,9 @@ pub struct HeadlessRenderer<'a> {
     tonemap: Option<ToneMap>,
     /// Deferred techniques: every object's material, indexed by the G-buffer's object ids.
     objects: Option<Buffer>,
+    /// --debug-view shadow-map: the pass that paints the map over the output, and its set per
+    /// frame slot (pointing at that slot's colour target).
+    shadow_map_view: Option<(ComputePass, Vec<vk::DescriptorSet>)>,
     /// clustered-gpu: light-index entries every frame recorded from now on must hold (grows
     /// when a frame reports it needed more).
     required_indices: usize,
@@ -135,6 +138,7 @@ impl<'a> HeadlessRenderer<'a> {
             lighting: None,
             tonemap: None,
             objects: None,
+            shadow_map_view: None,
             required_indices: 0,
             overflowed: vec![false; FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
@@ -176,17 +180,17 @@ impl<'a> HeadlessRenderer<'a> {
         }
         // Per frame at most: the shading set (1 uniform + 3 storage), the build set (1 uniform
         // + 8 storage), the lighting set (1 uniform, 4 storage, 3 sampled images, 1 storage
-        // image), the subpass input set (1 storage, 3 input attachments) and the tone map's set
-        // (1 sampled image, 1 storage image).
+        // image), the subpass input set (1 storage, 4 input attachments), the tone map's set
+        // (1 sampled image, 1 storage image) and the shadow-map view's (1 storage image).
         let n = FRAMES_IN_FLIGHT as u32;
         let sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 3 * n },
             vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 16 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 4 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: 2 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::INPUT_ATTACHMENT, descriptor_count: 3 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 5 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: 3 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::INPUT_ATTACHMENT, descriptor_count: 4 * n },
         ];
-        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(5 * n).pool_sizes(&sizes);
+        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(6 * n).pool_sizes(&sizes);
         // SAFETY: as above.
         self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
         let render_pass = self.pass.render_pass;
@@ -211,6 +215,21 @@ impl<'a> HeadlessRenderer<'a> {
         };
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
+        }
+        if self.settings.debug_view == DebugView::ShadowMap {
+            let bindings = [(0, vk::DescriptorType::STORAGE_IMAGE)];
+            let pass = ComputePass::new(ctx, &bindings, &[self.textures.set_layout], (ml_shaders::DEBUG_SHADOW_MAP_COMP, &[]))?;
+            let mut sets = Vec::new();
+            let layout = pass.set_layout;
+            self.shadow_map_view = Some((pass, Vec::new()));
+            for frame in &self.frames {
+                let set = allocate_set(ctx, self.descriptor_pool, layout)?;
+                let target = frame.targets.as_ref().expect("made with the frame");
+                let info = vk::DescriptorImageInfo::default().image_view(target.color.view).image_layout(vk::ImageLayout::GENERAL);
+                write_image(ctx, set, 0, vk::DescriptorType::STORAGE_IMAGE, info);
+                sets.push(set);
+            }
+            self.shadow_map_view.as_mut().expect("set above").1 = sets;
         }
         if self.builder.is_some() {
             // The boxes depend on projection and size only: once here.
@@ -357,10 +376,7 @@ impl<'a> HeadlessRenderer<'a> {
 
     fn write_uniforms(&mut self, f: usize, t: f32) {
         let g = &self.grid;
-        let debug_view = match self.settings.debug_view {
-            DebugView::None => DEBUG_VIEW_NONE,
-            DebugView::ClusterHeat => DEBUG_VIEW_CLUSTER_HEAT,
-        };
+        let debug_view = self.settings.debug_view.code();
         let cam = &self.scene.camera;
         let bp = &self.scene.blinn_phong;
         // World size of a shadow-map texel: the orthographic projection's first row is the
@@ -439,6 +455,10 @@ impl<'a> HeadlessRenderer<'a> {
             frame.timer.begin(ctx, cmd, pass);
             tonemap.record(ctx, cmd, frame.tonemap_set, targets, self.extent);
             frame.timer.end(ctx, cmd, pass);
+        }
+        if let Some((view, sets)) = &self.shadow_map_view {
+            // Over whatever the technique drew (untimed: a debug view).
+            view.record_into_colour_target(ctx, cmd, &[sets[f], self.textures.set], targets.color.raw, self.extent);
         }
         // SAFETY: recording state.
         unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")
@@ -530,6 +550,9 @@ impl Drop for HeadlessRenderer<'_> {
         }
         if let Some(mut b) = self.objects.take() {
             b.destroy(ctx);
+        }
+        if let Some((mut view, _)) = self.shadow_map_view.take() {
+            view.destroy(ctx);
         }
         for mesh in &mut self.meshes {
             mesh.destroy(ctx);

@@ -21,6 +21,7 @@ const BINDING_SHADOW: u32 = 0;
 const BINDING_SKY: u32 = 1;
 const BINDING_ALBEDO: u32 = 2;
 const BINDING_NORMAL: u32 = 3;
+const BINDING_SHADOW_DEPTH: u32 = 4;
 
 /// Texels per side of the sun's shadow map (blinn-phong).
 pub const SHADOW_MAP_SIZE: u32 = 2048;
@@ -74,10 +75,16 @@ impl SceneTextures {
         let stages = vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
         self.set_layout = shader::set_layout(
             ctx,
-            &[(BINDING_SHADOW, sampled), (BINDING_SKY, sampled), (BINDING_ALBEDO, sampled), (BINDING_NORMAL, sampled)],
+            &[
+                (BINDING_SHADOW, sampled),
+                (BINDING_SKY, sampled),
+                (BINDING_ALBEDO, sampled),
+                (BINDING_NORMAL, sampled),
+                (BINDING_SHADOW_DEPTH, sampled),
+            ],
             stages,
         )?;
-        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: 4 }];
+        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: 5 }];
         // SAFETY: valid device and create info.
         self.pool =
             unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
@@ -146,6 +153,17 @@ impl SceneTextures {
         write_image(ctx, self.set, BINDING_SKY, sampled, info(sky_sampler, &i[sky], read_only));
         write_image(ctx, self.set, BINDING_ALBEDO, sampled, info(material_sampler, &i[albedo], read_only));
         write_image(ctx, self.set, BINDING_NORMAL, sampled, info(material_sampler, &i[normal], read_only));
+        // The same map read as plain depths (the shadow-map debug view).
+        let depth_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE, vk::Filter::NEAREST, None)?;
+        self.samplers.push(depth_sampler);
+        let i = &self.images;
+        write_image(
+            ctx,
+            self.set,
+            BINDING_SHADOW_DEPTH,
+            sampled,
+            info(depth_sampler, &i[shadow_image], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+        );
         Ok(())
     }
 

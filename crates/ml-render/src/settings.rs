@@ -106,16 +106,60 @@ impl ShadingModel {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DebugView {
     None,
-    /// Lights per cluster as a heat map (clustered techniques).
+    /// Lights per cluster as a heat map (clustered forward techniques).
     ClusterHeat,
+    /// The G-buffer's channels (any technique: the values it shades with): albedo (texture
+    /// included), normal·0.5 + 0.5, (roughness, metallic, 0).
+    GBufferAlbedo,
+    GBufferNormal,
+    GBufferMaterial,
+    /// View depth, ln(depth/near)/ln(far/near) in grey.
+    Depth,
+    /// The sun's shadow map over the whole image (blinn-phong).
+    ShadowMap,
 }
 
 impl DebugView {
+    pub const ALL: [DebugView; 7] = [
+        DebugView::None,
+        DebugView::ClusterHeat,
+        DebugView::GBufferAlbedo,
+        DebugView::GBufferNormal,
+        DebugView::GBufferMaterial,
+        DebugView::Depth,
+        DebugView::ShadowMap,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            DebugView::None => "none",
+            DebugView::ClusterHeat => "cluster-heat",
+            DebugView::GBufferAlbedo => "gbuffer-albedo",
+            DebugView::GBufferNormal => "gbuffer-normal",
+            DebugView::GBufferMaterial => "gbuffer-material",
+            DebugView::Depth => "depth",
+            DebugView::ShadowMap => "shadow-map",
+        }
+    }
+
     pub fn from_name(name: &str) -> Result<DebugView, RenderError> {
-        match name {
-            "none" => Ok(DebugView::None),
-            "cluster-heat" => Ok(DebugView::ClusterHeat),
-            _ => Err(RenderError::Invalid(format!("unknown debug view '{name}': expected one of none, cluster-heat"))),
+        DebugView::ALL.into_iter().find(|v| v.name() == name).ok_or_else(|| {
+            let expected = DebugView::ALL.map(|v| v.name()).join(", ");
+            RenderError::Invalid(format!("unknown debug view '{name}': expected one of {expected}"))
+        })
+    }
+
+    /// The value shaders see (DEBUG_VIEW_* in common.glsl).
+    pub fn code(self) -> u32 {
+        use ml_cpu::gpu_types as g;
+        match self {
+            DebugView::None => g::DEBUG_VIEW_NONE,
+            DebugView::ClusterHeat => g::DEBUG_VIEW_CLUSTER_HEAT,
+            DebugView::GBufferAlbedo => g::DEBUG_VIEW_GBUFFER_ALBEDO,
+            DebugView::GBufferNormal => g::DEBUG_VIEW_GBUFFER_NORMAL,
+            DebugView::GBufferMaterial => g::DEBUG_VIEW_GBUFFER_MATERIAL,
+            DebugView::Depth => g::DEBUG_VIEW_DEPTH,
+            DebugView::ShadowMap => g::DEBUG_VIEW_SHADOW_MAP,
         }
     }
 }
@@ -179,6 +223,11 @@ impl RenderSettings {
                 "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}",
                 self.technique.name()
             )));
+        }
+        if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
+            return Err(RenderError::Invalid(
+                "--debug-view shadow-map needs --shading blinn-phong (the seed model casts no shadows)".into(),
+            ));
         }
         if self.frames == 0 {
             return Err(RenderError::Invalid("--frames must be at least 1".into()));

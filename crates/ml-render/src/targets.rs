@@ -110,7 +110,8 @@ impl Targets {
         // tile memory (the device still backs it with ordinary memory where it has no lazy kind).
         let inside_pass = U::INPUT_ATTACHMENT | U::TRANSIENT_ATTACHMENT;
         let (color_usage, depth_usage, gbuffer_usage) = match output {
-            Output::Color => (U::COLOR_ATTACHMENT | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT, U::empty()),
+            // STORAGE: the shadow-map debug view paints over it with a compute pass.
+            Output::Color => (U::COLOR_ATTACHMENT | U::TRANSFER_SRC | U::STORAGE, U::DEPTH_STENCIL_ATTACHMENT, U::empty()),
             Output::GBuffer => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::COLOR_ATTACHMENT | U::SAMPLED),
             Output::Subpasses => {
                 (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | inside_pass, U::COLOR_ATTACHMENT | inside_pass)

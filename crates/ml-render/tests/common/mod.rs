@@ -2,7 +2,7 @@
 //! Validation (with synchronization validation) is always on; any message fails the test,
 //! including those the layer reports while the device and instance are destroyed.
 
-#![allow(dead_code)]
+#![allow(dead_code)] // each test binary uses part of the harness
 
 use ml_cpu::scene::Scene;
 use ml_render::{HeadlessRenderer, RenderOutput, RenderSettings, Technique};
@@ -50,7 +50,6 @@ pub fn max_difference(a: &RenderOutput, b: &RenderOutput) -> (u8, usize) {
 }
 
 /// Pixels whose largest channel difference exceeds `limit`.
-#[allow(dead_code)] // not every test binary uses it
 pub fn pixels_beyond(a: &RenderOutput, b: &RenderOutput, limit: u8) -> usize {
     a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)).filter(|(pa, pb)| pa.iter().zip(*pb).any(|(x, y)| x.abs_diff(*y) > limit)).count()
 }
