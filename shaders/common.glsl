@@ -9,6 +9,7 @@
 
 #define SHADING_SEED 0u
 #define SHADING_BLINN_PHONG 1u
+#define SHADING_PBR 2u
 
 #define DEBUG_VIEW_NONE 0u
 #define DEBUG_VIEW_CLUSTER_HEAT 1u
@@ -90,7 +91,8 @@ struct ShadowPush {
 const vec4 CLEAR_COLOR = vec4(0.02, 0.02, 0.02, 1.0);
 
 // Linear colour → what the 8-bit target stores: the seed's gamma 1/2.2 (values above 1 clip).
-vec3 encode_output(vec3 linear) {
+// The pbr model tone-maps first (encode_output in shading_model.glsl); debug views use this.
+vec3 encode_gamma(vec3 linear) {
     return pow(linear, vec3(1.0 / 2.2));
 }
 

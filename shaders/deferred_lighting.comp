@@ -35,8 +35,10 @@ void main() {
     ObjectPush object = objects[texelFetch(object_image, p, 0).r];
     vec3 albedo = object.albedo_roughness.rgb * texelFetch(albedo_image, p, 0).rgb;
     vec3 color;
-    if (!debug_surface(world, n, albedo, object.albedo_roughness.a, object.material.x, color)) {
-        color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, frag_xy);
+    if (debug_surface(world, n, albedo, object.albedo_roughness.a, object.material.x, color)) {
+        imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
+        return;
     }
+    color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, frag_xy);
     imageStore(out_image, p, vec4(encode_output(color), 1.0));
 }

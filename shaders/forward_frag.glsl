@@ -34,9 +34,11 @@ void main() {
     float roughness = object.albedo_roughness.a;
     float metallic = object.material.x;
     vec3 color;
-    if (!debug_surface(in_world_pos, s.normal, albedo, roughness, metallic, color)) {
-        color = shade_point(in_world_pos, s.normal, albedo, roughness, metallic, gl_FragCoord.xy);
+    if (debug_surface(in_world_pos, s.normal, albedo, roughness, metallic, color)) {
+        out_color = vec4(encode_gamma(color), 1.0);
+        return;
     }
+    color = shade_point(in_world_pos, s.normal, albedo, roughness, metallic, gl_FragCoord.xy);
     // The target is UNORM: the seed writes gamma-encoded values itself.
     out_color = vec4(encode_output(color), 1.0);
 }

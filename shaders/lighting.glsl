@@ -34,7 +34,7 @@
 #endif
 
 // Linear colour of a surface point: every light that reaches it plus what the model adds
-// (seed: ambient; blinn-phong: ambient, sun, spot, reflection). `frag_xy` is the pixel
+// (seed, pbr: ambient; blinn-phong: ambient, sun, spot, reflection). `frag_xy` is the pixel
 // centre (gl_FragCoord.xy), which picks the cluster.
 vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, vec2 frag_xy) {
     vec3 v = normalize(frame.camera_pos.xyz - world);
@@ -46,13 +46,18 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
         SUM_LIGHTS(lo, BP_LIGHT)
         return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo;
     }
+    if (MODEL_PBR) {
+#define PBR_LIGHT(l) pbr_point_light(l, world, n, v, albedo, roughness, metallic)
+        SUM_LIGHTS(lo, PBR_LIGHT)
+        return albedo * frame.ambient + lo;
+    }
 #define SEED_LIGHT(l) seed_point_light(l, world, n, v, albedo, roughness, metallic)
     SUM_LIGHTS(lo, SEED_LIGHT)
     return albedo * frame.ambient + lo;
 }
 
 // The surface debug views (G-buffer channels, depth): what the view shows at a surface point
-// as linear colour, which encode_output turns into the promised display values — albedo as
+// as linear colour, which encode_gamma turns into the promised display values — albedo as
 // it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
 // False for any other view. Every shading path calls it with the values it would shade with.
 bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, out vec3 color) {

@@ -52,4 +52,28 @@ vec3 seed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v,
     return spec * n_dot_l * light.color.rgb * radiance;
 }
 
+// The `pbr` model of SPEC §2: the seed's specular term plus Lambert diffuse weighted by
+// (1 − F)(1 − metallic), radiance (1 − d/r)²·N·L (N·L once: the seed's second N·L is its own).
+vec3 pbr_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
+    vec3 light_vec = light.position_radius.xyz - world_pos;
+    float dist = length(light_vec);
+    float radius = light.position_radius.w;
+    if (dist > radius) {
+        return vec3(0.0);
+    }
+    vec3 l = light_vec / dist;
+    float n_dot_l = clamp(dot(n, l), 0.0, 1.0);
+    if (n_dot_l <= 0.0) {
+        return vec3(0.0);
+    }
+    vec3 h = normalize(v + l);
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    float n_dot_h = clamp(dot(n, h), 0.0, 1.0);
+    float atten = clamp(1.0 - dist / radius, 0.0, 1.0);
+    vec3 f = f_schlick(n_dot_v, albedo, metallic);
+    vec3 spec = d_ggx(n_dot_h, roughness) * f * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, roughness));
+    vec3 diffuse = (1.0 - f) * (1.0 - metallic) * albedo / PI;
+    return (diffuse + spec) * light.color.rgb * (atten * atten) * n_dot_l;
+}
+
 #endif

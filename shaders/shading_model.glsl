@@ -1,11 +1,27 @@
-// Which shading model a pipeline is built for: a specialization constant (constant_id 10, set
-// by raster.rs and deferred.rs from --shading), so each pipeline carries only its model's code.
+// Which shading model a pipeline is built for: specialization constants (set by raster.rs,
+// deferred.rs and tonemap.rs from --shading), so each pipeline carries only its model's code.
 // A uniform switch cost the seed model's fragment shaders 1.3–1.4× on the H100 (measured):
-// the other model's code still took registers.
+// the other models' code still took registers.
 
 #ifndef MANYLIGHTS_SHADING_MODEL_GLSL
 #define MANYLIGHTS_SHADING_MODEL_GLSL
 
 layout(constant_id = 10) const bool MODEL_BLINN_PHONG = false;
+// pbr; in the tone-map pass: "apply pbr's tone map" (not for debug views).
+layout(constant_id = 11) const bool MODEL_PBR = false;
+
+// ACES filmic curve (Narkowicz 2015's fit): HDR → [0, 1].
+vec3 aces_tone_map(vec3 x) {
+    return clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+// Linear colour → what the 8-bit target stores under the pipeline's model: pbr tone-maps its
+// HDR result, the seed models clip; then gamma 1/2.2.
+vec3 encode_output(vec3 linear) {
+    if (MODEL_PBR) {
+        linear = aces_tone_map(linear);
+    }
+    return encode_gamma(linear);
+}
 
 #endif

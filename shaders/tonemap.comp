@@ -1,9 +1,11 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // After the deferred render pass: HDR (RGBA16F, linear) → the 8-bit output, with the same
-// encoding the forward path applies in its fragment shader. Alpha 0 marks pixels no object
+// encoding the forward path applies in its fragment shader (MODEL_PBR: tone-map first; not set
+// for debug views, whose values are shown as they are). Alpha 0 marks pixels no object
 // covers (the lighting subpass discards them): they get the background colour.
 #include "common.glsl"
+#include "shading_model.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 

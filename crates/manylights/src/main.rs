@@ -40,8 +40,9 @@ struct RenderArgs {
     /// deferred-compute.
     #[arg(long, default_value = "forward")]
     technique: String,
-    /// Shading model: seed (seed 000's Cook–Torrance) or blinn-phong (seed 002: shadowed sun,
-    /// spot light, textures, normal maps, sky reflections).
+    /// Shading model: seed (seed 000's Cook–Torrance), blinn-phong (seed 002: shadowed sun,
+    /// spot light, textures, normal maps, sky reflections) or pbr (seed's specular + Lambert
+    /// diffuse, ACES tone map).
     #[arg(long, default_value = "seed")]
     shading: String,
     /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).

@@ -29,6 +29,7 @@ macro_rules! gpu_struct {
 /// `SHADING_*` in common.glsl.
 pub const SHADING_SEED: u32 = 0;
 pub const SHADING_BLINN_PHONG: u32 = 1;
+pub const SHADING_PBR: u32 = 2;
 
 gpu_struct!(
     /// Per-frame uniforms (std140; every member 16-byte friendly).

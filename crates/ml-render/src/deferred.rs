@@ -4,7 +4,6 @@
 //! 132). Its output is the colour target, left in TRANSFER_SRC_OPTIMAL like the forward pass's.
 
 use crate::compute_pass::ComputePass;
-use crate::raster::SPEC_BLINN_PHONG;
 use crate::settings::ShadingModel;
 use crate::targets::Targets;
 use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
@@ -55,7 +54,7 @@ impl ComputeLighting {
             (BINDING_ALBEDO, image),
         ];
         // Set 1: the scene's textures (blinn-phong's shadow map and sky).
-        let model = [(SPEC_BLINN_PHONG, u32::from(shading == ShadingModel::BlinnPhong))];
+        let model = shading.spec_constants();
         let pass = ComputePass::new(ctx, &bindings, &[textures_layout], (ml_shaders::DEFERRED_LIGHTING_COMP, &model))?;
         Ok(ComputeLighting { pass })
     }

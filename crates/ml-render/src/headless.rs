@@ -16,7 +16,7 @@ use crate::targets::{depth_format, Output, Targets};
 use crate::tonemap::ToneMap;
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight, SHADING_BLINN_PHONG, SHADING_SEED};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::scene::Scene;
 use ml_vk::descriptors::{allocate_set, write_image};
@@ -176,7 +176,8 @@ impl<'a> HeadlessRenderer<'a> {
             self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.shading)?);
         }
         if self.settings.technique.lights_in_subpass() {
-            self.tonemap = Some(ToneMap::new(ctx)?);
+            let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);
+            self.tonemap = Some(ToneMap::new(ctx, self.settings.shading == ShadingModel::Pbr && !surface_view)?);
         }
         // Per frame at most: the shading set (1 uniform + 3 storage), the build set (1 uniform
         // + 8 storage), the lighting set (1 uniform, 4 storage, 3 sampled images, 1 storage
@@ -382,10 +383,7 @@ impl<'a> HeadlessRenderer<'a> {
         // World size of a shadow-map texel: the orthographic projection's first row is the
         // sun's x axis over the half-width it covers.
         let shadow_texel_world = 2.0 / self.shadow_view_proj.row(0).truncate().length() / self.textures.shadow_size as f32;
-        let shading_model = match self.settings.shading {
-            ShadingModel::Seed => SHADING_SEED,
-            ShadingModel::BlinnPhong => SHADING_BLINN_PHONG,
-        };
+        let shading_model = self.settings.shading.code();
         let frame = &mut self.frames[f];
         let uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),

@@ -47,9 +47,6 @@ pub struct RasterPass {
     shading: ShadingModel,
 }
 
-/// constant_id of `MODEL_BLINN_PHONG` in shading_model.glsl.
-pub const SPEC_BLINN_PHONG: u32 = 10;
-
 /// The kinds of draw in the pass.
 #[derive(Clone, Copy, PartialEq)]
 enum Draw {
@@ -196,8 +193,13 @@ impl RasterPass {
             }
         };
         // The shading model, compiled in (shading_model.glsl); the legend ignores it.
-        let model = [vk::SpecializationMapEntry { constant_id: SPEC_BLINN_PHONG, offset: 0, size: 4 }];
-        let model_data = u32::from(self.shading == ShadingModel::BlinnPhong).to_ne_bytes();
+        let constants = self.shading.spec_constants();
+        let model: Vec<vk::SpecializationMapEntry> = constants
+            .iter()
+            .enumerate()
+            .map(|(i, &(id, _))| vk::SpecializationMapEntry { constant_id: id, offset: 4 * i as u32, size: 4 })
+            .collect();
+        let model_data: Vec<u8> = constants.iter().flat_map(|&(_, v)| v.to_ne_bytes()).collect();
         let spec = vk::SpecializationInfo::default().map_entries(&model).data(&model_data);
         let stages = [
             vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),

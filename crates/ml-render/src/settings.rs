@@ -75,6 +75,10 @@ impl Technique {
     }
 }
 
+/// constant_id of `MODEL_BLINN_PHONG` and `MODEL_PBR` in shading_model.glsl.
+pub const SPEC_BLINN_PHONG: u32 = 10;
+pub const SPEC_PBR: u32 = 11;
+
 /// Shading models (SPEC §2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShadingModel {
@@ -82,16 +86,36 @@ pub enum ShadingModel {
     Seed,
     /// Seed 002: Blinn-Phong with a shadowed sun, a spot light, textures and reflections.
     BlinnPhong,
+    /// The seed's specular term plus Lambert diffuse weighted by (1 − F)(1 − metallic), HDR
+    /// tone-mapped (ACES) before gamma.
+    Pbr,
 }
 
 impl ShadingModel {
-    pub const ALL: [ShadingModel; 2] = [ShadingModel::Seed, ShadingModel::BlinnPhong];
+    pub const ALL: [ShadingModel; 3] = [ShadingModel::Seed, ShadingModel::BlinnPhong, ShadingModel::Pbr];
 
     pub fn name(self) -> &'static str {
         match self {
             ShadingModel::Seed => "seed",
             ShadingModel::BlinnPhong => "blinn-phong",
+            ShadingModel::Pbr => "pbr",
         }
+    }
+
+    /// The value shaders see in FrameUniforms (SHADING_* in common.glsl).
+    pub fn code(self) -> u32 {
+        use ml_cpu::gpu_types as g;
+        match self {
+            ShadingModel::Seed => g::SHADING_SEED,
+            ShadingModel::BlinnPhong => g::SHADING_BLINN_PHONG,
+            ShadingModel::Pbr => g::SHADING_PBR,
+        }
+    }
+
+    /// Specialization constants (id, value) that compile a pipeline for this model
+    /// (shading_model.glsl).
+    pub fn spec_constants(self) -> [(u32, u32); 2] {
+        [(SPEC_BLINN_PHONG, u32::from(self == ShadingModel::BlinnPhong)), (SPEC_PBR, u32::from(self == ShadingModel::Pbr))]
     }
 
     pub fn from_name(name: &str) -> Result<ShadingModel, RenderError> {

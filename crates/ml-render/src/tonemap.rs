@@ -3,6 +3,7 @@
 //! (tonemap.comp). A compute pass: on H100/H200 it runs on every SM.
 
 use crate::compute_pass::ComputePass;
+use crate::settings::SPEC_PBR;
 use crate::targets::Targets;
 use ml_vk::descriptors::{allocate_set, write_image};
 use ml_vk::{vk, Context, VkError};
@@ -15,10 +16,13 @@ pub struct ToneMap {
 }
 
 impl ToneMap {
-    pub fn new(ctx: &Context) -> Result<ToneMap, VkError> {
+    /// `aces`: apply pbr's tone-mapping curve before gamma (not for debug views, whose
+    /// values are shown as they are).
+    pub fn new(ctx: &Context, aces: bool) -> Result<ToneMap, VkError> {
         use vk::DescriptorType as T;
         let bindings = [(BINDING_HDR, T::COMBINED_IMAGE_SAMPLER), (BINDING_OUTPUT, T::STORAGE_IMAGE)];
-        Ok(ToneMap { pass: ComputePass::new(ctx, &bindings, &[], (ml_shaders::TONEMAP_COMP, &[]))? })
+        let curve = [(SPEC_PBR, u32::from(aces))];
+        Ok(ToneMap { pass: ComputePass::new(ctx, &bindings, &[], (ml_shaders::TONEMAP_COMP, &curve))? })
     }
 
     /// Allocate and fill a frame's set: its HDR image in, its colour target out.

@@ -121,23 +121,22 @@ fn every_technique_equals_forward_on_the_seed_scene() {
     }
 }
 
-/// Seed 002's model: textures, normal maps, a shadowed sun, a spot light and reflections on
-/// top of the point lights, the same in every technique.
+/// Seed 002's model (textures, normal maps, a shadowed sun, a spot light and reflections on
+/// top of the point lights) and the pbr model (diffuse + specular, tone-mapped HDR): the same
+/// in every technique.
 #[test]
-fn every_technique_equals_forward_with_blinn_phong() {
-    let gold = Material::named("gold").unwrap();
-    for object in [MeshKind::Sphere, MeshKind::Teapot] {
-        let scene = Scene::seed(object, gold, &LightParams::seed_default()).unwrap().with_floor();
-        assert_matches_forward_shaded(
-            &format!("blinn-phong seed scene ({})", object.name()),
-            &scene,
-            ClusterDims::DEFAULT,
-            ShadingModel::BlinnPhong,
-        );
-    }
-    for seed in 0..4 {
-        let scene = random_scene(2000 + seed, 2000);
-        assert_matches_forward_shaded(&format!("blinn-phong random scene {seed}"), &scene, ClusterDims::DEFAULT, ShadingModel::BlinnPhong);
+fn every_technique_equals_forward_with_blinn_phong_and_pbr() {
+    for model in [ShadingModel::BlinnPhong, ShadingModel::Pbr] {
+        let gold = Material::named("gold").unwrap();
+        for object in [MeshKind::Sphere, MeshKind::Teapot] {
+            let scene = Scene::seed(object, gold, &LightParams::seed_default()).unwrap().with_floor();
+            let name = format!("{} seed scene ({})", model.name(), object.name());
+            assert_matches_forward_shaded(&name, &scene, ClusterDims::DEFAULT, model);
+        }
+        for seed in 0..4 {
+            let scene = random_scene(2000 + seed, 2000);
+            assert_matches_forward_shaded(&format!("{} random scene {seed}", model.name()), &scene, ClusterDims::DEFAULT, model);
+        }
     }
 }
 
