@@ -26,54 +26,64 @@ vec3 f_schlick(float cos_theta, vec3 albedo, float metallic) {
     return f0 + (1.0 - f0) * pow(1.0 - cos_theta, 5.0);
 }
 
-// Light reflected towards V by one point light; exactly zero beyond the light's radius.
-vec3 seed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v,
-                      vec3 albedo, float roughness, float metallic) {
+// One point light at a surface point, as the seed computes it: the cosines, the falloff
+// (1 − d/r)², Schlick's F and the specular term D·F·G/(4·N·L·N·V). `reaches` is false beyond
+// the radius or behind the surface (nothing else is set then).
+struct SeedLightTerms {
+    bool reaches;
+    float n_dot_l;
+    float falloff;
+    vec3 f;
+    vec3 spec;
+};
+
+SeedLightTerms seed_light_terms(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
+    SeedLightTerms t;
+    t.reaches = false;
     vec3 light_vec = light.position_radius.xyz - world_pos;
     float dist = length(light_vec);
     float radius = light.position_radius.w;
     if (dist > radius) {
-        return vec3(0.0);
+        return t;
     }
     vec3 l = light_vec / dist;
     vec3 h = normalize(v + l);
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
-    float n_dot_l = clamp(dot(n, l), 0.0, 1.0);
+    t.n_dot_l = clamp(dot(n, l), 0.0, 1.0);
     float n_dot_h = clamp(dot(n, h), 0.0, 1.0);
-    if (n_dot_l <= 0.0) {
+    if (t.n_dot_l <= 0.0) {
+        return t;
+    }
+    t.reaches = true;
+    float atten = clamp(1.0 - dist / radius, 0.0, 1.0);
+    t.falloff = atten * atten;
+    float d = d_ggx(n_dot_h, roughness);
+    float g = g_schlick_smith_over_4nlnv(t.n_dot_l, n_dot_v, max(0.05, roughness));
+    t.f = f_schlick(n_dot_v, albedo, metallic);
+    t.spec = d * t.f * g;
+    return t;
+}
+
+// Light reflected towards V by one point light; exactly zero beyond the light's radius. The
+// seed's radiance is falloff·N·L, and it multiplies by N·L once more.
+vec3 seed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
+    SeedLightTerms t = seed_light_terms(light, world_pos, n, v, albedo, roughness, metallic);
+    if (!t.reaches) {
         return vec3(0.0);
     }
-    float atten = clamp(1.0 - dist / radius, 0.0, 1.0);
-    float radiance = atten * atten * n_dot_l;
-    float d = d_ggx(n_dot_h, roughness);
-    float g = g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, roughness));
-    vec3 f = f_schlick(n_dot_v, albedo, metallic);
-    vec3 spec = d * f * g;
-    return spec * n_dot_l * light.color.rgb * radiance;
+    float radiance = t.falloff * t.n_dot_l;
+    return t.spec * t.n_dot_l * light.color.rgb * radiance;
 }
 
 // The `pbr` model of SPEC §2: the seed's specular term plus Lambert diffuse weighted by
-// (1 − F)(1 − metallic), radiance (1 − d/r)²·N·L (N·L once: the seed's second N·L is its own).
+// (1 − F)(1 − metallic), radiance falloff·N·L (N·L once).
 vec3 pbr_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
-    vec3 light_vec = light.position_radius.xyz - world_pos;
-    float dist = length(light_vec);
-    float radius = light.position_radius.w;
-    if (dist > radius) {
+    SeedLightTerms t = seed_light_terms(light, world_pos, n, v, albedo, roughness, metallic);
+    if (!t.reaches) {
         return vec3(0.0);
     }
-    vec3 l = light_vec / dist;
-    float n_dot_l = clamp(dot(n, l), 0.0, 1.0);
-    if (n_dot_l <= 0.0) {
-        return vec3(0.0);
-    }
-    vec3 h = normalize(v + l);
-    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
-    float n_dot_h = clamp(dot(n, h), 0.0, 1.0);
-    float atten = clamp(1.0 - dist / radius, 0.0, 1.0);
-    vec3 f = f_schlick(n_dot_v, albedo, metallic);
-    vec3 spec = d_ggx(n_dot_h, roughness) * f * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, roughness));
-    vec3 diffuse = (1.0 - f) * (1.0 - metallic) * albedo / PI;
-    return (diffuse + spec) * light.color.rgb * (atten * atten) * n_dot_l;
+    vec3 diffuse = (1.0 - t.f) * (1.0 - metallic) * albedo / PI;
+    return (diffuse + t.spec) * light.color.rgb * (t.falloff * t.n_dot_l);
 }
 
 #endif
