@@ -189,7 +189,15 @@ fn render(args: &RenderArgs) -> Result<()> {
         None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
     }
     if technique.lights_in_subpass() || technique.lights_in_compute() {
-        rows.push(("g-buffer", format!("{} bytes/pixel + depth (octahedral normal 2×f32, object index u32)", gbuffer_bytes_per_pixel())));
+        let memory = match output.stats.gbuffer_lazily_allocated {
+            Some(true) => "; transient, lazily allocated",
+            Some(false) => "; transient (this device has no lazily allocated memory)",
+            None => "",
+        };
+        rows.push((
+            "g-buffer",
+            format!("{} bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo RGBA8){memory}", gbuffer_bytes_per_pixel()),
+        ));
     }
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));

@@ -285,6 +285,10 @@ impl<'a> HeadlessRenderer<'a> {
             self.collect_all(&mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        if self.pass.output == Output::Subpasses {
+            let targets = self.frames[0].targets.as_ref().expect("made with the frame");
+            stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
+        }
         // Averages are over every frame rendered, re-renders included.
         stats.frames = self.settings.frames + stats.rerendered_frames;
         self.last_frame = last;

@@ -19,6 +19,9 @@ pub struct FrameStats {
     pub overflowed_frames: u32,
     /// clustered-gpu: extra frames rendered because the last one overflowed.
     pub rerendered_frames: u32,
+    /// deferred, deferred-clustered: whether the transient G-buffer got lazily allocated
+    /// memory (only devices that have such memory, i.e. tilers, give it).
+    pub gbuffer_lazily_allocated: Option<bool>,
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -39,6 +42,7 @@ impl FrameStats {
             index_growths: 0,
             overflowed_frames: 0,
             rerendered_frames: 0,
+            gbuffer_lazily_allocated: None,
         }
     }
 

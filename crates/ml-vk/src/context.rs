@@ -324,6 +324,16 @@ impl Context {
         props.optimal_tiling_features.contains(features)
     }
 
+    /// A LAZILY_ALLOCATED memory type among `type_bits` (what an image accepts), if the device
+    /// has one (tile-based GPUs; not desktop NVIDIA, not lavapipe).
+    pub fn lazily_allocated_memory_type(&self, type_bits: u32) -> Option<u32> {
+        // SAFETY: a physical device of this instance.
+        let props = unsafe { self.instance().get_physical_device_memory_properties(self.physical_device) };
+        (0..props.memory_type_count).find(|&i| {
+            type_bits & (1 << i) != 0 && props.memory_types[i as usize].property_flags.contains(vk::MemoryPropertyFlags::LAZILY_ALLOCATED)
+        })
+    }
+
     pub fn wait_idle(&self) -> Result<()> {
         // SAFETY: valid device.
         unsafe { self.device.device_wait_idle() }.ctx("vkDeviceWaitIdle")

@@ -12,6 +12,9 @@ pub struct Image {
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     allocation: Option<Allocation>,
+    /// Memory of a transient attachment where the device has a lazily allocated kind (tilers:
+    /// it may never be backed); null otherwise.
+    lazy_memory: vk::DeviceMemory,
 }
 
 impl Image {
@@ -24,6 +27,7 @@ impl Image {
             format: vk::Format::UNDEFINED,
             extent: vk::Extent2D::default(),
             allocation: None,
+            lazy_memory: vk::DeviceMemory::null(),
         }
     }
 
@@ -65,6 +69,25 @@ impl Image {
         let raw = unsafe { ctx.device.create_image(&info, None) }.ctx("vkCreateImage")?;
         // SAFETY: `raw` was just created.
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
+        let mut image = Image { raw, view: vk::ImageView::null(), format, extent, allocation: None, lazy_memory: vk::DeviceMemory::null() };
+        let lazy_type = usage
+            .contains(vk::ImageUsageFlags::TRANSIENT_ATTACHMENT)
+            .then(|| ctx.lazily_allocated_memory_type(requirements.memory_type_bits))
+            .flatten();
+        if let Some(memory_type_index) = lazy_type {
+            let info = vk::MemoryAllocateInfo::default().allocation_size(requirements.size).memory_type_index(memory_type_index);
+            // SAFETY: valid device; a type the image accepts; freed in `destroy`.
+            let bound = unsafe { ctx.device.allocate_memory(&info, None) }.ctx("vkAllocateMemory").and_then(|memory| {
+                image.lazy_memory = memory;
+                // SAFETY: fresh memory of the required size and type.
+                unsafe { ctx.device.bind_image_memory(raw, memory, 0) }.ctx("vkBindImageMemory")
+            });
+            if let Err(e) = bound {
+                image.destroy(ctx);
+                return Err(e);
+            }
+            return image.with_view(ctx, shape, aspect);
+        }
         let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
             name,
             requirements,
@@ -72,7 +95,6 @@ impl Image {
             linear: false,
             allocation_scheme: AllocationScheme::GpuAllocatorManaged,
         });
-        let mut image = Image { raw, view: vk::ImageView::null(), format, extent, allocation: None };
         match allocation {
             Ok(a) => image.allocation = Some(a),
             Err(source) => {
@@ -86,6 +108,19 @@ impl Image {
             image.destroy(ctx);
             return Err(e);
         }
+        image.with_view(ctx, shape, aspect)
+    }
+
+    /// Whether the image lives in lazily allocated memory (a transient attachment on a device
+    /// that has such memory).
+    pub fn is_lazily_allocated(&self) -> bool {
+        self.lazy_memory != vk::DeviceMemory::null()
+    }
+
+    /// Add the view of a bound image (destroying the image if that fails).
+    fn with_view(mut self, ctx: &Context, shape: ImageShape, aspect: vk::ImageAspectFlags) -> Result<Image> {
+        let (raw, format) = (self.raw, self.format);
+        let image = &mut self;
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(if shape.cube { vk::ImageViewType::CUBE } else { vk::ImageViewType::TYPE_2D })
@@ -99,7 +134,7 @@ impl Image {
                 return Err(e);
             }
         }
-        Ok(image)
+        Ok(self)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -116,6 +151,11 @@ impl Image {
         }
         if let Some(a) = self.allocation.take() {
             let _ = ctx.allocator().free(a);
+        }
+        if self.lazy_memory != vk::DeviceMemory::null() {
+            // SAFETY: the image bound to it was destroyed above.
+            unsafe { ctx.device.free_memory(self.lazy_memory, None) };
+            self.lazy_memory = vk::DeviceMemory::null();
         }
     }
 }
