@@ -180,7 +180,7 @@ impl<'a> HeadlessRenderer<'a> {
             self.tonemap = Some(ToneMap::new(ctx, self.settings.shading == ShadingModel::Pbr && !surface_view)?);
         }
         // Per frame at most: the shading set (1 uniform + 3 storage), the build set (1 uniform
-        // + 8 storage), the lighting set (1 uniform, 4 storage, 3 sampled images, 1 storage
+        // + 8 storage), the lighting set (1 uniform, 4 storage, 4 sampled images, 1 storage
         // image), the subpass input set (1 storage, 4 input attachments), the tone map's set
         // (1 sampled image, 1 storage image) and the shadow-map view's (1 storage image).
         let n = FRAMES_IN_FLIGHT as u32;
