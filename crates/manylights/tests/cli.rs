@@ -100,7 +100,22 @@ fn bad_names_are_refused_with_the_choices() {
         &manylights(&["render", "--technique", "deferred-compute", "--debug-view", "cluster-heat", "--out", p], &[]),
         &["clustered forward technique"],
     );
+    assert_one_line_error(&manylights(&["render", "--shading", "phong", "--out", p], &[]), &["phong", "blinn-phong", "pbr"]);
+    assert_one_line_error(&manylights(&["render", "--debug-view", "shadow-map", "--out", p], &[]), &["shadow-map", "blinn-phong"]);
     assert!(!png.exists());
+}
+
+#[test]
+fn deferred_render_reports_its_gbuffer_and_passes() {
+    let png = temp_png("deferred.png");
+    let args =
+        ["render", "--validation", "--technique", "deferred-clustered", "--shading", "blinn-phong", "--width", "64", "--height", "36"];
+    let out = manylights(&[&args[..], &["--out", png.to_str().unwrap()]].concat(), &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    for key in ["blinn-phong", "g-buffer + lighting pass", "tone map pass", "16 bytes/pixel", "transient"] {
+        assert!(stdout.contains(key), "'{key}' missing from:\n{stdout}");
+    }
 }
 
 #[test]
