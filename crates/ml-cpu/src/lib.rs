@@ -10,6 +10,7 @@ pub mod gpu_types;
 pub mod lights;
 pub mod material;
 pub mod mesh;
+pub mod omni_shadow;
 pub mod random_scene;
 pub mod scene;
 pub mod shading;
