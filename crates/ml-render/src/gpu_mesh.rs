@@ -1,6 +1,6 @@
 //! Static meshes in device-local memory, uploaded once through a staging buffer (seed 000).
 
-use ml_cpu::mesh::{Mesh, MeshKind};
+use ml_cpu::mesh::{Mesh, MeshKind, Vertex};
 use ml_vk::{vk, Buffer, Context, VkError};
 
 pub struct GpuMesh {
@@ -27,4 +27,32 @@ impl GpuMesh {
         self.vertices.destroy(ctx);
         self.indices.destroy(ctx);
     }
+}
+
+/// The vertex buffer's binding (one, per vertex) as pipelines read it.
+pub fn vertex_binding() -> vk::VertexInputBindingDescription {
+    vk::VertexInputBindingDescription::default()
+        .binding(0)
+        .stride(std::mem::size_of::<Vertex>() as u32)
+        .input_rate(vk::VertexInputRate::VERTEX)
+}
+
+/// Every `Vertex` field as a vertex attribute, location = field order (forward.vert): position,
+/// normal, uv, tangent. A pipeline that needs only the first few takes a prefix.
+pub fn vertex_attributes() -> [vk::VertexInputAttributeDescription; 4] {
+    use std::mem::offset_of;
+    [
+        (vk::Format::R32G32B32_SFLOAT, offset_of!(Vertex, position)),
+        (vk::Format::R32G32B32_SFLOAT, offset_of!(Vertex, normal)),
+        (vk::Format::R32G32_SFLOAT, offset_of!(Vertex, uv)),
+        (vk::Format::R32G32B32A32_SFLOAT, offset_of!(Vertex, tangent)),
+    ]
+    .into_iter()
+    .enumerate()
+    .map(|(location, (format, offset))| {
+        vk::VertexInputAttributeDescription::default().location(location as u32).binding(0).format(format).offset(offset as u32)
+    })
+    .collect::<Vec<_>>()
+    .try_into()
+    .expect("four attributes")
 }

@@ -5,15 +5,14 @@
 //! 002's pass with two subpasses: subpass 0 writes the G-buffer, subpass 1 reads it as input
 //! attachments and shades a full-screen triangle into an HDR target (tone-mapped after).
 
-use crate::gpu_mesh::GpuMesh;
+use crate::gpu_mesh::{vertex_attributes, vertex_binding, GpuMesh};
 use crate::render_pass;
 use crate::settings::{ShadingModel, Technique};
 use crate::targets::{Output, Targets};
 use ml_cpu::gpu_types::ObjectPush;
-use ml_cpu::mesh::Vertex;
 use ml_cpu::scene::Object;
 use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
-use ml_vk::{shader, vk, Context, VkError, VkResultExt};
+use ml_vk::{shader, vk, Context, VkError};
 
 /// Binding numbers of set 0 (see the shaders).
 pub const BINDING_FRAME: u32 = 0;
@@ -183,104 +182,42 @@ impl RasterPass {
             Draw::Mesh | Draw::Overlay => (self.pipeline_layout, 0, self.output.colour_attachments()),
             Draw::Lighting => (self.lighting_layout, 1, 1),
         };
-        let vert = shader::module(ctx, vertex)?;
-        let frag = match shader::module(ctx, fragment) {
-            Ok(f) => f,
-            Err(e) => {
-                // SAFETY: unused module.
-                unsafe { ctx.device.destroy_shader_module(vert, None) };
-                return Err(e);
-            }
-        };
-        // The shading model, compiled in (shading_model.glsl); the legend ignores it.
-        let constants = self.shading.spec_constants();
-        let model: Vec<vk::SpecializationMapEntry> = constants
-            .iter()
-            .enumerate()
-            .map(|(i, &(id, _))| vk::SpecializationMapEntry { constant_id: id, offset: 4 * i as u32, size: 4 })
-            .collect();
-        let model_data: Vec<u8> = constants.iter().flat_map(|&(_, v)| v.to_ne_bytes()).collect();
-        let spec = vk::SpecializationInfo::default().map_entries(&model).data(&model_data);
-        let stages = [
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(frag)
-                .name(c"main")
-                .specialization_info(&spec),
-        ];
-        let vertex_bindings = [vk::VertexInputBindingDescription::default()
-            .binding(0)
-            .stride(std::mem::size_of::<Vertex>() as u32)
-            .input_rate(vk::VertexInputRate::VERTEX)];
-        let vertex_attributes = [
-            vk::VertexInputAttributeDescription::default()
-                .location(0)
-                .binding(0)
-                .format(vk::Format::R32G32B32_SFLOAT)
-                .offset(std::mem::offset_of!(Vertex, position) as u32),
-            vk::VertexInputAttributeDescription::default()
-                .location(1)
-                .binding(0)
-                .format(vk::Format::R32G32B32_SFLOAT)
-                .offset(std::mem::offset_of!(Vertex, normal) as u32),
-            vk::VertexInputAttributeDescription::default()
-                .location(2)
-                .binding(0)
-                .format(vk::Format::R32G32_SFLOAT)
-                .offset(std::mem::offset_of!(Vertex, uv) as u32),
-            vk::VertexInputAttributeDescription::default()
-                .location(3)
-                .binding(0)
-                .format(vk::Format::R32G32B32A32_SFLOAT)
-                .offset(std::mem::offset_of!(Vertex, tangent) as u32),
-        ];
+        let bindings = [vertex_binding()];
+        let attributes = vertex_attributes();
         let vertex_input = match draw {
             Draw::Mesh => vk::PipelineVertexInputStateCreateInfo::default()
-                .vertex_binding_descriptions(&vertex_bindings)
-                .vertex_attribute_descriptions(&vertex_attributes),
+                .vertex_binding_descriptions(&bindings)
+                .vertex_attribute_descriptions(&attributes),
             Draw::Overlay | Draw::Lighting => vk::PipelineVertexInputStateCreateInfo::default(),
         };
-        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         // Meshes wind counter-clockwise seen from outside; the Y-flipped projection keeps that
         // counter-clockwise in Vulkan's framebuffer convention.
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        let rasterization = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(if draw == Draw::Mesh { vk::CullModeFlags::BACK } else { vk::CullModeFlags::NONE })
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+        let depth_stencil = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(draw == Draw::Mesh)
             .depth_write_enable(draw == Draw::Mesh)
             .depth_compare_op(vk::CompareOp::LESS);
-        let blend_attachments =
-            vec![vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA); colour_attachments];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
-        let info = [vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
-            .vertex_input_state(&vertex_input)
-            .input_assembly_state(&input_assembly)
-            .viewport_state(&viewport)
-            .rasterization_state(&raster)
-            .multisample_state(&multisample)
-            .depth_stencil_state(&depth)
-            .color_blend_state(&blend)
-            .dynamic_state(&dynamic)
-            .layout(layout)
-            .render_pass(self.render_pass)
-            .subpass(subpass)];
-        // SAFETY: every referenced object is alive.
-        let result = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None) };
-        // SAFETY: modules are no longer needed once the pipeline exists (or failed).
-        unsafe {
-            ctx.device.destroy_shader_module(vert, None);
-            ctx.device.destroy_shader_module(frag, None);
-        }
-        result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")
+        // The shading model, compiled in (shading_model.glsl); the legend ignores it.
+        let model = self.shading.spec_constants();
+        shader::graphics_pipeline(
+            ctx,
+            &shader::GraphicsPipelineDesc {
+                vertex,
+                fragment: Some(fragment),
+                fragment_constants: &model,
+                vertex_input,
+                rasterization,
+                depth_stencil,
+                colour_attachments,
+                layout,
+                render_pass: self.render_pass,
+                subpass,
+            },
+        )
     }
 
     /// Record the whole pass: clear, draw every object with its push constants (and the

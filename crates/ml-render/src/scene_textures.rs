@@ -6,10 +6,9 @@
 //! move (only the point lights do, and they cast no shadows). Depth only, every object, an
 //! orthographic view along the sun fitted to the scene (ml_cpu::blinn_phong).
 
-use crate::gpu_mesh::GpuMesh;
+use crate::gpu_mesh::{vertex_attributes, vertex_binding, GpuMesh};
 use crate::raster::object_push;
 use ml_cpu::gpu_types::ShadowPush;
-use ml_cpu::mesh::Vertex;
 use ml_cpu::scene::Scene;
 use ml_cpu::textures;
 use ml_vk::descriptors::{allocate_set, write_image};
@@ -45,7 +44,10 @@ pub struct ShadowInputs<'a> {
     pub view_proj: glam::Mat4,
 }
 
-/// The shadow map's place in `SceneTextures::images`.
+/// Places in `SceneTextures::images` (the order `create` makes them in).
+const ALBEDO_IMAGE: usize = 0;
+const NORMAL_IMAGE: usize = 1;
+const SKY_IMAGE: usize = 2;
 const SHADOW_IMAGE: usize = 3;
 
 impl SceneTextures {
@@ -93,18 +95,17 @@ impl SceneTextures {
 
         let rgba = vk::Format::R8G8B8A8_UNORM;
         let flat = |size: u32| ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, cube: false };
-        let (albedo, normal, sky) = if real {
-            let a = textures::tiles_albedo(MATERIAL_MAP_SIZE);
-            let n = textures::bumps_normal_map(MATERIAL_MAP_SIZE);
-            let s = textures::sky_cube(SKY_SIZE);
-            let mips = |m: &textures::MipChain| ImageShape { levels: m.levels.len() as u32, ..flat(m.size) };
-            let albedo = texture_with(ctx, "albedo map", mips(&a), rgba, &a.levels.iter().map(|l| vec![l.as_slice()]).collect::<Vec<_>>())?;
-            self.images.push(albedo);
-            let normal = texture_with(ctx, "normal map", mips(&n), rgba, &n.levels.iter().map(|l| vec![l.as_slice()]).collect::<Vec<_>>())?;
-            self.images.push(normal);
+        if real {
+            // A mip chain as texture_with takes it: per level, its one layer.
+            let mipmapped = |name: &str, m: &textures::MipChain| {
+                let levels: Vec<Vec<&[u8]>> = m.levels.iter().map(|l| vec![l.as_slice()]).collect();
+                texture_with(ctx, name, ImageShape { levels: m.levels.len() as u32, ..flat(m.size) }, rgba, &levels)
+            };
+            self.images.push(mipmapped("albedo map", &textures::tiles_albedo(MATERIAL_MAP_SIZE))?);
+            self.images.push(mipmapped("normal map", &textures::bumps_normal_map(MATERIAL_MAP_SIZE))?);
+            let sky = textures::sky_cube(SKY_SIZE);
             let cube = ImageShape { cube: true, ..flat(SKY_SIZE) };
-            self.images.push(texture_with(ctx, "sky", cube, rgba, &[s.iter().map(|f| f.as_slice()).collect()])?);
-            (0, 1, 2)
+            self.images.push(texture_with(ctx, "sky", cube, rgba, &[sky.iter().map(|f| f.as_slice()).collect()])?);
         } else {
             let white = [255u8; 4];
             let up = [128u8, 128, 255, 255];
@@ -112,15 +113,13 @@ impl SceneTextures {
             self.images.push(texture_with(ctx, "normal map", flat(1), rgba, &[vec![&up[..]]])?);
             let cube = ImageShape { cube: true, ..flat(1) };
             self.images.push(texture_with(ctx, "sky", cube, rgba, &[vec![&white[..]; 6]])?);
-            (0, 1, 2)
-        };
+        }
         self.shadow_size = if real { SHADOW_MAP_SIZE } else { 1 };
         let extent = vk::Extent2D { width: self.shadow_size, height: self.shadow_size };
         let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
         self.images.push(Image::new_2d(ctx, "shadow map", extent, depth_format, usage, vk::ImageAspectFlags::DEPTH)?);
-        let shadow_image = SHADOW_IMAGE;
         // Cleared to the far plane ("lit everywhere") until the objects are drawn into it.
-        render_shadow_map(ctx, &self.images[shadow_image], None)?;
+        render_shadow_map(ctx, &self.images[SHADOW_IMAGE], None)?;
 
         let material_sampler = sampler(ctx, vk::SamplerAddressMode::REPEAT, vk::Filter::LINEAR, None)?;
         self.samplers.push(material_sampler);
@@ -148,11 +147,11 @@ impl SceneTextures {
             self.set,
             BINDING_SHADOW,
             sampled,
-            info(shadow_sampler, &i[shadow_image], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            info(shadow_sampler, &i[SHADOW_IMAGE], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
         );
-        write_image(ctx, self.set, BINDING_SKY, sampled, info(sky_sampler, &i[sky], read_only));
-        write_image(ctx, self.set, BINDING_ALBEDO, sampled, info(material_sampler, &i[albedo], read_only));
-        write_image(ctx, self.set, BINDING_NORMAL, sampled, info(material_sampler, &i[normal], read_only));
+        write_image(ctx, self.set, BINDING_SKY, sampled, info(sky_sampler, &i[SKY_IMAGE], read_only));
+        write_image(ctx, self.set, BINDING_ALBEDO, sampled, info(material_sampler, &i[ALBEDO_IMAGE], read_only));
+        write_image(ctx, self.set, BINDING_NORMAL, sampled, info(material_sampler, &i[NORMAL_IMAGE], read_only));
         // The same map read as plain depths (the shadow-map debug view).
         let depth_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE, vk::Filter::NEAREST, None)?;
         self.samplers.push(depth_sampler);
@@ -162,7 +161,7 @@ impl SceneTextures {
             self.set,
             BINDING_SHADOW_DEPTH,
             sampled,
-            info(depth_sampler, &i[shadow_image], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            info(depth_sampler, &i[SHADOW_IMAGE], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
         );
         Ok(())
     }
@@ -255,8 +254,11 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
     let result = (|| {
         // SAFETY: as above.
         framebuffer = unsafe { d.create_framebuffer(&fb_info, None) }.ctx("vkCreateFramebuffer")?;
-        layout = shader::pipeline_layout(ctx, &[], &push)?;
-        pipeline = shadow_pipeline(ctx, render_pass, layout)?;
+        // Only a pass that draws needs the pipeline (a clear does not).
+        if inputs.is_some() {
+            layout = shader::pipeline_layout(ctx, &[], &push)?;
+            pipeline = shadow_pipeline(ctx, render_pass, layout)?;
+        }
         let extent = target.extent;
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
         let clear = [vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } }];
@@ -299,46 +301,29 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
 
 /// Depth-only pipeline of the shadow pass: positions only, no fragment shader, both faces.
 fn shadow_pipeline(ctx: &Context, render_pass: vk::RenderPass, layout: vk::PipelineLayout) -> Result<vk::Pipeline, VkError> {
-    let vert = shader::module(ctx, ml_shaders::SHADOW_VERT)?;
-    let stages = [vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main")];
-    let bindings = [vk::VertexInputBindingDescription::default().binding(0).stride(std::mem::size_of::<Vertex>() as u32)];
-    let attributes = [vk::VertexInputAttributeDescription::default()
-        .location(0)
-        .binding(0)
-        .format(vk::Format::R32G32B32_SFLOAT)
-        .offset(std::mem::offset_of!(Vertex, position) as u32)];
-    let vertex_input =
-        vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&bindings).vertex_attribute_descriptions(&attributes);
-    let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-    let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
-    let raster = vk::PipelineRasterizationStateCreateInfo::default()
-        .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(vk::CullModeFlags::NONE)
-        .line_width(1.0);
-    let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(true)
-        .depth_write_enable(true)
-        .depth_compare_op(vk::CompareOp::LESS);
-    let blend = vk::PipelineColorBlendStateCreateInfo::default();
-    let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
-    let info = [vk::GraphicsPipelineCreateInfo::default()
-        .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&input_assembly)
-        .viewport_state(&viewport)
-        .rasterization_state(&raster)
-        .multisample_state(&multisample)
-        .depth_stencil_state(&depth)
-        .color_blend_state(&blend)
-        .dynamic_state(&dynamic)
-        .layout(layout)
-        .render_pass(render_pass)
-        .subpass(0)];
-    // SAFETY: every referenced object is alive.
-    let result = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None) };
-    // SAFETY: the module is not needed once the pipeline exists (or failed).
-    unsafe { ctx.device.destroy_shader_module(vert, None) };
-    result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")
+    let bindings = [vertex_binding()];
+    let attributes = vertex_attributes();
+    shader::graphics_pipeline(
+        ctx,
+        &shader::GraphicsPipelineDesc {
+            vertex: ml_shaders::SHADOW_VERT,
+            fragment: None,
+            fragment_constants: &[],
+            vertex_input: vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&bindings)
+                .vertex_attribute_descriptions(&attributes[..1]),
+            rasterization: vk::PipelineRasterizationStateCreateInfo::default()
+                .polygon_mode(vk::PolygonMode::FILL)
+                .cull_mode(vk::CullModeFlags::NONE)
+                .line_width(1.0),
+            depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default()
+                .depth_test_enable(true)
+                .depth_write_enable(true)
+                .depth_compare_op(vk::CompareOp::LESS),
+            colour_attachments: 0,
+            layout,
+            render_pass,
+            subpass: 0,
+        },
+    )
 }

@@ -11,16 +11,21 @@ pub fn module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
     unsafe { ctx.device.create_shader_module(&info, None) }.ctx("vkCreateShaderModule")
 }
 
-/// A compute pipeline running `main` of the given SPIR-V with `layout`; `constants` sets
-/// 32-bit specialization constants (id, value; a GLSL bool is 0 or 1).
-pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout, constants: &[(u32, u32)]) -> Result<vk::Pipeline> {
-    let module = module(ctx, spirv)?;
-    let entries: Vec<vk::SpecializationMapEntry> = constants
+/// Map entries and data of 32-bit specialization constants (id, value; a GLSL bool is 0 or 1).
+fn specialization(constants: &[(u32, u32)]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {
+    let entries = constants
         .iter()
         .enumerate()
         .map(|(i, &(id, _))| vk::SpecializationMapEntry { constant_id: id, offset: (i * 4) as u32, size: 4 })
         .collect();
-    let data: Vec<u8> = constants.iter().flat_map(|&(_, v)| v.to_ne_bytes()).collect();
+    (entries, constants.iter().flat_map(|&(_, v)| v.to_ne_bytes()).collect())
+}
+
+/// A compute pipeline running `main` of the given SPIR-V with `layout`; `constants` sets
+/// 32-bit specialization constants (id, value; a GLSL bool is 0 or 1).
+pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout, constants: &[(u32, u32)]) -> Result<vk::Pipeline> {
+    let module = module(ctx, spirv)?;
+    let (entries, data) = specialization(constants);
     let spec = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
     let stage = vk::PipelineShaderStageCreateInfo::default()
         .stage(vk::ShaderStageFlags::COMPUTE)
@@ -33,6 +38,77 @@ pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout,
     // SAFETY: the module is not needed once the pipeline exists (or failed).
     unsafe { ctx.device.destroy_shader_module(module, None) };
     result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateComputePipelines")
+}
+
+/// What differs between the graphics pipelines we make. Fixed for all: `main` entry points,
+/// triangle lists, dynamic viewport and scissor, one sample, colour written unblended.
+pub struct GraphicsPipelineDesc<'a> {
+    pub vertex: &'a [u8],
+    /// None: depth only.
+    pub fragment: Option<&'a [u8]>,
+    /// Specialization constants (id, value) of the fragment stage.
+    pub fragment_constants: &'a [(u32, u32)],
+    pub vertex_input: vk::PipelineVertexInputStateCreateInfo<'a>,
+    pub rasterization: vk::PipelineRasterizationStateCreateInfo<'a>,
+    pub depth_stencil: vk::PipelineDepthStencilStateCreateInfo<'a>,
+    pub colour_attachments: usize,
+    pub layout: vk::PipelineLayout,
+    pub render_pass: vk::RenderPass,
+    pub subpass: u32,
+}
+
+/// A graphics pipeline as `desc` says.
+pub fn graphics_pipeline(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<vk::Pipeline> {
+    let vert = module(ctx, desc.vertex)?;
+    let frag = match desc.fragment.map(|spirv| module(ctx, spirv)).transpose() {
+        Ok(f) => f,
+        Err(e) => {
+            // SAFETY: unused module.
+            unsafe { ctx.device.destroy_shader_module(vert, None) };
+            return Err(e);
+        }
+    };
+    let (entries, data) = specialization(desc.fragment_constants);
+    let spec = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
+    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main")];
+    if let Some(frag) = frag {
+        stages.push(
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(frag)
+                .name(c"main")
+                .specialization_info(&spec),
+        );
+    }
+    let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let blend_attachments =
+        vec![vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA); desc.colour_attachments];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+    let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+    let info = [vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&desc.vertex_input)
+        .input_assembly_state(&input_assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&desc.rasterization)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&desc.depth_stencil)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(desc.layout)
+        .render_pass(desc.render_pass)
+        .subpass(desc.subpass)];
+    // SAFETY: every referenced object is alive.
+    let result = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None) };
+    // SAFETY: modules are no longer needed once the pipeline exists (or failed); null is ignored.
+    unsafe {
+        ctx.device.destroy_shader_module(vert, None);
+        ctx.device.destroy_shader_module(frag.unwrap_or_default(), None);
+    }
+    result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")
 }
 
 /// A descriptor set layout of `bindings` (binding number, type), all visible to `stages`.
