@@ -58,15 +58,11 @@ vec3 bp_scene_lights(vec3 world, vec3 n, vec3 v, vec3 diffuse, vec3 r0, float sh
     vec3 sun_l = -frame.sun_direction.xyz;
     vec3 sun = bp_brdf(frame.sun_strength.rgb * max(dot(sun_l, n), 0.0), sun_l, n, v, diffuse, r0, shininess);
     color += sun * bp_sun_visibility(world, n);
-    vec3 to_spot = frame.spot_position_range.xyz - world;
-    float d = length(to_spot);
-    float range = frame.spot_position_range.w;
-    if (d <= range) {
-        vec3 l = to_spot / d;
-        float cone = pow(max(dot(-l, frame.spot_direction_power.xyz), 0.0), frame.spot_direction_power.w);
-        float falloff = clamp((range - d) / range, 0.0, 1.0);
-        color += bp_brdf(frame.spot_strength.rgb * max(dot(l, n), 0.0) * falloff * cone, l, n, v, diffuse, r0, shininess);
-    }
+    // The spot light is a point light (same range and falloff) dimmed by its cone.
+    vec3 spot_l = normalize(frame.spot_position_range.xyz - world);
+    float cone = pow(max(dot(-spot_l, frame.spot_direction_power.xyz), 0.0), frame.spot_direction_power.w);
+    PointLight spot = PointLight(frame.spot_position_range, vec4(frame.spot_strength.rgb * cone, 0.0));
+    color += bp_point_light(spot, world, n, v, diffuse, r0, shininess);
     vec3 r = reflect(-v, n);
     color += shininess * bp_schlick(r0, n, r) * textureLod(sky, r, 0.0).rgb;
     return color;

@@ -7,9 +7,6 @@
 #ifndef MANYLIGHTS_COMMON_GLSL
 #define MANYLIGHTS_COMMON_GLSL
 
-#define SHADING_SEED 0u
-#define SHADING_BLINN_PHONG 1u
-#define SHADING_PBR 2u
 
 #define DEBUG_VIEW_NONE 0u
 #define DEBUG_VIEW_CLUSTER_HEAT 1u
@@ -27,7 +24,7 @@ struct FrameUniforms {
     vec4 camera_pos;     // xyz: world position of the eye
     uint light_count;
     float ambient;       // seed: colour = albedo * ambient + Lo
-    uint shading_model;  // SHADING_*
+    uint _pad1;          // (the shading model is a specialization constant: shading_model.glsl)
     uint _pad0;
     uvec4 cluster_dims;  // xyz: cluster grid size; w: debug view (DEBUG_VIEW_*)
     uvec4 viewport;      // xy: image size in pixels

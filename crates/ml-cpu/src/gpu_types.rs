@@ -26,11 +26,6 @@ macro_rules! gpu_struct {
     };
 }
 
-/// `SHADING_*` in common.glsl.
-pub const SHADING_SEED: u32 = 0;
-pub const SHADING_BLINN_PHONG: u32 = 1;
-pub const SHADING_PBR: u32 = 2;
-
 gpu_struct!(
     /// Per-frame uniforms (std140; every member 16-byte friendly).
     FrameUniforms {
@@ -40,7 +35,7 @@ gpu_struct!(
         camera_pos: [f32; 4],
         light_count: u32,
         ambient: f32,
-        shading_model: u32,
+        _pad1: u32,
         _pad0: u32,
         /// xyz: cluster grid size; w: debug view (DEBUG_VIEW_*).
         cluster_dims: [u32; 4],

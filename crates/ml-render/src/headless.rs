@@ -387,7 +387,6 @@ impl<'a> HeadlessRenderer<'a> {
         // World size of a shadow-map texel: the orthographic projection's first row is the
         // sun's x axis over the half-width it covers.
         let shadow_texel_world = 2.0 / self.shadow_view_proj.row(0).truncate().length() / self.textures.shadow_size as f32;
-        let shading_model = self.settings.shading.code();
         let frame = &mut self.frames[f];
         let uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),
@@ -396,7 +395,7 @@ impl<'a> HeadlessRenderer<'a> {
             camera_pos: cam.position.extend(1.0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
-            shading_model,
+            _pad1: 0,
             _pad0: 0,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
             viewport: [self.extent.width, self.extent.height, 0, 0],

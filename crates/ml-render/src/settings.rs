@@ -102,16 +102,6 @@ impl ShadingModel {
         }
     }
 
-    /// The value shaders see in FrameUniforms (SHADING_* in common.glsl).
-    pub fn code(self) -> u32 {
-        use ml_cpu::gpu_types as g;
-        match self {
-            ShadingModel::Seed => g::SHADING_SEED,
-            ShadingModel::BlinnPhong => g::SHADING_BLINN_PHONG,
-            ShadingModel::Pbr => g::SHADING_PBR,
-        }
-    }
-
     /// Specialization constants (id, value) that compile a pipeline for this model
     /// (shading_model.glsl).
     pub fn spec_constants(self) -> [(u32, u32); 2] {
