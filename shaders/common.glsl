@@ -15,6 +15,7 @@
 #define DEBUG_VIEW_GBUFFER_MATERIAL 4u
 #define DEBUG_VIEW_DEPTH 5u
 #define DEBUG_VIEW_SHADOW_MAP 6u
+#define DEBUG_VIEW_SHADOW_CUBE 7u
 
 // Per frame, one uniform buffer per frame in flight (set 0, binding 0).
 struct FrameUniforms {
@@ -24,7 +25,7 @@ struct FrameUniforms {
     vec4 camera_pos;     // xyz: world position of the eye
     uint light_count;
     float ambient;       // seed: colour = albedo * ambient + Lo
-    uint _pad1;          // (the shading model is a specialization constant: shading_model.glsl)
+    float omni_texel;    // one texel of a point-light shadow cube face, in face units (2 / size)
     uint _pad0;
     uvec4 cluster_dims;  // xyz: cluster grid size; w: debug view (DEBUG_VIEW_*)
     uvec4 viewport;      // xy: image size in pixels
@@ -46,7 +47,7 @@ struct FrameUniforms {
 // A radius-limited point light (set 0, binding 1, std430 array).
 struct PointLight {
     vec4 position_radius; // xyz: world position, w: radius (no light at all beyond it)
-    vec4 color;           // rgb: linear colour; a unused
+    vec4 color;           // rgb: linear colour; a: its shadow cube's index + 1 (0: casts no shadow)
 };
 
 // Where a cluster's lights are in the light-index list (set 0, binding 2, std430 array).
@@ -81,6 +82,15 @@ struct ObjectPush {
 struct ShadowPush {
     ObjectPush object;
     mat4 light_view_proj;
+};
+
+// Push constants of the point-light shadow passes (omni_shadow.vert): the object, the light
+// and a view-projection — copy and direct: the face's (the seed's way); multiview: the
+// projection alone (the face's rotation comes from gl_ViewIndex).
+struct OmniShadowPush {
+    mat4 view_proj;
+    vec4 position_scale;        // the object's translation and uniform scale
+    vec4 light_position_radius; // xyz: the light this frame; w: its radius (stored depth = distance / radius)
 };
 
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with

@@ -1,13 +1,22 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// --debug-view shadow-map: the sun's shadow map over the whole output image (stretched), its
-// depth in grey: white nearest the sun, black at the far plane (nothing there).
+// The shadow-map debug views, painted over the whole output image, depth in grey (white
+// nearest the light, black where nothing is: the clear value).
+// --debug-view shadow-map: the sun's shadow map, stretched.
+// --debug-view shadow-cube (CUBE): the six faces of the first shadowed point light's cube,
+// unfolded as a cross (+Y above; −X, +Z, +X, −Z across; −Y below), each face as its texels
+// lie (u right, v down), which makes the cross's shared edges meet.
 #include "common.glsl"
 #include "textures.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+layout(constant_id = 0) const bool CUBE = false;
+
 layout(set = 0, binding = 0, rgba8) uniform writeonly image2D out_image;
+
+// Cross cell (column, row) of each face +X, −X, +Y, −Y, +Z, −Z.
+const ivec2 FACE_CELL[6] = ivec2[](ivec2(2, 1), ivec2(0, 1), ivec2(1, 0), ivec2(1, 2), ivec2(1, 1), ivec2(3, 1));
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -15,8 +24,20 @@ void main() {
     if (any(greaterThanEqual(p, size))) {
         return;
     }
-    float depth = textureLod(shadow_depth, (vec2(p) + 0.5) / vec2(size), 0.0).r;
-    // The sun's box spans depth 0 (nearest the sun) to 1 (the clear value: nothing there).
-    float grey = 1.0 - depth;
-    imageStore(out_image, p, vec4(vec3(grey), 1.0));
+    float depth = 1.0;
+    if (CUBE) {
+        // Square cells, as large as fit 4 × 3 of them; outside the cross stays black.
+        int cell = max(min(size.x / 4, size.y / 3), 1);
+        ivec2 c = p / cell;
+        int faces = textureSize(omni_faces, 0).x;
+        for (int face = 0; face < 6; ++face) {
+            if (c == FACE_CELL[face]) {
+                ivec2 texel = (p - c * cell) * faces / cell;
+                depth = texelFetch(omni_faces, ivec3(texel, face), 0).r;
+            }
+        }
+    } else {
+        depth = textureLod(shadow_depth, (vec2(p) + 0.5) / vec2(size), 0.0).r;
+    }
+    imageStore(out_image, p, vec4(vec3(1.0 - depth), 1.0));
 }

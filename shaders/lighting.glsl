@@ -12,6 +12,7 @@
 #include "seed_brdf.glsl"
 #include "blinn_phong.glsl"
 #include "cluster.glsl"
+#include "omni_shadow.glsl"
 
 // Sum LIGHT(light) over every light that may reach the point: the cluster's lights in
 // ascending index order, or all of them. A macro, so that each shading model gets its own
@@ -42,16 +43,16 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
     if (MODEL_BLINN_PHONG) {
         vec3 r0 = mix(vec3(0.04), albedo, metallic);
         float shininess = 1.0 - roughness;
-#define BP_LIGHT(l) bp_point_light(l, world, n, v, albedo, r0, shininess)
+#define BP_LIGHT(l) (bp_point_light(l, world, n, v, albedo, r0, shininess) * omni_visibility(l, world, n))
         SUM_LIGHTS(lo, BP_LIGHT)
         return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo;
     }
     if (MODEL_PBR) {
-#define PBR_LIGHT(l) pbr_point_light(l, world, n, v, albedo, roughness, metallic)
+#define PBR_LIGHT(l) (pbr_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
         SUM_LIGHTS(lo, PBR_LIGHT)
         return albedo * frame.ambient + lo;
     }
-#define SEED_LIGHT(l) seed_point_light(l, world, n, v, albedo, roughness, metallic)
+#define SEED_LIGHT(l) (seed_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
     SUM_LIGHTS(lo, SEED_LIGHT)
     return albedo * frame.ambient + lo;
 }

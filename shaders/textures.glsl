@@ -9,5 +9,9 @@ layout(set = 1, binding = 1) uniform samplerCube sky;            // environment 
 layout(set = 1, binding = 2) uniform sampler2D albedo_map;
 layout(set = 1, binding = 3) uniform sampler2D normal_map;       // tangent space, n·0.5 + 0.5
 layout(set = 1, binding = 4) uniform sampler2D shadow_depth;     // the shadow map's depths (debug view)
+// Point-light shadow cubes (omni_shadow.glsl): distance / radius, compared; and the same
+// layers as plain depths, six per light (the shadow-cube debug view).
+layout(set = 1, binding = 5) uniform samplerCubeArrayShadow omni_shadows;
+layout(set = 1, binding = 6) uniform sampler2DArray omni_faces;
 
 #endif

@@ -10,7 +10,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::report::table;
 use ml_render::targets::gbuffer_bytes_per_pixel;
-use ml_render::{DebugView, HeadlessRenderer, RenderSettings, ShadingModel, Technique};
+use ml_render::{DebugView, HeadlessRenderer, OmniShadowMode, OmniShadowSettings, RenderSettings, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -33,7 +33,8 @@ enum Command {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Scene to render (built in: seed).
+    /// Scene to render (built in: seed; room: a closed room with a pillar and one point light,
+    /// for point-light shadows).
     #[arg(long, default_value = "seed")]
     scene: String,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
@@ -49,10 +50,11 @@ struct RenderArgs {
     #[arg(long, default_value = "16x9x24")]
     clusters: String,
     /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu),
-    /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (blinn-phong).
+    /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (blinn-phong),
+    /// shadow-cube (the first shadowed point light's cube, unfolded; needs --omni-shadow).
     #[arg(long, default_value = "none")]
     debug_view: String,
-    /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc.
+    /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.
     #[arg(long, default_value = "sphere")]
     object: String,
     /// Material: gold, copper, chromium, nickel, titanium, cobalt, platinum, white, red, blue, black.
@@ -70,6 +72,17 @@ struct RenderArgs {
     /// Light radius R, or MIN..MAX for radii drawn per light.
     #[arg(long, default_value = "15")]
     light_radius: String,
+    /// Point-light shadows (seed 003): off, or how the cubes are rendered — copy (seed 003:
+    /// each face offscreen, then copied into the cube), direct (each face into its cube
+    /// layer) or multiview (all six faces in one pass).
+    #[arg(long, default_value = "off")]
+    omni_shadow: String,
+    /// How many point lights cast shadows (the strongest as seen from the camera).
+    #[arg(long, default_value_t = 1)]
+    shadowed_lights: u32,
+    /// Texels per side of each shadow-cube face.
+    #[arg(long, default_value_t = OmniShadowSettings::DEFAULT_SIZE)]
+    cube_size: u32,
     #[arg(long, default_value_t = 1280)]
     width: u32,
     #[arg(long, default_value_t = 720)]
@@ -121,8 +134,11 @@ fn main() -> ExitCode {
 }
 
 fn build_scene(args: &RenderArgs) -> Result<Scene> {
+    if args.scene == "room" {
+        return Ok(Scene::shadow_room());
+    }
     if args.scene != "seed" {
-        bail!("unknown scene '{}': expected seed", args.scene);
+        bail!("unknown scene '{}': expected seed or room", args.scene);
     }
     let lights = LightParams {
         count: LightParams::check_count(args.lights)?,
@@ -161,6 +177,10 @@ fn render(args: &RenderArgs) -> Result<()> {
         shading: ShadingModel::from_name(&args.shading)?,
         clusters: ClusterDims::parse(&args.clusters)?,
         debug_view: DebugView::from_name(&args.debug_view)?,
+        omni: match args.omni_shadow.as_str() {
+            "off" => None,
+            mode => Some(OmniShadowSettings { mode: OmniShadowMode::from_name(mode)?, lights: args.shadowed_lights, size: args.cube_size }),
+        },
         width: args.width,
         height: args.height,
         frames: args.frames,
@@ -221,6 +241,9 @@ fn render(args: &RenderArgs) -> Result<()> {
         let top = stats.clusters.map_or(1, |c| c.max_lights.max(1));
         rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights per cluster")));
     }
+    if let Some(o) = settings.omni {
+        rows.push(("omni shadows", format!("{}: {} light(s), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size)));
+    }
     rows.push(("cpu ms/frame", format!("{:.3}  (update + assign + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
     rows.push(("output", args.out.display().to_string()));
@@ -249,6 +272,9 @@ fn info() -> Result<()> {
             ("maxComputeSharedMemorySize", l.max_compute_shared_memory_size.to_string()),
             ("timestampPeriod (ns)", l.timestamp_period.to_string()),
             ("timestampComputeAndGraphics", (l.timestamp_compute_and_graphics != 0).to_string()),
+            ("maxImageArrayLayers", l.max_image_array_layers.to_string()),
+            ("imageCubeArray", d.features.image_cube_array.to_string()),
+            ("multiview", d.features.multiview.to_string()),
         ];
         println!("{}", table(&rows));
     }

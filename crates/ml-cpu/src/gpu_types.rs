@@ -35,7 +35,8 @@ gpu_struct!(
         camera_pos: [f32; 4],
         light_count: u32,
         ambient: f32,
-        _pad1: u32,
+        /// One texel of a point-light shadow cube face in face units: 2 / size.
+        omni_texel: f32,
         _pad0: u32,
         /// xyz: cluster grid size; w: debug view (DEBUG_VIEW_*).
         cluster_dims: [u32; 4],
@@ -66,7 +67,7 @@ gpu_struct!(
     PointLight {
         /// xyz world position, w radius.
         position_radius: [f32; 4],
-        /// rgb linear colour.
+        /// rgb linear colour; a: the index of its shadow cube + 1 (0: casts no shadow).
         color: [f32; 4],
     }
 );
@@ -105,6 +106,7 @@ pub const DEBUG_VIEW_GBUFFER_NORMAL: u32 = 3;
 pub const DEBUG_VIEW_GBUFFER_MATERIAL: u32 = 4;
 pub const DEBUG_VIEW_DEPTH: u32 = 5;
 pub const DEBUG_VIEW_SHADOW_MAP: u32 = 6;
+pub const DEBUG_VIEW_SHADOW_CUBE: u32 = 7;
 
 gpu_struct!(
     /// Per-draw push constants.
@@ -122,5 +124,15 @@ gpu_struct!(
     ShadowPush {
         object: ObjectPush,
         light_view_proj: [[f32; 4]; 4],
+    }
+);
+
+gpu_struct!(
+    /// Push constants of the point-light shadow passes (omni_shadow.vert): copy and direct
+    /// carry the face's view-projection, multiview the projection alone.
+    OmniShadowPush {
+        view_proj: [[f32; 4]; 4],
+        position_scale: [f32; 4],
+        light_position_radius: [f32; 4],
     }
 );

@@ -6,6 +6,8 @@
 //! `textures::cube_direction`, Vulkan's cube-map convention).
 
 use crate::gpu_types::PointLight;
+use crate::mesh::MeshKind;
+use crate::scene::Scene;
 use glam::{Mat4, Vec3};
 
 /// Forward and up of cube face `face` (+X, −X, +Y, −Y, +Z, −Z: Vulkan's layer order).
@@ -43,6 +45,125 @@ pub fn shadowed_lights(lights: &[PointLight], k: usize, eye: Vec3) -> Vec<u32> {
     order
 }
 
+/// A scene object as the CPU ray test sees it (analytic shapes of the built-in meshes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Solid {
+    Sphere { centre: Vec3, radius: f32 },
+    /// A box seen from outside (the cube mesh).
+    Block { lo: Vec3, hi: Vec3 },
+    /// A box seen from inside (the room mesh): its walls face inwards and shadow nothing
+    /// inside it (a box is convex).
+    Room { lo: Vec3, hi: Vec3 },
+}
+
+/// The scene's objects as solids; None if one has a mesh the ray test does not model.
+pub fn solids(scene: &Scene) -> Option<Vec<Solid>> {
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let (c, s) = (o.position, o.scale);
+            match o.mesh {
+                MeshKind::Sphere => Some(Solid::Sphere { centre: c, radius: s }),
+                MeshKind::Cube => Some(Solid::Block { lo: c - Vec3::splat(s), hi: c + Vec3::splat(s) }),
+                MeshKind::Room => Some(Solid::Room { lo: c - Vec3::splat(s), hi: c + Vec3::splat(s) }),
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+/// Entry and exit distances of the ray (origin, unit dir) through the box, if it meets it.
+fn slab(lo: Vec3, hi: Vec3, origin: Vec3, dir: Vec3) -> Option<(f32, f32, Vec3, Vec3)> {
+    let inv = dir.recip();
+    let (t0, t1) = ((lo - origin) * inv, (hi - origin) * inv);
+    let (near, far) = (t0.min(t1), t0.max(t1));
+    let (t_in, t_out) = (near.max_element(), far.min_element());
+    if t_in > t_out || t_out < 0.0 {
+        return None;
+    }
+    // The face crossed on entry and on exit: the axis that set each bound.
+    let axis = |v: Vec3, t: f32| Vec3::select(v.cmpeq(Vec3::splat(t)), Vec3::ONE, Vec3::ZERO);
+    let n_in = -axis(near, t_in) * dir.signum();
+    let n_out = axis(far, t_out) * dir.signum();
+    Some((t_in, t_out, n_in, n_out))
+}
+
+impl Solid {
+    /// Nearest hit at distance > 0 along (origin, unit dir): distance and the normal there
+    /// (towards the side the surface faces).
+    pub fn hit(&self, origin: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        match *self {
+            Solid::Sphere { centre, radius } => {
+                let oc = origin - centre;
+                let b = oc.dot(dir);
+                let disc = b * b - (oc.length_squared() - radius * radius);
+                if disc < 0.0 {
+                    return None;
+                }
+                let t = [-b - disc.sqrt(), -b + disc.sqrt()].into_iter().find(|&t| t > 0.0)?;
+                Some((t, (origin + dir * t - centre) / radius))
+            }
+            Solid::Block { lo, hi } => slab(lo, hi, origin, dir).filter(|h| h.0 > 0.0).map(|h| (h.0, h.2)),
+            Solid::Room { lo, hi } => slab(lo, hi, origin, dir).filter(|h| h.1 > 0.0).map(|h| (h.1, -h.3)),
+        }
+    }
+
+    /// This solid grown (`by` > 0) or shrunk (`by` < 0) by `by` in every direction.
+    fn grown(&self, by: f32) -> Solid {
+        match *self {
+            Solid::Sphere { centre, radius } => Solid::Sphere { centre, radius: (radius + by).max(0.0) },
+            Solid::Block { lo, hi } => Solid::Block { lo: lo - Vec3::splat(by), hi: (hi + Vec3::splat(by)).max(lo - Vec3::splat(by)) },
+            room => room,
+        }
+    }
+
+    /// Whether it blocks the segment from `a` to `b`.
+    fn blocks(&self, a: Vec3, b: Vec3) -> bool {
+        let (dir, len) = ((b - a).normalize(), a.distance(b));
+        match *self {
+            Solid::Room { .. } => false,
+            Solid::Sphere { centre, radius } => {
+                let t = (centre - a).dot(dir).clamp(0.0, len);
+                (a + dir * t).distance(centre) < radius
+            }
+            Solid::Block { lo, hi } => slab(lo, hi, a, dir).is_some_and(|(t_in, t_out, ..)| t_in < len && t_out > 0.0),
+        }
+    }
+}
+
+/// The first solid a ray meets: its index, distance and normal.
+pub fn first_hit(solids: &[Solid], origin: Vec3, dir: Vec3) -> Option<(usize, f32, Vec3)> {
+    solids
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.hit(origin, dir).map(|(t, n)| (i, t, n)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// What the CPU ray test says of a light at a surface point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sight {
+    Lit,
+    Shadowed,
+    /// Within `margin` of a shadow edge: the shadow map's texels and filter decide.
+    Unsure,
+}
+
+/// Whether `light` sees `point` (normal `n`): Shadowed if even the solids shrunk by `margin`
+/// block the way, Lit if not even the solids grown by `margin` do (the segment starts
+/// `2·margin` off the surface, so its own solid does not count), Unsure in between.
+pub fn light_sight(solids: &[Solid], point: Vec3, n: Vec3, light: Vec3, margin: f32) -> Sight {
+    let start = point + n * (2.0 * margin);
+    if solids.iter().any(|s| s.grown(-margin).blocks(start, light)) {
+        Sight::Shadowed
+    } else if solids.iter().any(|s| s.grown(margin).blocks(start, light)) {
+        Sight::Unsure
+    } else {
+        Sight::Lit
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -78,6 +199,34 @@ mod tests {
         for (face, axes) in expected.iter().enumerate() {
             assert_eq!(face_axes(face as u32), *axes);
         }
+    }
+
+    #[test]
+    fn the_ray_test_sees_walls_from_inside_and_blocks_behind_occluders() {
+        let room = Solid::Room { lo: Vec3::splat(-5.0), hi: Vec3::splat(5.0) };
+        let ball = Solid::Sphere { centre: Vec3::new(2.0, 0.0, 0.0), radius: 0.5 };
+        let block = Solid::Block { lo: Vec3::new(-3.0, -5.0, -1.0), hi: Vec3::new(-2.0, -2.0, 0.0) };
+        let all = [room, ball, block];
+        // From the centre along +X: the ball first, then the wall facing back at us.
+        assert_eq!(first_hit(&all, Vec3::ZERO, Vec3::X).map(|h| (h.0, h.1)), Some((1, 1.5)));
+        let (i, t, n) = first_hit(&all, Vec3::ZERO, Vec3::Z).unwrap();
+        assert_eq!((i, t, n), (0, 5.0, -Vec3::Z));
+        let (i, t, n) = first_hit(&all, Vec3::new(-2.5, 0.0, -0.5), -Vec3::Y).unwrap();
+        assert_eq!((i, t, n), (2, 2.0, Vec3::Y));
+        let light = Vec3::ZERO;
+        let wall = |p: Vec3| light_sight(&all, p, -p.normalize(), light, 0.05);
+        assert_eq!(wall(Vec3::new(5.0, 0.0, 0.0)), Sight::Shadowed);
+        assert_eq!(wall(Vec3::new(5.0, 0.0, 3.0)), Sight::Lit);
+        // The ball's shadow edge on the +X wall: tangent rays at sin = 0.5 / 2.
+        let edge = 5.0 * (0.25f32).asin().tan();
+        assert_eq!(wall(Vec3::new(5.0, 0.0, edge)), Sight::Unsure);
+        assert_eq!(wall(Vec3::new(5.0, 0.0, edge + 0.3)), Sight::Lit);
+        assert_eq!(wall(Vec3::new(5.0, 0.0, edge - 0.3)), Sight::Shadowed);
+        // The floor behind the block, and beside it.
+        let floor = |x: f32, z: f32| light_sight(&all, Vec3::new(x, -5.0, z), Vec3::Y, light, 0.05);
+        assert_eq!(floor(-4.0, -1.0), Sight::Shadowed);
+        assert_eq!(floor(-4.0, 2.0), Sight::Lit);
+        assert!(solids(&Scene::shadow_room()).is_some());
     }
 
     #[test]

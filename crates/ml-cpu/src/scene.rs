@@ -62,6 +62,26 @@ impl Scene {
         self
     }
 
+    /// SPEC §4's point-light shadow scene (`--scene room`): a closed room 10 m across, a
+    /// 1×3×1 m pillar of three cubes on its floor, one white point light reaching every
+    /// corner, a camera in a corner looking past the pillar. For the lit shading models
+    /// (pbr, blinn-phong): the seed model's walls show little besides highlights.
+    pub fn shadow_room() -> Scene {
+        let walls = Material { albedo: Vec3::new(0.8, 0.78, 0.75), roughness: 0.8, metallic: 0.0 };
+        let stone = Material { albedo: Vec3::new(0.7, 0.3, 0.2), roughness: 0.6, metallic: 0.0 };
+        let mut objects = vec![Object { mesh: MeshKind::Room, position: Vec3::ZERO, scale: 5.0, material: walls }];
+        for level in 0..3 {
+            objects.push(Object { mesh: MeshKind::Cube, position: Vec3::new(1.5, -4.5 + level as f32, 0.5), scale: 0.5, material: stone });
+        }
+        Scene {
+            objects,
+            lights: vec![PointLight { position_radius: [-1.0, 0.5, -1.0, 20.0], color: [3.0, 3.0, 3.0, 0.0] }],
+            camera: Camera::looking_at(Vec3::new(-4.2, 2.5, -4.0), Vec3::new(2.0, -3.0, 2.0), 75.0, 0.05, 50.0),
+            ambient: SEED_AMBIENT,
+            blinn_phong: BlinnPhongLights::default(),
+        }
+    }
+
     /// World box around every object (each mesh fits [−1, 1]³ before scale and translation).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.objects.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), o| {

@@ -4,7 +4,7 @@
 //! 132). Its output is the colour target, left in TRANSFER_SRC_OPTIMAL like the forward pass's.
 
 use crate::compute_pass::ComputePass;
-use crate::settings::ShadingModel;
+use crate::settings::Shading;
 use crate::targets::Targets;
 use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
 use ml_vk::{vk, Context, VkError};
@@ -37,7 +37,7 @@ pub struct LightingInputs<'a> {
 }
 
 impl ComputeLighting {
-    pub fn new(ctx: &Context, textures_layout: vk::DescriptorSetLayout, shading: ShadingModel) -> Result<ComputeLighting, VkError> {
+    pub fn new(ctx: &Context, textures_layout: vk::DescriptorSetLayout, shading: Shading) -> Result<ComputeLighting, VkError> {
         use vk::DescriptorType as T;
         let storage = T::STORAGE_BUFFER;
         let image = T::COMBINED_IMAGE_SAMPLER;

@@ -1,6 +1,7 @@
 //! Static meshes in device-local memory, uploaded once through a staging buffer (seed 000).
 
 use ml_cpu::mesh::{Mesh, MeshKind, Vertex};
+use ml_cpu::scene::Object;
 use ml_vk::{vk, Buffer, Context, VkError};
 
 pub struct GpuMesh {
@@ -55,4 +56,33 @@ pub fn vertex_attributes() -> [vk::VertexInputAttributeDescription; 4] {
     .collect::<Vec<_>>()
     .try_into()
     .expect("four attributes")
+}
+
+/// Record the indexed draws of `objects` that `keep` accepts: per mesh, its buffers bound,
+/// then its objects in scene order, each after `push(index in the scene, object)` (which
+/// records the draw's push constants).
+pub fn record_draws(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    (meshes, objects): (&[GpuMesh], &[Object]),
+    keep: impl Fn(&Object) -> bool,
+    mut push: impl FnMut(u32, &Object),
+) {
+    let d = &ctx.device;
+    for mesh in meshes {
+        let mut bound = false;
+        for (index, object) in objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind && keep(o)) {
+            // SAFETY: recording state inside a render pass with a pipeline bound; the
+            // buffers are alive while the command buffer is.
+            unsafe {
+                if !bound {
+                    d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
+                    d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
+                    bound = true;
+                }
+                push(index as u32, object);
+                d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
+            }
+        }
+    }
 }

@@ -7,6 +7,7 @@ use crate::deferred::ComputeLighting;
 use crate::error::RenderError;
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
+use crate::omni_shadow::{OmniShadows, ShadowedLight};
 use crate::raster::{object_push, DrawList, PassFrame, RasterPass};
 use crate::report::FrameStats;
 use crate::scene_textures::{SceneTextures, ShadowInputs};
@@ -18,6 +19,7 @@ use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight};
 use ml_cpu::lights::{animate_into, animation_offset};
+use ml_cpu::omni_shadow::shadowed_lights;
 use ml_cpu::scene::Scene;
 use ml_vk::descriptors::{allocate_set, write_image};
 use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
@@ -43,8 +45,14 @@ pub struct HeadlessRenderer<'a> {
     settings: RenderSettings,
     extent: vk::Extent2D,
     pass: RasterPass,
-    /// Set 1 of every shading pipeline (blinn-phong's shadow map, sky, albedo and normal maps).
+    /// Set 1 of every shading pipeline (blinn-phong's shadow map, sky, albedo and normal maps,
+    /// the point-light shadow cubes).
     textures: SceneTextures,
+    /// Point-light shadow cubes (a stand-in without shadowed lights).
+    omni: OmniShadows,
+    /// The lights with a shadow cube (cube i: `shadowed[i]`), and where they are this frame.
+    shadowed: Vec<u32>,
+    shadowed_now: Vec<ShadowedLight>,
     /// The sun's shadow-map view-projection (blinn-phong).
     shadow_view_proj: glam::Mat4,
     meshes: Vec<GpuMesh>,
@@ -97,8 +105,13 @@ const DEFAULT_HEAT_TOP: f32 = 64.0;
 const MAX_RERENDERS: u32 = 2;
 
 impl<'a> HeadlessRenderer<'a> {
-    pub fn new(ctx: &'a Context, scene: Scene, settings: RenderSettings) -> Result<HeadlessRenderer<'a>, RenderError> {
+    pub fn new(ctx: &'a Context, mut scene: Scene, settings: RenderSettings) -> Result<HeadlessRenderer<'a>, RenderError> {
         settings.check(ctx, scene.lights.len())?;
+        // The shadowed lights carry their cube's index + 1 (PointLight::color[3]).
+        let shadowed = settings.omni.map_or(Vec::new(), |o| shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position));
+        for (cube, &i) in shadowed.iter().enumerate() {
+            scene.lights[i as usize].color[3] = (cube + 1) as f32;
+        }
         let depth = depth_format(ctx, Output::of(settings.technique))?;
         let extent = vk::Extent2D { width: settings.width, height: settings.height };
         // clustered-gpu animates on the GPU; the others keep an animated copy on the CPU.
@@ -107,12 +120,19 @@ impl<'a> HeadlessRenderer<'a> {
         let clusters =
             settings.technique.is_cpu_built().then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
         let blinn_phong = settings.shading == ShadingModel::BlinnPhong;
-        let textures = SceneTextures::new(ctx, blinn_phong, depth_format(ctx, Output::GBuffer)?)?;
-        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.shading), textures.set_layout) {
+        let mut omni = OmniShadows::new(ctx, settings.omni)?;
+        let mut textures = match SceneTextures::new(ctx, blinn_phong, depth_format(ctx, Output::GBuffer)?, &omni) {
+            Ok(t) => t,
+            Err(e) => {
+                omni.destroy(ctx);
+                return Err(e.into());
+            }
+        };
+        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.lighting()), textures.set_layout) {
             Ok(p) => p,
             Err(e) => {
-                let mut textures = textures;
                 textures.destroy(ctx);
+                omni.destroy(ctx);
                 return Err(e.into());
             }
         };
@@ -125,6 +145,9 @@ impl<'a> HeadlessRenderer<'a> {
             extent,
             pass,
             textures,
+            omni,
+            shadowed,
+            shadowed_now: Vec::new(),
             shadow_view_proj,
             meshes: Vec::new(),
             command_pool: vk::CommandPool::null(),
@@ -173,7 +196,7 @@ impl<'a> HeadlessRenderer<'a> {
             self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         }
         if self.settings.technique.lights_in_compute() {
-            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.shading)?);
+            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting())?);
         }
         if self.settings.technique.lights_in_subpass() {
             let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);
@@ -217,9 +240,11 @@ impl<'a> HeadlessRenderer<'a> {
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
         }
-        if self.settings.debug_view == DebugView::ShadowMap {
+        if matches!(self.settings.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
             let bindings = [(0, vk::DescriptorType::STORAGE_IMAGE)];
-            let pass = ComputePass::new(ctx, &bindings, &[self.textures.set_layout], (ml_shaders::DEBUG_SHADOW_MAP_COMP, &[]))?;
+            // constant_id 0 (CUBE): the point-light cube instead of the sun's map.
+            let cube = [(0, u32::from(self.settings.debug_view == DebugView::ShadowCube))];
+            let pass = ComputePass::new(ctx, &bindings, &[self.textures.set_layout], (ml_shaders::DEBUG_SHADOW_MAP_COMP, &cube))?;
             let mut sets = Vec::new();
             let layout = pass.set_layout;
             self.shadow_map_view = Some((pass, Vec::new()));
@@ -246,6 +271,12 @@ impl<'a> HeadlessRenderer<'a> {
 
     /// The passes the timer reports, in order.
     fn pass_names(&self) -> Vec<&'static str> {
+        let mut names = if self.omni.active() { vec!["omni shadows"] } else { Vec::new() };
+        names.extend(self.technique_pass_names());
+        names
+    }
+
+    fn technique_pass_names(&self) -> Vec<&'static str> {
         let t = self.settings.technique;
         if t.lights_in_compute() {
             vec!["cluster build", "g-buffer", "lighting"]
@@ -375,6 +406,16 @@ impl<'a> HeadlessRenderer<'a> {
                 stats.index_growths += 1;
             }
         }
+        let offset = animation_offset(t);
+        self.shadowed_now = self
+            .shadowed
+            .iter()
+            .map(|&i| {
+                let p = self.scene.lights[i as usize].position_radius;
+                // The same sum the light buffer (CPU or GPU animation) holds for this light.
+                ShadowedLight { position: glam::Vec3::new(p[0] + offset.x, p[1] + offset.y, p[2] + offset.z), radius: p[3] }
+            })
+            .collect();
         self.write_uniforms(f, t);
         Ok(())
     }
@@ -395,7 +436,7 @@ impl<'a> HeadlessRenderer<'a> {
             camera_pos: cam.position.extend(1.0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
-            _pad1: 0,
+            omni_texel: self.omni.texel(),
             _pad0: 0,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
             viewport: [self.extent.width, self.extent.height, 0, 0],
@@ -427,6 +468,12 @@ impl<'a> HeadlessRenderer<'a> {
         }
         frame.timer.reset(ctx, cmd);
         let mut pass = 0;
+        if self.omni.active() {
+            frame.timer.begin(ctx, cmd, pass);
+            self.omni.record(ctx, cmd, &self.shadowed_now, (&self.meshes, &self.scene.objects));
+            frame.timer.end(ctx, cmd, pass);
+            pass += 1;
+        }
         if let (Some(builder), Some(gpu)) = (&self.builder, &frame.gpu) {
             frame.timer.begin(ctx, cmd, pass);
             builder.record(ctx, cmd, gpu);
@@ -565,5 +612,6 @@ impl Drop for HeadlessRenderer<'_> {
         }
         self.pass.destroy(ctx);
         self.textures.destroy(ctx);
+        self.omni.destroy(ctx);
     }
 }

@@ -4,10 +4,12 @@
 pub mod cluster_build;
 pub mod compute_pass;
 pub mod deferred;
+pub mod depth_pass;
 pub mod error;
 pub mod frame;
 pub mod gpu_mesh;
 pub mod headless;
+pub mod omni_shadow;
 pub mod raster;
 pub mod render_pass;
 pub mod report;
@@ -18,4 +20,4 @@ pub mod tonemap;
 
 pub use error::RenderError;
 pub use headless::{HeadlessRenderer, RenderOutput};
-pub use settings::{DebugView, RenderSettings, ShadingModel, Technique};
+pub use settings::{DebugView, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique};

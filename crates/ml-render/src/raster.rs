@@ -5,9 +5,9 @@
 //! 002's pass with two subpasses: subpass 0 writes the G-buffer, subpass 1 reads it as input
 //! attachments and shades a full-screen triangle into an HDR target (tone-mapped after).
 
-use crate::gpu_mesh::{vertex_attributes, vertex_binding, GpuMesh};
+use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding, GpuMesh};
 use crate::render_pass;
-use crate::settings::{ShadingModel, Technique};
+use crate::settings::{Shading, Technique};
 use crate::targets::{Output, Targets};
 use ml_cpu::gpu_types::ObjectPush;
 use ml_cpu::scene::Object;
@@ -43,7 +43,7 @@ pub struct RasterPass {
     pub lighting_layout: vk::PipelineLayout,
     pub input_set_layout: vk::DescriptorSetLayout,
     pub output: Output,
-    shading: ShadingModel,
+    shading: Shading,
 }
 
 /// The kinds of draw in the pass.
@@ -81,7 +81,7 @@ impl RasterPass {
     pub fn new(
         ctx: &Context,
         depth_format: vk::Format,
-        (technique, shading): (Technique, ShadingModel),
+        (technique, shading): (Technique, Shading),
         textures_layout: vk::DescriptorSetLayout,
     ) -> Result<RasterPass, VkError> {
         let output = Output::of(technique);
@@ -201,7 +201,8 @@ impl RasterPass {
             .depth_test_enable(draw == Draw::Mesh)
             .depth_write_enable(draw == Draw::Mesh)
             .depth_compare_op(vk::CompareOp::LESS);
-        // The shading model, compiled in (shading_model.glsl); the legend ignores it.
+        // The shading model and point-light shadows, compiled in (shading_model.glsl,
+        // omni_shadow.glsl); the legend ignores them.
         let model = self.shading.spec_constants();
         shader::graphics_pipeline(
             ctx,
@@ -252,21 +253,11 @@ impl RasterPass {
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[area]);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[frame.set, frame.textures], &[]);
-            for mesh in draws.meshes {
-                d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
-                d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
-                for (index, object) in draws.objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
-                    let push = object_push(object, index as u32);
-                    d.cmd_push_constants(
-                        cmd,
-                        self.pipeline_layout,
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
-                        bytemuck::bytes_of(&push),
-                    );
-                    d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
-                }
-            }
+            record_draws(ctx, cmd, (draws.meshes, draws.objects), |_| true, |index, object| {
+                let push = object_push(object, index);
+                let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                d.cmd_push_constants(cmd, self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
+            });
             if legend {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.legend_pipeline);
                 d.cmd_draw(cmd, 6, 1, 0, 0);

@@ -6,7 +6,9 @@
 //! move (only the point lights do, and they cast no shadows). Depth only, every object, an
 //! orthographic view along the sun fitted to the scene (ml_cpu::blinn_phong).
 
-use crate::gpu_mesh::{vertex_attributes, vertex_binding, GpuMesh};
+use crate::depth_pass::{self, DepthPassDesc};
+use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::omni_shadow::{self, OmniShadows};
 use crate::raster::object_push;
 use ml_cpu::gpu_types::ShadowPush;
 use ml_cpu::scene::Scene;
@@ -21,6 +23,8 @@ const BINDING_SKY: u32 = 1;
 const BINDING_ALBEDO: u32 = 2;
 const BINDING_NORMAL: u32 = 3;
 const BINDING_SHADOW_DEPTH: u32 = 4;
+const BINDING_OMNI_SHADOWS: u32 = 5;
+const BINDING_OMNI_FACES: u32 = 6;
 
 /// Texels per side of the sun's shadow map (blinn-phong).
 pub const SHADOW_MAP_SIZE: u32 = 2048;
@@ -53,8 +57,8 @@ const SHADOW_IMAGE: usize = 3;
 impl SceneTextures {
     /// The textures: with `blinn_phong` the real maps and a shadow map (cleared: fill it with
     /// `render_shadow_map` once the meshes are on the GPU), else 1×1 stand-ins. The shadow map
-    /// uses `depth_format`, which must be sampleable.
-    pub fn new(ctx: &Context, blinn_phong: bool, depth_format: vk::Format) -> Result<SceneTextures, VkError> {
+    /// uses `depth_format`, which must be sampleable. `omni` holds the point-light shadow cubes.
+    pub fn new(ctx: &Context, blinn_phong: bool, depth_format: vk::Format, omni: &OmniShadows) -> Result<SceneTextures, VkError> {
         let t = SceneTextures {
             set_layout: vk::DescriptorSetLayout::null(),
             set: vk::DescriptorSet::null(),
@@ -63,7 +67,7 @@ impl SceneTextures {
             samplers: Vec::new(),
             shadow_size: 1,
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, blinn_phong, depth_format))
+        ml_vk::build(ctx, t, |t| t.create(ctx, blinn_phong, depth_format, omni))
     }
 
     /// Draw every object of `inputs` into the shadow map, from the sun.
@@ -71,7 +75,7 @@ impl SceneTextures {
         render_shadow_map(ctx, &self.images[SHADOW_IMAGE], Some(inputs))
     }
 
-    fn create(&mut self, ctx: &Context, real: bool, depth_format: vk::Format) -> Result<(), VkError> {
+    fn create(&mut self, ctx: &Context, real: bool, depth_format: vk::Format, omni: &OmniShadows) -> Result<(), VkError> {
         use vk::DescriptorType as T;
         let sampled = T::COMBINED_IMAGE_SAMPLER;
         let stages = vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
@@ -83,10 +87,12 @@ impl SceneTextures {
                 (BINDING_ALBEDO, sampled),
                 (BINDING_NORMAL, sampled),
                 (BINDING_SHADOW_DEPTH, sampled),
+                (BINDING_OMNI_SHADOWS, sampled),
+                (BINDING_OMNI_FACES, sampled),
             ],
             stages,
         )?;
-        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: 5 }];
+        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: 7 }];
         // SAFETY: valid device and create info.
         self.pool =
             unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
@@ -94,7 +100,7 @@ impl SceneTextures {
         self.set = allocate_set(ctx, self.pool, self.set_layout)?;
 
         let rgba = vk::Format::R8G8B8A8_UNORM;
-        let flat = |size: u32| ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, cube: false };
+        let flat = |size: u32| ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, layers: 1, view: vk::ImageViewType::TYPE_2D };
         if real {
             // A mip chain as texture_with takes it: per level, its one layer.
             let mipmapped = |name: &str, m: &textures::MipChain| {
@@ -104,14 +110,14 @@ impl SceneTextures {
             self.images.push(mipmapped("albedo map", &textures::tiles_albedo(MATERIAL_MAP_SIZE))?);
             self.images.push(mipmapped("normal map", &textures::bumps_normal_map(MATERIAL_MAP_SIZE))?);
             let sky = textures::sky_cube(SKY_SIZE);
-            let cube = ImageShape { cube: true, ..flat(SKY_SIZE) };
+            let cube = ImageShape { view: vk::ImageViewType::CUBE, layers: 6, ..flat(SKY_SIZE) };
             self.images.push(texture_with(ctx, "sky", cube, rgba, &[sky.iter().map(|f| f.as_slice()).collect()])?);
         } else {
             let white = [255u8; 4];
             let up = [128u8, 128, 255, 255];
             self.images.push(texture_with(ctx, "albedo map", flat(1), rgba, &[vec![&white[..]]])?);
             self.images.push(texture_with(ctx, "normal map", flat(1), rgba, &[vec![&up[..]]])?);
-            let cube = ImageShape { cube: true, ..flat(1) };
+            let cube = ImageShape { view: vk::ImageViewType::CUBE, layers: 6, ..flat(1) };
             self.images.push(texture_with(ctx, "sky", cube, rgba, &[vec![&white[..]; 6]])?);
         }
         self.shadow_size = if real { SHADOW_MAP_SIZE } else { 1 };
@@ -130,13 +136,12 @@ impl SceneTextures {
         // the lit fraction changes continuously with the position: a position rebuilt from
         // depth (deferred) then moves it by as little as the position moved, where a nearest
         // tap would jump by a ninth of the sun across a texel boundary.
-        let depth_filter = if ctx.format_supports(depth_format, vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR) {
-            vk::Filter::LINEAR
-        } else {
-            vk::Filter::NEAREST
-        };
-        let shadow_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_BORDER, depth_filter, Some(vk::CompareOp::LESS_OR_EQUAL))?;
+        let shadow_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_BORDER, depth_filter(ctx, depth_format), Some(vk::CompareOp::LESS_OR_EQUAL))?;
         self.samplers.push(shadow_sampler);
+        // The point-light cubes compare the same way (cube sampling never leaves the cube).
+        let omni_filter = depth_filter(ctx, omni_shadow::CUBE_FORMAT);
+        let omni_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE, omni_filter, Some(vk::CompareOp::LESS_OR_EQUAL))?;
+        self.samplers.push(omni_sampler);
         let info = |sampler: vk::Sampler, image: &Image, layout: vk::ImageLayout| {
             vk::DescriptorImageInfo::default().sampler(sampler).image_view(image.view).image_layout(layout)
         };
@@ -163,6 +168,10 @@ impl SceneTextures {
             sampled,
             info(depth_sampler, &i[SHADOW_IMAGE], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
         );
+        let depth_read = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+        write_image(ctx, self.set, BINDING_OMNI_SHADOWS, sampled, info(omni_sampler, &omni.cubes, depth_read));
+        let faces = vk::DescriptorImageInfo::default().sampler(depth_sampler).image_view(omni.faces_view).image_layout(depth_read);
+        write_image(ctx, self.set, BINDING_OMNI_FACES, sampled, faces);
         Ok(())
     }
 
@@ -186,6 +195,15 @@ impl SceneTextures {
 impl ml_vk::Release for SceneTextures {
     fn release(&mut self, ctx: &Context) {
         self.destroy(ctx);
+    }
+}
+
+/// LINEAR where the format filters (each tap then blends four comparisons), else NEAREST.
+fn depth_filter(ctx: &Context, format: vk::Format) -> vk::Filter {
+    if ctx.format_supports(format, vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR) {
+        vk::Filter::LINEAR
+    } else {
+        vk::Filter::NEAREST
     }
 }
 
@@ -214,31 +232,18 @@ fn sampler(
 /// leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL for the shading passes.
 fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs>) -> Result<(), VkError> {
     let d = &ctx.device;
-    let attachment = [vk::AttachmentDescription::default()
-        .format(target.format)
-        .samples(vk::SampleCountFlags::TYPE_1)
-        .load_op(vk::AttachmentLoadOp::CLEAR)
-        .store_op(vk::AttachmentStoreOp::STORE)
-        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-        .initial_layout(vk::ImageLayout::UNDEFINED)
-        .final_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)];
-    let depth_ref = vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
-    let subpass =
-        [vk::SubpassDescription::default().pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS).depth_stencil_attachment(&depth_ref)];
-    let tests = vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
     // The depth writes before every later shader read of the map (frames come after this
     // submission in queue order).
-    let dependency = [vk::SubpassDependency::default()
-        .src_subpass(0)
-        .dst_subpass(vk::SUBPASS_EXTERNAL)
-        .src_stage_mask(tests)
-        .src_access_mask(vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER)
-        .dst_access_mask(vk::AccessFlags::SHADER_READ)];
-    let info = vk::RenderPassCreateInfo::default().attachments(&attachment).subpasses(&subpass).dependencies(&dependency);
-    // SAFETY: valid device and create info.
-    let render_pass = unsafe { d.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")?;
+    let render_pass = depth_pass::render_pass(
+        ctx,
+        &DepthPassDesc {
+            format: target.format,
+            final_layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+            after: vk::PipelineStageFlags::empty(),
+            readers: (vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ),
+            view_mask: 0,
+        },
+    )?;
     let views = [target.view];
     let fb_info = vk::FramebufferCreateInfo::default()
         .render_pass(render_pass)
@@ -257,33 +262,25 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
         // Only a pass that draws needs the pipeline (a clear does not).
         if inputs.is_some() {
             layout = shader::pipeline_layout(ctx, &[], &push)?;
-            pipeline = shadow_pipeline(ctx, render_pass, layout)?;
+            pipeline = depth_pass::pipeline(ctx, render_pass, layout, (ml_shaders::SHADOW_VERT, None))?;
         }
-        let extent = target.extent;
-        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
-        let clear = [vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } }];
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: target.extent };
         ml_vk::commands::one_shot(ctx, |cmd| {
-            let begin =
-                vk::RenderPassBeginInfo::default().render_pass(render_pass).framebuffer(framebuffer).render_area(area).clear_values(&clear);
-            let viewport =
-                vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+            let begin = vk::RenderPassBeginInfo::default()
+                .render_pass(render_pass)
+                .framebuffer(framebuffer)
+                .render_area(area)
+                .clear_values(&depth_pass::CLEAR_FAR);
             // SAFETY: recording state; everything used is alive until the wait in one_shot.
             unsafe {
                 d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
                 if let Some(s) = inputs {
                     d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                    d.cmd_set_viewport(cmd, 0, &[viewport]);
-                    d.cmd_set_scissor(cmd, 0, &[area]);
-                    for mesh in s.meshes {
-                        d.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
-                        d.cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
-                        for (index, object) in s.scene.objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
-                            let push =
-                                ShadowPush { object: object_push(object, index as u32), light_view_proj: s.view_proj.to_cols_array_2d() };
-                            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
-                            d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
-                        }
-                    }
+                    depth_pass::set_square_viewport(ctx, cmd, target.extent.width);
+                    record_draws(ctx, cmd, (s.meshes, &s.scene.objects), |_| true, |index, object| {
+                        let push = ShadowPush { object: object_push(object, index), light_view_proj: s.view_proj.to_cols_array_2d() };
+                        d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
+                    });
                 }
                 d.cmd_end_render_pass(cmd);
             }
@@ -297,33 +294,4 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
         d.destroy_render_pass(render_pass, None);
     }
     result
-}
-
-/// Depth-only pipeline of the shadow pass: positions only, no fragment shader, both faces.
-fn shadow_pipeline(ctx: &Context, render_pass: vk::RenderPass, layout: vk::PipelineLayout) -> Result<vk::Pipeline, VkError> {
-    let bindings = [vertex_binding()];
-    let attributes = vertex_attributes();
-    shader::graphics_pipeline(
-        ctx,
-        &shader::GraphicsPipelineDesc {
-            vertex: ml_shaders::SHADOW_VERT,
-            fragment: None,
-            fragment_constants: &[],
-            vertex_input: vk::PipelineVertexInputStateCreateInfo::default()
-                .vertex_binding_descriptions(&bindings)
-                .vertex_attribute_descriptions(&attributes[..1]),
-            rasterization: vk::PipelineRasterizationStateCreateInfo::default()
-                .polygon_mode(vk::PolygonMode::FILL)
-                .cull_mode(vk::CullModeFlags::NONE)
-                .line_width(1.0),
-            depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default()
-                .depth_test_enable(true)
-                .depth_write_enable(true)
-                .depth_compare_op(vk::CompareOp::LESS),
-            colour_attachments: 0,
-            layout,
-            render_pass,
-            subpass: 0,
-        },
-    )
 }

@@ -116,6 +116,76 @@ impl ShadingModel {
     }
 }
 
+/// constant_id of `OMNI_SHADOWS` in omni_shadow.glsl.
+pub const SPEC_OMNI_SHADOWS: u32 = 12;
+
+/// What a lighting pipeline is compiled for: the model and whether point lights cast
+/// shadows (specialization constants, so each pipeline carries only what it runs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shading {
+    pub model: ShadingModel,
+    pub omni_shadows: bool,
+}
+
+impl Shading {
+    pub fn spec_constants(self) -> [(u32, u32); 3] {
+        let [a, b] = self.model.spec_constants();
+        [a, b, (SPEC_OMNI_SHADOWS, u32::from(self.omni_shadows))]
+    }
+}
+
+/// How point-light shadow cubes are rendered (SPEC §4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OmniShadowMode {
+    /// Seed 003: each face into one offscreen depth target, then copied into the cube.
+    Copy,
+    /// Each face straight into its cube layer (a framebuffer per layer).
+    Direct,
+    /// All six faces in one pass (VK_KHR_multiview, view i = face i).
+    Multiview,
+}
+
+impl OmniShadowMode {
+    pub const ALL: [OmniShadowMode; 3] = [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OmniShadowMode::Copy => "copy",
+            OmniShadowMode::Direct => "direct",
+            OmniShadowMode::Multiview => "multiview",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<OmniShadowMode, RenderError> {
+        OmniShadowMode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
+            let expected = OmniShadowMode::ALL.map(|m| m.name()).join(", ");
+            RenderError::Invalid(format!("unknown --omni-shadow mode '{name}': expected one of {expected}"))
+        })
+    }
+}
+
+/// Point-light shadows: how the cubes are made, for how many lights, how large.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OmniShadowSettings {
+    pub mode: OmniShadowMode,
+    /// Lights with a shadow cube (the strongest as seen from the camera).
+    pub lights: u32,
+    /// Texels per side of each cube face.
+    pub size: u32,
+}
+
+impl OmniShadowSettings {
+    pub const DEFAULT_SIZE: u32 = 1024;
+
+    /// Bytes of the cube array (32-bit depth).
+    pub fn bytes(&self) -> u64 {
+        self.lights as u64 * 6 * self.size as u64 * self.size as u64 * 4
+    }
+}
+
+/// Most memory the shadow cubes may take, whatever the device has: 16 lights at 2048² are 1.5 GiB.
+pub const MAX_OMNI_BYTES: u64 = 4 << 30;
+
 /// What the image shows instead of the shaded scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DebugView {
@@ -131,10 +201,12 @@ pub enum DebugView {
     Depth,
     /// The sun's shadow map over the whole image (blinn-phong).
     ShadowMap,
+    /// The six faces of the first shadowed point light's cube, unfolded as a cross.
+    ShadowCube,
 }
 
 impl DebugView {
-    pub const ALL: [DebugView; 7] = [
+    pub const ALL: [DebugView; 8] = [
         DebugView::None,
         DebugView::ClusterHeat,
         DebugView::GBufferAlbedo,
@@ -142,6 +214,7 @@ impl DebugView {
         DebugView::GBufferMaterial,
         DebugView::Depth,
         DebugView::ShadowMap,
+        DebugView::ShadowCube,
     ];
 
     pub fn name(self) -> &'static str {
@@ -153,6 +226,7 @@ impl DebugView {
             DebugView::GBufferMaterial => "gbuffer-material",
             DebugView::Depth => "depth",
             DebugView::ShadowMap => "shadow-map",
+            DebugView::ShadowCube => "shadow-cube",
         }
     }
 
@@ -174,6 +248,7 @@ impl DebugView {
             DebugView::GBufferMaterial => g::DEBUG_VIEW_GBUFFER_MATERIAL,
             DebugView::Depth => g::DEBUG_VIEW_DEPTH,
             DebugView::ShadowMap => g::DEBUG_VIEW_SHADOW_MAP,
+            DebugView::ShadowCube => g::DEBUG_VIEW_SHADOW_CUBE,
         }
     }
 }
@@ -189,6 +264,8 @@ pub struct RenderSettings {
     /// Cluster grid of the clustered techniques.
     pub clusters: ClusterDims,
     pub debug_view: DebugView,
+    /// Point-light shadow cubes (None: point lights cast no shadows).
+    pub omni: Option<OmniShadowSettings>,
     pub width: u32,
     pub height: u32,
     /// Frames to render; the image is the last one's, timings are averaged over all.
@@ -210,6 +287,7 @@ impl RenderSettings {
             shading: ShadingModel::Seed,
             clusters: ClusterDims::DEFAULT,
             debug_view: DebugView::None,
+            omni: None,
             width,
             height,
             frames: 1,
@@ -222,9 +300,21 @@ impl RenderSettings {
         self.time.unwrap_or(i as f32 * FRAME_SECONDS * TIMER_SPEED)
     }
 
+    /// What the lighting pipelines are compiled for.
+    pub fn lighting(&self) -> Shading {
+        Shading { model: self.shading, omni_shadows: self.omni.is_some() }
+    }
+
     /// Reject sizes and counts the device (or common sense) cannot take, before allocating.
     pub fn check(&self, ctx: &Context, lights: usize) -> Result<(), RenderError> {
         let limits = &ctx.info.limits;
+        // Every lighting shader declares the point-light shadow cubes (textures.glsl).
+        if !ctx.info.features.image_cube_array {
+            return Err(RenderError::Invalid(format!(
+                "'{}' lacks the imageCubeArray feature, which every shading pipeline needs (point-light shadow cubes)",
+                ctx.info.name
+            )));
+        }
         let max_dim = limits.max_image_dimension2_d.min(MAX_DIMENSION);
         for (what, v) in [("--width", self.width), ("--height", self.height)] {
             if v == 0 || v > max_dim {
@@ -243,6 +333,12 @@ impl RenderSettings {
                 "--debug-view shadow-map needs --shading blinn-phong (the seed model casts no shadows)".into(),
             ));
         }
+        if self.debug_view == DebugView::ShadowCube && self.omni.is_none() {
+            return Err(RenderError::Invalid("--debug-view shadow-cube needs point-light shadows (--omni-shadow)".into()));
+        }
+        if let Some(omni) = &self.omni {
+            check_omni(ctx, omni, lights)?;
+        }
         if self.frames == 0 {
             return Err(RenderError::Invalid("--frames must be at least 1".into()));
         }
@@ -258,4 +354,34 @@ impl RenderSettings {
         }
         Ok(())
     }
+}
+
+/// Reject shadow-cube requests the device or the scene cannot take, before allocating.
+fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result<(), RenderError> {
+    let limits = &ctx.info.limits;
+    let invalid = |m: String| Err(RenderError::Invalid(m));
+    if omni.lights == 0 || omni.lights as usize > lights {
+        return invalid(format!("--shadowed-lights {} is out of range: the scene has {lights} lights (use 1 to {lights})", omni.lights));
+    }
+    let max_cubes = limits.max_image_array_layers / 6;
+    if omni.lights > max_cubes {
+        return invalid(format!("--shadowed-lights {} is more than the {max_cubes} shadow cubes '{}' holds in one array", omni.lights, ctx.info.name));
+    }
+    let max_size = limits.max_image_dimension_cube.min(MAX_DIMENSION);
+    if omni.size == 0 || omni.size > max_size {
+        return invalid(format!("--cube-size {} is out of range: use 1 to {max_size}", omni.size));
+    }
+    if omni.bytes() > MAX_OMNI_BYTES {
+        return invalid(format!(
+            "{} shadow cubes of {}² take {} MiB, more than the {} MiB we allow: use fewer --shadowed-lights or a smaller --cube-size",
+            omni.lights,
+            omni.size,
+            omni.bytes() >> 20,
+            MAX_OMNI_BYTES >> 20
+        ));
+    }
+    if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
+        return invalid(format!("--omni-shadow multiview needs the multiview feature, which '{}' lacks: use copy or direct", ctx.info.name));
+    }
+    Ok(())
 }

@@ -2,7 +2,7 @@
 //! reflection of the compiled shaders reports (seed mistake 5: the std140 trap). A field
 //! moved on either side fails here.
 
-use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectPush, PointLight, ShadowPush};
+use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectPush, OmniShadowPush, PointLight, ShadowPush};
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
 use std::collections::HashMap;
@@ -78,6 +78,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<PointLight>(&structs);
     check::<ObjectPush>(&structs);
     check::<ShadowPush>(&structs);
+    check::<OmniShadowPush>(&structs);
     check::<ClusterRange>(&structs);
     check::<ClusterBounds>(&structs);
     check::<ClusterFeedback>(&structs);

@@ -32,8 +32,19 @@ pub struct DeviceInfo {
     pub driver_name: String,
     pub driver_info: String,
     pub limits: vk::PhysicalDeviceLimits,
+    /// Optional features the device has (and the context enables).
+    pub features: OptionalFeatures,
     /// Whether it has a graphics queue and Vulkan ≥ 1.2.
     pub suitable: bool,
+}
+
+/// Features beyond Vulkan 1.2's required ones that some path uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OptionalFeatures {
+    /// Cube-map arrays (several shadowed point lights).
+    pub image_cube_array: bool,
+    /// VK_KHR_multiview, core in 1.1 (one pass renders all six faces of a shadow cube).
+    pub multiview: bool,
 }
 
 impl DeviceInfo {
@@ -150,8 +161,18 @@ impl InstanceParts {
             // SAFETY: core in 1.1+, and the device reports 1.2+.
             unsafe { self.instance.get_physical_device_properties2(pd, &mut props2) };
         }
+        let mut v11 = vk::PhysicalDeviceVulkan11Features::default();
+        let mut features = OptionalFeatures::default();
+        if props.api_version >= MIN_API {
+            let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v11);
+            // SAFETY: core in 1.1+, and the device reports 1.2+.
+            unsafe { self.instance.get_physical_device_features2(pd, &mut features2) };
+            let image_cube_array = features2.features.image_cube_array == vk::TRUE;
+            features = OptionalFeatures { image_cube_array, multiview: v11.multiview == vk::TRUE };
+        }
         let name = c_text(props.device_name_as_c_str());
         DeviceInfo {
+            features,
             index,
             name,
             device_type: props.device_type,
@@ -291,8 +312,13 @@ impl Context {
         let (family, family_props) = graphics_queue_family(&parts.instance, pd).expect("checked by `suitable`");
         let priorities = [1.0];
         let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
-        let info_create = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
-        // SAFETY: valid physical device and create info.
+        // Optional features, enabled where the device has them; the renderer checks `info.features`
+        // before it needs one and refuses in one line otherwise.
+        let features = info.features;
+        let core = vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array);
+        let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
+        let info_create = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut v11);
+        // SAFETY: valid physical device and create info; only supported features are enabled.
         let device = unsafe { parts.instance.create_device(pd, &info_create, None) }.ctx("vkCreateDevice")?;
         Ok((pd, info, device, family, family_props.timestamp_valid_bits))
     }

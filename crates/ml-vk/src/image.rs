@@ -1,4 +1,4 @@
-//! 2D images with one view, memory from the allocator.
+//! Images (2D, arrays, cubes) with one view of the whole, memory from the allocator.
 
 use crate::context::Context;
 use crate::error::{Result, VkError, VkResultExt};
@@ -39,10 +39,11 @@ impl Image {
         usage: vk::ImageUsageFlags,
         aspect: vk::ImageAspectFlags,
     ) -> Result<Image> {
-        Image::new(ctx, name, ImageShape { extent, levels: 1, cube: false }, format, usage, aspect)
+        Image::new(ctx, name, ImageShape { extent, levels: 1, layers: 1, view: vk::ImageViewType::TYPE_2D }, format, usage, aspect)
     }
 
-    /// A 2D image (or a cubemap: six layers, a cube view) with `shape.levels` mip levels.
+    /// A 2D image, 2D array, cubemap or cube-map array (`shape`) with `shape.levels` mip
+    /// levels, and one view of all of it.
     pub fn new(
         ctx: &Context,
         name: &str,
@@ -52,9 +53,9 @@ impl Image {
         aspect: vk::ImageAspectFlags,
     ) -> Result<Image> {
         let extent = shape.extent;
-        let layers = if shape.cube { 6 } else { 1 };
+        let layers = shape.layers;
         let info = vk::ImageCreateInfo::default()
-            .flags(if shape.cube { vk::ImageCreateFlags::CUBE_COMPATIBLE } else { vk::ImageCreateFlags::empty() })
+            .flags(if shape.is_cube() { vk::ImageCreateFlags::CUBE_COMPATIBLE } else { vk::ImageCreateFlags::empty() })
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
             .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
@@ -119,22 +120,32 @@ impl Image {
 
     /// Add the view of a bound image (destroying the image if that fails).
     fn with_view(mut self, ctx: &Context, shape: ImageShape, aspect: vk::ImageAspectFlags) -> Result<Image> {
-        let (raw, format) = (self.raw, self.format);
-        let image = &mut self;
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(if shape.cube { vk::ImageViewType::CUBE } else { vk::ImageViewType::TYPE_2D })
-            .format(format)
-            .subresource_range(full_range(aspect));
-        // SAFETY: bound image.
-        match unsafe { ctx.device.create_image_view(&view_info, None) }.ctx("vkCreateImageView") {
-            Ok(v) => image.view = v,
+        match self.view_of(ctx, shape.view, 0..shape.layers, aspect) {
+            Ok(v) => self.view = v,
             Err(e) => {
-                image.destroy(ctx);
+                self.destroy(ctx);
                 return Err(e);
             }
         }
         Ok(self)
+    }
+
+    /// Another view of mip level 0 of `layers` (the caller destroys it before the image).
+    pub fn view_of(
+        &self,
+        ctx: &Context,
+        view_type: vk::ImageViewType,
+        layers: std::ops::Range<u32>,
+        aspect: vk::ImageAspectFlags,
+    ) -> Result<vk::ImageView> {
+        let range = vk::ImageSubresourceRange::default()
+            .aspect_mask(aspect)
+            .level_count(vk::REMAINING_MIP_LEVELS)
+            .base_array_layer(layers.start)
+            .layer_count(layers.len() as u32);
+        let info = vk::ImageViewCreateInfo::default().image(self.raw).view_type(view_type).format(self.format).subresource_range(range);
+        // SAFETY: bound image; the range lies within it (the caller's contract).
+        unsafe { ctx.device.create_image_view(&info, None) }.ctx("vkCreateImageView")
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -165,8 +176,16 @@ impl Image {
 pub struct ImageShape {
     pub extent: vk::Extent2D,
     pub levels: u32,
-    /// Six layers viewed as a cube.
-    pub cube: bool,
+    /// Array layers (6 per cube).
+    pub layers: u32,
+    /// How `Image::view` sees all of it (a cube or cube array makes the image cube-compatible).
+    pub view: vk::ImageViewType,
+}
+
+impl ImageShape {
+    pub fn is_cube(&self) -> bool {
+        matches!(self.view, vk::ImageViewType::CUBE | vk::ImageViewType::CUBE_ARRAY)
+    }
 }
 
 /// Every mip level and layer of an image.

@@ -14,7 +14,7 @@ pub mod timing;
 
 pub use ash::vk;
 pub use buffer::Buffer;
-pub use context::{Context, ContextDesc, DeviceInfo};
+pub use context::{Context, ContextDesc, DeviceInfo, OptionalFeatures};
 pub use error::{VkError, VkResultExt};
 pub use image::{Image, ImageShape};
 pub use timing::GpuTimer;

@@ -1,0 +1,302 @@
+//! Point-light shadow cubes (SPEC §4, seed 003), the GPU half: a cube-map array with six
+//! depth layers per shadowed light, each texel the distance from the light to the nearest
+//! surface over the light's radius (omni_shadow.frag), rendered every frame (the lights
+//! move) before the shading passes, which read it through set 1 (omni_shadow.glsl).
+//!
+//! Three ways to fill it, one image: `copy` (seed 003: each face into one offscreen depth
+//! target, then an image copy into the cube's layer), `direct` (each face straight into its
+//! layer, a framebuffer per layer), `multiview` (one pass per light, view i = face i). Without
+//! shadowed lights the array is a cleared 1×1 stand-in the shaders never sample.
+
+use crate::depth_pass::{self, DepthPassDesc};
+use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::settings::{OmniShadowMode, OmniShadowSettings};
+use glam::{Mat4, Vec3};
+use ml_cpu::gpu_types::OmniShadowPush;
+use ml_cpu::omni_shadow::face_view_proj;
+use ml_cpu::scene::Object;
+use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
+
+/// The cube's depth format: 32-bit float, which holds distance / radius to 2⁻²⁴.
+pub const CUBE_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// Faces' near plane as a fraction of the light's radius (geometry nearer than this to the
+/// light is clipped away; the stored depth is not the projection's, so this costs no precision).
+const NEAR_FRACTION: f32 = 1e-3;
+
+/// Where a shadowed light is this frame.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowedLight {
+    pub position: Vec3,
+    pub radius: f32,
+}
+
+pub struct OmniShadows {
+    pub settings: Option<OmniShadowSettings>,
+    /// Six layers per shadowed light, viewed as a cube array (`cubes.view`).
+    pub cubes: Image,
+    /// The same layers as a 2D array (the shadow-cube debug view fetches texels).
+    pub faces_view: vk::ImageView,
+    /// copy: the one offscreen target every face is rendered into.
+    offscreen: Image,
+    /// direct: a 2D view per layer; multiview: a 6-layer view per light.
+    targets: Vec<vk::ImageView>,
+    framebuffers: Vec<vk::Framebuffer>,
+    render_pass: vk::RenderPass,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+}
+
+const DEPTH: vk::ImageAspectFlags = vk::ImageAspectFlags::DEPTH;
+const SHADER_READERS: vk::PipelineStageFlags =
+    vk::PipelineStageFlags::from_raw(vk::PipelineStageFlags::FRAGMENT_SHADER.as_raw() | vk::PipelineStageFlags::COMPUTE_SHADER.as_raw());
+
+impl OmniShadows {
+    /// The cubes for `settings` (None: the stand-in), with what renders them.
+    pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>) -> Result<OmniShadows, VkError> {
+        let features = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE;
+        if !ctx.format_supports(CUBE_FORMAT, features) {
+            return Err(VkError::Limit(format!("'{}' cannot render and sample D32_SFLOAT (point-light shadow cubes)", ctx.info.name)));
+        }
+        let shadows = OmniShadows {
+            settings,
+            cubes: Image::null(),
+            faces_view: vk::ImageView::null(),
+            offscreen: Image::null(),
+            targets: Vec::new(),
+            framebuffers: Vec::new(),
+            render_pass: vk::RenderPass::null(),
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+        };
+        ml_vk::build(ctx, shadows, |s| s.create(ctx))
+    }
+
+    fn create(&mut self, ctx: &Context) -> Result<(), VkError> {
+        let (cubes, size) = self.settings.map_or((1, 1), |s| (s.lights, s.size));
+        let layers = cubes * 6;
+        let shape = ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, layers, view: vk::ImageViewType::CUBE_ARRAY };
+        // The shaders read it in DEPTH_STENCIL_READ_ONLY_OPTIMAL, which needs the attachment
+        // usage even where only copies (or the stand-in's clear) write it.
+        let usage =
+            vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_DST;
+        self.cubes = Image::new(ctx, "shadow cubes", shape, CUBE_FORMAT, usage, DEPTH)?;
+        self.faces_view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D_ARRAY, 0..layers, DEPTH)?;
+        let Some(settings) = self.settings else {
+            return clear_stand_in(ctx, &self.cubes);
+        };
+        let readers = (SHADER_READERS, vk::AccessFlags::SHADER_READ);
+        // Each pass clears its target, so it waits for whoever read that target last: the
+        // previous frame's shading (direct, multiview) or this frame's previous copy (copy).
+        let (final_layout, after, readers) = match settings.mode {
+            OmniShadowMode::Copy => (
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                vk::PipelineStageFlags::TRANSFER,
+                (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
+            ),
+            _ => (vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL, SHADER_READERS, readers),
+        };
+        let view_mask = if settings.mode == OmniShadowMode::Multiview { 0b11_1111 } else { 0 };
+        self.render_pass =
+            depth_pass::render_pass(ctx, &DepthPassDesc { format: CUBE_FORMAT, final_layout, after, readers, view_mask })?;
+        let push = [vk::PushConstantRange::default()
+            .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+            .size(size_of::<OmniShadowPush>() as u32)];
+        self.layout = shader::pipeline_layout(ctx, &[], &push)?;
+        let vertex =
+            if settings.mode == OmniShadowMode::Multiview { ml_shaders::OMNI_SHADOW_MULTIVIEW_VERT } else { ml_shaders::OMNI_SHADOW_VERT };
+        self.pipeline = depth_pass::pipeline(ctx, self.render_pass, self.layout, (vertex, Some(ml_shaders::OMNI_SHADOW_FRAG)))?;
+        let extent = shape.extent;
+        match settings.mode {
+            OmniShadowMode::Copy => {
+                let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+                self.offscreen = Image::new_2d(ctx, "shadow face", extent, CUBE_FORMAT, usage, DEPTH)?;
+                let view = self.offscreen.view;
+                self.add_framebuffer(ctx, view, size)?;
+            }
+            OmniShadowMode::Direct => {
+                for layer in 0..layers {
+                    let view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D, layer..layer + 1, DEPTH)?;
+                    self.targets.push(view);
+                    self.add_framebuffer(ctx, view, size)?;
+                }
+            }
+            OmniShadowMode::Multiview => {
+                for cube in 0..cubes {
+                    let view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D_ARRAY, cube * 6..cube * 6 + 6, DEPTH)?;
+                    self.targets.push(view);
+                    self.add_framebuffer(ctx, view, size)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn add_framebuffer(&mut self, ctx: &Context, view: vk::ImageView, size: u32) -> Result<(), VkError> {
+        let views = [view];
+        let info =
+            vk::FramebufferCreateInfo::default().render_pass(self.render_pass).attachments(&views).width(size).height(size).layers(1);
+        // SAFETY: valid device; the view matches the render pass's attachment.
+        let framebuffer = unsafe { ctx.device.create_framebuffer(&info, None) }.ctx("vkCreateFramebuffer")?;
+        self.framebuffers.push(framebuffer);
+        Ok(())
+    }
+
+    /// Whether any light casts shadows (the pass records work).
+    pub fn active(&self) -> bool {
+        self.settings.is_some()
+    }
+
+    /// One texel of a face in face units (FrameUniforms::omni_texel).
+    pub fn texel(&self) -> f32 {
+        2.0 / self.cubes.extent.width as f32
+    }
+
+    /// Render every cube: `lights[i]` into cube i, the objects that reach into its sphere.
+    /// Leaves the array DEPTH_STENCIL_READ_ONLY_OPTIMAL, its writes visible to fragment and
+    /// compute shaders.
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
+        let Some(settings) = self.settings else { return };
+        let d = &ctx.device;
+        let size = settings.size;
+        let copy = settings.mode == OmniShadowMode::Copy;
+        if copy {
+            // Whatever the previous frame's shading read is overwritten by copies.
+            self.barrier(ctx, cmd, (SHADER_READERS, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), TRANSFER_DST);
+        }
+        for (cube, light) in lights.iter().enumerate().take(settings.lights as usize) {
+            let near = light.radius * NEAR_FRACTION;
+            let reaches = |o: &Object| o.position.distance(light.position) <= light.radius + o.scale * 3f32.sqrt();
+            let light_position_radius = light.position.extend(light.radius).to_array();
+            let passes: Vec<(Option<u32>, Mat4)> = if settings.mode == OmniShadowMode::Multiview {
+                vec![(None, Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, near, light.radius))]
+            } else {
+                (0..6).map(|face| (Some(face), face_view_proj(light.position, face, near, light.radius))).collect()
+            };
+            for (face, view_proj) in passes {
+                let framebuffer = match (settings.mode, face) {
+                    (OmniShadowMode::Copy, _) => self.framebuffers[0],
+                    (OmniShadowMode::Direct, Some(f)) => self.framebuffers[cube * 6 + f as usize],
+                    _ => self.framebuffers[cube],
+                };
+                let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: size, height: size } };
+                let begin = vk::RenderPassBeginInfo::default()
+                    .render_pass(self.render_pass)
+                    .framebuffer(framebuffer)
+                    .render_area(area)
+                    .clear_values(&depth_pass::CLEAR_FAR);
+                // SAFETY: recording state; every handle lives as long as this object, which
+                // outlives the frames that use it.
+                unsafe {
+                    d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+                    depth_pass::set_square_viewport(ctx, cmd, size);
+                    record_draws(ctx, cmd, (meshes, objects), reaches, |_, object| {
+                        let push = OmniShadowPush {
+                            view_proj: view_proj.to_cols_array_2d(),
+                            position_scale: object.position.extend(object.scale).to_array(),
+                            light_position_radius,
+                        };
+                        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                        d.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&push));
+                    });
+                    d.cmd_end_render_pass(cmd);
+                }
+                if let (true, Some(f)) = (copy, face) {
+                    self.copy_face(ctx, cmd, cube as u32 * 6 + f);
+                }
+            }
+        }
+        if copy {
+            self.barrier(ctx, cmd, TRANSFER_DST, (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
+        }
+    }
+
+    /// Seed 003's step: the offscreen face (left TRANSFER_SRC_OPTIMAL by the pass, whose
+    /// outgoing dependency orders this copy after its depth writes) into cube layer `layer`.
+    fn copy_face(&self, ctx: &Context, cmd: vk::CommandBuffer, layer: u32) {
+        let subresource = |base: u32| vk::ImageSubresourceLayers::default().aspect_mask(DEPTH).base_array_layer(base).layer_count(1);
+        let size = self.offscreen.extent;
+        let region = [vk::ImageCopy::default()
+            .src_subresource(subresource(0))
+            .dst_subresource(subresource(layer))
+            .extent(vk::Extent3D { width: size.width, height: size.height, depth: 1 })];
+        // SAFETY: recording state outside a render pass; both images are alive, in the
+        // layouts named, and the region lies within both.
+        unsafe {
+            ctx.device.cmd_copy_image(
+                cmd,
+                self.offscreen.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                self.cubes.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+            )
+        };
+    }
+
+    /// A layout transition of every layer of the cube array.
+    fn barrier(&self, ctx: &Context, cmd: vk::CommandBuffer, from: StageAccessLayout, to: StageAccessLayout) {
+        transition(ctx, cmd, self.cubes.raw, from, to);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the device is idle (the caller's contract); null handles are ignored.
+        unsafe {
+            for f in self.framebuffers.drain(..) {
+                ctx.device.destroy_framebuffer(f, None);
+            }
+            for v in self.targets.drain(..) {
+                ctx.device.destroy_image_view(v, None);
+            }
+            ctx.device.destroy_image_view(self.faces_view, None);
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device.destroy_render_pass(self.render_pass, None);
+        }
+        self.faces_view = vk::ImageView::null();
+        self.pipeline = vk::Pipeline::null();
+        self.layout = vk::PipelineLayout::null();
+        self.render_pass = vk::RenderPass::null();
+        self.offscreen.destroy(ctx);
+        self.cubes.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for OmniShadows {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
+
+type StageAccessLayout = (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout);
+
+const TRANSFER_DST: StageAccessLayout =
+    (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+
+fn transition(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: StageAccessLayout, to: StageAccessLayout) {
+    let b = [vk::ImageMemoryBarrier::default()
+        .src_access_mask(from.1)
+        .dst_access_mask(to.1)
+        .old_layout(from.2)
+        .new_layout(to.2)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(ml_vk::image::full_range(DEPTH))];
+    // SAFETY: recording state, outside a render pass.
+    unsafe { ctx.device.cmd_pipeline_barrier(cmd, from.0, to.0, vk::DependencyFlags::empty(), &[], &[], &b) };
+}
+
+/// The stand-in: every layer cleared to 1.0 (nothing in reach), left as the shaders expect.
+fn clear_stand_in(ctx: &Context, cubes: &Image) -> Result<(), VkError> {
+    ml_vk::commands::one_shot(ctx, |cmd| {
+        transition(ctx, cmd, cubes.raw, (vk::PipelineStageFlags::TOP_OF_PIPE, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), TRANSFER_DST);
+        let clear = vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 };
+        // SAFETY: recording state; the image is in TRANSFER_DST_OPTIMAL.
+        unsafe {
+            ctx.device.cmd_clear_depth_stencil_image(cmd, cubes.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &clear, &[ml_vk::image::full_range(DEPTH)])
+        };
+        transition(ctx, cmd, cubes.raw, TRANSFER_DST, (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
+    })
+}
