@@ -1,4 +1,5 @@
-// What both point-light shadow vertex shaders share: the inputs and the object's transform.
+// What the point-light shadow vertex shaders share: the inputs, the object's transform and,
+// for the one-pass modes (multiview, layered), each face's view built from its axes.
 
 layout(location = 0) in vec3 in_position;
 layout(location = 0) out vec3 out_to_light;
@@ -7,4 +8,19 @@ layout(push_constant) uniform OmniShadowPushBlock { OmniShadowPush omni; };
 
 vec3 omni_world_position() {
     return in_position * omni.position_scale.w + omni.position_scale.xyz;
+}
+
+// Forward and up of each face: +X, −X, +Y, −Y, +Z, −Z (seed 003's list,
+// ml_cpu::omni_shadow::face_axes).
+const vec3 FACE_FORWARD[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
+const vec3 FACE_UP[6] = vec3[](vec3(0, -1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1), vec3(0, -1, 0), vec3(0, -1, 0));
+
+// Clip position of `rel` (world position − light) on cube face `face`: the face's rotation
+// (look_at_rh's rows: side = forward × up, up' = side × forward, −forward), then the push
+// constant's projection.
+vec4 omni_face_clip(vec3 rel, int face) {
+    vec3 f = FACE_FORWARD[face];
+    vec3 s = normalize(cross(f, FACE_UP[face]));
+    vec3 u = cross(s, f);
+    return omni.view_proj * vec4(dot(s, rel), dot(u, rel), -dot(f, rel), 1.0);
 }

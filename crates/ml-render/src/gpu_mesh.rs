@@ -58,13 +58,13 @@ pub fn vertex_attributes() -> [vk::VertexInputAttributeDescription; 4] {
     .expect("four attributes")
 }
 
-/// Record the indexed draws of `objects` that `keep` accepts: per mesh, its buffers bound,
-/// then its objects in scene order, each after `push(index in the scene, object)` (which
-/// records the draw's push constants).
+/// Record the indexed draws of `objects` that `keep` accepts, `instances` instances each:
+/// per mesh, its buffers bound, then its objects in scene order, each after
+/// `push(index in the scene, object)` (which records the draw's push constants).
 pub fn record_draws(
     ctx: &Context,
     cmd: vk::CommandBuffer,
-    (meshes, objects): (&[GpuMesh], &[Object]),
+    (meshes, objects, instances): (&[GpuMesh], &[Object], u32),
     keep: impl Fn(&Object) -> bool,
     mut push: impl FnMut(u32, &Object),
 ) {
@@ -81,7 +81,7 @@ pub fn record_draws(
                     bound = true;
                 }
                 push(index as u32, object);
-                d.cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
+                d.cmd_draw_indexed(cmd, mesh.index_count, instances, 0, 0, 0);
             }
         }
     }

@@ -3,9 +3,11 @@
 //! surface over the light's radius (omni_shadow.frag), rendered every frame (the lights
 //! move) before the shading passes, which read it through set 1 (omni_shadow.glsl).
 //!
-//! Three ways to fill it, one image: `copy` (seed 003: each face into one offscreen depth
+//! Four ways to fill it, one image: `copy` (seed 003: each face into one offscreen depth
 //! target, then an image copy into the cube's layer), `direct` (each face straight into its
-//! layer, a framebuffer per layer), `multiview` (one pass per light, view i = face i). Without
+//! layer, a framebuffer per layer), and one pass per light for all six faces: `multiview`
+//! (VK_KHR_multiview, view i = face i) or `layered` (six instances per draw, instance i
+//! writes gl_Layer = i). Without
 //! shadowed lights the array is a cleared 1×1 stand-in the shaders never sample.
 
 use crate::depth_pass::{self, DepthPassDesc};
@@ -39,7 +41,7 @@ pub struct OmniShadows {
     pub faces_view: vk::ImageView,
     /// copy: the one offscreen target every face is rendered into.
     offscreen: Image,
-    /// direct: a 2D view per layer; multiview: a 6-layer view per light.
+    /// direct: a 2D view per layer; multiview, layered: a 6-layer view per light.
     targets: Vec<vk::ImageView>,
     framebuffers: Vec<vk::Framebuffer>,
     render_pass: vk::RenderPass,
@@ -96,15 +98,19 @@ impl OmniShadows {
             ),
             _ => (vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL, SHADER_READERS, readers),
         };
-        let view_mask = if settings.mode == OmniShadowMode::Multiview { 0b11_1111 } else { 0 };
+        let multiview = settings.mode == OmniShadowMode::Multiview;
+        let view_mask = if multiview { 0b11_1111 } else { 0 };
         self.render_pass =
             depth_pass::render_pass(ctx, &DepthPassDesc { format: CUBE_FORMAT, final_layout, after, readers, view_mask })?;
         let push = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             .size(size_of::<OmniShadowPush>() as u32)];
         self.layout = shader::pipeline_layout(ctx, &[], &push)?;
-        let vertex =
-            if settings.mode == OmniShadowMode::Multiview { ml_shaders::OMNI_SHADOW_MULTIVIEW_VERT } else { ml_shaders::OMNI_SHADOW_VERT };
+        let vertex = match settings.mode {
+            OmniShadowMode::Multiview => ml_shaders::OMNI_SHADOW_MULTIVIEW_VERT,
+            OmniShadowMode::Layered => ml_shaders::OMNI_SHADOW_LAYERED_VERT,
+            _ => ml_shaders::OMNI_SHADOW_VERT,
+        };
         self.pipeline = depth_pass::pipeline(ctx, self.render_pass, self.layout, (vertex, Some(ml_shaders::OMNI_SHADOW_FRAG)))?;
         let extent = shape.extent;
         match settings.mode {
@@ -112,30 +118,33 @@ impl OmniShadows {
                 let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
                 self.offscreen = Image::new_2d(ctx, "shadow face", extent, CUBE_FORMAT, usage, DEPTH)?;
                 let view = self.offscreen.view;
-                self.add_framebuffer(ctx, view, size)?;
+                self.add_framebuffer(ctx, view, (size, 1))?;
             }
             OmniShadowMode::Direct => {
                 for layer in 0..layers {
                     let view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D, layer..layer + 1, DEPTH)?;
                     self.targets.push(view);
-                    self.add_framebuffer(ctx, view, size)?;
+                    self.add_framebuffer(ctx, view, (size, 1))?;
                 }
             }
-            OmniShadowMode::Multiview => {
+            OmniShadowMode::Multiview | OmniShadowMode::Layered => {
+                // Multiview: one layer of framebuffer, the view mask spreads it over six;
+                // layered: six framebuffer layers the shader picks from.
                 for cube in 0..cubes {
                     let view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D_ARRAY, cube * 6..cube * 6 + 6, DEPTH)?;
                     self.targets.push(view);
-                    self.add_framebuffer(ctx, view, size)?;
+                    let layers = if multiview { 1 } else { 6 };
+                    self.add_framebuffer(ctx, view, (size, layers))?;
                 }
             }
         }
         Ok(())
     }
 
-    fn add_framebuffer(&mut self, ctx: &Context, view: vk::ImageView, size: u32) -> Result<(), VkError> {
+    fn add_framebuffer(&mut self, ctx: &Context, view: vk::ImageView, (size, layers): (u32, u32)) -> Result<(), VkError> {
         let views = [view];
         let info =
-            vk::FramebufferCreateInfo::default().render_pass(self.render_pass).attachments(&views).width(size).height(size).layers(1);
+            vk::FramebufferCreateInfo::default().render_pass(self.render_pass).attachments(&views).width(size).height(size).layers(layers);
         // SAFETY: valid device; the view matches the render pass's attachment.
         let framebuffer = unsafe { ctx.device.create_framebuffer(&info, None) }.ctx("vkCreateFramebuffer")?;
         self.framebuffers.push(framebuffer);
@@ -168,11 +177,13 @@ impl OmniShadows {
             let near = light.radius * NEAR_FRACTION;
             let reaches = |o: &Object| o.position.distance(light.position) <= light.radius + o.scale * 3f32.sqrt();
             let light_position_radius = light.position.extend(light.radius).to_array();
-            let passes: Vec<(Option<u32>, Mat4)> = if settings.mode == OmniShadowMode::Multiview {
+            let one_pass = matches!(settings.mode, OmniShadowMode::Multiview | OmniShadowMode::Layered);
+            let passes: Vec<(Option<u32>, Mat4)> = if one_pass {
                 vec![(None, Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, near, light.radius))]
             } else {
                 (0..6).map(|face| (Some(face), face_view_proj(light.position, face, near, light.radius))).collect()
             };
+            let instances = if settings.mode == OmniShadowMode::Layered { 6 } else { 1 };
             for (face, view_proj) in passes {
                 let framebuffer = match (settings.mode, face) {
                     (OmniShadowMode::Copy, _) => self.framebuffers[0],
@@ -191,7 +202,7 @@ impl OmniShadows {
                     d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
                     d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
                     depth_pass::set_square_viewport(ctx, cmd, size);
-                    record_draws(ctx, cmd, (meshes, objects), reaches, |_, object| {
+                    record_draws(ctx, cmd, (meshes, objects, instances), reaches, |_, object| {
                         let push = OmniShadowPush {
                             view_proj: view_proj.to_cols_array_2d(),
                             position_scale: object.position.extend(object.scale).to_array(),

@@ -143,16 +143,20 @@ pub enum OmniShadowMode {
     Direct,
     /// All six faces in one pass (VK_KHR_multiview, view i = face i).
     Multiview,
+    /// All six faces in one pass by layered rendering: six instances of each draw, instance i
+    /// writes gl_Layer = i (shaderOutputLayer).
+    Layered,
 }
 
 impl OmniShadowMode {
-    pub const ALL: [OmniShadowMode; 3] = [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview];
+    pub const ALL: [OmniShadowMode; 4] = [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview, OmniShadowMode::Layered];
 
     pub fn name(self) -> &'static str {
         match self {
             OmniShadowMode::Copy => "copy",
             OmniShadowMode::Direct => "direct",
             OmniShadowMode::Multiview => "multiview",
+            OmniShadowMode::Layered => "layered",
         }
     }
 
@@ -381,7 +385,24 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
         ));
     }
     if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
-        return invalid(format!("--omni-shadow multiview needs the multiview feature, which '{}' lacks: use copy or direct", ctx.info.name));
+        return invalid(format!("--omni-shadow multiview needs the multiview feature, which '{}' lacks: use layered, direct or copy", ctx.info.name));
+    }
+    if omni.mode == OmniShadowMode::Multiview && multiview_depth_is_broken(ctx) {
+        return invalid(format!(
+            "--omni-shadow multiview: '{}' ({}) renders every view of a depth-only multiview pass into the first layer (measured on Mesa 22.3 lavapipe): use layered, direct or copy",
+            ctx.info.name, ctx.info.driver_info
+        ));
+    }
+    if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
+        return invalid(format!("--omni-shadow layered needs the shaderOutputLayer feature, which '{}' lacks: use direct or copy", ctx.info.name));
     }
     Ok(())
+}
+
+/// Whether the driver is one that renders a depth-only multiview pass wrong: Mesa's
+/// lavapipe 22.3 (Debian 12's) draws all six views into layer 0 — found by the shadow-cube
+/// debug view; the same pass on the H100 matches `direct` exactly (docs/BENCHMARKS.md).
+/// Later Mesa releases are not known to be fixed, so every lavapipe refuses it.
+pub fn multiview_depth_is_broken(ctx: &Context) -> bool {
+    ctx.info.name.starts_with("llvmpipe")
 }

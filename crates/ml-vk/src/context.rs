@@ -45,6 +45,8 @@ pub struct OptionalFeatures {
     pub image_cube_array: bool,
     /// VK_KHR_multiview, core in 1.1 (one pass renders all six faces of a shadow cube).
     pub multiview: bool,
+    /// shaderOutputLayer (Vulkan 1.2): a vertex shader picks the layer it draws into.
+    pub shader_output_layer: bool,
 }
 
 impl DeviceInfo {
@@ -162,13 +164,18 @@ impl InstanceParts {
             unsafe { self.instance.get_physical_device_properties2(pd, &mut props2) };
         }
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default();
+        let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
         let mut features = OptionalFeatures::default();
         if props.api_version >= MIN_API {
-            let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v11);
+            let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v11).push_next(&mut v12);
             // SAFETY: core in 1.1+, and the device reports 1.2+.
             unsafe { self.instance.get_physical_device_features2(pd, &mut features2) };
             let image_cube_array = features2.features.image_cube_array == vk::TRUE;
-            features = OptionalFeatures { image_cube_array, multiview: v11.multiview == vk::TRUE };
+            features = OptionalFeatures {
+                image_cube_array,
+                multiview: v11.multiview == vk::TRUE,
+                shader_output_layer: v12.shader_output_layer == vk::TRUE,
+            };
         }
         let name = c_text(props.device_name_as_c_str());
         DeviceInfo {
@@ -317,7 +324,9 @@ impl Context {
         let features = info.features;
         let core = vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array);
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
-        let info_create = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut v11);
+        let mut v12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(features.shader_output_layer);
+        let info_create =
+            vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut v11).push_next(&mut v12);
         // SAFETY: valid physical device and create info; only supported features are enabled.
         let device = unsafe { parts.instance.create_device(pd, &info_create, None) }.ctx("vkCreateDevice")?;
         Ok((pd, info, device, family, family_props.timestamp_valid_bits))

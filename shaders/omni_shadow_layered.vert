@@ -1,0 +1,13 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#extension GL_ARB_shader_viewport_layer_array : require
+// Point-light shadow cubes, all six faces in one pass (--omni-shadow layered): each draw has
+// six instances, instance i renders face i into layer i of the light's six.
+#include "common.glsl"
+#include "omni_shadow_vertex.glsl"
+
+void main() {
+    out_to_light = omni_world_position() - omni.light_position_radius.xyz;
+    gl_Layer = gl_InstanceIndex;
+    gl_Position = omni_face_clip(out_to_light, gl_InstanceIndex);
+}
