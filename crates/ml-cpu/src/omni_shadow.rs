@@ -57,8 +57,10 @@ pub enum Solid {
 }
 
 /// The scene's objects as solids; None if one has a mesh the ray test does not model.
+/// Blocks stacked face to face (a pillar of cubes) become one, so that shrinking it for the
+/// margin does not open gaps between them.
 pub fn solids(scene: &Scene) -> Option<Vec<Solid>> {
-    scene
+    let mut all: Vec<Solid> = scene
         .objects
         .iter()
         .map(|o| {
@@ -70,7 +72,24 @@ pub fn solids(scene: &Scene) -> Option<Vec<Solid>> {
                 _ => None,
             }
         })
-        .collect()
+        .collect::<Option<_>>()?;
+    while let Some((i, j, merged)) = (0..all.len())
+        .flat_map(|i| (0..all.len()).map(move |j| (i, j)))
+        .find_map(|(i, j)| if i < j { merged_blocks(&all[i], &all[j]).map(|m| (i, j, m)) } else { None })
+    {
+        all[i] = merged;
+        all.remove(j);
+    }
+    Some(all)
+}
+
+/// Two blocks whose union is a box (equal in two axes, touching or overlapping in the third).
+fn merged_blocks(a: &Solid, b: &Solid) -> Option<Solid> {
+    let (Solid::Block { lo: alo, hi: ahi }, Solid::Block { lo: blo, hi: bhi }) = (*a, *b) else { return None };
+    let same = (alo - blo).abs().cmple(Vec3::splat(1e-6)) & (ahi - bhi).abs().cmple(Vec3::splat(1e-6));
+    let touch = alo.cmple(bhi + Vec3::splat(1e-6)) & blo.cmple(ahi + Vec3::splat(1e-6));
+    let differing = (!same).bitmask().count_ones();
+    (differing <= 1 && touch.all()).then(|| Solid::Block { lo: alo.min(blo), hi: ahi.max(bhi) })
 }
 
 /// Entry and exit distances of the ray (origin, unit dir) through the box, if it meets it.
@@ -226,7 +245,10 @@ mod tests {
         let floor = |x: f32, z: f32| light_sight(&all, Vec3::new(x, -5.0, z), Vec3::Y, light, 0.05);
         assert_eq!(floor(-4.0, -1.0), Sight::Shadowed);
         assert_eq!(floor(-4.0, 2.0), Sight::Lit);
-        assert!(solids(&Scene::shadow_room()).is_some());
+        // The room's pillar of three cubes is one block.
+        let room_solids = solids(&Scene::shadow_room()).unwrap();
+        assert_eq!(room_solids.len(), 2);
+        assert_eq!(room_solids[1], Solid::Block { lo: Vec3::new(1.0, -5.0, 0.0), hi: Vec3::new(2.0, -2.0, 1.0) });
     }
 
     #[test]

@@ -75,7 +75,8 @@ impl Scene {
         }
         Scene {
             objects,
-            lights: vec![PointLight { position_radius: [-1.0, 0.5, -1.0, 20.0], color: [3.0, 3.0, 3.0, 0.0] }],
+            // Below the pillar's top, so its shadow crosses the floor and climbs the far wall.
+            lights: vec![PointLight { position_radius: [-1.5, -2.5, -1.5, 20.0], color: [3.0, 3.0, 3.0, 0.0] }],
             camera: Camera::looking_at(Vec3::new(-4.2, 2.5, -4.0), Vec3::new(2.0, -3.0, 2.0), 75.0, 0.05, 50.0),
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),
