@@ -29,6 +29,24 @@ pub fn face_view_proj(light: Vec3, face: u32, near: f32, far: f32) -> Mat4 {
     Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, near, far) * Mat4::look_at_rh(light, light + forward, up)
 }
 
+/// The cube faces (bit i: face i, in `face_axes` order) whose 90° pyramid a sphere at
+/// `centre` (relative to the light) of `radius` may reach: conservative, from the four
+/// planes that bound each pyramid.
+pub fn sphere_faces(centre: Vec3, radius: f32) -> u32 {
+    let reach = radius * std::f32::consts::SQRT_2;
+    let c = centre.to_array();
+    let mut mask = 0;
+    for face in 0..6 {
+        let (axis, sign) = (face as usize / 2, if face % 2 == 0 { 1.0 } else { -1.0 });
+        let along = sign * c[axis];
+        let inside = (0..3).filter(|&o| o != axis).all(|o| along - c[o].abs() >= -reach);
+        if inside {
+            mask |= 1 << face;
+        }
+    }
+    mask
+}
+
 /// The `k` lights that get a shadow cube: the strongest as seen from `eye` — colour
 /// luminance × radius over the distance from the eye to the light's sphere (ties: lower
 /// index). Returns light indices, strongest first.
@@ -201,6 +219,24 @@ mod tests {
                 let expect = |i: u32| 2.0 * (i as f32 + 0.5) / size as f32 - 1.0;
                 assert!((ndc.x - expect(x)).abs() < 1e-4 && (ndc.y - expect(y)).abs() < 1e-4, "face {face} texel ({x}, {y}): {ndc}");
                 assert!((0.0..=1.0).contains(&ndc.z));
+            }
+        }
+    }
+
+    #[test]
+    fn a_sphere_is_drawn_into_the_faces_it_reaches() {
+        assert_eq!(sphere_faces(Vec3::new(5.0, 0.0, 0.0), 1.0), 0b000001);
+        assert_eq!(sphere_faces(Vec3::new(0.0, -5.0, 0.0), 1.0), 0b001000);
+        // On the +X/+Z edge: both faces.
+        assert_eq!(sphere_faces(Vec3::new(5.0, 0.0, 5.0), 0.5), 0b010001);
+        // Around the light: every face.
+        assert_eq!(sphere_faces(Vec3::new(0.2, 0.0, 0.0), 1.0), 0b111111);
+        // Every texel direction of a face lies in that face's pyramid: a tiny sphere there
+        // is drawn into it.
+        for face in 0..6 {
+            for (x, y) in [(0, 0), (15, 15), (3, 12), (8, 8)] {
+                let d = cube_direction(face, x, y, 16) * 4.0;
+                assert!(sphere_faces(d, 1e-3) & (1 << face) != 0, "face {face} ({x}, {y})");
             }
         }
     }

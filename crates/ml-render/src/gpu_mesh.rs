@@ -58,20 +58,25 @@ pub fn vertex_attributes() -> [vk::VertexInputAttributeDescription; 4] {
     .expect("four attributes")
 }
 
-/// Record the indexed draws of `objects` that `keep` accepts, `instances` instances each:
-/// per mesh, its buffers bound, then its objects in scene order, each after
-/// `push(index in the scene, object)` (which records the draw's push constants).
+/// Record the indexed draws of `objects` whose instance mask (`instances`: bit i asks for
+/// instance i; 0 skips the object) is not empty: per mesh, its buffers bound, then its
+/// objects in scene order, each after `push(index in the scene, object)` (which records the
+/// draw's push constants), one draw per run of consecutive instances.
 pub fn record_draws(
     ctx: &Context,
     cmd: vk::CommandBuffer,
-    (meshes, objects, instances): (&[GpuMesh], &[Object], u32),
-    keep: impl Fn(&Object) -> bool,
+    (meshes, objects): (&[GpuMesh], &[Object]),
+    instances: impl Fn(&Object) -> u32,
     mut push: impl FnMut(u32, &Object),
 ) {
     let d = &ctx.device;
     for mesh in meshes {
         let mut bound = false;
-        for (index, object) in objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind && keep(o)) {
+        for (index, object) in objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
+            let mut mask = instances(object);
+            if mask == 0 {
+                continue;
+            }
             // SAFETY: recording state inside a render pass with a pipeline bound; the
             // buffers are alive while the command buffer is.
             unsafe {
@@ -81,7 +86,12 @@ pub fn record_draws(
                     bound = true;
                 }
                 push(index as u32, object);
-                d.cmd_draw_indexed(cmd, mesh.index_count, instances, 0, 0, 0);
+                while mask != 0 {
+                    let first = mask.trailing_zeros();
+                    let count = (mask >> first).trailing_ones();
+                    d.cmd_draw_indexed(cmd, mesh.index_count, count, 0, 0, first);
+                    mask &= !((((1u64 << count) - 1) as u32) << first);
+                }
             }
         }
     }

@@ -6,8 +6,8 @@
 //! Four ways to fill it, one image: `copy` (seed 003: each face into one offscreen depth
 //! target, then an image copy into the cube's layer), `direct` (each face straight into its
 //! layer, a framebuffer per layer), and one pass per light for all six faces: `multiview`
-//! (VK_KHR_multiview, view i = face i) or `layered` (six instances per draw, instance i
-//! writes gl_Layer = i). Without
+//! (VK_KHR_multiview, view i = face i) or `layered` (instance i of a draw writes
+//! gl_Layer = i; each object is drawn as the instances of the faces it reaches). Without
 //! shadowed lights the array is a cleared 1×1 stand-in the shaders never sample.
 
 use crate::depth_pass::{self, DepthPassDesc};
@@ -15,7 +15,7 @@ use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::settings::{OmniShadowMode, OmniShadowSettings};
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
-use ml_cpu::omni_shadow::face_view_proj;
+use ml_cpu::omni_shadow::{face_view_proj, sphere_faces};
 use ml_cpu::scene::Object;
 use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 
@@ -175,7 +175,15 @@ impl OmniShadows {
         }
         for (cube, light) in lights.iter().enumerate().take(settings.lights as usize) {
             let near = light.radius * NEAR_FRACTION;
-            let reaches = |o: &Object| o.position.distance(light.position) <= light.radius + o.scale * 3f32.sqrt();
+            // Objects are drawn into the faces their bounding sphere reaches (none when it
+            // misses the light's sphere).
+            let faces = |o: &Object| {
+                let bound = o.scale * 3f32.sqrt();
+                if o.position.distance(light.position) > light.radius + bound {
+                    return 0;
+                }
+                sphere_faces(o.position - light.position, bound)
+            };
             let light_position_radius = light.position.extend(light.radius).to_array();
             let one_pass = matches!(settings.mode, OmniShadowMode::Multiview | OmniShadowMode::Layered);
             let passes: Vec<(Option<u32>, Mat4)> = if one_pass {
@@ -183,7 +191,7 @@ impl OmniShadows {
             } else {
                 (0..6).map(|face| (Some(face), face_view_proj(light.position, face, near, light.radius))).collect()
             };
-            let instances = if settings.mode == OmniShadowMode::Layered { 6 } else { 1 };
+
             for (face, view_proj) in passes {
                 let framebuffer = match (settings.mode, face) {
                     (OmniShadowMode::Copy, _) => self.framebuffers[0],
@@ -202,7 +210,15 @@ impl OmniShadows {
                     d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
                     d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
                     depth_pass::set_square_viewport(ctx, cmd, size);
-                    record_draws(ctx, cmd, (meshes, objects, instances), reaches, |_, object| {
+                    // Per-face passes draw an object if it reaches their face; layered draws
+                    // instance i (face i) of each face it reaches; multiview draws every view.
+                    let instances = |o: &Object| match (settings.mode, face) {
+                        (OmniShadowMode::Layered, _) => faces(o),
+                        (OmniShadowMode::Multiview, _) => u32::from(faces(o) != 0),
+                        (_, Some(f)) => (faces(o) >> f) & 1,
+                        (_, None) => 0,
+                    };
+                    record_draws(ctx, cmd, (meshes, objects), instances, |_, object| {
                         let push = OmniShadowPush {
                             view_proj: view_proj.to_cols_array_2d(),
                             position_scale: object.position.extend(object.scale).to_array(),

@@ -277,7 +277,7 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
                 if let Some(s) = inputs {
                     d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
                     depth_pass::set_square_viewport(ctx, cmd, target.extent.width);
-                    record_draws(ctx, cmd, (s.meshes, &s.scene.objects, 1), |_| true, |index, object| {
+                    record_draws(ctx, cmd, (s.meshes, &s.scene.objects), |_| 1, |index, object| {
                         let push = ShadowPush { object: object_push(object, index), light_view_proj: s.view_proj.to_cols_array_2d() };
                         d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
                     });

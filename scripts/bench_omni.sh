@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Issue 6's measurement: GPU ms of the point-light shadow pass (every cube rendered every
+# frame) for 1, 4 and 16 shadowed lights, cube faces of 1024², by each way of filling the
+# cubes; the seed scene (49 spheres, the seed's 64 grid lights of radius 15), 1280×720,
+# seed shading with forward. Usage: scripts/bench_omni.sh [BINARY] [OUTDIR] [FRAMES]
+# A mode the device refuses (multiview on lavapipe) prints its one-line reason.
+set -euo pipefail
+bin=${1:-target/release/manylights}
+out=${2:-bench-omni}
+frames=${3:-20}
+mkdir -p "$out"
+for k in 1 4 16; do
+  for mode in copy direct multiview layered; do
+    echo "== $mode, $k shadowed lights, $frames frames"
+    "$bin" render --omni-shadow "$mode" --shadowed-lights "$k" --cube-size "${CUBE:-1024}" --width 1280 --height 720 \
+      --frames "$frames" --out "$out/$mode-$k.png" 2>&1 | grep -E "gpu ms|device|error" || true
+  done
+done
