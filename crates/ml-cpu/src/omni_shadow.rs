@@ -66,12 +66,21 @@ pub fn shadowed_lights(lights: &[PointLight], k: usize, eye: Vec3) -> Vec<u32> {
 /// A scene object as the CPU ray test sees it (analytic shapes of the built-in meshes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Solid {
-    Sphere { centre: Vec3, radius: f32 },
+    Sphere {
+        centre: Vec3,
+        radius: f32,
+    },
     /// A box seen from outside (the cube mesh).
-    Block { lo: Vec3, hi: Vec3 },
+    Block {
+        lo: Vec3,
+        hi: Vec3,
+    },
     /// A box seen from inside (the room mesh): its walls face inwards and shadow nothing
     /// inside it (a box is convex).
-    Room { lo: Vec3, hi: Vec3 },
+    Room {
+        lo: Vec3,
+        hi: Vec3,
+    },
 }
 
 /// The scene's objects as solids; None if one has a mesh the ray test does not model.
@@ -91,10 +100,13 @@ pub fn solids(scene: &Scene) -> Option<Vec<Solid>> {
             }
         })
         .collect::<Option<_>>()?;
-    while let Some((i, j, merged)) = (0..all.len())
-        .flat_map(|i| (0..all.len()).map(move |j| (i, j)))
-        .find_map(|(i, j)| if i < j { merged_blocks(&all[i], &all[j]).map(|m| (i, j, m)) } else { None })
-    {
+    while let Some((i, j, merged)) = (0..all.len()).flat_map(|i| (0..all.len()).map(move |j| (i, j))).find_map(|(i, j)| {
+        if i < j {
+            merged_blocks(&all[i], &all[j]).map(|m| (i, j, m))
+        } else {
+            None
+        }
+    }) {
         all[i] = merged;
         all.remove(j);
     }
@@ -171,11 +183,7 @@ impl Solid {
 
 /// The first solid a ray meets: its index, distance and normal.
 pub fn first_hit(solids: &[Solid], origin: Vec3, dir: Vec3) -> Option<(usize, f32, Vec3)> {
-    solids
-        .iter()
-        .enumerate()
-        .filter_map(|(i, s)| s.hit(origin, dir).map(|(t, n)| (i, t, n)))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
+    solids.iter().enumerate().filter_map(|(i, s)| s.hit(origin, dir).map(|(t, n)| (i, t, n))).min_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// What the CPU ray test says of a light at a surface point.

@@ -18,8 +18,9 @@ pub struct DepthPassDesc {
     pub view_mask: u32,
 }
 
-const TESTS: vk::PipelineStageFlags =
-    vk::PipelineStageFlags::from_raw(vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS.as_raw());
+const TESTS: vk::PipelineStageFlags = vk::PipelineStageFlags::from_raw(
+    vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS.as_raw(),
+);
 
 pub fn render_pass(ctx: &Context, desc: &DepthPassDesc) -> Result<vk::RenderPass, VkError> {
     let attachment = [vk::AttachmentDescription::default()

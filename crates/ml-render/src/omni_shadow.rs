@@ -77,11 +77,11 @@ impl OmniShadows {
     fn create(&mut self, ctx: &Context) -> Result<(), VkError> {
         let (cubes, size) = self.settings.map_or((1, 1), |s| (s.lights, s.size));
         let layers = cubes * 6;
-        let shape = ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, layers, view: vk::ImageViewType::CUBE_ARRAY };
+        let shape =
+            ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, layers, view: vk::ImageViewType::CUBE_ARRAY };
         // The shaders read it in DEPTH_STENCIL_READ_ONLY_OPTIMAL, which needs the attachment
         // usage even where only copies (or the stand-in's clear) write it.
-        let usage =
-            vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_DST;
+        let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_DST;
         self.cubes = Image::new(ctx, "shadow cubes", shape, CUBE_FORMAT, usage, DEPTH)?;
         self.faces_view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D_ARRAY, 0..layers, DEPTH)?;
         let Some(settings) = self.settings else {
@@ -100,8 +100,7 @@ impl OmniShadows {
         };
         let multiview = settings.mode == OmniShadowMode::Multiview;
         let view_mask = if multiview { 0b11_1111 } else { 0 };
-        self.render_pass =
-            depth_pass::render_pass(ctx, &DepthPassDesc { format: CUBE_FORMAT, final_layout, after, readers, view_mask })?;
+        self.render_pass = depth_pass::render_pass(ctx, &DepthPassDesc { format: CUBE_FORMAT, final_layout, after, readers, view_mask })?;
         let push = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             .size(size_of::<OmniShadowPush>() as u32)];
@@ -235,7 +234,12 @@ impl OmniShadows {
             }
         }
         if copy {
-            self.barrier(ctx, cmd, TRANSFER_DST, (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
+            self.barrier(
+                ctx,
+                cmd,
+                TRANSFER_DST,
+                (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            );
         }
     }
 
@@ -244,10 +248,11 @@ impl OmniShadows {
     fn copy_face(&self, ctx: &Context, cmd: vk::CommandBuffer, layer: u32) {
         let subresource = |base: u32| vk::ImageSubresourceLayers::default().aspect_mask(DEPTH).base_array_layer(base).layer_count(1);
         let size = self.offscreen.extent;
-        let region = [vk::ImageCopy::default()
-            .src_subresource(subresource(0))
-            .dst_subresource(subresource(layer))
-            .extent(vk::Extent3D { width: size.width, height: size.height, depth: 1 })];
+        let region = [vk::ImageCopy::default().src_subresource(subresource(0)).dst_subresource(subresource(layer)).extent(vk::Extent3D {
+            width: size.width,
+            height: size.height,
+            depth: 1,
+        })];
         // SAFETY: recording state outside a render pass; both images are alive, in the
         // layouts named, and the region lies within both.
         unsafe {
@@ -318,12 +323,30 @@ fn transition(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: Sta
 /// The stand-in: every layer cleared to 1.0 (nothing in reach), left as the shaders expect.
 fn clear_stand_in(ctx: &Context, cubes: &Image) -> Result<(), VkError> {
     ml_vk::commands::one_shot(ctx, |cmd| {
-        transition(ctx, cmd, cubes.raw, (vk::PipelineStageFlags::TOP_OF_PIPE, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), TRANSFER_DST);
+        transition(
+            ctx,
+            cmd,
+            cubes.raw,
+            (vk::PipelineStageFlags::TOP_OF_PIPE, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED),
+            TRANSFER_DST,
+        );
         let clear = vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 };
         // SAFETY: recording state; the image is in TRANSFER_DST_OPTIMAL.
         unsafe {
-            ctx.device.cmd_clear_depth_stencil_image(cmd, cubes.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &clear, &[ml_vk::image::full_range(DEPTH)])
+            ctx.device.cmd_clear_depth_stencil_image(
+                cmd,
+                cubes.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &clear,
+                &[ml_vk::image::full_range(DEPTH)],
+            )
         };
-        transition(ctx, cmd, cubes.raw, TRANSFER_DST, (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
+        transition(
+            ctx,
+            cmd,
+            cubes.raw,
+            TRANSFER_DST,
+            (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+        );
     })
 }

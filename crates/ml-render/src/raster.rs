@@ -253,11 +253,17 @@ impl RasterPass {
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[area]);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[frame.set, frame.textures], &[]);
-            record_draws(ctx, cmd, (draws.meshes, draws.objects), |_| 1, |index, object| {
-                let push = object_push(object, index);
-                let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-                d.cmd_push_constants(cmd, self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
-            });
+            record_draws(
+                ctx,
+                cmd,
+                (draws.meshes, draws.objects),
+                |_| 1,
+                |index, object| {
+                    let push = object_push(object, index);
+                    let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                    d.cmd_push_constants(cmd, self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
+                },
+            );
             if legend {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.legend_pipeline);
                 d.cmd_draw(cmd, 6, 1, 0, 0);

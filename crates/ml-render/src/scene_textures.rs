@@ -100,7 +100,12 @@ impl SceneTextures {
         self.set = allocate_set(ctx, self.pool, self.set_layout)?;
 
         let rgba = vk::Format::R8G8B8A8_UNORM;
-        let flat = |size: u32| ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, layers: 1, view: vk::ImageViewType::TYPE_2D };
+        let flat = |size: u32| ImageShape {
+            extent: vk::Extent2D { width: size, height: size },
+            levels: 1,
+            layers: 1,
+            view: vk::ImageViewType::TYPE_2D,
+        };
         if real {
             // A mip chain as texture_with takes it: per level, its one layer.
             let mipmapped = |name: &str, m: &textures::MipChain| {
@@ -136,7 +141,8 @@ impl SceneTextures {
         // the lit fraction changes continuously with the position: a position rebuilt from
         // depth (deferred) then moves it by as little as the position moved, where a nearest
         // tap would jump by a ninth of the sun across a texel boundary.
-        let shadow_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_BORDER, depth_filter(ctx, depth_format), Some(vk::CompareOp::LESS_OR_EQUAL))?;
+        let shadow_sampler =
+            sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_BORDER, depth_filter(ctx, depth_format), Some(vk::CompareOp::LESS_OR_EQUAL))?;
         self.samplers.push(shadow_sampler);
         // The point-light cubes compare the same way (cube sampling never leaves the cube).
         let omni_filter = depth_filter(ctx, omni_shadow::CUBE_FORMAT);
@@ -277,10 +283,16 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
                 if let Some(s) = inputs {
                     d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
                     depth_pass::set_square_viewport(ctx, cmd, target.extent.width);
-                    record_draws(ctx, cmd, (s.meshes, &s.scene.objects), |_| 1, |index, object| {
-                        let push = ShadowPush { object: object_push(object, index), light_view_proj: s.view_proj.to_cols_array_2d() };
-                        d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
-                    });
+                    record_draws(
+                        ctx,
+                        cmd,
+                        (s.meshes, &s.scene.objects),
+                        |_| 1,
+                        |index, object| {
+                            let push = ShadowPush { object: object_push(object, index), light_view_proj: s.view_proj.to_cols_array_2d() };
+                            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
+                        },
+                    );
                 }
                 d.cmd_end_render_pass(cmd);
             }

@@ -369,7 +369,10 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
     }
     let max_cubes = limits.max_image_array_layers / 6;
     if omni.lights > max_cubes {
-        return invalid(format!("--shadowed-lights {} is more than the {max_cubes} shadow cubes '{}' holds in one array", omni.lights, ctx.info.name));
+        return invalid(format!(
+            "--shadowed-lights {} is more than the {max_cubes} shadow cubes '{}' holds in one array",
+            omni.lights, ctx.info.name
+        ));
     }
     let max_size = limits.max_image_dimension_cube.min(MAX_DIMENSION);
     if omni.size == 0 || omni.size > max_size {
@@ -385,7 +388,10 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
         ));
     }
     if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
-        return invalid(format!("--omni-shadow multiview needs the multiview feature, which '{}' lacks: use layered, direct or copy", ctx.info.name));
+        return invalid(format!(
+            "--omni-shadow multiview needs the multiview feature, which '{}' lacks: use layered, direct or copy",
+            ctx.info.name
+        ));
     }
     if omni.mode == OmniShadowMode::Multiview && multiview_depth_is_broken(ctx) {
         return invalid(format!(
@@ -394,7 +400,10 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
         ));
     }
     if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
-        return invalid(format!("--omni-shadow layered needs the shaderOutputLayer feature, which '{}' lacks: use direct or copy", ctx.info.name));
+        return invalid(format!(
+            "--omni-shadow layered needs the shaderOutputLayer feature, which '{}' lacks: use direct or copy",
+            ctx.info.name
+        ));
     }
     Ok(())
 }

@@ -2,7 +2,9 @@
 //! reflection of the compiled shaders reports (seed mistake 5: the std140 trap). A field
 //! moved on either side fails here.
 
-use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectPush, OmniShadowPush, PointLight, ShadowPush};
+use ml_cpu::gpu_types::{
+    ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectPush, OmniShadowPush, PointLight, ShadowPush,
+};
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
 use std::collections::HashMap;

@@ -135,7 +135,11 @@ fn ray_test(scene: &Scene, size: u32, mode: OmniShadowMode) -> RayTestResult {
 
 fn assert_matches(what: &str, r: &RayTestResult, min_lit: usize, min_shadowed: usize) {
     println!("{what}: {} lit, {} shadowed, {} mixed pixels checked; {} wrong", r.lit, r.shadowed, r.mixed, r.wrong.len());
-    assert!(r.wrong.is_empty(), "{what}: pixels that disagree with the ray test (pixel, rendered, expected): {:?}", &r.wrong[..r.wrong.len().min(12)]);
+    assert!(
+        r.wrong.is_empty(),
+        "{what}: pixels that disagree with the ray test (pixel, rendered, expected): {:?}",
+        &r.wrong[..r.wrong.len().min(12)]
+    );
     assert!(r.lit >= min_lit && r.shadowed >= min_shadowed, "{what}: too few pixels checked");
 }
 
