@@ -178,6 +178,9 @@ fn render(args: &RenderArgs) -> Result<()> {
         clusters: ClusterDims::parse(&args.clusters)?,
         debug_view: DebugView::from_name(&args.debug_view)?,
         omni: match args.omni_shadow.as_str() {
+            "off" if args.shadowed_lights != 1 || args.cube_size != OmniShadowSettings::DEFAULT_SIZE => {
+                bail!("--shadowed-lights and --cube-size need point-light shadows: add --omni-shadow layered|direct|multiview|copy")
+            }
             "off" => None,
             mode => Some(OmniShadowSettings { mode: OmniShadowMode::from_name(mode)?, lights: args.shadowed_lights, size: args.cube_size }),
         },

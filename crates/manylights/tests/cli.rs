@@ -102,6 +102,9 @@ fn bad_names_are_refused_with_the_choices() {
     );
     assert_one_line_error(&manylights(&["render", "--shading", "phong", "--out", p], &[]), &["phong", "blinn-phong", "pbr"]);
     assert_one_line_error(&manylights(&["render", "--debug-view", "shadow-map", "--out", p], &[]), &["shadow-map", "blinn-phong"]);
+    assert_one_line_error(&manylights(&["render", "--omni-shadow", "sideways", "--out", p], &[]), &["sideways", "layered"]);
+    assert_one_line_error(&manylights(&["render", "--debug-view", "shadow-cube", "--out", p], &[]), &["shadow-cube", "--omni-shadow"]);
+    assert_one_line_error(&manylights(&["render", "--shadowed-lights", "4", "--out", p], &[]), &["--shadowed-lights", "--omni-shadow"]);
     assert!(!png.exists());
 }
 
@@ -127,6 +130,13 @@ fn absurd_sizes_and_counts_are_refused() {
     assert_one_line_error(&manylights(&["render", "--width", "0", "--out", p], &[]), &["--width 0"]);
     assert_one_line_error(&manylights(&["render", "--height", "100000", "--out", p], &[]), &["--height 100000"]);
     assert_one_line_error(&manylights(&["render", "--frames", "0", "--out", p], &[]), &["--frames"]);
+    let omni = |k: &str, size: &str| {
+        manylights(&["render", "--omni-shadow", "direct", "--shadowed-lights", k, "--cube-size", size, "--out", p], &[])
+    };
+    assert_one_line_error(&omni("65", "64"), &["--shadowed-lights 65", "64 lights"]);
+    assert_one_line_error(&omni("0", "64"), &["--shadowed-lights 0"]);
+    assert_one_line_error(&omni("1", "0"), &["--cube-size 0"]);
+    assert_one_line_error(&omni("64", "8192"), &["shadow cubes", "MiB"]);
     assert!(!png.exists());
 }
 
