@@ -98,6 +98,9 @@ fn with_lights(scene: &Scene, on: &[bool]) -> Scene {
     s
 }
 
+/// A pixel, what was rendered there and what the ray test expected.
+type Disagreement = ((u32, u32), [u8; 3], [u8; 3]);
+
 struct RayTestResult {
     /// Pixels checked where every light reaches / none does / some do.
     lit: usize,
@@ -106,7 +109,7 @@ struct RayTestResult {
     /// Pixels checked per light pattern (which lights reach them).
     patterns: HashMap<Vec<bool>, usize>,
     /// Checked pixels further than 1/255 from the expected render.
-    wrong: Vec<((u32, u32), [u8; 3], [u8; 3])>,
+    wrong: Vec<Disagreement>,
 }
 
 /// Render `scene` with every light shadowed (`mode`) and compare every sure pixel.
