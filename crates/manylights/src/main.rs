@@ -8,6 +8,7 @@ use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
+use ml_cpu::scene_file;
 use ml_render::report::table;
 use ml_render::targets::gbuffer_bytes_per_pixel;
 use ml_render::{DebugView, HeadlessRenderer, OmniShadowMode, OmniShadowSettings, RenderSettings, ShadingModel, Technique};
@@ -33,8 +34,8 @@ enum Command {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Scene to render (built in: seed; room: a closed room with a pillar and one point light,
-    /// for point-light shadows).
+    /// Scene to render: seed (built in), room (a closed room with a pillar and one point light,
+    /// for point-light shadows), or a scene file FILE.toml (README: "Scene files").
     #[arg(long, default_value = "seed")]
     scene: String,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
@@ -43,9 +44,9 @@ struct RenderArgs {
     technique: String,
     /// Shading model: seed (seed 000's Cook–Torrance), blinn-phong (seed 002: shadowed sun,
     /// spot light, textures, normal maps, sky reflections) or pbr (seed's specular + Lambert
-    /// diffuse, ACES tone map).
-    #[arg(long, default_value = "seed")]
-    shading: String,
+    /// diffuse, ACES tone map). Default: the scene file's [shading] model, else seed.
+    #[arg(long)]
+    shading: Option<String>,
     /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).
     #[arg(long, default_value = "16x9x24")]
     clusters: String,
@@ -60,9 +61,10 @@ struct RenderArgs {
     /// Material: gold, copper, chromium, nickel, titanium, cobalt, platinum, white, red, blue, black.
     #[arg(long, default_value = "gold")]
     material: String,
-    /// Number of point lights.
-    #[arg(long, default_value_t = 64)]
-    lights: u64,
+    /// Number of point lights (default 64; with a scene file: replaces the file's lights with
+    /// N lights of --light-layout).
+    #[arg(long)]
+    lights: Option<u64>,
     /// Light placement: grid (the seed's) or random (uniform in x,z ∈ [−20,20], y ∈ [−2,12]).
     #[arg(long, default_value = "grid")]
     light_layout: String,
@@ -133,22 +135,40 @@ fn main() -> ExitCode {
     }
 }
 
-fn build_scene(args: &RenderArgs) -> Result<Scene> {
-    if args.scene == "room" {
-        return Ok(Scene::shadow_room());
-    }
-    if args.scene != "seed" {
-        bail!("unknown scene '{}': expected seed or room", args.scene);
-    }
-    let lights = LightParams {
-        count: LightParams::check_count(args.lights)?,
-        layout: LightLayout::from_name(&args.light_layout)?,
-        seed: args.light_seed,
-        radius: RadiusRange::parse(&args.light_radius)?,
+/// The scene and the shading model to render it with.
+fn build_scene(args: &RenderArgs) -> Result<(Scene, ShadingModel)> {
+    let lights = |count: u64| -> Result<LightParams> {
+        Ok(LightParams {
+            count: LightParams::check_count(count)?,
+            layout: LightLayout::from_name(&args.light_layout)?,
+            seed: args.light_seed,
+            radius: RadiusRange::parse(&args.light_radius)?,
+        })
     };
-    let scene = Scene::seed(MeshKind::from_name(&args.object)?, Material::named(&args.material)?, &lights)?;
-    // Seed 002's lighting wants something to cast shadows on.
-    Ok(if ShadingModel::from_name(&args.shading)? == ShadingModel::BlinnPhong { scene.with_floor() } else { scene })
+    let shading = |file: Option<&str>| ShadingModel::from_name(args.shading.as_deref().or(file).unwrap_or("seed"));
+    match args.scene.as_str() {
+        "room" => Ok((Scene::shadow_room(), shading(None)?)),
+        "seed" => {
+            let model = shading(None)?;
+            let scene =
+                Scene::seed(MeshKind::from_name(&args.object)?, Material::named(&args.material)?, &lights(args.lights.unwrap_or(64))?)?;
+            // Seed 002's lighting wants something to cast shadows on.
+            Ok((if model == ShadingModel::BlinnPhong { scene.with_floor() } else { scene }, model))
+        }
+        path if path.ends_with(".toml") => {
+            let file = scene_file::load(Path::new(path))?;
+            let model = shading(file.shading.as_deref()).with_context(|| format!("scene file '{path}': [shading] model"))?;
+            let mut scene = file.scene;
+            if let Some(n) = args.lights {
+                scene.lights = lights(n)?.build()?;
+            }
+            if scene.lights.is_empty() {
+                bail!("scene file '{path}': no lights: add [[lights]] entries or pass --lights N");
+            }
+            Ok((scene, model))
+        }
+        other => bail!("unknown scene '{other}': expected seed, room or a scene file FILE.toml"),
+    }
 }
 
 /// Fail before rendering if the PNG could not be written: nothing is computed for nothing.
@@ -170,11 +190,11 @@ fn check_output(path: &Path) -> Result<()> {
 
 fn render(args: &RenderArgs) -> Result<()> {
     let technique = Technique::from_name(&args.technique)?;
-    let scene = build_scene(args)?;
+    let (scene, shading) = build_scene(args)?;
     check_output(&args.out)?;
     let settings = RenderSettings {
         technique,
-        shading: ShadingModel::from_name(&args.shading)?,
+        shading,
         clusters: ClusterDims::parse(&args.clusters)?,
         debug_view: DebugView::from_name(&args.debug_view)?,
         omni: match args.omni_shadow.as_str() {

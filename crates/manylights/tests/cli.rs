@@ -165,3 +165,58 @@ fn missing_device_index_is_refused() {
     let png = temp_png("never4.png");
     assert_one_line_error(&manylights(&["render", "--device", "99", "--out", png.to_str().unwrap()], &[]), &["--device 99"]);
 }
+
+/// Each broken text and a fragment of the error it must give.
+fn broken_scene_files() -> Vec<(&'static str, &'static str)> {
+    vec![
+        ("", "missing field `objects`"),
+        ("objects = []", "no objects"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[objects]\n", "line 3"),
+        ("[[objects]]\nmesh = \"sphere\"\ncolour = 1\n", "unknown field `colour`"),
+        ("[[objects]]\nmesh = \"cylinder\"\n", "unknown object 'cylinder'"),
+        ("[[objects]]\n", "needs a mesh"),
+        ("[[objects]]\nmesh = \"sphere\"\ngltf = \"a.gltf\"\n", "either mesh or gltf"),
+        ("[[objects]]\nmesh = 3\n", "invalid type"),
+        ("[[objects]]\nmesh = \"sphere\"\nposition = [1.0, 2.0]\n", "line 3"),
+        ("[[objects]]\nmesh = \"sphere\"\nposition = [nan, 0.0, 0.0]\n", "not a finite number"),
+        ("[[objects]]\nmesh = \"sphere\"\nposition = [inf, 0.0, 0.0]\n", "not a finite number"),
+        ("[[objects]]\nmesh = \"sphere\"\nscale = 0.0\n", "scale 0 must be greater than 0"),
+        ("[[objects]]\nmesh = \"sphere\"\nscale = -2.0\n", "scale -2 must be greater than 0"),
+        ("[[objects]]\nmesh = \"sphere\"\nmaterial = { roughness = 1.5 }\n", "roughness 1.5 must lie in [0, 1]"),
+        ("[[objects]]\nmesh = \"sphere\"\nmaterial = { metallic = -0.1 }\n", "metallic -0.1 must lie in [0, 1]"),
+        ("[[objects]]\nmesh = \"sphere\"\nmaterial = { albedo = [-1.0, 0.0, 0.0] }\n", "albedo -1 must not be negative"),
+        ("[[objects]]\nmesh = \"sphere\"\nmaterial = { name = \"mithril\" }\n", "unknown material 'mithril'"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\ncolor = [1.0, 1.0, 1.0]\n", "missing field `position`"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nposition = [0.0, 1.0, 0.0]\nradius = 0.0\n", "radius 0 must be greater than 0"),
+        (
+            "[[objects]]\nmesh = \"sphere\"\n[[lights]]\nposition = [0.0, 1.0, 0.0]\ncolor = [1.0, -1.0, 0.0]\n",
+            "color -1 must not be negative",
+        ),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"area\"\nposition = [0.0, 1.0, 0.0]\n", "unknown kind 'area'"),
+        ("[[objects]]\nmesh = \"sphere\"\n[camera]\nfov_y_deg = 180.0\n", "fov_y_deg 180"),
+        ("[[objects]]\nmesh = \"sphere\"\n[camera]\nnear = 10.0\nfar = 1.0\n", "near 10 must be less than far 1"),
+        ("[[objects]]\nmesh = \"sphere\"\n[camera]\nposition = [1.0, 1.0, 1.0]\ntarget = [1.0, 1.0, 1.0]\n", "the same point"),
+        ("[[objects]]\nmesh = \"sphere\"\n[camera]\nposition = [0.0, 5.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\n", "straight up or down"),
+        ("[[objects]]\nmesh = \"sphere\"\n[shading]\nambient = -1.0\n", "ambient -1 must not be negative"),
+        ("[[objects]]\nmesh = \"sphere\"\n[shading]\nmodel = 7\n", "invalid type"),
+        ("[[objects]]\nmesh = \"sphere\"\n[camera]\nzoom = 2.0\n", "unknown field `zoom`"),
+        ("objects = \"sphere\"", "invalid type"),
+        ("[[objects]]\nmesh = \"sphere\"\nposition = [1e39, 0.0, 0.0]\n", "not a finite number"),
+    ]
+}
+
+/// Every broken scene file (written by this test from the table above) ends the run with one
+/// error line naming the file and the problem, exit code 1, no PNG.
+#[test]
+fn broken_scene_files_are_refused_one_line_each() {
+    let png = temp_png("never-scene.png");
+    let p = png.to_str().unwrap();
+    for (i, (text, expected)) in broken_scene_files().into_iter().enumerate() {
+        let file = temp_png(&format!("broken-{i}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let out = manylights(&["render", "--scene", file.to_str().unwrap(), "--out", p], &[]);
+        assert_one_line_error(&out, &[expected, file.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(1), "{text:?}");
+    }
+    assert!(!png.exists());
+}

@@ -13,6 +13,7 @@ pub mod mesh;
 pub mod omni_shadow;
 pub mod random_scene;
 pub mod scene;
+pub mod scene_file;
 pub mod shading;
 mod teapot;
 pub mod textures;

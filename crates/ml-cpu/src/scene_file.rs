@@ -1,0 +1,318 @@
+//! Scene files (`--scene FILE.toml`, issue 7): camera, shading, point lights and objects made
+//! of the built-in meshes. Every field is optional but `objects`; unknown fields are errors
+//! (a typo must not be silently ignored). Everything read is checked — finite numbers, sane
+//! ranges, counts and file size limited before anything is allocated — and every problem is
+//! one error naming the file and, where the parser knows it, the line.
+
+use crate::blinn_phong::BlinnPhongLights;
+use crate::camera::Camera;
+use crate::gpu_types::PointLight;
+use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
+use crate::material::Material;
+use crate::mesh::MeshKind;
+use crate::scene::{Object, Scene, SEED_AMBIENT};
+use glam::Vec3;
+use serde::Deserialize;
+use std::path::Path;
+use thiserror::Error;
+
+/// Largest scene file we read (a million objects fit in well under this).
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+/// Most objects a scene file may hold.
+pub const MAX_OBJECTS: usize = 1 << 20;
+
+#[derive(Debug, Error, PartialEq)]
+#[error("scene file '{path}': {problem}")]
+pub struct SceneFileError {
+    pub path: String,
+    pub problem: String,
+}
+
+/// A loaded scene file: the scene, and the shading model it names (checked by the renderer,
+/// which knows the models).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneFile {
+    pub scene: Scene,
+    pub shading: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileScene {
+    camera: Option<FileCamera>,
+    shading: Option<FileShading>,
+    #[serde(default)]
+    lights: Vec<FileLight>,
+    objects: Vec<FileObject>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileCamera {
+    position: Option<[f32; 3]>,
+    target: Option<[f32; 3]>,
+    fov_y_deg: Option<f32>,
+    near: Option<f32>,
+    far: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileShading {
+    model: Option<String>,
+    ambient: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileLight {
+    kind: Option<String>,
+    position: [f32; 3],
+    color: Option<[f32; 3]>,
+    radius: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileObject {
+    mesh: Option<String>,
+    gltf: Option<String>,
+    position: Option<[f32; 3]>,
+    scale: Option<f32>,
+    material: Option<FileMaterial>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileMaterial {
+    /// A built-in material's name (its albedo, roughness and metallic), overridden field by
+    /// field by the others.
+    name: Option<String>,
+    albedo: Option<[f32; 3]>,
+    roughness: Option<f32>,
+    metallic: Option<f32>,
+}
+
+/// Read and check the scene file at `path`.
+pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
+    let fail = |problem: String| SceneFileError { path: path.display().to_string(), problem };
+    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read it: {e}")))?;
+    if meta.is_dir() {
+        return Err(fail("it is a directory, not a file".into()));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(fail(format!("{} bytes is more than the {MAX_FILE_BYTES} a scene file may have", meta.len())));
+    }
+    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read it: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| fail(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
+    parse(&text).map_err(fail)
+}
+
+/// Parse scene-file text; the error is the problem, without the file's name.
+pub fn parse(text: &str) -> Result<SceneFile, String> {
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(format!("{} bytes is more than the {MAX_FILE_BYTES} a scene file may have", text.len()));
+    }
+    let file: FileScene = toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let message = e.message().replace('\n', " ");
+        match line {
+            Some(l) => format!("line {l}: {message}"),
+            None => message,
+        }
+    })?;
+    build(file)
+}
+
+fn build(file: FileScene) -> Result<SceneFile, String> {
+    if file.objects.is_empty() {
+        return Err("no objects: a scene needs at least one [[objects]] entry".into());
+    }
+    if file.objects.len() > MAX_OBJECTS {
+        return Err(format!("{} objects is more than the {MAX_OBJECTS} a scene file may hold", file.objects.len()));
+    }
+    if file.lights.len() as u64 > MAX_LIGHTS {
+        return Err(format!("{} lights is more than the {MAX_LIGHTS} a scene may hold", file.lights.len()));
+    }
+    let objects =
+        file.objects.iter().enumerate().map(|(i, o)| object(o).map_err(|e| format!("objects[{i}]: {e}"))).collect::<Result<Vec<_>, _>>()?;
+    let lights =
+        file.lights.iter().enumerate().map(|(i, l)| light(l).map_err(|e| format!("lights[{i}]: {e}"))).collect::<Result<Vec<_>, _>>()?;
+    let (shading, ambient) = match &file.shading {
+        Some(s) => (s.model.clone(), s.ambient.map(|a| non_negative("[shading] ambient", a)).transpose()?),
+        None => (None, None),
+    };
+    let mut scene = Scene {
+        objects,
+        lights,
+        camera: Camera::seed(),
+        ambient: ambient.unwrap_or(SEED_AMBIENT),
+        blinn_phong: BlinnPhongLights::default(),
+    };
+    scene.camera = camera(file.camera.as_ref(), &scene)?;
+    Ok(SceneFile { scene, shading })
+}
+
+fn finite(what: &str, v: f32) -> Result<f32, String> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{what} {v} is not a finite number"))
+    }
+}
+
+fn vec3(what: &str, v: [f32; 3]) -> Result<Vec3, String> {
+    for x in v {
+        finite(what, x)?;
+    }
+    Ok(Vec3::from(v))
+}
+
+fn positive(what: &str, v: f32) -> Result<f32, String> {
+    if finite(what, v)? > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{what} {v} must be greater than 0"))
+    }
+}
+
+fn non_negative(what: &str, v: f32) -> Result<f32, String> {
+    if finite(what, v)? >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{what} {v} must not be negative"))
+    }
+}
+
+fn unit(what: &str, v: f32) -> Result<f32, String> {
+    if (0.0..=1.0).contains(&finite(what, v)?) {
+        Ok(v)
+    } else {
+        Err(format!("{what} {v} must lie in [0, 1]"))
+    }
+}
+
+fn object(o: &FileObject) -> Result<Object, String> {
+    let mesh = match (&o.mesh, &o.gltf) {
+        (Some(name), None) => MeshKind::from_name(name).map_err(|e| e.to_string())?,
+        (None, Some(_)) => return Err("gltf objects are not supported yet (issue 7): use a built-in mesh".into()),
+        (Some(_), Some(_)) => return Err("give either mesh or gltf, not both".into()),
+        (None, None) => return Err("needs a mesh (a built-in name) or a gltf file".into()),
+    };
+    let mut material = Material::named("white").expect("built in");
+    if let Some(m) = &o.material {
+        if let Some(name) = &m.name {
+            material = Material::named(name).map_err(|e| e.to_string())?;
+        }
+        if let Some(a) = m.albedo {
+            material.albedo = vec3("material albedo", a)?;
+            for x in a {
+                non_negative("material albedo", x)?;
+            }
+        }
+        if let Some(r) = m.roughness {
+            material.roughness = unit("material roughness", r)?;
+        }
+        if let Some(v) = m.metallic {
+            material.metallic = unit("material metallic", v)?;
+        }
+    }
+    Ok(Object {
+        mesh,
+        position: o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO),
+        scale: o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0),
+        material,
+    })
+}
+
+fn light(l: &FileLight) -> Result<PointLight, String> {
+    match l.kind.as_deref() {
+        None | Some("point") => {}
+        Some(kind @ ("spot" | "directional")) => return Err(format!("kind '{kind}' is not supported yet (issue 7): use point lights")),
+        Some(kind) => return Err(format!("unknown kind '{kind}': expected point, spot or directional")),
+    }
+    let p = vec3("position", l.position)?;
+    let radius = l.radius.map(|r| positive("radius", r)).transpose()?.unwrap_or(SEED_RADIUS);
+    let color = l.color.map(|c| vec3("color", c)).transpose()?.unwrap_or(Vec3::ONE);
+    for x in color.to_array() {
+        non_negative("color", x)?;
+    }
+    Ok(PointLight { position_radius: p.extend(radius).to_array(), color: color.extend(0.0).to_array() })
+}
+
+/// The file's camera; fields it leaves out come from a camera framing every object (looking
+/// at the centre of their bounds from above and in front, the whole box in view).
+fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, String> {
+    let (lo, hi) = scene.bounds();
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let fov = match c.and_then(|c| c.fov_y_deg) {
+        Some(f) if finite("[camera] fov_y_deg", f)? > 0.0 && f < 180.0 => f,
+        Some(f) => return Err(format!("[camera] fov_y_deg {f} must lie strictly between 0 and 180")),
+        None => 60.0,
+    };
+    let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
+    let position = match c.and_then(|c| c.position) {
+        Some(p) => vec3("[camera] position", p)?,
+        None => centre + Vec3::new(0.0, 0.5, 1.0).normalize() * distance,
+    };
+    let target = match c.and_then(|c| c.target) {
+        Some(t) => vec3("[camera] target", t)?,
+        None => centre,
+    };
+    if position.distance(target) < 1e-6 {
+        return Err("[camera] position and target are the same point: the camera looks nowhere".into());
+    }
+    let near =
+        c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or((distance - radius).max(distance * 1e-3) * 0.5);
+    let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(position.distance(centre) + radius * 2.0);
+    if near >= far {
+        return Err(format!("[camera] near {near} must be less than far {far}"));
+    }
+    let dir = (target - position).normalize();
+    if dir.y.abs() > 0.9999 {
+        return Err("[camera] looks straight up or down, where its yaw is undefined: move target or position sideways".into());
+    }
+    Ok(Camera::looking_at(position, target, fov, near, far))
+}
+
+/// `scene` as a scene file (built-in meshes only), every field written out: what `load` reads
+/// back into the same scene (up to the camera, given as position + target).
+pub fn to_toml(scene: &Scene, shading: &str, target: Vec3) -> String {
+    let v = |v: Vec3| format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z);
+    let c = &scene.camera;
+    let mut out = format!(
+        "[camera]\nposition = {}\ntarget = {}\nfov_y_deg = {:?}\nnear = {:?}\nfar = {:?}\n\n[shading]\nmodel = \"{shading}\"\nambient = {:?}\n",
+        v(c.position),
+        v(target),
+        c.fov_y_deg,
+        c.near,
+        c.far,
+        scene.ambient
+    );
+    for l in &scene.lights {
+        let p = l.position_radius;
+        out += &format!(
+            "\n[[lights]]\nposition = {}\ncolor = {}\nradius = {:?}\n",
+            v(Vec3::new(p[0], p[1], p[2])),
+            v(Vec3::new(l.color[0], l.color[1], l.color[2])),
+            p[3]
+        );
+    }
+    for o in &scene.objects {
+        let m = &o.material;
+        out += &format!(
+            "\n[[objects]]\nmesh = \"{}\"\nposition = {}\nscale = {:?}\nmaterial = {{ albedo = {}, roughness = {:?}, metallic = {:?} }}\n",
+            o.mesh.name(),
+            v(o.position),
+            o.scale,
+            v(m.albedo),
+            m.roughness,
+            m.metallic
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;

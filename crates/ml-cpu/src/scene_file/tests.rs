@@ -1,0 +1,121 @@
+use super::*;
+use crate::lights::LightParams;
+
+const MINIMAL: &str = "[[objects]]\nmesh = \"sphere\"\n";
+
+#[test]
+fn only_objects_are_required() {
+    let f = parse(MINIMAL).unwrap();
+    assert_eq!(f.shading, None);
+    let s = &f.scene;
+    assert_eq!(s.objects.len(), 1);
+    assert_eq!(
+        s.objects[0],
+        Object { mesh: MeshKind::Sphere, position: Vec3::ZERO, scale: 1.0, material: Material::named("white").unwrap() }
+    );
+    assert!(s.lights.is_empty());
+    assert_eq!(s.ambient, SEED_AMBIENT);
+    // The default camera frames the object: the sphere's centre is ahead of it, its whole
+    // bounding box inside the view.
+    let c = &s.camera;
+    assert!((c.forward() - (Vec3::ZERO - c.position).normalize()).length() < 1e-5);
+    let view_proj = c.projection(1.0) * c.view();
+    for corner in [Vec3::splat(-1.0), Vec3::splat(1.0), Vec3::new(-1.0, 1.0, 1.0), Vec3::new(1.0, -1.0, -1.0)] {
+        let p = view_proj.project_point3(corner);
+        assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0 && (0.0..=1.0).contains(&p.z), "{corner} → {p}");
+    }
+}
+
+#[test]
+fn every_field_is_read() {
+    let text = r#"
+[camera]
+position = [0.0, 2.0, 6.0]
+target = [0.0, 0.0, 0.0]
+fov_y_deg = 50.0
+near = 0.5
+far = 100.0
+[shading]
+model = "pbr"
+ambient = 0.05
+[[lights]]
+position = [1.0, 3.0, 2.0]
+color = [1.0, 0.5, 0.2]
+radius = 12.0
+[[lights]]
+kind = "point"
+position = [-1.0, 3.0, 2.0]
+[[objects]]
+mesh = "teapot"
+position = [1.0, 0.0, 0.0]
+scale = 2.0
+material = { albedo = [1.0, 0.765557, 0.336057], roughness = 0.5, metallic = 1.0 }
+[[objects]]
+mesh = "plane"
+material = { name = "copper", roughness = 0.3 }
+"#;
+    let f = parse(text).unwrap();
+    assert_eq!(f.shading.as_deref(), Some("pbr"));
+    let s = &f.scene;
+    assert_eq!(s.ambient, 0.05);
+    assert_eq!(s.camera, Camera::looking_at(Vec3::new(0.0, 2.0, 6.0), Vec3::ZERO, 50.0, 0.5, 100.0));
+    assert_eq!(s.lights[0], PointLight { position_radius: [1.0, 3.0, 2.0, 12.0], color: [1.0, 0.5, 0.2, 0.0] });
+    assert_eq!(s.lights[1], PointLight { position_radius: [-1.0, 3.0, 2.0, SEED_RADIUS], color: [1.0, 1.0, 1.0, 0.0] });
+    assert_eq!(s.objects[0].mesh, MeshKind::Teapot);
+    assert_eq!((s.objects[0].position, s.objects[0].scale), (Vec3::X, 2.0));
+    assert_eq!(s.objects[0].material, Material { albedo: Vec3::new(1.0, 0.765557, 0.336057), roughness: 0.5, metallic: 1.0 });
+    let copper = Material::named("copper").unwrap();
+    assert_eq!(s.objects[1].material, Material { roughness: 0.3, ..copper });
+}
+
+#[test]
+fn the_seed_scene_survives_a_round_trip() {
+    let seed = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
+    let target = seed.camera.position + seed.camera.forward() * 10.0;
+    let f = parse(&to_toml(&seed, "seed", target)).unwrap();
+    assert_eq!(f.shading.as_deref(), Some("seed"));
+    assert_eq!(f.scene.objects, seed.objects);
+    assert_eq!(f.scene.lights, seed.lights);
+    assert_eq!(f.scene.ambient, seed.ambient);
+    let (a, b) = (f.scene.camera, seed.camera);
+    assert_eq!((a.position, a.fov_y_deg, a.near, a.far), (b.position, b.fov_y_deg, b.near, b.far));
+    assert!((a.pitch_deg - b.pitch_deg).abs() < 1e-4 && (a.yaw_deg - b.yaw_deg).abs() < 1e-4, "{a:?} vs {b:?}");
+}
+
+// The broken texts (each with its expected error, through the binary and its exit code):
+// crates/manylights/tests/cli.rs.
+
+#[test]
+fn files_that_are_no_scene_files_are_refused() {
+    let dir = std::env::temp_dir().join(format!("manylights-scene-file-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let err = |p: &Path| load(p).unwrap_err().to_string();
+    assert!(err(&dir).contains("a directory"));
+    assert!(err(&dir.join("missing.toml")).contains("cannot read it"));
+    let binary = dir.join("binary.toml");
+    std::fs::write(&binary, [0x5b, 0xff, 0xfe, 0x00]).unwrap();
+    assert!(err(&binary).contains("not UTF-8"));
+    let huge = dir.join("huge.toml");
+    let f = std::fs::File::create(&huge).unwrap();
+    f.set_len(MAX_FILE_BYTES + 1).unwrap(); // sparse: nothing written, nothing read
+    let e = err(&huge);
+    assert!(e.contains("more than the") && e.contains("huge.toml"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `scenes/seed.toml`, the seed scene as a scene file (SPEC §1; issue 7's acceptance 4 renders
+/// both): it must hold exactly the built-in scene. `WRITE_SCENES=1` writes it anew.
+#[test]
+fn the_committed_seed_scene_file_is_the_seed_scene() {
+    let seed = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/seed.toml");
+    if std::env::var_os("WRITE_SCENES").is_some() {
+        let header = "# The built-in seed scene (SPEC §1) as a scene file: 7×7 gold spheres, the seed's 64 lights\n# and camera. `manylights render --scene scenes/seed.toml` renders what `--scene seed` does.\n\n";
+        let target = seed.camera.position + seed.camera.forward() * 10.0;
+        std::fs::write(&path, format!("{header}{}", to_toml(&seed, "seed", target))).unwrap();
+    }
+    let f = load(&path).unwrap();
+    assert_eq!(f.scene.objects, seed.objects);
+    assert_eq!(f.scene.lights, seed.lights);
+    assert_eq!(f.shading.as_deref(), Some("seed"));
+}
