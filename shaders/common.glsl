@@ -70,27 +70,34 @@ struct ClusterFeedback {
     uint _pad0;
 };
 
-// Per draw, by push constants as in seed 000.
-struct ObjectPush {
-    vec4 position_scale;   // xyz: world translation, w: uniform scale
+// Per object (set 0, binding 4, std430 array, every shading path): where it is and what it
+// is made of.
+struct ObjectData {
+    mat4 model;            // object space → world
+    mat4 normal_matrix;    // upper 3×3: the inverse transpose of model's (normals, tangents)
     vec4 albedo_roughness; // rgb: albedo, a: roughness
     vec4 material;         // x: metallic; yzw unused
-    uvec4 ids;             // x: index of the object in the scene's object buffer
 };
 
-// Push constants of the sun's shadow pass (blinn-phong): the object and the light's matrix.
+// Per draw, by push constants (seed 000 pushed the object itself; we push its index).
+struct ObjectPush {
+    uvec4 ids;             // x: index of the object in the object buffer
+};
+
+// Push constants of the sun's shadow pass (blinn-phong): the object's and the light's matrix.
 struct ShadowPush {
-    ObjectPush object;
+    mat4 model;
     mat4 light_view_proj;
 };
 
-// Push constants of the point-light shadow passes (omni_shadow.vert): the object, the light
-// and a view-projection — copy and direct: the face's (the seed's way); multiview: the
-// projection alone (the face's rotation comes from gl_ViewIndex).
+// Push constants of the point-light shadow passes (omni_shadow.vert), in the light's frame
+// measured in radii (so the stored depth, distance / radius, is just a length):
+// `model_to_light` = scale(1 / radius) · translate(−light) · model; `view_proj` — copy and
+// direct: the face's rotation and projection (the seed's view by push constant); multiview
+// and layered: the projection alone (the rotation comes from the view or instance index).
 struct OmniShadowPush {
     mat4 view_proj;
-    vec4 position_scale;        // the object's translation and uniform scale
-    vec4 light_position_radius; // xyz: the light this frame; w: its radius (stored depth = distance / radius)
+    mat4 model_to_light;
 };
 
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with

@@ -8,7 +8,6 @@
 
 #include "scene_bindings.glsl"
 #include "textures.glsl"
-layout(std430, set = 2, binding = 0) readonly buffer ObjectBuffer { ObjectPush objects[]; };
 layout(input_attachment_index = 0, set = 2, binding = 1) uniform subpassInput depth_input;
 layout(input_attachment_index = 1, set = 2, binding = 2) uniform subpassInput normal_input;
 layout(input_attachment_index = 2, set = 2, binding = 3) uniform usubpassInput object_input;
@@ -25,7 +24,7 @@ void main() {
     }
     vec3 world = world_from_depth(gl_FragCoord.xy, z);
     vec3 n = oct_decode(subpassLoad(normal_input).xy);
-    ObjectPush object = objects[subpassLoad(object_input).r];
+    ObjectData object = objects[subpassLoad(object_input).r];
     vec3 albedo = object.albedo_roughness.rgb * subpassLoad(albedo_input).rgb;
     vec3 color;
     if (!debug_surface(world, n, albedo, object.albedo_roughness.a, object.material.x, color)) {

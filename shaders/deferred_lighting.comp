@@ -9,7 +9,6 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "scene_bindings.glsl"
-layout(std430, set = 0, binding = 4) readonly buffer ObjectBuffer { ObjectPush objects[]; };
 layout(set = 0, binding = 5) uniform sampler2D depth_image;
 layout(set = 0, binding = 6) uniform sampler2D normal_image;
 layout(set = 0, binding = 7) uniform usampler2D object_image;
@@ -32,7 +31,7 @@ void main() {
     vec2 frag_xy = vec2(p) + 0.5;
     vec3 world = world_from_depth(frag_xy, z);
     vec3 n = oct_decode(texelFetch(normal_image, p, 0).xy);
-    ObjectPush object = objects[texelFetch(object_image, p, 0).r];
+    ObjectData object = objects[texelFetch(object_image, p, 0).r];
     vec3 albedo = object.albedo_roughness.rgb * texelFetch(albedo_image, p, 0).rgb;
     vec3 color;
     if (debug_surface(world, n, albedo, object.albedo_roughness.a, object.material.x, color)) {

@@ -4,10 +4,8 @@
 // (linear, so every face and the lookup agree on one scale), not the projection's depth.
 #include "common.glsl"
 
-layout(location = 0) in vec3 in_to_light;
-
-layout(push_constant) uniform OmniShadowPushBlock { OmniShadowPush omni; };
+layout(location = 0) in vec3 in_from_light; // in radii
 
 void main() {
-    gl_FragDepth = length(in_to_light) / omni.light_position_radius.w;
+    gl_FragDepth = length(in_from_light);
 }

@@ -6,7 +6,6 @@
 #include "omni_shadow_vertex.glsl"
 
 void main() {
-    vec3 world = omni_world_position();
-    out_to_light = world - omni.light_position_radius.xyz;
-    gl_Position = omni.view_proj * vec4(world, 1.0);
+    out_from_light = omni_from_light();
+    gl_Position = omni.view_proj * vec4(out_from_light, 1.0);
 }

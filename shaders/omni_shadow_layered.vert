@@ -7,7 +7,7 @@
 #include "omni_shadow_vertex.glsl"
 
 void main() {
-    out_to_light = omni_world_position() - omni.light_position_radius.xyz;
+    out_from_light = omni_from_light();
     gl_Layer = gl_InstanceIndex;
-    gl_Position = omni_face_clip(out_to_light, gl_InstanceIndex);
+    gl_Position = omni_face_clip(out_from_light, gl_InstanceIndex);
 }

@@ -1,13 +1,13 @@
-// What the point-light shadow vertex shaders share: the inputs, the object's transform and,
-// for the one-pass modes (multiview, layered), each face's view built from its axes.
+// What the point-light shadow vertex shaders share: the inputs, the object's place relative
+// to the light and, for the one-pass modes (multiview, layered), each face's rotation.
 
 layout(location = 0) in vec3 in_position;
-layout(location = 0) out vec3 out_to_light;
+layout(location = 0) out vec3 out_from_light; // in radii
 
 layout(push_constant) uniform OmniShadowPushBlock { OmniShadowPush omni; };
 
-vec3 omni_world_position() {
-    return in_position * omni.position_scale.w + omni.position_scale.xyz;
+vec3 omni_from_light() {
+    return (omni.model_to_light * vec4(in_position, 1.0)).xyz;
 }
 
 // Forward and up of each face: +X, −X, +Y, −Y, +Z, −Z (seed 003's list,
@@ -15,7 +15,7 @@ vec3 omni_world_position() {
 const vec3 FACE_FORWARD[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
 const vec3 FACE_UP[6] = vec3[](vec3(0, -1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1), vec3(0, -1, 0), vec3(0, -1, 0));
 
-// Clip position of `rel` (world position − light) on cube face `face`: the face's rotation
+// Clip position of `rel` (position − light, in radii) on cube face `face`: the face's rotation
 // (look_at_rh's rows: side = forward × up, up' = side × forward, −forward), then the push
 // constant's projection.
 vec4 omni_face_clip(vec3 rel, int face) {

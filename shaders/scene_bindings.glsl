@@ -1,11 +1,13 @@
-// Set 0 as every shading path sees it: the frame's uniforms, the lights and, with CLUSTERED
-// defined, the cluster lists (raster.rs BINDING_*, deferred.rs BINDING_* use the same numbers).
+// Set 0 as every shading path sees it: the frame's uniforms, the lights, the objects and, with
+// CLUSTERED defined, the cluster lists (raster.rs BINDING_*, deferred.rs BINDING_* use the
+// same numbers).
 
 #ifndef MANYLIGHTS_SCENE_BINDINGS_GLSL
 #define MANYLIGHTS_SCENE_BINDINGS_GLSL
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer { PointLight lights[]; };
+layout(std430, set = 0, binding = 4) readonly buffer ObjectBuffer { ObjectData objects[]; };
 #ifdef CLUSTERED
 layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { ClusterRange cluster_ranges[]; };
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };

@@ -8,6 +8,5 @@ layout(location = 0) in vec3 in_position;
 layout(push_constant) uniform ShadowPushBlock { ShadowPush shadow; };
 
 void main() {
-    vec3 world = in_position * shadow.object.position_scale.w + shadow.object.position_scale.xyz;
-    gl_Position = shadow.light_view_proj * vec4(world, 1.0);
+    gl_Position = shadow.light_view_proj * (shadow.model * vec4(in_position, 1.0));
 }

@@ -109,12 +109,22 @@ pub const DEBUG_VIEW_SHADOW_MAP: u32 = 6;
 pub const DEBUG_VIEW_SHADOW_CUBE: u32 = 7;
 
 gpu_struct!(
+    /// One object of the object buffer (std430).
+    ObjectData {
+        /// Object space → world.
+        model: [[f32; 4]; 4],
+        /// Upper 3×3: the inverse transpose of model's.
+        normal_matrix: [[f32; 4]; 4],
+        albedo_roughness: [f32; 4],
+        /// x: metallic.
+        material: [f32; 4],
+    }
+);
+
+gpu_struct!(
     /// Per-draw push constants.
     ObjectPush {
-        position_scale: [f32; 4],
-        albedo_roughness: [f32; 4],
-        material: [f32; 4],
-        /// x: index of the object in the scene's object buffer (deferred-compute).
+        /// x: index of the object in the object buffer.
         ids: [u32; 4],
     }
 );
@@ -122,17 +132,17 @@ gpu_struct!(
 gpu_struct!(
     /// Push constants of the sun's shadow pass (blinn-phong).
     ShadowPush {
-        object: ObjectPush,
+        model: [[f32; 4]; 4],
         light_view_proj: [[f32; 4]; 4],
     }
 );
 
 gpu_struct!(
     /// Push constants of the point-light shadow passes (omni_shadow.vert): copy and direct
-    /// carry the face's view-projection, multiview the projection alone.
+    /// carry the face's rotation and projection, multiview and layered the projection alone;
+    /// `model_to_light` = scale(1 / radius) · translate(−light) · model.
     OmniShadowPush {
         view_proj: [[f32; 4]; 4],
-        position_scale: [f32; 4],
-        light_position_radius: [f32; 4],
+        model_to_light: [[f32; 4]; 4],
     }
 );

@@ -83,7 +83,8 @@ pub enum Solid {
     },
 }
 
-/// The scene's objects as solids; None if one has a mesh the ray test does not model.
+/// The scene's objects as solids; None if one has a mesh the ray test does not model or a
+/// transform other than a move and an even scale.
 /// Blocks stacked face to face (a pillar of cubes) become one, so that shrinking it for the
 /// margin does not open gaps between them.
 pub fn solids(scene: &Scene) -> Option<Vec<Solid>> {
@@ -91,7 +92,7 @@ pub fn solids(scene: &Scene) -> Option<Vec<Solid>> {
         .objects
         .iter()
         .map(|o| {
-            let (c, s) = (o.position, o.scale);
+            let (c, s) = o.as_placed()?;
             match o.mesh {
                 MeshKind::Sphere => Some(Solid::Sphere { centre: c, radius: s }),
                 MeshKind::Cube => Some(Solid::Block { lo: c - Vec3::splat(s), hi: c + Vec3::splat(s) }),

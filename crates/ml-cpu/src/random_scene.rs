@@ -51,16 +51,10 @@ pub fn random_scene(seed: u64, max_lights: u32) -> Scene {
         .map(|i| {
             let (_, albedo) = NAMED_ALBEDOS[rng.random_range(0..NAMED_ALBEDOS.len())];
             let at = |k: i32| (k as f32 - 3.5) * 2.5;
-            Object {
-                mesh: SHAPES[rng.random_range(0..SHAPES.len())],
-                position: Vec3::new(at(i / 7), 0.0, at(i % 7)),
-                scale: 1.0,
-                material: Material {
-                    albedo: Vec3::from(albedo),
-                    roughness: rng.random_range(0.1..0.9),
-                    metallic: rng.random_range(0.0..1.0),
-                },
-            }
+            let mesh = SHAPES[rng.random_range(0..SHAPES.len())];
+            let material =
+                Material { albedo: Vec3::from(albedo), roughness: rng.random_range(0.1..0.9), metallic: rng.random_range(0.0..1.0) };
+            Object::placed(mesh, Vec3::new(at(i / 7), 0.0, at(i % 7)), 1.0, material)
         })
         .collect();
     Scene { objects, lights, camera, ambient: SEED_AMBIENT, blinn_phong: Default::default() }

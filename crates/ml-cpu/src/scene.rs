@@ -1,4 +1,4 @@
-//! Scenes: objects with a mesh kind, position, scale and material; lights; a camera.
+//! Scenes: objects (a mesh, an object-to-world transform, a material); lights; a camera.
 
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
@@ -7,7 +7,7 @@ use crate::lights::LightParams;
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::SceneError;
-use glam::Vec3;
+use glam::{Mat4, Quat, Vec3};
 
 /// The seed's ambient factor: colour = albedo · 0.02 + Lo.
 pub const SEED_AMBIENT: f32 = 0.02;
@@ -15,9 +15,44 @@ pub const SEED_AMBIENT: f32 = 0.02;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Object {
     pub mesh: MeshKind,
-    pub position: Vec3,
-    pub scale: f32,
+    /// Object space → world (any affine transform: glTF nodes rotate and scale unevenly).
+    pub transform: Mat4,
     pub material: Material,
+}
+
+impl Object {
+    /// `mesh` scaled by `scale` about its origin, then moved to `position`.
+    pub fn placed(mesh: MeshKind, position: Vec3, scale: f32, material: Material) -> Object {
+        Object { mesh, transform: Mat4::from_scale_rotation_translation(Vec3::splat(scale), Quat::IDENTITY, position), material }
+    }
+
+    /// Where its origin lands.
+    pub fn position(&self) -> Vec3 {
+        self.transform.w_axis.truncate()
+    }
+
+    /// World box around it, its mesh taken as the cube [−1, 1]³ (every built-in mesh fits it).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let centre = self.position();
+        // |M|·(1, 1, 1): the half-extent of the transformed cube along each world axis.
+        let m = glam::Mat3::from_mat4(self.transform);
+        let half = m.x_axis.abs() + m.y_axis.abs() + m.z_axis.abs();
+        (centre - half, centre + half)
+    }
+
+    /// A sphere around it (centre, radius).
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        let (lo, hi) = self.bounds();
+        ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+    }
+
+    /// (position, scale) if it is only moved and scaled evenly (no rotation, no shear).
+    pub fn as_placed(&self) -> Option<(Vec3, f32)> {
+        let m = glam::Mat3::from_mat4(self.transform);
+        let s = m.x_axis.x;
+        let even = glam::Mat3::from_diagonal(Vec3::splat(s));
+        (m.abs_diff_eq(even, 0.0) && self.transform.row(3) == glam::Vec4::W).then_some((self.position(), s))
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -39,7 +74,7 @@ impl Scene {
         for i in 0..7 {
             for j in 0..7 {
                 let at = |k: i32| (k as f32 - 3.5) * 2.5;
-                objects.push(Object { mesh, position: Vec3::new(at(i), 0.0, at(j)), scale: 1.0, material });
+                objects.push(Object::placed(mesh, Vec3::new(at(i), 0.0, at(j)), 1.0, material));
             }
         }
         Ok(Scene {
@@ -58,7 +93,7 @@ impl Scene {
         let (lo, hi) = self.bounds();
         let centre = (lo + hi) * 0.5;
         let half = (hi - lo).max_element() * 0.5 + 2.0;
-        self.objects.push(Object { mesh: MeshKind::Plane, position: Vec3::new(centre.x, lo.y, centre.z), scale: half, material: floor });
+        self.objects.push(Object::placed(MeshKind::Plane, Vec3::new(centre.x, lo.y, centre.z), half, floor));
         self
     }
 
@@ -69,9 +104,9 @@ impl Scene {
     pub fn shadow_room() -> Scene {
         let walls = Material { albedo: Vec3::new(0.8, 0.78, 0.75), roughness: 0.8, metallic: 0.0 };
         let stone = Material { albedo: Vec3::new(0.7, 0.3, 0.2), roughness: 0.6, metallic: 0.0 };
-        let mut objects = vec![Object { mesh: MeshKind::Room, position: Vec3::ZERO, scale: 5.0, material: walls }];
+        let mut objects = vec![Object::placed(MeshKind::Room, Vec3::ZERO, 5.0, walls)];
         for level in 0..3 {
-            objects.push(Object { mesh: MeshKind::Cube, position: Vec3::new(1.5, -4.5 + level as f32, 0.5), scale: 0.5, material: stone });
+            objects.push(Object::placed(MeshKind::Cube, Vec3::new(1.5, -4.5 + level as f32, 0.5), 0.5, stone));
         }
         Scene {
             objects,
@@ -83,10 +118,11 @@ impl Scene {
         }
     }
 
-    /// World box around every object (each mesh fits [−1, 1]³ before scale and translation).
+    /// World box around every object (each mesh fits [−1, 1]³ in object space).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.objects.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), o| {
-            (lo.min(o.position - Vec3::splat(o.scale)), hi.max(o.position + Vec3::splat(o.scale)))
+            let (a, b) = o.bounds();
+            (lo.min(a), hi.max(b))
         })
     }
 
@@ -110,9 +146,24 @@ mod tests {
     fn seed_scene_is_a_7x7_grid() {
         let s = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
         assert_eq!(s.objects.len(), 49);
-        assert_eq!(s.objects[0].position, Vec3::new(-8.75, 0.0, -8.75));
-        assert_eq!(s.objects[48].position, Vec3::new(6.25, 0.0, 6.25));
+        assert_eq!(s.objects[0].position(), Vec3::new(-8.75, 0.0, -8.75));
+        assert_eq!(s.objects[48].position(), Vec3::new(6.25, 0.0, 6.25));
+        assert_eq!(s.objects[0].as_placed(), Some((Vec3::new(-8.75, 0.0, -8.75), 1.0)));
         assert_eq!(s.mesh_kinds(), vec![MeshKind::Sphere]);
         assert_eq!(s.lights.len(), 64);
+    }
+
+    #[test]
+    fn a_turned_object_has_a_box_around_its_turned_mesh() {
+        let white = Material::named("white").unwrap();
+        let mut o = Object::placed(MeshKind::Cube, Vec3::new(1.0, 2.0, 3.0), 2.0, white);
+        assert_eq!(o.bounds(), (Vec3::new(-1.0, 0.0, 1.0), Vec3::new(3.0, 4.0, 5.0)));
+        o.transform = Mat4::from_translation(Vec3::X) * Mat4::from_rotation_y(std::f32::consts::FRAC_PI_4);
+        let (lo, hi) = o.bounds();
+        let r = std::f32::consts::SQRT_2;
+        assert!(
+            (lo - Vec3::new(1.0 - r, -1.0, -r)).abs().max_element() < 1e-5 && (hi - Vec3::new(1.0 + r, 1.0, r)).abs().max_element() < 1e-5
+        );
+        assert_eq!(o.as_placed(), None);
     }
 }

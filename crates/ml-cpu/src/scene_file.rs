@@ -217,12 +217,9 @@ fn object(o: &FileObject) -> Result<Object, String> {
             material.metallic = unit("material metallic", v)?;
         }
     }
-    Ok(Object {
-        mesh,
-        position: o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO),
-        scale: o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0),
-        material,
-    })
+    let position = o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
+    let scale = o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0);
+    Ok(Object::placed(mesh, position, scale, material))
 }
 
 fn light(l: &FileLight) -> Result<PointLight, String> {
@@ -301,11 +298,13 @@ pub fn to_toml(scene: &Scene, shading: &str, target: Vec3) -> String {
     }
     for o in &scene.objects {
         let m = &o.material;
+        // Scene files place objects by position and scale only (rotations: not yet).
+        let (position, scale) = o.as_placed().expect("a moved and evenly scaled object");
         out += &format!(
             "\n[[objects]]\nmesh = \"{}\"\nposition = {}\nscale = {:?}\nmaterial = {{ albedo = {}, roughness = {:?}, metallic = {:?} }}\n",
             o.mesh.name(),
-            v(o.position),
-            o.scale,
+            v(position),
+            scale,
             v(m.albedo),
             m.roughness,
             m.metallic

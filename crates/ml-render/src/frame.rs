@@ -5,7 +5,7 @@
 
 use crate::cluster_build::{self as build, GpuClusterBuilder, GpuClusterFrame};
 use crate::deferred::{self, ComputeLighting, LightingInputs};
-use crate::raster::{RasterPass, BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES};
+use crate::raster::{RasterPass, BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES, BINDING_OBJECTS};
 use crate::targets::Targets;
 use crate::tonemap::ToneMap;
 use gpu_allocator::MemoryLocation;
@@ -57,7 +57,7 @@ pub struct FrameSetup<'a> {
     /// Set for deferred, deferred-clustered: the pass whose lighting subpass reads the
     /// G-buffer, and the tone map after it.
     pub subpasses: Option<(&'a RasterPass, &'a ToneMap)>,
-    /// Every object's material, for the deferred techniques (null otherwise).
+    /// The object buffer (transforms and materials).
     pub objects: vk::Buffer,
 }
 
@@ -107,6 +107,7 @@ impl FrameInFlight {
         self.set = allocate_set(ctx, setup.descriptor_pool, setup.set_layout)?;
         self.bind(ctx, BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
         for (binding, buffer) in [
+            (BINDING_OBJECTS, setup.objects),
             (BINDING_LIGHTS, self.lights.raw),
             (BINDING_CLUSTER_RANGES, self.cluster_ranges.raw),
             (BINDING_LIGHT_INDICES, self.light_indices.raw),
@@ -147,7 +148,7 @@ impl FrameInFlight {
         }
         if let Some((pass, tonemap)) = setup.subpasses {
             let targets = self.targets.as_ref().expect("made above");
-            self.input_set = pass.input_set(ctx, setup.descriptor_pool, targets, setup.objects)?;
+            self.input_set = pass.input_set(ctx, setup.descriptor_pool, targets)?;
             self.tonemap_set = tonemap.frame_set(ctx, setup.descriptor_pool, targets)?;
         }
         Ok(())

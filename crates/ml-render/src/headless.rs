@@ -8,7 +8,7 @@ use crate::error::RenderError;
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
 use crate::omni_shadow::{OmniShadows, ShadowedLight};
-use crate::raster::{object_push, DrawList, PassFrame, RasterPass};
+use crate::raster::{object_data, DrawList, PassFrame, RasterPass};
 use crate::report::FrameStats;
 use crate::scene_textures::{SceneTextures, ShadowInputs};
 use crate::settings::ShadingModel;
@@ -17,7 +17,7 @@ use crate::targets::{depth_format, Output, Targets};
 use crate::tonemap::ToneMap;
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectPush, PointLight};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectData, PointLight};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::omni_shadow::shadowed_lights;
 use ml_cpu::scene::Scene;
@@ -72,7 +72,7 @@ pub struct HeadlessRenderer<'a> {
     lighting: Option<ComputeLighting>,
     /// deferred, deferred-clustered: the tone map after the render pass.
     tonemap: Option<ToneMap>,
-    /// Deferred techniques: every object's material, indexed by the G-buffer's object ids.
+    /// Every object's transform and material (draws push their index; the G-buffer stores it).
     objects: Option<Buffer>,
     /// --debug-view shadow-map: the pass that paints the map over the output, and its set per
     /// frame slot (pointing at that slot's colour target).
@@ -190,11 +190,9 @@ impl<'a> HeadlessRenderer<'a> {
         if self.settings.technique.is_gpu_built() {
             self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
         }
-        if self.pass.output != Output::Color {
-            let objects: Vec<ObjectPush> = self.scene.objects.iter().enumerate().map(|(i, o)| object_push(o, i as u32)).collect();
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
-        }
+        let objects: Vec<ObjectData> = self.scene.objects.iter().map(object_data).collect();
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         if self.settings.technique.lights_in_compute() {
             self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting())?);
         }

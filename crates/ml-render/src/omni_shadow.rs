@@ -23,7 +23,8 @@ use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 pub const CUBE_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
 /// Faces' near plane as a fraction of the light's radius (geometry nearer than this to the
-/// light is clipped away; the stored depth is not the projection's, so this costs no precision).
+/// light is clipped away; the stored depth is not the projection's, so this costs no
+/// precision). The passes work in the light's frame measured in radii: far is 1.
 const NEAR_FRACTION: f32 = 1e-3;
 
 /// Where a shadowed light is this frame.
@@ -101,9 +102,7 @@ impl OmniShadows {
         let multiview = settings.mode == OmniShadowMode::Multiview;
         let view_mask = if multiview { 0b11_1111 } else { 0 };
         self.render_pass = depth_pass::render_pass(ctx, &DepthPassDesc { format: CUBE_FORMAT, final_layout, after, readers, view_mask })?;
-        let push = [vk::PushConstantRange::default()
-            .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
-            .size(size_of::<OmniShadowPush>() as u32)];
+        let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::VERTEX).size(size_of::<OmniShadowPush>() as u32)];
         self.layout = shader::pipeline_layout(ctx, &[], &push)?;
         let vertex = match settings.mode {
             OmniShadowMode::Multiview => ml_shaders::OMNI_SHADOW_MULTIVIEW_VERT,
@@ -173,22 +172,21 @@ impl OmniShadows {
             self.barrier(ctx, cmd, (SHADER_READERS, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), TRANSFER_DST);
         }
         for (cube, light) in lights.iter().enumerate().take(settings.lights as usize) {
-            let near = light.radius * NEAR_FRACTION;
             // Objects are drawn into the faces their bounding sphere reaches (none when it
             // misses the light's sphere).
             let faces = |o: &Object| {
-                let bound = o.scale * 3f32.sqrt();
-                if o.position.distance(light.position) > light.radius + bound {
+                let (centre, bound) = o.bounding_sphere();
+                if centre.distance(light.position) > light.radius + bound {
                     return 0;
                 }
-                sphere_faces(o.position - light.position, bound)
+                sphere_faces(centre - light.position, bound)
             };
-            let light_position_radius = light.position.extend(light.radius).to_array();
+            let world_to_light = Mat4::from_scale(Vec3::splat(1.0 / light.radius)) * Mat4::from_translation(-light.position);
             let one_pass = matches!(settings.mode, OmniShadowMode::Multiview | OmniShadowMode::Layered);
             let passes: Vec<(Option<u32>, Mat4)> = if one_pass {
-                vec![(None, Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, near, light.radius))]
+                vec![(None, Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, NEAR_FRACTION, 1.0))]
             } else {
-                (0..6).map(|face| (Some(face), face_view_proj(light.position, face, near, light.radius))).collect()
+                (0..6).map(|face| (Some(face), face_view_proj(Vec3::ZERO, face, NEAR_FRACTION, 1.0))).collect()
             };
 
             for (face, view_proj) in passes {
@@ -220,11 +218,9 @@ impl OmniShadows {
                     record_draws(ctx, cmd, (meshes, objects), instances, |_, object| {
                         let push = OmniShadowPush {
                             view_proj: view_proj.to_cols_array_2d(),
-                            position_scale: object.position.extend(object.scale).to_array(),
-                            light_position_radius,
+                            model_to_light: (world_to_light * object.transform).to_cols_array_2d(),
                         };
-                        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-                        d.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&push));
+                        d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
                     });
                     d.cmd_end_render_pass(cmd);
                 }

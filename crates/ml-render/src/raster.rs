@@ -9,9 +9,9 @@ use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding, GpuMesh};
 use crate::render_pass;
 use crate::settings::{Shading, Technique};
 use crate::targets::{Output, Targets};
-use ml_cpu::gpu_types::ObjectPush;
+use ml_cpu::gpu_types::{ObjectData, ObjectPush};
 use ml_cpu::scene::Object;
-use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
+use ml_vk::descriptors::{allocate_set, write_image};
 use ml_vk::{shader, vk, Context, VkError};
 
 /// Binding numbers of set 0 (see the shaders).
@@ -19,9 +19,9 @@ pub const BINDING_FRAME: u32 = 0;
 pub const BINDING_LIGHTS: u32 = 1;
 pub const BINDING_CLUSTER_RANGES: u32 = 2;
 pub const BINDING_LIGHT_INDICES: u32 = 3;
+pub const BINDING_OBJECTS: u32 = 4;
 /// Bindings of set 2, the lighting subpass's inputs (deferred_frag.glsl; set 1 holds the
 /// scene's textures in every pipeline of the pass).
-pub const BINDING_INPUT_OBJECTS: u32 = 0;
 pub const BINDING_INPUT_DEPTH: u32 = 1;
 pub const BINDING_INPUT_NORMAL: u32 = 2;
 pub const BINDING_INPUT_OBJECT_ID: u32 = 3;
@@ -124,6 +124,7 @@ impl RasterPass {
                 (BINDING_LIGHTS, storage),
                 (BINDING_CLUSTER_RANGES, storage),
                 (BINDING_LIGHT_INDICES, storage),
+                (BINDING_OBJECTS, storage),
             ],
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
         )?;
@@ -140,7 +141,6 @@ impl RasterPass {
             self.input_set_layout = shader::set_layout(
                 ctx,
                 &[
-                    (BINDING_INPUT_OBJECTS, T::STORAGE_BUFFER),
                     (BINDING_INPUT_DEPTH, T::INPUT_ATTACHMENT),
                     (BINDING_INPUT_NORMAL, T::INPUT_ATTACHMENT),
                     (BINDING_INPUT_OBJECT_ID, T::INPUT_ATTACHMENT),
@@ -155,15 +155,8 @@ impl RasterPass {
     }
 
     /// Set 2 of a frame's lighting subpass: the object buffer and its targets' G-buffer.
-    pub fn input_set(
-        &self,
-        ctx: &Context,
-        pool: vk::DescriptorPool,
-        targets: &Targets,
-        objects: vk::Buffer,
-    ) -> Result<vk::DescriptorSet, VkError> {
+    pub fn input_set(&self, ctx: &Context, pool: vk::DescriptorPool, targets: &Targets) -> Result<vk::DescriptorSet, VkError> {
         let set = allocate_set(ctx, pool, self.input_set_layout)?;
-        write_buffer(ctx, set, BINDING_INPUT_OBJECTS, vk::DescriptorType::STORAGE_BUFFER, objects);
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         for (binding, view, layout) in [
             (BINDING_INPUT_DEPTH, targets.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
@@ -258,8 +251,8 @@ impl RasterPass {
                 cmd,
                 (draws.meshes, draws.objects),
                 |_| 1,
-                |index, object| {
-                    let push = object_push(object, index);
+                |index, _| {
+                    let push = ObjectPush { ids: [index, 0, 0, 0] };
                     let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
                     d.cmd_push_constants(cmd, self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
                 },
@@ -294,14 +287,15 @@ impl RasterPass {
     }
 }
 
-/// What a draw of object `index` pushes (also the object buffer's entry for deferred-compute).
-pub fn object_push(o: &Object, index: u32) -> ObjectPush {
+/// Object `o`'s entry in the object buffer.
+pub fn object_data(o: &Object) -> ObjectData {
     let m = &o.material;
-    ObjectPush {
-        position_scale: [o.position.x, o.position.y, o.position.z, o.scale],
+    let normal = glam::Mat4::from_mat3(glam::Mat3::from_mat4(o.transform).inverse().transpose());
+    ObjectData {
+        model: o.transform.to_cols_array_2d(),
+        normal_matrix: normal.to_cols_array_2d(),
         albedo_roughness: [m.albedo.x, m.albedo.y, m.albedo.z, m.roughness],
         material: [m.metallic, 0.0, 0.0, 0.0],
-        ids: [index, 0, 0, 0],
     }
 }
 

@@ -9,7 +9,6 @@
 use crate::depth_pass::{self, DepthPassDesc};
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::omni_shadow::{self, OmniShadows};
-use crate::raster::object_push;
 use ml_cpu::gpu_types::ShadowPush;
 use ml_cpu::scene::Scene;
 use ml_cpu::textures;
@@ -288,8 +287,9 @@ fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs
                         cmd,
                         (s.meshes, &s.scene.objects),
                         |_| 1,
-                        |index, object| {
-                            let push = ShadowPush { object: object_push(object, index), light_view_proj: s.view_proj.to_cols_array_2d() };
+                        |_, object| {
+                            let push =
+                                ShadowPush { model: object.transform.to_cols_array_2d(), light_view_proj: s.view_proj.to_cols_array_2d() };
                             d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
                         },
                     );

@@ -3,7 +3,7 @@
 //! moved on either side fails here.
 
 use ml_cpu::gpu_types::{
-    ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectPush, OmniShadowPush, PointLight, ShadowPush,
+    ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectData, ObjectPush, OmniShadowPush, PointLight, ShadowPush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -81,6 +81,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<ObjectPush>(&structs);
     check::<ShadowPush>(&structs);
     check::<OmniShadowPush>(&structs);
+    check::<ObjectData>(&structs);
     check::<ClusterRange>(&structs);
     check::<ClusterBounds>(&structs);
     check::<ClusterFeedback>(&structs);

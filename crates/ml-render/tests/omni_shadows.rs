@@ -164,7 +164,7 @@ fn each_face_casts_its_occluders_shadow_on_its_own_wall() {
     let grey = Material { albedo: Vec3::splat(0.7), roughness: 0.7, metallic: 0.0 };
     scene.objects.truncate(1);
     for (centre, radius) in occluders() {
-        scene.objects.push(Object { mesh: MeshKind::Sphere, position: centre, scale: radius, material: grey });
+        scene.objects.push(Object::placed(MeshKind::Sphere, centre, radius, grey));
     }
     scene.lights = vec![PointLight { position_radius: [light.x, light.y, light.z, 20.0], color: [3.0, 3.0, 3.0, 0.0] }];
     for (face, axis) in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z].into_iter().enumerate() {
@@ -246,7 +246,7 @@ fn shadow_cube_view_shows_each_face_in_its_cell() {
     let grey = Material { albedo: Vec3::splat(0.7), roughness: 0.7, metallic: 0.0 };
     scene.objects.truncate(1);
     for (centre, radius) in occluders() {
-        scene.objects.push(Object { mesh: MeshKind::Sphere, position: centre, scale: radius, material: grey });
+        scene.objects.push(Object::placed(MeshKind::Sphere, centre, radius, grey));
     }
     scene.lights = vec![PointLight { position_radius: [0.0, 0.0, 0.0, 20.0], color: [3.0, 3.0, 3.0, 0.0] }];
     let (width, height) = (4 * SIZE, 3 * SIZE);

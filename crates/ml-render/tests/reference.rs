@@ -36,7 +36,7 @@ fn light(p: [f32; 3], radius: f32, color: [f32; 3]) -> PointLight {
 
 fn sphere_scene(material: Material) -> Scene {
     Scene {
-        objects: vec![Object { mesh: MeshKind::Sphere, position: Vec3::ZERO, scale: 1.0, material }],
+        objects: vec![Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, material)],
         lights: vec![
             light([2.0, 2.0, 2.0], 6.0, [1.0, 0.2, 0.1]),
             light([-2.5, 0.5, 1.5], 4.0, [0.1, 1.0, 0.3]),

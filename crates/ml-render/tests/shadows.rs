@@ -26,10 +26,10 @@ fn sun() -> Vec3 {
 /// point light far away (a light buffer may not be empty).
 fn scene(ball: bool, sun_on: bool, camera: Camera) -> Scene {
     let floor = Material { albedo: Vec3::splat(0.8), roughness: 0.9, metallic: 0.0 };
-    let mut objects = vec![Object { mesh: MeshKind::Plane, position: Vec3::ZERO, scale: 4.0, material: floor }];
-    let ball_object = Object { mesh: MeshKind::Sphere, position: BALL_CENTRE, scale: BALL_RADIUS, material: floor };
+    let mut objects = vec![Object::placed(MeshKind::Plane, Vec3::ZERO, 4.0, floor)];
     // The ball stays in the scene's bounds either way, so the shadow map's texels are the same.
-    objects.push(Object { position: if ball { BALL_CENTRE } else { Vec3::new(0.0, -3.0, 0.0) }, ..ball_object });
+    let at = if ball { BALL_CENTRE } else { Vec3::new(0.0, -3.0, 0.0) };
+    objects.push(Object::placed(MeshKind::Sphere, at, BALL_RADIUS, floor));
     let mut lights =
         BlinnPhongLights { sun_direction: sun(), sun_strength: Vec3::splat(if sun_on { 1.0 } else { 0.0 }), ..Default::default() };
     lights.spot.strength = Vec3::ZERO;

@@ -9,10 +9,7 @@ fn only_objects_are_required() {
     assert_eq!(f.shading, None);
     let s = &f.scene;
     assert_eq!(s.objects.len(), 1);
-    assert_eq!(
-        s.objects[0],
-        Object { mesh: MeshKind::Sphere, position: Vec3::ZERO, scale: 1.0, material: Material::named("white").unwrap() }
-    );
+    assert_eq!(s.objects[0], Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, Material::named("white").unwrap()));
     assert!(s.lights.is_empty());
     assert_eq!(s.ambient, SEED_AMBIENT);
     // The default camera frames the object: the sphere's centre is ahead of it, its whole
@@ -62,7 +59,7 @@ material = { name = "copper", roughness = 0.3 }
     assert_eq!(s.lights[0], PointLight { position_radius: [1.0, 3.0, 2.0, 12.0], color: [1.0, 0.5, 0.2, 0.0] });
     assert_eq!(s.lights[1], PointLight { position_radius: [-1.0, 3.0, 2.0, SEED_RADIUS], color: [1.0, 1.0, 1.0, 0.0] });
     assert_eq!(s.objects[0].mesh, MeshKind::Teapot);
-    assert_eq!((s.objects[0].position, s.objects[0].scale), (Vec3::X, 2.0));
+    assert_eq!(s.objects[0].as_placed(), Some((Vec3::X, 2.0)));
     assert_eq!(s.objects[0].material, Material { albedo: Vec3::new(1.0, 0.765557, 0.336057), roughness: 0.5, metallic: 1.0 });
     let copper = Material::named("copper").unwrap();
     assert_eq!(s.objects[1].material, Material { roughness: 0.3, ..copper });
