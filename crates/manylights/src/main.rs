@@ -8,7 +8,7 @@ use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
-use ml_cpu::scene_file;
+use ml_cpu::{gltf_scene, scene_file};
 use ml_render::report::table;
 use ml_render::targets::gbuffer_bytes_per_pixel;
 use ml_render::{DebugView, HeadlessRenderer, OmniShadowMode, OmniShadowSettings, RenderSettings, ShadingModel, Technique};
@@ -35,7 +35,8 @@ enum Command {
 #[derive(Args)]
 struct RenderArgs {
     /// Scene to render: seed (built in), room (a closed room with a pillar and one point light,
-    /// for point-light shadows), or a scene file FILE.toml (README: "Scene files").
+    /// for point-light shadows), a scene file FILE.toml (README: "Scene files") or a glTF 2.0
+    /// file FILE.gltf|FILE.glb (rendered with pbr unless --shading says otherwise).
     #[arg(long, default_value = "seed")]
     scene: String,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
@@ -155,19 +156,23 @@ fn build_scene(args: &RenderArgs) -> Result<(Scene, ShadingModel)> {
             // Seed 002's lighting wants something to cast shadows on.
             Ok((if model == ShadingModel::BlinnPhong { scene.with_floor() } else { scene }, model))
         }
-        path if path.ends_with(".toml") => {
-            let file = scene_file::load(Path::new(path))?;
-            let model = shading(file.shading.as_deref()).with_context(|| format!("scene file '{path}': [shading] model"))?;
+        path if [".toml", ".gltf", ".glb"].iter().any(|ext| path.to_lowercase().ends_with(ext)) => {
+            let file = if path.to_lowercase().ends_with(".toml") {
+                scene_file::load(Path::new(path))?
+            } else {
+                gltf_scene::load(Path::new(path))?
+            };
+            let model = shading(file.shading.as_deref()).with_context(|| format!("'{path}': shading model"))?;
             let mut scene = file.scene;
             if let Some(n) = args.lights {
                 scene.lights = lights(n)?.build()?;
             }
             if scene.lights.is_empty() {
-                bail!("scene file '{path}': no lights: add [[lights]] entries or pass --lights N");
+                bail!("'{path}': the scene has no point lights: add some (scene file: [[lights]]; glTF: KHR_lights_punctual) or pass --lights N");
             }
             Ok((scene, model))
         }
-        other => bail!("unknown scene '{other}': expected seed, room or a scene file FILE.toml"),
+        other => bail!("unknown scene '{other}': expected seed, room, a scene file FILE.toml or a glTF file FILE.gltf|FILE.glb"),
     }
 }
 

@@ -6,6 +6,8 @@ pub mod blinn_phong;
 pub mod camera;
 pub mod cluster;
 pub mod error;
+pub mod gltf_scene;
+pub mod gltf_writer;
 pub mod gpu_types;
 pub mod lights;
 pub mod material;

@@ -21,7 +21,7 @@ pub struct Vertex {
     pub tangent: [f32; 4],
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     pub vertices: Vec<Vertex>,
     pub indices: Vec<u32>,
@@ -39,6 +39,8 @@ pub enum MeshKind {
     Cube,
     /// The same cube seen from inside: faces inwards (a closed room).
     Room,
+    /// The scene's own mesh of this index (`Scene::meshes`, from a glTF file).
+    Loaded(u32),
 }
 
 impl MeshKind {
@@ -54,6 +56,7 @@ impl MeshKind {
             MeshKind::Disc => "disc",
             MeshKind::Cube => "cube",
             MeshKind::Room => "room",
+            MeshKind::Loaded(_) => "loaded",
         }
     }
 
@@ -65,6 +68,7 @@ impl MeshKind {
         })
     }
 
+    /// A built-in mesh (empty for `Loaded`: those live in `Scene::meshes`).
     pub fn build(self) -> Mesh {
         let mut mesh = match self {
             MeshKind::Sphere => uv_sphere(SPHERE_STACKS, SPHERE_SLICES),
@@ -74,6 +78,9 @@ impl MeshKind {
             MeshKind::Disc => disc(64),
             MeshKind::Cube => cube(1.0),
             MeshKind::Room => cube(-1.0),
+            // Only through Scene::mesh, which holds them; the file's vertices carry their own
+            // tangents.
+            MeshKind::Loaded(_) => return Mesh::default(),
         };
         compute_tangents(&mut mesh);
         mesh

@@ -5,7 +5,7 @@ use crate::camera::Camera;
 use crate::gpu_types::PointLight;
 use crate::lights::LightParams;
 use crate::material::Material;
-use crate::mesh::MeshKind;
+use crate::mesh::{Mesh, MeshKind};
 use crate::SceneError;
 use glam::{Mat4, Quat, Vec3};
 
@@ -64,6 +64,10 @@ pub struct Scene {
     pub ambient: f32,
     /// The other lights of the blinn-phong model (the seed model ignores them).
     pub blinn_phong: BlinnPhongLights,
+    /// Meshes of the scene's own (glTF), drawn by objects of kind `MeshKind::Loaded(index)`;
+    /// each fits [−1, 1]³ like the built-in ones (the loader folds its box into the objects'
+    /// transforms).
+    pub meshes: Vec<Mesh>,
 }
 
 impl Scene {
@@ -83,6 +87,7 @@ impl Scene {
             camera: Camera::seed(),
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),
+            meshes: Vec::new(),
         })
     }
 
@@ -115,6 +120,7 @@ impl Scene {
             camera: Camera::looking_at(Vec3::new(-4.2, 2.5, -4.0), Vec3::new(2.0, -3.0, 2.0), 75.0, 0.05, 50.0),
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),
+            meshes: Vec::new(),
         }
     }
 
@@ -124,6 +130,14 @@ impl Scene {
             let (a, b) = o.bounds();
             (lo.min(a), hi.max(b))
         })
+    }
+
+    /// The vertices and indices of `kind`: built in, or one of the scene's own.
+    pub fn mesh(&self, kind: MeshKind) -> Option<Mesh> {
+        match kind {
+            MeshKind::Loaded(i) => self.meshes.get(i as usize).cloned(),
+            builtin => Some(builtin.build()),
+        }
     }
 
     /// The distinct meshes this scene draws, in first-use order.

@@ -21,11 +21,27 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// Most objects a scene file may hold.
 pub const MAX_OBJECTS: usize = 1 << 20;
 
+/// A file that could not be loaded: which kind, where, and what is wrong (one line).
 #[derive(Debug, Error, PartialEq)]
-#[error("scene file '{path}': {problem}")]
+#[error("{kind} '{path}': {problem}")]
 pub struct SceneFileError {
+    /// "scene file" or "glTF file".
+    pub kind: &'static str,
     pub path: String,
     pub problem: String,
+}
+
+/// Read a whole file of at most `max` bytes, refusing directories and missing files in one
+/// line each (the problem, without the path).
+pub fn read_capped(path: &Path, max: u64) -> Result<Vec<u8>, String> {
+    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read it: {e}"))?;
+    if meta.is_dir() {
+        return Err("it is a directory, not a file".into());
+    }
+    if meta.len() > max {
+        return Err(format!("{} bytes is more than the {max} we read", meta.len()));
+    }
+    std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))
 }
 
 /// A loaded scene file: the scene, and the shading model it names (checked by the renderer,
@@ -95,15 +111,8 @@ struct FileMaterial {
 
 /// Read and check the scene file at `path`.
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
-    let fail = |problem: String| SceneFileError { path: path.display().to_string(), problem };
-    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read it: {e}")))?;
-    if meta.is_dir() {
-        return Err(fail("it is a directory, not a file".into()));
-    }
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(fail(format!("{} bytes is more than the {MAX_FILE_BYTES} a scene file may have", meta.len())));
-    }
-    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read it: {e}")))?;
+    let fail = |problem: String| SceneFileError { kind: "scene file", path: path.display().to_string(), problem };
+    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(fail)?;
     let text = String::from_utf8(bytes).map_err(|e| fail(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
     parse(&text).map_err(fail)
 }
@@ -148,6 +157,7 @@ fn build(file: FileScene) -> Result<SceneFile, String> {
         camera: Camera::seed(),
         ambient: ambient.unwrap_or(SEED_AMBIENT),
         blinn_phong: BlinnPhongLights::default(),
+        meshes: Vec::new(),
     };
     scene.camera = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading })

@@ -176,7 +176,8 @@ impl<'a> HeadlessRenderer<'a> {
     fn create_resources(&mut self, depth: vk::Format) -> Result<(), VkError> {
         let ctx = self.ctx;
         for kind in self.scene.mesh_kinds() {
-            self.meshes.push(GpuMesh::upload(ctx, kind, &kind.build())?);
+            let mesh = self.scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
+            self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
         }
         if self.settings.shading == ShadingModel::BlinnPhong {
             let inputs = ShadowInputs { scene: &self.scene, meshes: &self.meshes, view_proj: self.shadow_view_proj };

@@ -47,6 +47,7 @@ fn sphere_scene(material: Material) -> Scene {
         camera: Camera::looking_at(Vec3::new(0.3, 0.6, 3.2), Vec3::ZERO, 45.0, 0.1, 100.0),
         ambient: 0.02,
         blinn_phong: Default::default(),
+        meshes: Vec::new(),
     }
 }
 

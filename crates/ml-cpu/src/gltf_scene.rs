@@ -1,0 +1,469 @@
+//! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`, issue 7): the node hierarchy with its
+//! transforms, every triangle primitive (indexed or not; u8/u16/u32 indices; missing normals
+//! computed flat, tangents computed from the texture coordinates), metallic-roughness
+//! material factors, KHR_lights_punctual point lights and the first perspective camera (else a
+//! camera framing the scene).
+//!
+//! The `gltf` crate parses and validates the JSON; everything it hands over unchecked is
+//! checked here before it is used or allocated: buffer sources and lengths, accessor bounds
+//! and strides, index ranges, finite numbers, counts. Every problem is one line naming it.
+//! Not yet: textures (base colour, normal, metallic-roughness, occlusion, emissive), spot and
+//! directional lights (skipped with a warning), sparse accessors, orthographic cameras.
+
+use crate::blinn_phong::BlinnPhongLights;
+use crate::camera::Camera;
+use crate::gpu_types::PointLight;
+use crate::material::Material;
+use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
+use crate::scene::{Object, Scene, SEED_AMBIENT};
+use crate::scene_file::{read_capped, SceneFile, SceneFileError, MAX_OBJECTS};
+use base64::Engine as _;
+use glam::{Mat4, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Largest glTF or GLB file, and largest external buffer, we read.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// Most vertices (after un-indexing for flat normals) and triangles of a whole scene.
+pub const MAX_VERTICES: usize = 1 << 26;
+/// Deepest node hierarchy we follow.
+pub const MAX_NODE_DEPTH: usize = 256;
+/// Extensions a file may require: the ones we read.
+const SUPPORTED_REQUIRED: [&str; 1] = ["KHR_lights_punctual"];
+
+/// Load the glTF or GLB file at `path` (external buffers relative to its folder).
+pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
+    let fail = |problem: String| SceneFileError { kind: "glTF file", path: path.display().to_string(), problem };
+    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(fail)?;
+    let scene = from_bytes(&bytes, path.parent()).map_err(fail)?;
+    Ok(SceneFile { scene, shading: Some("pbr".into()) })
+}
+
+/// Read a glTF scene from the file's bytes; `base` is the folder external buffers are in
+/// (None: external buffers are refused).
+pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
+    if bytes.is_empty() {
+        return Err("the file is empty".into());
+    }
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(describe_gltf_error)?;
+    for ext in gltf.extensions_required() {
+        if !SUPPORTED_REQUIRED.contains(&ext) {
+            return Err(format!("requires extension {ext}, which manylights does not support"));
+        }
+    }
+    let buffers = load_buffers(&gltf, base)?;
+    let mut builder = Builder {
+        buffers,
+        meshes: Vec::new(),
+        by_primitive: HashMap::new(),
+        objects: Vec::new(),
+        lights: Vec::new(),
+        camera: None,
+        vertices: 0,
+    };
+    let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            // No scene: every node nobody names as a child.
+            let children: std::collections::HashSet<usize> = gltf.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
+            gltf.nodes().filter(|n| !children.contains(&n.index())).collect()
+        }
+    };
+    // Depth first in document order (objects and lights keep the file's order).
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        if depth > MAX_NODE_DEPTH {
+            return Err(format!("the node hierarchy is deeper than {MAX_NODE_DEPTH} (or has a cycle) at node {}", node.index()));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !local.is_finite() {
+            return Err(format!("node {}: its transform is not finite", node.index()));
+        }
+        let world = parent * local;
+        builder.node(&node, world)?;
+        let children: Vec<gltf::Node> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
+    }
+    if builder.objects.is_empty() {
+        return Err("the scene has no triangles to draw".into());
+    }
+    let Builder { objects, lights, camera, meshes, .. } = builder;
+    let mut scene =
+        Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong: BlinnPhongLights::default(), meshes };
+    scene.camera = match camera {
+        Some(c) => c,
+        None => framing_camera(&scene),
+    };
+    Ok(scene)
+}
+
+/// The gltf crate's error as one line (its validation errors name the JSON path).
+fn describe_gltf_error(e: gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(errors) => {
+            let first: Vec<String> = errors.iter().take(3).map(|(path, err)| format!("{path}: {err}")).collect();
+            format!(
+                "invalid glTF: {}{}",
+                first.join("; "),
+                if errors.len() > 3 { format!(" (and {} more)", errors.len() - 3) } else { String::new() }
+            )
+        }
+        other => format!("not a readable glTF/GLB file: {}", other.to_string().replace('\n', " ")),
+    }
+}
+
+/// Every buffer's bytes, each at least as long as the file says it is.
+fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, String> {
+    let mut out = Vec::new();
+    let mut total = 0u64;
+    for buffer in gltf.buffers() {
+        let length = buffer.length() as u64;
+        let what = format!("buffer {}", buffer.index());
+        total += length;
+        if length > MAX_FILE_BYTES || total > MAX_FILE_BYTES {
+            return Err(format!("{what}: {length} bytes claimed, more than the {MAX_FILE_BYTES} we read"));
+        }
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => {
+                let blob =
+                    gltf.blob.as_ref().ok_or_else(|| format!("{what}: refers to the GLB binary chunk, which the file does not have"))?;
+                blob.clone()
+            }
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, base).map_err(|e| format!("{what}: {e}"))?,
+        };
+        if (data.len() as u64) < length {
+            return Err(format!("{what}: holds {} bytes but claims {length}", data.len()));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// A buffer's data: a base64 data URI or a file beside the glTF.
+fn read_uri(uri: &str, base: Option<&Path>) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, data) = rest.split_once(";base64,").ok_or("a data URI that is not base64")?;
+        return base64::engine::general_purpose::STANDARD.decode(data).map_err(|e| format!("bad base64 data: {e}"));
+    }
+    if uri.contains("://") {
+        return Err(format!("'{uri}' is not a local file (manylights never downloads)"));
+    }
+    let base = base.ok_or("external files are not allowed here")?;
+    let path = base.join(uri);
+    read_capped(&path, MAX_FILE_BYTES).map_err(|e| format!("'{}': {e}", path.display()))
+}
+
+struct Builder {
+    buffers: Vec<Vec<u8>>,
+    meshes: Vec<Mesh>,
+    /// (mesh, primitive) → (index in `meshes`, its box's centre and half-size), so that
+    /// instanced meshes are loaded once.
+    by_primitive: HashMap<(usize, usize), (u32, Vec3, f32)>,
+    objects: Vec<Object>,
+    lights: Vec<PointLight>,
+    camera: Option<Camera>,
+    vertices: usize,
+}
+
+impl Builder {
+    fn node(&mut self, node: &gltf::Node, world: Mat4) -> Result<(), String> {
+        if let Some(mesh) = node.mesh() {
+            for primitive in mesh.primitives() {
+                let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
+                let Some((index, centre, half)) = self.primitive(&mesh, &primitive).map_err(|e| format!("{what}: {e}"))? else {
+                    continue;
+                };
+                if self.objects.len() == MAX_OBJECTS {
+                    return Err(format!("more than {MAX_OBJECTS} drawn primitives"));
+                }
+                let material = material(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
+                // The mesh was stored fitted to [−1, 1]³: undo that inside the object's transform.
+                let transform = world * Mat4::from_translation(centre) * Mat4::from_scale(Vec3::splat(half));
+                self.objects.push(Object { mesh: MeshKind::Loaded(index), transform, material });
+            }
+        }
+        if let Some(light) = node.light() {
+            self.light(&light, world).map_err(|e| format!("light {}: {e}", light.index()))?;
+        }
+        if let (Some(camera), None) = (node.camera(), &self.camera) {
+            self.camera = camera_at(&camera, world).map_err(|e| format!("camera {}: {e}", camera.index()))?;
+        }
+        Ok(())
+    }
+
+    /// Load a primitive's triangles (once per primitive); None for points and lines.
+    fn primitive(&mut self, mesh: &gltf::Mesh, primitive: &gltf::Primitive) -> Result<Option<(u32, Vec3, f32)>, String> {
+        use gltf::mesh::Mode;
+        let key = (mesh.index(), primitive.index());
+        if let Some(&known) = self.by_primitive.get(&key) {
+            return Ok(Some(known));
+        }
+        let mode = primitive.mode();
+        if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+            eprintln!("warning: mesh {} primitive {}: {mode:?} are not drawn (triangles only)", key.0, key.1);
+            return Ok(None);
+        }
+        let position = primitive.get(&gltf::Semantic::Positions).ok_or("has no POSITION")?;
+        let positions = read_floats::<3>(&self.buffers, &position, "POSITION")?;
+        let count = positions.len();
+        self.vertices += count;
+        if self.vertices > MAX_VERTICES {
+            return Err(format!("the scene has more than {MAX_VERTICES} vertices"));
+        }
+        let normals = match primitive.get(&gltf::Semantic::Normals) {
+            Some(a) => Some(read_floats::<3>(&self.buffers, &a, "NORMAL")?),
+            None => None,
+        };
+        let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
+            Some(a) => Some(read_floats::<2>(&self.buffers, &a, "TEXCOORD_0")?),
+            None => None,
+        };
+        for (name, n) in [("NORMAL", normals.as_ref().map(Vec::len)), ("TEXCOORD_0", uvs.as_ref().map(Vec::len))] {
+            if n.is_some_and(|n| n != count) {
+                return Err(format!("{name} has {} entries but POSITION has {count}", n.unwrap_or(0)));
+            }
+        }
+        let indices = match primitive.indices() {
+            Some(a) => read_indices(&self.buffers, &a, count)?,
+            None => (0..count as u32).collect(),
+        };
+        let triangles = triangle_list(mode, &indices)?;
+        if triangles.is_empty() {
+            return Ok(None);
+        }
+        let mut out = Mesh::default();
+        let vertex = |i: u32, n: Vec3| {
+            let i = i as usize;
+            Vertex { position: positions[i], normal: n.to_array(), uv: uvs.as_ref().map_or([0.0; 2], |u| u[i]), tangent: [0.0; 4] }
+        };
+        match &normals {
+            Some(ns) => {
+                out.vertices = (0..count as u32).map(|i| vertex(i, Vec3::from(ns[i as usize]).normalize_or(Vec3::Y))).collect();
+                out.indices = triangles;
+            }
+            None => {
+                // glTF: without normals, flat shading — each triangle its own three vertices.
+                self.vertices += triangles.len();
+                if self.vertices > MAX_VERTICES {
+                    return Err(format!("the scene has more than {MAX_VERTICES} vertices"));
+                }
+                for tri in triangles.chunks_exact(3) {
+                    let p = |k: usize| Vec3::from(positions[tri[k] as usize]);
+                    let n = (p(1) - p(0)).cross(p(2) - p(0)).normalize_or(Vec3::Y);
+                    for &i in tri {
+                        out.indices.push(out.vertices.len() as u32);
+                        out.vertices.push(vertex(i, n));
+                    }
+                }
+            }
+        }
+        compute_tangents(&mut out);
+        // Fit [−1, 1]³ (what every mesh of a scene does; the object's transform undoes it).
+        let (lo, hi) = out.vertices.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), v| {
+            (lo.min(Vec3::from(v.position)), hi.max(Vec3::from(v.position)))
+        });
+        let centre = (lo + hi) * 0.5;
+        let half = ((hi - lo).max_element() * 0.5).max(f32::MIN_POSITIVE);
+        for v in &mut out.vertices {
+            v.position = ((Vec3::from(v.position) - centre) / half).to_array();
+        }
+        let index = self.meshes.len() as u32;
+        self.meshes.push(out);
+        self.by_primitive.insert(key, (index, centre, half));
+        Ok(Some((index, centre, half)))
+    }
+
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<(), String> {
+        use gltf::khr_lights_punctual::Kind;
+        let kind = match light.kind() {
+            Kind::Point => "point",
+            Kind::Spot { .. } => "spot",
+            Kind::Directional => "directional",
+        };
+        if kind != "point" {
+            eprintln!("warning: light {}: {kind} lights are not supported yet; it is left out", light.index());
+            return Ok(());
+        }
+        let color = Vec3::from(light.color()) * light.intensity();
+        if !color.is_finite() || color.min_element() < 0.0 {
+            return Err("colour × intensity must be finite and not negative".into());
+        }
+        // Our lights end at a radius. glTF's range is one; without it, the distance where
+        // intensity / d² falls to 1/256 (about what an 8-bit image still shows).
+        let radius = match light.range() {
+            Some(r) if r.is_finite() && r > 0.0 => r,
+            Some(r) => return Err(format!("range {r} must be finite and > 0")),
+            None => (light.intensity().max(0.0) * 256.0).sqrt().max(1e-3),
+        };
+        let position = world.transform_point3(Vec3::ZERO);
+        if !position.is_finite() {
+            return Err("its node's position is not finite".into());
+        }
+        self.lights.push(PointLight { position_radius: position.extend(radius).to_array(), color: color.extend(0.0).to_array() });
+        Ok(())
+    }
+}
+
+/// glTF's metallic-roughness factors (textures: not yet).
+fn material(m: &gltf::Material) -> Result<Material, String> {
+    let pbr = m.pbr_metallic_roughness();
+    let [r, g, b, _] = pbr.base_color_factor();
+    let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
+    for (name, v) in [("base colour", r), ("base colour", g), ("base colour", b), ("metallic", metallic), ("roughness", roughness)] {
+        if !(0.0..=1.0).contains(&v) {
+            return Err(format!("material {}: {name} factor {v} is outside [0, 1]", m.index().map_or("default".into(), |i| i.to_string())));
+        }
+    }
+    Ok(Material { albedo: Vec3::new(r, g, b), roughness, metallic })
+}
+
+/// The camera at a node: perspective only (orthographic ones are skipped with a warning).
+fn camera_at(camera: &gltf::Camera, world: Mat4) -> Result<Option<Camera>, String> {
+    let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+        eprintln!("warning: camera {}: orthographic cameras are not supported; the scene is framed instead", camera.index());
+        return Ok(None);
+    };
+    let fov = p.yfov().to_degrees();
+    let near = p.znear();
+    let far = p.zfar().unwrap_or(near * 1e5);
+    if !(fov > 0.0 && fov < 180.0) || !(near > 0.0 && near.is_finite()) || !(far > near && far.is_finite()) {
+        return Err(format!("yfov {} rad, znear {near}, zfar {far}: need 0 < yfov < π and 0 < znear < zfar", p.yfov()));
+    }
+    let position = world.transform_point3(Vec3::ZERO);
+    let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+    if !position.is_finite() || forward == Vec3::ZERO {
+        return Err("its node's transform is not usable (not finite, or it collapses the view direction)".into());
+    }
+    if forward.y.abs() > 0.9999 {
+        eprintln!("warning: camera {}: it looks straight up or down; the scene is framed instead", camera.index());
+        return Ok(None);
+    }
+    Ok(Some(Camera::looking_at(position, position + forward, fov, near, far)))
+}
+
+/// A camera that sees every object: from above and in front of the bounds' centre.
+pub fn framing_camera(scene: &Scene) -> Camera {
+    let (lo, hi) = scene.bounds();
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let fov = 60.0f32;
+    let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
+    let position = centre + Vec3::new(0.0, 0.5, 1.0).normalize() * distance;
+    Camera::looking_at(position, centre, fov, (distance - radius).max(distance * 1e-3) * 0.5, distance + radius * 2.0)
+}
+
+/// Triangle-list indices from a list, strip or fan.
+fn triangle_list(mode: gltf::mesh::Mode, indices: &[u32]) -> Result<Vec<u32>, String> {
+    use gltf::mesh::Mode;
+    Ok(match mode {
+        Mode::Triangles => {
+            if indices.len() % 3 != 0 {
+                return Err(format!("{} indices do not make whole triangles", indices.len()));
+            }
+            indices.to_vec()
+        }
+        Mode::TriangleStrip => (2..indices.len())
+            .flat_map(
+                |i| if i % 2 == 0 { [indices[i - 2], indices[i - 1], indices[i]] } else { [indices[i - 1], indices[i - 2], indices[i]] },
+            )
+            .collect(),
+        _ => (2..indices.len()).flat_map(|i| [indices[0], indices[i - 1], indices[i]]).collect(),
+    })
+}
+
+/// The bytes of each element of `accessor`, checked against its view and buffer.
+fn elements<'b>(buffers: &'b [Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Result<(Vec<&'b [u8]>, DataType), String> {
+    if accessor.sparse().is_some() {
+        return Err(format!("{what}: sparse accessors are not supported"));
+    }
+    let view = accessor.view().ok_or_else(|| format!("{what}: accessor {} has no buffer view", accessor.index()))?;
+    let data = &buffers[view.buffer().index()];
+    let (view_offset, view_length) = (view.offset(), view.length());
+    view_offset.checked_add(view_length).filter(|&e| e <= data.len()).ok_or_else(|| {
+        format!(
+            "{what}: buffer view {} ({view_length} bytes at {view_offset}) lies outside its buffer of {} bytes",
+            view.index(),
+            data.len()
+        )
+    })?;
+    let element = accessor.size();
+    let stride = view.stride().unwrap_or(element);
+    if stride < element {
+        return Err(format!("{what}: stride {stride} is smaller than an element ({element} bytes)"));
+    }
+    let count = accessor.count();
+    if count > MAX_VERTICES * 3 {
+        return Err(format!("{what}: {count} elements is more than we read"));
+    }
+    let needed = match count {
+        0 => Some(0),
+        n => (n - 1).checked_mul(stride).and_then(|x| x.checked_add(accessor.offset())).and_then(|x| x.checked_add(element)),
+    }
+    .ok_or_else(|| format!("{what}: its size overflows"))?;
+    if needed > view_length {
+        return Err(format!("{what}: {count} elements of {element} bytes (stride {stride}, offset {}) need {needed} bytes but buffer view {} has {view_length}", accessor.offset(), view.index()));
+    }
+    let start = view_offset + accessor.offset();
+    let slices = (0..count).map(|i| &data[start + i * stride..start + i * stride + element]).collect();
+    Ok((slices, accessor.data_type()))
+}
+
+/// A float accessor of N components (f32, or normalised u8/u16 for texture coordinates),
+/// every value finite.
+fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Result<Vec<[f32; N]>, String> {
+    let dims = match N {
+        2 => Dimensions::Vec2,
+        _ => Dimensions::Vec3,
+    };
+    if accessor.dimensions() != dims {
+        return Err(format!("{what}: expected {dims:?} elements, found {:?}", accessor.dimensions()));
+    }
+    let (elements, ty) = elements(buffers, accessor, what)?;
+    let component = |bytes: &[u8], k: usize| -> Option<f32> {
+        match (ty, accessor.normalized()) {
+            (DataType::F32, _) => Some(f32::from_le_bytes(bytes[k * 4..k * 4 + 4].try_into().ok()?)),
+            (DataType::U8, true) => Some(bytes[k] as f32 / 255.0),
+            (DataType::U16, true) => Some(u16::from_le_bytes(bytes[k * 2..k * 2 + 2].try_into().ok()?) as f32 / 65535.0),
+            _ => None,
+        }
+    };
+    let mut out = Vec::with_capacity(elements.len());
+    for (i, e) in elements.iter().enumerate() {
+        let mut v = [0.0; N];
+        for (k, slot) in v.iter_mut().enumerate() {
+            *slot = component(e, k)
+                .ok_or_else(|| format!("{what}: component type {ty:?} (normalized: {}) is not allowed", accessor.normalized()))?;
+            if !slot.is_finite() {
+                return Err(format!("{what}: element {i} is not finite ({slot})"));
+            }
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+/// An index accessor (u8, u16 or u32 scalars), every index below `vertices`.
+fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor, vertices: usize) -> Result<Vec<u32>, String> {
+    if accessor.dimensions() != Dimensions::Scalar {
+        return Err(format!("indices: expected scalars, found {:?}", accessor.dimensions()));
+    }
+    let (elements, ty) = elements(buffers, accessor, "indices")?;
+    let mut out = Vec::with_capacity(elements.len());
+    for (i, e) in elements.iter().enumerate() {
+        let index = match ty {
+            DataType::U8 => e[0] as u32,
+            DataType::U16 => u16::from_le_bytes([e[0], e[1]]) as u32,
+            DataType::U32 => u32::from_le_bytes([e[0], e[1], e[2], e[3]]),
+            other => return Err(format!("indices: component type {other:?} is not an index type")),
+        };
+        if index as usize >= vertices {
+            return Err(format!("indices: element {i} is {index}, but there are only {vertices} vertices"));
+        }
+        out.push(index);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests;

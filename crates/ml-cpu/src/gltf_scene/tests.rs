@@ -1,0 +1,113 @@
+use super::*;
+use crate::gltf_writer::{cube_without_normals, quad, GltfWriter, IndexType, PrimitiveData};
+use serde_json::json;
+
+fn load_bytes(bytes: &[u8]) -> Scene {
+    from_bytes(bytes, None).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// World position of a loaded object's mesh vertex `i`.
+fn world_vertex(scene: &Scene, object: usize, i: usize) -> Vec3 {
+    let o = &scene.objects[object];
+    let mesh = scene.mesh(o.mesh).unwrap();
+    o.transform.transform_point3(Vec3::from(mesh.vertices[i].position))
+}
+
+#[test]
+fn a_quad_keeps_its_place_material_and_normals() {
+    let mut w = GltfWriter::new();
+    let m = w.material([0.2, 0.4, 0.6, 1.0], 0.25, 0.75);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(json!({ "mesh": mesh, "translation": [1.0, 2.0, 3.0], "scale": [2.0, 1.0, 1.0] }), true);
+    for bytes in [w.to_gltf(), w.to_glb()] {
+        let s = load_bytes(&bytes);
+        assert_eq!(s.objects.len(), 1);
+        assert_eq!(s.objects[0].material, Material { albedo: Vec3::new(0.2, 0.4, 0.6), roughness: 0.75, metallic: 0.25 });
+        // Corner (1, 0, 1) of the quad, scaled by 2 in x and moved.
+        let mesh = s.mesh(s.objects[0].mesh).unwrap();
+        let corner = (0..4).map(|i| world_vertex(&s, 0, i)).find(|p| p.x > 2.0 && p.z > 3.5).unwrap();
+        assert!((corner - Vec3::new(3.0, 2.0, 4.0)).length() < 1e-5, "{corner}");
+        assert!(mesh.vertices.iter().all(|v| v.normal == [0.0, 1.0, 0.0] && v.position.iter().all(|c| c.abs() <= 1.0 + 1e-6)));
+        // The default camera sees it.
+        let p = (s.camera.projection(1.0) * s.camera.view()).project_point3(Vec3::new(1.0, 2.0, 3.0));
+        assert!(p.x.abs() < 1.0 && p.y.abs() < 1.0 && (0.0..1.0).contains(&p.z));
+    }
+}
+
+#[test]
+fn missing_normals_are_flat_for_every_index_type() {
+    for ty in [IndexType::U8, IndexType::U16, IndexType::U32] {
+        let mut w = GltfWriter::new();
+        let mesh = w.mesh(&[cube_without_normals(ty)]);
+        w.node(json!({ "mesh": mesh }), true);
+        let s = load_bytes(&w.to_gltf());
+        let m = s.mesh(s.objects[0].mesh).unwrap();
+        assert_eq!(m.indices.len(), 36, "{ty:?}");
+        assert_eq!(m.vertices.len(), 36, "flat: three vertices per triangle");
+        for v in &m.vertices {
+            // Each face's normal is its axis, pointing out of the cube.
+            let n = Vec3::from(v.normal);
+            let p = Vec3::from(v.position);
+            assert!((n.abs().max_element() - 1.0).abs() < 1e-6 && n.dot(p) > 0.0, "{ty:?}: {n} at {p}");
+        }
+        // Tangents were computed (orthogonal to the normal).
+        assert!(m.vertices.iter().all(|v| Vec3::from_slice(&v.tangent[..3]).dot(Vec3::from(v.normal)).abs() < 1e-5));
+    }
+}
+
+#[test]
+fn node_hierarchies_multiply_and_meshes_are_shared() {
+    let mut w = GltfWriter::new();
+    let mesh = w.mesh(&[quad()]);
+    let child = w.node(json!({ "mesh": mesh, "translation": [0.0, 0.0, 5.0] }), false);
+    // A quarter turn about +Y: the child's +Z offset lands on +X.
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    w.node(json!({ "rotation": [0.0, half, 0.0, half], "children": [child], "mesh": mesh }), true);
+    let s = load_bytes(&w.to_gltf());
+    assert_eq!(s.objects.len(), 2);
+    assert_eq!(s.meshes.len(), 1, "one primitive, loaded once");
+    let centres: Vec<Vec3> = (0..2).map(|o| (0..4).map(|i| world_vertex(&s, o, i)).sum::<Vec3>() / 4.0).collect();
+    assert!(centres.iter().any(|c| c.length() < 1e-5));
+    assert!(centres.iter().any(|c| (*c - Vec3::new(5.0, 0.0, 0.0)).length() < 1e-5), "{centres:?}");
+}
+
+#[test]
+fn lights_and_cameras_come_from_their_nodes() {
+    let mut w = GltfWriter::new();
+    let mesh = w.mesh(&[quad()]);
+    w.node(json!({ "mesh": mesh }), true);
+    let point = w.light(json!({ "type": "point", "color": [1.0, 0.5, 0.25], "intensity": 2.0, "range": 7.0 }));
+    let far = w.light(json!({ "type": "point", "intensity": 4.0 }));
+    let spot = w.light(json!({ "type": "spot", "spot": {} }));
+    for (light, at) in [(point, [0.0, 3.0, 0.0]), (far, [1.0, 1.0, 1.0]), (spot, [0.0, 1.0, 0.0])] {
+        w.node(json!({ "translation": at, "extensions": { "KHR_lights_punctual": { "light": light } } }), true);
+    }
+    let camera = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.05, "zfar": 80.0 } }));
+    w.node(json!({ "camera": camera, "translation": [0.0, 1.0, 4.0] }), true);
+    let s = load_bytes(&w.to_gltf());
+    assert_eq!(s.lights.len(), 2, "the spot light is left out (not yet supported)");
+    assert_eq!(s.lights[0], PointLight { position_radius: [0.0, 3.0, 0.0, 7.0], color: [2.0, 1.0, 0.5, 0.0] });
+    // No range: where 4 / d² falls to 1/256, d = 32.
+    assert_eq!(s.lights[1].position_radius, [1.0, 1.0, 1.0, 32.0]);
+    assert_eq!(s.camera.position, Vec3::new(0.0, 1.0, 4.0));
+    assert!((s.camera.forward() - (-Vec3::Z)).length() < 1e-5);
+    assert!((s.camera.fov_y_deg - 0.8f32.to_degrees()).abs() < 1e-4 && s.camera.near == 0.05 && s.camera.far == 80.0);
+}
+
+#[test]
+fn strips_fans_and_unindexed_triangles_become_lists() {
+    let p = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0]];
+    for (mode, triangles) in [(4, 1), (5, 2), (6, 2)] {
+        let mut w = GltfWriter::new();
+        let positions = if mode == 4 { p[..3].to_vec() } else { p.clone() };
+        let mesh = w.mesh(&[PrimitiveData {
+            positions,
+            normals: Some(vec![[0.0, 1.0, 0.0]; if mode == 4 { 3 } else { 4 }]),
+            ..Default::default()
+        }]);
+        w.json["meshes"][mesh]["primitives"][0]["mode"] = json!(mode);
+        w.node(json!({ "mesh": mesh }), true);
+        let s = load_bytes(&w.to_gltf());
+        assert_eq!(s.mesh(s.objects[0].mesh).unwrap().indices.len(), triangles * 3, "mode {mode}");
+    }
+}
