@@ -162,6 +162,9 @@ fn build_scene(args: &RenderArgs) -> Result<(Scene, ShadingModel)> {
             } else {
                 gltf_scene::load(Path::new(path))?
             };
+            for w in &file.warnings {
+                eprintln!("warning: '{path}': {w}");
+            }
             let model = shading(file.shading.as_deref()).with_context(|| format!("'{path}': shading model"))?;
             let mut scene = file.scene;
             if let Some(n) = args.lights {

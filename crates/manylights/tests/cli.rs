@@ -220,3 +220,153 @@ fn broken_scene_files_are_refused_one_line_each() {
     }
     assert!(!png.exists());
 }
+
+/// A valid glTF (a quad, a point light) as the writer makes it, for breaking.
+fn good_gltf() -> ml_cpu::gltf_writer::GltfWriter {
+    use serde_json::json;
+    let mut w = ml_cpu::gltf_writer::GltfWriter::new();
+    let mesh = w.mesh(&[ml_cpu::gltf_writer::quad()]);
+    w.node(json!({ "mesh": mesh }), true);
+    let light = w.light(json!({ "type": "point", "intensity": 4.0 }));
+    w.node(json!({ "translation": [0.0, 2.0, 0.0], "extensions": { "KHR_lights_punctual": { "light": light } } }), true);
+    w
+}
+
+/// Each broken glTF (bytes, file extension) and a fragment of the error it must give.
+fn broken_gltf_files() -> Vec<(Vec<u8>, &'static str, &'static str)> {
+    use serde_json::json;
+    let good = good_gltf();
+    let text = |w: &ml_cpu::gltf_writer::GltfWriter| w.to_gltf();
+    let edit = |f: &dyn Fn(&mut ml_cpu::gltf_writer::GltfWriter)| {
+        let mut w = good_gltf();
+        f(&mut w);
+        w.to_gltf()
+    };
+    let mut nan_position = good_gltf();
+    nan_position.bin[0..4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let glb = good.to_glb();
+    let mut glb_without_bin = glb.clone();
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    glb_without_bin.truncate(20 + json_len);
+    let total = glb_without_bin.len() as u32;
+    glb_without_bin[8..12].copy_from_slice(&total.to_le_bytes());
+    vec![
+        (Vec::new(), "gltf", "the file is empty"),
+        (b"{".to_vec(), "gltf", "not a readable glTF"),
+        (b"[1, 2, 3]".to_vec(), "gltf", "not a readable glTF"),
+        (b"\x00\x01\x02garbage".to_vec(), "glb", "not a readable glTF"),
+        (glb[..40].to_vec(), "glb", "not a readable glTF"),
+        (glb_without_bin, "glb", "GLB binary chunk"),
+        (text(&good)[..60].to_vec(), "gltf", "not a readable glTF"),
+        (edit(&|w| w.json["asset"] = json!({})), "gltf", "missing field `version`"),
+        (edit(&|w| w.json["accessors"][0]["count"] = json!(1000)), "gltf", "need"),
+        (edit(&|w| w.json["accessors"][0]["byteOffset"] = json!(44)), "gltf", "need"),
+        (edit(&|w| w.json["bufferViews"][0]["byteStride"] = json!(4)), "gltf", "stride"),
+        (edit(&|w| w.json["bufferViews"][0]["byteLength"] = json!(100000)), "gltf", "outside its buffer"),
+        (edit(&|w| w.json["bufferViews"][0]["byteOffset"] = json!(4000000000u64)), "gltf", "outside its buffer"),
+        (
+            edit(&|w| w.json["buffers"] = json!([{ "byteLength": 10_000_000_000u64, "uri": "data:application/octet-stream;base64,AAAA" }])),
+            "gltf",
+            "more than the",
+        ),
+        (
+            edit(&|w| w.json["buffers"] = json!([{ "byteLength": 64, "uri": "data:application/octet-stream;base64,AAAA" }])),
+            "gltf",
+            "holds 3 bytes but claims 64",
+        ),
+        (
+            edit(&|w| w.json["buffers"] = json!([{ "byteLength": 64, "uri": "data:application/octet-stream;base64,@@@" }])),
+            "gltf",
+            "bad base64",
+        ),
+        (edit(&|w| w.json["buffers"] = json!([{ "byteLength": 64, "uri": "missing.bin" }])), "gltf", "cannot read it"),
+        (edit(&|w| w.json["buffers"] = json!([{ "byteLength": 64, "uri": "https://example.com/a.bin" }])), "gltf", "never downloads"),
+        (edit(&|w| w.json["bufferViews"][0]["buffer"] = json!(5)), "gltf", "invalid glTF: bufferViews[0].buffer"),
+        (edit(&|w| w.json["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(99)), "gltf", "POSITION names accessor 99"),
+        (edit(&|w| w.json["meshes"][0]["primitives"][0]["attributes"] = json!({})), "gltf", "POSITION\"]: Missing data"),
+        (edit(&|w| w.json["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = json!(2)), "gltf", "NORMAL: expected Vec3"),
+        (edit(&|w| w.json["accessors"][3]["componentType"] = json!(5122)), "gltf", "not an index type"),
+        (edit(&|w| w.json["accessors"][3]["count"] = json!(5)), "gltf", "whole triangles"),
+        (edit(&|w| w.json["accessors"][1]["count"] = json!(3)), "gltf", "entries but POSITION has 4"),
+        (
+            edit(&|w| {
+                w.json["accessors"][0]["sparse"] =
+                    json!({ "count": 1, "indices": { "bufferView": 0, "componentType": 5125 }, "values": { "bufferView": 0 } })
+            }),
+            "gltf",
+            "sparse",
+        ),
+        // Indices follow 4 positions, 4 normals and 4 texture coordinates (128 bytes).
+        (
+            edit(&|w| {
+                w.bin[128..130].copy_from_slice(&9u16.to_le_bytes());
+            }),
+            "gltf",
+            "only 4 vertices",
+        ),
+        (nan_position.to_gltf(), "gltf", "not finite"),
+        (edit(&|w| w.json["extensionsRequired"] = json!(["KHR_draco_mesh_compression"])), "gltf", "KHR_draco_mesh_compression"),
+        (edit(&|w| w.json["nodes"][0]["children"] = json!([0])), "gltf", "deeper than"),
+        (edit(&|w| w.json["nodes"][0]["matrix"] = json!([1e39, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])), "gltf", "not finite"),
+        (
+            edit(&|w| {
+                w.json["materials"] = json!([{ "pbrMetallicRoughness": { "metallicFactor": 2.0 } }]);
+                w.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+            }),
+            "gltf",
+            "metallic factor 2",
+        ),
+        (
+            edit(&|w| {
+                let c = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 1.0, "zfar": 0.5 } }));
+                w.node(json!({ "camera": c }), true);
+            }),
+            "gltf",
+            "0 < znear < zfar",
+        ),
+        (edit(&|w| w.json["meshes"][0]["primitives"][0]["mode"] = json!(0)), "gltf", "no triangles"),
+        (edit(&|w| w.json["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = json!(-1.0)), "gltf", "range -1"),
+        (edit(&|w| w.json["scenes"][0]["nodes"] = json!([])), "gltf", "no triangles"),
+    ]
+}
+
+/// Every broken glTF (made above from a good one) ends the run with one error line naming the
+/// file and the problem, exit code 1, no PNG; a directory named .gltf too.
+#[test]
+fn broken_gltf_files_are_refused_one_line_each() {
+    let png = temp_png("never-gltf.png");
+    let p = png.to_str().unwrap();
+    let cases = broken_gltf_files();
+    assert!(cases.len() + broken_scene_files().len() >= 40);
+    let mut wrong = Vec::new();
+    for (i, (bytes, ext, expected)) in cases.into_iter().enumerate() {
+        let file = temp_png(&format!("broken-{i}.{ext}"));
+        std::fs::write(&file, &bytes).unwrap();
+        let out = manylights(&["render", "--scene", file.to_str().unwrap(), "--out", p], &[]);
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        let one_line = stderr.lines().count() == 1 && stderr.starts_with("error: ") && !stderr.contains("panicked");
+        if !(one_line && stderr.contains(expected) && stderr.contains(file.to_str().unwrap()) && out.status.code() == Some(1)) {
+            wrong.push(format!("case {i} (expected '{expected}', exit 1): exit {:?}: {stderr}", out.status.code()));
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    let dir = temp_png("folder.gltf");
+    std::fs::create_dir_all(&dir).unwrap();
+    assert_one_line_error(&manylights(&["render", "--scene", dir.to_str().unwrap(), "--out", p], &[]), &["a directory"]);
+    assert!(!png.exists());
+}
+
+/// The good file renders (validation on), with pbr by default.
+#[test]
+fn a_gltf_file_renders() {
+    let file = temp_png("good.glb");
+    std::fs::write(&file, good_gltf().to_glb()).unwrap();
+    let png = temp_png("good-gltf.png");
+    let out = manylights(
+        &["render", "--validation", "--scene", file.to_str().unwrap(), "--width", "64", "--height", "48", "--out", png.to_str().unwrap()],
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("pbr") && png.exists(), "{stdout}");
+}

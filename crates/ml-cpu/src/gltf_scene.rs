@@ -8,7 +8,7 @@
 //! checked here before it is used or allocated: buffer sources and lengths, accessor bounds
 //! and strides, index ranges, finite numbers, counts. Every problem is one line naming it.
 //! Not yet: textures (base colour, normal, metallic-roughness, occlusion, emissive), spot and
-//! directional lights (skipped with a warning), sparse accessors, orthographic cameras.
+//! directional lights (left out, with a warning), sparse accessors, orthographic cameras.
 
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
@@ -36,17 +36,17 @@ const SUPPORTED_REQUIRED: [&str; 1] = ["KHR_lights_punctual"];
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
     let fail = |problem: String| SceneFileError { kind: "glTF file", path: path.display().to_string(), problem };
     let bytes = read_capped(path, MAX_FILE_BYTES).map_err(fail)?;
-    let scene = from_bytes(&bytes, path.parent()).map_err(fail)?;
-    Ok(SceneFile { scene, shading: Some("pbr".into()) })
+    let (scene, warnings) = from_bytes(&bytes, path.parent()).map_err(fail)?;
+    Ok(SceneFile { scene, shading: Some("pbr".into()), warnings })
 }
 
-/// Read a glTF scene from the file's bytes; `base` is the folder external buffers are in
-/// (None: external buffers are refused).
-pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
+/// Read a glTF scene from the file's bytes, and what it holds that is left out; `base` is the
+/// folder external buffers are in (None: external buffers are refused).
+pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<String>), String> {
     if bytes.is_empty() {
         return Err("the file is empty".into());
     }
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(describe_gltf_error)?;
+    let gltf = parse_and_validate(bytes)?;
     for ext in gltf.extensions_required() {
         if !SUPPORTED_REQUIRED.contains(&ext) {
             return Err(format!("requires extension {ext}, which manylights does not support"));
@@ -61,6 +61,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
         lights: Vec::new(),
         camera: None,
         vertices: 0,
+        warnings: Vec::new(),
     };
     let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
@@ -88,14 +89,42 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
     if builder.objects.is_empty() {
         return Err("the scene has no triangles to draw".into());
     }
-    let Builder { objects, lights, camera, meshes, .. } = builder;
+    let Builder { objects, lights, camera, meshes, warnings, .. } = builder;
     let mut scene =
         Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong: BlinnPhongLights::default(), meshes };
     scene.camera = match camera {
         Some(c) => c,
         None => framing_camera(&scene),
     };
-    Ok(scene)
+    Ok((scene, warnings))
+}
+
+/// The gltf crate's parse and validation, minus its one known panic: its validation indexes
+/// the accessor a primitive's POSITION names without checking it exists (gltf-json 1.4.1,
+/// mesh.rs), so that index is checked first.
+fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
+    let blob = raw.blob;
+    let root = raw.document.into_json();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &primitive.attributes {
+                if index.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        gltf::json::validation::Checked::Valid(s) => s.to_string(),
+                        gltf::json::validation::Checked::Invalid => "an attribute".into(),
+                    };
+                    return Err(format!(
+                        "mesh {m} primitive {p}: {name} names accessor {}, but there are {}",
+                        index.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    let document = gltf::Document::from_json(root).map_err(describe_gltf_error)?;
+    Ok(gltf::Gltf { document, blob })
 }
 
 /// The gltf crate's error as one line (its validation errors name the JSON path).
@@ -164,6 +193,8 @@ struct Builder {
     lights: Vec<PointLight>,
     camera: Option<Camera>,
     vertices: usize,
+    /// What the file holds that is left out.
+    warnings: Vec<String>,
 }
 
 impl Builder {
@@ -187,7 +218,7 @@ impl Builder {
             self.light(&light, world).map_err(|e| format!("light {}: {e}", light.index()))?;
         }
         if let (Some(camera), None) = (node.camera(), &self.camera) {
-            self.camera = camera_at(&camera, world).map_err(|e| format!("camera {}: {e}", camera.index()))?;
+            self.camera = camera_at(&camera, world, &mut self.warnings).map_err(|e| format!("camera {}: {e}", camera.index()))?;
         }
         Ok(())
     }
@@ -201,7 +232,7 @@ impl Builder {
         }
         let mode = primitive.mode();
         if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
-            eprintln!("warning: mesh {} primitive {}: {mode:?} are not drawn (triangles only)", key.0, key.1);
+            self.warnings.push(format!("mesh {} primitive {}: {mode:?} are not drawn (triangles only)", key.0, key.1));
             return Ok(None);
         }
         let position = primitive.get(&gltf::Semantic::Positions).ok_or("has no POSITION")?;
@@ -282,7 +313,7 @@ impl Builder {
             Kind::Directional => "directional",
         };
         if kind != "point" {
-            eprintln!("warning: light {}: {kind} lights are not supported yet; it is left out", light.index());
+            self.warnings.push(format!("light {}: {kind} lights are not supported yet; it is left out", light.index()));
             return Ok(());
         }
         let color = Vec3::from(light.color()) * light.intensity();
@@ -319,9 +350,9 @@ fn material(m: &gltf::Material) -> Result<Material, String> {
 }
 
 /// The camera at a node: perspective only (orthographic ones are skipped with a warning).
-fn camera_at(camera: &gltf::Camera, world: Mat4) -> Result<Option<Camera>, String> {
+fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> Result<Option<Camera>, String> {
     let gltf::camera::Projection::Perspective(p) = camera.projection() else {
-        eprintln!("warning: camera {}: orthographic cameras are not supported; the scene is framed instead", camera.index());
+        warnings.push(format!("camera {}: orthographic cameras are not supported; the scene is framed instead", camera.index()));
         return Ok(None);
     };
     let fov = p.yfov().to_degrees();
@@ -336,7 +367,7 @@ fn camera_at(camera: &gltf::Camera, world: Mat4) -> Result<Option<Camera>, Strin
         return Err("its node's transform is not usable (not finite, or it collapses the view direction)".into());
     }
     if forward.y.abs() > 0.9999 {
-        eprintln!("warning: camera {}: it looks straight up or down; the scene is framed instead", camera.index());
+        warnings.push(format!("camera {}: it looks straight up or down; the scene is framed instead", camera.index()));
         return Ok(None);
     }
     Ok(Some(Camera::looking_at(position, position + forward, fov, near, far)))

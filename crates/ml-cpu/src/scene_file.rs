@@ -44,12 +44,13 @@ pub fn read_capped(path: &Path, max: u64) -> Result<Vec<u8>, String> {
     std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))
 }
 
-/// A loaded scene file: the scene, and the shading model it names (checked by the renderer,
-/// which knows the models).
+/// A loaded scene file: the scene, the shading model it names (checked by the renderer,
+/// which knows the models), and what it holds that is left out (printed once it loaded).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneFile {
     pub scene: Scene,
     pub shading: Option<String>,
+    pub warnings: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -160,7 +161,7 @@ fn build(file: FileScene) -> Result<SceneFile, String> {
         meshes: Vec::new(),
     };
     scene.camera = camera(file.camera.as_ref(), &scene)?;
-    Ok(SceneFile { scene, shading })
+    Ok(SceneFile { scene, shading, warnings: Vec::new() })
 }
 
 fn finite(what: &str, v: f32) -> Result<f32, String> {
