@@ -23,3 +23,60 @@ fn the_seed_scene_file_renders_the_seed_scene() {
     // Not a blank frame: the spheres are lit.
     assert!(outputs[0].rgba.chunks_exact(4).filter(|p| p[0] > 60).count() > 200);
 }
+
+/// A glTF file made by our writer: three quads of three colours, each placed by its own node
+/// (turned to face the camera, moved, scaled unevenly, one a child of another), seen by the
+/// file's camera. The albedo view shows each colour where the CPU projects its quad's centre,
+/// and the background elsewhere; the shaded image is lit where the point light is.
+#[test]
+fn gltf_nodes_place_their_coloured_quads() {
+    use glam::Vec3;
+    use ml_cpu::gltf_writer::{quad, GltfWriter, PrimitiveData};
+    use ml_render::{DebugView, RenderSettings, ShadingModel, Technique};
+    use serde_json::json;
+    let mut w = GltfWriter::new();
+    let colours = [[1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 1.0], [0.0, 0.0, 1.0, 1.0]];
+    let meshes: Vec<usize> = colours
+        .iter()
+        .map(|&c| {
+            let m = w.material(c, 0.0, 0.8);
+            w.mesh(&[PrimitiveData { material: Some(m), ..quad() }])
+        })
+        .collect();
+    // A quarter turn about +X: the quad's +Y normal turns to +Z, towards the camera.
+    let turn = [std::f32::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f32::consts::FRAC_1_SQRT_2];
+    let blue = w.node(json!({ "mesh": meshes[2], "translation": [0.0, 0.0, 3.0] }), false);
+    w.node(json!({ "mesh": meshes[0], "translation": [-3.0, 0.0, 0.0], "rotation": turn, "scale": [0.8, 1.0, 1.6] }), true);
+    w.node(json!({ "mesh": meshes[1], "translation": [3.0, 0.0, 0.0], "rotation": turn, "children": [blue] }), true);
+    let camera = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 1.2, "znear": 0.1, "zfar": 100.0 } }));
+    w.node(json!({ "camera": camera, "translation": [0.0, 0.0, 10.0] }), true);
+    let light = w.light(json!({ "type": "point", "intensity": 40.0, "range": 30.0 }));
+    w.node(json!({ "translation": [0.0, 0.0, 6.0], "extensions": { "KHR_lights_punctual": { "light": light } } }), true);
+    let (scene, warnings) = ml_cpu::gltf_scene::from_bytes(&w.to_glb(), None).expect("a good file");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    const SIZE: u32 = 128;
+    let mut albedo = RenderSettings::new(Technique::Forward, SIZE, SIZE);
+    albedo.shading = ShadingModel::Pbr;
+    albedo.debug_view = DebugView::GBufferAlbedo;
+    let shaded = RenderSettings { debug_view: DebugView::None, technique: Technique::DeferredCompute, ..albedo };
+    let outputs = common::render_each(&scene, &[albedo, shaded]);
+    let view_proj = scene.camera.projection(1.0) * scene.camera.view();
+    // The blue quad's node is the green node's child: its +z offset turns with the parent to −y.
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    let parent = glam::Mat4::from_rotation_translation(glam::Quat::from_xyzw(half, 0.0, 0.0, half), Vec3::new(3.0, 0.0, 0.0));
+    let blue_centre = parent.transform_point3(Vec3::new(0.0, 0.0, 3.0));
+    for (centre, expected) in
+        [(Vec3::new(-3.0, 0.0, 0.0), [255, 0, 0]), (Vec3::new(3.0, 0.0, 0.0), [0, 255, 0]), (blue_centre, [0, 0, 255])]
+    {
+        let ndc = view_proj.project_point3(centre);
+        let (x, y) = (((ndc.x + 1.0) * 0.5 * SIZE as f32) as u32, ((ndc.y + 1.0) * 0.5 * SIZE as f32) as u32);
+        assert_eq!(common::pixel(&outputs[0], x, y), expected, "quad at {centre} (pixel {x}, {y})");
+        // Lit: clearly brighter than the ambient term alone.
+        let lit = common::pixel(&outputs[1], x, y);
+        assert!(lit.iter().map(|&c| c as u32).sum::<u32>() > 150, "quad at {centre} is dark: {lit:?}");
+    }
+    // Between the red and green quads: background.
+    let gap = view_proj.project_point3(Vec3::new(0.0, 2.5, 0.0));
+    let (x, y) = (((gap.x + 1.0) * 0.5 * SIZE as f32) as u32, ((gap.y + 1.0) * 0.5 * SIZE as f32) as u32);
+    assert_eq!(common::pixel(&outputs[0], x, y), [5, 5, 5]);
+}
