@@ -115,11 +115,17 @@ pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
     let fail = |problem: String| SceneFileError { kind: "scene file", path: path.display().to_string(), problem };
     let bytes = read_capped(path, MAX_FILE_BYTES).map_err(fail)?;
     let text = String::from_utf8(bytes).map_err(|e| fail(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
-    parse(&text).map_err(fail)
+    parse_in(&text, path.parent()).map_err(fail)
 }
 
-/// Parse scene-file text; the error is the problem, without the file's name.
+/// Parse scene-file text (glTF objects are refused: they need the file's folder); the error
+/// is the problem, without the file's name.
 pub fn parse(text: &str) -> Result<SceneFile, String> {
+    parse_in(text, None)
+}
+
+/// Parse scene-file text whose `gltf` paths are relative to `base`.
+fn parse_in(text: &str, base: Option<&Path>) -> Result<SceneFile, String> {
     if text.len() as u64 > MAX_FILE_BYTES {
         return Err(format!("{} bytes is more than the {MAX_FILE_BYTES} a scene file may have", text.len()));
     }
@@ -131,10 +137,10 @@ pub fn parse(text: &str) -> Result<SceneFile, String> {
             None => message,
         }
     })?;
-    build(file)
+    build(file, base)
 }
 
-fn build(file: FileScene) -> Result<SceneFile, String> {
+fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
     if file.objects.is_empty() {
         return Err("no objects: a scene needs at least one [[objects]] entry".into());
     }
@@ -144,8 +150,20 @@ fn build(file: FileScene) -> Result<SceneFile, String> {
     if file.lights.len() as u64 > MAX_LIGHTS {
         return Err(format!("{} lights is more than the {MAX_LIGHTS} a scene may hold", file.lights.len()));
     }
-    let objects =
-        file.objects.iter().enumerate().map(|(i, o)| object(o).map_err(|e| format!("objects[{i}]: {e}"))).collect::<Result<Vec<_>, _>>()?;
+    let (mut objects, mut meshes, mut warnings) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, o) in file.objects.iter().enumerate() {
+        match &o.gltf {
+            Some(gltf) => {
+                let loaded = gltf_object(o, gltf, base, &mut meshes).map_err(|e| format!("objects[{i}]: {e}"))?;
+                objects.extend(loaded.0);
+                warnings.extend(loaded.1.into_iter().map(|w| format!("objects[{i}] ({gltf}): {w}")));
+            }
+            None => objects.push(object(o).map_err(|e| format!("objects[{i}]: {e}"))?),
+        }
+        if objects.len() > MAX_OBJECTS {
+            return Err(format!("more than the {MAX_OBJECTS} objects a scene may hold"));
+        }
+    }
     let lights =
         file.lights.iter().enumerate().map(|(i, l)| light(l).map_err(|e| format!("lights[{i}]: {e}"))).collect::<Result<Vec<_>, _>>()?;
     let (shading, ambient) = match &file.shading {
@@ -158,10 +176,10 @@ fn build(file: FileScene) -> Result<SceneFile, String> {
         camera: Camera::seed(),
         ambient: ambient.unwrap_or(SEED_AMBIENT),
         blinn_phong: BlinnPhongLights::default(),
-        meshes: Vec::new(),
+        meshes: std::mem::take(&mut meshes),
     };
     scene.camera = camera(file.camera.as_ref(), &scene)?;
-    Ok(SceneFile { scene, shading, warnings: Vec::new() })
+    Ok(SceneFile { scene, shading, warnings })
 }
 
 fn finite(what: &str, v: f32) -> Result<f32, String> {
@@ -204,12 +222,8 @@ fn unit(what: &str, v: f32) -> Result<f32, String> {
 }
 
 fn object(o: &FileObject) -> Result<Object, String> {
-    let mesh = match (&o.mesh, &o.gltf) {
-        (Some(name), None) => MeshKind::from_name(name).map_err(|e| e.to_string())?,
-        (None, Some(_)) => return Err("gltf objects are not supported yet (issue 7): use a built-in mesh".into()),
-        (Some(_), Some(_)) => return Err("give either mesh or gltf, not both".into()),
-        (None, None) => return Err("needs a mesh (a built-in name) or a gltf file".into()),
-    };
+    let name = o.mesh.as_ref().ok_or("needs a mesh (a built-in name) or a gltf file")?;
+    let mesh = MeshKind::from_name(name).map_err(|e| e.to_string())?;
     let mut material = Material::named("white").expect("built in");
     if let Some(m) = &o.material {
         if let Some(name) = &m.name {
@@ -231,6 +245,47 @@ fn object(o: &FileObject) -> Result<Object, String> {
     let position = o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
     let scale = o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0);
     Ok(Object::placed(mesh, position, scale, material))
+}
+
+/// A `gltf = "path"` object: every drawn primitive of that file, its materials, placed by the
+/// object's position and scale; its meshes appended to `meshes`. Its lights and camera are
+/// not used (the scene file says where lights and camera are).
+fn gltf_object(
+    o: &FileObject,
+    gltf: &str,
+    base: Option<&Path>,
+    meshes: &mut Vec<crate::mesh::Mesh>,
+) -> Result<(Vec<Object>, Vec<String>), String> {
+    if o.mesh.is_some() {
+        return Err("give either mesh or gltf, not both".into());
+    }
+    if o.material.is_some() {
+        return Err("material applies to built-in meshes; a glTF object has its own".into());
+    }
+    let base = base.ok_or("gltf objects need the scene file's folder (load it from a file)")?;
+    let path = base.join(gltf);
+    let (scene, warnings) = crate::gltf_scene::from_bytes(
+        &read_capped(&path, crate::gltf_scene::MAX_FILE_BYTES).map_err(|e| format!("'{gltf}': {e}"))?,
+        path.parent(),
+    )
+    .map_err(|e| format!("'{gltf}': {e}"))?;
+    let position = o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
+    let scale = o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0);
+    let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);
+    let offset = meshes.len() as u32;
+    meshes.extend(scene.meshes);
+    let objects = scene
+        .objects
+        .into_iter()
+        .map(|obj| {
+            let mesh = match obj.mesh {
+                MeshKind::Loaded(i) => MeshKind::Loaded(i + offset),
+                builtin => builtin,
+            };
+            Object { mesh, transform: place * obj.transform, ..obj }
+        })
+        .collect();
+    Ok((objects, warnings))
 }
 
 fn light(l: &FileLight) -> Result<PointLight, String> {

@@ -116,3 +116,34 @@ fn the_committed_seed_scene_file_is_the_seed_scene() {
     assert_eq!(f.scene.lights, seed.lights);
     assert_eq!(f.shading.as_deref(), Some("seed"));
 }
+
+#[test]
+fn gltf_objects_bring_their_meshes_placed_by_the_scene_file() {
+    use crate::gltf_writer::{quad, GltfWriter, PrimitiveData};
+    let dir = std::env::temp_dir().join(format!("manylights-scene-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("models")).unwrap();
+    let mut w = GltfWriter::new();
+    let m = w.material([0.5, 0.25, 1.0, 1.0], 0.0, 0.5);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(serde_json::json!({ "mesh": mesh, "translation": [0.0, 1.0, 0.0] }), true);
+    std::fs::write(dir.join("models/quad.glb"), w.to_glb()).unwrap();
+    let text = "[[objects]]\nmesh = \"cube\"\n[[objects]]\ngltf = \"models/quad.glb\"\nposition = [10.0, 0.0, 0.0]\nscale = 2.0\n[[objects]]\ngltf = \"models/quad.glb\"\n";
+    std::fs::write(dir.join("scene.toml"), text).unwrap();
+    let f = load(&dir.join("scene.toml")).unwrap();
+    let s = &f.scene;
+    assert_eq!(s.objects.len(), 3);
+    assert_eq!(s.meshes.len(), 2, "each glTF object brings its own copy");
+    assert_eq!(s.objects[1].mesh, MeshKind::Loaded(0));
+    assert_eq!(s.objects[2].mesh, MeshKind::Loaded(1));
+    assert_eq!(s.objects[1].material.albedo, Vec3::new(0.5, 0.25, 1.0));
+    // The glTF node's (0, 1, 0), scaled by 2 and moved by 10 in x.
+    assert!((s.objects[1].position() - Vec3::new(10.0, 2.0, 0.0)).length() < 1e-5, "{}", s.objects[1].position());
+    assert!((s.objects[2].position() - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-5);
+    // Refused: a material on it, a missing file, no folder to look in.
+    std::fs::write(dir.join("bad.toml"), "[[objects]]\ngltf = \"models/quad.glb\"\nmaterial = { roughness = 0.5 }\n").unwrap();
+    assert!(load(&dir.join("bad.toml")).unwrap_err().problem.contains("has its own"));
+    std::fs::write(dir.join("missing.toml"), "[[objects]]\ngltf = \"nope.gltf\"\n").unwrap();
+    assert!(load(&dir.join("missing.toml")).unwrap_err().problem.contains("'nope.gltf': cannot read it"));
+    assert!(parse("[[objects]]\ngltf = \"a.gltf\"\n").unwrap_err().contains("folder"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
