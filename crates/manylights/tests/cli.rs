@@ -256,6 +256,9 @@ fn broken_gltf_files() -> Vec<(Vec<u8>, &'static str, &'static str)> {
         (b"[1, 2, 3]".to_vec(), "gltf", "not a readable glTF"),
         (b"\x00\x01\x02garbage".to_vec(), "glb", "not a readable glTF"),
         (glb[..40].to_vec(), "glb", "not a readable glTF"),
+        // Found by the fuzzer: a GLB header length below the header's own size.
+        ([&glb[..8], &[0u8; 4][..], &glb[12..]].concat(), "glb", "the GLB header says 0 bytes"),
+        ([&glb[..4], &[1u8, 0, 0, 0][..], &glb[8..]].concat(), "glb", "GLB version 1"),
         (glb_without_bin, "glb", "GLB binary chunk"),
         (text(&good)[..60].to_vec(), "gltf", "not a readable glTF"),
         (edit(&|w| w.json["asset"] = json!({})), "gltf", "missing field `version`"),

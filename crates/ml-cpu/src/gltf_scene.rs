@@ -103,6 +103,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
 /// the accessor a primitive's POSITION names without checking it exists (gltf-json 1.4.1,
 /// mesh.rs), so that index is checked first.
 fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    check_glb_header(bytes)?;
     let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
     let blob = raw.blob;
     let root = raw.document.into_json();
@@ -125,6 +126,25 @@ fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, String> {
     }
     let document = gltf::Document::from_json(root).map_err(describe_gltf_error)?;
     Ok(gltf::Gltf { document, blob })
+}
+
+/// A GLB's 12-byte header, checked before the gltf crate reads it: its length field less the
+/// header is computed unchecked there (gltf 1.4.1, binary.rs — an overflow found by the fuzzer).
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let word = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes(b.try_into().expect("four bytes")));
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err("not a readable glTF/GLB file: the GLB header is cut short".into());
+    };
+    if version != 2 {
+        return Err(format!("not a readable glTF/GLB file: GLB version {version} (only 2 exists)"));
+    }
+    if (length as usize) < 12 + 8 || length as usize > bytes.len() {
+        return Err(format!("not a readable glTF/GLB file: the GLB header says {length} bytes, the file has {}", bytes.len()));
+    }
+    Ok(())
 }
 
 /// The gltf crate's error as one line (its validation errors name the JSON path).
