@@ -77,6 +77,7 @@ struct ObjectData {
     mat4 normal_matrix;    // upper 3×3: the inverse transpose of model's (normals, tangents)
     vec4 albedo_roughness; // rgb: albedo, a: roughness
     vec4 material;         // x: metallic; yzw unused
+    uvec4 textures;        // 1 where the object has its own texture (surface.glsl, set 2): x base colour, y normal map
 };
 
 // Per draw, by push constants (seed 000 pushed the object itself; we push its index).

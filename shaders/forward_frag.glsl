@@ -29,8 +29,8 @@ void main() {
         return;
     }
 #endif
-    Surface s = surface_at(in_normal, in_tangent, in_uv);
     ObjectData o = objects[object.ids.x];
+    Surface s = surface_at(in_normal, in_tangent, in_uv, o.textures);
     vec3 albedo = o.albedo_roughness.rgb * s.albedo_factor;
     float roughness = o.albedo_roughness.a;
     float metallic = o.material.x;

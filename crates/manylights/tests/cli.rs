@@ -232,6 +232,16 @@ fn good_gltf() -> ml_cpu::gltf_writer::GltfWriter {
     w
 }
 
+/// `good_gltf` with a base-colour texture on its quad, broken by `f`.
+fn textured(f: &dyn Fn(&mut ml_cpu::gltf_writer::GltfWriter)) -> Vec<u8> {
+    let mut w = good_gltf();
+    let t = w.texture(ml_cpu::gltf_writer::png(1, 1, &[255, 0, 0, 255]), "image/png");
+    let m = w.textured_material(Some(t), None);
+    w.json["meshes"][0]["primitives"][0]["material"] = serde_json::json!(m);
+    f(&mut w);
+    w.to_gltf()
+}
+
 /// Each broken glTF (bytes, file extension) and a fragment of the error it must give.
 fn broken_gltf_files() -> Vec<(Vec<u8>, &'static str, &'static str)> {
     use serde_json::json;
@@ -330,6 +340,21 @@ fn broken_gltf_files() -> Vec<(Vec<u8>, &'static str, &'static str)> {
         (edit(&|w| w.json["meshes"][0]["primitives"][0]["mode"] = json!(0)), "gltf", "no triangles"),
         (edit(&|w| w.json["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = json!(-1.0)), "gltf", "range -1"),
         (edit(&|w| w.json["scenes"][0]["nodes"] = json!([])), "gltf", "no triangles"),
+        // Textures: an image with no source (the gltf crate's own accessor panics on it), a
+        // buffer view without a MIME type, bytes that are no image, a PNG claiming 10⁵ pixels a side.
+        (textured(&|w| w.json["images"][0] = json!({})), "gltf", "needs either a uri or a bufferView"),
+        (textured(&|w| w.json["images"][0] = json!({ "bufferView": 0 })), "gltf", "without a mimeType"),
+        (textured(&|w| w.json["images"][0] = json!({ "uri": "data:image/png;base64,AAAA" })), "gltf", "cannot decode"),
+        (
+            textured(&|w| {
+                let mut huge = ml_cpu::gltf_writer::png(1, 1, &[0, 0, 0, 255]);
+                huge[16..20].copy_from_slice(&100_000u32.to_be_bytes());
+                let t = w.texture(huge, "image/png");
+                w.json["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": t });
+            }),
+            "gltf",
+            "cannot decode",
+        ),
     ]
 }
 

@@ -27,7 +27,8 @@ fn main() {
     std::fs::write(gltf_dir.join("scene.gltf"), w.to_gltf()).expect("write");
     std::fs::write(gltf_dir.join("scene.glb"), w.to_glb()).expect("write");
     let mut strip = GltfWriter::new();
-    let s = strip.mesh(&[PrimitiveData { positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]], ..Default::default() }]);
+    let s =
+        strip.mesh(&[PrimitiveData { positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]], ..Default::default() }]);
     strip.json["meshes"][s]["primitives"][0]["mode"] = json!(5);
     strip.node(json!({ "mesh": s, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 2, 0, 0, 1] }), true);
     std::fs::write(gltf_dir.join("strip.glb"), strip.to_glb()).expect("write");

@@ -6,17 +6,20 @@
 //!
 //! The `gltf` crate parses and validates the JSON; everything it hands over unchecked is
 //! checked here before it is used or allocated: buffer sources and lengths, accessor bounds
-//! and strides, index ranges, finite numbers, counts. Every problem is one line naming it.
-//! Not yet: textures (base colour, normal, metallic-roughness, occlusion, emissive), spot and
-//! directional lights (left out, with a warning), sparse accessors, orthographic cameras.
+//! and strides, index ranges, images, finite numbers, counts. Every problem is one line
+//! naming it. Base-colour (sRGB) and normal textures are read (PNG, JPEG); not yet:
+//! metallic-roughness, occlusion and emissive textures, samplers (every texture repeats,
+//! filtered trilinearly), spot and directional lights, sparse accessors, orthographic cameras
+//! (each left out with a warning).
 
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
 use crate::gpu_types::PointLight;
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
-use crate::scene::{Object, Scene, SEED_AMBIENT};
+use crate::scene::{Object, ObjectTextures, Scene, SEED_AMBIENT};
 use crate::scene_file::{read_capped, SceneFile, SceneFileError, MAX_OBJECTS};
+use crate::textures::TextureImage;
 use base64::Engine as _;
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -27,6 +30,8 @@ use std::path::Path;
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
 /// Most vertices (after un-indexing for flat normals) and triangles of a whole scene.
 pub const MAX_VERTICES: usize = 1 << 26;
+/// Widest and tallest texture we decode.
+pub const MAX_TEXTURE_SIZE: u32 = 16384;
 /// Deepest node hierarchy we follow.
 pub const MAX_NODE_DEPTH: usize = 256;
 /// Extensions a file may require: the ones we read.
@@ -54,6 +59,10 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     }
     let buffers = load_buffers(&gltf, base)?;
     let mut builder = Builder {
+        doc: &gltf.document,
+        base,
+        textures: Vec::new(),
+        by_image: HashMap::new(),
         buffers,
         meshes: Vec::new(),
         by_primitive: HashMap::new(),
@@ -89,9 +98,9 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     if builder.objects.is_empty() {
         return Err("the scene has no triangles to draw".into());
     }
-    let Builder { objects, lights, camera, meshes, warnings, .. } = builder;
-    let mut scene =
-        Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong: BlinnPhongLights::default(), meshes };
+    let Builder { objects, lights, camera, meshes, warnings, textures, .. } = builder;
+    let blinn_phong = BlinnPhongLights::default();
+    let mut scene = Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong, meshes, textures };
     scene.camera = match camera {
         Some(c) => c,
         None => framing_camera(&scene),
@@ -203,7 +212,13 @@ fn read_uri(uri: &str, base: Option<&Path>) -> Result<Vec<u8>, String> {
     read_capped(&path, MAX_FILE_BYTES).map_err(|e| format!("'{}': {e}", path.display()))
 }
 
-struct Builder {
+struct Builder<'a> {
+    doc: &'a gltf::Document,
+    /// Where external files are (None: refused).
+    base: Option<&'a Path>,
+    textures: Vec<TextureImage>,
+    /// (image, as sRGB) → index in `textures`: each image decoded once per use.
+    by_image: HashMap<(usize, bool), u32>,
     buffers: Vec<Vec<u8>>,
     meshes: Vec<Mesh>,
     /// (mesh, primitive) → (index in `meshes`, its box's centre and half-size), so that
@@ -217,7 +232,7 @@ struct Builder {
     warnings: Vec<String>,
 }
 
-impl Builder {
+impl Builder<'_> {
     fn node(&mut self, node: &gltf::Node, world: Mat4) -> Result<(), String> {
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
@@ -229,9 +244,10 @@ impl Builder {
                     return Err(format!("more than {MAX_OBJECTS} drawn primitives"));
                 }
                 let material = material(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
+                let textures = self.object_textures(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
                 // The mesh was stored fitted to [−1, 1]³: undo that inside the object's transform.
                 let transform = world * Mat4::from_translation(centre) * Mat4::from_scale(Vec3::splat(half));
-                self.objects.push(Object { mesh: MeshKind::Loaded(index), transform, material });
+                self.objects.push(Object { mesh: MeshKind::Loaded(index), transform, material, textures });
             }
         }
         if let Some(light) = node.light() {
@@ -325,6 +341,71 @@ impl Builder {
         Ok(Some((index, centre, half)))
     }
 
+    /// The material's base-colour and normal textures (first texture coordinates); what else
+    /// it has is named in a warning.
+    fn object_textures(&mut self, m: &gltf::Material) -> Result<ObjectTextures, String> {
+        let name = m.index().map_or("default".to_string(), |i| i.to_string());
+        let pbr = m.pbr_metallic_roughness();
+        let mut out = ObjectTextures::default();
+        if let Some(info) = pbr.base_color_texture() {
+            self.tex_coord_warning(&name, "base colour", info.tex_coord());
+            out.base_color =
+                Some(self.image(info.texture().source().index(), true).map_err(|e| format!("material {name} base colour: {e}"))?);
+        }
+        if let Some(normal) = m.normal_texture() {
+            self.tex_coord_warning(&name, "normal", normal.tex_coord());
+            if normal.scale() != 1.0 {
+                self.warnings.push(format!("material {name}: normal scale {} is read as 1", normal.scale()));
+            }
+            out.normal = Some(self.image(normal.texture().source().index(), false).map_err(|e| format!("material {name} normal: {e}"))?);
+        }
+        let unread = [
+            ("metallic-roughness", pbr.metallic_roughness_texture().is_some()),
+            ("occlusion", m.occlusion_texture().is_some()),
+            ("emissive", m.emissive_texture().is_some()),
+        ];
+        for (what, present) in unread {
+            if present {
+                self.warnings.push(format!("material {name}: its {what} texture is not used yet"));
+            }
+        }
+        Ok(out)
+    }
+
+    fn tex_coord_warning(&mut self, material: &str, what: &str, set: u32) {
+        if set != 0 {
+            self.warnings.push(format!("material {material}: the {what} texture names TEXCOORD_{set}; TEXCOORD_0 is used"));
+        }
+    }
+
+    /// Image `index` decoded to RGBA8 (once per colour space), checked before it is read:
+    /// the gltf crate's own accessor for an image's source panics on an image with neither a
+    /// URI nor a buffer view, and on a buffer view without a MIME type.
+    fn image(&mut self, index: usize, srgb: bool) -> Result<u32, String> {
+        if let Some(&known) = self.by_image.get(&(index, srgb)) {
+            return Ok(known);
+        }
+        let json = &self.doc.as_json().images[index];
+        let bytes: Vec<u8> = match (&json.uri, &json.buffer_view, &json.mime_type) {
+            (Some(uri), None, _) => read_uri(uri, self.base).map_err(|e| format!("image {index}: {e}"))?,
+            (None, Some(view), Some(_)) => {
+                let view = &self.doc.as_json().buffer_views[view.value()];
+                let data = &self.buffers[view.buffer.value()];
+                let start = view.byte_offset.map_or(0, |o| o.0 as usize);
+                let end = start.checked_add(view.byte_length.0 as usize).filter(|&e| e <= data.len());
+                let end = end.ok_or_else(|| format!("image {index}: its buffer view lies outside its buffer"))?;
+                data[start..end].to_vec()
+            }
+            (None, Some(_), None) => return Err(format!("image {index}: a buffer view without a mimeType")),
+            _ => return Err(format!("image {index}: needs either a uri or a bufferView")),
+        };
+        let texture = decode_image(&bytes, srgb).map_err(|e| format!("image {index}: {e}"))?;
+        let slot = self.textures.len() as u32;
+        self.textures.push(texture);
+        self.by_image.insert((index, srgb), slot);
+        Ok(slot)
+    }
+
     fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<(), String> {
         use gltf::khr_lights_punctual::Kind;
         let kind = match light.kind() {
@@ -356,7 +437,20 @@ impl Builder {
     }
 }
 
-/// glTF's metallic-roughness factors (textures: not yet).
+/// PNG or JPEG bytes as an RGBA8 texture, its size and memory capped before decoding.
+fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, String> {
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIZE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIZE);
+    limits.max_alloc = Some(1 << 30);
+    reader.limits(limits);
+    let decoded = reader.decode().map_err(|e| format!("cannot decode it: {e}"))?.to_rgba8();
+    let (width, height) = decoded.dimensions();
+    Ok(TextureImage { width, height, rgba: decoded.into_raw(), srgb })
+}
+
+/// glTF's metallic-roughness factors.
 fn material(m: &gltf::Material) -> Result<Material, String> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();

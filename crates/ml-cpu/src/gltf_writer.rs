@@ -119,6 +119,35 @@ impl GltfWriter {
         )
     }
 
+    /// A texture of these PNG (or other image) bytes, stored in the buffer; returns its index.
+    /// Materials name it with `{"index": i}` (`textured_material`).
+    pub fn texture(&mut self, image: Vec<u8>, mime_type: &str) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let view = self.push("bufferViews", json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": image.len() }));
+        self.bin.extend(image);
+        for key in ["images", "textures"] {
+            if self.json[key].is_null() {
+                self.json[key] = json!([]);
+            }
+        }
+        let image = self.push("images", json!({ "bufferView": view, "mimeType": mime_type }));
+        self.push("textures", json!({ "source": image }))
+    }
+
+    /// A material with a base-colour texture and/or a normal map (texture indices).
+    pub fn textured_material(&mut self, base_colour: Option<usize>, normal: Option<usize>) -> usize {
+        let m = self.material([1.0; 4], 0.0, 0.8);
+        if let Some(t) = base_colour {
+            self.json["materials"][m]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": t });
+        }
+        if let Some(t) = normal {
+            self.json["materials"][m]["normalTexture"] = json!({ "index": t });
+        }
+        m
+    }
+
     /// A node (any JSON: "mesh", "matrix", "translation", "children", …); returns its index.
     /// `root` puts it in the scene.
     pub fn node(&mut self, node: Value, root: bool) -> usize {
@@ -209,4 +238,12 @@ pub fn cube_without_normals(indices: IndexType) -> PrimitiveData {
         indices: Some((mesh.indices, indices)),
         material: None,
     }
+}
+
+/// RGBA8 texels (row 0 at the top) as a PNG file.
+pub fn png(width: u32, height: u32, rgba: &[u8]) -> Vec<u8> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::write_buffer_with_format(&mut out, rgba, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
+        .expect("a PNG in memory");
+    out.into_inner()
 }

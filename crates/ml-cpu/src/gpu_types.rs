@@ -118,6 +118,8 @@ gpu_struct!(
         albedo_roughness: [f32; 4],
         /// x: metallic.
         material: [f32; 4],
+        /// 1 where the object has its own texture (bound per draw): x base colour, y normal map.
+        textures: [u32; 4],
     }
 );
 

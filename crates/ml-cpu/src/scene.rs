@@ -6,6 +6,7 @@ use crate::gpu_types::PointLight;
 use crate::lights::LightParams;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshKind};
+use crate::textures::TextureImage;
 use crate::SceneError;
 use glam::{Mat4, Quat, Vec3};
 
@@ -18,12 +19,24 @@ pub struct Object {
     /// Object space → world (any affine transform: glTF nodes rotate and scale unevenly).
     pub transform: Mat4,
     pub material: Material,
+    pub textures: ObjectTextures,
+}
+
+/// An object's own textures (indices into `Scene::textures`), sampled with its first texture
+/// coordinates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ObjectTextures {
+    /// Multiplies the material's albedo (sRGB).
+    pub base_color: Option<u32>,
+    /// Tangent-space normal map (n·0.5 + 0.5).
+    pub normal: Option<u32>,
 }
 
 impl Object {
     /// `mesh` scaled by `scale` about its origin, then moved to `position`.
     pub fn placed(mesh: MeshKind, position: Vec3, scale: f32, material: Material) -> Object {
-        Object { mesh, transform: Mat4::from_scale_rotation_translation(Vec3::splat(scale), Quat::IDENTITY, position), material }
+        let transform = Mat4::from_scale_rotation_translation(Vec3::splat(scale), Quat::IDENTITY, position);
+        Object { mesh, transform, material, textures: ObjectTextures::default() }
     }
 
     /// Where its origin lands.
@@ -68,6 +81,8 @@ pub struct Scene {
     /// each fits [−1, 1]³ like the built-in ones (the loader folds its box into the objects'
     /// transforms).
     pub meshes: Vec<Mesh>,
+    /// Textures of the scene's own (glTF), named by `Object::textures`.
+    pub textures: Vec<TextureImage>,
 }
 
 impl Scene {
@@ -88,6 +103,7 @@ impl Scene {
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),
             meshes: Vec::new(),
+            textures: Vec::new(),
         })
     }
 
@@ -121,6 +137,7 @@ impl Scene {
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),
             meshes: Vec::new(),
+            textures: Vec::new(),
         }
     }
 

@@ -10,7 +10,7 @@ use crate::gpu_types::PointLight;
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
-use crate::scene::{Object, Scene, SEED_AMBIENT};
+use crate::scene::{Object, ObjectTextures, Scene, SEED_AMBIENT};
 use glam::Vec3;
 use serde::Deserialize;
 use std::path::Path;
@@ -150,11 +150,11 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
     if file.lights.len() as u64 > MAX_LIGHTS {
         return Err(format!("{} lights is more than the {MAX_LIGHTS} a scene may hold", file.lights.len()));
     }
-    let (mut objects, mut meshes, mut warnings) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut objects, mut meshes, mut textures, mut warnings) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (i, o) in file.objects.iter().enumerate() {
         match &o.gltf {
             Some(gltf) => {
-                let loaded = gltf_object(o, gltf, base, &mut meshes).map_err(|e| format!("objects[{i}]: {e}"))?;
+                let loaded = gltf_object(o, gltf, base, (&mut meshes, &mut textures)).map_err(|e| format!("objects[{i}]: {e}"))?;
                 objects.extend(loaded.0);
                 warnings.extend(loaded.1.into_iter().map(|w| format!("objects[{i}] ({gltf}): {w}")));
             }
@@ -177,6 +177,7 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
         ambient: ambient.unwrap_or(SEED_AMBIENT),
         blinn_phong: BlinnPhongLights::default(),
         meshes: std::mem::take(&mut meshes),
+        textures: std::mem::take(&mut textures),
     };
     scene.camera = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading, warnings })
@@ -254,7 +255,7 @@ fn gltf_object(
     o: &FileObject,
     gltf: &str,
     base: Option<&Path>,
-    meshes: &mut Vec<crate::mesh::Mesh>,
+    (meshes, textures): (&mut Vec<crate::mesh::Mesh>, &mut Vec<crate::textures::TextureImage>),
 ) -> Result<(Vec<Object>, Vec<String>), String> {
     if o.mesh.is_some() {
         return Err("give either mesh or gltf, not both".into());
@@ -274,6 +275,9 @@ fn gltf_object(
     let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);
     let offset = meshes.len() as u32;
     meshes.extend(scene.meshes);
+    let texture_offset = textures.len() as u32;
+    textures.extend(scene.textures);
+    let shift = |t: Option<u32>| t.map(|i| i + texture_offset);
     let objects = scene
         .objects
         .into_iter()
@@ -282,7 +286,9 @@ fn gltf_object(
                 MeshKind::Loaded(i) => MeshKind::Loaded(i + offset),
                 builtin => builtin,
             };
-            Object { mesh, transform: place * obj.transform, ..obj }
+            let t = obj.textures;
+            let textures = ObjectTextures { base_color: shift(t.base_color), normal: shift(t.normal) };
+            Object { mesh, transform: place * obj.transform, textures, ..obj }
         })
         .collect();
     Ok((objects, warnings))

@@ -11,6 +11,60 @@ pub struct MipChain {
     pub levels: Vec<Vec<u8>>,
 }
 
+/// A material texture of a scene (glTF): RGBA8 texels, row 0 at the top; `srgb` for colour
+/// (the GPU decodes it), not for data such as normal maps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureImage {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+    pub srgb: bool,
+}
+
+impl TextureImage {
+    /// Its mip chain, level 0 first, each level ⌊half⌋ the size (at least 1) down to 1×1; each
+    /// texel the mean of the 2×2 texels above it (edges repeat at odd sizes), in linear light
+    /// for sRGB images.
+    pub fn mips(&self) -> Vec<Vec<u8>> {
+        let to_linear = |c: u8| if self.srgb { srgb_to_linear(c as f32 / 255.0) } else { c as f32 / 255.0 };
+        let from_linear = |v: f32| encode(if self.srgb { linear_to_srgb(v) } else { v });
+        let (mut w, mut h) = (self.width, self.height);
+        let mut level: Vec<[f32; 4]> =
+            self.rgba.chunks_exact(4).map(|t| [to_linear(t[0]), to_linear(t[1]), to_linear(t[2]), t[3] as f32 / 255.0]).collect();
+        let mut out = vec![self.rgba.clone()];
+        while w > 1 || h > 1 {
+            let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+            let at = |x: u32, y: u32| level[(y.min(h - 1) * w + x.min(w - 1)) as usize];
+            let next: Vec<[f32; 4]> = (0..nw * nh)
+                .map(|i| {
+                    let (x, y) = (2 * (i % nw), 2 * (i / nw));
+                    let quad = [at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1)];
+                    std::array::from_fn(|c| quad.iter().map(|t| t[c]).sum::<f32>() / 4.0)
+                })
+                .collect();
+            out.push(next.iter().flat_map(|t| [from_linear(t[0]), from_linear(t[1]), from_linear(t[2]), encode(t[3])]).collect());
+            (w, h, level) = (nw, nh, next);
+        }
+        out
+    }
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn linear_to_srgb(v: f32) -> f32 {
+    if v <= 0.0031308 {
+        v * 12.92
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
 /// Tiles per texture side of both maps (they line up: the bumps sit on the tiles).
 pub const TILES: u32 = 4;
 
@@ -189,5 +243,19 @@ mod tests {
         let sky = sky_cube(8);
         assert_eq!(sky.len(), 6);
         assert!(sky[2][2] > sky[3][2], "the sky above is bluer than the ground");
+    }
+
+    #[test]
+    fn texture_mips_halve_down_to_one_texel_and_average_in_linear_light() {
+        // 3×2: black and white columns; sRGB.
+        let (b, w) = ([0u8, 0, 0, 255], [255u8, 255, 255, 255]);
+        let rgba: Vec<u8> = [b, w, b, b, w, b].concat();
+        let t = TextureImage { width: 3, height: 2, rgba, srgb: true };
+        let mips = t.mips();
+        assert_eq!(mips.iter().map(Vec::len).collect::<Vec<_>>(), vec![24, 4]);
+        // Level 1 (1×1) averages the top-left 2×2: half white in linear light is sRGB 188.
+        assert_eq!(mips[1], vec![188, 188, 188, 255]);
+        let data = TextureImage { srgb: false, ..t };
+        assert_eq!(data.mips()[1], vec![128, 128, 128, 255]);
     }
 }

@@ -7,6 +7,7 @@ use crate::deferred::ComputeLighting;
 use crate::error::RenderError;
 use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::GpuMesh;
+use crate::object_textures::ObjectTextureSets;
 use crate::omni_shadow::{OmniShadows, ShadowedLight};
 use crate::raster::{object_data, DrawList, PassFrame, RasterPass};
 use crate::report::FrameStats;
@@ -48,6 +49,8 @@ pub struct HeadlessRenderer<'a> {
     /// Set 1 of every shading pipeline (blinn-phong's shadow map, sky, albedo and normal maps,
     /// the point-light shadow cubes).
     textures: SceneTextures,
+    /// Set 2 of the mesh pipelines: each object's own textures.
+    object_textures: ObjectTextureSets,
     /// Point-light shadow cubes (a stand-in without shadowed lights).
     omni: OmniShadows,
     /// The lights with a shadow cube (cube i: `shadowed[i]`), and where they are this frame.
@@ -128,9 +131,19 @@ impl<'a> HeadlessRenderer<'a> {
                 return Err(e.into());
             }
         };
-        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.lighting()), textures.set_layout) {
+        let mut object_textures = match ObjectTextureSets::new(ctx, &scene.textures, &scene.objects) {
+            Ok(t) => t,
+            Err(e) => {
+                textures.destroy(ctx);
+                omni.destroy(ctx);
+                return Err(e.into());
+            }
+        };
+        let layouts = (textures.set_layout, object_textures.set_layout);
+        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.lighting()), layouts) {
             Ok(p) => p,
             Err(e) => {
+                object_textures.destroy(ctx);
                 textures.destroy(ctx);
                 omni.destroy(ctx);
                 return Err(e.into());
@@ -145,6 +158,7 @@ impl<'a> HeadlessRenderer<'a> {
             extent,
             pass,
             textures,
+            object_textures,
             omni,
             shadowed,
             shadowed_now: Vec::new(),
@@ -489,7 +503,8 @@ impl<'a> HeadlessRenderer<'a> {
             textures: self.textures.set,
             input_set: frame.input_set,
         };
-        self.pass.record(ctx, cmd, &pass_frame, &DrawList { meshes: &self.meshes, objects: &self.scene.objects }, legend);
+        let draws = DrawList { meshes: &self.meshes, objects: &self.scene.objects, object_sets: &self.object_textures.per_object };
+        self.pass.record(ctx, cmd, &pass_frame, &draws, legend);
         frame.timer.end(ctx, cmd, pass);
         if let Some(lighting) = &self.lighting {
             pass += 1;
@@ -611,6 +626,7 @@ impl Drop for HeadlessRenderer<'_> {
         }
         self.pass.destroy(ctx);
         self.textures.destroy(ctx);
+        self.object_textures.destroy(ctx);
         self.omni.destroy(ctx);
     }
 }

@@ -9,6 +9,7 @@ pub mod error;
 pub mod frame;
 pub mod gpu_mesh;
 pub mod headless;
+pub mod object_textures;
 pub mod omni_shadow;
 pub mod raster;
 pub mod render_pass;

@@ -73,16 +73,19 @@ pub struct PassFrame {
 pub struct DrawList<'a> {
     pub meshes: &'a [GpuMesh],
     pub objects: &'a [Object],
+    /// Per object: its textures' set (set 2).
+    pub object_sets: &'a [vk::DescriptorSet],
 }
 
 impl RasterPass {
     /// The pass for a technique and shading model; `textures_layout` is set 1 of every
-    /// pipeline (scene_textures.rs).
+    /// pipeline (scene_textures.rs), `object_textures_layout` set 2 of the mesh pipelines
+    /// (object_textures.rs).
     pub fn new(
         ctx: &Context,
         depth_format: vk::Format,
         (technique, shading): (Technique, Shading),
-        textures_layout: vk::DescriptorSetLayout,
+        (textures_layout, object_textures_layout): (vk::DescriptorSetLayout, vk::DescriptorSetLayout),
     ) -> Result<RasterPass, VkError> {
         let output = Output::of(technique);
         let pass = RasterPass {
@@ -104,7 +107,7 @@ impl RasterPass {
             (Output::Color, false) => ml_shaders::FORWARD_FRAG,
         };
         let lighting = if technique.is_clustered() { ml_shaders::DEFERRED_CLUSTERED_FRAG } else { ml_shaders::DEFERRED_FRAG };
-        ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, (fragment, lighting), textures_layout))
+        ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, (fragment, lighting), (textures_layout, object_textures_layout)))
     }
 
     fn create(
@@ -112,7 +115,7 @@ impl RasterPass {
         ctx: &Context,
         depth_format: vk::Format,
         (fragment, lighting): (&[u8], &[u8]),
-        textures_layout: vk::DescriptorSetLayout,
+        (textures_layout, object_textures_layout): (vk::DescriptorSetLayout, vk::DescriptorSetLayout),
     ) -> Result<(), VkError> {
         let output = self.output;
         self.render_pass = render_pass::describe(depth_format, output).create(ctx)?;
@@ -131,7 +134,7 @@ impl RasterPass {
         let push = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             .size(std::mem::size_of::<ObjectPush>() as u32)];
-        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout, textures_layout], &push)?;
+        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout, textures_layout, object_textures_layout], &push)?;
         self.pipeline = self.create_pipeline(ctx, ml_shaders::FORWARD_VERT, fragment, Draw::Mesh)?;
         if output == Output::Color {
             self.legend_pipeline = self.create_pipeline(ctx, ml_shaders::HEAT_LEGEND_VERT, ml_shaders::HEAT_LEGEND_FRAG, Draw::Overlay)?;
@@ -246,12 +249,18 @@ impl RasterPass {
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[area]);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[frame.set, frame.textures], &[]);
+            // Set 2 (the object's textures) changes only between objects with different ones.
+            let mut bound_set = None;
             record_draws(
                 ctx,
                 cmd,
                 (draws.meshes, draws.objects),
                 |_| 1,
                 |index, _| {
+                    let set = draws.object_sets[index as usize];
+                    if bound_set.replace(set) != Some(set) {
+                        d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 2, &[set], &[]);
+                    }
                     let push = ObjectPush { ids: [index, 0, 0, 0] };
                     let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
                     d.cmd_push_constants(cmd, self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
@@ -296,6 +305,7 @@ pub fn object_data(o: &Object) -> ObjectData {
         normal_matrix: normal.to_cols_array_2d(),
         albedo_roughness: [m.albedo.x, m.albedo.y, m.albedo.z, m.roughness],
         material: [m.metallic, 0.0, 0.0, 0.0],
+        textures: [u32::from(o.textures.base_color.is_some()), u32::from(o.textures.normal.is_some()), 0, 0],
     }
 }
 

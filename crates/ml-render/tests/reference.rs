@@ -48,6 +48,7 @@ fn sphere_scene(material: Material) -> Scene {
         ambient: 0.02,
         blinn_phong: Default::default(),
         meshes: Vec::new(),
+        textures: Vec::new(),
     }
 }
 

@@ -80,3 +80,89 @@ fn gltf_nodes_place_their_coloured_quads() {
     let (x, y) = (((gap.x + 1.0) * 0.5 * SIZE as f32) as u32, ((gap.y + 1.0) * 0.5 * SIZE as f32) as u32);
     assert_eq!(common::pixel(&outputs[0], x, y), [5, 5, 5]);
 }
+
+/// A 4×4 texture of four 2×2 quarters: red, green / blue, white (so bilinear taps near a
+/// quarter's centre see one colour).
+fn quarters() -> Vec<u8> {
+    let colour = |x: u32, y: u32| match (x / 2, y / 2) {
+        (0, 0) => [255, 0, 0, 255],
+        (1, 0) => [0, 255, 0, 255],
+        (0, 1) => [0, 0, 255, 255],
+        _ => [255, 255, 255, 255],
+    };
+    (0..16).flat_map(|i| colour(i % 4, i / 4)).collect()
+}
+
+/// glTF textures on quads facing the camera (turned a quarter about +X): a base-colour
+/// texture shows its four colours in the four quarters (albedo view), and a normal map that
+/// tilts the normal 30° towards +u (+x in the world) shows that normal (normal view) and
+/// makes the quad brighter under a light on its +x side than the same quad without it — and
+/// darker under a light on its −x side.
+#[test]
+fn gltf_textures_colour_and_bend_their_quads() {
+    use glam::{Mat4, Quat, Vec3};
+    use ml_cpu::gltf_writer::{png, quad, GltfWriter, PrimitiveData};
+    use ml_render::{DebugView, RenderSettings, ShadingModel, Technique};
+    use serde_json::json;
+    const SIZE: u32 = 128;
+    let turn = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let build = |light_x: f32| {
+        let mut w = GltfWriter::new();
+        let checker = w.texture(png(4, 4, &quarters()), "image/png");
+        let bump = w.texture(png(1, 1, &[191, 128, 238, 255]), "image/png");
+        let materials = [w.textured_material(Some(checker), None), w.textured_material(None, Some(bump)), w.textured_material(None, None)];
+        for (m, x) in materials.iter().zip([-3.0f32, 0.0, 3.0]) {
+            let mesh = w.mesh(&[PrimitiveData { material: Some(*m), ..quad() }]);
+            w.node(json!({ "mesh": mesh, "translation": [x, 0.0, 0.0], "rotation": turn.to_array() }), true);
+        }
+        let camera = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 1.0, "znear": 0.1, "zfar": 100.0 } }));
+        w.node(json!({ "camera": camera, "translation": [0.0, 0.0, 8.0] }), true);
+        let light = w.light(json!({ "type": "point", "intensity": 3.0, "range": 12.0 }));
+        w.node(json!({ "translation": [light_x, 0.0, 1.5], "extensions": { "KHR_lights_punctual": { "light": light } } }), true);
+        ml_cpu::gltf_scene::from_bytes(&w.to_glb(), None).expect("a good file").0
+    };
+    let scene = build(0.0);
+    let settings = |view: DebugView, technique: Technique| {
+        let mut s = RenderSettings::new(technique, SIZE, SIZE);
+        s.shading = ShadingModel::Pbr;
+        s.debug_view = view;
+        s
+    };
+    let outputs = common::render_each(
+        &scene,
+        &[settings(DebugView::GBufferAlbedo, Technique::Forward), settings(DebugView::GBufferNormal, Technique::Deferred)],
+    );
+    let view_proj = scene.camera.projection(1.0) * scene.camera.view();
+    let pixel_at = |x: f32, object_point: Vec3| {
+        let world = Mat4::from_rotation_translation(turn, Vec3::new(x, 0.0, 0.0)).transform_point3(object_point);
+        let ndc = view_proj.project_point3(world);
+        (((ndc.x + 1.0) * 0.5 * SIZE as f32) as u32, ((ndc.y + 1.0) * 0.5 * SIZE as f32) as u32)
+    };
+    // The quad's (x, z) ↦ uv ((x + 1) / 2, (z + 1) / 2): texel (i, j) is around x, z = ±0.5.
+    for ((u, v), colour) in
+        [((-0.5, -0.5), [255, 0, 0]), ((0.5, -0.5), [0, 255, 0]), ((-0.5, 0.5), [0, 0, 255]), ((0.5, 0.5), [255, 255, 255])]
+    {
+        let (px, py) = pixel_at(-3.0, Vec3::new(u, 0.0, v));
+        assert_eq!(common::pixel(&outputs[0], px, py), colour, "texel at object ({u}, {v}), pixel ({px}, {py})");
+    }
+    // The bent normal (0.5, 0, 0.866) in the normal view (n·0.5 + 0.5), deferred.
+    let (px, py) = pixel_at(0.0, Vec3::ZERO);
+    let shown = common::pixel(&outputs[1], px, py);
+    for (got, want) in shown.iter().zip([191u8, 128, 238]) {
+        assert!(got.abs_diff(want) <= 2, "normal-mapped quad shows {shown:?}, expected ≈ [191, 128, 238]");
+    }
+    let (flat_x, flat_y) = pixel_at(3.0, Vec3::ZERO);
+    let plain = common::pixel(&outputs[1], flat_x, flat_y);
+    assert!(plain[0].abs_diff(128) <= 1 && plain[1].abs_diff(128) <= 1 && plain[2] == 255, "the plain quad faces +z: {plain:?}");
+    // Lit from its +x side, the bent quad is brighter than with the light on its −x side; the
+    // plain quad (lit symmetrically) sets the scale.
+    let brightness = |light_x: f32, quad_x: f32| {
+        let s = build(light_x);
+        let out = common::render(s, settings(DebugView::None, Technique::Forward));
+        let (px, py) = pixel_at(quad_x, Vec3::ZERO);
+        common::pixel(&out, px, py).iter().map(|&c| c as u32).sum::<u32>()
+    };
+    let (towards, away) = (brightness(1.5, 0.0), brightness(-1.5, 0.0));
+    println!("bent quad: light towards its normal {towards}, away {away}");
+    assert!(towards > away + 60, "the normal map should turn the quad towards +x: {towards} vs {away}");
+}

@@ -112,3 +112,24 @@ fn strips_fans_and_unindexed_triangles_become_lists() {
         assert_eq!(s.mesh(s.objects[0].mesh).unwrap().indices.len(), triangles * 3, "mode {mode}");
     }
 }
+
+#[test]
+fn textures_are_decoded_once_per_use_in_their_colour_space() {
+    use crate::gltf_writer::png;
+    let mut w = GltfWriter::new();
+    let checker = w.texture(png(2, 2, &[255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255]), "image/png");
+    let bump = w.texture(png(1, 1, &[191, 128, 238, 255]), "image/png");
+    let both = w.textured_material(Some(checker), Some(bump));
+    let base_only = w.textured_material(Some(checker), None);
+    let a = w.mesh(&[PrimitiveData { material: Some(both), ..quad() }]);
+    let b = w.mesh(&[PrimitiveData { material: Some(base_only), ..quad() }]);
+    w.node(json!({ "mesh": a }), true);
+    w.node(json!({ "mesh": b, "translation": [3.0, 0.0, 0.0] }), true);
+    let s = load_bytes(&w.to_glb());
+    assert_eq!(s.textures.len(), 2, "the checker once, the normal map once");
+    assert_eq!(s.objects[0].textures, ObjectTextures { base_color: Some(0), normal: Some(1) });
+    assert_eq!(s.objects[1].textures, ObjectTextures { base_color: Some(0), normal: None });
+    assert!(s.textures[0].srgb && !s.textures[1].srgb);
+    assert_eq!((s.textures[0].width, s.textures[0].height), (2, 2));
+    assert_eq!(&s.textures[0].rgba[4..8], &[0, 255, 0, 255]);
+}
