@@ -503,7 +503,7 @@ fn triangle_list(mode: gltf::mesh::Mode, indices: &[u32]) -> Result<Vec<u32>, St
     use gltf::mesh::Mode;
     Ok(match mode {
         Mode::Triangles => {
-            if indices.len() % 3 != 0 {
+            if !indices.len().is_multiple_of(3) {
                 return Err(format!("{} indices do not make whole triangles", indices.len()));
             }
             indices.to_vec()

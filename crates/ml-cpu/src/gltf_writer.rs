@@ -59,7 +59,7 @@ impl GltfWriter {
 
     /// Append bytes as a buffer view (4-byte aligned) and an accessor over it.
     fn accessor(&mut self, bytes: Vec<u8>, count: usize, component: u32, kind: &str, extra: Value) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let view = self.push("bufferViews", json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() }));
@@ -122,7 +122,7 @@ impl GltfWriter {
     /// A texture of these PNG (or other image) bytes, stored in the buffer; returns its index.
     /// Materials name it with `{"index": i}` (`textured_material`).
     pub fn texture(&mut self, image: Vec<u8>, mime_type: &str) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let view = self.push("bufferViews", json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": image.len() }));
@@ -195,11 +195,11 @@ impl GltfWriter {
             json["buffers"] = json!([{ "byteLength": self.bin.len() }]);
         }
         let mut text = serde_json::to_vec(&json).expect("serialisable");
-        while text.len() % 4 != 0 {
+        while !text.len().is_multiple_of(4) {
             text.push(b' ');
         }
         let mut bin = self.bin.clone();
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let total = 12 + 8 + text.len() + 8 + bin.len();
