@@ -472,7 +472,8 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
     let fov = p.yfov().to_degrees();
     let near = p.znear();
     let far = p.zfar().unwrap_or(near * 1e5);
-    if !(fov > 0.0 && fov < 180.0) || !(near > 0.0 && near.is_finite()) || !(far > near && far.is_finite()) {
+    let sane = fov > 0.0 && fov < 180.0 && near > 0.0 && near.is_finite() && far > near && far.is_finite();
+    if !sane {
         return Err(format!("yfov {} rad, znear {near}, zfar {far}: need 0 < yfov < π and 0 < znear < zfar", p.yfov()));
     }
     let position = world.transform_point3(Vec3::ZERO);
