@@ -1,6 +1,6 @@
 //! Seed files for the fuzzers (scripts/fuzz.sh): glTF/GLB files made by our writer and the
 //! seed scene as a scene file. Usage: fuzz_seeds GLTF_DIR SCENE_DIR
-use ml_cpu::gltf_writer::{cube_without_normals, quad, GltfWriter, IndexType, PrimitiveData};
+use ml_cpu::gltf_writer::{cube_without_normals, png, quad, GltfWriter, IndexType, PrimitiveData};
 use serde_json::json;
 
 fn main() {
@@ -32,6 +32,13 @@ fn main() {
     strip.json["meshes"][s]["primitives"][0]["mode"] = json!(5);
     strip.node(json!({ "mesh": s, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 2, 0, 0, 1] }), true);
     std::fs::write(gltf_dir.join("strip.glb"), strip.to_glb()).expect("write");
+    let mut textured = GltfWriter::new();
+    let base = textured.texture(png(2, 2, &[255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255]), "image/png");
+    let normal = textured.texture(png(1, 1, &[191, 128, 238, 255]), "image/png");
+    let m = textured.textured_material(Some(base), Some(normal));
+    let q = textured.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    textured.node(json!({ "mesh": q }), true);
+    std::fs::write(gltf_dir.join("textured.glb"), textured.to_glb()).expect("write");
     let seed = include_str!("../../../scenes/seed.toml");
     std::fs::write(scene_dir.join("seed.toml"), seed).expect("write");
     std::fs::write(scene_dir.join("small.toml"), "[camera]\nposition = [0.0, 2.0, 6.0]\n[shading]\nmodel = \"pbr\"\n[[lights]]\nposition = [1.0, 3.0, 2.0]\n[[objects]]\nmesh = \"teapot\"\nmaterial = { name = \"gold\", roughness = 0.3 }\n").expect("write");
