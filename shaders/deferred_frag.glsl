@@ -24,11 +24,13 @@ void main() {
     }
     vec3 world = world_from_depth(gl_FragCoord.xy, z);
     vec3 n = oct_decode(subpassLoad(normal_input).xy);
-    ObjectData object = objects[subpassLoad(object_input).r];
-    vec3 albedo = object.albedo_roughness.rgb * subpassLoad(albedo_input).rgb;
+    uint id = subpassLoad(object_input).r;
+    vec4 albedo_roughness = objects[id].albedo_roughness;
+    float metallic = objects[id].material.x;
+    vec3 albedo = albedo_roughness.rgb * subpassLoad(albedo_input).rgb;
     vec3 color;
-    if (!debug_surface(world, n, albedo, object.albedo_roughness.a, object.material.x, color)) {
-        color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, gl_FragCoord.xy);
+    if (!debug_surface(world, n, albedo, albedo_roughness.a, metallic, color)) {
+        color = shade_point(world, n, albedo, albedo_roughness.a, metallic, gl_FragCoord.xy);
     }
     out_hdr = vec4(color, 1.0);
 }

@@ -31,13 +31,15 @@ void main() {
     vec2 frag_xy = vec2(p) + 0.5;
     vec3 world = world_from_depth(frag_xy, z);
     vec3 n = oct_decode(texelFetch(normal_image, p, 0).xy);
-    ObjectData object = objects[texelFetch(object_image, p, 0).r];
-    vec3 albedo = object.albedo_roughness.rgb * texelFetch(albedo_image, p, 0).rgb;
+    uint id = texelFetch(object_image, p, 0).r;
+    vec4 albedo_roughness = objects[id].albedo_roughness;
+    float metallic = objects[id].material.x;
+    vec3 albedo = albedo_roughness.rgb * texelFetch(albedo_image, p, 0).rgb;
     vec3 color;
-    if (debug_surface(world, n, albedo, object.albedo_roughness.a, object.material.x, color)) {
+    if (debug_surface(world, n, albedo, albedo_roughness.a, metallic, color)) {
         imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
         return;
     }
-    color = shade_point(world, n, albedo, object.albedo_roughness.a, object.material.x, frag_xy);
+    color = shade_point(world, n, albedo, albedo_roughness.a, metallic, frag_xy);
     imageStore(out_image, p, vec4(encode_output(color), 1.0));
 }

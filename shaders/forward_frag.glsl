@@ -29,11 +29,10 @@ void main() {
         return;
     }
 #endif
-    ObjectData o = objects[object.ids.x];
-    Surface s = surface_at(in_normal, in_tangent, in_uv, o.textures);
-    vec3 albedo = o.albedo_roughness.rgb * s.albedo_factor;
-    float roughness = o.albedo_roughness.a;
-    float metallic = o.material.x;
+    Surface s = surface_at(in_normal, in_tangent, in_uv, object.ids.yz);
+    vec3 albedo = object.albedo_roughness.rgb * s.albedo_factor;
+    float roughness = object.albedo_roughness.a;
+    float metallic = object.material.x;
     vec3 color;
     if (debug_surface(in_world_pos, s.normal, albedo, roughness, metallic, color)) {
         out_color = vec4(encode_gamma(color), 1.0);

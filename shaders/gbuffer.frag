@@ -21,7 +21,7 @@ layout(location = 1) out uint out_object;
 layout(location = 2) out vec4 out_albedo_factor;
 
 void main() {
-    Surface s = surface_at(in_normal, in_tangent, in_uv, objects[object.ids.x].textures);
+    Surface s = surface_at(in_normal, in_tangent, in_uv, object.ids.yz);
     out_normal = oct_encode(s.normal);
     out_object = object.ids.x;
     out_albedo_factor = vec4(s.albedo_factor, 1.0);

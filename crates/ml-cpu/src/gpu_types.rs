@@ -118,16 +118,17 @@ gpu_struct!(
         albedo_roughness: [f32; 4],
         /// x: metallic.
         material: [f32; 4],
-        /// 1 where the object has its own texture (bound per draw): x base colour, y normal map.
-        textures: [u32; 4],
     }
 );
 
 gpu_struct!(
-    /// Per-draw push constants.
+    /// Per-draw push constants (the material again: see common.glsl).
     ObjectPush {
-        /// x: index of the object in the object buffer.
+        /// x: index of the object in the object buffer; y, z: 1 where it has its own
+        /// base-colour texture, normal map.
         ids: [u32; 4],
+        albedo_roughness: [f32; 4],
+        material: [f32; 4],
     }
 );
 

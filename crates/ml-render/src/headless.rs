@@ -140,7 +140,7 @@ impl<'a> HeadlessRenderer<'a> {
             }
         };
         let layouts = (textures.set_layout, object_textures.set_layout);
-        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.lighting()), layouts) {
+        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.lighting(!scene.textures.is_empty())), layouts) {
             Ok(p) => p,
             Err(e) => {
                 object_textures.destroy(ctx);
@@ -209,7 +209,7 @@ impl<'a> HeadlessRenderer<'a> {
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         if self.settings.technique.lights_in_compute() {
-            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting())?);
+            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting(!self.scene.textures.is_empty()))?);
         }
         if self.settings.technique.lights_in_subpass() {
             let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);

@@ -256,12 +256,12 @@ impl RasterPass {
                 cmd,
                 (draws.meshes, draws.objects),
                 |_| 1,
-                |index, _| {
+                |index, o| {
                     let set = draws.object_sets[index as usize];
                     if bound_set.replace(set) != Some(set) {
                         d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 2, &[set], &[]);
                     }
-                    let push = ObjectPush { ids: [index, 0, 0, 0] };
+                    let push = object_push(o, index);
                     let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
                     d.cmd_push_constants(cmd, self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
                 },
@@ -298,15 +298,22 @@ impl RasterPass {
 
 /// Object `o`'s entry in the object buffer.
 pub fn object_data(o: &Object) -> ObjectData {
-    let m = &o.material;
     let normal = glam::Mat4::from_mat3(glam::Mat3::from_mat4(o.transform).inverse().transpose());
-    ObjectData {
-        model: o.transform.to_cols_array_2d(),
-        normal_matrix: normal.to_cols_array_2d(),
-        albedo_roughness: [m.albedo.x, m.albedo.y, m.albedo.z, m.roughness],
-        material: [m.metallic, 0.0, 0.0, 0.0],
-        textures: [u32::from(o.textures.base_color.is_some()), u32::from(o.textures.normal.is_some()), 0, 0],
-    }
+    let (albedo_roughness, material) = material_vectors(o);
+    ObjectData { model: o.transform.to_cols_array_2d(), normal_matrix: normal.to_cols_array_2d(), albedo_roughness, material }
+}
+
+/// What a draw of object `o` (at `index`) pushes.
+pub fn object_push(o: &Object, index: u32) -> ObjectPush {
+    let (albedo_roughness, material) = material_vectors(o);
+    let textures = [u32::from(o.textures.base_color.is_some()), u32::from(o.textures.normal.is_some())];
+    ObjectPush { ids: [index, textures[0], textures[1], 0], albedo_roughness, material }
+}
+
+/// The material as the shaders read it: (albedo, roughness), (metallic, 0, 0, 0).
+fn material_vectors(o: &Object) -> ([f32; 4], [f32; 4]) {
+    let m = &o.material;
+    ([m.albedo.x, m.albedo.y, m.albedo.z, m.roughness], [m.metallic, 0.0, 0.0, 0.0])
 }
 
 impl ml_vk::Release for RasterPass {

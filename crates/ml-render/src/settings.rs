@@ -116,21 +116,24 @@ impl ShadingModel {
     }
 }
 
-/// constant_id of `OMNI_SHADOWS` in omni_shadow.glsl.
+/// constant_id of `OMNI_SHADOWS` in omni_shadow.glsl and `OBJECT_TEXTURES` in surface.glsl.
 pub const SPEC_OMNI_SHADOWS: u32 = 12;
+pub const SPEC_OBJECT_TEXTURES: u32 = 13;
 
-/// What a lighting pipeline is compiled for: the model and whether point lights cast
-/// shadows (specialization constants, so each pipeline carries only what it runs).
+/// What a lighting pipeline is compiled for: the model, whether point lights cast shadows and
+/// whether objects have textures of their own (specialization constants, so each pipeline
+/// carries only what it runs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shading {
     pub model: ShadingModel,
     pub omni_shadows: bool,
+    pub object_textures: bool,
 }
 
 impl Shading {
-    pub fn spec_constants(self) -> [(u32, u32); 3] {
+    pub fn spec_constants(self) -> [(u32, u32); 4] {
         let [a, b] = self.model.spec_constants();
-        [a, b, (SPEC_OMNI_SHADOWS, u32::from(self.omni_shadows))]
+        [a, b, (SPEC_OMNI_SHADOWS, u32::from(self.omni_shadows)), (SPEC_OBJECT_TEXTURES, u32::from(self.object_textures))]
     }
 }
 
@@ -304,9 +307,10 @@ impl RenderSettings {
         self.time.unwrap_or(i as f32 * FRAME_SECONDS * TIMER_SPEED)
     }
 
-    /// What the lighting pipelines are compiled for.
-    pub fn lighting(&self) -> Shading {
-        Shading { model: self.shading, omni_shadows: self.omni.is_some() }
+    /// What the lighting pipelines are compiled for, for a scene whose objects do or do not
+    /// have textures of their own.
+    pub fn lighting(&self, object_textures: bool) -> Shading {
+        Shading { model: self.shading, omni_shadows: self.omni.is_some(), object_textures }
     }
 
     /// Reject sizes and counts the device (or common sense) cannot take, before allocating.
