@@ -23,7 +23,7 @@ use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::omni_shadow::shadowed_lights;
 use ml_cpu::scene::Scene;
 use ml_vk::descriptors::{allocate_set, write_image};
-use ml_vk::{commands, vk, Buffer, Context, VkError, VkResultExt};
+use ml_vk::{commands, release_on_error, vk, Buffer, Context, VkError, VkResultExt};
 use std::time::Instant;
 
 /// CPU-side cluster state of `clustered-cpu`: the assigner and this frame's lists.
@@ -123,32 +123,15 @@ impl<'a> HeadlessRenderer<'a> {
         let clusters =
             settings.technique.is_cpu_built().then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
         let blinn_phong = settings.shading == ShadingModel::BlinnPhong;
+        // Each of these needs the ones before it; a failure releases those.
+        let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
         let mut omni = OmniShadows::new(ctx, settings.omni)?;
-        let mut textures = match SceneTextures::new(ctx, blinn_phong, depth_format(ctx, Output::GBuffer)?, &omni) {
-            Ok(t) => t,
-            Err(e) => {
-                omni.destroy(ctx);
-                return Err(e.into());
-            }
-        };
-        let mut object_textures = match ObjectTextureSets::new(ctx, &scene.textures, &scene.objects) {
-            Ok(t) => t,
-            Err(e) => {
-                textures.destroy(ctx);
-                omni.destroy(ctx);
-                return Err(e.into());
-            }
-        };
+        let mut textures = release_on_error(ctx, SceneTextures::new(ctx, blinn_phong, gbuffer_depth, &omni), &mut [&mut omni])?;
+        let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
+        let mut object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
         let layouts = (textures.set_layout, object_textures.set_layout);
-        let pass = match RasterPass::new(ctx, depth, (settings.technique, settings.lighting(!scene.textures.is_empty())), layouts) {
-            Ok(p) => p,
-            Err(e) => {
-                object_textures.destroy(ctx);
-                textures.destroy(ctx);
-                omni.destroy(ctx);
-                return Err(e.into());
-            }
-        };
+        let made = RasterPass::new(ctx, depth, (settings.technique, settings.lighting(!scene.textures.is_empty())), layouts);
+        let pass = release_on_error(ctx, made, &mut [&mut omni, &mut textures, &mut object_textures])?;
         let (lo, hi) = scene.bounds();
         let shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
         let mut r = HeadlessRenderer {
@@ -209,7 +192,8 @@ impl<'a> HeadlessRenderer<'a> {
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         if self.settings.technique.lights_in_compute() {
-            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting(!self.scene.textures.is_empty()))?);
+            self.lighting =
+                Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting(!self.scene.textures.is_empty()))?);
         }
         if self.settings.technique.lights_in_subpass() {
             let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);

@@ -24,6 +24,16 @@ pub trait Release {
     fn release(&mut self, ctx: &Context);
 }
 
+/// `made`, or — if it failed — its error after releasing `earlier` (newest first): for a
+/// sequence of objects each of which needs the ones before it.
+pub fn release_on_error<T, E>(ctx: &Context, made: Result<T, E>, earlier: &mut [&mut dyn Release]) -> Result<T, E> {
+    made.inspect_err(|_| {
+        for r in earlier.iter_mut().rev() {
+            r.release(ctx);
+        }
+    })
+}
+
 /// Finish building `value` (which starts with null parts) with `create`; if that fails,
 /// release whatever it made before returning the error.
 pub fn build<T: Release, E>(ctx: &Context, mut value: T, create: impl FnOnce(&mut T) -> Result<(), E>) -> Result<T, E> {
