@@ -26,7 +26,7 @@ struct FrameUniforms {
     uint light_count;
     float ambient;       // seed: colour = albedo * ambient + Lo
     float omni_texel;    // one texel of a point-light shadow cube face, in face units (2 / size)
-    uint _pad0;
+    uint directional_count; // lights in directional_direction/colour
     uvec4 cluster_dims;  // xyz: cluster grid size; w: debug view (DEBUG_VIEW_*)
     uvec4 viewport;      // xy: image size in pixels
     vec4 cluster_slices; // x, y: slice = floor(log(depth) * x + y); z: heat-map top (lights)
@@ -42,6 +42,9 @@ struct FrameUniforms {
     vec4 spot_strength;        // rgb
     vec4 ambient_light;        // rgb: ambient colour
     vec4 texture_transform;    // the 2×2 transform of texture coordinates: columns xy and zw
+    // Directional lights (glTF, scene files; every model): xyz the direction the light travels.
+    vec4 directional_direction[4];
+    vec4 directional_color[4]; // rgb
 };
 
 // A radius-limited point light (set 0, binding 1, std430 array).

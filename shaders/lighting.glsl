@@ -34,6 +34,16 @@
     }
 #endif
 
+// Add LIGHT(light) for every directional light: each as a point light 10 km away with a
+// radius of 10³⁰ m, so every model's own point-light code applies with a falloff of exactly 1
+// (1 − 10⁴/10³⁰ rounds to 1) and a direction off by under 10⁻⁷ rad.
+#define SUM_DIRECTIONAL(sum, LIGHT)                                                                   \
+    for (uint d_ = 0u; d_ < frame.directional_count; ++d_) {                                           \
+        PointLight far_ = PointLight(vec4(world - frame.directional_direction[d_].xyz * 1e4, 1e30),   \
+                                     vec4(frame.directional_color[d_].rgb, 0.0));                      \
+        sum += LIGHT(far_);                                                                            \
+    }
+
 // Linear colour of a surface point: every light that reaches it plus what the model adds
 // (seed, pbr: ambient; blinn-phong: ambient, sun, spot, reflection). `frag_xy` is the pixel
 // centre (gl_FragCoord.xy), which picks the cluster.
@@ -45,15 +55,18 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
         float shininess = 1.0 - roughness;
 #define BP_LIGHT(l) (bp_point_light(l, world, n, v, albedo, r0, shininess) * omni_visibility(l, world, n))
         SUM_LIGHTS(lo, BP_LIGHT)
+        SUM_DIRECTIONAL(lo, BP_LIGHT)
         return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo;
     }
     if (MODEL_PBR) {
 #define PBR_LIGHT(l) (pbr_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
         SUM_LIGHTS(lo, PBR_LIGHT)
+        SUM_DIRECTIONAL(lo, PBR_LIGHT)
         return albedo * frame.ambient + lo;
     }
 #define SEED_LIGHT(l) (seed_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
     SUM_LIGHTS(lo, SEED_LIGHT)
+    SUM_DIRECTIONAL(lo, SEED_LIGHT)
     return albedo * frame.ambient + lo;
 }
 

@@ -186,7 +186,13 @@ fn broken_scene_files() -> Vec<(&'static str, &'static str)> {
         ("[[objects]]\nmesh = \"sphere\"\nmaterial = { metallic = -0.1 }\n", "metallic -0.1 must lie in [0, 1]"),
         ("[[objects]]\nmesh = \"sphere\"\nmaterial = { albedo = [-1.0, 0.0, 0.0] }\n", "albedo -1 must not be negative"),
         ("[[objects]]\nmesh = \"sphere\"\nmaterial = { name = \"mithril\" }\n", "unknown material 'mithril'"),
-        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\ncolor = [1.0, 1.0, 1.0]\n", "missing field `position`"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\ncolor = [1.0, 1.0, 1.0]\n", "a point light needs a position"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"directional\"\n", "a directional light needs a direction"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"directional\"\ndirection = [0.0, 0.0, 0.0]\n", "must not be zero"),
+        (
+            "[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nradius = 3.0\n",
+            "no position or radius",
+        ),
         ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nposition = [0.0, 1.0, 0.0]\nradius = 0.0\n", "radius 0 must be greater than 0"),
         (
             "[[objects]]\nmesh = \"sphere\"\n[[lights]]\nposition = [0.0, 1.0, 0.0]\ncolor = [1.0, -1.0, 0.0]\n",

@@ -1,7 +1,8 @@
 //! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`, issue 7): the node hierarchy with its
 //! transforms, every triangle primitive (indexed or not; u8/u16/u32 indices; missing normals
 //! computed flat, tangents computed from the texture coordinates), metallic-roughness
-//! material factors, KHR_lights_punctual point lights and the first perspective camera (else a
+//! material factors, KHR_lights_punctual point and directional lights and the first perspective
+//! camera (else a
 //! camera framing the scene).
 //!
 //! The `gltf` crate parses and validates the JSON; everything it hands over unchecked is
@@ -9,15 +10,15 @@
 //! and strides, index ranges, images, finite numbers, counts. Every problem is one line
 //! naming it. Base-colour (sRGB) and normal textures are read (PNG, JPEG); not yet:
 //! metallic-roughness, occlusion and emissive textures, samplers (every texture repeats,
-//! filtered trilinearly), spot and directional lights, sparse accessors, orthographic cameras
-//! (each left out with a warning).
+//! filtered trilinearly), spot lights, sparse accessors, orthographic cameras (each left out
+//! with a warning). Directional lights: up to MAX_DIRECTIONAL_LIGHTS.
 
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
 use crate::gpu_types::PointLight;
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
-use crate::scene::{Object, ObjectTextures, Scene, SEED_AMBIENT};
+use crate::scene::{DirectionalLight, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
 use crate::scene_file::{read_capped, SceneFile, SceneFileError, MAX_OBJECTS};
 use crate::textures::TextureImage;
 use base64::Engine as _;
@@ -62,6 +63,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         doc: &gltf.document,
         base,
         textures: Vec::new(),
+        directional: Vec::new(),
         by_image: HashMap::new(),
         buffers,
         meshes: Vec::new(),
@@ -98,9 +100,9 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     if builder.objects.is_empty() {
         return Err("the scene has no triangles to draw".into());
     }
-    let Builder { objects, lights, camera, meshes, warnings, textures, .. } = builder;
+    let Builder { objects, lights, camera, meshes, warnings, textures, directional, .. } = builder;
     let blinn_phong = BlinnPhongLights::default();
-    let mut scene = Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong, meshes, textures };
+    let mut scene = Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong, meshes, textures, directional };
     scene.camera = match camera {
         Some(c) => c,
         None => framing_camera(&scene),
@@ -217,6 +219,7 @@ struct Builder<'a> {
     /// Where external files are (None: refused).
     base: Option<&'a Path>,
     textures: Vec<TextureImage>,
+    directional: Vec<DirectionalLight>,
     /// (image, as sRGB) → index in `textures`: each image decoded once per use.
     by_image: HashMap<(usize, bool), u32>,
     buffers: Vec<Vec<u8>>,
@@ -413,6 +416,19 @@ impl Builder<'_> {
             Kind::Spot { .. } => "spot",
             Kind::Directional => "directional",
         };
+        if kind == "directional" {
+            // The node's −Z, in lux: colour × intensity.
+            let direction = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+            let color = Vec3::from(light.color()) * light.intensity();
+            if direction == Vec3::ZERO || !direction.is_finite() || !color.is_finite() || color.min_element() < 0.0 {
+                return Err("a directional light needs a usable node direction and a finite, non-negative colour × intensity".into());
+            }
+            if self.directional.len() == MAX_DIRECTIONAL_LIGHTS {
+                return Err(format!("more than {MAX_DIRECTIONAL_LIGHTS} directional lights"));
+            }
+            self.directional.push(DirectionalLight { direction, color });
+            return Ok(());
+        }
         if kind != "point" {
             self.warnings.push(format!("light {}: {kind} lights are not supported yet; it is left out", light.index()));
             return Ok(());

@@ -37,7 +37,8 @@ gpu_struct!(
         ambient: f32,
         /// One texel of a point-light shadow cube face in face units: 2 / size.
         omni_texel: f32,
-        _pad0: u32,
+        /// Lights in `directional_*`.
+        directional_count: u32,
         /// xyz: cluster grid size; w: debug view (DEBUG_VIEW_*).
         cluster_dims: [u32; 4],
         /// xy: image size in pixels.
@@ -59,6 +60,9 @@ gpu_struct!(
         spot_strength: [f32; 4],
         ambient_light: [f32; 4],
         texture_transform: [f32; 4],
+        /// xyz: the direction each directional light travels.
+        directional_direction: [[f32; 4]; 4],
+        directional_color: [[f32; 4]; 4],
     }
 );
 

@@ -57,5 +57,14 @@ pub fn random_scene(seed: u64, max_lights: u32) -> Scene {
             Object::placed(mesh, Vec3::new(at(i / 7), 0.0, at(i % 7)), 1.0, material)
         })
         .collect();
-    Scene { objects, lights, camera, ambient: SEED_AMBIENT, blinn_phong: Default::default(), meshes: Vec::new(), textures: Vec::new() }
+    Scene {
+        objects,
+        lights,
+        camera,
+        ambient: SEED_AMBIENT,
+        blinn_phong: Default::default(),
+        meshes: Vec::new(),
+        textures: Vec::new(),
+        directional: Vec::new(),
+    }
 }

@@ -83,6 +83,20 @@ pub struct Scene {
     pub meshes: Vec<Mesh>,
     /// Textures of the scene's own (glTF), named by `Object::textures`.
     pub textures: Vec<TextureImage>,
+    /// Lights infinitely far away (glTF, scene files): at most MAX_DIRECTIONAL_LIGHTS.
+    pub directional: Vec<DirectionalLight>,
+}
+
+/// Most directional lights a scene may have (FrameUniforms holds them).
+pub const MAX_DIRECTIONAL_LIGHTS: usize = 4;
+
+/// A light infinitely far away: the same everywhere, from one direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLight {
+    /// Unit direction the light travels.
+    pub direction: Vec3,
+    /// Linear colour × strength.
+    pub color: Vec3,
 }
 
 impl Scene {
@@ -104,6 +118,7 @@ impl Scene {
             blinn_phong: BlinnPhongLights::default(),
             meshes: Vec::new(),
             textures: Vec::new(),
+            directional: Vec::new(),
         })
     }
 
@@ -138,6 +153,7 @@ impl Scene {
             blinn_phong: BlinnPhongLights::default(),
             meshes: Vec::new(),
             textures: Vec::new(),
+            directional: Vec::new(),
         }
     }
 

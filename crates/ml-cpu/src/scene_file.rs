@@ -10,7 +10,7 @@ use crate::gpu_types::PointLight;
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
-use crate::scene::{Object, ObjectTextures, Scene, SEED_AMBIENT};
+use crate::scene::{DirectionalLight, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
 use glam::Vec3;
 use serde::Deserialize;
 use std::path::Path;
@@ -84,9 +84,18 @@ struct FileShading {
 #[serde(deny_unknown_fields)]
 struct FileLight {
     kind: Option<String>,
-    position: [f32; 3],
+    /// Point lights.
+    position: Option<[f32; 3]>,
     color: Option<[f32; 3]>,
     radius: Option<f32>,
+    /// Directional lights: where the light travels.
+    direction: Option<[f32; 3]>,
+}
+
+/// A light of a scene file, by kind.
+enum Light {
+    Point(PointLight),
+    Directional(DirectionalLight),
 }
 
 #[derive(Deserialize)]
@@ -164,8 +173,14 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
             return Err(format!("more than the {MAX_OBJECTS} objects a scene may hold"));
         }
     }
-    let lights =
-        file.lights.iter().enumerate().map(|(i, l)| light(l).map_err(|e| format!("lights[{i}]: {e}"))).collect::<Result<Vec<_>, _>>()?;
+    let (mut lights, mut directional) = (Vec::new(), Vec::new());
+    for (i, l) in file.lights.iter().enumerate() {
+        match light(l).map_err(|e| format!("lights[{i}]: {e}"))? {
+            Light::Point(p) => lights.push(p),
+            Light::Directional(d) if directional.len() < MAX_DIRECTIONAL_LIGHTS => directional.push(d),
+            Light::Directional(_) => return Err(format!("lights[{i}]: more than {MAX_DIRECTIONAL_LIGHTS} directional lights")),
+        }
+    }
     let (shading, ambient) = match &file.shading {
         Some(s) => (s.model.clone(), s.ambient.map(|a| non_negative("[shading] ambient", a)).transpose()?),
         None => (None, None),
@@ -178,6 +193,7 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
         blinn_phong: BlinnPhongLights::default(),
         meshes: std::mem::take(&mut meshes),
         textures: std::mem::take(&mut textures),
+        directional,
     };
     scene.camera = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading, warnings })
@@ -294,19 +310,33 @@ fn gltf_object(
     Ok((objects, warnings))
 }
 
-fn light(l: &FileLight) -> Result<PointLight, String> {
-    match l.kind.as_deref() {
-        None | Some("point") => {}
-        Some(kind @ ("spot" | "directional")) => return Err(format!("kind '{kind}' is not supported yet (issue 7): use point lights")),
-        Some(kind) => return Err(format!("unknown kind '{kind}': expected point, spot or directional")),
-    }
-    let p = vec3("position", l.position)?;
-    let radius = l.radius.map(|r| positive("radius", r)).transpose()?.unwrap_or(SEED_RADIUS);
+fn light(l: &FileLight) -> Result<Light, String> {
     let color = l.color.map(|c| vec3("color", c)).transpose()?.unwrap_or(Vec3::ONE);
     for x in color.to_array() {
         non_negative("color", x)?;
     }
-    Ok(PointLight { position_radius: p.extend(radius).to_array(), color: color.extend(0.0).to_array() })
+    match l.kind.as_deref() {
+        None | Some("point") => {
+            if l.direction.is_some() {
+                return Err("a point light has no direction (kind = \"directional\"?)".into());
+            }
+            let p = vec3("position", l.position.ok_or("a point light needs a position")?)?;
+            let radius = l.radius.map(|r| positive("radius", r)).transpose()?.unwrap_or(SEED_RADIUS);
+            Ok(Light::Point(PointLight { position_radius: p.extend(radius).to_array(), color: color.extend(0.0).to_array() }))
+        }
+        Some("directional") => {
+            if l.position.is_some() || l.radius.is_some() {
+                return Err("a directional light has no position or radius, only a direction".into());
+            }
+            let d = vec3("direction", l.direction.ok_or("a directional light needs a direction")?)?;
+            if d.length() < 1e-6 {
+                return Err("direction must not be zero".into());
+            }
+            Ok(Light::Directional(DirectionalLight { direction: d.normalize(), color }))
+        }
+        Some(kind @ "spot") => Err(format!("kind '{kind}' is not supported yet (issue 7): use point or directional lights")),
+        Some(kind) => Err(format!("unknown kind '{kind}': expected point, spot or directional")),
+    }
 }
 
 /// The file's camera; fields it leaves out come from a camera framing every object (looking
@@ -367,6 +397,9 @@ pub fn to_toml(scene: &Scene, shading: &str, target: Vec3) -> String {
             v(Vec3::new(l.color[0], l.color[1], l.color[2])),
             p[3]
         );
+    }
+    for d in &scene.directional {
+        out += &format!("\n[[lights]]\nkind = \"directional\"\ndirection = {}\ncolor = {}\n", v(d.direction), v(d.color));
     }
     for o in &scene.objects {
         let m = &o.material;

@@ -434,7 +434,7 @@ impl<'a> HeadlessRenderer<'a> {
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
             omni_texel: self.omni.texel(),
-            _pad0: 0,
+            directional_count: self.scene.directional.len() as u32,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
             viewport: [self.extent.width, self.extent.height, 0, 0],
             cluster_slices: [g.log_scale, g.log_bias, self.heat_top, 0.0],
@@ -449,6 +449,10 @@ impl<'a> HeadlessRenderer<'a> {
             spot_strength: bp.spot.strength.extend(0.0).to_array(),
             ambient_light: bp.ambient.extend(0.0).to_array(),
             texture_transform: bp.texture_transform.to_cols_array(),
+            directional_direction: std::array::from_fn(|i| {
+                self.scene.directional.get(i).map_or([0.0; 4], |d| d.direction.extend(0.0).to_array())
+            }),
+            directional_color: std::array::from_fn(|i| self.scene.directional.get(i).map_or([0.0; 4], |d| d.color.extend(0.0).to_array())),
         };
         frame.uniforms.write(0, &[uniforms]);
     }

@@ -20,7 +20,7 @@ use ml_cpu::gpu_types::PointLight;
 use ml_cpu::lights::animate_into;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
-use ml_cpu::scene::{Object, Scene};
+use ml_cpu::scene::{DirectionalLight, Object, Scene};
 use ml_cpu::shading::{encode_gamma_unorm8, shade_seed};
 
 const SIZE: u32 = 256;
@@ -49,6 +49,7 @@ fn sphere_scene(material: Material) -> Scene {
         blinn_phong: Default::default(),
         meshes: Vec::new(),
         textures: Vec::new(),
+        directional: Vec::new(),
     }
 }
 
@@ -60,8 +61,9 @@ fn hit_unit_sphere(origin: Vec3, dir: Vec3) -> Option<Vec3> {
     (disc >= 0.0).then(|| origin + dir * (-b - disc.sqrt()))
 }
 
-fn compare(material: Material) {
-    let scene = sphere_scene(material);
+fn compare(material: Material, directional: &[DirectionalLight]) {
+    let mut scene = sphere_scene(material);
+    scene.directional = directional.to_vec();
     let out = common::render(scene.clone(), common::settings(SIZE, SIZE));
     let cam = &scene.camera;
     // The renderer animates lights (time 0 moves them by (0, 0, 0.1)); shade what it drew.
@@ -76,7 +78,14 @@ fn compare(material: Material) {
             if n.dot(-dir) < 0.2 {
                 continue;
             }
-            let shade = |n: Vec3| encode_gamma_unorm8(shade_seed(p, n, cam.position, &material, &lights, scene.ambient));
+            // A directional light is the seed's point light with no falloff, from one direction:
+            // on the CPU, exactly that (a light 10⁴ m back along it whose radius never ends).
+            let mut all = lights.clone();
+            all.extend(directional.iter().map(|d| PointLight {
+                position_radius: (p - d.direction * 1e4).extend(1e30).to_array(),
+                color: d.color.extend(0.0).to_array(),
+            }));
+            let shade = |n: Vec3| encode_gamma_unorm8(shade_seed(p, n, cam.position, &material, &all, scene.ambient));
             let expected = shade(n);
             let (t1, t2) = n.any_orthonormal_pair();
             let tilted = [t1, -t1, t2, -t2].map(|t| shade((n + t * NORMAL_TOLERANCE).normalize()));
@@ -104,10 +113,18 @@ fn compare(material: Material) {
 
 #[test]
 fn gpu_matches_cpu_reference_on_a_seed_material() {
-    compare(Material::named("gold").unwrap());
+    compare(Material::named("gold").unwrap(), &[]);
 }
 
 #[test]
 fn gpu_matches_cpu_reference_on_a_rough_dielectric() {
-    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 });
+    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &[]);
+}
+
+#[test]
+fn directional_lights_match_the_cpu_reference() {
+    let sun = DirectionalLight { direction: Vec3::new(0.5, -1.0, -0.3).normalize(), color: Vec3::new(0.6, 0.6, 0.5) };
+    let fill = DirectionalLight { direction: Vec3::new(-0.8, 0.4, -0.6).normalize(), color: Vec3::new(0.1, 0.2, 0.4) };
+    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &[sun, fill]);
+    compare(Material::named("gold").unwrap(), &[sun]);
 }

@@ -56,6 +56,7 @@ fn a_turned_uneven_ellipsoid_has_the_analytic_normals() {
         blinn_phong: Default::default(),
         meshes: Vec::new(),
         textures: Vec::new(),
+        directional: Vec::new(),
     };
     let settings: Vec<RenderSettings> = [Technique::Forward, Technique::Deferred, Technique::DeferredCompute]
         .iter()

@@ -82,6 +82,10 @@ fn lights_and_cameras_come_from_their_nodes() {
     for (light, at) in [(point, [0.0, 3.0, 0.0]), (far, [1.0, 1.0, 1.0]), (spot, [0.0, 1.0, 0.0])] {
         w.node(json!({ "translation": at, "extensions": { "KHR_lights_punctual": { "light": light } } }), true);
     }
+    // A directional light turned a quarter about −X: its −Z points down (−Y).
+    let sun = w.light(json!({ "type": "directional", "color": [1.0, 0.9, 0.8], "intensity": 2.0 }));
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    w.node(json!({ "rotation": [-half, 0.0, 0.0, half], "extensions": { "KHR_lights_punctual": { "light": sun } } }), true);
     let camera = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.05, "zfar": 80.0 } }));
     w.node(json!({ "camera": camera, "translation": [0.0, 1.0, 4.0] }), true);
     let (s, warnings) = from_bytes(&w.to_gltf(), None).unwrap();
@@ -90,6 +94,9 @@ fn lights_and_cameras_come_from_their_nodes() {
     assert_eq!(s.lights[0], PointLight { position_radius: [0.0, 3.0, 0.0, 7.0], color: [2.0, 1.0, 0.5, 0.0] });
     // No range: where 4 / d² falls to 1/256, d = 32.
     assert_eq!(s.lights[1].position_radius, [1.0, 1.0, 1.0, 32.0]);
+    assert_eq!(s.directional.len(), 1);
+    assert!((s.directional[0].direction - (-Vec3::Y)).length() < 1e-5, "{:?}", s.directional[0]);
+    assert_eq!(s.directional[0].color, Vec3::new(2.0, 1.8, 1.6));
     assert_eq!(s.camera.position, Vec3::new(0.0, 1.0, 4.0));
     assert!((s.camera.forward() - (-Vec3::Z)).length() < 1e-5);
     assert!((s.camera.fov_y_deg - 0.8f32.to_degrees()).abs() < 1e-4 && s.camera.near == 0.05 && s.camera.far == 80.0);

@@ -42,6 +42,10 @@ radius = 12.0
 [[lights]]
 kind = "point"
 position = [-1.0, 3.0, 2.0]
+[[lights]]
+kind = "directional"
+direction = [0.0, -2.0, 0.0]
+color = [0.5, 0.5, 0.5]
 [[objects]]
 mesh = "teapot"
 position = [1.0, 0.0, 0.0]
@@ -58,6 +62,7 @@ material = { name = "copper", roughness = 0.3 }
     assert_eq!(s.camera, Camera::looking_at(Vec3::new(0.0, 2.0, 6.0), Vec3::ZERO, 50.0, 0.5, 100.0));
     assert_eq!(s.lights[0], PointLight { position_radius: [1.0, 3.0, 2.0, 12.0], color: [1.0, 0.5, 0.2, 0.0] });
     assert_eq!(s.lights[1], PointLight { position_radius: [-1.0, 3.0, 2.0, SEED_RADIUS], color: [1.0, 1.0, 1.0, 0.0] });
+    assert_eq!(s.directional, vec![crate::scene::DirectionalLight { direction: -Vec3::Y, color: Vec3::splat(0.5) }]);
     assert_eq!(s.objects[0].mesh, MeshKind::Teapot);
     assert_eq!(s.objects[0].as_placed(), Some((Vec3::X, 2.0)));
     assert_eq!(s.objects[0].material, Material { albedo: Vec3::new(1.0, 0.765557, 0.336057), roughness: 0.5, metallic: 1.0 });
