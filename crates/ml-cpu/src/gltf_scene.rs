@@ -1,9 +1,8 @@
 //! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`, issue 7): the node hierarchy with its
 //! transforms, every triangle primitive (indexed or not; u8/u16/u32 indices; missing normals
 //! computed flat, tangents computed from the texture coordinates), metallic-roughness
-//! material factors, KHR_lights_punctual point and directional lights and the first perspective
-//! camera (else a
-//! camera framing the scene).
+//! material factors, KHR_lights_punctual point and directional lights and the first
+//! perspective camera (else a camera framing the scene).
 //!
 //! The `gltf` crate parses and validates the JSON; everything it hands over unchecked is
 //! checked here before it is used or allocated: buffer sources and lengths, accessor bounds
