@@ -53,6 +53,14 @@ struct PointLight {
     vec4 color;           // rgb: linear colour; a: its shadow cube's index + 1 (0: casts no shadow)
 };
 
+// A spot light's cone, parallel to the light buffer (set 0, binding 10; std430), for scenes
+// with spot lights (SPOT_LIGHTS): factor = clamp(cos_to_axis · scale + offset, 0, 1)², glTF's
+// smooth edge between the inner and outer cone angles; a point light has scale 0, offset 1.
+struct LightCone {
+    vec4 direction_scale; // xyz: unit axis (where the light points); w: 1 / (cos inner − cos outer)
+    vec4 offset;          // x: −cos outer · scale
+};
+
 // Where a cluster's lights are in the light-index list (set 0, binding 2, std430 array).
 struct ClusterRange {
     uint offset;

@@ -24,15 +24,30 @@
         float depth_ = -(frame.view * vec4(world, 1.0)).z;                       \
         ClusterRange range_ = cluster_ranges[cluster_of(frame, frag_xy, depth_)]; \
         for (uint k_ = 0u; k_ < range_.count; ++k_) {                           \
-            sum += LIGHT(lights[light_indices[range_.offset + k_]]);             \
+            uint i_ = light_indices[range_.offset + k_];                         \
+            sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);         \
         }                                                                        \
     }
 #else
-#define SUM_LIGHTS(sum, LIGHT)                           \
-    for (uint i_ = 0u; i_ < frame.light_count; ++i_) { \
-        sum += LIGHT(lights[i_]);                        \
+#define SUM_LIGHTS(sum, LIGHT)                                         \
+    for (uint i_ = 0u; i_ < frame.light_count; ++i_) {               \
+        sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);   \
     }
 #endif
+
+// Scenes with spot lights (a specialization constant: the others run the loop they always ran).
+layout(constant_id = 14) const bool SPOT_LIGHTS = false;
+
+// How much of light `i`'s cone reaches `world` (1 for point lights and scenes without spots).
+float spot_cone(uint i, PointLight l, vec3 world) {
+    if (SPOT_LIGHTS) {
+        LightCone c = light_cones[i];
+        float cos_to_axis = dot(normalize(world - l.position_radius.xyz), c.direction_scale.xyz);
+        float f = clamp(cos_to_axis * c.direction_scale.w + c.offset.x, 0.0, 1.0);
+        return f * f;
+    }
+    return 1.0;
+}
 
 // Add LIGHT(light) for every directional light: each as a point light 10 km away with a
 // radius of 10³⁰ m, so every model's own point-light code applies with a falloff of exactly 1

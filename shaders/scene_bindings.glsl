@@ -8,6 +8,7 @@
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer { PointLight lights[]; };
 layout(std430, set = 0, binding = 4) readonly buffer ObjectBuffer { ObjectData objects[]; };
+layout(std430, set = 0, binding = 10) readonly buffer LightConeBuffer { LightCone light_cones[]; };
 #ifdef CLUSTERED
 layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { ClusterRange cluster_ranges[]; };
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };

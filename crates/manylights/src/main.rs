@@ -169,6 +169,8 @@ fn build_scene(args: &RenderArgs) -> Result<(Scene, ShadingModel)> {
             let mut scene = file.scene;
             if let Some(n) = args.lights {
                 scene.lights = lights(n)?.build()?;
+                // The file's spot cones belonged to its own lights.
+                scene.cones.clear();
             }
             if scene.lights.is_empty() {
                 bail!("'{path}': the scene has no point lights: add some (scene file: [[lights]]; glTF: KHR_lights_punctual) or pass --lights N");

@@ -186,8 +186,10 @@ fn broken_scene_files() -> Vec<(&'static str, &'static str)> {
         ("[[objects]]\nmesh = \"sphere\"\nmaterial = { metallic = -0.1 }\n", "metallic -0.1 must lie in [0, 1]"),
         ("[[objects]]\nmesh = \"sphere\"\nmaterial = { albedo = [-1.0, 0.0, 0.0] }\n", "albedo -1 must not be negative"),
         ("[[objects]]\nmesh = \"sphere\"\nmaterial = { name = \"mithril\" }\n", "unknown material 'mithril'"),
-        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\ncolor = [1.0, 1.0, 1.0]\n", "a point light needs a position"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\ncolor = [1.0, 1.0, 1.0]\n", "a point or spot light needs a position"),
         ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"directional\"\n", "a directional light needs a direction"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"spot\"\nposition = [0.0, 1.0, 0.0]\n", "a spot light needs a direction"),
+        ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"spot\"\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ninner_deg = 30.0\nouter_deg = 20.0\n", "need 0 ≤ inner < outer ≤ 90"),
         ("[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"directional\"\ndirection = [0.0, 0.0, 0.0]\n", "must not be zero"),
         (
             "[[objects]]\nmesh = \"sphere\"\n[[lights]]\nkind = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nradius = 3.0\n",
@@ -345,6 +347,14 @@ fn broken_gltf_files() -> Vec<(Vec<u8>, &'static str, &'static str)> {
         ),
         (edit(&|w| w.json["meshes"][0]["primitives"][0]["mode"] = json!(0)), "gltf", "no triangles"),
         (edit(&|w| w.json["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = json!(-1.0)), "gltf", "range -1"),
+        (
+            edit(&|w| {
+                w.json["extensions"]["KHR_lights_punctual"]["lights"][0] =
+                    json!({ "type": "spot", "spot": { "innerConeAngle": 0.9, "outerConeAngle": 0.5 } })
+            }),
+            "gltf",
+            "need 0 ≤ inner < outer ≤ π/2",
+        ),
         (edit(&|w| w.json["scenes"][0]["nodes"] = json!([])), "gltf", "no triangles"),
         // Textures: an image with no source (the gltf crate's own accessor panics on it), a
         // buffer view without a MIME type, bytes that are no image, a PNG claiming 10⁵ pixels a side.

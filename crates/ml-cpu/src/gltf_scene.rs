@@ -1,7 +1,7 @@
 //! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`, issue 7): the node hierarchy with its
 //! transforms, every triangle primitive (indexed or not; u8/u16/u32 indices; missing normals
 //! computed flat, tangents computed from the texture coordinates), metallic-roughness
-//! material factors, KHR_lights_punctual point and directional lights and the first
+//! material factors, KHR_lights_punctual point, spot and directional lights and the first
 //! perspective camera (else a camera framing the scene).
 //!
 //! The `gltf` crate parses and validates the JSON; everything it hands over unchecked is
@@ -9,12 +9,12 @@
 //! and strides, index ranges, images, finite numbers, counts. Every problem is one line
 //! naming it. Base-colour (sRGB) and normal textures are read (PNG, JPEG); not yet:
 //! metallic-roughness, occlusion and emissive textures, samplers (every texture repeats,
-//! filtered trilinearly), spot lights, sparse accessors, orthographic cameras (each left out
-//! with a warning). Directional lights: up to MAX_DIRECTIONAL_LIGHTS.
+//! filtered trilinearly), sparse accessors, orthographic cameras (each left out with a
+//! warning). Directional lights: up to MAX_DIRECTIONAL_LIGHTS.
 
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
-use crate::gpu_types::PointLight;
+use crate::gpu_types::{LightCone, PointLight};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
 use crate::scene::{DirectionalLight, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
@@ -63,6 +63,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         base,
         textures: Vec::new(),
         directional: Vec::new(),
+        cones: Vec::new(),
         by_image: HashMap::new(),
         buffers,
         meshes: Vec::new(),
@@ -99,9 +100,13 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     if builder.objects.is_empty() {
         return Err("the scene has no triangles to draw".into());
     }
-    let Builder { objects, lights, camera, meshes, warnings, textures, directional, .. } = builder;
+    let Builder { objects, lights, camera, meshes, warnings, textures, directional, mut cones, .. } = builder;
+    if cones.iter().all(|c| *c == LightCone::NONE) {
+        cones.clear();
+    }
     let blinn_phong = BlinnPhongLights::default();
-    let mut scene = Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong, meshes, textures, directional };
+    let mut scene =
+        Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong, meshes, textures, directional, cones };
     scene.camera = match camera {
         Some(c) => c,
         None => framing_camera(&scene),
@@ -219,6 +224,8 @@ struct Builder<'a> {
     base: Option<&'a Path>,
     textures: Vec<TextureImage>,
     directional: Vec<DirectionalLight>,
+    /// One per light in `lights` (kept only if one of them is a spot).
+    cones: Vec<LightCone>,
     /// (image, as sRGB) → index in `textures`: each image decoded once per use.
     by_image: HashMap<(usize, bool), u32>,
     buffers: Vec<Vec<u8>>,
@@ -410,10 +417,10 @@ impl Builder<'_> {
 
     fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<(), String> {
         use gltf::khr_lights_punctual::Kind;
-        let kind = match light.kind() {
-            Kind::Point => "point",
-            Kind::Spot { .. } => "spot",
-            Kind::Directional => "directional",
+        let (kind, cone) = match light.kind() {
+            Kind::Point => ("point", None),
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => ("spot", Some((inner_cone_angle, outer_cone_angle))),
+            Kind::Directional => ("directional", None),
         };
         if kind == "directional" {
             // The node's −Z, in lux: colour × intensity.
@@ -428,10 +435,20 @@ impl Builder<'_> {
             self.directional.push(DirectionalLight { direction, color });
             return Ok(());
         }
-        if kind != "point" {
-            self.warnings.push(format!("light {}: {kind} lights are not supported yet; it is left out", light.index()));
-            return Ok(());
-        }
+        let cone = match cone {
+            None => LightCone::NONE,
+            Some((inner, outer)) => {
+                // glTF: 0 ≤ inner < outer ≤ π/2.
+                if !(inner >= 0.0 && inner < outer && outer <= std::f32::consts::FRAC_PI_2 + 1e-6) {
+                    return Err(format!("spot cone angles inner {inner}, outer {outer}: need 0 ≤ inner < outer ≤ π/2"));
+                }
+                let axis = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+                if axis == Vec3::ZERO || !axis.is_finite() {
+                    return Err("its node's transform collapses the spot's direction".into());
+                }
+                LightCone::spot(axis, inner, outer)
+            }
+        };
         let color = Vec3::from(light.color()) * light.intensity();
         if !color.is_finite() || color.min_element() < 0.0 {
             return Err("colour × intensity must be finite and not negative".into());
@@ -448,6 +465,7 @@ impl Builder<'_> {
             return Err("its node's position is not finite".into());
         }
         self.lights.push(PointLight { position_radius: position.extend(radius).to_array(), color: color.extend(0.0).to_array() });
+        self.cones.push(cone);
         Ok(())
     }
 }

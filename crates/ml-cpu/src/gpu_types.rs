@@ -77,6 +77,29 @@ gpu_struct!(
 );
 
 gpu_struct!(
+    /// A spot light's cone (std430), parallel to the light buffer; see common.glsl.
+    LightCone {
+        /// xyz: unit axis; w: 1 / (cos inner − cos outer).
+        direction_scale: [f32; 4],
+        /// x: −cos outer · scale.
+        offset: [f32; 4],
+    }
+);
+
+impl LightCone {
+    /// The cone of a point light: no cone (factor 1 everywhere).
+    pub const NONE: LightCone = LightCone { direction_scale: [0.0, 0.0, 1.0, 0.0], offset: [1.0, 0.0, 0.0, 0.0] };
+
+    /// glTF's spot: full light within `inner` radians of `axis`, none beyond `outer`.
+    pub fn spot(axis: glam::Vec3, inner: f32, outer: f32) -> LightCone {
+        let (ci, co) = (inner.cos(), outer.cos());
+        let scale = 1.0 / (ci - co).max(1e-3);
+        let a = axis.normalize();
+        LightCone { direction_scale: [a.x, a.y, a.z, scale], offset: [-co * scale, 0.0, 0.0, 0.0] }
+    }
+}
+
+gpu_struct!(
     /// Where a cluster's lights are in the light-index list (std430, 8 bytes).
     ClusterRange {
         offset: u32,

@@ -66,5 +66,6 @@ pub fn random_scene(seed: u64, max_lights: u32) -> Scene {
         meshes: Vec::new(),
         textures: Vec::new(),
         directional: Vec::new(),
+        cones: Vec::new(),
     }
 }

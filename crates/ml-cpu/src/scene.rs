@@ -2,7 +2,7 @@
 
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
-use crate::gpu_types::PointLight;
+use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::LightParams;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshKind};
@@ -85,6 +85,9 @@ pub struct Scene {
     pub textures: Vec<TextureImage>,
     /// Lights infinitely far away (glTF, scene files): at most MAX_DIRECTIONAL_LIGHTS.
     pub directional: Vec<DirectionalLight>,
+    /// Spot cones, one per light (LightCone::NONE for point lights) — or none at all in a
+    /// scene without spot lights.
+    pub cones: Vec<LightCone>,
 }
 
 /// Most directional lights a scene may have (FrameUniforms holds them).
@@ -119,6 +122,7 @@ impl Scene {
             meshes: Vec::new(),
             textures: Vec::new(),
             directional: Vec::new(),
+            cones: Vec::new(),
         })
     }
 
@@ -154,6 +158,7 @@ impl Scene {
             meshes: Vec::new(),
             textures: Vec::new(),
             directional: Vec::new(),
+            cones: Vec::new(),
         }
     }
 

@@ -6,7 +6,7 @@
 
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
-use crate::gpu_types::PointLight;
+use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
@@ -88,13 +88,17 @@ struct FileLight {
     position: Option<[f32; 3]>,
     color: Option<[f32; 3]>,
     radius: Option<f32>,
-    /// Directional lights: where the light travels.
+    /// Directional and spot lights: where the light travels / points.
     direction: Option<[f32; 3]>,
+    /// Spot lights: full light within the inner angle of the axis, none beyond the outer
+    /// (degrees; defaults 0 and 45, glTF's).
+    inner_deg: Option<f32>,
+    outer_deg: Option<f32>,
 }
 
 /// A light of a scene file, by kind.
 enum Light {
-    Point(PointLight),
+    Point(PointLight, LightCone),
     Directional(DirectionalLight),
 }
 
@@ -173,10 +177,13 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
             return Err(format!("more than the {MAX_OBJECTS} objects a scene may hold"));
         }
     }
-    let (mut lights, mut directional) = (Vec::new(), Vec::new());
+    let (mut lights, mut cones, mut directional) = (Vec::new(), Vec::new(), Vec::new());
     for (i, l) in file.lights.iter().enumerate() {
         match light(l).map_err(|e| format!("lights[{i}]: {e}"))? {
-            Light::Point(p) => lights.push(p),
+            Light::Point(p, cone) => {
+                lights.push(p);
+                cones.push(cone);
+            }
             Light::Directional(d) if directional.len() < MAX_DIRECTIONAL_LIGHTS => directional.push(d),
             Light::Directional(_) => return Err(format!("lights[{i}]: more than {MAX_DIRECTIONAL_LIGHTS} directional lights")),
         }
@@ -194,6 +201,8 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
         meshes: std::mem::take(&mut meshes),
         textures: std::mem::take(&mut textures),
         directional,
+        // Only scenes with a spot keep the cones.
+        cones: if cones.iter().all(|c| *c == LightCone::NONE) { Vec::new() } else { cones },
     };
     scene.camera = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading, warnings })
@@ -316,13 +325,27 @@ fn light(l: &FileLight) -> Result<Light, String> {
         non_negative("color", x)?;
     }
     match l.kind.as_deref() {
-        None | Some("point") => {
-            if l.direction.is_some() {
-                return Err("a point light has no direction (kind = \"directional\"?)".into());
+        kind @ (None | Some("point") | Some("spot")) => {
+            let spot = kind == Some("spot");
+            if !spot && (l.direction.is_some() || l.inner_deg.is_some() || l.outer_deg.is_some()) {
+                return Err("a point light has no direction or cone (kind = \"spot\" or \"directional\"?)".into());
             }
-            let p = vec3("position", l.position.ok_or("a point light needs a position")?)?;
+            let p = vec3("position", l.position.ok_or("a point or spot light needs a position")?)?;
             let radius = l.radius.map(|r| positive("radius", r)).transpose()?.unwrap_or(SEED_RADIUS);
-            Ok(Light::Point(PointLight { position_radius: p.extend(radius).to_array(), color: color.extend(0.0).to_array() }))
+            let point = PointLight { position_radius: p.extend(radius).to_array(), color: color.extend(0.0).to_array() };
+            if !spot {
+                return Ok(Light::Point(point, LightCone::NONE));
+            }
+            let axis = vec3("direction", l.direction.ok_or("a spot light needs a direction")?)?;
+            if axis.length() < 1e-6 {
+                return Err("direction must not be zero".into());
+            }
+            let inner = finite("inner_deg", l.inner_deg.unwrap_or(0.0))?;
+            let outer = finite("outer_deg", l.outer_deg.unwrap_or(45.0))?;
+            if !(inner >= 0.0 && inner < outer && outer <= 90.0) {
+                return Err(format!("inner_deg {inner} and outer_deg {outer}: need 0 ≤ inner < outer ≤ 90"));
+            }
+            Ok(Light::Point(point, LightCone::spot(axis, inner.to_radians(), outer.to_radians())))
         }
         Some("directional") => {
             if l.position.is_some() || l.radius.is_some() {
@@ -334,7 +357,6 @@ fn light(l: &FileLight) -> Result<Light, String> {
             }
             Ok(Light::Directional(DirectionalLight { direction: d.normalize(), color }))
         }
-        Some(kind @ "spot") => Err(format!("kind '{kind}' is not supported yet (issue 7): use point or directional lights")),
         Some(kind) => Err(format!("unknown kind '{kind}': expected point, spot or directional")),
     }
 }

@@ -20,6 +20,7 @@ pub const BINDING_NORMAL: u32 = 6;
 pub const BINDING_OBJECT_ID: u32 = 7;
 pub const BINDING_OUTPUT: u32 = 8;
 pub const BINDING_ALBEDO: u32 = 9;
+pub const BINDING_LIGHT_CONES: u32 = 10;
 
 pub struct ComputeLighting {
     pass: ComputePass,
@@ -33,6 +34,8 @@ pub struct LightingInputs<'a> {
     pub indices: vk::Buffer,
     /// Every object's material (what the raster pass pushes), indexed by the G-buffer.
     pub objects: vk::Buffer,
+    /// The lights' spot cones.
+    pub cones: vk::Buffer,
     pub targets: &'a Targets,
 }
 
@@ -47,6 +50,7 @@ impl ComputeLighting {
             (BINDING_RANGES, storage),
             (BINDING_INDICES, storage),
             (BINDING_OBJECTS, storage),
+            (BINDING_LIGHT_CONES, storage),
             (BINDING_DEPTH, image),
             (BINDING_NORMAL, image),
             (BINDING_OBJECT_ID, image),
@@ -68,6 +72,7 @@ impl ComputeLighting {
             (BINDING_RANGES, inputs.ranges),
             (BINDING_INDICES, inputs.indices),
             (BINDING_OBJECTS, inputs.objects),
+            (BINDING_LIGHT_CONES, inputs.cones),
         ] {
             write_buffer(ctx, set, binding, vk::DescriptorType::STORAGE_BUFFER, buffer);
         }

@@ -5,7 +5,9 @@
 
 use crate::cluster_build::{self as build, GpuClusterBuilder, GpuClusterFrame};
 use crate::deferred::{self, ComputeLighting, LightingInputs};
-use crate::raster::{RasterPass, BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_INDICES, BINDING_OBJECTS};
+use crate::raster::{
+    RasterPass, BINDING_CLUSTER_RANGES, BINDING_FRAME, BINDING_LIGHTS, BINDING_LIGHT_CONES, BINDING_LIGHT_INDICES, BINDING_OBJECTS,
+};
 use crate::targets::Targets;
 use crate::tonemap::ToneMap;
 use gpu_allocator::MemoryLocation;
@@ -59,6 +61,8 @@ pub struct FrameSetup<'a> {
     pub subpasses: Option<(&'a RasterPass, &'a ToneMap)>,
     /// The object buffer (transforms and materials).
     pub objects: vk::Buffer,
+    /// The lights' spot cones.
+    pub cones: vk::Buffer,
 }
 
 /// Storage buffer for lights or cluster lists. Device-local ones can also be copied out
@@ -108,6 +112,7 @@ impl FrameInFlight {
         self.bind(ctx, BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER, self.uniforms.raw);
         for (binding, buffer) in [
             (BINDING_OBJECTS, setup.objects),
+            (BINDING_LIGHT_CONES, setup.cones),
             (BINDING_LIGHTS, self.lights.raw),
             (BINDING_CLUSTER_RANGES, self.cluster_ranges.raw),
             (BINDING_LIGHT_INDICES, self.light_indices.raw),
@@ -142,6 +147,7 @@ impl FrameInFlight {
                 ranges: self.cluster_ranges.raw,
                 indices: self.light_indices.raw,
                 objects: setup.objects,
+                cones: setup.cones,
                 targets: self.targets.as_ref().expect("made above"),
             };
             self.lighting_set = lighting.frame_set(ctx, setup.descriptor_pool, &inputs)?;

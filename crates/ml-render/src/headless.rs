@@ -18,7 +18,7 @@ use crate::targets::{depth_format, Output, Targets};
 use crate::tonemap::ToneMap;
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, ObjectData, PointLight};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, LightCone, ObjectData, PointLight};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::omni_shadow::shadowed_lights;
 use ml_cpu::scene::Scene;
@@ -77,6 +77,8 @@ pub struct HeadlessRenderer<'a> {
     tonemap: Option<ToneMap>,
     /// Every object's transform and material (draws push their index; the G-buffer stores it).
     objects: Option<Buffer>,
+    /// Spot cones, parallel to the lights (static: only positions animate).
+    cones: Option<Buffer>,
     /// --debug-view shadow-map: the pass that paints the map over the output, and its set per
     /// frame slot (pointing at that slot's colour target).
     shadow_map_view: Option<(ComputePass, Vec<vk::DescriptorSet>)>,
@@ -110,6 +112,9 @@ const MAX_RERENDERS: u32 = 2;
 impl<'a> HeadlessRenderer<'a> {
     pub fn new(ctx: &'a Context, mut scene: Scene, settings: RenderSettings) -> Result<HeadlessRenderer<'a>, RenderError> {
         settings.check(ctx, scene.lights.len())?;
+        if !scene.cones.is_empty() && scene.cones.len() != scene.lights.len() {
+            return Err(RenderError::Invalid(format!("the scene has {} spot cones for {} lights", scene.cones.len(), scene.lights.len())));
+        }
         // The shadowed lights carry their cube's index + 1 (PointLight::color[3]).
         let shadowed = settings.omni.map_or(Vec::new(), |o| shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position));
         for (cube, &i) in shadowed.iter().enumerate() {
@@ -130,7 +135,7 @@ impl<'a> HeadlessRenderer<'a> {
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
         let mut object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
         let layouts = (textures.set_layout, object_textures.set_layout);
-        let made = RasterPass::new(ctx, depth, (settings.technique, settings.lighting(!scene.textures.is_empty())), layouts);
+        let made = RasterPass::new(ctx, depth, (settings.technique, settings.lighting(&scene)), layouts);
         let pass = release_on_error(ctx, made, &mut [&mut omni, &mut textures, &mut object_textures])?;
         let (lo, hi) = scene.bounds();
         let shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
@@ -158,6 +163,7 @@ impl<'a> HeadlessRenderer<'a> {
             lighting: None,
             tonemap: None,
             objects: None,
+            cones: None,
             shadow_map_view: None,
             required_indices: 0,
             overflowed: vec![false; FRAMES_IN_FLIGHT],
@@ -191,22 +197,25 @@ impl<'a> HeadlessRenderer<'a> {
         let objects: Vec<ObjectData> = self.scene.objects.iter().map(object_data).collect();
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
+        // One cone per light where the scene has spots; else one the shaders never read.
+        let cones = if self.scene.cones.is_empty() { vec![LightCone::NONE] } else { self.scene.cones.clone() };
+        self.cones = Some(Buffer::device_local_with(ctx, "light cones", bytemuck::cast_slice(&cones), usage)?);
         if self.settings.technique.lights_in_compute() {
-            self.lighting =
-                Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting(!self.scene.textures.is_empty()))?);
+            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting(&self.scene))?);
         }
         if self.settings.technique.lights_in_subpass() {
             let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);
             self.tonemap = Some(ToneMap::new(ctx, self.settings.shading == ShadingModel::Pbr && !surface_view)?);
         }
-        // Per frame at most: the shading set (1 uniform + 3 storage), the build set (1 uniform
-        // + 8 storage), the lighting set (1 uniform, 4 storage, 4 sampled images, 1 storage
-        // image), the subpass input set (1 storage, 4 input attachments), the tone map's set
-        // (1 sampled image, 1 storage image) and the shadow-map view's (1 storage image).
+        // Per frame at most: the shading set (1 uniform + 5 storage: lights, cluster ranges and
+        // indices, objects, cones), the build set (1 uniform + 8 storage), the lighting set
+        // (1 uniform, 5 storage, 4 sampled images, 1 storage image), the subpass input set (4
+        // input attachments), the tone map's set (1 sampled image, 1 storage image) and the
+        // shadow-map view's (1 storage image).
         let n = FRAMES_IN_FLIGHT as u32;
         let sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 3 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 16 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 18 * n },
             vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 5 * n },
             vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: 3 * n },
             vk::DescriptorPoolSize { ty: vk::DescriptorType::INPUT_ATTACHMENT, descriptor_count: 4 * n },
@@ -233,6 +242,7 @@ impl<'a> HeadlessRenderer<'a> {
             lighting: self.lighting.as_ref(),
             subpasses: self.tonemap.as_ref().map(|t| (&self.pass, t)),
             objects: self.objects.as_ref().map_or(vk::Buffer::null(), |b| b.raw),
+            cones: self.cones.as_ref().map_or(vk::Buffer::null(), |b| b.raw),
         };
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
@@ -598,7 +608,7 @@ impl Drop for HeadlessRenderer<'_> {
         if let Some(mut t) = self.tonemap.take() {
             t.destroy(ctx);
         }
-        if let Some(mut b) = self.objects.take() {
+        for mut b in [self.objects.take(), self.cones.take()].into_iter().flatten() {
             b.destroy(ctx);
         }
         if let Some((mut view, _)) = self.shadow_map_view.take() {

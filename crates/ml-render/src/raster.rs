@@ -20,6 +20,7 @@ pub const BINDING_LIGHTS: u32 = 1;
 pub const BINDING_CLUSTER_RANGES: u32 = 2;
 pub const BINDING_LIGHT_INDICES: u32 = 3;
 pub const BINDING_OBJECTS: u32 = 4;
+pub const BINDING_LIGHT_CONES: u32 = 10;
 /// Bindings of set 2, the lighting subpass's inputs (deferred_frag.glsl; set 1 holds the
 /// scene's textures in every pipeline of the pass).
 pub const BINDING_INPUT_DEPTH: u32 = 1;
@@ -128,6 +129,7 @@ impl RasterPass {
                 (BINDING_CLUSTER_RANGES, storage),
                 (BINDING_LIGHT_INDICES, storage),
                 (BINDING_OBJECTS, storage),
+                (BINDING_LIGHT_CONES, storage),
             ],
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
         )?;

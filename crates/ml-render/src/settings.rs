@@ -116,24 +116,33 @@ impl ShadingModel {
     }
 }
 
-/// constant_id of `OMNI_SHADOWS` in omni_shadow.glsl and `OBJECT_TEXTURES` in surface.glsl.
+/// constant_id of `OMNI_SHADOWS` (omni_shadow.glsl), `OBJECT_TEXTURES` (surface.glsl) and
+/// `SPOT_LIGHTS` (lighting.glsl).
 pub const SPEC_OMNI_SHADOWS: u32 = 12;
 pub const SPEC_OBJECT_TEXTURES: u32 = 13;
+pub const SPEC_SPOT_LIGHTS: u32 = 14;
 
-/// What a lighting pipeline is compiled for: the model, whether point lights cast shadows and
-/// whether objects have textures of their own (specialization constants, so each pipeline
-/// carries only what it runs).
+/// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
+/// whether objects have textures of their own and whether there are spot lights
+/// (specialization constants, so each pipeline carries only what it runs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shading {
     pub model: ShadingModel,
     pub omni_shadows: bool,
     pub object_textures: bool,
+    pub spot_lights: bool,
 }
 
 impl Shading {
-    pub fn spec_constants(self) -> [(u32, u32); 4] {
+    pub fn spec_constants(self) -> [(u32, u32); 5] {
         let [a, b] = self.model.spec_constants();
-        [a, b, (SPEC_OMNI_SHADOWS, u32::from(self.omni_shadows)), (SPEC_OBJECT_TEXTURES, u32::from(self.object_textures))]
+        [
+            a,
+            b,
+            (SPEC_OMNI_SHADOWS, u32::from(self.omni_shadows)),
+            (SPEC_OBJECT_TEXTURES, u32::from(self.object_textures)),
+            (SPEC_SPOT_LIGHTS, u32::from(self.spot_lights)),
+        ]
     }
 }
 
@@ -307,10 +316,14 @@ impl RenderSettings {
         self.time.unwrap_or(i as f32 * FRAME_SECONDS * TIMER_SPEED)
     }
 
-    /// What the lighting pipelines are compiled for, for a scene whose objects do or do not
-    /// have textures of their own.
-    pub fn lighting(&self, object_textures: bool) -> Shading {
-        Shading { model: self.shading, omni_shadows: self.omni.is_some(), object_textures }
+    /// What the lighting pipelines are compiled for, for `scene`.
+    pub fn lighting(&self, scene: &ml_cpu::scene::Scene) -> Shading {
+        Shading {
+            model: self.shading,
+            omni_shadows: self.omni.is_some(),
+            object_textures: !scene.textures.is_empty(),
+            spot_lights: !scene.cones.is_empty(),
+        }
     }
 
     /// Reject sizes and counts the device (or common sense) cannot take, before allocating.

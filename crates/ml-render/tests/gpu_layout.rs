@@ -3,7 +3,8 @@
 //! moved on either side fails here.
 
 use ml_cpu::gpu_types::{
-    ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, ObjectData, ObjectPush, OmniShadowPush, PointLight, ShadowPush,
+    ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, LightCone, ObjectData, ObjectPush, OmniShadowPush, PointLight,
+    ShadowPush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -82,6 +83,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<ShadowPush>(&structs);
     check::<OmniShadowPush>(&structs);
     check::<ObjectData>(&structs);
+    check::<LightCone>(&structs);
     check::<ClusterRange>(&structs);
     check::<ClusterBounds>(&structs);
     check::<ClusterFeedback>(&structs);

@@ -50,6 +50,7 @@ fn sphere_scene(material: Material) -> Scene {
         meshes: Vec::new(),
         textures: Vec::new(),
         directional: Vec::new(),
+        cones: Vec::new(),
     }
 }
 

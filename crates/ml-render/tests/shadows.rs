@@ -44,6 +44,7 @@ fn scene(ball: bool, sun_on: bool, camera: Camera) -> Scene {
         meshes: Vec::new(),
         textures: Vec::new(),
         directional: Vec::new(),
+        cones: Vec::new(),
     }
 }
 

@@ -57,6 +57,7 @@ fn a_turned_uneven_ellipsoid_has_the_analytic_normals() {
         meshes: Vec::new(),
         textures: Vec::new(),
         directional: Vec::new(),
+        cones: Vec::new(),
     };
     let settings: Vec<RenderSettings> = [Technique::Forward, Technique::Deferred, Technique::DeferredCompute]
         .iter()

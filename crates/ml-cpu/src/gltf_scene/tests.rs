@@ -89,8 +89,11 @@ fn lights_and_cameras_come_from_their_nodes() {
     let camera = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.05, "zfar": 80.0 } }));
     w.node(json!({ "camera": camera, "translation": [0.0, 1.0, 4.0] }), true);
     let (s, warnings) = from_bytes(&w.to_gltf(), None).unwrap();
-    assert_eq!(s.lights.len(), 2, "the spot light is left out (not yet supported)");
-    assert_eq!(warnings, vec!["light 2: spot lights are not supported yet; it is left out".to_string()]);
+    assert_eq!(s.lights.len(), 3);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    // The spot keeps its cone (glTF's defaults: inner 0, outer π/4, along the node's −Z); the
+    // point lights have none.
+    assert_eq!(s.cones, vec![LightCone::NONE, LightCone::NONE, LightCone::spot(-Vec3::Z, 0.0, std::f32::consts::FRAC_PI_4)]);
     assert_eq!(s.lights[0], PointLight { position_radius: [0.0, 3.0, 0.0, 7.0], color: [2.0, 1.0, 0.5, 0.0] });
     // No range: where 4 / d² falls to 1/256, d = 32.
     assert_eq!(s.lights[1].position_radius, [1.0, 1.0, 1.0, 32.0]);

@@ -1,4 +1,5 @@
 use super::*;
+use crate::gpu_types::LightCone;
 use crate::lights::LightParams;
 
 const MINIMAL: &str = "[[objects]]\nmesh = \"sphere\"\n";
@@ -46,6 +47,12 @@ position = [-1.0, 3.0, 2.0]
 kind = "directional"
 direction = [0.0, -2.0, 0.0]
 color = [0.5, 0.5, 0.5]
+[[lights]]
+kind = "spot"
+position = [0.0, 4.0, 0.0]
+direction = [0.0, -1.0, 0.0]
+inner_deg = 10.0
+outer_deg = 20.0
 [[objects]]
 mesh = "teapot"
 position = [1.0, 0.0, 0.0]
@@ -63,6 +70,10 @@ material = { name = "copper", roughness = 0.3 }
     assert_eq!(s.lights[0], PointLight { position_radius: [1.0, 3.0, 2.0, 12.0], color: [1.0, 0.5, 0.2, 0.0] });
     assert_eq!(s.lights[1], PointLight { position_radius: [-1.0, 3.0, 2.0, SEED_RADIUS], color: [1.0, 1.0, 1.0, 0.0] });
     assert_eq!(s.directional, vec![crate::scene::DirectionalLight { direction: -Vec3::Y, color: Vec3::splat(0.5) }]);
+    // With a spot among them, every light has a cone: none for the point lights.
+    let spot = LightCone::spot(-Vec3::Y, 10f32.to_radians(), 20f32.to_radians());
+    assert_eq!(s.cones, vec![LightCone::NONE, LightCone::NONE, spot]);
+    assert_eq!(s.lights[2].position_radius, [0.0, 4.0, 0.0, SEED_RADIUS]);
     assert_eq!(s.objects[0].mesh, MeshKind::Teapot);
     assert_eq!(s.objects[0].as_placed(), Some((Vec3::X, 2.0)));
     assert_eq!(s.objects[0].material, Material { albedo: Vec3::new(1.0, 0.765557, 0.336057), roughness: 0.5, metallic: 1.0 });
