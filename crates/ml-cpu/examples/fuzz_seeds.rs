@@ -22,6 +22,10 @@ fn main() {
     w.node(json!({ "mesh": q, "rotation": [0.0, 0.38268343, 0.0, 0.9238795], "children": [child] }), true);
     let light = w.light(json!({ "type": "point", "intensity": 3.0, "range": 9.0 }));
     w.node(json!({ "translation": [0.0, 3.0, 0.0], "extensions": { "KHR_lights_punctual": { "light": light } } }), true);
+    let spot = w.light(json!({ "type": "spot", "intensity": 5.0, "range": 12.0, "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.5 } }));
+    w.node(json!({ "translation": [1.0, 4.0, 0.0], "rotation": [-0.70710677, 0.0, 0.0, 0.70710677], "extensions": { "KHR_lights_punctual": { "light": spot } } }), true);
+    let sun = w.light(json!({ "type": "directional", "intensity": 1.5 }));
+    w.node(json!({ "rotation": [-0.3826834, 0.0, 0.0, 0.9238795], "extensions": { "KHR_lights_punctual": { "light": sun } } }), true);
     let camera = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 0.9, "znear": 0.1 } }));
     w.node(json!({ "camera": camera, "translation": [0.0, 1.0, 5.0] }), true);
     std::fs::write(gltf_dir.join("scene.gltf"), w.to_gltf()).expect("write");
@@ -41,5 +45,5 @@ fn main() {
     std::fs::write(gltf_dir.join("textured.glb"), textured.to_glb()).expect("write");
     let seed = include_str!("../../../scenes/seed.toml");
     std::fs::write(scene_dir.join("seed.toml"), seed).expect("write");
-    std::fs::write(scene_dir.join("small.toml"), "[camera]\nposition = [0.0, 2.0, 6.0]\n[shading]\nmodel = \"pbr\"\n[[lights]]\nposition = [1.0, 3.0, 2.0]\n[[objects]]\nmesh = \"teapot\"\nmaterial = { name = \"gold\", roughness = 0.3 }\n").expect("write");
+    std::fs::write(scene_dir.join("small.toml"), "[camera]\nposition = [0.0, 2.0, 6.0]\n[shading]\nmodel = \"pbr\"\n[[lights]]\nposition = [1.0, 3.0, 2.0]\n[[lights]]\nkind = \"spot\"\nposition = [0.0, 4.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ninner_deg = 10.0\nouter_deg = 25.0\n[[lights]]\nkind = \"directional\"\ndirection = [0.3, -1.0, 0.0]\n[[objects]]\nmesh = \"teapot\"\nmaterial = { name = \"gold\", roughness = 0.3 }\n").expect("write");
 }
