@@ -22,7 +22,8 @@ fn main() {
     w.node(json!({ "mesh": q, "rotation": [0.0, 0.38268343, 0.0, 0.9238795], "children": [child] }), true);
     let light = w.light(json!({ "type": "point", "intensity": 3.0, "range": 9.0 }));
     w.node(json!({ "translation": [0.0, 3.0, 0.0], "extensions": { "KHR_lights_punctual": { "light": light } } }), true);
-    let spot = w.light(json!({ "type": "spot", "intensity": 5.0, "range": 12.0, "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.5 } }));
+    let spot =
+        w.light(json!({ "type": "spot", "intensity": 5.0, "range": 12.0, "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.5 } }));
     w.node(json!({ "translation": [1.0, 4.0, 0.0], "rotation": [-0.70710677, 0.0, 0.0, 0.70710677], "extensions": { "KHR_lights_punctual": { "light": spot } } }), true);
     let sun = w.light(json!({ "type": "directional", "intensity": 1.5 }));
     w.node(json!({ "rotation": [-0.3826834, 0.0, 0.0, 0.9238795], "extensions": { "KHR_lights_punctual": { "light": sun } } }), true);

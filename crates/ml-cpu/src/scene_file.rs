@@ -411,7 +411,7 @@ pub fn to_toml(scene: &Scene, shading: &str, target: Vec3) -> String {
         c.far,
         scene.ambient
     );
-    for l in &scene.lights {
+    for (i, l) in scene.lights.iter().enumerate() {
         let p = l.position_radius;
         out += &format!(
             "\n[[lights]]\nposition = {}\ncolor = {}\nradius = {:?}\n",
@@ -419,6 +419,18 @@ pub fn to_toml(scene: &Scene, shading: &str, target: Vec3) -> String {
             v(Vec3::new(l.color[0], l.color[1], l.color[2])),
             p[3]
         );
+        if let Some(c) = scene.cones.get(i).filter(|c| **c != LightCone::NONE) {
+            // Back from scale = 1 / (cos inner − cos outer), offset = −cos outer · scale.
+            let (scale, axis) = (c.direction_scale[3], Vec3::from_slice(&c.direction_scale[..3]));
+            let cos_outer = -c.offset[0] / scale;
+            let cos_inner = cos_outer + 1.0 / scale;
+            out += &format!(
+                "kind = \"spot\"\ndirection = {}\ninner_deg = {:?}\nouter_deg = {:?}\n",
+                v(axis),
+                cos_inner.clamp(-1.0, 1.0).acos().to_degrees(),
+                cos_outer.clamp(-1.0, 1.0).acos().to_degrees()
+            );
+        }
     }
     for d in &scene.directional {
         out += &format!("\n[[lights]]\nkind = \"directional\"\ndirection = {}\ncolor = {}\n", v(d.direction), v(d.color));

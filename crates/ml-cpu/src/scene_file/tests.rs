@@ -163,3 +163,18 @@ fn gltf_objects_bring_their_meshes_placed_by_the_scene_file() {
     assert!(parse("[[objects]]\ngltf = \"a.gltf\"\n").unwrap_err().contains("folder"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn spot_and_directional_lights_survive_a_round_trip() {
+    let text = "[[objects]]\nmesh = \"plane\"\n[[lights]]\nposition = [0.0, 2.0, 0.0]\n[[lights]]\nkind = \"spot\"\nposition = [1.0, 3.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ninner_deg = 15.0\nouter_deg = 35.0\n[[lights]]\nkind = \"directional\"\ndirection = [1.0, -1.0, 0.0]\n";
+    let first = parse(text).unwrap().scene;
+    let again = parse(&to_toml(&first, "pbr", Vec3::ZERO)).unwrap().scene;
+    assert_eq!(again.lights, first.lights);
+    assert_eq!(again.directional.len(), 1);
+    assert!((again.directional[0].direction - first.directional[0].direction).length() < 1e-6);
+    for (a, b) in again.cones.iter().zip(&first.cones) {
+        let close = |x: &[f32; 4], y: &[f32; 4]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= 1e-3 * q.abs().max(1.0));
+        assert!(close(&a.direction_scale, &b.direction_scale) && close(&a.offset, &b.offset), "{a:?} vs {b:?}");
+    }
+    assert_eq!(again.cones.len(), 2);
+}
