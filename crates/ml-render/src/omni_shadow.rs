@@ -17,6 +17,7 @@ use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
 use ml_cpu::omni_shadow::{face_view_proj, sphere_faces};
 use ml_cpu::scene::Object;
+use ml_vk::commands::{aspect_transition, StageAccessLayout};
 use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 
 /// The cube's depth format: 32-bit float, which holds distance / radius to 2⁻²⁴.
@@ -169,7 +170,7 @@ impl OmniShadows {
         let copy = settings.mode == OmniShadowMode::Copy;
         if copy {
             // Whatever the previous frame's shading read is overwritten by copies.
-            self.barrier(ctx, cmd, (SHADER_READERS, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), TRANSFER_DST);
+            transition(ctx, cmd, self.cubes.raw, (SHADER_READERS, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), TRANSFER_DST);
         }
         for (cube, light) in lights.iter().enumerate().take(settings.lights as usize) {
             // Objects are drawn into the faces their bounding sphere reaches (none when it
@@ -230,9 +231,10 @@ impl OmniShadows {
             }
         }
         if copy {
-            self.barrier(
+            transition(
                 ctx,
                 cmd,
+                self.cubes.raw,
                 TRANSFER_DST,
                 (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
             );
@@ -261,11 +263,6 @@ impl OmniShadows {
                 &region,
             )
         };
-    }
-
-    /// A layout transition of every layer of the cube array.
-    fn barrier(&self, ctx: &Context, cmd: vk::CommandBuffer, from: StageAccessLayout, to: StageAccessLayout) {
-        transition(ctx, cmd, self.cubes.raw, from, to);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -297,23 +294,12 @@ impl ml_vk::Release for OmniShadows {
     }
 }
 
-type StageAccessLayout = (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout);
-
 const TRANSFER_DST: StageAccessLayout =
     (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
 
+/// A layout transition of every layer of the cube array.
 fn transition(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: StageAccessLayout, to: StageAccessLayout) {
-    let b = [vk::ImageMemoryBarrier::default()
-        .src_access_mask(from.1)
-        .dst_access_mask(to.1)
-        .old_layout(from.2)
-        .new_layout(to.2)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(ml_vk::image::full_range(DEPTH))];
-    // SAFETY: recording state, outside a render pass.
-    unsafe { ctx.device.cmd_pipeline_barrier(cmd, from.0, to.0, vk::DependencyFlags::empty(), &[], &[], &b) };
+    aspect_transition(ctx, cmd, (image, DEPTH), from, to);
 }
 
 /// The stand-in: every layer cleared to 1.0 (nothing in reach), left as the shaders expect.

@@ -58,13 +58,21 @@ pub fn memory_barrier(
     unsafe { ctx.device.cmd_pipeline_barrier(cmd, src.0, dst.0, vk::DependencyFlags::empty(), &b, &[], &[]) };
 }
 
+/// (stage, access, layout) on one side of a barrier.
+pub type StageAccessLayout = (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout);
+
 /// A colour image's layout transition: `from` (stage, access, layout) before `to`.
-pub fn image_transition(
+pub fn image_transition(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: StageAccessLayout, to: StageAccessLayout) {
+    aspect_transition(ctx, cmd, (image, vk::ImageAspectFlags::COLOR), from, to);
+}
+
+/// The layout transition of every mip level and layer of `aspect` of an image.
+pub fn aspect_transition(
     ctx: &Context,
     cmd: vk::CommandBuffer,
-    image: vk::Image,
-    from: (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout),
-    to: (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout),
+    (image, aspect): (vk::Image, vk::ImageAspectFlags),
+    from: StageAccessLayout,
+    to: StageAccessLayout,
 ) {
     let b = [vk::ImageMemoryBarrier::default()
         .src_access_mask(from.1)
@@ -74,7 +82,7 @@ pub fn image_transition(
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)
-        .subresource_range(crate::image::full_range(vk::ImageAspectFlags::COLOR))];
+        .subresource_range(crate::image::full_range(aspect))];
     // SAFETY: recording state, outside a render pass.
     unsafe { ctx.device.cmd_pipeline_barrier(cmd, from.0, to.0, vk::DependencyFlags::empty(), &[], &[], &b) };
 }
