@@ -12,12 +12,11 @@
 //! filtered trilinearly), sparse accessors, orthographic cameras (each left out with a
 //! warning). Directional lights: up to MAX_DIRECTIONAL_LIGHTS.
 
-use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
-use crate::scene::{DirectionalLight, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
+use crate::scene::{DirectionalLight, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
 use crate::scene_file::{read_capped, SceneFile, SceneFileError, MAX_OBJECTS};
 use crate::textures::TextureImage;
 use base64::Engine as _;
@@ -104,9 +103,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     if cones.iter().all(|c| *c == LightCone::NONE) {
         cones.clear();
     }
-    let blinn_phong = BlinnPhongLights::default();
-    let mut scene =
-        Scene { objects, lights, camera: Camera::seed(), ambient: SEED_AMBIENT, blinn_phong, meshes, textures, directional, cones };
+    let mut scene = Scene { meshes, textures, directional, cones, ..Scene::new(objects, lights, Camera::seed()) };
     scene.camera = match camera {
         Some(c) => c,
         None => framing_camera(&scene),

@@ -8,7 +8,7 @@ use crate::gpu_types::PointLight;
 use crate::lights::{LightLayout, LightParams, RadiusRange};
 use crate::material::{Material, NAMED_ALBEDOS};
 use crate::mesh::MeshKind;
-use crate::scene::{Object, Scene, SEED_AMBIENT};
+use crate::scene::{Object, Scene};
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 
@@ -57,15 +57,5 @@ pub fn random_scene(seed: u64, max_lights: u32) -> Scene {
             Object::placed(mesh, Vec3::new(at(i / 7), 0.0, at(i % 7)), 1.0, material)
         })
         .collect();
-    Scene {
-        objects,
-        lights,
-        camera,
-        ambient: SEED_AMBIENT,
-        blinn_phong: Default::default(),
-        meshes: Vec::new(),
-        textures: Vec::new(),
-        directional: Vec::new(),
-        cones: Vec::new(),
-    }
+    Scene::new(objects, lights, camera)
 }

@@ -113,17 +113,24 @@ impl Scene {
                 objects.push(Object::placed(mesh, Vec3::new(at(i), 0.0, at(j)), 1.0, material));
             }
         }
-        Ok(Scene {
+        Ok(Scene::new(objects, lights.build()?, Camera::seed()))
+    }
+
+    /// `objects` lit by point `lights` and the seed's ambient, seen by `camera`; the
+    /// blinn-phong model's default lights; no meshes, textures, spot or directional lights of
+    /// its own.
+    pub fn new(objects: Vec<Object>, lights: Vec<PointLight>, camera: Camera) -> Scene {
+        Scene {
             objects,
-            lights: lights.build()?,
-            camera: Camera::seed(),
+            lights,
+            camera,
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),
             meshes: Vec::new(),
             textures: Vec::new(),
             directional: Vec::new(),
             cones: Vec::new(),
-        })
+        }
     }
 
     /// Seed 002's setting for the seed scene: the same grid standing on a floor (which
@@ -148,18 +155,10 @@ impl Scene {
         for level in 0..3 {
             objects.push(Object::placed(MeshKind::Cube, Vec3::new(1.5, -4.5 + level as f32, 0.5), 0.5, stone));
         }
-        Scene {
-            objects,
-            // Below the pillar's top, so its shadow crosses the floor and climbs the far wall.
-            lights: vec![PointLight { position_radius: [-1.5, -2.5, -1.5, 20.0], color: [3.0, 3.0, 3.0, 0.0] }],
-            camera: Camera::looking_at(Vec3::new(-4.2, 2.5, -4.0), Vec3::new(2.0, -3.0, 2.0), 75.0, 0.05, 50.0),
-            ambient: SEED_AMBIENT,
-            blinn_phong: BlinnPhongLights::default(),
-            meshes: Vec::new(),
-            textures: Vec::new(),
-            directional: Vec::new(),
-            cones: Vec::new(),
-        }
+        // Below the pillar's top, so its shadow crosses the floor and climbs the far wall.
+        let light = PointLight { position_radius: [-1.5, -2.5, -1.5, 20.0], color: [3.0, 3.0, 3.0, 0.0] };
+        let camera = Camera::looking_at(Vec3::new(-4.2, 2.5, -4.0), Vec3::new(2.0, -3.0, 2.0), 75.0, 0.05, 50.0);
+        Scene::new(objects, vec![light], camera)
     }
 
     /// World box around every object (each mesh fits [−1, 1]³ in object space).

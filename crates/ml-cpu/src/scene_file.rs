@@ -4,7 +4,6 @@
 //! ranges, counts and file size limited before anything is allocated — and every problem is
 //! one error naming the file and, where the parser knows it, the line.
 
-use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
@@ -193,16 +192,13 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
         None => (None, None),
     };
     let mut scene = Scene {
-        objects,
-        lights,
-        camera: Camera::seed(),
         ambient: ambient.unwrap_or(SEED_AMBIENT),
-        blinn_phong: BlinnPhongLights::default(),
-        meshes: std::mem::take(&mut meshes),
-        textures: std::mem::take(&mut textures),
+        meshes,
+        textures,
         directional,
         // Only scenes with a spot keep the cones.
         cones: if cones.iter().all(|c| *c == LightCone::NONE) { Vec::new() } else { cones },
+        ..Scene::new(objects, lights, Camera::seed())
     };
     scene.camera = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading, warnings })

@@ -35,23 +35,15 @@ fn light(p: [f32; 3], radius: f32, color: [f32; 3]) -> PointLight {
 }
 
 fn sphere_scene(material: Material) -> Scene {
-    Scene {
-        objects: vec![Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, material)],
-        lights: vec![
-            light([2.0, 2.0, 2.0], 6.0, [1.0, 0.2, 0.1]),
-            light([-2.5, 0.5, 1.5], 4.0, [0.1, 1.0, 0.3]),
-            light([0.0, -2.0, 2.5], 4.5, [0.2, 0.3, 1.0]),
-            // Its sphere of influence ends inside the object: a hard cut-off across the surface.
-            light([0.5, 2.2, 0.5], 1.8, [1.0, 1.0, 0.0]),
-        ],
-        camera: Camera::looking_at(Vec3::new(0.3, 0.6, 3.2), Vec3::ZERO, 45.0, 0.1, 100.0),
-        ambient: 0.02,
-        blinn_phong: Default::default(),
-        meshes: Vec::new(),
-        textures: Vec::new(),
-        directional: Vec::new(),
-        cones: Vec::new(),
-    }
+    let lights = vec![
+        light([2.0, 2.0, 2.0], 6.0, [1.0, 0.2, 0.1]),
+        light([-2.5, 0.5, 1.5], 4.0, [0.1, 1.0, 0.3]),
+        light([0.0, -2.0, 2.5], 4.5, [0.2, 0.3, 1.0]),
+        // Its sphere of influence ends inside the object: a hard cut-off across the surface.
+        light([0.5, 2.2, 0.5], 1.8, [1.0, 1.0, 0.0]),
+    ];
+    let camera = Camera::looking_at(Vec3::new(0.3, 0.6, 3.2), Vec3::ZERO, 45.0, 0.1, 100.0);
+    Scene::new(vec![Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, material)], lights, camera)
 }
 
 /// First intersection of a ray with the unit sphere at the origin.

@@ -35,17 +35,7 @@ fn scene(ball: bool, sun_on: bool, camera: Camera) -> Scene {
     lights.spot.strength = Vec3::ZERO;
     lights.ambient = Vec3::splat(0.1);
     let far_light = PointLight { position_radius: [100.0, 100.0, 100.0, 0.1], color: [1.0; 4] };
-    Scene {
-        objects,
-        lights: vec![far_light],
-        camera,
-        ambient: 0.02,
-        blinn_phong: lights,
-        meshes: Vec::new(),
-        textures: Vec::new(),
-        directional: Vec::new(),
-        cones: Vec::new(),
-    }
+    Scene { blinn_phong: lights, ..Scene::new(objects, vec![far_light], camera) }
 }
 
 fn render_abc(camera: Camera, size: u32) -> [RenderOutput; 3] {

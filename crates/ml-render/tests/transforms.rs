@@ -48,17 +48,7 @@ fn a_turned_uneven_ellipsoid_has_the_analytic_normals() {
     let object = Object { mesh: MeshKind::Sphere, transform: transform(), material: white, textures: Default::default() };
     let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 6.0), Vec3::ZERO, 45.0, 0.1, 50.0);
     let light = PointLight { position_radius: [0.0, 3.0, 3.0, 20.0], color: [1.0, 1.0, 1.0, 0.0] };
-    let scene = Scene {
-        objects: vec![object],
-        lights: vec![light],
-        camera,
-        ambient: 0.02,
-        blinn_phong: Default::default(),
-        meshes: Vec::new(),
-        textures: Vec::new(),
-        directional: Vec::new(),
-        cones: Vec::new(),
-    };
+    let scene = Scene::new(vec![object], vec![light], camera);
     let settings: Vec<RenderSettings> = [Technique::Forward, Technique::Deferred, Technique::DeferredCompute]
         .iter()
         .map(|&t| {
