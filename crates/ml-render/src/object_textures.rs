@@ -8,6 +8,7 @@ use ml_cpu::scene::{Object, ObjectTextures};
 use ml_cpu::textures::TextureImage;
 use ml_vk::descriptors::{allocate_set, write_image};
 use ml_vk::image::texture_with;
+use crate::scene_textures::sampler;
 use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 use std::collections::HashMap;
 
@@ -52,16 +53,8 @@ impl ObjectTextureSets {
         let one = ImageShape { extent: vk::Extent2D { width: 1, height: 1 }, levels: 1, layers: 1, view: vk::ImageViewType::TYPE_2D };
         self.images.push(texture_with(ctx, "no object texture", one, vk::Format::R8G8B8A8_UNORM, &[vec![&white[..]]])?);
         let stand_in = self.images.len() - 1;
-        let info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::LINEAR)
-            .min_filter(vk::Filter::LINEAR)
-            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-            .address_mode_u(vk::SamplerAddressMode::REPEAT)
-            .address_mode_v(vk::SamplerAddressMode::REPEAT)
-            .address_mode_w(vk::SamplerAddressMode::REPEAT)
-            .max_lod(vk::LOD_CLAMP_NONE);
-        // SAFETY: valid device and create info.
-        self.sampler = unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")?;
+        // Repeating, trilinear (glTF's samplers are not read yet).
+        self.sampler = sampler(ctx, vk::SamplerAddressMode::REPEAT, vk::Filter::LINEAR, None)?;
         let mut pairs: Vec<ObjectTextures> = Vec::new();
         for o in objects {
             if !pairs.contains(&o.textures) {

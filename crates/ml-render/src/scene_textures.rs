@@ -212,7 +212,8 @@ fn depth_filter(ctx: &Context, format: vk::Format) -> vk::Filter {
     }
 }
 
-fn sampler(
+/// A sampler (clamp-to-border samples read opaque white); `compare`: a depth comparison.
+pub(crate) fn sampler(
     ctx: &Context,
     address: vk::SamplerAddressMode,
     filter: vk::Filter,
