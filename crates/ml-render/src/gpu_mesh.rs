@@ -58,22 +58,22 @@ pub fn vertex_attributes() -> [vk::VertexInputAttributeDescription; 4] {
     .expect("four attributes")
 }
 
-/// Record the indexed draws of `objects` whose instance mask (`instances`: bit i asks for
-/// instance i; 0 skips the object) is not empty: per mesh, its buffers bound, then its
+/// Record the indexed draws of `objects` whose instance mask (`instances(index in the scene)`:
+/// bit i asks for instance i; 0 skips the object) is not empty: per mesh, its buffers bound, then its
 /// objects in scene order, each after `push(index in the scene, object)` (which records the
 /// draw's push constants), one draw per run of consecutive instances.
 pub fn record_draws(
     ctx: &Context,
     cmd: vk::CommandBuffer,
     (meshes, objects): (&[GpuMesh], &[Object]),
-    instances: impl Fn(&Object) -> u32,
+    instances: impl Fn(u32) -> u32,
     mut push: impl FnMut(u32, &Object),
 ) {
     let d = &ctx.device;
     for mesh in meshes {
         let mut bound = false;
         for (index, object) in objects.iter().enumerate().filter(|(_, o)| o.mesh == mesh.kind) {
-            let mut mask = instances(object);
+            let mut mask = instances(index as u32);
             if mask == 0 {
                 continue;
             }

@@ -4,11 +4,11 @@
 //! to sample). A set per draw rather than one array indexed per draw: lavapipe cannot index
 //! sampler arrays dynamically.
 
+use crate::scene_textures::sampler;
 use ml_cpu::scene::{Object, ObjectTextures};
 use ml_cpu::textures::TextureImage;
 use ml_vk::descriptors::{allocate_set, write_image};
 use ml_vk::image::texture_with;
-use crate::scene_textures::sampler;
 use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 use std::collections::HashMap;
 

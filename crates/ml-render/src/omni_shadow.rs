@@ -174,14 +174,17 @@ impl OmniShadows {
         }
         for (cube, light) in lights.iter().enumerate().take(settings.lights as usize) {
             // Objects are drawn into the faces their bounding sphere reaches (none when it
-            // misses the light's sphere).
-            let faces = |o: &Object| {
-                let (centre, bound) = o.bounding_sphere();
-                if centre.distance(light.position) > light.radius + bound {
-                    return 0;
-                }
-                sphere_faces(centre - light.position, bound)
-            };
+            // misses the light's sphere): per object, once per light.
+            let faces: Vec<u32> = objects
+                .iter()
+                .map(|o| {
+                    let (centre, bound) = o.bounding_sphere();
+                    if centre.distance(light.position) > light.radius + bound {
+                        return 0;
+                    }
+                    sphere_faces(centre - light.position, bound)
+                })
+                .collect();
             let world_to_light = Mat4::from_scale(Vec3::splat(1.0 / light.radius)) * Mat4::from_translation(-light.position);
             let one_pass = matches!(settings.mode, OmniShadowMode::Multiview | OmniShadowMode::Layered);
             let passes: Vec<(Option<u32>, Mat4)> = if one_pass {
@@ -210,10 +213,10 @@ impl OmniShadows {
                     depth_pass::set_square_viewport(ctx, cmd, size);
                     // Per-face passes draw an object if it reaches their face; layered draws
                     // instance i (face i) of each face it reaches; multiview draws every view.
-                    let instances = |o: &Object| match (settings.mode, face) {
-                        (OmniShadowMode::Layered, _) => faces(o),
-                        (OmniShadowMode::Multiview, _) => u32::from(faces(o) != 0),
-                        (_, Some(f)) => (faces(o) >> f) & 1,
+                    let instances = |i: u32| match (settings.mode, face) {
+                        (OmniShadowMode::Layered, _) => faces[i as usize],
+                        (OmniShadowMode::Multiview, _) => u32::from(faces[i as usize] != 0),
+                        (_, Some(f)) => (faces[i as usize] >> f) & 1,
                         (_, None) => 0,
                     };
                     record_draws(ctx, cmd, (meshes, objects), instances, |_, object| {
