@@ -25,6 +25,16 @@ float cluster_slice_start(FrameUniforms f, uint k) {
     return f.cluster_frustum.x * pow(f.cluster_frustum.y / f.cluster_frustum.x, float(k) / float(f.cluster_dims.z));
 }
 
+// Clip w at view depth `depth`: the depth for a perspective camera, 1 for an orthographic
+// one (camera_pos.w says which; grid.rs w_of_depth, inv_w).
+float cluster_w(FrameUniforms f, float depth) {
+    return f.camera_pos.w * depth + (1.0 - f.camera_pos.w);
+}
+
+float cluster_inv_w(FrameUniforms f, float depth) {
+    return 1.0 / cluster_w(f, depth);
+}
+
 uint cluster_tile(uint pixel, uint tiles, uint size) {
     return pixel * tiles / size;
 }
@@ -41,7 +51,7 @@ bool cluster_pixel_span(float lo, float hi, uint size, out uvec2 span) {
     return true;
 }
 
-// Tiles under the view-space box v ∈ [va, vb], 1/depth ∈ inv (x: 1/d0, y: 1/d1), along an axis
+// Tiles under the view-space box v ∈ [va, vb], 1/w ∈ inv (x: 1/w0, y: 1/w1), along an axis
 // with projection scale `scale`. Keep in sync with grid.rs tile_span_x / projected_span.
 bool cluster_tile_span(float scale, float va, float vb, vec2 inv, uint size, uint tiles, out uvec2 span) {
     vec4 c = vec4(va * inv.x, va * inv.y, vb * inv.x, vb * inv.y) * scale;

@@ -35,9 +35,12 @@ void main() {
         float px = (corner & 1) == 0 ? xs.x : xs.y;
         float py = (corner & 2) == 0 ? ys.x : ys.y;
         vec2 ndc = vec2(px / float(frame.viewport.x), py / float(frame.viewport.y)) * 2.0 - 1.0;
-        vec3 dir = vec3(ndc.x / frame.cluster_frustum.z, ndc.y / frame.cluster_frustum.w, -1.0);
-        lo = min(lo, min(dir * z0, dir * z1));
-        hi = max(hi, max(dir * z0, dir * z1));
+        // At view depth d the pixel is at ndc · w / p (w: clip w, cluster_w).
+        vec2 dir = vec2(ndc.x / frame.cluster_frustum.z, ndc.y / frame.cluster_frustum.w);
+        vec3 p0 = vec3(dir * cluster_w(frame, z0), -z0);
+        vec3 p1 = vec3(dir * cluster_w(frame, z1), -z1);
+        lo = min(lo, min(p0, p1));
+        hi = max(hi, max(p0, p1));
     }
     vec3 pad = max(hi - lo, vec3(z1 - z0)) * CLUSTER_SLACK;
     bounds[index] = ClusterBounds(vec4(lo - pad, 0.0), vec4(hi + pad, 0.0));

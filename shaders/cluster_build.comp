@@ -59,13 +59,15 @@ void main() {
     // Wholly outside a side plane of the frustum (grid.rs outside_side_planes)?
     float p00 = frame.cluster_frustum.z;
     float p11 = abs(frame.cluster_frustum.w);
-    if (p00 * abs(c.x) - depth > r * sqrt(p00 * p00 + 1.0) || p11 * abs(c.y) - depth > r * sqrt(p11 * p11 + 1.0)) {
+    float a = frame.camera_pos.w;
+    float w = cluster_w(frame, depth);
+    if (p00 * abs(c.x) - w > r * sqrt(p00 * p00 + a * a) || p11 * abs(c.y) - w > r * sqrt(p11 * p11 + a * a)) {
         return;
     }
     uvec3 d = frame.cluster_dims.xyz;
     uvec2 size = frame.viewport.xy;
     float d0 = max(dmin, near);
-    vec2 inv = vec2(1.0 / d0, 1.0 / dmax);
+    vec2 inv = vec2(cluster_inv_w(frame, d0), cluster_inv_w(frame, dmax));
     uvec2 xs;
     uvec2 ys;
     if (!cluster_tile_span(frame.cluster_frustum.z, c.x - r, c.x + r, inv, size.x, d.x, xs)
@@ -85,7 +87,7 @@ void main() {
         if (k0 != k1) {
             float closest = clamp(depth, s0, s1);
             float rr = sqrt(max(r2 - (closest - depth) * (closest - depth), 0.0));
-            vec2 slab = vec2(1.0 / s0, 1.0 / s1);
+            vec2 slab = vec2(cluster_inv_w(frame, s0), cluster_inv_w(frame, s1));
             if (!cluster_tile_span(frame.cluster_frustum.z, c.x - rr, c.x + rr, slab, size.x, d.x, xs)
                 || !cluster_tile_span(frame.cluster_frustum.w, c.y - rr, c.y + rr, slab, size.y, d.y, ys)) {
                 continue;

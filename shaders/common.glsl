@@ -22,7 +22,7 @@ struct FrameUniforms {
     mat4 view;
     mat4 proj;           // Vulkan clip space: Y flipped, depth 0..1
     mat4 inv_view_proj;  // clip → world (deferred-compute rebuilds positions from depth)
-    vec4 camera_pos;     // xyz: world position of the eye
+    vec4 camera_pos;     // xyz: world position of the eye; w: 1 perspective, 0 orthographic
     uint light_count;
     float ambient;       // seed: colour = albedo * ambient + Lo
     float omni_texel;    // one texel of a point-light shadow cube face, in face units (2 / size)
@@ -87,7 +87,8 @@ struct ObjectData {
     mat4 model;            // object space → world
     mat4 normal_matrix;    // upper 3×3: the inverse transpose of model's (normals, tangents)
     vec4 albedo_roughness; // rgb: albedo, a: roughness
-    vec4 material;         // x: metallic; yzw unused
+    vec4 material;         // x: metallic, y: occlusion strength, z: normal scale (glTF)
+    vec4 emissive;         // rgb: emissive factor (glTF)
 };
 
 // Per draw, by push constants: the object's index and, again, its material — the forward
@@ -95,10 +96,11 @@ struct ObjectData {
 // pass at 4,096 lights 345 ms instead of 332.5 on the H100, measured); the deferred lighting
 // reads the object buffer.
 struct ObjectPush {
-    uvec4 ids;             // x: index in the object buffer; y, z: 1 where the object has its own
-                           // base-colour texture, normal map (surface.glsl, set 2)
+    uvec4 ids;             // x: index in the object buffer; y: bit i set where the object has
+                           // its own texture i (surface.glsl, set 2)
     vec4 albedo_roughness;
-    vec4 material;         // x: metallic
+    vec4 material;         // as ObjectData's
+    vec4 emissive;
 };
 
 // Push constants of the sun's shadow pass (blinn-phong): the object's and the light's matrix.

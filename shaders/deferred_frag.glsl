@@ -12,6 +12,8 @@ layout(input_attachment_index = 0, set = 2, binding = 1) uniform subpassInput de
 layout(input_attachment_index = 1, set = 2, binding = 2) uniform subpassInput normal_input;
 layout(input_attachment_index = 2, set = 2, binding = 3) uniform usubpassInput object_input;
 layout(input_attachment_index = 3, set = 2, binding = 4) uniform subpassInput albedo_input;
+layout(input_attachment_index = 4, set = 2, binding = 5) uniform subpassInput roughness_metallic_input;
+layout(input_attachment_index = 5, set = 2, binding = 6) uniform subpassInput emissive_input;
 
 #include "lighting.glsl"
 
@@ -25,12 +27,14 @@ void main() {
     vec3 world = world_from_depth(gl_FragCoord.xy, z);
     vec3 n = oct_decode(subpassLoad(normal_input).xy);
     uint id = subpassLoad(object_input).r;
-    vec4 albedo_roughness = objects[id].albedo_roughness;
-    float metallic = objects[id].material.x;
-    vec3 albedo = albedo_roughness.rgb * subpassLoad(albedo_input).rgb;
+    // Without OBJECT_TEXTURES the material and emissive attachments are not written.
+    vec2 roughness_metallic = OBJECT_TEXTURES ? subpassLoad(roughness_metallic_input).xy : vec2(1.0);
+    vec3 emissive_factor = OBJECT_TEXTURES ? subpassLoad(emissive_input).rgb : vec3(1.0);
+    PointMaterial m =
+        point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, subpassLoad(albedo_input), roughness_metallic, emissive_factor);
     vec3 color;
-    if (!debug_surface(world, n, albedo, albedo_roughness.a, metallic, color)) {
-        color = shade_point(world, n, albedo, albedo_roughness.a, metallic, gl_FragCoord.xy);
+    if (!debug_surface(world, n, m.albedo, m.roughness, m.metallic, color)) {
+        color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
     }
     out_hdr = vec4(color, 1.0);
 }

@@ -14,6 +14,8 @@ layout(set = 0, binding = 6) uniform sampler2D normal_image;
 layout(set = 0, binding = 7) uniform usampler2D object_image;
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 layout(set = 0, binding = 9) uniform sampler2D albedo_image;
+layout(set = 0, binding = 11) uniform sampler2D roughness_metallic_image;
+layout(set = 0, binding = 12) uniform sampler2D emissive_image;
 #include "textures.glsl"
 
 #include "lighting.glsl"
@@ -32,14 +34,16 @@ void main() {
     vec3 world = world_from_depth(frag_xy, z);
     vec3 n = oct_decode(texelFetch(normal_image, p, 0).xy);
     uint id = texelFetch(object_image, p, 0).r;
-    vec4 albedo_roughness = objects[id].albedo_roughness;
-    float metallic = objects[id].material.x;
-    vec3 albedo = albedo_roughness.rgb * texelFetch(albedo_image, p, 0).rgb;
+    // Without OBJECT_TEXTURES the material and emissive images are not written.
+    vec2 roughness_metallic = OBJECT_TEXTURES ? texelFetch(roughness_metallic_image, p, 0).xy : vec2(1.0);
+    vec3 emissive_factor = OBJECT_TEXTURES ? texelFetch(emissive_image, p, 0).rgb : vec3(1.0);
+    PointMaterial m =
+        point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, texelFetch(albedo_image, p, 0), roughness_metallic, emissive_factor);
     vec3 color;
-    if (debug_surface(world, n, albedo, albedo_roughness.a, metallic, color)) {
+    if (debug_surface(world, n, m.albedo, m.roughness, m.metallic, color)) {
         imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
         return;
     }
-    color = shade_point(world, n, albedo, albedo_roughness.a, metallic, frag_xy);
+    color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
     imageStore(out_image, p, vec4(encode_output(color), 1.0));
 }

@@ -29,16 +29,15 @@ void main() {
         return;
     }
 #endif
-    Surface s = surface_at(in_normal, in_tangent, in_uv, object.ids.yz);
-    vec3 albedo = object.albedo_roughness.rgb * s.albedo_factor;
-    float roughness = object.albedo_roughness.a;
-    float metallic = object.material.x;
+    Surface s = surface_at(in_normal, in_tangent, in_uv, object.ids.y, object.material);
+    PointMaterial m = point_material(object.albedo_roughness, object.material, object.emissive, vec4(s.albedo_factor, s.occlusion),
+                                     s.roughness_metallic, s.emissive_factor);
     vec3 color;
-    if (debug_surface(in_world_pos, s.normal, albedo, roughness, metallic, color)) {
+    if (debug_surface(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, color)) {
         out_color = vec4(encode_gamma(color), 1.0);
         return;
     }
-    color = shade_point(in_world_pos, s.normal, albedo, roughness, metallic, gl_FragCoord.xy);
+    color = shade_point(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
     // The target is UNORM: the seed writes gamma-encoded values itself.
     out_color = vec4(encode_output(color), 1.0);
 }

@@ -59,11 +59,36 @@ float spot_cone(uint i, PointLight l, vec3 world) {
         sum += LIGHT(far_);                                                                            \
     }
 
+// What a surface point is shaded with: the object's material (ObjectData's or ObjectPush's
+// vectors) times the factors its textures give (Surface, or their copy in the G-buffer).
+struct PointMaterial {
+    vec3 albedo;
+    float roughness;
+    float metallic;
+    float occlusion;
+    vec3 emission;
+};
+
+PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive, vec4 albedo_occlusion, vec2 roughness_metallic,
+                             vec3 emissive_factor) {
+    PointMaterial m;
+    m.albedo = albedo_roughness.rgb * albedo_occlusion.rgb;
+    m.roughness = albedo_roughness.a * roughness_metallic.x;
+    m.metallic = material.x * roughness_metallic.y;
+    m.occlusion = albedo_occlusion.a;
+    m.emission = emissive.rgb * emissive_factor;
+    return m;
+}
+
 // Linear colour of a surface point: every light that reaches it plus what the model adds
-// (seed, pbr: ambient; blinn-phong: ambient, sun, spot, reflection). `frag_xy` is the pixel
-// centre (gl_FragCoord.xy), which picks the cluster.
-vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, vec2 frag_xy) {
-    vec3 v = normalize(frame.camera_pos.xyz - world);
+// (seed, pbr: ambient, times `occlusion`; blinn-phong: ambient, sun, spot, reflection) plus
+// the light it gives off (`emission`). `frag_xy` is the pixel centre (gl_FragCoord.xy),
+// which picks the cluster.
+vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, float occlusion, vec3 emission, vec2 frag_xy) {
+    // Towards the eye; an orthographic camera looks along its axis everywhere (the view
+    // matrix's third row is the eye's +Z, its back, in world space).
+    vec3 back = vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
+    vec3 v = frame.camera_pos.w != 0.0 ? normalize(frame.camera_pos.xyz - world) : back;
     vec3 lo = vec3(0.0);
     if (MODEL_BLINN_PHONG) {
         vec3 r0 = mix(vec3(0.04), albedo, metallic);
@@ -71,18 +96,18 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
 #define BP_LIGHT(l) (bp_point_light(l, world, n, v, albedo, r0, shininess) * omni_visibility(l, world, n))
         SUM_LIGHTS(lo, BP_LIGHT)
         SUM_DIRECTIONAL(lo, BP_LIGHT)
-        return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo;
+        return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo + emission;
     }
     if (MODEL_PBR) {
 #define PBR_LIGHT(l) (pbr_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
         SUM_LIGHTS(lo, PBR_LIGHT)
         SUM_DIRECTIONAL(lo, PBR_LIGHT)
-        return albedo * frame.ambient + lo;
+        return albedo * frame.ambient * occlusion + lo + emission;
     }
 #define SEED_LIGHT(l) (seed_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
     SUM_LIGHTS(lo, SEED_LIGHT)
     SUM_DIRECTIONAL(lo, SEED_LIGHT)
-    return albedo * frame.ambient + lo;
+    return albedo * frame.ambient * occlusion + lo + emission;
 }
 
 // The surface debug views (G-buffer channels, depth): what the view shows at a surface point

@@ -1,7 +1,8 @@
 // What the rasterised surface contributes before lighting (forward fragment shaders and the
 // G-buffer pass alike): an object's own base-colour texture and normal map (glTF), and
 // blinn-phong's albedo texture and normal map; normal maps perturb the normal through the
-// tangent frame (TBN). The seed model's built-in objects use none.
+// tangent frame (TBN); glTF's metallic-roughness, occlusion and emissive textures. The seed
+// model's built-in objects use none.
 // Needs common.glsl, scene_bindings.glsl and textures.glsl. Fragment stage (implicit LOD).
 
 #ifndef MANYLIGHTS_SURFACE_GLSL
@@ -10,43 +11,68 @@
 #include "shading_model.glsl"
 
 // Set 2 of the mesh pipelines, bound per draw: the object's own textures (glTF), or white
-// stand-ins where ObjectPush.ids says it has none (object_textures.rs). A set per draw,
+// stand-ins where ObjectPush.ids.y says it has none (object_textures.rs). A set per draw,
 // not an array indexed per draw: lavapipe has no dynamic indexing of sampler arrays.
-// OBJECT_TEXTURES (a specialization constant): whether the scene has such textures at all; with
-// the runtime test alone the seed scene's G-buffer pass took 1.90 ms instead of 1.55 and its
-// forward pass at 64 lights 11.1 ms instead of 10.2 on the H100 (measured).
-layout(constant_id = 13) const bool OBJECT_TEXTURES = false;
-layout(set = 2, binding = 0) uniform sampler2D object_base_color;
-layout(set = 2, binding = 1) uniform sampler2D object_normal_map;
+layout(set = 2, binding = 0) uniform sampler2D object_base_color;         // sRGB
+layout(set = 2, binding = 1) uniform sampler2D object_normal_map;         // n·0.5 + 0.5
+layout(set = 2, binding = 2) uniform sampler2D object_metallic_roughness; // g: roughness, b: metallic
+layout(set = 2, binding = 3) uniform sampler2D object_occlusion;          // r
+layout(set = 2, binding = 4) uniform sampler2D object_emissive;           // sRGB
+// Bits of ObjectPush.ids.y (ObjectTextures::bits).
+const uint TEXTURE_BASE_COLOR = 1u;
+const uint TEXTURE_NORMAL = 2u;
+const uint TEXTURE_METALLIC_ROUGHNESS = 4u;
+const uint TEXTURE_OCCLUSION = 8u;
+const uint TEXTURE_EMISSIVE = 16u;
 
+// What the textures make of the object's material: factors that multiply its own values.
 struct Surface {
-    vec3 normal;         // unit, world space
-    vec3 albedo_factor;  // multiplies the object's albedo
+    vec3 normal;                // unit, world space
+    vec3 albedo_factor;         // multiplies the object's albedo
+    vec2 roughness_metallic;    // multiply its roughness and metallic
+    float occlusion;            // of ambient light (1: none)
+    vec3 emissive_factor;       // multiplies its emissive factor
 };
 
-// `n` perturbed by a tangent-space normal-map texel (n·0.5 + 0.5 encoded).
-vec3 perturb_normal(vec3 n, vec4 tangent, vec3 texel) {
+// `n` perturbed by a tangent-space normal-map texel (n·0.5 + 0.5 encoded), its x and y
+// scaled by `scale` (glTF's normalTexture.scale).
+vec3 perturb_normal(vec3 n, vec4 tangent, vec3 texel, float scale) {
     vec3 t = normalize(tangent.xyz - dot(tangent.xyz, n) * n);
     vec3 b = tangent.w * cross(n, t);
-    vec3 m = texel * 2.0 - 1.0;
+    vec3 m = (texel * 2.0 - 1.0) * vec3(scale, scale, 1.0);
     return normalize(m.x * t + m.y * b + m.z * n);
 }
 
-// `textures`: whether the object has its own base-colour texture (x) and normal map (y).
-Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uvec2 textures) {
+// `textures`: which textures the object has of its own (TEXTURE_* bits); `material`: its
+// ObjectData.material (y: occlusion strength, z: normal scale).
+Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, vec4 material) {
     Surface s;
     s.normal = normalize(geometric_normal);
     s.albedo_factor = vec3(1.0);
-    if (OBJECT_TEXTURES && textures.x != 0u) {
-        s.albedo_factor = texture(object_base_color, uv).rgb;
-    }
-    if (OBJECT_TEXTURES && textures.y != 0u) {
-        s.normal = perturb_normal(s.normal, tangent, texture(object_normal_map, uv).xyz);
+    s.roughness_metallic = vec2(1.0);
+    s.occlusion = 1.0;
+    s.emissive_factor = vec3(1.0);
+    if (OBJECT_TEXTURES) {
+        if ((textures & TEXTURE_BASE_COLOR) != 0u) {
+            s.albedo_factor = texture(object_base_color, uv).rgb;
+        }
+        if ((textures & TEXTURE_NORMAL) != 0u) {
+            s.normal = perturb_normal(s.normal, tangent, texture(object_normal_map, uv).xyz, material.z);
+        }
+        if ((textures & TEXTURE_METALLIC_ROUGHNESS) != 0u) {
+            s.roughness_metallic = texture(object_metallic_roughness, uv).gb;
+        }
+        if ((textures & TEXTURE_OCCLUSION) != 0u) {
+            s.occlusion = 1.0 + material.y * (texture(object_occlusion, uv).r - 1.0);
+        }
+        if ((textures & TEXTURE_EMISSIVE) != 0u) {
+            s.emissive_factor = texture(object_emissive, uv).rgb;
+        }
     }
     if (MODEL_BLINN_PHONG) {
         vec2 st = mat2(frame.texture_transform.xy, frame.texture_transform.zw) * uv;
         s.albedo_factor *= texture(albedo_map, st).rgb;
-        s.normal = perturb_normal(s.normal, tangent, texture(normal_map, st).xyz);
+        s.normal = perturb_normal(s.normal, tangent, texture(normal_map, st).xyz, 1.0);
     }
     return s;
 }

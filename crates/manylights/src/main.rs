@@ -172,8 +172,8 @@ fn build_scene(args: &RenderArgs) -> Result<(Scene, ShadingModel)> {
                 // The file's spot cones belonged to its own lights.
                 scene.cones.clear();
             }
-            if scene.lights.is_empty() {
-                bail!("'{path}': the scene has no point lights: add some (scene file: [[lights]]; glTF: KHR_lights_punctual) or pass --lights N");
+            if scene.lights.is_empty() && scene.directional.is_empty() {
+                eprintln!("warning: '{path}': the scene has no lights, so only ambient and emitted light show (--lights N adds some)");
             }
             Ok((scene, model))
         }
@@ -222,6 +222,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device })?;
     let messages = ctx.validation_counter();
     let light_count = scene.lights.len();
+    let object_textures = !scene.textures.is_empty();
     let result = HeadlessRenderer::new(&ctx, scene, settings).and_then(|mut r| r.render());
     let device = format!("{} ({}, {} {})", ctx.info.name, ctx.info.type_name(), ctx.info.driver_name, ctx.info.driver_info);
     drop(ctx);
@@ -247,10 +248,12 @@ fn render(args: &RenderArgs) -> Result<()> {
             Some(false) => "; transient (this device has no lazily allocated memory)",
             None => "",
         };
-        rows.push((
-            "g-buffer",
-            format!("{} bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo RGBA8){memory}", gbuffer_bytes_per_pixel()),
-        ));
+        let layout = if object_textures {
+            "octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8, roughness-metallic RG8, emissive RGBA8"
+        } else {
+            "octahedral normal 2×f32, object index u32, albedo RGBA8"
+        };
+        rows.push(("g-buffer", format!("{} bytes/pixel + depth ({layout}){memory}", gbuffer_bytes_per_pixel(object_textures))));
     }
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
@@ -308,6 +311,7 @@ fn info() -> Result<()> {
             ("maxImageArrayLayers", l.max_image_array_layers.to_string()),
             ("imageCubeArray", d.features.image_cube_array.to_string()),
             ("multiview", d.features.multiview.to_string()),
+            ("independentBlend", d.features.independent_blend.to_string()),
         ];
         println!("{}", table(&rows));
     }

@@ -210,6 +210,7 @@ fn broken_scene_files() -> Vec<(&'static str, &'static str)> {
         ("[[objects]]\nmesh = \"sphere\"\n[camera]\nzoom = 2.0\n", "unknown field `zoom`"),
         ("objects = \"sphere\"", "invalid type"),
         ("[[objects]]\nmesh = \"sphere\"\nposition = [1e39, 0.0, 0.0]\n", "not a finite number"),
+        ("[[objects]]\nmesh = \"sphere\"\n[camera]\northo_half_height = 0.0\n", "ortho_half_height 0 must be greater than 0"),
     ]
 }
 
@@ -370,6 +371,38 @@ fn broken_gltf_files() -> Vec<(Vec<u8>, &'static str, &'static str)> {
             }),
             "gltf",
             "cannot decode",
+        ),
+        // The other material textures go through the same checks; their factors are checked.
+        (
+            textured(&|w| {
+                w.json["materials"][0]["occlusionTexture"] = json!({ "index": 0 });
+                w.json["images"][0] = json!({});
+            }),
+            "gltf",
+            "needs either a uri or a bufferView",
+        ),
+        (textured(&|w| w.json["materials"][0]["emissiveFactor"] = json!([2.0, 0.0, 0.0])), "gltf", "emissive factor 2"),
+        (textured(&|w| w.json["materials"][0]["normalTexture"] = json!({ "index": 0, "scale": 1e39 })), "gltf", "normal scale inf"),
+        (textured(&|w| w.json["samplers"] = json!([{ "wrapS": 12345 }])), "gltf", "invalid glTF"),
+        // Sparse accessors: an index past the end, indices that do not rise, values cut short.
+        (edit(&|w| w.sparse(0, &[99], &[[0.0; 3]])), "gltf", "sparse index 0 is 99"),
+        (edit(&|w| w.sparse(0, &[2, 1], &[[0.0; 3], [1.0; 3]])), "gltf", "sparse index 1 is 1; they must rise"),
+        (
+            edit(&|w| {
+                w.sparse(0, &[1], &[[0.0; 3]]);
+                w.json["accessors"][0]["sparse"]["count"] = json!(3);
+            }),
+            "gltf",
+            "the sparse indices (6 bytes at 0) lie outside",
+        ),
+        (
+            edit(&|w| {
+                let c =
+                    w.camera(json!({ "type": "orthographic", "orthographic": { "xmag": 1.0, "ymag": 0.0, "znear": 0.1, "zfar": 9.0 } }));
+                w.node(json!({ "camera": c }), true);
+            }),
+            "gltf",
+            "need ymag > 0",
         ),
     ]
 }

@@ -41,10 +41,21 @@ fn main() {
     let base = textured.texture(png(2, 2, &[255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255]), "image/png");
     let normal = textured.texture(png(1, 1, &[191, 128, 238, 255]), "image/png");
     let m = textured.textured_material(Some(base), Some(normal));
+    // Every material texture, a sampler, the factors; a sparse accessor; an orthographic camera.
+    textured.sampler(base, json!({ "magFilter": 9728, "minFilter": 9986, "wrapS": 33071, "wrapT": 33648 }));
+    textured.json["materials"][m]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = json!({ "index": base });
+    textured.json["materials"][m]["occlusionTexture"] = json!({ "index": base, "strength": 0.5 });
+    textured.json["materials"][m]["emissiveTexture"] = json!({ "index": base });
+    textured.json["materials"][m]["emissiveFactor"] = json!([1.0, 0.5, 0.0]);
     let q = textured.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
-    textured.node(json!({ "mesh": q }), true);
+    let positions = textured.json["meshes"][q]["primitives"][0]["attributes"]["POSITION"].as_u64().expect("an accessor") as usize;
+    textured.sparse(positions, &[1, 3], &[[2.0, 0.0, -1.0], [2.0, 0.0, 1.0]]);
+    textured.node(json!({ "mesh": q, "rotation": [0.70710677, 0.0, 0.0, 0.70710677] }), true);
+    let ortho =
+        textured.camera(json!({ "type": "orthographic", "orthographic": { "xmag": 2.0, "ymag": 2.0, "znear": 0.0, "zfar": 20.0 } }));
+    textured.node(json!({ "camera": ortho, "translation": [0.0, 0.0, 5.0] }), true);
     std::fs::write(gltf_dir.join("textured.glb"), textured.to_glb()).expect("write");
     let seed = include_str!("../../../scenes/seed.toml");
     std::fs::write(scene_dir.join("seed.toml"), seed).expect("write");
-    std::fs::write(scene_dir.join("small.toml"), "[camera]\nposition = [0.0, 2.0, 6.0]\n[shading]\nmodel = \"pbr\"\n[[lights]]\nposition = [1.0, 3.0, 2.0]\n[[lights]]\nkind = \"spot\"\nposition = [0.0, 4.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ninner_deg = 10.0\nouter_deg = 25.0\n[[lights]]\nkind = \"directional\"\ndirection = [0.3, -1.0, 0.0]\n[[objects]]\nmesh = \"teapot\"\nmaterial = { name = \"gold\", roughness = 0.3 }\n").expect("write");
+    std::fs::write(scene_dir.join("small.toml"), "[camera]\nposition = [0.0, 2.0, 6.0]\northo_half_height = 3.0\n[shading]\nmodel = \"pbr\"\n[[lights]]\nposition = [1.0, 3.0, 2.0]\n[[lights]]\nkind = \"spot\"\nposition = [0.0, 4.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ninner_deg = 10.0\nouter_deg = 25.0\n[[lights]]\nkind = \"directional\"\ndirection = [0.3, -1.0, 0.0]\n[[objects]]\nmesh = \"teapot\"\nmaterial = { name = \"gold\", roughness = 0.3 }\n").expect("write");
 }

@@ -1,5 +1,5 @@
-//! Perspective camera (SPEC §6): right-handed, +Y up, view looks down −Z, Vulkan clip space
-//! with Y flipped in the projection (seeds 001/004) and depth 0..1.
+//! Camera (SPEC §6): right-handed, +Y up, view looks down −Z, Vulkan clip space with Y flipped
+//! in the projection (seeds 001/004) and depth 0..1; perspective, or orthographic (glTF).
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -13,6 +13,9 @@ pub struct Camera {
     pub fov_y_deg: f32,
     pub near: f32,
     pub far: f32,
+    /// Some(h): an orthographic camera seeing h world units above and below its axis (the
+    /// width follows the image's aspect); fov_y_deg is then unused. None: perspective.
+    pub orthographic: Option<f32>,
 }
 
 impl Camera {
@@ -21,13 +24,29 @@ impl Camera {
     /// (`camPos = camera.position * -1`) in a Y-down world; in our +Y-up world the eye is at
     /// (−10, 13, −1.8), facing +X.
     pub fn seed() -> Camera {
-        Camera { position: Vec3::new(-10.0, 13.0, -1.8), pitch_deg: -62.5, yaw_deg: 0.0, fov_y_deg: 60.0, near: 0.1, far: 256.0 }
+        Camera {
+            position: Vec3::new(-10.0, 13.0, -1.8),
+            pitch_deg: -62.5,
+            yaw_deg: 0.0,
+            fov_y_deg: 60.0,
+            near: 0.1,
+            far: 256.0,
+            orthographic: None,
+        }
     }
 
     /// A camera at `position` looking at `target`.
     pub fn looking_at(position: Vec3, target: Vec3, fov_y_deg: f32, near: f32, far: f32) -> Camera {
         let d = (target - position).normalize();
-        Camera { position, pitch_deg: d.y.asin().to_degrees(), yaw_deg: d.z.atan2(d.x).to_degrees(), fov_y_deg, near, far }
+        Camera {
+            position,
+            pitch_deg: d.y.asin().to_degrees(),
+            yaw_deg: d.z.atan2(d.x).to_degrees(),
+            fov_y_deg,
+            near,
+            far,
+            orthographic: None,
+        }
     }
 
     pub fn forward(&self) -> Vec3 {
@@ -39,11 +58,24 @@ impl Camera {
         Mat4::look_to_rh(self.position, self.forward(), Vec3::Y)
     }
 
-    /// Vulkan projection: glam's right-handed 0..1 depth perspective with Y flipped.
+    /// Vulkan projection: glam's right-handed 0..1 depth perspective or orthographic
+    /// projection with Y flipped.
     pub fn projection(&self, aspect: f32) -> Mat4 {
-        let mut p = Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far);
+        let mut p = match self.orthographic {
+            None => Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far),
+            Some(h) => Mat4::orthographic_rh(-h * aspect, h * aspect, -h, h, self.near, self.far),
+        };
         p.y_axis.y = -p.y_axis.y;
         p
+    }
+
+    /// Clip-space w at view depth d is `a·d + b`, (a, b) = this: (1, 0) for a perspective, (0, 1)
+    /// for an orthographic projection (what the cluster code divides by).
+    pub fn w_of_depth(&self) -> (f32, f32) {
+        match self.orthographic {
+            None => (1.0, 0.0),
+            Some(_) => (0.0, 1.0),
+        }
     }
 
     /// World-space ray (origin, unit direction) through the centre of pixel (x, y) of a
@@ -77,6 +109,22 @@ mod tests {
         assert!((clip(Vec3::new(0.0, 0.0, -256.0)).z - 1.0).abs() < 1e-5);
         // +Y in the world is up, so it lands in the upper half: negative y in Vulkan NDC.
         assert!(clip(Vec3::new(0.0, 1.0, -5.0)).y < 0.0);
+    }
+
+    #[test]
+    fn orthographic_projection_keeps_sizes_at_every_depth() {
+        let cam = Camera { orthographic: Some(2.0), ..Camera::looking_at(Vec3::ZERO, -Vec3::Z, 60.0, 0.5, 50.0) };
+        let vp = cam.projection(2.0) * cam.view();
+        for depth in [0.5, 5.0, 50.0] {
+            let c = vp * Vec3::new(4.0, 2.0, -depth).extend(1.0);
+            assert!((c.w - 1.0).abs() < 1e-6);
+            assert!((c.x - 1.0).abs() < 1e-5 && (c.y + 1.0).abs() < 1e-5, "{c}");
+            assert!((c.z - (depth - 0.5) / 49.5).abs() < 1e-5);
+        }
+        // Every pixel's ray runs along the axis, from the near plane.
+        let (o, d) = cam.pixel_ray(0, 0, 64, 32);
+        assert!(d.abs_diff_eq(-Vec3::Z, 1e-5) && (o.z + 0.5).abs() < 1e-5 && o.x < -3.8 && o.y > 1.9, "{o} {d}");
+        assert_eq!(cam.w_of_depth(), (0.0, 1.0));
     }
 
     #[test]

@@ -1,24 +1,25 @@
 //! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`, issue 7): the node hierarchy with its
 //! transforms, every triangle primitive (indexed or not; u8/u16/u32 indices; missing normals
 //! computed flat, tangents computed from the texture coordinates), metallic-roughness
-//! material factors, KHR_lights_punctual point, spot and directional lights and the first
-//! perspective camera (else a camera framing the scene).
+//! materials with their textures, KHR_lights_punctual point, spot and directional lights and
+//! the first camera (else a camera framing the scene).
 //!
 //! The `gltf` crate parses and validates the JSON; everything it hands over unchecked is
 //! checked here before it is used or allocated: buffer sources and lengths, accessor bounds
-//! and strides, index ranges, images, finite numbers, counts. Every problem is one line
-//! naming it. Base-colour (sRGB) and normal textures are read (PNG, JPEG); not yet:
-//! metallic-roughness, occlusion and emissive textures, samplers (every texture repeats,
-//! filtered trilinearly), sparse accessors, orthographic cameras (each left out with a
-//! warning). Directional lights: up to MAX_DIRECTIONAL_LIGHTS.
+//! and strides (sparse accessors too), index ranges, images, finite numbers, counts. Every
+//! problem is one line naming it. Textures (PNG, JPEG; base colour and emissive in sRGB):
+//! base colour, normal (with its scale), metallic-roughness, occlusion (with its strength)
+//! and emissive, each with its sampler's wrapping and filters; all read with TEXCOORD_0 (a
+//! texture naming another set gets a warning). Directional lights: up to
+//! MAX_DIRECTIONAL_LIGHTS. Cameras: perspective or orthographic.
 
 use crate::camera::Camera;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
-use crate::scene::{DirectionalLight, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
+use crate::scene::{DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
 use crate::scene_file::{read_capped, SceneFile, SceneFileError, MAX_OBJECTS};
-use crate::textures::TextureImage;
+use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use base64::Engine as _;
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -63,7 +64,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         textures: Vec::new(),
         directional: Vec::new(),
         cones: Vec::new(),
-        by_image: HashMap::new(),
+        by_texture: HashMap::new(),
         buffers,
         meshes: Vec::new(),
         by_primitive: HashMap::new(),
@@ -223,8 +224,9 @@ struct Builder<'a> {
     directional: Vec<DirectionalLight>,
     /// One per light in `lights` (kept only if one of them is a spot).
     cones: Vec<LightCone>,
-    /// (image, as sRGB) → index in `textures`: each image decoded once per use.
-    by_image: HashMap<(usize, bool), u32>,
+    /// (image, as sRGB, sampler) → index in `textures`: each image decoded once per colour
+    /// space.
+    by_texture: HashMap<(usize, bool, TextureSampler), u32>,
     buffers: Vec<Vec<u8>>,
     meshes: Vec<Mesh>,
     /// (mesh, primitive) → (index in `meshes`, its box's centre and half-size), so that
@@ -249,11 +251,11 @@ impl Builder<'_> {
                 if self.objects.len() == MAX_OBJECTS {
                     return Err(format!("more than {MAX_OBJECTS} drawn primitives"));
                 }
-                let material = material(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
+                let (material, extras) = material(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
                 let textures = self.object_textures(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
                 // The mesh was stored fitted to [−1, 1]³: undo that inside the object's transform.
                 let transform = world * Mat4::from_translation(centre) * Mat4::from_scale(Vec3::splat(half));
-                self.objects.push(Object { mesh: MeshKind::Loaded(index), transform, material, textures });
+                self.objects.push(Object { mesh: MeshKind::Loaded(index), transform, material, textures, extras });
             }
         }
         if let Some(light) = node.light() {
@@ -347,69 +349,68 @@ impl Builder<'_> {
         Ok(Some((index, centre, half)))
     }
 
-    /// The material's base-colour and normal textures (first texture coordinates); what else
-    /// it has is named in a warning.
+    /// The material's textures (first texture coordinates) with their samplers.
     fn object_textures(&mut self, m: &gltf::Material) -> Result<ObjectTextures, String> {
         let name = m.index().map_or("default".to_string(), |i| i.to_string());
         let pbr = m.pbr_metallic_roughness();
-        let mut out = ObjectTextures::default();
-        if let Some(info) = pbr.base_color_texture() {
-            self.tex_coord_warning(&name, "base colour", info.tex_coord());
-            out.base_color =
-                Some(self.image(info.texture().source().index(), true).map_err(|e| format!("material {name} base colour: {e}"))?);
-        }
-        if let Some(normal) = m.normal_texture() {
-            self.tex_coord_warning(&name, "normal", normal.tex_coord());
-            if normal.scale() != 1.0 {
-                self.warnings.push(format!("material {name}: normal scale {} is read as 1", normal.scale()));
+        let base_color = pbr.base_color_texture().map(|t| (t.texture(), t.tex_coord()));
+        let metallic_roughness = pbr.metallic_roughness_texture().map(|t| (t.texture(), t.tex_coord()));
+        let normal = m.normal_texture().map(|t| (t.texture(), t.tex_coord()));
+        let occlusion = m.occlusion_texture().map(|t| (t.texture(), t.tex_coord()));
+        let emissive = m.emissive_texture().map(|t| (t.texture(), t.tex_coord()));
+        let mut slot = |what: &str, texture: Option<(gltf::Texture, u32)>, srgb: bool| -> Result<Option<u32>, String> {
+            let Some((texture, set)) = texture else { return Ok(None) };
+            if set != 0 {
+                self.warnings.push(format!("material {name}: the {what} texture names TEXCOORD_{set}; TEXCOORD_0 is used"));
             }
-            out.normal = Some(self.image(normal.texture().source().index(), false).map_err(|e| format!("material {name} normal: {e}"))?);
-        }
-        let unread = [
-            ("metallic-roughness", pbr.metallic_roughness_texture().is_some()),
-            ("occlusion", m.occlusion_texture().is_some()),
-            ("emissive", m.emissive_texture().is_some()),
-        ];
-        for (what, present) in unread {
-            if present {
-                self.warnings.push(format!("material {name}: its {what} texture is not used yet"));
-            }
-        }
-        Ok(out)
+            self.texture(&texture, srgb).map(Some).map_err(|e| format!("material {name} {what} texture: {e}"))
+        };
+        Ok(ObjectTextures {
+            base_color: slot("base colour", base_color, true)?,
+            normal: slot("normal", normal, false)?,
+            metallic_roughness: slot("metallic-roughness", metallic_roughness, false)?,
+            occlusion: slot("occlusion", occlusion, false)?,
+            emissive: slot("emissive", emissive, true)?,
+        })
     }
 
-    fn tex_coord_warning(&mut self, material: &str, what: &str, set: u32) {
-        if set != 0 {
-            self.warnings.push(format!("material {material}: the {what} texture names TEXCOORD_{set}; TEXCOORD_0 is used"));
-        }
-    }
-
-    /// Image `index` decoded to RGBA8 (once per colour space), checked before it is read:
-    /// the gltf crate's own accessor for an image's source panics on an image with neither a
-    /// URI nor a buffer view, and on a buffer view without a MIME type.
-    fn image(&mut self, index: usize, srgb: bool) -> Result<u32, String> {
-        if let Some(&known) = self.by_image.get(&(index, srgb)) {
+    /// A glTF texture: its image decoded to RGBA8 (once per colour space) with its sampler.
+    fn texture(&mut self, texture: &gltf::Texture, srgb: bool) -> Result<u32, String> {
+        let sampler = sampler_of(&texture.sampler());
+        let index = texture.source().index();
+        if let Some(&known) = self.by_texture.get(&(index, srgb, sampler)) {
             return Ok(known);
         }
+        let decoded = match self.by_texture.iter().find(|((i, s, _), _)| (*i, *s) == (index, srgb)) {
+            // The same image with another sampler: decoded already.
+            Some((_, &other)) => TextureImage { sampler, ..self.textures[other as usize].clone() },
+            None => TextureImage { sampler, ..self.image(index, srgb).map_err(|e| format!("image {index}: {e}"))? },
+        };
+        let slot = self.textures.len() as u32;
+        self.textures.push(decoded);
+        self.by_texture.insert((index, srgb, sampler), slot);
+        Ok(slot)
+    }
+
+    /// Image `index` decoded to RGBA8, checked before it is read: the gltf crate's own accessor
+    /// for an image's source panics on an image with neither a URI nor a buffer view, and on a
+    /// buffer view without a MIME type.
+    fn image(&self, index: usize, srgb: bool) -> Result<TextureImage, String> {
         let json = &self.doc.as_json().images[index];
         let bytes: Vec<u8> = match (&json.uri, &json.buffer_view, &json.mime_type) {
-            (Some(uri), None, _) => read_uri(uri, self.base).map_err(|e| format!("image {index}: {e}"))?,
+            (Some(uri), None, _) => read_uri(uri, self.base)?,
             (None, Some(view), Some(_)) => {
                 let view = &self.doc.as_json().buffer_views[view.value()];
                 let data = &self.buffers[view.buffer.value()];
                 let start = view.byte_offset.map_or(0, |o| o.0 as usize);
                 let end = start.checked_add(view.byte_length.0 as usize).filter(|&e| e <= data.len());
-                let end = end.ok_or_else(|| format!("image {index}: its buffer view lies outside its buffer"))?;
+                let end = end.ok_or("its buffer view lies outside its buffer")?;
                 data[start..end].to_vec()
             }
-            (None, Some(_), None) => return Err(format!("image {index}: a buffer view without a mimeType")),
-            _ => return Err(format!("image {index}: needs either a uri or a bufferView")),
+            (None, Some(_), None) => return Err("a buffer view without a mimeType".into()),
+            _ => return Err("needs either a uri or a bufferView".into()),
         };
-        let texture = decode_image(&bytes, srgb).map_err(|e| format!("image {index}: {e}"))?;
-        let slot = self.textures.len() as u32;
-        self.textures.push(texture);
-        self.by_image.insert((index, srgb), slot);
-        Ok(slot)
+        decode_image(&bytes, srgb)
     }
 
     fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<(), String> {
@@ -477,35 +478,92 @@ fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, String> {
     reader.limits(limits);
     let decoded = reader.decode().map_err(|e| format!("cannot decode it: {e}"))?.to_rgba8();
     let (width, height) = decoded.dimensions();
-    Ok(TextureImage { width, height, rgba: decoded.into_raw(), srgb })
+    Ok(TextureImage { width, height, rgba: decoded.into_raw(), srgb, sampler: TextureSampler::default() })
 }
 
-/// glTF's metallic-roughness factors.
-fn material(m: &gltf::Material) -> Result<Material, String> {
+/// glTF's metallic-roughness factors, and its emissive factor, normal scale and occlusion
+/// strength.
+fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras), String> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();
     let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-    for (name, v) in [("base colour", r), ("base colour", g), ("base colour", b), ("metallic", metallic), ("roughness", roughness)] {
+    let [er, eg, eb] = m.emissive_factor();
+    let strength = m.occlusion_texture().map_or(1.0, |t| t.strength());
+    let unit = [
+        ("base colour", r),
+        ("base colour", g),
+        ("base colour", b),
+        ("metallic", metallic),
+        ("roughness", roughness),
+        ("emissive", er),
+        ("emissive", eg),
+        ("emissive", eb),
+        ("occlusion strength", strength),
+    ];
+    let name = || m.index().map_or("default".into(), |i| i.to_string());
+    for (what, v) in unit {
         if !(0.0..=1.0).contains(&v) {
-            return Err(format!("material {}: {name} factor {v} is outside [0, 1]", m.index().map_or("default".into(), |i| i.to_string())));
+            return Err(format!("material {}: {what} factor {v} is outside [0, 1]", name()));
         }
     }
-    Ok(Material { albedo: Vec3::new(r, g, b), roughness, metallic })
+    let normal_scale = m.normal_texture().map_or(1.0, |t| t.scale());
+    if !normal_scale.is_finite() {
+        return Err(format!("material {}: normal scale {normal_scale} is not finite", name()));
+    }
+    let extras = MaterialExtras { emissive: Vec3::new(er, eg, eb), normal_scale, occlusion_strength: strength };
+    Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras))
 }
 
-/// The camera at a node: perspective only (orthographic ones are skipped with a warning).
-fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> Result<Option<Camera>, String> {
-    let gltf::camera::Projection::Perspective(p) = camera.projection() else {
-        warnings.push(format!("camera {}: orthographic cameras are not supported; the scene is framed instead", camera.index()));
-        return Ok(None);
+/// A glTF sampler (filters glTF leaves open: linear, trilinear between mips).
+fn sampler_of(s: &gltf::texture::Sampler) -> TextureSampler {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
     };
-    let fov = p.yfov().to_degrees();
-    let near = p.znear();
-    let far = p.zfar().unwrap_or(near * 1e5);
-    let sane = fov > 0.0 && fov < 180.0 && near > 0.0 && near.is_finite() && far > near && far.is_finite();
-    if !sane {
-        return Err(format!("yfov {} rad, znear {near}, zfar {far}: need 0 < yfov < π and 0 < znear < zfar", p.yfov()));
-    }
+    let mag = match s.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        Some(MagFilter::Linear) | None => Filter::Linear,
+    };
+    let (min, mipmap) = match s.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, None),
+        Some(MinFilter::Linear) => (Filter::Linear, None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Some(Filter::Nearest)),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Some(Filter::Nearest)),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Some(Filter::Linear)),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Some(Filter::Linear)),
+    };
+    TextureSampler { wrap_u: wrap(s.wrap_s()), wrap_v: wrap(s.wrap_t()), mag, min, mipmap }
+}
+
+/// The camera at a node, perspective or orthographic (its height; the width follows the
+/// image, as a perspective camera's does).
+fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> Result<Option<Camera>, String> {
+    let (fov, near, far, orthographic) = match camera.projection() {
+        gltf::camera::Projection::Perspective(p) => {
+            let (fov, near) = (p.yfov().to_degrees(), p.znear());
+            let far = p.zfar().unwrap_or(near * 1e5);
+            let sane = fov > 0.0 && fov < 180.0 && near > 0.0 && near.is_finite() && far > near && far.is_finite();
+            if !sane {
+                return Err(format!("yfov {} rad, znear {near}, zfar {far}: need 0 < yfov < π and 0 < znear < zfar", p.yfov()));
+            }
+            (fov, near, far, None)
+        }
+        gltf::camera::Projection::Orthographic(o) => {
+            let (ymag, near, far) = (o.ymag(), o.znear(), o.zfar());
+            let sane = ymag > 0.0 && ymag.is_finite() && near >= 0.0 && far > near && far.is_finite();
+            if !sane {
+                return Err(format!("ymag {ymag}, znear {near}, zfar {far}: need ymag > 0 and 0 ≤ znear < zfar"));
+            }
+            // Depth slices are logarithmic in depth: they need a near plane in front of the eye.
+            let least = far * 1e-4;
+            if near < least {
+                warnings.push(format!("camera {}: znear {near} is read as {least} (zfar / 10⁴)", camera.index()));
+            }
+            (60.0, near.max(least), far, Some(ymag))
+        }
+    };
     let position = world.transform_point3(Vec3::ZERO);
     let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
     if !position.is_finite() || forward == Vec3::ZERO {
@@ -515,7 +573,7 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
         warnings.push(format!("camera {}: it looks straight up or down; the scene is framed instead", camera.index()));
         return Ok(None);
     }
-    Ok(Some(Camera::looking_at(position, position + forward, fov, near, far)))
+    Ok(Some(Camera { orthographic, ..Camera::looking_at(position, position + forward, fov, near, far) }))
 }
 
 /// A camera that sees every object: from above and in front of the bounds' centre.
@@ -548,41 +606,80 @@ fn triangle_list(mode: gltf::mesh::Mode, indices: &[u32]) -> Result<Vec<u32>, St
     })
 }
 
-/// The bytes of each element of `accessor`, checked against its view and buffer.
-fn elements<'b>(buffers: &'b [Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Result<(Vec<&'b [u8]>, DataType), String> {
-    if accessor.sparse().is_some() {
-        return Err(format!("{what}: sparse accessors are not supported"));
-    }
-    let view = accessor.view().ok_or_else(|| format!("{what}: accessor {} has no buffer view", accessor.index()))?;
-    let data = &buffers[view.buffer().index()];
-    let (view_offset, view_length) = (view.offset(), view.length());
-    view_offset.checked_add(view_length).filter(|&e| e <= data.len()).ok_or_else(|| {
-        format!(
-            "{what}: buffer view {} ({view_length} bytes at {view_offset}) lies outside its buffer of {} bytes",
-            view.index(),
-            data.len()
-        )
-    })?;
+/// Every element of `accessor`, `size()` bytes each, back to back: read from its buffer view
+/// (each range checked against view and buffer), or zeros without one, then the sparse
+/// substitutions applied.
+fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Result<(Vec<u8>, DataType), String> {
     let element = accessor.size();
-    let stride = view.stride().unwrap_or(element);
-    if stride < element {
-        return Err(format!("{what}: stride {stride} is smaller than an element ({element} bytes)"));
-    }
     let count = accessor.count();
-    if count > MAX_VERTICES * 3 {
+    if count > MAX_VERTICES * 3 || count.saturating_mul(element) as u64 > MAX_FILE_BYTES {
         return Err(format!("{what}: {count} elements is more than we read"));
     }
-    let needed = match count {
-        0 => Some(0),
-        n => (n - 1).checked_mul(stride).and_then(|x| x.checked_add(accessor.offset())).and_then(|x| x.checked_add(element)),
+    let mut out = match accessor.view() {
+        Some(view) => {
+            let stride = view.stride().unwrap_or(element);
+            if stride < element {
+                return Err(format!("{what}: stride {stride} is smaller than an element ({element} bytes)"));
+            }
+            let needed = match count {
+                0 => Some(0),
+                n => (n - 1).checked_mul(stride).and_then(|x| x.checked_add(accessor.offset())).and_then(|x| x.checked_add(element)),
+            }
+            .ok_or_else(|| format!("{what}: its size overflows"))?;
+            if needed > view.length() {
+                return Err(format!(
+                    "{what}: {count} elements of {element} bytes (stride {stride}, offset {}) need {needed} bytes but buffer view {} has {}",
+                    accessor.offset(),
+                    view.index(),
+                    view.length()
+                ));
+            }
+            let data = view_bytes(buffers, &view, what)?;
+            (0..count).flat_map(|i| &data[accessor.offset() + i * stride..][..element]).copied().collect()
+        }
+        None if accessor.sparse().is_some() => vec![0; count * element],
+        None => return Err(format!("{what}: accessor {} has no buffer view", accessor.index())),
+    };
+    if let Some(sparse) = accessor.sparse() {
+        let n = sparse.count();
+        if n > count {
+            return Err(format!("{what}: {n} sparse substitutions for {count} elements"));
+        }
+        let (indices, values) = (sparse.indices(), sparse.values());
+        let index_size = match indices.index_type() {
+            gltf::accessor::sparse::IndexType::U8 => 1,
+            gltf::accessor::sparse::IndexType::U16 => 2,
+            gltf::accessor::sparse::IndexType::U32 => 4,
+        };
+        let range = |data: &[u8], offset: usize, len: usize, part: &str| -> Result<Vec<u8>, String> {
+            offset
+                .checked_add(len)
+                .filter(|&end| end <= data.len())
+                .map(|end| data[offset..end].to_vec())
+                .ok_or_else(|| format!("{what}: the sparse {part} ({len} bytes at {offset}) lie outside their buffer view"))
+        };
+        let index_bytes = range(view_bytes(buffers, &indices.view(), what)?, indices.offset(), n * index_size, "indices")?;
+        let value_bytes = range(view_bytes(buffers, &values.view(), what)?, values.offset(), n * element, "values")?;
+        let mut previous = None;
+        for (k, (i, value)) in index_bytes.chunks_exact(index_size).zip(value_bytes.chunks_exact(element)).enumerate() {
+            let i = i.iter().rev().fold(0usize, |acc, &b| acc << 8 | b as usize);
+            if i >= count || previous.is_some_and(|p| i <= p) {
+                return Err(format!("{what}: sparse index {k} is {i}; they must rise and stay below {count}"));
+            }
+            out[i * element..][..element].copy_from_slice(value);
+            previous = Some(i);
+        }
     }
-    .ok_or_else(|| format!("{what}: its size overflows"))?;
-    if needed > view_length {
-        return Err(format!("{what}: {count} elements of {element} bytes (stride {stride}, offset {}) need {needed} bytes but buffer view {} has {view_length}", accessor.offset(), view.index()));
-    }
-    let start = view_offset + accessor.offset();
-    let slices = (0..count).map(|i| &data[start + i * stride..start + i * stride + element]).collect();
-    Ok((slices, accessor.data_type()))
+    Ok((out, accessor.data_type()))
+}
+
+/// The bytes of buffer view `view`, checked against its buffer.
+fn view_bytes<'b>(buffers: &'b [Vec<u8>], view: &gltf::buffer::View, what: &str) -> Result<&'b [u8], String> {
+    let data = &buffers[view.buffer().index()];
+    let (offset, length) = (view.offset(), view.length());
+    offset.checked_add(length).filter(|&e| e <= data.len()).map(|end| &data[offset..end]).ok_or_else(|| {
+        format!("{what}: buffer view {} ({length} bytes at {offset}) lies outside its buffer of {} bytes", view.index(), data.len())
+    })
 }
 
 /// A float accessor of N components (f32, or normalised u8/u16 for texture coordinates),
@@ -595,7 +692,7 @@ fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, w
     if accessor.dimensions() != dims {
         return Err(format!("{what}: expected {dims:?} elements, found {:?}", accessor.dimensions()));
     }
-    let (elements, ty) = elements(buffers, accessor, what)?;
+    let (bytes, ty) = elements(buffers, accessor, what)?;
     let component = |bytes: &[u8], k: usize| -> Option<f32> {
         match (ty, accessor.normalized()) {
             (DataType::F32, _) => Some(f32::from_le_bytes(bytes[k * 4..k * 4 + 4].try_into().ok()?)),
@@ -604,8 +701,8 @@ fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, w
             _ => None,
         }
     };
-    let mut out = Vec::with_capacity(elements.len());
-    for (i, e) in elements.iter().enumerate() {
+    let mut out = Vec::with_capacity(accessor.count());
+    for (i, e) in bytes.chunks_exact(accessor.size()).enumerate() {
         let mut v = [0.0; N];
         for (k, slot) in v.iter_mut().enumerate() {
             *slot = component(e, k)
@@ -624,9 +721,9 @@ fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor, vertices: usize)
     if accessor.dimensions() != Dimensions::Scalar {
         return Err(format!("indices: expected scalars, found {:?}", accessor.dimensions()));
     }
-    let (elements, ty) = elements(buffers, accessor, "indices")?;
-    let mut out = Vec::with_capacity(elements.len());
-    for (i, e) in elements.iter().enumerate() {
+    let (bytes, ty) = elements(buffers, accessor, "indices")?;
+    let mut out = Vec::with_capacity(accessor.count());
+    for (i, e) in bytes.chunks_exact(accessor.size()).enumerate() {
         let index = match ty {
             DataType::U8 => e[0] as u32,
             DataType::U16 => u16::from_le_bytes([e[0], e[1]]) as u32,

@@ -83,6 +83,26 @@ impl GltfWriter {
         self.accessor(bytes, values.len(), 5126, kind, extra)
     }
 
+    /// Make accessor `accessor` (of VEC3 floats) sparse: element indices[k] is replaced by
+    /// values[k] (u16 indices).
+    pub fn sparse(&mut self, accessor: usize, indices: &[u16], values: &[[f32; 3]]) {
+        let mut view = |bytes: Vec<u8>| {
+            while !self.bin.len().is_multiple_of(4) {
+                self.bin.push(0);
+            }
+            let v = self.push("bufferViews", json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() }));
+            self.bin.extend(bytes);
+            v
+        };
+        let index_view = view(indices.iter().flat_map(|i| i.to_le_bytes()).collect());
+        let value_view = view(values.iter().flatten().flat_map(|f| f.to_le_bytes()).collect());
+        self.json["accessors"][accessor]["sparse"] = json!({
+            "count": indices.len(),
+            "indices": { "bufferView": index_view, "componentType": 5123 },
+            "values": { "bufferView": value_view },
+        });
+    }
+
     /// A mesh of `primitives`; returns its index.
     pub fn mesh(&mut self, primitives: &[PrimitiveData]) -> usize {
         let mut list = Vec::new();
@@ -134,6 +154,15 @@ impl GltfWriter {
         }
         let image = self.push("images", json!({ "bufferView": view, "mimeType": mime_type }));
         self.push("textures", json!({ "source": image }))
+    }
+
+    /// Give texture `texture` a sampler (glTF JSON: magFilter, minFilter, wrapS, wrapT).
+    pub fn sampler(&mut self, texture: usize, sampler: Value) {
+        if self.json["samplers"].is_null() {
+            self.json["samplers"] = json!([]);
+        }
+        let s = self.push("samplers", sampler);
+        self.json["textures"][texture]["sampler"] = json!(s);
     }
 
     /// A material with a base-colour texture and/or a normal map (texture indices).
@@ -246,4 +275,16 @@ pub fn png(width: u32, height: u32, rgba: &[u8]) -> Vec<u8> {
     image::write_buffer_with_format(&mut out, rgba, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
         .expect("a PNG in memory");
     out.into_inner()
+}
+
+/// A 4×4 RGBA8 image of four 2×2 quarters: red, green / blue, white (bilinear taps near a
+/// quarter's centre see one colour), for tests of textures.
+pub fn quarters() -> Vec<u8> {
+    let colour = |x: u32, y: u32| match (x / 2, y / 2) {
+        (0, 0) => [255, 0, 0, 255],
+        (1, 0) => [0, 255, 0, 255],
+        (0, 1) => [0, 0, 255, 255],
+        _ => [255, 255, 255, 255],
+    };
+    (0..16).flat_map(|i| colour(i % 4, i / 4)).collect()
 }

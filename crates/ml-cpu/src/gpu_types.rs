@@ -143,19 +143,22 @@ gpu_struct!(
         /// Upper 3×3: the inverse transpose of model's.
         normal_matrix: [[f32; 4]; 4],
         albedo_roughness: [f32; 4],
-        /// x: metallic.
+        /// x: metallic, y: occlusion strength, z: normal scale.
         material: [f32; 4],
+        /// rgb: emissive factor.
+        emissive: [f32; 4],
     }
 );
 
 gpu_struct!(
     /// Per-draw push constants (the material again: see common.glsl).
     ObjectPush {
-        /// x: index of the object in the object buffer; y, z: 1 where it has its own
-        /// base-colour texture, normal map.
+        /// x: index of the object in the object buffer; y: which textures it has of its own
+        /// (`ObjectTextures::bits`).
         ids: [u32; 4],
         albedo_roughness: [f32; 4],
         material: [f32; 4],
+        emissive: [f32; 4],
     }
 );
 

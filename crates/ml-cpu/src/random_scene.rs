@@ -15,11 +15,13 @@ use rand::{Rng, SeedableRng};
 /// The shapes random scenes draw from (a room would enclose its neighbours).
 const SHAPES: [MeshKind; 5] = [MeshKind::Sphere, MeshKind::Teapot, MeshKind::TorusKnot, MeshKind::Plane, MeshKind::Disc];
 
-/// A camera somewhere in the light box, looking at a random point near the ground.
+/// A camera somewhere in the light box, looking at a random point near the ground; one in
+/// four orthographic.
 pub fn random_camera(rng: &mut impl Rng) -> Camera {
     let eye = Vec3::new(rng.random_range(-18.0..18.0), rng.random_range(0.5..14.0), rng.random_range(-18.0..18.0));
     let target = Vec3::new(rng.random_range(-10.0..10.0), rng.random_range(-2.0..2.0), rng.random_range(-10.0..10.0));
-    Camera::looking_at(eye, target, rng.random_range(40.0..90.0), 0.1, 256.0)
+    let orthographic = rng.random_bool(0.25).then(|| rng.random_range(2.0..15.0));
+    Camera { orthographic, ..Camera::looking_at(eye, target, rng.random_range(40.0..90.0), 0.1, 256.0) }
 }
 
 /// `count` random lights (radii 0.2–40) plus 12 placed against `camera`'s edge cases.

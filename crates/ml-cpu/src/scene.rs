@@ -20,23 +20,69 @@ pub struct Object {
     pub transform: Mat4,
     pub material: Material,
     pub textures: ObjectTextures,
+    pub extras: MaterialExtras,
 }
 
 /// An object's own textures (indices into `Scene::textures`), sampled with its first texture
-/// coordinates.
+/// coordinates; glTF's metallic-roughness material.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct ObjectTextures {
     /// Multiplies the material's albedo (sRGB).
     pub base_color: Option<u32>,
     /// Tangent-space normal map (n·0.5 + 0.5).
     pub normal: Option<u32>,
+    /// Green multiplies the roughness, blue the metallic (linear).
+    pub metallic_roughness: Option<u32>,
+    /// Red: how much ambient light reaches the point (linear).
+    pub occlusion: Option<u32>,
+    /// Multiplies `MaterialExtras::emissive` (sRGB).
+    pub emissive: Option<u32>,
+}
+
+/// Number of texture slots of an object (`ObjectTextures::slots`).
+pub const TEXTURE_SLOTS: usize = 5;
+
+impl ObjectTextures {
+    /// The slots in binding order (object_textures.rs, surface.glsl): base colour, normal,
+    /// metallic-roughness, occlusion, emissive.
+    pub fn slots(&self) -> [Option<u32>; TEXTURE_SLOTS] {
+        [self.base_color, self.normal, self.metallic_roughness, self.occlusion, self.emissive]
+    }
+
+    /// Bit i set where slot i holds a texture (what the shaders test).
+    pub fn bits(&self) -> u32 {
+        self.slots().iter().enumerate().map(|(i, s)| u32::from(s.is_some()) << i).sum()
+    }
+
+    /// Every texture index changed by `f`.
+    pub fn map(self, f: impl Fn(u32) -> u32) -> ObjectTextures {
+        let [base_color, normal, metallic_roughness, occlusion, emissive] = self.slots().map(|s| s.map(&f));
+        ObjectTextures { base_color, normal, metallic_roughness, occlusion, emissive }
+    }
+}
+
+/// A glTF material's factors beyond the seed's albedo, roughness and metallic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialExtras {
+    /// Light the surface gives off itself (linear), added to every model's result.
+    pub emissive: Vec3,
+    /// Scales the normal map's tangent-space x and y.
+    pub normal_scale: f32,
+    /// How much of the occlusion texture applies: 1 + strength · (texel − 1).
+    pub occlusion_strength: f32,
+}
+
+impl Default for MaterialExtras {
+    fn default() -> MaterialExtras {
+        MaterialExtras { emissive: Vec3::ZERO, normal_scale: 1.0, occlusion_strength: 1.0 }
+    }
 }
 
 impl Object {
     /// `mesh` scaled by `scale` about its origin, then moved to `position`.
     pub fn placed(mesh: MeshKind, position: Vec3, scale: f32, material: Material) -> Object {
         let transform = Mat4::from_scale_rotation_translation(Vec3::splat(scale), Quat::IDENTITY, position);
-        Object { mesh, transform, material, textures: ObjectTextures::default() }
+        Object { mesh, transform, material, textures: ObjectTextures::default(), extras: MaterialExtras::default() }
     }
 
     /// Where its origin lands.

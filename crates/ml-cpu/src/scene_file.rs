@@ -9,7 +9,7 @@ use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
-use crate::scene::{DirectionalLight, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
+use crate::scene::{DirectionalLight, Object, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
 use glam::Vec3;
 use serde::Deserialize;
 use std::path::Path;
@@ -68,6 +68,8 @@ struct FileCamera {
     position: Option<[f32; 3]>,
     target: Option<[f32; 3]>,
     fov_y_deg: Option<f32>,
+    /// Makes the camera orthographic: world units seen above and below its axis.
+    ortho_half_height: Option<f32>,
     near: Option<f32>,
     far: Option<f32>,
 }
@@ -298,7 +300,6 @@ fn gltf_object(
     meshes.extend(scene.meshes);
     let texture_offset = textures.len() as u32;
     textures.extend(scene.textures);
-    let shift = |t: Option<u32>| t.map(|i| i + texture_offset);
     let objects = scene
         .objects
         .into_iter()
@@ -307,8 +308,7 @@ fn gltf_object(
                 MeshKind::Loaded(i) => MeshKind::Loaded(i + offset),
                 builtin => builtin,
             };
-            let t = obj.textures;
-            let textures = ObjectTextures { base_color: shift(t.base_color), normal: shift(t.normal) };
+            let textures = obj.textures.map(|i| i + texture_offset);
             Object { mesh, transform: place * obj.transform, textures, ..obj }
         })
         .collect();
@@ -390,7 +390,8 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, String> {
     if dir.y.abs() > 0.9999 {
         return Err("[camera] looks straight up or down, where its yaw is undefined: move target or position sideways".into());
     }
-    Ok(Camera::looking_at(position, target, fov, near, far))
+    let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| positive("[camera] ortho_half_height", h)).transpose()?;
+    Ok(Camera { orthographic, ..Camera::looking_at(position, target, fov, near, far) })
 }
 
 /// `scene` as a scene file (built-in meshes only), every field written out: what `load` reads
@@ -398,8 +399,9 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, String> {
 pub fn to_toml(scene: &Scene, shading: &str, target: Vec3) -> String {
     let v = |v: Vec3| format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z);
     let c = &scene.camera;
+    let ortho = c.orthographic.map_or(String::new(), |h| format!("ortho_half_height = {h:?}\n"));
     let mut out = format!(
-        "[camera]\nposition = {}\ntarget = {}\nfov_y_deg = {:?}\nnear = {:?}\nfar = {:?}\n\n[shading]\nmodel = \"{shading}\"\nambient = {:?}\n",
+        "[camera]\nposition = {}\ntarget = {}\nfov_y_deg = {:?}\n{ortho}near = {:?}\nfar = {:?}\n\n[shading]\nmodel = \"{shading}\"\nambient = {:?}\n",
         v(c.position),
         v(target),
         c.fov_y_deg,

@@ -12,13 +12,53 @@ pub struct MipChain {
 }
 
 /// A material texture of a scene (glTF): RGBA8 texels, row 0 at the top; `srgb` for colour
-/// (the GPU decodes it), not for data such as normal maps.
+/// (the GPU decodes it), not for data such as normal maps; and how it is sampled.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureImage {
     pub width: u32,
     pub height: u32,
     pub rgba: Vec<u8>,
     pub srgb: bool,
+    pub sampler: TextureSampler,
+}
+
+/// How texture coordinates outside [0, 1] wrap (glTF's wrapS / wrapT).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    MirroredRepeat,
+    ClampToEdge,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Filter {
+    Nearest,
+    #[default]
+    Linear,
+}
+
+/// A glTF sampler. The default (glTF leaves filters to the renderer): repeating, trilinear.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TextureSampler {
+    pub wrap_u: Wrap,
+    pub wrap_v: Wrap,
+    pub mag: Filter,
+    pub min: Filter,
+    /// Between mip levels; None: the base level alone (glTF's NEAREST and LINEAR minFilter).
+    pub mipmap: Option<Filter>,
+}
+
+impl Default for TextureSampler {
+    fn default() -> TextureSampler {
+        TextureSampler {
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::Repeat,
+            mag: Filter::Linear,
+            min: Filter::Linear,
+            mipmap: Some(Filter::Linear),
+        }
+    }
 }
 
 impl TextureImage {
@@ -250,7 +290,7 @@ mod tests {
         // 3×2: black and white columns; sRGB.
         let (b, w) = ([0u8, 0, 0, 255], [255u8, 255, 255, 255]);
         let rgba: Vec<u8> = [b, w, b, b, w, b].concat();
-        let t = TextureImage { width: 3, height: 2, rgba, srgb: true };
+        let t = TextureImage { width: 3, height: 2, rgba, srgb: true, sampler: TextureSampler::default() };
         let mips = t.mips();
         assert_eq!(mips.iter().map(Vec::len).collect::<Vec<_>>(), vec![24, 4]);
         // Level 1 (1×1) averages the top-left 2×2: half white in linear light is sRGB 188.

@@ -21,6 +21,11 @@ pub const BINDING_OBJECT_ID: u32 = 7;
 pub const BINDING_OUTPUT: u32 = 8;
 pub const BINDING_ALBEDO: u32 = 9;
 pub const BINDING_LIGHT_CONES: u32 = 10;
+pub const BINDING_ROUGHNESS_METALLIC: u32 = 11;
+pub const BINDING_EMISSIVE: u32 = 12;
+/// Where each of GBUFFER's images is bound.
+const GBUFFER_BINDINGS: [u32; crate::targets::GBUFFER.len()] =
+    [BINDING_NORMAL, BINDING_OBJECT_ID, BINDING_ALBEDO, BINDING_ROUGHNESS_METALLIC, BINDING_EMISSIVE];
 
 pub struct ComputeLighting {
     pass: ComputePass,
@@ -56,6 +61,8 @@ impl ComputeLighting {
             (BINDING_OBJECT_ID, image),
             (BINDING_OUTPUT, T::STORAGE_IMAGE),
             (BINDING_ALBEDO, image),
+            (BINDING_ROUGHNESS_METALLIC, image),
+            (BINDING_EMISSIVE, image),
         ];
         // Set 1: the scene's textures (blinn-phong's shadow map and sky).
         let model = shading.spec_constants();
@@ -83,9 +90,9 @@ impl ComputeLighting {
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         let image = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
         write_image(ctx, set, BINDING_DEPTH, image, sampled(t.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
-        write_image(ctx, set, BINDING_NORMAL, image, sampled(t.gbuffer[0].view, read_only));
-        write_image(ctx, set, BINDING_OBJECT_ID, image, sampled(t.gbuffer[1].view, read_only));
-        write_image(ctx, set, BINDING_ALBEDO, image, sampled(t.gbuffer[2].view, read_only));
+        for (binding, g) in GBUFFER_BINDINGS.into_iter().zip(&t.gbuffer) {
+            write_image(ctx, set, binding, image, sampled(g.view, read_only));
+        }
         let output = vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL);
         write_image(ctx, set, BINDING_OUTPUT, vk::DescriptorType::STORAGE_IMAGE, output);
         Ok(set)

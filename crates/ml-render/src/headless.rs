@@ -440,7 +440,8 @@ impl<'a> HeadlessRenderer<'a> {
             view: g.view.to_cols_array_2d(),
             proj: g.projection.to_cols_array_2d(),
             inv_view_proj: (g.projection * g.view).inverse().to_cols_array_2d(),
-            camera_pos: cam.position.extend(1.0).to_array(),
+            // w: clip w = w·depth + (1 − w) (Camera::w_of_depth).
+            camera_pos: cam.position.extend(cam.w_of_depth().0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
             omni_texel: self.omni.texel(),

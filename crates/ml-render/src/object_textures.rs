@@ -1,19 +1,16 @@
-//! Set 2 of the mesh pipelines: an object's own textures (glTF base colour, sRGB, and normal
-//! map), mipmapped, bound per draw. One descriptor set per distinct pair an object uses, and
-//! one of white stand-ins for objects with none (ObjectData.textures tells the shaders what
-//! to sample). A set per draw rather than one array indexed per draw: lavapipe cannot index
-//! sampler arrays dynamically.
+//! Set 2 of the mesh pipelines: an object's own textures (glTF's base colour, normal,
+//! metallic-roughness, occlusion and emissive), mipmapped, each with its glTF sampler, bound
+//! per draw. One descriptor set per distinct combination objects use, white stand-ins in the
+//! slots an object leaves empty (ObjectPush.ids.y tells the shaders which to sample). A set
+//! per draw rather than one array indexed per draw: lavapipe cannot index sampler arrays
+//! dynamically.
 
-use crate::scene_textures::sampler;
-use ml_cpu::scene::{Object, ObjectTextures};
-use ml_cpu::textures::TextureImage;
+use ml_cpu::scene::{Object, ObjectTextures, TEXTURE_SLOTS};
+use ml_cpu::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use ml_vk::descriptors::{allocate_set, write_image};
 use ml_vk::image::texture_with;
 use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 use std::collections::HashMap;
-
-const BINDING_BASE_COLOR: u32 = 0;
-const BINDING_NORMAL: u32 = 1;
 
 pub struct ObjectTextureSets {
     pub set_layout: vk::DescriptorSetLayout,
@@ -21,7 +18,7 @@ pub struct ObjectTextureSets {
     pub per_object: Vec<vk::DescriptorSet>,
     pool: vk::DescriptorPool,
     images: Vec<Image>,
-    sampler: vk::Sampler,
+    samplers: Vec<vk::Sampler>,
 }
 
 impl ObjectTextureSets {
@@ -32,15 +29,16 @@ impl ObjectTextureSets {
             per_object: Vec::new(),
             pool: vk::DescriptorPool::null(),
             images: Vec::new(),
-            sampler: vk::Sampler::null(),
+            samplers: Vec::new(),
         };
         ml_vk::build(ctx, sets, |s| s.create(ctx, textures, objects))
     }
 
     fn create(&mut self, ctx: &Context, textures: &[TextureImage], objects: &[Object]) -> Result<(), VkError> {
         let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
-        self.set_layout =
-            shader::set_layout(ctx, &[(BINDING_BASE_COLOR, sampled), (BINDING_NORMAL, sampled)], vk::ShaderStageFlags::FRAGMENT)?;
+        // Binding i: slot i of ObjectTextures::slots.
+        let bindings: Vec<(u32, vk::DescriptorType)> = (0..TEXTURE_SLOTS as u32).map(|b| (b, sampled)).collect();
+        self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::FRAGMENT)?;
         for (i, t) in textures.iter().enumerate() {
             let mips = t.mips();
             let levels: Vec<Vec<&[u8]>> = mips.iter().map(|l| vec![l.as_slice()]).collect();
@@ -53,34 +51,42 @@ impl ObjectTextureSets {
         let one = ImageShape { extent: vk::Extent2D { width: 1, height: 1 }, levels: 1, layers: 1, view: vk::ImageViewType::TYPE_2D };
         self.images.push(texture_with(ctx, "no object texture", one, vk::Format::R8G8B8A8_UNORM, &[vec![&white[..]]])?);
         let stand_in = self.images.len() - 1;
-        // Repeating, trilinear (glTF's samplers are not read yet).
-        self.sampler = sampler(ctx, vk::SamplerAddressMode::REPEAT, vk::Filter::LINEAR, None)?;
-        let mut pairs: Vec<ObjectTextures> = Vec::new();
-        for o in objects {
-            if !pairs.contains(&o.textures) {
-                pairs.push(o.textures);
+        // One sampler per distinct glTF sampler (the stand-in uses the default's).
+        let mut by_sampler: HashMap<TextureSampler, vk::Sampler> = HashMap::new();
+        for desc in textures.iter().map(|t| t.sampler).chain([TextureSampler::default()]) {
+            if let std::collections::hash_map::Entry::Vacant(slot) = by_sampler.entry(desc) {
+                let made = create_sampler(ctx, &desc)?;
+                self.samplers.push(made);
+                slot.insert(made);
             }
         }
-        let n = pairs.len().max(1) as u32;
-        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: 2 * n }];
+        let mut combinations: Vec<ObjectTextures> = Vec::new();
+        for o in objects {
+            if !combinations.contains(&o.textures) {
+                combinations.push(o.textures);
+            }
+        }
+        let n = combinations.len().max(1) as u32;
+        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: TEXTURE_SLOTS as u32 * n }];
         // SAFETY: valid device and create info.
         self.pool =
             unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&sizes), None) }
                 .ctx("vkCreateDescriptorPool")?;
-        let mut by_pair = HashMap::new();
-        for pair in pairs {
+        let mut by_combination = HashMap::new();
+        for combination in combinations {
             let set = allocate_set(ctx, self.pool, self.set_layout)?;
-            for (binding, texture) in [(BINDING_BASE_COLOR, pair.base_color), (BINDING_NORMAL, pair.normal)] {
-                let image = &self.images[texture.map_or(stand_in, |i| i as usize)];
+            for (binding, texture) in (0u32..).zip(combination.slots()) {
+                let index = texture.map_or(stand_in, |i| i as usize);
+                let desc = textures.get(index).map_or(TextureSampler::default(), |t| t.sampler);
                 let info = vk::DescriptorImageInfo::default()
-                    .sampler(self.sampler)
-                    .image_view(image.view)
+                    .sampler(by_sampler[&desc])
+                    .image_view(self.images[index].view)
                     .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
                 write_image(ctx, set, binding, sampled, info);
             }
-            by_pair.insert(pair, set);
+            by_combination.insert(combination, set);
         }
-        self.per_object = objects.iter().map(|o| by_pair[&o.textures]).collect();
+        self.per_object = objects.iter().map(|o| by_combination[&o.textures]).collect();
         Ok(())
     }
 
@@ -90,14 +96,43 @@ impl ObjectTextureSets {
         }
         // SAFETY: the device is idle (the caller's contract); null handles are ignored.
         unsafe {
-            ctx.device.destroy_sampler(self.sampler, None);
+            for sampler in self.samplers.drain(..) {
+                ctx.device.destroy_sampler(sampler, None);
+            }
             ctx.device.destroy_descriptor_pool(self.pool, None);
             ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
-        self.sampler = vk::Sampler::null();
         self.pool = vk::DescriptorPool::null();
         self.set_layout = vk::DescriptorSetLayout::null();
     }
+}
+
+/// The Vulkan sampler of a glTF sampler. Without mipmaps only the base level is sampled
+/// (max LOD 0, as glTF's NEAREST and LINEAR minification filters mean).
+fn create_sampler(ctx: &Context, desc: &TextureSampler) -> Result<vk::Sampler, VkError> {
+    let filter = |f: Filter| match f {
+        Filter::Nearest => vk::Filter::NEAREST,
+        Filter::Linear => vk::Filter::LINEAR,
+    };
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => vk::SamplerAddressMode::REPEAT,
+        Wrap::MirroredRepeat => vk::SamplerAddressMode::MIRRORED_REPEAT,
+        Wrap::ClampToEdge => vk::SamplerAddressMode::CLAMP_TO_EDGE,
+    };
+    let mipmap_mode = match desc.mipmap {
+        Some(Filter::Linear) => vk::SamplerMipmapMode::LINEAR,
+        Some(Filter::Nearest) | None => vk::SamplerMipmapMode::NEAREST,
+    };
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(filter(desc.mag))
+        .min_filter(filter(desc.min))
+        .mipmap_mode(mipmap_mode)
+        .address_mode_u(wrap(desc.wrap_u))
+        .address_mode_v(wrap(desc.wrap_v))
+        .address_mode_w(vk::SamplerAddressMode::REPEAT)
+        .max_lod(if desc.mipmap.is_some() { vk::LOD_CLAMP_NONE } else { 0.0 });
+    // SAFETY: valid device and create info.
+    unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")
 }
 
 impl ml_vk::Release for ObjectTextureSets {

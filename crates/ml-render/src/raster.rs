@@ -8,7 +8,7 @@
 use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding, GpuMesh};
 use crate::render_pass;
 use crate::settings::{Shading, Technique};
-use crate::targets::{Output, Targets};
+use crate::targets::{Output, Targets, GBUFFER};
 use ml_cpu::gpu_types::{ObjectData, ObjectPush};
 use ml_cpu::scene::Object;
 use ml_vk::descriptors::{allocate_set, write_image};
@@ -22,11 +22,9 @@ pub const BINDING_LIGHT_INDICES: u32 = 3;
 pub const BINDING_OBJECTS: u32 = 4;
 pub const BINDING_LIGHT_CONES: u32 = 10;
 /// Bindings of set 2, the lighting subpass's inputs (deferred_frag.glsl; set 1 holds the
-/// scene's textures in every pipeline of the pass).
+/// scene's textures in every pipeline of the pass): depth, then GBUFFER's images in order.
 pub const BINDING_INPUT_DEPTH: u32 = 1;
-pub const BINDING_INPUT_NORMAL: u32 = 2;
-pub const BINDING_INPUT_OBJECT_ID: u32 = 3;
-pub const BINDING_INPUT_ALBEDO: u32 = 4;
+pub const BINDING_INPUT_GBUFFER: u32 = 2;
 
 /// Background of pixels no object covers (linear, before the UNORM store).
 pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
@@ -143,16 +141,9 @@ impl RasterPass {
         }
         if output == Output::Subpasses {
             use vk::DescriptorType as T;
-            self.input_set_layout = shader::set_layout(
-                ctx,
-                &[
-                    (BINDING_INPUT_DEPTH, T::INPUT_ATTACHMENT),
-                    (BINDING_INPUT_NORMAL, T::INPUT_ATTACHMENT),
-                    (BINDING_INPUT_OBJECT_ID, T::INPUT_ATTACHMENT),
-                    (BINDING_INPUT_ALBEDO, T::INPUT_ATTACHMENT),
-                ],
-                vk::ShaderStageFlags::FRAGMENT,
-            )?;
+            let inputs: Vec<(u32, T)> =
+                (BINDING_INPUT_DEPTH..BINDING_INPUT_GBUFFER + GBUFFER.len() as u32).map(|binding| (binding, T::INPUT_ATTACHMENT)).collect();
+            self.input_set_layout = shader::set_layout(ctx, &inputs, vk::ShaderStageFlags::FRAGMENT)?;
             self.lighting_layout = shader::pipeline_layout(ctx, &[self.set_layout, textures_layout, self.input_set_layout], &[])?;
             self.lighting_pipeline = self.create_pipeline(ctx, ml_shaders::FULLSCREEN_VERT, lighting, Draw::Lighting)?;
         }
@@ -163,12 +154,9 @@ impl RasterPass {
     pub fn input_set(&self, ctx: &Context, pool: vk::DescriptorPool, targets: &Targets) -> Result<vk::DescriptorSet, VkError> {
         let set = allocate_set(ctx, pool, self.input_set_layout)?;
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-        for (binding, view, layout) in [
-            (BINDING_INPUT_DEPTH, targets.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-            (BINDING_INPUT_NORMAL, targets.gbuffer[0].view, read_only),
-            (BINDING_INPUT_OBJECT_ID, targets.gbuffer[1].view, read_only),
-            (BINDING_INPUT_ALBEDO, targets.gbuffer[2].view, read_only),
-        ] {
+        let depth = (BINDING_INPUT_DEPTH, targets.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        let gbuffer = (BINDING_INPUT_GBUFFER..).zip(&targets.gbuffer).map(|(binding, image)| (binding, image.view, read_only));
+        for (binding, view, layout) in [depth].into_iter().chain(gbuffer) {
             let info = vk::DescriptorImageInfo::default().image_view(view).image_layout(layout);
             write_image(ctx, set, binding, vk::DescriptorType::INPUT_ATTACHMENT, info);
         }
@@ -176,9 +164,11 @@ impl RasterPass {
     }
 
     fn create_pipeline(&self, ctx: &Context, vertex: &[u8], fragment: &[u8], draw: Draw) -> Result<vk::Pipeline, VkError> {
-        let (layout, subpass, colour_attachments) = match draw {
-            Draw::Mesh | Draw::Overlay => (self.pipeline_layout, 0, self.output.colour_attachments()),
-            Draw::Lighting => (self.lighting_layout, 1, 1),
+        let (layout, subpass, colour_writes) = match draw {
+            Draw::Mesh | Draw::Overlay => {
+                (self.pipeline_layout, 0, self.output.colour_writes(self.shading.object_textures, ctx.info.features.independent_blend))
+            }
+            Draw::Lighting => (self.lighting_layout, 1, vec![vk::ColorComponentFlags::RGBA]),
         };
         let bindings = [vertex_binding()];
         let attributes = vertex_attributes();
@@ -211,7 +201,7 @@ impl RasterPass {
                 vertex_input,
                 rasterization,
                 depth_stencil,
-                colour_attachments,
+                colour_writes: &colour_writes,
                 layout,
                 render_pass: self.render_pass,
                 subpass,
@@ -230,11 +220,14 @@ impl RasterPass {
         let colour = vk::ClearValue { color: vk::ClearColorValue { float32: CLEAR_COLOR } };
         let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
-        let clear: Vec<vk::ClearValue> = match self.output {
-            Output::Color => vec![colour, depth],
-            Output::GBuffer => vec![zero, zero, zero, depth],
-            Output::Subpasses => vec![zero, zero, zero, depth, zero],
+        let mut clear: Vec<vk::ClearValue> = match self.output {
+            Output::Color => vec![colour],
+            Output::GBuffer | Output::Subpasses => vec![zero; GBUFFER.len()],
         };
+        clear.push(depth);
+        if self.output == Output::Subpasses {
+            clear.push(zero);
+        }
         let extent = frame.extent;
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
         let begin = vk::RenderPassBeginInfo::default()
@@ -301,21 +294,21 @@ impl RasterPass {
 /// Object `o`'s entry in the object buffer.
 pub fn object_data(o: &Object) -> ObjectData {
     let normal = glam::Mat4::from_mat3(glam::Mat3::from_mat4(o.transform).inverse().transpose());
-    let (albedo_roughness, material) = material_vectors(o);
-    ObjectData { model: o.transform.to_cols_array_2d(), normal_matrix: normal.to_cols_array_2d(), albedo_roughness, material }
+    let [albedo_roughness, material, emissive] = material_vectors(o);
+    ObjectData { model: o.transform.to_cols_array_2d(), normal_matrix: normal.to_cols_array_2d(), albedo_roughness, material, emissive }
 }
 
 /// What a draw of object `o` (at `index`) pushes.
 pub fn object_push(o: &Object, index: u32) -> ObjectPush {
-    let (albedo_roughness, material) = material_vectors(o);
-    let textures = [u32::from(o.textures.base_color.is_some()), u32::from(o.textures.normal.is_some())];
-    ObjectPush { ids: [index, textures[0], textures[1], 0], albedo_roughness, material }
+    let [albedo_roughness, material, emissive] = material_vectors(o);
+    ObjectPush { ids: [index, o.textures.bits(), 0, 0], albedo_roughness, material, emissive }
 }
 
-/// The material as the shaders read it: (albedo, roughness), (metallic, 0, 0, 0).
-fn material_vectors(o: &Object) -> ([f32; 4], [f32; 4]) {
-    let m = &o.material;
-    ([m.albedo.x, m.albedo.y, m.albedo.z, m.roughness], [m.metallic, 0.0, 0.0, 0.0])
+/// The material as the shaders read it: (albedo, roughness), (metallic, occlusion strength,
+/// normal scale, 0), (emissive, 0).
+fn material_vectors(o: &Object) -> [[f32; 4]; 3] {
+    let (m, x) = (&o.material, &o.extras);
+    [m.albedo.extend(m.roughness).to_array(), [m.metallic, x.occlusion_strength, x.normal_scale, 0.0], x.emissive.extend(0.0).to_array()]
 }
 
 impl ml_vk::Release for RasterPass {

@@ -6,7 +6,7 @@
 //! subpass 1 as input attachments, never stored — and 4 HDR colour, written by subpass 1 and
 //! read by the tone-map compute pass.
 
-use crate::targets::{Output, COLOR_FORMAT, GBUFFER_ALBEDO_FORMAT, GBUFFER_NORMAL_FORMAT, GBUFFER_OBJECT_FORMAT, HDR_FORMAT};
+use crate::targets::{Output, COLOR_FORMAT, GBUFFER, HDR_FORMAT};
 use ml_vk::{vk, Context, VkError, VkResultExt};
 
 /// One subpass: which attachments it writes and reads.
@@ -78,12 +78,11 @@ fn one_subpass(depth_format: vk::Format, output: Output) -> RenderPassDesc {
             attachment(depth_format, false, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
         ],
         // Everything is read by the lighting compute pass.
-        _ => vec![
-            attachment(GBUFFER_NORMAL_FORMAT, true, read_only),
-            attachment(GBUFFER_OBJECT_FORMAT, true, read_only),
-            attachment(GBUFFER_ALBEDO_FORMAT, true, read_only),
-            attachment(depth_format, true, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-        ],
+        _ => GBUFFER
+            .iter()
+            .map(|g| attachment(g.format, true, read_only))
+            .chain([attachment(depth_format, true, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)])
+            .collect(),
     };
     let colour_count = output.colour_attachments() as u32;
     let subpass = Subpass {
@@ -115,24 +114,24 @@ fn two_subpasses(depth_format: vk::Format) -> RenderPassDesc {
     let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
     let depth_read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
     let colour = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
-    let attachments = vec![
-        attachment(GBUFFER_NORMAL_FORMAT, false, read_only),
-        attachment(GBUFFER_OBJECT_FORMAT, false, read_only),
-        attachment(GBUFFER_ALBEDO_FORMAT, false, read_only),
-        attachment(depth_format, false, depth_read_only),
-        attachment(HDR_FORMAT, true, read_only),
-    ];
+    let g = GBUFFER.len() as u32;
+    let (depth, hdr) = (g, g + 1);
+    let attachments: Vec<vk::AttachmentDescription> = GBUFFER
+        .iter()
+        .map(|image| attachment(image.format, false, read_only))
+        .chain([attachment(depth_format, false, depth_read_only), attachment(HDR_FORMAT, true, read_only)])
+        .collect();
     let subpasses = vec![
         Subpass {
-            colour: vec![reference(0, colour), reference(1, colour), reference(2, colour)],
-            depth: Some(reference(3, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
+            colour: (0..g).map(|a| reference(a, colour)).collect(),
+            depth: Some(reference(depth, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
             inputs: Vec::new(),
         },
-        // input_attachment_index 0, 1, 2, 3 in deferred_frag.glsl.
+        // input_attachment_index 0 (depth), then 1… (the G-buffer) in deferred_frag.glsl.
         Subpass {
-            colour: vec![reference(4, colour)],
+            colour: vec![reference(hdr, colour)],
             depth: None,
-            inputs: vec![reference(3, depth_read_only), reference(0, read_only), reference(1, read_only), reference(2, read_only)],
+            inputs: [reference(depth, depth_read_only)].into_iter().chain((0..g).map(|a| reference(a, read_only))).collect(),
         },
     ];
     let fragment = vk::PipelineStageFlags::FRAGMENT_SHADER;

@@ -381,6 +381,9 @@ impl RenderSettings {
 fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result<(), RenderError> {
     let limits = &ctx.info.limits;
     let invalid = |m: String| Err(RenderError::Invalid(m));
+    if lights == 0 {
+        return invalid("point-light shadows need point lights, and the scene has none (--lights N adds some)".into());
+    }
     if omni.lights == 0 || omni.lights as usize > lights {
         return invalid(format!("--shadowed-lights {} is out of range: the scene has {lights} lights (use 1 to {lights})", omni.lights));
     }

@@ -8,13 +8,29 @@ use ml_vk::{vk, Context, Image, VkError, VkResultExt};
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// What the deferred lighting subpass writes: linear HDR colour (seed 002), tone-mapped after.
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
-/// G-buffer: octahedral normal in two floats (8 B) — half floats would move the seed's sharp
-/// highlights by several 8-bit steps — the object index (4 B) and the albedo factor (4 B);
-/// 16 B/pixel besides depth.
-pub const GBUFFER_NORMAL_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
-pub const GBUFFER_OBJECT_FORMAT: vk::Format = vk::Format::R32_UINT;
-/// The surface's albedo factor (blinn-phong's texture sample; 1 for the seed model).
-pub const GBUFFER_ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+/// The G-buffer's images in attachment order (subpass 0's colour outputs, the lighting
+/// subpass's inputs after depth, deferred-compute's bindings): the octahedral normal in two
+/// floats (8 B; half floats would move the seed's sharp highlights by several 8-bit steps),
+/// the object's index (4 B; its material is read from the object buffer at full precision),
+/// the albedo factor with the ambient occlusion in alpha (4 B) — 16 B/pixel besides depth —
+/// then, used only in scenes whose objects have textures of their own, the roughness and
+/// metallic factors (2 B) and the emissive factor (4 B, sRGB like its texture).
+pub const GBUFFER: [GBufferImage; 5] = [
+    GBufferImage { name: "g-buffer normal", format: vk::Format::R32G32_SFLOAT, bytes: 8 },
+    GBufferImage { name: "g-buffer object", format: vk::Format::R32_UINT, bytes: 4 },
+    GBufferImage { name: "g-buffer albedo-occlusion", format: vk::Format::R8G8B8A8_UNORM, bytes: 4 },
+    GBufferImage { name: "g-buffer roughness-metallic", format: vk::Format::R8G8_UNORM, bytes: 2 },
+    GBufferImage { name: "g-buffer emissive", format: vk::Format::R8G8B8A8_SRGB, bytes: 4 },
+];
+
+pub struct GBufferImage {
+    pub name: &'static str,
+    pub format: vk::Format,
+    /// Per pixel.
+    pub bytes: u32,
+}
+/// How many of GBUFFER's images only scenes with object textures write (the last ones).
+pub const GBUFFER_TEXTURED_ONLY: usize = 2;
 
 /// What the raster pass writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,14 +59,27 @@ impl Output {
     pub fn colour_attachments(self) -> usize {
         match self {
             Output::Color => 1,
-            Output::GBuffer | Output::Subpasses => 3,
+            Output::GBuffer | Output::Subpasses => GBUFFER.len(),
         }
+    }
+
+    /// Which components of each colour attachment of subpass 0 the mesh pipeline writes: the
+    /// G-buffer's material and emissive images only in scenes with object textures (and on
+    /// devices with independentBlend, which differing masks need; others write them all).
+    pub fn colour_writes(self, object_textures: bool, independent_blend: bool) -> Vec<vk::ColorComponentFlags> {
+        let mut writes = vec![vk::ColorComponentFlags::RGBA; self.colour_attachments()];
+        if self != Output::Color && !object_textures && independent_blend {
+            writes[GBUFFER.len() - GBUFFER_TEXTURED_ONLY..].fill(vk::ColorComponentFlags::empty());
+        }
+        writes
     }
 }
 
-/// Bytes per pixel of the G-buffer, depth excluded (the figure `render` prints).
-pub fn gbuffer_bytes_per_pixel() -> u32 {
-    8 + 4 + 4
+/// Bytes per pixel of the G-buffer that a scene writes, depth excluded (the figure `render`
+/// prints).
+pub fn gbuffer_bytes_per_pixel(object_textures: bool) -> u32 {
+    let used = if object_textures { GBUFFER.len() } else { GBUFFER.len() - GBUFFER_TEXTURED_ONLY };
+    GBUFFER[..used].iter().map(|g| g.bytes).sum()
 }
 
 /// The first depth format the device can render to (and, for a G-buffer, sample).
@@ -71,7 +100,7 @@ pub struct Targets {
     /// compute pass or the tone map writes).
     pub color: Image,
     pub depth: Image,
-    /// Deferred techniques: normal, object-index and albedo images (empty otherwise).
+    /// Deferred techniques: the GBUFFER images (empty otherwise).
     pub gbuffer: Vec<Image>,
     /// deferred, deferred-clustered: the lighting subpass's HDR output (null otherwise).
     pub hdr: Image,
@@ -120,23 +149,22 @@ impl Targets {
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
         self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
         if output != Output::Color {
-            for (name, format) in [
-                ("g-buffer normal", GBUFFER_NORMAL_FORMAT),
-                ("g-buffer object", GBUFFER_OBJECT_FORMAT),
-                ("g-buffer albedo", GBUFFER_ALBEDO_FORMAT),
-            ] {
-                self.gbuffer.push(Image::new_2d(ctx, name, extent, format, gbuffer_usage, colour)?);
+            for g in GBUFFER {
+                self.gbuffer.push(Image::new_2d(ctx, g.name, extent, g.format, gbuffer_usage, colour)?);
             }
         }
         if output == Output::Subpasses {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
         }
-        // Attachment order: see raster.rs create_render_pass.
-        let views: Vec<vk::ImageView> = match output {
-            Output::Color => vec![self.color.view, self.depth.view],
-            Output::GBuffer => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.gbuffer[2].view, self.depth.view],
-            Output::Subpasses => vec![self.gbuffer[0].view, self.gbuffer[1].view, self.gbuffer[2].view, self.depth.view, self.hdr.view],
+        // Attachment order: see render_pass.rs.
+        let mut views: Vec<vk::ImageView> = match output {
+            Output::Color => vec![self.color.view],
+            _ => self.gbuffer.iter().map(|g| g.view).collect(),
         };
+        views.push(self.depth.view);
+        if output == Output::Subpasses {
+            views.push(self.hdr.view);
+        }
         let info = vk::FramebufferCreateInfo::default()
             .render_pass(render_pass)
             .attachments(&views)

@@ -11,7 +11,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::render_pass::describe;
-use ml_render::targets::{gbuffer_bytes_per_pixel, Output, GBUFFER_NORMAL_FORMAT, GBUFFER_OBJECT_FORMAT, HDR_FORMAT};
+use ml_render::targets::{gbuffer_bytes_per_pixel, Output, GBUFFER, HDR_FORMAT};
 use ml_render::{RenderSettings, Technique};
 use ml_vk::vk;
 use spirq::prelude::*;
@@ -45,10 +45,13 @@ fn deferred_pass_has_two_subpasses_joined_by_input_attachments() {
     assert_eq!(dep.dst_access_mask, vk::AccessFlags::INPUT_ATTACHMENT_READ);
     assert_eq!(dep.dst_stage_mask, vk::PipelineStageFlags::FRAGMENT_SHADER);
     assert_eq!(dep.dependency_flags, vk::DependencyFlags::BY_REGION);
-    // The G-buffer is compact: target ≤ 16 bytes per pixel besides depth (the seed's: 68).
-    assert_eq!(d.attachments[0].format, GBUFFER_NORMAL_FORMAT);
-    assert_eq!(d.attachments[1].format, GBUFFER_OBJECT_FORMAT);
-    assert!(gbuffer_bytes_per_pixel() <= 16);
+    // The G-buffer is compact: target ≤ 16 bytes per pixel besides depth (the seed's: 68),
+    // 22 where objects have textures of their own.
+    assert_eq!(d.attachments[0].format, vk::Format::R32G32_SFLOAT);
+    assert_eq!(d.attachments[1].format, vk::Format::R32_UINT);
+    assert!(d.attachments.iter().zip(GBUFFER).all(|(a, g)| a.format == g.format));
+    assert_eq!(gbuffer_bytes_per_pixel(false), 16);
+    assert_eq!(gbuffer_bytes_per_pixel(true), 22);
 }
 
 #[test]

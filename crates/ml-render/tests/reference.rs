@@ -54,9 +54,10 @@ fn hit_unit_sphere(origin: Vec3, dir: Vec3) -> Option<Vec3> {
     (disc >= 0.0).then(|| origin + dir * (-b - disc.sqrt()))
 }
 
-fn compare(material: Material, directional: &[DirectionalLight]) {
+fn compare(material: Material, directional: &[DirectionalLight], orthographic: Option<f32>) {
     let mut scene = sphere_scene(material);
     scene.directional = directional.to_vec();
+    scene.camera.orthographic = orthographic;
     let out = common::render(scene.clone(), common::settings(SIZE, SIZE));
     let cam = &scene.camera;
     // The renderer animates lights (time 0 moves them by (0, 0, 0.1)); shade what it drew.
@@ -78,7 +79,9 @@ fn compare(material: Material, directional: &[DirectionalLight]) {
                 position_radius: (p - d.direction * 1e4).extend(1e30).to_array(),
                 color: d.color.extend(0.0).to_array(),
             }));
-            let shade = |n: Vec3| encode_gamma_unorm8(shade_seed(p, n, cam.position, &material, &all, scene.ambient));
+            // An orthographic camera looks along its axis at every point: an eye far back on the ray.
+            let eye = if orthographic.is_some() { p - dir * 1e5 } else { cam.position };
+            let shade = |n: Vec3| encode_gamma_unorm8(shade_seed(p, n, eye, &material, &all, scene.ambient));
             let expected = shade(n);
             let (t1, t2) = n.any_orthonormal_pair();
             let tilted = [t1, -t1, t2, -t2].map(|t| shade((n + t * NORMAL_TOLERANCE).normalize()));
@@ -106,18 +109,23 @@ fn compare(material: Material, directional: &[DirectionalLight]) {
 
 #[test]
 fn gpu_matches_cpu_reference_on_a_seed_material() {
-    compare(Material::named("gold").unwrap(), &[]);
+    compare(Material::named("gold").unwrap(), &[], None);
+}
+
+#[test]
+fn an_orthographic_camera_matches_the_cpu_reference() {
+    compare(Material::named("gold").unwrap(), &[], Some(1.3));
 }
 
 #[test]
 fn gpu_matches_cpu_reference_on_a_rough_dielectric() {
-    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &[]);
+    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &[], None);
 }
 
 #[test]
 fn directional_lights_match_the_cpu_reference() {
     let sun = DirectionalLight { direction: Vec3::new(0.5, -1.0, -0.3).normalize(), color: Vec3::new(0.6, 0.6, 0.5) };
     let fill = DirectionalLight { direction: Vec3::new(-0.8, 0.4, -0.6).normalize(), color: Vec3::new(0.1, 0.2, 0.4) };
-    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &[sun, fill]);
-    compare(Material::named("gold").unwrap(), &[sun]);
+    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &[sun, fill], None);
+    compare(Material::named("gold").unwrap(), &[sun], None);
 }

@@ -81,18 +81,6 @@ fn gltf_nodes_place_their_coloured_quads() {
     assert_eq!(common::pixel(&outputs[0], x, y), [5, 5, 5]);
 }
 
-/// A 4×4 texture of four 2×2 quarters: red, green / blue, white (so bilinear taps near a
-/// quarter's centre see one colour).
-fn quarters() -> Vec<u8> {
-    let colour = |x: u32, y: u32| match (x / 2, y / 2) {
-        (0, 0) => [255, 0, 0, 255],
-        (1, 0) => [0, 255, 0, 255],
-        (0, 1) => [0, 0, 255, 255],
-        _ => [255, 255, 255, 255],
-    };
-    (0..16).flat_map(|i| colour(i % 4, i / 4)).collect()
-}
-
 /// glTF textures on quads facing the camera (turned a quarter about +X): a base-colour
 /// texture shows its four colours in the four quarters (albedo view), and a normal map that
 /// tilts the normal 30° towards +u (+x in the world) shows that normal (normal view) and
@@ -101,7 +89,7 @@ fn quarters() -> Vec<u8> {
 #[test]
 fn gltf_textures_colour_and_bend_their_quads() {
     use glam::{Mat4, Quat, Vec3};
-    use ml_cpu::gltf_writer::{png, quad, GltfWriter, PrimitiveData};
+    use ml_cpu::gltf_writer::{png, quad, quarters, GltfWriter, PrimitiveData};
     use ml_render::{DebugView, RenderSettings, ShadingModel, Technique};
     use serde_json::json;
     const SIZE: u32 = 128;

@@ -45,7 +45,13 @@ fn analytic_normal(camera: &Camera, x: u32, y: u32) -> Option<Vec3> {
 #[test]
 fn a_turned_uneven_ellipsoid_has_the_analytic_normals() {
     let white = Material::named("white").unwrap();
-    let object = Object { mesh: MeshKind::Sphere, transform: transform(), material: white, textures: Default::default() };
+    let object = Object {
+        mesh: MeshKind::Sphere,
+        transform: transform(),
+        material: white,
+        textures: Default::default(),
+        extras: Default::default(),
+    };
     let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 6.0), Vec3::ZERO, 45.0, 0.1, 50.0);
     let light = PointLight { position_radius: [0.0, 3.0, 3.0, 20.0], color: [1.0, 1.0, 1.0, 0.0] };
     let scene = Scene::new(vec![object], vec![light], camera);

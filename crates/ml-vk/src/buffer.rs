@@ -68,7 +68,12 @@ impl Buffer {
     }
 
     /// A device-local buffer filled with `data` through a staging buffer (freed after the copy).
+    /// Empty data (a scene without lights) gives a minimal buffer nothing is copied into:
+    /// Vulkan has no empty buffers and no empty copies.
     pub fn device_local_with(ctx: &Context, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+        if data.is_empty() {
+            return Buffer::new(ctx, name, 0, usage, MemoryLocation::GpuOnly);
+        }
         let size = data.len() as vk::DeviceSize;
         let mut staging = Buffer::new(ctx, "staging", size, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
         staging.write(0, data);

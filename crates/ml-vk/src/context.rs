@@ -47,6 +47,9 @@ pub struct OptionalFeatures {
     pub multiview: bool,
     /// shaderOutputLayer (Vulkan 1.2): a vertex shader picks the layer it draws into.
     pub shader_output_layer: bool,
+    /// independentBlend: colour attachments of one pipeline with different write masks (the
+    /// G-buffer images a scene without object textures leaves unwritten).
+    pub independent_blend: bool,
 }
 
 impl DeviceInfo {
@@ -170,9 +173,10 @@ impl InstanceParts {
             let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v11).push_next(&mut v12);
             // SAFETY: core in 1.1+, and the device reports 1.2+.
             unsafe { self.instance.get_physical_device_features2(pd, &mut features2) };
-            let image_cube_array = features2.features.image_cube_array == vk::TRUE;
+            let core = features2.features;
             features = OptionalFeatures {
-                image_cube_array,
+                image_cube_array: core.image_cube_array == vk::TRUE,
+                independent_blend: core.independent_blend == vk::TRUE,
                 multiview: v11.multiview == vk::TRUE,
                 shader_output_layer: v12.shader_output_layer == vk::TRUE,
             };
@@ -322,7 +326,8 @@ impl Context {
         // Optional features, enabled where the device has them; the renderer checks `info.features`
         // before it needs one and refuses in one line otherwise.
         let features = info.features;
-        let core = vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array);
+        let core =
+            vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array).independent_blend(features.independent_blend);
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
         let mut v12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(features.shader_output_layer);
         let info_create =

@@ -202,14 +202,15 @@ fn light_cluster_runs(grid: &ClusterGrid, light: &PointLight, mut emit: impl FnM
     if dmax < grid.near || dmin > grid.far {
         return;
     }
-    // Outside a side plane of the view frustum? For the symmetric perspective the planes are
-    // p00·x = ±depth and p11·y = ±depth; most lights of a large scene fail here, cheaply.
+    // Outside a side plane of the view frustum? The planes are p00·x = ±w and p11·y = ±w (w
+    // the depth for a perspective, 1 for an orthographic camera); most lights of a large
+    // scene fail here, cheaply.
     if grid.outside_side_planes(c, r) {
         return;
     }
     // Off screen as a whole? (The projected box also catches what the planes let through.)
     let d0 = max(dmin, grid.near);
-    let inv = (1.0 / d0, 1.0 / dmax);
+    let inv = (grid.inv_w(d0), grid.inv_w(dmax));
     let (Some(whole_x), Some(whole_y)) = (grid.tile_span_x(c.x - r, c.x + r, inv), grid.tile_span_y(c.y - r, c.y + r, inv)) else {
         return;
     };
@@ -240,7 +241,7 @@ fn light_cluster_runs(grid: &ClusterGrid, light: &PointLight, mut emit: impl FnM
         } else {
             let closest = depth.clamp(s0, s1);
             let rr = max(r2 - (closest - depth) * (closest - depth), 0.0).sqrt();
-            let inv = (1.0 / s0, 1.0 / s1);
+            let inv = (grid.inv_w(s0), grid.inv_w(s1));
             let Some(xs) = grid.tile_span_x(c.x - rr, c.x + rr, inv) else { continue };
             let Some(ys) = grid.tile_span_y(c.y - rr, c.y + rr, inv) else { continue };
             (xs, ys)

@@ -79,9 +79,10 @@ pub(super) fn min(a: f32, b: f32) -> f32 {
     }
 }
 
-/// NDC range of scale·v/d over v ∈ [va, vb], d ∈ [d0, d1] with d > 0 (given as 1/d0, 1/d1):
-/// the extremes are at the corners, and v/d is monotonic in each.
-/// With va ≤ vb the least v/d is at va and the greatest at vb (either depth).
+/// NDC range of scale·v/w over v ∈ [va, vb], w ∈ [w0, w1] with w > 0 (given as 1/w0, 1/w1;
+/// w is the clip w: the depth for a perspective, 1 for an orthographic projection): the
+/// extremes are at the corners, and v/w is monotonic in each.
+/// With va ≤ vb the least v/w is at va and the greatest at vb (either w).
 #[inline]
 fn projected_span(scale: f32, va: f32, vb: f32, (inv0, inv1): (f32, f32)) -> (f32, f32) {
     let (lo, hi) = (min(va * inv0, va * inv1), max(vb * inv0, vb * inv1));
@@ -123,6 +124,8 @@ pub struct ClusterGrid {
     pub log_bias: f32,
     pub view: Mat4,
     pub projection: Mat4,
+    /// Clip w at view depth d = a·d + b: (1, 0) perspective, (0, 1) orthographic.
+    pub w_of_depth: (f32, f32),
     /// View-space bounds of every cluster, index = (z·Y + y)·X + x.
     pub bounds: Vec<Aabb>,
     /// The same boxes by axis: a cluster's x extent depends only on its tile column and
@@ -162,6 +165,7 @@ impl ClusterGrid {
             log_bias,
             view: camera.view(),
             projection,
+            w_of_depth: camera.w_of_depth(),
             bounds: Vec::with_capacity(dims.count()),
             slice_starts: Vec::new(),
             tile_of_column: Vec::new(),
@@ -170,10 +174,12 @@ impl ClusterGrid {
             y_extents: Vec::new(),
             z_extents: Vec::new(),
         };
-        // The tile spans below project with x_clip = p00·x, y_clip = p11·y, w = −z: a symmetric
-        // perspective, which is what `Camera::projection` makes.
+        // The tile spans below project with x_clip = p00·x, y_clip = p11·y, w = a·depth + b: a
+        // symmetric perspective or orthographic projection, which is what `Camera::projection`
+        // makes.
         let p = grid.projection;
-        debug_assert!(p.z_axis.x == 0.0 && p.z_axis.y == 0.0 && p.z_axis.w == -1.0 && p.w_axis.w == 0.0);
+        debug_assert!(p.z_axis.x == 0.0 && p.z_axis.y == 0.0 && p.w_axis.x == 0.0 && p.w_axis.y == 0.0);
+        debug_assert!((-p.z_axis.w, p.w_axis.w) == grid.w_of_depth);
         grid.slice_starts = (0..=dims.z).map(|k| grid.slice_start(k)).collect();
         grid.tile_of_column = (0..width).map(|px| tile_of(px, dims.x, width)).collect();
         grid.tile_of_row = (0..height).map(|py| tile_of(py, dims.y, height)).collect();
@@ -197,11 +203,19 @@ impl ClusterGrid {
     /// Whether a view-space sphere lies wholly outside one of the four side planes of the view
     /// frustum (so no pixel can see any of it).
     pub fn outside_side_planes(&self, centre: Vec3, radius: f32) -> bool {
-        let depth = -centre.z;
+        let (a, b) = self.w_of_depth;
+        let w = a * -centre.z + b;
         let (p00, p11) = (self.projection.x_axis.x, self.projection.y_axis.y.abs());
-        // Signed distance to the plane p·v = depth (outward positive) is (p·v − depth)/√(p²+1).
-        let outside = |p: f32, v: f32| (p * v.abs() - depth) > radius * (p * p + 1.0).sqrt();
+        // Signed distance to the plane p·v = a·depth + b (outward positive) is
+        // (p·v − a·depth − b)/√(p² + a²).
+        let outside = |p: f32, v: f32| (p * v.abs() - w) > radius * (p * p + a * a).sqrt();
         outside(p00, centre.x) || outside(p11, centre.y)
+    }
+
+    /// 1 / clip w at view depth `depth` (> 0), what tile spans take.
+    #[inline]
+    pub fn inv_w(&self, depth: f32) -> f32 {
+        1.0 / (self.w_of_depth.0 * depth + self.w_of_depth.1)
     }
 
     /// Depth range of slice `k`, widened by the slack the cluster boxes carry.
@@ -210,7 +224,7 @@ impl ClusterGrid {
     }
 
     /// Tiles in x under the view-space box x ∈ [xa, xb], depth ∈ [d0, d1] (0 < d0 ≤ d1),
-    /// given as `inv_depths` = (1/d0, 1/d1); None when the box is off screen. A shaded point
+    /// given as `inv_depths` = (inv_w(d0), inv_w(d1)); None when the box is off screen. A shaded point
     /// projects to its pixel's centre, so a pixel of margin absorbs rounding.
     #[inline]
     pub fn tile_span_x(&self, xa: f32, xb: f32, inv_depths: (f32, f32)) -> Option<(u32, u32)> {
@@ -263,12 +277,14 @@ impl ClusterGrid {
     }
 
     fn compute_bounds(&self) -> Vec<Aabb> {
-        // View-space direction through a pixel position, scaled to depth 1 (z = −1); for the
-        // symmetric perspective ndc = p·v/(−z). Keep in sync with cluster_bounds.comp.
+        // The view-space point of a pixel position at a depth: ndc = p·v / w, w = a·depth + b.
+        // Keep in sync with cluster_bounds.comp.
         let (p00, p11) = (self.projection.x_axis.x, self.projection.y_axis.y);
-        let ray = |px: f32, py: f32| {
+        let (a, b) = self.w_of_depth;
+        let point = |px: f32, py: f32, depth: f32| {
             let ndc = (px / self.width as f32 * 2.0 - 1.0, py / self.height as f32 * 2.0 - 1.0);
-            Vec3::new(ndc.0 / p00, ndc.1 / p11, -1.0)
+            let w = a * depth + b;
+            Vec3::new(ndc.0 / p00 * w, ndc.1 / p11 * w, -depth)
         };
         let d = self.dims;
         let mut bounds = Vec::with_capacity(d.count());
@@ -281,9 +297,8 @@ impl ClusterGrid {
                     let (x0, x1) = Self::tile_centres(x, d.x, self.width);
                     let (mut b_min, mut b_max) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
                     for (px, py) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
-                        let dir = ray(px, py);
                         for depth in [z0, z1] {
-                            let p = dir * depth;
+                            let p = point(px, py, depth);
                             b_min = b_min.min(p);
                             b_max = b_max.max(p);
                         }

@@ -20,11 +20,17 @@ fn assign(grid: &ClusterGrid, lights: &[PointLight]) -> ClusterLists {
 }
 
 /// World position of the point seen through the centre of pixel (px, py) at view depth z.
+/// (Perspective or orthographic: unprojected at the NDC depth that view depth has.)
 fn world_point(grid: &ClusterGrid, px: u32, py: u32, depth: f32) -> Vec3 {
-    let ndc = Vec4::new((px as f32 + 0.5) / grid.width as f32 * 2.0 - 1.0, (py as f32 + 0.5) / grid.height as f32 * 2.0 - 1.0, 1.0, 1.0);
+    let clip_z = grid.projection * Vec4::new(0.0, 0.0, -depth, 1.0);
+    let ndc = Vec4::new(
+        (px as f32 + 0.5) / grid.width as f32 * 2.0 - 1.0,
+        (py as f32 + 0.5) / grid.height as f32 * 2.0 - 1.0,
+        clip_z.z / clip_z.w,
+        1.0,
+    );
     let v = grid.projection.inverse() * ndc;
-    let dir = v.xyz() / v.w;
-    let view_point = dir / -dir.z * depth;
+    let view_point = v.xyz() / v.w;
     (grid.view.inverse() * view_point.extend(1.0)).xyz()
 }
 
@@ -94,7 +100,7 @@ fn no_light_that_reaches_a_point_is_missing_from_its_cluster() {
                 Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize_or(Vec3::X);
             let q = Vec3::from_slice(&l.position_radius[..3]) + dir * l.position_radius[3] * rng.random_range(0.9..1.0);
             let clip = view_proj * q.extend(1.0);
-            let (depth, ndc) = (clip.w, clip.xyz() / clip.w);
+            let (depth, ndc) = (-(grid.view * q.extend(1.0)).z, clip.xyz() / clip.w);
             if depth > grid.near && depth < grid.far && ndc.x.abs() < 1.0 && ndc.y.abs() < 1.0 {
                 let px = (((ndc.x + 1.0) * 0.5 * W as f32) as u32).min(W - 1);
                 let py = (((ndc.y + 1.0) * 0.5 * H as f32) as u32).min(H - 1);

@@ -137,9 +137,79 @@ fn textures_are_decoded_once_per_use_in_their_colour_space() {
     w.node(json!({ "mesh": b, "translation": [3.0, 0.0, 0.0] }), true);
     let s = load_bytes(&w.to_glb());
     assert_eq!(s.textures.len(), 2, "the checker once, the normal map once");
-    assert_eq!(s.objects[0].textures, ObjectTextures { base_color: Some(0), normal: Some(1) });
-    assert_eq!(s.objects[1].textures, ObjectTextures { base_color: Some(0), normal: None });
+    assert_eq!(s.objects[0].textures, ObjectTextures { base_color: Some(0), normal: Some(1), ..Default::default() });
+    assert_eq!(s.objects[1].textures, ObjectTextures { base_color: Some(0), ..Default::default() });
     assert!(s.textures[0].srgb && !s.textures[1].srgb);
     assert_eq!((s.textures[0].width, s.textures[0].height), (2, 2));
     assert_eq!(&s.textures[0].rgba[4..8], &[0, 255, 0, 255]);
+}
+
+#[test]
+fn every_material_texture_and_factor_and_sampler_is_read() {
+    use crate::gltf_writer::png;
+    use crate::textures::{Filter, TextureSampler, Wrap};
+    let mut w = GltfWriter::new();
+    let white = png(1, 1, &[255; 4]);
+    let [base, normal, orm, emissive] = [0; 4].map(|_| w.texture(white.clone(), "image/png"));
+    // The occlusion map is the metallic-roughness texture itself (glTF's packed ORM), read
+    // once as linear data.
+    w.sampler(base, json!({ "magFilter": 9728, "minFilter": 9984, "wrapS": 33071, "wrapT": 33648 }));
+    w.sampler(orm, json!({ "minFilter": 9729 }));
+    let m = w.textured_material(Some(base), Some(normal));
+    w.json["materials"][m]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = json!({ "index": orm });
+    w.json["materials"][m]["occlusionTexture"] = json!({ "index": orm, "strength": 0.25 });
+    w.json["materials"][m]["emissiveTexture"] = json!({ "index": emissive });
+    w.json["materials"][m]["emissiveFactor"] = json!([1.0, 0.5, 0.0]);
+    w.json["materials"][m]["normalTexture"]["scale"] = json!(0.5);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(json!({ "mesh": mesh }), true);
+    let (s, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let t = s.objects[0].textures;
+    assert_eq!(t.metallic_roughness, t.occlusion);
+    assert_eq!(t.bits(), 0b11111);
+    assert_eq!(s.textures.len(), 4, "base, normal, ORM once, emissive");
+    let srgb: Vec<bool> = t.slots().iter().map(|i| s.textures[i.unwrap() as usize].srgb).collect();
+    assert_eq!(srgb, [true, false, false, false, true]);
+    let sampler = |i: Option<u32>| s.textures[i.unwrap() as usize].sampler;
+    let nearest = TextureSampler {
+        wrap_u: Wrap::ClampToEdge,
+        wrap_v: Wrap::MirroredRepeat,
+        mag: Filter::Nearest,
+        min: Filter::Nearest,
+        mipmap: Some(Filter::Nearest),
+    };
+    assert_eq!(sampler(t.base_color), nearest);
+    assert_eq!(sampler(t.occlusion), TextureSampler { mipmap: None, ..TextureSampler::default() });
+    assert_eq!(sampler(t.normal), TextureSampler::default());
+    let x = s.objects[0].extras;
+    assert_eq!((x.emissive, x.normal_scale, x.occlusion_strength), (Vec3::new(1.0, 0.5, 0.0), 0.5, 0.25));
+}
+
+#[test]
+fn sparse_accessors_replace_their_elements() {
+    // A quad whose last corner a sparse substitution moves from (1, 0, 1) to (1, 0, 3) (min and
+    // max left stale: they are not trusted), and the same quad from an accessor without a
+    // buffer view: zeros but for the substituted corners.
+    let world_corners = |s: &Scene| -> Vec<Vec3> {
+        let o = &s.objects[0];
+        s.mesh(o.mesh).unwrap().vertices.iter().map(|v| o.transform.transform_point3(Vec3::from(v.position))).collect()
+    };
+    let mut w = GltfWriter::new();
+    let mesh = w.mesh(&[quad()]);
+    let positions = w.json["meshes"][mesh]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize;
+    w.sparse(positions, &[3], &[[1.0, 0.0, 3.0]]);
+    w.node(json!({ "mesh": mesh }), true);
+    let s = load_bytes(&w.to_glb());
+    let corners = world_corners(&s);
+    assert!(
+        corners[3].abs_diff_eq(Vec3::new(1.0, 0.0, 3.0), 1e-5) && corners[0].abs_diff_eq(Vec3::new(-1.0, 0.0, -1.0), 1e-5),
+        "{corners:?}"
+    );
+
+    w.json["accessors"][positions].as_object_mut().unwrap().remove("bufferView");
+    w.sparse(positions, &[1, 2, 3], &[[2.0, 0.0, 0.0], [0.0, 0.0, 2.0], [2.0, 0.0, 2.0]]);
+    let corners = world_corners(&load_bytes(&w.to_glb()));
+    let want = [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0), Vec3::new(2.0, 0.0, 2.0)];
+    assert!(corners.iter().zip(want).all(|(c, w)| c.abs_diff_eq(w, 1e-5)), "{corners:?}");
 }
