@@ -12,8 +12,13 @@ layout(input_attachment_index = 0, set = 2, binding = 1) uniform subpassInput de
 layout(input_attachment_index = 1, set = 2, binding = 2) uniform subpassInput normal_input;
 layout(input_attachment_index = 2, set = 2, binding = 3) uniform usubpassInput object_input;
 layout(input_attachment_index = 3, set = 2, binding = 4) uniform subpassInput albedo_input;
+// GBUFFER_MATERIAL (the *_textured.frag variants): scenes whose objects have textures of their
+// own, whose G-buffer has two more images (targets.rs gbuffer_images). A variant, not a
+// specialization constant: a subpass may not even declare inputs it lacks.
+#ifdef GBUFFER_MATERIAL
 layout(input_attachment_index = 4, set = 2, binding = 5) uniform subpassInput roughness_metallic_input;
 layout(input_attachment_index = 5, set = 2, binding = 6) uniform subpassInput emissive_input;
+#endif
 
 #include "lighting.glsl"
 
@@ -27,9 +32,13 @@ void main() {
     vec3 world = world_from_depth(gl_FragCoord.xy, z);
     vec3 n = oct_decode(subpassLoad(normal_input).xy);
     uint id = subpassLoad(object_input).r;
-    // Without OBJECT_TEXTURES the material and emissive attachments are not written.
-    vec2 roughness_metallic = OBJECT_TEXTURES ? subpassLoad(roughness_metallic_input).xy : vec2(1.0);
-    vec3 emissive_factor = OBJECT_TEXTURES ? subpassLoad(emissive_input).rgb : vec3(1.0);
+#ifdef GBUFFER_MATERIAL
+    vec2 roughness_metallic = subpassLoad(roughness_metallic_input).xy;
+    vec3 emissive_factor = subpassLoad(emissive_input).rgb;
+#else
+    vec2 roughness_metallic = vec2(1.0);
+    vec3 emissive_factor = vec3(1.0);
+#endif
     PointMaterial m =
         point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, subpassLoad(albedo_input), roughness_metallic, emissive_factor);
     vec3 color;

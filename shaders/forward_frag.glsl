@@ -5,13 +5,8 @@
 
 #include "common.glsl"
 
-layout(location = 0) in vec3 in_world_pos;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
-layout(location = 3) in vec4 in_tangent;
-
+#include "mesh_fragment_inputs.glsl"
 #include "scene_bindings.glsl"
-layout(push_constant) uniform PushBlock { ObjectPush object; };
 
 #include "textures.glsl"
 #include "surface.glsl"

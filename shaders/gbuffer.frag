@@ -1,35 +1,4 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// G-buffer of the deferred techniques: 16 bytes per pixel besides depth — the normal
-// (octahedral, two floats: exact enough that the seed's sharp highlights do not move), the
-// object's index (its material comes from the object buffer at full precision) and the
-// surface's albedo factor (the base-colour or blinn-phong texture; 1 for the seed model) with
-// the ambient occlusion in alpha — and, in scenes whose objects have textures of their own
-// (OBJECT_TEXTURES), 8 more: the roughness and metallic factors and the emissive factor
-// (targets.rs). Position comes from depth.
-#include "common.glsl"
-#include "scene_bindings.glsl"
-#include "textures.glsl"
-#include "surface.glsl"
-
-layout(location = 0) in vec3 in_world_pos;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
-layout(location = 3) in vec4 in_tangent;
-layout(push_constant) uniform PushBlock { ObjectPush object; };
-
-layout(location = 0) out vec2 out_normal;
-layout(location = 1) out uint out_object;
-layout(location = 2) out vec4 out_albedo_occlusion;
-// Written only with OBJECT_TEXTURES (the pipeline masks them otherwise).
-layout(location = 3) out vec4 out_roughness_metallic;
-layout(location = 4) out vec4 out_emissive;
-
-void main() {
-    Surface s = surface_at(in_normal, in_tangent, in_uv, object.ids.y, object.material);
-    out_normal = oct_encode(s.normal);
-    out_object = object.ids.x;
-    out_albedo_occlusion = vec4(s.albedo_factor, s.occlusion);
-    out_roughness_metallic = vec4(s.roughness_metallic, 0.0, 1.0);
-    out_emissive = vec4(s.emissive_factor, 1.0);
-}
+// The G-buffer pass of the deferred techniques (gbuffer_frag.glsl).
+#include "gbuffer_frag.glsl"

@@ -311,7 +311,6 @@ fn info() -> Result<()> {
             ("maxImageArrayLayers", l.max_image_array_layers.to_string()),
             ("imageCubeArray", d.features.image_cube_array.to_string()),
             ("multiview", d.features.multiview.to_string()),
-            ("independentBlend", d.features.independent_blend.to_string()),
         ];
         println!("{}", table(&rows));
     }

@@ -90,7 +90,11 @@ impl ComputeLighting {
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         let image = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
         write_image(ctx, set, BINDING_DEPTH, image, sampled(t.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
-        for (binding, g) in GBUFFER_BINDINGS.into_iter().zip(&t.gbuffer) {
+        // A G-buffer without the material and emissive images (a scene without object
+        // textures) binds the albedo image in their place: the shader, specialised for such
+        // scenes, never reads them, but Vulkan wants every binding it names written.
+        for (i, binding) in GBUFFER_BINDINGS.into_iter().enumerate() {
+            let g = t.gbuffer.get(i).unwrap_or(&t.gbuffer[2]);
             write_image(ctx, set, binding, image, sampled(g.view, read_only));
         }
         let output = vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL);

@@ -89,7 +89,7 @@ pub fn pipeline(
                 .depth_test_enable(true)
                 .depth_write_enable(true)
                 .depth_compare_op(vk::CompareOp::LESS),
-            colour_writes: &[],
+            colour_attachments: 0,
             layout,
             render_pass,
             subpass: 0,

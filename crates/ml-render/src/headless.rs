@@ -226,7 +226,8 @@ impl<'a> HeadlessRenderer<'a> {
         let render_pass = self.pass.render_pass;
         let extent = self.extent;
         let output = self.pass.output;
-        let make_targets = || Targets::new(ctx, render_pass, extent, depth, output);
+        let gbuffer = self.pass.gbuffer();
+        let make_targets = || Targets::new(ctx, render_pass, extent, depth, (output, gbuffer));
         let setup = FrameSetup {
             pool: self.command_pool,
             descriptor_pool: self.descriptor_pool,

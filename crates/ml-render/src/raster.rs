@@ -8,7 +8,7 @@
 use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding, GpuMesh};
 use crate::render_pass;
 use crate::settings::{Shading, Technique};
-use crate::targets::{Output, Targets, GBUFFER};
+use crate::targets::{gbuffer_images, GBufferImage, Output, Targets};
 use ml_cpu::gpu_types::{ObjectData, ObjectPush};
 use ml_cpu::scene::Object;
 use ml_vk::descriptors::{allocate_set, write_image};
@@ -101,11 +101,17 @@ impl RasterPass {
         };
         // On failure, destroy what was made (null handles are ignored by vkDestroy*).
         let fragment = match (output, technique.is_clustered()) {
+            (Output::GBuffer | Output::Subpasses, _) if shading.object_textures => ml_shaders::GBUFFER_TEXTURED_FRAG,
             (Output::GBuffer | Output::Subpasses, _) => ml_shaders::GBUFFER_FRAG,
             (Output::Color, true) => ml_shaders::CLUSTERED_FRAG,
             (Output::Color, false) => ml_shaders::FORWARD_FRAG,
         };
-        let lighting = if technique.is_clustered() { ml_shaders::DEFERRED_CLUSTERED_FRAG } else { ml_shaders::DEFERRED_FRAG };
+        let lighting = match (technique.is_clustered(), shading.object_textures) {
+            (false, false) => ml_shaders::DEFERRED_FRAG,
+            (true, false) => ml_shaders::DEFERRED_CLUSTERED_FRAG,
+            (false, true) => ml_shaders::DEFERRED_TEXTURED_FRAG,
+            (true, true) => ml_shaders::DEFERRED_CLUSTERED_TEXTURED_FRAG,
+        };
         ml_vk::build(ctx, pass, |p| p.create(ctx, depth_format, (fragment, lighting), (textures_layout, object_textures_layout)))
     }
 
@@ -117,7 +123,7 @@ impl RasterPass {
         (textures_layout, object_textures_layout): (vk::DescriptorSetLayout, vk::DescriptorSetLayout),
     ) -> Result<(), VkError> {
         let output = self.output;
-        self.render_pass = render_pass::describe(depth_format, output).create(ctx)?;
+        self.render_pass = render_pass::describe(depth_format, output, self.gbuffer()).create(ctx)?;
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         self.set_layout = shader::set_layout(
             ctx,
@@ -141,8 +147,9 @@ impl RasterPass {
         }
         if output == Output::Subpasses {
             use vk::DescriptorType as T;
-            let inputs: Vec<(u32, T)> =
-                (BINDING_INPUT_DEPTH..BINDING_INPUT_GBUFFER + GBUFFER.len() as u32).map(|binding| (binding, T::INPUT_ATTACHMENT)).collect();
+            let inputs: Vec<(u32, T)> = (BINDING_INPUT_DEPTH..BINDING_INPUT_GBUFFER + self.gbuffer().len() as u32)
+                .map(|binding| (binding, T::INPUT_ATTACHMENT))
+                .collect();
             self.input_set_layout = shader::set_layout(ctx, &inputs, vk::ShaderStageFlags::FRAGMENT)?;
             self.lighting_layout = shader::pipeline_layout(ctx, &[self.set_layout, textures_layout, self.input_set_layout], &[])?;
             self.lighting_pipeline = self.create_pipeline(ctx, ml_shaders::FULLSCREEN_VERT, lighting, Draw::Lighting)?;
@@ -164,11 +171,9 @@ impl RasterPass {
     }
 
     fn create_pipeline(&self, ctx: &Context, vertex: &[u8], fragment: &[u8], draw: Draw) -> Result<vk::Pipeline, VkError> {
-        let (layout, subpass, colour_writes) = match draw {
-            Draw::Mesh | Draw::Overlay => {
-                (self.pipeline_layout, 0, self.output.colour_writes(self.shading.object_textures, ctx.info.features.independent_blend))
-            }
-            Draw::Lighting => (self.lighting_layout, 1, vec![vk::ColorComponentFlags::RGBA]),
+        let (layout, subpass, colour_attachments) = match draw {
+            Draw::Mesh | Draw::Overlay => (self.pipeline_layout, 0, self.output.colour_attachments(self.gbuffer())),
+            Draw::Lighting => (self.lighting_layout, 1, 1),
         };
         let bindings = [vertex_binding()];
         let attributes = vertex_attributes();
@@ -201,7 +206,7 @@ impl RasterPass {
                 vertex_input,
                 rasterization,
                 depth_stencil,
-                colour_writes: &colour_writes,
+                colour_attachments,
                 layout,
                 render_pass: self.render_pass,
                 subpass,
@@ -222,7 +227,7 @@ impl RasterPass {
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
         let mut clear: Vec<vk::ClearValue> = match self.output {
             Output::Color => vec![colour],
-            Output::GBuffer | Output::Subpasses => vec![zero; GBUFFER.len()],
+            Output::GBuffer | Output::Subpasses => vec![zero; self.gbuffer().len()],
         };
         clear.push(depth);
         if self.output == Output::Subpasses {
@@ -274,6 +279,11 @@ impl RasterPass {
             }
             d.cmd_end_render_pass(cmd);
         }
+    }
+
+    /// The G-buffer images the pass writes (where its output is a G-buffer).
+    pub fn gbuffer(&self) -> &'static [GBufferImage] {
+        gbuffer_images(self.shading.object_textures)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -1,12 +1,13 @@
 //! The raster pass's VkRenderPass as plain data first (tests inspect it: SPEC §3 asks for seed
 //! 002's two subpasses with input attachments), then created from that data.
 //!
-//! Output::Color and Output::GBuffer: one subpass. Output::Subpasses (seed 002): attachments
-//! 0 normal, 1 object index, 2 albedo, 3 depth — the G-buffer, written by subpass 0, read by
-//! subpass 1 as input attachments, never stored — and 4 HDR colour, written by subpass 1 and
-//! read by the tone-map compute pass.
+//! Output::Color and Output::GBuffer: one subpass. Output::Subpasses (seed 002): the G-buffer
+//! images (normal, object index, albedo, and in scenes with object textures roughness-metallic
+//! and emissive), then depth — written by subpass 0, read by subpass 1 as input attachments,
+//! never stored — and last HDR colour, written by subpass 1 and read by the tone-map compute
+//! pass.
 
-use crate::targets::{Output, COLOR_FORMAT, GBUFFER, HDR_FORMAT};
+use crate::targets::{GBufferImage, Output, COLOR_FORMAT, HDR_FORMAT};
 use ml_vk::{vk, Context, VkError, VkResultExt};
 
 /// One subpass: which attachments it writes and reads.
@@ -61,15 +62,16 @@ fn dependency(
         .dst_access_mask(dst.2)
 }
 
-/// The render pass the raster pass uses for `output`.
-pub fn describe(depth_format: vk::Format, output: Output) -> RenderPassDesc {
+/// The render pass the raster pass uses for `output`, with `gbuffer`'s images (targets.rs
+/// gbuffer_images) where it writes a G-buffer.
+pub fn describe(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage]) -> RenderPassDesc {
     match output {
-        Output::Color | Output::GBuffer => one_subpass(depth_format, output),
-        Output::Subpasses => two_subpasses(depth_format),
+        Output::Color | Output::GBuffer => one_subpass(depth_format, output, gbuffer),
+        Output::Subpasses => two_subpasses(depth_format, gbuffer),
     }
 }
 
-fn one_subpass(depth_format: vk::Format, output: Output) -> RenderPassDesc {
+fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage]) -> RenderPassDesc {
     let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
     let attachments = match output {
         // The colour result is copied out; depth is not needed afterwards.
@@ -78,13 +80,13 @@ fn one_subpass(depth_format: vk::Format, output: Output) -> RenderPassDesc {
             attachment(depth_format, false, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
         ],
         // Everything is read by the lighting compute pass.
-        _ => GBUFFER
+        _ => gbuffer
             .iter()
             .map(|g| attachment(g.format, true, read_only))
             .chain([attachment(depth_format, true, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)])
             .collect(),
     };
-    let colour_count = output.colour_attachments() as u32;
+    let colour_count = output.colour_attachments(gbuffer) as u32;
     let subpass = Subpass {
         colour: (0..colour_count).map(|a| reference(a, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)).collect(),
         depth: Some(reference(colour_count, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
@@ -110,13 +112,13 @@ fn one_subpass(depth_format: vk::Format, output: Output) -> RenderPassDesc {
     RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
 }
 
-fn two_subpasses(depth_format: vk::Format) -> RenderPassDesc {
+fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage]) -> RenderPassDesc {
     let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
     let depth_read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
     let colour = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
-    let g = GBUFFER.len() as u32;
+    let g = gbuffer.len() as u32;
     let (depth, hdr) = (g, g + 1);
-    let attachments: Vec<vk::AttachmentDescription> = GBUFFER
+    let attachments: Vec<vk::AttachmentDescription> = gbuffer
         .iter()
         .map(|image| attachment(image.format, false, read_only))
         .chain([attachment(depth_format, false, depth_read_only), attachment(HDR_FORMAT, true, read_only)])

@@ -11,7 +11,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::render_pass::describe;
-use ml_render::targets::{gbuffer_bytes_per_pixel, Output, GBUFFER, HDR_FORMAT};
+use ml_render::targets::{gbuffer_bytes_per_pixel, gbuffer_images, Output, HDR_FORMAT};
 use ml_render::{RenderSettings, Technique};
 use ml_vk::vk;
 use spirq::prelude::*;
@@ -19,7 +19,19 @@ use spirq::ty::DescriptorType;
 
 #[test]
 fn deferred_pass_has_two_subpasses_joined_by_input_attachments() {
-    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses);
+    for object_textures in [false, true] {
+        check_two_subpasses(object_textures);
+    }
+    // The G-buffer is compact: target ≤ 16 bytes per pixel besides depth (the seed's: 68),
+    // 22 where objects have textures of their own.
+    assert_eq!(gbuffer_bytes_per_pixel(false), 16);
+    assert_eq!(gbuffer_bytes_per_pixel(true), 22);
+}
+
+fn check_two_subpasses(object_textures: bool) {
+    let images = gbuffer_images(object_textures);
+    assert_eq!(images.len(), if object_textures { 5 } else { 3 });
+    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, images);
     assert_eq!(d.subpasses.len(), 2);
     let (gbuffer, lighting) = (&d.subpasses[0], &d.subpasses[1]);
     // Subpass 1 reads exactly what subpass 0 wrote: its colour attachments and its depth.
@@ -45,20 +57,23 @@ fn deferred_pass_has_two_subpasses_joined_by_input_attachments() {
     assert_eq!(dep.dst_access_mask, vk::AccessFlags::INPUT_ATTACHMENT_READ);
     assert_eq!(dep.dst_stage_mask, vk::PipelineStageFlags::FRAGMENT_SHADER);
     assert_eq!(dep.dependency_flags, vk::DependencyFlags::BY_REGION);
-    // The G-buffer is compact: target ≤ 16 bytes per pixel besides depth (the seed's: 68),
-    // 22 where objects have textures of their own.
     assert_eq!(d.attachments[0].format, vk::Format::R32G32_SFLOAT);
     assert_eq!(d.attachments[1].format, vk::Format::R32_UINT);
-    assert!(d.attachments.iter().zip(GBUFFER).all(|(a, g)| a.format == g.format));
-    assert_eq!(gbuffer_bytes_per_pixel(false), 16);
-    assert_eq!(gbuffer_bytes_per_pixel(true), 22);
+    assert!(d.attachments.iter().zip(images).all(|(a, g)| a.format == g.format));
+    assert_eq!(d.attachments.len(), images.len() + 2, "the G-buffer, depth and HDR");
 }
 
 #[test]
 fn lighting_shaders_load_the_gbuffer_as_input_attachments() {
-    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses);
-    let inputs = d.subpasses[1].inputs.len() as u32;
-    for (name, spirv) in [("deferred.frag", ml_shaders::DEFERRED_FRAG), ("deferred_clustered.frag", ml_shaders::DEFERRED_CLUSTERED_FRAG)] {
+    use ml_shaders::{DEFERRED_CLUSTERED_FRAG, DEFERRED_CLUSTERED_TEXTURED_FRAG, DEFERRED_FRAG, DEFERRED_TEXTURED_FRAG};
+    for (name, spirv, object_textures) in [
+        ("deferred.frag", DEFERRED_FRAG, false),
+        ("deferred_clustered.frag", DEFERRED_CLUSTERED_FRAG, false),
+        ("deferred_textured.frag", DEFERRED_TEXTURED_FRAG, true),
+        ("deferred_clustered_textured.frag", DEFERRED_CLUSTERED_TEXTURED_FRAG, true),
+    ] {
+        let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(object_textures));
+        let inputs = d.subpasses[1].inputs.len() as u32;
         let words: Vec<u32> = spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         let entries = ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().expect("reflect");
         let mut indices: Vec<u32> = entries[0]

@@ -47,9 +47,6 @@ pub struct OptionalFeatures {
     pub multiview: bool,
     /// shaderOutputLayer (Vulkan 1.2): a vertex shader picks the layer it draws into.
     pub shader_output_layer: bool,
-    /// independentBlend: colour attachments of one pipeline with different write masks (the
-    /// G-buffer images a scene without object textures leaves unwritten).
-    pub independent_blend: bool,
 }
 
 impl DeviceInfo {
@@ -173,10 +170,9 @@ impl InstanceParts {
             let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v11).push_next(&mut v12);
             // SAFETY: core in 1.1+, and the device reports 1.2+.
             unsafe { self.instance.get_physical_device_features2(pd, &mut features2) };
-            let core = features2.features;
+            let image_cube_array = features2.features.image_cube_array == vk::TRUE;
             features = OptionalFeatures {
-                image_cube_array: core.image_cube_array == vk::TRUE,
-                independent_blend: core.independent_blend == vk::TRUE,
+                image_cube_array,
                 multiview: v11.multiview == vk::TRUE,
                 shader_output_layer: v12.shader_output_layer == vk::TRUE,
             };
@@ -326,8 +322,7 @@ impl Context {
         // Optional features, enabled where the device has them; the renderer checks `info.features`
         // before it needs one and refuses in one line otherwise.
         let features = info.features;
-        let core =
-            vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array).independent_blend(features.independent_blend);
+        let core = vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array);
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
         let mut v12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(features.shader_output_layer);
         let info_create =

@@ -41,7 +41,7 @@ pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout,
 }
 
 /// What differs between the graphics pipelines we make. Fixed for all: `main` entry points,
-/// triangle lists, dynamic viewport and scissor, one sample, colour unblended.
+/// triangle lists, dynamic viewport and scissor, one sample, colour written unblended.
 pub struct GraphicsPipelineDesc<'a> {
     pub vertex: &'a [u8],
     /// None: depth only.
@@ -51,8 +51,7 @@ pub struct GraphicsPipelineDesc<'a> {
     pub vertex_input: vk::PipelineVertexInputStateCreateInfo<'a>,
     pub rasterization: vk::PipelineRasterizationStateCreateInfo<'a>,
     pub depth_stencil: vk::PipelineDepthStencilStateCreateInfo<'a>,
-    /// Per colour attachment of the subpass, which components the pipeline writes.
-    pub colour_writes: &'a [vk::ColorComponentFlags],
+    pub colour_attachments: usize,
     pub layout: vk::PipelineLayout,
     pub render_pass: vk::RenderPass,
     pub subpass: u32,
@@ -84,8 +83,8 @@ pub fn graphics_pipeline(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<v
     let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
     let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
     let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let blend_attachments: Vec<vk::PipelineColorBlendAttachmentState> =
-        desc.colour_writes.iter().map(|&mask| vk::PipelineColorBlendAttachmentState::default().color_write_mask(mask)).collect();
+    let blend_attachments =
+        vec![vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA); desc.colour_attachments];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
