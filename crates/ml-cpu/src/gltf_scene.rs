@@ -34,8 +34,8 @@ pub const MAX_VERTICES: usize = 1 << 26;
 pub const MAX_TEXTURE_SIZE: u32 = 16384;
 /// Deepest node hierarchy we follow.
 pub const MAX_NODE_DEPTH: usize = 256;
-/// Extensions a file may require: the ones we read.
-const SUPPORTED_REQUIRED: [&str; 1] = ["KHR_lights_punctual"];
+/// Extensions we read (a file may require these; others it may only use, with a warning).
+const SUPPORTED_EXTENSIONS: [&str; 1] = ["KHR_lights_punctual"];
 
 /// Load the glTF or GLB file at `path` (external buffers relative to its folder).
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
@@ -53,10 +53,12 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     }
     let gltf = parse_and_validate(bytes)?;
     for ext in gltf.extensions_required() {
-        if !SUPPORTED_REQUIRED.contains(&ext) {
+        if !SUPPORTED_EXTENSIONS.contains(&ext) {
             return Err(format!("requires extension {ext}, which manylights does not support"));
         }
     }
+    // Optional extensions we do not read are left out, and said so.
+    let unread: Vec<String> = gltf.extensions_used().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).map(str::to_owned).collect();
     let buffers = load_buffers(&gltf, base)?;
     let mut builder = Builder {
         doc: &gltf.document,
@@ -72,7 +74,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         lights: Vec::new(),
         camera: None,
         vertices: 0,
-        warnings: Vec::new(),
+        warnings: unread.into_iter().map(|e| format!("extension {e} is not supported; the file is read without it")).collect(),
     };
     let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(scene) => scene.nodes().collect(),

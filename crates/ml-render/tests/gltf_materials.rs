@@ -1,5 +1,5 @@
 //! glTF materials beyond base colour and normal maps (issue 7): metallic-roughness, occlusion
-//! and emissive textures with their factors, texture samplers, and orthographic cameras — each
+//! and emissive textures with their factors, texture samplers, mipmaps and orthographic cameras — each
 //! rendered from a file our writer makes and checked where the CPU knows the answer, through
 //! every technique (the deferred ones carry these values through the G-buffer).
 
@@ -219,5 +219,34 @@ fn orthographic_cameras_keep_sizes_and_every_technique_agrees() {
     for (out, t) in outputs.iter().zip(Technique::ALL).skip(1) {
         let (max, differing) = common::max_difference(&outputs[0], out);
         assert!(max <= 1, "{} differs from forward by {max}/255 at {differing} pixels", t.name());
+    }
+}
+
+/// Mipmaps: a 64×64 checker of red and green texels on a quad 12 pixels wide is sampled from
+/// its mip levels, each texel of which (above level 0) is exactly half red, half green — so
+/// the albedo view shows the blend everywhere inside the quad, not the checker's aliasing.
+#[test]
+fn a_minified_texture_is_read_from_its_mipmaps() {
+    let mut w = GltfWriter::new();
+    let checker: Vec<u8> =
+        (0..64 * 64).flat_map(|i| if (i % 64 + i / 64) % 2 == 0 { [255, 0, 0, 255] } else { [0, 255, 0, 255] }).collect();
+    let texture = w.texture(png(64, 64, &checker), "image/png");
+    let m = w.textured_material(Some(texture), None);
+    let scene = row_of_quads(&mut w, &[(m, 0.0)], 8.0, 1.0);
+    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, DebugView::GBufferAlbedo, (SIZE, SIZE))
+        .into_iter()
+        .filter(|s| [Technique::Forward, Technique::DeferredCompute].contains(&s.technique))
+        .collect();
+    // Linear 0.5 stored as sRGB 188, shown through gamma 1/2.2: 187.
+    let blend = [187, 187, 0];
+    for out in common::render_each(&scene, &settings) {
+        let (x0, y0) = pixel_of(&scene, (SIZE, SIZE), 0.0, (-0.7, -0.7));
+        let (x1, y1) = pixel_of(&scene, (SIZE, SIZE), 0.0, (0.7, 0.7));
+        assert!(x1 > x0 + 6 && y1 > y0 + 6, "the quad covers ({x0}, {y0})–({x1}, {y1})");
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                assert_close(&out, (x, y), blend, 3, "minified checker");
+            }
+        }
     }
 }

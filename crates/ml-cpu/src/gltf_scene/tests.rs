@@ -213,3 +213,13 @@ fn sparse_accessors_replace_their_elements() {
     let want = [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0), Vec3::new(2.0, 0.0, 2.0)];
     assert!(corners.iter().zip(want).all(|(c, w)| c.abs_diff_eq(w, 1e-5)), "{corners:?}");
 }
+
+#[test]
+fn optional_extensions_we_do_not_read_are_named_in_a_warning() {
+    let mut w = GltfWriter::new();
+    let mesh = w.mesh(&[quad()]);
+    w.node(json!({ "mesh": mesh }), true);
+    w.json["extensionsUsed"] = json!(["KHR_texture_transform"]);
+    let (_, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert_eq!(warnings, ["extension KHR_texture_transform is not supported; the file is read without it"]);
+}
