@@ -28,12 +28,42 @@ struct Cli {
 enum Command {
     /// Render a scene headless (no window system) to a PNG and print a timing table.
     Render(Box<RenderArgs>),
+    /// Open a window on a scene: first-person camera (WASD/QE, right-drag, wheel), an overlay
+    /// of settings and GPU times, P pause, F12 screenshot, Esc quit.
+    View(Box<ViewArgs>),
     /// List Vulkan devices, drivers, versions and the limits manylights depends on.
     Info,
 }
 
 #[derive(Args)]
 struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Frames to render; timings are averaged over them, the image is the last one.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    /// Output PNG file.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(Args)]
+struct ViewArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Present without waiting for the display (mailbox, else immediate, where the window
+    /// system has them).
+    #[arg(long)]
+    no_vsync: bool,
+    /// Run a scripted session (README: "Viewer"): frames, technique and light changes,
+    /// resizes, screenshots, quit.
+    #[arg(long)]
+    script: Option<PathBuf>,
+}
+
+/// What `render` and `view` share: the scene, technique and their settings.
+#[derive(Args, Clone)]
+struct SceneArgs {
     /// Scene to render: seed (built in), room (a closed room with a pillar and one point light,
     /// for point-light shadows), a scene file FILE.toml (README: "Scene files") or a glTF 2.0
     /// file FILE.gltf|FILE.glb (rendered with pbr unless --shading says otherwise).
@@ -90,12 +120,10 @@ struct RenderArgs {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// Fix the animation clock at T (otherwise it advances 1/60 s per frame from 0).
+    /// Fix the animation clock at T (otherwise it advances 1/60 s per frame from 0; in the
+    /// viewer, with real time).
     #[arg(long)]
     time: Option<f32>,
-    /// Frames to render; timings are averaged over them, the image is the last one.
-    #[arg(long, default_value_t = 1)]
-    frames: u32,
     /// Enable the Khronos validation layer with synchronization validation; any message
     /// makes the run fail.
     #[arg(long)]
@@ -103,9 +131,6 @@ struct RenderArgs {
     /// Vulkan device index (see `manylights info`); default: the best one (discrete first).
     #[arg(long)]
     device: Option<usize>,
-    /// Output PNG file.
-    #[arg(long)]
-    out: PathBuf,
 }
 
 fn main() -> ExitCode {
@@ -125,6 +150,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Render(args) => render(&args),
+        Command::View(args) => view(&args),
         Command::Info => info(),
     };
     match result {
@@ -137,7 +163,7 @@ fn main() -> ExitCode {
 }
 
 /// The scene and the shading model to render it with.
-fn build_scene(args: &RenderArgs) -> Result<(Scene, ShadingModel)> {
+fn build_scene(args: &SceneArgs) -> Result<(Scene, ShadingModel)> {
     let lights = |count: u64| -> Result<LightParams> {
         Ok(LightParams {
             count: LightParams::check_count(count)?,
@@ -198,12 +224,10 @@ fn check_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
-fn render(args: &RenderArgs) -> Result<()> {
-    let technique = Technique::from_name(&args.technique)?;
-    let (scene, shading) = build_scene(args)?;
-    check_output(&args.out)?;
-    let settings = RenderSettings {
-        technique,
+/// Render settings from the arguments (the shading model as the scene decided).
+fn render_settings(args: &SceneArgs, shading: ShadingModel, frames: u32) -> Result<RenderSettings> {
+    Ok(RenderSettings {
+        technique: Technique::from_name(&args.technique)?,
         shading,
         clusters: ClusterDims::parse(&args.clusters)?,
         debug_view: DebugView::from_name(&args.debug_view)?,
@@ -216,10 +240,18 @@ fn render(args: &RenderArgs) -> Result<()> {
         },
         width: args.width,
         height: args.height,
-        frames: args.frames,
+        frames,
         time: args.time,
-    };
-    let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device })?;
+    })
+}
+
+fn render(cmd: &RenderArgs) -> Result<()> {
+    let args = &cmd.scene;
+    let technique = Technique::from_name(&args.technique)?;
+    let (scene, shading) = build_scene(args)?;
+    check_output(&cmd.out)?;
+    let settings = render_settings(args, shading, cmd.frames)?;
+    let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();
     let light_count = scene.lights.len();
     let object_textures = !scene.textures.is_empty();
@@ -227,8 +259,8 @@ fn render(args: &RenderArgs) -> Result<()> {
     let device = format!("{} ({}, {} {})", ctx.info.name, ctx.info.type_name(), ctx.info.driver_name, ctx.info.driver_info);
     drop(ctx);
     let output = result?;
-    image::save_buffer_with_format(&args.out, &output.rgba, output.width, output.height, image::ColorType::Rgba8, image::ImageFormat::Png)
-        .with_context(|| format!("cannot write '{}'", args.out.display()))?;
+    image::save_buffer_with_format(&cmd.out, &output.rgba, output.width, output.height, image::ColorType::Rgba8, image::ImageFormat::Png)
+        .with_context(|| format!("cannot write '{}'", cmd.out.display()))?;
     let stats = &output.stats;
     let mut rows = vec![
         ("device", device),
@@ -282,13 +314,80 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     rows.push(("cpu ms/frame", format!("{:.3}  (update + assign + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
-    rows.push(("output", args.out.display().to_string()));
+    rows.push(("output", cmd.out.display().to_string()));
     print!("{}", table(&rows));
     let count = messages.load(Ordering::SeqCst);
     if count > 0 {
         bail!("the validation layer reported {count} message(s) (printed above)");
     }
     Ok(())
+}
+
+fn view(cmd: &ViewArgs) -> Result<()> {
+    let args = &cmd.scene;
+    let script = match &cmd.script {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).with_context(|| format!("cannot read script '{}'", path.display()))?;
+            Some(ml_viewer::script::parse(&text).map_err(|e| anyhow::anyhow!("script '{}': {e}", path.display()))?)
+        }
+        None => None,
+    };
+    // Checked once up front, so that a bad argument fails before a window opens.
+    let (scene, shading) = build_scene(args)?;
+    let first = render_settings(args, shading, 1)?;
+    let choices = ml_viewer::Choices {
+        technique: first.technique,
+        shading: first.shading,
+        object: args.object.clone(),
+        material: args.material.clone(),
+        lights: scene.lights.len() as u64,
+        layout: args.light_layout.clone(),
+        radius: RadiusRange::parse(&args.light_radius)?.max,
+        clusters: first.clusters,
+        debug_view: first.debug_view,
+        omni: first.omni,
+    };
+    let initial = choices.clone();
+    // The arguments with what the overlay changed; a scene file keeps its own lights until the
+    // light count, layout or radius is changed.
+    let build = |c: &ml_viewer::Choices, (width, height): (u32, u32)| -> Result<(Scene, RenderSettings)> {
+        let mut a = args.clone();
+        a.shading = Some(c.shading.name().to_owned());
+        a.object = c.object.clone();
+        a.material = c.material.clone();
+        if (c.lights, &c.layout, c.radius) != (initial.lights, &initial.layout, initial.radius) {
+            a.lights = Some(c.lights);
+            a.light_layout = c.layout.clone();
+            if c.radius != initial.radius {
+                a.light_radius = c.radius.to_string();
+            }
+        }
+        let (scene, shading) = build_scene(&a)?;
+        let settings = RenderSettings {
+            technique: c.technique,
+            shading,
+            clusters: c.clusters,
+            debug_view: c.debug_view,
+            omni: c.omni,
+            width,
+            height,
+            frames: 1,
+            time: args.time,
+        };
+        Ok((scene, settings))
+    };
+    let options = ml_viewer::ViewerOptions {
+        choices,
+        width: args.width,
+        height: args.height,
+        vsync: !cmd.no_vsync,
+        validation: args.validation,
+        device: args.device,
+        time: args.time,
+        seed_scene: args.scene == "seed",
+        script,
+    };
+    ml_viewer::run(options, &build)
 }
 
 fn info() -> Result<()> {

@@ -17,13 +17,14 @@ use crate::settings::{DebugView, RenderSettings};
 use crate::targets::{depth_format, Output, Targets};
 use crate::tonemap::ToneMap;
 use ml_cpu::blinn_phong::shadow_view_proj;
+use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, LightCone, ObjectData, PointLight};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::omni_shadow::shadowed_lights;
 use ml_cpu::scene::Scene;
 use ml_vk::descriptors::{allocate_set, write_image};
-use ml_vk::{commands, release_on_error, vk, Buffer, Context, VkError, VkResultExt};
+use ml_vk::{commands, release_on_error, vk, Buffer, Context, Image, VkError, VkResultExt};
 use std::time::Instant;
 
 /// CPU-side cluster state of `clustered-cpu`: the assigner and this frame's lists.
@@ -108,6 +109,16 @@ const DEFAULT_HEAT_TOP: f32 = 64.0;
 /// clustered-gpu re-renders a final frame whose lists overflowed (after growing them); if it
 /// still overflows this often something is wrong, and the render fails instead of lying.
 const MAX_RERENDERS: u32 = 2;
+
+/// What a window adds to each frame (the viewer): commands recorded after the frame's passes,
+/// in the same command buffer, and the semaphores its submission waits on and signals.
+pub trait FrameHook {
+    /// Record after the frame's passes; `colour` is the frame's colour target (the image a
+    /// headless render reads back), in TRANSFER_SRC_OPTIMAL, and stays so.
+    fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer, colour: &Image) -> Result<(), VkError>;
+    /// The semaphore the submission waits on (and at which stage), and the one it signals.
+    fn semaphores(&self) -> (Option<(vk::Semaphore, vk::PipelineStageFlags)>, Option<vk::Semaphore>);
+}
 
 impl<'a> HeadlessRenderer<'a> {
     pub fn new(ctx: &'a Context, mut scene: Scene, settings: RenderSettings) -> Result<HeadlessRenderer<'a>, RenderError> {
@@ -306,7 +317,7 @@ impl<'a> HeadlessRenderer<'a> {
         let mut last = 0;
         for i in 0..self.settings.frames {
             last = i as usize % FRAMES_IN_FLIGHT;
-            self.run_frame(last, self.settings.clock(i), &mut stats)?;
+            self.run_frame(last, self.settings.clock(i), &mut stats, None)?;
         }
         self.collect_all(&mut stats)?;
         let mut rerenders = 0;
@@ -320,7 +331,7 @@ impl<'a> HeadlessRenderer<'a> {
             rerenders += 1;
             stats.rerendered_frames += 1;
             last = (last + 1) % FRAMES_IN_FLIGHT;
-            self.run_frame(last, self.settings.clock(self.settings.frames - 1), &mut stats)?;
+            self.run_frame(last, self.settings.clock(self.settings.frames - 1), &mut stats, None)?;
             self.collect_all(&mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -335,19 +346,75 @@ impl<'a> HeadlessRenderer<'a> {
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
     }
 
-    /// Wait for slot `f`, collect its results, update, record and submit a frame at clock `t`.
-    fn run_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<(), RenderError> {
+    /// The scene's camera (where the next frame is seen from).
+    pub fn camera(&self) -> Camera {
+        self.scene.camera
+    }
+
+    /// See the next frames from `camera` (the viewer's moving camera; same projection): the
+    /// cluster grid follows. clustered-gpu's view-space cluster boxes depend on the projection
+    /// only and stay.
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.scene.camera = camera;
+        self.grid = ClusterGrid::new(self.settings.clusters, self.extent.width, self.extent.height, &camera);
+    }
+
+    /// The settings it renders with.
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// Wait until the next frame slot's previous frame is done (its timings go into `stats`);
+    /// returns the slot, which `draw` renders into next.
+    pub fn wait_next_slot(&mut self, stats: &mut FrameStats) -> Result<usize, RenderError> {
+        let f = (self.last_frame + 1) % FRAMES_IN_FLIGHT;
+        self.collect(f, stats)?;
+        Ok(f)
+    }
+
+    /// Render one frame at clock `t` into the next frame slot, two in flight, with `hook`'s
+    /// commands and semaphores (the viewer presents it); the slot's previous frame's timings
+    /// go into `stats`.
+    pub fn draw(&mut self, t: f32, hook: &mut dyn FrameHook, stats: &mut FrameStats) -> Result<(), RenderError> {
+        let f = (self.last_frame + 1) % FRAMES_IN_FLIGHT;
+        self.run_frame(f, t, stats, Some(hook))?;
+        self.last_frame = f;
+        Ok(())
+    }
+
+    /// The newest frame's colour target, read back (waits for it): what `render` returns.
+    pub fn read_newest(&mut self) -> Result<Vec<u8>, RenderError> {
+        let mut stats = FrameStats::new(&self.pass_names());
+        self.collect_all(&mut stats)?;
+        Ok(self.read_back(self.last_frame)?)
+    }
+
+    /// Names of the passes whose GPU times `FrameStats` reports, in order.
+    pub fn timed_passes(&self) -> Vec<&'static str> {
+        self.pass_names()
+    }
+
+    /// Wait for slot `f`, collect its results, update, record and submit a frame at clock `t`
+    /// (with `hook`'s commands and semaphores).
+    fn run_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats, hook: Option<&mut dyn FrameHook>) -> Result<(), RenderError> {
         let ctx = self.ctx;
         let fence = self.frames[f].fence;
         self.collect(f, stats)?;
         let cpu = Instant::now();
         self.update_frame(f, t, stats)?;
-        self.record(f)?;
+        let (wait, signal) = hook.as_ref().map_or((None, None), |h| h.semaphores());
+        self.record(f, hook)?;
+        let (waits, stages): (Vec<vk::Semaphore>, Vec<vk::PipelineStageFlags>) = wait.into_iter().unzip();
+        let signals: Vec<vk::Semaphore> = signal.into_iter().collect();
         // SAFETY: the fence was waited on in `collect` and the command buffer is executable.
         unsafe {
             ctx.device.reset_fences(&[fence]).ctx("vkResetFences")?;
             let cmds = [self.frames[f].cmd];
-            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+            let submit = [vk::SubmitInfo::default()
+                .command_buffers(&cmds)
+                .wait_semaphores(&waits)
+                .wait_dst_stage_mask(&stages)
+                .signal_semaphores(&signals)];
             ctx.device.queue_submit(ctx.queue, &submit, fence).ctx("vkQueueSubmit")?;
         }
         self.pending[f] = true;
@@ -469,7 +536,7 @@ impl<'a> HeadlessRenderer<'a> {
         frame.uniforms.write(0, &[uniforms]);
     }
 
-    fn record(&mut self, f: usize) -> Result<(), VkError> {
+    fn record(&mut self, f: usize, hook: Option<&mut dyn FrameHook>) -> Result<(), VkError> {
         let ctx = self.ctx;
         let frame = &mut self.frames[f];
         let cmd = frame.cmd;
@@ -521,6 +588,9 @@ impl<'a> HeadlessRenderer<'a> {
         if let Some((view, sets)) = &self.shadow_map_view {
             // Over whatever the technique drew (untimed: a debug view).
             view.record_into_colour_target(ctx, cmd, &[sets[f], self.textures.set], targets.color.raw, self.extent);
+        }
+        if let Some(hook) = hook {
+            hook.record(ctx, cmd, &targets.color)?;
         }
         // SAFETY: recording state.
         unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")

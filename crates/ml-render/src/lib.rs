@@ -20,5 +20,8 @@ pub mod targets;
 pub mod tonemap;
 
 pub use error::RenderError;
-pub use headless::{HeadlessRenderer, RenderOutput};
-pub use settings::{DebugView, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique};
+pub use frame::FRAMES_IN_FLIGHT;
+pub use headless::{FrameHook, HeadlessRenderer, RenderOutput};
+pub use settings::{
+    DebugView, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique, FRAME_SECONDS, TIMER_SPEED,
+};

@@ -81,7 +81,7 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
 
 #[test]
 fn glsl_and_rust_slices_agree_on_random_depths() {
-    let ctx = Context::new(&ContextDesc { validation: true, device_index: None }).expect("Vulkan with validation");
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("Vulkan with validation");
     let counter = ctx.validation_counter();
     let grid = ClusterGrid::new(ClusterDims::DEFAULT, 1920, 1080, &Camera::seed());
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);

@@ -26,7 +26,7 @@ const BORDER: f32 = 1e-3;
 
 #[test]
 fn gpu_lists_equal_the_cpu_assignment_on_random_scenes() {
-    let ctx = Context::new(&ContextDesc { validation: true, device_index: None }).expect("Vulkan with validation");
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("Vulkan with validation");
     let counter = ctx.validation_counter();
     let (mut pairs, mut borderline) = (0usize, 0usize);
     for seed in 0..20 {
@@ -100,7 +100,7 @@ fn lists_larger_than_a_storage_buffer_fail_loudly() {
     // binds (128 MiB). Both builders must say so, not render short lists.
     let lights = LightParams { count: 1000, layout: LightLayout::Random, seed: 3, radius: RadiusRange::fixed(40.0) };
     let scene = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &lights).unwrap();
-    let ctx = Context::new(&ContextDesc { validation: true, device_index: None }).expect("Vulkan with validation");
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("Vulkan with validation");
     let counter = ctx.validation_counter();
     let limit = ctx.info.limits.max_storage_buffer_range as u64;
     for technique in [Technique::ClusteredCpu, Technique::ClusteredGpu] {

@@ -79,7 +79,7 @@ fn shadow_map_view_paints_the_map_and_needs_shadows() {
     greys.dedup();
     // Black where the map is empty, many greys where the floor and the spheres are.
     assert!(greys[0] == 0 && greys.len() > 20, "{} grey levels", greys.len());
-    let ctx = Context::new(&ContextDesc { validation: true, device_index: None }).expect("device");
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("device");
     let mut settings = RenderSettings::new(Technique::Forward, W, H);
     settings.debug_view = DebugView::ShadowMap;
     let err = HeadlessRenderer::new(&ctx, scene, settings).err().expect("the seed model has no shadow map").to_string();

@@ -34,7 +34,7 @@ fn settings(technique: Technique, size: u32, omni: Option<(OmniShadowMode, u32)>
 
 /// The one-pass mode this device renders right (multiview where it works, else layered).
 fn one_pass_modes() -> Vec<OmniShadowMode> {
-    let ctx = Context::new(&ContextDesc { validation: false, device_index: None }).expect("a Vulkan device");
+    let ctx = Context::new(&ContextDesc::default()).expect("a Vulkan device");
     let mut modes = vec![OmniShadowMode::Layered];
     if ctx.info.features.multiview && !multiview_depth_is_broken(&ctx) {
         modes.push(OmniShadowMode::Multiview);

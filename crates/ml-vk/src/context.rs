@@ -1,6 +1,7 @@
 //! Instance (with optional validation + synchronization validation and a debug messenger
 //! that counts messages), physical-device choice, logical device, one graphics queue, and
-//! the memory allocator.
+//! the memory allocator; for the viewer, a window's surface (the queue can present to it and
+//! the device has VK_KHR_swapchain).
 
 use crate::error::{Result, VkError, VkResultExt};
 use ash::{ext::debug_utils, vk};
@@ -20,6 +21,21 @@ pub struct ContextDesc {
     pub validation: bool,
     /// Pick this device (index in `manylights info`) instead of the best one.
     pub device_index: Option<usize>,
+    /// Present to this window: make its surface, and a device that can present to it.
+    pub window: Option<WindowHandles>,
+}
+
+/// A window's raw handles (winit's, through raw-window-handle).
+#[derive(Clone, Copy, Debug)]
+pub struct WindowHandles {
+    pub display: raw_window_handle::RawDisplayHandle,
+    pub window: raw_window_handle::RawWindowHandle,
+}
+
+/// A window's Vulkan surface.
+pub struct Surface {
+    pub loader: ash::khr::surface::Instance,
+    pub raw: vk::SurfaceKHR,
 }
 
 /// What `info` prints about a device and what the renderer checks against.
@@ -82,14 +98,20 @@ struct InstanceParts {
     instance: ash::Instance,
     debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     messages: Arc<AtomicU32>,
+    surface: Option<Surface>,
 }
 
 impl InstanceParts {
-    fn new(validation: bool) -> Result<InstanceParts> {
+    fn new(validation: bool, window: Option<WindowHandles>) -> Result<InstanceParts> {
         // SAFETY: loading the system Vulkan loader; its symbols are used through ash only.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))?;
         let mut layers = Vec::new();
         let mut extensions = Vec::new();
+        if let Some(w) = window {
+            let needed = ash_window::enumerate_required_extensions(w.display)
+                .map_err(|e| VkError::Call { what: "the window system's surface extensions", result: e })?;
+            extensions.extend_from_slice(needed);
+        }
         if validation {
             // SAFETY: plain enumeration.
             let available = unsafe { entry.enumerate_instance_layer_properties() }.ctx("vkEnumerateInstanceLayerProperties")?;
@@ -142,7 +164,27 @@ impl InstanceParts {
         } else {
             None
         };
-        Ok(InstanceParts { entry, instance, debug, messages })
+        let mut parts = InstanceParts { entry, instance, debug, messages, surface: None };
+        if let Some(w) = window {
+            // SAFETY: the handles come from a live window that outlives the context (the viewer's
+            // contract); the instance has the extensions they need.
+            match unsafe { ash_window::create_surface(&parts.entry, &parts.instance, w.display, w.window, None) } {
+                Ok(raw) => parts.surface = Some(Surface { loader: ash::khr::surface::Instance::new(&parts.entry, &parts.instance), raw }),
+                Err(e) => {
+                    parts.destroy();
+                    return Err(VkError::Call { what: "vkCreate*SurfaceKHR", result: e });
+                }
+            }
+        }
+        Ok(parts)
+    }
+
+    /// Whether queue family `family` of `pd` can present to the surface (true without one).
+    fn presents(&self, pd: vk::PhysicalDevice, family: u32) -> bool {
+        self.surface.as_ref().is_none_or(|s| {
+            // SAFETY: a physical device and surface of this instance.
+            unsafe { s.loader.get_physical_device_surface_support(pd, family, s.raw) }.unwrap_or(false)
+        })
     }
 
     fn devices(&self) -> Result<Vec<(vk::PhysicalDevice, DeviceInfo)>> {
@@ -187,13 +229,17 @@ impl InstanceParts {
             driver_name: c_text(driver.driver_name_as_c_str()),
             driver_info: c_text(driver.driver_info_as_c_str()),
             limits: props.limits,
-            suitable: props.api_version >= MIN_API && graphics_queue_family(&self.instance, pd).is_some(),
+            suitable: props.api_version >= MIN_API
+                && graphics_queue_family(&self.instance, pd).is_some_and(|(family, _)| self.presents(pd, family)),
         }
     }
 
     fn destroy(&mut self) {
         // SAFETY: called once, after every child object is gone.
         unsafe {
+            if let Some(s) = self.surface.take() {
+                s.loader.destroy_surface(s.raw, None);
+            }
             if let Some((loader, m)) = self.debug.take() {
                 loader.destroy_debug_utils_messenger(m, None);
             }
@@ -252,7 +298,7 @@ pub struct Context {
 
 /// Describe every Vulkan device (for `manylights info`).
 pub fn list_devices() -> Result<Vec<DeviceInfo>> {
-    let mut parts = InstanceParts::new(false)?;
+    let mut parts = InstanceParts::new(false, None)?;
     let devices = parts.devices().map(|d| d.into_iter().map(|(_, info)| info).collect());
     parts.destroy();
     devices
@@ -260,7 +306,7 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>> {
 
 impl Context {
     pub fn new(desc: &ContextDesc) -> Result<Context> {
-        let mut parts = InstanceParts::new(desc.validation)?;
+        let mut parts = InstanceParts::new(desc.validation, desc.window)?;
         match Self::with_instance(&parts, desc) {
             Ok((physical_device, info, device, queue_family, timestamp_valid_bits)) => {
                 // SAFETY: the device was created with one queue in this family.
@@ -325,8 +371,13 @@ impl Context {
         let core = vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array);
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
         let mut v12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(features.shader_output_layer);
-        let info_create =
-            vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut v11).push_next(&mut v12);
+        let extensions = if parts.surface.is_some() { vec![ash::khr::swapchain::NAME.as_ptr()] } else { Vec::new() };
+        let info_create = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queues)
+            .enabled_extension_names(&extensions)
+            .enabled_features(&core)
+            .push_next(&mut v11)
+            .push_next(&mut v12);
         // SAFETY: valid physical device and create info; only supported features are enabled.
         let device = unsafe { parts.instance.create_device(pd, &info_create, None) }.ctx("vkCreateDevice")?;
         Ok((pd, info, device, family, family_props.timestamp_valid_bits))
@@ -338,6 +389,11 @@ impl Context {
 
     pub fn entry(&self) -> &ash::Entry {
         &self.parts.entry
+    }
+
+    /// The window's surface (a context made with `ContextDesc::window`).
+    pub fn surface(&self) -> Option<&Surface> {
+        self.parts.surface.as_ref()
     }
 
     /// Validation messages (warnings and errors) so far, through a handle that stays readable

@@ -10,12 +10,14 @@ pub mod descriptors;
 pub mod error;
 pub mod image;
 pub mod shader;
+pub mod swapchain;
 pub mod timing;
 
 pub use ash::vk;
 pub use buffer::Buffer;
-pub use context::{Context, ContextDesc, DeviceInfo, OptionalFeatures};
+pub use context::{Context, ContextDesc, DeviceInfo, OptionalFeatures, Surface, WindowHandles};
 pub use error::{VkError, VkResultExt};
+pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageShape};
 pub use timing::GpuTimer;
 

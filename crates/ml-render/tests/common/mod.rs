@@ -20,7 +20,7 @@ pub fn render(scene: Scene, settings: RenderSettings) -> RenderOutput {
 
 /// Render the scene once per settings on one validated context; no validation message allowed.
 pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutput> {
-    let ctx = Context::new(&ContextDesc { validation: true, device_index: None })
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() })
         .expect("a Vulkan device with the validation layer (CI installs lavapipe and vulkan-validationlayers)");
     let counter = ctx.validation_counter();
     let outputs = settings
