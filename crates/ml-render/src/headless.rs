@@ -94,6 +94,8 @@ pub struct HeadlessRenderer<'a> {
     heat_top: f32,
     /// Slot of the frame that was read back last.
     last_frame: usize,
+    /// Format of the depth target (targets are made again on a resize).
+    depth_format: vk::Format,
 }
 
 /// Copies into host-visible buffers, then read by the CPU.
@@ -126,11 +128,7 @@ impl<'a> HeadlessRenderer<'a> {
         if !scene.cones.is_empty() && scene.cones.len() != scene.lights.len() {
             return Err(RenderError::Invalid(format!("the scene has {} spot cones for {} lights", scene.cones.len(), scene.lights.len())));
         }
-        // The shadowed lights carry their cube's index + 1 (PointLight::color[3]).
-        let shadowed = settings.omni.map_or(Vec::new(), |o| shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position));
-        for (cube, &i) in shadowed.iter().enumerate() {
-            scene.lights[i as usize].color[3] = (cube + 1) as f32;
-        }
+        let shadowed = mark_shadowed(&mut scene, &settings);
         let depth = depth_format(ctx, Output::of(settings.technique))?;
         let extent = vk::Extent2D { width: settings.width, height: settings.height };
         // clustered-gpu animates on the GPU; the others keep an animated copy on the CPU.
@@ -181,13 +179,77 @@ impl<'a> HeadlessRenderer<'a> {
             pending: vec![false; FRAMES_IN_FLIGHT],
             heat_top: DEFAULT_HEAT_TOP,
             last_frame: 0,
+            depth_format: depth,
         };
         // Anything made before a failure is released by Drop.
-        r.create_resources(depth)?;
+        r.create_resources()?;
+        r.create_frames()?;
         Ok(r)
     }
 
-    fn create_resources(&mut self, depth: vk::Format) -> Result<(), VkError> {
+    /// Render at `width`×`height` from now on (the viewer's window changed size): new frame
+    /// slots (targets, their descriptor sets, per-frame buffers) and cluster grid; pipelines,
+    /// meshes, textures and scene buffers stay.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        let settings = RenderSettings { width, height, ..self.settings };
+        settings.check(self.ctx, self.scene.lights.len())?;
+        self.release_frames()?;
+        self.settings = settings;
+        self.extent = vk::Extent2D { width, height };
+        self.grid = ClusterGrid::new(settings.clusters, width, height, &self.scene.camera);
+        self.create_frames()?;
+        Ok(())
+    }
+
+    /// Light the scene with `lights` from now on (the viewer's light count, layout or radius
+    /// changed): new light buffers, frame slots and, for clustered-gpu, builder; pipelines,
+    /// meshes and textures stay. Scenes with spot lights refuse (their cones belong to their
+    /// lights and are compiled into the pipelines): make a new renderer for those.
+    pub fn set_lights(&mut self, lights: Vec<PointLight>) -> Result<(), RenderError> {
+        if !self.scene.cones.is_empty() {
+            return Err(RenderError::Invalid("a scene with spot lights cannot change its lights in place".into()));
+        }
+        self.settings.check(self.ctx, lights.len())?;
+        let ctx = self.ctx;
+        self.release_frames()?;
+        if let Some(mut b) = self.builder.take() {
+            b.destroy(ctx);
+        }
+        self.scene.lights = lights;
+        self.shadowed = mark_shadowed(&mut self.scene, &self.settings);
+        self.animated = if self.settings.technique.is_gpu_built() { Vec::new() } else { self.scene.lights.clone() };
+        self.required_indices = 0;
+        if self.settings.technique.is_gpu_built() {
+            self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
+        }
+        self.create_frames()?;
+        Ok(())
+    }
+
+    /// Destroy the frame slots and what points at them (for `resize` and `set_lights`).
+    fn release_frames(&mut self) -> Result<(), VkError> {
+        let ctx = self.ctx;
+        ctx.wait_idle()?;
+        for frame in &mut self.frames {
+            frame.destroy(ctx);
+        }
+        self.frames.clear();
+        self.pending.fill(false);
+        self.overflowed.fill(false);
+        if let Some(mut b) = self.readback.take() {
+            b.destroy(ctx);
+        }
+        if let Some((_, sets)) = &mut self.shadow_map_view {
+            sets.clear();
+        }
+        // SAFETY: the device is idle and the frames that used the pool's sets are gone.
+        unsafe { ctx.device.reset_descriptor_pool(self.descriptor_pool, vk::DescriptorPoolResetFlags::empty()) }
+            .ctx("vkResetDescriptorPool")
+    }
+
+    /// What every frame shares: meshes, the shadow map, pools, the scene's buffers, the
+    /// technique's compute passes.
+    fn create_resources(&mut self) -> Result<(), VkError> {
         let ctx = self.ctx;
         for kind in self.scene.mesh_kinds() {
             let mesh = self.scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
@@ -234,6 +296,21 @@ impl<'a> HeadlessRenderer<'a> {
         let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(6 * n).pool_sizes(&sizes);
         // SAFETY: as above.
         self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
+        if matches!(self.settings.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
+            let bindings = [(0, vk::DescriptorType::STORAGE_IMAGE)];
+            // constant_id 0 (CUBE): the point-light cube instead of the sun's map.
+            let cube = [(0, u32::from(self.settings.debug_view == DebugView::ShadowCube))];
+            let pass = ComputePass::new(ctx, &bindings, &[self.textures.set_layout], (ml_shaders::DEBUG_SHADOW_MAP_COMP, &cube))?;
+            self.shadow_map_view = Some((pass, Vec::new()));
+        }
+        Ok(())
+    }
+
+    /// The frame slots (targets at the current size, their sets and buffers), the cluster
+    /// boxes of clustered-gpu and the read-back buffer.
+    fn create_frames(&mut self) -> Result<(), VkError> {
+        let ctx = self.ctx;
+        let depth = self.depth_format;
         let render_pass = self.pass.render_pass;
         let extent = self.extent;
         let output = self.pass.output;
@@ -259,14 +336,9 @@ impl<'a> HeadlessRenderer<'a> {
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
         }
-        if matches!(self.settings.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
-            let bindings = [(0, vk::DescriptorType::STORAGE_IMAGE)];
-            // constant_id 0 (CUBE): the point-light cube instead of the sun's map.
-            let cube = [(0, u32::from(self.settings.debug_view == DebugView::ShadowCube))];
-            let pass = ComputePass::new(ctx, &bindings, &[self.textures.set_layout], (ml_shaders::DEBUG_SHADOW_MAP_COMP, &cube))?;
+        if let Some((pass, _)) = &self.shadow_map_view {
             let mut sets = Vec::new();
             let layout = pass.set_layout;
-            self.shadow_map_view = Some((pass, Vec::new()));
             for frame in &self.frames {
                 let set = allocate_set(ctx, self.descriptor_pool, layout)?;
                 let target = frame.targets.as_ref().expect("made with the frame");
@@ -351,12 +423,21 @@ impl<'a> HeadlessRenderer<'a> {
         self.scene.camera
     }
 
-    /// See the next frames from `camera` (the viewer's moving camera; same projection): the
-    /// cluster grid follows. clustered-gpu's view-space cluster boxes depend on the projection
-    /// only and stay.
-    pub fn set_camera(&mut self, camera: Camera) {
+    /// See the next frames from `camera` (the viewer's moving camera): the cluster grid
+    /// follows. clustered-gpu's view-space cluster boxes depend on the projection only: made
+    /// again when it changed (field of view, near, far).
+    pub fn set_camera(&mut self, camera: Camera) -> Result<(), RenderError> {
         self.scene.camera = camera;
+        let projection = self.grid.projection;
         self.grid = ClusterGrid::new(self.settings.clusters, self.extent.width, self.extent.height, &camera);
+        if self.grid.projection != projection && self.builder.is_some() {
+            // Frame 0's uniforms carry the projection to the bounds pass: wait for its frame.
+            self.ctx.wait_idle()?;
+            self.write_uniforms(0, 0.0);
+            let set = self.frames[0].gpu.as_ref().expect("made with the builder").set;
+            self.builder.as_ref().expect("checked").compute_bounds(self.ctx, set)?;
+        }
+        Ok(())
     }
 
     /// The settings it renders with.
@@ -659,6 +740,16 @@ impl<'a> HeadlessRenderer<'a> {
         })?;
         Ok(buffer.mapped().to_vec())
     }
+}
+
+/// Pick the lights that get a shadow cube (the strongest as seen from the camera) and mark
+/// them: PointLight::color[3] = cube index + 1. Returns their indices, cube order.
+fn mark_shadowed(scene: &mut Scene, settings: &RenderSettings) -> Vec<u32> {
+    let shadowed = settings.omni.map_or(Vec::new(), |o| shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position));
+    for (cube, &i) in shadowed.iter().enumerate() {
+        scene.lights[i as usize].color[3] = (cube + 1) as f32;
+    }
+    shadowed
 }
 
 impl Drop for HeadlessRenderer<'_> {

@@ -124,8 +124,10 @@ struct Session<'c> {
     egui_winit: egui_winit::State,
     command_pool: vk::CommandPool,
     control: FirstPerson,
-    /// Right mouse button held: mouse motion turns the camera.
+    /// Right mouse button held: mouse motion turns the camera (the last cursor position).
     looking: Option<(f64, f64)>,
+    /// Mouse motion while looking since the last frame (pixels).
+    drag: (f64, f64),
     clock: f32,
     fixed_time: Option<f32>,
     vsync: bool,
@@ -137,6 +139,20 @@ struct Session<'c> {
     screenshot: Option<std::path::PathBuf>,
     window_shot: Option<std::path::PathBuf>,
     quit: bool,
+    counts: Counts,
+}
+
+/// What a session did (printed at the end of a scripted one).
+#[derive(Default, Debug)]
+struct Counts {
+    frames: u32,
+    swapchains: u32,
+    resizes: u32,
+    /// Light changes made in place (new light buffers, same pipelines).
+    light_changes: u32,
+    renderers: u32,
+    /// Loop turns without a frame: the window was minimised or had no area.
+    paused_turns: u32,
 }
 
 impl<'c> Session<'c> {
@@ -169,6 +185,7 @@ impl<'c> Session<'c> {
             command_pool,
             control: FirstPerson::default(),
             looking: None,
+            drag: (0.0, 0.0),
             clock: options.time.unwrap_or(0.0),
             fixed_time: options.time,
             vsync: options.vsync,
@@ -179,9 +196,18 @@ impl<'c> Session<'c> {
             screenshot: None,
             window_shot: None,
             quit: false,
+            counts: Counts { swapchains: 1, ..Counts::default() },
         };
+        let scripted = !session.script.is_empty();
         let result = session.main_loop(event_loop, events, build);
         session.release();
+        if scripted && result.is_ok() {
+            let c = &session.counts;
+            println!(
+                "view: {} frames, {} swapchains, {} renderer resizes, {} light changes, {} renderers, {} turns paused",
+                c.frames, c.swapchains, c.resizes, c.light_changes, c.renderers, c.paused_turns
+            );
+        }
         result
     }
 
@@ -214,12 +240,14 @@ impl<'c> Session<'c> {
             last = now;
             let size = window.inner_size();
             if self.minimized || size.width == 0 || size.height == 0 {
+                self.counts.paused_turns += 1;
                 continue;
             }
             if self.swapchain_stale || self.presenter.swapchain.extent != (vk::Extent2D { width: size.width, height: size.height }) {
                 self.ctx.wait_idle()?;
                 self.presenter.recreate(self.ctx, vk::Extent2D { width: size.width, height: size.height }, self.vsync)?;
                 self.swapchain_stale = false;
+                self.counts.swapchains += 1;
             }
             let extent = self.presenter.swapchain.extent;
             // A renderer for the current choices at the window's size.
@@ -227,13 +255,22 @@ impl<'c> Session<'c> {
                 let s = r.settings();
                 (s.width, s.height) == (extent.width, extent.height)
             });
-            if !fits || self.choices_changed() {
+            let changed = self.choices_changed();
+            if let (Some(r), false) = (&mut self.renderer, fits) {
+                // A new size needs new targets, not new pipelines.
+                r.resize(extent.width, extent.height)?;
+                self.counts.resizes += 1;
+            }
+            if changed && !(self.lights_only_change() && self.change_lights(build, extent)) {
                 camera = self.renderer.as_ref().map(|r| r.camera()).or(camera);
                 self.rebuild(build, extent, camera)?;
             }
             let renderer = self.renderer.as_mut().expect("made above");
+            if self.drag != (0.0, 0.0) {
+                renderer.set_camera(self.control.turned(renderer.camera(), std::mem::take(&mut self.drag)))?;
+            }
             if self.control.keys != camera_control::MoveKeys::default() {
-                renderer.set_camera(self.control.moved(renderer.camera(), seconds));
+                renderer.set_camera(self.control.moved(renderer.camera(), seconds))?;
             }
             if !self.overlay.paused && self.fixed_time.is_none() {
                 self.clock += seconds * TIMER_SPEED;
@@ -248,6 +285,24 @@ impl<'c> Session<'c> {
         self.built.as_ref() != Some(&self.choices)
     }
 
+    /// Whether only the lights (count, layout, radius) changed.
+    fn lights_only_change(&self) -> bool {
+        self.built
+            .as_ref()
+            .is_some_and(|b| Choices { lights: b.lights, layout: b.layout.clone(), radius: b.radius, ..self.choices.clone() } == *b)
+    }
+
+    /// New lights for the current renderer, in place; false if it cannot (a new renderer then).
+    fn change_lights(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
+        let Some(renderer) = &mut self.renderer else { return false };
+        let changed = build(&self.choices, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_lights(scene.lights)?));
+        if changed.is_ok() {
+            self.built = Some(self.choices.clone());
+            self.counts.light_changes += 1;
+        }
+        changed.is_ok()
+    }
+
     /// A renderer for the current choices at `extent`, seen from `camera` if given (the
     /// scene's own camera otherwise). A new scene, pipelines and targets: what a changed
     /// technique, model, light count or size needs. If the choices cannot be rendered, the
@@ -258,13 +313,14 @@ impl<'c> Session<'c> {
         let made = build(&self.choices, (extent.width, extent.height)).and_then(|(scene, settings)| {
             let mut r = HeadlessRenderer::new(self.ctx, scene, settings)?;
             if let Some(c) = camera {
-                r.set_camera(c);
+                r.set_camera(c)?;
             }
             Ok(r)
         });
         match (made, self.built.clone()) {
             (Ok(r), _) => {
                 self.renderer = Some(r);
+                self.counts.renderers += 1;
                 self.built = Some(self.choices.clone());
                 self.overlay.error = None;
                 Ok(())
@@ -287,7 +343,8 @@ impl<'c> Session<'c> {
             WindowEvent::CloseRequested => self.quit = true,
             WindowEvent::Resized(size) => {
                 self.minimized = size.width == 0 || size.height == 0;
-                self.swapchain_stale = true;
+                let current = self.presenter.swapchain.extent;
+                self.swapchain_stale |= (size.width, size.height) != (current.width, current.height);
             }
             WindowEvent::Occluded(hidden) => self.minimized = *hidden,
             WindowEvent::KeyboardInput { event: key, .. } if !taken => {
@@ -313,8 +370,9 @@ impl<'c> Session<'c> {
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if let Some((x, y)) = self.looking {
-                    if let (Some(r), false) = (&mut self.renderer, x.is_nan()) {
-                        r.set_camera(self.control.turned(r.camera(), (position.x - x, position.y - y)));
+                    if !x.is_nan() {
+                        self.drag.0 += position.x - x;
+                        self.drag.1 += position.y - y;
                     }
                     self.looking = Some((position.x, position.y));
                 }
@@ -405,6 +463,7 @@ impl<'c> Session<'c> {
         };
         let t = self.clock;
         renderer.draw(t, &mut hook, &mut stats)?;
+        self.counts.frames += 1;
         if !self.presenter.swapchain.present(self.ctx, image, self.presenter.rendered_semaphore(image))? {
             self.swapchain_stale = true;
         }

@@ -1,0 +1,108 @@
+//! `manylights view` under a virtual X server (Xvfb, installed by scripts/setup.sh) on
+//! lavapipe, with validation and synchronization validation on (issue 8): a scripted session
+//! — frames, a technique switch, a new light count, 20 resizes, minimise/restore, screenshots,
+//! quit — runs without a message, and its screenshot equals `manylights render` of the same
+//! settings.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("manylights-viewer-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_manylights")
+}
+
+/// `manylights view ARGS` in a fresh virtual X server (xvfb-run picks a free display).
+fn view_under_xvfb(args: &[&str]) -> Output {
+    let found = Command::new("xvfb-run").arg("--help").output();
+    assert!(found.is_ok(), "xvfb-run is missing: run scripts/setup.sh (it installs xvfb and xauth)");
+    Command::new("xvfb-run").args(["-a", "-s", "-screen 0 1280x800x24", bin(), "view"]).args(args).output().expect("run xvfb-run")
+}
+
+fn rgba(path: &Path) -> (u32, u32, Vec<u8>) {
+    let image = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8();
+    (image.width(), image.height(), image.into_raw())
+}
+
+/// The session of the issue's first acceptance point, then its second: the screenshot (the
+/// rendered image, no overlay) against `render` with the same technique, lights, size and
+/// clock.
+#[test]
+fn a_scripted_session_is_validation_clean_and_its_screenshot_equals_render() {
+    let d = dir();
+    let (shot, window_shot, rendered) = (d.join("shot.png"), d.join("window.png"), d.join("render.png"));
+    let mut script =
+        vec!["frames 3".to_owned(), "technique clustered-cpu".into(), "frames 2".into(), "lights 500".into(), "frames 2".into()];
+    script.extend(["technique deferred-compute".to_owned(), "frames 2".into()]);
+    for i in 0..20 {
+        script.push(format!("resize {} {}", 240 + 16 * i, 320 - 8 * i));
+        script.push("frames 2".into());
+    }
+    script.extend(["resize 320 180".to_owned(), "frames 4".into(), "minimize".into(), "frames 5".into(), "restore".into()]);
+    script.extend(["frames 5".to_owned(), "technique deferred".into(), "frames 3".into()]);
+    script.push(format!("screenshot {}", shot.display()));
+    script.push(format!("window-shot {}", window_shot.display()));
+    // The README's picture (docs/viewer.png is a copy of it): the overlay at a readable size.
+    let readme = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer-window.png");
+    script.extend(["resize 960 540".to_owned(), "frames 3".into(), format!("window-shot {}", readme.display()), "quit".into()]);
+    let script_file = d.join("session.txt");
+    std::fs::write(&script_file, script.join("\n")).unwrap();
+    let common = ["--width", "320", "--height", "180", "--time", "0"];
+    let mut args = vec!["--validation", "--script", script_file.to_str().unwrap()];
+    args.extend(common);
+    let out = view_under_xvfb(&args);
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "the session failed: {stdout}{stderr}");
+    assert!(!stderr.contains("VALIDATION") && !stderr.contains("panicked"), "{stderr}");
+    // What it did: every resize reached the renderer as new targets, not a new renderer.
+    let summary = stdout.lines().find(|l| l.starts_with("view: ")).unwrap_or_else(|| panic!("no summary: {stdout}"));
+    let numbers: Vec<u32> = summary.split(|c: char| !c.is_ascii_digit()).filter_map(|w| w.parse().ok()).collect();
+    let [frames, swapchains, resizes, light_changes, renderers, _paused] = numbers[..] else { panic!("{summary}") };
+    // Renderers: the first and one per technique switch; the light count changes in place.
+    assert!(frames >= 70 && swapchains >= 22 && resizes >= 21 && light_changes == 1 && renderers == 4, "{summary}");
+
+    let mut render = vec!["render", "--technique", "deferred", "--lights", "500", "--out", rendered.to_str().unwrap()];
+    render.extend(common);
+    let r = Command::new(bin()).args(&render).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let (a, b) = (rgba(&shot), rgba(&rendered));
+    assert_eq!((a.0, a.1), (b.0, b.1));
+    let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    assert!(worst <= 1, "the viewer's screenshot differs from render by {worst}/255");
+    // The window as presented: the same image under the overlay, whose panel sits top left.
+    let w = rgba(&window_shot);
+    assert_eq!((w.0, w.1), (320, 180));
+    let overlaid = (0..180u32)
+        .flat_map(|y| (0..60u32).map(move |x| ((y * 320 + x) * 4) as usize))
+        .filter(|&i| w.2[i..i + 3].iter().zip(&a.2[i..i + 3]).any(|(p, q)| p.abs_diff(*q) > 1))
+        .count();
+    assert!(overlaid > 2000, "no overlay in the window's top-left corner ({overlaid} pixels differ)");
+    assert_eq!(rgba(&readme).0, 960);
+}
+
+/// A script with a mistake is refused before a window opens: one error line naming the line.
+#[test]
+fn a_broken_script_is_one_error_line() {
+    let d = dir();
+    let file = d.join("broken.txt");
+    std::fs::write(&file, "frames 2\nteleport 3\n").unwrap();
+    let out = Command::new(bin()).args(["view", "--script", file.to_str().unwrap()]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.lines().count() == 1 && stderr.contains("line 2") && stderr.contains("teleport"), "{stderr}");
+}
+
+/// No window system: one error line saying what to do, not a panic.
+#[test]
+fn without_a_display_view_is_one_error_line() {
+    let out =
+        Command::new(bin()).arg("view").env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY").env_remove("WAYLAND_SOCKET").output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.lines().count() == 1 && stderr.contains("cannot open a window") && stderr.contains("xvfb-run"), "{stderr}");
+}
