@@ -187,18 +187,50 @@ impl<'a> HeadlessRenderer<'a> {
         Ok(r)
     }
 
-    /// Render at `width`×`height` from now on (the viewer's window changed size): new frame
-    /// slots (targets, their descriptor sets, per-frame buffers) and cluster grid; pipelines,
-    /// meshes, textures and scene buffers stay.
-    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
-        let settings = RenderSettings { width, height, ..self.settings };
+    /// Render with `settings` from now on where they differ from the current ones only in
+    /// what the pipelines do not depend on — size, cluster grid, debug view, frames, clock —
+    /// and say so (true); false, changing nothing, for anything else (make a new renderer).
+    /// New frame slots (targets, their sets, per-frame buffers), cluster grid, clustered-gpu
+    /// builder for a new grid, tone map and shadow-map view for a new debug view; pipelines,
+    /// meshes, textures and the scene's buffers stay (the viewer's resizes and overlay).
+    pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<bool, RenderError> {
+        let same_pipelines = RenderSettings {
+            width: self.settings.width,
+            height: self.settings.height,
+            clusters: self.settings.clusters,
+            debug_view: self.settings.debug_view,
+            frames: self.settings.frames,
+            time: self.settings.time,
+            ..settings
+        } == self.settings;
+        if !same_pipelines {
+            return Ok(false);
+        }
         settings.check(self.ctx, self.scene.lights.len())?;
+        let ctx = self.ctx;
         self.release_frames()?;
+        let (new_grid, new_view) = (settings.clusters != self.settings.clusters, settings.debug_view != self.settings.debug_view);
         self.settings = settings;
-        self.extent = vk::Extent2D { width, height };
-        self.grid = ClusterGrid::new(settings.clusters, width, height, &self.scene.camera);
+        self.extent = vk::Extent2D { width: settings.width, height: settings.height };
+        self.grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
+        if new_grid {
+            if let Some(mut b) = self.builder.take() {
+                b.destroy(ctx);
+                self.required_indices = 0;
+                self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, settings.clusters.count())?);
+            }
+        }
+        if new_view {
+            if let Some(mut t) = self.tonemap.take() {
+                t.destroy(ctx);
+            }
+            if let Some((mut view, _)) = self.shadow_map_view.take() {
+                view.destroy(ctx);
+            }
+            self.create_view_passes()?;
+        }
         self.create_frames()?;
-        Ok(())
+        Ok(true)
     }
 
     /// Light the scene with `lights` from now on (the viewer's light count, layout or radius
@@ -276,10 +308,7 @@ impl<'a> HeadlessRenderer<'a> {
         if self.settings.technique.lights_in_compute() {
             self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting(&self.scene))?);
         }
-        if self.settings.technique.lights_in_subpass() {
-            let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);
-            self.tonemap = Some(ToneMap::new(ctx, self.settings.shading == ShadingModel::Pbr && !surface_view)?);
-        }
+        self.create_view_passes()?;
         // Per frame at most: the shading set (1 uniform + 5 storage: lights, cluster ranges and
         // indices, objects, cones), the build set (1 uniform + 8 storage), the lighting set
         // (1 uniform, 5 storage, 4 sampled images, 1 storage image), the subpass input set (4
@@ -296,6 +325,17 @@ impl<'a> HeadlessRenderer<'a> {
         let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(6 * n).pool_sizes(&sizes);
         // SAFETY: as above.
         self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
+        Ok(())
+    }
+
+    /// The passes the debug view decides: the tone map (pbr's curve, not for surface views) of
+    /// the subpass techniques and the shadow-map view's compute pass.
+    fn create_view_passes(&mut self) -> Result<(), VkError> {
+        let ctx = self.ctx;
+        if self.settings.technique.lights_in_subpass() {
+            let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);
+            self.tonemap = Some(ToneMap::new(ctx, self.settings.shading == ShadingModel::Pbr && !surface_view)?);
+        }
         if matches!(self.settings.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
             let bindings = [(0, vk::DescriptorType::STORAGE_IMAGE)];
             // constant_id 0 (CUBE): the point-light cube instead of the sun's map.

@@ -1,17 +1,19 @@
-//! What the viewer changes in a live renderer (issue 8): a new size (new targets and frame
-//! slots) and new lights (new light buffers, frame slots and clustered-gpu builder) must give
-//! exactly the image a renderer made for them from the start gives — in every technique, with
-//! validation on — and moving the camera must match a renderer made at that camera.
+//! What the viewer changes in a live renderer (issue 8): a new size, cluster grid and debug
+//! view (new targets, frame slots, clustered-gpu builder, tone map) and new lights (new light
+//! buffers, frame slots and builder) must give exactly the image a renderer made for them
+//! from the start gives — in every technique, with validation on — and moving the camera must
+//! match a renderer made at that camera.
 
 mod common;
 
 use glam::Vec3;
 use ml_cpu::camera::Camera;
+use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
-use ml_render::{HeadlessRenderer, RenderSettings, Technique};
+use ml_render::{DebugView, HeadlessRenderer, RenderSettings, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -29,7 +31,22 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
         let settings = |w, h| RenderSettings { frames: 2, ..RenderSettings::new(technique, w, h) };
         let mut live = HeadlessRenderer::new(&ctx, seed_scene(&LightParams::seed_default()), settings(96, 64)).expect("renderer");
         live.render().expect("render");
-        live.resize(120, 80).expect("resize");
+        let mut resized = RenderSettings { clusters: ClusterDims { x: 8, y: 6, z: 12 }, ..settings(120, 80) };
+        assert!(live.reconfigure(resized).expect("resize"), "a new size and grid keep the pipelines");
+        resized.clusters = ClusterDims::DEFAULT;
+        assert!(live.reconfigure(resized).expect("the grid back"));
+        assert!(
+            !live.reconfigure(RenderSettings { shading: ShadingModel::Pbr, ..resized }).expect("a new model"),
+            "a new model needs new pipelines"
+        );
+        // A debug view and back (the subpass techniques swap their tone map).
+        let depth_view = RenderSettings { debug_view: DebugView::Depth, ..resized };
+        assert!(live.reconfigure(depth_view).expect("a debug view"));
+        let depth = live.render().expect("render the depth view");
+        let fresh_depth =
+            HeadlessRenderer::new(&ctx, seed_scene(&LightParams::seed_default()), depth_view).and_then(|mut r| r.render()).unwrap();
+        assert_eq!(common::max_difference(&depth, &fresh_depth).0, 0, "{}: the depth view after reconfigure", technique.name());
+        assert!(live.reconfigure(resized).expect("no debug view"));
         live.set_lights(many.build().unwrap()).expect("new lights");
         let changed = live.render().expect("render after the changes");
         live.set_camera(camera).expect("move");

@@ -148,8 +148,8 @@ struct Counts {
     frames: u32,
     swapchains: u32,
     resizes: u32,
-    /// Light changes made in place (new light buffers, same pipelines).
-    light_changes: u32,
+    /// Overlay changes made in place (new lights, grid or debug view; same pipelines).
+    changes_in_place: u32,
     renderers: u32,
     /// Loop turns without a frame: the window was minimised or had no area.
     paused_turns: u32,
@@ -204,8 +204,8 @@ impl<'c> Session<'c> {
         if scripted && result.is_ok() {
             let c = &session.counts;
             println!(
-                "view: {} frames, {} swapchains, {} renderer resizes, {} light changes, {} renderers, {} turns paused",
-                c.frames, c.swapchains, c.resizes, c.light_changes, c.renderers, c.paused_turns
+                "view: {} frames, {} swapchains, {} renderer resizes, {} changes in place, {} renderers, {} turns paused",
+                c.frames, c.swapchains, c.resizes, c.changes_in_place, c.renderers, c.paused_turns
             );
         }
         result
@@ -258,10 +258,10 @@ impl<'c> Session<'c> {
             let changed = self.choices_changed();
             if let (Some(r), false) = (&mut self.renderer, fits) {
                 // A new size needs new targets, not new pipelines.
-                r.resize(extent.width, extent.height)?;
+                r.reconfigure(RenderSettings { width: extent.width, height: extent.height, ..*r.settings() })?;
                 self.counts.resizes += 1;
             }
-            if changed && !(self.lights_only_change() && self.change_lights(build, extent)) {
+            if changed && !self.change_in_place(build, extent) {
                 camera = self.renderer.as_ref().map(|r| r.camera()).or(camera);
                 self.rebuild(build, extent, camera)?;
             }
@@ -285,22 +285,27 @@ impl<'c> Session<'c> {
         self.built.as_ref() != Some(&self.choices)
     }
 
-    /// Whether only the lights (count, layout, radius) changed.
-    fn lights_only_change(&self) -> bool {
-        self.built
-            .as_ref()
-            .is_some_and(|b| Choices { lights: b.lights, layout: b.layout.clone(), radius: b.radius, ..self.choices.clone() } == *b)
-    }
-
-    /// New lights for the current renderer, in place; false if it cannot (a new renderer then).
-    fn change_lights(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
-        let Some(renderer) = &mut self.renderer else { return false };
-        let changed = build(&self.choices, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_lights(scene.lights)?));
-        if changed.is_ok() {
+    /// Apply the changed choices to the current renderer where they allow it: new lights
+    /// (count, layout, radius) or a new cluster grid or debug view. False if they do not (or
+    /// it failed): a new renderer then.
+    fn change_in_place(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
+        let (Some(renderer), Some(built)) = (&mut self.renderer, &self.built) else { return false };
+        let c = &self.choices;
+        let lights_only = Choices { lights: built.lights, layout: built.layout.clone(), radius: built.radius, ..c.clone() } == *built;
+        let settings_only = Choices { clusters: built.clusters, debug_view: built.debug_view, ..c.clone() } == *built;
+        let done = if lights_only {
+            build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_lights(scene.lights)?)).is_ok()
+        } else if settings_only {
+            let settings = RenderSettings { clusters: c.clusters, debug_view: c.debug_view, ..*renderer.settings() };
+            matches!(renderer.reconfigure(settings), Ok(true))
+        } else {
+            false
+        };
+        if done {
             self.built = Some(self.choices.clone());
-            self.counts.light_changes += 1;
+            self.counts.changes_in_place += 1;
         }
-        changed.is_ok()
+        done
     }
 
     /// A renderer for the current choices at `extent`, seen from `camera` if given (the
