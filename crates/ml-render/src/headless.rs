@@ -283,14 +283,7 @@ impl<'a> HeadlessRenderer<'a> {
     /// technique's compute passes.
     fn create_resources(&mut self) -> Result<(), VkError> {
         let ctx = self.ctx;
-        for kind in self.scene.mesh_kinds() {
-            let mesh = self.scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
-            self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
-        }
-        if self.settings.shading == ShadingModel::BlinnPhong {
-            let inputs = ShadowInputs { scene: &self.scene, meshes: &self.meshes, view_proj: self.shadow_view_proj };
-            self.textures.render_shadow_map(ctx, &inputs)?;
-        }
+        self.upload_objects()?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -299,9 +292,7 @@ impl<'a> HeadlessRenderer<'a> {
         if self.settings.technique.is_gpu_built() {
             self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
         }
-        let objects: Vec<ObjectData> = self.scene.objects.iter().map(object_data).collect();
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        self.objects = Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), usage)?);
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if self.scene.cones.is_empty() { vec![LightCone::NONE] } else { self.scene.cones.clone() };
         self.cones = Some(Buffer::device_local_with(ctx, "light cones", bytemuck::cast_slice(&cones), usage)?);
@@ -326,6 +317,53 @@ impl<'a> HeadlessRenderer<'a> {
         // SAFETY: as above.
         self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
         Ok(())
+    }
+
+    /// The scene's objects on the GPU: its meshes, the object buffer, and (blinn-phong) the
+    /// sun's shadow map of them.
+    fn upload_objects(&mut self) -> Result<(), VkError> {
+        let ctx = self.ctx;
+        for kind in self.scene.mesh_kinds() {
+            let mesh = self.scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
+            self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
+        }
+        let objects: Vec<ObjectData> = self.scene.objects.iter().map(object_data).collect();
+        self.objects =
+            Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?);
+        if self.settings.shading == ShadingModel::BlinnPhong {
+            let inputs = ShadowInputs { scene: &self.scene, meshes: &self.meshes, view_proj: self.shadow_view_proj };
+            self.textures.render_shadow_map(ctx, &inputs)?;
+        }
+        Ok(())
+    }
+
+    /// Draw `scene`'s objects (and meshes) from now on, lights and camera unchanged (the
+    /// viewer's object and material combos): new meshes, object buffer, sun shadow map and
+    /// frame slots; pipelines stay. False, changing nothing, where either scene has object
+    /// textures (their sets and the pipelines' texture code depend on them).
+    pub fn set_objects(&mut self, scene: &Scene) -> Result<bool, RenderError> {
+        let Some(&stand_ins) = self.object_textures.per_object.first() else { return Ok(false) };
+        if !scene.textures.is_empty() || !self.scene.textures.is_empty() {
+            return Ok(false);
+        }
+        let ctx = self.ctx;
+        self.release_frames()?;
+        for mesh in &mut self.meshes {
+            mesh.destroy(ctx);
+        }
+        self.meshes.clear();
+        if let Some(mut b) = self.objects.take() {
+            b.destroy(ctx);
+        }
+        self.scene.objects = scene.objects.clone();
+        self.scene.meshes = scene.meshes.clone();
+        let (lo, hi) = self.scene.bounds();
+        self.shadow_view_proj = shadow_view_proj(lo, hi, self.scene.blinn_phong.sun_direction);
+        // Without textures every object binds the one set of stand-ins.
+        self.object_textures.per_object = vec![stand_ins; self.scene.objects.len()];
+        self.upload_objects()?;
+        self.create_frames()?;
+        Ok(true)
     }
 
     /// The passes the debug view decides: the tone map (pbr's curve, not for surface views) of

@@ -1,8 +1,8 @@
 //! What the viewer changes in a live renderer (issue 8): a new size, cluster grid and debug
-//! view (new targets, frame slots, clustered-gpu builder, tone map) and new lights (new light
-//! buffers, frame slots and builder) must give exactly the image a renderer made for them
-//! from the start gives — in every technique, with validation on — and moving the camera must
-//! match a renderer made at that camera.
+//! view (new targets, frame slots, clustered-gpu builder, tone map), new lights (light
+//! buffers, frame slots, builder) and new objects (meshes, object buffer) must give exactly
+//! the image a renderer made for them from the start gives — in every technique, with
+//! validation on — and moving the camera must match a renderer made at that camera.
 
 mod common;
 
@@ -48,12 +48,15 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
         assert_eq!(common::max_difference(&depth, &fresh_depth).0, 0, "{}: the depth view after reconfigure", technique.name());
         assert!(live.reconfigure(resized).expect("no debug view"));
         live.set_lights(many.build().unwrap()).expect("new lights");
+        // The seed's "Type" and "Material" combos: teapots of copper.
+        let teapots = Scene::seed(MeshKind::Teapot, Material::named("copper").unwrap(), &many).unwrap();
+        assert!(live.set_objects(&teapots).expect("new objects"));
         let changed = live.render().expect("render after the changes");
         live.set_camera(camera).expect("move");
         let moved = live.render().expect("render after moving");
         drop(live);
         let fresh = |camera: Option<Camera>| {
-            let mut scene = seed_scene(&many);
+            let mut scene = teapots.clone();
             if let Some(c) = camera {
                 scene.camera = c;
             }

@@ -148,7 +148,7 @@ struct Counts {
     frames: u32,
     swapchains: u32,
     resizes: u32,
-    /// Overlay changes made in place (new lights, grid or debug view; same pipelines).
+    /// Overlay changes made in place (new lights, objects, grid or debug view; same pipelines).
     changes_in_place: u32,
     renderers: u32,
     /// Loop turns without a frame: the window was minimised or had no area.
@@ -286,15 +286,18 @@ impl<'c> Session<'c> {
     }
 
     /// Apply the changed choices to the current renderer where they allow it: new lights
-    /// (count, layout, radius) or a new cluster grid or debug view. False if they do not (or
-    /// it failed): a new renderer then.
+    /// (count, layout, radius), objects (kind, material), cluster grid or debug view. False if
+    /// they do not (or it failed): a new renderer then.
     fn change_in_place(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
         let (Some(renderer), Some(built)) = (&mut self.renderer, &self.built) else { return false };
         let c = &self.choices;
         let lights_only = Choices { lights: built.lights, layout: built.layout.clone(), radius: built.radius, ..c.clone() } == *built;
         let settings_only = Choices { clusters: built.clusters, debug_view: built.debug_view, ..c.clone() } == *built;
+        let objects_only = Choices { object: built.object.clone(), material: built.material.clone(), ..c.clone() } == *built;
         let done = if lights_only {
             build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_lights(scene.lights)?)).is_ok()
+        } else if objects_only {
+            matches!(build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_objects(&scene)?)), Ok(true))
         } else if settings_only {
             let settings = RenderSettings { clusters: c.clusters, debug_view: c.debug_view, ..*renderer.settings() };
             matches!(renderer.reconfigure(settings), Ok(true))
