@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser, Subcommand};
+use ml_cpu::bench_scene::bench_scene;
 use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 use ml_cpu::material::Material;
@@ -14,6 +15,8 @@ use ml_render::targets::gbuffer_bytes_per_pixel;
 use ml_render::{DebugView, HeadlessRenderer, OmniShadowMode, OmniShadowSettings, RenderSettings, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
+
+mod bench;
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
@@ -31,6 +34,9 @@ enum Command {
     /// Open a window on a scene: first-person camera (WASD/QE, right-drag, wheel), an overlay
     /// of settings and GPU times, P pause, F12 screenshot, Esc quit.
     View(Box<ViewArgs>),
+    /// Measure techniques × light counts: per-pass GPU time (median, p95), CPU time, lights
+    /// per cluster; writes results.csv and results.json.
+    Bench(Box<bench::BenchArgs>),
     /// List Vulkan devices, drivers, versions and the limits manylights depends on.
     Info,
 }
@@ -65,8 +71,10 @@ struct ViewArgs {
 #[derive(Args, Clone)]
 struct SceneArgs {
     /// Scene to render: seed (built in), room (a closed room with a pillar and one point light,
-    /// for point-light shadows), a scene file FILE.toml (README: "Scene files") or a glTF 2.0
-    /// file FILE.gltf|FILE.glb (rendered with pbr unless --shading says otherwise).
+    /// for point-light shadows), bench (a floor, 300 objects, --lights N (default 1024) lights
+    /// whose radius shrinks as N^(−1/3): the benchmark's), a scene file FILE.toml (README:
+    /// "Scene files") or a glTF 2.0 file FILE.gltf|FILE.glb (rendered with pbr unless
+    /// --shading says otherwise).
     #[arg(long, default_value = "seed")]
     scene: String,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
@@ -151,6 +159,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render(&args),
         Command::View(args) => view(&args),
+        Command::Bench(args) => bench::bench(&args),
         Command::Info => info(),
     };
     match result {
@@ -175,6 +184,8 @@ fn build_scene(args: &SceneArgs) -> Result<(Scene, ShadingModel)> {
     let shading = |file: Option<&str>| ShadingModel::from_name(args.shading.as_deref().or(file).unwrap_or("seed"));
     match args.scene.as_str() {
         "room" => Ok((Scene::shadow_room(), shading(None)?)),
+        // Lights uniform in the random box, their radius following the count (bench_scene.rs).
+        "bench" => Ok((bench_scene(lights(args.lights.unwrap_or(1024))?.count, args.light_seed)?, shading(None)?)),
         "seed" => {
             let model = shading(None)?;
             let scene =

@@ -6,6 +6,9 @@ pub struct FrameStats {
     pub pass_names: Vec<&'static str>,
     gpu_sum_ms: Vec<f64>,
     gpu_frames: u32,
+    /// Every frame's GPU ms per pass and CPU ms, in the order the frames finished.
+    gpu_samples: Vec<Vec<f64>>,
+    cpu_samples: Vec<f64>,
     cpu_sum_ms: f64,
     assign_sum_ms: f64,
     assign_frames: u32,
@@ -33,6 +36,8 @@ impl FrameStats {
             pass_names: pass_names.to_vec(),
             gpu_sum_ms: vec![0.0; pass_names.len()],
             gpu_frames: 0,
+            gpu_samples: Vec::new(),
+            cpu_samples: Vec::new(),
             cpu_sum_ms: 0.0,
             assign_sum_ms: 0.0,
             assign_frames: 0,
@@ -51,6 +56,7 @@ impl FrameStats {
             *sum += v;
         }
         self.gpu_frames += 1;
+        self.gpu_samples.push(ms.to_vec());
     }
 
     pub fn add_assign_ms(&mut self, ms: f64) {
@@ -65,6 +71,19 @@ impl FrameStats {
 
     pub fn add_cpu_ms(&mut self, ms: f64) {
         self.cpu_sum_ms += ms;
+        self.cpu_samples.push(ms);
+    }
+
+    /// Median, 95th percentile and mean GPU ms of each pass over the frames after the first
+    /// `skip` (warm-up); None without timestamps or frames.
+    pub fn gpu_spread(&self, skip: usize) -> Option<Vec<(&'static str, Spread)>> {
+        let frames = self.gpu_samples.get(skip..).filter(|f| !f.is_empty())?;
+        Some(self.pass_names.iter().enumerate().map(|(i, n)| (*n, Spread::of(frames.iter().map(|f| f[i]).collect()))).collect())
+    }
+
+    /// The same for the CPU time per frame (update, assign, record, submit).
+    pub fn cpu_spread(&self, skip: usize) -> Option<Spread> {
+        self.cpu_samples.get(skip..).filter(|s| !s.is_empty()).map(|s| Spread::of(s.to_vec()))
     }
 
     pub fn gpu_ms(&self) -> PassTimes {
@@ -82,8 +101,46 @@ impl FrameStats {
     }
 }
 
+/// Median, 95th percentile (nearest rank) and mean of some samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spread {
+    pub median: f64,
+    pub p95: f64,
+    pub mean: f64,
+}
+
+impl Spread {
+    /// Of a non-empty list.
+    pub fn of(mut samples: Vec<f64>) -> Spread {
+        samples.sort_by(f64::total_cmp);
+        let rank = |q: f64| samples[((q * samples.len() as f64).ceil() as usize).clamp(1, samples.len()) - 1];
+        Spread { median: rank(0.5), p95: rank(0.95), mean: samples.iter().sum::<f64>() / samples.len() as f64 }
+    }
+}
+
 /// The table `manylights render` prints.
 pub fn table(rows: &[(&str, String)]) -> String {
     let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
     rows.iter().map(|(k, v)| format!("{k:<width$}  {v}\n")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spreads_take_nearest_ranks_and_skip_the_warm_up() {
+        let s = Spread::of((1..=20).rev().map(f64::from).collect());
+        assert_eq!((s.median, s.p95, s.mean), (10.0, 19.0, 10.5));
+        let mut stats = FrameStats::new(&["a", "b"]);
+        for i in 0..5 {
+            stats.add_gpu(&[100.0 * f64::from(i == 0), f64::from(i)]);
+            stats.add_cpu_ms(f64::from(i));
+        }
+        let gpu = stats.gpu_spread(1).unwrap();
+        assert_eq!(gpu[0], ("a", Spread { median: 0.0, p95: 0.0, mean: 0.0 }));
+        assert_eq!(gpu[1].1.median, 2.0);
+        assert_eq!(stats.cpu_spread(1).unwrap().p95, 4.0);
+        assert!(stats.gpu_spread(5).is_none());
+    }
 }

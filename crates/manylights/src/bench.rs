@@ -1,0 +1,232 @@
+//! `manylights bench` (issue 9): every technique × light count on one scene, per-pass GPU
+//! time (median, p95, mean over the frames after the warm-up), CPU time per frame and lights
+//! per cluster, written to results.csv and results.json. A combination whose frames would take
+//! longer than the budget (estimated from one frame) is skipped and says so.
+
+use crate::{build_scene, render_settings, SceneArgs};
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, Parser};
+use ml_render::report::Spread;
+use ml_render::{HeadlessRenderer, RenderOutput, Technique};
+use ml_vk::{Context, ContextDesc};
+use serde_json::{json, Value};
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Scene: bench (a floor, 300 objects, lights whose radius shrinks as N^(−1/3)), seed,
+    /// room, FILE.toml, FILE.gltf|FILE.glb.
+    #[arg(long, default_value = "bench")]
+    scene: String,
+    /// Techniques, comma-separated.
+    #[arg(long, default_value = "forward,clustered-cpu,clustered-gpu,deferred,deferred-clustered,deferred-compute")]
+    techniques: String,
+    /// Light counts, comma-separated; k and M multiply by 1,000 and 1,000,000.
+    #[arg(long, default_value = "1k,16k,256k,1M")]
+    lights: String,
+    #[arg(long, default_value = "1920x1080")]
+    resolution: String,
+    /// Measured frames per combination.
+    #[arg(long, default_value_t = 300)]
+    frames: u32,
+    /// Frames rendered first and not measured.
+    #[arg(long, default_value_t = 60)]
+    warmup: u32,
+    /// Skip a combination whose frames would take longer than this many seconds (estimated
+    /// from one frame).
+    #[arg(long, default_value_t = 120.0)]
+    budget_s: f64,
+    /// Shading model (default: the scene's, else seed).
+    #[arg(long)]
+    shading: Option<String>,
+    #[arg(long)]
+    validation: bool,
+    #[arg(long)]
+    device: Option<usize>,
+    /// Folder for results.csv and results.json (made if missing).
+    #[arg(long, default_value = "bench-results")]
+    out: PathBuf,
+}
+
+/// `123`, `16k`, `1M`.
+fn parse_count(text: &str) -> Result<u64> {
+    let t = text.trim();
+    let (digits, factor) = match t.chars().last() {
+        Some('k' | 'K') => (&t[..t.len() - 1], 1_000),
+        Some('m' | 'M') => (&t[..t.len() - 1], 1_000_000),
+        _ => (t, 1),
+    };
+    let n: u64 = digits.parse().with_context(|| format!("'{text}' is not a light count (e.g. 4096, 16k, 1M)"))?;
+    n.checked_mul(factor).filter(|&n| n > 0).with_context(|| format!("light count '{text}' is out of range"))
+}
+
+fn parse_resolution(text: &str) -> Result<(u32, u32)> {
+    let (w, h) = text.split_once('x').with_context(|| format!("resolution '{text}': expected WxH, e.g. 1920x1080"))?;
+    Ok((w.trim().parse().context("resolution width")?, h.trim().parse().context("resolution height")?))
+}
+
+/// The scene arguments `render` would get for one combination.
+fn scene_args(a: &BenchArgs, technique: Technique, lights: u64, (w, h): (u32, u32)) -> Result<SceneArgs> {
+    #[derive(Parser)]
+    struct Wrap {
+        #[command(flatten)]
+        scene: SceneArgs,
+    }
+    let (lights, w, h) = (lights.to_string(), w.to_string(), h.to_string());
+    let mut argv = vec!["bench", "--scene", &a.scene, "--technique", technique.name(), "--lights", &lights, "--width", &w, "--height", &h];
+    if let Some(s) = &a.shading {
+        argv.extend(["--shading", s]);
+    }
+    if a.validation {
+        argv.push("--validation");
+    }
+    Ok(Wrap::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().lines().next().unwrap_or("bad arguments")))?.scene)
+}
+
+/// One combination's result.
+struct Measured {
+    technique: Technique,
+    lights: u64,
+    /// Why it was not measured.
+    skipped: Option<String>,
+    output: Option<RenderOutput>,
+}
+
+pub fn bench(a: &BenchArgs) -> Result<()> {
+    let techniques: Vec<Technique> = a.techniques.split(',').map(|t| Technique::from_name(t.trim())).collect::<Result<_, _>>()?;
+    let counts: Vec<u64> = a.lights.split(',').map(parse_count).collect::<Result<_>>()?;
+    let resolution = parse_resolution(&a.resolution)?;
+    if a.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    if a.budget_s.is_nan() || a.budget_s <= 0.0 {
+        bail!("--budget-s must be greater than 0");
+    }
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
+    let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
+    let messages = ctx.validation_counter();
+    let bar = indicatif::ProgressBar::new((techniques.len() * counts.len()) as u64);
+    bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("a valid template"));
+    let mut results = Vec::new();
+    for &lights in &counts {
+        for &technique in &techniques {
+            bar.set_message(format!("{} at {lights} lights", technique.name()));
+            results.push(measure(&ctx, a, technique, lights, resolution)?);
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    let device = json!({
+        "name": ctx.info.name,
+        "type": ctx.info.type_name(),
+        "driver": format!("{} {}", ctx.info.driver_name, ctx.info.driver_info),
+        "vulkan": ctx.info.api_version_string(),
+    });
+    drop(ctx);
+    write_results(a, resolution, &device, &results)?;
+    let count = messages.load(Ordering::SeqCst);
+    if count > 0 {
+        bail!("the validation layer reported {count} message(s) (printed above)");
+    }
+    Ok(())
+}
+
+/// One frame to estimate the cost, then warm-up + measured frames unless over budget.
+fn measure(ctx: &Context, a: &BenchArgs, technique: Technique, lights: u64, resolution: (u32, u32)) -> Result<Measured> {
+    let args = scene_args(a, technique, lights, resolution)?;
+    let (scene, shading) = build_scene(&args)?;
+    let mut settings = render_settings(&args, shading, 1)?;
+    settings.time = None;
+    let probe = HeadlessRenderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
+    let frames = a.warmup + a.frames;
+    let estimate_s = probe.stats.wall_ms * frames as f64 / 1e3;
+    if estimate_s > a.budget_s {
+        let why = format!(
+            "skipped: {frames} frames would take about {estimate_s:.0} s (one took {:.0} ms; budget {} s)",
+            probe.stats.wall_ms, a.budget_s
+        );
+        return Ok(Measured { technique, lights, skipped: Some(why), output: None });
+    }
+    settings.frames = frames;
+    let output = HeadlessRenderer::new(ctx, scene, settings).and_then(|mut r| r.render())?;
+    Ok(Measured { technique, lights, skipped: None, output: Some(output) })
+}
+
+fn spread_json(s: &Spread) -> Value {
+    json!({ "median_ms": s.median, "p95_ms": s.p95, "mean_ms": s.mean })
+}
+
+fn write_results(a: &BenchArgs, (w, h): (u32, u32), device: &Value, results: &[Measured]) -> Result<()> {
+    let skip = a.warmup as usize;
+    let mut csv = String::from(
+        "technique,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,assign_mean_ms,lights_per_cluster_mean,lights_per_cluster_max\n",
+    );
+    let mut rows = Vec::new();
+    for m in results {
+        let head = format!("{},{},{w},{h},{}", m.technique.name(), m.lights, a.frames);
+        let Some(out) = &m.output else {
+            let why = m.skipped.clone().unwrap_or_default();
+            csv += &format!("{head},\"{why}\",,,,,,,,,\n");
+            rows.push(json!({ "technique": m.technique.name(), "lights": m.lights, "status": why }));
+            continue;
+        };
+        let stats = &out.stats;
+        let cpu = stats.cpu_spread(skip);
+        let assign = stats.assign_ms().map_or(String::new(), |ms| format!("{ms:.4}"));
+        let clusters =
+            stats.clusters.map_or((String::new(), String::new()), |c| (format!("{:.3}", c.mean_lights), c.max_lights.to_string()));
+        let passes = stats.gpu_spread(skip).unwrap_or_default();
+        let cpu_cols = cpu.map_or(",".to_owned(), |c| format!("{:.4},{:.4}", c.median, c.p95));
+        if passes.is_empty() {
+            csv += &format!("{head},measured (no GPU timestamps),,,,,{cpu_cols},{assign},{},{}\n", clusters.0, clusters.1);
+        }
+        for (pass, s) in &passes {
+            csv += &format!(
+                "{head},measured,{pass},{:.4},{:.4},{:.4},{cpu_cols},{assign},{},{}\n",
+                s.median, s.p95, s.mean, clusters.0, clusters.1
+            );
+        }
+        rows.push(json!({
+            "technique": m.technique.name(),
+            "lights": m.lights,
+            "status": "measured",
+            "passes": passes.iter().map(|(n, s)| json!({ "pass": n, "gpu": spread_json(s) })).collect::<Vec<_>>(),
+            "cpu": cpu.as_ref().map(spread_json),
+            "assign_mean_ms": stats.assign_ms(),
+            "lights_per_cluster": stats.clusters.map(|c| json!({ "mean": c.mean_lights, "max": c.max_lights })),
+        }));
+    }
+    let report = json!({
+        "device": device,
+        "commit": env!("MANYLIGHTS_COMMIT"),
+        "settings": {
+            "scene": a.scene, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
+            "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
+        },
+        "results": rows,
+    });
+    let write = |name: &str, text: String| {
+        let path = a.out.join(name);
+        std::fs::write(&path, text).with_context(|| format!("cannot write '{}'", path.display()))
+    };
+    write("results.csv", csv.clone())?;
+    write("results.json", serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
+    print!("{csv}");
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_and_resolutions_parse() {
+        assert_eq!(["64", "16k", "1M", "2m"].map(|t| parse_count(t).unwrap()), [64, 16_000, 1_000_000, 2_000_000]);
+        for bad in ["", "0", "k", "1.5k", "-3"] {
+            assert!(parse_count(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_resolution("64x48").unwrap(), (64, 48));
+        assert!(parse_resolution("64").is_err());
+    }
+}

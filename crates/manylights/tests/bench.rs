@@ -1,0 +1,66 @@
+//! `manylights bench` (issue 9, acceptance 1): a tiny run — 2 techniques × 2 light counts,
+//! 64×64, 5 frames — on lavapipe with validation writes results.csv and results.json with
+//! every column and a row per pass, and a combination over the time budget is skipped with
+//! its reason instead of run.
+
+use std::process::Command;
+
+#[test]
+fn a_tiny_bench_writes_its_tables() {
+    let out_dir = std::env::temp_dir().join(format!("manylights-bench-{}", std::process::id()));
+    let args = ["bench", "--validation", "--techniques", "forward,clustered-gpu", "--lights", "64,1k", "--resolution", "64x64"];
+    let run = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args(args)
+        .args(["--frames", "5", "--warmup", "1", "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(!stderr.contains("VALIDATION"), "{stderr}");
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for column in ["technique", "lights", "status", "pass", "gpu_median_ms", "gpu_p95_ms", "cpu_median_ms", "lights_per_cluster_mean"] {
+        assert!(header.contains(&column), "no column {column}: {header:?}");
+    }
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // forward: one pass; clustered-gpu: build + shading; at 64 and 1,000 lights.
+    assert_eq!(rows.len(), 2 * (1 + 2), "{csv}");
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    for r in &rows {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+        assert_eq!(r[col("status")], "measured");
+        let (median, p95): (f64, f64) = (r[col("gpu_median_ms")].parse().unwrap(), r[col("gpu_p95_ms")].parse().unwrap());
+        assert!(median > 0.0 && p95 >= median, "{r:?}");
+    }
+    let clustered = rows.iter().find(|r| r[0] == "clustered-gpu" && r[1] == "1000").unwrap();
+    assert!(clustered[col("lights_per_cluster_mean")].parse::<f64>().unwrap() > 0.0);
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap();
+    assert!(json["device"]["name"].is_string() && json["commit"].is_string(), "{json}");
+    assert_eq!(json["settings"]["frames"], 5);
+    assert_eq!(json["results"].as_array().unwrap().len(), 4);
+
+    // A budget no frame fits: every combination is skipped and says why.
+    let skipped = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args(["bench", "--techniques", "forward", "--lights", "64", "--resolution", "32x32", "--frames", "3", "--warmup", "0"])
+        .args(["--budget-s", "0.000001", "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(skipped.status.success(), "{}", String::from_utf8_lossy(&skipped.stderr));
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    assert!(csv.lines().nth(1).unwrap().contains("skipped: 3 frames would take"), "{csv}");
+}
+
+#[test]
+fn bad_bench_arguments_are_one_error_line() {
+    for (args, needle) in [
+        (&["bench", "--lights", "many"][..], "not a light count"),
+        (&["bench", "--techniques", "raytracing"][..], "raytracing"),
+        (&["bench", "--resolution", "big"][..], "expected WxH"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_manylights")).args(args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.lines().count() == 1 && stderr.contains(needle), "{args:?}: {stderr}");
+    }
+}
