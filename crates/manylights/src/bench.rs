@@ -95,7 +95,10 @@ struct Measured {
 
 pub fn bench(a: &BenchArgs) -> Result<()> {
     let techniques: Vec<Technique> = a.techniques.split(',').map(|t| Technique::from_name(t.trim())).collect::<Result<_, _>>()?;
-    let counts: Vec<u64> = a.lights.split(',').map(parse_count).collect::<Result<_>>()?;
+    let mut counts: Vec<u64> = a.lights.split(',').map(parse_count).collect::<Result<_>>()?;
+    // Ascending: each count's estimate can lean on the smaller ones measured before it.
+    counts.sort_unstable();
+    counts.dedup();
     let resolution = parse_resolution(&a.resolution)?;
     if a.frames == 0 {
         bail!("--frames must be at least 1");
@@ -108,11 +111,17 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     let messages = ctx.validation_counter();
     let bar = indicatif::ProgressBar::new((techniques.len() * counts.len()) as u64);
     bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("a valid template"));
-    let mut results = Vec::new();
+    let mut results: Vec<Measured> = Vec::new();
     for &lights in &counts {
         for &technique in &techniques {
             bar.set_message(format!("{} at {lights} lights", technique.name()));
-            results.push(measure(&ctx, a, technique, lights, resolution)?);
+            // The same technique at the largest smaller count measured so far.
+            let previous = results
+                .iter()
+                .filter(|m| m.technique == technique && m.lights < lights)
+                .filter_map(|m| m.output.as_ref().map(|o| (m.lights, o.stats.wall_ms_per_frame())))
+                .max_by_key(|&(n, _)| n);
+            results.push(measure(&ctx, a, (technique, lights), resolution, previous)?);
             bar.inc(1);
         }
     }
@@ -133,19 +142,35 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
 }
 
 /// One frame to estimate the cost, then warm-up + measured frames unless over budget.
-fn measure(ctx: &Context, a: &BenchArgs, technique: Technique, lights: u64, resolution: (u32, u32)) -> Result<Measured> {
+/// The time per frame a technique took at a smaller light count, `(lights, ms)`: its frames at
+/// more lights are estimated as if they grew linearly with the count (what brute force does;
+/// clustered techniques grow slower), so a hopeless combination is skipped without even one
+/// frame of it.
+type Previous = Option<(u64, f64)>;
+
+fn measure(
+    ctx: &Context,
+    a: &BenchArgs,
+    (technique, lights): (Technique, u64),
+    resolution: (u32, u32),
+    previous: Previous,
+) -> Result<Measured> {
+    let frames = a.warmup + a.frames;
+    let skip = |ms: f64, how: &str| {
+        let estimate_s = ms * frames as f64 / 1e3;
+        (estimate_s > a.budget_s).then(|| {
+            format!("skipped: {frames} frames would take about {estimate_s:.0} s ({ms:.0} ms a frame, {how}; budget {} s)", a.budget_s)
+        })
+    };
+    if let Some(why) = previous.and_then(|(n, ms)| skip(ms * lights as f64 / n as f64, &format!("scaled from {n} lights"))) {
+        return Ok(Measured { technique, lights, skipped: Some(why), output: None });
+    }
     let args = scene_args(a, technique, lights, resolution)?;
     let (scene, shading) = build_scene(&args)?;
     let mut settings = render_settings(&args, shading, 1)?;
     settings.time = None;
     let probe = HeadlessRenderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
-    let frames = a.warmup + a.frames;
-    let estimate_s = probe.stats.wall_ms * frames as f64 / 1e3;
-    if estimate_s > a.budget_s {
-        let why = format!(
-            "skipped: {frames} frames would take about {estimate_s:.0} s (one took {:.0} ms; budget {} s)",
-            probe.stats.wall_ms, a.budget_s
-        );
+    if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
         return Ok(Measured { technique, lights, skipped: Some(why), output: None });
     }
     settings.frames = frames;
