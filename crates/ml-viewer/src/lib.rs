@@ -222,6 +222,8 @@ impl<'c> Session<'c> {
     fn main_loop(&mut self, event_loop: &mut EventLoop<()>, events: &mut Events, build: &Build) -> Result<()> {
         let mut last = Instant::now();
         let mut camera = None;
+        let first = self.presenter.swapchain.extent;
+        let mut made_for = (first.width, first.height);
         loop {
             let timeout = if self.minimized { Duration::from_millis(16) } else { Duration::ZERO };
             if let PumpStatus::Exit(_) = event_loop.pump_app_events(Some(timeout), events) {
@@ -243,11 +245,13 @@ impl<'c> Session<'c> {
                 self.counts.paused_turns += 1;
                 continue;
             }
-            if self.swapchain_stale || self.presenter.swapchain.extent != (vk::Extent2D { width: size.width, height: size.height }) {
+            // The size the swapchain was last made for (the surface may settle on another).
+            if self.swapchain_stale || made_for != (size.width, size.height) {
                 self.ctx.wait_idle()?;
                 self.presenter.recreate(self.ctx, vk::Extent2D { width: size.width, height: size.height }, self.vsync)?;
                 self.swapchain_stale = false;
                 self.counts.swapchains += 1;
+                made_for = (size.width, size.height);
             }
             let extent = self.presenter.swapchain.extent;
             // A renderer for the current choices at the window's size.

@@ -74,11 +74,9 @@ impl Presenter {
     /// must be idle.
     pub fn recreate(&mut self, ctx: &Context, size: vk::Extent2D, vsync: bool) -> anyhow::Result<()> {
         self.destroy_per_image(ctx);
-        let old = std::mem::replace(&mut self.swapchain.raw, vk::SwapchainKHR::null());
-        let made = Swapchain::new(ctx, size, vsync, old);
-        // SAFETY: the old swapchain is retired (or the new one failed) and idle.
-        let mut retired = std::mem::replace(&mut self.swapchain, made?);
-        retired.raw = old;
+        let made = Swapchain::new(ctx, size, vsync, self.swapchain.raw)?;
+        // The old swapchain is retired into the new one and idle: destroy it and its views.
+        let mut retired = std::mem::replace(&mut self.swapchain, made);
         retired.destroy(ctx);
         self.make_framebuffers(ctx)?;
         Ok(())
