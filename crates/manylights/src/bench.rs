@@ -237,7 +237,74 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), device: &Value, results: &[M
     };
     write("results.csv", csv.clone())?;
     write("results.json", serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
+    let series = frame_times(results, skip);
+    if series.iter().any(|(_, points)| !points.is_empty()) {
+        plot(&a.out.join("results.png"), &series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
+    }
     print!("{csv}");
+    Ok(())
+}
+
+/// Per technique, (lights, GPU ms per frame: the pass medians summed) of each measured count.
+fn frame_times(results: &[Measured], skip: usize) -> Vec<(Technique, Vec<(f64, f64)>)> {
+    let mut series: Vec<(Technique, Vec<(f64, f64)>)> = Vec::new();
+    for m in results {
+        let Some(passes) = m.output.as_ref().and_then(|o| o.stats.gpu_spread(skip)) else { continue };
+        let ms: f64 = passes.iter().map(|(_, s)| s.median).sum();
+        match series.iter_mut().find(|(t, _)| *t == m.technique) {
+            Some((_, points)) => points.push((m.lights as f64, ms)),
+            None => series.push((m.technique, vec![(m.lights as f64, ms)])),
+        }
+    }
+    series
+}
+
+/// results.png: GPU ms per frame against lights, log-log, a line per technique (the text in
+/// egui's embedded Ubuntu font: no system fonts needed).
+fn plot(path: &std::path::Path, series: &[(Technique, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    static FONT: std::sync::Once = std::sync::Once::new();
+    FONT.call_once(|| {
+        // Fails only for a broken font file, which egui's is not; text would then be missing.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+    });
+    let points = series.iter().flat_map(|(_, p)| p.iter());
+    let (x0, x1) = points.clone().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
+    let (y0, y1) = points.fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
+    // Whole decades, so that the log axes have labels.
+    let decades =
+        |lo: f64, hi: f64| (10f64.powf(lo.log10().floor()), 10f64.powf(hi.log10().ceil()).max(10f64.powf(lo.log10().floor() + 1.0)));
+    let ((x0, x1), (y0, y1)) = (decades(x0, x1), decades(y0, y1));
+    let root = BitMapBackend::new(path, (960, 600)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("GPU ms per frame at {w}x{h} (median)"), ("sans-serif", 24))
+        .margin(16)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("lights")
+        .y_desc("GPU ms per frame")
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v}"))
+        .draw()?;
+    for (i, (technique, points)) in series.iter().enumerate() {
+        let colour = Palette99::pick(i).to_rgba();
+        chart
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
+            .label(technique.name())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+        chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
     Ok(())
 }
 

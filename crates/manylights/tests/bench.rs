@@ -1,6 +1,6 @@
 //! `manylights bench` (issue 9, acceptance 1): a tiny run — 2 techniques × 2 light counts,
 //! 64×64, 5 frames — on lavapipe with validation writes results.csv and results.json with
-//! every column and a row per pass, and a combination over the time budget is skipped with
+//! every column and a row per pass and the results.png plot, and a combination over the time budget is skipped with
 //! its reason instead of run.
 
 use std::process::Command;
@@ -39,6 +39,11 @@ fn a_tiny_bench_writes_its_tables() {
     assert!(json["device"]["name"].is_string() && json["commit"].is_string(), "{json}");
     assert_eq!(json["settings"]["frames"], 5);
     assert_eq!(json["results"].as_array().unwrap().len(), 4);
+    // The plot: frame time against lights, a line per technique.
+    let plot = image::open(out_dir.join("results.png")).expect("results.png").to_rgb8();
+    assert_eq!(plot.dimensions(), (960, 600));
+    let coloured = plot.pixels().filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 100).count();
+    assert!(coloured > 500, "the plot has no coloured lines ({coloured} pixels)");
 
     // A budget no frame fits: every combination is skipped and says why.
     let skipped = Command::new(env!("CARGO_BIN_EXE_manylights"))
