@@ -402,12 +402,8 @@ impl Builder<'_> {
         let bytes: Vec<u8> = match (&json.uri, &json.buffer_view, &json.mime_type) {
             (Some(uri), None, _) => read_uri(uri, self.base)?,
             (None, Some(view), Some(_)) => {
-                let view = &self.doc.as_json().buffer_views[view.value()];
-                let data = &self.buffers[view.buffer.value()];
-                let start = view.byte_offset.map_or(0, |o| o.0 as usize);
-                let end = start.checked_add(view.byte_length.0 as usize).filter(|&e| e <= data.len());
-                let end = end.ok_or("its buffer view lies outside its buffer")?;
-                data[start..end].to_vec()
+                let view = self.doc.views().nth(view.value()).ok_or("its buffer view does not exist")?;
+                view_bytes(&self.buffers, &view, "its data")?.to_vec()
             }
             (None, Some(_), None) => return Err("a buffer view without a mimeType".into()),
             _ => return Err("needs either a uri or a bufferView".into()),

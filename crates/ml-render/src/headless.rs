@@ -214,11 +214,7 @@ impl<'a> HeadlessRenderer<'a> {
         self.extent = vk::Extent2D { width: settings.width, height: settings.height };
         self.grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
         if new_grid {
-            if let Some(mut b) = self.builder.take() {
-                b.destroy(ctx);
-                self.required_indices = 0;
-                self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, settings.clusters.count())?);
-            }
+            self.make_builder()?;
         }
         if new_view {
             if let Some(mut t) = self.tonemap.take() {
@@ -242,18 +238,11 @@ impl<'a> HeadlessRenderer<'a> {
             return Err(RenderError::Invalid("a scene with spot lights cannot change its lights in place".into()));
         }
         self.settings.check(self.ctx, lights.len())?;
-        let ctx = self.ctx;
         self.release_frames()?;
-        if let Some(mut b) = self.builder.take() {
-            b.destroy(ctx);
-        }
         self.scene.lights = lights;
         self.shadowed = mark_shadowed(&mut self.scene, &self.settings);
         self.animated = if self.settings.technique.is_gpu_built() { Vec::new() } else { self.scene.lights.clone() };
-        self.required_indices = 0;
-        if self.settings.technique.is_gpu_built() {
-            self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
-        }
+        self.make_builder()?;
         self.create_frames()?;
         Ok(())
     }
@@ -289,9 +278,7 @@ impl<'a> HeadlessRenderer<'a> {
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         // SAFETY: valid device and create infos.
         self.command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
-        if self.settings.technique.is_gpu_built() {
-            self.builder = Some(GpuClusterBuilder::new(ctx, &self.scene.lights, self.settings.clusters.count())?);
-        }
+        self.make_builder()?;
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if self.scene.cones.is_empty() { vec![LightCone::NONE] } else { self.scene.cones.clone() };
@@ -426,12 +413,8 @@ impl<'a> HeadlessRenderer<'a> {
             }
             self.shadow_map_view.as_mut().expect("set above").1 = sets;
         }
-        if self.builder.is_some() {
-            // The boxes depend on projection and size only: once here.
-            self.write_uniforms(0, 0.0);
-            let set = self.frames[0].gpu.as_ref().expect("made with the builder").set;
-            self.builder.as_ref().expect("checked").compute_bounds(ctx, set)?;
-        }
+        // The boxes depend on projection and size only: once here.
+        self.compute_cluster_bounds()?;
         let bytes = extent.width as u64 * extent.height as u64 * 4;
         self.readback =
             Some(Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
@@ -511,6 +494,28 @@ impl<'a> HeadlessRenderer<'a> {
         if self.grid.projection != projection && self.builder.is_some() {
             // Frame 0's uniforms carry the projection to the bounds pass: wait for its frame.
             self.ctx.wait_idle()?;
+            self.compute_cluster_bounds()?;
+        }
+        Ok(())
+    }
+
+    /// clustered-gpu and deferred-compute: a fresh GPU cluster builder for the scene's lights
+    /// and the grid (its lists start small again); nothing for the other techniques.
+    fn make_builder(&mut self) -> Result<(), VkError> {
+        if let Some(mut b) = self.builder.take() {
+            b.destroy(self.ctx);
+        }
+        self.required_indices = 0;
+        if self.settings.technique.is_gpu_built() {
+            self.builder = Some(GpuClusterBuilder::new(self.ctx, &self.scene.lights, self.settings.clusters.count())?);
+        }
+        Ok(())
+    }
+
+    /// clustered-gpu's view-space cluster boxes, from the grid frame 0's uniforms carry (its
+    /// frame must be done); nothing without a GPU builder.
+    fn compute_cluster_bounds(&mut self) -> Result<(), VkError> {
+        if self.builder.is_some() {
             self.write_uniforms(0, 0.0);
             let set = self.frames[0].gpu.as_ref().expect("made with the builder").set;
             self.builder.as_ref().expect("checked").compute_bounds(self.ctx, set)?;
@@ -808,14 +813,7 @@ impl<'a> HeadlessRenderer<'a> {
         let image = self.frames[f].targets.as_ref().expect("made with the frame").color.raw;
         let buffer = self.readback.as_ref().expect("created with the renderer");
         let extent = self.extent;
-        commands::one_shot(ctx, |cmd| {
-            let region = [vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1))
-                .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })];
-            // SAFETY: recording state; image and buffer are alive and large enough.
-            unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &region) };
-            commands::memory_barrier(ctx, cmd, TRANSFER_TO_HOST.0, TRANSFER_TO_HOST.1);
-        })?;
+        commands::one_shot(ctx, |cmd| commands::copy_colour_to_host(ctx, cmd, image, extent, buffer.raw))?;
         Ok(buffer.mapped().to_vec())
     }
 }

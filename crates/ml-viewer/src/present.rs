@@ -237,17 +237,7 @@ fn capture(ctx: &Context, cmd: vk::CommandBuffer, p: &mut Presenter, image: vk::
         (transfer, vk::AccessFlags::empty(), vk::ImageLayout::PRESENT_SRC_KHR),
         (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
     );
-    let region = [vk::BufferImageCopy::default()
-        .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1))
-        .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })];
-    // SAFETY: recording state; image and buffer are alive and large enough.
-    unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &region) };
-    ml_vk::commands::memory_barrier(
-        ctx,
-        cmd,
-        (transfer, vk::AccessFlags::TRANSFER_WRITE),
-        (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
-    );
+    ml_vk::commands::copy_colour_to_host(ctx, cmd, image, extent, buffer.raw);
     image_transition(
         ctx,
         cmd,

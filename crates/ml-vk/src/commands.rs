@@ -58,6 +58,23 @@ pub fn memory_barrier(
     unsafe { ctx.device.cmd_pipeline_barrier(cmd, src.0, dst.0, vk::DependencyFlags::empty(), &b, &[], &[]) };
 }
 
+/// Copy a colour image's first level (`extent`, in TRANSFER_SRC_OPTIMAL, its writes already
+/// made visible to transfers) into `buffer`, tightly packed, and make the copy visible to the
+/// host (read-backs and screenshots).
+pub fn copy_colour_to_host(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, extent: vk::Extent2D, buffer: vk::Buffer) {
+    let region = [vk::BufferImageCopy::default()
+        .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1))
+        .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })];
+    // SAFETY: recording state; the caller's image and buffer are alive and large enough.
+    unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer, &region) };
+    memory_barrier(
+        ctx,
+        cmd,
+        (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
+        (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+    );
+}
+
 /// (stage, access, layout) on one side of a barrier.
 pub type StageAccessLayout = (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout);
 
