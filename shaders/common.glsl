@@ -119,6 +119,12 @@ struct OmniShadowPush {
     mat4 model_to_light;
 };
 
+// Push constants of the compute-vs-fragment probe (stage_probe.glsl): the same light loop
+// over the same pixels as a fragment shader and as a compute shader.
+struct StageProbePush {
+    uvec4 size_lights; // xy: pixels; z: lights every pixel sums
+};
+
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with
 // raster.rs CLEAR_COLOR.
 const vec4 CLEAR_COLOR = vec4(0.02, 0.02, 0.02, 1.0);

@@ -3,15 +3,19 @@
 //! per cluster, written to results.csv and results.json. A combination whose frames would take
 //! longer than the budget (estimated from one frame) is skipped and says so.
 
+use crate::auto::technique_choice;
 use crate::{build_scene, render_settings, SceneArgs};
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser};
 use ml_render::report::Spread;
+use ml_render::stage_probe::{pick_lighting_path, quick_probe};
 use ml_render::{HeadlessRenderer, RenderOutput, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
+
+mod probe;
 
 #[derive(Args)]
 pub struct BenchArgs {
@@ -19,7 +23,7 @@ pub struct BenchArgs {
     /// room, FILE.toml, FILE.gltf|FILE.glb.
     #[arg(long, default_value = "bench")]
     scene: String,
-    /// Techniques, comma-separated.
+    /// Techniques, comma-separated (auto: the one `--technique auto` picks on this device).
     #[arg(long, default_value = "forward,clustered-cpu,clustered-gpu,deferred,deferred-clustered,deferred-compute")]
     techniques: String,
     /// Light counts, comma-separated; k and M multiply by 1,000 and 1,000,000.
@@ -44,9 +48,18 @@ pub struct BenchArgs {
     validation: bool,
     #[arg(long)]
     device: Option<usize>,
-    /// Folder for results.csv and results.json (made if missing).
+    /// Folder for results.csv, results.json and results.png (with --probe: probe.csv and
+    /// probe.json), made if missing.
     #[arg(long, default_value = "bench-results")]
     out: PathBuf,
+    /// Instead of the techniques: the compute-vs-fragment probe — one BRDF loop over every
+    /// pixel of --resolution as a fragment shader and as a compute shader, --warmup + --frames
+    /// rounds per loop length of --probe-lights — and the ratio of their times.
+    #[arg(long)]
+    probe: bool,
+    /// Loop lengths (lights every pixel sums) of --probe, comma-separated.
+    #[arg(long, default_value = "16,64,256,1024")]
+    probe_lights: String,
 }
 
 /// `123`, `16k`, `1M`.
@@ -94,7 +107,7 @@ struct Measured {
 }
 
 pub fn bench(a: &BenchArgs) -> Result<()> {
-    let techniques: Vec<Technique> = a.techniques.split(',').map(|t| Technique::from_name(t.trim())).collect::<Result<_, _>>()?;
+    let choices: Vec<Option<Technique>> = a.techniques.split(',').map(|t| technique_choice(t.trim())).collect::<Result<_>>()?;
     let mut counts: Vec<u64> = a.lights.split(',').map(parse_count).collect::<Result<_>>()?;
     // Ascending: each count's estimate can lean on the smaller ones measured before it.
     counts.sort_unstable();
@@ -106,9 +119,30 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     if a.budget_s.is_nan() || a.budget_s <= 0.0 {
         bail!("--budget-s must be greater than 0");
     }
+    let probe_lengths = if a.probe { Some(probe_lengths(&a.probe_lights)?) } else { None };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
     let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
     let messages = ctx.validation_counter();
+    if let Some(lengths) = probe_lengths {
+        let result = probe::run(&ctx, a, resolution, &lengths);
+        let device = device_json(&ctx);
+        drop(ctx);
+        let rows = result?;
+        probe::write(a, resolution, &device, &rows)?;
+        return check_messages(messages.load(Ordering::SeqCst));
+    }
+    // Every run records the quick probe and what auto makes of it.
+    let quick = quick_probe(&ctx)?;
+    let (auto_technique, auto_why) = pick_lighting_path(&quick);
+    println!("auto: {}: {auto_why}", auto_technique.name());
+    let mut techniques: Vec<Technique> = choices.into_iter().map(|c| c.unwrap_or(auto_technique)).collect();
+    let mut seen = Vec::new();
+    techniques.retain(|t| {
+        !seen.contains(t) && {
+            seen.push(*t);
+            true
+        }
+    });
     let bar = indicatif::ProgressBar::new((techniques.len() * counts.len()) as u64);
     bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("a valid template"));
     let mut results: Vec<Measured> = Vec::new();
@@ -126,19 +160,45 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         }
     }
     bar.finish_and_clear();
-    let device = json!({
-        "name": ctx.info.name,
-        "type": ctx.info.type_name(),
-        "driver": format!("{} {}", ctx.info.driver_name, ctx.info.driver_info),
-        "vulkan": ctx.info.api_version_string(),
-    });
+    let device = device_json(&ctx);
     drop(ctx);
-    write_results(a, resolution, &device, &results)?;
-    let count = messages.load(Ordering::SeqCst);
+    let auto = json!({ "technique": auto_technique.name(), "why": auto_why, "probe": probe::times_json(&quick) });
+    write_results(a, resolution, (&device, &auto), &results)?;
+    check_messages(messages.load(Ordering::SeqCst))
+}
+
+fn check_messages(count: u32) -> Result<()> {
     if count > 0 {
         bail!("the validation layer reported {count} message(s) (printed above)");
     }
     Ok(())
+}
+
+fn device_json(ctx: &Context) -> Value {
+    json!({
+        "name": ctx.info.name,
+        "type": ctx.info.type_name(),
+        "driver": format!("{} {}", ctx.info.driver_name, ctx.info.driver_info),
+        "vulkan": ctx.info.api_version_string(),
+    })
+}
+
+/// --probe-lights: ascending loop lengths, each at most 65,536 (a longer loop at 1080p is
+/// hours on a CPU device and says nothing a shorter one does not).
+fn probe_lengths(text: &str) -> Result<Vec<u32>> {
+    let mut lengths: Vec<u32> = text
+        .split(',')
+        .map(|t| {
+            let n = parse_count(t)?;
+            u32::try_from(n)
+                .ok()
+                .filter(|&n| n <= probe::MAX_LIGHTS)
+                .with_context(|| format!("--probe-lights '{}': at most {} lights per pixel", t.trim(), probe::MAX_LIGHTS))
+        })
+        .collect::<Result<_>>()?;
+    lengths.sort_unstable();
+    lengths.dedup();
+    Ok(lengths)
 }
 
 /// One frame to estimate the cost, then warm-up + measured frames unless over budget.
@@ -182,7 +242,7 @@ fn spread_json(s: &Spread) -> Value {
     json!({ "median_ms": s.median, "p95_ms": s.p95, "mean_ms": s.mean })
 }
 
-fn write_results(a: &BenchArgs, (w, h): (u32, u32), device: &Value, results: &[Measured]) -> Result<()> {
+fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Value), results: &[Measured]) -> Result<()> {
     let skip = a.warmup as usize;
     let mut csv = String::from(
         "technique,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,assign_mean_ms,lights_per_cluster_mean,lights_per_cluster_max\n",
@@ -229,20 +289,22 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), device: &Value, results: &[M
             "scene": a.scene, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
             "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
         },
+        "auto": auto,
         "results": rows,
     });
-    let write = |name: &str, text: String| {
-        let path = a.out.join(name);
-        std::fs::write(&path, text).with_context(|| format!("cannot write '{}'", path.display()))
-    };
-    write("results.csv", csv.clone())?;
-    write("results.json", serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
+    write_file(a, "results.csv", &csv)?;
+    write_file(a, "results.json", &serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
     let series = frame_times(results, skip);
     if series.iter().any(|(_, points)| !points.is_empty()) {
         plot(&a.out.join("results.png"), &series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
     }
     print!("{csv}");
     Ok(())
+}
+
+fn write_file(a: &BenchArgs, name: &str, text: &str) -> Result<()> {
+    let path = a.out.join(name);
+    std::fs::write(&path, text).with_context(|| format!("cannot write '{}'", path.display()))
 }
 
 /// Per technique, (lights, GPU ms per frame: the pass medians summed) of each measured count.

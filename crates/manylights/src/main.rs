@@ -16,6 +16,7 @@ use ml_render::{DebugView, HeadlessRenderer, OmniShadowMode, OmniShadowSettings,
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 
+mod auto;
 mod bench;
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -78,7 +79,9 @@ struct SceneArgs {
     #[arg(long, default_value = "seed")]
     scene: String,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
-    /// deferred-compute.
+    /// deferred-compute, or auto: deferred-compute where this device runs the probe's light loop
+    /// (`bench --probe`) over 1.25× faster as a compute shader than as a fragment shader, else
+    /// deferred-clustered.
     #[arg(long, default_value = "forward")]
     technique: String,
     /// Shading model: seed (seed 000's Cook–Torrance), blinn-phong (seed 002: shadowed sun,
@@ -257,13 +260,23 @@ fn render_settings(args: &SceneArgs, shading: ShadingModel, frames: u32) -> Resu
 }
 
 fn render(cmd: &RenderArgs) -> Result<()> {
-    let args = &cmd.scene;
-    let technique = Technique::from_name(&args.technique)?;
-    let (scene, shading) = build_scene(args)?;
+    let mut args = cmd.scene.clone();
+    let choice = auto::technique_choice(&args.technique)?;
+    let (scene, shading) = build_scene(&args)?;
     check_output(&cmd.out)?;
-    let settings = render_settings(args, shading, cmd.frames)?;
+    // Every other setting is checked before the GPU work (auto's technique is known after it).
+    render_settings(&SceneArgs { technique: Technique::Forward.name().into(), ..args.clone() }, shading, cmd.frames)?;
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();
+    let (technique, auto_why) = match choice {
+        Some(t) => (t, None),
+        None => {
+            let (t, why) = auto::pick(&ctx)?;
+            (t, Some(why))
+        }
+    };
+    args.technique = technique.name().into();
+    let settings = render_settings(&args, shading, cmd.frames)?;
     let light_count = scene.lights.len();
     let object_textures = !scene.textures.is_empty();
     let result = HeadlessRenderer::new(&ctx, scene, settings).and_then(|mut r| r.render());
@@ -276,11 +289,14 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let mut rows = vec![
         ("device", device),
         ("resolution", format!("{}x{}", output.width, output.height)),
-        ("technique", technique.name().to_owned()),
+        ("technique", technique.name().to_owned() + if auto_why.is_some() { " (auto)" } else { "" }),
         ("shading", settings.shading.name().to_owned()),
         ("lights", light_count.to_string()),
         ("frames", stats.frames.to_string()),
     ];
+    if let Some(why) = auto_why {
+        rows.push(("auto", why));
+    }
     match stats.gpu_ms() {
         Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
         None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
@@ -344,7 +360,11 @@ fn view(cmd: &ViewArgs) -> Result<()> {
         None => None,
     };
     // Checked once up front, so that a bad argument fails before a window opens.
+    auto::technique_choice(&args.technique)?;
     let (scene, shading) = build_scene(args)?;
+    let mut args = args.clone();
+    args.technique = auto::resolve_alone(&args.technique, args.validation, args.device)?.name().into();
+    let args = &args;
     let first = render_settings(args, shading, 1)?;
     let choices = ml_viewer::Choices {
         technique: first.technique,

@@ -39,6 +39,9 @@ fn a_tiny_bench_writes_its_tables() {
     assert!(json["device"]["name"].is_string() && json["commit"].is_string(), "{json}");
     assert_eq!(json["settings"]["frames"], 5);
     assert_eq!(json["results"].as_array().unwrap().len(), 4);
+    // What auto would run here, from the quick probe.
+    assert!(["deferred-compute", "deferred-clustered"].contains(&json["auto"]["technique"].as_str().unwrap()), "{json}");
+    assert!(json["auto"]["probe"]["ratio"].as_f64().unwrap() > 0.0, "{json}");
     // The plot: frame time against lights, a line per technique.
     let plot = image::open(out_dir.join("results.png")).expect("results.png").to_rgb8();
     assert_eq!(plot.dimensions(), (960, 600));
@@ -62,10 +65,55 @@ fn bad_bench_arguments_are_one_error_line() {
         (&["bench", "--lights", "many"][..], "not a light count"),
         (&["bench", "--techniques", "raytracing"][..], "raytracing"),
         (&["bench", "--resolution", "big"][..], "expected WxH"),
+        (&["bench", "--probe", "--probe-lights", "100k"][..], "at most 65536 lights per pixel"),
+        (&["bench", "--probe", "--resolution", "0x10"][..], "each side must be 1 to"),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_manylights")).args(args).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
         assert!(stderr.lines().count() == 1 && stderr.contains(needle), "{args:?}: {stderr}");
     }
+}
+
+/// `bench --probe`: both kinds of pass timed over the same pixels per loop length, the ratio
+/// and auto's pick written to probe.csv and probe.json; a length over the budget is skipped.
+#[test]
+fn the_probe_writes_its_ratios() {
+    let out_dir = std::env::temp_dir().join(format!("manylights-probe-{}", std::process::id()));
+    let run = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args(["bench", "--probe", "--validation", "--resolution", "64x48", "--frames", "3", "--warmup", "1"])
+        .args(["--probe-lights", "4,16", "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&run.stdout), String::from_utf8_lossy(&run.stderr));
+    assert!(run.status.success() && !stderr.contains("VALIDATION"), "{stderr}");
+    assert!(stdout.lines().any(|l| l.starts_with("auto: deferred-c")), "{stdout}");
+    let csv = std::fs::read_to_string(out_dir.join("probe.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}: {header:?}"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.iter().map(|r| r[col("lights")]).collect::<Vec<_>>(), ["4", "16"], "{csv}");
+    for r in &rows {
+        assert_eq!((r.len(), r[col("status")], r[col("width")], r[col("height")]), (header.len(), "measured", "64", "48"), "{r:?}");
+        let num = |name: &str| r[col(name)].parse::<f64>().unwrap();
+        assert!(num("fragment_median_ms") > 0.0 && num("fragment_p95_ms") >= num("fragment_median_ms"), "{r:?}");
+        assert!(num("compute_median_ms") > 0.0 && num("compute_p95_ms") >= num("compute_median_ms"), "{r:?}");
+        let ratio = num("fragment_median_ms") / num("compute_median_ms");
+        assert!((num("ratio") - ratio).abs() <= 0.01 * ratio, "{r:?}");
+    }
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("probe.json")).unwrap()).unwrap();
+    assert!(json["device"]["name"].is_string() && json["auto"]["technique"].is_string(), "{json}");
+    assert_eq!(json["results"][1]["times"]["lights"], 16);
+
+    // No round fits the budget: the length is skipped and says why.
+    let skipped = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args(["bench", "--probe", "--resolution", "32x32", "--frames", "2", "--warmup", "0", "--probe-lights", "8"])
+        .args(["--budget-s", "0.000001", "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(skipped.status.success(), "{}", String::from_utf8_lossy(&skipped.stderr));
+    let csv = std::fs::read_to_string(out_dir.join("probe.csv")).unwrap();
+    assert!(csv.lines().nth(1).unwrap().contains("skipped: 2 rounds would take"), "{csv}");
+    assert!(String::from_utf8_lossy(&skipped.stdout).contains("auto: nothing measured"));
 }

@@ -447,3 +447,23 @@ fn a_gltf_file_renders() {
     assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
     assert!(stdout.contains("pbr") && png.exists(), "{stdout}");
 }
+
+/// `--technique auto` probes the device, names the technique it picked and why, and renders
+/// exactly what that technique renders.
+#[test]
+fn auto_renders_what_it_picked() {
+    let (auto_png, picked_png) = (temp_png("auto.png"), temp_png("picked.png"));
+    let common = ["render", "--validation", "--scene", "bench", "--lights", "300", "--width", "96", "--height", "54", "--time", "0"];
+    let out = manylights(&[&common[..], &["--technique", "auto", "--out", auto_png.to_str().unwrap()]].concat(), &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let technique_row = stdout.lines().find(|l| l.starts_with("technique")).expect("a technique row");
+    let picked = technique_row.split_whitespace().nth(1).unwrap().to_owned();
+    assert!(technique_row.ends_with("(auto)") && ["deferred-compute", "deferred-clustered"].contains(&picked.as_str()), "{stdout}");
+    let why = stdout.lines().find(|l| l.starts_with("auto")).expect("an auto row");
+    assert!(why.contains("as a fragment shader") && why.contains("as a compute shader"), "{why}");
+    let out = manylights(&[&common[..], &["--technique", &picked, "--out", picked_png.to_str().unwrap()]].concat(), &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (a, b) = (image::open(&auto_png).unwrap().to_rgba8(), image::open(&picked_png).unwrap().to_rgba8());
+    assert!(a == b, "auto's image differs from {picked}'s");
+}

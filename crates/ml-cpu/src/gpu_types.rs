@@ -179,3 +179,11 @@ gpu_struct!(
         model_to_light: [[f32; 4]; 4],
     }
 );
+
+gpu_struct!(
+    /// Push constants of the compute-vs-fragment probe (stage_probe.glsl).
+    StageProbePush {
+        /// xy: pixels; z: lights every pixel sums.
+        size_lights: [u32; 4],
+    }
+);

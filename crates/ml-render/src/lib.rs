@@ -16,6 +16,7 @@ pub mod render_pass;
 pub mod report;
 pub mod scene_textures;
 pub mod settings;
+pub mod stage_probe;
 pub mod targets;
 pub mod tonemap;
 

@@ -4,7 +4,7 @@
 
 use ml_cpu::gpu_types::{
     ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, LightCone, ObjectData, ObjectPush, OmniShadowPush, PointLight,
-    ShadowPush,
+    ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -82,6 +82,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<ObjectPush>(&structs);
     check::<ShadowPush>(&structs);
     check::<OmniShadowPush>(&structs);
+    check::<StageProbePush>(&structs);
     check::<ObjectData>(&structs);
     check::<LightCone>(&structs);
     check::<ClusterRange>(&structs);
