@@ -7,6 +7,7 @@ use crate::auto::technique_choice;
 use crate::{build_scene, render_settings, SceneArgs};
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser};
+use ml_cpu::cluster::ClusterDims;
 use ml_render::report::Spread;
 use ml_render::stage_probe::{pick_lighting_path, quick_probe};
 use ml_render::{HeadlessRenderer, RenderOutput, Technique};
@@ -44,6 +45,9 @@ pub struct BenchArgs {
     /// Shading model (default: the scene's, else seed).
     #[arg(long)]
     shading: Option<String>,
+    /// Cluster grid XxYxZ, or auto (render's --clusters: scaled with each light count).
+    #[arg(long, default_value = "auto")]
+    clusters: String,
     #[arg(long)]
     validation: bool,
     #[arg(long)]
@@ -88,6 +92,7 @@ fn scene_args(a: &BenchArgs, technique: Technique, lights: u64, (w, h): (u32, u3
     }
     let (lights, w, h) = (lights.to_string(), w.to_string(), h.to_string());
     let mut argv = vec!["bench", "--scene", &a.scene, "--technique", technique.name(), "--lights", &lights, "--width", &w, "--height", &h];
+    argv.extend(["--clusters", &a.clusters]);
     if let Some(s) = &a.shading {
         argv.extend(["--shading", s]);
     }
@@ -104,6 +109,8 @@ struct Measured {
     /// Why it was not measured.
     skipped: Option<String>,
     output: Option<RenderOutput>,
+    /// The cluster grid of a measured clustered technique.
+    grid: Option<ClusterDims>,
 }
 
 pub fn bench(a: &BenchArgs) -> Result<()> {
@@ -223,19 +230,20 @@ fn measure(
         })
     };
     if let Some(why) = previous.and_then(|(n, ms)| skip(ms * lights as f64 / n as f64, &format!("scaled from {n} lights"))) {
-        return Ok(Measured { technique, lights, skipped: Some(why), output: None });
+        return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None });
     }
     let args = scene_args(a, technique, lights, resolution)?;
     let (scene, shading) = build_scene(&args)?;
-    let mut settings = render_settings(&args, shading, 1)?;
+    let mut settings = render_settings(&args, scene.lights.len(), shading, 1)?;
     settings.time = None;
     let probe = HeadlessRenderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
-        return Ok(Measured { technique, lights, skipped: Some(why), output: None });
+        return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None });
     }
     settings.frames = frames;
     let output = HeadlessRenderer::new(ctx, scene, settings).and_then(|mut r| r.render())?;
-    Ok(Measured { technique, lights, skipped: None, output: Some(output) })
+    let grid = technique.is_clustered().then_some(settings.clusters);
+    Ok(Measured { technique, lights, skipped: None, output: Some(output), grid })
 }
 
 fn spread_json(s: &Spread) -> Value {
@@ -245,30 +253,31 @@ fn spread_json(s: &Spread) -> Value {
 fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Value), results: &[Measured]) -> Result<()> {
     let skip = a.warmup as usize;
     let mut csv = String::from(
-        "technique,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,assign_mean_ms,lights_per_cluster_mean,lights_per_cluster_max\n",
+        "technique,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,assign_mean_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
     );
     let mut rows = Vec::new();
     for m in results {
         let head = format!("{},{},{w},{h},{}", m.technique.name(), m.lights, a.frames);
         let Some(out) = &m.output else {
             let why = m.skipped.clone().unwrap_or_default();
-            csv += &format!("{head},\"{why}\",,,,,,,,,\n");
+            csv += &format!("{head},\"{why}\",,,,,,,,,,\n");
             rows.push(json!({ "technique": m.technique.name(), "lights": m.lights, "status": why }));
             continue;
         };
         let stats = &out.stats;
         let cpu = stats.cpu_spread(skip);
         let assign = stats.assign_ms().map_or(String::new(), |ms| format!("{ms:.4}"));
+        let grid = m.grid.map_or(String::new(), |d| format!("{}x{}x{}", d.x, d.y, d.z));
         let clusters =
             stats.clusters.map_or((String::new(), String::new()), |c| (format!("{:.3}", c.mean_lights), c.max_lights.to_string()));
         let passes = stats.gpu_spread(skip).unwrap_or_default();
         let cpu_cols = cpu.map_or(",".to_owned(), |c| format!("{:.4},{:.4}", c.median, c.p95));
         if passes.is_empty() {
-            csv += &format!("{head},measured (no GPU timestamps),,,,,{cpu_cols},{assign},{},{}\n", clusters.0, clusters.1);
+            csv += &format!("{head},measured (no GPU timestamps),,,,,{cpu_cols},{assign},{grid},{},{}\n", clusters.0, clusters.1);
         }
         for (pass, s) in &passes {
             csv += &format!(
-                "{head},measured,{pass},{:.4},{:.4},{:.4},{cpu_cols},{assign},{},{}\n",
+                "{head},measured,{pass},{:.4},{:.4},{:.4},{cpu_cols},{assign},{grid},{},{}\n",
                 s.median, s.p95, s.mean, clusters.0, clusters.1
             );
         }
@@ -279,6 +288,7 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
             "passes": passes.iter().map(|(n, s)| json!({ "pass": n, "gpu": spread_json(s) })).collect::<Vec<_>>(),
             "cpu": cpu.as_ref().map(spread_json),
             "assign_mean_ms": stats.assign_ms(),
+            "clusters": m.grid.map(|d| [d.x, d.y, d.z]),
             "lights_per_cluster": stats.clusters.map(|c| json!({ "mean": c.mean_lights, "max": c.max_lights })),
         }));
     }
@@ -288,6 +298,7 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
         "settings": {
             "scene": a.scene, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
             "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
+            "clusters": a.clusters,
         },
         "auto": auto,
         "results": rows,

@@ -89,8 +89,10 @@ struct SceneArgs {
     /// diffuse, ACES tone map). Default: the scene file's [shading] model, else seed.
     #[arg(long)]
     shading: Option<String>,
-    /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2).
-    #[arg(long, default_value = "16x9x24")]
+    /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2), or auto:
+    /// 16x9x24 scaled by 1, 2 or 4 on every axis as ∛(lights / 4096) rounds (32x18x48 from
+    /// ~11.6k lights, 64x36x96 from ~93k), so that lights per cluster stay few as lights shrink.
+    #[arg(long, default_value = "auto")]
     clusters: String,
     /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu),
     /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (blinn-phong),
@@ -238,12 +240,16 @@ fn check_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Render settings from the arguments (the shading model as the scene decided).
-fn render_settings(args: &SceneArgs, shading: ShadingModel, frames: u32) -> Result<RenderSettings> {
+/// Render settings from the arguments for a scene of `lights` point lights (the shading model
+/// as the scene decided).
+fn render_settings(args: &SceneArgs, lights: usize, shading: ShadingModel, frames: u32) -> Result<RenderSettings> {
     Ok(RenderSettings {
         technique: Technique::from_name(&args.technique)?,
         shading,
-        clusters: ClusterDims::parse(&args.clusters)?,
+        clusters: match args.clusters.as_str() {
+            "auto" => ClusterDims::for_lights(lights, args.width, args.height),
+            grid => ClusterDims::parse(grid)?,
+        },
         debug_view: DebugView::from_name(&args.debug_view)?,
         omni: match args.omni_shadow.as_str() {
             "off" if args.shadowed_lights != 1 || args.cube_size != OmniShadowSettings::DEFAULT_SIZE => {
@@ -265,7 +271,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let (scene, shading) = build_scene(&args)?;
     check_output(&cmd.out)?;
     // Every other setting is checked before the GPU work (auto's technique is known after it).
-    render_settings(&SceneArgs { technique: Technique::Forward.name().into(), ..args.clone() }, shading, cmd.frames)?;
+    render_settings(&SceneArgs { technique: Technique::Forward.name().into(), ..args.clone() }, scene.lights.len(), shading, cmd.frames)?;
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();
     let (technique, auto_why) = match choice {
@@ -276,7 +282,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         }
     };
     args.technique = technique.name().into();
-    let settings = render_settings(&args, shading, cmd.frames)?;
+    let settings = render_settings(&args, scene.lights.len(), shading, cmd.frames)?;
     let light_count = scene.lights.len();
     let object_textures = !scene.textures.is_empty();
     let result = HeadlessRenderer::new(&ctx, scene, settings).and_then(|mut r| r.render());
@@ -365,7 +371,7 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     let mut args = args.clone();
     args.technique = auto::resolve_alone(&args.technique, args.validation, args.device)?.name().into();
     let args = &args;
-    let first = render_settings(args, shading, 1)?;
+    let first = render_settings(args, scene.lights.len(), shading, 1)?;
     let choices = ml_viewer::Choices {
         technique: first.technique,
         shading: first.shading,

@@ -34,6 +34,8 @@ fn a_tiny_bench_writes_its_tables() {
         assert!(median > 0.0 && p95 >= median, "{r:?}");
     }
     let clustered = rows.iter().find(|r| r[0] == "clustered-gpu" && r[1] == "1000").unwrap();
+    // --clusters auto at 64×64: the default grid (no scaling below ~11.6k lights).
+    assert_eq!(clustered[col("clusters")], "16x9x24");
     assert!(clustered[col("lights_per_cluster_mean")].parse::<f64>().unwrap() > 0.0);
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap();
     assert!(json["device"]["name"].is_string() && json["commit"].is_string(), "{json}");

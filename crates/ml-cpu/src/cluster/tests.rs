@@ -255,3 +255,23 @@ fn cluster_boxes_are_separable_by_axis() {
         }
     }
 }
+
+#[test]
+fn auto_grids_grow_with_the_cube_root_of_the_light_count() {
+    let auto = |n, w, h| {
+        let d = ClusterDims::for_lights(n, w, h);
+        (d.x, d.y, d.z)
+    };
+    // The default up to ~11.6k lights (s = 1 while ∛(N/4096) < √2).
+    for n in [0, 1, 64, 1000, 4096, 11_000] {
+        assert_eq!(auto(n, 1920, 1080), (16, 9, 24), "{n}");
+    }
+    assert_eq!(auto(16_000, 1920, 1080), (32, 18, 48));
+    for n in [256_000, 1_000_000, 50_000_000] {
+        assert_eq!(auto(n, 1920, 1080), (64, 36, 96), "{n}");
+    }
+    // Tiles stay at least 16 px when scaling up, and never fall below the default grid.
+    assert_eq!(auto(1_000_000, 640, 360), (40, 22, 96));
+    assert_eq!(auto(1_000_000, 64, 64), (16, 9, 96));
+    assert!(ClusterDims::for_lights(usize::MAX, u32::MAX, u32::MAX).count() as u64 <= ClusterDims::MAX_CLUSTERS);
+}
