@@ -1,7 +1,8 @@
 //! `manylights bench` (issue 9): every technique × light count on one scene, per-pass GPU
 //! time (median, p95, mean over the frames after the warm-up), CPU time per frame and lights
-//! per cluster, written to results.csv and results.json. A combination whose frames would take
-//! longer than the budget (estimated from one frame) is skipped and says so.
+//! per cluster, written to results.csv, results.json and results.png. A combination whose frames
+//! would take longer than the budget is skipped and says so: brute force estimated from a smaller
+//! count (linear), clustered techniques from one frame (see `Previous`).
 
 use crate::auto::technique_choice;
 use crate::{build_scene, render_settings, SceneArgs};
@@ -111,6 +112,8 @@ struct Measured {
     output: Option<RenderOutput>,
     /// The cluster grid of a measured clustered technique.
     grid: Option<ClusterDims>,
+    /// Milliseconds a frame: measured (wall clock), or estimated where skipped.
+    ms_per_frame: f64,
 }
 
 pub fn bench(a: &BenchArgs) -> Result<()> {
@@ -156,11 +159,11 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     for &lights in &counts {
         for &technique in &techniques {
             bar.set_message(format!("{} at {lights} lights", technique.name()));
-            // The same technique at the largest smaller count measured so far.
+            // The same technique at the largest smaller count, measured or estimated.
             let previous = results
                 .iter()
                 .filter(|m| m.technique == technique && m.lights < lights)
-                .filter_map(|m| m.output.as_ref().map(|o| (m.lights, o.stats.wall_ms_per_frame())))
+                .map(|m| (m.lights, m.ms_per_frame))
                 .max_by_key(|&(n, _)| n);
             results.push(measure(&ctx, a, (technique, lights), resolution, previous)?);
             bar.inc(1);
@@ -208,11 +211,11 @@ fn probe_lengths(text: &str) -> Result<Vec<u32>> {
     Ok(lengths)
 }
 
-/// One frame to estimate the cost, then warm-up + measured frames unless over budget.
-/// The time per frame a technique took at a smaller light count, `(lights, ms)`: its frames at
-/// more lights are estimated as if they grew linearly with the count (what brute force does;
-/// clustered techniques grow slower), so a hopeless combination is skipped without even one
-/// frame of it.
+/// The time per frame a technique took (or was estimated to take) at a smaller light count,
+/// `(lights, ms)`. Scaled linearly to more lights it is what brute force will take, so a
+/// hopeless brute-force combination is skipped without a frame of it; clustered techniques
+/// grow slower than linearly, so for them it only decides whether one frame may be rendered,
+/// which then estimates the rest.
 type Previous = Option<(u64, f64)>;
 
 fn measure(
@@ -229,8 +232,18 @@ fn measure(
             format!("skipped: {frames} frames would take about {estimate_s:.0} s ({ms:.0} ms a frame, {how}; budget {} s)", a.budget_s)
         })
     };
-    if let Some(why) = previous.and_then(|(n, ms)| skip(ms * lights as f64 / n as f64, &format!("scaled from {n} lights"))) {
-        return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None });
+    if let Some((n, ms)) = previous {
+        let scaled = ms * lights as f64 / n as f64;
+        let why = if technique.is_clustered() {
+            (scaled / 1e3 > a.budget_s).then(|| {
+                format!("skipped: one frame would take about {:.0} s (scaled from {n} lights; budget {} s)", scaled / 1e3, a.budget_s)
+            })
+        } else {
+            skip(scaled, &format!("scaled from {n} lights"))
+        };
+        if let Some(why) = why {
+            return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: scaled });
+        }
     }
     let args = scene_args(a, technique, lights, resolution)?;
     let (scene, shading) = build_scene(&args)?;
@@ -238,12 +251,13 @@ fn measure(
     settings.time = None;
     let probe = HeadlessRenderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
-        return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None });
+        return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: probe.stats.wall_ms });
     }
     settings.frames = frames;
     let output = HeadlessRenderer::new(ctx, scene, settings).and_then(|mut r| r.render())?;
     let grid = technique.is_clustered().then_some(settings.clusters);
-    Ok(Measured { technique, lights, skipped: None, output: Some(output), grid })
+    let ms_per_frame = output.stats.wall_ms_per_frame();
+    Ok(Measured { technique, lights, skipped: None, output: Some(output), grid, ms_per_frame })
 }
 
 fn spread_json(s: &Spread) -> Value {
@@ -353,6 +367,8 @@ fn plot(path: &std::path::Path, series: &[(Technique, Vec<(f64, f64)>)], (w, h):
     let mut chart = ChartBuilder::on(&root)
         .caption(format!("GPU ms per frame at {w}x{h} (median)"), ("sans-serif", 24))
         .margin(16)
+        // Room for the last decade's label, which is centred on the right edge.
+        .margin_right(48)
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
@@ -360,7 +376,7 @@ fn plot(path: &std::path::Path, series: &[(Technique, Vec<(f64, f64)>)], (w, h):
         .configure_mesh()
         .x_desc("lights")
         .y_desc("GPU ms per frame")
-        .x_label_formatter(&|v| format!("{v:.0}"))
+        .x_label_formatter(&|v| count_label(*v))
         .y_label_formatter(&|v| format!("{v}"))
         .draw()?;
     for (i, (technique, points)) in series.iter().enumerate() {
@@ -381,9 +397,23 @@ fn plot(path: &std::path::Path, series: &[(Technique, Vec<(f64, f64)>)], (w, h):
     Ok(())
 }
 
+/// 1000 → 1k, 1000000 → 1M (axis labels).
+fn count_label(v: f64) -> String {
+    match v {
+        v if v >= 1e6 => format!("{}M", v / 1e6),
+        v if v >= 1e3 => format!("{}k", v / 1e3),
+        v => format!("{v:.0}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn axis_labels_are_short() {
+        assert_eq!([10.0, 1000.0, 16000.0, 1e6].map(count_label), ["10", "1k", "16k", "1M"]);
+    }
 
     #[test]
     fn counts_and_resolutions_parse() {

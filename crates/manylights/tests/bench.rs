@@ -50,15 +50,21 @@ fn a_tiny_bench_writes_its_tables() {
     let coloured = plot.pixels().filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 100).count();
     assert!(coloured > 500, "the plot has no coloured lines ({coloured} pixels)");
 
-    // A budget no frame fits: every combination is skipped and says why.
+    // A budget no frame fits: every combination is skipped and says why; at 1M lights from the
+    // estimate at 64 (scaled linearly), without rendering a frame of them.
     let skipped = Command::new(env!("CARGO_BIN_EXE_manylights"))
-        .args(["bench", "--techniques", "forward", "--lights", "64", "--resolution", "32x32", "--frames", "3", "--warmup", "0"])
-        .args(["--budget-s", "0.000001", "--out", out_dir.to_str().unwrap()])
+        .args(["bench", "--techniques", "forward,clustered-gpu", "--lights", "64,1M", "--resolution", "32x32"])
+        .args(["--frames", "3", "--warmup", "0", "--budget-s", "0.000001", "--out", out_dir.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(skipped.status.success(), "{}", String::from_utf8_lossy(&skipped.stderr));
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
-    assert!(csv.lines().nth(1).unwrap().contains("skipped: 3 frames would take"), "{csv}");
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 4, "{csv}");
+    assert!(rows[0].starts_with("forward,64,") && rows[0].contains("skipped: 3 frames would take"), "{csv}");
+    assert!(rows[0].contains("one frame measured") && rows[1].contains("one frame measured"), "{csv}");
+    assert!(rows[2].starts_with("forward,1000000,") && rows[2].contains("scaled from 64 lights"), "{csv}");
+    assert!(rows[3].contains("skipped: one frame would take about") && rows[3].contains("scaled from 64 lights"), "{csv}");
 }
 
 #[test]
