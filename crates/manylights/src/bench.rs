@@ -267,31 +267,34 @@ fn spread_json(s: &Spread) -> Value {
 fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Value), results: &[Measured]) -> Result<()> {
     let skip = a.warmup as usize;
     let mut csv = String::from(
-        "technique,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,assign_mean_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
+        "technique,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,cpu_assign_median_ms,cpu_upload_median_ms,cpu_record_median_ms,cpu_submit_median_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
     );
     let mut rows = Vec::new();
     for m in results {
         let head = format!("{},{},{w},{h},{}", m.technique.name(), m.lights, a.frames);
         let Some(out) = &m.output else {
             let why = m.skipped.clone().unwrap_or_default();
-            csv += &format!("{head},\"{why}\",,,,,,,,,,\n");
+            csv += &format!("{head},\"{why}\",,,,,,,,,,,,,\n");
             rows.push(json!({ "technique": m.technique.name(), "lights": m.lights, "status": why }));
             continue;
         };
         let stats = &out.stats;
         let cpu = stats.cpu_spread(skip);
-        let assign = stats.assign_ms().map_or(String::new(), |ms| format!("{ms:.4}"));
         let grid = m.grid.map_or(String::new(), |d| format!("{}x{}x{}", d.x, d.y, d.z));
         let clusters =
             stats.clusters.map_or((String::new(), String::new()), |c| (format!("{:.3}", c.mean_lights), c.max_lights.to_string()));
         let passes = stats.gpu_spread(skip).unwrap_or_default();
-        let cpu_cols = cpu.map_or(",".to_owned(), |c| format!("{:.4},{:.4}", c.median, c.p95));
+        // Total median and p95, then each phase's median.
+        let cpu_cols = cpu.map_or(",,,,,".to_owned(), |(total, phases)| {
+            let medians: Vec<String> = phases.iter().map(|(_, s)| format!("{:.4}", s.median)).collect();
+            format!("{:.4},{:.4},{}", total.median, total.p95, medians.join(","))
+        });
         if passes.is_empty() {
-            csv += &format!("{head},measured (no GPU timestamps),,,,,{cpu_cols},{assign},{grid},{},{}\n", clusters.0, clusters.1);
+            csv += &format!("{head},measured (no GPU timestamps),,,,,{cpu_cols},{grid},{},{}\n", clusters.0, clusters.1);
         }
         for (pass, s) in &passes {
             csv += &format!(
-                "{head},measured,{pass},{:.4},{:.4},{:.4},{cpu_cols},{assign},{grid},{},{}\n",
+                "{head},measured,{pass},{:.4},{:.4},{:.4},{cpu_cols},{grid},{},{}\n",
                 s.median, s.p95, s.mean, clusters.0, clusters.1
             );
         }
@@ -300,8 +303,13 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
             "lights": m.lights,
             "status": "measured",
             "passes": passes.iter().map(|(n, s)| json!({ "pass": n, "gpu": spread_json(s) })).collect::<Vec<_>>(),
-            "cpu": cpu.as_ref().map(spread_json),
-            "assign_mean_ms": stats.assign_ms(),
+            "cpu": cpu.as_ref().map(|(total, phases)| {
+                let mut j = json!({ "total": spread_json(total) });
+                for (name, s) in phases {
+                    j[*name] = spread_json(s);
+                }
+                j
+            }),
             "clusters": m.grid.map(|d| [d.x, d.y, d.z]),
             "lights_per_cluster": stats.clusters.map(|c| json!({ "mean": c.mean_lights, "max": c.max_lights })),
         }));

@@ -345,7 +345,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     if let Some(o) = settings.omni {
         rows.push(("omni shadows", format!("{}: {} light(s), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size)));
     }
-    rows.push(("cpu ms/frame", format!("{:.3}  (update + assign + record + submit)", stats.cpu_ms())));
+    rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
     rows.push(("output", cmd.out.display().to_string()));
     print!("{}", table(&rows));

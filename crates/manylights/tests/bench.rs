@@ -20,7 +20,20 @@ fn a_tiny_bench_writes_its_tables() {
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    for column in ["technique", "lights", "status", "pass", "gpu_median_ms", "gpu_p95_ms", "cpu_median_ms", "lights_per_cluster_mean"] {
+    for column in [
+        "technique",
+        "lights",
+        "status",
+        "pass",
+        "gpu_median_ms",
+        "gpu_p95_ms",
+        "cpu_median_ms",
+        "cpu_assign_median_ms",
+        "cpu_upload_median_ms",
+        "cpu_record_median_ms",
+        "cpu_submit_median_ms",
+        "lights_per_cluster_mean",
+    ] {
         assert!(header.contains(&column), "no column {column}: {header:?}");
     }
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
@@ -32,6 +45,10 @@ fn a_tiny_bench_writes_its_tables() {
         assert_eq!(r[col("status")], "measured");
         let (median, p95): (f64, f64) = (r[col("gpu_median_ms")].parse().unwrap(), r[col("gpu_p95_ms")].parse().unwrap());
         assert!(median > 0.0 && p95 >= median, "{r:?}");
+        // CPU phases: recording takes time in every technique; only CPU-built clusters assign.
+        let phase = |name: &str| r[col(name)].parse::<f64>().unwrap();
+        assert!(phase("cpu_record_median_ms") > 0.0 && phase("cpu_median_ms") >= phase("cpu_record_median_ms"), "{r:?}");
+        assert_eq!(phase("cpu_assign_median_ms"), 0.0, "{r:?}");
     }
     let clustered = rows.iter().find(|r| r[0] == "clustered-gpu" && r[1] == "1000").unwrap();
     // --clusters auto at 64×64: the default grid (no scaling below ~11.6k lights).

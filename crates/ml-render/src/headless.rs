@@ -10,7 +10,7 @@ use crate::gpu_mesh::GpuMesh;
 use crate::object_textures::ObjectTextureSets;
 use crate::omni_shadow::{OmniShadows, ShadowedLight};
 use crate::raster::{object_data, DrawList, PassFrame, RasterPass};
-use crate::report::FrameStats;
+use crate::report::{CpuPhases, FrameStats};
 use crate::scene_textures::{SceneTextures, ShadowInputs};
 use crate::settings::ShadingModel;
 use crate::settings::{DebugView, RenderSettings};
@@ -564,10 +564,12 @@ impl<'a> HeadlessRenderer<'a> {
         let ctx = self.ctx;
         let fence = self.frames[f].fence;
         self.collect(f, stats)?;
-        let cpu = Instant::now();
-        self.update_frame(f, t, stats)?;
+        let start = Instant::now();
+        let assign = self.update_frame(f, t, stats)?;
+        let updated = Instant::now();
         let (wait, signal) = hook.as_ref().map_or((None, None), |h| h.semaphores());
         self.record(f, hook)?;
+        let recorded = Instant::now();
         let (waits, stages): (Vec<vk::Semaphore>, Vec<vk::PipelineStageFlags>) = wait.into_iter().unzip();
         let signals: Vec<vk::Semaphore> = signal.into_iter().collect();
         // SAFETY: the fence was waited on in `collect` and the command buffer is executable.
@@ -582,7 +584,13 @@ impl<'a> HeadlessRenderer<'a> {
             ctx.device.queue_submit(ctx.queue, &submit, fence).ctx("vkQueueSubmit")?;
         }
         self.pending[f] = true;
-        stats.add_cpu_ms(cpu.elapsed().as_secs_f64() * 1e3);
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        stats.add_cpu(CpuPhases {
+            assign,
+            upload: ms(updated - start) - assign,
+            record: ms(recorded - updated),
+            submit: ms(recorded.elapsed()),
+        });
         Ok(())
     }
 
@@ -621,7 +629,9 @@ impl<'a> HeadlessRenderer<'a> {
         (0..FRAMES_IN_FLIGHT).try_for_each(|f| self.collect(f, stats))
     }
 
-    fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<(), VkError> {
+    /// Write slot `f`'s buffers for clock `t`; the milliseconds of CPU light assignment in it.
+    fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<f64, VkError> {
+        let mut assign_ms = 0.0;
         if self.builder.is_some() {
             if self.frames[f].ensure_index_capacity(self.ctx, self.required_indices)? {
                 stats.index_growths += 1;
@@ -637,7 +647,8 @@ impl<'a> HeadlessRenderer<'a> {
             c.assigner
                 .assign(&self.grid, &self.animated, &mut c.lists, limit)
                 .map_err(|e| frame::lists_too_long(e.at_least, limit, "clustered-cpu builds (or the device binds)"))?;
-            stats.add_assign_ms(start.elapsed().as_secs_f64() * 1e3);
+            assign_ms = start.elapsed().as_secs_f64() * 1e3;
+            stats.add_assign_ms(assign_ms);
             let cluster_stats = c.lists.stats();
             self.heat_top = cluster_stats.max_lights.max(1) as f32;
             stats.clusters = Some(cluster_stats);
@@ -656,7 +667,7 @@ impl<'a> HeadlessRenderer<'a> {
             })
             .collect();
         self.write_uniforms(f, t);
-        Ok(())
+        Ok(assign_ms)
     }
 
     fn write_uniforms(&mut self, f: usize, t: f32) {

@@ -6,9 +6,9 @@ pub struct FrameStats {
     pub pass_names: Vec<&'static str>,
     gpu_sum_ms: Vec<f64>,
     gpu_frames: u32,
-    /// Every frame's GPU ms per pass and CPU ms, in the order the frames finished.
+    /// Every frame's GPU ms per pass and CPU ms per phase, in the order the frames finished.
     gpu_samples: Vec<Vec<f64>>,
-    cpu_samples: Vec<f64>,
+    cpu_samples: Vec<CpuPhases>,
     cpu_sum_ms: f64,
     assign_sum_ms: f64,
     assign_frames: u32,
@@ -69,9 +69,9 @@ impl FrameStats {
         (self.assign_frames > 0).then(|| self.assign_sum_ms / self.assign_frames as f64)
     }
 
-    pub fn add_cpu_ms(&mut self, ms: f64) {
-        self.cpu_sum_ms += ms;
-        self.cpu_samples.push(ms);
+    pub fn add_cpu(&mut self, phases: CpuPhases) {
+        self.cpu_sum_ms += phases.total();
+        self.cpu_samples.push(phases);
     }
 
     /// Median, 95th percentile and mean GPU ms of each pass over the frames after the first
@@ -81,9 +81,12 @@ impl FrameStats {
         Some(self.pass_names.iter().enumerate().map(|(i, n)| (*n, Spread::of(frames.iter().map(|f| f[i]).collect()))).collect())
     }
 
-    /// The same for the CPU time per frame (update, assign, record, submit).
-    pub fn cpu_spread(&self, skip: usize) -> Option<Spread> {
-        self.cpu_samples.get(skip..).filter(|s| !s.is_empty()).map(|s| Spread::of(s.to_vec()))
+    /// The same for the CPU time per frame (assign, upload, record, submit), and for each
+    /// phase of it.
+    pub fn cpu_spread(&self, skip: usize) -> Option<(Spread, [(&'static str, Spread); 4])> {
+        let frames = self.cpu_samples.get(skip..).filter(|s| !s.is_empty())?;
+        let phase = |i: usize| Spread::of(frames.iter().map(|p| p.as_array()[i]).collect());
+        Some((Spread::of(frames.iter().map(CpuPhases::total).collect()), std::array::from_fn(|i| (CpuPhases::NAMES[i], phase(i)))))
     }
 
     pub fn gpu_ms(&self) -> PassTimes {
@@ -98,6 +101,31 @@ impl FrameStats {
     /// Wall-clock time per frame over the whole run (includes waiting for the GPU).
     pub fn wall_ms_per_frame(&self) -> f64 {
         self.wall_ms / self.frames.max(1) as f64
+    }
+}
+
+/// One frame's CPU milliseconds by phase.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CpuPhases {
+    /// Light assignment (clustered-cpu, deferred-clustered; 0 elsewhere).
+    pub assign: f64,
+    /// Writing the frame's buffers: animated lights, cluster lists, uniforms.
+    pub upload: f64,
+    /// Recording the command buffer.
+    pub record: f64,
+    /// vkQueueSubmit.
+    pub submit: f64,
+}
+
+impl CpuPhases {
+    pub const NAMES: [&'static str; 4] = ["assign", "upload", "record", "submit"];
+
+    pub fn as_array(&self) -> [f64; 4] {
+        [self.assign, self.upload, self.record, self.submit]
+    }
+
+    pub fn total(&self) -> f64 {
+        self.as_array().iter().sum()
     }
 }
 
@@ -135,12 +163,15 @@ mod tests {
         let mut stats = FrameStats::new(&["a", "b"]);
         for i in 0..5 {
             stats.add_gpu(&[100.0 * f64::from(i == 0), f64::from(i)]);
-            stats.add_cpu_ms(f64::from(i));
+            let i = f64::from(i);
+            stats.add_cpu(CpuPhases { assign: i, upload: 2.0 * i, record: 0.5, submit: 0.25 });
         }
         let gpu = stats.gpu_spread(1).unwrap();
         assert_eq!(gpu[0], ("a", Spread { median: 0.0, p95: 0.0, mean: 0.0 }));
         assert_eq!(gpu[1].1.median, 2.0);
-        assert_eq!(stats.cpu_spread(1).unwrap().p95, 4.0);
+        let (total, phases) = stats.cpu_spread(1).unwrap();
+        assert_eq!((total.p95, total.median), (12.75, 6.75));
+        assert_eq!(phases.map(|(n, s)| (n, s.median)), [("assign", 2.0), ("upload", 4.0), ("record", 0.5), ("submit", 0.25)]);
         assert!(stats.gpu_spread(5).is_none());
     }
 }
