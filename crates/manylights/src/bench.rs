@@ -387,8 +387,9 @@ fn plot(path: &std::path::Path, series: &[(Technique, Vec<(f64, f64)>)], (w, h):
         .x_label_formatter(&|v| count_label(*v))
         .y_label_formatter(&|v| format!("{v}"))
         .draw()?;
-    for (i, (technique, points)) in series.iter().enumerate() {
-        let colour = Palette99::pick(i).to_rgba();
+    for (technique, points) in series {
+        // A technique keeps its colour in every plot, whichever others are in it.
+        let colour = Palette99::pick(Technique::ALL.iter().position(|t| t == technique).unwrap_or(0)).to_rgba();
         chart
             .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
             .label(technique.name())
