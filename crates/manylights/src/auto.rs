@@ -2,7 +2,7 @@
 //! the compute-vs-fragment probe (ml_render::stage_probe) measured on it.
 
 use anyhow::{bail, Result};
-use ml_render::stage_probe::{pick_lighting_path, quick_probe};
+use ml_render::stage_probe::{pick_lighting_path, quick_probe, StageTimes};
 use ml_render::Technique;
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
@@ -17,9 +17,17 @@ pub fn technique_choice(name: &str) -> Result<Option<Technique>> {
     Technique::from_name(name).map(Some).map_err(|e| anyhow::anyhow!("{e}, or auto"))
 }
 
-/// Probe `ctx`'s device and say which technique `auto` is there, and why.
-pub fn pick(ctx: &Context) -> Result<(Technique, String)> {
-    Ok(pick_lighting_path(&quick_probe(ctx)?))
+/// Probe `ctx`'s device and say which technique `auto` is there, why, and what the probe
+/// measured.
+pub fn pick(ctx: &Context) -> Result<(Technique, String, StageTimes)> {
+    let times = quick_probe(ctx)?;
+    let (technique, why) = pick_lighting_path(&times);
+    Ok((technique, why, times))
+}
+
+/// The line that tells what `auto` picked and why.
+pub fn announce(technique: Technique, why: &str) {
+    println!("auto: {}: {why}", technique.name());
 }
 
 /// `name`'s technique; for `auto`, probed on a context of its own (the viewer makes its own
@@ -36,8 +44,8 @@ pub fn resolve_alone(name: &str, validation: bool, device_index: Option<usize>) 
     if count > 0 {
         bail!("the validation layer reported {count} message(s) while probing for --technique auto (printed above)");
     }
-    let (technique, why) = picked?;
-    println!("auto: {}: {why}", technique.name());
+    let (technique, why, _) = picked?;
+    announce(technique, &why);
     Ok(technique)
 }
 

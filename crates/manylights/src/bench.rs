@@ -4,13 +4,12 @@
 //! would take longer than the budget is skipped and says so: brute force estimated from a smaller
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
-use crate::auto::technique_choice;
+use crate::auto::{self, technique_choice};
 use crate::{build_scene, render_settings, SceneArgs};
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser};
 use ml_cpu::cluster::ClusterDims;
 use ml_render::report::Spread;
-use ml_render::stage_probe::{pick_lighting_path, quick_probe};
 use ml_render::{HeadlessRenderer, RenderOutput, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
@@ -84,15 +83,15 @@ fn parse_resolution(text: &str) -> Result<(u32, u32)> {
     Ok((w.trim().parse().context("resolution width")?, h.trim().parse().context("resolution height")?))
 }
 
-/// The scene arguments `render` would get for one combination.
-fn scene_args(a: &BenchArgs, technique: Technique, lights: u64, (w, h): (u32, u32)) -> Result<SceneArgs> {
+/// The scene arguments `render` would get for one combination (its technique aside).
+fn scene_args(a: &BenchArgs, lights: u64, (w, h): (u32, u32)) -> Result<SceneArgs> {
     #[derive(Parser)]
     struct Wrap {
         #[command(flatten)]
         scene: SceneArgs,
     }
     let (lights, w, h) = (lights.to_string(), w.to_string(), h.to_string());
-    let mut argv = vec!["bench", "--scene", &a.scene, "--technique", technique.name(), "--lights", &lights, "--width", &w, "--height", &h];
+    let mut argv = vec!["bench", "--scene", &a.scene, "--lights", &lights, "--width", &w, "--height", &h];
     argv.extend(["--clusters", &a.clusters]);
     if let Some(s) = &a.shading {
         argv.extend(["--shading", s]);
@@ -142,17 +141,14 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         return check_messages(messages.load(Ordering::SeqCst));
     }
     // Every run records the quick probe and what auto makes of it.
-    let quick = quick_probe(&ctx)?;
-    let (auto_technique, auto_why) = pick_lighting_path(&quick);
-    println!("auto: {}: {auto_why}", auto_technique.name());
-    let mut techniques: Vec<Technique> = choices.into_iter().map(|c| c.unwrap_or(auto_technique)).collect();
-    let mut seen = Vec::new();
-    techniques.retain(|t| {
-        !seen.contains(t) && {
-            seen.push(*t);
-            true
+    let (auto_technique, auto_why, quick) = auto::pick(&ctx)?;
+    auto::announce(auto_technique, &auto_why);
+    let mut techniques: Vec<Technique> = Vec::new();
+    for t in choices.into_iter().map(|c| c.unwrap_or(auto_technique)) {
+        if !techniques.contains(&t) {
+            techniques.push(t);
         }
-    });
+    }
     let bar = indicatif::ProgressBar::new((techniques.len() * counts.len()) as u64);
     bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("a valid template"));
     let mut results: Vec<Measured> = Vec::new();
@@ -245,9 +241,9 @@ fn measure(
             return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: scaled });
         }
     }
-    let args = scene_args(a, technique, lights, resolution)?;
+    let args = scene_args(a, lights, resolution)?;
     let (scene, shading) = build_scene(&args)?;
-    let mut settings = render_settings(&args, scene.lights.len(), shading, 1)?;
+    let mut settings = render_settings(&args, technique, scene.lights.len(), shading, 1)?;
     settings.time = None;
     let probe = HeadlessRenderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {

@@ -240,11 +240,11 @@ fn check_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Render settings from the arguments for a scene of `lights` point lights (the shading model
-/// as the scene decided).
-fn render_settings(args: &SceneArgs, lights: usize, shading: ShadingModel, frames: u32) -> Result<RenderSettings> {
+/// Render settings from the arguments for `technique` (`--technique` itself may say auto) and
+/// a scene of `lights` point lights (the shading model as the scene decided).
+fn render_settings(args: &SceneArgs, technique: Technique, lights: usize, shading: ShadingModel, frames: u32) -> Result<RenderSettings> {
     Ok(RenderSettings {
-        technique: Technique::from_name(&args.technique)?,
+        technique,
         shading,
         clusters: match args.clusters.as_str() {
             "auto" => ClusterDims::for_lights(lights, args.width, args.height),
@@ -266,23 +266,23 @@ fn render_settings(args: &SceneArgs, lights: usize, shading: ShadingModel, frame
 }
 
 fn render(cmd: &RenderArgs) -> Result<()> {
-    let mut args = cmd.scene.clone();
+    let args = &cmd.scene;
     let choice = auto::technique_choice(&args.technique)?;
-    let (scene, shading) = build_scene(&args)?;
+    let (scene, shading) = build_scene(args)?;
     check_output(&cmd.out)?;
-    // Every other setting is checked before the GPU work (auto's technique is known after it).
-    render_settings(&SceneArgs { technique: Technique::Forward.name().into(), ..args.clone() }, scene.lights.len(), shading, cmd.frames)?;
+    // Every setting is checked before the GPU work; auto's technique is set once it is known.
+    let mut settings = render_settings(args, choice.unwrap_or(Technique::DeferredClustered), scene.lights.len(), shading, cmd.frames)?;
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();
-    let (technique, auto_why) = match choice {
-        Some(t) => (t, None),
+    let auto_why = match choice {
+        Some(_) => None,
         None => {
-            let (t, why) = auto::pick(&ctx)?;
-            (t, Some(why))
+            let (t, why, _) = auto::pick(&ctx)?;
+            settings.technique = t;
+            Some(why)
         }
     };
-    args.technique = technique.name().into();
-    let settings = render_settings(&args, scene.lights.len(), shading, cmd.frames)?;
+    let technique = settings.technique;
     let light_count = scene.lights.len();
     let object_textures = !scene.textures.is_empty();
     let result = HeadlessRenderer::new(&ctx, scene, settings).and_then(|mut r| r.render());
@@ -368,10 +368,8 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     // Checked once up front, so that a bad argument fails before a window opens.
     auto::technique_choice(&args.technique)?;
     let (scene, shading) = build_scene(args)?;
-    let mut args = args.clone();
-    args.technique = auto::resolve_alone(&args.technique, args.validation, args.device)?.name().into();
-    let args = &args;
-    let first = render_settings(args, scene.lights.len(), shading, 1)?;
+    let technique = auto::resolve_alone(&args.technique, args.validation, args.device)?;
+    let first = render_settings(args, technique, scene.lights.len(), shading, 1)?;
     let choices = ml_viewer::Choices {
         technique: first.technique,
         shading: first.shading,

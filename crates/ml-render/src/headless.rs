@@ -587,7 +587,7 @@ impl<'a> HeadlessRenderer<'a> {
         let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
         stats.add_cpu(CpuPhases {
             assign,
-            upload: ms(updated - start) - assign,
+            upload: ms(updated - start) - assign.unwrap_or(0.0),
             record: ms(recorded - updated),
             submit: ms(recorded.elapsed()),
         });
@@ -629,9 +629,10 @@ impl<'a> HeadlessRenderer<'a> {
         (0..FRAMES_IN_FLIGHT).try_for_each(|f| self.collect(f, stats))
     }
 
-    /// Write slot `f`'s buffers for clock `t`; the milliseconds of CPU light assignment in it.
-    fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<f64, VkError> {
-        let mut assign_ms = 0.0;
+    /// Write slot `f`'s buffers for clock `t`; the milliseconds of CPU light assignment in it
+    /// (None where the CPU does not assign).
+    fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, VkError> {
+        let mut assign_ms = None;
         if self.builder.is_some() {
             if self.frames[f].ensure_index_capacity(self.ctx, self.required_indices)? {
                 stats.index_growths += 1;
@@ -647,8 +648,7 @@ impl<'a> HeadlessRenderer<'a> {
             c.assigner
                 .assign(&self.grid, &self.animated, &mut c.lists, limit)
                 .map_err(|e| frame::lists_too_long(e.at_least, limit, "clustered-cpu builds (or the device binds)"))?;
-            assign_ms = start.elapsed().as_secs_f64() * 1e3;
-            stats.add_assign_ms(assign_ms);
+            assign_ms = Some(start.elapsed().as_secs_f64() * 1e3);
             let cluster_stats = c.lists.stats();
             self.heat_top = cluster_stats.max_lights.max(1) as f32;
             stats.clusters = Some(cluster_stats);

@@ -1,17 +1,12 @@
 //! Frame measurements and the table `render` prints.
 
-/// Per-pass GPU times (timestamp queries) and CPU times, summed over frames.
+/// Per-pass GPU times (timestamp queries) and CPU times of every frame.
 #[derive(Clone, Debug)]
 pub struct FrameStats {
     pub pass_names: Vec<&'static str>,
-    gpu_sum_ms: Vec<f64>,
-    gpu_frames: u32,
     /// Every frame's GPU ms per pass and CPU ms per phase, in the order the frames finished.
     gpu_samples: Vec<Vec<f64>>,
     cpu_samples: Vec<CpuPhases>,
-    cpu_sum_ms: f64,
-    assign_sum_ms: f64,
-    assign_frames: u32,
     pub frames: u32,
     pub wall_ms: f64,
     /// Cluster statistics of the last frame (clustered techniques).
@@ -34,13 +29,8 @@ impl FrameStats {
     pub fn new(pass_names: &[&'static str]) -> FrameStats {
         FrameStats {
             pass_names: pass_names.to_vec(),
-            gpu_sum_ms: vec![0.0; pass_names.len()],
-            gpu_frames: 0,
             gpu_samples: Vec::new(),
             cpu_samples: Vec::new(),
-            cpu_sum_ms: 0.0,
-            assign_sum_ms: 0.0,
-            assign_frames: 0,
             frames: 0,
             wall_ms: 0.0,
             clusters: None,
@@ -52,25 +42,16 @@ impl FrameStats {
     }
 
     pub fn add_gpu(&mut self, ms: &[f64]) {
-        for (sum, v) in self.gpu_sum_ms.iter_mut().zip(ms) {
-            *sum += v;
-        }
-        self.gpu_frames += 1;
         self.gpu_samples.push(ms.to_vec());
     }
 
-    pub fn add_assign_ms(&mut self, ms: f64) {
-        self.assign_sum_ms += ms;
-        self.assign_frames += 1;
-    }
-
-    /// Mean CPU light-assignment time (clustered-cpu).
+    /// Mean CPU light-assignment time over the frames that assigned (the CPU-built techniques).
     pub fn assign_ms(&self) -> Option<f64> {
-        (self.assign_frames > 0).then(|| self.assign_sum_ms / self.assign_frames as f64)
+        let assigned: Vec<f64> = self.cpu_samples.iter().filter_map(|p| p.assign).collect();
+        (!assigned.is_empty()).then(|| assigned.iter().sum::<f64>() / assigned.len() as f64)
     }
 
     pub fn add_cpu(&mut self, phases: CpuPhases) {
-        self.cpu_sum_ms += phases.total();
         self.cpu_samples.push(phases);
     }
 
@@ -90,12 +71,16 @@ impl FrameStats {
     }
 
     pub fn gpu_ms(&self) -> PassTimes {
-        (self.gpu_frames > 0).then(|| self.pass_names.iter().zip(&self.gpu_sum_ms).map(|(n, s)| (*n, s / self.gpu_frames as f64)).collect())
+        let frames = &self.gpu_samples;
+        (!frames.is_empty()).then(|| {
+            let mean = |i: usize| frames.iter().map(|f| f[i]).sum::<f64>() / frames.len() as f64;
+            self.pass_names.iter().enumerate().map(|(i, n)| (*n, mean(i))).collect()
+        })
     }
 
-    /// CPU time to update, record and submit one frame.
+    /// CPU time to assign, upload, record and submit one frame.
     pub fn cpu_ms(&self) -> f64 {
-        self.cpu_sum_ms / self.frames.max(1) as f64
+        self.cpu_samples.iter().map(CpuPhases::total).sum::<f64>() / self.frames.max(1) as f64
     }
 
     /// Wall-clock time per frame over the whole run (includes waiting for the GPU).
@@ -107,8 +92,8 @@ impl FrameStats {
 /// One frame's CPU milliseconds by phase.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CpuPhases {
-    /// Light assignment (clustered-cpu, deferred-clustered; 0 elsewhere).
-    pub assign: f64,
+    /// Light assignment (clustered-cpu, deferred-clustered; None elsewhere).
+    pub assign: Option<f64>,
     /// Writing the frame's buffers: animated lights, cluster lists, uniforms.
     pub upload: f64,
     /// Recording the command buffer.
@@ -120,8 +105,9 @@ pub struct CpuPhases {
 impl CpuPhases {
     pub const NAMES: [&'static str; 4] = ["assign", "upload", "record", "submit"];
 
+    /// The phases in NAMES order, a technique that does not assign counting 0 for it.
     pub fn as_array(&self) -> [f64; 4] {
-        [self.assign, self.upload, self.record, self.submit]
+        [self.assign.unwrap_or(0.0), self.upload, self.record, self.submit]
     }
 
     pub fn total(&self) -> f64 {
@@ -164,7 +150,7 @@ mod tests {
         for i in 0..5 {
             stats.add_gpu(&[100.0 * f64::from(i == 0), f64::from(i)]);
             let i = f64::from(i);
-            stats.add_cpu(CpuPhases { assign: i, upload: 2.0 * i, record: 0.5, submit: 0.25 });
+            stats.add_cpu(CpuPhases { assign: Some(i), upload: 2.0 * i, record: 0.5, submit: 0.25 });
         }
         let gpu = stats.gpu_spread(1).unwrap();
         assert_eq!(gpu[0], ("a", Spread { median: 0.0, p95: 0.0, mean: 0.0 }));

@@ -109,8 +109,13 @@ impl ml_vk::Release for StageProbe {
 
 impl StageProbe {
     pub fn new(ctx: &Context, width: u32, height: u32, max_lights: u32) -> Result<StageProbe, VkError> {
-        let probe = StageProbe {
-            extent: vk::Extent2D { width, height },
+        ml_vk::build(ctx, StageProbe::empty(vk::Extent2D { width, height }, max_lights), |p| p.create(ctx))
+    }
+
+    /// A probe that owns nothing yet (or any more): every handle null.
+    fn empty(extent: vk::Extent2D, max_lights: u32) -> StageProbe {
+        StageProbe {
+            extent,
             max_lights,
             lights: Buffer::null(),
             fragment_target: Image::null(),
@@ -127,8 +132,7 @@ impl StageProbe {
             fragment_set: vk::DescriptorSet::null(),
             compute_set: vk::DescriptorSet::null(),
             timer: GpuTimer::null(),
-        };
-        ml_vk::build(ctx, probe, |p| p.create(ctx))
+        }
     }
 
     fn create(&mut self, ctx: &Context) -> Result<(), VkError> {
@@ -328,18 +332,10 @@ impl StageProbe {
             d.destroy_framebuffer(self.framebuffer, None);
             d.destroy_render_pass(self.render_pass, None);
         }
-        self.pool = vk::DescriptorPool::null();
-        self.fragment_pipeline = vk::Pipeline::null();
-        self.compute_pipeline = vk::Pipeline::null();
-        self.fragment_layout = vk::PipelineLayout::null();
-        self.compute_layout = vk::PipelineLayout::null();
-        self.fragment_set_layout = vk::DescriptorSetLayout::null();
-        self.compute_set_layout = vk::DescriptorSetLayout::null();
-        self.framebuffer = vk::Framebuffer::null();
-        self.render_pass = vk::RenderPass::null();
         self.fragment_target.destroy(ctx);
         self.compute_target.destroy(ctx);
         self.lights.destroy(ctx);
+        *self = StageProbe::empty(self.extent, self.max_lights);
     }
 }
 

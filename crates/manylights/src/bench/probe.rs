@@ -109,10 +109,7 @@ pub fn write(a: &BenchArgs, (w, h): (u32, u32), device: &Value, rows: &[ProbeRow
         }
     }
     let longest = rows.iter().rev().find_map(|r| r.outcome.as_ref().ok());
-    let auto = longest.map(|t| {
-        let (technique, why) = pick_lighting_path(t);
-        json!({ "technique": technique.name(), "why": why })
-    });
+    let pick = longest.map(pick_lighting_path);
     let report = json!({
         "device": device,
         "commit": env!("MANYLIGHTS_COMMIT"),
@@ -120,14 +117,14 @@ pub fn write(a: &BenchArgs, (w, h): (u32, u32), device: &Value, rows: &[ProbeRow
             "resolution": [w, h], "frames": a.frames, "warmup": a.warmup, "budget_s": a.budget_s,
             "probe_lights": a.probe_lights,
         },
-        "auto": auto,
+        "auto": pick.as_ref().map(|(technique, why)| json!({ "technique": technique.name(), "why": why })),
         "results": json_rows,
     });
     write_file(a, "probe.csv", &csv)?;
     write_file(a, "probe.json", &serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
     print!("{csv}");
-    match auto {
-        Some(auto) => println!("auto: {}: {}", auto["technique"].as_str().unwrap_or("?"), auto["why"].as_str().unwrap_or("")),
+    match pick {
+        Some((technique, why)) => crate::auto::announce(technique, &why),
         None => println!("auto: nothing measured within the budget"),
     }
     Ok(())
