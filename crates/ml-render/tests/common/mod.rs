@@ -20,6 +20,11 @@ pub fn render(scene: Scene, settings: RenderSettings) -> RenderOutput {
 
 /// Render the scene once per settings on one validated context; no validation message allowed.
 pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutput> {
+    render_each_on_device(scene, settings).0
+}
+
+/// `render_each`, and whether the device was Mesa's lavapipe (the driver CI runs).
+pub fn render_each_on_device(scene: &Scene, settings: &[RenderSettings]) -> (Vec<RenderOutput>, bool) {
     let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() })
         .expect("a Vulkan device with the validation layer (CI installs lavapipe and vulkan-validationlayers)");
     let counter = ctx.validation_counter();
@@ -30,9 +35,10 @@ pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutp
             renderer.render().expect("render")
         })
         .collect();
+    let lavapipe = ctx.info.name.starts_with("llvmpipe");
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
-    outputs
+    (outputs, lavapipe)
 }
 
 /// Largest per-channel difference between two images of the same size, and how many
