@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Issue 5's measurement: seed scene 1920×1080, 64 lights (the seed's grid, radius 15) and
+# The deferred-shading measurement (docs/BENCHMARKS.md, "Deferred shading: two subpasses in one
+# render pass"): seed scene 1920×1080, 64 lights (the seed's grid, radius 15) and
 # 4,096 / 65,536 random lights of radius 1–3; GPU ms per pass of every forward and deferred
 # technique. Usage: scripts/bench_deferred.sh [BINARY] [OUTDIR] [FRAMES_FAST] [FRAMES_SLOW]
 # MAX_BRUTE=N skips forward and deferred (every light at every pixel) above N lights: on
 # lavapipe one 65,536-light frame of those takes a quarter of an hour. SHADING=blinn-phong
-# measures seed 002's model instead of the seed's.
+# measures the blinn-phong model (docs/DESIGN.md#shading-models) instead of the seed model.
 set -euo pipefail
 bin=${1:-target/release/manylights}
 out=${2:-bench-deferred}

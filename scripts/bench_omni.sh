@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Issue 6's measurement: GPU ms of the point-light shadow pass (every cube rendered every
+# The point-light shadow measurement (docs/BENCHMARKS.md#point-light-shadow-cubes-copy-vs-direct-vs-multiview-vs-layered):
+# GPU ms of the shadow pass (every cube rendered every
 # frame) for 1, 4 and 16 shadowed lights, cube faces of 1024², by each way of filling the
 # cubes; the seed scene (49 spheres, the seed's 64 grid lights of radius 15), 1280×720,
 # seed shading with forward. Usage: scripts/bench_omni.sh [BINARY] [OUTDIR] [FRAMES]

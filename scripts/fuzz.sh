@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Fuzz the glTF loader and the scene-file parser (issue 7) with cargo-fuzz (libFuzzer).
-# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] (default 60; the issue's acceptance run used 600).
+# Fuzz the glTF loader and the scene-file parser (docs/scenes.md#gltf-20-files,
+# docs/scenes.md#scene-files-toml) with cargo-fuzz (libFuzzer); see docs/testing.md#fuzzing.
+# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] (default 60; the loaders' thorough run used 600).
 # Needs cargo-fuzz (`cargo install cargo-fuzz`); on stable Rust RUSTC_BOOTSTRAP=1 gives it the
 # nightly flags it uses. Seeds come from our own writer (crates/ml-cpu/examples/fuzz_seeds.rs);
 # a crash leaves its input under fuzz/artifacts/ and fails the script.

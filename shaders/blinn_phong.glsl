@@ -1,9 +1,9 @@
-// The `blinn-phong` shading model of SPEC §2 (seed 002, the "DX12 book" lighting): linear
-// falloff, Lambert, Blinn-Phong specular with shininess = (1 − roughness)·256 normalised by
-// (m + 8)/8, Schlick Fresnel on the half vector; a directional light with a 3×3 PCF shadow
+// The `blinn-phong` shading model, the "DX12 book" lighting (docs/DESIGN.md#shading-models):
+// linear falloff, Lambert, Blinn-Phong specular with shininess = (1 − roughness)·256 normalised
+// by (m + 8)/8, Schlick Fresnel on the half vector; a directional light with a 3×3 PCF shadow
 // map, point lights, one spot light, ambient, and an environment reflection weighted by
-// shininess × Fresnel. Unlike the seed, the shadow darkens only the light that casts it, and
-// the specular term is not tinted by the diffuse texture.
+// shininess × Fresnel. Unlike the demo this model comes from, the shadow darkens only the light
+// that casts it, and the specular term is not tinted by the diffuse texture.
 // Needs common.glsl, scene_bindings.glsl and textures.glsl.
 
 #ifndef MANYLIGHTS_BLINN_PHONG_GLSL

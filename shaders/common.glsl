@@ -2,7 +2,8 @@
 // Keep in sync: the test `gpu_layout` compares each Rust field offset and struct size with
 // what SPIR-V reflection of the compiled shaders reports, so a moved field fails CI.
 // Storage buffers are std430 (no 16-byte padding of scalars in arrays, no 64 KiB uniform cap:
-// seed mistake 5); the one uniform block is std140, so it holds only vec4-aligned members.
+// mistake 5 of docs/DESIGN.md#mistakes-we-avoid); the one uniform block is std140, so it holds
+// only vec4-aligned members.
 
 #ifndef MANYLIGHTS_COMMON_GLSL
 #define MANYLIGHTS_COMMON_GLSL
@@ -33,7 +34,8 @@ struct FrameUniforms {
     vec4 cluster_frustum; // x: near, y: far, z: proj[0][0], w: proj[1][1] (symmetric perspective)
     vec4 light_animation; // xyz: offset every light moves by this frame (the seed's animation)
     uvec4 cluster_build;  // x: light-index capacity (entries) of this frame's list
-    // The blinn-phong model's other lights (seed 002); the seed model ignores them.
+    // The blinn-phong model's other lights (docs/DESIGN.md#shading-models); the seed model
+    // ignores them.
     mat4 shadow_view_proj;     // world → the sun's shadow-map clip space (depth 0..1)
     vec4 sun_direction;        // xyz: direction the sunlight travels; w: shadow-map texel (uv units)
     vec4 sun_strength;         // rgb: colour × strength; w: shadow-map texel in world units

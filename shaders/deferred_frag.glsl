@@ -1,8 +1,9 @@
-// Subpass 1 of the deferred render pass (seed 002): reads the G-buffer that subpass 0 wrote as
-// input attachments (this pixel only: subpassLoad), rebuilds the position from depth and
-// shades it with lighting.glsl into the HDR target. `deferred.frag` loops over every light,
-// `deferred_clustered.frag` over the fragment's cluster. Pixels no object covers keep the
-// clear value (alpha 0), which the tone-map pass turns into the background colour.
+// Subpass 1 of the deferred render pass (docs/DESIGN.md#deferred-shading-in-one-render-pass):
+// reads the G-buffer that subpass 0 wrote as input attachments (this pixel only: subpassLoad),
+// rebuilds the position from depth and shades it with lighting.glsl into the HDR target.
+// `deferred.frag` loops over every light, `deferred_clustered.frag` over the fragment's
+// cluster. Pixels no object covers keep the clear value (alpha 0), which the tone-map pass
+// turns into the background colour.
 
 #include "common.glsl"
 

@@ -1,6 +1,6 @@
-// Point-light shadows (SPEC §4, seed 003), read side: each shadowed light has a cube in the
-// cube-map array `omni_shadows` holding, per texel, the distance from the light to the
-// nearest surface over the light's radius. Compiled in only when OMNI_SHADOWS is set (a
+// Point-light shadows (docs/DESIGN.md#point-light-shadows), read side: each shadowed light has
+// a cube in the cube-map array `omni_shadows` holding, per texel, the distance from the light
+// to the nearest surface over the light's radius. Compiled in only when OMNI_SHADOWS is set (a
 // specialization constant), so renders without them run the loop they always ran.
 
 #ifndef MANYLIGHTS_OMNI_SHADOW_GLSL

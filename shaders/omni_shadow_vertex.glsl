@@ -10,8 +10,8 @@ vec3 omni_from_light() {
     return (omni.model_to_light * vec4(in_position, 1.0)).xyz;
 }
 
-// Forward and up of each face: +X, −X, +Y, −Y, +Z, −Z (seed 003's list,
-// ml_cpu::omni_shadow::face_axes).
+// Forward and up of each face: +X, −X, +Y, −Y, +Z, −Z (Vulkan's cube layout, the classic face
+// list: docs/DESIGN.md#point-light-shadows; ml_cpu::omni_shadow::face_axes).
 const vec3 FACE_FORWARD[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
 const vec3 FACE_UP[6] = vec3[](vec3(0, -1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1), vec3(0, -1, 0), vec3(0, -1, 0));
 

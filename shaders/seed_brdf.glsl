@@ -1,4 +1,4 @@
-// The `seed` shading model of SPEC §2 (seed 000): specular-only Cook-Torrance.
+// The `seed` shading model (docs/DESIGN.md#shading-models): specular-only Cook-Torrance.
 // Mirrored on the CPU by crates/ml-cpu/src/shading.rs (keep in sync; tests compare them).
 
 #ifndef MANYLIGHTS_SEED_BRDF_GLSL
@@ -99,12 +99,13 @@ vec3 cook_torrance_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v,
     return spec * n_dot_l * light.color.rgb * radiance;
 }
 
-// The `seed` model (seed 000).
+// The `seed` model: specular only (docs/DESIGN.md#shading-models).
 vec3 seed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
     return cook_torrance_point_light(light, world_pos, n, v, albedo, roughness, metallic, false);
 }
 
-// The `pbr` model of SPEC §2: the seed's specular term plus Lambert diffuse.
+// The `pbr` model (docs/DESIGN.md#shading-models): the seed model's specular term plus Lambert
+// diffuse.
 vec3 pbr_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic) {
     return cook_torrance_point_light(light, world_pos, n, v, albedo, roughness, metallic, true);
 }

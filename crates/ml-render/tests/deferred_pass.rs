@@ -1,8 +1,9 @@
-//! Seed 002's render pass: one VkRenderPass with two subpasses, the second reading what the
-//! first wrote as input attachments (SPEC §3 `deferred`). Checked on the pass's description
-//! (what `vkCreateRenderPass` gets), on the compiled lighting shaders (SPIR-V reflection:
-//! they really declare those input attachments), and by rendering with validation on (the
-//! layer checks each pipeline against its subpass; `techniques.rs` compares the images).
+//! The deferred render pass (docs/DESIGN.md#deferred-shading-in-one-render-pass): one
+//! VkRenderPass with two subpasses, the second reading what the first wrote as input
+//! attachments. Checked on the pass's description (what `vkCreateRenderPass` gets), on the
+//! compiled lighting shaders (SPIR-V reflection: they really declare those input attachments),
+//! and by rendering with validation on (the layer checks each pipeline against its subpass;
+//! `techniques.rs` compares the images).
 
 mod common;
 
@@ -50,7 +51,8 @@ fn check_two_subpasses(object_textures: bool) {
     for a in &written {
         assert_eq!(d.attachments[*a as usize].store_op, vk::AttachmentStoreOp::DONT_CARE, "attachment {a} is stored");
     }
-    // Seed 002's dependency 0 → 1: attachment writes → input-attachment reads, by region.
+    // The dependency 0 → 1 (docs/DESIGN.md#deferred-shading-in-one-render-pass): attachment
+    // writes → input-attachment reads, by region.
     let dep = d.dependencies.iter().find(|x| x.src_subpass == 0 && x.dst_subpass == 1).expect("a 0 → 1 dependency");
     assert!(dep.src_access_mask.contains(vk::AccessFlags::COLOR_ATTACHMENT_WRITE | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE));
     assert!(dep.src_stage_mask.contains(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS));

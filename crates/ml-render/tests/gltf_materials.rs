@@ -1,7 +1,8 @@
-//! glTF materials beyond base colour and normal maps (issue 7): metallic-roughness, occlusion
-//! and emissive textures with their factors, texture samplers, mipmaps and orthographic cameras — each
-//! rendered from a file our writer makes and checked where the CPU knows the answer, through
-//! every technique (the deferred ones carry these values through the G-buffer).
+//! glTF materials beyond base colour and normal maps (docs/scenes.md#gltf-20-files):
+//! metallic-roughness, occlusion and emissive textures with their factors, texture samplers,
+//! mipmaps and orthographic cameras — each rendered from a file our writer makes and checked
+//! where the CPU knows the answer, through every technique (the deferred ones carry these
+//! values through the G-buffer).
 
 mod common;
 

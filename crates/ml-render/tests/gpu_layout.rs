@@ -1,6 +1,6 @@
 //! Every Rust struct shared with the shaders has the field offsets and size that SPIR-V
-//! reflection of the compiled shaders reports (seed mistake 5: the std140 trap). A field
-//! moved on either side fails here.
+//! reflection of the compiled shaders reports (the std140 trap: mistake 5 of
+//! docs/DESIGN.md#mistakes-we-avoid). A field moved on either side fails here.
 
 use ml_cpu::gpu_types::{
     ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, LightCone, ObjectData, ObjectPush, OmniShadowPush, PointLight,
@@ -90,8 +90,9 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<ClusterFeedback>(&structs);
 }
 
-/// Seed mistake 5: its index list was a std140 uint array, 16 bytes per index. Ours is a
-/// std430 uint array: stride 4, as the Rust side uploads it (`Vec<u32>`).
+/// Mistake 5 (docs/DESIGN.md#mistakes-we-avoid): the original demo's index list was a std140
+/// uint array, 16 bytes per index. Ours is a std430 uint array: stride 4, as the Rust side
+/// uploads it (`Vec<u32>`).
 #[test]
 fn light_index_list_is_packed() {
     let mut stride = None;

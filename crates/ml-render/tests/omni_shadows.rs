@@ -1,9 +1,9 @@
-//! Point-light shadow cubes (issue 6, seed 003) against a CPU ray test. A light's
-//! contribution adds up, so at a pixel where the ray test is sure which lights see the
-//! surface, the shadowed image must equal the shadow-less render of the scene with only
-//! those lights switched on (the others' colour zeroed) — exactly where every PCF tap agrees,
-//! which is also the "no acne, no peter-panning" check. Pixels within a few cube texels of a
-//! shadow edge (or on an object's silhouette) are left out.
+//! Point-light shadow cubes (docs/DESIGN.md#point-light-shadows) against a CPU ray test. A
+//! light's contribution adds up, so at a pixel where the ray test is sure which lights see the
+//! surface, the shadowed image must equal the shadow-less render of the scene with only those
+//! lights switched on (the others' colour zeroed) — exactly where every PCF tap agrees, which
+//! is also the "no acne, no peter-panning" check. Pixels within a few cube texels of a shadow
+//! edge (or on an object's silhouette) are left out.
 
 mod common;
 
@@ -146,9 +146,10 @@ fn assert_matches(what: &str, r: &RayTestResult, min_lit: usize, min_shadowed: u
     assert!(r.lit >= min_lit && r.shadowed >= min_shadowed, "{what}: too few pixels checked");
 }
 
-/// A closed room with a pillar and a point light (SPEC §4): the pillar's shadow on the
-/// floor and walls where the ray test says, the lit walls and floor free of acne, and the
-/// shadow touching the pillar's foot (no peter-panning: the margin is a few texels).
+/// A closed room with a pillar and a point light (the room scene, docs/scenes.md#room): the
+/// pillar's shadow on the floor and walls where the ray test says, the lit walls and floor free
+/// of acne, and the shadow touching the pillar's foot (no peter-panning: the margin is a few
+/// texels).
 #[test]
 fn pillar_shadow_falls_where_the_ray_test_says() {
     let r = ray_test(&Scene::shadow_room(), 128, OmniShadowMode::Direct);

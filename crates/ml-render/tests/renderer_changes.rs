@@ -1,8 +1,8 @@
-//! What the viewer changes in a live renderer (issue 8): a new size, cluster grid and debug
-//! view (new targets, frame slots, clustered-gpu builder, tone map), new lights (light
-//! buffers, frame slots, builder) and new objects (meshes, object buffer) must give exactly
-//! the image a renderer made for them from the start gives — in every technique, with
-//! validation on — and moving the camera must match a renderer made at that camera.
+//! What the viewer (docs/usage.md#view-the-window) changes in a live renderer: a new size,
+//! cluster grid and debug view (new targets, frame slots, clustered-gpu builder, tone map), new
+//! lights (light buffers, frame slots, builder) and new objects (meshes, object buffer) must
+//! give exactly the image a renderer made for them from the start gives — in every technique,
+//! with validation on — and moving the camera must match a renderer made at that camera.
 
 mod common;
 

@@ -1,5 +1,6 @@
-//! Scene files (issue 7): the committed `scenes/seed.toml` renders the built-in seed scene's
-//! image (SPEC §1), through the same renderer (≤ 1/255; measured: identical).
+//! Scene files (docs/scenes.md#scene-files-toml): the committed `scenes/seed.toml` renders the
+//! built-in seed scene's image (docs/DESIGN.md#the-seed-scene), through the same renderer
+//! (≤ 1/255; measured: identical).
 
 mod common;
 

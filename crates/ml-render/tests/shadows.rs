@@ -1,7 +1,8 @@
-//! The blinn-phong sun's shadow (seed 002's shadow map with 3×3 PCF): a ball above a floor,
-//! lit by the sun at 45°. Rendered with the ball (A), without it (B) and with the sun off (C).
-//! Since the sun's light adds up, the sun's visibility at a floor pixel is, in linear light,
-//! v = (A − C) / (B − C): 0 in the umbra, 1 in the open, a ramp across the PCF edge.
+//! The blinn-phong sun's shadow (a shadow map with 3×3 PCF, docs/DESIGN.md#sun-shadow-map): a
+//! ball above a floor, lit by the sun at 45°. Rendered with the ball (A), without it (B) and
+//! with the sun off (C). Since the sun's light adds up, the sun's visibility at a floor pixel
+//! is, in linear light, v = (A − C) / (B − C): 0 in the umbra, 1 in the open, a ramp across the
+//! PCF edge.
 
 mod common;
 

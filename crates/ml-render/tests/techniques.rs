@@ -1,7 +1,7 @@
-//! Every culling technique gives the brute-force image (SPEC §3): lights have a hard radius,
-//! so correct culling changes no pixel. Random scenes with lights behind the camera,
-//! straddling the near plane, around the eye, radii 0.2–40 (cameras inside light spheres)
-//! and 1–5,000 lights, plus the seed scene; max channel difference ≤ 1/255.
+//! Every culling technique gives the brute-force image (docs/DESIGN.md#exactness): lights have
+//! a hard radius, so correct culling changes no pixel. Random scenes with lights behind the
+//! camera, straddling the near plane, around the eye, radii 0.2–40 (cameras inside light
+//! spheres) and 1–5,000 lights, plus the seed scene; max channel difference ≤ 1/255.
 //! clustered-gpu fills its lists with atomics, so a cluster's lights come in any order and the
 //! float sum may round differently: that is what the 1/255 is for. The deferred techniques
 //! (deferred and deferred-clustered: G-buffer subpass → lighting subpass → HDR → tone map;
@@ -121,9 +121,9 @@ fn every_technique_equals_forward_on_the_seed_scene() {
     }
 }
 
-/// Seed 002's model (textures, normal maps, a shadowed sun, a spot light and reflections on
-/// top of the point lights) and the pbr model (diffuse + specular, tone-mapped HDR): the same
-/// in every technique.
+/// The blinn-phong model (docs/DESIGN.md#shading-models: textures, normal maps, a shadowed sun,
+/// a spot light and reflections on top of the point lights) and the pbr model (diffuse +
+/// specular, tone-mapped HDR): the same in every technique.
 #[test]
 fn every_technique_equals_forward_with_blinn_phong_and_pbr() {
     for model in [ShadingModel::BlinnPhong, ShadingModel::Pbr] {

@@ -1,8 +1,8 @@
-//! `manylights view` (issue 8): a window on the renderer. Each frame is the headless
-//! renderer's frame (same passes, same frames in flight) with a present hook: the colour
-//! target is blitted into the swapchain image and the egui overlay drawn over it
-//! (present.rs). winit's events are pumped from this loop (no callback owns the renderer),
-//! so context, renderer and window live on one stack and drop in order.
+//! `manylights view` (docs/usage.md#view-the-window): a window on the renderer. Each frame is
+//! the headless renderer's frame (same passes, same frames in flight) with a present hook: the
+//! colour target is blitted into the swapchain image and the egui overlay drawn over it
+//! (present.rs). winit's events are pumped from this loop (no callback owns the renderer), so
+//! context, renderer and window live on one stack and drop in order.
 
 pub mod camera_control;
 pub mod overlay;

@@ -1,6 +1,7 @@
 //! Buffers with memory from the allocator: host-visible ones stay mapped for their lifetime
-//! (per-frame uniforms and lights, seeds 001/004); device-local static data is filled through
-//! a staging buffer that is freed right after the copy (seed 000).
+//! (per-frame uniforms and lights: docs/DESIGN.md#frames-in-flight); device-local static data is
+//! filled through a staging buffer that is freed right after the copy
+//! (docs/DESIGN.md#conventions).
 
 use crate::context::Context;
 use crate::error::{Result, VkError, VkResultExt};

@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
-/// The lowest Vulkan version we run on (SPEC §5: any Vulkan 1.2+ device).
+/// The lowest Vulkan version we run on: any Vulkan 1.2+ device (docs/DESIGN.md#headless-first).
 pub const MIN_API: u32 = vk::API_VERSION_1_2;
 
 #[derive(Clone, Debug, Default)]
