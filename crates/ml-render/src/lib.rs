@@ -1,28 +1,31 @@
 //! manylights techniques and passes: what is drawn and how, on top of the Vulkan plumbing
 //! (ml-vk) and the CPU scene (ml-cpu).
 
-pub mod cluster_build;
 pub mod compute_pass;
-pub mod deferred;
 pub mod depth_pass;
+pub mod descriptors;
 pub mod error;
 pub mod frame;
 pub mod gpu_mesh;
-pub mod headless;
+pub mod mesh_raster;
 pub mod object_textures;
 pub mod omni_shadow;
-pub mod raster;
+pub mod pass;
+pub mod passes;
 pub mod render_pass;
+pub mod renderer;
 pub mod report;
+pub mod scene_gpu;
 pub mod scene_textures;
 pub mod settings;
 pub mod stage_probe;
+pub mod sun_shadow;
 pub mod targets;
-pub mod tonemap;
 
 pub use error::RenderError;
 pub use frame::FRAMES_IN_FLIGHT;
-pub use headless::{FrameHook, HeadlessRenderer, RenderOutput};
+pub use renderer::{FrameHook, HeadlessRenderer, RenderOutput, Renderer};
 pub use settings::{
-    DebugView, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique, FRAME_SECONDS, TIMER_SPEED,
+    DebugView, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique,
+    FRAME_SECONDS, TIMER_SPEED,
 };

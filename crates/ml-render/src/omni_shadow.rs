@@ -106,11 +106,11 @@ impl OmniShadows {
         let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::VERTEX).size(size_of::<OmniShadowPush>() as u32)];
         self.layout = shader::pipeline_layout(ctx, &[], &push)?;
         let vertex = match settings.mode {
-            OmniShadowMode::Multiview => ml_shaders::OMNI_SHADOW_MULTIVIEW_VERT,
-            OmniShadowMode::Layered => ml_shaders::OMNI_SHADOW_LAYERED_VERT,
-            _ => ml_shaders::OMNI_SHADOW_VERT,
+            OmniShadowMode::Multiview => ml_shaders::OMNI_SHADOW_MULTIVIEW_VERT.spirv,
+            OmniShadowMode::Layered => ml_shaders::OMNI_SHADOW_LAYERED_VERT.spirv,
+            _ => ml_shaders::OMNI_SHADOW_VERT.spirv,
         };
-        self.pipeline = depth_pass::pipeline(ctx, self.render_pass, self.layout, (vertex, Some(ml_shaders::OMNI_SHADOW_FRAG)))?;
+        self.pipeline = depth_pass::pipeline(ctx, self.render_pass, self.layout, (vertex, Some(ml_shaders::OMNI_SHADOW_FRAG.spirv)))?;
         let extent = shape.extent;
         match settings.mode {
             OmniShadowMode::Copy => {

@@ -1,29 +1,15 @@
-//! Set 1 of every shading pipeline: the scene's textures. For the blinn-phong model (seed 002)
-//! the sun's shadow map, a sky cubemap for reflections, the albedo and normal maps (all made by
-//! our code: ml_cpu::textures); the seed model binds 1×1 stand-ins it never samples.
-//!
-//! The shadow map is rendered once, when the renderer is made: the sun and the objects do not
-//! move (only the point lights do, and they cast no shadows). Depth only, every object, an
-//! orthographic view along the sun fitted to the scene (ml_cpu::blinn_phong).
+//! Set 1 of every shading pipeline: the scene's textures. For the blinn-phong model the sun's
+//! shadow map (drawn by sun_shadow.rs), a sky cubemap for reflections, the albedo and normal
+//! maps (all made by our code: ml_cpu::textures); the seed model binds 1×1 stand-ins it never
+//! samples. The layout is textures.glsl's set 1, as reflected from the shaders.
 
-use crate::depth_pass::{self, DepthPassDesc};
-use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::descriptors::{self, Resource, SetLayout};
 use crate::omni_shadow::{self, OmniShadows};
-use ml_cpu::gpu_types::ShadowPush;
-use ml_cpu::scene::Scene;
+use crate::sun_shadow::{render_shadow_map, ShadowInputs};
 use ml_cpu::textures;
-use ml_vk::descriptors::{allocate_set, write_image};
+use ml_vk::descriptors::allocate_set;
 use ml_vk::image::{texture_with, ImageShape};
-use ml_vk::{shader, vk, Context, Image, VkError, VkResultExt};
-
-/// Bindings of set 1 (textures.glsl).
-const BINDING_SHADOW: u32 = 0;
-const BINDING_SKY: u32 = 1;
-const BINDING_ALBEDO: u32 = 2;
-const BINDING_NORMAL: u32 = 3;
-const BINDING_SHADOW_DEPTH: u32 = 4;
-const BINDING_OMNI_SHADOWS: u32 = 5;
-const BINDING_OMNI_FACES: u32 = 6;
+use ml_vk::{vk, Context, Image, VkError, VkResultExt};
 
 /// Texels per side of the sun's shadow map (blinn-phong).
 pub const SHADOW_MAP_SIZE: u32 = 2048;
@@ -31,20 +17,13 @@ const MATERIAL_MAP_SIZE: u32 = 256;
 const SKY_SIZE: u32 = 64;
 
 pub struct SceneTextures {
-    pub set_layout: vk::DescriptorSetLayout,
+    pub set_layout: SetLayout,
     pub set: vk::DescriptorSet,
     pool: vk::DescriptorPool,
     images: Vec<Image>,
     samplers: Vec<vk::Sampler>,
     /// Texels per side of the shadow map (1 for the seed model).
     pub shadow_size: u32,
-}
-
-/// What the sun's shadow pass draws.
-pub struct ShadowInputs<'a> {
-    pub scene: &'a Scene,
-    pub meshes: &'a [GpuMesh],
-    pub view_proj: glam::Mat4,
 }
 
 /// Places in `SceneTextures::images` (the order `create` makes them in).
@@ -59,7 +38,7 @@ impl SceneTextures {
     /// uses `depth_format`, which must be sampleable. `omni` holds the point-light shadow cubes.
     pub fn new(ctx: &Context, blinn_phong: bool, depth_format: vk::Format, omni: &OmniShadows) -> Result<SceneTextures, VkError> {
         let t = SceneTextures {
-            set_layout: vk::DescriptorSetLayout::null(),
+            set_layout: SetLayout::null(),
             set: vk::DescriptorSet::null(),
             pool: vk::DescriptorPool::null(),
             images: Vec::new(),
@@ -75,28 +54,14 @@ impl SceneTextures {
     }
 
     fn create(&mut self, ctx: &Context, real: bool, depth_format: vk::Format, omni: &OmniShadows) -> Result<(), VkError> {
-        use vk::DescriptorType as T;
-        let sampled = T::COMBINED_IMAGE_SAMPLER;
-        let stages = vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
-        self.set_layout = shader::set_layout(
-            ctx,
-            &[
-                (BINDING_SHADOW, sampled),
-                (BINDING_SKY, sampled),
-                (BINDING_ALBEDO, sampled),
-                (BINDING_NORMAL, sampled),
-                (BINDING_SHADOW_DEPTH, sampled),
-                (BINDING_OMNI_SHADOWS, sampled),
-                (BINDING_OMNI_FACES, sampled),
-            ],
-            stages,
-        )?;
-        let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: 7 }];
-        // SAFETY: valid device and create info.
-        self.pool =
-            unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
-                .ctx("vkCreateDescriptorPool")?;
-        self.set = allocate_set(ctx, self.pool, self.set_layout)?;
+        // Read by the fragment shaders and the compute lighting pass: textures.glsl's set 1.
+        let stages = [
+            (&ml_shaders::FORWARD_FRAG, vk::ShaderStageFlags::FRAGMENT),
+            (&ml_shaders::DEFERRED_LIGHTING_COMP, vk::ShaderStageFlags::COMPUTE),
+        ];
+        self.set_layout = SetLayout::new(ctx, &stages, 1)?;
+        self.pool = descriptors::pool(ctx, &[(&self.set_layout, 1)])?;
+        self.set = allocate_set(ctx, self.pool, self.set_layout.raw)?;
 
         let rgba = vk::Format::R8G8B8A8_UNORM;
         let flat = |size: u32| ImageShape {
@@ -151,32 +116,25 @@ impl SceneTextures {
             vk::DescriptorImageInfo::default().sampler(sampler).image_view(image.view).image_layout(layout)
         };
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-        let i = &self.images;
-        write_image(
-            ctx,
-            self.set,
-            BINDING_SHADOW,
-            sampled,
-            info(shadow_sampler, &i[SHADOW_IMAGE], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-        );
-        write_image(ctx, self.set, BINDING_SKY, sampled, info(sky_sampler, &i[SKY_IMAGE], read_only));
-        write_image(ctx, self.set, BINDING_ALBEDO, sampled, info(material_sampler, &i[ALBEDO_IMAGE], read_only));
-        write_image(ctx, self.set, BINDING_NORMAL, sampled, info(material_sampler, &i[NORMAL_IMAGE], read_only));
-        // The same map read as plain depths (the shadow-map debug view).
+        let depth_read = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+        // The shadow map read as plain depths (the shadow-map debug view), the cubes' faces too.
         let depth_sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE, vk::Filter::NEAREST, None)?;
         self.samplers.push(depth_sampler);
         let i = &self.images;
-        write_image(
-            ctx,
-            self.set,
-            BINDING_SHADOW_DEPTH,
-            sampled,
-            info(depth_sampler, &i[SHADOW_IMAGE], vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-        );
-        let depth_read = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
-        write_image(ctx, self.set, BINDING_OMNI_SHADOWS, sampled, info(omni_sampler, &omni.cubes, depth_read));
         let faces = vk::DescriptorImageInfo::default().sampler(depth_sampler).image_view(omni.faces_view).image_layout(depth_read);
-        write_image(ctx, self.set, BINDING_OMNI_FACES, sampled, faces);
+        let image = |name: &str| {
+            Some(Resource::Image(match name {
+                "shadow_map" => info(shadow_sampler, &i[SHADOW_IMAGE], depth_read),
+                "sky" => info(sky_sampler, &i[SKY_IMAGE], read_only),
+                "albedo_map" => info(material_sampler, &i[ALBEDO_IMAGE], read_only),
+                "normal_map" => info(material_sampler, &i[NORMAL_IMAGE], read_only),
+                "shadow_depth" => info(depth_sampler, &i[SHADOW_IMAGE], depth_read),
+                "omni_shadows" => info(omni_sampler, &omni.cubes, depth_read),
+                "omni_faces" => faces,
+                _ => return None,
+            }))
+        };
+        self.set_layout.write(ctx, self.set, &image)?;
         Ok(())
     }
 
@@ -190,10 +148,9 @@ impl SceneTextures {
                 ctx.device.destroy_sampler(s, None);
             }
             ctx.device.destroy_descriptor_pool(self.pool, None);
-            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
         self.pool = vk::DescriptorPool::null();
-        self.set_layout = vk::DescriptorSetLayout::null();
+        self.set_layout.destroy(ctx);
     }
 }
 
@@ -232,79 +189,4 @@ pub(crate) fn sampler(
         .max_lod(vk::LOD_CLAMP_NONE);
     // SAFETY: valid device and create info.
     unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")
-}
-
-/// Clear `target` to the far plane and, given inputs, draw every object into it from the sun;
-/// leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL for the shading passes.
-fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs>) -> Result<(), VkError> {
-    let d = &ctx.device;
-    // The depth writes before every later shader read of the map (frames come after this
-    // submission in queue order).
-    let render_pass = depth_pass::render_pass(
-        ctx,
-        &DepthPassDesc {
-            format: target.format,
-            final_layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
-            after: vk::PipelineStageFlags::empty(),
-            readers: (vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ),
-            view_mask: 0,
-        },
-    )?;
-    let views = [target.view];
-    let fb_info = vk::FramebufferCreateInfo::default()
-        .render_pass(render_pass)
-        .attachments(&views)
-        .width(target.extent.width)
-        .height(target.extent.height)
-        .layers(1);
-    let push_size = std::mem::size_of::<ShadowPush>() as u32;
-    let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::VERTEX).size(push_size)];
-    let mut framebuffer = vk::Framebuffer::null();
-    let mut layout = vk::PipelineLayout::null();
-    let mut pipeline = vk::Pipeline::null();
-    let result = (|| {
-        // SAFETY: as above.
-        framebuffer = unsafe { d.create_framebuffer(&fb_info, None) }.ctx("vkCreateFramebuffer")?;
-        // Only a pass that draws needs the pipeline (a clear does not).
-        if inputs.is_some() {
-            layout = shader::pipeline_layout(ctx, &[], &push)?;
-            pipeline = depth_pass::pipeline(ctx, render_pass, layout, (ml_shaders::SHADOW_VERT, None))?;
-        }
-        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: target.extent };
-        ml_vk::commands::one_shot(ctx, |cmd| {
-            let begin = vk::RenderPassBeginInfo::default()
-                .render_pass(render_pass)
-                .framebuffer(framebuffer)
-                .render_area(area)
-                .clear_values(&depth_pass::CLEAR_FAR);
-            // SAFETY: recording state; everything used is alive until the wait in one_shot.
-            unsafe {
-                d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-                if let Some(s) = inputs {
-                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                    depth_pass::set_square_viewport(ctx, cmd, target.extent.width);
-                    record_draws(
-                        ctx,
-                        cmd,
-                        (s.meshes, &s.scene.objects),
-                        |_| 1,
-                        |_, object| {
-                            let push =
-                                ShadowPush { model: object.transform.to_cols_array_2d(), light_view_proj: s.view_proj.to_cols_array_2d() };
-                            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
-                        },
-                    );
-                }
-                d.cmd_end_render_pass(cmd);
-            }
-        })
-    })();
-    // SAFETY: one_shot waited for the GPU (or nothing was submitted); null handles are ignored.
-    unsafe {
-        d.destroy_pipeline(pipeline, None);
-        d.destroy_pipeline_layout(layout, None);
-        d.destroy_framebuffer(framebuffer, None);
-        d.destroy_render_pass(render_pass, None);
-    }
-    result
 }

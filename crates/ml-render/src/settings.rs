@@ -43,28 +43,46 @@ impl Technique {
         }
     }
 
+    /// Where lights are assigned to clusters (docs/DESIGN.md#techniques-are-two-choices).
+    pub fn assignment(self) -> LightAssignment {
+        match self {
+            Technique::Forward | Technique::Deferred => LightAssignment::None,
+            Technique::ClusteredCpu | Technique::DeferredClustered => LightAssignment::Cpu,
+            Technique::ClusteredGpu | Technique::DeferredCompute => LightAssignment::Gpu,
+        }
+    }
+
+    /// Where the lighting runs.
+    pub fn lighting_stage(self) -> LightingStage {
+        match self {
+            Technique::Forward | Technique::ClusteredCpu | Technique::ClusteredGpu => LightingStage::Forward,
+            Technique::Deferred | Technique::DeferredClustered => LightingStage::Subpass,
+            Technique::DeferredCompute => LightingStage::Compute,
+        }
+    }
+
     pub fn is_clustered(self) -> bool {
-        matches!(self, Technique::ClusteredCpu | Technique::ClusteredGpu | Technique::DeferredClustered | Technique::DeferredCompute)
+        self.assignment() != LightAssignment::None
     }
 
     /// Whether the CPU assigns lights to clusters every frame.
     pub fn is_cpu_built(self) -> bool {
-        matches!(self, Technique::ClusteredCpu | Technique::DeferredClustered)
+        self.assignment() == LightAssignment::Cpu
     }
 
-    /// Whether the lighting runs in the second subpass of the raster pass (seed 002).
+    /// Whether the lighting runs in the second subpass of the raster pass.
     pub fn lights_in_subpass(self) -> bool {
-        matches!(self, Technique::Deferred | Technique::DeferredClustered)
+        self.lighting_stage() == LightingStage::Subpass
     }
 
     /// Whether the lighting runs as a compute pass over a G-buffer.
     pub fn lights_in_compute(self) -> bool {
-        matches!(self, Technique::DeferredCompute)
+        self.lighting_stage() == LightingStage::Compute
     }
 
     /// Whether the GPU builds the clusters (and animates the lights).
     pub fn is_gpu_built(self) -> bool {
-        matches!(self, Technique::ClusteredGpu | Technique::DeferredCompute)
+        self.assignment() == LightAssignment::Gpu
     }
 
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {
@@ -73,6 +91,28 @@ impl Technique {
             RenderError::Invalid(format!("unknown technique '{name}': expected one of {expected}"))
         })
     }
+}
+
+/// Where lights are assigned to clusters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightAssignment {
+    /// Nowhere: every pixel loops over every light.
+    None,
+    /// On the CPU every frame, uploaded into the frame's lists.
+    Cpu,
+    /// By compute shaders every frame (which also animate the lights).
+    Gpu,
+}
+
+/// Where the lighting runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightingStage {
+    /// In the fragment shader that draws the objects.
+    Forward,
+    /// In the second subpass of the deferred render pass, over the G-buffer.
+    Subpass,
+    /// In a compute pass over the G-buffer.
+    Compute,
 }
 
 /// constant_id of `MODEL_BLINN_PHONG` and `MODEL_PBR` in shading_model.glsl.

@@ -162,12 +162,12 @@ impl StageProbe {
         let push = |stage| [vk::PushConstantRange::default().stage_flags(stage).size(std::mem::size_of::<StageProbePush>() as u32)];
         self.fragment_layout = shader::pipeline_layout(ctx, &[self.fragment_set_layout], &push(vk::ShaderStageFlags::FRAGMENT))?;
         self.compute_layout = shader::pipeline_layout(ctx, &[self.compute_set_layout], &push(vk::ShaderStageFlags::COMPUTE))?;
-        self.compute_pipeline = shader::compute_pipeline(ctx, ml_shaders::STAGE_PROBE_COMP, self.compute_layout, &[])?;
+        self.compute_pipeline = shader::compute_pipeline(ctx, ml_shaders::STAGE_PROBE_COMP.spirv, self.compute_layout, &[])?;
         self.fragment_pipeline = shader::graphics_pipeline(
             ctx,
             &shader::GraphicsPipelineDesc {
-                vertex: ml_shaders::FULLSCREEN_VERT,
-                fragment: Some(ml_shaders::STAGE_PROBE_FRAG),
+                vertex: ml_shaders::FULLSCREEN_VERT.spirv,
+                fragment: Some(ml_shaders::STAGE_PROBE_FRAG.spirv),
                 fragment_constants: &[],
                 vertex_input: vk::PipelineVertexInputStateCreateInfo::default(),
                 rasterization: vk::PipelineRasterizationStateCreateInfo::default()

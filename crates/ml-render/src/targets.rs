@@ -1,8 +1,9 @@
-//! Offscreen render targets for headless rendering: the colour image that is read back, the
-//! depth buffer, the G-buffer of deferred-compute, and the framebuffer of the raster pass.
+//! Offscreen render targets of a frame slot: the colour image that is read back, the depth
+//! buffer, the G-buffer and the HDR image of the deferred techniques. The raster passes make
+//! their framebuffers over them.
 
 use crate::settings::Technique;
-use ml_vk::{vk, Context, Image, VkError, VkResultExt};
+use ml_vk::{vk, Context, Image, VkError};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
@@ -16,14 +17,16 @@ pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// then, only in scenes whose objects have textures of their own (`gbuffer_images`), the
 /// roughness and metallic factors (2 B) and the emissive factor (4 B, sRGB like its texture).
 pub const GBUFFER: [GBufferImage; 5] = [
-    GBufferImage { name: "g-buffer normal", format: vk::Format::R32G32_SFLOAT, bytes: 8 },
-    GBufferImage { name: "g-buffer object", format: vk::Format::R32_UINT, bytes: 4 },
-    GBufferImage { name: "g-buffer albedo-occlusion", format: vk::Format::R8G8B8A8_UNORM, bytes: 4 },
-    GBufferImage { name: "g-buffer roughness-metallic", format: vk::Format::R8G8_UNORM, bytes: 2 },
-    GBufferImage { name: "g-buffer emissive", format: vk::Format::R8G8B8A8_SRGB, bytes: 4 },
+    GBufferImage { key: "normal", name: "g-buffer normal", format: vk::Format::R32G32_SFLOAT, bytes: 8 },
+    GBufferImage { key: "object", name: "g-buffer object", format: vk::Format::R32_UINT, bytes: 4 },
+    GBufferImage { key: "albedo", name: "g-buffer albedo-occlusion", format: vk::Format::R8G8B8A8_UNORM, bytes: 4 },
+    GBufferImage { key: "roughness_metallic", name: "g-buffer roughness-metallic", format: vk::Format::R8G8_UNORM, bytes: 2 },
+    GBufferImage { key: "emissive", name: "g-buffer emissive", format: vk::Format::R8G8B8A8_SRGB, bytes: 4 },
 ];
 
 pub struct GBufferImage {
+    /// What the shaders call it (`normal_image`, `normal_input`: `normal`).
+    pub key: &'static str,
     pub name: &'static str,
     pub format: vk::Format,
     /// Per pixel.
@@ -96,31 +99,22 @@ pub struct Targets {
     pub gbuffer: Vec<Image>,
     /// deferred, deferred-clustered: the lighting subpass's HDR output (null otherwise).
     pub hdr: Image,
-    pub framebuffer: vk::Framebuffer,
 }
 
 impl Targets {
     pub fn new(
         ctx: &Context,
-        render_pass: vk::RenderPass,
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
     ) -> Result<Targets, VkError> {
-        let t = Targets {
-            color: Image::null(),
-            depth: Image::null(),
-            gbuffer: Vec::new(),
-            hdr: Image::null(),
-            framebuffer: vk::Framebuffer::null(),
-        };
-        ml_vk::build(ctx, t, |t| t.create(ctx, render_pass, extent, depth_format, (output, gbuffer)))
+        let t = Targets { color: Image::null(), depth: Image::null(), gbuffer: Vec::new(), hdr: Image::null() };
+        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer)))
     }
 
     fn create(
         &mut self,
         ctx: &Context,
-        render_pass: vk::RenderPass,
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
@@ -148,30 +142,16 @@ impl Targets {
         if output == Output::Subpasses {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
         }
-        // Attachment order: see render_pass.rs.
-        let mut views: Vec<vk::ImageView> = match output {
-            Output::Color => vec![self.color.view],
-            _ => self.gbuffer.iter().map(|g| g.view).collect(),
-        };
-        views.push(self.depth.view);
-        if output == Output::Subpasses {
-            views.push(self.hdr.view);
-        }
-        let info = vk::FramebufferCreateInfo::default()
-            .render_pass(render_pass)
-            .attachments(&views)
-            .width(extent.width)
-            .height(extent.height)
-            .layers(1);
-        // SAFETY: views and render pass are compatible and alive.
-        self.framebuffer = unsafe { ctx.device.create_framebuffer(&info, None) }.ctx("vkCreateFramebuffer")?;
         Ok(())
     }
 
+    /// The G-buffer image the shaders call `key` (`normal`, `object`, `albedo`, …), where the
+    /// scene's G-buffer has it.
+    pub fn gbuffer_image(&self, key: &str) -> Option<&Image> {
+        GBUFFER.iter().position(|g| g.key == key).and_then(|i| self.gbuffer.get(i))
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: no pending work uses the framebuffer; a null handle is ignored.
-        unsafe { ctx.device.destroy_framebuffer(self.framebuffer, None) };
-        self.framebuffer = vk::Framebuffer::null();
         self.color.destroy(ctx);
         self.depth.destroy(ctx);
         for image in &mut self.gbuffer {

@@ -22,7 +22,7 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
             .unwrap();
     let layouts = [layout];
     let pipeline_layout = shader::pipeline_layout(ctx, &layouts, &[]).unwrap();
-    let pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SLICE_PROBE_COMP, pipeline_layout, &[]).unwrap();
+    let pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SLICE_PROBE_COMP.spirv, pipeline_layout, &[]).unwrap();
     let sizes = [
         vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
         vk::DescriptorPoolSize { ty: storage, descriptor_count: 2 },

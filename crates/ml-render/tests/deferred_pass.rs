@@ -76,7 +76,7 @@ fn lighting_shaders_load_the_gbuffer_as_input_attachments() {
     ] {
         let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(object_textures));
         let inputs = d.subpasses[1].inputs.len() as u32;
-        let words: Vec<u32> = spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+        let words: Vec<u32> = spirv.spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         let entries = ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().expect("reflect");
         let mut indices: Vec<u32> = entries[0]
             .vars

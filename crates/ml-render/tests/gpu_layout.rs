@@ -45,7 +45,8 @@ fn record(s: &StructType, stride: Option<usize>, out: &mut HashMap<String, Refle
 
 fn reflect_all() -> HashMap<String, Reflected> {
     let mut structs = HashMap::new();
-    for (file, spirv) in ml_shaders::ALL {
+    for shader in ml_shaders::ALL {
+        let (file, spirv) = (shader.file, shader.spirv);
         let words: Vec<u32> = spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         let entries = ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().unwrap_or_else(|e| panic!("{file}: {e}"));
         for entry in entries {
@@ -96,8 +97,8 @@ fn rust_mirrors_match_spirv_reflection() {
 #[test]
 fn light_index_list_is_packed() {
     let mut stride = None;
-    for (_, spirv) in ml_shaders::ALL {
-        let words: Vec<u32> = spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+    for shader in ml_shaders::ALL {
+        let words: Vec<u32> = shader.spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         for entry in ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().unwrap() {
             for var in &entry.vars {
                 if let Type::Struct(s) = var.ty() {

@@ -9,23 +9,14 @@
 //! follows the (light, cluster) pairs, not lights × clusters.
 //! Capacity: the index list has a size; the SCAN pass reports what the frame needed and cuts
 //! ranges to fit when it was too small; the CPU reads that after the frame's fence and grows
-//! the list for every later frame (see `headless.rs`).
+//! the list for every later frame (the renderer grows it from `SlotReport`).
 
+use crate::descriptors::{FrameSets, Resource};
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::pass::{FrameResources, Pass, Recording, SlotReport};
 use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
 use ml_vk::commands::memory_barrier;
-use ml_vk::descriptors::allocate_set;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
-
-/// Bindings of the build's descriptor set (see the shaders).
-pub const BINDING_FRAME: u32 = 0;
-pub const BINDING_REST_LIGHTS: u32 = 1;
-pub const BINDING_LIGHTS: u32 = 2;
-pub const BINDING_BOUNDS: u32 = 3;
-pub const BINDING_COUNTERS: u32 = 4;
-pub const BINDING_RANGES: u32 = 5;
-pub const BINDING_INDICES: u32 = 6;
-pub const BINDING_FEEDBACK: u32 = 7;
-pub const BINDING_SCAN_BLOCKS: u32 = 8;
 
 const BUILD_GROUP: u32 = 128;
 const BOUNDS_GROUP: u32 = 64;
@@ -39,8 +30,11 @@ fn lanes_per_light(lights: u32) -> u32 {
     (65_536 / lights.max(1)).clamp(1, 64).next_power_of_two().min(64)
 }
 
-pub struct GpuClusterBuilder {
-    pub set_layout: vk::DescriptorSetLayout,
+pub struct ClusterBuild {
+    /// The build's set per frame slot (one layout for every step: the union of the shaders').
+    sets: FrameSets,
+    /// Per frame slot: its counters, feedback and scan blocks.
+    frames: Vec<GpuClusterFrame>,
     pipeline_layout: vk::PipelineLayout,
     bounds_pipeline: vk::Pipeline,
     count_pipeline: vk::Pipeline,
@@ -56,31 +50,33 @@ pub struct GpuClusterBuilder {
     cluster_count: u32,
 }
 
-/// Per frame in flight: the counters/cursors, the feedback the CPU reads, the build's set.
-pub struct GpuClusterFrame {
-    pub counters: Buffer,
-    pub feedback: Buffer,
+/// Per frame in flight: the counters/cursors, the feedback the CPU reads.
+struct GpuClusterFrame {
+    counters: Buffer,
+    feedback: Buffer,
     /// Per scan block: its total and largest count, then its offset.
-    pub scan_blocks: Buffer,
-    pub set: vk::DescriptorSet,
+    scan_blocks: Buffer,
 }
 
 impl GpuClusterFrame {
-    pub fn feedback(&self) -> ClusterFeedback {
+    fn feedback(&self) -> ClusterFeedback {
         bytemuck::pod_read_unaligned(&self.feedback.mapped()[..size_of::<ClusterFeedback>()])
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
+    fn destroy(&mut self, ctx: &Context) {
         self.counters.destroy(ctx);
         self.feedback.destroy(ctx);
         self.scan_blocks.destroy(ctx);
     }
 }
 
-impl GpuClusterBuilder {
-    pub fn new(ctx: &Context, rest_lights: &[PointLight], cluster_count: usize) -> Result<GpuClusterBuilder, VkError> {
-        let b = GpuClusterBuilder {
-            set_layout: vk::DescriptorSetLayout::null(),
+impl ClusterBuild {
+    pub fn new(ctx: &Context, rest_lights: &[PointLight], cluster_count: usize) -> Result<ClusterBuild, VkError> {
+        let steps = [&ml_shaders::CLUSTER_BOUNDS_COMP, &ml_shaders::CLUSTER_BUILD_COMP, &ml_shaders::CLUSTER_SCAN_COMP];
+        let stages: Vec<(&ml_shaders::Shader, vk::ShaderStageFlags)> = steps.iter().map(|&s| (s, vk::ShaderStageFlags::COMPUTE)).collect();
+        let b = ClusterBuild {
+            sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
+            frames: Vec::new(),
             pipeline_layout: vk::PipelineLayout::null(),
             bounds_pipeline: vk::Pipeline::null(),
             count_pipeline: vk::Pipeline::null(),
@@ -96,31 +92,15 @@ impl GpuClusterBuilder {
     }
 
     fn create(&mut self, ctx: &Context, rest_lights: &[PointLight]) -> Result<(), VkError> {
-        let storage = vk::DescriptorType::STORAGE_BUFFER;
-        let mut bindings = vec![(BINDING_FRAME, vk::DescriptorType::UNIFORM_BUFFER)];
-        bindings.extend(
-            [
-                BINDING_REST_LIGHTS,
-                BINDING_LIGHTS,
-                BINDING_BOUNDS,
-                BINDING_COUNTERS,
-                BINDING_RANGES,
-                BINDING_INDICES,
-                BINDING_FEEDBACK,
-                BINDING_SCAN_BLOCKS,
-            ]
-            .map(|b| (b, storage)),
-        );
-        self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::COMPUTE)?;
-        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.set_layout], &[])?;
-        self.bounds_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BOUNDS_COMP, self.pipeline_layout, &[])?;
+        self.pipeline_layout = shader::pipeline_layout(ctx, &[self.sets.layout.raw], &[])?;
+        self.bounds_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BOUNDS_COMP.spirv, self.pipeline_layout, &[])?;
         // Specialization constants: 0 = FILL, 1 = LANES (cluster_build.comp); 0 = STEP (scan).
         self.count_pipeline =
-            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 0), (1, self.lanes)])?;
+            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP.spirv, self.pipeline_layout, &[(0, 0), (1, self.lanes)])?;
         self.fill_pipeline =
-            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP, self.pipeline_layout, &[(0, 1), (1, self.lanes)])?;
+            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP.spirv, self.pipeline_layout, &[(0, 1), (1, self.lanes)])?;
         for (step, pipeline) in self.scan_pipelines.iter_mut().enumerate() {
-            *pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SCAN_COMP, self.pipeline_layout, &[(0, step as u32)])?;
+            *pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SCAN_COMP.spirv, self.pipeline_layout, &[(0, step as u32)])?;
         }
         self.rest_lights =
             Buffer::device_local_with(ctx, "lights at rest", bytemuck::cast_slice(rest_lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
@@ -131,12 +111,15 @@ impl GpuClusterBuilder {
             vk::BufferUsageFlags::STORAGE_BUFFER,
             gpu_allocator::MemoryLocation::GpuOnly,
         )?;
+        for _ in 0..FRAMES_IN_FLIGHT {
+            self.frames.push(self.frame_resources(ctx)?);
+        }
         Ok(())
     }
 
     /// Rebuild every cluster's box (when projection or image size change) with the grid in
     /// `set`'s uniforms, and wait for it.
-    pub fn compute_bounds(&self, ctx: &Context, set: vk::DescriptorSet) -> Result<(), VkError> {
+    fn compute_bounds(&self, ctx: &Context, set: vk::DescriptorSet) -> Result<(), VkError> {
         ml_vk::commands::one_shot(ctx, |cmd| {
             // SAFETY: recording state; all bound objects are alive.
             unsafe {
@@ -151,7 +134,8 @@ impl GpuClusterBuilder {
 
     /// Record the frame's build. Afterwards the lights, ranges and index list are visible to
     /// fragment and compute shaders and the feedback to the host.
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: &GpuClusterFrame) {
+    fn record_build(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
+        let (frame, set) = (&self.frames[slot], self.sets.sets[slot]);
         let d = &ctx.device;
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
@@ -178,7 +162,7 @@ impl GpuClusterBuilder {
         unsafe {
             d.cmd_fill_buffer(cmd, frame.counters.raw, 0, vk::WHOLE_SIZE, 0);
             memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
-            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[frame.set], &[]);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
             for (i, (pipeline, groups)) in steps.into_iter().enumerate() {
                 if i > 0 {
                     memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
@@ -198,14 +182,9 @@ impl GpuClusterBuilder {
         );
     }
 
-    /// This frame's build resources (its set is written by the caller, see `frame.rs`).
-    pub fn frame_resources(&self, ctx: &Context, pool: vk::DescriptorPool) -> Result<GpuClusterFrame, VkError> {
-        let frame = GpuClusterFrame {
-            counters: Buffer::null(),
-            feedback: Buffer::null(),
-            scan_blocks: Buffer::null(),
-            set: vk::DescriptorSet::null(),
-        };
+    /// A frame slot's build buffers.
+    fn frame_resources(&self, ctx: &Context) -> Result<GpuClusterFrame, VkError> {
+        let frame = GpuClusterFrame { counters: Buffer::null(), feedback: Buffer::null(), scan_blocks: Buffer::null() };
         ml_vk::build(ctx, frame, |frame| {
             frame.counters = Buffer::new(
                 ctx,
@@ -228,12 +207,15 @@ impl GpuClusterBuilder {
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 gpu_allocator::MemoryLocation::GpuOnly,
             )?;
-            frame.set = allocate_set(ctx, pool, self.set_layout)?;
             Ok(())
         })
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
+    fn release_all(&mut self, ctx: &Context) {
+        for f in &mut self.frames {
+            f.destroy(ctx);
+        }
+        self.sets.destroy(ctx);
         self.rest_lights.destroy(ctx);
         self.bounds.destroy(ctx);
         // SAFETY: the device is idle; null handles are ignored.
@@ -242,14 +224,54 @@ impl GpuClusterBuilder {
                 ctx.device.destroy_pipeline(p, None);
             }
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
-            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }
 
-impl ml_vk::Release for GpuClusterBuilder {
+impl ml_vk::Release for ClusterBuild {
     fn release(&mut self, ctx: &Context) {
-        self.destroy(ctx);
+        self.release_all(ctx);
+    }
+}
+
+impl Pass for ClusterBuild {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("cluster build")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let own = &self.frames[frame.slot];
+        self.sets.write(ctx, frame.slot, &|name| {
+            let buffer = match name {
+                "RestLightBuffer" => self.rest_lights.raw,
+                "BoundsBuffer" => self.bounds.raw,
+                "CounterBuffer" => own.counters.raw,
+                "FeedbackBuffer" => own.feedback.raw,
+                "BlockBuffer" => own.scan_blocks.raw,
+                _ => return frame.buffer(name),
+            };
+            Some(Resource::Buffer(buffer))
+        })
+    }
+
+    fn record(&self, rec: &Recording) {
+        self.record_build(rec.ctx, rec.cmd, rec.slot);
+    }
+
+    fn collect(&self, slot: usize, report: &mut SlotReport) {
+        let f = self.frames[slot].feedback();
+        report.index_entries = Some(f.needed as usize);
+        report.max_lights = Some(f.max_count);
+        report.overflowed = f.overflowed != 0;
+    }
+
+    /// The boxes depend on projection and size only: built with slot 0's uniforms.
+    fn projection_changed(&mut self, ctx: &Context) -> Result<(), VkError> {
+        self.compute_bounds(ctx, self.sets.sets[0])
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.release_all(ctx);
     }
 }
 

@@ -1,37 +1,26 @@
-//! Headless rendering (SPEC §5): offscreen targets, frames in flight, a read-back of the
-//! last frame into host memory. No window system needed.
+//! The renderer: the scene on the GPU, the frames in flight and the technique's passes.
+//! Headless (offscreen targets, a read-back of the last frame, no window system) or under a
+//! window (the viewer adds its commands through a `FrameHook`). It knows no pass by name:
+//! the technique's choices give an ordered list of passes (`passes::assemble`) that it
+//! binds, records, times and collects from.
 
-use crate::cluster_build::GpuClusterBuilder;
-use crate::compute_pass::ComputePass;
-use crate::deferred::ComputeLighting;
 use crate::error::RenderError;
-use crate::frame::{self, FrameInFlight, FrameSetup, FRAMES_IN_FLIGHT};
-use crate::gpu_mesh::GpuMesh;
-use crate::object_textures::ObjectTextureSets;
-use crate::omni_shadow::{OmniShadows, ShadowedLight};
-use crate::raster::{object_data, DrawList, PassFrame, RasterPass};
+use crate::frame::{FrameInFlight, FrameSetup, SlotLists, FRAMES_IN_FLIGHT};
+use crate::omni_shadow::ShadowedLight;
+use crate::pass::{Pass, Recording, SlotReport, Update};
+use crate::passes::{assemble, Assembly};
 use crate::report::{CpuPhases, FrameStats};
-use crate::scene_textures::{SceneTextures, ShadowInputs};
-use crate::settings::ShadingModel;
-use crate::settings::{DebugView, RenderSettings};
+use crate::scene_gpu::SceneGpu;
+use crate::settings::{LightAssignment, RenderSettings};
 use crate::targets::{depth_format, Output, Targets};
-use crate::tonemap::ToneMap;
-use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::camera::Camera;
-use ml_cpu::cluster::{ClusterAssigner, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, LightCone, ObjectData, PointLight};
+use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
+use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
 use ml_cpu::lights::{animate_into, animation_offset};
 use ml_cpu::omni_shadow::shadowed_lights;
 use ml_cpu::scene::Scene;
-use ml_vk::descriptors::{allocate_set, write_image};
-use ml_vk::{commands, release_on_error, vk, Buffer, Context, Image, VkError, VkResultExt};
+use ml_vk::{commands, vk, Buffer, Context, Image, VkError, VkResultExt};
 use std::time::Instant;
-
-/// CPU-side cluster state of `clustered-cpu`: the assigner and this frame's lists.
-struct CpuClusters {
-    assigner: ClusterAssigner,
-    lists: ClusterLists,
-}
 
 /// A rendered image (tightly packed RGBA8, row 0 at the top) and its measurements.
 pub struct RenderOutput {
@@ -41,53 +30,32 @@ pub struct RenderOutput {
     pub stats: FrameStats,
 }
 
-pub struct HeadlessRenderer<'a> {
+pub struct Renderer<'a> {
     ctx: &'a Context,
     scene: Scene,
     settings: RenderSettings,
     extent: vk::Extent2D,
-    pass: RasterPass,
-    /// Set 1 of every shading pipeline (blinn-phong's shadow map, sky, albedo and normal maps,
-    /// the point-light shadow cubes).
-    textures: SceneTextures,
-    /// Set 2 of the mesh pipelines: each object's own textures.
-    object_textures: ObjectTextureSets,
-    /// Point-light shadow cubes (a stand-in without shadowed lights).
-    omni: OmniShadows,
+    /// The scene's meshes, buffers and textures on the GPU.
+    gpu: SceneGpu,
+    /// The technique's passes, in recording order.
+    passes: Vec<Box<dyn Pass>>,
+    command_pool: vk::CommandPool,
+    frames: Vec<FrameInFlight>,
+    readback: Option<Buffer>,
+    /// Whether lights are animated on the GPU (by the cluster build), else on the CPU into
+    /// `animated`, which every frame uploads.
+    lights_on_gpu: bool,
+    animated: Vec<PointLight>,
     /// The lights with a shadow cube (cube i: `shadowed[i]`), and where they are this frame.
     shadowed: Vec<u32>,
     shadowed_now: Vec<ShadowedLight>,
-    /// The sun's shadow-map view-projection (blinn-phong).
-    shadow_view_proj: glam::Mat4,
-    meshes: Vec<GpuMesh>,
-    command_pool: vk::CommandPool,
-    descriptor_pool: vk::DescriptorPool,
-    frames: Vec<FrameInFlight>,
-    readback: Option<Buffer>,
-    /// Lights of the current frame (animated copy of the scene's).
-    animated: Vec<PointLight>,
-    clusters: Option<CpuClusters>,
-    /// The cluster grid (fixed: headless rendering keeps camera and size; its shader
-    /// parameters are also set for `forward`, which ignores them).
+    /// The cluster grid (its shader parameters are also set for techniques without one).
     grid: ClusterGrid,
-    /// clustered-gpu, deferred-compute: the compute passes and their shared buffers.
-    builder: Option<GpuClusterBuilder>,
-    /// deferred-compute: the lighting compute pass.
-    lighting: Option<ComputeLighting>,
-    /// deferred, deferred-clustered: the tone map after the render pass.
-    tonemap: Option<ToneMap>,
-    /// Every object's transform and material (draws push their index; the G-buffer stores it).
-    objects: Option<Buffer>,
-    /// Spot cones, parallel to the lights (static: only positions animate).
-    cones: Option<Buffer>,
-    /// --debug-view shadow-map: the pass that paints the map over the output, and its set per
-    /// frame slot (pointing at that slot's colour target).
-    shadow_map_view: Option<(ComputePass, Vec<vk::DescriptorSet>)>,
-    /// clustered-gpu: light-index entries every frame recorded from now on must hold (grows
-    /// when a frame reports it needed more).
+    /// Light-index entries every frame recorded from now on must hold (grows when a frame
+    /// reports it needed more).
     required_indices: usize,
-    /// Per frame slot: whether the frame it last ran overflowed its light-index list.
-    overflowed: Vec<bool>,
+    /// Per frame slot: what its last frame reported (GPU light assignment).
+    reports: Vec<SlotReport>,
     /// Per frame slot: whether it has been submitted since its results were last collected.
     pending: Vec<bool>,
     /// Top of the heat-map scale (lights per cluster), from the newest known frame.
@@ -98,13 +66,12 @@ pub struct HeadlessRenderer<'a> {
     depth_format: vk::Format,
 }
 
+/// The renderer's former name: headless rendering is what it does without a window.
+pub type HeadlessRenderer<'a> = Renderer<'a>;
+
 /// Copies into host-visible buffers, then read by the CPU.
 const TRANSFER_TO_HOST: ((vk::PipelineStageFlags, vk::AccessFlags), (vk::PipelineStageFlags, vk::AccessFlags)) =
     ((vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));
-
-/// Most light-index entries clustered-cpu builds (512 MiB of indices, twice that while
-/// assigning); beyond it the render fails with a clear message.
-const MAX_CPU_LIST_ENTRIES: usize = 1 << 27;
 
 /// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
 const DEFAULT_HEAT_TOP: f32 = 64.0;
@@ -122,77 +89,73 @@ pub trait FrameHook {
     fn semaphores(&self) -> (Option<(vk::Semaphore, vk::PipelineStageFlags)>, Option<vk::Semaphore>);
 }
 
-impl<'a> HeadlessRenderer<'a> {
-    pub fn new(ctx: &'a Context, mut scene: Scene, settings: RenderSettings) -> Result<HeadlessRenderer<'a>, RenderError> {
+impl<'a> Renderer<'a> {
+    pub fn new(ctx: &'a Context, mut scene: Scene, settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
         settings.check(ctx, scene.lights.len())?;
         if !scene.cones.is_empty() && scene.cones.len() != scene.lights.len() {
             return Err(RenderError::Invalid(format!("the scene has {} spot cones for {} lights", scene.cones.len(), scene.lights.len())));
         }
         let shadowed = mark_shadowed(&mut scene, &settings);
         let depth = depth_format(ctx, Output::of(settings.technique))?;
-        let extent = vk::Extent2D { width: settings.width, height: settings.height };
-        // clustered-gpu animates on the GPU; the others keep an animated copy on the CPU.
-        let animated = if settings.technique.is_gpu_built() { Vec::new() } else { scene.lights.clone() };
-        let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
-        let clusters =
-            settings.technique.is_cpu_built().then(|| CpuClusters { assigner: ClusterAssigner::new(), lists: ClusterLists::default() });
-        let blinn_phong = settings.shading == ShadingModel::BlinnPhong;
-        // Each of these needs the ones before it; a failure releases those.
-        let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
-        let mut omni = OmniShadows::new(ctx, settings.omni)?;
-        let mut textures = release_on_error(ctx, SceneTextures::new(ctx, blinn_phong, gbuffer_depth, &omni), &mut [&mut omni])?;
-        let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
-        let mut object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
-        let layouts = (textures.set_layout, object_textures.set_layout);
-        let made = RasterPass::new(ctx, depth, (settings.technique, settings.lighting(&scene)), layouts);
-        let pass = release_on_error(ctx, made, &mut [&mut omni, &mut textures, &mut object_textures])?;
-        let (lo, hi) = scene.bounds();
-        let shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
-        let mut r = HeadlessRenderer {
+        let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
+        let gpu = SceneGpu::new(ctx, &scene, &settings)?;
+        let mut r = Renderer {
             ctx,
+            extent: vk::Extent2D { width: settings.width, height: settings.height },
+            grid: ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera),
+            animated: if lights_on_gpu { Vec::new() } else { scene.lights.clone() },
             scene,
             settings,
-            extent,
-            pass,
-            textures,
-            object_textures,
-            omni,
-            shadowed,
-            shadowed_now: Vec::new(),
-            shadow_view_proj,
-            meshes: Vec::new(),
+            gpu,
+            passes: Vec::new(),
             command_pool: vk::CommandPool::null(),
-            descriptor_pool: vk::DescriptorPool::null(),
             frames: Vec::new(),
             readback: None,
-            animated,
-            clusters,
-            grid,
-            builder: None,
-            lighting: None,
-            tonemap: None,
-            objects: None,
-            cones: None,
-            shadow_map_view: None,
+            lights_on_gpu,
+            shadowed,
+            shadowed_now: Vec::new(),
             required_indices: 0,
-            overflowed: vec![false; FRAMES_IN_FLIGHT],
+            reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
             heat_top: DEFAULT_HEAT_TOP,
             last_frame: 0,
             depth_format: depth,
         };
         // Anything made before a failure is released by Drop.
-        r.create_resources()?;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        // SAFETY: valid device and create infos.
+        r.command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
+        r.make_passes()?;
         r.create_frames()?;
         Ok(r)
+    }
+
+    /// The technique's passes for the current scene and settings (replacing any).
+    fn make_passes(&mut self) -> Result<(), VkError> {
+        for p in &mut self.passes {
+            p.destroy(self.ctx);
+        }
+        self.passes.clear();
+        self.required_indices = 0;
+        let assembly = Assembly {
+            settings: &self.settings,
+            shading: self.settings.lighting(&self.scene),
+            lights: &self.scene.lights,
+            scene: &self.gpu,
+            depth_format: self.depth_format,
+        };
+        self.passes = assemble(self.ctx, &assembly)?;
+        Ok(())
     }
 
     /// Render with `settings` from now on where they differ from the current ones only in
     /// what the pipelines do not depend on — size, cluster grid, debug view, frames, clock —
     /// and say so (true); false, changing nothing, for anything else (make a new renderer).
-    /// New frame slots (targets, their sets, per-frame buffers), cluster grid, clustered-gpu
-    /// builder for a new grid, tone map and shadow-map view for a new debug view; pipelines,
-    /// meshes, textures and the scene's buffers stay (the viewer's resizes and overlay).
+    /// New frame slots (targets, per-frame buffers, the passes' sets), cluster grid, and new
+    /// passes for a new grid or debug view; meshes, textures and the scene's buffers stay (the
+    /// viewer's resizes and overlay).
     pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<bool, RenderError> {
         let same_pipelines = RenderSettings {
             width: self.settings.width,
@@ -207,31 +170,22 @@ impl<'a> HeadlessRenderer<'a> {
             return Ok(false);
         }
         settings.check(self.ctx, self.scene.lights.len())?;
-        let ctx = self.ctx;
         self.release_frames()?;
         let (new_grid, new_view) = (settings.clusters != self.settings.clusters, settings.debug_view != self.settings.debug_view);
         self.settings = settings;
         self.extent = vk::Extent2D { width: settings.width, height: settings.height };
         self.grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
-        if new_grid {
-            self.make_builder()?;
-        }
-        if new_view {
-            if let Some(mut t) = self.tonemap.take() {
-                t.destroy(ctx);
-            }
-            if let Some((mut view, _)) = self.shadow_map_view.take() {
-                view.destroy(ctx);
-            }
-            self.create_view_passes()?;
+        // The passes depend on the grid (the GPU build's sizes) and the debug view (legend,
+        // tone-map curve, view passes); sizes only need new frame slots.
+        if new_grid || new_view {
+            self.make_passes()?;
         }
         self.create_frames()?;
         Ok(true)
     }
 
     /// Light the scene with `lights` from now on (the viewer's light count, layout or radius
-    /// changed): new light buffers, frame slots and, for clustered-gpu, builder; pipelines,
-    /// meshes and textures stay. Scenes with spot lights refuse (their cones belong to their
+    /// changed): new light buffers, frame slots and passes; meshes and textures stay. Scenes with spot lights refuse (their cones belong to their
     /// lights and are compiled into the pipelines): make a new renderer for those.
     pub fn set_lights(&mut self, lights: Vec<PointLight>) -> Result<(), RenderError> {
         if !self.scene.cones.is_empty() {
@@ -241,8 +195,8 @@ impl<'a> HeadlessRenderer<'a> {
         self.release_frames()?;
         self.scene.lights = lights;
         self.shadowed = mark_shadowed(&mut self.scene, &self.settings);
-        self.animated = if self.settings.technique.is_gpu_built() { Vec::new() } else { self.scene.lights.clone() };
-        self.make_builder()?;
+        self.animated = if self.lights_on_gpu { Vec::new() } else { self.scene.lights.clone() };
+        self.make_passes()?;
         self.create_frames()?;
         Ok(())
     }
@@ -256,189 +210,77 @@ impl<'a> HeadlessRenderer<'a> {
         }
         self.frames.clear();
         self.pending.fill(false);
-        self.overflowed.fill(false);
+        self.reports.fill(SlotReport::default());
         if let Some(mut b) = self.readback.take() {
             b.destroy(ctx);
-        }
-        if let Some((_, sets)) = &mut self.shadow_map_view {
-            sets.clear();
-        }
-        // SAFETY: the device is idle and the frames that used the pool's sets are gone.
-        unsafe { ctx.device.reset_descriptor_pool(self.descriptor_pool, vk::DescriptorPoolResetFlags::empty()) }
-            .ctx("vkResetDescriptorPool")
-    }
-
-    /// What every frame shares: meshes, the shadow map, pools, the scene's buffers, the
-    /// technique's compute passes.
-    fn create_resources(&mut self) -> Result<(), VkError> {
-        let ctx = self.ctx;
-        self.upload_objects()?;
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(ctx.queue_family)
-            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        // SAFETY: valid device and create infos.
-        self.command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
-        self.make_builder()?;
-        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        // One cone per light where the scene has spots; else one the shaders never read.
-        let cones = if self.scene.cones.is_empty() { vec![LightCone::NONE] } else { self.scene.cones.clone() };
-        self.cones = Some(Buffer::device_local_with(ctx, "light cones", bytemuck::cast_slice(&cones), usage)?);
-        if self.settings.technique.lights_in_compute() {
-            self.lighting = Some(ComputeLighting::new(ctx, self.textures.set_layout, self.settings.lighting(&self.scene))?);
-        }
-        self.create_view_passes()?;
-        // Per frame at most: the shading set (1 uniform + 5 storage: lights, cluster ranges and
-        // indices, objects, cones), the build set (1 uniform + 8 storage), the lighting set
-        // (1 uniform, 5 storage, 4 sampled images, 1 storage image), the subpass input set (4
-        // input attachments), the tone map's set (1 sampled image, 1 storage image) and the
-        // shadow-map view's (1 storage image).
-        let n = FRAMES_IN_FLIGHT as u32;
-        let sizes = [
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 3 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 18 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 5 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: 3 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::INPUT_ATTACHMENT, descriptor_count: 4 * n },
-        ];
-        let dp_info = vk::DescriptorPoolCreateInfo::default().max_sets(6 * n).pool_sizes(&sizes);
-        // SAFETY: as above.
-        self.descriptor_pool = unsafe { ctx.device.create_descriptor_pool(&dp_info, None) }.ctx("vkCreateDescriptorPool")?;
-        Ok(())
-    }
-
-    /// The scene's objects on the GPU: its meshes, the object buffer, and (blinn-phong) the
-    /// sun's shadow map of them.
-    fn upload_objects(&mut self) -> Result<(), VkError> {
-        let ctx = self.ctx;
-        for kind in self.scene.mesh_kinds() {
-            let mesh = self.scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
-            self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
-        }
-        let objects: Vec<ObjectData> = self.scene.objects.iter().map(object_data).collect();
-        self.objects =
-            Some(Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?);
-        if self.settings.shading == ShadingModel::BlinnPhong {
-            let inputs = ShadowInputs { scene: &self.scene, meshes: &self.meshes, view_proj: self.shadow_view_proj };
-            self.textures.render_shadow_map(ctx, &inputs)?;
         }
         Ok(())
     }
 
     /// Draw `scene`'s objects (and meshes) from now on, lights and camera unchanged (the
     /// viewer's object and material combos): new meshes, object buffer, sun shadow map and
-    /// frame slots; pipelines stay. False, changing nothing, where either scene has object
+    /// frame slots; passes stay. False, changing nothing, where either scene has object
     /// textures (their sets and the pipelines' texture code depend on them).
     pub fn set_objects(&mut self, scene: &Scene) -> Result<bool, RenderError> {
-        let Some(&stand_ins) = self.object_textures.per_object.first() else { return Ok(false) };
-        if !scene.textures.is_empty() || !self.scene.textures.is_empty() {
+        if self.gpu.object_textures.per_object.is_empty() || !scene.textures.is_empty() || !self.scene.textures.is_empty() {
             return Ok(false);
         }
-        let ctx = self.ctx;
         self.release_frames()?;
-        for mesh in &mut self.meshes {
-            mesh.destroy(ctx);
-        }
-        self.meshes.clear();
-        if let Some(mut b) = self.objects.take() {
-            b.destroy(ctx);
-        }
         self.scene.objects = scene.objects.clone();
         self.scene.meshes = scene.meshes.clone();
-        let (lo, hi) = self.scene.bounds();
-        self.shadow_view_proj = shadow_view_proj(lo, hi, self.scene.blinn_phong.sun_direction);
-        // Without textures every object binds the one set of stand-ins.
-        self.object_textures.per_object = vec![stand_ins; self.scene.objects.len()];
-        self.upload_objects()?;
+        self.gpu.replace_objects(self.ctx, &self.scene)?;
         self.create_frames()?;
         Ok(true)
     }
 
-    /// The passes the debug view decides: the tone map (pbr's curve, not for surface views) of
-    /// the subpass techniques and the shadow-map view's compute pass.
-    fn create_view_passes(&mut self) -> Result<(), VkError> {
-        let ctx = self.ctx;
-        if self.settings.technique.lights_in_subpass() {
-            let surface_view = !matches!(self.settings.debug_view, DebugView::None | DebugView::ClusterHeat);
-            self.tonemap = Some(ToneMap::new(ctx, self.settings.shading == ShadingModel::Pbr && !surface_view)?);
-        }
-        if matches!(self.settings.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
-            let bindings = [(0, vk::DescriptorType::STORAGE_IMAGE)];
-            // constant_id 0 (CUBE): the point-light cube instead of the sun's map.
-            let cube = [(0, u32::from(self.settings.debug_view == DebugView::ShadowCube))];
-            let pass = ComputePass::new(ctx, &bindings, &[self.textures.set_layout], (ml_shaders::DEBUG_SHADOW_MAP_COMP, &cube))?;
-            self.shadow_map_view = Some((pass, Vec::new()));
-        }
-        Ok(())
-    }
-
-    /// The frame slots (targets at the current size, their sets and buffers), the cluster
-    /// boxes of clustered-gpu and the read-back buffer.
+    /// The frame slots (targets at the current size, buffers), the passes' sets pointing at
+    /// them, what the projection decides (the GPU build's cluster boxes) and the read-back.
     fn create_frames(&mut self) -> Result<(), VkError> {
         let ctx = self.ctx;
-        let depth = self.depth_format;
-        let render_pass = self.pass.render_pass;
-        let extent = self.extent;
-        let output = self.pass.output;
-        let gbuffer = self.pass.gbuffer();
-        let make_targets = || Targets::new(ctx, render_pass, extent, depth, (output, gbuffer));
+        let (extent, depth) = (self.extent, self.depth_format);
+        let technique = self.settings.technique;
+        let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
+        let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer));
         let setup = FrameSetup {
             pool: self.command_pool,
-            descriptor_pool: self.descriptor_pool,
-            set_layout: self.pass.set_layout,
             light_count: self.scene.lights.len(),
             cluster_count: self.settings.clusters.count(),
             // Clustered techniques start with room for 16 entries per light (grown on demand);
             // forward never reads the list.
-            initial_indices: if self.settings.technique.is_clustered() { self.scene.lights.len() * 16 } else { 1 },
+            initial_indices: if technique.is_clustered() { self.scene.lights.len() * 16 } else { 1 },
             passes: self.pass_names().len() as u32,
             make_targets: &make_targets,
-            builder: self.builder.as_ref(),
-            lighting: self.lighting.as_ref(),
-            subpasses: self.tonemap.as_ref().map(|t| (&self.pass, t)),
-            objects: self.objects.as_ref().map_or(vk::Buffer::null(), |b| b.raw),
-            cones: self.cones.as_ref().map_or(vk::Buffer::null(), |b| b.raw),
+            written_by_gpu: self.lights_on_gpu,
         };
         for _ in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
         }
-        if let Some((pass, _)) = &self.shadow_map_view {
-            let mut sets = Vec::new();
-            let layout = pass.set_layout;
-            for frame in &self.frames {
-                let set = allocate_set(ctx, self.descriptor_pool, layout)?;
-                let target = frame.targets.as_ref().expect("made with the frame");
-                let info = vk::DescriptorImageInfo::default().image_view(target.color.view).image_layout(vk::ImageLayout::GENERAL);
-                write_image(ctx, set, 0, vk::DescriptorType::STORAGE_IMAGE, info);
-                sets.push(set);
-            }
-            self.shadow_map_view.as_mut().expect("set above").1 = sets;
+        for f in 0..FRAMES_IN_FLIGHT {
+            self.bind_passes(f)?;
         }
-        // The boxes depend on projection and size only: once here.
-        self.compute_cluster_bounds()?;
+        self.projection_changed()?;
         let bytes = extent.width as u64 * extent.height as u64 * 4;
         self.readback =
             Some(Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
         Ok(())
     }
 
-    /// The passes the timer reports, in order.
-    fn pass_names(&self) -> Vec<&'static str> {
-        let mut names = if self.omni.active() { vec!["omni shadows"] } else { Vec::new() };
-        names.extend(self.technique_pass_names());
-        names
+    /// Point every pass's sets of slot `f` at its buffers and targets (the slot is idle).
+    fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
+        let resources = self.frames[f].resources(f, (self.gpu.objects.raw, self.gpu.cones.raw));
+        self.passes.iter_mut().try_for_each(|p| p.bind_frame(self.ctx, &resources))
     }
 
-    fn technique_pass_names(&self) -> Vec<&'static str> {
-        let t = self.settings.technique;
-        if t.lights_in_compute() {
-            vec!["cluster build", "g-buffer", "lighting"]
-        } else if t.lights_in_subpass() {
-            vec!["g-buffer + lighting", "tone map"]
-        } else if t.is_gpu_built() {
-            vec!["cluster build", t.name()]
-        } else {
-            vec![t.name()]
-        }
+    /// Tell the passes the projection (or size) changed, with slot 0's uniforms holding it (no
+    /// frame in flight).
+    fn projection_changed(&mut self) -> Result<(), VkError> {
+        self.write_uniforms(0, 0.0);
+        self.passes.iter_mut().try_for_each(|p| p.projection_changed(self.ctx))
+    }
+
+    /// The passes the timer reports, in order.
+    fn pass_names(&self) -> Vec<&'static str> {
+        self.passes.iter().filter_map(|p| p.timer_name()).collect()
     }
 
     /// Render `settings.frames` frames, two in flight, and read back the last one. With
@@ -454,7 +296,7 @@ impl<'a> HeadlessRenderer<'a> {
         }
         self.collect_all(&mut stats)?;
         let mut rerenders = 0;
-        while self.overflowed[last] {
+        while self.reports[last].overflowed {
             if rerenders == MAX_RERENDERS {
                 return Err(RenderError::Invalid(format!(
                     "clustered-gpu: the light lists still overflowed after {MAX_RERENDERS} re-renders ({} entries needed)",
@@ -468,7 +310,7 @@ impl<'a> HeadlessRenderer<'a> {
             self.collect_all(&mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        if self.pass.output == Output::Subpasses {
+        if Output::of(self.settings.technique) == Output::Subpasses {
             let targets = self.frames[0].targets.as_ref().expect("made with the frame");
             stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
         }
@@ -485,40 +327,16 @@ impl<'a> HeadlessRenderer<'a> {
     }
 
     /// See the next frames from `camera` (the viewer's moving camera): the cluster grid
-    /// follows. clustered-gpu's view-space cluster boxes depend on the projection only: made
+    /// follows. The GPU build's view-space cluster boxes depend on the projection only: made
     /// again when it changed (field of view, near, far).
     pub fn set_camera(&mut self, camera: Camera) -> Result<(), RenderError> {
         self.scene.camera = camera;
         let projection = self.grid.projection;
         self.grid = ClusterGrid::new(self.settings.clusters, self.extent.width, self.extent.height, &camera);
-        if self.grid.projection != projection && self.builder.is_some() {
-            // Frame 0's uniforms carry the projection to the bounds pass: wait for its frame.
+        if self.grid.projection != projection {
+            // Frame 0's uniforms carry the projection to the passes: wait for its frame.
             self.ctx.wait_idle()?;
-            self.compute_cluster_bounds()?;
-        }
-        Ok(())
-    }
-
-    /// clustered-gpu and deferred-compute: a fresh GPU cluster builder for the scene's lights
-    /// and the grid (its lists start small again); nothing for the other techniques.
-    fn make_builder(&mut self) -> Result<(), VkError> {
-        if let Some(mut b) = self.builder.take() {
-            b.destroy(self.ctx);
-        }
-        self.required_indices = 0;
-        if self.settings.technique.is_gpu_built() {
-            self.builder = Some(GpuClusterBuilder::new(self.ctx, &self.scene.lights, self.settings.clusters.count())?);
-        }
-        Ok(())
-    }
-
-    /// clustered-gpu's view-space cluster boxes, from the grid frame 0's uniforms carry (its
-    /// frame must be done); nothing without a GPU builder.
-    fn compute_cluster_bounds(&mut self) -> Result<(), VkError> {
-        if self.builder.is_some() {
-            self.write_uniforms(0, 0.0);
-            let set = self.frames[0].gpu.as_ref().expect("made with the builder").set;
-            self.builder.as_ref().expect("checked").compute_bounds(self.ctx, set)?;
+            self.projection_changed()?;
         }
         Ok(())
     }
@@ -605,15 +423,16 @@ impl<'a> HeadlessRenderer<'a> {
         if let Some(ms) = self.frames[f].timer.read_ms(ctx)? {
             stats.add_gpu(&ms);
         }
-        if let Some(gpu) = &self.frames[f].gpu {
-            let feedback = gpu.feedback();
-            let needed = feedback.needed as usize;
+        let mut report = SlotReport::default();
+        for p in &self.passes {
+            p.collect(f, &mut report);
+        }
+        self.reports[f] = report;
+        if let (Some(needed), Some(max_lights)) = (report.index_entries, report.max_lights) {
             let clusters = self.settings.clusters.count();
-            stats.clusters =
-                Some(ClusterStats { mean_lights: needed as f64 / clusters as f64, max_lights: feedback.max_count, index_len: needed });
-            self.heat_top = feedback.max_count.max(1) as f32;
-            self.overflowed[f] = feedback.overflowed != 0;
-            if self.overflowed[f] {
+            stats.clusters = Some(ClusterStats { mean_lights: needed as f64 / clusters as f64, max_lights, index_len: needed });
+            self.heat_top = max_lights.max(1) as f32;
+            if report.overflowed {
                 stats.overflowed_frames += 1;
                 eprintln!(
                     "clustered-gpu: a frame needed {needed} light-index entries but its list held {}; growing the lists (that frame is re-rendered if it is the last)",
@@ -632,29 +451,26 @@ impl<'a> HeadlessRenderer<'a> {
     /// Write slot `f`'s buffers for clock `t`; the milliseconds of CPU light assignment in it
     /// (None where the CPU does not assign).
     fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, VkError> {
-        let mut assign_ms = None;
-        if self.builder.is_some() {
-            if self.frames[f].ensure_index_capacity(self.ctx, self.required_indices)? {
-                stats.index_growths += 1;
-            }
-        } else {
+        let ctx = self.ctx;
+        let mut grew = self.frames[f].ensure_index_capacity(ctx, self.required_indices)?;
+        if !self.lights_on_gpu {
             animate_into(&self.scene.lights, t, &mut self.animated);
             self.frames[f].lights.write(0, &self.animated);
         }
-        if let Some(c) = &mut self.clusters {
-            let start = Instant::now();
-            // The CPU also holds the lists (and their pairs) in memory: cap what it builds.
-            let limit = frame::max_index_entries(self.ctx).min(MAX_CPU_LIST_ENTRIES);
-            c.assigner
-                .assign(&self.grid, &self.animated, &mut c.lists, limit)
-                .map_err(|e| frame::lists_too_long(e.at_least, limit, "clustered-cpu builds (or the device binds)"))?;
-            assign_ms = Some(start.elapsed().as_secs_f64() * 1e3);
-            let cluster_stats = c.lists.stats();
-            self.heat_top = cluster_stats.max_lights.max(1) as f32;
-            stats.clusters = Some(cluster_stats);
-            if self.frames[f].upload_clusters(self.ctx, &c.lists)? {
-                stats.index_growths += 1;
+        let mut assign_ms = None;
+        let mut lists = SlotLists { frame: &mut self.frames[f], grew: false };
+        let mut update = Update { ctx, grid: &self.grid, lights: &self.animated, lists: &mut lists };
+        for p in &mut self.passes {
+            if let Some((ms, cluster_stats)) = p.update(&mut update)? {
+                assign_ms = Some(ms);
+                self.heat_top = cluster_stats.max_lights.max(1) as f32;
+                stats.clusters = Some(cluster_stats);
             }
+        }
+        grew |= lists.grew;
+        if grew {
+            stats.index_growths += 1;
+            self.bind_passes(f)?;
         }
         let offset = animation_offset(t);
         self.shadowed_now = self
@@ -677,7 +493,7 @@ impl<'a> HeadlessRenderer<'a> {
         let bp = &self.scene.blinn_phong;
         // World size of a shadow-map texel: the orthographic projection's first row is the
         // sun's x axis over the half-width it covers.
-        let shadow_texel_world = 2.0 / self.shadow_view_proj.row(0).truncate().length() / self.textures.shadow_size as f32;
+        let shadow_texel_world = 2.0 / self.gpu.shadow_view_proj.row(0).truncate().length() / self.gpu.textures.shadow_size as f32;
         let frame = &mut self.frames[f];
         let uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),
@@ -687,7 +503,7 @@ impl<'a> HeadlessRenderer<'a> {
             camera_pos: cam.position.extend(cam.w_of_depth().0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
-            omni_texel: self.omni.texel(),
+            omni_texel: self.gpu.omni.texel(),
             directional_count: self.scene.directional.len() as u32,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
             viewport: [self.extent.width, self.extent.height, 0, 0],
@@ -695,8 +511,8 @@ impl<'a> HeadlessRenderer<'a> {
             cluster_frustum: [g.near, g.far, g.projection.x_axis.x, g.projection.y_axis.y],
             light_animation: animation_offset(t).extend(0.0).to_array(),
             cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
-            shadow_view_proj: self.shadow_view_proj.to_cols_array_2d(),
-            sun_direction: bp.sun_direction.extend(1.0 / self.textures.shadow_size as f32).to_array(),
+            shadow_view_proj: self.gpu.shadow_view_proj.to_cols_array_2d(),
+            sun_direction: bp.sun_direction.extend(1.0 / self.gpu.textures.shadow_size as f32).to_array(),
             sun_strength: bp.sun_strength.extend(shadow_texel_world).to_array(),
             spot_position_range: bp.spot.position.extend(bp.spot.range).to_array(),
             spot_direction_power: bp.spot.direction.extend(bp.spot.power).to_array(),
@@ -722,47 +538,28 @@ impl<'a> HeadlessRenderer<'a> {
             ctx.device.begin_command_buffer(cmd, &begin).ctx("vkBeginCommandBuffer")?;
         }
         frame.timer.reset(ctx, cmd);
-        let mut pass = 0;
-        if self.omni.active() {
-            frame.timer.begin(ctx, cmd, pass);
-            self.omni.record(ctx, cmd, &self.shadowed_now, (&self.meshes, &self.scene.objects));
-            frame.timer.end(ctx, cmd, pass);
-            pass += 1;
-        }
-        if let (Some(builder), Some(gpu)) = (&self.builder, &frame.gpu) {
-            frame.timer.begin(ctx, cmd, pass);
-            builder.record(ctx, cmd, gpu);
-            frame.timer.end(ctx, cmd, pass);
-            pass += 1;
-        }
-        frame.timer.begin(ctx, cmd, pass);
         let targets = frame.targets.as_ref().expect("made with the frame");
-        let legend = self.settings.debug_view == DebugView::ClusterHeat;
-        let pass_frame = PassFrame {
-            framebuffer: targets.framebuffer,
+        let rec = Recording {
+            ctx,
+            cmd,
+            slot: f,
             extent: self.extent,
-            set: frame.set,
-            textures: self.textures.set,
-            input_set: frame.input_set,
+            targets,
+            scene: &self.gpu,
+            objects: &self.scene.objects,
+            shadowed: &self.shadowed_now,
         };
-        let draws = DrawList { meshes: &self.meshes, objects: &self.scene.objects, object_sets: &self.object_textures.per_object };
-        self.pass.record(ctx, cmd, &pass_frame, &draws, legend);
-        frame.timer.end(ctx, cmd, pass);
-        if let Some(lighting) = &self.lighting {
-            pass += 1;
-            frame.timer.begin(ctx, cmd, pass);
-            lighting.record(ctx, cmd, [frame.lighting_set, self.textures.set], targets, self.extent);
-            frame.timer.end(ctx, cmd, pass);
-        }
-        if let Some(tonemap) = &self.tonemap {
-            pass += 1;
-            frame.timer.begin(ctx, cmd, pass);
-            tonemap.record(ctx, cmd, frame.tonemap_set, targets, self.extent);
-            frame.timer.end(ctx, cmd, pass);
-        }
-        if let Some((view, sets)) = &self.shadow_map_view {
-            // Over whatever the technique drew (untimed: a debug view).
-            view.record_into_colour_target(ctx, cmd, &[sets[f], self.textures.set], targets.color.raw, self.extent);
+        let mut timed = 0;
+        for pass in &self.passes {
+            match pass.timer_name() {
+                Some(_) => {
+                    frame.timer.begin(ctx, cmd, timed);
+                    pass.record(&rec);
+                    frame.timer.end(ctx, cmd, timed);
+                    timed += 1;
+                }
+                None => pass.record(&rec),
+            }
         }
         if let Some(hook) = hook {
             hook.record(ctx, cmd, &targets.color)?;
@@ -775,12 +572,9 @@ impl<'a> HeadlessRenderer<'a> {
     /// otherwise), copied to the host. Lists are sorted per cluster (the GPU's order is not
     /// deterministic); for tests and tools, not the frame loop.
     pub fn gpu_cluster_lists(&self) -> Result<Option<ClusterLists>, VkError> {
-        if self.builder.is_none() {
-            return Ok(None);
-        }
+        let Some(needed) = self.reports[self.last_frame].index_entries.map(|n| n as u64) else { return Ok(None) };
         let ctx = self.ctx;
         let frame = &self.frames[self.last_frame];
-        let needed = frame.gpu.as_ref().expect("clustered-gpu frame").feedback().needed as u64;
         let copies = [(&frame.cluster_ranges, frame.cluster_ranges.size), (&frame.light_indices, (needed * 4).max(4))];
         let mut host = Vec::new();
         for (_, size) in copies {
@@ -839,7 +633,7 @@ fn mark_shadowed(scene: &mut Scene, settings: &RenderSettings) -> Vec<u32> {
     shadowed
 }
 
-impl Drop for HeadlessRenderer<'_> {
+impl Drop for Renderer<'_> {
     fn drop(&mut self) {
         let ctx = self.ctx;
         let _ = ctx.wait_idle();
@@ -849,32 +643,11 @@ impl Drop for HeadlessRenderer<'_> {
         if let Some(mut b) = self.readback.take() {
             b.destroy(ctx);
         }
-        if let Some(mut b) = self.builder.take() {
-            b.destroy(ctx);
+        for p in &mut self.passes {
+            p.destroy(ctx);
         }
-        if let Some(mut l) = self.lighting.take() {
-            l.destroy(ctx);
-        }
-        if let Some(mut t) = self.tonemap.take() {
-            t.destroy(ctx);
-        }
-        for mut b in [self.objects.take(), self.cones.take()].into_iter().flatten() {
-            b.destroy(ctx);
-        }
-        if let Some((mut view, _)) = self.shadow_map_view.take() {
-            view.destroy(ctx);
-        }
-        for mesh in &mut self.meshes {
-            mesh.destroy(ctx);
-        }
-        // SAFETY: the device is idle; null handles are ignored.
-        unsafe {
-            ctx.device.destroy_descriptor_pool(self.descriptor_pool, None);
-            ctx.device.destroy_command_pool(self.command_pool, None);
-        }
-        self.pass.destroy(ctx);
-        self.textures.destroy(ctx);
-        self.object_textures.destroy(ctx);
-        self.omni.destroy(ctx);
+        // SAFETY: the device is idle; a null handle is ignored.
+        unsafe { ctx.device.destroy_command_pool(self.command_pool, None) };
+        self.gpu.destroy(ctx);
     }
 }

@@ -1,0 +1,242 @@
+//! What the three raster passes (forward, G-buffer, deferred subpasses) share: their render
+//! pass, the pipeline that draws the scene's meshes into its first subpass, its per-frame set 0
+//! and framebuffer, and the recording of every object with its push constants. Each pass adds
+//! what is its own (the heat legend, the lighting subpass).
+
+use crate::descriptors::FrameSets;
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding};
+use crate::pass::{FrameResources, Recording};
+use crate::render_pass;
+use crate::settings::Shading;
+use crate::targets::{GBufferImage, Output};
+use ml_cpu::gpu_types::{ObjectData, ObjectPush};
+use ml_cpu::scene::Object;
+use ml_shaders::Shader;
+use ml_vk::{shader, vk, Context, VkError, VkResultExt};
+
+/// Background of pixels no object covers (linear, before the UNORM store).
+pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
+
+/// The kinds of draw in a raster pass.
+#[derive(Clone, Copy, PartialEq)]
+pub enum Draw {
+    /// Scene meshes: vertex buffer, depth test, back-face culling.
+    Mesh,
+    /// A full-screen or screen-space draw made from the vertex index, no depth.
+    Screen,
+}
+
+pub struct MeshRaster {
+    pub render_pass: vk::RenderPass,
+    /// Set 0 of the mesh pipeline, one per frame slot.
+    sets: FrameSets,
+    pub pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    framebuffers: Vec<vk::Framebuffer>,
+    pub output: Output,
+    pub gbuffer: &'static [GBufferImage],
+    pub shading: Shading,
+}
+
+impl MeshRaster {
+    /// The render pass for `output` and the mesh pipeline with `fragment`; sets 1 and 2 are
+    /// the scene's textures and the object's textures.
+    pub fn new(
+        ctx: &Context,
+        (depth_format, output, gbuffer): (vk::Format, Output, &'static [GBufferImage]),
+        (fragment, shading): (&Shader, Shading),
+        (textures_layout, object_textures_layout): (vk::DescriptorSetLayout, vk::DescriptorSetLayout),
+    ) -> Result<MeshRaster, VkError> {
+        let stages = [(&ml_shaders::FORWARD_VERT, vk::ShaderStageFlags::VERTEX), (fragment, vk::ShaderStageFlags::FRAGMENT)];
+        let mut r = MeshRaster {
+            render_pass: vk::RenderPass::null(),
+            sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
+            pipeline_layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            framebuffers: vec![vk::Framebuffer::null(); FRAMES_IN_FLIGHT],
+            output,
+            gbuffer,
+            shading,
+        };
+        let made = (|| {
+            r.render_pass = render_pass::describe(depth_format, output, gbuffer).create(ctx)?;
+            let push = [vk::PushConstantRange::default()
+                .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+                .size(std::mem::size_of::<ObjectPush>() as u32)];
+            r.pipeline_layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw, textures_layout, object_textures_layout], &push)?;
+            r.pipeline = r.pipeline(ctx, (&ml_shaders::FORWARD_VERT, fragment), Draw::Mesh, (r.pipeline_layout, 0))?;
+            Ok(())
+        })();
+        match made {
+            Ok(()) => Ok(r),
+            Err(e) => {
+                r.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// A pipeline of this pass: `draw` kind, in `subpass` with `layout`, compiled for the
+    /// shading (specialization constants; screen draws ignore them where they do not shade).
+    pub fn pipeline(
+        &self,
+        ctx: &Context,
+        (vertex, fragment): (&Shader, &Shader),
+        draw: Draw,
+        (layout, subpass): (vk::PipelineLayout, u32),
+    ) -> Result<vk::Pipeline, VkError> {
+        let colour_attachments = if subpass == 0 { self.output.colour_attachments(self.gbuffer) } else { 1 };
+        let bindings = [vertex_binding()];
+        let attributes = vertex_attributes();
+        let vertex_input = match draw {
+            Draw::Mesh => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&bindings)
+                .vertex_attribute_descriptions(&attributes),
+            Draw::Screen => vk::PipelineVertexInputStateCreateInfo::default(),
+        };
+        // Meshes wind counter-clockwise seen from outside; the Y-flipped projection keeps that
+        // counter-clockwise in Vulkan's framebuffer convention.
+        let rasterization = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(if draw == Draw::Mesh { vk::CullModeFlags::BACK } else { vk::CullModeFlags::NONE })
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let depth_stencil = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(draw == Draw::Mesh)
+            .depth_write_enable(draw == Draw::Mesh)
+            .depth_compare_op(vk::CompareOp::LESS);
+        let model = self.shading.spec_constants();
+        shader::graphics_pipeline(
+            ctx,
+            &shader::GraphicsPipelineDesc {
+                vertex: vertex.spirv,
+                fragment: Some(fragment.spirv),
+                fragment_constants: &model,
+                vertex_input,
+                rasterization,
+                depth_stencil,
+                colour_attachments,
+                layout,
+                render_pass: self.render_pass,
+                subpass,
+            },
+        )
+    }
+
+    /// Slot `frame.slot`'s framebuffer over `frame.targets` (attachment order: render_pass.rs)
+    /// and its set 0.
+    pub fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        self.sets.write(ctx, frame.slot, &|name| frame.buffer(name))?;
+        let t = frame.targets;
+        let mut views: Vec<vk::ImageView> = match self.output {
+            Output::Color => vec![t.color.view],
+            _ => t.gbuffer.iter().map(|g| g.view).collect(),
+        };
+        views.push(t.depth.view);
+        if self.output == Output::Subpasses {
+            views.push(t.hdr.view);
+        }
+        let info = vk::FramebufferCreateInfo::default()
+            .render_pass(self.render_pass)
+            .attachments(&views)
+            .width(t.color.extent.width)
+            .height(t.color.extent.height)
+            .layers(1);
+        // SAFETY: views and render pass are compatible and alive; the slot is not in flight.
+        unsafe {
+            ctx.device.destroy_framebuffer(self.framebuffers[frame.slot], None);
+            self.framebuffers[frame.slot] = vk::Framebuffer::null();
+            self.framebuffers[frame.slot] = ctx.device.create_framebuffer(&info, None).ctx("vkCreateFramebuffer")?;
+        }
+        Ok(())
+    }
+
+    /// Begin the render pass (colour to the background, the G-buffer to zeros, depth to the far
+    /// plane, HDR to alpha 0 — "no object here", see tonemap.comp) and draw every object with its
+    /// push constants; the caller records the rest and ends the pass.
+    pub fn begin_and_draw_meshes(&self, rec: &Recording) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let d = &ctx.device;
+        let colour = vk::ClearValue { color: vk::ClearColorValue { float32: CLEAR_COLOR } };
+        let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
+        let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
+        let mut clear: Vec<vk::ClearValue> = match self.output {
+            Output::Color => vec![colour],
+            Output::GBuffer | Output::Subpasses => vec![zero; self.gbuffer.len()],
+        };
+        clear.push(depth);
+        if self.output == Output::Subpasses {
+            clear.push(zero);
+        }
+        let extent = rec.extent;
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(self.render_pass)
+            .framebuffer(self.framebuffers[rec.slot])
+            .render_area(area)
+            .clear_values(&clear);
+        let viewport =
+            vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+        let scene = rec.scene;
+        let sets = [self.sets.sets[rec.slot], scene.textures.set];
+        // SAFETY: recording state; every handle is alive until the frame's fence signals.
+        unsafe {
+            d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_set_viewport(cmd, 0, &[viewport]);
+            d.cmd_set_scissor(cmd, 0, &[area]);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &sets, &[]);
+            // Set 2 (the object's textures) changes only between objects with different ones.
+            let mut bound_set = None;
+            record_draws(
+                ctx,
+                cmd,
+                (&scene.meshes, rec.objects),
+                |_| 1,
+                |index, o| {
+                    let set = scene.object_textures.per_object[index as usize];
+                    if bound_set.replace(set) != Some(set) {
+                        d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 2, &[set], &[]);
+                    }
+                    let push = object_push(o, index);
+                    let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                    d.cmd_push_constants(cmd, self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
+                },
+            );
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: no pending work uses these objects; null handles are ignored.
+        unsafe {
+            for fb in self.framebuffers.drain(..) {
+                ctx.device.destroy_framebuffer(fb, None);
+            }
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device.destroy_render_pass(self.render_pass, None);
+        }
+        self.sets.destroy(ctx);
+    }
+}
+
+/// Object `o`'s entry in the object buffer.
+pub fn object_data(o: &Object) -> ObjectData {
+    let normal = glam::Mat4::from_mat3(glam::Mat3::from_mat4(o.transform).inverse().transpose());
+    let [albedo_roughness, material, emissive] = material_vectors(o);
+    ObjectData { model: o.transform.to_cols_array_2d(), normal_matrix: normal.to_cols_array_2d(), albedo_roughness, material, emissive }
+}
+
+/// What a draw of object `o` (at `index`) pushes.
+pub fn object_push(o: &Object, index: u32) -> ObjectPush {
+    let [albedo_roughness, material, emissive] = material_vectors(o);
+    ObjectPush { ids: [index, o.textures.bits(), 0, 0], albedo_roughness, material, emissive }
+}
+
+/// The material as the shaders read it: (albedo, roughness), (metallic, occlusion strength,
+/// normal scale, 0), (emissive, 0).
+fn material_vectors(o: &Object) -> [[f32; 4]; 3] {
+    let (m, x) = (&o.material, &o.extras);
+    [m.albedo.extend(m.roughness).to_array(), [m.metallic, x.occlusion_strength, x.normal_scale, 0.0], x.emissive.extend(0.0).to_array()]
+}

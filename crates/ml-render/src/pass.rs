@@ -1,0 +1,113 @@
+//! What every pass of a frame is to the renderer. A technique is an ordered list of passes
+//! (`passes::assemble`); the renderer loops over it to bind, record, time and collect, and
+//! knows no pass by name. Each pass owns its pipelines, its per-frame descriptor sets (and
+//! framebuffers) and rewrites them when a frame slot's buffers or targets change.
+
+use crate::descriptors::Resource;
+use crate::omni_shadow::ShadowedLight;
+use crate::scene_gpu::SceneGpu;
+use crate::targets::Targets;
+use ml_cpu::cluster::{ClusterGrid, ClusterLists};
+use ml_cpu::gpu_types::PointLight;
+use ml_vk::{vk, Context, VkError};
+
+/// One frame slot's shared buffers and targets, and the scene's, as passes bind them: by the
+/// names the shaders give them.
+pub struct FrameResources<'a> {
+    pub slot: usize,
+    pub uniforms: vk::Buffer,
+    pub lights: vk::Buffer,
+    pub cluster_ranges: vk::Buffer,
+    pub light_indices: vk::Buffer,
+    pub objects: vk::Buffer,
+    pub cones: vk::Buffer,
+    pub targets: &'a Targets,
+}
+
+impl FrameResources<'_> {
+    /// The buffers every shading shader may declare (scene_bindings.glsl's blocks).
+    pub fn buffer(&self, name: &str) -> Option<Resource> {
+        let buffer = match name {
+            "FrameBlock" => self.uniforms,
+            "LightBuffer" => self.lights,
+            "ClusterRangeBuffer" => self.cluster_ranges,
+            "LightIndexBuffer" => self.light_indices,
+            "ObjectBuffer" => self.objects,
+            "LightConeBuffer" => self.cones,
+            _ => return None,
+        };
+        Some(Resource::Buffer(buffer))
+    }
+}
+
+/// What a pass records with.
+pub struct Recording<'a> {
+    pub ctx: &'a Context,
+    pub cmd: vk::CommandBuffer,
+    pub slot: usize,
+    pub extent: vk::Extent2D,
+    pub targets: &'a Targets,
+    pub scene: &'a SceneGpu,
+    pub objects: &'a [ml_cpu::scene::Object],
+    /// Where this frame's shadowed lights are (cube i: `shadowed[i]`).
+    pub shadowed: &'a [ShadowedLight],
+}
+
+/// What a frame slot's finished frame told the passes (GPU light assignment feedback).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SlotReport {
+    /// Light-index entries the frame needed.
+    pub index_entries: Option<usize>,
+    /// Most lights in one cluster.
+    pub max_lights: Option<u32>,
+    /// Whether its light-index list was too short (some lists were cut).
+    pub overflowed: bool,
+}
+
+/// The CPU side of a frame, before it is recorded: a pass that assigns lights on the CPU
+/// writes the slot's lists here.
+pub struct Update<'a> {
+    pub ctx: &'a Context,
+    pub grid: &'a ClusterGrid,
+    /// This frame's (animated) lights.
+    pub lights: &'a [PointLight],
+    /// The slot's lists (written, grown by the renderer where they are too short).
+    pub lists: &'a mut dyn ListUpload,
+}
+
+/// Where a CPU assignment's lists go: the frame slot's buffers.
+pub trait ListUpload {
+    fn upload(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<(), VkError>;
+    /// The most entries the slot's list may ever hold (what the device binds).
+    fn max_entries(&self, ctx: &Context) -> usize;
+}
+
+pub trait Pass {
+    /// Name in the timing table; None: untimed (debug views, CPU work).
+    fn timer_name(&self) -> Option<&'static str>;
+
+    /// (Re)point this pass's sets (and framebuffers) of `frame.slot` at that slot's buffers
+    /// and targets: when the slot is made and when its buffers grow. Only while the slot is
+    /// not in flight.
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError>;
+
+    /// Record the pass into a frame's command buffer.
+    fn record(&self, rec: &Recording);
+
+    /// CPU work of a frame before it is recorded (lights assigned on the CPU); returns its
+    /// milliseconds where it did some.
+    fn update(&mut self, _update: &mut Update) -> Result<Option<(f64, ml_cpu::cluster::ClusterStats)>, VkError> {
+        Ok(None)
+    }
+
+    /// Read what slot `slot`'s finished frame reports (its fence has signalled).
+    fn collect(&self, _slot: usize, _report: &mut SlotReport) {}
+
+    /// The projection or image size changed; slot 0's uniforms hold the new ones and no frame
+    /// is in flight.
+    fn projection_changed(&mut self, _ctx: &Context) -> Result<(), VkError> {
+        Ok(())
+    }
+
+    fn destroy(&mut self, ctx: &Context);
+}

@@ -1,0 +1,65 @@
+//! Compute lighting (technique deferred-compute; docs/DESIGN.md#compute-lighting): the
+//! G-buffer pass's images lit by a compute pass through the GPU-built cluster lists — the same
+//! BRDF, cluster lookup and light order as the fragment path, on every SM (H100/H200 give
+//! graphics work 4 of 132). Its output is the colour target, left in TRANSFER_SRC_OPTIMAL
+//! like the forward pass's.
+
+use crate::compute_pass::ComputePass;
+use crate::descriptors::Resource;
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::scene_gpu::SceneGpu;
+use crate::settings::Shading;
+use ml_vk::{vk, Context, VkError};
+
+pub struct ComputeLighting {
+    pass: ComputePass,
+}
+
+impl ComputeLighting {
+    pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading) -> Result<ComputeLighting, VkError> {
+        // Set 1: the scene's textures (blinn-phong's shadow map and sky, the shadow cubes).
+        let model = shading.spec_constants();
+        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (&ml_shaders::DEFERRED_LIGHTING_COMP, &model))?;
+        Ok(ComputeLighting { pass })
+    }
+}
+
+impl Pass for ComputeLighting {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("lighting")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let t = frame.targets;
+        let sampler = self.pass.sampler;
+        let sampled = |image: &ml_vk::Image, layout| {
+            Some(Resource::Image(vk::DescriptorImageInfo::default().sampler(sampler).image_view(image.view).image_layout(layout)))
+        };
+        self.pass.bind_frame(ctx, frame.slot, &|name| match name {
+            "depth_image" => sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            "out_image" => {
+                Some(Resource::Image(vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL)))
+            }
+            // A G-buffer without the material and emissive images (a scene without object
+            // textures) binds the albedo image in their place: the shader, specialised for such
+            // scenes, never reads them, but Vulkan wants every binding it names written.
+            _ => match name.strip_suffix("_image") {
+                Some(g) => t
+                    .gbuffer_image(g)
+                    .or_else(|| t.gbuffer_image("albedo"))
+                    .and_then(|g| sampled(g, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)),
+                None => frame.buffer(name),
+            },
+        })
+    }
+
+    /// After the G-buffer pass and the cluster build.
+    fn record(&self, rec: &Recording) {
+        let sets = [rec.scene.textures.set];
+        self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &sets), rec.targets.color.raw, rec.extent);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pass.destroy(ctx);
+    }
+}

@@ -1,0 +1,111 @@
+//! Deferred shading in one render pass with two subpasses (techniques deferred,
+//! deferred-clustered; docs/DESIGN.md#deferred-shading-in-one-render-pass): subpass 0 draws
+//! every object into the G-buffer and depth, subpass 1 reads them as input attachments (this
+//! pixel only) and lights a full-screen triangle into the HDR target — over every light, or
+//! over the pixel's cluster — which the tone-map pass turns into the colour target.
+
+use crate::descriptors::{FrameSets, Resource};
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::mesh_raster::{Draw, MeshRaster};
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::scene_gpu::SceneGpu;
+use crate::settings::Shading;
+use crate::targets::{gbuffer_images, Output};
+use ml_vk::{shader, vk, Context, VkError};
+
+pub struct DeferredSubpasses {
+    raster: MeshRaster,
+    /// The lighting subpass's set 0 (uniforms, lights, lists, objects, cones) and set 2 (the
+    /// G-buffer and depth as input attachments), per frame slot.
+    lighting_sets: FrameSets,
+    input_sets: FrameSets,
+    lighting_layout: vk::PipelineLayout,
+    lighting: vk::Pipeline,
+}
+
+impl DeferredSubpasses {
+    pub fn new(
+        ctx: &Context,
+        scene: &SceneGpu,
+        (depth_format, shading): (vk::Format, Shading),
+        clustered: bool,
+    ) -> Result<DeferredSubpasses, VkError> {
+        let gbuffer = if shading.object_textures { &ml_shaders::GBUFFER_TEXTURED_FRAG } else { &ml_shaders::GBUFFER_FRAG };
+        let lighting = match (clustered, shading.object_textures) {
+            (false, false) => &ml_shaders::DEFERRED_FRAG,
+            (true, false) => &ml_shaders::DEFERRED_CLUSTERED_FRAG,
+            (false, true) => &ml_shaders::DEFERRED_TEXTURED_FRAG,
+            (true, true) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_FRAG,
+        };
+        let textures = scene.textures.set_layout.raw;
+        let attachments = (depth_format, Output::Subpasses, gbuffer_images(shading.object_textures));
+        let raster = MeshRaster::new(ctx, attachments, (gbuffer, shading), (textures, scene.object_textures.set_layout))?;
+        let stages = [(&ml_shaders::FULLSCREEN_VERT, vk::ShaderStageFlags::VERTEX), (lighting, vk::ShaderStageFlags::FRAGMENT)];
+        let mut pass = DeferredSubpasses {
+            raster,
+            lighting_sets: FrameSets::empty(),
+            input_sets: FrameSets::empty(),
+            lighting_layout: vk::PipelineLayout::null(),
+            lighting: vk::Pipeline::null(),
+        };
+        let made = (|| {
+            pass.lighting_sets = FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?;
+            pass.input_sets = FrameSets::new(ctx, &stages, 2, FRAMES_IN_FLIGHT)?;
+            let layouts = [pass.lighting_sets.layout.raw, textures, pass.input_sets.layout.raw];
+            pass.lighting_layout = shader::pipeline_layout(ctx, &layouts, &[])?;
+            pass.lighting = pass.raster.pipeline(ctx, (&ml_shaders::FULLSCREEN_VERT, lighting), Draw::Screen, (pass.lighting_layout, 1))?;
+            Ok(())
+        })();
+        match made {
+            Ok(()) => Ok(pass),
+            Err(e) => {
+                pass.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+}
+
+impl Pass for DeferredSubpasses {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("g-buffer + lighting")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        self.raster.bind_frame(ctx, frame)?;
+        self.lighting_sets.write(ctx, frame.slot, &|name| frame.buffer(name))?;
+        let t = frame.targets;
+        let input =
+            |view: vk::ImageView, layout| Some(Resource::Image(vk::DescriptorImageInfo::default().image_view(view).image_layout(layout)));
+        let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        self.input_sets.write(ctx, frame.slot, &|name| match name {
+            "depth_input" => input(t.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            _ => t.gbuffer_image(name.trim_end_matches("_input")).and_then(|g| input(g.view, read_only)),
+        })
+    }
+
+    fn record(&self, rec: &Recording) {
+        self.raster.begin_and_draw_meshes(rec);
+        let d = &rec.ctx.device;
+        let sets = [self.lighting_sets.sets[rec.slot], rec.scene.textures.set, self.input_sets.sets[rec.slot]];
+        // SAFETY: recording inside the render pass begun above; every handle is alive.
+        unsafe {
+            d.cmd_next_subpass(rec.cmd, vk::SubpassContents::INLINE);
+            d.cmd_bind_pipeline(rec.cmd, vk::PipelineBindPoint::GRAPHICS, self.lighting);
+            d.cmd_bind_descriptor_sets(rec.cmd, vk::PipelineBindPoint::GRAPHICS, self.lighting_layout, 0, &sets, &[]);
+            d.cmd_draw(rec.cmd, 3, 1, 0, 0);
+            d.cmd_end_render_pass(rec.cmd);
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: no pending work uses them; null handles are ignored.
+        unsafe {
+            ctx.device.destroy_pipeline(self.lighting, None);
+            ctx.device.destroy_pipeline_layout(self.lighting_layout, None);
+        }
+        self.lighting_sets.destroy(ctx);
+        self.input_sets.destroy(ctx);
+        self.raster.destroy(ctx);
+    }
+}

@@ -1,0 +1,75 @@
+//! Forward shading (techniques forward, clustered-cpu, clustered-gpu): one render pass that
+//! draws every object and lights each fragment there — over every light (brute force), or
+//! over the lights of the fragment's cluster (docs/DESIGN.md#clustered-light-assignment).
+//! Leaves the colour target in TRANSFER_SRC_OPTIMAL for the read-back.
+
+use crate::mesh_raster::{Draw, MeshRaster};
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::scene_gpu::SceneGpu;
+use crate::settings::Shading;
+use crate::targets::Output;
+use ml_vk::{vk, Context, VkError};
+
+pub struct Forward {
+    raster: MeshRaster,
+    /// Draws the cluster-heat legend over the image (debug view cluster-heat; else null).
+    legend: vk::Pipeline,
+    name: &'static str,
+}
+
+impl Forward {
+    /// `clustered`: loop over the fragment's cluster; `legend`: draw the heat legend; `name`:
+    /// the timer's (the technique's).
+    pub fn new(
+        ctx: &Context,
+        scene: &SceneGpu,
+        (depth_format, shading): (vk::Format, Shading),
+        (clustered, legend): (bool, bool),
+        name: &'static str,
+    ) -> Result<Forward, VkError> {
+        let fragment = if clustered { &ml_shaders::CLUSTERED_FRAG } else { &ml_shaders::FORWARD_FRAG };
+        let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
+        let raster = MeshRaster::new(ctx, (depth_format, Output::Color, &[]), (fragment, shading), layouts)?;
+        let mut pass = Forward { raster, legend: vk::Pipeline::null(), name };
+        if legend {
+            let shaders = (&ml_shaders::HEAT_LEGEND_VERT, &ml_shaders::HEAT_LEGEND_FRAG);
+            match pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.raster.pipeline_layout, 0)) {
+                Ok(p) => pass.legend = p,
+                Err(e) => {
+                    pass.destroy(ctx);
+                    return Err(e);
+                }
+            }
+        }
+        Ok(pass)
+    }
+}
+
+impl Pass for Forward {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some(self.name)
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        self.raster.bind_frame(ctx, frame)
+    }
+
+    fn record(&self, rec: &Recording) {
+        self.raster.begin_and_draw_meshes(rec);
+        let d = &rec.ctx.device;
+        // SAFETY: recording inside the render pass begun above.
+        unsafe {
+            if self.legend != vk::Pipeline::null() {
+                d.cmd_bind_pipeline(rec.cmd, vk::PipelineBindPoint::GRAPHICS, self.legend);
+                d.cmd_draw(rec.cmd, 6, 1, 0, 0);
+            }
+            d.cmd_end_render_pass(rec.cmd);
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: no pending work uses it; a null handle is ignored.
+        unsafe { ctx.device.destroy_pipeline(self.legend, None) };
+        self.raster.destroy(ctx);
+    }
+}

@@ -1,0 +1,44 @@
+//! The G-buffer pass of compute lighting (technique deferred-compute): draws every object
+//! into the G-buffer (targets.rs GBUFFER: normal, object index, albedo-occlusion and, with
+//! object textures, roughness-metallic and emissive) and depth, read next by the compute
+//! lighting pass.
+
+use crate::mesh_raster::MeshRaster;
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::scene_gpu::SceneGpu;
+use crate::settings::Shading;
+use crate::targets::{gbuffer_images, Output};
+use ml_vk::{vk, Context, VkError};
+
+pub struct GBuffer {
+    raster: MeshRaster,
+}
+
+impl GBuffer {
+    pub fn new(ctx: &Context, scene: &SceneGpu, (depth_format, shading): (vk::Format, Shading)) -> Result<GBuffer, VkError> {
+        let fragment = if shading.object_textures { &ml_shaders::GBUFFER_TEXTURED_FRAG } else { &ml_shaders::GBUFFER_FRAG };
+        let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
+        let attachments = (depth_format, Output::GBuffer, gbuffer_images(shading.object_textures));
+        Ok(GBuffer { raster: MeshRaster::new(ctx, attachments, (fragment, shading), layouts)? })
+    }
+}
+
+impl Pass for GBuffer {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("g-buffer")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        self.raster.bind_frame(ctx, frame)
+    }
+
+    fn record(&self, rec: &Recording) {
+        self.raster.begin_and_draw_meshes(rec);
+        // SAFETY: recording inside the render pass begun above.
+        unsafe { rec.ctx.device.cmd_end_render_pass(rec.cmd) };
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.raster.destroy(ctx);
+    }
+}

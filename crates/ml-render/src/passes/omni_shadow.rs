@@ -1,0 +1,25 @@
+//! Point-light shadows (docs/DESIGN.md#point-light-shadows): every frame, before shading, the
+//! shadowed lights' cubes are rendered where the lights are now. The cube array is a scene
+//! resource (the shading passes sample it through the scene's texture set); this pass records
+//! its rendering in the mode the settings chose (omni_shadow.rs).
+
+use crate::pass::{FrameResources, Pass, Recording};
+use ml_vk::{Context, VkError};
+
+pub struct OmniShadowPass;
+
+impl Pass for OmniShadowPass {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("omni shadows")
+    }
+
+    fn bind_frame(&mut self, _: &Context, _: &FrameResources) -> Result<(), VkError> {
+        Ok(())
+    }
+
+    fn record(&self, rec: &Recording) {
+        rec.scene.omni.record(rec.ctx, rec.cmd, rec.shadowed, (&rec.scene.meshes, rec.objects));
+    }
+
+    fn destroy(&mut self, _: &Context) {}
+}

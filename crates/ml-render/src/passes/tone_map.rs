@@ -1,0 +1,53 @@
+//! After the deferred render pass: the HDR image (linear RGBA16F) → the 8-bit colour target
+//! that is read back, with the encoding the forward path applies in its fragment shader
+//! (tonemap.comp). A compute pass: on H100/H200 it runs on every SM.
+
+use crate::compute_pass::ComputePass;
+use crate::descriptors::Resource;
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::settings::SPEC_PBR;
+use ml_vk::{vk, Context, VkError};
+
+pub struct ToneMap {
+    pass: ComputePass,
+}
+
+impl ToneMap {
+    /// `aces`: apply pbr's tone-mapping curve before gamma (not for debug views, whose
+    /// values are shown as they are).
+    pub fn new(ctx: &Context, aces: bool) -> Result<ToneMap, VkError> {
+        let curve = [(SPEC_PBR, u32::from(aces))];
+        Ok(ToneMap { pass: ComputePass::new(ctx, &[], (&ml_shaders::TONEMAP_COMP, &curve))? })
+    }
+}
+
+impl Pass for ToneMap {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("tone map")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let t = frame.targets;
+        let sampler = self.pass.sampler;
+        self.pass.bind_frame(ctx, frame.slot, &|name| {
+            Some(Resource::Image(match name {
+                "hdr_image" => vk::DescriptorImageInfo::default()
+                    .sampler(sampler)
+                    .image_view(t.hdr.view)
+                    .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+                "out_image" => vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL),
+                _ => return None,
+            }))
+        })
+    }
+
+    /// After the render pass, whose outgoing dependency orders the HDR writes before this
+    /// pass's reads.
+    fn record(&self, rec: &Recording) {
+        self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &[]), rec.targets.color.raw, rec.extent);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pass.destroy(ctx);
+    }
+}

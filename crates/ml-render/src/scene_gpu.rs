@@ -1,0 +1,112 @@
+//! The scene on the GPU, shared by every pass and frame: meshes, the object and spot-cone
+//! buffers, the scene's textures (set 1 of every shading pipeline: the sun's shadow map, the
+//! sky, material maps, the point-light shadow cubes) and each object's own textures (set 2).
+
+use crate::error::RenderError;
+use crate::gpu_mesh::GpuMesh;
+use crate::mesh_raster::object_data;
+use crate::object_textures::ObjectTextureSets;
+use crate::omni_shadow::OmniShadows;
+use crate::scene_textures::SceneTextures;
+use crate::settings::{RenderSettings, ShadingModel};
+use crate::sun_shadow;
+use crate::targets::{depth_format, Output};
+use ml_cpu::blinn_phong::shadow_view_proj;
+use ml_cpu::gpu_types::{LightCone, ObjectData};
+use ml_cpu::scene::Scene;
+use ml_vk::{release_on_error, vk, Buffer, Context, VkError};
+
+pub struct SceneGpu {
+    pub meshes: Vec<GpuMesh>,
+    /// Every object's transform and material (draws push their index; the G-buffer stores it).
+    pub objects: Buffer,
+    /// Spot cones, parallel to the lights (static: only positions animate).
+    pub cones: Buffer,
+    pub textures: SceneTextures,
+    pub object_textures: ObjectTextureSets,
+    /// Point-light shadow cubes (a stand-in without shadowed lights): part of the scene's
+    /// texture set, rendered each frame by the omni-shadow pass.
+    pub omni: OmniShadows,
+    /// The sun's shadow-map view-projection (blinn-phong).
+    pub shadow_view_proj: glam::Mat4,
+    /// Whether the sun's shadow map is drawn (blinn-phong).
+    sun: bool,
+}
+
+impl SceneGpu {
+    pub fn new(ctx: &Context, scene: &Scene, settings: &RenderSettings) -> Result<SceneGpu, RenderError> {
+        let sun = settings.shading == ShadingModel::BlinnPhong;
+        // Each of these needs the ones before it; a failure releases those.
+        let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
+        let mut omni = OmniShadows::new(ctx, settings.omni)?;
+        let mut textures = release_on_error(ctx, SceneTextures::new(ctx, sun, gbuffer_depth, &omni), &mut [&mut omni])?;
+        let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
+        let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
+        let mut gpu = SceneGpu {
+            meshes: Vec::new(),
+            objects: Buffer::null(),
+            cones: Buffer::null(),
+            textures,
+            object_textures,
+            omni,
+            shadow_view_proj: glam::Mat4::IDENTITY,
+            sun,
+        };
+        // One cone per light where the scene has spots; else one the shaders never read.
+        let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
+        let made = Buffer::device_local_with(ctx, "light cones", bytemuck::cast_slice(&cones), vk::BufferUsageFlags::STORAGE_BUFFER)
+            .and_then(|cones| {
+                gpu.cones = cones;
+                gpu.upload_objects(ctx, scene)
+            });
+        if let Err(e) = made {
+            gpu.destroy(ctx);
+            return Err(e.into());
+        }
+        Ok(gpu)
+    }
+
+    /// The scene's objects on the GPU: its meshes, the object buffer, and (blinn-phong) the
+    /// sun's shadow map of them.
+    fn upload_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), VkError> {
+        for kind in scene.mesh_kinds() {
+            let mesh = scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
+            self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
+        }
+        let objects: Vec<ObjectData> = scene.objects.iter().map(object_data).collect();
+        self.objects = Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        let (lo, hi) = scene.bounds();
+        self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
+        if self.sun {
+            let inputs = sun_shadow::ShadowInputs { scene, meshes: &self.meshes, view_proj: self.shadow_view_proj };
+            self.textures.render_shadow_map(ctx, &inputs)?;
+        }
+        Ok(())
+    }
+
+    /// Draw `scene`'s objects from now on (no frame in flight): new meshes, object buffer and
+    /// sun shadow map. Only for scenes without object textures (every object binds the one
+    /// set of stand-ins).
+    pub fn replace_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), VkError> {
+        self.release_objects(ctx);
+        let stand_ins = self.object_textures.per_object[0];
+        self.object_textures.per_object = vec![stand_ins; scene.objects.len()];
+        self.upload_objects(ctx, scene)
+    }
+
+    fn release_objects(&mut self, ctx: &Context) {
+        for mesh in &mut self.meshes {
+            mesh.destroy(ctx);
+        }
+        self.meshes.clear();
+        self.objects.destroy(ctx);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.release_objects(ctx);
+        self.cones.destroy(ctx);
+        self.textures.destroy(ctx);
+        self.object_textures.destroy(ctx);
+        self.omni.destroy(ctx);
+    }
+}
