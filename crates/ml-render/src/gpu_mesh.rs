@@ -1,4 +1,4 @@
-//! Static meshes in device-local memory, uploaded once through a staging buffer (seed 000).
+//! Static meshes in device-local memory, uploaded once through a staging buffer (docs/DESIGN.md#conventions).
 
 use ml_cpu::mesh::{Mesh, MeshKind, Vertex};
 use ml_cpu::scene::Object;

@@ -1,9 +1,9 @@
-//! Point-light shadow cubes (SPEC §4, seed 003), the GPU half: a cube-map array with six
+//! Point-light shadow cubes (docs/DESIGN.md#point-light-shadows), the GPU half: a cube-map array with six
 //! depth layers per shadowed light, each texel the distance from the light to the nearest
 //! surface over the light's radius (omni_shadow.frag), rendered every frame (the lights
 //! move) before the shading passes, which read it through set 1 (omni_shadow.glsl).
 //!
-//! Four ways to fill it, one image: `copy` (seed 003: each face into one offscreen depth
+//! Four ways to fill it, one image: `copy` (the classic way: each face into one offscreen depth
 //! target, then an image copy into the cube's layer), `direct` (each face straight into its
 //! layer, a framebuffer per layer), and one pass per light for all six faces: `multiview`
 //! (VK_KHR_multiview, view i = face i) or `layered` (instance i of a draw writes
@@ -244,7 +244,7 @@ impl OmniShadows {
         }
     }
 
-    /// Seed 003's step: the offscreen face (left TRANSFER_SRC_OPTIMAL by the pass, whose
+    /// The copy mode's step: the offscreen face (left TRANSFER_SRC_OPTIMAL by the pass, whose
     /// outgoing dependency orders this copy after its depth writes) into cube layer `layer`.
     fn copy_face(&self, ctx: &Context, cmd: vk::CommandBuffer, layer: u32) {
         let subresource = |base: u32| vk::ImageSubresourceLayers::default().aspect_mask(DEPTH).base_array_layer(base).layer_count(1);

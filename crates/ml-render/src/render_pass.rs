@@ -1,7 +1,6 @@
-//! The raster pass's VkRenderPass as plain data first (tests inspect it: SPEC §3 asks for seed
-//! 002's two subpasses with input attachments), then created from that data.
+//! The raster pass's VkRenderPass as plain data first (tests inspect it: the deferred technique is two subpasses with input attachments), then created from that data.
 //!
-//! Output::Color and Output::GBuffer: one subpass. Output::Subpasses (seed 002): the G-buffer
+//! Output::Color and Output::GBuffer: one subpass. Output::Subpasses (docs/DESIGN.md#deferred-shading-in-one-render-pass): the G-buffer
 //! images (normal, object index, albedo, and in scenes with object textures roughness-metallic
 //! and emissive), then depth — written by subpass 0, read by subpass 1 as input attachments,
 //! never stored — and last HDR colour, written by subpass 1 and read by the tone-map compute
@@ -149,7 +148,7 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage]) -> RenderPa
         ),
         // ... and the HDR image written by its subpass 1 and read by its tone map.
         dependency((external, COLOUR_OUT | compute, colour_write), (1, COLOUR_OUT, colour_write)),
-        // Seed 002's dependency: G-buffer writes before the lighting subpass reads them, per
+        // The subpass dependency: G-buffer writes before the lighting subpass reads them, per
         // pixel (BY_REGION: a tiler never leaves the tile).
         dependency((0, COLOUR_OUT | FRAGMENT_TESTS, ATTACHMENT_WRITES), (1, fragment, vk::AccessFlags::INPUT_ATTACHMENT_READ))
             .dependency_flags(vk::DependencyFlags::BY_REGION),

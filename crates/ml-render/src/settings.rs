@@ -4,7 +4,7 @@ use crate::error::RenderError;
 use ml_cpu::cluster::ClusterDims;
 use ml_vk::Context;
 
-/// Lighting techniques (SPEC §3). Each must give the same image as `Forward`.
+/// Lighting techniques (docs/DESIGN.md#techniques-are-two-choices). Each must give the same image as `Forward`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Technique {
     /// Brute force: every fragment loops over every light.
@@ -13,7 +13,7 @@ pub enum Technique {
     ClusteredCpu,
     /// Cluster grid built by compute shaders every frame; lights animated on the GPU.
     ClusteredGpu,
-    /// Seed 002: one render pass, G-buffer subpass → lighting subpass (input attachments),
+    /// One render pass, G-buffer subpass → lighting subpass (input attachments),
     /// every light per pixel, into an HDR target; then a tone-map pass.
     Deferred,
     /// `Deferred` with the lighting subpass looping over its cluster's lights (CPU-assigned).
@@ -119,12 +119,12 @@ pub enum LightingStage {
 pub const SPEC_BLINN_PHONG: u32 = 10;
 pub const SPEC_PBR: u32 = 11;
 
-/// Shading models (SPEC §2).
+/// Shading models (docs/DESIGN.md#shading-models).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShadingModel {
-    /// Seed 000: specular-only Cook–Torrance, ambient factor, gamma.
+    /// The seed scene's model: specular-only Cook–Torrance, ambient factor, gamma.
     Seed,
-    /// Seed 002: Blinn-Phong with a shadowed sun, a spot light, textures and reflections.
+    /// Blinn-Phong with a shadowed sun, a spot light, textures and reflections.
     BlinnPhong,
     /// The seed's specular term plus Lambert diffuse weighted by (1 − F)(1 − metallic), HDR
     /// tone-mapped (ACES) before gamma.
@@ -186,10 +186,10 @@ impl Shading {
     }
 }
 
-/// How point-light shadow cubes are rendered (SPEC §4).
+/// How point-light shadow cubes are rendered (docs/DESIGN.md#point-light-shadows).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OmniShadowMode {
-    /// Seed 003: each face into one offscreen depth target, then copied into the cube.
+    /// The classic way: each face into one offscreen depth target, then copied into the cube.
     Copy,
     /// Each face straight into its cube layer (a framebuffer per layer).
     Direct,

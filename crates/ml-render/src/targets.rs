@@ -7,7 +7,7 @@ use ml_vk::{vk, Context, Image, VkError};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
-/// What the deferred lighting subpass writes: linear HDR colour (seed 002), tone-mapped after.
+/// What the deferred lighting subpass writes: linear HDR colour, tone-mapped after.
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// The G-buffer's images in attachment order (subpass 0's colour outputs, the lighting
 /// subpass's inputs after depth, deferred-compute's bindings): the octahedral normal in two

@@ -1,4 +1,4 @@
-//! Technique `clustered-gpu` (SPEC §3): the cluster grid built by compute shaders every frame
+//! The GPU cluster build (docs/DESIGN.md#gpu-cluster-build): the cluster grid built by compute shaders every frame
 //! from the light buffer, with no per-light CPU work and no read-back in the frame.
 //!
 //! Per frame: clear the counters → COUNT (1–64 invocations per light: animate it, write it for
