@@ -7,6 +7,7 @@ pub mod blinn_phong;
 pub mod camera;
 pub mod cluster;
 pub mod error;
+mod geometry;
 pub mod gltf_scene;
 pub mod gltf_writer;
 pub mod gpu_types;
