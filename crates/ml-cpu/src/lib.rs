@@ -18,6 +18,7 @@ pub mod omni_shadow;
 pub mod random_scene;
 pub mod scene;
 pub mod scene_file;
+pub mod scene_load;
 pub mod shading;
 mod teapot;
 pub mod textures;
