@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 
 mod auto;
 mod bench;
+mod messages;
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
@@ -170,7 +171,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", format!("{e:#}").replace('\n', " "));
+            eprintln!("error: {}", messages::describe(&e).replace('\n', " "));
             ExitCode::FAILURE
         }
     }

@@ -44,11 +44,7 @@ impl MeshKind {
     }
 
     pub fn from_name(name: &str) -> Result<MeshKind, crate::SceneError> {
-        MeshKind::ALL.into_iter().find(|k| k.name() == name).ok_or_else(|| crate::SceneError::UnknownName {
-            kind: "object",
-            name: name.to_owned(),
-            expected: MeshKind::ALL.map(|k| k.name()).join(", "),
-        })
+        crate::error::find_named("object", &MeshKind::ALL, MeshKind::name, name)
     }
 
     /// A built-in mesh (empty for `Loaded`: those live in `Scene::meshes`).
