@@ -3,6 +3,7 @@
 //! flag instead ("--width 0 is out of range").
 
 use ml_cpu::lights::MAX_LIGHTS;
+use ml_cpu::scene_request::SceneRequestError;
 use ml_cpu::SceneError;
 use ml_render::error::{Named, Setting, SettingsError};
 use ml_render::RenderError;
@@ -25,6 +26,9 @@ fn with_flags(cause: &(dyn Error + 'static)) -> Option<String> {
             }
             _ => None,
         };
+    }
+    if let Some(SceneRequestError::Scene(e)) = cause.downcast_ref::<SceneRequestError>() {
+        return scene(e);
     }
     if let Some(e) = cause.downcast_ref::<SettingsError>() {
         return Some(settings(e));

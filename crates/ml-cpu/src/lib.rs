@@ -19,7 +19,9 @@ pub mod random_scene;
 pub mod scene;
 pub mod scene_file;
 pub mod scene_load;
+pub mod scene_request;
 pub mod shading;
+pub mod shading_model;
 mod teapot;
 pub mod textures;
 

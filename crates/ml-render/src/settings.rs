@@ -2,6 +2,7 @@
 
 use crate::error::{Named, RenderError, Setting, SettingsError};
 use ml_cpu::cluster::ClusterDims;
+pub use ml_cpu::shading_model::ShadingModel;
 use ml_vk::Context;
 
 /// Lighting techniques (SPEC §3). Each must give the same image as `Forward`.
@@ -79,41 +80,10 @@ impl Technique {
 pub const SPEC_BLINN_PHONG: u32 = 10;
 pub const SPEC_PBR: u32 = 11;
 
-/// Shading models (SPEC §2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ShadingModel {
-    /// Seed 000: specular-only Cook–Torrance, ambient factor, gamma.
-    Seed,
-    /// Seed 002: Blinn-Phong with a shadowed sun, a spot light, textures and reflections.
-    BlinnPhong,
-    /// The seed's specular term plus Lambert diffuse weighted by (1 − F)(1 − metallic), HDR
-    /// tone-mapped (ACES) before gamma.
-    Pbr,
-}
-
-impl ShadingModel {
-    pub const ALL: [ShadingModel; 3] = [ShadingModel::Seed, ShadingModel::BlinnPhong, ShadingModel::Pbr];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ShadingModel::Seed => "seed",
-            ShadingModel::BlinnPhong => "blinn-phong",
-            ShadingModel::Pbr => "pbr",
-        }
-    }
-
-    /// Specialization constants (id, value) that compile a pipeline for this model
-    /// (shading_model.glsl).
-    pub fn spec_constants(self) -> [(u32, u32); 2] {
-        [(SPEC_BLINN_PHONG, u32::from(self == ShadingModel::BlinnPhong)), (SPEC_PBR, u32::from(self == ShadingModel::Pbr))]
-    }
-
-    pub fn from_name(name: &str) -> Result<ShadingModel, RenderError> {
-        ShadingModel::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
-            let expected = ShadingModel::ALL.map(|m| m.name()).join(", ");
-            RenderError::Invalid(format!("unknown shading model '{name}': expected one of {expected}"))
-        })
-    }
+/// Specialization constants (id, value) that compile a pipeline for `model`
+/// (shading_model.glsl).
+fn model_spec_constants(model: ShadingModel) -> [(u32, u32); 2] {
+    [(SPEC_BLINN_PHONG, u32::from(model == ShadingModel::BlinnPhong)), (SPEC_PBR, u32::from(model == ShadingModel::Pbr))]
 }
 
 /// constant_id of `OMNI_SHADOWS` (omni_shadow.glsl), `OBJECT_TEXTURES` (surface.glsl) and
@@ -135,7 +105,7 @@ pub struct Shading {
 
 impl Shading {
     pub fn spec_constants(self) -> [(u32, u32); 5] {
-        let [a, b] = self.model.spec_constants();
+        let [a, b] = model_spec_constants(self.model);
         [
             a,
             b,
@@ -412,4 +382,36 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
 /// Later Mesa releases are not known to be fixed, so every lavapipe refuses it.
 pub fn multiview_depth_is_broken(ctx: &Context) -> bool {
     ctx.info.name.starts_with("llvmpipe")
+}
+
+/// The settings a command asks for, before the scene is known: its cluster grid may be left
+/// to the scene's light count, and its shading model comes with the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SettingsRequest {
+    pub technique: Technique,
+    /// Cluster grid; None: `ClusterDims::for_lights` for the scene's lights at this size.
+    pub clusters: Option<ClusterDims>,
+    pub debug_view: DebugView,
+    pub omni: Option<OmniShadowSettings>,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub time: Option<f32>,
+}
+
+impl SettingsRequest {
+    /// The settings that render `scene` with `shading` (the model its request resolved to).
+    pub fn for_scene(&self, scene: &ml_cpu::scene::Scene, shading: ShadingModel) -> RenderSettings {
+        RenderSettings {
+            technique: self.technique,
+            shading,
+            clusters: self.clusters.unwrap_or_else(|| ClusterDims::for_lights(scene.lights.len(), self.width, self.height)),
+            debug_view: self.debug_view,
+            omni: self.omni,
+            width: self.width,
+            height: self.height,
+            frames: self.frames,
+            time: self.time,
+        }
+    }
 }
