@@ -8,9 +8,8 @@ use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
-use ml_render::report::table;
+use ml_render::report;
 use ml_render::settings::SettingsRequest;
-use ml_render::targets::gbuffer_bytes_per_pixel;
 use ml_render::{DebugView, HeadlessRenderer, OmniShadowMode, OmniShadowSettings, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
@@ -281,73 +280,16 @@ fn render(cmd: &RenderArgs) -> Result<()> {
             Some(why)
         }
     };
-    let technique = settings.technique;
-    let light_count = built.scene.lights.len();
-    let object_textures = !built.scene.textures.is_empty();
+    let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
     let result = HeadlessRenderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render());
-    let device = format!("{} ({}, {} {})", ctx.info.name, ctx.info.type_name(), ctx.info.driver_name, ctx.info.driver_info);
+    let device = report::device_line(&ctx.info);
     drop(ctx);
     let output = result?;
     image::save_buffer_with_format(&cmd.out, &output.rgba, output.width, output.height, image::ColorType::Rgba8, image::ImageFormat::Png)
         .with_context(|| format!("cannot write '{}'", cmd.out.display()))?;
-    let stats = &output.stats;
-    let mut rows = vec![
-        ("device", device),
-        ("resolution", format!("{}x{}", output.width, output.height)),
-        ("technique", technique.name().to_owned() + if auto_why.is_some() { " (auto)" } else { "" }),
-        ("shading", settings.shading.name().to_owned()),
-        ("lights", light_count.to_string()),
-        ("frames", stats.frames.to_string()),
-    ];
-    if let Some(why) = auto_why {
-        rows.push(("auto", why));
-    }
-    match stats.gpu_ms() {
-        Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
-        None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
-    }
-    if technique.lights_in_subpass() || technique.lights_in_compute() {
-        let memory = match output.stats.gbuffer_lazily_allocated {
-            Some(true) => "; transient, lazily allocated",
-            Some(false) => "; transient (this device has no lazily allocated memory)",
-            None => "",
-        };
-        let layout = if object_textures {
-            "octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8, roughness-metallic RG8, emissive RGBA8"
-        } else {
-            "octahedral normal 2×f32, object index u32, albedo RGBA8"
-        };
-        rows.push(("g-buffer", format!("{} bytes/pixel + depth ({layout}){memory}", gbuffer_bytes_per_pixel(object_textures))));
-    }
-    if let Some(ms) = stats.assign_ms() {
-        rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
-    }
-    if let Some(c) = stats.clusters {
-        let d = settings.clusters;
-        rows.push(("clusters", format!("{}x{}x{} = {}", d.x, d.y, d.z, d.count())));
-        rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
-        rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
-    }
-    if stats.overflowed_frames > 0 {
-        rows.push((
-            "overflows",
-            format!(
-                "{} frame(s) outgrew their light lists; {} re-rendered at the grown size",
-                stats.overflowed_frames, stats.rerendered_frames
-            ),
-        ));
-    }
-    if settings.debug_view == DebugView::ClusterHeat {
-        let top = stats.clusters.map_or(1, |c| c.max_lights.max(1));
-        rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights per cluster")));
-    }
-    if let Some(o) = settings.omni {
-        rows.push(("omni shadows", format!("{}: {} light(s), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size)));
-    }
-    rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
-    rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
-    rows.push(("output", cmd.out.display().to_string()));
-    print!("{}", table(&rows));
+    let facts =
+        report::RenderFacts { device: &device, settings: &settings, lights, object_textures, auto: auto_why.as_deref(), output: &cmd.out };
+    print!("{}", report::table(&report::render_rows(&facts, &output.stats)));
     let count = messages.load(Ordering::SeqCst);
     if count > 0 {
         bail!("the validation layer reported {count} message(s) (printed above)");
@@ -389,25 +331,7 @@ fn view(cmd: &ViewArgs) -> Result<()> {
 fn info() -> Result<()> {
     let devices = ml_vk::context::list_devices()?;
     for d in devices {
-        let l = &d.limits;
-        let rows = vec![
-            ("device", format!("{}: {} ({})", d.index, d.name, d.type_name())),
-            ("vulkan", d.api_version_string()),
-            ("driver", format!("{} {}", d.driver_name, d.driver_info)),
-            ("usable", if d.suitable { "yes".into() } else { "no (needs Vulkan 1.2 and a graphics queue)".to_string() }),
-            ("maxImageDimension2D", l.max_image_dimension2_d.to_string()),
-            ("maxStorageBufferRange", l.max_storage_buffer_range.to_string()),
-            ("maxUniformBufferRange", l.max_uniform_buffer_range.to_string()),
-            ("maxPushConstantsSize", l.max_push_constants_size.to_string()),
-            ("maxComputeWorkGroupInvocations", l.max_compute_work_group_invocations.to_string()),
-            ("maxComputeSharedMemorySize", l.max_compute_shared_memory_size.to_string()),
-            ("timestampPeriod (ns)", l.timestamp_period.to_string()),
-            ("timestampComputeAndGraphics", (l.timestamp_compute_and_graphics != 0).to_string()),
-            ("maxImageArrayLayers", l.max_image_array_layers.to_string()),
-            ("imageCubeArray", d.features.image_cube_array.to_string()),
-            ("multiview", d.features.multiview.to_string()),
-        ];
-        println!("{}", table(&rows));
+        println!("{}", report::table(&report::device_rows(&d)));
     }
     Ok(())
 }
