@@ -1,16 +1,20 @@
-//! `manylights bench` (issue 9): every technique × light count on one scene, per-pass GPU
+//! `manylights bench`: every technique × light count on one scene, per-pass GPU
 //! time (median, p95, mean over the frames after the warm-up), CPU time per frame and lights
 //! per cluster, written to results.csv, results.json and results.png. A combination whose frames
 //! would take longer than the budget is skipped and says so: brute force estimated from a smaller
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
 use crate::auto::{self, technique_choice};
-use crate::{build_scene, render_settings, SceneArgs};
+use crate::{cluster_choice, print_warnings, scene_source, shading_choice};
 use anyhow::{bail, Context as _, Result};
-use clap::{Args, Parser};
+use clap::Args;
 use ml_cpu::cluster::ClusterDims;
+use ml_cpu::material::Material;
+use ml_cpu::mesh::MeshKind;
+use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
-use ml_render::{HeadlessRenderer, RenderOutput, Technique};
+use ml_render::settings::SettingsRequest;
+use ml_render::{DebugView, HeadlessRenderer, RenderOutput, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -83,23 +87,37 @@ fn parse_resolution(text: &str) -> Result<(u32, u32)> {
     Ok((w.trim().parse().context("resolution width")?, h.trim().parse().context("resolution height")?))
 }
 
-/// The scene arguments `render` would get for one combination (its technique aside).
-fn scene_args(a: &BenchArgs, lights: u64, (w, h): (u32, u32)) -> Result<SceneArgs> {
-    #[derive(Parser)]
-    struct Wrap {
-        #[command(flatten)]
-        scene: SceneArgs,
+/// What every combination renders: the scene (its light count set per combination) and the
+/// settings (the technique set per combination), as `render` would with the same arguments.
+struct Plan {
+    scene: SceneRequest,
+    settings: SettingsRequest,
+    /// Whether the scene's warnings were shown (once for the run).
+    warned: bool,
+}
+
+impl Plan {
+    fn new(a: &BenchArgs, (width, height): (u32, u32)) -> Result<Plan> {
+        let source = scene_source(&a.scene, MeshKind::Sphere, Material::named("gold")?)?;
+        let scene = SceneRequest { shading: shading_choice(a.shading.as_deref())?, ..SceneRequest::new(source) };
+        let settings = SettingsRequest {
+            technique: Technique::Forward,
+            clusters: cluster_choice(&a.clusters)?,
+            debug_view: DebugView::None,
+            omni: None,
+            width,
+            height,
+            frames: 1,
+            time: None,
+        };
+        Ok(Plan { scene, settings, warned: false })
     }
-    let (lights, w, h) = (lights.to_string(), w.to_string(), h.to_string());
-    let mut argv = vec!["bench", "--scene", &a.scene, "--lights", &lights, "--width", &w, "--height", &h];
-    argv.extend(["--clusters", &a.clusters]);
-    if let Some(s) = &a.shading {
-        argv.extend(["--shading", s]);
-    }
-    if a.validation {
-        argv.push("--validation");
-    }
-    Ok(Wrap::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().lines().next().unwrap_or("bad arguments")))?.scene)
+}
+
+/// What a run measures: the probe at these loop lengths, or the techniques.
+enum Work {
+    Probe(Vec<u32>),
+    Techniques(Plan),
 }
 
 /// One combination's result.
@@ -128,18 +146,21 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     if a.budget_s.is_nan() || a.budget_s <= 0.0 {
         bail!("--budget-s must be greater than 0");
     }
-    let probe_lengths = if a.probe { Some(probe_lengths(&a.probe_lights)?) } else { None };
+    let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Plan::new(a, resolution)?) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
     let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
     let messages = ctx.validation_counter();
-    if let Some(lengths) = probe_lengths {
-        let result = probe::run(&ctx, a, resolution, &lengths);
-        let device = device_json(&ctx);
-        drop(ctx);
-        let rows = result?;
-        probe::write(a, resolution, &device, &rows)?;
-        return check_messages(messages.load(Ordering::SeqCst));
-    }
+    let mut plan = match work {
+        Work::Techniques(plan) => plan,
+        Work::Probe(lengths) => {
+            let result = probe::run(&ctx, a, resolution, &lengths);
+            let device = device_json(&ctx);
+            drop(ctx);
+            let rows = result?;
+            probe::write(a, resolution, &device, &rows)?;
+            return check_messages(messages.load(Ordering::SeqCst));
+        }
+    };
     // Every run records the quick probe and what auto makes of it.
     let (auto_technique, auto_why, quick) = auto::pick(&ctx)?;
     auto::announce(auto_technique, &auto_why);
@@ -161,7 +182,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 .filter(|m| m.technique == technique && m.lights < lights)
                 .map(|m| (m.lights, m.ms_per_frame))
                 .max_by_key(|&(n, _)| n);
-            results.push(measure(&ctx, a, (technique, lights), resolution, previous)?);
+            results.push(measure(&ctx, a, &mut plan, (technique, lights), previous)?);
             bar.inc(1);
         }
     }
@@ -214,13 +235,7 @@ fn probe_lengths(text: &str) -> Result<Vec<u32>> {
 /// which then estimates the rest.
 type Previous = Option<(u64, f64)>;
 
-fn measure(
-    ctx: &Context,
-    a: &BenchArgs,
-    (technique, lights): (Technique, u64),
-    resolution: (u32, u32),
-    previous: Previous,
-) -> Result<Measured> {
+fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (technique, lights): (Technique, u64), previous: Previous) -> Result<Measured> {
     let frames = a.warmup + a.frames;
     let skip = |ms: f64, how: &str| {
         let estimate_s = ms * frames as f64 / 1e3;
@@ -241,10 +256,12 @@ fn measure(
             return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: scaled });
         }
     }
-    let args = scene_args(a, lights, resolution)?;
-    let (scene, shading) = build_scene(&args)?;
-    let mut settings = render_settings(&args, technique, scene.lights.len(), shading, 1)?;
-    settings.time = None;
+    let built = SceneRequest { lights: Some(lights), ..plan.scene.clone() }.build()?;
+    if !std::mem::replace(&mut plan.warned, true) {
+        print_warnings(&built.warnings);
+    }
+    let scene = built.scene;
+    let mut settings = SettingsRequest { technique, ..plan.settings }.for_scene(&scene, built.shading);
     let probe = HeadlessRenderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
         return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: probe.stats.wall_ms });

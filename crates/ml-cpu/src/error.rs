@@ -1,14 +1,25 @@
 use thiserror::Error;
 
-/// What can be wrong with a scene request before any GPU work starts.
+/// What can be wrong with a scene request before any GPU work starts: a name nothing has, a
+/// count or size out of range. The messages name the setting, not how a command spells it.
 #[derive(Debug, Error, PartialEq)]
 pub enum SceneError {
-    #[error("--lights {0} is out of range: use 1 to {max}", max = crate::lights::MAX_LIGHTS)]
+    #[error("light count {0} is out of range: use 1 to {max}", max = crate::lights::MAX_LIGHTS)]
     LightCount(u64),
     #[error("light radius {0} is invalid: radii must be finite and > 0 (R or MIN..MAX with MIN <= MAX)")]
     LightRadius(String),
-    #[error("--clusters {0} is invalid: use XxYxZ with each at least 1 and at most {max} clusters in all", max = crate::cluster::ClusterDims::MAX_CLUSTERS)]
+    #[error("cluster grid {0} is invalid: use XxYxZ with each at least 1 and at most {max} clusters in all", max = crate::cluster::ClusterDims::MAX_CLUSTERS)]
     Clusters(String),
     #[error("unknown {kind} '{name}': expected one of {expected}")]
     UnknownName { kind: &'static str, name: String, expected: String },
+}
+
+/// The one of `all` that `name_of` calls `name`; else an `UnknownName` of `kind` that lists
+/// every name.
+pub(crate) fn find_named<T: Copy>(kind: &'static str, all: &[T], name_of: impl Fn(T) -> &'static str, name: &str) -> Result<T, SceneError> {
+    all.iter().copied().find(|&t| name_of(t) == name).ok_or_else(|| SceneError::UnknownName {
+        kind,
+        name: name.to_owned(),
+        expected: all.iter().map(|&t| name_of(t)).collect::<Vec<_>>().join(", "),
+    })
 }

@@ -1,4 +1,4 @@
-//! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`, issue 7): the node hierarchy with its
+//! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`): the node hierarchy with its
 //! transforms, every triangle primitive (indexed or not; u8/u16/u32 indices; missing normals
 //! computed flat, tangents computed from the texture coordinates), metallic-roughness
 //! materials with their textures, KHR_lights_punctual point, spot and directional lights and
@@ -18,13 +18,14 @@ use crate::gpu_types::{LightCone, PointLight};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
 use crate::scene::{DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
-use crate::scene_file::{read_capped, SceneFile, SceneFileError, MAX_OBJECTS};
+use crate::scene_load::{read_capped, ReadError, SceneFile, MAX_OBJECTS};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use base64::Engine as _;
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
 
 /// Largest glTF or GLB file, and largest external buffer, we read.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
@@ -37,24 +38,231 @@ pub const MAX_NODE_DEPTH: usize = 256;
 /// Extensions we read (a file may require these; others it may only use, with a warning).
 const SUPPORTED_EXTENSIONS: [&str; 1] = ["KHR_lights_punctual"];
 
+/// A glTF file that could not be loaded: where, and what is wrong (one line).
+#[derive(Debug, Error)]
+#[error("glTF file '{}': {problem}", path.display())]
+pub struct GltfFileError {
+    pub path: PathBuf,
+    pub problem: GltfError,
+}
+
+/// The part of a glTF file a problem is in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    Buffer(usize),
+    Primitive {
+        mesh: usize,
+        primitive: usize,
+    },
+    Light(usize),
+    Camera(usize),
+    Image(usize),
+    /// One of a material's textures ("base colour", "normal", …); material None: glTF's
+    /// default material.
+    Texture {
+        material: Option<usize>,
+        slot: &'static str,
+    },
+    /// The data an accessor or buffer view holds: POSITION, NORMAL, TEXCOORD_0, indices, an
+    /// image's bytes.
+    Data(&'static str),
+}
+
+impl std::fmt::Display for Part {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            Part::Buffer(i) => write!(f, "buffer {i}"),
+            Part::Primitive { mesh, primitive } => write!(f, "mesh {mesh} primitive {primitive}"),
+            Part::Light(i) => write!(f, "light {i}"),
+            Part::Camera(i) => write!(f, "camera {i}"),
+            Part::Image(i) => write!(f, "image {i}"),
+            Part::Texture { material, slot } => write!(f, "material {} {slot} texture", MaterialName(*material)),
+            Part::Data(what) => f.write_str(what),
+        }
+    }
+}
+
+/// A material by its index, or glTF's default material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MaterialName(pub Option<usize>);
+
+impl std::fmt::Display for MaterialName {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self.0 {
+            Some(i) => write!(f, "{i}"),
+            None => f.write_str("default"),
+        }
+    }
+}
+
+/// A GLB header that cannot be right.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Error)]
+pub enum GlbHeader {
+    #[error("the GLB header is cut short")]
+    CutShort,
+    #[error("GLB version {0} (only 2 exists)")]
+    Version(u32),
+    #[error("the GLB header says {claimed} bytes, the file has {actual}")]
+    Length { claimed: u32, actual: usize },
+}
+
+/// What is wrong with a glTF file.
+#[derive(Debug, Error)]
+pub enum GltfError {
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    #[error("{part}: {problem}")]
+    In { part: Part, problem: Box<GltfError> },
+    #[error("the file is empty")]
+    Empty,
+    #[error("not a readable glTF/GLB file: {0}")]
+    Glb(GlbHeader),
+    /// What the gltf crate could not parse.
+    #[error("not a readable glTF/GLB file: {}", .0.to_string().replace('\n', " "))]
+    Unreadable(gltf::Error),
+    /// What the gltf crate's validation found: each place (a JSON path) and its error.
+    #[error("invalid glTF: {}", describe_invalid(.0))]
+    Invalid(Vec<(gltf::json::Path, gltf::json::validation::Error)>),
+    #[error("requires extension {0}, which manylights does not support")]
+    RequiredExtension(String),
+    #[error("the node hierarchy is deeper than {max} (or has a cycle) at node {0}", max = MAX_NODE_DEPTH)]
+    TooDeep(usize),
+    #[error("node {0}: its transform is not finite")]
+    NodeTransform(usize),
+    #[error("the scene has no triangles to draw")]
+    NoTriangles,
+    /// A primitive's attribute naming an accessor that does not exist.
+    #[error("{attribute} names accessor {accessor}, but there are {accessors}")]
+    NoAccessor { attribute: String, accessor: usize, accessors: usize },
+    #[error("{claimed} bytes claimed, more than the {max} we read", max = MAX_FILE_BYTES)]
+    BufferTooLarge { claimed: u64 },
+    #[error("refers to the GLB binary chunk, which the file does not have")]
+    NoBinaryChunk,
+    #[error("holds {holds} bytes but claims {claims}")]
+    BufferShort { holds: usize, claims: u64 },
+    #[error("a data URI that is not base64")]
+    NotBase64,
+    #[error("bad base64 data: {0}")]
+    Base64(base64::DecodeError),
+    #[error("'{0}' is not a local file (manylights never downloads)")]
+    Remote(String),
+    #[error("external files are not allowed here")]
+    NoFolder,
+    /// A file beside the glTF (a buffer or an image) that cannot be read.
+    #[error("'{}': {problem}", path.display())]
+    External { path: PathBuf, problem: ReadError },
+    #[error("more than {max} drawn primitives", max = MAX_OBJECTS)]
+    TooManyPrimitives,
+    #[error("has no POSITION")]
+    NoPositions,
+    #[error("the scene has more than {max} vertices", max = MAX_VERTICES)]
+    TooManyVertices,
+    #[error("{attribute} has {entries} entries but POSITION has {positions}")]
+    AttributeCount { attribute: &'static str, entries: usize, positions: usize },
+    #[error("{0} indices do not make whole triangles")]
+    PartialTriangle(usize),
+    #[error("{0} elements is more than we read")]
+    TooManyElements(usize),
+    #[error("stride {stride} is smaller than an element ({element} bytes)")]
+    Stride { stride: usize, element: usize },
+    #[error("its size overflows")]
+    SizeOverflow,
+    #[error(
+        "{count} elements of {element} bytes (stride {stride}, offset {offset}) need {needed} bytes but buffer view {view} has {length}"
+    )]
+    ViewTooShort { count: usize, element: usize, stride: usize, offset: usize, needed: usize, view: usize, length: usize },
+    #[error("accessor {0} has no buffer view")]
+    NoView(usize),
+    #[error("{substitutions} sparse substitutions for {count} elements")]
+    TooManySparse { substitutions: usize, count: usize },
+    /// `part`: the sparse "indices" or "values".
+    #[error("the sparse {part} ({len} bytes at {offset}) lie outside their buffer view")]
+    SparseOutside { part: &'static str, len: usize, offset: usize },
+    #[error("sparse index {k} is {index}; they must rise and stay below {count}")]
+    SparseIndex { k: usize, index: usize, count: usize },
+    #[error("buffer view {view} ({length} bytes at {offset}) lies outside its buffer of {buffer} bytes")]
+    ViewOutside { view: usize, length: usize, offset: usize, buffer: usize },
+    #[error("expected {expected:?} elements, found {found:?}")]
+    Dimensions { expected: Dimensions, found: Dimensions },
+    #[error("component type {ty:?} (normalized: {normalized}) is not allowed")]
+    ComponentType { ty: DataType, normalized: bool },
+    #[error("element {index} is not finite ({value})")]
+    NotFinite { index: usize, value: f32 },
+    #[error("expected scalars, found {0:?}")]
+    NotScalar(Dimensions),
+    #[error("component type {0:?} is not an index type")]
+    NotIndexType(DataType),
+    #[error("element {index} is {value}, but there are only {vertices} vertices")]
+    IndexOutOfRange { index: usize, value: u32, vertices: usize },
+    #[error("material {material}: {factor} factor {value} is outside [0, 1]")]
+    Factor { material: MaterialName, factor: &'static str, value: f32 },
+    #[error("material {material}: normal scale {value} is not finite")]
+    NormalScale { material: MaterialName, value: f32 },
+    #[error("its buffer view does not exist")]
+    NoImageView,
+    #[error("a buffer view without a mimeType")]
+    NoMimeType,
+    #[error("needs either a uri or a bufferView")]
+    NoImageSource,
+    /// An image whose format cannot be told.
+    #[error("{0}")]
+    ImageFormat(std::io::Error),
+    #[error("cannot decode it: {0}")]
+    Decode(image::ImageError),
+    #[error("a directional light needs a usable node direction and a finite, non-negative colour × intensity")]
+    Directional,
+    #[error("more than {max} directional lights", max = MAX_DIRECTIONAL_LIGHTS)]
+    TooManyDirectional,
+    #[error("spot cone angles inner {inner}, outer {outer}: need 0 ≤ inner < outer ≤ π/2")]
+    SpotCone { inner: f32, outer: f32 },
+    #[error("its node's transform collapses the spot's direction")]
+    SpotDirection,
+    #[error("colour × intensity must be finite and not negative")]
+    LightColor,
+    #[error("range {0} must be finite and > 0")]
+    Range(f32),
+    #[error("its node's position is not finite")]
+    LightPosition,
+    #[error("yfov {yfov} rad, znear {znear}, zfar {zfar}: need 0 < yfov < π and 0 < znear < zfar")]
+    Perspective { yfov: f32, znear: f32, zfar: f32 },
+    #[error("ymag {ymag}, znear {znear}, zfar {zfar}: need ymag > 0 and 0 ≤ znear < zfar")]
+    Orthographic { ymag: f32, znear: f32, zfar: f32 },
+    #[error("its node's transform is not usable (not finite, or it collapses the view direction)")]
+    CameraTransform,
+}
+
+impl GltfError {
+    /// This problem, said to be in `part`.
+    fn within(self, part: Part) -> GltfError {
+        GltfError::In { part, problem: Box::new(self) }
+    }
+}
+
+/// The first three validation errors, and how many more there are.
+fn describe_invalid(errors: &[(gltf::json::Path, gltf::json::validation::Error)]) -> String {
+    let first: Vec<String> = errors.iter().take(3).map(|(path, err)| format!("{path}: {err}")).collect();
+    let more = if errors.len() > 3 { format!(" (and {} more)", errors.len() - 3) } else { String::new() };
+    first.join("; ") + &more
+}
+
 /// Load the glTF or GLB file at `path` (external buffers relative to its folder).
-pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
-    let fail = |problem: String| SceneFileError { kind: "glTF file", path: path.display().to_string(), problem };
-    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(fail)?;
+pub fn load(path: &Path) -> Result<SceneFile, GltfFileError> {
+    let fail = |problem: GltfError| GltfFileError { path: path.to_path_buf(), problem };
+    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
     let (scene, warnings) = from_bytes(&bytes, path.parent()).map_err(fail)?;
     Ok(SceneFile { scene, shading: Some("pbr".into()), warnings })
 }
 
 /// Read a glTF scene from the file's bytes, and what it holds that is left out; `base` is the
 /// folder external buffers are in (None: external buffers are refused).
-pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<String>), String> {
+pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<String>), GltfError> {
     if bytes.is_empty() {
-        return Err("the file is empty".into());
+        return Err(GltfError::Empty);
     }
     let gltf = parse_and_validate(bytes)?;
     for ext in gltf.extensions_required() {
         if !SUPPORTED_EXTENSIONS.contains(&ext) {
-            return Err(format!("requires extension {ext}, which manylights does not support"));
+            return Err(GltfError::RequiredExtension(ext.to_owned()));
         }
     }
     // Optional extensions we do not read are left out, and said so.
@@ -88,11 +296,11 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > MAX_NODE_DEPTH {
-            return Err(format!("the node hierarchy is deeper than {MAX_NODE_DEPTH} (or has a cycle) at node {}", node.index()));
+            return Err(GltfError::TooDeep(node.index()));
         }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         if !local.is_finite() {
-            return Err(format!("node {}: its transform is not finite", node.index()));
+            return Err(GltfError::NodeTransform(node.index()));
         }
         let world = parent * local;
         builder.node(&node, world)?;
@@ -100,7 +308,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
     }
     if builder.objects.is_empty() {
-        return Err("the scene has no triangles to draw".into());
+        return Err(GltfError::NoTriangles);
     }
     let Builder { objects, lights, camera, meshes, warnings, textures, directional, mut cones, .. } = builder;
     if cones.iter().all(|c| *c == LightCone::NONE) {
@@ -117,7 +325,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
 /// The gltf crate's parse and validation, minus its one known panic: its validation indexes
 /// the accessor a primitive's POSITION names without checking it exists (gltf-json 1.4.1,
 /// mesh.rs), so that index is checked first.
-fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
     check_glb_header(bytes)?;
     let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
     let blob = raw.blob;
@@ -130,11 +338,8 @@ fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, String> {
                         gltf::json::validation::Checked::Valid(s) => s.to_string(),
                         gltf::json::validation::Checked::Invalid => "an attribute".into(),
                     };
-                    return Err(format!(
-                        "mesh {m} primitive {p}: {name} names accessor {}, but there are {}",
-                        index.value(),
-                        root.accessors.len()
-                    ));
+                    let problem = GltfError::NoAccessor { attribute: name, accessor: index.value(), accessors: root.accessors.len() };
+                    return Err(problem.within(Part::Primitive { mesh: m, primitive: p }));
                 }
             }
         }
@@ -145,59 +350,49 @@ fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, String> {
 
 /// A GLB's 12-byte header, checked before the gltf crate reads it: its length field less the
 /// header is computed unchecked there (gltf 1.4.1, binary.rs — an overflow found by the fuzzer).
-fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+fn check_glb_header(bytes: &[u8]) -> Result<(), GltfError> {
     if !bytes.starts_with(b"glTF") {
         return Ok(());
     }
     let word = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes(b.try_into().expect("four bytes")));
     let (Some(version), Some(length)) = (word(4), word(8)) else {
-        return Err("not a readable glTF/GLB file: the GLB header is cut short".into());
+        return Err(GltfError::Glb(GlbHeader::CutShort));
     };
     if version != 2 {
-        return Err(format!("not a readable glTF/GLB file: GLB version {version} (only 2 exists)"));
+        return Err(GltfError::Glb(GlbHeader::Version(version)));
     }
     if (length as usize) < 12 + 8 || length as usize > bytes.len() {
-        return Err(format!("not a readable glTF/GLB file: the GLB header says {length} bytes, the file has {}", bytes.len()));
+        return Err(GltfError::Glb(GlbHeader::Length { claimed: length, actual: bytes.len() }));
     }
     Ok(())
 }
 
-/// The gltf crate's error as one line (its validation errors name the JSON path).
-fn describe_gltf_error(e: gltf::Error) -> String {
+/// The gltf crate's error: its validation errors (which name the JSON path), or what it could
+/// not read.
+fn describe_gltf_error(e: gltf::Error) -> GltfError {
     match e {
-        gltf::Error::Validation(errors) => {
-            let first: Vec<String> = errors.iter().take(3).map(|(path, err)| format!("{path}: {err}")).collect();
-            format!(
-                "invalid glTF: {}{}",
-                first.join("; "),
-                if errors.len() > 3 { format!(" (and {} more)", errors.len() - 3) } else { String::new() }
-            )
-        }
-        other => format!("not a readable glTF/GLB file: {}", other.to_string().replace('\n', " ")),
+        gltf::Error::Validation(errors) => GltfError::Invalid(errors),
+        other => GltfError::Unreadable(other),
     }
 }
 
 /// Every buffer's bytes, each at least as long as the file says it is.
-fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, String> {
+fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, GltfError> {
     let mut out = Vec::new();
     let mut total = 0u64;
     for buffer in gltf.buffers() {
         let length = buffer.length() as u64;
-        let what = format!("buffer {}", buffer.index());
+        let what = Part::Buffer(buffer.index());
         total += length;
         if length > MAX_FILE_BYTES || total > MAX_FILE_BYTES {
-            return Err(format!("{what}: {length} bytes claimed, more than the {MAX_FILE_BYTES} we read"));
+            return Err(GltfError::BufferTooLarge { claimed: length }.within(what));
         }
         let data = match buffer.source() {
-            gltf::buffer::Source::Bin => {
-                let blob =
-                    gltf.blob.as_ref().ok_or_else(|| format!("{what}: refers to the GLB binary chunk, which the file does not have"))?;
-                blob.clone()
-            }
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, base).map_err(|e| format!("{what}: {e}"))?,
+            gltf::buffer::Source::Bin => gltf.blob.as_ref().ok_or_else(|| GltfError::NoBinaryChunk.within(what))?.clone(),
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, base).map_err(|e| e.within(what))?,
         };
         if (data.len() as u64) < length {
-            return Err(format!("{what}: holds {} bytes but claims {length}", data.len()));
+            return Err(GltfError::BufferShort { holds: data.len(), claims: length }.within(what));
         }
         out.push(data);
     }
@@ -205,17 +400,17 @@ fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, 
 }
 
 /// A buffer's data: a base64 data URI or a file beside the glTF.
-fn read_uri(uri: &str, base: Option<&Path>) -> Result<Vec<u8>, String> {
+fn read_uri(uri: &str, base: Option<&Path>) -> Result<Vec<u8>, GltfError> {
     if let Some(rest) = uri.strip_prefix("data:") {
-        let (_, data) = rest.split_once(";base64,").ok_or("a data URI that is not base64")?;
-        return base64::engine::general_purpose::STANDARD.decode(data).map_err(|e| format!("bad base64 data: {e}"));
+        let (_, data) = rest.split_once(";base64,").ok_or(GltfError::NotBase64)?;
+        return base64::engine::general_purpose::STANDARD.decode(data).map_err(GltfError::Base64);
     }
     if uri.contains("://") {
-        return Err(format!("'{uri}' is not a local file (manylights never downloads)"));
+        return Err(GltfError::Remote(uri.to_owned()));
     }
-    let base = base.ok_or("external files are not allowed here")?;
+    let base = base.ok_or(GltfError::NoFolder)?;
     let path = base.join(uri);
-    read_capped(&path, MAX_FILE_BYTES).map_err(|e| format!("'{}': {e}", path.display()))
+    read_capped(&path, MAX_FILE_BYTES).map_err(|problem| GltfError::External { path, problem })
 }
 
 struct Builder<'a> {
@@ -243,34 +438,34 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
-    fn node(&mut self, node: &gltf::Node, world: Mat4) -> Result<(), String> {
+    fn node(&mut self, node: &gltf::Node, world: Mat4) -> Result<(), GltfError> {
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
-                let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
-                let Some((index, centre, half)) = self.primitive(&mesh, &primitive).map_err(|e| format!("{what}: {e}"))? else {
+                let what = Part::Primitive { mesh: mesh.index(), primitive: primitive.index() };
+                let Some((index, centre, half)) = self.primitive(&mesh, &primitive).map_err(|e| e.within(what))? else {
                     continue;
                 };
                 if self.objects.len() == MAX_OBJECTS {
-                    return Err(format!("more than {MAX_OBJECTS} drawn primitives"));
+                    return Err(GltfError::TooManyPrimitives);
                 }
-                let (material, extras) = material(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
-                let textures = self.object_textures(&primitive.material()).map_err(|e| format!("{what}: {e}"))?;
+                let (material, extras) = material(&primitive.material()).map_err(|e| e.within(what))?;
+                let textures = self.object_textures(&primitive.material()).map_err(|e| e.within(what))?;
                 // The mesh was stored fitted to [−1, 1]³: undo that inside the object's transform.
                 let transform = world * Mat4::from_translation(centre) * Mat4::from_scale(Vec3::splat(half));
                 self.objects.push(Object { mesh: MeshKind::Loaded(index), transform, material, textures, extras });
             }
         }
         if let Some(light) = node.light() {
-            self.light(&light, world).map_err(|e| format!("light {}: {e}", light.index()))?;
+            self.light(&light, world).map_err(|e| e.within(Part::Light(light.index())))?;
         }
         if let (Some(camera), None) = (node.camera(), &self.camera) {
-            self.camera = camera_at(&camera, world, &mut self.warnings).map_err(|e| format!("camera {}: {e}", camera.index()))?;
+            self.camera = camera_at(&camera, world, &mut self.warnings).map_err(|e| e.within(Part::Camera(camera.index())))?;
         }
         Ok(())
     }
 
     /// Load a primitive's triangles (once per primitive); None for points and lines.
-    fn primitive(&mut self, mesh: &gltf::Mesh, primitive: &gltf::Primitive) -> Result<Option<(u32, Vec3, f32)>, String> {
+    fn primitive(&mut self, mesh: &gltf::Mesh, primitive: &gltf::Primitive) -> Result<Option<(u32, Vec3, f32)>, GltfError> {
         use gltf::mesh::Mode;
         let key = (mesh.index(), primitive.index());
         if let Some(&known) = self.by_primitive.get(&key) {
@@ -281,12 +476,12 @@ impl Builder<'_> {
             self.warnings.push(format!("mesh {} primitive {}: {mode:?} are not drawn (triangles only)", key.0, key.1));
             return Ok(None);
         }
-        let position = primitive.get(&gltf::Semantic::Positions).ok_or("has no POSITION")?;
+        let position = primitive.get(&gltf::Semantic::Positions).ok_or(GltfError::NoPositions)?;
         let positions = read_floats::<3>(&self.buffers, &position, "POSITION")?;
         let count = positions.len();
         self.vertices += count;
         if self.vertices > MAX_VERTICES {
-            return Err(format!("the scene has more than {MAX_VERTICES} vertices"));
+            return Err(GltfError::TooManyVertices);
         }
         let normals = match primitive.get(&gltf::Semantic::Normals) {
             Some(a) => Some(read_floats::<3>(&self.buffers, &a, "NORMAL")?),
@@ -296,9 +491,9 @@ impl Builder<'_> {
             Some(a) => Some(read_floats::<2>(&self.buffers, &a, "TEXCOORD_0")?),
             None => None,
         };
-        for (name, n) in [("NORMAL", normals.as_ref().map(Vec::len)), ("TEXCOORD_0", uvs.as_ref().map(Vec::len))] {
-            if n.is_some_and(|n| n != count) {
-                return Err(format!("{name} has {} entries but POSITION has {count}", n.unwrap_or(0)));
+        for (attribute, n) in [("NORMAL", normals.as_ref().map(Vec::len)), ("TEXCOORD_0", uvs.as_ref().map(Vec::len))] {
+            if let Some(entries) = n.filter(|&n| n != count) {
+                return Err(GltfError::AttributeCount { attribute, entries, positions: count });
             }
         }
         let indices = match primitive.indices() {
@@ -323,7 +518,7 @@ impl Builder<'_> {
                 // glTF: without normals, flat shading — each triangle its own three vertices.
                 self.vertices += triangles.len();
                 if self.vertices > MAX_VERTICES {
-                    return Err(format!("the scene has more than {MAX_VERTICES} vertices"));
+                    return Err(GltfError::TooManyVertices);
                 }
                 for tri in triangles.chunks_exact(3) {
                     let p = |k: usize| Vec3::from(positions[tri[k] as usize]);
@@ -352,20 +547,20 @@ impl Builder<'_> {
     }
 
     /// The material's textures (first texture coordinates) with their samplers.
-    fn object_textures(&mut self, m: &gltf::Material) -> Result<ObjectTextures, String> {
-        let name = m.index().map_or("default".to_string(), |i| i.to_string());
+    fn object_textures(&mut self, m: &gltf::Material) -> Result<ObjectTextures, GltfError> {
+        let name = MaterialName(m.index());
         let pbr = m.pbr_metallic_roughness();
         let base_color = pbr.base_color_texture().map(|t| (t.texture(), t.tex_coord()));
         let metallic_roughness = pbr.metallic_roughness_texture().map(|t| (t.texture(), t.tex_coord()));
         let normal = m.normal_texture().map(|t| (t.texture(), t.tex_coord()));
         let occlusion = m.occlusion_texture().map(|t| (t.texture(), t.tex_coord()));
         let emissive = m.emissive_texture().map(|t| (t.texture(), t.tex_coord()));
-        let mut slot = |what: &str, texture: Option<(gltf::Texture, u32)>, srgb: bool| -> Result<Option<u32>, String> {
+        let mut slot = |what: &'static str, texture: Option<(gltf::Texture, u32)>, srgb: bool| -> Result<Option<u32>, GltfError> {
             let Some((texture, set)) = texture else { return Ok(None) };
             if set != 0 {
                 self.warnings.push(format!("material {name}: the {what} texture names TEXCOORD_{set}; TEXCOORD_0 is used"));
             }
-            self.texture(&texture, srgb).map(Some).map_err(|e| format!("material {name} {what} texture: {e}"))
+            self.texture(&texture, srgb).map(Some).map_err(|e| e.within(Part::Texture { material: name.0, slot: what }))
         };
         Ok(ObjectTextures {
             base_color: slot("base colour", base_color, true)?,
@@ -377,7 +572,7 @@ impl Builder<'_> {
     }
 
     /// A glTF texture: its image decoded to RGBA8 (once per colour space) with its sampler.
-    fn texture(&mut self, texture: &gltf::Texture, srgb: bool) -> Result<u32, String> {
+    fn texture(&mut self, texture: &gltf::Texture, srgb: bool) -> Result<u32, GltfError> {
         let sampler = sampler_of(&texture.sampler());
         let index = texture.source().index();
         if let Some(&known) = self.by_texture.get(&(index, srgb, sampler)) {
@@ -386,7 +581,7 @@ impl Builder<'_> {
         let decoded = match self.by_texture.iter().find(|((i, s, _), _)| (*i, *s) == (index, srgb)) {
             // The same image with another sampler: decoded already.
             Some((_, &other)) => TextureImage { sampler, ..self.textures[other as usize].clone() },
-            None => TextureImage { sampler, ..self.image(index, srgb).map_err(|e| format!("image {index}: {e}"))? },
+            None => TextureImage { sampler, ..self.image(index, srgb).map_err(|e| e.within(Part::Image(index)))? },
         };
         let slot = self.textures.len() as u32;
         self.textures.push(decoded);
@@ -397,21 +592,21 @@ impl Builder<'_> {
     /// Image `index` decoded to RGBA8, checked before it is read: the gltf crate's own accessor
     /// for an image's source panics on an image with neither a URI nor a buffer view, and on a
     /// buffer view without a MIME type.
-    fn image(&self, index: usize, srgb: bool) -> Result<TextureImage, String> {
+    fn image(&self, index: usize, srgb: bool) -> Result<TextureImage, GltfError> {
         let json = &self.doc.as_json().images[index];
         let bytes: Vec<u8> = match (&json.uri, &json.buffer_view, &json.mime_type) {
             (Some(uri), None, _) => read_uri(uri, self.base)?,
             (None, Some(view), Some(_)) => {
-                let view = self.doc.views().nth(view.value()).ok_or("its buffer view does not exist")?;
+                let view = self.doc.views().nth(view.value()).ok_or(GltfError::NoImageView)?;
                 view_bytes(&self.buffers, &view, "its data")?.to_vec()
             }
-            (None, Some(_), None) => return Err("a buffer view without a mimeType".into()),
-            _ => return Err("needs either a uri or a bufferView".into()),
+            (None, Some(_), None) => return Err(GltfError::NoMimeType),
+            _ => return Err(GltfError::NoImageSource),
         };
         decode_image(&bytes, srgb)
     }
 
-    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<(), String> {
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<(), GltfError> {
         use gltf::khr_lights_punctual::Kind;
         let (kind, cone) = match light.kind() {
             Kind::Point => ("point", None),
@@ -423,10 +618,10 @@ impl Builder<'_> {
             let direction = world.transform_vector3(-Vec3::Z).normalize_or_zero();
             let color = Vec3::from(light.color()) * light.intensity();
             if direction == Vec3::ZERO || !direction.is_finite() || !color.is_finite() || color.min_element() < 0.0 {
-                return Err("a directional light needs a usable node direction and a finite, non-negative colour × intensity".into());
+                return Err(GltfError::Directional);
             }
             if self.directional.len() == MAX_DIRECTIONAL_LIGHTS {
-                return Err(format!("more than {MAX_DIRECTIONAL_LIGHTS} directional lights"));
+                return Err(GltfError::TooManyDirectional);
             }
             self.directional.push(DirectionalLight { direction, color });
             return Ok(());
@@ -436,29 +631,29 @@ impl Builder<'_> {
             Some((inner, outer)) => {
                 // glTF: 0 ≤ inner < outer ≤ π/2.
                 if !(inner >= 0.0 && inner < outer && outer <= std::f32::consts::FRAC_PI_2 + 1e-6) {
-                    return Err(format!("spot cone angles inner {inner}, outer {outer}: need 0 ≤ inner < outer ≤ π/2"));
+                    return Err(GltfError::SpotCone { inner, outer });
                 }
                 let axis = world.transform_vector3(-Vec3::Z).normalize_or_zero();
                 if axis == Vec3::ZERO || !axis.is_finite() {
-                    return Err("its node's transform collapses the spot's direction".into());
+                    return Err(GltfError::SpotDirection);
                 }
                 LightCone::spot(axis, inner, outer)
             }
         };
         let color = Vec3::from(light.color()) * light.intensity();
         if !color.is_finite() || color.min_element() < 0.0 {
-            return Err("colour × intensity must be finite and not negative".into());
+            return Err(GltfError::LightColor);
         }
         // Our lights end at a radius. glTF's range is one; without it, the distance where
         // intensity / d² falls to 1/256 (about what an 8-bit image still shows).
         let radius = match light.range() {
             Some(r) if r.is_finite() && r > 0.0 => r,
-            Some(r) => return Err(format!("range {r} must be finite and > 0")),
+            Some(r) => return Err(GltfError::Range(r)),
             None => (light.intensity().max(0.0) * 256.0).sqrt().max(1e-3),
         };
         let position = world.transform_point3(Vec3::ZERO);
         if !position.is_finite() {
-            return Err("its node's position is not finite".into());
+            return Err(GltfError::LightPosition);
         }
         self.lights.push(PointLight { position_radius: position.extend(radius).to_array(), color: color.extend(0.0).to_array() });
         self.cones.push(cone);
@@ -467,21 +662,21 @@ impl Builder<'_> {
 }
 
 /// PNG or JPEG bytes as an RGBA8 texture, its size and memory capped before decoding.
-fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, String> {
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
+fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, GltfError> {
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(GltfError::ImageFormat)?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_TEXTURE_SIZE);
     limits.max_image_height = Some(MAX_TEXTURE_SIZE);
     limits.max_alloc = Some(1 << 30);
     reader.limits(limits);
-    let decoded = reader.decode().map_err(|e| format!("cannot decode it: {e}"))?.to_rgba8();
+    let decoded = reader.decode().map_err(GltfError::Decode)?.to_rgba8();
     let (width, height) = decoded.dimensions();
     Ok(TextureImage { width, height, rgba: decoded.into_raw(), srgb, sampler: TextureSampler::default() })
 }
 
 /// glTF's metallic-roughness factors, and its emissive factor, normal scale and occlusion
 /// strength.
-fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras), String> {
+fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras), GltfError> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();
     let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
@@ -498,15 +693,15 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras), String> {
         ("emissive", eb),
         ("occlusion strength", strength),
     ];
-    let name = || m.index().map_or("default".into(), |i| i.to_string());
-    for (what, v) in unit {
-        if !(0.0..=1.0).contains(&v) {
-            return Err(format!("material {}: {what} factor {v} is outside [0, 1]", name()));
+    let material = MaterialName(m.index());
+    for (factor, value) in unit {
+        if !(0.0..=1.0).contains(&value) {
+            return Err(GltfError::Factor { material, factor, value });
         }
     }
     let normal_scale = m.normal_texture().map_or(1.0, |t| t.scale());
     if !normal_scale.is_finite() {
-        return Err(format!("material {}: normal scale {normal_scale} is not finite", name()));
+        return Err(GltfError::NormalScale { material, value: normal_scale });
     }
     let extras = MaterialExtras { emissive: Vec3::new(er, eg, eb), normal_scale, occlusion_strength: strength };
     Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras))
@@ -537,14 +732,14 @@ fn sampler_of(s: &gltf::texture::Sampler) -> TextureSampler {
 
 /// The camera at a node, perspective or orthographic (its height; the width follows the
 /// image, as a perspective camera's does).
-fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> Result<Option<Camera>, String> {
+fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> Result<Option<Camera>, GltfError> {
     let (fov, near, far, orthographic) = match camera.projection() {
         gltf::camera::Projection::Perspective(p) => {
             let (fov, near) = (p.yfov().to_degrees(), p.znear());
             let far = p.zfar().unwrap_or(near * 1e5);
             let sane = fov > 0.0 && fov < 180.0 && near > 0.0 && near.is_finite() && far > near && far.is_finite();
             if !sane {
-                return Err(format!("yfov {} rad, znear {near}, zfar {far}: need 0 < yfov < π and 0 < znear < zfar", p.yfov()));
+                return Err(GltfError::Perspective { yfov: p.yfov(), znear: near, zfar: far });
             }
             (fov, near, far, None)
         }
@@ -552,7 +747,7 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
             let (ymag, near, far) = (o.ymag(), o.znear(), o.zfar());
             let sane = ymag > 0.0 && ymag.is_finite() && near >= 0.0 && far > near && far.is_finite();
             if !sane {
-                return Err(format!("ymag {ymag}, znear {near}, zfar {far}: need ymag > 0 and 0 ≤ znear < zfar"));
+                return Err(GltfError::Orthographic { ymag, znear: near, zfar: far });
             }
             // Depth slices are logarithmic in depth: they need a near plane in front of the eye.
             let least = far * 1e-4;
@@ -565,7 +760,7 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
     let position = world.transform_point3(Vec3::ZERO);
     let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
     if !position.is_finite() || forward == Vec3::ZERO {
-        return Err("its node's transform is not usable (not finite, or it collapses the view direction)".into());
+        return Err(GltfError::CameraTransform);
     }
     if forward.y.abs() > 0.9999 {
         warnings.push(format!("camera {}: it looks straight up or down; the scene is framed instead", camera.index()));
@@ -586,12 +781,12 @@ pub fn framing_camera(scene: &Scene) -> Camera {
 }
 
 /// Triangle-list indices from a list, strip or fan.
-fn triangle_list(mode: gltf::mesh::Mode, indices: &[u32]) -> Result<Vec<u32>, String> {
+fn triangle_list(mode: gltf::mesh::Mode, indices: &[u32]) -> Result<Vec<u32>, GltfError> {
     use gltf::mesh::Mode;
     Ok(match mode {
         Mode::Triangles => {
             if !indices.len().is_multiple_of(3) {
-                return Err(format!("{} indices do not make whole triangles", indices.len()));
+                return Err(GltfError::PartialTriangle(indices.len()));
             }
             indices.to_vec()
         }
@@ -607,41 +802,38 @@ fn triangle_list(mode: gltf::mesh::Mode, indices: &[u32]) -> Result<Vec<u32>, St
 /// Every element of `accessor`, `size()` bytes each, back to back: read from its buffer view
 /// (each range checked against view and buffer), or zeros without one, then the sparse
 /// substitutions applied.
-fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Result<(Vec<u8>, DataType), String> {
+fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &'static str) -> Result<(Vec<u8>, DataType), GltfError> {
     let element = accessor.size();
     let count = accessor.count();
+    let fail = |e: GltfError| e.within(Part::Data(what));
     if count > MAX_VERTICES * 3 || count.saturating_mul(element) as u64 > MAX_FILE_BYTES {
-        return Err(format!("{what}: {count} elements is more than we read"));
+        return Err(fail(GltfError::TooManyElements(count)));
     }
     let mut out = match accessor.view() {
         Some(view) => {
             let stride = view.stride().unwrap_or(element);
             if stride < element {
-                return Err(format!("{what}: stride {stride} is smaller than an element ({element} bytes)"));
+                return Err(fail(GltfError::Stride { stride, element }));
             }
             let needed = match count {
                 0 => Some(0),
                 n => (n - 1).checked_mul(stride).and_then(|x| x.checked_add(accessor.offset())).and_then(|x| x.checked_add(element)),
             }
-            .ok_or_else(|| format!("{what}: its size overflows"))?;
+            .ok_or_else(|| fail(GltfError::SizeOverflow))?;
             if needed > view.length() {
-                return Err(format!(
-                    "{what}: {count} elements of {element} bytes (stride {stride}, offset {}) need {needed} bytes but buffer view {} has {}",
-                    accessor.offset(),
-                    view.index(),
-                    view.length()
-                ));
+                let (offset, view, length) = (accessor.offset(), view.index(), view.length());
+                return Err(fail(GltfError::ViewTooShort { count, element, stride, offset, needed, view, length }));
             }
             let data = view_bytes(buffers, &view, what)?;
             (0..count).flat_map(|i| &data[accessor.offset() + i * stride..][..element]).copied().collect()
         }
         None if accessor.sparse().is_some() => vec![0; count * element],
-        None => return Err(format!("{what}: accessor {} has no buffer view", accessor.index())),
+        None => return Err(fail(GltfError::NoView(accessor.index()))),
     };
     if let Some(sparse) = accessor.sparse() {
         let n = sparse.count();
         if n > count {
-            return Err(format!("{what}: {n} sparse substitutions for {count} elements"));
+            return Err(fail(GltfError::TooManySparse { substitutions: n, count }));
         }
         let (indices, values) = (sparse.indices(), sparse.values());
         let index_size = match indices.index_type() {
@@ -649,12 +841,12 @@ fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Resul
             gltf::accessor::sparse::IndexType::U16 => 2,
             gltf::accessor::sparse::IndexType::U32 => 4,
         };
-        let range = |data: &[u8], offset: usize, len: usize, part: &str| -> Result<Vec<u8>, String> {
+        let range = |data: &[u8], offset: usize, len: usize, part: &'static str| -> Result<Vec<u8>, GltfError> {
             offset
                 .checked_add(len)
                 .filter(|&end| end <= data.len())
                 .map(|end| data[offset..end].to_vec())
-                .ok_or_else(|| format!("{what}: the sparse {part} ({len} bytes at {offset}) lie outside their buffer view"))
+                .ok_or_else(|| fail(GltfError::SparseOutside { part, len, offset }))
         };
         let index_bytes = range(view_bytes(buffers, &indices.view(), what)?, indices.offset(), n * index_size, "indices")?;
         let value_bytes = range(view_bytes(buffers, &values.view(), what)?, values.offset(), n * element, "values")?;
@@ -662,7 +854,7 @@ fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Resul
         for (k, (i, value)) in index_bytes.chunks_exact(index_size).zip(value_bytes.chunks_exact(element)).enumerate() {
             let i = i.iter().rev().fold(0usize, |acc, &b| acc << 8 | b as usize);
             if i >= count || previous.is_some_and(|p| i <= p) {
-                return Err(format!("{what}: sparse index {k} is {i}; they must rise and stay below {count}"));
+                return Err(fail(GltfError::SparseIndex { k, index: i, count }));
             }
             out[i * element..][..element].copy_from_slice(value);
             previous = Some(i);
@@ -672,23 +864,26 @@ fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Resul
 }
 
 /// The bytes of buffer view `view`, checked against its buffer.
-fn view_bytes<'b>(buffers: &'b [Vec<u8>], view: &gltf::buffer::View, what: &str) -> Result<&'b [u8], String> {
+fn view_bytes<'b>(buffers: &'b [Vec<u8>], view: &gltf::buffer::View, what: &'static str) -> Result<&'b [u8], GltfError> {
     let data = &buffers[view.buffer().index()];
     let (offset, length) = (view.offset(), view.length());
-    offset.checked_add(length).filter(|&e| e <= data.len()).map(|end| &data[offset..end]).ok_or_else(|| {
-        format!("{what}: buffer view {} ({length} bytes at {offset}) lies outside its buffer of {} bytes", view.index(), data.len())
-    })
+    offset
+        .checked_add(length)
+        .filter(|&e| e <= data.len())
+        .map(|end| &data[offset..end])
+        .ok_or_else(|| GltfError::ViewOutside { view: view.index(), length, offset, buffer: data.len() }.within(Part::Data(what)))
 }
 
 /// A float accessor of N components (f32, or normalised u8/u16 for texture coordinates),
 /// every value finite.
-fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &str) -> Result<Vec<[f32; N]>, String> {
+fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &'static str) -> Result<Vec<[f32; N]>, GltfError> {
     let dims = match N {
         2 => Dimensions::Vec2,
         _ => Dimensions::Vec3,
     };
+    let fail = |e: GltfError| e.within(Part::Data(what));
     if accessor.dimensions() != dims {
-        return Err(format!("{what}: expected {dims:?} elements, found {:?}", accessor.dimensions()));
+        return Err(fail(GltfError::Dimensions { expected: dims, found: accessor.dimensions() }));
     }
     let (bytes, ty) = elements(buffers, accessor, what)?;
     let component = |bytes: &[u8], k: usize| -> Option<f32> {
@@ -703,10 +898,9 @@ fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, w
     for (i, e) in bytes.chunks_exact(accessor.size()).enumerate() {
         let mut v = [0.0; N];
         for (k, slot) in v.iter_mut().enumerate() {
-            *slot = component(e, k)
-                .ok_or_else(|| format!("{what}: component type {ty:?} (normalized: {}) is not allowed", accessor.normalized()))?;
+            *slot = component(e, k).ok_or_else(|| fail(GltfError::ComponentType { ty, normalized: accessor.normalized() }))?;
             if !slot.is_finite() {
-                return Err(format!("{what}: element {i} is not finite ({slot})"));
+                return Err(fail(GltfError::NotFinite { index: i, value: *slot }));
             }
         }
         out.push(v);
@@ -715,9 +909,10 @@ fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, w
 }
 
 /// An index accessor (u8, u16 or u32 scalars), every index below `vertices`.
-fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor, vertices: usize) -> Result<Vec<u32>, String> {
+fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor, vertices: usize) -> Result<Vec<u32>, GltfError> {
+    let fail = |e: GltfError| e.within(Part::Data("indices"));
     if accessor.dimensions() != Dimensions::Scalar {
-        return Err(format!("indices: expected scalars, found {:?}", accessor.dimensions()));
+        return Err(fail(GltfError::NotScalar(accessor.dimensions())));
     }
     let (bytes, ty) = elements(buffers, accessor, "indices")?;
     let mut out = Vec::with_capacity(accessor.count());
@@ -726,10 +921,10 @@ fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor, vertices: usize)
             DataType::U8 => e[0] as u32,
             DataType::U16 => u16::from_le_bytes([e[0], e[1]]) as u32,
             DataType::U32 => u32::from_le_bytes([e[0], e[1], e[2], e[3]]),
-            other => return Err(format!("indices: component type {other:?} is not an index type")),
+            other => return Err(fail(GltfError::NotIndexType(other))),
         };
         if index as usize >= vertices {
-            return Err(format!("indices: element {i} is {index}, but there are only {vertices} vertices"));
+            return Err(fail(GltfError::IndexOutOfRange { index: i, value: index, vertices }));
         }
         out.push(index);
     }

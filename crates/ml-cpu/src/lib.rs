@@ -7,6 +7,7 @@ pub mod blinn_phong;
 pub mod camera;
 pub mod cluster;
 pub mod error;
+mod geometry;
 pub mod gltf_scene;
 pub mod gltf_writer;
 pub mod gpu_types;
@@ -17,7 +18,10 @@ pub mod omni_shadow;
 pub mod random_scene;
 pub mod scene;
 pub mod scene_file;
+pub mod scene_load;
+pub mod scene_request;
 pub mod shading;
+pub mod shading_model;
 mod teapot;
 pub mod textures;
 

@@ -1,4 +1,4 @@
-//! Light layouts (SPEC §1 and the `--light-layout` flag) and the seed's light animation.
+//! Light layouts (the seed's grid, or seeded random places) and the seed's light animation.
 
 use crate::gpu_types::PointLight;
 use crate::SceneError;
@@ -31,12 +31,17 @@ pub enum LightLayout {
 }
 
 impl LightLayout {
-    pub fn from_name(name: &str) -> Result<LightLayout, SceneError> {
-        match name {
-            "grid" => Ok(LightLayout::Grid),
-            "random" => Ok(LightLayout::Random),
-            _ => Err(SceneError::UnknownName { kind: "light layout", name: name.into(), expected: "grid, random".into() }),
+    pub const ALL: [LightLayout; 2] = [LightLayout::Grid, LightLayout::Random];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            LightLayout::Grid => "grid",
+            LightLayout::Random => "random",
         }
+    }
+
+    pub fn from_name(name: &str) -> Result<LightLayout, SceneError> {
+        crate::error::find_named("light layout", &LightLayout::ALL, LightLayout::name, name)
     }
 }
 

@@ -1,4 +1,4 @@
-//! The seed's materials (SPEC §1): albedo with roughness 0.1 and metallic 1.0.
+//! The seed's materials: albedo with roughness 0.1 and metallic 1.0.
 
 use glam::Vec3;
 
@@ -31,15 +31,25 @@ pub const SEED_METALLIC: f32 = 1.0;
 impl Material {
     /// A built-in material by (lower-case) name.
     pub fn named(name: &str) -> Result<Material, crate::SceneError> {
-        NAMED_ALBEDOS
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, a)| Material { albedo: Vec3::from(*a), roughness: SEED_ROUGHNESS, metallic: SEED_METALLIC })
-            .ok_or_else(|| crate::SceneError::UnknownName {
-                kind: "material",
-                name: name.to_owned(),
-                expected: NAMED_ALBEDOS.map(|(n, _)| n).join(", "),
-            })
+        NAMED_ALBEDOS.iter().find(|(n, _)| *n == name).map(|(_, a)| Material::seed(*a)).ok_or_else(|| crate::SceneError::UnknownName {
+            kind: "material",
+            name: name.to_owned(),
+            expected: NAMED_ALBEDOS.map(|(n, _)| n).join(", "),
+        })
+    }
+
+    /// Every built-in material, in the seed's order.
+    pub fn built_in() -> [Material; NAMED_ALBEDOS.len()] {
+        NAMED_ALBEDOS.map(|(_, a)| Material::seed(a))
+    }
+
+    /// The name of the built-in material this is, if it is one.
+    pub fn name(&self) -> Option<&'static str> {
+        NAMED_ALBEDOS.iter().find(|(_, a)| Material::seed(*a) == *self).map(|(n, _)| *n)
+    }
+
+    fn seed(albedo: [f32; 3]) -> Material {
+        Material { albedo: Vec3::from(albedo), roughness: SEED_ROUGHNESS, metallic: SEED_METALLIC }
     }
 }
 
@@ -54,6 +64,10 @@ mod tests {
             assert_eq!(m.albedo, Vec3::from(albedo));
             assert_eq!((m.roughness, m.metallic), (0.1, 1.0));
         }
+        for m in Material::built_in() {
+            assert_eq!(Material::named(m.name().unwrap()), Ok(m));
+        }
+        assert_eq!(Material { roughness: 0.5, ..Material::built_in()[0] }.name(), None);
         let err = Material::named("unobtainium").unwrap_err().to_string();
         assert!(err.contains("unobtainium") && err.contains("gold") && err.contains("black"), "{err}");
     }

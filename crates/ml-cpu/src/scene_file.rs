@@ -1,56 +1,129 @@
-//! Scene files (`--scene FILE.toml`, issue 7): camera, shading, point lights and objects made
+//! Scene files (`--scene FILE.toml`): camera, shading, point lights and objects made
 //! of the built-in meshes. Every field is optional but `objects`; unknown fields are errors
 //! (a typo must not be silently ignored). Everything read is checked — finite numbers, sane
 //! ranges, counts and file size limited before anything is allocated — and every problem is
 //! one error naming the file and, where the parser knows it, the line.
 
 use crate::camera::Camera;
+use crate::gltf_scene::GltfError;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::{DirectionalLight, Object, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
+use crate::scene_load::{read_capped, ReadError};
+pub use crate::scene_load::{SceneFile, MAX_OBJECTS};
+use crate::SceneError;
 use glam::Vec3;
 use serde::Deserialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// Largest scene file we read (a million objects fit in well under this).
 pub const MAX_FILE_BYTES: u64 = 64 << 20;
-/// Most objects a scene file may hold.
-pub const MAX_OBJECTS: usize = 1 << 20;
 
-/// A file that could not be loaded: which kind, where, and what is wrong (one line).
-#[derive(Debug, Error, PartialEq)]
-#[error("{kind} '{path}': {problem}")]
+/// A scene file that could not be loaded: where, and what is wrong (one line).
+#[derive(Debug, Error)]
+#[error("scene file '{}': {problem}", path.display())]
 pub struct SceneFileError {
-    /// "scene file" or "glTF file".
-    pub kind: &'static str,
-    pub path: String,
-    pub problem: String,
+    pub path: PathBuf,
+    pub problem: SceneFileProblem,
 }
 
-/// Read a whole file of at most `max` bytes, refusing directories and missing files in one
-/// line each (the problem, without the path).
-pub fn read_capped(path: &Path, max: u64) -> Result<Vec<u8>, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read it: {e}"))?;
-    if meta.is_dir() {
-        return Err("it is a directory, not a file".into());
-    }
-    if meta.len() > max {
-        return Err(format!("{} bytes is more than the {max} we read", meta.len()));
-    }
-    std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))
+/// An entry of a scene file's `[[objects]]` or `[[lights]]`, by its index.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Entry {
+    Object(usize),
+    Light(usize),
 }
 
-/// A loaded scene file: the scene, the shading model it names (checked by the renderer,
-/// which knows the models), and what it holds that is left out (printed once it loaded).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SceneFile {
-    pub scene: Scene,
-    pub shading: Option<String>,
-    pub warnings: Vec<String>,
+impl std::fmt::Display for Entry {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            Entry::Object(i) => write!(f, "objects[{i}]"),
+            Entry::Light(i) => write!(f, "lights[{i}]"),
+        }
+    }
 }
+
+/// What is wrong with a scene file. Fields are named as the file spells them (`what`).
+#[derive(Debug, Error)]
+pub enum SceneFileProblem {
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    #[error("not UTF-8 text (byte {0})")]
+    NotUtf8(usize),
+    #[error("{0} bytes is more than the {max} a scene file may have", max = MAX_FILE_BYTES)]
+    TooLong(usize),
+    /// The TOML does not parse, or does not fit the format (unknown fields, wrong types).
+    #[error("{}{message}", line.map_or(String::new(), |l| format!("line {l}: ")))]
+    Syntax { line: Option<usize>, message: String },
+    #[error("no objects: a scene needs at least one [[objects]] entry")]
+    NoObjects,
+    #[error("{0} objects is more than the {max} a scene file may hold", max = MAX_OBJECTS)]
+    TooManyObjects(usize),
+    /// More objects than a scene holds once its glTF objects are read.
+    #[error("more than the {max} objects a scene may hold", max = MAX_OBJECTS)]
+    TooManyDrawn,
+    #[error("{0} lights is more than the {max} a scene may hold", max = MAX_LIGHTS)]
+    TooManyLights(usize),
+    #[error("{entry}: {problem}")]
+    In { entry: Entry, problem: Box<SceneFileProblem> },
+    #[error("{what} {value} is not a finite number")]
+    NotFinite { what: &'static str, value: f32 },
+    #[error("{what} {value} must be greater than 0")]
+    NotPositive { what: &'static str, value: f32 },
+    #[error("{what} {value} must not be negative")]
+    Negative { what: &'static str, value: f32 },
+    #[error("{what} {value} must lie in [0, 1]")]
+    NotUnit { what: &'static str, value: f32 },
+    /// An unknown mesh or material name.
+    #[error(transparent)]
+    Name(#[from] SceneError),
+    #[error("needs a mesh (a built-in name) or a gltf file")]
+    NoMesh,
+    #[error("give either mesh or gltf, not both")]
+    MeshAndGltf,
+    #[error("material applies to built-in meshes; a glTF object has its own")]
+    GltfMaterial,
+    #[error("gltf objects need the scene file's folder (load it from a file)")]
+    NoFolder,
+    /// A `gltf = "file"` object whose file does not load.
+    #[error("'{file}': {problem}")]
+    Gltf { file: String, problem: GltfError },
+    #[error("a point light has no direction or cone (kind = \"spot\" or \"directional\"?)")]
+    PointWithDirection,
+    /// A light without a field its kind needs ("a spot light needs a direction").
+    #[error("a {light} light needs a {field}")]
+    Missing { light: &'static str, field: &'static str },
+    #[error("direction must not be zero")]
+    ZeroDirection,
+    #[error("inner_deg {inner} and outer_deg {outer}: need 0 ≤ inner < outer ≤ 90")]
+    Cone { inner: f32, outer: f32 },
+    #[error("a directional light has no position or radius, only a direction")]
+    DirectionalWithPosition,
+    #[error("more than {max} directional lights", max = MAX_DIRECTIONAL_LIGHTS)]
+    TooManyDirectional,
+    #[error("unknown kind '{0}': expected point, spot or directional")]
+    UnknownLightKind(String),
+    #[error("[camera] fov_y_deg {0} must lie strictly between 0 and 180")]
+    FieldOfView(f32),
+    #[error("[camera] position and target are the same point: the camera looks nowhere")]
+    CameraNowhere,
+    #[error("[camera] near {near} must be less than far {far}")]
+    NearFar { near: f32, far: f32 },
+    #[error("[camera] looks straight up or down, where its yaw is undefined: move target or position sideways")]
+    CameraVertical,
+}
+
+impl SceneFileProblem {
+    /// This problem, said to be in `entry`.
+    fn at(self, entry: Entry) -> SceneFileProblem {
+        SceneFileProblem::In { entry, problem: Box::new(self) }
+    }
+}
+
+type Problem = SceneFileProblem;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -126,67 +199,63 @@ struct FileMaterial {
 
 /// Read and check the scene file at `path`.
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
-    let fail = |problem: String| SceneFileError { kind: "scene file", path: path.display().to_string(), problem };
-    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(fail)?;
-    let text = String::from_utf8(bytes).map_err(|e| fail(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
+    let fail = |problem: Problem| SceneFileError { path: path.to_path_buf(), problem };
+    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
+    let text = String::from_utf8(bytes).map_err(|e| fail(Problem::NotUtf8(e.utf8_error().valid_up_to())))?;
     parse_in(&text, path.parent()).map_err(fail)
 }
 
 /// Parse scene-file text (glTF objects are refused: they need the file's folder); the error
 /// is the problem, without the file's name.
-pub fn parse(text: &str) -> Result<SceneFile, String> {
+pub fn parse(text: &str) -> Result<SceneFile, SceneFileProblem> {
     parse_in(text, None)
 }
 
 /// Parse scene-file text whose `gltf` paths are relative to `base`.
-fn parse_in(text: &str, base: Option<&Path>) -> Result<SceneFile, String> {
+fn parse_in(text: &str, base: Option<&Path>) -> Result<SceneFile, Problem> {
     if text.len() as u64 > MAX_FILE_BYTES {
-        return Err(format!("{} bytes is more than the {MAX_FILE_BYTES} a scene file may have", text.len()));
+        return Err(Problem::TooLong(text.len()));
     }
-    let file: FileScene = toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-        let message = e.message().replace('\n', " ");
-        match line {
-            Some(l) => format!("line {l}: {message}"),
-            None => message,
-        }
+    let file: FileScene = toml::from_str(text).map_err(|e| Problem::Syntax {
+        line: e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1),
+        message: e.message().replace('\n', " "),
     })?;
     build(file, base)
 }
 
-fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
+fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
     if file.objects.is_empty() {
-        return Err("no objects: a scene needs at least one [[objects]] entry".into());
+        return Err(Problem::NoObjects);
     }
     if file.objects.len() > MAX_OBJECTS {
-        return Err(format!("{} objects is more than the {MAX_OBJECTS} a scene file may hold", file.objects.len()));
+        return Err(Problem::TooManyObjects(file.objects.len()));
     }
     if file.lights.len() as u64 > MAX_LIGHTS {
-        return Err(format!("{} lights is more than the {MAX_LIGHTS} a scene may hold", file.lights.len()));
+        return Err(Problem::TooManyLights(file.lights.len()));
     }
     let (mut objects, mut meshes, mut textures, mut warnings) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (i, o) in file.objects.iter().enumerate() {
         match &o.gltf {
             Some(gltf) => {
-                let loaded = gltf_object(o, gltf, base, (&mut meshes, &mut textures)).map_err(|e| format!("objects[{i}]: {e}"))?;
+                let loaded = gltf_object(o, gltf, base, (&mut meshes, &mut textures)).map_err(|e| e.at(Entry::Object(i)))?;
                 objects.extend(loaded.0);
                 warnings.extend(loaded.1.into_iter().map(|w| format!("objects[{i}] ({gltf}): {w}")));
             }
-            None => objects.push(object(o).map_err(|e| format!("objects[{i}]: {e}"))?),
+            None => objects.push(object(o).map_err(|e| e.at(Entry::Object(i)))?),
         }
         if objects.len() > MAX_OBJECTS {
-            return Err(format!("more than the {MAX_OBJECTS} objects a scene may hold"));
+            return Err(Problem::TooManyDrawn);
         }
     }
     let (mut lights, mut cones, mut directional) = (Vec::new(), Vec::new(), Vec::new());
     for (i, l) in file.lights.iter().enumerate() {
-        match light(l).map_err(|e| format!("lights[{i}]: {e}"))? {
+        match light(l).map_err(|e| e.at(Entry::Light(i)))? {
             Light::Point(p, cone) => {
                 lights.push(p);
                 cones.push(cone);
             }
             Light::Directional(d) if directional.len() < MAX_DIRECTIONAL_LIGHTS => directional.push(d),
-            Light::Directional(_) => return Err(format!("lights[{i}]: more than {MAX_DIRECTIONAL_LIGHTS} directional lights")),
+            Light::Directional(_) => return Err(Problem::TooManyDirectional.at(Entry::Light(i))),
         }
     }
     let (shading, ambient) = match &file.shading {
@@ -206,52 +275,52 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, String> {
     Ok(SceneFile { scene, shading, warnings })
 }
 
-fn finite(what: &str, v: f32) -> Result<f32, String> {
-    if v.is_finite() {
-        Ok(v)
+fn finite(what: &'static str, value: f32) -> Result<f32, Problem> {
+    if value.is_finite() {
+        Ok(value)
     } else {
-        Err(format!("{what} {v} is not a finite number"))
+        Err(Problem::NotFinite { what, value })
     }
 }
 
-fn vec3(what: &str, v: [f32; 3]) -> Result<Vec3, String> {
+fn vec3(what: &'static str, v: [f32; 3]) -> Result<Vec3, Problem> {
     for x in v {
         finite(what, x)?;
     }
     Ok(Vec3::from(v))
 }
 
-fn positive(what: &str, v: f32) -> Result<f32, String> {
-    if finite(what, v)? > 0.0 {
-        Ok(v)
+fn positive(what: &'static str, value: f32) -> Result<f32, Problem> {
+    if finite(what, value)? > 0.0 {
+        Ok(value)
     } else {
-        Err(format!("{what} {v} must be greater than 0"))
+        Err(Problem::NotPositive { what, value })
     }
 }
 
-fn non_negative(what: &str, v: f32) -> Result<f32, String> {
-    if finite(what, v)? >= 0.0 {
-        Ok(v)
+fn non_negative(what: &'static str, value: f32) -> Result<f32, Problem> {
+    if finite(what, value)? >= 0.0 {
+        Ok(value)
     } else {
-        Err(format!("{what} {v} must not be negative"))
+        Err(Problem::Negative { what, value })
     }
 }
 
-fn unit(what: &str, v: f32) -> Result<f32, String> {
-    if (0.0..=1.0).contains(&finite(what, v)?) {
-        Ok(v)
+fn unit(what: &'static str, value: f32) -> Result<f32, Problem> {
+    if (0.0..=1.0).contains(&finite(what, value)?) {
+        Ok(value)
     } else {
-        Err(format!("{what} {v} must lie in [0, 1]"))
+        Err(Problem::NotUnit { what, value })
     }
 }
 
-fn object(o: &FileObject) -> Result<Object, String> {
-    let name = o.mesh.as_ref().ok_or("needs a mesh (a built-in name) or a gltf file")?;
-    let mesh = MeshKind::from_name(name).map_err(|e| e.to_string())?;
+fn object(o: &FileObject) -> Result<Object, Problem> {
+    let name = o.mesh.as_ref().ok_or(Problem::NoMesh)?;
+    let mesh = MeshKind::from_name(name)?;
     let mut material = Material::named("white").expect("built in");
     if let Some(m) = &o.material {
         if let Some(name) = &m.name {
-            material = Material::named(name).map_err(|e| e.to_string())?;
+            material = Material::named(name)?;
         }
         if let Some(a) = m.albedo {
             material.albedo = vec3("material albedo", a)?;
@@ -279,20 +348,19 @@ fn gltf_object(
     gltf: &str,
     base: Option<&Path>,
     (meshes, textures): (&mut Vec<crate::mesh::Mesh>, &mut Vec<crate::textures::TextureImage>),
-) -> Result<(Vec<Object>, Vec<String>), String> {
+) -> Result<(Vec<Object>, Vec<String>), Problem> {
     if o.mesh.is_some() {
-        return Err("give either mesh or gltf, not both".into());
+        return Err(Problem::MeshAndGltf);
     }
     if o.material.is_some() {
-        return Err("material applies to built-in meshes; a glTF object has its own".into());
+        return Err(Problem::GltfMaterial);
     }
-    let base = base.ok_or("gltf objects need the scene file's folder (load it from a file)")?;
+    let base = base.ok_or(Problem::NoFolder)?;
     let path = base.join(gltf);
-    let (scene, warnings) = crate::gltf_scene::from_bytes(
-        &read_capped(&path, crate::gltf_scene::MAX_FILE_BYTES).map_err(|e| format!("'{gltf}': {e}"))?,
-        path.parent(),
-    )
-    .map_err(|e| format!("'{gltf}': {e}"))?;
+    let (scene, warnings) = read_capped(&path, crate::gltf_scene::MAX_FILE_BYTES)
+        .map_err(GltfError::Read)
+        .and_then(|bytes| crate::gltf_scene::from_bytes(&bytes, path.parent()))
+        .map_err(|problem| Problem::Gltf { file: gltf.to_owned(), problem })?;
     let position = o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
     let scale = o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0);
     let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);
@@ -315,7 +383,7 @@ fn gltf_object(
     Ok((objects, warnings))
 }
 
-fn light(l: &FileLight) -> Result<Light, String> {
+fn light(l: &FileLight) -> Result<Light, Problem> {
     let color = l.color.map(|c| vec3("color", c)).transpose()?.unwrap_or(Vec3::ONE);
     for x in color.to_array() {
         non_negative("color", x)?;
@@ -324,48 +392,48 @@ fn light(l: &FileLight) -> Result<Light, String> {
         kind @ (None | Some("point") | Some("spot")) => {
             let spot = kind == Some("spot");
             if !spot && (l.direction.is_some() || l.inner_deg.is_some() || l.outer_deg.is_some()) {
-                return Err("a point light has no direction or cone (kind = \"spot\" or \"directional\"?)".into());
+                return Err(Problem::PointWithDirection);
             }
-            let p = vec3("position", l.position.ok_or("a point or spot light needs a position")?)?;
+            let p = vec3("position", l.position.ok_or(Problem::Missing { light: "point or spot", field: "position" })?)?;
             let radius = l.radius.map(|r| positive("radius", r)).transpose()?.unwrap_or(SEED_RADIUS);
             let point = PointLight { position_radius: p.extend(radius).to_array(), color: color.extend(0.0).to_array() };
             if !spot {
                 return Ok(Light::Point(point, LightCone::NONE));
             }
-            let axis = vec3("direction", l.direction.ok_or("a spot light needs a direction")?)?;
+            let axis = vec3("direction", l.direction.ok_or(Problem::Missing { light: "spot", field: "direction" })?)?;
             if axis.length() < 1e-6 {
-                return Err("direction must not be zero".into());
+                return Err(Problem::ZeroDirection);
             }
             let inner = finite("inner_deg", l.inner_deg.unwrap_or(0.0))?;
             let outer = finite("outer_deg", l.outer_deg.unwrap_or(45.0))?;
             if !(inner >= 0.0 && inner < outer && outer <= 90.0) {
-                return Err(format!("inner_deg {inner} and outer_deg {outer}: need 0 ≤ inner < outer ≤ 90"));
+                return Err(Problem::Cone { inner, outer });
             }
             Ok(Light::Point(point, LightCone::spot(axis, inner.to_radians(), outer.to_radians())))
         }
         Some("directional") => {
             if l.position.is_some() || l.radius.is_some() {
-                return Err("a directional light has no position or radius, only a direction".into());
+                return Err(Problem::DirectionalWithPosition);
             }
-            let d = vec3("direction", l.direction.ok_or("a directional light needs a direction")?)?;
+            let d = vec3("direction", l.direction.ok_or(Problem::Missing { light: "directional", field: "direction" })?)?;
             if d.length() < 1e-6 {
-                return Err("direction must not be zero".into());
+                return Err(Problem::ZeroDirection);
             }
             Ok(Light::Directional(DirectionalLight { direction: d.normalize(), color }))
         }
-        Some(kind) => Err(format!("unknown kind '{kind}': expected point, spot or directional")),
+        Some(kind) => Err(Problem::UnknownLightKind(kind.to_owned())),
     }
 }
 
 /// The file's camera; fields it leaves out come from a camera framing every object (looking
 /// at the centre of their bounds from above and in front, the whole box in view).
-fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, String> {
+fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
     let (lo, hi) = scene.bounds();
     let centre = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
     let fov = match c.and_then(|c| c.fov_y_deg) {
         Some(f) if finite("[camera] fov_y_deg", f)? > 0.0 && f < 180.0 => f,
-        Some(f) => return Err(format!("[camera] fov_y_deg {f} must lie strictly between 0 and 180")),
+        Some(f) => return Err(Problem::FieldOfView(f)),
         None => 60.0,
     };
     let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
@@ -378,17 +446,17 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, String> {
         None => centre,
     };
     if position.distance(target) < 1e-6 {
-        return Err("[camera] position and target are the same point: the camera looks nowhere".into());
+        return Err(Problem::CameraNowhere);
     }
     let near =
         c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or((distance - radius).max(distance * 1e-3) * 0.5);
     let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(position.distance(centre) + radius * 2.0);
     if near >= far {
-        return Err(format!("[camera] near {near} must be less than far {far}"));
+        return Err(Problem::NearFar { near, far });
     }
     let dir = (target - position).normalize();
     if dir.y.abs() > 0.9999 {
-        return Err("[camera] looks straight up or down, where its yaw is undefined: move target or position sideways".into());
+        return Err(Problem::CameraVertical);
     }
     let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| positive("[camera] ortho_half_height", h)).transpose()?;
     Ok(Camera { orthographic, ..Camera::looking_at(position, target, fov, near, far) })

@@ -2,7 +2,7 @@
 //! 10-patch form with mirror symmetry that GLUT popularised: 127 control points, z up.
 //! Tessellated here into 32 bicubic patches and turned to +Y up.
 
-use crate::mesh::{grid_indices, orient_triangles_to_normals, vertex_uv, Mesh};
+use crate::geometry::{grid_indices, orient_triangles_to_normals, vertex_uv, Mesh};
 use glam::{Mat3, Vec3};
 
 /// Control-point indices of the 10 source patches (rim, body ×2, lid ×2, bottom, handle ×2,

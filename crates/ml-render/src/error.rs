@@ -1,3 +1,4 @@
+use crate::settings::{OmniShadowMode, Technique};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -6,6 +7,86 @@ pub enum RenderError {
     Vulkan(#[from] ml_vk::VkError),
     #[error(transparent)]
     Scene(#[from] ml_cpu::SceneError),
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// A name that is none of `kind`'s; `expected` lists them.
+    #[error("unknown {kind} '{name}': expected one of {expected}")]
+    UnknownName { kind: Named, name: String, expected: String },
     #[error("{0}")]
     Invalid(String),
+}
+
+/// What a name given to `from_name` was meant to be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Named {
+    Technique,
+    DebugView,
+    OmniShadowMode,
+}
+
+impl std::fmt::Display for Named {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(match self {
+            Named::Technique => "technique",
+            Named::DebugView => "debug view",
+            Named::OmniShadowMode => "point-light shadow mode",
+        })
+    }
+}
+
+/// A number of the settings an error is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Setting {
+    Width,
+    Height,
+    /// Texels per side of a shadow-cube face.
+    CubeSize,
+}
+
+impl std::fmt::Display for Setting {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(match self {
+            Setting::Width => "width",
+            Setting::Height => "height",
+            Setting::CubeSize => "cube size",
+        })
+    }
+}
+
+/// Settings the device, the scene or each other refuse (`RenderSettings::check`), found
+/// before anything is allocated.
+#[derive(Debug, Error, PartialEq)]
+pub enum SettingsError {
+    #[error("'{device}' lacks the imageCubeArray feature, which every shading pipeline needs (point-light shadow cubes)")]
+    NoCubeArrays { device: String },
+    #[error("{what} {value} is out of range: use 1 to {max}")]
+    OutOfRange { what: Setting, value: u32, max: u32 },
+    /// The cluster-heat debug view is drawn by the clustered forward techniques only.
+    #[error("the cluster-heat debug view needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}", technique.name())]
+    HeatNeedsClusteredForward { technique: Technique },
+    #[error("the shadow-map debug view needs the blinn-phong shading model (the seed model casts no shadows)")]
+    ShadowMapNeedsBlinnPhong,
+    #[error("the shadow-cube debug view needs point-light shadows")]
+    ShadowCubeNeedsShadows,
+    #[error("frames must be at least 1")]
+    NoFrames,
+    #[error("time {0} is not a finite number")]
+    Time(f32),
+    #[error("{lights} lights need {bytes} bytes of light buffer but '{device}' allows {max} bytes per storage buffer")]
+    LightBuffer { lights: usize, bytes: u64, device: String, max: u32 },
+    #[error("point-light shadows need point lights, and the scene has none")]
+    ShadowsWithoutLights,
+    #[error("{value} shadowed lights is out of range: the scene has {lights} lights (use 1 to {lights})")]
+    ShadowedLights { value: u32, lights: usize },
+    #[error("{value} shadowed lights is more than the {max} shadow cubes '{device}' holds in one array")]
+    TooManyCubes { value: u32, max: u32, device: String },
+    #[error("{lights} shadow cubes of {size}² take {mib} MiB, more than the {max_mib} MiB we allow")]
+    ShadowMemory { lights: u32, size: u32, mib: u64, max_mib: u64 },
+    /// A way of rendering the cubes that needs a feature the device lacks; `instead`: the
+    /// modes to use.
+    #[error("{} point-light shadows need the {feature} feature, which '{device}' lacks: use {instead}", mode.name())]
+    MissingFeature { mode: OmniShadowMode, feature: &'static str, device: String, instead: &'static str },
+    /// A depth-only multiview pass that the driver renders wrong (multiview_depth_is_broken).
+    #[error("multiview point-light shadows: '{device}' ({driver}) renders every view of a depth-only multiview pass into the first layer (measured on Mesa 22.3 lavapipe): use layered, direct or copy")]
+    BrokenMultiview { device: String, driver: String },
 }

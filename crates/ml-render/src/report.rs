@@ -1,4 +1,9 @@
-//! Frame measurements and the table `render` prints.
+//! Frame measurements and the tables `render` and `info` print.
+
+use crate::settings::{DebugView, RenderSettings};
+use crate::targets::{gbuffer_bytes_per_pixel, gbuffer_images};
+use ml_vk::DeviceInfo;
+use std::path::Path;
 
 /// Per-pass GPU times (timestamp queries) and CPU times of every frame.
 #[derive(Clone, Debug)]
@@ -132,10 +137,119 @@ impl Spread {
     }
 }
 
-/// The table `manylights render` prints.
+/// Rows as a table: keys in a column as wide as the widest, then the values.
 pub fn table(rows: &[(&str, String)]) -> String {
     let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
     rows.iter().map(|(k, v)| format!("{k:<width$}  {v}\n")).collect()
+}
+
+/// A device and its driver in one line.
+pub fn device_line(info: &DeviceInfo) -> String {
+    format!("{} ({}, {} {})", info.name, info.type_name(), info.driver_name, info.driver_info)
+}
+
+/// What a finished render is reported with besides its frame measurements.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderFacts<'a> {
+    /// `device_line` of the device it ran on.
+    pub device: &'a str,
+    /// The settings it ran with (the technique `auto` picked, where it picked).
+    pub settings: &'a RenderSettings,
+    /// Point lights of the scene.
+    pub lights: usize,
+    /// Whether the scene's objects have textures of their own (they widen the G-buffer).
+    pub object_textures: bool,
+    /// Why `auto` picked the technique; None where it was asked for by name.
+    pub auto: Option<&'a str>,
+    /// Where the image was written.
+    pub output: &'a Path,
+}
+
+/// The rows of the table `render` prints (`table`).
+pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str, String)> {
+    let settings = facts.settings;
+    let technique = settings.technique;
+    let mut rows = vec![
+        ("device", facts.device.to_owned()),
+        ("resolution", format!("{}x{}", settings.width, settings.height)),
+        ("technique", technique.name().to_owned() + if facts.auto.is_some() { " (auto)" } else { "" }),
+        ("shading", settings.shading.name().to_owned()),
+        ("lights", facts.lights.to_string()),
+        ("frames", stats.frames.to_string()),
+    ];
+    if let Some(why) = facts.auto {
+        rows.push(("auto", why.to_owned()));
+    }
+    match stats.gpu_ms() {
+        Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
+        None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
+    }
+    if technique.lights_in_subpass() || technique.lights_in_compute() {
+        rows.push(("g-buffer", gbuffer_line(facts.object_textures, stats.gbuffer_lazily_allocated)));
+    }
+    if let Some(ms) = stats.assign_ms() {
+        rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
+    }
+    if let Some(c) = stats.clusters {
+        let d = settings.clusters;
+        rows.push(("clusters", format!("{}x{}x{} = {}", d.x, d.y, d.z, d.count())));
+        rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
+        rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
+    }
+    if stats.overflowed_frames > 0 {
+        rows.push((
+            "overflows",
+            format!(
+                "{} frame(s) outgrew their light lists; {} re-rendered at the grown size",
+                stats.overflowed_frames, stats.rerendered_frames
+            ),
+        ));
+    }
+    if settings.debug_view == DebugView::ClusterHeat {
+        let top = stats.clusters.map_or(1, |c| c.max_lights.max(1));
+        rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights per cluster")));
+    }
+    if let Some(o) = settings.omni {
+        rows.push(("omni shadows", format!("{}: {} light(s), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size)));
+    }
+    rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
+    rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
+    rows.push(("output", facts.output.display().to_string()));
+    rows
+}
+
+/// The G-buffer of a scene (with object textures or not): its size, its images, and whether
+/// it got lazily allocated memory (None: it lives outside a render pass).
+fn gbuffer_line(object_textures: bool, lazily_allocated: Option<bool>) -> String {
+    let memory = match lazily_allocated {
+        Some(true) => "; transient, lazily allocated",
+        Some(false) => "; transient (this device has no lazily allocated memory)",
+        None => "",
+    };
+    let layout: Vec<&str> = gbuffer_images(object_textures).iter().map(|g| g.layout).collect();
+    format!("{} bytes/pixel + depth ({}){memory}", gbuffer_bytes_per_pixel(object_textures), layout.join(", "))
+}
+
+/// The rows `info` prints for a device: what it is and the limits manylights depends on.
+pub fn device_rows(d: &DeviceInfo) -> Vec<(&'static str, String)> {
+    let l = &d.limits;
+    vec![
+        ("device", format!("{}: {} ({})", d.index, d.name, d.type_name())),
+        ("vulkan", d.api_version_string()),
+        ("driver", format!("{} {}", d.driver_name, d.driver_info)),
+        ("usable", if d.suitable { "yes".into() } else { "no (needs Vulkan 1.2 and a graphics queue)".to_string() }),
+        ("maxImageDimension2D", l.max_image_dimension2_d.to_string()),
+        ("maxStorageBufferRange", l.max_storage_buffer_range.to_string()),
+        ("maxUniformBufferRange", l.max_uniform_buffer_range.to_string()),
+        ("maxPushConstantsSize", l.max_push_constants_size.to_string()),
+        ("maxComputeWorkGroupInvocations", l.max_compute_work_group_invocations.to_string()),
+        ("maxComputeSharedMemorySize", l.max_compute_shared_memory_size.to_string()),
+        ("timestampPeriod (ns)", l.timestamp_period.to_string()),
+        ("timestampComputeAndGraphics", (l.timestamp_compute_and_graphics != 0).to_string()),
+        ("maxImageArrayLayers", l.max_image_array_layers.to_string()),
+        ("imageCubeArray", d.features.image_cube_array.to_string()),
+        ("multiview", d.features.multiview.to_string()),
+    ]
 }
 
 #[cfg(test)]
@@ -159,5 +273,49 @@ mod tests {
         assert_eq!((total.p95, total.median), (12.75, 6.75));
         assert_eq!(phases.map(|(n, s)| (n, s.median)), [("assign", 2.0), ("upload", 4.0), ("record", 0.5), ("submit", 0.25)]);
         assert!(stats.gpu_spread(5).is_none());
+    }
+
+    #[test]
+    fn render_rows_follow_the_technique_and_describe_the_gbuffer_from_its_images() {
+        use crate::settings::{RenderSettings, Technique};
+        let settings = RenderSettings::new(Technique::DeferredClustered, 64, 36);
+        let mut facts =
+            RenderFacts { device: "gpu", settings: &settings, lights: 5, object_textures: false, auto: None, output: Path::new("a.png") };
+        let mut stats = FrameStats::new(&["g-buffer + lighting"]);
+        stats.frames = 1;
+        stats.gbuffer_lazily_allocated = Some(true);
+        let rows = render_rows(&facts, &stats);
+        let keys: Vec<&str> = rows.iter().map(|(k, _)| *k).collect();
+        assert_eq!(
+            keys,
+            [
+                "device",
+                "resolution",
+                "technique",
+                "shading",
+                "lights",
+                "frames",
+                "gpu ms",
+                "g-buffer",
+                "cpu ms/frame",
+                "wall ms/frame",
+                "output"
+            ]
+        );
+        let value = |rows: &[(&str, String)], key: &str| rows.iter().find(|(k, _)| *k == key).map(|(_, v)| v.clone()).unwrap();
+        assert_eq!(value(&rows, "resolution"), "64x36");
+        assert_eq!(value(&rows, "gpu ms"), "n/a (device has no timestamp queries)");
+        assert_eq!(
+            value(&rows, "g-buffer"),
+            "16 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8); transient, lazily allocated"
+        );
+        facts.object_textures = true;
+        facts.auto = Some("it was faster");
+        let rows = render_rows(&facts, &stats);
+        assert!(value(&rows, "g-buffer").starts_with("22 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8, roughness-metallic RG8, emissive RGBA8)"));
+        assert_eq!((value(&rows, "technique").as_str(), value(&rows, "auto").as_str()), ("deferred-clustered (auto)", "it was faster"));
+        let forward = RenderSettings::new(Technique::Forward, 64, 36);
+        let rows = render_rows(&RenderFacts { settings: &forward, ..facts }, &stats);
+        assert!(rows.iter().all(|(k, _)| *k != "g-buffer"));
     }
 }

@@ -1,7 +1,8 @@
 //! What a render is asked to do, checked against the device before anything is allocated.
 
-use crate::error::RenderError;
+use crate::error::{Named, RenderError, Setting, SettingsError};
 use ml_cpu::cluster::ClusterDims;
+pub use ml_cpu::shading_model::ShadingModel;
 use ml_vk::Context;
 
 /// Lighting techniques (docs/DESIGN.md#techniques-are-two-choices). Each must give the same image as `Forward`.
@@ -88,7 +89,7 @@ impl Technique {
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {
         Technique::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| {
             let expected = Technique::ALL.map(|t| t.name()).join(", ");
-            RenderError::Invalid(format!("unknown technique '{name}': expected one of {expected}"))
+            RenderError::UnknownName { kind: Named::Technique, name: name.to_owned(), expected }
         })
     }
 }
@@ -119,41 +120,10 @@ pub enum LightingStage {
 pub const SPEC_BLINN_PHONG: u32 = 10;
 pub const SPEC_PBR: u32 = 11;
 
-/// Shading models (docs/DESIGN.md#shading-models).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ShadingModel {
-    /// The seed scene's model: specular-only Cook–Torrance, ambient factor, gamma.
-    Seed,
-    /// Blinn-Phong with a shadowed sun, a spot light, textures and reflections.
-    BlinnPhong,
-    /// The seed's specular term plus Lambert diffuse weighted by (1 − F)(1 − metallic), HDR
-    /// tone-mapped (ACES) before gamma.
-    Pbr,
-}
-
-impl ShadingModel {
-    pub const ALL: [ShadingModel; 3] = [ShadingModel::Seed, ShadingModel::BlinnPhong, ShadingModel::Pbr];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ShadingModel::Seed => "seed",
-            ShadingModel::BlinnPhong => "blinn-phong",
-            ShadingModel::Pbr => "pbr",
-        }
-    }
-
-    /// Specialization constants (id, value) that compile a pipeline for this model
-    /// (shading_model.glsl).
-    pub fn spec_constants(self) -> [(u32, u32); 2] {
-        [(SPEC_BLINN_PHONG, u32::from(self == ShadingModel::BlinnPhong)), (SPEC_PBR, u32::from(self == ShadingModel::Pbr))]
-    }
-
-    pub fn from_name(name: &str) -> Result<ShadingModel, RenderError> {
-        ShadingModel::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
-            let expected = ShadingModel::ALL.map(|m| m.name()).join(", ");
-            RenderError::Invalid(format!("unknown shading model '{name}': expected one of {expected}"))
-        })
-    }
+/// Specialization constants (id, value) that compile a pipeline for `model`
+/// (shading_model.glsl).
+fn model_spec_constants(model: ShadingModel) -> [(u32, u32); 2] {
+    [(SPEC_BLINN_PHONG, u32::from(model == ShadingModel::BlinnPhong)), (SPEC_PBR, u32::from(model == ShadingModel::Pbr))]
 }
 
 /// constant_id of `OMNI_SHADOWS` (omni_shadow.glsl), `OBJECT_TEXTURES` (surface.glsl) and
@@ -175,7 +145,7 @@ pub struct Shading {
 
 impl Shading {
     pub fn spec_constants(self) -> [(u32, u32); 5] {
-        let [a, b] = self.model.spec_constants();
+        let [a, b] = model_spec_constants(self.model);
         [
             a,
             b,
@@ -215,7 +185,7 @@ impl OmniShadowMode {
     pub fn from_name(name: &str) -> Result<OmniShadowMode, RenderError> {
         OmniShadowMode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
             let expected = OmniShadowMode::ALL.map(|m| m.name()).join(", ");
-            RenderError::Invalid(format!("unknown --omni-shadow mode '{name}': expected one of {expected}"))
+            RenderError::UnknownName { kind: Named::OmniShadowMode, name: name.to_owned(), expected }
         })
     }
 }
@@ -289,7 +259,7 @@ impl DebugView {
     pub fn from_name(name: &str) -> Result<DebugView, RenderError> {
         DebugView::ALL.into_iter().find(|v| v.name() == name).ok_or_else(|| {
             let expected = DebugView::ALL.map(|v| v.name()).join(", ");
-            RenderError::Invalid(format!("unknown debug view '{name}': expected one of {expected}"))
+            RenderError::UnknownName { kind: Named::DebugView, name: name.to_owned(), expected }
         })
     }
 
@@ -369,101 +339,79 @@ impl RenderSettings {
     /// Reject sizes and counts the device (or common sense) cannot take, before allocating.
     pub fn check(&self, ctx: &Context, lights: usize) -> Result<(), RenderError> {
         let limits = &ctx.info.limits;
+        let device = || ctx.info.name.clone();
         // Every lighting shader declares the point-light shadow cubes (textures.glsl).
         if !ctx.info.features.image_cube_array {
-            return Err(RenderError::Invalid(format!(
-                "'{}' lacks the imageCubeArray feature, which every shading pipeline needs (point-light shadow cubes)",
-                ctx.info.name
-            )));
+            return Err(SettingsError::NoCubeArrays { device: device() }.into());
         }
-        let max_dim = limits.max_image_dimension2_d.min(MAX_DIMENSION);
-        for (what, v) in [("--width", self.width), ("--height", self.height)] {
-            if v == 0 || v > max_dim {
-                return Err(RenderError::Invalid(format!("{what} {v} is out of range: use 1 to {max_dim}")));
+        let max = limits.max_image_dimension2_d.min(MAX_DIMENSION);
+        for (what, value) in [(Setting::Width, self.width), (Setting::Height, self.height)] {
+            if value == 0 || value > max {
+                return Err(SettingsError::OutOfRange { what, value, max }.into());
             }
         }
         // The heat view is drawn by the clustered forward fragment shader.
         if self.debug_view == DebugView::ClusterHeat && !matches!(self.technique, Technique::ClusteredCpu | Technique::ClusteredGpu) {
-            return Err(RenderError::Invalid(format!(
-                "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}",
-                self.technique.name()
-            )));
+            return Err(SettingsError::HeatNeedsClusteredForward { technique: self.technique }.into());
         }
         if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
-            return Err(RenderError::Invalid(
-                "--debug-view shadow-map needs --shading blinn-phong (the seed model casts no shadows)".into(),
-            ));
+            return Err(SettingsError::ShadowMapNeedsBlinnPhong.into());
         }
         if self.debug_view == DebugView::ShadowCube && self.omni.is_none() {
-            return Err(RenderError::Invalid("--debug-view shadow-cube needs point-light shadows (--omni-shadow)".into()));
+            return Err(SettingsError::ShadowCubeNeedsShadows.into());
         }
         if let Some(omni) = &self.omni {
             check_omni(ctx, omni, lights)?;
         }
         if self.frames == 0 {
-            return Err(RenderError::Invalid("--frames must be at least 1".into()));
+            return Err(SettingsError::NoFrames.into());
         }
         if let Some(t) = self.time.filter(|t| !t.is_finite()) {
-            return Err(RenderError::Invalid(format!("--time {t} is not a finite number")));
+            return Err(SettingsError::Time(t).into());
         }
         let bytes = lights as u64 * std::mem::size_of::<ml_cpu::gpu_types::PointLight>() as u64;
         if bytes > limits.max_storage_buffer_range as u64 {
-            return Err(RenderError::Invalid(format!(
-                "{lights} lights need {bytes} bytes of light buffer but '{}' allows {} bytes per storage buffer",
-                ctx.info.name, limits.max_storage_buffer_range
-            )));
+            return Err(SettingsError::LightBuffer { lights, bytes, device: device(), max: limits.max_storage_buffer_range }.into());
         }
         Ok(())
     }
 }
 
 /// Reject shadow-cube requests the device or the scene cannot take, before allocating.
-fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result<(), RenderError> {
+fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result<(), SettingsError> {
     let limits = &ctx.info.limits;
-    let invalid = |m: String| Err(RenderError::Invalid(m));
+    let device = || ctx.info.name.clone();
     if lights == 0 {
-        return invalid("point-light shadows need point lights, and the scene has none (--lights N adds some)".into());
+        return Err(SettingsError::ShadowsWithoutLights);
     }
     if omni.lights == 0 || omni.lights as usize > lights {
-        return invalid(format!("--shadowed-lights {} is out of range: the scene has {lights} lights (use 1 to {lights})", omni.lights));
+        return Err(SettingsError::ShadowedLights { value: omni.lights, lights });
     }
     let max_cubes = limits.max_image_array_layers / 6;
     if omni.lights > max_cubes {
-        return invalid(format!(
-            "--shadowed-lights {} is more than the {max_cubes} shadow cubes '{}' holds in one array",
-            omni.lights, ctx.info.name
-        ));
+        return Err(SettingsError::TooManyCubes { value: omni.lights, max: max_cubes, device: device() });
     }
     let max_size = limits.max_image_dimension_cube.min(MAX_DIMENSION);
     if omni.size == 0 || omni.size > max_size {
-        return invalid(format!("--cube-size {} is out of range: use 1 to {max_size}", omni.size));
+        return Err(SettingsError::OutOfRange { what: Setting::CubeSize, value: omni.size, max: max_size });
     }
     if omni.bytes() > MAX_OMNI_BYTES {
-        return invalid(format!(
-            "{} shadow cubes of {}² take {} MiB, more than the {} MiB we allow: use fewer --shadowed-lights or a smaller --cube-size",
-            omni.lights,
-            omni.size,
-            omni.bytes() >> 20,
-            MAX_OMNI_BYTES >> 20
-        ));
+        return Err(SettingsError::ShadowMemory {
+            lights: omni.lights,
+            size: omni.size,
+            mib: omni.bytes() >> 20,
+            max_mib: MAX_OMNI_BYTES >> 20,
+        });
     }
+    let missing = |feature, instead| SettingsError::MissingFeature { mode: omni.mode, feature, device: device(), instead };
     if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
-        return invalid(format!(
-            "--omni-shadow multiview needs the multiview feature, which '{}' lacks: use layered, direct or copy",
-            ctx.info.name
-        ));
+        return Err(missing("multiview", "layered, direct or copy"));
     }
     if omni.mode == OmniShadowMode::Multiview && multiview_depth_is_broken(ctx) {
-        return invalid(format!(
-            "--omni-shadow multiview: '{}' ({}) renders every view of a depth-only multiview pass into the first layer (measured on Mesa 22.3 lavapipe): use layered, direct or copy",
-            ctx.info.name, ctx.info.driver_info
-        ));
+        return Err(SettingsError::BrokenMultiview { device: device(), driver: ctx.info.driver_info.clone() });
     }
     if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
-        return invalid(format!(
-            "--omni-shadow layered needs the shaderOutputLayer feature, which '{}' lacks: use direct or copy",
-            ctx.info.name
-        ));
+        return Err(missing("shaderOutputLayer", "direct or copy"));
     }
     Ok(())
 }
@@ -474,4 +422,36 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
 /// Later Mesa releases are not known to be fixed, so every lavapipe refuses it.
 pub fn multiview_depth_is_broken(ctx: &Context) -> bool {
     ctx.info.name.starts_with("llvmpipe")
+}
+
+/// The settings a command asks for, before the scene is known: its cluster grid may be left
+/// to the scene's light count, and its shading model comes with the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SettingsRequest {
+    pub technique: Technique,
+    /// Cluster grid; None: `ClusterDims::for_lights` for the scene's lights at this size.
+    pub clusters: Option<ClusterDims>,
+    pub debug_view: DebugView,
+    pub omni: Option<OmniShadowSettings>,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub time: Option<f32>,
+}
+
+impl SettingsRequest {
+    /// The settings that render `scene` with `shading` (the model its request resolved to).
+    pub fn for_scene(&self, scene: &ml_cpu::scene::Scene, shading: ShadingModel) -> RenderSettings {
+        RenderSettings {
+            technique: self.technique,
+            shading,
+            clusters: self.clusters.unwrap_or_else(|| ClusterDims::for_lights(scene.lights.len(), self.width, self.height)),
+            debug_view: self.debug_view,
+            omni: self.omni,
+            width: self.width,
+            height: self.height,
+            frames: self.frames,
+            time: self.time,
+        }
+    }
 }

@@ -17,11 +17,25 @@ pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// then, only in scenes whose objects have textures of their own (`gbuffer_images`), the
 /// roughness and metallic factors (2 B) and the emissive factor (4 B, sRGB like its texture).
 pub const GBUFFER: [GBufferImage; 5] = [
-    GBufferImage { key: "normal", name: "g-buffer normal", format: vk::Format::R32G32_SFLOAT, bytes: 8 },
-    GBufferImage { key: "object", name: "g-buffer object", format: vk::Format::R32_UINT, bytes: 4 },
-    GBufferImage { key: "albedo", name: "g-buffer albedo-occlusion", format: vk::Format::R8G8B8A8_UNORM, bytes: 4 },
-    GBufferImage { key: "roughness_metallic", name: "g-buffer roughness-metallic", format: vk::Format::R8G8_UNORM, bytes: 2 },
-    GBufferImage { key: "emissive", name: "g-buffer emissive", format: vk::Format::R8G8B8A8_SRGB, bytes: 4 },
+    GBufferImage {
+        key: "normal", name: "g-buffer normal", format: vk::Format::R32G32_SFLOAT, bytes: 8, layout: "octahedral normal 2×f32"
+    },
+    GBufferImage { key: "object", name: "g-buffer object", format: vk::Format::R32_UINT, bytes: 4, layout: "object index u32" },
+    GBufferImage {
+        key: "albedo",
+        name: "g-buffer albedo-occlusion",
+        format: vk::Format::R8G8B8A8_UNORM,
+        bytes: 4,
+        layout: "albedo-occlusion RGBA8",
+    },
+    GBufferImage {
+        key: "roughness_metallic",
+        name: "g-buffer roughness-metallic",
+        format: vk::Format::R8G8_UNORM,
+        bytes: 2,
+        layout: "roughness-metallic RG8",
+    },
+    GBufferImage { key: "emissive", name: "g-buffer emissive", format: vk::Format::R8G8B8A8_SRGB, bytes: 4, layout: "emissive RGBA8" },
 ];
 
 pub struct GBufferImage {
@@ -31,6 +45,8 @@ pub struct GBufferImage {
     pub format: vk::Format,
     /// Per pixel.
     pub bytes: u32,
+    /// What it holds and how, in a few words (the table `render` prints).
+    pub layout: &'static str,
 }
 /// The G-buffer images of a scene: GBUFFER's first three, or all five where objects have
 /// textures of their own. The two more images cost scenes without textures even when left

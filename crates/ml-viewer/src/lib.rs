@@ -12,6 +12,7 @@ pub mod script;
 use anyhow::{bail, Context as _, Result};
 use camera_control::FirstPerson;
 use ml_cpu::scene::Scene;
+use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::FrameStats;
 use ml_render::{HeadlessRenderer, RenderSettings, TIMER_SPEED};
 use ml_vk::swapchain::Acquired;
@@ -34,6 +35,9 @@ use winit::window::{Window, WindowId};
 
 /// How the viewer starts.
 pub struct ViewerOptions {
+    /// The scene; the overlay's changes are made to it (`Choices::request`).
+    pub scene: SceneRequest,
+    /// The choices it starts with (`Choices::new`).
     pub choices: Choices,
     /// Window (and first render) size.
     pub width: u32,
@@ -44,17 +48,25 @@ pub struct ViewerOptions {
     pub device: Option<usize>,
     /// A fixed animation clock (scripted sessions); None: real time.
     pub time: Option<f32>,
-    /// Whether the scene is the built-in seed scene (its object and material can change).
-    pub seed_scene: bool,
     pub script: Option<Vec<Command>>,
 }
 
-/// Makes the scene and settings for a set of choices at a size (the command line's own
-/// scene building, so the window shows what `render` would).
-pub type Build<'a> = dyn Fn(&Choices, (u32, u32)) -> Result<(Scene, RenderSettings)> + 'a;
+/// Makes the scene and settings for a set of choices at a size.
+type Build<'a> = dyn Fn(&Choices, (u32, u32)) -> Result<(Scene, RenderSettings)> + 'a;
 
 /// Open the window and run until it is closed, Esc is pressed or the script quits.
-pub fn run(options: ViewerOptions, build: &Build) -> Result<()> {
+pub fn run(options: ViewerOptions) -> Result<()> {
+    // What the request builds is what `render` would show. A rebuilt scene's warnings are
+    // dropped: its file gave them when the viewer started.
+    let (initial, base, time) = (options.choices.clone(), options.scene.clone(), options.time);
+    let build = move |c: &Choices, size: (u32, u32)| -> Result<(Scene, RenderSettings)> {
+        let built = c.request(&base, &initial).build()?;
+        Ok((built.scene, c.settings(size, time)))
+    };
+    run_with(options, &build)
+}
+
+fn run_with(options: ViewerOptions, build: &Build) -> Result<()> {
     let mut event_loop = EventLoop::new().context("cannot open a window (no display? set DISPLAY, or run under xvfb-run)")?;
     let mut events = Events { size: (options.width, options.height), ..Events::default() };
     while events.window.is_none() {
@@ -176,7 +188,7 @@ impl<'c> Session<'c> {
         let mut session = Session {
             ctx,
             renderer: None,
-            overlay: OverlayState::new(&options.choices, options.seed_scene),
+            overlay: OverlayState::new(&options.choices, options.scene.is_seed()),
             choices: options.choices,
             built: None,
             presenter,
@@ -295,9 +307,9 @@ impl<'c> Session<'c> {
     fn change_in_place(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
         let (Some(renderer), Some(built)) = (&mut self.renderer, &self.built) else { return false };
         let c = &self.choices;
-        let lights_only = Choices { lights: built.lights, layout: built.layout.clone(), radius: built.radius, ..c.clone() } == *built;
+        let lights_only = Choices { lights: built.lights, layout: built.layout, radius: built.radius, ..c.clone() } == *built;
         let settings_only = Choices { clusters: built.clusters, debug_view: built.debug_view, ..c.clone() } == *built;
-        let objects_only = Choices { object: built.object.clone(), material: built.material.clone(), ..c.clone() } == *built;
+        let objects_only = Choices { object: built.object, material: built.material, ..c.clone() } == *built;
         let done = if lights_only {
             build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_lights(scene.lights)?)).is_ok()
         } else if objects_only {

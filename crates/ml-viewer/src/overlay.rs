@@ -3,9 +3,11 @@
 
 use egui::{ComboBox, DragValue, Slider};
 use ml_cpu::cluster::ClusterDims;
-use ml_cpu::material::NAMED_ALBEDOS;
+use ml_cpu::lights::{LightLayout, RadiusRange};
+use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
-use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, ShadingModel, Technique};
+use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
+use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, RenderSettings, ShadingModel, Technique};
 use std::collections::VecDeque;
 
 /// Everything the overlay can change that needs a new scene or renderer.
@@ -14,15 +16,69 @@ pub struct Choices {
     pub technique: Technique,
     pub shading: ShadingModel,
     /// Seed scene only: its object kind and material.
-    pub object: String,
-    pub material: String,
+    pub object: MeshKind,
+    pub material: Material,
     pub lights: u64,
-    /// "grid" or "random".
-    pub layout: String,
+    pub layout: LightLayout,
     pub radius: f32,
     pub clusters: ClusterDims,
     pub debug_view: DebugView,
     pub omni: Option<OmniShadowSettings>,
+}
+
+impl Choices {
+    /// What a viewer of `request`'s scene starts with: the scene as built, rendered with
+    /// `settings` (the seed scene's object and material where the scene is another).
+    pub fn new(request: &SceneRequest, built: &BuiltScene, settings: &RenderSettings) -> Choices {
+        let (object, material) = match request.source {
+            SceneSource::Seed { object, material } => (object, material),
+            _ => (MeshKind::Sphere, Material::built_in()[0]),
+        };
+        Choices {
+            technique: settings.technique,
+            shading: built.shading,
+            object,
+            material,
+            lights: built.scene.lights.len() as u64,
+            layout: request.layout,
+            radius: request.radius.max,
+            clusters: settings.clusters,
+            debug_view: settings.debug_view,
+            omni: settings.omni,
+        }
+    }
+
+    /// `base` (the request these choices started from, as `initial`) with what changed since:
+    /// the model, the seed scene's object and material, and the lights — a scene file keeps its
+    /// own until their count, layout or radius changes.
+    pub fn request(&self, base: &SceneRequest, initial: &Choices) -> SceneRequest {
+        let mut r = SceneRequest { shading: Some(self.shading), ..base.clone() };
+        if let SceneSource::Seed { object, material } = &mut r.source {
+            (*object, *material) = (self.object, self.material);
+        }
+        if (self.lights, self.layout, self.radius) != (initial.lights, initial.layout, initial.radius) {
+            (r.lights, r.layout) = (Some(self.lights), self.layout);
+            if self.radius != initial.radius {
+                r.radius = RadiusRange::fixed(self.radius);
+            }
+        }
+        r
+    }
+
+    /// The settings of these choices at a size, the clock fixed at `time` if given.
+    pub fn settings(&self, (width, height): (u32, u32), time: Option<f32>) -> RenderSettings {
+        RenderSettings {
+            technique: self.technique,
+            shading: self.shading,
+            clusters: self.clusters,
+            debug_view: self.debug_view,
+            omni: self.omni,
+            width,
+            height,
+            frames: 1,
+            time,
+        }
+    }
 }
 
 /// Frames the graph shows.
@@ -74,17 +130,14 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         combo(ui, "Technique", &mut choices.technique, &Technique::ALL, |t| t.name());
         combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());
         ui.add_enabled_ui(state.seed_scene, |ui| {
-            let kinds: Vec<String> = MeshKind::ALL.iter().map(|k| k.name().to_owned()).collect();
-            combo(ui, "Type", &mut choices.object, &kinds, |k| k.as_str());
-            let materials: Vec<String> = NAMED_ALBEDOS.iter().map(|(n, _)| (*n).to_owned()).collect();
-            combo(ui, "Material", &mut choices.material, &materials, |m| m.as_str());
+            combo(ui, "Type", &mut choices.object, &MeshKind::ALL, |k| k.name());
+            combo(ui, "Material", &mut choices.material, &Material::built_in(), |m| m.name().unwrap_or("custom"));
         });
         let lights = ui.add(Slider::new(&mut state.lights_edit, 1..=1_000_000).logarithmic(true).text("lights"));
         if !lights.dragged() && !lights.has_focus() {
             choices.lights = state.lights_edit;
         }
-        let layouts = ["grid".to_owned(), "random".to_owned()];
-        combo(ui, "Layout", &mut choices.layout, &layouts, |l| l.as_str());
+        combo(ui, "Layout", &mut choices.layout, &LightLayout::ALL, |l| l.name());
         ui.add(Slider::new(&mut choices.radius, 0.1..=100.0).logarithmic(true).text("light radius"));
         ui.horizontal(|ui| {
             ui.label("clusters");
@@ -140,4 +193,46 @@ fn frame_graph(ui: &mut egui::Ui, ms: &VecDeque<f32>) {
         .map(|(i, &m)| egui::pos2(rect.left() + rect.width() * i as f32 / GRAPH_FRAMES as f32, rect.bottom() - rect.height() * m / top))
         .collect();
     painter.add(egui::Shape::line(points, egui::Stroke::new(1.0, egui::Color32::LIGHT_GREEN)));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn initial() -> Choices {
+        Choices {
+            technique: Technique::Forward,
+            shading: ShadingModel::Seed,
+            object: MeshKind::Sphere,
+            material: Material::built_in()[0],
+            lights: 7,
+            layout: LightLayout::Grid,
+            radius: 3.0,
+            clusters: ClusterDims::DEFAULT,
+            debug_view: DebugView::None,
+            omni: None,
+        }
+    }
+
+    #[test]
+    fn a_file_keeps_its_lights_until_their_count_layout_or_radius_changes() {
+        let base = SceneRequest { radius: RadiusRange { min: 1.0, max: 3.0 }, ..SceneRequest::new(SceneSource::File("a.toml".into())) };
+        let start = initial();
+        let pbr = Choices { shading: ShadingModel::Pbr, ..start.clone() };
+        assert_eq!(pbr.request(&base, &start), SceneRequest { shading: Some(ShadingModel::Pbr), ..base.clone() });
+        let more = Choices { lights: 9, layout: LightLayout::Random, ..start.clone() }.request(&base, &start);
+        assert_eq!((more.lights, more.layout, more.radius), (Some(9), LightLayout::Random, base.radius));
+        let smaller = Choices { radius: 2.0, ..start.clone() }.request(&base, &start);
+        assert_eq!((smaller.lights, smaller.radius), (Some(7), RadiusRange::fixed(2.0)));
+    }
+
+    #[test]
+    fn the_seed_scene_takes_the_object_and_material_chosen() {
+        let start = initial();
+        let base = SceneRequest::new(SceneSource::Seed { object: start.object, material: start.material });
+        let copper = Material::named("copper").unwrap();
+        let teapot = Choices { object: MeshKind::Teapot, material: copper, ..start.clone() }.request(&base, &start);
+        assert_eq!(teapot.source, SceneSource::Seed { object: MeshKind::Teapot, material: copper });
+        assert_eq!(teapot.lights, None);
+    }
 }

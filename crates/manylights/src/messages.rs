@@ -1,0 +1,105 @@
+//! The error line a user sees. The libraries' errors name what is wrong with a setting ("width
+//! 0 is out of range"); on the command line the user gave it as a flag, so the line names the
+//! flag instead ("--width 0 is out of range").
+
+use ml_cpu::lights::MAX_LIGHTS;
+use ml_cpu::scene_request::SceneRequestError;
+use ml_cpu::SceneError;
+use ml_render::error::{Named, Setting, SettingsError};
+use ml_render::RenderError;
+use std::error::Error;
+
+/// The error and its causes in one line, as anyhow's `{:#}` writes it, each cause that is
+/// about a flag's value said with that flag.
+pub fn describe(e: &anyhow::Error) -> String {
+    e.chain().map(|cause| with_flags(cause).unwrap_or_else(|| cause.to_string())).collect::<Vec<_>>().join(": ")
+}
+
+/// `cause` in the command line's words, where they differ from the library's.
+fn with_flags(cause: &(dyn Error + 'static)) -> Option<String> {
+    if let Some(e) = cause.downcast_ref::<RenderError>() {
+        return match e {
+            RenderError::Scene(e) => scene(e),
+            RenderError::Settings(e) => Some(settings(e)),
+            RenderError::UnknownName { kind: Named::OmniShadowMode, name, expected } => {
+                Some(format!("unknown --omni-shadow mode '{name}': expected one of {expected}"))
+            }
+            _ => None,
+        };
+    }
+    if let Some(SceneRequestError::Scene(e)) = cause.downcast_ref::<SceneRequestError>() {
+        return scene(e);
+    }
+    if let Some(e) = cause.downcast_ref::<SettingsError>() {
+        return Some(settings(e));
+    }
+    cause.downcast_ref::<SceneError>().and_then(scene)
+}
+
+fn scene(e: &SceneError) -> Option<String> {
+    match e {
+        SceneError::LightCount(n) => Some(format!("--lights {n} is out of range: use 1 to {MAX_LIGHTS}")),
+        SceneError::Clusters(text) => Some(format!(
+            "--clusters {text} is invalid: use XxYxZ with each at least 1 and at most {} clusters in all",
+            ml_cpu::cluster::ClusterDims::MAX_CLUSTERS
+        )),
+        _ => None,
+    }
+}
+
+fn flag(s: Setting) -> &'static str {
+    match s {
+        Setting::Width => "--width",
+        Setting::Height => "--height",
+        Setting::CubeSize => "--cube-size",
+    }
+}
+
+fn settings(e: &SettingsError) -> String {
+    match e {
+        SettingsError::OutOfRange { what, value, max } => format!("{} {value} is out of range: use 1 to {max}", flag(*what)),
+        SettingsError::HeatNeedsClusteredForward { technique } => format!(
+            "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}",
+            technique.name()
+        ),
+        SettingsError::ShadowMapNeedsBlinnPhong => {
+            "--debug-view shadow-map needs --shading blinn-phong (the seed model casts no shadows)".into()
+        }
+        SettingsError::ShadowCubeNeedsShadows => "--debug-view shadow-cube needs point-light shadows (--omni-shadow)".into(),
+        SettingsError::NoFrames => "--frames must be at least 1".into(),
+        SettingsError::Time(t) => format!("--time {t} is not a finite number"),
+        SettingsError::ShadowsWithoutLights => format!("{e} (--lights N adds some)"),
+        SettingsError::ShadowedLights { value, lights } => {
+            format!("--shadowed-lights {value} is out of range: the scene has {lights} lights (use 1 to {lights})")
+        }
+        SettingsError::TooManyCubes { value, max, device } => {
+            format!("--shadowed-lights {value} is more than the {max} shadow cubes '{device}' holds in one array")
+        }
+        SettingsError::ShadowMemory { .. } => format!("{e}: use fewer --shadowed-lights or a smaller --cube-size"),
+        SettingsError::MissingFeature { mode, feature, device, instead } => {
+            format!("--omni-shadow {} needs the {feature} feature, which '{device}' lacks: use {instead}", mode.name())
+        }
+        SettingsError::BrokenMultiview { device, driver } => format!(
+            "--omni-shadow multiview: '{device}' ({driver}) renders every view of a depth-only multiview pass into the first layer (measured on Mesa 22.3 lavapipe): use layered, direct or copy"
+        ),
+        other => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn setting_errors_name_their_flags_and_context_stays() {
+        let e = anyhow::Error::from(RenderError::Settings(SettingsError::OutOfRange { what: Setting::Width, value: 0, max: 9 }));
+        assert_eq!(describe(&e), "--width 0 is out of range: use 1 to 9");
+        let e = anyhow::Error::from(SceneError::LightCount(0)).context("bench");
+        assert_eq!(describe(&e), format!("bench: --lights 0 is out of range: use 1 to {MAX_LIGHTS}"));
+        let e = anyhow::Error::from(SettingsError::ShadowsWithoutLights);
+        assert_eq!(describe(&e), "point-light shadows need point lights, and the scene has none (--lights N adds some)");
+        // Errors about no flag read as the library wrote them.
+        let e = anyhow::Error::from(SceneError::LightRadius("0".into()));
+        assert_eq!(describe(&e), format!("{:#}", anyhow::Error::from(SceneError::LightRadius("0".into()))));
+    }
+}

@@ -1,0 +1,200 @@
+//! A scene as a command asks for it — which scene, how many lights and how they are placed,
+//! which shading model — and the building of it. What is left out or worth knowing comes back
+//! as warnings, for the caller to show.
+
+use crate::bench_scene::bench_scene;
+use crate::gltf_scene::{self, GltfFileError};
+use crate::lights::{LightLayout, LightParams, RadiusRange, SEED_RADIUS};
+use crate::material::Material;
+use crate::mesh::MeshKind;
+use crate::scene::Scene;
+use crate::scene_file::{self, SceneFileError};
+use crate::shading_model::ShadingModel;
+use crate::SceneError;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Point lights of the seed and bench scenes when the request does not say.
+pub const SEED_LIGHTS: u64 = 64;
+pub const BENCH_LIGHTS: u64 = 1024;
+
+/// Which scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneSource {
+    /// The built-in 7×7 grid of one object kind in one material (with a floor under it for
+    /// the blinn-phong model, whose sun casts shadows).
+    Seed { object: MeshKind, material: Material },
+    /// The closed room with a pillar and one light (`Scene::shadow_room`); keeps its light.
+    Room,
+    /// The benchmark scene (bench_scene.rs): random lights whose radius follows their count;
+    /// the request's layout and radius do not apply.
+    Bench,
+    /// A scene file (`.toml`) or a glTF file (anything else: `.gltf`, `.glb`).
+    File(PathBuf),
+}
+
+/// A scene to build.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneRequest {
+    pub source: SceneSource,
+    /// Point lights: None keeps the scene's own (the seed scene 64, the bench scene 1024, a
+    /// file its own); Some(n) places n lights by `layout`, `seed` and `radius` (a file's
+    /// lights and spot cones are then replaced).
+    pub lights: Option<u64>,
+    pub layout: LightLayout,
+    /// Seed of the random layout and of radii drawn from a range.
+    pub seed: u64,
+    pub radius: RadiusRange,
+    /// The shading model; None: the file's, else the seed model.
+    pub shading: Option<ShadingModel>,
+}
+
+/// A built scene and the shading model to render it with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BuiltScene {
+    pub scene: Scene,
+    pub shading: ShadingModel,
+    pub warnings: Vec<SceneWarning>,
+}
+
+/// Something about a built scene its user should hear of.
+#[derive(Clone, Debug, PartialEq, Eq, Error)]
+pub enum SceneWarning {
+    /// What a file holds that is left out.
+    #[error("'{}': {message}", path.display())]
+    Left { path: PathBuf, message: String },
+    /// A file's scene without any light (asking for lights adds some).
+    #[error("'{}': the scene has no lights, so only ambient and emitted light show", path.display())]
+    NoLights { path: PathBuf },
+}
+
+/// Why a requested scene could not be built.
+#[derive(Debug, Error)]
+pub enum SceneRequestError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    SceneFile(#[from] SceneFileError),
+    #[error(transparent)]
+    Gltf(#[from] GltfFileError),
+    /// A file naming a shading model that does not exist.
+    #[error("'{}': shading model: {problem}", path.display())]
+    FileShading { path: PathBuf, problem: SceneError },
+}
+
+impl SceneRequest {
+    /// `source` with the defaults: its own lights (placed as the seed's grid, seed 1, radius
+    /// 15 where a count is given), its own shading model.
+    pub fn new(source: SceneSource) -> SceneRequest {
+        SceneRequest { source, lights: None, layout: LightLayout::Grid, seed: 1, radius: RadiusRange::fixed(SEED_RADIUS), shading: None }
+    }
+
+    /// Whether the scene is the seed's grid (its object and material may change).
+    pub fn is_seed(&self) -> bool {
+        matches!(self.source, SceneSource::Seed { .. })
+    }
+
+    fn lights_of(&self, count: u64) -> Result<LightParams, SceneError> {
+        Ok(LightParams { count: LightParams::check_count(count)?, layout: self.layout, seed: self.seed, radius: self.radius })
+    }
+
+    pub fn build(&self) -> Result<BuiltScene, SceneRequestError> {
+        let model = self.shading.unwrap_or(ShadingModel::Seed);
+        let built = |scene| BuiltScene { scene, shading: model, warnings: Vec::new() };
+        match &self.source {
+            SceneSource::Room => Ok(built(Scene::shadow_room())),
+            SceneSource::Bench => {
+                let count = self.lights_of(self.lights.unwrap_or(BENCH_LIGHTS))?.count;
+                Ok(built(bench_scene(count, self.seed)?))
+            }
+            SceneSource::Seed { object, material } => {
+                let scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS))?)?;
+                Ok(built(if model == ShadingModel::BlinnPhong { scene.with_floor() } else { scene }))
+            }
+            SceneSource::File(path) => self.build_file(path),
+        }
+    }
+
+    fn build_file(&self, path: &Path) -> Result<BuiltScene, SceneRequestError> {
+        let is_toml = path.to_string_lossy().to_lowercase().ends_with(".toml");
+        let file = if is_toml { scene_file::load(path)? } else { gltf_scene::load(path)? };
+        let path = path.to_path_buf();
+        let shading = match (self.shading, &file.shading) {
+            (Some(model), _) => model,
+            (None, Some(name)) => {
+                ShadingModel::from_name(name).map_err(|problem| SceneRequestError::FileShading { path: path.clone(), problem })?
+            }
+            (None, None) => ShadingModel::Seed,
+        };
+        let mut warnings: Vec<SceneWarning> =
+            file.warnings.into_iter().map(|message| SceneWarning::Left { path: path.clone(), message }).collect();
+        let mut scene = file.scene;
+        if let Some(n) = self.lights {
+            scene.lights = self.lights_of(n)?.build()?;
+            // The file's spot cones belonged to its own lights.
+            scene.cones.clear();
+        }
+        if scene.lights.is_empty() && scene.directional.is_empty() {
+            warnings.push(SceneWarning::NoLights { path: path.clone() });
+        }
+        Ok(BuiltScene { scene, shading, warnings })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seed() -> SceneSource {
+        SceneSource::Seed { object: MeshKind::Sphere, material: Material::named("gold").unwrap() }
+    }
+
+    #[test]
+    fn the_seed_scene_has_its_lights_and_a_floor_under_blinn_phong() {
+        let plain = SceneRequest::new(seed()).build().unwrap();
+        assert_eq!((plain.scene.lights.len(), plain.scene.objects.len(), plain.shading), (64, 49, ShadingModel::Seed));
+        let lit = SceneRequest { shading: Some(ShadingModel::BlinnPhong), lights: Some(5), ..SceneRequest::new(seed()) }.build().unwrap();
+        assert_eq!((lit.scene.lights.len(), lit.scene.objects.len(), lit.shading), (5, 50, ShadingModel::BlinnPhong));
+        assert!(lit.warnings.is_empty());
+    }
+
+    #[test]
+    fn room_and_bench_keep_their_own_lights_and_bench_takes_a_count() {
+        let room = SceneRequest { lights: Some(9), ..SceneRequest::new(SceneSource::Room) }.build().unwrap();
+        assert_eq!(room.scene, Scene::shadow_room());
+        let bench = SceneRequest { lights: Some(300), seed: 3, ..SceneRequest::new(SceneSource::Bench) }.build().unwrap();
+        assert_eq!(bench.scene, bench_scene(300, 3).unwrap());
+        assert_eq!(SceneRequest::new(SceneSource::Bench).build().unwrap().scene.lights.len(), 1024);
+    }
+
+    #[test]
+    fn light_counts_out_of_range_are_refused() {
+        let e = SceneRequest { lights: Some(0), ..SceneRequest::new(seed()) }.build().unwrap_err();
+        assert!(matches!(e, SceneRequestError::Scene(SceneError::LightCount(0))), "{e}");
+    }
+
+    #[test]
+    fn a_file_names_its_model_keeps_or_replaces_its_lights_and_says_what_is_missing() {
+        let dir = std::env::temp_dir().join(format!("ml-scene-request-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = |name: &str, text: &str| {
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            SceneRequest::new(SceneSource::File(path))
+        };
+        let dark = file("dark.toml", "[shading]\nmodel = \"pbr\"\n[[objects]]\nmesh = \"sphere\"\n");
+        let built = dark.build().unwrap();
+        assert_eq!(built.shading, ShadingModel::Pbr);
+        assert_eq!(built.warnings, [SceneWarning::NoLights { path: dir.join("dark.toml") }]);
+        let lit = SceneRequest { lights: Some(4), shading: Some(ShadingModel::Seed), ..dark }.build().unwrap();
+        assert_eq!((lit.scene.lights.len(), lit.shading), (4, ShadingModel::Seed));
+        assert!(lit.warnings.is_empty());
+        let odd = file("odd.toml", "[shading]\nmodel = \"phong\"\n[[objects]]\nmesh = \"sphere\"\n");
+        let e = odd.build().unwrap_err().to_string();
+        assert!(e.ends_with("odd.toml': shading model: unknown shading model 'phong': expected one of seed, blinn-phong, pbr"), "{e}");
+        // Asked for another model, the file's unknown one does not matter.
+        assert!(SceneRequest { shading: Some(ShadingModel::Pbr), ..odd }.build().is_ok());
+        let e = file("empty.glb", "").build().unwrap_err().to_string();
+        assert!(e.starts_with("glTF file '") && e.ends_with("empty.glb': the file is empty"), "{e}");
+    }
+}
