@@ -14,7 +14,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, HeadlessRenderer, RenderOutput, Technique};
+use ml_render::{DebugView, RenderOutput, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -262,12 +262,12 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (technique, lights): (
     }
     let scene = built.scene;
     let mut settings = SettingsRequest { technique, ..plan.settings }.for_scene(&scene, built.shading);
-    let probe = HeadlessRenderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
+    let probe = Renderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
         return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: probe.stats.wall_ms });
     }
     settings.frames = frames;
-    let output = HeadlessRenderer::new(ctx, scene, settings).and_then(|mut r| r.render())?;
+    let output = Renderer::new(ctx, scene, settings).and_then(|mut r| r.render())?;
     let grid = technique.is_clustered().then_some(settings.clusters);
     let ms_per_frame = output.stats.wall_ms_per_frame();
     Ok(Measured { technique, lights, skipped: None, output: Some(output), grid, ms_per_frame })

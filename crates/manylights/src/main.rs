@@ -10,7 +10,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::report;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, HeadlessRenderer, OmniShadowMode, OmniShadowSettings, ShadingModel, Technique};
+use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -281,7 +281,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         }
     };
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
-    let result = HeadlessRenderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render());
+    let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render());
     let device = report::device_line(&ctx.info);
     drop(ctx);
     let output = result?;

@@ -24,7 +24,7 @@ pub mod targets;
 
 pub use error::RenderError;
 pub use frame::FRAMES_IN_FLIGHT;
-pub use renderer::{FrameHook, HeadlessRenderer, RenderOutput, Renderer};
+pub use renderer::{FrameHook, RenderOutput, Renderer};
 pub use settings::{
     DebugView, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique,
     FRAME_SECONDS, TIMER_SPEED,

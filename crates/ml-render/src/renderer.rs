@@ -66,9 +66,6 @@ pub struct Renderer<'a> {
     depth_format: vk::Format,
 }
 
-/// The renderer's former name: headless rendering is what it does without a window.
-pub type HeadlessRenderer<'a> = Renderer<'a>;
-
 /// Copies into host-visible buffers, then read by the CPU.
 const TRANSFER_TO_HOST: ((vk::PipelineStageFlags, vk::AccessFlags), (vk::PipelineStageFlags, vk::AccessFlags)) =
     ((vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));

@@ -66,11 +66,6 @@ impl Technique {
         self.assignment() != LightAssignment::None
     }
 
-    /// Whether the CPU assigns lights to clusters every frame.
-    pub fn is_cpu_built(self) -> bool {
-        self.assignment() == LightAssignment::Cpu
-    }
-
     /// Whether the lighting runs in the second subpass of the raster pass.
     pub fn lights_in_subpass(self) -> bool {
         self.lighting_stage() == LightingStage::Subpass
@@ -79,11 +74,6 @@ impl Technique {
     /// Whether the lighting runs as a compute pass over a G-buffer.
     pub fn lights_in_compute(self) -> bool {
         self.lighting_stage() == LightingStage::Compute
-    }
-
-    /// Whether the GPU builds the clusters (and animates the lights).
-    pub fn is_gpu_built(self) -> bool {
-        self.assignment() == LightAssignment::Gpu
     }
 
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {

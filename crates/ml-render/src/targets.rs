@@ -2,7 +2,7 @@
 //! buffer, the G-buffer and the HDR image of the deferred techniques. The raster passes make
 //! their framebuffers over them.
 
-use crate::settings::Technique;
+use crate::settings::{LightingStage, Technique};
 use ml_vk::{vk, Context, Image, VkError};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
@@ -70,12 +70,10 @@ pub enum Output {
 
 impl Output {
     pub fn of(technique: Technique) -> Output {
-        if technique.lights_in_compute() {
-            Output::GBuffer
-        } else if technique.lights_in_subpass() {
-            Output::Subpasses
-        } else {
-            Output::Color
+        match technique.lighting_stage() {
+            LightingStage::Forward => Output::Color,
+            LightingStage::Subpass => Output::Subpasses,
+            LightingStage::Compute => Output::GBuffer,
         }
     }
 

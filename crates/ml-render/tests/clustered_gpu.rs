@@ -10,7 +10,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::random_scene::random_scene;
 use ml_cpu::scene::Scene;
-use ml_render::{HeadlessRenderer, RenderSettings, Technique};
+use ml_render::{RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -41,7 +41,7 @@ fn gpu_lists_equal_the_cpu_assignment_on_random_scenes() {
         let mut settings = RenderSettings::new(Technique::ClusteredGpu, W, H);
         settings.clusters = dims;
         settings.frames = 2;
-        let mut renderer = HeadlessRenderer::new(&ctx, scene.clone(), settings).expect("renderer");
+        let mut renderer = Renderer::new(&ctx, scene.clone(), settings).expect("renderer");
         renderer.render().expect("render");
         let gpu = renderer.gpu_cluster_lists().expect("read back").expect("clustered-gpu lists");
         drop(renderer);
@@ -106,7 +106,7 @@ fn lists_larger_than_a_storage_buffer_fail_loudly() {
     for technique in [Technique::ClusteredCpu, Technique::ClusteredGpu] {
         let mut settings = RenderSettings::new(technique, 64, 36);
         settings.clusters = ClusterDims { x: 64, y: 36, z: 32 };
-        let result = HeadlessRenderer::new(&ctx, scene.clone(), settings).and_then(|mut r| r.render());
+        let result = Renderer::new(&ctx, scene.clone(), settings).and_then(|mut r| r.render());
         match result {
             Err(e) => {
                 let text = e.to_string();

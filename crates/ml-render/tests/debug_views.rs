@@ -8,7 +8,7 @@ use ml_cpu::lights::LightParams;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
-use ml_render::{DebugView, HeadlessRenderer, RenderOutput, RenderSettings, ShadingModel, Technique};
+use ml_render::{DebugView, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 
 const W: u32 = 160;
@@ -82,6 +82,6 @@ fn shadow_map_view_paints_the_map_and_needs_shadows() {
     let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("device");
     let mut settings = RenderSettings::new(Technique::Forward, W, H);
     settings.debug_view = DebugView::ShadowMap;
-    let err = HeadlessRenderer::new(&ctx, scene, settings).err().expect("the seed model has no shadow map").to_string();
+    let err = Renderer::new(&ctx, scene, settings).err().expect("the seed model has no shadow map").to_string();
     assert!(err.contains("blinn-phong"), "{err}");
 }

@@ -13,7 +13,7 @@ use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
-use ml_render::{DebugView, HeadlessRenderer, RenderSettings, ShadingModel, Technique};
+use ml_render::{DebugView, RenderSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -29,7 +29,7 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
     let camera = Camera::looking_at(Vec3::new(-6.0, 9.0, 12.0), Vec3::ZERO, 50.0, 0.1, 200.0);
     for technique in Technique::ALL {
         let settings = |w, h| RenderSettings { frames: 2, ..RenderSettings::new(technique, w, h) };
-        let mut live = HeadlessRenderer::new(&ctx, seed_scene(&LightParams::seed_default()), settings(96, 64)).expect("renderer");
+        let mut live = Renderer::new(&ctx, seed_scene(&LightParams::seed_default()), settings(96, 64)).expect("renderer");
         live.render().expect("render");
         let mut resized = RenderSettings { clusters: ClusterDims { x: 8, y: 6, z: 12 }, ..settings(120, 80) };
         assert!(live.reconfigure(resized).expect("resize"), "a new size and grid keep the pipelines");
@@ -43,8 +43,7 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
         let depth_view = RenderSettings { debug_view: DebugView::Depth, ..resized };
         assert!(live.reconfigure(depth_view).expect("a debug view"));
         let depth = live.render().expect("render the depth view");
-        let fresh_depth =
-            HeadlessRenderer::new(&ctx, seed_scene(&LightParams::seed_default()), depth_view).and_then(|mut r| r.render()).unwrap();
+        let fresh_depth = Renderer::new(&ctx, seed_scene(&LightParams::seed_default()), depth_view).and_then(|mut r| r.render()).unwrap();
         assert_eq!(common::max_difference(&depth, &fresh_depth).0, 0, "{}: the depth view after reconfigure", technique.name());
         assert!(live.reconfigure(resized).expect("no debug view"));
         live.set_lights(many.build().unwrap()).expect("new lights");
@@ -60,7 +59,7 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
             if let Some(c) = camera {
                 scene.camera = c;
             }
-            HeadlessRenderer::new(&ctx, scene, settings(120, 80)).and_then(|mut r| r.render()).expect("fresh render")
+            Renderer::new(&ctx, scene, settings(120, 80)).and_then(|mut r| r.render()).expect("fresh render")
         };
         for (what, live, fresh) in [("resized and relit", &changed, &fresh(None)), ("moved", &moved, &fresh(Some(camera)))] {
             assert_eq!((live.width, live.height), (120, 80));
@@ -69,7 +68,7 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
         }
         // The new lights show: the image is not the one the old lights give.
         let old_lights =
-            HeadlessRenderer::new(&ctx, seed_scene(&LightParams::seed_default()), settings(120, 80)).and_then(|mut r| r.render()).unwrap();
+            Renderer::new(&ctx, seed_scene(&LightParams::seed_default()), settings(120, 80)).and_then(|mut r| r.render()).unwrap();
         let (max, _) = common::max_difference(&changed, &old_lights);
         assert!(max > 30, "{}: the new lights changed the image by only {max}/255", technique.name());
     }

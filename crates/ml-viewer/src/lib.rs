@@ -14,7 +14,7 @@ use camera_control::FirstPerson;
 use ml_cpu::scene::Scene;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::FrameStats;
-use ml_render::{HeadlessRenderer, RenderSettings, TIMER_SPEED};
+use ml_render::{RenderSettings, Renderer, TIMER_SPEED};
 use ml_vk::swapchain::Acquired;
 use ml_vk::{vk, Context, ContextDesc, WindowHandles};
 pub use overlay::Choices;
@@ -126,7 +126,7 @@ impl ApplicationHandler for Events {
 /// The viewer's state between frames.
 struct Session<'c> {
     ctx: &'c Context,
-    renderer: Option<HeadlessRenderer<'c>>,
+    renderer: Option<Renderer<'c>>,
     presenter: Presenter,
     /// What the overlay shows (and the user edits), and what the renderer was made with.
     choices: Choices,
@@ -335,7 +335,7 @@ impl<'c> Session<'c> {
         self.ctx.wait_idle()?;
         self.renderer = None;
         let made = build(&self.choices, (extent.width, extent.height)).and_then(|(scene, settings)| {
-            let mut r = HeadlessRenderer::new(self.ctx, scene, settings)?;
+            let mut r = Renderer::new(self.ctx, scene, settings)?;
             if let Some(c) = camera {
                 r.set_camera(c)?;
             }

@@ -9,6 +9,7 @@ use crate::descriptors::Resource;
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Shading;
+use crate::targets::GBUFFER;
 use ml_vk::{vk, Context, VkError};
 
 pub struct ComputeLighting {
@@ -43,9 +44,10 @@ impl Pass for ComputeLighting {
             // A G-buffer without the material and emissive images (a scene without object
             // textures) binds the albedo image in their place: the shader, specialised for such
             // scenes, never reads them, but Vulkan wants every binding it names written.
-            _ => match name.strip_suffix("_image") {
-                Some(g) => t
-                    .gbuffer_image(g)
+            // Only G-buffer images fall back; any other name nobody provides stays an error.
+            _ => match name.strip_suffix("_image").filter(|key| GBUFFER.iter().any(|g| g.key == *key)) {
+                Some(key) => t
+                    .gbuffer_image(key)
                     .or_else(|| t.gbuffer_image("albedo"))
                     .and_then(|g| sampled(g, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)),
                 None => frame.buffer(name),

@@ -5,7 +5,7 @@
 #![allow(dead_code)] // each test binary uses part of the harness
 
 use ml_cpu::scene::Scene;
-use ml_render::{HeadlessRenderer, RenderOutput, RenderSettings, Technique};
+use ml_render::{RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -31,7 +31,7 @@ pub fn render_each_on_device(scene: &Scene, settings: &[RenderSettings]) -> (Vec
     let outputs = settings
         .iter()
         .map(|s| {
-            let mut renderer = HeadlessRenderer::new(&ctx, scene.clone(), *s).expect("renderer");
+            let mut renderer = Renderer::new(&ctx, scene.clone(), *s).expect("renderer");
             renderer.render().expect("render")
         })
         .collect();
