@@ -17,6 +17,8 @@
 #define DEBUG_VIEW_DEPTH 5u
 #define DEBUG_VIEW_SHADOW_MAP 6u
 #define DEBUG_VIEW_SHADOW_CUBE 7u
+#define DEBUG_VIEW_MESHLETS 8u
+#define DEBUG_VIEW_TRIANGLES 9u
 
 // Per frame, one uniform buffer per frame in flight (set 0, binding 0).
 struct FrameUniforms {
@@ -125,6 +127,44 @@ struct OmniShadowPush {
 // over the same pixels as a fragment shader and as a compute shader.
 struct StageProbePush {
     uvec4 size_lights; // xy: pixels; z: lights every pixel sums
+};
+
+// A meshlet of a mesh (≤ 64 vertices, ≤ 124 triangles), in object space (meshlets.rs; std430).
+struct Meshlet {
+    vec4 center_radius;    // bounding sphere
+    vec4 cone_axis_cutoff; // back-face cone: only back faces seen where dot(normalize(apex − eye), axis) ≥ cutoff
+    vec4 cone_apex;        // xyz
+    uvec4 triangles;       // x: first entry of the meshlet index buffer; y: triangles (3 entries each)
+};
+
+// A visibility id's low bits: the triangle in its meshlet (meshlets.rs TRIANGLE_BITS).
+const uint VISIBILITY_TRIANGLE_BITS = 7u;
+
+// Bits of Instance.meshlets.w.
+const uint INSTANCE_CONE_CULLING = 1u; // rotation, uniform scale, mirror: cones hold
+const uint INSTANCE_MIRRORED = 2u;     // a mirror turns the cones around
+
+// An object as the meshlet culling sees it (same index as the object buffer; std430).
+struct Instance {
+    vec4 bounds;    // world-space bounding sphere
+    vec4 scale;     // x: the largest stretch of its transform (meshlet spheres grow by it)
+    uvec4 meshlets; // x: first meshlet; y: meshlet count; z: first meshlet-instance id; w: INSTANCE_*
+    uvec4 surface;  // x: its own textures (TEXTURE_* bits); y: its texture set
+};
+
+// The counts of a frame's culling (std430): the late phase's dispatch reads `dispatch`, the
+// raster passes read the draw counts; the CPU reads the rest after the frame.
+struct CullCounters {
+    uvec4 dispatch;  // x: instances that passed the frustum test (work groups), y, z: 1
+    uvec4 draws;     // x: early-phase draws, y: late-phase draws (a meshlet each)
+    uvec4 triangles; // x: early-phase triangles, y: late-phase triangles
+    uvec4 tested;    // x: meshlets tested early, y: late; z: instances tested
+};
+
+// Push constants of the culling passes.
+struct CullPush {
+    uvec4 mode;    // x: phase (0: early, 1: late); y: 1 culling on, 0 everything drawn;
+                   // z: depth-pyramid levels; w: draw capacity (late draws start there)
 };
 
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with

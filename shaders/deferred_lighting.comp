@@ -19,6 +19,7 @@ layout(set = 0, binding = 12) uniform sampler2D emissive_image;
 #include "textures.glsl"
 
 #include "lighting.glsl"
+#include "compute_shading.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -40,11 +41,5 @@ void main() {
     vec3 emissive_factor = OBJECT_TEXTURES ? texelFetch(emissive_image, p, 0).rgb : vec3(1.0);
     PointMaterial m =
         point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, texelFetch(albedo_image, p, 0), roughness_metallic, emissive_factor);
-    vec3 color;
-    if (debug_surface(world, n, m.albedo, m.roughness, m.metallic, color)) {
-        imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
-        return;
-    }
-    color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
-    imageStore(out_image, p, vec4(encode_output(color), 1.0));
+    shade_and_store(p, frag_xy, world, n, m);
 }

@@ -3,12 +3,23 @@
 // blinn-phong's albedo texture and normal map; normal maps perturb the normal through the
 // tangent frame (TBN); glTF's metallic-roughness, occlusion and emissive textures. The seed
 // model's built-in objects use none.
-// Needs common.glsl, scene_bindings.glsl and textures.glsl. Fragment stage (implicit LOD).
+// Needs common.glsl, scene_bindings.glsl and textures.glsl. In a fragment shader textures
+// are sampled with the implicit derivatives; a compute shader defines SURFACE_GRADIENTS and
+// sets surface_uv_dx and surface_uv_dy (∂uv/∂x, ∂uv/∂y at the pixel) before surface_at.
 
 #ifndef MANYLIGHTS_SURFACE_GLSL
 #define MANYLIGHTS_SURFACE_GLSL
 
 #include "shading_model.glsl"
+
+// Sample `t` at `uv`, whose texture coordinates are `m` times the surface's.
+#ifdef SURFACE_GRADIENTS
+vec2 surface_uv_dx;
+vec2 surface_uv_dy;
+#define SURFACE_SAMPLE(t, uv, m) textureGrad(t, uv, (m) * surface_uv_dx, (m) * surface_uv_dy)
+#else
+#define SURFACE_SAMPLE(t, uv, m) texture(t, uv)
+#endif
 
 // Set 2 of the mesh pipelines, bound per draw: the object's own textures (glTF), or white
 // stand-ins where ObjectPush.ids.y says it has none (object_textures.rs). A set per draw,
@@ -54,25 +65,26 @@ Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, 
     s.emissive_factor = vec3(1.0);
     if (OBJECT_TEXTURES) {
         if ((textures & TEXTURE_BASE_COLOR) != 0u) {
-            s.albedo_factor = texture(object_base_color, uv).rgb;
+            s.albedo_factor = SURFACE_SAMPLE(object_base_color, uv, mat2(1.0)).rgb;
         }
         if ((textures & TEXTURE_NORMAL) != 0u) {
-            s.normal = perturb_normal(s.normal, tangent, texture(object_normal_map, uv).xyz, material.z);
+            s.normal = perturb_normal(s.normal, tangent, SURFACE_SAMPLE(object_normal_map, uv, mat2(1.0)).xyz, material.z);
         }
         if ((textures & TEXTURE_METALLIC_ROUGHNESS) != 0u) {
-            s.roughness_metallic = texture(object_metallic_roughness, uv).gb;
+            s.roughness_metallic = SURFACE_SAMPLE(object_metallic_roughness, uv, mat2(1.0)).gb;
         }
         if ((textures & TEXTURE_OCCLUSION) != 0u) {
-            s.occlusion = 1.0 + material.y * (texture(object_occlusion, uv).r - 1.0);
+            s.occlusion = 1.0 + material.y * (SURFACE_SAMPLE(object_occlusion, uv, mat2(1.0)).r - 1.0);
         }
         if ((textures & TEXTURE_EMISSIVE) != 0u) {
-            s.emissive_factor = texture(object_emissive, uv).rgb;
+            s.emissive_factor = SURFACE_SAMPLE(object_emissive, uv, mat2(1.0)).rgb;
         }
     }
     if (MODEL_BLINN_PHONG) {
-        vec2 st = mat2(frame.texture_transform.xy, frame.texture_transform.zw) * uv;
-        s.albedo_factor *= texture(albedo_map, st).rgb;
-        s.normal = perturb_normal(s.normal, tangent, texture(normal_map, st).xyz, 1.0);
+        mat2 st_transform = mat2(frame.texture_transform.xy, frame.texture_transform.zw);
+        vec2 st = st_transform * uv;
+        s.albedo_factor *= SURFACE_SAMPLE(albedo_map, st, st_transform).rgb;
+        s.normal = perturb_normal(s.normal, tangent, SURFACE_SAMPLE(normal_map, st, st_transform).xyz, 1.0);
     }
     return s;
 }

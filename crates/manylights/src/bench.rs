@@ -109,6 +109,7 @@ impl Plan {
             height,
             frames: 1,
             time: None,
+            culling: true,
         };
         Ok(Plan { scene, settings, warned: false })
     }

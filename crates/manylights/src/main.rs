@@ -78,7 +78,8 @@ struct SceneArgs {
     #[arg(long, default_value = "seed")]
     scene: String,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
-    /// deferred-compute, or auto: deferred-compute where this device runs the probe's light loop
+    /// deferred-compute, visibility (meshlets culled on the GPU into a visibility buffer, lit
+    /// in compute), or auto: deferred-compute where this device runs the probe's light loop
     /// (`bench --probe`) over 1.25× faster as a compute shader than as a fragment shader, else
     /// deferred-clustered.
     #[arg(long, default_value = "forward")]
@@ -95,7 +96,8 @@ struct SceneArgs {
     clusters: String,
     /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu),
     /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (blinn-phong),
-    /// shadow-cube (the first shadowed point light's cube, unfolded; needs --omni-shadow).
+    /// shadow-cube (the first shadowed point light's cube, unfolded; needs --omni-shadow),
+    /// meshlets, triangles (a colour per meshlet or triangle; visibility).
     #[arg(long, default_value = "none")]
     debug_view: String,
     /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.
@@ -136,6 +138,10 @@ struct SceneArgs {
     /// viewer, with real time).
     #[arg(long)]
     time: Option<f32>,
+    /// GPU culling of the visibility technique: on, or off (every meshlet drawn; the image
+    /// must not change).
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    culling: String,
     /// Enable the Khronos validation layer with synchronization validation; any message
     /// makes the run fail.
     #[arg(long)]
@@ -230,6 +236,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         height: args.height,
         frames,
         time: args.time,
+        culling: args.culling == "on",
     })
 }
 

@@ -134,6 +134,8 @@ pub const DEBUG_VIEW_GBUFFER_MATERIAL: u32 = 4;
 pub const DEBUG_VIEW_DEPTH: u32 = 5;
 pub const DEBUG_VIEW_SHADOW_MAP: u32 = 6;
 pub const DEBUG_VIEW_SHADOW_CUBE: u32 = 7;
+pub const DEBUG_VIEW_MESHLETS: u32 = 8;
+pub const DEBUG_VIEW_TRIANGLES: u32 = 9;
 
 gpu_struct!(
     /// One object of the object buffer (std430).
@@ -185,5 +187,64 @@ gpu_struct!(
     StageProbePush {
         /// xy: pixels; z: lights every pixel sums.
         size_lights: [u32; 4],
+    }
+);
+
+gpu_struct!(
+    /// A meshlet of a mesh, in object space (`meshlets.rs`; std430, 64 bytes).
+    Meshlet {
+        /// xyz: centre of the bounding sphere; w: its radius.
+        center_radius: [f32; 4],
+        /// xyz: the back-face cone's axis; w: its cutoff (every triangle faces away from an
+        /// eye where dot(normalize(apex − eye), axis) ≥ cutoff).
+        cone_axis_cutoff: [f32; 4],
+        /// xyz: the cone's apex.
+        cone_apex: [f32; 4],
+        /// x: first entry in the meshlet index buffer; y: triangles (3 entries each).
+        triangles: [u32; 4],
+    }
+);
+
+/// `Instance::meshlets.w` bits.
+pub const INSTANCE_CONE_CULLING: u32 = 1;
+pub const INSTANCE_MIRRORED: u32 = 2;
+
+gpu_struct!(
+    /// An object as the meshlet culling sees it (same index as the object buffer; std430).
+    Instance {
+        /// xyz: centre of the world-space bounding sphere; w: its radius.
+        bounds: [f32; 4],
+        /// x: the largest factor by which its transform stretches lengths (meshlet spheres
+        /// grow by it).
+        scale: [f32; 4],
+        /// x: first meshlet of its mesh; y: meshlet count; z: its first meshlet-instance id;
+        /// w: `INSTANCE_*` bits.
+        meshlets: [u32; 4],
+        /// x: which textures it has of its own (`ObjectTextures::bits`); y: its texture set
+        /// (which descriptor set holds them).
+        surface: [u32; 4],
+    }
+);
+
+gpu_struct!(
+    /// The counts of a frame's culling (`CullCounters` in common.glsl).
+    CullCounters {
+        /// x: instances that passed the frustum test; y, z: 1 (an indirect dispatch).
+        dispatch: [u32; 4],
+        /// x: early-phase draws; y: late-phase draws.
+        draws: [u32; 4],
+        /// x: early-phase triangles; y: late-phase triangles.
+        triangles: [u32; 4],
+        /// x: meshlets tested early; y: late; z: instances tested.
+        tested: [u32; 4],
+    }
+);
+
+gpu_struct!(
+    /// Push constants of the culling passes.
+    CullPush {
+        /// x: phase (0 early, 1 late); y: culling on (1) or off; z: depth-pyramid levels;
+        /// w: draw capacity (the late phase's draws start there).
+        mode: [u32; 4],
     }
 );

@@ -14,6 +14,7 @@ pub mod gpu_types;
 pub mod lights;
 pub mod material;
 pub mod mesh;
+pub mod meshlets;
 pub mod omni_shadow;
 pub mod random_scene;
 pub mod scene;

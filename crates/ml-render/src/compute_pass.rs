@@ -5,7 +5,7 @@
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame::FRAMES_IN_FLIGHT;
 use ml_shaders::Shader;
-use ml_vk::commands::image_transition;
+use ml_vk::commands::{image_transition, memory_barrier};
 use ml_vk::image::fetch_sampler;
 use ml_vk::{shader, vk, Context, VkError};
 
@@ -27,6 +27,16 @@ impl ComputePass {
         more_sets: &[vk::DescriptorSetLayout],
         (shader, constants): (&Shader, &[(u32, u32)]),
     ) -> Result<ComputePass, VkError> {
+        ComputePass::with_push(ctx, more_sets, (shader, constants), 0)
+    }
+
+    /// As `new`, with `push_bytes` of push constants (0: none) that `record_runs` sets.
+    pub fn with_push(
+        ctx: &Context,
+        more_sets: &[vk::DescriptorSetLayout],
+        (shader, constants): (&Shader, &[(u32, u32)]),
+        push_bytes: u32,
+    ) -> Result<ComputePass, VkError> {
         let p = ComputePass {
             sets: FrameSets::new(ctx, &[(shader, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
             sampler: vk::Sampler::null(),
@@ -35,7 +45,8 @@ impl ComputePass {
         };
         ml_vk::build(ctx, p, |p| {
             let layouts: Vec<vk::DescriptorSetLayout> = std::iter::once(p.sets.layout.raw).chain(more_sets.iter().copied()).collect();
-            p.pipeline_layout = shader::pipeline_layout(ctx, &layouts, &[])?;
+            let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(push_bytes)];
+            p.pipeline_layout = shader::pipeline_layout(ctx, &layouts, if push_bytes > 0 { &push } else { &[] })?;
             p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, constants)?;
             p.sampler = fetch_sampler(ctx)?;
             Ok(())
@@ -58,7 +69,20 @@ impl ComputePass {
         color: vk::Image,
         extent: vk::Extent2D,
     ) {
-        let sets: Vec<vk::DescriptorSet> = std::iter::once(self.sets.sets[slot]).chain(more_sets.iter().copied()).collect();
+        self.record_runs(ctx, cmd, slot, &[(more_sets.to_vec(), Vec::new())], (color, extent));
+    }
+
+    /// As `record_into_colour_target`, with one dispatch per run: its sets after set 0 and its
+    /// push constants. Runs write distinct pixels, but synchronization validation tracks whole
+    /// images: a barrier orders them.
+    pub fn record_runs(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        runs: &[(Vec<vk::DescriptorSet>, Vec<u8>)],
+        (color, extent): (vk::Image, vk::Extent2D),
+    ) {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let d = &ctx.device;
@@ -68,8 +92,17 @@ impl ComputePass {
         // SAFETY: recording state outside a render pass; everything bound is alive.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &sets, &[]);
-            d.cmd_dispatch(cmd, extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP), 1);
+            for (i, (more_sets, push)) in runs.iter().enumerate() {
+                if i > 0 {
+                    memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_WRITE));
+                }
+                let sets: Vec<vk::DescriptorSet> = std::iter::once(self.sets.sets[slot]).chain(more_sets.iter().copied()).collect();
+                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &sets, &[]);
+                if !push.is_empty() {
+                    d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+                }
+                d.cmd_dispatch(cmd, extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP), 1);
+            }
         }
         image_transition(ctx, cmd, color, storage, (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL));
     }

@@ -1,4 +1,4 @@
-use crate::settings::{OmniShadowMode, Technique};
+use crate::settings::{DebugView, OmniShadowMode, Technique};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -68,6 +68,10 @@ pub enum SettingsError {
     ShadowMapNeedsBlinnPhong,
     #[error("the shadow-cube debug view needs point-light shadows")]
     ShadowCubeNeedsShadows,
+    #[error("the {} debug view shows the meshlets of the visibility technique, not {}", view.name(), technique.name())]
+    ViewNeedsMeshlets { view: DebugView, technique: Technique },
+    #[error("the {} technique needs {feature}, which '{device}' lacks: use deferred-compute", technique.name())]
+    TechniqueFeature { technique: Technique, feature: &'static str, device: String },
     #[error("frames must be at least 1")]
     NoFrames,
     #[error("time {0} is not a finite number")]

@@ -8,6 +8,7 @@ pub mod error;
 pub mod frame;
 pub mod gpu_mesh;
 pub mod mesh_raster;
+pub mod meshlet_scene;
 pub mod object_textures;
 pub mod omni_shadow;
 pub mod pass;
@@ -26,6 +27,6 @@ pub use error::RenderError;
 pub use frame::FRAMES_IN_FLIGHT;
 pub use renderer::{FrameHook, RenderOutput, Renderer};
 pub use settings::{
-    DebugView, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique,
+    DebugView, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, RenderSettings, Shading, ShadingModel, Technique,
     FRAME_SECONDS, TIMER_SPEED,
 };

@@ -162,7 +162,7 @@ impl MeshRaster {
         let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
         let mut clear: Vec<vk::ClearValue> = match self.output {
-            Output::Color => vec![colour],
+            Output::Color | Output::Visibility => vec![colour],
             Output::GBuffer | Output::Subpasses => vec![zero; self.gbuffer.len()],
         };
         clear.push(depth);

@@ -16,6 +16,10 @@ pub struct ObjectTextureSets {
     pub set_layout: vk::DescriptorSetLayout,
     /// Per object of the scene, the set its draws bind.
     pub per_object: Vec<vk::DescriptorSet>,
+    /// The distinct sets (texture sets), and per object the index of its own among them
+    /// (the visibility lighting shades one texture set per dispatch).
+    pub sets: Vec<vk::DescriptorSet>,
+    pub set_index: Vec<u32>,
     pool: vk::DescriptorPool,
     images: Vec<Image>,
     samplers: Vec<vk::Sampler>,
@@ -27,6 +31,8 @@ impl ObjectTextureSets {
         let sets = ObjectTextureSets {
             set_layout: vk::DescriptorSetLayout::null(),
             per_object: Vec::new(),
+            sets: Vec::new(),
+            set_index: Vec::new(),
             pool: vk::DescriptorPool::null(),
             images: Vec::new(),
             samplers: Vec::new(),
@@ -38,7 +44,8 @@ impl ObjectTextureSets {
         let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
         // Binding i: slot i of ObjectTextures::slots.
         let bindings: Vec<(u32, vk::DescriptorType)> = (0..TEXTURE_SLOTS as u32).map(|b| (b, sampled)).collect();
-        self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::FRAGMENT)?;
+        // Fragment shaders (per draw) and the visibility lighting (per texture set) read them.
+        self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE)?;
         for (i, t) in textures.iter().enumerate() {
             let mips = t.mips();
             let levels: Vec<Vec<&[u8]>> = mips.iter().map(|l| vec![l.as_slice()]).collect();
@@ -66,7 +73,11 @@ impl ObjectTextureSets {
                 combinations.push(o.textures);
             }
         }
-        let n = combinations.len().max(1) as u32;
+        // A scene without objects still binds a set (of stand-ins).
+        if combinations.is_empty() {
+            combinations.push(ObjectTextures::default());
+        }
+        let n = combinations.len() as u32;
         let sizes = [vk::DescriptorPoolSize { ty: sampled, descriptor_count: TEXTURE_SLOTS as u32 * n }];
         // SAFETY: valid device and create info.
         self.pool =
@@ -84,9 +95,11 @@ impl ObjectTextureSets {
                     .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
                 write_image(ctx, set, binding, sampled, info);
             }
-            by_combination.insert(combination, set);
+            by_combination.insert(combination, self.sets.len() as u32);
+            self.sets.push(set);
         }
-        self.per_object = objects.iter().map(|o| by_combination[&o.textures]).collect();
+        self.set_index = objects.iter().map(|o| by_combination[&o.textures]).collect();
+        self.per_object = self.set_index.iter().map(|&i| self.sets[i as usize]).collect();
         Ok(())
     }
 

@@ -62,6 +62,8 @@ pub struct SlotReport {
     pub max_lights: Option<u32>,
     /// Whether its light-index list was too short (some lists were cut).
     pub overflowed: bool,
+    /// What its GPU culling kept (visibility).
+    pub culling: Option<crate::report::CullStats>,
 }
 
 /// The CPU side of a frame, before it is recorded: a pass that assigns lights on the CPU

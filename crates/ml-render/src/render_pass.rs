@@ -6,7 +6,7 @@
 //! never stored — and last HDR colour, written by subpass 1 and read by the tone-map compute
 //! pass.
 
-use crate::targets::{GBufferImage, Output, COLOR_FORMAT, HDR_FORMAT};
+use crate::targets::{GBufferImage, Output, COLOR_FORMAT, HDR_FORMAT, VISIBILITY_FORMAT};
 use ml_vk::{vk, Context, VkError, VkResultExt};
 
 /// One subpass: which attachments it writes and reads.
@@ -67,7 +67,57 @@ pub fn describe(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImag
     match output {
         Output::Color | Output::GBuffer => one_subpass(depth_format, output, gbuffer),
         Output::Subpasses => two_subpasses(depth_format, gbuffer),
+        Output::Visibility => visibility(depth_format, true),
     }
+}
+
+/// The visibility raster's pass: the visibility buffer and depth, cleared by the early phase
+/// (`first`), kept by the late one. Between them the depth pyramid samples depth; after the
+/// late phase the lighting pass samples both.
+pub fn visibility(depth_format: vk::Format, first: bool) -> RenderPassDesc {
+    let colour = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+    let depth_read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+    let kept = |a: vk::AttachmentDescription, before: vk::ImageLayout| {
+        if first {
+            a
+        } else {
+            a.load_op(vk::AttachmentLoadOp::LOAD).initial_layout(before)
+        }
+    };
+    let ids_after = if first { colour } else { vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL };
+    let attachments = vec![
+        kept(attachment(VISIBILITY_FORMAT, true, ids_after), colour),
+        kept(attachment(depth_format, true, depth_read_only), depth_read_only),
+    ];
+    let subpass = Subpass {
+        colour: vec![reference(0, colour)],
+        depth: Some(reference(1, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
+        inputs: Vec::new(),
+    };
+    let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+    // The draws and their count come from the culling pass (compute writes); the vertex
+    // shader reads the scene's buffers.
+    let draws = vk::PipelineStageFlags::DRAW_INDIRECT | vk::PipelineStageFlags::VERTEX_SHADER;
+    let draws_read = vk::AccessFlags::INDIRECT_COMMAND_READ | vk::AccessFlags::SHADER_READ;
+    let dependencies = vec![
+        // The earlier frame's (or, late, the pyramid's) readers of the attachments, the culling's
+        // writes of the draws.
+        dependency(
+            (vk::SUBPASS_EXTERNAL, COLOUR_OUT | FRAGMENT_TESTS | compute, ATTACHMENT_WRITES | vk::AccessFlags::SHADER_WRITE),
+            (
+                0,
+                COLOUR_OUT | FRAGMENT_TESTS | draws,
+                ATTACHMENT_WRITES | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags::COLOR_ATTACHMENT_READ | draws_read,
+            ),
+        ),
+        // The pyramid (depth) and the lighting (both) read them in compute; the late phase
+        // loads them again.
+        dependency(
+            (0, COLOUR_OUT | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS, ATTACHMENT_WRITES),
+            (vk::SUBPASS_EXTERNAL, compute | COLOUR_OUT | FRAGMENT_TESTS, vk::AccessFlags::SHADER_READ | ATTACHMENT_WRITES),
+        ),
+    ];
+    RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
 }
 
 fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage]) -> RenderPassDesc {

@@ -141,6 +141,7 @@ impl<'a> Renderer<'a> {
             shading: self.settings.lighting(&self.scene),
             lights: &self.scene.lights,
             scene: &self.gpu,
+            source: &self.scene,
             depth_format: self.depth_format,
         };
         self.passes = assemble(self.ctx, &assembly)?;
@@ -425,6 +426,9 @@ impl<'a> Renderer<'a> {
             p.collect(f, &mut report);
         }
         self.reports[f] = report;
+        if report.culling.is_some() {
+            stats.culling = report.culling;
+        }
         if let (Some(needed), Some(max_lights)) = (report.index_entries, report.max_lights) {
             let clusters = self.settings.clusters.count();
             stats.clusters = Some(ClusterStats { mean_lights: needed as f64 / clusters as f64, max_lights, index_len: needed });

@@ -25,6 +25,27 @@ pub struct FrameStats {
     /// deferred, deferred-clustered: whether the transient G-buffer got lazily allocated
     /// memory (only devices that have such memory, i.e. tilers, give it).
     pub gbuffer_lazily_allocated: Option<bool>,
+    /// visibility: what the last frame's culling kept.
+    pub culling: Option<CullStats>,
+}
+
+/// What one frame's GPU culling tested and kept (visibility).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CullStats {
+    /// Instances (objects) tested, and those inside the frustum.
+    pub instances: u32,
+    pub visible_instances: u32,
+    /// Meshlet instances of the scene (objects × meshlets of their meshes).
+    pub meshlet_instances: u32,
+    /// Early phase: meshlets visible last frame, tested; those drawn.
+    pub early_tested: u32,
+    pub early_drawn: u32,
+    /// Late phase: every meshlet of the instances in the frustum, tested; those newly drawn.
+    pub late_tested: u32,
+    pub late_drawn: u32,
+    /// Triangles drawn (both phases), and those of every object together.
+    pub triangles: u64,
+    pub scene_triangles: u64,
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -43,6 +64,7 @@ impl FrameStats {
             overflowed_frames: 0,
             rerendered_frames: 0,
             gbuffer_lazily_allocated: None,
+            culling: None,
         }
     }
 
@@ -184,8 +206,22 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
         None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
     }
-    if technique.lights_in_subpass() || technique.lights_in_compute() {
+    if technique.geometry() == crate::settings::Geometry::Meshlets {
+        rows.push(("visibility", "4 bytes/pixel + depth (meshlet instance << 7 | triangle, u32)".to_owned()));
+    } else if technique.lights_in_subpass() || technique.lights_in_compute() {
         rows.push(("g-buffer", gbuffer_line(facts.object_textures, stats.gbuffer_lazily_allocated)));
+    }
+    if let Some(c) = stats.culling {
+        rows.push(("instances", format!("{} submitted, {} in the frustum", c.instances, c.visible_instances)));
+        rows.push((
+            "meshlets",
+            format!(
+                "{} in the scene; early: {} tested, {} drawn; late: {} tested, {} drawn",
+                c.meshlet_instances, c.early_tested, c.early_drawn, c.late_tested, c.late_drawn
+            ),
+        ));
+        let share = 100.0 * c.triangles as f64 / c.scene_triangles.max(1) as f64;
+        rows.push(("triangles", format!("{} drawn of {} ({share:.1} %)", c.triangles, c.scene_triangles)));
     }
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
@@ -249,6 +285,11 @@ pub fn device_rows(d: &DeviceInfo) -> Vec<(&'static str, String)> {
         ("maxImageArrayLayers", l.max_image_array_layers.to_string()),
         ("imageCubeArray", d.features.image_cube_array.to_string()),
         ("multiview", d.features.multiview.to_string()),
+        ("shaderOutputLayer", d.features.shader_output_layer.to_string()),
+        ("multiDrawIndirect + drawIndirectCount", d.features.indirect_count.to_string()),
+        ("sampledImageArrayDynamicIndexing", d.features.sampled_image_array_indexing.to_string()),
+        ("shaderBufferInt64Atomics", d.features.buffer_int64_atomics.to_string()),
+        ("geometryShader", d.features.geometry_shader.to_string()),
     ]
 }
 

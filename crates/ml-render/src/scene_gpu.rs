@@ -89,8 +89,9 @@ impl SceneGpu {
     /// set of stand-ins).
     pub fn replace_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), VkError> {
         self.release_objects(ctx);
-        let stand_ins = self.object_textures.per_object[0];
+        let stand_ins = self.object_textures.sets[0];
         self.object_textures.per_object = vec![stand_ins; scene.objects.len()];
+        self.object_textures.set_index = vec![0; scene.objects.len()];
         self.upload_objects(ctx, scene)
     }
 

@@ -21,16 +21,21 @@ pub enum Technique {
     DeferredClustered,
     /// clustered-gpu's lists, with the lighting as a compute pass over a G-buffer.
     DeferredCompute,
+    /// GPU-driven: meshlets culled on the GPU (frustum, back-face cones, occlusion in two
+    /// phases), drawn indirectly into a visibility buffer, lit by a compute pass through
+    /// clustered-gpu's lists.
+    Visibility,
 }
 
 impl Technique {
-    pub const ALL: [Technique; 6] = [
+    pub const ALL: [Technique; 7] = [
         Technique::Forward,
         Technique::ClusteredCpu,
         Technique::ClusteredGpu,
         Technique::Deferred,
         Technique::DeferredClustered,
         Technique::DeferredCompute,
+        Technique::Visibility,
     ];
 
     pub fn name(self) -> &'static str {
@@ -41,6 +46,7 @@ impl Technique {
             Technique::Deferred => "deferred",
             Technique::DeferredClustered => "deferred-clustered",
             Technique::DeferredCompute => "deferred-compute",
+            Technique::Visibility => "visibility",
         }
     }
 
@@ -49,7 +55,7 @@ impl Technique {
         match self {
             Technique::Forward | Technique::Deferred => LightAssignment::None,
             Technique::ClusteredCpu | Technique::DeferredClustered => LightAssignment::Cpu,
-            Technique::ClusteredGpu | Technique::DeferredCompute => LightAssignment::Gpu,
+            Technique::ClusteredGpu | Technique::DeferredCompute | Technique::Visibility => LightAssignment::Gpu,
         }
     }
 
@@ -58,7 +64,15 @@ impl Technique {
         match self {
             Technique::Forward | Technique::ClusteredCpu | Technique::ClusteredGpu => LightingStage::Forward,
             Technique::Deferred | Technique::DeferredClustered => LightingStage::Subpass,
-            Technique::DeferredCompute => LightingStage::Compute,
+            Technique::DeferredCompute | Technique::Visibility => LightingStage::Compute,
+        }
+    }
+
+    /// How the geometry reaches the pixels.
+    pub fn geometry(self) -> Geometry {
+        match self {
+            Technique::Visibility => Geometry::Meshlets,
+            _ => Geometry::Meshes,
         }
     }
 
@@ -104,6 +118,15 @@ pub enum LightingStage {
     Subpass,
     /// In a compute pass over the G-buffer.
     Compute,
+}
+
+/// How the geometry reaches the pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Geometry {
+    /// Every object's mesh drawn with one draw call from the CPU, every frame.
+    Meshes,
+    /// Meshlets culled on the GPU and drawn by indirect draws into a visibility buffer.
+    Meshlets,
 }
 
 /// constant_id of `MODEL_BLINN_PHONG` and `MODEL_PBR` in shading_model.glsl.
@@ -219,10 +242,14 @@ pub enum DebugView {
     ShadowMap,
     /// The six faces of the first shadowed point light's cube, unfolded as a cross.
     ShadowCube,
+    /// A colour per meshlet instance (visibility).
+    Meshlets,
+    /// A colour per triangle (visibility).
+    Triangles,
 }
 
 impl DebugView {
-    pub const ALL: [DebugView; 8] = [
+    pub const ALL: [DebugView; 10] = [
         DebugView::None,
         DebugView::ClusterHeat,
         DebugView::GBufferAlbedo,
@@ -231,6 +258,8 @@ impl DebugView {
         DebugView::Depth,
         DebugView::ShadowMap,
         DebugView::ShadowCube,
+        DebugView::Meshlets,
+        DebugView::Triangles,
     ];
 
     pub fn name(self) -> &'static str {
@@ -243,6 +272,8 @@ impl DebugView {
             DebugView::Depth => "depth",
             DebugView::ShadowMap => "shadow-map",
             DebugView::ShadowCube => "shadow-cube",
+            DebugView::Meshlets => "meshlets",
+            DebugView::Triangles => "triangles",
         }
     }
 
@@ -265,6 +296,8 @@ impl DebugView {
             DebugView::Depth => g::DEBUG_VIEW_DEPTH,
             DebugView::ShadowMap => g::DEBUG_VIEW_SHADOW_MAP,
             DebugView::ShadowCube => g::DEBUG_VIEW_SHADOW_CUBE,
+            DebugView::Meshlets => g::DEBUG_VIEW_MESHLETS,
+            DebugView::Triangles => g::DEBUG_VIEW_TRIANGLES,
         }
     }
 }
@@ -288,6 +321,8 @@ pub struct RenderSettings {
     pub frames: u32,
     /// Fixed animation clock; None advances it by 1/60 s per frame from 0 (deterministic).
     pub time: Option<f32>,
+    /// GPU culling of the meshlet techniques (off: every meshlet drawn, for comparisons).
+    pub culling: bool,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -308,6 +343,7 @@ impl RenderSettings {
             height,
             frames: 1,
             time: Some(0.0),
+            culling: true,
         }
     }
 
@@ -343,6 +379,20 @@ impl RenderSettings {
         // The heat view is drawn by the clustered forward fragment shader.
         if self.debug_view == DebugView::ClusterHeat && !matches!(self.technique, Technique::ClusteredCpu | Technique::ClusteredGpu) {
             return Err(SettingsError::HeatNeedsClusteredForward { technique: self.technique }.into());
+        }
+        if matches!(self.debug_view, DebugView::Meshlets | DebugView::Triangles) && self.technique.geometry() != Geometry::Meshlets {
+            return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view, technique: self.technique }.into());
+        }
+        if self.technique.geometry() == Geometry::Meshlets {
+            let f = &ctx.info.features;
+            for (has, feature) in [
+                (f.indirect_count, "multiDrawIndirect, drawIndirectFirstInstance and drawIndirectCount"),
+                (f.geometry_shader, "geometryShader (gl_PrimitiveID in fragment shaders)"),
+            ] {
+                if !has {
+                    return Err(SettingsError::TechniqueFeature { technique: self.technique, feature, device: device() }.into());
+                }
+            }
         }
         if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
             return Err(SettingsError::ShadowMapNeedsBlinnPhong.into());
@@ -427,6 +477,7 @@ pub struct SettingsRequest {
     pub height: u32,
     pub frames: u32,
     pub time: Option<f32>,
+    pub culling: bool,
 }
 
 impl SettingsRequest {
@@ -442,6 +493,7 @@ impl SettingsRequest {
             height: self.height,
             frames: self.frames,
             time: self.time,
+            culling: self.culling,
         }
     }
 }

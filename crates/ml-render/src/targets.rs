@@ -2,8 +2,8 @@
 //! buffer, the G-buffer and the HDR image of the deferred techniques. The raster passes make
 //! their framebuffers over them.
 
-use crate::settings::{LightingStage, Technique};
-use ml_vk::{vk, Context, Image, VkError};
+use crate::settings::{Geometry, LightingStage, Technique};
+use ml_vk::{vk, Buffer, Context, Image, VkError};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
@@ -66,21 +66,25 @@ pub enum Output {
     /// A G-buffer that the pass's second subpass lights into an HDR image (deferred,
     /// deferred-clustered); the G-buffer and depth live only inside the pass.
     Subpasses,
+    /// A visibility buffer (an id per pixel) and depth, which a compute pass lights
+    /// (visibility).
+    Visibility,
 }
 
 impl Output {
     pub fn of(technique: Technique) -> Output {
-        match technique.lighting_stage() {
-            LightingStage::Forward => Output::Color,
-            LightingStage::Subpass => Output::Subpasses,
-            LightingStage::Compute => Output::GBuffer,
+        match (technique.geometry(), technique.lighting_stage()) {
+            (Geometry::Meshlets, _) => Output::Visibility,
+            (Geometry::Meshes, LightingStage::Forward) => Output::Color,
+            (Geometry::Meshes, LightingStage::Subpass) => Output::Subpasses,
+            (Geometry::Meshes, LightingStage::Compute) => Output::GBuffer,
         }
     }
 
     /// Colour attachments the meshes are drawn into (subpass 0), given the G-buffer's images.
     pub fn colour_attachments(self, gbuffer: &[GBufferImage]) -> usize {
         match self {
-            Output::Color => 1,
+            Output::Color | Output::Visibility => 1,
             Output::GBuffer | Output::Subpasses => gbuffer.len(),
         }
     }
@@ -113,6 +117,35 @@ pub struct Targets {
     pub gbuffer: Vec<Image>,
     /// deferred, deferred-clustered: the lighting subpass's HDR output (null otherwise).
     pub hdr: Image,
+    /// visibility: the visibility buffer (null otherwise).
+    pub visibility: Image,
+    /// visibility: the depth pyramid of the late culling phase, level after level (null
+    /// otherwise).
+    pub depth_pyramid: Buffer,
+}
+
+/// Format of the visibility buffer: the 32-bit id (meshlets.rs).
+pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R32_UINT;
+
+/// The depth pyramid's level 0 for an image of `extent`: its size rounded up to powers of
+/// two and halved (every level then halves exactly), and the levels down to 1×1.
+/// (depth_pyramid.glsl lays it out the same way).
+pub fn depth_pyramid_shape(extent: vk::Extent2D) -> (vk::Extent2D, u32) {
+    let half = |n: u32| (n.max(2).next_power_of_two() / 2).max(1);
+    let base = vk::Extent2D { width: half(extent.width), height: half(extent.height) };
+    (base, base.width.max(base.height).ilog2() + 1)
+}
+
+/// Size of level `level` of the depth pyramid of an image of `extent`.
+pub fn depth_pyramid_level(extent: vk::Extent2D, level: u32) -> vk::Extent2D {
+    let (base, _) = depth_pyramid_shape(extent);
+    vk::Extent2D { width: (base.width >> level).max(1), height: (base.height >> level).max(1) }
+}
+
+/// Depths of every level of the pyramid together.
+pub fn depth_pyramid_len(extent: vk::Extent2D) -> u64 {
+    let (_, levels) = depth_pyramid_shape(extent);
+    (0..levels).map(|l| depth_pyramid_level(extent, l)).map(|e| e.width as u64 * e.height as u64).sum()
 }
 
 impl Targets {
@@ -122,7 +155,14 @@ impl Targets {
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
     ) -> Result<Targets, VkError> {
-        let t = Targets { color: Image::null(), depth: Image::null(), gbuffer: Vec::new(), hdr: Image::null() };
+        let t = Targets {
+            color: Image::null(),
+            depth: Image::null(),
+            gbuffer: Vec::new(),
+            hdr: Image::null(),
+            visibility: Image::null(),
+            depth_pyramid: Buffer::null(),
+        };
         ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer)))
     }
 
@@ -145,16 +185,23 @@ impl Targets {
             Output::Subpasses => {
                 (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | inside_pass, U::COLOR_ATTACHMENT | inside_pass)
             }
+            Output::Visibility => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::empty()),
         };
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
         self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
-        if output != Output::Color {
+        if matches!(output, Output::GBuffer | Output::Subpasses) {
             for g in gbuffer {
                 self.gbuffer.push(Image::new_2d(ctx, g.name, extent, g.format, gbuffer_usage, colour)?);
             }
         }
         if output == Output::Subpasses {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
+        }
+        if output == Output::Visibility {
+            self.visibility = Image::new_2d(ctx, "visibility buffer", extent, VISIBILITY_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
+            let bytes = depth_pyramid_len(extent) * 4;
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            self.depth_pyramid = Buffer::new(ctx, "depth pyramid", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
         }
         Ok(())
     }
@@ -172,6 +219,8 @@ impl Targets {
             image.destroy(ctx);
         }
         self.hdr.destroy(ctx);
+        self.visibility.destroy(ctx);
+        self.depth_pyramid.destroy(ctx);
     }
 }
 

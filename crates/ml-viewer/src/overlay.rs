@@ -77,6 +77,7 @@ impl Choices {
             height,
             frames: 1,
             time,
+            culling: true,
         }
     }
 }

@@ -63,6 +63,17 @@ pub struct OptionalFeatures {
     pub multiview: bool,
     /// shaderOutputLayer (Vulkan 1.2): a vertex shader picks the layer it draws into.
     pub shader_output_layer: bool,
+    /// multiDrawIndirect and drawIndirectFirstInstance (core 1.0) with drawIndirectCount
+    /// (Vulkan 1.2): GPU-written draw lists whose length the GPU decides (meshlet culling).
+    pub indirect_count: bool,
+    /// shaderSampledImageArrayDynamicIndexing (core 1.0): a texture array indexed by a value
+    /// the same for the whole subgroup, the way the visibility pass reads objects' textures.
+    pub sampled_image_array_indexing: bool,
+    /// shaderInt64 with shaderBufferInt64Atomics (Vulkan 1.2): 64-bit atomics on buffers.
+    pub buffer_int64_atomics: bool,
+    /// geometryShader (core 1.0): besides geometry shaders, gl_PrimitiveID in fragment
+    /// shaders (the visibility buffer's triangle index).
+    pub geometry_shader: bool,
 }
 
 impl DeviceInfo {
@@ -212,11 +223,16 @@ impl InstanceParts {
             let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v11).push_next(&mut v12);
             // SAFETY: core in 1.1+, and the device reports 1.2+.
             unsafe { self.instance.get_physical_device_features2(pd, &mut features2) };
-            let image_cube_array = features2.features.image_cube_array == vk::TRUE;
+            let core = &features2.features;
+            let on = |f: vk::Bool32| f == vk::TRUE;
             features = OptionalFeatures {
-                image_cube_array,
-                multiview: v11.multiview == vk::TRUE,
-                shader_output_layer: v12.shader_output_layer == vk::TRUE,
+                image_cube_array: on(core.image_cube_array),
+                multiview: on(v11.multiview),
+                shader_output_layer: on(v12.shader_output_layer),
+                indirect_count: on(core.multi_draw_indirect) && on(core.draw_indirect_first_instance) && on(v12.draw_indirect_count),
+                sampled_image_array_indexing: on(core.shader_sampled_image_array_dynamic_indexing),
+                buffer_int64_atomics: on(core.shader_int64) && on(v12.shader_buffer_int64_atomics),
+                geometry_shader: on(core.geometry_shader),
             };
         }
         let name = c_text(props.device_name_as_c_str());
@@ -368,9 +384,18 @@ impl Context {
         // Optional features, enabled where the device has them; the renderer checks `info.features`
         // before it needs one and refuses in one line otherwise.
         let features = info.features;
-        let core = vk::PhysicalDeviceFeatures::default().image_cube_array(features.image_cube_array);
+        let core = vk::PhysicalDeviceFeatures::default()
+            .image_cube_array(features.image_cube_array)
+            .multi_draw_indirect(features.indirect_count)
+            .draw_indirect_first_instance(features.indirect_count)
+            .shader_sampled_image_array_dynamic_indexing(features.sampled_image_array_indexing)
+            .shader_int64(features.buffer_int64_atomics)
+            .geometry_shader(features.geometry_shader);
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
-        let mut v12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(features.shader_output_layer);
+        let mut v12 = vk::PhysicalDeviceVulkan12Features::default()
+            .shader_output_layer(features.shader_output_layer)
+            .draw_indirect_count(features.indirect_count)
+            .shader_buffer_int64_atomics(features.buffer_int64_atomics);
         let extensions = if parts.surface.is_some() { vec![ash::khr::swapchain::NAME.as_ptr()] } else { Vec::new() };
         let info_create = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queues)

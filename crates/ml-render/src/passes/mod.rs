@@ -6,15 +6,23 @@ pub mod cluster_assign_cpu;
 pub mod cluster_build;
 pub mod compute_lighting;
 pub mod deferred_subpass;
+pub mod depth_pyramid;
 pub mod forward;
 pub mod gbuffer;
+pub mod meshlet_cull;
 pub mod omni_shadow;
 pub mod shadow_map_view;
 pub mod tone_map;
+pub mod visibility_lighting;
+pub mod visibility_raster;
 
 use crate::pass::Pass;
 use crate::scene_gpu::SceneGpu;
-use crate::settings::{DebugView, LightAssignment, LightingStage, RenderSettings, Shading, ShadingModel};
+use crate::meshlet_scene::MeshletScene;
+use crate::settings::{DebugView, Geometry, LightAssignment, LightingStage, RenderSettings, Shading, ShadingModel};
+use meshlet_cull::Phase;
+use ml_cpu::meshlets::SceneMeshlets;
+use ml_cpu::scene::Scene;
 use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context, VkError};
 
@@ -25,6 +33,8 @@ pub struct Assembly<'a> {
     /// The scene's lights at rest (the GPU build animates them).
     pub lights: &'a [PointLight],
     pub scene: &'a SceneGpu,
+    /// The scene as loaded (the meshlet techniques build their geometry from it).
+    pub source: &'a Scene,
     /// Depth format of the technique's raster pass.
     pub depth_format: vk::Format,
 }
@@ -57,18 +67,19 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
         LightAssignment::Cpu => passes.push(Box::<cluster_assign_cpu::CpuClusterAssign>::default()),
         LightAssignment::Gpu => passes.push(Box::new(cluster_build::ClusterBuild::new(ctx, a.lights, s.clusters.count())?)),
     }
-    match technique.lighting_stage() {
-        LightingStage::Forward => {
+    match (technique.geometry(), technique.lighting_stage()) {
+        (Geometry::Meshlets, _) => add_meshlet_passes(ctx, a, passes)?,
+        (Geometry::Meshes, LightingStage::Forward) => {
             let legend = s.debug_view == DebugView::ClusterHeat;
             passes.push(Box::new(forward::Forward::new(ctx, a.scene, raster, (clustered, legend), technique.name())?));
         }
-        LightingStage::Subpass => {
+        (Geometry::Meshes, LightingStage::Subpass) => {
             passes.push(Box::new(deferred_subpass::DeferredSubpasses::new(ctx, a.scene, raster, clustered)?));
             // pbr's curve, not for surface views (their values are shown as they are).
             let surface_view = !matches!(s.debug_view, DebugView::None | DebugView::ClusterHeat);
             passes.push(Box::new(tone_map::ToneMap::new(ctx, s.shading == ShadingModel::Pbr && !surface_view)?));
         }
-        LightingStage::Compute => {
+        (Geometry::Meshes, LightingStage::Compute) => {
             passes.push(Box::new(gbuffer::GBuffer::new(ctx, a.scene, raster)?));
             passes.push(Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?));
         }
@@ -76,5 +87,20 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     if matches!(s.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
         passes.push(Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view == DebugView::ShadowCube)?));
     }
+    Ok(())
+}
+
+/// GPU-driven geometry: early culling and raster, the depth pyramid, late culling and
+/// raster, then lighting from the visibility buffer.
+fn add_meshlet_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> Result<(), VkError> {
+    let geometry = SceneMeshlets::build(a.source).map_err(|e| VkError::Limit(e.to_string()))?;
+    let scene = MeshletScene::new(ctx, geometry, &a.scene.object_textures.set_index)?;
+    let culling = a.settings.culling;
+    passes.push(Box::new(meshlet_cull::MeshletCull::new(ctx, scene.clone(), Phase::Early, culling)?));
+    passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), Phase::Early, a.depth_format)?));
+    passes.push(Box::new(depth_pyramid::DepthPyramid::new(ctx)?));
+    passes.push(Box::new(meshlet_cull::MeshletCull::new(ctx, scene.clone(), Phase::Late, culling)?));
+    passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), Phase::Late, a.depth_format)?));
+    passes.push(Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, scene, a.shading)?));
     Ok(())
 }

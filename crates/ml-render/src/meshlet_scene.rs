@@ -1,0 +1,169 @@
+//! The scene as the GPU-driven passes draw it (technique visibility; docs/DESIGN.md#gpu-culling):
+//! the meshlet geometry, uploaded once; per frame slot, the culling's buffers (counters, the
+//! visible-instance list, the indirect draws, a read-back of the counters); and, shared by the
+//! slots, each meshlet instance's visibility at the end of the last frame (frames run in
+//! submission order, so the next frame reads what the last one wrote). The culling, raster
+//! and lighting passes share it and bind its buffers by the names the shaders give them.
+
+use crate::descriptors::Resource;
+use crate::frame::FRAMES_IN_FLIGHT;
+use gpu_allocator::MemoryLocation;
+use ml_cpu::gpu_types::CullCounters;
+use ml_cpu::meshlets::SceneMeshlets;
+use ml_vk::{vk, Buffer, Context, VkError};
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// Size of one VkDrawIndexedIndirectCommand.
+pub const DRAW_COMMAND_BYTES: u64 = 20;
+
+/// The culling's buffers of one frame slot.
+pub struct CullFrame {
+    pub counters: Buffer,
+    /// The counters, copied after the late phase for the CPU.
+    pub readback: Buffer,
+    pub visible_instances: Buffer,
+    /// Early draws from 0, late draws from `capacity` on.
+    pub draws: Buffer,
+}
+
+pub struct MeshletScene {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub meshlets: Buffer,
+    pub instances: Buffer,
+    pub meshlet_instances: Buffer,
+    /// Per meshlet instance: 1 where it was visible at the end of the last frame.
+    pub visibility: Buffer,
+    pub frames: Vec<CullFrame>,
+    /// Draws one phase may write: every meshlet instance (each is drawn at most once a frame).
+    pub capacity: u32,
+    pub instance_count: u32,
+    /// Triangles of every object together.
+    pub triangles: u64,
+}
+
+/// Shared by the passes of one technique; destroyed by whichever is destroyed first.
+pub type SharedMeshletScene = Rc<RefCell<MeshletScene>>;
+
+impl MeshletScene {
+    /// Upload `geometry`, whose instances' texture sets are `texture_sets` (per object).
+    pub fn new(ctx: &Context, mut geometry: SceneMeshlets, texture_sets: &[u32]) -> Result<SharedMeshletScene, VkError> {
+        for (instance, &set) in geometry.instances.iter_mut().zip(texture_sets) {
+            instance.surface[1] = set;
+        }
+        let s = MeshletScene {
+            vertices: Buffer::null(),
+            indices: Buffer::null(),
+            meshlets: Buffer::null(),
+            instances: Buffer::null(),
+            meshlet_instances: Buffer::null(),
+            visibility: Buffer::null(),
+            frames: Vec::new(),
+            capacity: geometry.meshlet_instances.len().max(1) as u32,
+            instance_count: geometry.instances.len() as u32,
+            triangles: geometry.triangles,
+        };
+        let made = ml_vk::build(ctx, s, |s| s.create(ctx, &geometry))?;
+        Ok(Rc::new(RefCell::new(made)))
+    }
+
+    fn create(&mut self, ctx: &Context, g: &SceneMeshlets) -> Result<(), VkError> {
+        use vk::BufferUsageFlags as U;
+        let storage = U::STORAGE_BUFFER;
+        let max = ctx.info.limits.max_storage_buffer_range as u64;
+        // Every one is bound whole as a storage buffer: larger than the device binds is an
+        // error, never a shortened scene.
+        let checked = |name: &str, bytes: u64| {
+            if bytes > max {
+                Err(VkError::Limit(format!("the scene's {name} take {} MiB, more than the {} MiB '{}' binds as one storage buffer", bytes >> 20, max >> 20, ctx.info.name)))
+            } else {
+                Ok(bytes)
+            }
+        };
+        let upload = |name: &str, data: &[u8], usage| {
+            checked(name, data.len() as u64)?;
+            Buffer::device_local_with(ctx, name, data, usage)
+        };
+        self.vertices = upload("meshlet vertices", bytemuck::cast_slice(&g.vertices), U::VERTEX_BUFFER | storage)?;
+        self.indices = upload("meshlet indices", bytemuck::cast_slice(&g.indices), U::INDEX_BUFFER | storage)?;
+        self.meshlets = upload("meshlets", bytemuck::cast_slice(&g.meshlets), storage)?;
+        self.instances = upload("instances", bytemuck::cast_slice(&g.instances), storage)?;
+        self.meshlet_instances = upload("meshlet instances", bytemuck::cast_slice(&g.meshlet_instances), storage)?;
+        // Nothing was visible before the first frame: its early phase draws nothing.
+        let bits = checked("meshlet visibility", self.capacity as u64 * 4)?;
+        self.visibility = Buffer::device_local_with(ctx, "meshlet visibility", &vec![0u8; bits as usize], storage)?;
+        let draw_bytes = checked("indirect draws", 2 * self.capacity as u64 * DRAW_COMMAND_BYTES)?;
+        for _ in 0..FRAMES_IN_FLIGHT {
+            let counter_bytes = std::mem::size_of::<CullCounters>() as u64;
+            let mut f = CullFrame { counters: Buffer::null(), readback: Buffer::null(), visible_instances: Buffer::null(), draws: Buffer::null() };
+            let made = (|| {
+                f.counters = Buffer::new(
+                    ctx,
+                    "cull counters",
+                    counter_bytes,
+                    storage | U::INDIRECT_BUFFER | U::TRANSFER_DST | U::TRANSFER_SRC,
+                    MemoryLocation::GpuOnly,
+                )?;
+                f.readback = Buffer::new(ctx, "cull counters read-back", counter_bytes, U::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+                f.visible_instances =
+                    Buffer::new(ctx, "visible instances", self.instance_count.max(1) as u64 * 4, storage, MemoryLocation::GpuOnly)?;
+                f.draws = Buffer::new(ctx, "indirect draws", draw_bytes, storage | U::INDIRECT_BUFFER, MemoryLocation::GpuOnly)?;
+                Ok(())
+            })();
+            if let Err(e) = made {
+                f.destroy(ctx);
+                return Err(e);
+            }
+            self.frames.push(f);
+        }
+        Ok(())
+    }
+
+    /// The buffer a culling, raster or lighting shader calls `name`, of slot `slot`.
+    pub fn buffer(&self, slot: usize, name: &str) -> Option<Resource> {
+        let f = &self.frames[slot];
+        let buffer = match name {
+            "VertexBuffer" => &self.vertices,
+            "MeshletIndexBuffer" => &self.indices,
+            "MeshletBuffer" => &self.meshlets,
+            "InstanceBuffer" => &self.instances,
+            "MeshletInstanceBuffer" => &self.meshlet_instances,
+            "MeshletVisibilityBuffer" => &self.visibility,
+            "VisibleInstanceBuffer" => &f.visible_instances,
+            "CullCounterBuffer" => &f.counters,
+            "DrawBuffer" => &f.draws,
+            _ => return None,
+        };
+        Some(Resource::Buffer(buffer.raw))
+    }
+
+    /// Slot `slot`'s counters as its last finished frame left them.
+    pub fn counters(&self, slot: usize) -> CullCounters {
+        bytemuck::pod_read_unaligned(&self.frames[slot].readback.mapped()[..std::mem::size_of::<CullCounters>()])
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [&mut self.vertices, &mut self.indices, &mut self.meshlets, &mut self.instances, &mut self.meshlet_instances, &mut self.visibility] {
+            b.destroy(ctx);
+        }
+        for f in &mut self.frames {
+            f.destroy(ctx);
+        }
+        self.frames.clear();
+    }
+}
+
+impl CullFrame {
+    fn destroy(&mut self, ctx: &Context) {
+        for b in [&mut self.counters, &mut self.readback, &mut self.visible_instances, &mut self.draws] {
+            b.destroy(ctx);
+        }
+    }
+}
+
+impl ml_vk::Release for MeshletScene {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}

@@ -1,0 +1,106 @@
+//! The depth pyramid of the late culling phase (depth_pyramid.comp): level 0 the early
+//! raster's depth reduced 2×2 to the farthest value, each level the one below it reduced
+//! again, a dispatch per level, into one storage buffer (a frame target, made again with the
+//! others). A buffer rather than a mipmapped image: plain loads, no per-level views, and the
+//! same answers on every driver.
+
+use crate::descriptors::{FrameSets, Resource};
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::targets::{depth_pyramid_level, depth_pyramid_shape};
+use ml_vk::commands::memory_barrier;
+use ml_vk::image::fetch_sampler;
+use ml_vk::{shader, vk, Context, VkError};
+
+const GROUP: u32 = 8;
+
+pub struct DepthPyramid {
+    sets: FrameSets,
+    sampler: vk::Sampler,
+    pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+}
+
+impl DepthPyramid {
+    pub fn new(ctx: &Context) -> Result<DepthPyramid, VkError> {
+        let shader = &ml_shaders::DEPTH_PYRAMID_COMP;
+        let p = DepthPyramid {
+            sets: FrameSets::new(ctx, &[(shader, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
+            sampler: vk::Sampler::null(),
+            pipeline_layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+        };
+        ml_vk::build(ctx, p, |p| {
+            let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(16)];
+            p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
+            p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, &[])?;
+            p.sampler = fetch_sampler(ctx)?;
+            Ok(())
+        })
+    }
+}
+
+impl Pass for DepthPyramid {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("depth pyramid")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let t = frame.targets;
+        let depth = vk::DescriptorImageInfo::default()
+            .sampler(self.sampler)
+            .image_view(t.depth.view)
+            .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        self.sets.write(ctx, frame.slot, &|name| match name {
+            "depth_image" => Some(Resource::Image(depth)),
+            "DepthPyramidBuffer" => Some(Resource::Buffer(t.depth_pyramid.raw)),
+            _ => None,
+        })
+    }
+
+    /// After the early raster (its render pass makes depth visible to compute); the late
+    /// culling reads the result.
+    fn record(&self, rec: &Recording) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let d = &ctx.device;
+        let (_, levels) = depth_pyramid_shape(rec.extent);
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        // The last frame's late culling read this slot's pyramid two frames ago.
+        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_READ), (compute, rw));
+        // SAFETY: recording state outside a render pass; everything bound is alive.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[self.sets.sets[rec.slot]], &[]);
+            for level in 0..levels {
+                if level > 0 {
+                    memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
+                }
+                let push = [level, rec.extent.width, rec.extent.height, 0];
+                d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::cast_slice(&push));
+                let size = depth_pyramid_level(rec.extent, level);
+                d.cmd_dispatch(cmd, size.width.div_ceil(GROUP), size.height.div_ceil(GROUP), 1);
+            }
+        }
+        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the device is idle; null handles are ignored.
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device.destroy_sampler(self.sampler, None);
+        }
+        self.pipeline = vk::Pipeline::null();
+        self.pipeline_layout = vk::PipelineLayout::null();
+        self.sampler = vk::Sampler::null();
+        self.sets.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for DepthPyramid {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}

@@ -1,0 +1,186 @@
+//! GPU culling of the visibility technique (docs/DESIGN.md#gpu-culling), in two phases, no
+//! CPU work per object. Early: the counters cleared, every instance tested against the frustum
+//! (instance_cull.comp), then a work group per surviving instance tests its meshlets that were
+//! visible last frame against the frustum and their back-face cones (meshlet_cull.comp) and
+//! writes an indirect draw per survivor. Late (after the early raster and the depth
+//! pyramid): every meshlet of those instances again, now also against the pyramid; the newly
+//! visible are drawn, and every meshlet's visibility is kept for the next frame. The late
+//! pass copies the counters out for the report.
+
+use crate::descriptors::{FrameSets, Resource};
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::meshlet_scene::SharedMeshletScene;
+use crate::pass::{FrameResources, Pass, Recording, SlotReport};
+use crate::report::CullStats;
+use crate::targets::depth_pyramid_shape;
+use ml_cpu::gpu_types::{CullCounters, CullPush};
+use ml_vk::commands::memory_barrier;
+use ml_vk::{shader, vk, Context, VkError};
+
+/// Work-group size of both culling shaders.
+const GROUP: u32 = 64;
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Phase {
+    Early,
+    Late,
+}
+
+pub struct MeshletCull {
+    phase: Phase,
+    culling: bool,
+    scene: SharedMeshletScene,
+    sets: FrameSets,
+    pipeline_layout: vk::PipelineLayout,
+    /// The instance test (early phase only; null in the late one).
+    instance_pipeline: vk::Pipeline,
+    meshlet_pipeline: vk::Pipeline,
+}
+
+impl MeshletCull {
+    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, culling: bool) -> Result<MeshletCull, VkError> {
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let stages = [(&ml_shaders::INSTANCE_CULL_COMP, compute), (&ml_shaders::MESHLET_CULL_COMP, compute)];
+        let pass = MeshletCull {
+            phase,
+            culling,
+            scene,
+            sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
+            pipeline_layout: vk::PipelineLayout::null(),
+            instance_pipeline: vk::Pipeline::null(),
+            meshlet_pipeline: vk::Pipeline::null(),
+        };
+        ml_vk::build(ctx, pass, |p| {
+            let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
+            p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
+            if phase == Phase::Early {
+                p.instance_pipeline = shader::compute_pipeline(ctx, ml_shaders::INSTANCE_CULL_COMP.spirv, p.pipeline_layout, &[])?;
+            }
+            p.meshlet_pipeline = shader::compute_pipeline(ctx, ml_shaders::MESHLET_CULL_COMP.spirv, p.pipeline_layout, &[])?;
+            Ok(())
+        })
+    }
+
+    fn push(&self, extent: vk::Extent2D) -> CullPush {
+        let (_, levels) = depth_pyramid_shape(extent);
+        let capacity = self.scene.borrow().capacity;
+        CullPush { mode: [u32::from(self.phase == Phase::Late), u32::from(self.culling), levels, capacity] }
+    }
+}
+
+impl Pass for MeshletCull {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some(match self.phase {
+            Phase::Early => "cull (early)",
+            Phase::Late => "cull (late)",
+        })
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let scene = self.scene.borrow();
+        self.sets.write(ctx, frame.slot, &|name| match name {
+            "DepthPyramidBuffer" => Some(Resource::Buffer(frame.targets.depth_pyramid.raw)),
+            _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
+        })
+    }
+
+    fn record(&self, rec: &Recording) {
+        let (ctx, cmd, slot) = (rec.ctx, rec.cmd, rec.slot);
+        let d = &ctx.device;
+        let scene = self.scene.borrow();
+        let f = &scene.frames[slot];
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        let push = self.push(rec.extent);
+        let set = [self.sets.sets[slot]];
+        // SAFETY: recording state outside a render pass; everything bound is alive until the
+        // frame's fence signals.
+        unsafe {
+            if self.phase == Phase::Early {
+                // This slot's buffers were last used two frames ago (draws read, counters copied),
+                // the visibility written by the last frame's late phase.
+                memory_barrier(
+                    ctx,
+                    cmd,
+                    (compute | indirect | transfer | vk::PipelineStageFlags::VERTEX_SHADER, vk::AccessFlags::SHADER_WRITE),
+                    (compute | transfer, rw | vk::AccessFlags::TRANSFER_WRITE),
+                );
+                d.cmd_fill_buffer(cmd, f.counters.raw, 0, vk::WHOLE_SIZE, 0);
+                memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
+                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
+                d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.instance_pipeline);
+                d.cmd_dispatch(cmd, scene.instance_count.div_ceil(GROUP).max(1), 1, 1);
+                memory_barrier(
+                    ctx,
+                    cmd,
+                    (compute, vk::AccessFlags::SHADER_WRITE),
+                    (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ),
+                );
+            } else {
+                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
+                d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
+            }
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.meshlet_pipeline);
+            d.cmd_dispatch_indirect(cmd, f.counters.raw, 0);
+            // The raster reads the draws and their count.
+            memory_barrier(
+                ctx,
+                cmd,
+                (compute, vk::AccessFlags::SHADER_WRITE),
+                (indirect | vk::PipelineStageFlags::VERTEX_SHADER | compute | transfer, vk::AccessFlags::INDIRECT_COMMAND_READ | rw | vk::AccessFlags::TRANSFER_READ),
+            );
+            if self.phase == Phase::Late {
+                let size = std::mem::size_of::<CullCounters>() as u64;
+                d.cmd_copy_buffer(cmd, f.counters.raw, f.readback.raw, &[vk::BufferCopy::default().size(size)]);
+                memory_barrier(
+                    ctx,
+                    cmd,
+                    (transfer, vk::AccessFlags::TRANSFER_WRITE),
+                    (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+                );
+            }
+        }
+    }
+
+    fn collect(&self, slot: usize, report: &mut SlotReport) {
+        if self.phase != Phase::Late {
+            return;
+        }
+        let scene = self.scene.borrow();
+        let c = scene.counters(slot);
+        report.culling = Some(CullStats {
+            instances: c.tested[2],
+            visible_instances: c.dispatch[0],
+            meshlet_instances: scene.capacity,
+            early_tested: c.tested[0],
+            early_drawn: c.draws[0],
+            late_tested: c.tested[1],
+            late_drawn: c.draws[1],
+            triangles: c.triangles[0] as u64 + c.triangles[1] as u64,
+            scene_triangles: scene.triangles,
+        });
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the device is idle; null handles are ignored.
+        unsafe {
+            ctx.device.destroy_pipeline(self.instance_pipeline, None);
+            ctx.device.destroy_pipeline(self.meshlet_pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+        }
+        self.instance_pipeline = vk::Pipeline::null();
+        self.meshlet_pipeline = vk::Pipeline::null();
+        self.pipeline_layout = vk::PipelineLayout::null();
+        self.sets.destroy(ctx);
+        self.scene.borrow_mut().destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for MeshletCull {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}

@@ -1,0 +1,65 @@
+//! Lighting from the visibility buffer (technique visibility; docs/DESIGN.md#visibility-buffer):
+//! per pixel the triangle the id names is fetched and interpolated, the material evaluated
+//! and the clustered light loop run, in compute. Objects' own textures are set 2, bound per
+//! texture set: a dispatch per set, each shading its objects' pixels. Its output is the colour
+//! target, left in TRANSFER_SRC_OPTIMAL like the other lighting passes'.
+
+use crate::compute_pass::ComputePass;
+use crate::descriptors::Resource;
+use crate::meshlet_scene::SharedMeshletScene;
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::scene_gpu::SceneGpu;
+use crate::settings::Shading;
+use ml_vk::{vk, Context, VkError};
+
+pub struct VisibilityLighting {
+    pass: ComputePass,
+    scene: SharedMeshletScene,
+}
+
+impl VisibilityLighting {
+    pub fn new(ctx: &Context, gpu: &SceneGpu, scene: SharedMeshletScene, shading: Shading) -> Result<VisibilityLighting, VkError> {
+        let model = shading.spec_constants();
+        let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
+        let pass = ComputePass::with_push(ctx, &more_sets, (&ml_shaders::VISIBILITY_LIGHTING_COMP, &model), 16)?;
+        Ok(VisibilityLighting { pass, scene })
+    }
+}
+
+impl Pass for VisibilityLighting {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("lighting")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let t = frame.targets;
+        let sampler = self.pass.sampler;
+        let sampled = |image: &ml_vk::Image, layout| {
+            Some(Resource::Image(vk::DescriptorImageInfo::default().sampler(sampler).image_view(image.view).image_layout(layout)))
+        };
+        let scene = self.scene.borrow();
+        self.pass.bind_frame(ctx, frame.slot, &|name| match name {
+            "depth_image" => sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            "visibility_image" => sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+            "out_image" => {
+                Some(Resource::Image(vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL)))
+            }
+            _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
+        })
+    }
+
+    /// After the late raster and the cluster build.
+    fn record(&self, rec: &Recording) {
+        let sets = &rec.scene.object_textures.sets;
+        let runs: Vec<(Vec<vk::DescriptorSet>, Vec<u8>)> = (0u32..)
+            .zip(sets)
+            .map(|(i, &set)| (vec![rec.scene.textures.set, set], bytemuck::cast_slice(&[i, 0u32, 0, 0]).to_vec()))
+            .collect();
+        self.pass.record_runs(rec.ctx, rec.cmd, rec.slot, &runs, (rec.targets.color.raw, rec.extent));
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pass.destroy(ctx);
+        self.scene.borrow_mut().destroy(ctx);
+    }
+}

@@ -1,0 +1,175 @@
+//! The visibility raster (docs/DESIGN.md#visibility-buffer): the meshlets the culling kept,
+//! one indexed draw each, from the GPU-written draw list and count (vkCmdDrawIndexedIndirectCount);
+//! per pixel the depth and a 32-bit id (visibility.frag). The early phase clears both images,
+//! the late one draws the newly visible meshlets over them.
+
+use crate::descriptors::FrameSets;
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::meshlet_scene::{SharedMeshletScene, DRAW_COMMAND_BYTES};
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::passes::meshlet_cull::Phase;
+use crate::render_pass;
+use ml_cpu::mesh::Vertex;
+use ml_vk::{shader, vk, Context, VkError, VkResultExt};
+
+pub struct VisibilityRaster {
+    phase: Phase,
+    scene: SharedMeshletScene,
+    render_pass: vk::RenderPass,
+    sets: FrameSets,
+    pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    framebuffers: Vec<vk::Framebuffer>,
+}
+
+impl VisibilityRaster {
+    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, depth_format: vk::Format) -> Result<VisibilityRaster, VkError> {
+        let (vert, frag) = (&ml_shaders::VISIBILITY_VERT, &ml_shaders::VISIBILITY_FRAG);
+        let stages = [(vert, vk::ShaderStageFlags::VERTEX), (frag, vk::ShaderStageFlags::FRAGMENT)];
+        let pass = VisibilityRaster {
+            phase,
+            scene,
+            render_pass: vk::RenderPass::null(),
+            sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
+            pipeline_layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            framebuffers: vec![vk::Framebuffer::null(); FRAMES_IN_FLIGHT],
+        };
+        ml_vk::build(ctx, pass, |p| {
+            p.render_pass = render_pass::visibility(depth_format, phase == Phase::Early).create(ctx)?;
+            p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &[])?;
+            // Positions only, from the scene's one vertex buffer.
+            let bindings = [vk::VertexInputBindingDescription::default()
+                .binding(0)
+                .stride(std::mem::size_of::<Vertex>() as u32)
+                .input_rate(vk::VertexInputRate::VERTEX)];
+            let attributes = [vk::VertexInputAttributeDescription::default()
+                .location(0)
+                .binding(0)
+                .format(vk::Format::R32G32B32_SFLOAT)
+                .offset(std::mem::offset_of!(Vertex, position) as u32)];
+            // The G-buffer pass's state: back faces culled (counter-clockwise fronts), depth LESS.
+            p.pipeline = shader::graphics_pipeline(
+                ctx,
+                &shader::GraphicsPipelineDesc {
+                    vertex: vert.spirv,
+                    fragment: Some(frag.spirv),
+                    fragment_constants: &[],
+                    vertex_input: vk::PipelineVertexInputStateCreateInfo::default()
+                        .vertex_binding_descriptions(&bindings)
+                        .vertex_attribute_descriptions(&attributes),
+                    rasterization: vk::PipelineRasterizationStateCreateInfo::default()
+                        .polygon_mode(vk::PolygonMode::FILL)
+                        .cull_mode(vk::CullModeFlags::BACK)
+                        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+                        .line_width(1.0),
+                    depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default()
+                        .depth_test_enable(true)
+                        .depth_write_enable(true)
+                        .depth_compare_op(vk::CompareOp::LESS),
+                    colour_attachments: 1,
+                    layout: p.pipeline_layout,
+                    render_pass: p.render_pass,
+                    subpass: 0,
+                },
+            )?;
+            Ok(())
+        })
+    }
+}
+
+impl Pass for VisibilityRaster {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some(match self.phase {
+            Phase::Early => "raster (early)",
+            Phase::Late => "raster (late)",
+        })
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let scene = self.scene.borrow();
+        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))?;
+        let t = frame.targets;
+        let views = [t.visibility.view, t.depth.view];
+        let info = vk::FramebufferCreateInfo::default()
+            .render_pass(self.render_pass)
+            .attachments(&views)
+            .width(t.visibility.extent.width)
+            .height(t.visibility.extent.height)
+            .layers(1);
+        // SAFETY: views and render pass are compatible and alive; the slot is not in flight.
+        unsafe {
+            ctx.device.destroy_framebuffer(self.framebuffers[frame.slot], None);
+            self.framebuffers[frame.slot] = vk::Framebuffer::null();
+            self.framebuffers[frame.slot] = ctx.device.create_framebuffer(&info, None).ctx("vkCreateFramebuffer")?;
+        }
+        Ok(())
+    }
+
+    fn record(&self, rec: &Recording) {
+        let (ctx, cmd, slot, extent) = (rec.ctx, rec.cmd, rec.slot, rec.extent);
+        let d = &ctx.device;
+        let scene = self.scene.borrow();
+        let f = &scene.frames[slot];
+        // Ids: 0 (pixels without geometry keep depth 1, which is what says so).
+        let clear = [
+            vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } },
+            vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } },
+        ];
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(self.render_pass)
+            .framebuffer(self.framebuffers[slot])
+            .render_area(area)
+            .clear_values(&clear);
+        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+        let (first_draw, count_offset) = match self.phase {
+            Phase::Early => (0, 16),
+            Phase::Late => (scene.capacity as u64 * DRAW_COMMAND_BYTES, 20),
+        };
+        // SAFETY: recording state; every handle is alive until the frame's fence signals.
+        unsafe {
+            d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_set_viewport(cmd, 0, &[viewport]);
+            d.cmd_set_scissor(cmd, 0, &[area]);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[self.sets.sets[slot]], &[]);
+            d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.raw], &[0]);
+            d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
+            d.cmd_draw_indexed_indirect_count(
+                cmd,
+                f.draws.raw,
+                first_draw,
+                f.counters.raw,
+                count_offset,
+                scene.capacity,
+                DRAW_COMMAND_BYTES as u32,
+            );
+            d.cmd_end_render_pass(cmd);
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the device is idle; null handles are ignored.
+        unsafe {
+            for fb in &mut self.framebuffers {
+                ctx.device.destroy_framebuffer(*fb, None);
+                *fb = vk::Framebuffer::null();
+            }
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device.destroy_render_pass(self.render_pass, None);
+        }
+        self.pipeline = vk::Pipeline::null();
+        self.pipeline_layout = vk::PipelineLayout::null();
+        self.render_pass = vk::RenderPass::null();
+        self.sets.destroy(ctx);
+        self.scene.borrow_mut().destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for VisibilityRaster {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}

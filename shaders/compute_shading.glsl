@@ -1,0 +1,18 @@
+// The end of both compute lighting passes (deferred_lighting.comp from the G-buffer,
+// visibility_lighting.comp from the visibility buffer): a surface point shaded — or shown
+// by a surface debug view — and stored. Needs lighting.glsl and `out_image`.
+
+#ifndef MANYLIGHTS_COMPUTE_SHADING_GLSL
+#define MANYLIGHTS_COMPUTE_SHADING_GLSL
+
+void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m) {
+    vec3 color;
+    if (debug_surface(world, n, m.albedo, m.roughness, m.metallic, color)) {
+        imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
+        return;
+    }
+    color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+    imageStore(out_image, p, vec4(encode_output(color), 1.0));
+}
+
+#endif
