@@ -9,7 +9,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0) uniform sampler2D depth_image;
 layout(std430, set = 0, binding = 1) buffer DepthPyramidBuffer { float depth_pyramid[]; };
-layout(push_constant) uniform PushBlock { uvec4 level; }; // x: the level written; yz: image size
+layout(push_constant) uniform PyramidPushBlock { uvec4 level; }; // x: the level written; yz: image size
 
 void main() {
     uvec2 image = level.yz;

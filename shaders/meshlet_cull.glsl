@@ -28,7 +28,7 @@ layout(std430, set = 0, binding = 6) writeonly buffer DrawBuffer { DrawCommand d
 layout(std430, set = 0, binding = 7) buffer MeshletVisibilityBuffer { uint meshlet_visible[]; };
 // Farthest depth over 2^(level+1) pixels a side (depth_pyramid.glsl); the late phase's test.
 layout(std430, set = 0, binding = 8) readonly buffer DepthPyramidBuffer { float depth_pyramid[]; };
-layout(push_constant) uniform PushBlock { CullPush cull; };
+layout(push_constant) uniform CullPushBlock { CullPush cull; };
 
 // Whether a world-space sphere is at least partly inside the view frustum (Vulkan clip
 // space: −w ≤ x, y ≤ w, 0 ≤ z ≤ w; the planes are rows of the view-projection).

@@ -25,7 +25,7 @@ layout(std430, set = 0, binding = 14) readonly buffer MeshletIndexBuffer { uint 
 layout(std430, set = 0, binding = 15) readonly buffer MeshletBuffer { Meshlet meshlets[]; };
 layout(std430, set = 0, binding = 16) readonly buffer MeshletInstanceBuffer { uvec2 meshlet_instances[]; };
 layout(std430, set = 0, binding = 17) readonly buffer InstanceBuffer { Instance instances[]; };
-layout(push_constant) uniform PushBlock { uvec4 texture_set; }; // x: the set this dispatch shades
+layout(push_constant) uniform ShadingSetPushBlock { uvec4 texture_set; }; // x: the set this dispatch shades
 #include "textures.glsl"
 #include "surface.glsl"
 #include "lighting.glsl"
@@ -108,13 +108,15 @@ void main() {
     vec2 frag_xy = vec2(p) + 0.5;
     vec3 b = barycentrics(c, frag_xy);
     // Texture derivatives as a fragment shader's: differences across its 2×2 quad, the
-    // triangle's attributes taken at the pixel's horizontal and vertical neighbour in the quad.
-    vec3 bx = barycentrics(c, vec2(p.x ^ 1, p.y) + 0.5);
-    vec3 by = barycentrics(c, vec2(p.x, p.y ^ 1) + 0.5);
+    // triangle's attributes taken at the quad's pixels (extrapolated where the triangle does
+    // not cover them, as helper invocations do) — the quad's first row and column, as
+    // lavapipe derives them (coarse derivatives: one pair for the whole quad).
     mat3x2 uvs = mat3x2(v[0].uv, v[1].uv, v[2].uv);
     vec2 uv = uvs * b;
-    surface_uv_dx = (uvs * bx - uv) * ((p.x & 1) == 0 ? 1.0 : -1.0);
-    surface_uv_dy = (uvs * by - uv) * ((p.y & 1) == 0 ? 1.0 : -1.0);
+    vec2 q = vec2(p & ~1) + 0.5;
+    vec2 uv00 = uvs * barycentrics(c, q);
+    surface_uv_dx = uvs * barycentrics(c, q + vec2(1.0, 0.0)) - uv00;
+    surface_uv_dy = uvs * barycentrics(c, q + vec2(0.0, 1.0)) - uv00;
     vec3 normal = mat3(o.normal_matrix) * (mat3(v[0].normal, v[1].normal, v[2].normal) * b);
     vec4 tangent = mat4(v[0].tangent, v[1].tangent, v[2].tangent, vec4(0.0)) * vec4(b, 0.0);
     tangent.xyz = mat3(o.model) * tangent.xyz;

@@ -3,7 +3,8 @@
 //! docs/DESIGN.md#mistakes-we-avoid). A field moved on either side fails here.
 
 use ml_cpu::gpu_types::{
-    ClusterBounds, ClusterFeedback, ClusterRange, FrameUniforms, GpuLayout, LightCone, ObjectData, ObjectPush, OmniShadowPush, PointLight,
+    ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, FrameUniforms, GpuLayout, Instance, LightCone, Meshlet, ObjectData,
+    ObjectPush, OmniShadowPush, PointLight,
     ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
@@ -89,6 +90,10 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<ClusterRange>(&structs);
     check::<ClusterBounds>(&structs);
     check::<ClusterFeedback>(&structs);
+    check::<Meshlet>(&structs);
+    check::<Instance>(&structs);
+    check::<CullCounters>(&structs);
+    check::<CullPush>(&structs);
 }
 
 /// Mistake 5 (docs/DESIGN.md#mistakes-we-avoid): the original demo's index list was a std140

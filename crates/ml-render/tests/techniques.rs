@@ -40,8 +40,8 @@ const MAX_DIFF_DEFERRED: u8 = 2;
 const SHADOW_OUTLIERS: usize = 8;
 const MAX_DIFF_SHADOW_OUTLIER: u8 = 32;
 
-const OTHERS: [Technique; 5] =
-    [Technique::ClusteredCpu, Technique::ClusteredGpu, Technique::Deferred, Technique::DeferredClustered, Technique::DeferredCompute];
+const OTHERS: [Technique; 6] =
+    [Technique::ClusteredCpu, Technique::ClusteredGpu, Technique::Deferred, Technique::DeferredClustered, Technique::DeferredCompute, Technique::Visibility];
 
 /// What a comparison saw, summed over scenes.
 #[derive(Default)]
