@@ -99,13 +99,16 @@ impl SceneMeshlets {
             per_mesh.push((first_meshlet, built.meshlets.len() as u32, bounding_sphere(&mesh), (mesh.indices.len() / 3) as u64));
             s.vertices.extend_from_slice(&mesh.vertices);
         }
-        let count: usize = scene.objects.iter().map(|o| per_mesh[kinds.iter().position(|&k| k == o.mesh).unwrap()].1 as usize).sum();
+        // Each object's mesh (kinds holds every object's).
+        let mesh_of: Vec<usize> =
+            scene.objects.iter().map(|o| kinds.iter().position(|&k| k == o.mesh).expect("kinds of the objects")).collect();
+        let count: usize = mesh_of.iter().map(|&m| per_mesh[m].1 as usize).sum();
         if count > MAX_MESHLET_INSTANCES {
             return Err(MeshletError::TooManyInstances { count });
         }
         s.meshlet_instances.reserve(count);
-        for (object, o) in scene.objects.iter().enumerate() {
-            let (first, n, (centre, radius), triangles) = per_mesh[kinds.iter().position(|&k| k == o.mesh).expect("kinds of the objects")];
+        for (object, (o, &m)) in scene.objects.iter().zip(&mesh_of).enumerate() {
+            let (first, n, (centre, radius), triangles) = per_mesh[m];
             let placement = Placement::of(o.transform);
             let world = o.transform.transform_point3(centre);
             s.instances.push(Instance {
@@ -137,9 +140,8 @@ impl Placement {
         let max_scale = lengths.into_iter().fold(0.0, f32::max);
         let tolerance = 1e-4 * max_scale;
         let uniform = lengths.iter().all(|l| (l - max_scale).abs() <= tolerance);
-        let orthogonal = [m.x_axis.dot(m.y_axis), m.y_axis.dot(m.z_axis), m.z_axis.dot(m.x_axis)]
-            .iter()
-            .all(|d| d.abs() <= tolerance * max_scale);
+        let orthogonal =
+            [m.x_axis.dot(m.y_axis), m.y_axis.dot(m.z_axis), m.z_axis.dot(m.x_axis)].iter().all(|d| d.abs() <= tolerance * max_scale);
         let mut flags = 0;
         if uniform && orthogonal && max_scale > 0.0 {
             flags |= INSTANCE_CONE_CULLING;
@@ -207,10 +209,12 @@ mod tests {
             let m = build(&mesh);
             let mut culled = 0;
             let p = |i: u32| Vec3::from(mesh.vertices[i as usize].position);
-            let eyes: Vec<Vec3> = (0..64).map(|i| {
-                let a = i as f32 * 2.399;
-                Vec3::new(a.cos(), (i as f32 / 32.0) - 1.0, a.sin()) * (1.5 + (i % 5) as f32)
-            }).collect();
+            let eyes: Vec<Vec3> = (0..64)
+                .map(|i| {
+                    let a = i as f32 * 2.399;
+                    Vec3::new(a.cos(), (i as f32 / 32.0) - 1.0, a.sin()) * (1.5 + (i % 5) as f32)
+                })
+                .collect();
             for meshlet in &m.meshlets {
                 let c = Vec3::from_slice(&meshlet.center_radius[..3]);
                 let [first, triangles, ..] = meshlet.triangles;
@@ -238,7 +242,9 @@ mod tests {
 
     #[test]
     fn scene_meshlets_index_one_vertex_buffer() {
-        let scene = Scene::seed(MeshKind::Teapot, crate::material::Material::named("gold").unwrap(), &crate::lights::LightParams::seed_default()).unwrap();
+        let scene =
+            Scene::seed(MeshKind::Teapot, crate::material::Material::named("gold").unwrap(), &crate::lights::LightParams::seed_default())
+                .unwrap();
         let s = SceneMeshlets::build(&scene).unwrap();
         assert_eq!(s.instances.len(), scene.objects.len());
         assert!(s.indices.iter().all(|&i| (i as usize) < s.vertices.len()));

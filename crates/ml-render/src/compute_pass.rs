@@ -4,10 +4,11 @@
 
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame::FRAMES_IN_FLIGHT;
+use crate::pass::FrameResources;
 use ml_shaders::Shader;
 use ml_vk::commands::{image_transition, memory_barrier};
 use ml_vk::image::fetch_sampler;
-use ml_vk::{shader, vk, Context, VkError};
+use ml_vk::{shader, vk, Context, Image, VkError};
 
 /// Work-group size of these passes (8×8 in the shaders).
 const GROUP: u32 = 8;
@@ -53,9 +54,16 @@ impl ComputePass {
         })
     }
 
-    /// Point slot `slot`'s set 0 at what `lookup` names.
-    pub fn bind_frame(&self, ctx: &Context, slot: usize, lookup: &dyn Fn(&str) -> Option<Resource>) -> Result<(), VkError> {
-        self.sets.write(ctx, slot, lookup)
+    /// Point slot `frame.slot`'s set 0 at the colour target (`out_image`, which every such
+    /// pass writes) and at what `lookup` names.
+    pub fn bind_frame(&self, ctx: &Context, frame: &FrameResources, lookup: &dyn Fn(&str) -> Option<Resource>) -> Result<(), VkError> {
+        let out = vk::DescriptorImageInfo::default().image_view(frame.targets.color.view).image_layout(vk::ImageLayout::GENERAL);
+        self.sets.write(ctx, frame.slot, &|name| if name == "out_image" { Some(Resource::Image(out)) } else { lookup(name) })
+    }
+
+    /// `image` in `layout`, read through this pass's fetch sampler.
+    pub fn sampled(&self, image: &Image, layout: vk::ImageLayout) -> Option<Resource> {
+        Some(Resource::Image(vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(image.view).image_layout(layout)))
     }
 
     /// Run over `extent` with slot `slot`'s set 0 and `more_sets` after it, writing `color` as a

@@ -13,7 +13,7 @@ use crate::targets::{GBufferImage, Output};
 use ml_cpu::gpu_types::{ObjectData, ObjectPush};
 use ml_cpu::scene::Object;
 use ml_shaders::Shader;
-use ml_vk::{shader, vk, Context, VkError, VkResultExt};
+use ml_vk::{shader, vk, Context, VkError};
 
 /// Background of pixels no object covers (linear, before the UNORM store).
 pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
@@ -137,19 +137,7 @@ impl MeshRaster {
         if self.output == Output::Subpasses {
             views.push(t.hdr.view);
         }
-        let info = vk::FramebufferCreateInfo::default()
-            .render_pass(self.render_pass)
-            .attachments(&views)
-            .width(t.color.extent.width)
-            .height(t.color.extent.height)
-            .layers(1);
-        // SAFETY: views and render pass are compatible and alive; the slot is not in flight.
-        unsafe {
-            ctx.device.destroy_framebuffer(self.framebuffers[frame.slot], None);
-            self.framebuffers[frame.slot] = vk::Framebuffer::null();
-            self.framebuffers[frame.slot] = ctx.device.create_framebuffer(&info, None).ctx("vkCreateFramebuffer")?;
-        }
-        Ok(())
+        render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.color.extent)
     }
 
     /// Begin the render pass (colour to the background, the G-buffer to zeros, depth to the far

@@ -76,7 +76,12 @@ impl MeshletScene {
         // error, never a shortened scene.
         let checked = |name: &str, bytes: u64| {
             if bytes > max {
-                Err(VkError::Limit(format!("the scene's {name} take {} MiB, more than the {} MiB '{}' binds as one storage buffer", bytes >> 20, max >> 20, ctx.info.name)))
+                Err(VkError::Limit(format!(
+                    "the scene's {name} take {} MiB, more than the {} MiB '{}' binds as one storage buffer",
+                    bytes >> 20,
+                    max >> 20,
+                    ctx.info.name
+                )))
             } else {
                 Ok(bytes)
             }
@@ -96,7 +101,8 @@ impl MeshletScene {
         let draw_bytes = checked("indirect draws", 2 * self.capacity as u64 * DRAW_COMMAND_BYTES)?;
         for _ in 0..FRAMES_IN_FLIGHT {
             let counter_bytes = std::mem::size_of::<CullCounters>() as u64;
-            let mut f = CullFrame { counters: Buffer::null(), readback: Buffer::null(), visible_instances: Buffer::null(), draws: Buffer::null() };
+            let mut f =
+                CullFrame { counters: Buffer::null(), readback: Buffer::null(), visible_instances: Buffer::null(), draws: Buffer::null() };
             let made = (|| {
                 f.counters = Buffer::new(
                     ctx,
@@ -144,7 +150,14 @@ impl MeshletScene {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for b in [&mut self.vertices, &mut self.indices, &mut self.meshlets, &mut self.instances, &mut self.meshlet_instances, &mut self.visibility] {
+        for b in [
+            &mut self.vertices,
+            &mut self.indices,
+            &mut self.meshlets,
+            &mut self.instances,
+            &mut self.meshlet_instances,
+            &mut self.visibility,
+        ] {
             b.destroy(ctx);
         }
         for f in &mut self.frames {

@@ -208,6 +208,32 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage]) -> RenderPa
     RenderPassDesc { attachments, subpasses, dependencies }
 }
 
+/// Replace `framebuffer` (destroyed; null while a new one is made, so a failure leaves
+/// nothing to destroy twice) by one of `render_pass` over `views`, `extent` large. Only while
+/// no frame that uses it is in flight.
+pub fn replace_framebuffer(
+    ctx: &Context,
+    framebuffer: &mut vk::Framebuffer,
+    render_pass: vk::RenderPass,
+    views: &[vk::ImageView],
+    extent: vk::Extent2D,
+) -> Result<(), VkError> {
+    let info = vk::FramebufferCreateInfo::default()
+        .render_pass(render_pass)
+        .attachments(views)
+        .width(extent.width)
+        .height(extent.height)
+        .layers(1);
+    // SAFETY: the caller's views and render pass are compatible and alive; the old framebuffer
+    // is not in use.
+    unsafe {
+        ctx.device.destroy_framebuffer(*framebuffer, None);
+        *framebuffer = vk::Framebuffer::null();
+        *framebuffer = ctx.device.create_framebuffer(&info, None).ctx("vkCreateFramebuffer")?;
+    }
+    Ok(())
+}
+
 impl RenderPassDesc {
     pub fn create(&self, ctx: &Context) -> Result<vk::RenderPass, VkError> {
         let subpasses: Vec<vk::SubpassDescription> = self

@@ -29,7 +29,8 @@ fn walled_scene() -> Scene {
     scene.objects = scene.objects.into_iter().step_by(3).collect();
     for i in 0..3 {
         let z = -5.0 + 5.0 * i as f32 + 1.25;
-        let transform = Mat4::from_scale_rotation_translation(Vec3::new(6.0, 1.5, 0.1), Quat::IDENTITY, Vec3::new(-2.0 + 2.0 * i as f32, 0.5, z));
+        let transform =
+            Mat4::from_scale_rotation_translation(Vec3::new(6.0, 1.5, 0.1), Quat::IDENTITY, Vec3::new(-2.0 + 2.0 * i as f32, 0.5, z));
         scene.objects.push(Object { transform, ..Object::placed(MeshKind::Cube, Vec3::ZERO, 1.0, Material::named("white").unwrap()) });
     }
     scene

@@ -3,9 +3,8 @@
 //! docs/DESIGN.md#mistakes-we-avoid). A field moved on either side fails here.
 
 use ml_cpu::gpu_types::{
-    ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, FrameUniforms, GpuLayout, Instance, LightCone, Meshlet, ObjectData,
-    ObjectPush, OmniShadowPush, PointLight,
-    ShadowPush, StageProbePush,
+    ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, FrameUniforms, GpuLayout, Instance, LightCone, Meshlet,
+    ObjectData, ObjectPush, OmniShadowPush, PointLight, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;

@@ -40,8 +40,14 @@ const MAX_DIFF_DEFERRED: u8 = 2;
 const SHADOW_OUTLIERS: usize = 8;
 const MAX_DIFF_SHADOW_OUTLIER: u8 = 32;
 
-const OTHERS: [Technique; 6] =
-    [Technique::ClusteredCpu, Technique::ClusteredGpu, Technique::Deferred, Technique::DeferredClustered, Technique::DeferredCompute, Technique::Visibility];
+const OTHERS: [Technique; 6] = [
+    Technique::ClusteredCpu,
+    Technique::ClusteredGpu,
+    Technique::Deferred,
+    Technique::DeferredClustered,
+    Technique::DeferredCompute,
+    Technique::Visibility,
+];
 
 /// What a comparison saw, summed over scenes.
 #[derive(Default)]

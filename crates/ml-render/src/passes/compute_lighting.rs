@@ -5,7 +5,6 @@
 //! like the forward pass's.
 
 use crate::compute_pass::ComputePass;
-use crate::descriptors::Resource;
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Shading;
@@ -32,15 +31,9 @@ impl Pass for ComputeLighting {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let t = frame.targets;
-        let sampler = self.pass.sampler;
-        let sampled = |image: &ml_vk::Image, layout| {
-            Some(Resource::Image(vk::DescriptorImageInfo::default().sampler(sampler).image_view(image.view).image_layout(layout)))
-        };
-        self.pass.bind_frame(ctx, frame.slot, &|name| match name {
+        let sampled = |image, layout| self.pass.sampled(image, layout);
+        self.pass.bind_frame(ctx, frame, &|name| match name {
             "depth_image" => sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-            "out_image" => {
-                Some(Resource::Image(vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL)))
-            }
             // A G-buffer without the material and emissive images (a scene without object
             // textures) binds the albedo image in their place: the shader, specialised for such
             // scenes, never reads them, but Vulkan wants every binding it names written.

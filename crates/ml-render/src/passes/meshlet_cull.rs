@@ -130,7 +130,10 @@ impl Pass for MeshletCull {
                 ctx,
                 cmd,
                 (compute, vk::AccessFlags::SHADER_WRITE),
-                (indirect | vk::PipelineStageFlags::VERTEX_SHADER | compute | transfer, vk::AccessFlags::INDIRECT_COMMAND_READ | rw | vk::AccessFlags::TRANSFER_READ),
+                (
+                    indirect | vk::PipelineStageFlags::VERTEX_SHADER | compute | transfer,
+                    vk::AccessFlags::INDIRECT_COMMAND_READ | rw | vk::AccessFlags::TRANSFER_READ,
+                ),
             );
             if self.phase == Phase::Late {
                 let size = std::mem::size_of::<CullCounters>() as u64;

@@ -16,14 +16,14 @@ pub mod tone_map;
 pub mod visibility_lighting;
 pub mod visibility_raster;
 
+use crate::meshlet_scene::MeshletScene;
 use crate::pass::Pass;
 use crate::scene_gpu::SceneGpu;
-use crate::meshlet_scene::MeshletScene;
 use crate::settings::{DebugView, Geometry, LightAssignment, LightingStage, RenderSettings, Shading, ShadingModel};
 use meshlet_cull::Phase;
+use ml_cpu::gpu_types::PointLight;
 use ml_cpu::meshlets::SceneMeshlets;
 use ml_cpu::scene::Scene;
-use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context, VkError};
 
 /// What the passes of a technique are made for.

@@ -2,10 +2,9 @@
 //! light's cube, unfolded as a cross) over whatever the technique drew. Untimed.
 
 use crate::compute_pass::ComputePass;
-use crate::descriptors::Resource;
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::scene_gpu::SceneGpu;
-use ml_vk::{vk, Context, VkError};
+use ml_vk::{Context, VkError};
 
 pub struct ShadowMapView {
     pass: ComputePass,
@@ -26,8 +25,7 @@ impl Pass for ShadowMapView {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        let out = vk::DescriptorImageInfo::default().image_view(frame.targets.color.view).image_layout(vk::ImageLayout::GENERAL);
-        self.pass.bind_frame(ctx, frame.slot, &|name| (name == "out_image").then_some(Resource::Image(out)))
+        self.pass.bind_frame(ctx, frame, &|_| None)
     }
 
     fn record(&self, rec: &Recording) {

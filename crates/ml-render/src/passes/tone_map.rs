@@ -3,7 +3,6 @@
 //! (tonemap.comp). A compute pass: on H100/H200 it runs on every SM.
 
 use crate::compute_pass::ComputePass;
-use crate::descriptors::Resource;
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::settings::SPEC_PBR;
 use ml_vk::{vk, Context, VkError};
@@ -27,18 +26,8 @@ impl Pass for ToneMap {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        let t = frame.targets;
-        let sampler = self.pass.sampler;
-        self.pass.bind_frame(ctx, frame.slot, &|name| {
-            Some(Resource::Image(match name {
-                "hdr_image" => vk::DescriptorImageInfo::default()
-                    .sampler(sampler)
-                    .image_view(t.hdr.view)
-                    .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
-                "out_image" => vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL),
-                _ => return None,
-            }))
-        })
+        let hdr = self.pass.sampled(&frame.targets.hdr, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+        self.pass.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { None })
     }
 
     /// After the render pass, whose outgoing dependency orders the HDR writes before this

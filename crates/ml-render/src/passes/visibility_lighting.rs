@@ -5,7 +5,6 @@
 //! target, left in TRANSFER_SRC_OPTIMAL like the other lighting passes'.
 
 use crate::compute_pass::ComputePass;
-use crate::descriptors::Resource;
 use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::scene_gpu::SceneGpu;
@@ -33,17 +32,10 @@ impl Pass for VisibilityLighting {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let t = frame.targets;
-        let sampler = self.pass.sampler;
-        let sampled = |image: &ml_vk::Image, layout| {
-            Some(Resource::Image(vk::DescriptorImageInfo::default().sampler(sampler).image_view(image.view).image_layout(layout)))
-        };
         let scene = self.scene.borrow();
-        self.pass.bind_frame(ctx, frame.slot, &|name| match name {
-            "depth_image" => sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-            "visibility_image" => sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
-            "out_image" => {
-                Some(Resource::Image(vk::DescriptorImageInfo::default().image_view(t.color.view).image_layout(vk::ImageLayout::GENERAL)))
-            }
+        self.pass.bind_frame(ctx, frame, &|name| match name {
+            "depth_image" => self.pass.sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            "visibility_image" => self.pass.sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
             _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
         })
     }

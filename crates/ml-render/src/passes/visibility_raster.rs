@@ -9,8 +9,9 @@ use crate::meshlet_scene::{SharedMeshletScene, DRAW_COMMAND_BYTES};
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::passes::meshlet_cull::Phase;
 use crate::render_pass;
+use ml_cpu::gpu_types::CullCounters;
 use ml_cpu::mesh::Vertex;
-use ml_vk::{shader, vk, Context, VkError, VkResultExt};
+use ml_vk::{shader, vk, Context, VkError};
 
 pub struct VisibilityRaster {
     phase: Phase,
@@ -91,19 +92,7 @@ impl Pass for VisibilityRaster {
         self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))?;
         let t = frame.targets;
         let views = [t.visibility.view, t.depth.view];
-        let info = vk::FramebufferCreateInfo::default()
-            .render_pass(self.render_pass)
-            .attachments(&views)
-            .width(t.visibility.extent.width)
-            .height(t.visibility.extent.height)
-            .layers(1);
-        // SAFETY: views and render pass are compatible and alive; the slot is not in flight.
-        unsafe {
-            ctx.device.destroy_framebuffer(self.framebuffers[frame.slot], None);
-            self.framebuffers[frame.slot] = vk::Framebuffer::null();
-            self.framebuffers[frame.slot] = ctx.device.create_framebuffer(&info, None).ctx("vkCreateFramebuffer")?;
-        }
-        Ok(())
+        render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.visibility.extent)
     }
 
     fn record(&self, rec: &Recording) {
@@ -122,10 +111,13 @@ impl Pass for VisibilityRaster {
             .framebuffer(self.framebuffers[slot])
             .render_area(area)
             .clear_values(&clear);
-        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+        let viewport =
+            vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
+        // CullCounters.draws: x early, y late.
+        let draws = std::mem::offset_of!(CullCounters, draws) as u64;
         let (first_draw, count_offset) = match self.phase {
-            Phase::Early => (0, 16),
-            Phase::Late => (scene.capacity as u64 * DRAW_COMMAND_BYTES, 20),
+            Phase::Early => (0, draws),
+            Phase::Late => (scene.capacity as u64 * DRAW_COMMAND_BYTES, draws + 4),
         };
         // SAFETY: recording state; every handle is alive until the frame's fence signals.
         unsafe {
