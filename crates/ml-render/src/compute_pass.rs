@@ -5,8 +5,7 @@
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame::FRAMES_IN_FLIGHT;
 use ml_shaders::Shader;
-use ml_vk::commands::image_transition;
-use ml_vk::image::fetch_sampler;
+use ml_vk::image::{fetch_sampler, image_transition};
 use ml_vk::{shader, vk, Context, VkError};
 
 /// Work-group size of these passes (8×8 in the shaders).

@@ -8,7 +8,8 @@
 use crate::report::Spread;
 use crate::settings::Technique;
 use ml_cpu::gpu_types::{PointLight, StageProbePush};
-use ml_vk::commands::{copy_colour_to_host, image_transition, one_shot};
+use ml_vk::commands::{copy_colour_to_host, one_shot};
+use ml_vk::image::image_transition;
 use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
 use ml_vk::{shader, vk, Buffer, Context, GpuTimer, Image, MemoryLocation, VkError, VkResultExt};
 use std::time::Instant;
