@@ -72,8 +72,8 @@ struct ViewArgs {
 struct SceneArgs {
     /// Scene to render: seed (built in), room (a closed room with a pillar and one point light,
     /// for point-light shadows), bench (a floor, 300 objects, --lights N (default 1024) lights
-    /// whose radius shrinks as N^(−1/3): the benchmark's), a scene file FILE.toml (README:
-    /// "Scene files") or a glTF 2.0 file FILE.gltf|FILE.glb (rendered with pbr unless
+    /// whose radius shrinks as N^(−1/3): the benchmark's), a scene file FILE.toml
+    /// (docs/scenes.md) or a glTF 2.0 file FILE.gltf|FILE.glb (rendered with pbr unless
     /// --shading says otherwise).
     #[arg(long, default_value = "seed")]
     scene: String,
@@ -84,8 +84,9 @@ struct SceneArgs {
     /// deferred-clustered.
     #[arg(long, default_value = "forward")]
     technique: String,
-    /// Shading model: seed (seed 000's Cook–Torrance), blinn-phong (seed 002: shadowed sun,
-    /// spot light, textures, normal maps, sky reflections) or pbr (seed's specular + Lambert
+    /// Shading model: seed (specular-only Cook–Torrance: GGX, Schlick–Smith, Schlick Fresnel),
+    /// blinn-phong (Lambert + normalised Blinn-Phong with a shadowed sun, a spot light,
+    /// textures, normal maps and sky reflections) or pbr (the seed model's specular + Lambert
     /// diffuse, ACES tone map). Default: the scene file's [shading] model, else seed.
     #[arg(long)]
     shading: Option<String>,
@@ -119,9 +120,10 @@ struct SceneArgs {
     /// Light radius R, or MIN..MAX for radii drawn per light.
     #[arg(long, default_value = "15")]
     light_radius: String,
-    /// Point-light shadows (seed 003): off, or how the cubes are rendered — copy (seed 003:
-    /// each face offscreen, then copied into the cube), direct (each face into its cube
-    /// layer) or multiview (all six faces in one pass).
+    /// Point-light shadows through cube maps: off, or how the cubes are rendered — copy (each
+    /// face offscreen, then copied into its cube layer), direct (each face into its cube
+    /// layer), multiview (all six faces in one pass) or layered (one pass, each face an
+    /// instance writing its layer).
     #[arg(long, default_value = "off")]
     omni_shadow: String,
     /// How many point lights cast shadows (the strongest as seen from the camera).

@@ -7,6 +7,7 @@ use ml_cpu::scene_request::SceneRequestError;
 use ml_cpu::SceneError;
 use ml_render::error::{Named, Setting, SettingsError};
 use ml_render::RenderError;
+use ml_vk::VkError;
 use std::error::Error;
 
 /// The error and its causes in one line, as anyhow's `{:#}` writes it, each cause that is
@@ -21,6 +22,10 @@ fn with_flags(cause: &(dyn Error + 'static)) -> Option<String> {
         return match e {
             RenderError::Scene(e) => scene(e),
             RenderError::Settings(e) => Some(settings(e)),
+            RenderError::Vulkan(e) => vulkan(e),
+            RenderError::ListsTooLong(e) => {
+                Some(format!("{e}: use fewer --lights or a smaller --light-radius, or a coarser --clusters grid"))
+            }
             RenderError::UnknownName { kind: Named::OmniShadowMode, name, expected } => {
                 Some(format!("unknown --omni-shadow mode '{name}': expected one of {expected}"))
             }
@@ -33,7 +38,19 @@ fn with_flags(cause: &(dyn Error + 'static)) -> Option<String> {
     if let Some(e) = cause.downcast_ref::<SettingsError>() {
         return Some(settings(e));
     }
+    if let Some(e) = cause.downcast_ref::<VkError>() {
+        return vulkan(e);
+    }
     cause.downcast_ref::<SceneError>().and_then(scene)
+}
+
+fn vulkan(e: &VkError) -> Option<String> {
+    match e {
+        VkError::DeviceIndex { index, count } => {
+            Some(format!("--device {index} does not exist: {count} Vulkan device(s) found (see `manylights info`)"))
+        }
+        _ => None,
+    }
 }
 
 fn scene(e: &SceneError) -> Option<String> {
@@ -96,6 +113,14 @@ mod tests {
         assert_eq!(describe(&e), "--width 0 is out of range: use 1 to 9");
         let e = anyhow::Error::from(SceneError::LightCount(0)).context("bench");
         assert_eq!(describe(&e), format!("bench: --lights 0 is out of range: use 1 to {MAX_LIGHTS}"));
+        let e = anyhow::Error::from(ml_vk::VkError::DeviceIndex { index: 3, count: 1 });
+        assert_eq!(describe(&e), "--device 3 does not exist: 1 Vulkan device(s) found (see `manylights info`)");
+        let lists = ml_render::error::ListsTooLong { needed: 1 << 20, limit: 1 << 18, holder: "'gpu' binds as one storage buffer".into() };
+        let e = anyhow::Error::from(RenderError::ListsTooLong(lists));
+        assert_eq!(
+            describe(&e),
+            "the cluster light lists need at least 1048576 entries (4 MiB), more than the 1 MiB 'gpu' binds as one storage buffer: use fewer --lights or a smaller --light-radius, or a coarser --clusters grid"
+        );
         let e = anyhow::Error::from(SettingsError::ShadowsWithoutLights);
         assert_eq!(describe(&e), "point-light shadows need point lights, and the scene has none (--lights N adds some)");
         // Errors about no flag read as the library wrote them.

@@ -1,4 +1,4 @@
-//! `manylights bench` (issue 9, acceptance 1): a tiny run — 2 techniques × 2 light counts,
+//! `manylights bench` (docs/usage.md#bench-the-benchmark-harness): a tiny run — 2 techniques × 2 light counts,
 //! 64×64, 5 frames — on lavapipe with validation writes results.csv and results.json with
 //! every column and a row per pass and the results.png plot, and a combination over the time budget is skipped with
 //! its reason instead of run.

@@ -1,8 +1,7 @@
 //! `manylights view` under a virtual X server (Xvfb, installed by scripts/setup.sh) on
-//! lavapipe, with validation and synchronization validation on (issue 8): a scripted session
-//! — frames, a technique switch, a new light count, 20 resizes, minimise/restore, screenshots,
-//! quit — runs without a message, and its screenshot equals `manylights render` of the same
-//! settings.
+//! lavapipe, with validation and synchronization validation on: a scripted session — frames, a
+//! technique switch, a new light count, 20 resizes, minimise/restore, screenshots, quit — runs
+//! without a message, and its screenshot equals `manylights render` of the same settings.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -1,4 +1,4 @@
-//! The benchmark scene (`--scene bench`, issue 9): a large floor with a few hundred objects of
+//! The benchmark scene (`--scene bench`, docs/scenes.md#bench): a large floor with a few hundred objects of
 //! mixed kinds and sizes, and N lights spread uniformly through the random-layout box with a
 //! radius that shrinks as N^(−1/3), so that a point is reached by about the same number of
 //! lights at every N: cost against N then shows the algorithm, not the light density.

@@ -1,4 +1,4 @@
-//! The lights of seed 002's model (`--shading blinn-phong`) besides the point lights: one
+//! The lights of the blinn-phong model (`--shading blinn-phong`) besides the point lights: one
 //! directional light with a shadow map, one spot light, an ambient colour, and the transform
 //! of the texture coordinates (the seed's `matTransform`).
 

@@ -1,5 +1,5 @@
-//! Camera (SPEC §6): right-handed, +Y up, view looks down −Z, Vulkan clip space with Y flipped
-//! in the projection (seeds 001/004) and depth 0..1; perspective, or orthographic (glTF).
+//! Camera (docs/DESIGN.md#conventions): right-handed, +Y up, view looks down −Z, Vulkan clip
+//! space with Y flipped in the projection and depth 0..1; perspective, or orthographic (glTF).
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -19,8 +19,8 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// The seed's first-person camera, 62.5° down towards the grid. Seed 000 calls
-    /// `setPosition(10, 13, 1.8)`, but its framework stores the negated eye position
+    /// The seed scene's first-person camera, 62.5° down towards the grid. The demo it comes
+    /// from calls `setPosition(10, 13, 1.8)`, but its framework stores the negated eye position
     /// (`camPos = camera.position * -1`) in a Y-down world; in our +Y-up world the eye is at
     /// (−10, 13, −1.8), facing +X.
     pub fn seed() -> Camera {

@@ -1,9 +1,9 @@
-//! Omnidirectional point-light shadows (SPEC §4, seed 003), the CPU half: the six cube-face
-//! cameras of a light and which lights get a shadow cube. The faces follow seed 003's list
-//! (+X up −Y, −X up −Y, +Y up +Z, −Y up −Z, +Z up −Y, −Z up −Y): with them, and a 90°
-//! projection whose NDC y runs down the framebuffer (Vulkan rows), the texel a face renders a
-//! direction into is the texel cube sampling fetches for that direction (tested against
-//! `textures::cube_direction`, Vulkan's cube-map convention).
+//! Omnidirectional point-light shadows (docs/DESIGN.md#point-light-shadows), the CPU half: the
+//! six cube-face cameras of a light and which lights get a shadow cube. The faces follow
+//! Vulkan's cube layout (+X up −Y, −X up −Y, +Y up +Z, −Y up −Z, +Z up −Y, −Z up −Y): with
+//! them, and a 90° projection whose NDC y runs down the framebuffer (Vulkan rows), the texel a
+//! face renders a direction into is the texel cube sampling fetches for that direction (tested
+//! against `textures::cube_direction`, Vulkan's cube-map convention).
 
 use crate::gpu_types::PointLight;
 use crate::mesh::MeshKind;

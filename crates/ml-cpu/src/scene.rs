@@ -149,7 +149,7 @@ pub struct DirectionalLight {
 }
 
 impl Scene {
-    /// The built-in `seed` scene (SPEC §1): a 7×7 grid of one object kind at
+    /// The built-in `seed` scene (docs/DESIGN.md#the-seed-scene): a 7×7 grid of one object kind at
     /// x,z = (i − 3.5)·2.5, y = 0, in one material.
     pub fn seed(mesh: MeshKind, material: Material, lights: &LightParams) -> Result<Scene, SceneError> {
         let mut objects = Vec::with_capacity(49);
@@ -179,7 +179,7 @@ impl Scene {
         }
     }
 
-    /// Seed 002's setting for the seed scene: the same grid standing on a floor (which
+    /// The seed scene as the blinn-phong model shows it: the same grid standing on a floor (which
     /// receives the sun's shadows), for the blinn-phong model.
     pub fn with_floor(mut self) -> Scene {
         let floor = Material { albedo: Vec3::splat(0.8), roughness: 0.7, metallic: 0.0 };
@@ -190,7 +190,7 @@ impl Scene {
         self
     }
 
-    /// SPEC §4's point-light shadow scene (`--scene room`): a closed room 10 m across, a
+    /// The point-light shadow scene (`--scene room`): a closed room 10 m across, a
     /// 1×3×1 m pillar of three cubes on its floor, one white point light reaching every
     /// corner, a camera in a corner looking past the pillar. For the lit shading models
     /// (pbr, blinn-phong): the seed model's walls show little besides highlights.

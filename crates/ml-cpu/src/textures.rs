@@ -1,6 +1,6 @@
-//! Procedural textures of the blinn-phong model's built-in scene (seed 002 used image files;
-//! we ship none): an albedo of tiles, a normal map of round bumps, and a sky cubemap for the
-//! environment reflection. RGBA8, every mip level made here (box filter).
+//! Procedural textures of the blinn-phong model's built-in scene (made by code, so the
+//! repository ships no image files): an albedo of tiles, a normal map of round bumps, and a sky
+//! cubemap for the environment reflection. RGBA8, every mip level made here (box filter).
 
 use glam::{Vec2, Vec3};
 

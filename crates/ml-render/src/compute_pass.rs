@@ -6,8 +6,8 @@ use crate::descriptors::{FrameSets, Resource};
 use crate::frame::FRAMES_IN_FLIGHT;
 use crate::pass::FrameResources;
 use ml_shaders::Shader;
-use ml_vk::commands::{image_transition, memory_barrier};
-use ml_vk::image::fetch_sampler;
+use ml_vk::commands::memory_barrier;
+use ml_vk::image::{fetch_sampler, image_transition};
 use ml_vk::{shader, vk, Context, Image, VkError};
 
 /// Work-group size of these passes (8×8 in the shaders).

@@ -12,8 +12,25 @@ pub enum RenderError {
     /// A name that is none of `kind`'s; `expected` lists them.
     #[error("unknown {kind} '{name}': expected one of {expected}")]
     UnknownName { kind: Named, name: String, expected: String },
+    #[error("{0}: use fewer or smaller lights, or a coarser cluster grid")]
+    ListsTooLong(ListsTooLong),
     #[error("{0}")]
     Invalid(String),
+}
+
+/// Cluster light lists longer than what `holder` can take: `needed` entries against `limit`.
+#[derive(Debug, Error, PartialEq)]
+#[error("the cluster light lists need at least {needed} entries ({} MiB), more than the {} MiB {holder}", mib(*needed), mib(*limit))]
+pub struct ListsTooLong {
+    pub needed: usize,
+    pub limit: usize,
+    /// What the limit is, in words ("'lavapipe' binds as one storage buffer").
+    pub holder: String,
+}
+
+/// MiB of `entries` light indices (4 bytes each), rounded down.
+fn mib(entries: usize) -> u64 {
+    (entries as u64 * 4) >> 20
 }
 
 /// What a name given to `from_name` was meant to be.

@@ -3,6 +3,7 @@
 //! timer and its render targets. The passes point their own per-frame sets at these. Cluster
 //! buffers grow when a frame needs more; nothing is ever dropped.
 
+use crate::error::{ListsTooLong, RenderError};
 use crate::pass::{FrameResources, ListUpload};
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
@@ -107,7 +108,7 @@ impl FrameInFlight {
     /// (maxStorageBufferRange) is an error, never a silently shortened list. Returns whether
     /// it grew (the passes must then be bound to it again). Call only after the frame's fence
     /// has signalled.
-    pub fn ensure_index_capacity(&mut self, ctx: &Context, needed: usize) -> Result<bool, VkError> {
+    pub fn ensure_index_capacity(&mut self, ctx: &Context, needed: usize) -> Result<bool, RenderError> {
         if needed <= self.index_capacity() {
             return Ok(false);
         }
@@ -142,12 +143,8 @@ pub fn max_index_entries(ctx: &Context) -> usize {
 }
 
 /// The error for light lists longer than `limit` entries, which is what `holder` can take.
-pub fn lists_too_long(needed: usize, limit: usize, holder: &str) -> VkError {
-    VkError::Limit(format!(
-        "the cluster light lists need at least {needed} entries ({} MiB), more than the {} MiB {holder}: use fewer or smaller lights, or a coarser --clusters grid",
-        (needed as u64 * 4) >> 20,
-        (limit as u64 * 4) >> 20
-    ))
+pub fn lists_too_long(needed: usize, limit: usize, holder: &str) -> RenderError {
+    RenderError::ListsTooLong(ListsTooLong { needed, limit, holder: holder.into() })
 }
 
 impl ml_vk::Release for FrameInFlight {
@@ -164,7 +161,7 @@ pub struct SlotLists<'a> {
 
 impl ListUpload for SlotLists<'_> {
     /// Copy the lists into the slot's buffers, growing the index buffer when it is too small.
-    fn upload(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<(), VkError> {
+    fn upload(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<(), RenderError> {
         self.grew |= self.frame.ensure_index_capacity(ctx, lists.indices.len())?;
         self.frame.cluster_ranges.write(0, &lists.ranges);
         self.frame.light_indices.write(0, &lists.indices);

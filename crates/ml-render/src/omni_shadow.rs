@@ -17,7 +17,7 @@ use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
 use ml_cpu::omni_shadow::{face_view_proj, sphere_faces};
 use ml_cpu::scene::Object;
-use ml_vk::commands::{aspect_transition, StageAccessLayout};
+use ml_vk::image::{aspect_transition, full_range, StageAccessLayout};
 use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 
 /// The cube's depth format: 32-bit float, which holds distance / radius to 2⁻²⁴.
@@ -318,13 +318,7 @@ fn clear_stand_in(ctx: &Context, cubes: &Image) -> Result<(), VkError> {
         let clear = vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 };
         // SAFETY: recording state; the image is in TRANSFER_DST_OPTIMAL.
         unsafe {
-            ctx.device.cmd_clear_depth_stencil_image(
-                cmd,
-                cubes.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &clear,
-                &[ml_vk::image::full_range(DEPTH)],
-            )
+            ctx.device.cmd_clear_depth_stencil_image(cmd, cubes.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &clear, &[full_range(DEPTH)])
         };
         transition(
             ctx,

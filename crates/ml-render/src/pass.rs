@@ -4,6 +4,7 @@
 //! framebuffers) and rewrites them when a frame slot's buffers or targets change.
 
 use crate::descriptors::Resource;
+use crate::error::RenderError;
 use crate::omni_shadow::ShadowedLight;
 use crate::scene_gpu::SceneGpu;
 use crate::targets::Targets;
@@ -79,7 +80,7 @@ pub struct Update<'a> {
 
 /// Where a CPU assignment's lists go: the frame slot's buffers.
 pub trait ListUpload {
-    fn upload(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<(), VkError>;
+    fn upload(&mut self, ctx: &Context, lists: &ClusterLists) -> Result<(), RenderError>;
     /// The most entries the slot's list may ever hold (what the device binds).
     fn max_entries(&self, ctx: &Context) -> usize;
 }
@@ -98,7 +99,7 @@ pub trait Pass {
 
     /// CPU work of a frame before it is recorded (lights assigned on the CPU); returns its
     /// milliseconds where it did some.
-    fn update(&mut self, _update: &mut Update) -> Result<Option<(f64, ml_cpu::cluster::ClusterStats)>, VkError> {
+    fn update(&mut self, _update: &mut Update) -> Result<Option<(f64, ml_cpu::cluster::ClusterStats)>, RenderError> {
         Ok(None)
     }
 

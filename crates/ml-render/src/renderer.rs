@@ -451,7 +451,7 @@ impl<'a> Renderer<'a> {
 
     /// Write slot `f`'s buffers for clock `t`; the milliseconds of CPU light assignment in it
     /// (None where the CPU does not assign).
-    fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, VkError> {
+    fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, RenderError> {
         let ctx = self.ctx;
         let mut grew = self.frames[f].ensure_index_capacity(ctx, self.required_indices)?;
         if !self.lights_on_gpu {

@@ -5,11 +5,14 @@
 //! magnitude here — the H100/H200 run graphics shaders on 4 of their 132 SMs — so which
 //! lighting path is fastest is measured, not assumed.
 
+use crate::descriptors::{self, Resource, SetLayout};
 use crate::report::Spread;
 use crate::settings::Technique;
 use ml_cpu::gpu_types::{PointLight, StageProbePush};
-use ml_vk::commands::{copy_colour_to_host, image_transition, one_shot};
-use ml_vk::descriptors::{allocate_set, write_buffer, write_image};
+use ml_shaders::{FULLSCREEN_VERT, STAGE_PROBE_COMP, STAGE_PROBE_FRAG};
+use ml_vk::commands::{copy_colour_to_host, one_shot};
+use ml_vk::descriptors::allocate_set;
+use ml_vk::image::image_transition;
 use ml_vk::{shader, vk, Buffer, Context, GpuTimer, Image, MemoryLocation, VkError, VkResultExt};
 use std::time::Instant;
 
@@ -89,8 +92,8 @@ pub struct StageProbe {
     compute_target: Image,
     render_pass: vk::RenderPass,
     framebuffer: vk::Framebuffer,
-    fragment_set_layout: vk::DescriptorSetLayout,
-    compute_set_layout: vk::DescriptorSetLayout,
+    fragment_set_layout: SetLayout,
+    compute_set_layout: SetLayout,
     fragment_layout: vk::PipelineLayout,
     compute_layout: vk::PipelineLayout,
     fragment_pipeline: vk::Pipeline,
@@ -122,8 +125,8 @@ impl StageProbe {
             compute_target: Image::null(),
             render_pass: vk::RenderPass::null(),
             framebuffer: vk::Framebuffer::null(),
-            fragment_set_layout: vk::DescriptorSetLayout::null(),
-            compute_set_layout: vk::DescriptorSetLayout::null(),
+            fragment_set_layout: SetLayout::null(),
+            compute_set_layout: SetLayout::null(),
             fragment_layout: vk::PipelineLayout::null(),
             compute_layout: vk::PipelineLayout::null(),
             fragment_pipeline: vk::Pipeline::null(),
@@ -136,7 +139,6 @@ impl StageProbe {
     }
 
     fn create(&mut self, ctx: &Context) -> Result<(), VkError> {
-        use vk::DescriptorType as T;
         let d = &ctx.device;
         let lights = probe_lights(self.max_lights);
         self.lights = Buffer::device_local_with(ctx, "probe lights", bytemuck::cast_slice(&lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
@@ -157,17 +159,20 @@ impl StageProbe {
         // SAFETY: the render pass and view are alive and match.
         self.framebuffer = unsafe { d.create_framebuffer(&info, None) }.ctx("vkCreateFramebuffer")?;
 
-        self.fragment_set_layout = shader::set_layout(ctx, &[(0, T::STORAGE_BUFFER)], vk::ShaderStageFlags::FRAGMENT)?;
-        self.compute_set_layout = shader::set_layout(ctx, &[(0, T::STORAGE_BUFFER), (1, T::STORAGE_IMAGE)], vk::ShaderStageFlags::COMPUTE)?;
+        // Set 0 of each half as its shaders declare it (stage_probe.glsl's lights, the compute
+        // half's output image).
+        let fragment_stages = [(&FULLSCREEN_VERT, vk::ShaderStageFlags::VERTEX), (&STAGE_PROBE_FRAG, vk::ShaderStageFlags::FRAGMENT)];
+        self.fragment_set_layout = SetLayout::new(ctx, &fragment_stages, 0)?;
+        self.compute_set_layout = SetLayout::new(ctx, &[(&STAGE_PROBE_COMP, vk::ShaderStageFlags::COMPUTE)], 0)?;
         let push = |stage| [vk::PushConstantRange::default().stage_flags(stage).size(std::mem::size_of::<StageProbePush>() as u32)];
-        self.fragment_layout = shader::pipeline_layout(ctx, &[self.fragment_set_layout], &push(vk::ShaderStageFlags::FRAGMENT))?;
-        self.compute_layout = shader::pipeline_layout(ctx, &[self.compute_set_layout], &push(vk::ShaderStageFlags::COMPUTE))?;
-        self.compute_pipeline = shader::compute_pipeline(ctx, ml_shaders::STAGE_PROBE_COMP.spirv, self.compute_layout, &[])?;
+        self.fragment_layout = shader::pipeline_layout(ctx, &[self.fragment_set_layout.raw], &push(vk::ShaderStageFlags::FRAGMENT))?;
+        self.compute_layout = shader::pipeline_layout(ctx, &[self.compute_set_layout.raw], &push(vk::ShaderStageFlags::COMPUTE))?;
+        self.compute_pipeline = shader::compute_pipeline(ctx, STAGE_PROBE_COMP.spirv, self.compute_layout, &[])?;
         self.fragment_pipeline = shader::graphics_pipeline(
             ctx,
             &shader::GraphicsPipelineDesc {
-                vertex: ml_shaders::FULLSCREEN_VERT.spirv,
-                fragment: Some(ml_shaders::STAGE_PROBE_FRAG.spirv),
+                vertex: FULLSCREEN_VERT.spirv,
+                fragment: Some(STAGE_PROBE_FRAG.spirv),
                 fragment_constants: &[],
                 vertex_input: vk::PipelineVertexInputStateCreateInfo::default(),
                 rasterization: vk::PipelineRasterizationStateCreateInfo::default()
@@ -182,19 +187,17 @@ impl StageProbe {
             },
         )?;
 
-        let sizes = [
-            vk::DescriptorPoolSize { ty: T::STORAGE_BUFFER, descriptor_count: 2 },
-            vk::DescriptorPoolSize { ty: T::STORAGE_IMAGE, descriptor_count: 1 },
-        ];
-        // SAFETY: valid device and create info.
-        self.pool = unsafe { d.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(2).pool_sizes(&sizes), None) }
-            .ctx("vkCreateDescriptorPool")?;
-        self.fragment_set = allocate_set(ctx, self.pool, self.fragment_set_layout)?;
-        self.compute_set = allocate_set(ctx, self.pool, self.compute_set_layout)?;
-        write_buffer(ctx, self.fragment_set, 0, T::STORAGE_BUFFER, self.lights.raw);
-        write_buffer(ctx, self.compute_set, 0, T::STORAGE_BUFFER, self.lights.raw);
+        self.pool = descriptors::pool(ctx, &[(&self.fragment_set_layout, 1), (&self.compute_set_layout, 1)])?;
+        self.fragment_set = allocate_set(ctx, self.pool, self.fragment_set_layout.raw)?;
+        self.compute_set = allocate_set(ctx, self.pool, self.compute_set_layout.raw)?;
         let out = vk::DescriptorImageInfo::default().image_view(self.compute_target.view).image_layout(vk::ImageLayout::GENERAL);
-        write_image(ctx, self.compute_set, 1, T::STORAGE_IMAGE, out);
+        let lookup = |name: &str| match name {
+            "ProbeLights" => Some(Resource::Buffer(self.lights.raw)),
+            "out_image" => Some(Resource::Image(out)),
+            _ => None,
+        };
+        self.fragment_set_layout.write(ctx, self.fragment_set, &lookup)?;
+        self.compute_set_layout.write(ctx, self.compute_set, &lookup)?;
         self.timer = GpuTimer::new(ctx, 1)?;
         Ok(())
     }
@@ -327,11 +330,11 @@ impl StageProbe {
             d.destroy_pipeline(self.compute_pipeline, None);
             d.destroy_pipeline_layout(self.fragment_layout, None);
             d.destroy_pipeline_layout(self.compute_layout, None);
-            d.destroy_descriptor_set_layout(self.fragment_set_layout, None);
-            d.destroy_descriptor_set_layout(self.compute_set_layout, None);
             d.destroy_framebuffer(self.framebuffer, None);
             d.destroy_render_pass(self.render_pass, None);
         }
+        self.fragment_set_layout.destroy(ctx);
+        self.compute_set_layout.destroy(ctx);
         self.fragment_target.destroy(ctx);
         self.compute_target.destroy(ctx);
         self.lights.destroy(ctx);

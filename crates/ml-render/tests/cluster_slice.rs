@@ -9,28 +9,20 @@ use gpu_allocator::MemoryLocation;
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterDims, ClusterGrid};
 use ml_cpu::gpu_types::FrameUniforms;
-use ml_vk::{commands, descriptors, shader, Buffer, Context, ContextDesc};
+use ml_render::descriptors::{FrameSets, Resource};
+use ml_vk::{commands, shader, Buffer, Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
 
 const COUNT: usize = 100_000;
 
 fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
-    let storage = vk::DescriptorType::STORAGE_BUFFER;
-    let layout =
-        shader::set_layout(ctx, &[(0, vk::DescriptorType::UNIFORM_BUFFER), (1, storage), (2, storage)], vk::ShaderStageFlags::COMPUTE)
-            .unwrap();
-    let layouts = [layout];
-    let pipeline_layout = shader::pipeline_layout(ctx, &layouts, &[]).unwrap();
-    let pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SLICE_PROBE_COMP.spirv, pipeline_layout, &[]).unwrap();
-    let sizes = [
-        vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
-        vk::DescriptorPoolSize { ty: storage, descriptor_count: 2 },
-    ];
-    // SAFETY: as above.
-    let pool = unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
-        .unwrap();
-    let set = descriptors::allocate_set(ctx, pool, layout).unwrap();
+    // One set 0, laid out as the shader declares it.
+    let probe = &ml_shaders::CLUSTER_SLICE_PROBE_COMP;
+    let mut sets = FrameSets::new(ctx, &[(probe, vk::ShaderStageFlags::COMPUTE)], 0, 1).unwrap();
+    let pipeline_layout = shader::pipeline_layout(ctx, &[sets.layout.raw], &[]).unwrap();
+    let pipeline = shader::compute_pipeline(ctx, probe.spirv, pipeline_layout, &[]).unwrap();
+    let set = sets.sets[0];
 
     let frame = FrameUniforms {
         cluster_dims: [grid.dims.x, grid.dims.y, grid.dims.z, 0],
@@ -47,9 +39,13 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     input.write(0, depths);
     let mut output =
         Buffer::new(ctx, "slices", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
-    descriptors::write_buffer(ctx, set, 0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.raw);
-    descriptors::write_buffer(ctx, set, 1, storage, input.raw);
-    descriptors::write_buffer(ctx, set, 2, storage, output.raw);
+    let buffer = |name: &str| match name {
+        "FrameBlock" => Some(Resource::Buffer(uniforms.raw)),
+        "DepthBuffer" => Some(Resource::Buffer(input.raw)),
+        "SliceBuffer" => Some(Resource::Buffer(output.raw)),
+        _ => None,
+    };
+    sets.write(ctx, 0, &buffer).unwrap();
     commands::one_shot(ctx, |cmd| {
         // SAFETY: recording state; all bound objects are alive.
         unsafe {
@@ -71,11 +67,10 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     }
     // SAFETY: the GPU is idle (one_shot waited).
     unsafe {
-        ctx.device.destroy_descriptor_pool(pool, None);
         ctx.device.destroy_pipeline(pipeline, None);
         ctx.device.destroy_pipeline_layout(pipeline_layout, None);
-        ctx.device.destroy_descriptor_set_layout(layout, None);
     }
+    sets.destroy(ctx);
     slices
 }
 

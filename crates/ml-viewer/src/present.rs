@@ -5,7 +5,7 @@
 
 use egui_ash_renderer::{Options, Renderer};
 use ml_render::FrameHook;
-use ml_vk::commands::image_transition;
+use ml_vk::image::image_transition;
 use ml_vk::swapchain::Swapchain;
 use ml_vk::{vk, Buffer, Context, Image, MemoryLocation, VkError, VkResultExt};
 

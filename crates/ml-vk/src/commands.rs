@@ -1,4 +1,5 @@
-//! One-shot command buffers for setup work (uploads, read-backs), waited on with a fence.
+//! One-shot command buffers for setup work (uploads, read-backs), waited on with a fence, and
+//! the memory barriers they record.
 
 use crate::context::Context;
 use crate::error::{Result, VkResultExt};
@@ -73,33 +74,4 @@ pub fn copy_colour_to_host(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Ima
         (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
         (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
     );
-}
-
-/// (stage, access, layout) on one side of a barrier.
-pub type StageAccessLayout = (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout);
-
-/// A colour image's layout transition: `from` (stage, access, layout) before `to`.
-pub fn image_transition(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: StageAccessLayout, to: StageAccessLayout) {
-    aspect_transition(ctx, cmd, (image, vk::ImageAspectFlags::COLOR), from, to);
-}
-
-/// The layout transition of every mip level and layer of `aspect` of an image.
-pub fn aspect_transition(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    (image, aspect): (vk::Image, vk::ImageAspectFlags),
-    from: StageAccessLayout,
-    to: StageAccessLayout,
-) {
-    let b = [vk::ImageMemoryBarrier::default()
-        .src_access_mask(from.1)
-        .dst_access_mask(to.1)
-        .old_layout(from.2)
-        .new_layout(to.2)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(crate::image::full_range(aspect))];
-    // SAFETY: recording state, outside a render pass.
-    unsafe { ctx.device.cmd_pipeline_barrier(cmd, from.0, to.0, vk::DependencyFlags::empty(), &[], &[], &b) };
 }

@@ -10,7 +10,7 @@ pub enum VkError {
     NoDriver,
     #[error("no Vulkan device supports what manylights needs (Vulkan 1.2 and a graphics queue){0}")]
     NoSuitableDevice(String),
-    #[error("--device {index} does not exist: {count} Vulkan device(s) found (see `manylights info`)")]
+    #[error("device {index} does not exist: {count} Vulkan device(s) found")]
     DeviceIndex { index: usize, count: usize },
     #[error(
         "validation was requested but the layer VK_LAYER_KHRONOS_validation is not installed: `apt-get install vulkan-validationlayers`"

@@ -1,5 +1,7 @@
-//! Images (2D, arrays, cubes) with one view of the whole, memory from the allocator.
+//! Images (2D, arrays, cubes) with one view of the whole, memory from the allocator; their
+//! layout transitions; textures uploaded through a staging buffer.
 
+use crate::commands::one_shot;
 use crate::context::Context;
 use crate::error::{Result, VkError, VkResultExt};
 use ash::vk;
@@ -193,6 +195,35 @@ pub fn full_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(vk::REMAINING_MIP_LEVELS).layer_count(vk::REMAINING_ARRAY_LAYERS)
 }
 
+/// (stage, access, layout) on one side of a barrier.
+pub type StageAccessLayout = (vk::PipelineStageFlags, vk::AccessFlags, vk::ImageLayout);
+
+/// A colour image's layout transition: `from` (stage, access, layout) before `to`.
+pub fn image_transition(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: StageAccessLayout, to: StageAccessLayout) {
+    aspect_transition(ctx, cmd, (image, vk::ImageAspectFlags::COLOR), from, to);
+}
+
+/// The layout transition of every mip level and layer of `aspect` of an image.
+pub fn aspect_transition(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    (image, aspect): (vk::Image, vk::ImageAspectFlags),
+    from: StageAccessLayout,
+    to: StageAccessLayout,
+) {
+    let b = [vk::ImageMemoryBarrier::default()
+        .src_access_mask(from.1)
+        .dst_access_mask(to.1)
+        .old_layout(from.2)
+        .new_layout(to.2)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(full_range(aspect))];
+    // SAFETY: recording state, outside a render pass.
+    unsafe { ctx.device.cmd_pipeline_barrier(cmd, from.0, to.0, vk::DependencyFlags::empty(), &[], &[], &b) };
+}
+
 /// A sampled RGBA8 texture filled from `levels[level][layer]` (tightly packed texels; level
 /// 0 is `shape.extent`, each next level half the size) through a staging buffer, left in
 /// SHADER_READ_ONLY_OPTIMAL for fragment and compute shaders.
@@ -231,10 +262,10 @@ pub fn texture_with(ctx: &Context, name: &str, shape: ImageShape, format: vk::Fo
             offset += data.len() as u64;
         }
     }
-    let copied = crate::commands::one_shot(ctx, |cmd| {
+    let copied = one_shot(ctx, |cmd| {
         let whole = vk::PipelineStageFlags::TRANSFER;
         let to_transfer = (whole, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
-        crate::commands::image_transition(
+        image_transition(
             ctx,
             cmd,
             image.raw,
@@ -244,7 +275,7 @@ pub fn texture_with(ctx: &Context, name: &str, shape: ImageShape, format: vk::Fo
         // SAFETY: recording state; buffer and image are alive and the regions lie within them.
         unsafe { ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, image.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &regions) };
         let readers = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
-        crate::commands::image_transition(
+        image_transition(
             ctx,
             cmd,
             image.raw,

@@ -1,6 +1,6 @@
-//! Clustered light assignment (SPEC §3 `clustered-cpu`): the view frustum split into X×Y
-//! screen tiles and Z exponential depth slices; for every cluster, the lights whose sphere
-//! can reach a point inside it.
+//! Clustered light assignment (`clustered-cpu`, docs/DESIGN.md#clustered-light-assignment):
+//! the view frustum split into X×Y screen tiles and Z exponential depth slices; for every
+//! cluster, the lights whose sphere can reach a point inside it.
 
 mod assign;
 mod grid;

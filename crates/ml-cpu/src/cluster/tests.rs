@@ -146,9 +146,10 @@ fn lists_are_sorted_and_match_the_per_light_test() {
     assert!(stats.max_lights > 0);
 }
 
-// ---- The seed's five mistakes (SPEC §3), each with a case the seed's code gets wrong. ----
+// ---- The five clustering mistakes of the demo the seed scene comes from
+// (docs/DESIGN.md#mistakes-we-avoid), each with a case the demo's code gets wrong. ----
 
-/// Seed 000's tile range: screen extent radius/w in NDC, clamped to 0.5.
+/// The demo's tile range: screen extent radius/w in NDC, clamped to 0.5.
 fn seed_tile_range(grid: &ClusterGrid, l: &PointLight) -> Option<(u32, u32, u32, u32)> {
     let clip = grid.projection * grid.view * Vec4::new(l.position_radius[0], l.position_radius[1], l.position_radius[2], 1.0);
     if clip.w <= 0.0 {

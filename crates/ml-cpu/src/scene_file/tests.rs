@@ -116,14 +116,14 @@ fn files_that_are_no_scene_files_are_refused() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `scenes/seed.toml`, the seed scene as a scene file (SPEC §1; issue 7's acceptance 4 renders
-/// both): it must hold exactly the built-in scene. `WRITE_SCENES=1` writes it anew.
+/// `scenes/seed.toml`, the seed scene as a scene file (the render tests draw both and compare
+/// them): it must hold exactly the built-in scene. `WRITE_SCENES=1` writes it anew.
 #[test]
 fn the_committed_seed_scene_file_is_the_seed_scene() {
     let seed = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/seed.toml");
     if std::env::var_os("WRITE_SCENES").is_some() {
-        let header = "# The built-in seed scene (SPEC §1) as a scene file: 7×7 gold spheres, the seed's 64 lights\n# and camera. `manylights render --scene scenes/seed.toml` renders what `--scene seed` does.\n\n";
+        let header = "# The built-in seed scene as a scene file: 7×7 gold spheres, the seed scene's 64 lights and\n# camera. `manylights render --scene scenes/seed.toml` renders what `--scene seed` does.\n\n";
         let target = seed.camera.position + seed.camera.forward() * 10.0;
         std::fs::write(&path, format!("{header}{}", to_toml(&seed, "seed", target))).unwrap();
     }

@@ -3,6 +3,7 @@
 //! animated lights are assigned to the clusters (ml_cpu::cluster, multi-threaded) and the
 //! lists uploaded into the frame slot's buffers. No GPU work of its own.
 
+use crate::error::RenderError;
 use crate::frame::lists_too_long;
 use crate::pass::{FrameResources, Pass, Recording, Update};
 use ml_cpu::cluster::{ClusterAssigner, ClusterLists, ClusterStats};
@@ -30,7 +31,7 @@ impl Pass for CpuClusterAssign {
 
     fn record(&self, _: &Recording) {}
 
-    fn update(&mut self, up: &mut Update) -> Result<Option<(f64, ClusterStats)>, VkError> {
+    fn update(&mut self, up: &mut Update) -> Result<Option<(f64, ClusterStats)>, RenderError> {
         let start = Instant::now();
         // The CPU also holds the lists (and their pairs) in memory: cap what it builds.
         let limit = up.lists.max_entries(up.ctx).min(MAX_CPU_LIST_ENTRIES);
