@@ -216,9 +216,10 @@ impl<'a> Renderer<'a> {
     }
 
     /// Draw `scene`'s objects (and meshes) from now on, lights and camera unchanged (the
-    /// viewer's object and material combos): new meshes, object buffer, sun shadow map and
-    /// frame slots; passes stay. False, changing nothing, where either scene has object
-    /// textures (their sets and the pipelines' texture code depend on them).
+    /// viewer's object and material combos): new meshes, object buffer, sun shadow map,
+    /// passes (the GPU-driven ones hold the scene's meshlets) and frame slots. False, changing
+    /// nothing, where either scene has object textures (their sets and the pipelines' texture
+    /// code depend on them).
     pub fn set_objects(&mut self, scene: &Scene) -> Result<bool, RenderError> {
         if self.gpu.object_textures.per_object.is_empty() || !scene.textures.is_empty() || !self.scene.textures.is_empty() {
             return Ok(false);
@@ -227,6 +228,7 @@ impl<'a> Renderer<'a> {
         self.scene.objects = scene.objects.clone();
         self.scene.meshes = scene.meshes.clone();
         self.gpu.replace_objects(self.ctx, &self.scene)?;
+        self.make_passes()?;
         self.create_frames()?;
         Ok(true)
     }
