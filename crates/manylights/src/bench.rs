@@ -24,10 +24,13 @@ mod probe;
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Scene: bench (a floor, 300 objects, lights whose radius shrinks as N^(−1/3)), seed,
-    /// room, FILE.toml, FILE.gltf|FILE.glb.
+    /// Scene: bench (a floor, --objects objects, lights whose radius shrinks as N^(−1/3)),
+    /// seed, room, FILE.toml, FILE.gltf|FILE.glb.
     #[arg(long, default_value = "bench")]
     scene: String,
+    /// Objects of the bench scene (default 300): more on the same floor, denser.
+    #[arg(long)]
+    objects: Option<usize>,
     /// Techniques, comma-separated (auto: the one `--technique auto` picks on this device).
     #[arg(long, default_value = "forward,clustered-cpu,clustered-gpu,deferred,deferred-clustered,deferred-compute")]
     techniques: String,
@@ -98,7 +101,7 @@ struct Plan {
 
 impl Plan {
     fn new(a: &BenchArgs, (width, height): (u32, u32)) -> Result<Plan> {
-        let source = scene_source(&a.scene, MeshKind::Sphere, Material::named("gold")?)?;
+        let source = scene_source(&a.scene, MeshKind::Sphere, Material::named("gold")?, a.objects)?;
         let scene = SceneRequest { shading: shading_choice(a.shading.as_deref())?, ..SceneRequest::new(source) };
         let settings = SettingsRequest {
             technique: Technique::Forward,
@@ -332,7 +335,7 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
         "device": device,
         "commit": env!("MANYLIGHTS_COMMIT"),
         "settings": {
-            "scene": a.scene, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
+            "scene": a.scene, "objects": a.objects, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
             "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
             "clusters": a.clusters,
         },

@@ -71,12 +71,16 @@ struct ViewArgs {
 #[derive(Args)]
 struct SceneArgs {
     /// Scene to render: seed (built in), room (a closed room with a pillar and one point light,
-    /// for point-light shadows), bench (a floor, 300 objects, --lights N (default 1024) lights
-    /// whose radius shrinks as N^(−1/3): the benchmark's), a scene file FILE.toml
+    /// for point-light shadows), bench (a floor, --objects objects, --lights N (default 1024)
+    /// lights whose radius shrinks as N^(−1/3): the benchmark's), a scene file FILE.toml
     /// (docs/scenes.md) or a glTF 2.0 file FILE.gltf|FILE.glb (rendered with pbr unless
     /// --shading says otherwise).
     #[arg(long, default_value = "seed")]
     scene: String,
+    /// Objects of the bench scene (default 300): more objects on the same floor, denser; the
+    /// first 300 are always the same.
+    #[arg(long)]
+    objects: Option<usize>,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
     /// deferred-compute, visibility (meshlets culled on the GPU into a visibility buffer, lit
     /// in compute), or auto: deferred-compute where this device runs the probe's light loop
@@ -183,12 +187,16 @@ fn main() -> ExitCode {
     }
 }
 
-/// What `--scene` names: the seed scene (of `object` in `material`), room, bench, or a file.
-fn scene_source(name: &str, object: MeshKind, material: Material) -> Result<SceneSource> {
+/// What `--scene` names: the seed scene (of `object` in `material`), room, bench (of `objects`
+/// objects, which no other scene takes), or a file.
+fn scene_source(name: &str, object: MeshKind, material: Material, objects: Option<usize>) -> Result<SceneSource> {
+    if objects.is_some() && name != "bench" {
+        bail!("--objects sets the bench scene's object count: use it with --scene bench");
+    }
     Ok(match name {
         "seed" => SceneSource::Seed { object, material },
         "room" => SceneSource::Room,
-        "bench" => SceneSource::Bench,
+        "bench" => SceneSource::Bench { objects: objects.unwrap_or(ml_cpu::bench_scene::BENCH_OBJECTS) },
         path if [".toml", ".gltf", ".glb"].iter().any(|ext| path.to_lowercase().ends_with(ext)) => SceneSource::File(PathBuf::from(path)),
         other => bail!("unknown scene '{other}': expected seed, room, a scene file FILE.toml or a glTF file FILE.gltf|FILE.glb"),
     })
@@ -209,7 +217,7 @@ fn cluster_choice(text: &str) -> Result<Option<ClusterDims>> {
 
 /// The scene the arguments ask for.
 fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
-    let source = scene_source(&args.scene, MeshKind::from_name(&args.object)?, Material::named(&args.material)?)?;
+    let source = scene_source(&args.scene, MeshKind::from_name(&args.object)?, Material::named(&args.material)?, args.objects)?;
     Ok(SceneRequest {
         source,
         lights: args.lights,

@@ -56,6 +56,7 @@ fn vulkan(e: &VkError) -> Option<String> {
 fn scene(e: &SceneError) -> Option<String> {
     match e {
         SceneError::LightCount(n) => Some(format!("--lights {n} is out of range: use 1 to {MAX_LIGHTS}")),
+        SceneError::ObjectCount(n) => Some(format!("--objects {n} is out of range: use 0 to {}", ml_cpu::bench_scene::MAX_BENCH_OBJECTS)),
         SceneError::Clusters(text) => Some(format!(
             "--clusters {text} is invalid: use XxYxZ with each at least 1 and at most {} clusters in all",
             ml_cpu::cluster::ClusterDims::MAX_CLUSTERS

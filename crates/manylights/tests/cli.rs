@@ -130,6 +130,9 @@ fn absurd_sizes_and_counts_are_refused() {
     assert_one_line_error(&manylights(&["render", "--width", "0", "--out", p], &[]), &["--width 0"]);
     assert_one_line_error(&manylights(&["render", "--height", "100000", "--out", p], &[]), &["--height 100000"]);
     assert_one_line_error(&manylights(&["render", "--frames", "0", "--out", p], &[]), &["--frames"]);
+    let bench = |n: &str| manylights(&["render", "--scene", "bench", "--objects", n, "--out", p], &[]);
+    assert_one_line_error(&bench("100001"), &["--objects 100001", "100000"]);
+    assert_one_line_error(&manylights(&["render", "--objects", "10", "--out", p], &[]), &["--objects", "--scene bench"]);
     let omni = |k: &str, size: &str| {
         manylights(&["render", "--omni-shadow", "direct", "--shadowed-lights", k, "--cube-size", size, "--out", p], &[])
     };

@@ -6,6 +6,8 @@ use thiserror::Error;
 pub enum SceneError {
     #[error("light count {0} is out of range: use 1 to {max}", max = crate::lights::MAX_LIGHTS)]
     LightCount(u64),
+    #[error("bench object count {0} is out of range: use 0 to {max}", max = crate::bench_scene::MAX_BENCH_OBJECTS)]
+    ObjectCount(usize),
     #[error("light radius {0} is invalid: radii must be finite and > 0 (R or MIN..MAX with MIN <= MAX)")]
     LightRadius(String),
     #[error("cluster grid {0} is invalid: use XxYxZ with each at least 1 and at most {max} clusters in all", max = crate::cluster::ClusterDims::MAX_CLUSTERS)]

@@ -26,9 +26,9 @@ pub enum SceneSource {
     Seed { object: MeshKind, material: Material },
     /// The closed room with a pillar and one light (`Scene::shadow_room`); keeps its light.
     Room,
-    /// The benchmark scene (bench_scene.rs): random lights whose radius follows their count;
-    /// the request's layout and radius do not apply.
-    Bench,
+    /// The benchmark scene (bench_scene.rs) with `objects` objects: random lights whose radius
+    /// follows their count; the request's layout and radius do not apply.
+    Bench { objects: usize },
     /// A scene file (`.toml`) or a glTF file (anything else: `.gltf`, `.glb`).
     File(PathBuf),
 }
@@ -103,9 +103,9 @@ impl SceneRequest {
         let built = |scene| BuiltScene { scene, shading: model, warnings: Vec::new() };
         match &self.source {
             SceneSource::Room => Ok(built(Scene::shadow_room())),
-            SceneSource::Bench => {
+            SceneSource::Bench { objects } => {
                 let count = self.lights_of(self.lights.unwrap_or(BENCH_LIGHTS))?.count;
-                Ok(built(bench_scene(count, self.seed)?))
+                Ok(built(bench_scene(count, self.seed, *objects)?))
             }
             SceneSource::Seed { object, material } => {
                 let scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS))?)?;
@@ -144,6 +144,7 @@ impl SceneRequest {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench_scene::BENCH_OBJECTS;
 
     fn seed() -> SceneSource {
         SceneSource::Seed { object: MeshKind::Sphere, material: Material::named("gold").unwrap() }
@@ -162,9 +163,11 @@ mod tests {
     fn room_and_bench_keep_their_own_lights_and_bench_takes_a_count() {
         let room = SceneRequest { lights: Some(9), ..SceneRequest::new(SceneSource::Room) }.build().unwrap();
         assert_eq!(room.scene, Scene::shadow_room());
-        let bench = SceneRequest { lights: Some(300), seed: 3, ..SceneRequest::new(SceneSource::Bench) }.build().unwrap();
-        assert_eq!(bench.scene, bench_scene(300, 3).unwrap());
-        assert_eq!(SceneRequest::new(SceneSource::Bench).build().unwrap().scene.lights.len(), 1024);
+        let bench = SceneRequest { lights: Some(300), seed: 3, ..SceneRequest::new(SceneSource::Bench { objects: BENCH_OBJECTS }) }
+            .build()
+            .unwrap();
+        assert_eq!(bench.scene, bench_scene(300, 3, BENCH_OBJECTS).unwrap());
+        assert_eq!(SceneRequest::new(SceneSource::Bench { objects: BENCH_OBJECTS }).build().unwrap().scene.lights.len(), 1024);
     }
 
     #[test]

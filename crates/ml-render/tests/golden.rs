@@ -89,7 +89,7 @@ fn cases() -> Vec<Case> {
         Case::new("seed", seed.clone(), ShadingModel::Seed),
         Case::new("seed-blinn-phong", teapots.clone().with_floor(), ShadingModel::BlinnPhong),
         Case { omni, ..Case::new("room-pbr-omni", Scene::shadow_room(), ShadingModel::Pbr) },
-        Case::new("bench", bench_scene(4096, 1).expect("bench scene"), ShadingModel::Seed),
+        Case::new("bench", bench_scene(4096, 1, ml_cpu::bench_scene::BENCH_OBJECTS).expect("bench scene"), ShadingModel::Seed),
         Case::new("random-7", random_scene(7, 300), ShadingModel::Seed),
         Case::new("random-11-pbr", random_scene(11, 2000), ShadingModel::Pbr),
         Case::new("gltf-textured-pbr", textured_gltf(), ShadingModel::Pbr),
