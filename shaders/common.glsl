@@ -134,11 +134,18 @@ struct Meshlet {
     vec4 center_radius;    // bounding sphere
     vec4 cone_axis_cutoff; // back-face cone: only back faces seen where dot(normalize(apex − eye), axis) ≥ cutoff
     vec4 cone_apex;        // xyz
-    uvec4 triangles;       // x: first entry of the meshlet index buffer; y: triangles (3 entries each)
+    uvec4 triangles;       // x: first triangle in the meshlet triangle buffer; y: triangles;
+                           // z: first vertex in the meshlet vertex buffer; w: vertices
 };
 
 // A visibility id's low bits: the triangle in its meshlet (meshlets.rs TRIANGLE_BITS).
 const uint VISIBILITY_TRIANGLE_BITS = 7u;
+// Floats of a vertex in a vertex buffer read as storage (geometry.rs Vertex: position,
+// normal, uv, tangent).
+const uint VERTEX_FLOATS = 12u;
+// A compacted index's low bits: the vertex in its meshlet (meshlets.rs VERTEX_BITS); the
+// high bits are the draw slot.
+const uint INDEX_VERTEX_BITS = 6u;
 
 // Bits of Instance.meshlets.w.
 const uint INSTANCE_CONE_CULLING = 1u; // rotation, uniform scale, mirror: cones hold
@@ -152,19 +159,30 @@ struct Instance {
     uvec4 surface;  // x: its own textures (TEXTURE_* bits); y: its texture set
 };
 
-// The counts of a frame's culling (std430): the late phase's dispatch reads `dispatch`, the
-// raster passes read the draw counts; the CPU reads the rest after the frame.
+// VkDrawIndexedIndirectCommand.
+struct DrawIndexedCommand {
+    uint index_count;
+    uint instance_count;
+    uint first_index;
+    int vertex_offset;
+    uint first_instance;
+};
+
+// The counts of a frame's culling (std430): the culling's indirect dispatches read `dispatch`
+// and `meshlets`, the raster passes their phase's draw; the CPU reads the rest after the frame.
 struct CullCounters {
-    uvec4 dispatch;  // x: instances that passed the frustum test (work groups), y, z: 1
-    uvec4 draws;     // x: early-phase draws, y: late-phase draws (a meshlet each)
-    uvec4 triangles; // x: early-phase triangles, y: late-phase triangles
-    uvec4 tested;    // x: meshlets tested early, y: late; z: instances tested
+    uvec4 dispatch;              // x: instances that passed the frustum test (meshlet-culling work groups), y, z: 1
+    uvec4 meshlets[2];           // per phase: x: meshlets drawn (triangle-culling work groups), y, z: 1
+    uvec4 triangles;             // x, y: triangles of the early, late phase's meshlets; z, w: of those, drawn
+    uvec4 tested;                // x: meshlets tested early, y: late; z: instances tested
+    DrawIndexedCommand draws[2]; // per phase: the compacted triangles (index_count = 3 × drawn)
 };
 
 // Push constants of the culling passes.
 struct CullPush {
-    uvec4 mode;    // x: phase (0: early, 1: late); y: 1 culling on, 0 everything drawn;
-                   // z: depth-pyramid levels; w: draw capacity (late draws start there)
+    uvec4 mode;      // x: phase (0: early, 1: late); y: 1 culling on, 0 everything drawn;
+                     // z: depth-pyramid levels; w: draw capacity (late draw slots start there)
+    uvec4 triangles; // x: the scene's triangles (the late phase's triangle ids start there)
 };
 
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with

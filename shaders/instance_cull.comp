@@ -12,7 +12,13 @@ layout(local_size_x = 64) in;
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i == 0u) {
+        // The indirect dispatches' other sizes and the draws' instance counts (the rest of
+        // the counters start at 0).
         counters.dispatch.yz = uvec2(1u);
+        counters.meshlets[0].yz = uvec2(1u);
+        counters.meshlets[1].yz = uvec2(1u);
+        counters.draws[0].instance_count = 1u;
+        counters.draws[1].instance_count = 1u;
     }
     if (i >= instances.length()) {
         return;

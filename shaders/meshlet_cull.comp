@@ -1,7 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Culling, step 2, a work group per instance that passed the frustum test, a thread per
-// meshlet, in two phases (docs/DESIGN.md#gpu-culling):
+// meshlet, in two phases (docs/DESIGN.md#gpu-culling); the meshlets drawn get a draw slot
+// each, whose triangles triangle_cull.comp tests next:
 //  early: meshlets visible at the end of the last frame, tested against the frustum and
 //         their back-face cones, are drawn first;
 //  late:  after the depth pyramid of what the early draws left, every meshlet is tested
@@ -21,6 +22,10 @@ void main() {
     mat4 model = objects[instance].model;
     bool late = cull.mode.x == 1u;
     bool culling = cull.mode.y != 0u;
+    if (late && gl_GlobalInvocationID.x == 0u) {
+        // The early triangles are all compacted by now: the late ones follow them.
+        counters.draws[1].first_index = counters.draws[0].index_count;
+    }
     for (uint k = gl_LocalInvocationID.x; k < inst.meshlets.y; k += gl_WorkGroupSize.x) {
         uint id = inst.meshlets.z + k;
         Meshlet m = meshlets[inst.meshlets.x + k];
@@ -51,13 +56,13 @@ void main() {
         if (draw) {
             uint slot;
             if (late) {
-                slot = cull.mode.w + atomicAdd(counters.draws.y, 1u);
+                slot = cull.mode.w + atomicAdd(counters.meshlets[1].x, 1u);
                 atomicAdd(counters.triangles.y, m.triangles.y);
             } else {
-                slot = atomicAdd(counters.draws.x, 1u);
+                slot = atomicAdd(counters.meshlets[0].x, 1u);
                 atomicAdd(counters.triangles.x, m.triangles.y);
             }
-            draws[slot] = DrawCommand(m.triangles.y * 3u, 1u, m.triangles.x, 0, id);
+            draw_slots[slot] = uvec4(id, instance, m.triangles.z, inst.meshlets.x + k);
         }
     }
 }

@@ -1,6 +1,6 @@
-// What the culling passes share (instance_cull.comp, meshlet_cull.comp): their bindings and
-// the tests. Every test is conservative — it removes only what no pixel of this frame could
-// show — so culling never changes an image (docs/DESIGN.md#gpu-culling).
+// What the culling passes share (instance_cull.comp, meshlet_cull.comp, triangle_cull.comp):
+// their bindings and the tests. Every test is conservative — it removes only what no pixel of
+// this frame could show — so culling never changes an image (docs/DESIGN.md#gpu-culling).
 // Needs common.glsl.
 
 #ifndef MANYLIGHTS_MESHLET_CULL_GLSL
@@ -15,19 +15,22 @@ layout(std430, set = 0, binding = 3) readonly buffer MeshletBuffer { Meshlet mes
 // The instances that passed the frustum test this frame (a work group each in meshlet_cull).
 layout(std430, set = 0, binding = 4) buffer VisibleInstanceBuffer { uint visible_instances[]; };
 layout(std430, set = 0, binding = 5) buffer CullCounterBuffer { CullCounters counters; };
-// VkDrawIndexedIndirectCommand: early draws from 0, late draws from the capacity on.
-struct DrawCommand {
-    uint index_count;
-    uint instance_count;
-    uint first_index;
-    int vertex_offset;
-    uint first_instance; // the meshlet instance (the visibility id's high bits)
-};
-layout(std430, set = 0, binding = 6) writeonly buffer DrawBuffer { DrawCommand draws[]; };
+// The meshlets to draw, a draw slot each (early from 0, late from the capacity on): x: the
+// meshlet instance; y: its object; z: its first vertex in the meshlet vertex buffer; w: the
+// meshlet. The triangle culling reads them, and so does the raster (a compacted index's
+// high bits are the slot).
+layout(std430, set = 0, binding = 6) buffer DrawSlotBuffer { uvec4 draw_slots[]; };
 // Per meshlet instance: 1 where it was visible at the end of the last frame.
 layout(std430, set = 0, binding = 7) buffer MeshletVisibilityBuffer { uint meshlet_visible[]; };
 // Farthest depth over 2^(level+1) pixels a side (depth_pyramid.glsl); the late phase's test.
 layout(std430, set = 0, binding = 8) readonly buffer DepthPyramidBuffer { float depth_pyramid[]; };
+layout(std430, set = 0, binding = 9) readonly buffer MeshletVertexBuffer { uint meshlet_vertices[]; };
+layout(std430, set = 0, binding = 10) readonly buffer MeshletTriangleBuffer { uint meshlet_triangles[]; };
+layout(std430, set = 0, binding = 11) readonly buffer VertexBuffer { float vertex_data[]; };
+// The triangles that survive, both phases one after the other: 3 compacted indices each
+// (draw slot << INDEX_VERTEX_BITS | vertex in the meshlet) and their visibility ids.
+layout(std430, set = 0, binding = 12) writeonly buffer CompactedIndexBuffer { uint compacted_indices[]; };
+layout(std430, set = 0, binding = 13) writeonly buffer TriangleIdBuffer { uint triangle_ids[]; };
 layout(push_constant) uniform CullPushBlock { CullPush cull; };
 
 // Whether a world-space sphere is at least partly inside the view frustum (Vulkan clip

@@ -21,7 +21,8 @@ layout(set = 0, binding = 6) uniform usampler2D visibility_image;
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 // Every mesh's vertices (geometry.rs Vertex: position, normal, uv, tangent; 12 floats).
 layout(std430, set = 0, binding = 13) readonly buffer VertexBuffer { float vertex_data[]; };
-layout(std430, set = 0, binding = 14) readonly buffer MeshletIndexBuffer { uint meshlet_indices[]; };
+layout(std430, set = 0, binding = 14) readonly buffer MeshletVertexBuffer { uint meshlet_vertices[]; };
+layout(std430, set = 0, binding = 18) readonly buffer MeshletTriangleBuffer { uint meshlet_triangles[]; };
 layout(std430, set = 0, binding = 15) readonly buffer MeshletBuffer { Meshlet meshlets[]; };
 layout(std430, set = 0, binding = 16) readonly buffer MeshletInstanceBuffer { uvec2 meshlet_instances[]; };
 layout(std430, set = 0, binding = 17) readonly buffer InstanceBuffer { Instance instances[]; };
@@ -30,6 +31,7 @@ layout(push_constant) uniform ShadingSetPushBlock { uvec4 texture_set; }; // x: 
 #include "surface.glsl"
 #include "lighting.glsl"
 #include "compute_shading.glsl"
+#include "meshlet_geometry.glsl"
 
 struct Attributes {
     vec3 position;
@@ -39,7 +41,7 @@ struct Attributes {
 };
 
 Attributes vertex_at(uint i) {
-    uint b = 12u * i;
+    uint b = VERTEX_FLOATS * i;
 #define F(k) vertex_data[b + k]
     return Attributes(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), vec2(F(6u), F(7u)), vec4(F(8u), F(9u), F(10u), F(11u)));
 #undef F
@@ -96,12 +98,12 @@ void main() {
         imageStore(out_image, p, vec4(id_color(view == DEBUG_VIEW_MESHLETS ? meshlet_instance : id), 1.0));
         return;
     }
-    uint first = meshlets[object_meshlet.y].triangles.x + 3u * (id & ((1u << VISIBILITY_TRIANGLE_BITS) - 1u));
+    uvec3 corners = meshlet_triangle(meshlets[object_meshlet.y], id & ((1u << VISIBILITY_TRIANGLE_BITS) - 1u));
     ObjectData o = objects[object];
     Attributes v[3];
     vec4 c[3];
     for (int k = 0; k < 3; k++) {
-        v[k] = vertex_at(meshlet_indices[first + uint(k)]);
+        v[k] = vertex_at(corners[k]);
         vec3 world = (o.model * vec4(v[k].position, 1.0)).xyz;
         c[k] = frame.proj * frame.view * vec4(world, 1.0);
     }

@@ -200,7 +200,8 @@ gpu_struct!(
         cone_axis_cutoff: [f32; 4],
         /// xyz: the cone's apex.
         cone_apex: [f32; 4],
-        /// x: first entry in the meshlet index buffer; y: triangles (3 entries each).
+        /// x: first triangle in the meshlet triangle buffer; y: triangles; z: first vertex in
+        /// the meshlet vertex buffer; w: vertices.
         triangles: [u32; 4],
     }
 );
@@ -227,16 +228,29 @@ gpu_struct!(
 );
 
 gpu_struct!(
+    /// VkDrawIndexedIndirectCommand (`DrawIndexedCommand` in common.glsl; 20 bytes).
+    DrawIndexedCommand {
+        index_count: u32,
+        instance_count: u32,
+        first_index: u32,
+        vertex_offset: i32,
+        first_instance: u32,
+    }
+);
+
+gpu_struct!(
     /// The counts of a frame's culling (`CullCounters` in common.glsl).
     CullCounters {
         /// x: instances that passed the frustum test; y, z: 1 (an indirect dispatch).
         dispatch: [u32; 4],
-        /// x: early-phase draws; y: late-phase draws.
-        draws: [u32; 4],
-        /// x: early-phase triangles; y: late-phase triangles.
+        /// Per phase: x: meshlets drawn; y, z: 1 (the triangle culling's indirect dispatch).
+        meshlets: [[u32; 4]; 2],
+        /// x, y: triangles of the early and late phase's meshlets; z, w: of those, drawn.
         triangles: [u32; 4],
         /// x: meshlets tested early; y: late; z: instances tested.
         tested: [u32; 4],
+        /// Per phase: the compacted triangles' indexed draw.
+        draws: [DrawIndexedCommand; 2],
     }
 );
 
@@ -244,7 +258,9 @@ gpu_struct!(
     /// Push constants of the culling passes.
     CullPush {
         /// x: phase (0 early, 1 late); y: culling on (1) or off; z: depth-pyramid levels;
-        /// w: draw capacity (the late phase's draws start there).
+        /// w: draw capacity (the late phase's draw slots start there).
         mode: [u32; 4],
+        /// x: the scene's triangles (the late phase's triangle ids start there).
+        triangles: [u32; 4],
     }
 );

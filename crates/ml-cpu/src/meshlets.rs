@@ -2,10 +2,12 @@
 //! with a bounding sphere and a back-face cone (meshoptimizer builds both), so that the GPU
 //! can cull geometry in pieces small enough that what survives is close to what is seen.
 //!
-//! The scene's geometry for the GPU-driven passes: one vertex buffer of every mesh, one
-//! index buffer of every meshlet's triangles (indices into that vertex buffer), the meshlets,
-//! an instance per object, and a meshlet instance per (object, meshlet of its mesh). A
-//! meshlet instance's id and a triangle's index in its meshlet make the 32-bit visibility id
+//! The scene's geometry for the GPU-driven passes: one vertex buffer of every mesh; per
+//! meshlet, its vertices (indices into that buffer, ≤ 64) and its triangles (three 8-bit
+//! indices into the meshlet's vertices, packed in 32 bits); the meshlets; an instance per
+//! object; and a meshlet instance per (object, meshlet of its mesh). A meshlet instance's id
+//! and a triangle's index in its meshlet make the 32-bit visibility id; a draw slot and a
+//! meshlet vertex make a 32-bit index of the compacted index buffer
 //! (docs/DESIGN.md#visibility-buffer).
 
 use crate::geometry::{Mesh, Vertex};
@@ -16,6 +18,8 @@ use thiserror::Error;
 
 /// The most vertices of a meshlet (what mesh-shading hardware favours; fits a workgroup).
 pub const MAX_VERTICES: usize = 64;
+/// Low bits of a compacted index: the vertex in its meshlet.
+pub const VERTEX_BITS: u32 = 6;
 /// The most triangles of a meshlet: below 128, so a triangle's index takes 7 bits.
 pub const MAX_TRIANGLES: usize = 124;
 /// Low bits of a visibility id: the triangle in its meshlet.
@@ -34,11 +38,30 @@ pub enum MeshletError {
     TooManyInstances { count: usize },
 }
 
-/// A mesh's meshlets: the meshlets (their triangles' first index counts from 0) and their
-/// triangles as mesh-local vertex indices, 3 per triangle, meshlet after meshlet.
+/// A mesh's meshlets (their first triangle and first vertex count from 0), their vertices
+/// as mesh-local vertex indices and their triangles as packed meshlet-local indices, meshlet
+/// after meshlet.
 pub struct MeshMeshlets {
     pub meshlets: Vec<Meshlet>,
-    pub indices: Vec<u32>,
+    pub vertices: Vec<u32>,
+    pub triangles: Vec<u32>,
+}
+
+/// Three meshlet-local vertex indices (< 64) in one word: a | b << 8 | c << 16.
+pub fn pack_triangle(t: [u8; 3]) -> u32 {
+    t[0] as u32 | (t[1] as u32) << 8 | (t[2] as u32) << 16
+}
+
+impl MeshMeshlets {
+    /// Triangle `t` of `meshlet` as three indices into what `vertices` indexes.
+    pub fn triangle(&self, meshlet: &Meshlet, t: u32) -> [u32; 3] {
+        corners(&self.vertices, &self.triangles, meshlet, t)
+    }
+}
+
+fn corners(vertices: &[u32], triangles: &[u32], meshlet: &Meshlet, t: u32) -> [u32; 3] {
+    let packed = triangles[(meshlet.triangles[0] + t) as usize];
+    [0, 8, 16].map(|shift| vertices[(meshlet.triangles[2] + ((packed >> shift) & 0xff)) as usize])
 }
 
 /// Split `mesh` into meshlets, with bounds in object space.
@@ -47,16 +70,17 @@ pub fn build(mesh: &Mesh) -> MeshMeshlets {
     let adapter = meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<Vertex>(), std::mem::offset_of!(Vertex, position))
         .expect("the vertex layout has a position");
     let built = meshopt::build_meshlets(&mesh.indices, &adapter, MAX_VERTICES, MAX_TRIANGLES, CONE_WEIGHT);
-    let mut out = MeshMeshlets { meshlets: Vec::with_capacity(built.len()), indices: Vec::with_capacity(mesh.indices.len()) };
+    let mut out = MeshMeshlets { meshlets: Vec::with_capacity(built.len()), vertices: Vec::new(), triangles: Vec::new() };
     for m in built.iter() {
         let b = meshopt::compute_meshlet_bounds(m, &adapter);
-        let first = out.indices.len() as u32;
-        out.indices.extend(m.triangles.iter().map(|&local| m.vertices[local as usize]));
+        let (first_triangle, first_vertex) = (out.triangles.len() as u32, out.vertices.len() as u32);
+        out.vertices.extend_from_slice(m.vertices);
+        out.triangles.extend(m.triangles.chunks_exact(3).map(|t| pack_triangle([t[0], t[1], t[2]])));
         out.meshlets.push(Meshlet {
             center_radius: [b.center[0], b.center[1], b.center[2], b.radius],
             cone_axis_cutoff: [b.cone_axis[0], b.cone_axis[1], b.cone_axis[2], b.cone_cutoff],
             cone_apex: [b.cone_apex[0], b.cone_apex[1], b.cone_apex[2], 0.0],
-            triangles: [first, (m.triangles.len() / 3) as u32, 0, 0],
+            triangles: [first_triangle, (m.triangles.len() / 3) as u32, first_vertex, m.vertices.len() as u32],
         });
     }
     out
@@ -67,8 +91,10 @@ pub fn build(mesh: &Mesh) -> MeshMeshlets {
 pub struct SceneMeshlets {
     /// Every mesh's vertices, mesh after mesh (`Scene::mesh_kinds` order).
     pub vertices: Vec<Vertex>,
-    /// Every meshlet's triangles, 3 indices into `vertices` each.
-    pub indices: Vec<u32>,
+    /// Every meshlet's vertices: indices into `vertices`.
+    pub meshlet_vertices: Vec<u32>,
+    /// Every meshlet's triangles: three indices into its vertices, packed.
+    pub meshlet_triangles: Vec<u32>,
     pub meshlets: Vec<Meshlet>,
     /// Per object (same index): where its meshlets and meshlet instances are, its bounds.
     pub instances: Vec<Instance>,
@@ -88,12 +114,14 @@ impl SceneMeshlets {
             let mesh = scene.mesh(kind).unwrap_or_default();
             let base = s.vertices.len() as u32;
             let built = build(&mesh);
-            let first_index = s.indices.len() as u32;
+            let (first_triangle, first_vertex) = (s.meshlet_triangles.len() as u32, s.meshlet_vertices.len() as u32);
             let first_meshlet = s.meshlets.len() as u32;
-            s.indices.extend(built.indices.iter().map(|i| i + base));
+            s.meshlet_vertices.extend(built.vertices.iter().map(|i| i + base));
+            s.meshlet_triangles.extend_from_slice(&built.triangles);
             s.meshlets.extend(built.meshlets.iter().map(|m| {
                 let mut m = *m;
-                m.triangles[0] += first_index;
+                m.triangles[0] += first_triangle;
+                m.triangles[2] += first_vertex;
                 m
             }));
             per_mesh.push((first_meshlet, built.meshlets.len() as u32, bounding_sphere(&mesh), (mesh.indices.len() / 3) as u64));
@@ -121,6 +149,11 @@ impl SceneMeshlets {
             s.triangles += triangles;
         }
         Ok(s)
+    }
+
+    /// Triangle `t` of meshlet `meshlet` as three indices into `vertices`.
+    pub fn triangle(&self, meshlet: u32, t: u32) -> [u32; 3] {
+        corners(&self.meshlet_vertices, &self.meshlet_triangles, &self.meshlets[meshlet as usize], t)
     }
 }
 
@@ -182,21 +215,23 @@ mod tests {
                 [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
             };
             let mut expected: Vec<[u32; 3]> = mesh.indices.chunks_exact(3).map(canonical).collect();
-            let mut got: Vec<[u32; 3]> = m.indices.chunks_exact(3).map(canonical).collect();
+            let mut got: Vec<[u32; 3]> =
+                m.meshlets.iter().flat_map(|ml| (0..ml.triangles[1]).map(|t| canonical(&m.triangle(ml, t)))).collect();
             expected.sort();
             got.sort();
             assert_eq!(got, expected, "{kind:?}");
-            let mut next = 0;
+            let (mut next_triangle, mut next_vertex) = (0, 0);
             for meshlet in &m.meshlets {
-                let [first, triangles, ..] = meshlet.triangles;
-                assert_eq!(first, next, "{kind:?}: meshlets follow each other");
+                let [first, triangles, first_vertex, vertices] = meshlet.triangles;
+                assert_eq!((first, first_vertex), (next_triangle, next_vertex), "{kind:?}: meshlets follow each other");
                 assert!(triangles >= 1 && triangles as usize <= MAX_TRIANGLES);
-                let tris = &m.indices[first as usize..(first + 3 * triangles) as usize];
-                let vertices: HashSet<u32> = tris.iter().copied().collect();
-                assert!(vertices.len() <= MAX_VERTICES, "{kind:?}: {} vertices", vertices.len());
-                next = first + 3 * triangles;
+                assert!(vertices as usize <= MAX_VERTICES && vertices <= 1 << VERTEX_BITS, "{kind:?}: {vertices} vertices");
+                let used: HashSet<u32> = (0..triangles).flat_map(|t| m.triangle(meshlet, t)).collect();
+                assert_eq!(used.len(), vertices as usize, "{kind:?}: every meshlet vertex is used");
+                next_triangle = first + triangles;
+                next_vertex = first_vertex + vertices;
             }
-            assert_eq!(next as usize, m.indices.len());
+            assert_eq!((next_triangle as usize, next_vertex as usize), (m.triangles.len(), m.vertices.len()));
         }
     }
 
@@ -217,9 +252,8 @@ mod tests {
                 .collect();
             for meshlet in &m.meshlets {
                 let c = Vec3::from_slice(&meshlet.center_radius[..3]);
-                let [first, triangles, ..] = meshlet.triangles;
-                let tris = &m.indices[first as usize..(first + 3 * triangles) as usize];
-                for &i in tris {
+                let tris: Vec<u32> = (0..meshlet.triangles[1]).flat_map(|t| m.triangle(meshlet, t)).collect();
+                for &i in &tris {
                     assert!(p(i).distance(c) <= meshlet.center_radius[3] * (1.0 + 1e-5) + 1e-6, "{kind:?}: vertex outside");
                 }
                 let axis = Vec3::from_slice(&meshlet.cone_axis_cutoff[..3]);
@@ -247,7 +281,13 @@ mod tests {
                 .unwrap();
         let s = SceneMeshlets::build(&scene).unwrap();
         assert_eq!(s.instances.len(), scene.objects.len());
-        assert!(s.indices.iter().all(|&i| (i as usize) < s.vertices.len()));
+        assert!(s.meshlet_vertices.iter().all(|&i| (i as usize) < s.vertices.len()));
+        // Every meshlet triangle names a vertex of the scene.
+        for (k, meshlet) in s.meshlets.iter().enumerate() {
+            for t in 0..meshlet.triangles[1] {
+                assert!(s.triangle(k as u32, t).iter().all(|&i| (i as usize) < s.vertices.len()));
+            }
+        }
         let per_object = s.instances[0].meshlets[1] as usize;
         assert_eq!(s.meshlet_instances.len(), per_object * scene.objects.len());
         for (id, &[object, meshlet]) in s.meshlet_instances.iter().enumerate() {

@@ -1,9 +1,13 @@
 //! The scene as the GPU-driven passes draw it (technique visibility; docs/DESIGN.md#gpu-culling):
-//! the meshlet geometry, uploaded once; per frame slot, the culling's buffers (counters, the
-//! visible-instance list, the indirect draws, a read-back of the counters); and, shared by the
+//! the meshlet geometry, uploaded once; per frame slot, the culling's buffers (counters with
+//! the indirect dispatches and draws, the visible-instance list, the draw slots, the
+//! compacted indices and triangle ids, a read-back of the counters); and, shared by the
 //! slots, each meshlet instance's visibility at the end of the last frame (frames run in
 //! submission order, so the next frame reads what the last one wrote). The culling, raster
 //! and lighting passes share it and bind its buffers by the names the shaders give them.
+//!
+//! The compacted buffers hold every triangle of the scene once: a meshlet instance is drawn
+//! at most once a frame (early or late), so that is their worst case — culling off.
 
 use crate::descriptors::Resource;
 use crate::frame::FRAMES_IN_FLIGHT;
@@ -14,22 +18,25 @@ use ml_vk::{vk, Buffer, Context, VkError};
 use std::cell::RefCell;
 use std::rc::Rc;
 
-/// Size of one VkDrawIndexedIndirectCommand.
-pub const DRAW_COMMAND_BYTES: u64 = 20;
-
 /// The culling's buffers of one frame slot.
 pub struct CullFrame {
+    /// CullCounters: counts, the indirect dispatches and the two phases' draws.
     pub counters: Buffer,
     /// The counters, copied after the late phase for the CPU.
     pub readback: Buffer,
     pub visible_instances: Buffer,
-    /// Early draws from 0, late draws from `capacity` on.
-    pub draws: Buffer,
+    /// The meshlets to draw (uvec4 each): early from 0, late from `capacity` on.
+    pub draw_slots: Buffer,
+    /// 3 indices per kept triangle, early then late (the raster's index buffer).
+    pub indices: Buffer,
+    /// A visibility id per kept triangle: early from 0, late from `triangles` on.
+    pub triangle_ids: Buffer,
 }
 
 pub struct MeshletScene {
     pub vertices: Buffer,
-    pub indices: Buffer,
+    pub meshlet_vertices: Buffer,
+    pub meshlet_triangles: Buffer,
     pub meshlets: Buffer,
     pub instances: Buffer,
     pub meshlet_instances: Buffer,
@@ -54,7 +61,8 @@ impl MeshletScene {
         }
         let s = MeshletScene {
             vertices: Buffer::null(),
-            indices: Buffer::null(),
+            meshlet_vertices: Buffer::null(),
+            meshlet_triangles: Buffer::null(),
             meshlets: Buffer::null(),
             instances: Buffer::null(),
             meshlet_instances: Buffer::null(),
@@ -90,19 +98,29 @@ impl MeshletScene {
             checked(name, data.len() as u64)?;
             Buffer::device_local_with(ctx, name, data, usage)
         };
-        self.vertices = upload("meshlet vertices", bytemuck::cast_slice(&g.vertices), U::VERTEX_BUFFER | storage)?;
-        self.indices = upload("meshlet indices", bytemuck::cast_slice(&g.indices), U::INDEX_BUFFER | storage)?;
+        self.vertices = upload("vertices", bytemuck::cast_slice(&g.vertices), storage)?;
+        self.meshlet_vertices = upload("meshlet vertices", bytemuck::cast_slice(&g.meshlet_vertices), storage)?;
+        self.meshlet_triangles = upload("meshlet triangles", bytemuck::cast_slice(&g.meshlet_triangles), storage)?;
         self.meshlets = upload("meshlets", bytemuck::cast_slice(&g.meshlets), storage)?;
         self.instances = upload("instances", bytemuck::cast_slice(&g.instances), storage)?;
         self.meshlet_instances = upload("meshlet instances", bytemuck::cast_slice(&g.meshlet_instances), storage)?;
         // Nothing was visible before the first frame: its early phase draws nothing.
         let bits = checked("meshlet visibility", self.capacity as u64 * 4)?;
         self.visibility = Buffer::device_local_with(ctx, "meshlet visibility", &vec![0u8; bits as usize], storage)?;
-        let draw_bytes = checked("indirect draws", 2 * self.capacity as u64 * DRAW_COMMAND_BYTES)?;
+        let slot_bytes = checked("draw slots", 2 * self.capacity as u64 * 16)?;
+        let triangles = self.triangles.max(1);
+        let index_bytes = checked("compacted indices", 3 * triangles * 4)?;
+        let id_bytes = checked("triangle ids", 2 * triangles * 4)?;
         for _ in 0..FRAMES_IN_FLIGHT {
             let counter_bytes = std::mem::size_of::<CullCounters>() as u64;
-            let mut f =
-                CullFrame { counters: Buffer::null(), readback: Buffer::null(), visible_instances: Buffer::null(), draws: Buffer::null() };
+            let mut f = CullFrame {
+                counters: Buffer::null(),
+                readback: Buffer::null(),
+                visible_instances: Buffer::null(),
+                draw_slots: Buffer::null(),
+                indices: Buffer::null(),
+                triangle_ids: Buffer::null(),
+            };
             let made = (|| {
                 f.counters = Buffer::new(
                     ctx,
@@ -114,7 +132,9 @@ impl MeshletScene {
                 f.readback = Buffer::new(ctx, "cull counters read-back", counter_bytes, U::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
                 f.visible_instances =
                     Buffer::new(ctx, "visible instances", self.instance_count.max(1) as u64 * 4, storage, MemoryLocation::GpuOnly)?;
-                f.draws = Buffer::new(ctx, "indirect draws", draw_bytes, storage | U::INDIRECT_BUFFER, MemoryLocation::GpuOnly)?;
+                f.draw_slots = Buffer::new(ctx, "draw slots", slot_bytes, storage, MemoryLocation::GpuOnly)?;
+                f.indices = Buffer::new(ctx, "compacted indices", index_bytes, storage | U::INDEX_BUFFER, MemoryLocation::GpuOnly)?;
+                f.triangle_ids = Buffer::new(ctx, "triangle ids", id_bytes, storage, MemoryLocation::GpuOnly)?;
                 Ok(())
             })();
             if let Err(e) = made {
@@ -131,14 +151,17 @@ impl MeshletScene {
         let f = &self.frames[slot];
         let buffer = match name {
             "VertexBuffer" => &self.vertices,
-            "MeshletIndexBuffer" => &self.indices,
+            "MeshletVertexBuffer" => &self.meshlet_vertices,
+            "MeshletTriangleBuffer" => &self.meshlet_triangles,
             "MeshletBuffer" => &self.meshlets,
             "InstanceBuffer" => &self.instances,
             "MeshletInstanceBuffer" => &self.meshlet_instances,
             "MeshletVisibilityBuffer" => &self.visibility,
             "VisibleInstanceBuffer" => &f.visible_instances,
             "CullCounterBuffer" => &f.counters,
-            "DrawBuffer" => &f.draws,
+            "DrawSlotBuffer" => &f.draw_slots,
+            "CompactedIndexBuffer" => &f.indices,
+            "TriangleIdBuffer" => &f.triangle_ids,
             _ => return None,
         };
         Some(Resource::Buffer(buffer.raw))
@@ -152,7 +175,8 @@ impl MeshletScene {
     pub fn destroy(&mut self, ctx: &Context) {
         for b in [
             &mut self.vertices,
-            &mut self.indices,
+            &mut self.meshlet_vertices,
+            &mut self.meshlet_triangles,
             &mut self.meshlets,
             &mut self.instances,
             &mut self.meshlet_instances,
@@ -169,7 +193,14 @@ impl MeshletScene {
 
 impl CullFrame {
     fn destroy(&mut self, ctx: &Context) {
-        for b in [&mut self.counters, &mut self.readback, &mut self.visible_instances, &mut self.draws] {
+        for b in [
+            &mut self.counters,
+            &mut self.readback,
+            &mut self.visible_instances,
+            &mut self.draw_slots,
+            &mut self.indices,
+            &mut self.triangle_ids,
+        ] {
             b.destroy(ctx);
         }
     }

@@ -43,7 +43,9 @@ pub struct CullStats {
     /// Late phase: every meshlet of the instances in the frustum, tested; those newly drawn.
     pub late_tested: u32,
     pub late_drawn: u32,
-    /// Triangles drawn (both phases), and those of every object together.
+    /// Triangles of the meshlets drawn (both phases); of those, the triangles drawn (the rest
+    /// culled one by one); the triangles of every object together.
+    pub meshlet_triangles: u64,
     pub triangles: u64,
     pub scene_triangles: u64,
 }
@@ -221,7 +223,10 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             ),
         ));
         let share = 100.0 * c.triangles as f64 / c.scene_triangles.max(1) as f64;
-        rows.push(("triangles", format!("{} drawn of {} ({share:.1} %)", c.triangles, c.scene_triangles)));
+        rows.push((
+            "triangles",
+            format!("{} drawn of {} ({share:.1} %); the meshlets drawn held {}", c.triangles, c.scene_triangles, c.meshlet_triangles),
+        ));
     }
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
@@ -286,7 +291,7 @@ pub fn device_rows(d: &DeviceInfo) -> Vec<(&'static str, String)> {
         ("imageCubeArray", d.features.image_cube_array.to_string()),
         ("multiview", d.features.multiview.to_string()),
         ("shaderOutputLayer", d.features.shader_output_layer.to_string()),
-        ("multiDrawIndirect + drawIndirectCount", d.features.indirect_count.to_string()),
+        ("fullDrawIndexUint32", d.features.full_draw_index_uint32.to_string()),
         ("sampledImageArrayDynamicIndexing", d.features.sampled_image_array_indexing.to_string()),
         ("shaderBufferInt64Atomics", d.features.buffer_int64_atomics.to_string()),
         ("geometryShader", d.features.geometry_shader.to_string()),

@@ -386,7 +386,7 @@ impl RenderSettings {
         if self.technique.geometry() == Geometry::Meshlets {
             let f = &ctx.info.features;
             for (has, feature) in [
-                (f.indirect_count, "multiDrawIndirect, drawIndirectFirstInstance and drawIndirectCount"),
+                (f.full_draw_index_uint32, "fullDrawIndexUint32 (32-bit index values)"),
                 (f.geometry_shader, "geometryShader (gl_PrimitiveID in fragment shaders)"),
             ] {
                 if !has {

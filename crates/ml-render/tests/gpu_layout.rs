@@ -3,8 +3,8 @@
 //! docs/DESIGN.md#mistakes-we-avoid). A field moved on either side fails here.
 
 use ml_cpu::gpu_types::{
-    ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, FrameUniforms, GpuLayout, Instance, LightCone, Meshlet,
-    ObjectData, ObjectPush, OmniShadowPush, PointLight, ShadowPush, StageProbePush,
+    ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance,
+    LightCone, Meshlet, ObjectData, ObjectPush, OmniShadowPush, PointLight, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -92,6 +92,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<Meshlet>(&structs);
     check::<Instance>(&structs);
     check::<CullCounters>(&structs);
+    check::<DrawIndexedCommand>(&structs);
     check::<CullPush>(&structs);
 }
 

@@ -63,9 +63,9 @@ pub struct OptionalFeatures {
     pub multiview: bool,
     /// shaderOutputLayer (Vulkan 1.2): a vertex shader picks the layer it draws into.
     pub shader_output_layer: bool,
-    /// multiDrawIndirect and drawIndirectFirstInstance (core 1.0) with drawIndirectCount
-    /// (Vulkan 1.2): GPU-written draw lists whose length the GPU decides (meshlet culling).
-    pub indirect_count: bool,
+    /// fullDrawIndexUint32 (core 1.0): index values up to 2^32 − 1, as the visibility raster's
+    /// compacted indices (a draw slot and a meshlet vertex) use them.
+    pub full_draw_index_uint32: bool,
     /// shaderSampledImageArrayDynamicIndexing (core 1.0): a texture array indexed by a value
     /// the same for the whole subgroup, the way the visibility pass reads objects' textures.
     pub sampled_image_array_indexing: bool,
@@ -229,7 +229,7 @@ impl InstanceParts {
                 image_cube_array: on(core.image_cube_array),
                 multiview: on(v11.multiview),
                 shader_output_layer: on(v12.shader_output_layer),
-                indirect_count: on(core.multi_draw_indirect) && on(core.draw_indirect_first_instance) && on(v12.draw_indirect_count),
+                full_draw_index_uint32: on(core.full_draw_index_uint32),
                 sampled_image_array_indexing: on(core.shader_sampled_image_array_dynamic_indexing),
                 buffer_int64_atomics: on(core.shader_int64) && on(v12.shader_buffer_int64_atomics),
                 geometry_shader: on(core.geometry_shader),
@@ -386,15 +386,13 @@ impl Context {
         let features = info.features;
         let core = vk::PhysicalDeviceFeatures::default()
             .image_cube_array(features.image_cube_array)
-            .multi_draw_indirect(features.indirect_count)
-            .draw_indirect_first_instance(features.indirect_count)
+            .full_draw_index_uint32(features.full_draw_index_uint32)
             .shader_sampled_image_array_dynamic_indexing(features.sampled_image_array_indexing)
             .shader_int64(features.buffer_int64_atomics)
             .geometry_shader(features.geometry_shader);
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
         let mut v12 = vk::PhysicalDeviceVulkan12Features::default()
             .shader_output_layer(features.shader_output_layer)
-            .draw_indirect_count(features.indirect_count)
             .shader_buffer_int64_atomics(features.buffer_int64_atomics);
         let extensions = if parts.surface.is_some() { vec![ash::khr::swapchain::NAME.as_ptr()] } else { Vec::new() };
         let info_create = vk::DeviceCreateInfo::default()

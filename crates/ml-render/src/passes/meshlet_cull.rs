@@ -2,10 +2,12 @@
 //! CPU work per object. Early: the counters cleared, every instance tested against the frustum
 //! (instance_cull.comp), then a work group per surviving instance tests its meshlets that were
 //! visible last frame against the frustum and their back-face cones (meshlet_cull.comp) and
-//! writes an indirect draw per survivor. Late (after the early raster and the depth
-//! pyramid): every meshlet of those instances again, now also against the pyramid; the newly
-//! visible are drawn, and every meshlet's visibility is kept for the next frame. The late
-//! pass copies the counters out for the report.
+//! gives each survivor a draw slot; a work group per slot then tests its triangles
+//! (triangle_cull.comp) and appends the survivors to the compacted index buffer and the
+//! phase's indexed draw. Late (after the early raster and the depth pyramid): every meshlet of
+//! those instances again, now also against the pyramid; the newly visible are drawn the same
+//! way, and every meshlet's visibility is kept for the next frame. The late pass copies the
+//! counters out for the report.
 
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame::FRAMES_IN_FLIGHT;
@@ -35,12 +37,17 @@ pub struct MeshletCull {
     /// The instance test (early phase only; null in the late one).
     instance_pipeline: vk::Pipeline,
     meshlet_pipeline: vk::Pipeline,
+    triangle_pipeline: vk::Pipeline,
 }
 
 impl MeshletCull {
     pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, culling: bool) -> Result<MeshletCull, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
-        let stages = [(&ml_shaders::INSTANCE_CULL_COMP, compute), (&ml_shaders::MESHLET_CULL_COMP, compute)];
+        let stages = [
+            (&ml_shaders::INSTANCE_CULL_COMP, compute),
+            (&ml_shaders::MESHLET_CULL_COMP, compute),
+            (&ml_shaders::TRIANGLE_CULL_COMP, compute),
+        ];
         let pass = MeshletCull {
             phase,
             culling,
@@ -49,6 +56,7 @@ impl MeshletCull {
             pipeline_layout: vk::PipelineLayout::null(),
             instance_pipeline: vk::Pipeline::null(),
             meshlet_pipeline: vk::Pipeline::null(),
+            triangle_pipeline: vk::Pipeline::null(),
         };
         ml_vk::build(ctx, pass, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
@@ -57,14 +65,18 @@ impl MeshletCull {
                 p.instance_pipeline = shader::compute_pipeline(ctx, ml_shaders::INSTANCE_CULL_COMP.spirv, p.pipeline_layout, &[])?;
             }
             p.meshlet_pipeline = shader::compute_pipeline(ctx, ml_shaders::MESHLET_CULL_COMP.spirv, p.pipeline_layout, &[])?;
+            p.triangle_pipeline = shader::compute_pipeline(ctx, ml_shaders::TRIANGLE_CULL_COMP.spirv, p.pipeline_layout, &[])?;
             Ok(())
         })
     }
 
     fn push(&self, extent: vk::Extent2D) -> CullPush {
         let (_, levels) = depth_pyramid_shape(extent);
-        let capacity = self.scene.borrow().capacity;
-        CullPush { mode: [u32::from(self.phase == Phase::Late), u32::from(self.culling), levels, capacity] }
+        let scene = self.scene.borrow();
+        CullPush {
+            mode: [u32::from(self.phase == Phase::Late), u32::from(self.culling), levels, scene.capacity],
+            triangles: [scene.triangles as u32, 0, 0, 0],
+        }
     }
 }
 
@@ -92,19 +104,21 @@ impl Pass for MeshletCull {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
+        let raster = vk::PipelineStageFlags::VERTEX_INPUT | vk::PipelineStageFlags::VERTEX_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        let indirect_read = vk::AccessFlags::INDIRECT_COMMAND_READ;
         let push = self.push(rec.extent);
         let set = [self.sets.sets[slot]];
         // SAFETY: recording state outside a render pass; everything bound is alive until the
         // frame's fence signals.
         unsafe {
             if self.phase == Phase::Early {
-                // This slot's buffers were last used two frames ago (draws read, counters copied),
-                // the visibility written by the last frame's late phase.
+                // This slot's buffers were last used two frames ago (draws, indices and ids read,
+                // counters copied), the visibility written by the last frame's late phase.
                 memory_barrier(
                     ctx,
                     cmd,
-                    (compute | indirect | transfer | vk::PipelineStageFlags::VERTEX_SHADER, vk::AccessFlags::SHADER_WRITE),
+                    (compute | indirect | transfer | raster, vk::AccessFlags::SHADER_WRITE),
                     (compute | transfer, rw | vk::AccessFlags::TRANSFER_WRITE),
                 );
                 d.cmd_fill_buffer(cmd, f.counters.raw, 0, vk::WHOLE_SIZE, 0);
@@ -113,27 +127,27 @@ impl Pass for MeshletCull {
                 d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.instance_pipeline);
                 d.cmd_dispatch(cmd, scene.instance_count.div_ceil(GROUP).max(1), 1, 1);
-                memory_barrier(
-                    ctx,
-                    cmd,
-                    (compute, vk::AccessFlags::SHADER_WRITE),
-                    (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ),
-                );
+                memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute | indirect, rw | indirect_read));
             } else {
+                // The early raster read the compacted buffers this phase appends to.
+                memory_barrier(ctx, cmd, (raster, vk::AccessFlags::empty()), (compute, vk::AccessFlags::SHADER_WRITE));
                 d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
                 d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             }
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.meshlet_pipeline);
             d.cmd_dispatch_indirect(cmd, f.counters.raw, 0);
-            // The raster reads the draws and their count.
+            // The triangle culling: a work group per draw slot of this phase.
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute | indirect, rw | indirect_read));
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.triangle_pipeline);
+            let phase = usize::from(self.phase == Phase::Late);
+            let meshlets = (std::mem::offset_of!(CullCounters, meshlets) + phase * 16) as u64;
+            d.cmd_dispatch_indirect(cmd, f.counters.raw, meshlets);
+            // The raster reads the draw, indices, slots and ids; the late culling the counts.
             memory_barrier(
                 ctx,
                 cmd,
                 (compute, vk::AccessFlags::SHADER_WRITE),
-                (
-                    indirect | vk::PipelineStageFlags::VERTEX_SHADER | compute | transfer,
-                    vk::AccessFlags::INDIRECT_COMMAND_READ | rw | vk::AccessFlags::TRANSFER_READ,
-                ),
+                (indirect | raster | compute | transfer, indirect_read | vk::AccessFlags::INDEX_READ | rw | vk::AccessFlags::TRANSFER_READ),
             );
             if self.phase == Phase::Late {
                 let size = std::mem::size_of::<CullCounters>() as u64;
@@ -159,10 +173,11 @@ impl Pass for MeshletCull {
             visible_instances: c.dispatch[0],
             meshlet_instances: scene.capacity,
             early_tested: c.tested[0],
-            early_drawn: c.draws[0],
+            early_drawn: c.meshlets[0][0],
             late_tested: c.tested[1],
-            late_drawn: c.draws[1],
-            triangles: c.triangles[0] as u64 + c.triangles[1] as u64,
+            late_drawn: c.meshlets[1][0],
+            meshlet_triangles: c.triangles[0] as u64 + c.triangles[1] as u64,
+            triangles: c.triangles[2] as u64 + c.triangles[3] as u64,
             scene_triangles: scene.triangles,
         });
     }
@@ -172,10 +187,12 @@ impl Pass for MeshletCull {
         unsafe {
             ctx.device.destroy_pipeline(self.instance_pipeline, None);
             ctx.device.destroy_pipeline(self.meshlet_pipeline, None);
+            ctx.device.destroy_pipeline(self.triangle_pipeline, None);
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
         }
         self.instance_pipeline = vk::Pipeline::null();
         self.meshlet_pipeline = vk::Pipeline::null();
+        self.triangle_pipeline = vk::Pipeline::null();
         self.pipeline_layout = vk::PipelineLayout::null();
         self.sets.destroy(ctx);
         self.scene.borrow_mut().destroy(ctx);

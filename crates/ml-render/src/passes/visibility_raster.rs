@@ -1,16 +1,16 @@
-//! The visibility raster (docs/DESIGN.md#visibility-buffer): the meshlets the culling kept,
-//! one indexed draw each, from the GPU-written draw list and count (vkCmdDrawIndexedIndirectCount);
-//! per pixel the depth and a 32-bit id (visibility.frag). The early phase clears both images,
-//! the late one draws the newly visible meshlets over them.
+//! The visibility raster (docs/DESIGN.md#visibility-buffer): the triangles the culling kept,
+//! one indexed draw per phase whose count the GPU wrote (vkCmdDrawIndexedIndirect), from the
+//! compacted index buffer, vertices pulled from storage buffers; per pixel the depth and a
+//! 32-bit id (visibility.frag). The early phase clears both images, the late one draws the
+//! newly visible triangles over them.
 
 use crate::descriptors::FrameSets;
 use crate::frame::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::{SharedMeshletScene, DRAW_COMMAND_BYTES};
+use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::passes::meshlet_cull::Phase;
 use crate::render_pass;
-use ml_cpu::gpu_types::CullCounters;
-use ml_cpu::mesh::Vertex;
+use ml_cpu::gpu_types::{CullCounters, DrawIndexedCommand};
 use ml_vk::{shader, vk, Context, VkError};
 
 pub struct VisibilityRaster {
@@ -38,17 +38,8 @@ impl VisibilityRaster {
         };
         ml_vk::build(ctx, pass, |p| {
             p.render_pass = render_pass::visibility(depth_format, phase == Phase::Early).create(ctx)?;
-            p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &[])?;
-            // Positions only, from the scene's one vertex buffer.
-            let bindings = [vk::VertexInputBindingDescription::default()
-                .binding(0)
-                .stride(std::mem::size_of::<Vertex>() as u32)
-                .input_rate(vk::VertexInputRate::VERTEX)];
-            let attributes = [vk::VertexInputAttributeDescription::default()
-                .location(0)
-                .binding(0)
-                .format(vk::Format::R32G32B32_SFLOAT)
-                .offset(std::mem::offset_of!(Vertex, position) as u32)];
+            let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::FRAGMENT).size(16)];
+            p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             // The G-buffer pass's state: back faces culled (counter-clockwise fronts), depth LESS.
             p.pipeline = shader::graphics_pipeline(
                 ctx,
@@ -56,9 +47,8 @@ impl VisibilityRaster {
                     vertex: vert.spirv,
                     fragment: Some(frag.spirv),
                     fragment_constants: &[],
-                    vertex_input: vk::PipelineVertexInputStateCreateInfo::default()
-                        .vertex_binding_descriptions(&bindings)
-                        .vertex_attribute_descriptions(&attributes),
+                    // Vertices are pulled from storage buffers by index.
+                    vertex_input: vk::PipelineVertexInputStateCreateInfo::default(),
                     rasterization: vk::PipelineRasterizationStateCreateInfo::default()
                         .polygon_mode(vk::PolygonMode::FILL)
                         .cull_mode(vk::CullModeFlags::BACK)
@@ -113,12 +103,11 @@ impl Pass for VisibilityRaster {
             .clear_values(&clear);
         let viewport =
             vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
-        // CullCounters.draws: x early, y late.
-        let draws = std::mem::offset_of!(CullCounters, draws) as u64;
-        let (first_draw, count_offset) = match self.phase {
-            Phase::Early => (0, draws),
-            Phase::Late => (scene.capacity as u64 * DRAW_COMMAND_BYTES, draws + 4),
-        };
+        // CullCounters.draws[phase]; the phase's triangle ids start at 0 (early) or after
+        // room for every triangle of the scene (late).
+        let phase = usize::from(self.phase == Phase::Late);
+        let draw = (std::mem::offset_of!(CullCounters, draws) + phase * std::mem::size_of::<DrawIndexedCommand>()) as u64;
+        let first_id = [phase as u32 * scene.triangles as u32, 0, 0, 0];
         // SAFETY: recording state; every handle is alive until the frame's fence signals.
         unsafe {
             d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
@@ -126,17 +115,9 @@ impl Pass for VisibilityRaster {
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[area]);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &[self.sets.sets[slot]], &[]);
-            d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.raw], &[0]);
-            d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-            d.cmd_draw_indexed_indirect_count(
-                cmd,
-                f.draws.raw,
-                first_draw,
-                f.counters.raw,
-                count_offset,
-                scene.capacity,
-                DRAW_COMMAND_BYTES as u32,
-            );
+            d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::cast_slice(&first_id));
+            d.cmd_bind_index_buffer(cmd, f.indices.raw, 0, vk::IndexType::UINT32);
+            d.cmd_draw_indexed_indirect(cmd, f.counters.raw, draw, 1, std::mem::size_of::<DrawIndexedCommand>() as u32);
             d.cmd_end_render_pass(cmd);
         }
     }
