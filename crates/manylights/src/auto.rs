@@ -2,6 +2,7 @@
 //! the compute-vs-fragment probe (ml_render::stage_probe) measured on it.
 
 use anyhow::{bail, Result};
+use ml_render::settings::missing_meshlet_feature;
 use ml_render::stage_probe::{pick_lighting_path, quick_probe, StageTimes};
 use ml_render::Technique;
 use ml_vk::{Context, ContextDesc};
@@ -21,7 +22,7 @@ pub fn technique_choice(name: &str) -> Result<Option<Technique>> {
 /// measured.
 pub fn pick(ctx: &Context) -> Result<(Technique, String, StageTimes)> {
     let times = quick_probe(ctx)?;
-    let (technique, why) = pick_lighting_path(&times);
+    let (technique, why) = pick_lighting_path(&times, missing_meshlet_feature(&ctx.info.features).is_none());
     Ok((technique, why, times))
 }
 

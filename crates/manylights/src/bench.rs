@@ -159,9 +159,10 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         Work::Probe(lengths) => {
             let result = probe::run(&ctx, a, resolution, &lengths);
             let device = device_json(&ctx);
+            let meshlets = ml_render::settings::missing_meshlet_feature(&ctx.info.features).is_none();
             drop(ctx);
             let rows = result?;
-            probe::write(a, resolution, &device, &rows)?;
+            probe::write(a, resolution, &device, meshlets, &rows)?;
             return check_messages(messages.load(Ordering::SeqCst));
         }
     };

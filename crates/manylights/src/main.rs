@@ -83,9 +83,9 @@ struct SceneArgs {
     objects: Option<usize>,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
     /// deferred-compute, visibility (meshlets culled on the GPU into a visibility buffer, lit
-    /// in compute), or auto: deferred-compute where this device runs the probe's light loop
-    /// (`bench --probe`) over 1.25× faster as a compute shader than as a fragment shader, else
-    /// deferred-clustered.
+    /// in compute), or auto: visibility (deferred-compute on a device without its features)
+    /// where this device runs the probe's light loop (`bench --probe`) over 1.25× faster as a
+    /// compute shader than as a fragment shader, else deferred-clustered.
     #[arg(long, default_value = "forward")]
     technique: String,
     /// Shading model: seed (specular-only Cook–Torrance: GGX, Schlick–Smith, Schlick Fresnel),

@@ -384,14 +384,8 @@ impl RenderSettings {
             return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view, technique: self.technique }.into());
         }
         if self.technique.geometry() == Geometry::Meshlets {
-            let f = &ctx.info.features;
-            for (has, feature) in [
-                (f.full_draw_index_uint32, "fullDrawIndexUint32 (32-bit index values)"),
-                (f.geometry_shader, "geometryShader (gl_PrimitiveID in fragment shaders)"),
-            ] {
-                if !has {
-                    return Err(SettingsError::TechniqueFeature { technique: self.technique, feature, device: device() }.into());
-                }
+            if let Some(feature) = missing_meshlet_feature(&ctx.info.features) {
+                return Err(SettingsError::TechniqueFeature { technique: self.technique, feature, device: device() }.into());
             }
         }
         if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
@@ -496,4 +490,14 @@ impl SettingsRequest {
             culling: self.culling,
         }
     }
+}
+
+/// The first device feature the meshlet techniques need that `features` lacks, if any.
+pub fn missing_meshlet_feature(features: &ml_vk::OptionalFeatures) -> Option<&'static str> {
+    [
+        (features.full_draw_index_uint32, "fullDrawIndexUint32 (32-bit index values)"),
+        (features.geometry_shader, "geometryShader (gl_PrimitiveID in fragment shaders)"),
+    ]
+    .into_iter()
+    .find_map(|(has, feature)| (!has).then_some(feature))
 }

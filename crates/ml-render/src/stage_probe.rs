@@ -46,14 +46,19 @@ impl StageTimes {
 /// shading stays in the render pass as a subpass.
 pub const COMPUTE_WINS_ABOVE: f64 = 1.25;
 
-/// The lighting path `--technique auto` takes on a device whose probe measured `times`, and
-/// why. Both candidates are exact and cull by the same clusters; they differ in the kind of
-/// pass that runs the light loop (deferred-compute: a compute pass after the render pass;
-/// deferred-clustered: the render pass's second subpass, whose G-buffer reads stay on chip on
-/// tiled GPUs and need no storage image).
-pub fn pick_lighting_path(times: &StageTimes) -> (Technique, String) {
+/// The lighting path `--technique auto` takes on a device whose probe measured `times` (and
+/// which can run the meshlet techniques, or not), and why. The candidates are exact and cull
+/// lights by the same clusters; they differ in the kind of pass that runs the light loop
+/// (compute: `visibility`, whose GPU-culled geometry also beat the G-buffer pass wherever it
+/// was measured, else `deferred-compute`; the render pass's second subpass:
+/// `deferred-clustered`, whose G-buffer reads stay on chip on tiled GPUs).
+pub fn pick_lighting_path(times: &StageTimes, meshlets: bool) -> (Technique, String) {
     let ratio = times.ratio();
-    let technique = if ratio > COMPUTE_WINS_ABOVE { Technique::DeferredCompute } else { Technique::DeferredClustered };
+    let technique = match (ratio > COMPUTE_WINS_ABOVE, meshlets) {
+        (true, true) => Technique::Visibility,
+        (true, false) => Technique::DeferredCompute,
+        (false, _) => Technique::DeferredClustered,
+    };
     let why = format!(
         "the probe's light loop ({} px × {} lights) took {:.3} ms as a fragment shader and {:.3} ms as a compute shader \
          ({ratio:.2}×; compute wins above {COMPUTE_WINS_ABOVE}×)",
@@ -411,12 +416,13 @@ mod tests {
 
     #[test]
     fn auto_takes_compute_only_where_it_clearly_wins() {
-        assert_eq!(pick_lighting_path(&times(33.0, 1.0)).0, Technique::DeferredCompute);
-        assert_eq!(pick_lighting_path(&times(1.3, 1.0)).0, Technique::DeferredCompute);
-        assert_eq!(pick_lighting_path(&times(1.2, 1.0)).0, Technique::DeferredClustered);
-        assert_eq!(pick_lighting_path(&times(1.0, 1.0)).0, Technique::DeferredClustered);
-        assert_eq!(pick_lighting_path(&times(0.5, 1.0)).0, Technique::DeferredClustered);
-        assert!(pick_lighting_path(&times(33.0, 1.0)).1.contains("33.00×"));
+        assert_eq!(pick_lighting_path(&times(33.0, 1.0), true).0, Technique::Visibility);
+        assert_eq!(pick_lighting_path(&times(33.0, 1.0), false).0, Technique::DeferredCompute);
+        assert_eq!(pick_lighting_path(&times(1.3, 1.0), false).0, Technique::DeferredCompute);
+        assert_eq!(pick_lighting_path(&times(1.2, 1.0), true).0, Technique::DeferredClustered);
+        assert_eq!(pick_lighting_path(&times(1.0, 1.0), false).0, Technique::DeferredClustered);
+        assert_eq!(pick_lighting_path(&times(0.5, 1.0), true).0, Technique::DeferredClustered);
+        assert!(pick_lighting_path(&times(33.0, 1.0), true).1.contains("33.00×"));
     }
 
     #[test]

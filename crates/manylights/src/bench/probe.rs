@@ -83,7 +83,8 @@ fn clock(t: &StageTimes) -> &'static str {
     }
 }
 
-pub fn write(a: &BenchArgs, (w, h): (u32, u32), device: &Value, rows: &[ProbeRow]) -> Result<()> {
+/// `meshlets`: whether the device runs the meshlet techniques (what `auto` picks depends on it).
+pub fn write(a: &BenchArgs, (w, h): (u32, u32), device: &Value, meshlets: bool, rows: &[ProbeRow]) -> Result<()> {
     let mut csv =
         String::from("lights,width,height,frames,status,fragment_median_ms,fragment_p95_ms,compute_median_ms,compute_p95_ms,ratio,clock\n");
     let mut json_rows = Vec::new();
@@ -109,7 +110,7 @@ pub fn write(a: &BenchArgs, (w, h): (u32, u32), device: &Value, rows: &[ProbeRow
         }
     }
     let longest = rows.iter().rev().find_map(|r| r.outcome.as_ref().ok());
-    let pick = longest.map(pick_lighting_path);
+    let pick = longest.map(|t| pick_lighting_path(t, meshlets));
     let report = json!({
         "device": device,
         "commit": env!("MANYLIGHTS_COMMIT"),
