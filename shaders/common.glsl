@@ -213,4 +213,10 @@ vec3 oct_decode(vec2 p) {
     return normalize(n);
 }
 
+// The z of the cross product of two 2D vectors: twice the signed area of the triangle they
+// span (the edge function of the visibility passes).
+float cross2(vec2 a, vec2 b) {
+    return a.x * b.y - a.y * b.x;
+}
+
 #endif

@@ -26,10 +26,6 @@ shared vec4 clip[64];
 shared uint kept[4]; // a bit per triangle
 shared uint group_first;
 
-float cross2(vec2 a, vec2 b) {
-    return a.x * b.y - a.y * b.x;
-}
-
 bool triangle_visible(vec4 a, vec4 b, vec4 c) {
     if (a.z < 0.0 && b.z < 0.0 && c.z < 0.0) {
         return false;

@@ -47,10 +47,6 @@ Attributes vertex_at(uint i) {
 #undef F
 }
 
-float cross2(vec2 a, vec2 b) {
-    return a.x * b.y - a.y * b.x;
-}
-
 // Perspective-correct barycentrics at pixel position `xy` of the triangle whose clip-space
 // vertices are `c`: screen-space weights from the 2D edge functions, each divided by its
 // vertex's w, normalised — what the rasteriser interpolates with.

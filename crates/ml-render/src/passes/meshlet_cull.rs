@@ -112,6 +112,8 @@ impl Pass for MeshletCull {
         // SAFETY: recording state outside a render pass; everything bound is alive until the
         // frame's fence signals.
         unsafe {
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
+            d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             if self.phase == Phase::Early {
                 // This slot's buffers were last used two frames ago (draws, indices and ids read,
                 // counters copied), the visibility written by the last frame's late phase.
@@ -123,16 +125,12 @@ impl Pass for MeshletCull {
                 );
                 d.cmd_fill_buffer(cmd, f.counters.raw, 0, vk::WHOLE_SIZE, 0);
                 memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
-                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
-                d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.instance_pipeline);
                 d.cmd_dispatch(cmd, scene.instance_count.div_ceil(GROUP).max(1), 1, 1);
                 memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute | indirect, rw | indirect_read));
             } else {
                 // The early raster read the compacted buffers this phase appends to.
                 memory_barrier(ctx, cmd, (raster, vk::AccessFlags::empty()), (compute, vk::AccessFlags::SHADER_WRITE));
-                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
-                d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             }
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.meshlet_pipeline);
             d.cmd_dispatch_indirect(cmd, f.counters.raw, 0);
