@@ -6,7 +6,9 @@
 use glam::Vec3;
 use ml_cpu::material::Material;
 use ml_cpu::shading::seed_point_light;
+use ml_render::settings::missing_meshlet_feature;
 use ml_render::stage_probe::{pick_lighting_path, probe_lights, quick_probe, StageProbe};
+use ml_render::Technique;
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -68,8 +70,11 @@ fn the_quick_probe_measures_a_ratio_and_picks_a_path() {
     let t = quick_probe(&ctx).expect("quick probe");
     assert!(t.lights >= 16 && t.lights <= 4096 && t.pixels == 512 * 512);
     assert!(t.ratio().is_finite() && t.ratio() > 0.0, "{t:?}");
-    let (technique, why) = pick_lighting_path(&t);
+    let meshlets = missing_meshlet_feature(&ctx.info.features).is_none();
+    let (technique, why) = pick_lighting_path(&t, meshlets);
     assert!(technique.lights_in_compute() || technique.lights_in_subpass(), "{}", technique.name());
+    // Only a device that runs the meshlet passes is sent to the visibility buffer.
+    assert!(meshlets || technique != Technique::Visibility, "{}", technique.name());
     assert!(why.contains(&format!("{} lights", t.lights)), "{why}");
     drop(ctx);
     assert_eq!(messages.load(Ordering::SeqCst), 0, "validation messages (printed above)");
