@@ -175,6 +175,7 @@ struct CullCounters {
     uvec4 meshlets[2];           // per phase: x: meshlets drawn (triangle-culling work groups), y, z: 1
     uvec4 triangles;             // x, y: triangles of the early, late phase's meshlets; z, w: of those, drawn
     uvec4 tested;                // x: meshlets tested early, y: late; z: instances tested
+    uvec4 rasterized;            // compute raster: x, y: triangles it drew early, late; z: pixels it covered
     DrawIndexedCommand draws[2]; // per phase: the compacted triangles (index_count = 3 × drawn)
 };
 
@@ -182,7 +183,9 @@ struct CullCounters {
 struct CullPush {
     uvec4 mode;      // x: phase (0: early, 1: late); y: 1 culling on, 0 everything drawn;
                      // z: depth-pyramid levels; w: draw capacity (late draw slots start there)
-    uvec4 triangles; // x: the scene's triangles (the late phase's triangle ids start there)
+    uvec4 triangles; // x: the scene's triangles (the late phase's triangle ids start there);
+                     // y: compute raster: the largest triangle it draws (bounding box, pixels a
+                     // side), 0 with the hardware raster
 };
 
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with

@@ -2,9 +2,10 @@
 //! the compute-vs-fragment probe (ml_render::stage_probe) measured on it.
 
 use anyhow::{bail, Result};
-use ml_render::settings::missing_meshlet_feature;
+use ml_cpu::scene::Scene;
+use ml_render::settings::{missing_compute_raster_feature, missing_meshlet_feature};
 use ml_render::stage_probe::{pick_lighting_path, quick_probe, StageTimes};
-use ml_render::Technique;
+use ml_render::{Geometry, Raster, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -48,6 +49,60 @@ pub fn resolve_alone(name: &str, validation: bool, device_index: Option<usize>) 
     let (technique, why, _) = picked?;
     announce(technique, &why);
     Ok(technique)
+}
+
+/// Frames each rasteriser renders in `--raster auto`'s probe.
+pub const RASTER_PROBE_FRAMES: u32 = 4;
+
+/// The rasteriser for `settings` on `ctx`'s device and, where `auto` (`choice` None) chose it,
+/// why. Techniques without a visibility buffer keep the hardware (an explicit compute raster
+/// is refused by the settings check); a device without what the compute raster needs draws
+/// with the hardware, and says so; auto renders `scene` both ways and keeps the faster, the
+/// compute raster with `split`.
+pub fn resolve_raster(
+    ctx: &Context,
+    scene: &Scene,
+    settings: &RenderSettings,
+    (choice, split): (Option<Raster>, u32),
+) -> Result<(Raster, Option<String>)> {
+    if settings.technique.geometry() != Geometry::Meshlets {
+        return Ok((choice.unwrap_or(Raster::Hardware), None));
+    }
+    let device = &ctx.info.name;
+    Ok(match (choice, missing_compute_raster_feature(&ctx.info.features)) {
+        (Some(Raster::Compute { .. }), Some(feature)) => {
+            eprintln!("warning: the compute raster needs {feature}, which '{device}' lacks: drawing with the hardware");
+            (Raster::Hardware, None)
+        }
+        (Some(raster), _) => (raster, None),
+        (None, Some(feature)) => (Raster::Hardware, Some(format!("'{device}' lacks {feature}, which the compute raster needs"))),
+        (None, None) => {
+            let (raster, why) = pick_raster(ctx, scene, settings, Raster::Compute { split })?;
+            (raster, Some(why))
+        }
+    })
+}
+
+/// Render `scene` with `settings` and each rasteriser for RASTER_PROBE_FRAMES frames; the one
+/// whose frames took less GPU time (wall time where the device has no timestamps), and the
+/// line that says so.
+pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, compute: Raster) -> Result<(Raster, String)> {
+    let time = |raster| -> Result<f64> {
+        let s = RenderSettings { raster, frames: RASTER_PROBE_FRAMES, ..*settings };
+        let out = Renderer::new(ctx, scene.clone(), s)?.render()?;
+        Ok(match out.stats.gpu_ms() {
+            Some(passes) => passes.iter().map(|(_, ms)| ms).sum(),
+            None => out.stats.wall_ms_per_frame(),
+        })
+    };
+    let (hardware_ms, compute_ms) = (time(Raster::Hardware)?, time(compute)?);
+    let picked = if compute_ms < hardware_ms { compute } else { Raster::Hardware };
+    let why = format!(
+        "a frame of this scene took {hardware_ms:.3} ms with the hardware raster and {compute_ms:.3} ms with the compute raster \
+         ({:.2}×; mean of {RASTER_PROBE_FRAMES} frames each)",
+        hardware_ms / compute_ms
+    );
+    Ok((picked, why))
 }
 
 #[cfg(test)]

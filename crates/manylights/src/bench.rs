@@ -14,7 +14,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, RenderOutput, Renderer, Technique};
+use ml_render::{DebugView, Geometry, Raster, RenderOutput, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -32,7 +32,7 @@ pub struct BenchArgs {
     #[arg(long)]
     objects: Option<usize>,
     /// Techniques, comma-separated (auto: the one `--technique auto` picks on this device).
-    #[arg(long, default_value = "forward,clustered-cpu,clustered-gpu,deferred,deferred-clustered,deferred-compute")]
+    #[arg(long, default_value = "forward,clustered-cpu,clustered-gpu,deferred,deferred-clustered,deferred-compute,visibility")]
     techniques: String,
     /// Light counts, comma-separated; k and M multiply by 1,000 and 1,000,000.
     #[arg(long, default_value = "1k,16k,256k,1M")]
@@ -68,6 +68,13 @@ pub struct BenchArgs {
     /// rounds per loop length of --probe-lights — and the ratio of their times.
     #[arg(long)]
     probe: bool,
+    /// Rasterisers of the visibility technique, comma-separated: hardware, compute (each a
+    /// row of its own; the other techniques have one).
+    #[arg(long, default_value = "hardware,compute")]
+    raster: String,
+    /// The compute raster's largest triangle, pixels a side (render's --raster-split).
+    #[arg(long, default_value_t = Raster::DEFAULT_SPLIT)]
+    raster_split: u32,
     /// Loop lengths (lights every pixel sums) of --probe, comma-separated.
     #[arg(long, default_value = "16,64,256,1024")]
     probe_lights: String,
@@ -113,6 +120,7 @@ impl Plan {
             frames: 1,
             time: None,
             culling: true,
+            raster: Raster::Hardware,
         };
         Ok(Plan { scene, settings, warned: false })
     }
@@ -124,9 +132,42 @@ enum Work {
     Techniques(Plan),
 }
 
+/// What a row measures: a technique, and for the visibility technique its rasteriser.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Variant {
+    technique: Technique,
+    raster: Raster,
+}
+
+impl Variant {
+    /// `visibility`, `visibility (compute raster)`, `forward`, …
+    fn label(self) -> String {
+        match self.raster {
+            Raster::Hardware => self.technique.name().to_owned(),
+            Raster::Compute { .. } => format!("{} (compute raster)", self.technique.name()),
+        }
+    }
+}
+
+/// --raster: the rasterisers the visibility rows use.
+fn raster_list(a: &BenchArgs) -> Result<Vec<Raster>> {
+    let mut list = Vec::new();
+    for name in a.raster.split(',').map(str::trim) {
+        let raster = match name {
+            "hardware" => Raster::Hardware,
+            "compute" => Raster::Compute { split: a.raster_split },
+            other => bail!("unknown rasteriser '{other}' in --raster: expected hardware or compute"),
+        };
+        if !list.contains(&raster) {
+            list.push(raster);
+        }
+    }
+    Ok(list)
+}
+
 /// One combination's result.
 struct Measured {
-    technique: Technique,
+    variant: Variant,
     lights: u64,
     /// Why it was not measured.
     skipped: Option<String>,
@@ -150,6 +191,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     if a.budget_s.is_nan() || a.budget_s <= 0.0 {
         bail!("--budget-s must be greater than 0");
     }
+    let rasters = raster_list(a)?;
     let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Plan::new(a, resolution)?) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
     let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
@@ -169,25 +211,34 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     // Every run records the quick probe and what auto makes of it.
     let (auto_technique, auto_why, quick) = auto::pick(&ctx)?;
     auto::announce(auto_technique, &auto_why);
-    let mut techniques: Vec<Technique> = Vec::new();
-    for t in choices.into_iter().map(|c| c.unwrap_or(auto_technique)) {
-        if !techniques.contains(&t) {
-            techniques.push(t);
+    let mut variants: Vec<Variant> = Vec::new();
+    let compute_raster = ml_render::settings::missing_compute_raster_feature(&ctx.info.features);
+    for technique in choices.into_iter().map(|c| c.unwrap_or(auto_technique)) {
+        let rasters = if technique.geometry() == Geometry::Meshlets { rasters.clone() } else { vec![Raster::Hardware] };
+        for raster in rasters {
+            if let (Raster::Compute { .. }, Some(feature)) = (raster, compute_raster) {
+                eprintln!("warning: the compute raster needs {feature}, which '{}' lacks: not measured", ctx.info.name);
+                continue;
+            }
+            let v = Variant { technique, raster };
+            if !variants.contains(&v) {
+                variants.push(v);
+            }
         }
     }
-    let bar = indicatif::ProgressBar::new((techniques.len() * counts.len()) as u64);
+    let bar = indicatif::ProgressBar::new((variants.len() * counts.len()) as u64);
     bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("a valid template"));
     let mut results: Vec<Measured> = Vec::new();
     for &lights in &counts {
-        for &technique in &techniques {
-            bar.set_message(format!("{} at {lights} lights", technique.name()));
-            // The same technique at the largest smaller count, measured or estimated.
+        for &variant in &variants {
+            bar.set_message(format!("{} at {lights} lights", variant.label()));
+            // The same variant at the largest smaller count, measured or estimated.
             let previous = results
                 .iter()
-                .filter(|m| m.technique == technique && m.lights < lights)
+                .filter(|m| m.variant == variant && m.lights < lights)
                 .map(|m| (m.lights, m.ms_per_frame))
                 .max_by_key(|&(n, _)| n);
-            results.push(measure(&ctx, a, &mut plan, (technique, lights), previous)?);
+            results.push(measure(&ctx, a, &mut plan, (variant, lights), previous)?);
             bar.inc(1);
         }
     }
@@ -240,7 +291,8 @@ fn probe_lengths(text: &str) -> Result<Vec<u32>> {
 /// which then estimates the rest.
 type Previous = Option<(u64, f64)>;
 
-fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (technique, lights): (Technique, u64), previous: Previous) -> Result<Measured> {
+fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Variant, u64), previous: Previous) -> Result<Measured> {
+    let technique = variant.technique;
     let frames = a.warmup + a.frames;
     let skip = |ms: f64, how: &str| {
         let estimate_s = ms * frames as f64 / 1e3;
@@ -258,7 +310,7 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (technique, lights): (
             skip(scaled, &format!("scaled from {n} lights"))
         };
         if let Some(why) = why {
-            return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: scaled });
+            return Ok(Measured { variant, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: scaled });
         }
     }
     let built = SceneRequest { lights: Some(lights), ..plan.scene.clone() }.build()?;
@@ -266,16 +318,16 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (technique, lights): (
         print_warnings(&built.warnings);
     }
     let scene = built.scene;
-    let mut settings = SettingsRequest { technique, ..plan.settings }.for_scene(&scene, built.shading);
+    let mut settings = SettingsRequest { technique, raster: variant.raster, ..plan.settings }.for_scene(&scene, built.shading);
     let probe = Renderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
-        return Ok(Measured { technique, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: probe.stats.wall_ms });
+        return Ok(Measured { variant, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: probe.stats.wall_ms });
     }
     settings.frames = frames;
     let output = Renderer::new(ctx, scene, settings).and_then(|mut r| r.render())?;
     let grid = technique.is_clustered().then_some(settings.clusters);
     let ms_per_frame = output.stats.wall_ms_per_frame();
-    Ok(Measured { technique, lights, skipped: None, output: Some(output), grid, ms_per_frame })
+    Ok(Measured { variant, lights, skipped: None, output: Some(output), grid, ms_per_frame })
 }
 
 fn spread_json(s: &Spread) -> Value {
@@ -285,15 +337,16 @@ fn spread_json(s: &Spread) -> Value {
 fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Value), results: &[Measured]) -> Result<()> {
     let skip = a.warmup as usize;
     let mut csv = String::from(
-        "technique,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,cpu_assign_median_ms,cpu_upload_median_ms,cpu_record_median_ms,cpu_submit_median_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
+        "technique,raster,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,cpu_assign_median_ms,cpu_upload_median_ms,cpu_record_median_ms,cpu_submit_median_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
     );
     let mut rows = Vec::new();
     for m in results {
-        let head = format!("{},{},{w},{h},{}", m.technique.name(), m.lights, a.frames);
+        let (technique, raster) = (m.variant.technique.name(), raster_name(m.variant));
+        let head = format!("{technique},{raster},{},{w},{h},{}", m.lights, a.frames);
         let Some(out) = &m.output else {
             let why = m.skipped.clone().unwrap_or_default();
             csv += &format!("{head},\"{why}\",,,,,,,,,,,,,\n");
-            rows.push(json!({ "technique": m.technique.name(), "lights": m.lights, "status": why }));
+            rows.push(json!({ "technique": technique, "raster": raster, "lights": m.lights, "status": why }));
             continue;
         };
         let stats = &out.stats;
@@ -317,7 +370,8 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
             );
         }
         rows.push(json!({
-            "technique": m.technique.name(),
+            "technique": technique,
+            "raster": raster,
             "lights": m.lights,
             "status": "measured",
             "passes": passes.iter().map(|(n, s)| json!({ "pass": n, "gpu": spread_json(s) })).collect::<Vec<_>>(),
@@ -338,6 +392,7 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
         "settings": {
             "scene": a.scene, "objects": a.objects, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
             "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
+            "raster": a.raster, "raster_split": a.raster_split,
             "clusters": a.clusters,
         },
         "auto": auto,
@@ -358,15 +413,24 @@ fn write_file(a: &BenchArgs, name: &str, text: &str) -> Result<()> {
     std::fs::write(&path, text).with_context(|| format!("cannot write '{}'", path.display()))
 }
 
-/// Per technique, (lights, GPU ms per frame: the pass medians summed) of each measured count.
-fn frame_times(results: &[Measured], skip: usize) -> Vec<(Technique, Vec<(f64, f64)>)> {
-    let mut series: Vec<(Technique, Vec<(f64, f64)>)> = Vec::new();
+/// The raster column: the visibility technique's rasteriser, empty for the others.
+fn raster_name(v: Variant) -> &'static str {
+    if v.technique.geometry() == Geometry::Meshlets {
+        v.raster.name()
+    } else {
+        ""
+    }
+}
+
+/// Per variant, (lights, GPU ms per frame: the pass medians summed) of each measured count.
+fn frame_times(results: &[Measured], skip: usize) -> Vec<(Variant, Vec<(f64, f64)>)> {
+    let mut series: Vec<(Variant, Vec<(f64, f64)>)> = Vec::new();
     for m in results {
         let Some(passes) = m.output.as_ref().and_then(|o| o.stats.gpu_spread(skip)) else { continue };
         let ms: f64 = passes.iter().map(|(_, s)| s.median).sum();
-        match series.iter_mut().find(|(t, _)| *t == m.technique) {
+        match series.iter_mut().find(|(v, _)| *v == m.variant) {
             Some((_, points)) => points.push((m.lights as f64, ms)),
-            None => series.push((m.technique, vec![(m.lights as f64, ms)])),
+            None => series.push((m.variant, vec![(m.lights as f64, ms)])),
         }
     }
     series
@@ -374,7 +438,7 @@ fn frame_times(results: &[Measured], skip: usize) -> Vec<(Technique, Vec<(f64, f
 
 /// results.png: GPU ms per frame against lights, log-log, a line per technique (the text in
 /// egui's embedded Ubuntu font: no system fonts needed).
-fn plot(path: &std::path::Path, series: &[(Technique, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
+fn plot(path: &std::path::Path, series: &[(Variant, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
     static FONT: std::sync::Once = std::sync::Once::new();
     FONT.call_once(|| {
@@ -405,12 +469,13 @@ fn plot(path: &std::path::Path, series: &[(Technique, Vec<(f64, f64)>)], (w, h):
         .x_label_formatter(&|v| count_label(*v))
         .y_label_formatter(&|v| format!("{v}"))
         .draw()?;
-    for (technique, points) in series {
-        // A technique keeps its colour in every plot, whichever others are in it.
-        let colour = Palette99::pick(Technique::ALL.iter().position(|t| t == technique).unwrap_or(0)).to_rgba();
+    for (variant, points) in series {
+        // A variant keeps its colour in every plot, whichever others are in it.
+        let index = Technique::ALL.iter().position(|t| *t == variant.technique).unwrap_or(0);
+        let colour = Palette99::pick(if variant.raster == Raster::Hardware { index } else { Technique::ALL.len() + index }).to_rgba();
         chart
             .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
-            .label(technique.name())
+            .label(variant.label())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
         chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
     }

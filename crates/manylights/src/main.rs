@@ -10,7 +10,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::report;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, Renderer, ShadingModel, Technique};
+use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -148,6 +148,15 @@ struct SceneArgs {
     /// must not change).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     culling: String,
+    /// Who draws the visibility technique's visibility buffer: hardware (the graphics
+    /// pipeline), compute (triangles up to --raster-split pixels in a compute shader, the
+    /// others by the hardware into the same buffer) or auto (both timed on this device and
+    /// scene for a few frames, the faster kept, and said why).
+    #[arg(long, default_value = "auto", value_parser = ["hardware", "compute", "auto"])]
+    raster: String,
+    /// The compute raster's largest triangle: bounding box up to PX pixels a side (1 to 64).
+    #[arg(long, default_value_t = Raster::DEFAULT_SPLIT)]
+    raster_split: u32,
     /// Enable the Khronos validation layer with synchronization validation; any message
     /// makes the run fail.
     #[arg(long)]
@@ -247,7 +256,18 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         frames,
         time: args.time,
         culling: args.culling == "on",
+        // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
+        raster: Raster::Hardware,
     })
+}
+
+/// `--raster` with `--raster-split`: a rasteriser, or None for auto.
+fn raster_choice(args: &SceneArgs) -> Option<Raster> {
+    match args.raster.as_str() {
+        "hardware" => Some(Raster::Hardware),
+        "compute" => Some(Raster::Compute { split: args.raster_split }),
+        _ => None,
+    }
 }
 
 /// A built scene's warnings, one line each.
@@ -297,6 +317,8 @@ fn render(cmd: &RenderArgs) -> Result<()> {
             Some(why)
         }
     };
+    let raster_why;
+    (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args), args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
     let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render());
     let device = report::device_line(&ctx.info);
@@ -304,8 +326,15 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let output = result?;
     image::save_buffer_with_format(&cmd.out, &output.rgba, output.width, output.height, image::ColorType::Rgba8, image::ImageFormat::Png)
         .with_context(|| format!("cannot write '{}'", cmd.out.display()))?;
-    let facts =
-        report::RenderFacts { device: &device, settings: &settings, lights, object_textures, auto: auto_why.as_deref(), output: &cmd.out };
+    let facts = report::RenderFacts {
+        device: &device,
+        settings: &settings,
+        lights,
+        object_textures,
+        auto: auto_why.as_deref(),
+        raster_auto: raster_why.as_deref(),
+        output: &cmd.out,
+    };
     print!("{}", report::table(&report::render_rows(&facts, &output.stats)));
     let count = messages.load(Ordering::SeqCst);
     if count > 0 {

@@ -70,6 +70,7 @@ fn flag(s: Setting) -> &'static str {
         Setting::Width => "--width",
         Setting::Height => "--height",
         Setting::CubeSize => "--cube-size",
+        Setting::RasterSplit => "--raster-split",
     }
 }
 

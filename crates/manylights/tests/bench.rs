@@ -1,14 +1,15 @@
-//! `manylights bench` (docs/usage.md#bench-the-benchmark-harness): a tiny run — 2 techniques × 2 light counts,
-//! 64×64, 5 frames — on lavapipe with validation writes results.csv and results.json with
-//! every column and a row per pass and the results.png plot, and a combination over the time budget is skipped with
-//! its reason instead of run.
+//! `manylights bench` (docs/usage.md#bench-the-benchmark-harness): a tiny run — 3 techniques
+//! (visibility with both rasterisers) × 2 light counts, 64×64, 5 frames — on lavapipe with
+//! validation writes results.csv and results.json with every column and a row per pass and the
+//! results.png plot, and a combination over the time budget is skipped with its reason instead
+//! of run.
 
 use std::process::Command;
 
 #[test]
 fn a_tiny_bench_writes_its_tables() {
     let out_dir = std::env::temp_dir().join(format!("manylights-bench-{}", std::process::id()));
-    let args = ["bench", "--validation", "--techniques", "forward,clustered-gpu", "--lights", "64,1k", "--resolution", "64x64"];
+    let args = ["bench", "--validation", "--techniques", "forward,clustered-gpu,visibility", "--lights", "64,1k", "--resolution", "64x64"];
     let run = Command::new(env!("CARGO_BIN_EXE_manylights"))
         .args(args)
         .args(["--frames", "5", "--warmup", "1", "--out", out_dir.to_str().unwrap()])
@@ -22,6 +23,7 @@ fn a_tiny_bench_writes_its_tables() {
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     for column in [
         "technique",
+        "raster",
         "lights",
         "status",
         "pass",
@@ -37,9 +39,14 @@ fn a_tiny_bench_writes_its_tables() {
         assert!(header.contains(&column), "no column {column}: {header:?}");
     }
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    // forward: one pass; clustered-gpu: build + shading; at 64 and 1,000 lights.
-    assert_eq!(rows.len(), 2 * (1 + 2), "{csv}");
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let of = |technique: &str, raster: &str| rows.iter().filter(|r| r[col("technique")] == technique && r[col("raster")] == raster).count();
+    // forward: one pass; clustered-gpu: build + shading; at 64 and 1,000 lights.
+    assert_eq!((of("forward", ""), of("clustered-gpu", "")), (2, 2 * 2), "{csv}");
+    // visibility, a row per pass for each rasteriser: the compute raster's passes say so.
+    assert!(of("visibility", "hardware") >= 2 * 6 && of("visibility", "compute") >= 2 * 8, "{csv}");
+    assert!(rows.iter().any(|r| r[col("raster")] == "compute" && r[col("pass")] == "cull + compute raster (late)"), "{csv}");
+    assert_eq!(rows.len(), of("forward", "") + of("clustered-gpu", "") + of("visibility", "hardware") + of("visibility", "compute"));
     for r in &rows {
         assert_eq!(r.len(), header.len(), "{r:?}");
         assert_eq!(r[col("status")], "measured");
@@ -50,16 +57,17 @@ fn a_tiny_bench_writes_its_tables() {
         assert!(phase("cpu_record_median_ms") > 0.0 && phase("cpu_median_ms") >= phase("cpu_record_median_ms"), "{r:?}");
         assert_eq!(phase("cpu_assign_median_ms"), 0.0, "{r:?}");
     }
-    let clustered = rows.iter().find(|r| r[0] == "clustered-gpu" && r[1] == "1000").unwrap();
+    let clustered = rows.iter().find(|r| r[0] == "clustered-gpu" && r[col("lights")] == "1000").unwrap();
     // --clusters auto at 64×64: the default grid (no scaling below ~11.6k lights).
     assert_eq!(clustered[col("clusters")], "16x9x24");
     assert!(clustered[col("lights_per_cluster_mean")].parse::<f64>().unwrap() > 0.0);
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap();
     assert!(json["device"]["name"].is_string() && json["commit"].is_string(), "{json}");
     assert_eq!(json["settings"]["frames"], 5);
-    assert_eq!(json["results"].as_array().unwrap().len(), 4);
+    assert_eq!(json["results"].as_array().unwrap().len(), 8);
+    assert_eq!(json["results"][3]["raster"], "compute", "{json}");
     // What auto would run here, from the quick probe.
-    assert!(["deferred-compute", "deferred-clustered"].contains(&json["auto"]["technique"].as_str().unwrap()), "{json}");
+    assert!(["visibility", "deferred-compute", "deferred-clustered"].contains(&json["auto"]["technique"].as_str().unwrap()), "{json}");
     assert!(json["auto"]["probe"]["ratio"].as_f64().unwrap() > 0.0, "{json}");
     // The plot: frame time against lights, a line per technique.
     let plot = image::open(out_dir.join("results.png")).expect("results.png").to_rgb8();
@@ -78,9 +86,9 @@ fn a_tiny_bench_writes_its_tables() {
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), 4, "{csv}");
-    assert!(rows[0].starts_with("forward,64,") && rows[0].contains("skipped: 3 frames would take"), "{csv}");
+    assert!(rows[0].starts_with("forward,,64,") && rows[0].contains("skipped: 3 frames would take"), "{csv}");
     assert!(rows[0].contains("one frame measured") && rows[1].contains("one frame measured"), "{csv}");
-    assert!(rows[2].starts_with("forward,1000000,") && rows[2].contains("scaled from 64 lights"), "{csv}");
+    assert!(rows[2].starts_with("forward,,1000000,") && rows[2].contains("scaled from 64 lights"), "{csv}");
     assert!(rows[3].contains("skipped: one frame would take about") && rows[3].contains("scaled from 64 lights"), "{csv}");
 }
 
@@ -112,7 +120,7 @@ fn the_probe_writes_its_ratios() {
         .unwrap();
     let (stdout, stderr) = (String::from_utf8_lossy(&run.stdout), String::from_utf8_lossy(&run.stderr));
     assert!(run.status.success() && !stderr.contains("VALIDATION"), "{stderr}");
-    assert!(stdout.lines().any(|l| l.starts_with("auto: deferred-c")), "{stdout}");
+    assert!(stdout.lines().any(|l| l.starts_with("auto: deferred-c") || l.starts_with("auto: visibility")), "{stdout}");
     let csv = std::fs::read_to_string(out_dir.join("probe.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();

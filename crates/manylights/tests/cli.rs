@@ -456,17 +456,65 @@ fn a_gltf_file_renders() {
 #[test]
 fn auto_renders_what_it_picked() {
     let (auto_png, picked_png) = (temp_png("auto.png"), temp_png("picked.png"));
-    let common = ["render", "--validation", "--scene", "bench", "--lights", "300", "--width", "96", "--height", "54", "--time", "0"];
+    // One rasteriser for both runs: `--raster auto` could time them the other way round.
+    let common = [
+        "render",
+        "--validation",
+        "--scene",
+        "bench",
+        "--lights",
+        "300",
+        "--width",
+        "96",
+        "--height",
+        "54",
+        "--time",
+        "0",
+        "--raster",
+        "hardware",
+    ];
     let out = manylights(&[&common[..], &["--technique", "auto", "--out", auto_png.to_str().unwrap()]].concat(), &[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let technique_row = stdout.lines().find(|l| l.starts_with("technique")).expect("a technique row");
     let picked = technique_row.split_whitespace().nth(1).unwrap().to_owned();
-    assert!(technique_row.ends_with("(auto)") && ["deferred-compute", "deferred-clustered"].contains(&picked.as_str()), "{stdout}");
+    assert!(
+        technique_row.ends_with("(auto)") && ["visibility", "deferred-compute", "deferred-clustered"].contains(&picked.as_str()),
+        "{stdout}"
+    );
     let why = stdout.lines().find(|l| l.starts_with("auto")).expect("an auto row");
     assert!(why.contains("as a fragment shader") && why.contains("as a compute shader"), "{why}");
     let out = manylights(&[&common[..], &["--technique", &picked, "--out", picked_png.to_str().unwrap()]].concat(), &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let (a, b) = (image::open(&auto_png).unwrap().to_rgba8(), image::open(&picked_png).unwrap().to_rgba8());
     assert!(a == b, "auto's image differs from {picked}'s");
+}
+
+/// `--raster auto` renders the scene with both rasterisers, keeps the one whose frames took
+/// less time, and says so with both times; a rasteriser the settings cannot take is one
+/// error line.
+#[test]
+fn raster_auto_keeps_the_faster_and_says_why() {
+    let png = temp_png("raster-auto.png");
+    let args = ["render", "--validation", "--scene", "bench", "--objects", "40", "--lights", "200", "--width", "96", "--height", "54"];
+    let out = manylights(&[&args[..], &["--technique", "visibility", "--raster", "auto", "--out", png.to_str().unwrap()]].concat(), &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let why = stdout.lines().find(|l| l.starts_with("auto raster")).expect("an auto raster row");
+    let ms = |before: &str| -> f64 {
+        let head = &why[..why.find(before).unwrap_or_else(|| panic!("{why}"))];
+        head.split_whitespace().next_back().unwrap().parse().unwrap_or_else(|_| panic!("{why}"))
+    };
+    let (hardware, compute) = (ms(" ms with the hardware raster"), ms(" ms with the compute raster"));
+    let raster = stdout.lines().find(|l| l.starts_with("raster ")).expect("a raster row");
+    let faster = if compute < hardware { "compute" } else { "hardware" };
+    assert!(raster.split_whitespace().nth(1) == Some(faster) && raster.ends_with("(auto)"), "{raster} ({why})");
+    for (extra, needles) in [
+        (&["--technique", "forward", "--raster", "compute"][..], &["compute raster", "visibility", "--raster hardware"][..]),
+        (&["--technique", "visibility", "--raster", "compute", "--raster-split", "0"][..], &["--raster-split 0", "1 to 64"][..]),
+        (&["--technique", "visibility", "--raster", "sideways"][..], &["sideways"][..]),
+    ] {
+        let out = manylights(&[&args[..], extra, &["--out", png.to_str().unwrap()]].concat(), &[]);
+        assert_one_line_error(&out, needles);
+    }
 }

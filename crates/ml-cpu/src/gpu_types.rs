@@ -249,6 +249,9 @@ gpu_struct!(
         triangles: [u32; 4],
         /// x: meshlets tested early; y: late; z: instances tested.
         tested: [u32; 4],
+        /// The compute raster's: x, y: triangles it drew in the early, late phase; z: pixels
+        /// it covered (every covered pixel of every triangle, hidden or not).
+        rasterized: [u32; 4],
         /// Per phase: the compacted triangles' indexed draw.
         draws: [DrawIndexedCommand; 2],
     }
@@ -260,7 +263,8 @@ gpu_struct!(
         /// x: phase (0 early, 1 late); y: culling on (1) or off; z: depth-pyramid levels;
         /// w: draw capacity (the late phase's draw slots start there).
         mode: [u32; 4],
-        /// x: the scene's triangles (the late phase's triangle ids start there).
+        /// x: the scene's triangles (the late phase's triangle ids start there); y: the
+        /// compute raster's largest triangle (bounding box, pixels a side; 0: hardware raster).
         triangles: [u32; 4],
     }
 );

@@ -93,26 +93,39 @@ impl ComputePass {
     ) {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;
-        let d = &ctx.device;
         // The colour image was last read by a copy two frames ago (same queue).
         let storage = (compute, vk::AccessFlags::SHADER_WRITE, vk::ImageLayout::GENERAL);
         image_transition(ctx, cmd, color, (transfer, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), storage);
+        for (i, (more_sets, push)) in runs.iter().enumerate() {
+            if i > 0 {
+                memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_WRITE));
+            }
+            self.dispatch(ctx, cmd, slot, (more_sets, push), extent);
+        }
+        image_transition(ctx, cmd, color, storage, (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL));
+    }
+
+    /// One dispatch over `extent` with slot `slot`'s set 0, `more_sets` after it and `push`
+    /// (empty: none); the caller orders it with what comes before and after.
+    pub fn dispatch(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        (more_sets, push): (&[vk::DescriptorSet], &[u8]),
+        extent: vk::Extent2D,
+    ) {
+        let d = &ctx.device;
+        let sets: Vec<vk::DescriptorSet> = std::iter::once(self.sets.sets[slot]).chain(more_sets.iter().copied()).collect();
         // SAFETY: recording state outside a render pass; everything bound is alive.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            for (i, (more_sets, push)) in runs.iter().enumerate() {
-                if i > 0 {
-                    memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_WRITE));
-                }
-                let sets: Vec<vk::DescriptorSet> = std::iter::once(self.sets.sets[slot]).chain(more_sets.iter().copied()).collect();
-                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &sets, &[]);
-                if !push.is_empty() {
-                    d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, push);
-                }
-                d.cmd_dispatch(cmd, extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP), 1);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &sets, &[]);
+            if !push.is_empty() {
+                d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
+            d.cmd_dispatch(cmd, extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP), 1);
         }
-        image_transition(ctx, cmd, color, storage, (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL));
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

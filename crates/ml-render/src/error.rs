@@ -58,6 +58,8 @@ pub enum Setting {
     Height,
     /// Texels per side of a shadow-cube face.
     CubeSize,
+    /// The compute raster's largest triangle (pixels a side of its bounding box).
+    RasterSplit,
 }
 
 impl std::fmt::Display for Setting {
@@ -66,6 +68,7 @@ impl std::fmt::Display for Setting {
             Setting::Width => "width",
             Setting::Height => "height",
             Setting::CubeSize => "cube size",
+            Setting::RasterSplit => "raster split",
         })
     }
 }
@@ -89,6 +92,10 @@ pub enum SettingsError {
     ViewNeedsMeshlets { view: DebugView, technique: Technique },
     #[error("the {} technique needs {feature}, which '{device}' lacks: use deferred-compute", technique.name())]
     TechniqueFeature { technique: Technique, feature: &'static str, device: String },
+    #[error("the compute raster draws the visibility buffer of the visibility technique, not {}'s (use --raster hardware)", technique.name())]
+    RasterNeedsVisibility { technique: Technique },
+    #[error("the compute raster needs {feature}, which '{device}' lacks: use --raster hardware")]
+    RasterFeature { feature: &'static str, device: String },
     #[error("frames must be at least 1")]
     NoFrames,
     #[error("time {0} is not a finite number")]

@@ -120,6 +120,26 @@ pub fn visibility(depth_format: vk::Format, first: bool) -> RenderPassDesc {
     RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
 }
 
+/// The compute raster's hardware half (visibility_atomic.frag): no attachments — its
+/// fragments write the 64-bit visibility-depth buffer by atomic min — one subpass between the
+/// culling's writes (the draw, the compute raster's pixels) and the compute passes after it
+/// (the resolve, the late culling's raster).
+pub fn visibility_atomic() -> RenderPassDesc {
+    let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+    let fragment = vk::PipelineStageFlags::FRAGMENT_SHADER;
+    let draws =
+        vk::PipelineStageFlags::DRAW_INDIRECT | vk::PipelineStageFlags::VERTEX_INPUT | vk::PipelineStageFlags::VERTEX_SHADER | fragment;
+    let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+    let dependencies = vec![
+        dependency(
+            (vk::SUBPASS_EXTERNAL, compute, vk::AccessFlags::SHADER_WRITE),
+            (0, draws, vk::AccessFlags::INDIRECT_COMMAND_READ | vk::AccessFlags::INDEX_READ | rw),
+        ),
+        dependency((0, fragment, vk::AccessFlags::SHADER_WRITE), (vk::SUBPASS_EXTERNAL, compute, rw)),
+    ];
+    RenderPassDesc { attachments: Vec::new(), subpasses: vec![Subpass::default()], dependencies }
+}
+
 fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage]) -> RenderPassDesc {
     let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
     let attachments = match output {

@@ -240,7 +240,8 @@ impl<'a> Renderer<'a> {
         let (extent, depth) = (self.extent, self.depth_format);
         let technique = self.settings.technique;
         let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
-        let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer));
+        let raster = self.settings.raster;
+        let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), raster);
         let setup = FrameSetup {
             pool: self.command_pool,
             light_count: self.scene.lights.len(),

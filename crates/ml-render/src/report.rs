@@ -48,6 +48,10 @@ pub struct CullStats {
     pub meshlet_triangles: u64,
     pub triangles: u64,
     pub scene_triangles: u64,
+    /// Compute raster: of the triangles drawn, those it drew (the rest by the hardware), and
+    /// the pixels they covered (hidden ones too); 0 with the hardware raster.
+    pub compute_triangles: u64,
+    pub compute_pixels: u64,
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -185,8 +189,20 @@ pub struct RenderFacts<'a> {
     pub object_textures: bool,
     /// Why `auto` picked the technique; None where it was asked for by name.
     pub auto: Option<&'a str>,
+    /// Why `--raster auto` picked the rasteriser; None where it was asked for by name.
+    pub raster_auto: Option<&'a str>,
     /// Where the image was written.
     pub output: &'a Path,
+}
+
+/// Who drew the visibility buffer, in words.
+pub fn raster_line(raster: crate::settings::Raster) -> String {
+    match raster {
+        crate::settings::Raster::Hardware => "hardware (indexed draw per culling phase)".to_owned(),
+        crate::settings::Raster::Compute { split } => format!(
+            "compute (triangles up to {split} px a side; larger ones and those crossing the near plane by the hardware; 64-bit atomic min)"
+        ),
+    }
 }
 
 /// The rows of the table `render` prints (`table`).
@@ -210,6 +226,10 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     }
     if technique.geometry() == crate::settings::Geometry::Meshlets {
         rows.push(("visibility", "4 bytes/pixel + depth (meshlet instance << 7 | triangle, u32)".to_owned()));
+        rows.push(("raster", raster_line(settings.raster) + if facts.raster_auto.is_some() { " (auto)" } else { "" }));
+        if let Some(why) = facts.raster_auto {
+            rows.push(("auto raster", why.to_owned()));
+        }
     } else if technique.lights_in_subpass() || technique.lights_in_compute() {
         rows.push(("g-buffer", gbuffer_line(facts.object_textures, stats.gbuffer_lazily_allocated)));
     }
@@ -227,6 +247,17 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             "triangles",
             format!("{} drawn of {} ({share:.1} %); the meshlets drawn held {}", c.triangles, c.scene_triangles, c.meshlet_triangles),
         ));
+        if settings.raster != crate::settings::Raster::Hardware {
+            rows.push((
+                "compute raster",
+                format!(
+                    "{} triangles ({} pixels covered), {} by the hardware",
+                    c.compute_triangles,
+                    c.compute_pixels,
+                    c.triangles - c.compute_triangles
+                ),
+            ));
+        }
     }
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
@@ -295,6 +326,8 @@ pub fn device_rows(d: &DeviceInfo) -> Vec<(&'static str, String)> {
         ("sampledImageArrayDynamicIndexing", d.features.sampled_image_array_indexing.to_string()),
         ("shaderBufferInt64Atomics", d.features.buffer_int64_atomics.to_string()),
         ("geometryShader", d.features.geometry_shader.to_string()),
+        ("fragmentStoresAndAtomics", d.features.fragment_stores_and_atomics.to_string()),
+        ("subPixelPrecisionBits", l.sub_pixel_precision_bits.to_string()),
     ]
 }
 
@@ -325,8 +358,15 @@ mod tests {
     fn render_rows_follow_the_technique_and_describe_the_gbuffer_from_its_images() {
         use crate::settings::{RenderSettings, Technique};
         let settings = RenderSettings::new(Technique::DeferredClustered, 64, 36);
-        let mut facts =
-            RenderFacts { device: "gpu", settings: &settings, lights: 5, object_textures: false, auto: None, output: Path::new("a.png") };
+        let mut facts = RenderFacts {
+            device: "gpu",
+            settings: &settings,
+            lights: 5,
+            object_textures: false,
+            auto: None,
+            raster_auto: None,
+            output: Path::new("a.png"),
+        };
         let mut stats = FrameStats::new(&["g-buffer + lighting"]);
         stats.frames = 1;
         stats.gbuffer_lazily_allocated = Some(true);

@@ -222,6 +222,50 @@ impl OmniShadowSettings {
     }
 }
 
+/// Who draws the visibility buffer (technique visibility; docs/DESIGN.md#compute-raster).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Raster {
+    /// The graphics pipeline: each culling phase's triangles in one indexed draw.
+    Hardware,
+    /// A compute shader for every triangle whose bounding box is at most `split` pixels a side
+    /// and which lies wholly beyond the near plane; the others drawn by the hardware into the
+    /// same 64-bit buffer.
+    Compute { split: u32 },
+}
+
+impl Raster {
+    /// The compute raster's default split: triangles up to this many pixels a side are drawn
+    /// in compute (measured: docs/BENCHMARKS.md).
+    pub const DEFAULT_SPLIT: u32 = 32;
+    /// Its largest: the edge functions of a 64-pixel box at 1/256 pixel stay in 32 bits.
+    pub const MAX_SPLIT: u32 = 64;
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Raster::Hardware => "hardware",
+            Raster::Compute { .. } => "compute",
+        }
+    }
+
+    /// The largest triangle drawn in compute (0: none).
+    pub fn split(self) -> u32 {
+        match self {
+            Raster::Hardware => 0,
+            Raster::Compute { split } => split,
+        }
+    }
+}
+
+/// The first device feature the compute raster needs that `features` lacks, if any.
+pub fn missing_compute_raster_feature(features: &ml_vk::OptionalFeatures) -> Option<&'static str> {
+    [
+        (features.buffer_int64_atomics, "shaderBufferInt64Atomics (64-bit atomic min on buffers)"),
+        (features.fragment_stores_and_atomics, "fragmentStoresAndAtomics (the large triangles' fragments write the same buffer)"),
+    ]
+    .into_iter()
+    .find_map(|(has, feature)| (!has).then_some(feature))
+}
+
 /// Most memory the shadow cubes may take, whatever the device has: 16 lights at 2048² are 1.5 GiB.
 pub const MAX_OMNI_BYTES: u64 = 4 << 30;
 
@@ -323,6 +367,8 @@ pub struct RenderSettings {
     pub time: Option<f32>,
     /// GPU culling of the meshlet techniques (off: every meshlet drawn, for comparisons).
     pub culling: bool,
+    /// Who draws the visibility buffer (visibility only).
+    pub raster: Raster,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -344,6 +390,7 @@ impl RenderSettings {
             frames: 1,
             time: Some(0.0),
             culling: true,
+            raster: Raster::Hardware,
         }
     }
 
@@ -386,6 +433,17 @@ impl RenderSettings {
         if self.technique.geometry() == Geometry::Meshlets {
             if let Some(feature) = missing_meshlet_feature(&ctx.info.features) {
                 return Err(SettingsError::TechniqueFeature { technique: self.technique, feature, device: device() }.into());
+            }
+        }
+        if let Raster::Compute { split } = self.raster {
+            if self.technique.geometry() != Geometry::Meshlets {
+                return Err(SettingsError::RasterNeedsVisibility { technique: self.technique }.into());
+            }
+            if let Some(feature) = missing_compute_raster_feature(&ctx.info.features) {
+                return Err(SettingsError::RasterFeature { feature, device: device() }.into());
+            }
+            if split == 0 || split > Raster::MAX_SPLIT {
+                return Err(SettingsError::OutOfRange { what: Setting::RasterSplit, value: split, max: Raster::MAX_SPLIT }.into());
             }
         }
         if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
@@ -472,6 +530,7 @@ pub struct SettingsRequest {
     pub frames: u32,
     pub time: Option<f32>,
     pub culling: bool,
+    pub raster: Raster,
 }
 
 impl SettingsRequest {
@@ -488,6 +547,7 @@ impl SettingsRequest {
             frames: self.frames,
             time: self.time,
             culling: self.culling,
+            raster: self.raster,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! buffer, the G-buffer and the HDR image of the deferred techniques. The raster passes make
 //! their framebuffers over them.
 
-use crate::settings::{Geometry, LightingStage, Technique};
+use crate::settings::{Geometry, LightingStage, Raster, Technique};
 use ml_vk::{vk, Buffer, Context, Image, VkError};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
@@ -122,7 +122,20 @@ pub struct Targets {
     /// visibility: the depth pyramid of the late culling phase, level after level (null
     /// otherwise).
     pub depth_pyramid: Buffer,
+    /// visibility with the compute raster: 64 bits per pixel, depth and id, which both
+    /// rasterisers write by atomic min and the resolve makes into `visibility` and `depth`
+    /// (null otherwise).
+    pub visibility_depth: Buffer,
+    /// The layouts in which the passes after the raster read `depth` and `visibility`: the
+    /// render pass leaves them read-only; the compute raster's resolve writes them as storage
+    /// images and leaves them in GENERAL.
+    pub depth_layout: vk::ImageLayout,
+    pub visibility_layout: vk::ImageLayout,
 }
+
+/// Format of the depth image that the compute raster's resolve writes (a storage image,
+/// which depth formats cannot be).
+pub const COMPUTE_DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 
 /// Format of the visibility buffer: the 32-bit id (meshlets.rs).
 pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R32_UINT;
@@ -154,6 +167,7 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
+        raster: Raster,
     ) -> Result<Targets, VkError> {
         let t = Targets {
             color: Image::null(),
@@ -162,8 +176,11 @@ impl Targets {
             hdr: Image::null(),
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
+            visibility_depth: Buffer::null(),
+            depth_layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+            visibility_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer)))
+        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), raster))
     }
 
     fn create(
@@ -172,6 +189,7 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
+        raster: Raster,
     ) -> Result<(), VkError> {
         use vk::ImageUsageFlags as U;
         let colour = vk::ImageAspectFlags::COLOR;
@@ -187,8 +205,14 @@ impl Targets {
             }
             Output::Visibility => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::empty()),
         };
+        // The compute raster's resolve writes depth and ids as storage images.
+        let compute_raster = output == Output::Visibility && raster != Raster::Hardware;
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
-        self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
+        self.depth = if compute_raster {
+            Image::new_2d(ctx, "depth target", extent, COMPUTE_DEPTH_FORMAT, U::STORAGE | U::SAMPLED, colour)?
+        } else {
+            Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?
+        };
         if matches!(output, Output::GBuffer | Output::Subpasses) {
             for g in gbuffer {
                 self.gbuffer.push(Image::new_2d(ctx, g.name, extent, g.format, gbuffer_usage, colour)?);
@@ -198,10 +222,17 @@ impl Targets {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
         }
         if output == Output::Visibility {
-            self.visibility = Image::new_2d(ctx, "visibility buffer", extent, VISIBILITY_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
+            let usage = if compute_raster { U::STORAGE | U::SAMPLED } else { U::COLOR_ATTACHMENT | U::SAMPLED };
+            self.visibility = Image::new_2d(ctx, "visibility buffer", extent, VISIBILITY_FORMAT, usage, colour)?;
             let bytes = depth_pyramid_len(extent) * 4;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
             self.depth_pyramid = Buffer::new(ctx, "depth pyramid", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
+        }
+        if compute_raster {
+            let bytes = extent.width as u64 * extent.height as u64 * 8;
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            self.visibility_depth = Buffer::new(ctx, "visibility-depth buffer", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
+            (self.depth_layout, self.visibility_layout) = (vk::ImageLayout::GENERAL, vk::ImageLayout::GENERAL);
         }
         Ok(())
     }
@@ -221,6 +252,7 @@ impl Targets {
         self.hdr.destroy(ctx);
         self.visibility.destroy(ctx);
         self.depth_pyramid.destroy(ctx);
+        self.visibility_depth.destroy(ctx);
     }
 }
 

@@ -7,7 +7,7 @@ use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
-use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, RenderSettings, ShadingModel, Technique};
+use ml_render::{DebugView, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, Technique};
 use std::collections::VecDeque;
 
 /// Everything the overlay can change that needs a new scene or renderer.
@@ -24,6 +24,8 @@ pub struct Choices {
     pub clusters: ClusterDims,
     pub debug_view: DebugView,
     pub omni: Option<OmniShadowSettings>,
+    /// Who draws the visibility buffer (used where the technique is visibility).
+    pub raster: Raster,
 }
 
 impl Choices {
@@ -45,6 +47,7 @@ impl Choices {
             clusters: settings.clusters,
             debug_view: settings.debug_view,
             omni: settings.omni,
+            raster: settings.raster,
         }
     }
 
@@ -78,6 +81,8 @@ impl Choices {
             frames: 1,
             time,
             culling: true,
+            // Other techniques have no visibility buffer to draw.
+            raster: if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware },
         }
     }
 }
@@ -129,6 +134,14 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
     }
     egui::Window::new("manylights").default_pos([8.0, 8.0]).resizable(false).show(ctx, |ui| {
         combo(ui, "Technique", &mut choices.technique, &Technique::ALL, |t| t.name());
+        if choices.technique.geometry() == Geometry::Meshlets {
+            let split = if choices.raster.split() > 0 { choices.raster.split() } else { Raster::DEFAULT_SPLIT };
+            let options = [Raster::Hardware, Raster::Compute { split }];
+            combo(ui, "Raster", &mut choices.raster, &options, |r| r.name());
+            if let Raster::Compute { split } = &mut choices.raster {
+                ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
+            }
+        }
         combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());
         ui.add_enabled_ui(state.seed_scene, |ui| {
             combo(ui, "Type", &mut choices.object, &MeshKind::ALL, |k| k.name());

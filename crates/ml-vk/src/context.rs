@@ -74,6 +74,9 @@ pub struct OptionalFeatures {
     /// geometryShader (core 1.0): besides geometry shaders, gl_PrimitiveID in fragment
     /// shaders (the visibility buffer's triangle index).
     pub geometry_shader: bool,
+    /// fragmentStoresAndAtomics (core 1.0): fragment shaders write storage buffers (the
+    /// compute rasteriser's large triangles, drawn by the hardware into its 64-bit buffer).
+    pub fragment_stores_and_atomics: bool,
 }
 
 impl DeviceInfo {
@@ -233,6 +236,7 @@ impl InstanceParts {
                 sampled_image_array_indexing: on(core.shader_sampled_image_array_dynamic_indexing),
                 buffer_int64_atomics: on(core.shader_int64) && on(v12.shader_buffer_int64_atomics),
                 geometry_shader: on(core.geometry_shader),
+                fragment_stores_and_atomics: on(core.fragment_stores_and_atomics),
             };
         }
         let name = c_text(props.device_name_as_c_str());
@@ -389,7 +393,8 @@ impl Context {
             .full_draw_index_uint32(features.full_draw_index_uint32)
             .shader_sampled_image_array_dynamic_indexing(features.sampled_image_array_indexing)
             .shader_int64(features.buffer_int64_atomics)
-            .geometry_shader(features.geometry_shader);
+            .geometry_shader(features.geometry_shader)
+            .fragment_stores_and_atomics(features.fragment_stores_and_atomics);
         let mut v11 = vk::PhysicalDeviceVulkan11Features::default().multiview(features.multiview);
         let mut v12 = vk::PhysicalDeviceVulkan12Features::default()
             .shader_output_layer(features.shader_output_layer)

@@ -47,10 +47,7 @@ impl Pass for DepthPyramid {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let t = frame.targets;
-        let depth = vk::DescriptorImageInfo::default()
-            .sampler(self.sampler)
-            .image_view(t.depth.view)
-            .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        let depth = vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(t.depth.view).image_layout(t.depth_layout);
         self.sets.write(ctx, frame.slot, &|name| match name {
             "depth_image" => Some(Resource::Image(depth)),
             "DepthPyramidBuffer" => Some(Resource::Buffer(t.depth_pyramid.raw)),

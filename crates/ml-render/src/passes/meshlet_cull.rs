@@ -7,13 +7,16 @@
 //! phase's indexed draw. Late (after the early raster and the depth pyramid): every meshlet of
 //! those instances again, now also against the pyramid; the newly visible are drawn the same
 //! way, and every meshlet's visibility is kept for the next frame. The late pass copies the
-//! counters out for the report.
+//! counters out for the report. With the compute raster, step 3 is triangle_raster.comp: the
+//! same tests, then the small triangles rasterised there and only the others appended; the
+//! early phase clears its 64-bit buffer first.
 
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{FrameResources, Pass, Recording, SlotReport};
 use crate::report::CullStats;
+use crate::settings::Raster;
 use crate::targets::depth_pyramid_shape;
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::commands::memory_barrier;
@@ -31,6 +34,7 @@ pub enum Phase {
 pub struct MeshletCull {
     phase: Phase,
     culling: bool,
+    raster: Raster,
     scene: SharedMeshletScene,
     sets: FrameSets,
     pipeline_layout: vk::PipelineLayout,
@@ -41,16 +45,17 @@ pub struct MeshletCull {
 }
 
 impl MeshletCull {
-    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, culling: bool) -> Result<MeshletCull, VkError> {
+    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, (culling, raster): (bool, Raster)) -> Result<MeshletCull, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
-        let stages = [
-            (&ml_shaders::INSTANCE_CULL_COMP, compute),
-            (&ml_shaders::MESHLET_CULL_COMP, compute),
-            (&ml_shaders::TRIANGLE_CULL_COMP, compute),
-        ];
+        let triangles = match raster {
+            Raster::Hardware => &ml_shaders::TRIANGLE_CULL_COMP,
+            Raster::Compute { .. } => &ml_shaders::TRIANGLE_RASTER_COMP,
+        };
+        let stages = [(&ml_shaders::INSTANCE_CULL_COMP, compute), (&ml_shaders::MESHLET_CULL_COMP, compute), (triangles, compute)];
         let pass = MeshletCull {
             phase,
             culling,
+            raster,
             scene,
             sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
             pipeline_layout: vk::PipelineLayout::null(),
@@ -65,7 +70,7 @@ impl MeshletCull {
                 p.instance_pipeline = shader::compute_pipeline(ctx, ml_shaders::INSTANCE_CULL_COMP.spirv, p.pipeline_layout, &[])?;
             }
             p.meshlet_pipeline = shader::compute_pipeline(ctx, ml_shaders::MESHLET_CULL_COMP.spirv, p.pipeline_layout, &[])?;
-            p.triangle_pipeline = shader::compute_pipeline(ctx, ml_shaders::TRIANGLE_CULL_COMP.spirv, p.pipeline_layout, &[])?;
+            p.triangle_pipeline = shader::compute_pipeline(ctx, triangles.spirv, p.pipeline_layout, &[])?;
             Ok(())
         })
     }
@@ -75,14 +80,17 @@ impl MeshletCull {
         let scene = self.scene.borrow();
         CullPush {
             mode: [u32::from(self.phase == Phase::Late), u32::from(self.culling), levels, scene.capacity],
-            triangles: [scene.triangles as u32, 0, 0, 0],
+            triangles: [scene.triangles as u32, self.raster.split(), 0, 0],
         }
     }
 }
 
 impl Pass for MeshletCull {
     fn timer_name(&self) -> Option<&'static str> {
+        let compute = self.raster != Raster::Hardware;
         Some(match self.phase {
+            Phase::Early if compute => "cull + compute raster (early)",
+            Phase::Late if compute => "cull + compute raster (late)",
             Phase::Early => "cull (early)",
             Phase::Late => "cull (late)",
         })
@@ -92,6 +100,7 @@ impl Pass for MeshletCull {
         let scene = self.scene.borrow();
         self.sets.write(ctx, frame.slot, &|name| match name {
             "DepthPyramidBuffer" => Some(Resource::Buffer(frame.targets.depth_pyramid.raw)),
+            "VisibilityDepthBuffer" => Some(Resource::Buffer(frame.targets.visibility_depth.raw)),
             _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
         })
     }
@@ -124,6 +133,11 @@ impl Pass for MeshletCull {
                     (compute | transfer, rw | vk::AccessFlags::TRANSFER_WRITE),
                 );
                 d.cmd_fill_buffer(cmd, f.counters.raw, 0, vk::WHOLE_SIZE, 0);
+                if self.raster != Raster::Hardware {
+                    // Nothing drawn: all ones, above every depth-and-id (the last frame's
+                    // resolve on this slot read it).
+                    d.cmd_fill_buffer(cmd, rec.targets.visibility_depth.raw, 0, vk::WHOLE_SIZE, u32::MAX);
+                }
                 memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.instance_pipeline);
                 d.cmd_dispatch(cmd, scene.instance_count.div_ceil(GROUP).max(1), 1, 1);
@@ -175,7 +189,9 @@ impl Pass for MeshletCull {
             late_tested: c.tested[1],
             late_drawn: c.meshlets[1][0],
             meshlet_triangles: c.triangles[0] as u64 + c.triangles[1] as u64,
-            triangles: c.triangles[2] as u64 + c.triangles[3] as u64,
+            triangles: [c.triangles[2], c.triangles[3], c.rasterized[0], c.rasterized[1]].iter().map(|&n| n as u64).sum(),
+            compute_triangles: c.rasterized[0] as u64 + c.rasterized[1] as u64,
+            compute_pixels: c.rasterized[2] as u64,
             scene_triangles: scene.triangles,
         });
     }

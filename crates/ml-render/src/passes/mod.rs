@@ -15,11 +15,12 @@ pub mod shadow_map_view;
 pub mod tone_map;
 pub mod visibility_lighting;
 pub mod visibility_raster;
+pub mod visibility_resolve;
 
 use crate::meshlet_scene::MeshletScene;
 use crate::pass::Pass;
 use crate::scene_gpu::SceneGpu;
-use crate::settings::{DebugView, Geometry, LightAssignment, LightingStage, RenderSettings, Shading, ShadingModel};
+use crate::settings::{DebugView, Geometry, LightAssignment, LightingStage, Raster, RenderSettings, Shading, ShadingModel};
 use meshlet_cull::Phase;
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::meshlets::SceneMeshlets;
@@ -91,16 +92,24 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
 }
 
 /// GPU-driven geometry: early culling and raster, the depth pyramid, late culling and
-/// raster, then lighting from the visibility buffer.
+/// raster, then lighting from the visibility buffer. With the compute raster, each phase's
+/// culling also rasterises the small triangles, the hardware draws the others into the same
+/// buffer, and a resolve makes the images the passes after it read.
 fn add_meshlet_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> Result<(), VkError> {
     let geometry = SceneMeshlets::build(a.source).map_err(|e| VkError::Limit(e.to_string()))?;
     let scene = MeshletScene::new(ctx, geometry, &a.scene.object_textures.set_index)?;
-    let culling = a.settings.culling;
-    passes.push(Box::new(meshlet_cull::MeshletCull::new(ctx, scene.clone(), Phase::Early, culling)?));
-    passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), Phase::Early, a.depth_format)?));
-    passes.push(Box::new(depth_pyramid::DepthPyramid::new(ctx)?));
-    passes.push(Box::new(meshlet_cull::MeshletCull::new(ctx, scene.clone(), Phase::Late, culling)?));
-    passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), Phase::Late, a.depth_format)?));
+    let (culling, raster) = (a.settings.culling, a.settings.raster);
+    let compute = raster != Raster::Hardware;
+    for phase in [Phase::Early, Phase::Late] {
+        passes.push(Box::new(meshlet_cull::MeshletCull::new(ctx, scene.clone(), phase, (culling, raster))?));
+        passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), (phase, compute), a.depth_format)?));
+        if compute {
+            passes.push(Box::new(visibility_resolve::VisibilityResolve::new(ctx, phase)?));
+        }
+        if phase == Phase::Early {
+            passes.push(Box::new(depth_pyramid::DepthPyramid::new(ctx)?));
+        }
+    }
     passes.push(Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, scene, a.shading)?));
     Ok(())
 }

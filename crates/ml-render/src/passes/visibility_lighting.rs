@@ -34,8 +34,8 @@ impl Pass for VisibilityLighting {
         let t = frame.targets;
         let scene = self.scene.borrow();
         self.pass.bind_frame(ctx, frame, &|name| match name {
-            "depth_image" => self.pass.sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-            "visibility_image" => self.pass.sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+            "depth_image" => self.pass.sampled(&t.depth, t.depth_layout),
+            "visibility_image" => self.pass.sampled(&t.visibility, t.visibility_layout),
             _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
         })
     }

@@ -2,9 +2,12 @@
 //! one indexed draw per phase whose count the GPU wrote (vkCmdDrawIndexedIndirect), from the
 //! compacted index buffer, vertices pulled from storage buffers; per pixel the depth and a
 //! 32-bit id (visibility.frag). The early phase clears both images, the late one draws the
-//! newly visible triangles over them.
+//! newly visible triangles over them. With the compute raster the same draw holds only the
+//! triangles it leaves to the hardware (large ones, those crossing the near plane), and
+//! their fragments write its 64-bit buffer by atomic min (visibility_atomic.frag) in a pass
+//! without attachments.
 
-use crate::descriptors::FrameSets;
+use crate::descriptors::{FrameSets, Resource};
 use crate::frame::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{FrameResources, Pass, Recording};
@@ -15,6 +18,8 @@ use ml_vk::{shader, vk, Context, VkError};
 
 pub struct VisibilityRaster {
     phase: Phase,
+    /// The compute raster's hardware half (else the visibility raster).
+    atomic: bool,
     scene: SharedMeshletScene,
     render_pass: vk::RenderPass,
     sets: FrameSets,
@@ -24,11 +29,19 @@ pub struct VisibilityRaster {
 }
 
 impl VisibilityRaster {
-    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, depth_format: vk::Format) -> Result<VisibilityRaster, VkError> {
-        let (vert, frag) = (&ml_shaders::VISIBILITY_VERT, &ml_shaders::VISIBILITY_FRAG);
+    /// The pass of `phase`; `atomic`: the compute raster's hardware half.
+    pub fn new(
+        ctx: &Context,
+        scene: SharedMeshletScene,
+        (phase, atomic): (Phase, bool),
+        depth_format: vk::Format,
+    ) -> Result<VisibilityRaster, VkError> {
+        let vert = &ml_shaders::VISIBILITY_VERT;
+        let frag = if atomic { &ml_shaders::VISIBILITY_ATOMIC_FRAG } else { &ml_shaders::VISIBILITY_FRAG };
         let stages = [(vert, vk::ShaderStageFlags::VERTEX), (frag, vk::ShaderStageFlags::FRAGMENT)];
         let pass = VisibilityRaster {
             phase,
+            atomic,
             scene,
             render_pass: vk::RenderPass::null(),
             sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
@@ -37,10 +50,13 @@ impl VisibilityRaster {
             framebuffers: vec![vk::Framebuffer::null(); FRAMES_IN_FLIGHT],
         };
         ml_vk::build(ctx, pass, |p| {
-            p.render_pass = render_pass::visibility(depth_format, phase == Phase::Early).create(ctx)?;
+            p.render_pass =
+                if atomic { render_pass::visibility_atomic() } else { render_pass::visibility(depth_format, phase == Phase::Early) }
+                    .create(ctx)?;
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::FRAGMENT).size(16)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            // The G-buffer pass's state: back faces culled (counter-clockwise fronts), depth LESS.
+            // The G-buffer pass's state: back faces culled (counter-clockwise fronts), depth LESS
+            // (the atomic min is the test of the compute raster's half).
             p.pipeline = shader::graphics_pipeline(
                 ctx,
                 &shader::GraphicsPipelineDesc {
@@ -55,10 +71,10 @@ impl VisibilityRaster {
                         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
                         .line_width(1.0),
                     depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default()
-                        .depth_test_enable(true)
-                        .depth_write_enable(true)
+                        .depth_test_enable(!atomic)
+                        .depth_write_enable(!atomic)
                         .depth_compare_op(vk::CompareOp::LESS),
-                    colour_attachments: 1,
+                    colour_attachments: usize::from(!atomic),
                     layout: p.pipeline_layout,
                     render_pass: p.render_pass,
                     subpass: 0,
@@ -72,6 +88,8 @@ impl VisibilityRaster {
 impl Pass for VisibilityRaster {
     fn timer_name(&self) -> Option<&'static str> {
         Some(match self.phase {
+            Phase::Early if self.atomic => "large triangles (early)",
+            Phase::Late if self.atomic => "large triangles (late)",
             Phase::Early => "raster (early)",
             Phase::Late => "raster (late)",
         })
@@ -79,9 +97,12 @@ impl Pass for VisibilityRaster {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let scene = self.scene.borrow();
-        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))?;
         let t = frame.targets;
-        let views = [t.visibility.view, t.depth.view];
+        self.sets.write(ctx, frame.slot, &|name| match name {
+            "VisibilityDepthBuffer" => Some(Resource::Buffer(t.visibility_depth.raw)),
+            _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
+        })?;
+        let views = if self.atomic { Vec::new() } else { vec![t.visibility.view, t.depth.view] };
         render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.visibility.extent)
     }
 
@@ -100,14 +121,14 @@ impl Pass for VisibilityRaster {
             .render_pass(self.render_pass)
             .framebuffer(self.framebuffers[slot])
             .render_area(area)
-            .clear_values(&clear);
+            .clear_values(if self.atomic { &[] } else { &clear });
         let viewport =
             vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
         // CullCounters.draws[phase]; the phase's triangle ids start at 0 (early) or after
         // room for every triangle of the scene (late).
         let phase = usize::from(self.phase == Phase::Late);
         let draw = (std::mem::offset_of!(CullCounters, draws) + phase * std::mem::size_of::<DrawIndexedCommand>()) as u64;
-        let first_id = [phase as u32 * scene.triangles as u32, 0, 0, 0];
+        let first_id = [phase as u32 * scene.triangles as u32, extent.width, 0, 0];
         // SAFETY: recording state; every handle is alive until the frame's fence signals.
         unsafe {
             d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);

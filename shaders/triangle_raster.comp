@@ -1,0 +1,153 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+// The compute raster (docs/DESIGN.md#compute-raster), in place of culling step 3: a work group
+// per meshlet drawn in this phase, its vertices transformed once into shared memory, a thread
+// per triangle. A small triangle — bounding box within `cull.triangles.y` pixels a side, wholly
+// beyond the near plane — is rasterised here, by Vulkan's rules as the hardware applies them:
+// vertices snapped to 1/256 pixel, integer edge functions at pixel centres, the top-left rule
+// on edges, depth interpolated from the vertices' z/w, LESS against what is there. The
+// nearest (depth << 32 | visibility id) per pixel is kept by a 64-bit atomic min. Every other
+// triangle (large, or crossing the near plane, which the hardware clips) goes to the phase's
+// indexed draw, whose fragments do the same atomic min into the same buffer.
+#include "common.glsl"
+
+layout(local_size_x = 64) in;
+
+#include "meshlet_cull.glsl"
+#include "meshlet_geometry.glsl"
+#include "triangle_cull.glsl"
+
+// Per pixel, row by row: floatBitsToUint(depth) << 32 | visibility id, the nearest kept; all
+// ones where nothing was drawn (visibility_resolve.comp makes the two images of it).
+layout(std430, set = 0, binding = 14) buffer VisibilityDepthBuffer { uint64_t visibility_depth[]; };
+
+// The sub-pixel grid of the rasteriser we match: 8 bits, subPixelPrecisionBits of every device
+// we run on (`manylights info` lists it).
+const float SUBPIXEL = 256.0;
+
+const uint ROUTE_NONE = 0u;     // no pixel to draw
+const uint ROUTE_COMPUTE = 1u;  // drawn here
+const uint ROUTE_HARDWARE = 2u; // appended to the indexed draw
+
+shared uint group_triangles;
+shared uint group_pixels;
+
+// The viewport transform (xf = width/2 · x/w + width/2, y likewise), in pixels.
+vec2 framebuffer_xy(vec4 c) {
+    vec2 half_size = vec2(frame.viewport.xy) * 0.5;
+    return c.xy / c.w * half_size + half_size;
+}
+
+uint route(vec4 a, vec4 b, vec4 c) {
+    // In front of the near plane (or behind the eye): the hardware clips it.
+    if (a.z < 0.0 || b.z < 0.0 || c.z < 0.0 || a.w <= 0.0 || b.w <= 0.0 || c.w <= 0.0) {
+        return ROUTE_HARDWARE;
+    }
+    vec2 pa = framebuffer_xy(a), pb = framebuffer_xy(b), pc = framebuffer_xy(c);
+    vec2 lo = min(pa, min(pb, pc)), hi = max(pa, max(pb, pc));
+    if (any(greaterThan(hi - lo, vec2(float(cull.triangles.y))))) {
+        return ROUTE_HARDWARE;
+    }
+    // Off screen, with a pixel of margin for the snapping.
+    if (any(lessThan(hi, vec2(-1.0))) || any(greaterThan(lo, vec2(frame.viewport.xy) + 1.0))) {
+        return ROUTE_NONE;
+    }
+    return ROUTE_COMPUTE;
+}
+
+// The edge function of edge s → e at p (sub-pixel units): positive on the interior's side.
+int edge_function(ivec2 s, ivec2 e, ivec2 p) {
+    ivec2 d = e - s;
+    return d.x * (p.y - s.y) - d.y * (p.x - s.x);
+}
+
+// The fill rule: a pixel centre on an edge belongs to the triangle only if the edge is a top
+// or a left one — with the interior on the positive side (y down), a left edge runs upwards,
+// a top edge is horizontal and runs right. 1 for the other edges: their zero is outside.
+int fill_bias(ivec2 s, ivec2 e) {
+    ivec2 d = e - s;
+    return d.y < 0 || (d.y == 0 && d.x > 0) ? 0 : 1;
+}
+
+// Draws the triangle (clip-space corners) with visibility id `id`; returns the pixels covered.
+uint rasterize(vec4 ca, vec4 cb, vec4 cc, uint id) {
+    ivec2 a = ivec2(roundEven(framebuffer_xy(ca) * SUBPIXEL));
+    ivec2 b = ivec2(roundEven(framebuffer_xy(cb) * SUBPIXEL));
+    ivec2 c = ivec2(roundEven(framebuffer_xy(cc) * SUBPIXEL));
+    vec3 z = vec3(ca.z / ca.w, cb.z / cb.w, cc.z / cc.w);
+    // Relative to the box's corner: at most 64 pixels a side keeps every product below 2^31.
+    ivec2 lo = min(a, min(b, c)), hi = max(a, max(b, c));
+    a -= lo;
+    b -= lo;
+    c -= lo;
+    int area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    // Front faces (counter-clockwise, y down) have a negative area; the pipeline culls the
+    // others, and a zero-area triangle covers nothing.
+    if (area >= 0) {
+        return 0u;
+    }
+    // b and c swapped: the interior on every edge's positive side.
+    ivec2 t = b;
+    b = c;
+    c = t;
+    z = z.xzy;
+    area = -area;
+    // Pixel centres 256 i + 128 inside the box, within the image (>> rounds towards −∞).
+    ivec2 size = ivec2(frame.viewport.xy);
+    ivec2 first = max((lo - 128 + 255) >> 8, ivec2(0));
+    ivec2 last = min((hi - 128) >> 8, size - 1);
+    ivec3 bias = ivec3(fill_bias(b, c), fill_bias(c, a), fill_bias(a, b));
+    uint covered = 0u;
+    for (int y = first.y; y <= last.y; y++) {
+        for (int x = first.x; x <= last.x; x++) {
+            ivec2 p = ivec2(x, y) * 256 + 128 - lo;
+            ivec3 w = ivec3(edge_function(b, c, p), edge_function(c, a, p), edge_function(a, b, p));
+            if (any(lessThan(w - bias, ivec3(0)))) {
+                continue;
+            }
+            covered++;
+            float depth = dot(vec3(w), z) / float(area);
+            if (depth >= 1.0) {
+                continue;
+            }
+            uint64_t value = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(id);
+            atomicMin(visibility_depth[uint(y) * frame.viewport.x + uint(x)], value);
+        }
+    }
+    return covered;
+}
+
+void main() {
+    uvec4 d = draw_slots[group_slot()];
+    Meshlet m = meshlets[d.w];
+    if (gl_LocalInvocationID.x == 0u) {
+        group_triangles = 0u;
+        group_pixels = 0u;
+    }
+    transform_meshlet(m, d);
+    bool culling = cull.mode.y != 0u;
+    uint triangles = 0u, pixels = 0u;
+    for (uint t = gl_LocalInvocationID.x; t < m.triangles.y; t += gl_WorkGroupSize.x) {
+        uvec3 v = meshlet_corners(m, t);
+        vec4 a = clip[v.x], b = clip[v.y], c = clip[v.z];
+        if (culling && !triangle_visible(a, b, c)) {
+            continue;
+        }
+        uint r = route(a, b, c);
+        if (r == ROUTE_HARDWARE) {
+            keep_triangle(t);
+        } else if (r == ROUTE_COMPUTE) {
+            pixels += rasterize(a, b, c, (d.x << VISIBILITY_TRIANGLE_BITS) | t);
+            triangles++;
+        }
+    }
+    atomicAdd(group_triangles, triangles);
+    atomicAdd(group_pixels, pixels);
+    append_kept(m, d);
+    if (gl_LocalInvocationID.x == 0u) {
+        atomicAdd(counters.rasterized[cull.mode.x], group_triangles);
+        atomicAdd(counters.rasterized.z, group_pixels);
+    }
+}
