@@ -236,7 +236,7 @@ pub enum Raster {
 impl Raster {
     /// The compute raster's default split: triangles up to this many pixels a side are drawn
     /// in compute (measured: docs/BENCHMARKS.md).
-    pub const DEFAULT_SPLIT: u32 = 32;
+    pub const DEFAULT_SPLIT: u32 = 16;
     /// Its largest: the edge functions of a 64-pixel box at 1/256 pixel stay in 32 bits.
     pub const MAX_SPLIT: u32 = 64;
 

@@ -33,8 +33,8 @@ struct Drawn {
     shaded: [RenderOutput; 2],
 }
 
-fn draw_both(ctx: &Context, scene: &Scene, base: RenderSettings) -> Drawn {
-    let compute = Raster::Compute { split: Raster::DEFAULT_SPLIT };
+fn draw_both(ctx: &Context, scene: &Scene, base: RenderSettings, split: u32) -> Drawn {
+    let compute = Raster::Compute { split };
     let render = |raster, debug_view| {
         let settings = RenderSettings { raster, debug_view, ..base };
         Renderer::new(ctx, scene.clone(), settings).expect("renderer").render().expect("render")
@@ -132,20 +132,22 @@ fn the_compute_raster_draws_the_hardwares_triangles() {
     let counter = ctx.validation_counter();
     let bg = background(&ctx);
     let base = RenderSettings::new(Technique::Visibility, W, H);
-    let mut scenes: Vec<(String, Scene, RenderSettings)> = Vec::new();
+    let split = Raster::DEFAULT_SPLIT;
+    let mut scenes: Vec<(String, Scene, RenderSettings, u32)> = Vec::new();
     for seed in 0..4 {
-        scenes.push((format!("random scene {seed}"), low_random_scene(seed), base));
+        scenes.push((format!("random scene {seed}"), low_random_scene(seed), base, split));
     }
     for kind in MeshKind::ALL {
         let scene = Scene::seed(kind, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
-        scenes.push((format!("seed scene, {}", kind.name()), scene, base));
+        scenes.push((format!("seed scene, {}", kind.name()), scene, base, split));
     }
-    scenes.push(("bench scene".into(), ml_cpu::bench_scene::bench_scene(1000, 1, 60).unwrap(), base));
+    scenes.push(("bench scene".into(), ml_cpu::bench_scene::bench_scene(1000, 1, 60).unwrap(), base, split));
+    // Its quads' triangles are ~20 pixels: the largest split draws them in compute.
     let pbr = RenderSettings { shading: ShadingModel::Pbr, ..base };
-    scenes.push(("textured glTF".into(), textured_gltf_scene(), pbr));
+    scenes.push(("textured glTF".into(), textured_gltf_scene(), pbr, Raster::MAX_SPLIT));
     let (mut covered, mut differing) = (0, 0);
-    for (what, scene, settings) in &scenes {
-        let drawn = draw_both(&ctx, scene, *settings);
+    for (what, scene, settings, split) in &scenes {
+        let drawn = draw_both(&ctx, scene, *settings, *split);
         let c = drawn.ids[1].stats.culling.expect("culling stats");
         assert!(c.compute_triangles > 0, "{what}: the compute raster drew nothing");
         let (n, d) = compare(what, &drawn, bg);
