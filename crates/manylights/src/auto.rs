@@ -83,6 +83,32 @@ pub fn resolve_raster(
     })
 }
 
+/// `resolve_raster` on a context of its own (the viewer makes its own for the window), which
+/// must leave the validation layer silent; auto's pick is announced.
+pub fn resolve_raster_alone(
+    scene: &Scene,
+    settings: &RenderSettings,
+    choice: (Option<Raster>, u32),
+    (validation, device_index): (bool, Option<usize>),
+) -> Result<Raster> {
+    if settings.technique.geometry() != Geometry::Meshlets {
+        return Ok(choice.0.unwrap_or(Raster::Hardware));
+    }
+    let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
+    let messages = ctx.validation_counter();
+    let resolved = resolve_raster(&ctx, scene, settings, choice);
+    drop(ctx);
+    let count = messages.load(Ordering::SeqCst);
+    if count > 0 {
+        bail!("the validation layer reported {count} message(s) while timing the rasterisers for --raster auto (printed above)");
+    }
+    let (raster, why) = resolved?;
+    if let Some(why) = why {
+        println!("auto raster: {}: {why}", raster.name());
+    }
+    Ok(raster)
+}
+
 /// Render `scene` with `settings` and each rasteriser for RASTER_PROBE_FRAMES frames; the one
 /// whose frames took less GPU time (wall time where the device has no timestamps), and the
 /// line that says so.

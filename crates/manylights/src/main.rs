@@ -359,7 +359,9 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     let built = request.build()?;
     print_warnings(&built.warnings);
     let technique = auto::resolve_alone(&args.technique, args.validation, args.device)?;
-    let first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
+    let mut first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
+    first.raster =
+        auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args), args.raster_split), (args.validation, args.device))?;
     let options = ml_viewer::ViewerOptions {
         choices: ml_viewer::Choices::new(&request, &built, &first),
         scene: request,

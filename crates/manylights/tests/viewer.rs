@@ -105,3 +105,31 @@ fn without_a_display_view_is_one_error_line() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.lines().count() == 1 && stderr.contains("cannot open a window") && stderr.contains("xvfb-run"), "{stderr}");
 }
+
+/// The visibility technique with the compute raster in the window: through a resize (new
+/// targets, its 64-bit buffer among them) validation stays silent and the screenshot equals
+/// `render`'s image.
+#[test]
+fn the_compute_raster_views_what_it_renders() {
+    let d = dir();
+    let (shot, rendered) = (d.join("compute-raster-shot.png"), d.join("compute-raster-render.png"));
+    let script = ["frames 2", "resize 200 120", "frames 3", &format!("screenshot {}", shot.display()), "quit"].join("\n");
+    let script_file = d.join("compute-raster.txt");
+    std::fs::write(&script_file, script).unwrap();
+    let common =
+        ["--technique", "visibility", "--raster", "compute", "--scene", "bench", "--objects", "30", "--lights", "300", "--time", "0"];
+    let mut args = vec!["--validation", "--script", script_file.to_str().unwrap(), "--width", "160", "--height", "96"];
+    args.extend(common);
+    let out = view_under_xvfb(&args);
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "the session failed: {stdout}{stderr}");
+    assert!(!stderr.contains("VALIDATION") && !stderr.contains("panicked"), "{stderr}");
+    let mut render = vec!["render", "--validation", "--width", "200", "--height", "120", "--out", rendered.to_str().unwrap()];
+    render.extend(common);
+    let r = Command::new(bin()).args(&render).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let (a, b) = (rgba(&shot), rgba(&rendered));
+    assert_eq!((a.0, a.1), (b.0, b.1));
+    let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    assert!(worst <= 1, "the viewer's screenshot differs from render by {worst}/255");
+}
