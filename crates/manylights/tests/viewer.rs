@@ -65,14 +65,9 @@ fn a_scripted_session_is_validation_clean_and_its_screenshot_equals_render() {
     // Renderers: the first and one per technique switch; the light count changes in place.
     assert!(frames >= 70 && swapchains >= 22 && resizes >= 21 && changes_in_place == 1 && renderers == 4, "{summary}");
 
-    let mut render = vec!["render", "--technique", "deferred", "--lights", "500", "--out", rendered.to_str().unwrap()];
-    render.extend(common);
-    let r = Command::new(bin()).args(&render).output().unwrap();
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (a, b) = (rgba(&shot), rgba(&rendered));
-    assert_eq!((a.0, a.1), (b.0, b.1));
-    let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-    assert!(worst <= 1, "the viewer's screenshot differs from render by {worst}/255");
+    let render = [&["--technique", "deferred", "--lights", "500"][..], &common].concat();
+    assert_render_equals(&shot, &render, &rendered);
+    let a = rgba(&shot);
     // The window as presented: the same image under the overlay, whose panel sits top left.
     let w = rgba(&window_shot);
     assert_eq!((w.0, w.1), (320, 180));
@@ -124,11 +119,15 @@ fn the_compute_raster_views_what_it_renders() {
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "the session failed: {stdout}{stderr}");
     assert!(!stderr.contains("VALIDATION") && !stderr.contains("panicked"), "{stderr}");
-    let mut render = vec!["render", "--validation", "--width", "200", "--height", "120", "--out", rendered.to_str().unwrap()];
-    render.extend(common);
-    let r = Command::new(bin()).args(&render).output().unwrap();
+    assert_render_equals(&shot, &[&["--validation", "--width", "200", "--height", "120"][..], &common].concat(), &rendered);
+}
+
+/// `render ARGS --out rendered` succeeds and its image equals the viewer's screenshot `shot`
+/// within 1/255.
+fn assert_render_equals(shot: &Path, args: &[&str], rendered: &Path) {
+    let r = Command::new(bin()).arg("render").args(args).args(["--out", rendered.to_str().unwrap()]).output().unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (a, b) = (rgba(&shot), rgba(&rendered));
+    let (a, b) = (rgba(shot), rgba(rendered));
     assert_eq!((a.0, a.1), (b.0, b.1));
     let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
     assert!(worst <= 1, "the viewer's screenshot differs from render by {worst}/255");
