@@ -225,7 +225,16 @@ mod tests {
             clusters: ClusterDims::DEFAULT,
             debug_view: DebugView::None,
             omni: None,
+            raster: Raster::Hardware,
         }
+    }
+
+    #[test]
+    fn only_the_visibility_technique_takes_the_compute_raster() {
+        let compute = Choices { raster: Raster::Compute { split: 16 }, ..initial() };
+        assert_eq!(compute.settings((64, 64), None).raster, Raster::Hardware);
+        let visibility = Choices { technique: Technique::Visibility, ..compute };
+        assert_eq!(visibility.settings((64, 64), None).raster, Raster::Compute { split: 16 });
     }
 
     #[test]
