@@ -517,4 +517,9 @@ fn raster_auto_keeps_the_faster_and_says_why() {
         let out = manylights(&[&args[..], extra, &["--out", png.to_str().unwrap()]].concat(), &[]);
         assert_one_line_error(&out, needles);
     }
+    // 8 bytes a pixel in one storage buffer: more than any device we run allows (lavapipe:
+    // 128 MiB, the H100: 4 GiB).
+    let huge = ["render", "--technique", "visibility", "--raster", "compute", "--width", "16384", "--height", "16384"];
+    let out = manylights(&[&huge[..], &["--out", png.to_str().unwrap()]].concat(), &[]);
+    assert_one_line_error(&out, &["16384x16384", "bytes", "--raster hardware"]);
 }

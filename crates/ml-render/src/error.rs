@@ -96,6 +96,8 @@ pub enum SettingsError {
     RasterNeedsVisibility { technique: Technique },
     #[error("the compute raster needs {feature}, which '{device}' lacks: use --raster hardware")]
     RasterFeature { feature: &'static str, device: String },
+    #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size or --raster hardware")]
+    RasterBuffer { width: u32, height: u32, bytes: u64, device: String, max: u32 },
     #[error("frames must be at least 1")]
     NoFrames,
     #[error("time {0} is not a finite number")]

@@ -445,6 +445,12 @@ impl RenderSettings {
             if split == 0 || split > Raster::MAX_SPLIT {
                 return Err(SettingsError::OutOfRange { what: Setting::RasterSplit, value: split, max: Raster::MAX_SPLIT }.into());
             }
+            // Its depth-and-id buffer, 8 bytes a pixel, is one storage buffer.
+            let bytes = self.width as u64 * self.height as u64 * 8;
+            if bytes > limits.max_storage_buffer_range as u64 {
+                let (width, height, max) = (self.width, self.height, limits.max_storage_buffer_range);
+                return Err(SettingsError::RasterBuffer { width, height, bytes, device: device(), max }.into());
+            }
         }
         if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
             return Err(SettingsError::ShadowMapNeedsBlinnPhong.into());
