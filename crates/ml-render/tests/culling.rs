@@ -85,7 +85,7 @@ fn path(seed: u64) -> Vec<Camera> {
 /// such a pixel, whose centre lies on the silhouette's edge, with culling off and left it
 /// empty with culling on in some runs of the same binary and not in others — the culling's
 /// atomics order the triangles differently from run to run (measured: one pixel of one frame
-/// of these 600, in 6 of 12 runs). A culled triangle that should have been drawn leaves more
+/// of these 600, in 4 of 11 runs). A culled triangle that should have been drawn leaves more
 /// than a pixel, or one away from the silhouette.
 fn on_a_silhouette(a: &RenderOutput, b: &RenderOutput, k: usize) -> bool {
     let background = [5u8, 5, 5, 255];
