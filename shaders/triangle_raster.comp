@@ -40,12 +40,13 @@ vec2 framebuffer_xy(vec4 c) {
     return c.xy / c.w * half_size + half_size;
 }
 
-uint route(vec4 a, vec4 b, vec4 c) {
-    // In front of the near plane (or behind the eye): the hardware clips it.
-    if (a.z < 0.0 || b.z < 0.0 || c.z < 0.0 || a.w <= 0.0 || b.w <= 0.0 || c.w <= 0.0) {
-        return ROUTE_HARDWARE;
-    }
-    vec2 pa = framebuffer_xy(a), pb = framebuffer_xy(b), pc = framebuffer_xy(c);
+// In front of the near plane (or behind the eye) somewhere: the hardware clips it.
+bool crosses_near_plane(vec4 a, vec4 b, vec4 c) {
+    return a.z < 0.0 || b.z < 0.0 || c.z < 0.0 || a.w <= 0.0 || b.w <= 0.0 || c.w <= 0.0;
+}
+
+// Where a triangle wholly beyond the near plane is drawn, from its corners in pixels.
+uint route(vec2 pa, vec2 pb, vec2 pc) {
     vec2 lo = min(pa, min(pb, pc)), hi = max(pa, max(pb, pc));
     if (any(greaterThan(hi - lo, vec2(float(cull.triangles.y))))) {
         return ROUTE_HARDWARE;
@@ -71,12 +72,12 @@ int fill_bias(ivec2 s, ivec2 e) {
     return d.y < 0 || (d.y == 0 && d.x > 0) ? 0 : 1;
 }
 
-// Draws the triangle (clip-space corners) with visibility id `id`; returns the pixels covered.
-uint rasterize(vec4 ca, vec4 cb, vec4 cc, uint id) {
-    ivec2 a = ivec2(roundEven(framebuffer_xy(ca) * SUBPIXEL));
-    ivec2 b = ivec2(roundEven(framebuffer_xy(cb) * SUBPIXEL));
-    ivec2 c = ivec2(roundEven(framebuffer_xy(cc) * SUBPIXEL));
-    vec3 z = vec3(ca.z / ca.w, cb.z / cb.w, cc.z / cc.w);
+// Draws the triangle — its corners in pixels, their depths z/w — with visibility id `id`;
+// returns the pixels covered.
+uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id) {
+    ivec2 a = ivec2(roundEven(pa * SUBPIXEL));
+    ivec2 b = ivec2(roundEven(pb * SUBPIXEL));
+    ivec2 c = ivec2(roundEven(pc * SUBPIXEL));
     // Relative to the box's corner: at most 64 pixels a side keeps every product below 2^31.
     ivec2 lo = min(a, min(b, c)), hi = max(a, max(b, c));
     a -= lo;
@@ -135,11 +136,17 @@ void main() {
         if (culling && !triangle_visible(a, b, c)) {
             continue;
         }
-        uint r = route(a, b, c);
+        if (crosses_near_plane(a, b, c)) {
+            keep_triangle(t);
+            continue;
+        }
+        vec2 pa = framebuffer_xy(a), pb = framebuffer_xy(b), pc = framebuffer_xy(c);
+        uint r = route(pa, pb, pc);
         if (r == ROUTE_HARDWARE) {
             keep_triangle(t);
         } else if (r == ROUTE_COMPUTE) {
-            pixels += rasterize(a, b, c, (d.x << VISIBILITY_TRIANGLE_BITS) | t);
+            vec3 z = vec3(a.z / a.w, b.z / b.w, c.z / c.w);
+            pixels += rasterize(pa, pb, pc, z, (d.x << VISIBILITY_TRIANGLE_BITS) | t);
             triangles++;
         }
     }

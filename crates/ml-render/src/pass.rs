@@ -26,7 +26,9 @@ pub struct FrameResources<'a> {
 }
 
 impl FrameResources<'_> {
-    /// The buffers every shading shader may declare (scene_bindings.glsl's blocks).
+    /// The buffers every shading shader may declare (scene_bindings.glsl's blocks), and the
+    /// visibility technique's buffer targets (the depth pyramid, the compute raster's
+    /// depth-and-id buffer).
     pub fn buffer(&self, name: &str) -> Option<Resource> {
         let buffer = match name {
             "FrameBlock" => self.uniforms,
@@ -35,6 +37,8 @@ impl FrameResources<'_> {
             "LightIndexBuffer" => self.light_indices,
             "ObjectBuffer" => self.objects,
             "LightConeBuffer" => self.cones,
+            "DepthPyramidBuffer" => self.targets.depth_pyramid.raw,
+            "VisibilityDepthBuffer" => self.targets.visibility_depth.raw,
             _ => return None,
         };
         Some(Resource::Buffer(buffer))

@@ -50,8 +50,7 @@ impl Pass for DepthPyramid {
         let depth = vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(t.depth.view).image_layout(t.depth_layout);
         self.sets.write(ctx, frame.slot, &|name| match name {
             "depth_image" => Some(Resource::Image(depth)),
-            "DepthPyramidBuffer" => Some(Resource::Buffer(t.depth_pyramid.raw)),
-            _ => None,
+            _ => frame.buffer(name),
         })
     }
 

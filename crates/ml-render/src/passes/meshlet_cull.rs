@@ -11,7 +11,7 @@
 //! same tests, then the small triangles rasterised there and only the others appended; the
 //! early phase clears its 64-bit buffer first.
 
-use crate::descriptors::{FrameSets, Resource};
+use crate::descriptors::FrameSets;
 use crate::frame::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{FrameResources, Pass, Recording, SlotReport};
@@ -98,11 +98,7 @@ impl Pass for MeshletCull {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let scene = self.scene.borrow();
-        self.sets.write(ctx, frame.slot, &|name| match name {
-            "DepthPyramidBuffer" => Some(Resource::Buffer(frame.targets.depth_pyramid.raw)),
-            "VisibilityDepthBuffer" => Some(Resource::Buffer(frame.targets.visibility_depth.raw)),
-            _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
-        })
+        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))
     }
 
     fn record(&self, rec: &Recording) {

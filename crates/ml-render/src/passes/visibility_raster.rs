@@ -7,7 +7,7 @@
 //! their fragments write its 64-bit buffer by atomic min (visibility_atomic.frag) in a pass
 //! without attachments.
 
-use crate::descriptors::{FrameSets, Resource};
+use crate::descriptors::FrameSets;
 use crate::frame::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{FrameResources, Pass, Recording};
@@ -97,11 +97,8 @@ impl Pass for VisibilityRaster {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let scene = self.scene.borrow();
+        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))?;
         let t = frame.targets;
-        self.sets.write(ctx, frame.slot, &|name| match name {
-            "VisibilityDepthBuffer" => Some(Resource::Buffer(t.visibility_depth.raw)),
-            _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
-        })?;
         let views = if self.atomic { Vec::new() } else { vec![t.visibility.view, t.depth.view] };
         render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.visibility.extent)
     }

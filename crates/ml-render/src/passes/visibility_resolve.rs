@@ -35,10 +35,9 @@ impl Pass for VisibilityResolve {
         let storage =
             |view| Some(Resource::Image(vk::DescriptorImageInfo::default().image_view(view).image_layout(vk::ImageLayout::GENERAL)));
         self.pass.bind_frame(ctx, frame, &|name| match name {
-            "VisibilityDepthBuffer" => Some(Resource::Buffer(t.visibility_depth.raw)),
             "visibility_out" => storage(t.visibility.view),
             "depth_out" => storage(t.depth.view),
-            _ => None,
+            _ => frame.buffer(name),
         })
     }
 
