@@ -153,11 +153,7 @@ impl Variant {
 fn raster_list(a: &BenchArgs) -> Result<Vec<Raster>> {
     let mut list = Vec::new();
     for name in a.raster.split(',').map(str::trim) {
-        let raster = match name {
-            "hardware" => Raster::Hardware,
-            "compute" => Raster::Compute { split: a.raster_split },
-            other => bail!("unknown rasteriser '{other}' in --raster: expected hardware or compute"),
-        };
+        let raster = Raster::from_name(name, a.raster_split)?;
         if !list.contains(&raster) {
             list.push(raster);
         }

@@ -262,11 +262,10 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
 }
 
 /// `--raster` with `--raster-split`: a rasteriser, or None for auto.
-fn raster_choice(args: &SceneArgs) -> Option<Raster> {
+fn raster_choice(args: &SceneArgs) -> Result<Option<Raster>> {
     match args.raster.as_str() {
-        "hardware" => Some(Raster::Hardware),
-        "compute" => Some(Raster::Compute { split: args.raster_split }),
-        _ => None,
+        "auto" => Ok(None),
+        name => Ok(Some(Raster::from_name(name, args.raster_split)?)),
     }
 }
 
@@ -318,7 +317,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         }
     };
     let raster_why;
-    (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args), args.raster_split))?;
+    (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
     let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render());
     let device = report::device_line(&ctx.info);
@@ -361,7 +360,7 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     let technique = auto::resolve_alone(&args.technique, args.validation, args.device)?;
     let mut first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
     first.raster =
-        auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args), args.raster_split), (args.validation, args.device))?;
+        auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args)?, args.raster_split), (args.validation, args.device))?;
     let options = ml_viewer::ViewerOptions {
         choices: ml_viewer::Choices::new(&request, &built, &first),
         scene: request,

@@ -29,6 +29,9 @@ fn with_flags(cause: &(dyn Error + 'static)) -> Option<String> {
             RenderError::UnknownName { kind: Named::OmniShadowMode, name, expected } => {
                 Some(format!("unknown --omni-shadow mode '{name}': expected one of {expected}"))
             }
+            RenderError::UnknownName { kind: Named::Raster, name, expected } => {
+                Some(format!("unknown rasteriser '{name}' in --raster: expected one of {expected}"))
+            }
             _ => None,
         };
     }

@@ -98,6 +98,7 @@ fn bad_bench_arguments_are_one_error_line() {
         (&["bench", "--lights", "many"][..], "not a light count"),
         (&["bench", "--techniques", "raytracing"][..], "raytracing"),
         (&["bench", "--resolution", "big"][..], "expected WxH"),
+        (&["bench", "--raster", "hardware,sideways"][..], "rasteriser 'sideways' in --raster"),
         (&["bench", "--probe", "--probe-lights", "100k"][..], "at most 65536 lights per pixel"),
         (&["bench", "--probe", "--resolution", "0x10"][..], "each side must be 1 to"),
     ] {

@@ -39,6 +39,7 @@ pub enum Named {
     Technique,
     DebugView,
     OmniShadowMode,
+    Raster,
 }
 
 impl std::fmt::Display for Named {
@@ -47,6 +48,7 @@ impl std::fmt::Display for Named {
             Named::Technique => "technique",
             Named::DebugView => "debug view",
             Named::OmniShadowMode => "point-light shadow mode",
+            Named::Raster => "rasteriser",
         })
     }
 }

@@ -247,6 +247,15 @@ impl Raster {
         }
     }
 
+    /// The rasteriser `name` names (`hardware`, `compute`), the compute raster with `split`.
+    pub fn from_name(name: &str, split: u32) -> Result<Raster, RenderError> {
+        [Raster::Hardware, Raster::Compute { split }].into_iter().find(|r| r.name() == name).ok_or_else(|| RenderError::UnknownName {
+            kind: Named::Raster,
+            name: name.to_owned(),
+            expected: "hardware, compute".to_owned(),
+        })
+    }
+
     /// The largest triangle drawn in compute (0: none).
     pub fn split(self) -> u32 {
         match self {

@@ -45,14 +45,9 @@ fn draw_both(ctx: &Context, scene: &Scene, base: RenderSettings, split: u32) -> 
     }
 }
 
-fn rgb(out: &RenderOutput, x: i64, y: i64) -> Option<[u8; 3]> {
-    let inside = x >= 0 && y >= 0 && x < out.width as i64 && y < out.height as i64;
-    inside.then(|| common::pixel(out, x as u32, y as u32))
-}
-
 /// Whether `colour` is one of the 8 neighbours of (x, y) in `out`.
 fn next_to(out: &RenderOutput, (x, y): (i64, i64), colour: [u8; 3]) -> bool {
-    (-1..=1).any(|dy| (-1..=1).any(|dx| (dx, dy) != (0, 0) && rgb(out, x + dx, y + dy) == Some(colour)))
+    (-1..=1).any(|dy| (-1..=1).any(|dx| (dx, dy) != (0, 0) && common::pixel_at(out, x + dx, y + dy) == Some(colour)))
 }
 
 /// Covered pixels, and those whose ids differ; panics where the differences break the rules.
@@ -60,19 +55,20 @@ fn compare(what: &str, d: &Drawn, background: [u8; 3]) -> (usize, usize) {
     let [hw, cp] = &d.ids;
     let (mut covered, mut differing) = (0, 0);
     let mut stray = Vec::new();
-    for y in 0..H as i64 {
-        for x in 0..W as i64 {
-            let (a, b) = (rgb(hw, x, y).unwrap(), rgb(cp, x, y).unwrap());
+    for y in 0..H {
+        for x in 0..W {
+            let (a, b) = (common::pixel(hw, x, y), common::pixel(cp, x, y));
             covered += usize::from(a != background || b != background);
             if a == b {
-                let shaded = [rgb(&d.shaded[0], x, y).unwrap(), rgb(&d.shaded[1], x, y).unwrap()];
+                let shaded = [common::pixel(&d.shaded[0], x, y), common::pixel(&d.shaded[1], x, y)];
                 let diff = shaded[0].iter().zip(shaded[1]).map(|(p, q)| p.abs_diff(q)).max().unwrap();
                 assert!(diff <= 1, "{what}: pixel ({x}, {y}) shows one triangle but its shaded colours differ by {diff}/255");
                 continue;
             }
             differing += 1;
             // Where the two triangles meet: each one's triangle is next to the pixel in the other's image.
-            if !(next_to(hw, (x, y), b) || next_to(cp, (x, y), a)) {
+            let at = (x as i64, y as i64);
+            if !(next_to(hw, at, b) || next_to(cp, at, a)) {
                 stray.push((x, y));
             }
         }

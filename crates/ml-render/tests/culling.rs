@@ -8,6 +8,8 @@
 //! from a different place: the late phase must find everything else). Validation (with
 //! synchronization validation) stays silent throughout.
 
+mod common;
+
 use glam::{Mat4, Quat, Vec3};
 use ml_cpu::camera::Camera;
 use ml_cpu::material::Material;
@@ -88,17 +90,12 @@ fn path(seed: u64) -> Vec<Camera> {
 /// of these 600, in 4 of 11 runs). A culled triangle that should have been drawn leaves more
 /// than a pixel, or one away from the silhouette.
 fn on_a_silhouette(a: &RenderOutput, b: &RenderOutput, k: usize) -> bool {
-    let background = [5u8, 5, 5, 255];
-    let at = |o: &RenderOutput, x: i64, y: i64| -> Option<[u8; 4]> {
-        (x >= 0 && y >= 0 && x < W as i64 && y < H as i64).then(|| {
-            let i = (y as usize * W as usize + x as usize) * 4;
-            [o.rgba[i], o.rgba[i + 1], o.rgba[i + 2], o.rgba[i + 3]]
-        })
-    };
+    let background = [5u8, 5, 5];
+    let at = common::pixel_at;
     let (x, y) = ((k % W as usize) as i64, (k / W as usize) as i64);
     let one_is_background = (at(a, x, y) == Some(background)) != (at(b, x, y) == Some(background));
     let mixed = |o: &RenderOutput| {
-        let around: Vec<[u8; 4]> =
+        let around: Vec<[u8; 3]> =
             (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))).filter_map(|(dx, dy)| at(o, x + dx, y + dy)).collect();
         around.contains(&background) && around.iter().any(|p| *p != background)
     };

@@ -64,3 +64,9 @@ pub fn pixel(out: &RenderOutput, x: u32, y: u32) -> [u8; 3] {
     let i = ((y * out.width + x) * 4) as usize;
     [out.rgba[i], out.rgba[i + 1], out.rgba[i + 2]]
 }
+
+/// `pixel` at (x, y), None outside the image (for looking at a pixel's neighbours).
+pub fn pixel_at(out: &RenderOutput, x: i64, y: i64) -> Option<[u8; 3]> {
+    let inside = x >= 0 && y >= 0 && x < out.width as i64 && y < out.height as i64;
+    inside.then(|| pixel(out, x as u32, y as u32))
+}
