@@ -188,6 +188,23 @@ struct CullPush {
                      // side), 0 with the hardware raster
 };
 
+// Push constants of the compute shadow raster (omni_raster.glsl).
+struct OmniRasterPush {
+    mat4 projection; // every face's: 90°, near NEAR_FRACTION, far 1 (the light's frame, in radii)
+    uvec4 sizes;     // x: texels per face side; y: shadowed lights; z: the largest triangle one
+                     // thread draws (bounding box, texels a side); w: meshlet instances
+    uvec4 capacity;  // x: (meshlet instance, face) pairs the pair list holds; y: large triangles
+};
+
+// The counts of a frame's compute shadow raster.
+struct OmniRasterCounters {
+    uvec4 pairs; // x: the raster's work groups (at most 65535; each loops); y, z: 1; w: pairs listed
+    uvec4 large; // x: the large-triangle raster's work groups, likewise; y, z: 1; w: large triangles
+                 // listed (those past the list's capacity are drawn by their own thread)
+    uvec4 drawn; // x: triangles drawn by one thread; y: of those, large (the list was full);
+                 // z: texels covered
+};
+
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with
 // raster.rs CLEAR_COLOR.
 const vec4 CLEAR_COLOR = vec4(0.02, 0.02, 0.02, 1.0);

@@ -9,5 +9,5 @@
 void main() {
     out_from_light = omni_from_light();
     gl_Layer = gl_InstanceIndex;
-    gl_Position = omni_face_clip(out_from_light, gl_InstanceIndex);
+    gl_Position = omni_face_clip(omni.view_proj, out_from_light, gl_InstanceIndex);
 }

@@ -8,5 +8,5 @@
 
 void main() {
     out_from_light = omni_from_light();
-    gl_Position = omni_face_clip(out_from_light, gl_ViewIndex);
+    gl_Position = omni_face_clip(omni.view_proj, out_from_light, gl_ViewIndex);
 }

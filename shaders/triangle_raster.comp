@@ -18,14 +18,11 @@ layout(local_size_x = 64) in;
 #include "meshlet_cull.glsl"
 #include "meshlet_geometry.glsl"
 #include "triangle_cull.glsl"
+#include "raster_rules.glsl"
 
 // Per pixel, row by row: floatBitsToUint(depth) << 32 | visibility id, the nearest kept; all
 // ones where nothing was drawn (visibility_resolve.comp makes the two images of it).
 layout(std430, set = 0, binding = 14) buffer VisibilityDepthBuffer { uint64_t visibility_depth[]; };
-
-// The sub-pixel grid of the rasteriser we match: 8 bits, subPixelPrecisionBits of every device
-// we run on (`manylights info` lists it).
-const float SUBPIXEL = 256.0;
 
 const uint ROUTE_NONE = 0u;     // no pixel to draw
 const uint ROUTE_COMPUTE = 1u;  // drawn here
@@ -56,20 +53,6 @@ uint route(vec2 pa, vec2 pb, vec2 pc) {
         return ROUTE_NONE;
     }
     return ROUTE_COMPUTE;
-}
-
-// The edge function of edge s → e at p (sub-pixel units): positive on the interior's side.
-int edge_function(ivec2 s, ivec2 e, ivec2 p) {
-    ivec2 d = e - s;
-    return d.x * (p.y - s.y) - d.y * (p.x - s.x);
-}
-
-// The fill rule: a pixel centre on an edge belongs to the triangle only if the edge is a top
-// or a left one — with the interior on the positive side (y down), a left edge runs upwards,
-// a top edge is horizontal and runs right. 1 for the other edges: their zero is outside.
-int fill_bias(ivec2 s, ivec2 e) {
-    ivec2 d = e - s;
-    return d.y < 0 || (d.y == 0 && d.x > 0) ? 0 : 1;
 }
 
 // Draws the triangle — its corners in pixels, their depths z/w — with visibility id `id`;

@@ -126,8 +126,9 @@ struct SceneArgs {
     light_radius: String,
     /// Point-light shadows through cube maps: off, or how the cubes are rendered — copy (each
     /// face offscreen, then copied into its cube layer), direct (each face into its cube
-    /// layer), multiview (all six faces in one pass) or layered (one pass, each face an
-    /// instance writing its layer).
+    /// layer), multiview (all six faces in one pass), layered (one pass, each face an
+    /// instance writing its layer) or compute (every face of every cube drawn by compute
+    /// shaders, meshlets culled per face).
     #[arg(long, default_value = "off")]
     omni_shadow: String,
     /// How many point lights cast shadows (the strongest as seen from the camera).
@@ -241,7 +242,7 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
 fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Result<SettingsRequest> {
     let omni = match args.omni_shadow.as_str() {
         "off" if args.shadowed_lights != 1 || args.cube_size != OmniShadowSettings::DEFAULT_SIZE => {
-            bail!("--shadowed-lights and --cube-size need point-light shadows: add --omni-shadow layered|direct|multiview|copy")
+            bail!("--shadowed-lights and --cube-size need point-light shadows: add --omni-shadow layered|direct|multiview|copy|compute")
         }
         "off" => None,
         mode => Some(OmniShadowSettings { mode: OmniShadowMode::from_name(mode)?, lights: args.shadowed_lights, size: args.cube_size }),

@@ -98,6 +98,9 @@ fn settings(e: &SettingsError) -> String {
             format!("--shadowed-lights {value} is more than the {max} shadow cubes '{device}' holds in one array")
         }
         SettingsError::ShadowMemory { .. } => format!("{e}: use fewer --shadowed-lights or a smaller --cube-size"),
+        SettingsError::ShadowBuffer { .. } => {
+            format!("--omni-shadow compute: {e}: use fewer --shadowed-lights, a smaller --cube-size or --omni-shadow layered")
+        }
         SettingsError::MissingFeature { mode, feature, device, instead } => {
             format!("--omni-shadow {} needs the {feature} feature, which '{device}' lacks: use {instead}", mode.name())
         }

@@ -183,6 +183,32 @@ gpu_struct!(
 );
 
 gpu_struct!(
+    /// Push constants of the compute shadow raster (omni_raster.glsl).
+    OmniRasterPush {
+        /// Every face's projection (90°, depth 0..1), in the light's frame measured in radii.
+        projection: [[f32; 4]; 4],
+        /// x: texels per face side; y: shadowed lights; z: the largest triangle one thread
+        /// draws (bounding box, texels a side); w: meshlet instances.
+        sizes: [u32; 4],
+        /// x: (meshlet instance, face) pairs the pair list holds; y: large triangles it holds.
+        capacity: [u32; 4],
+    }
+);
+
+gpu_struct!(
+    /// The counts of a frame's compute shadow raster (`OmniRasterCounters` in common.glsl).
+    OmniRasterCounters {
+        /// x: the raster's work groups (at most 65535); y, z: 1; w: pairs listed.
+        pairs: [u32; 4],
+        /// x: the large-triangle raster's work groups; y, z: 1; w: large triangles listed.
+        large: [u32; 4],
+        /// x: triangles drawn by one thread; y: of those, large ones (the list was full);
+        /// z: texels covered.
+        drawn: [u32; 4],
+    }
+);
+
+gpu_struct!(
     /// Push constants of the compute-vs-fragment probe (stage_probe.glsl).
     StageProbePush {
         /// xy: pixels; z: lights every pixel sums.

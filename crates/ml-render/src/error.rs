@@ -114,6 +114,8 @@ pub enum SettingsError {
     TooManyCubes { value: u32, max: u32, device: String },
     #[error("{lights} shadow cubes of {size}² take {mib} MiB, more than the {max_mib} MiB we allow")]
     ShadowMemory { lights: u32, size: u32, mib: u64, max_mib: u64 },
+    #[error("{lights} shadow cubes of {size}² drawn in compute take a {mib} MiB buffer, more than the {max_mib} MiB '{device}' allows per storage buffer")]
+    ShadowBuffer { lights: u32, size: u32, mib: u64, device: String, max_mib: u64 },
     /// A way of rendering the cubes that needs a feature the device lacks; `instead`: the
     /// modes to use.
     #[error("{} point-light shadows need the {feature} feature, which '{device}' lacks: use {instead}", mode.name())]

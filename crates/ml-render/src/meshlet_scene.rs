@@ -33,13 +33,102 @@ pub struct CullFrame {
     pub triangle_ids: Buffer,
 }
 
-pub struct MeshletScene {
+/// The scene's meshlets on the GPU, uploaded once: what every meshlet pass reads (the
+/// visibility technique's culling and raster, the compute shadow raster).
+pub struct MeshletGeometry {
     pub vertices: Buffer,
     pub meshlet_vertices: Buffer,
     pub meshlet_triangles: Buffer,
     pub meshlets: Buffer,
     pub instances: Buffer,
     pub meshlet_instances: Buffer,
+    /// Meshlet instances: every meshlet of every object.
+    pub meshlet_instance_count: u32,
+    pub instance_count: u32,
+    /// Triangles of every object together.
+    pub triangles: u64,
+}
+
+impl MeshletGeometry {
+    /// Upload `g`; every buffer is bound whole as a storage buffer, so one larger than the
+    /// device binds is an error, never a shortened scene.
+    pub fn upload(ctx: &Context, g: &SceneMeshlets) -> Result<MeshletGeometry, VkError> {
+        let geometry = MeshletGeometry {
+            vertices: Buffer::null(),
+            meshlet_vertices: Buffer::null(),
+            meshlet_triangles: Buffer::null(),
+            meshlets: Buffer::null(),
+            instances: Buffer::null(),
+            meshlet_instances: Buffer::null(),
+            meshlet_instance_count: g.meshlet_instances.len() as u32,
+            instance_count: g.instances.len() as u32,
+            triangles: g.triangles,
+        };
+        ml_vk::build(ctx, geometry, |s| {
+            let upload = |name: &str, data: &[u8]| {
+                storage_bytes(ctx, name, data.len() as u64)?;
+                Buffer::device_local_with(ctx, name, data, vk::BufferUsageFlags::STORAGE_BUFFER)
+            };
+            s.vertices = upload("vertices", bytemuck::cast_slice(&g.vertices))?;
+            s.meshlet_vertices = upload("meshlet vertices", bytemuck::cast_slice(&g.meshlet_vertices))?;
+            s.meshlet_triangles = upload("meshlet triangles", bytemuck::cast_slice(&g.meshlet_triangles))?;
+            s.meshlets = upload("meshlets", bytemuck::cast_slice(&g.meshlets))?;
+            s.instances = upload("instances", bytemuck::cast_slice(&g.instances))?;
+            s.meshlet_instances = upload("meshlet instances", bytemuck::cast_slice(&g.meshlet_instances))?;
+            Ok(())
+        })
+    }
+
+    /// The buffer a meshlet shader calls `name`, if it is one of these.
+    pub fn buffer(&self, name: &str) -> Option<Resource> {
+        let buffer = match name {
+            "VertexBuffer" => &self.vertices,
+            "MeshletVertexBuffer" => &self.meshlet_vertices,
+            "MeshletTriangleBuffer" => &self.meshlet_triangles,
+            "MeshletBuffer" => &self.meshlets,
+            "InstanceBuffer" => &self.instances,
+            "MeshletInstanceBuffer" => &self.meshlet_instances,
+            _ => return None,
+        };
+        Some(Resource::Buffer(buffer.raw))
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [
+            &mut self.vertices,
+            &mut self.meshlet_vertices,
+            &mut self.meshlet_triangles,
+            &mut self.meshlets,
+            &mut self.instances,
+            &mut self.meshlet_instances,
+        ] {
+            b.destroy(ctx);
+        }
+    }
+}
+
+impl ml_vk::Release for MeshletGeometry {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
+
+/// `bytes` if the device binds that many as one storage buffer, else the error that says so.
+pub fn storage_bytes(ctx: &Context, name: &str, bytes: u64) -> Result<u64, VkError> {
+    let max = ctx.info.limits.max_storage_buffer_range as u64;
+    if bytes > max {
+        return Err(VkError::Limit(format!(
+            "the scene's {name} take {} MiB, more than the {} MiB '{}' binds as one storage buffer",
+            bytes >> 20,
+            max >> 20,
+            ctx.info.name
+        )));
+    }
+    Ok(bytes)
+}
+
+pub struct MeshletScene {
+    pub geometry: MeshletGeometry,
     /// Per meshlet instance: 1 where it was visible at the end of the last frame.
     pub visibility: Buffer,
     pub frames: Vec<CullFrame>,
@@ -60,50 +149,21 @@ impl MeshletScene {
             instance.surface[1] = set;
         }
         let s = MeshletScene {
-            vertices: Buffer::null(),
-            meshlet_vertices: Buffer::null(),
-            meshlet_triangles: Buffer::null(),
-            meshlets: Buffer::null(),
-            instances: Buffer::null(),
-            meshlet_instances: Buffer::null(),
+            geometry: MeshletGeometry::upload(ctx, &geometry)?,
             visibility: Buffer::null(),
             frames: Vec::new(),
             capacity: geometry.meshlet_instances.len().max(1) as u32,
             instance_count: geometry.instances.len() as u32,
             triangles: geometry.triangles,
         };
-        let made = ml_vk::build(ctx, s, |s| s.create(ctx, &geometry))?;
+        let made = ml_vk::build(ctx, s, |s| s.create(ctx))?;
         Ok(Rc::new(RefCell::new(made)))
     }
 
-    fn create(&mut self, ctx: &Context, g: &SceneMeshlets) -> Result<(), VkError> {
+    fn create(&mut self, ctx: &Context) -> Result<(), VkError> {
         use vk::BufferUsageFlags as U;
         let storage = U::STORAGE_BUFFER;
-        let max = ctx.info.limits.max_storage_buffer_range as u64;
-        // Every one is bound whole as a storage buffer: larger than the device binds is an
-        // error, never a shortened scene.
-        let checked = |name: &str, bytes: u64| {
-            if bytes > max {
-                Err(VkError::Limit(format!(
-                    "the scene's {name} take {} MiB, more than the {} MiB '{}' binds as one storage buffer",
-                    bytes >> 20,
-                    max >> 20,
-                    ctx.info.name
-                )))
-            } else {
-                Ok(bytes)
-            }
-        };
-        let upload = |name: &str, data: &[u8], usage| {
-            checked(name, data.len() as u64)?;
-            Buffer::device_local_with(ctx, name, data, usage)
-        };
-        self.vertices = upload("vertices", bytemuck::cast_slice(&g.vertices), storage)?;
-        self.meshlet_vertices = upload("meshlet vertices", bytemuck::cast_slice(&g.meshlet_vertices), storage)?;
-        self.meshlet_triangles = upload("meshlet triangles", bytemuck::cast_slice(&g.meshlet_triangles), storage)?;
-        self.meshlets = upload("meshlets", bytemuck::cast_slice(&g.meshlets), storage)?;
-        self.instances = upload("instances", bytemuck::cast_slice(&g.instances), storage)?;
-        self.meshlet_instances = upload("meshlet instances", bytemuck::cast_slice(&g.meshlet_instances), storage)?;
+        let checked = |name: &str, bytes: u64| storage_bytes(ctx, name, bytes);
         // Nothing was visible before the first frame: its early phase draws nothing.
         let bits = checked("meshlet visibility", self.capacity as u64 * 4)?;
         self.visibility = Buffer::device_local_with(ctx, "meshlet visibility", &vec![0u8; bits as usize], storage)?;
@@ -149,13 +209,10 @@ impl MeshletScene {
     /// The buffer a culling, raster or lighting shader calls `name`, of slot `slot`.
     pub fn buffer(&self, slot: usize, name: &str) -> Option<Resource> {
         let f = &self.frames[slot];
+        if let Some(found) = self.geometry.buffer(name) {
+            return Some(found);
+        }
         let buffer = match name {
-            "VertexBuffer" => &self.vertices,
-            "MeshletVertexBuffer" => &self.meshlet_vertices,
-            "MeshletTriangleBuffer" => &self.meshlet_triangles,
-            "MeshletBuffer" => &self.meshlets,
-            "InstanceBuffer" => &self.instances,
-            "MeshletInstanceBuffer" => &self.meshlet_instances,
             "MeshletVisibilityBuffer" => &self.visibility,
             "VisibleInstanceBuffer" => &f.visible_instances,
             "CullCounterBuffer" => &f.counters,
@@ -173,17 +230,8 @@ impl MeshletScene {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for b in [
-            &mut self.vertices,
-            &mut self.meshlet_vertices,
-            &mut self.meshlet_triangles,
-            &mut self.meshlets,
-            &mut self.instances,
-            &mut self.meshlet_instances,
-            &mut self.visibility,
-        ] {
-            b.destroy(ctx);
-        }
+        self.geometry.destroy(ctx);
+        self.visibility.destroy(ctx);
         for f in &mut self.frames {
             f.destroy(ctx);
         }

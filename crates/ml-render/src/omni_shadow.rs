@@ -3,11 +3,13 @@
 //! surface over the light's radius (omni_shadow.frag), rendered every frame (the lights
 //! move) before the shading passes, which read it through set 1 (omni_shadow.glsl).
 //!
-//! Four ways to fill it, one image: `copy` (the classic way: each face into one offscreen depth
+//! Five ways to fill it, one image: `copy` (the classic way: each face into one offscreen depth
 //! target, then an image copy into the cube's layer), `direct` (each face straight into its
 //! layer, a framebuffer per layer), and one pass per light for all six faces: `multiview`
 //! (VK_KHR_multiview, view i = face i) or `layered` (instance i of a draw writes
-//! gl_Layer = i; each object is drawn as the instances of the faces it reaches). Without
+//! gl_Layer = i; each object is drawn as the instances of the faces it reaches); or `compute`,
+//! whose own pass (passes/omni_shadow_compute.rs) draws every face in compute shaders and
+//! copies the depths in. Without
 //! shadowed lights the array is a cleared 1×1 stand-in the shaders never sample.
 
 use crate::depth_pass::{self, DepthPassDesc};
@@ -26,7 +28,7 @@ pub const CUBE_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// Faces' near plane as a fraction of the light's radius (geometry nearer than this to the
 /// light is clipped away; the stored depth is not the projection's, so this costs no
 /// precision). The passes work in the light's frame measured in radii: far is 1.
-const NEAR_FRACTION: f32 = 1e-3;
+pub const NEAR_FRACTION: f32 = 1e-3;
 
 /// Where a shadowed light is this frame.
 #[derive(Clone, Copy, Debug)]
@@ -83,12 +85,20 @@ impl OmniShadows {
             ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, layers, view: vk::ImageViewType::CUBE_ARRAY };
         // The shaders read it in DEPTH_STENCIL_READ_ONLY_OPTIMAL, which needs the attachment
         // usage even where only copies (or the stand-in's clear) write it.
-        let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_DST;
+        // (Transfer source: `read_depths`.)
+        let usage = vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+            | vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC;
         self.cubes = Image::new(ctx, "shadow cubes", shape, CUBE_FORMAT, usage, DEPTH)?;
         self.faces_view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D_ARRAY, 0..layers, DEPTH)?;
         let Some(settings) = self.settings else {
             return clear_stand_in(ctx, &self.cubes);
         };
+        if settings.mode == OmniShadowMode::Compute {
+            // Its own pass draws the cubes and copies them in (passes/omni_shadow_compute.rs).
+            return Ok(());
+        }
         let readers = (SHADER_READERS, vk::AccessFlags::SHADER_READ);
         // Each pass clears its target, so it waits for whoever read that target last: the
         // previous frame's shading (direct, multiview) or this frame's previous copy (copy).
@@ -136,6 +146,7 @@ impl OmniShadows {
                     self.add_framebuffer(ctx, view, (size, layers))?;
                 }
             }
+            OmniShadowMode::Compute => {}
         }
         Ok(())
     }
@@ -164,7 +175,7 @@ impl OmniShadows {
     /// Leaves the array DEPTH_STENCIL_READ_ONLY_OPTIMAL, its writes visible to fragment and
     /// compute shaders.
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
-        let Some(settings) = self.settings else { return };
+        let Some(settings) = self.settings.filter(|s| s.mode != OmniShadowMode::Compute) else { return };
         let d = &ctx.device;
         let size = settings.size;
         let copy = settings.mode == OmniShadowMode::Copy;
@@ -266,6 +277,45 @@ impl OmniShadows {
                 &region,
             )
         };
+    }
+
+    /// Every texel of every layer as the last frame left it (layer after layer, row by row),
+    /// copied to the host; for tests and tools, not the frame loop (it waits for the GPU).
+    pub fn read_depths(&self, ctx: &Context) -> Result<Vec<f32>, VkError> {
+        let extent = self.cubes.extent;
+        let layers = self.settings.map_or(1, |s| s.lights) * 6;
+        let bytes = extent.width as u64 * extent.height as u64 * layers as u64 * 4;
+        let mut host = ml_vk::Buffer::new(
+            ctx,
+            "shadow cube read-back",
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            gpu_allocator::MemoryLocation::GpuToCpu,
+        )?;
+        let sampled = (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        let source = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        let copied = ml_vk::commands::one_shot(ctx, |cmd| {
+            transition(ctx, cmd, self.cubes.raw, sampled, source);
+            let subresource = vk::ImageSubresourceLayers::default().aspect_mask(DEPTH).layer_count(layers);
+            let region = [vk::BufferImageCopy::default().image_subresource(subresource).image_extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            })];
+            // SAFETY: recording state; the image is in TRANSFER_SRC_OPTIMAL and the buffer holds
+            // every layer.
+            unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, self.cubes.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, host.raw, &region) };
+            transition(ctx, cmd, self.cubes.raw, source, sampled);
+            ml_vk::commands::memory_barrier(
+                ctx,
+                cmd,
+                (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
+                (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+            );
+        });
+        let depths = copied.map(|()| bytemuck::pod_collect_to_vec(host.mapped()));
+        host.destroy(ctx);
+        depths
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -69,6 +69,8 @@ pub struct SlotReport {
     pub overflowed: bool,
     /// What its GPU culling kept (visibility).
     pub culling: Option<crate::report::CullStats>,
+    /// What its compute shadow raster drew.
+    pub omni_raster: Option<crate::report::OmniRasterStats>,
 }
 
 /// The CPU side of a frame, before it is recorded: a pass that assigns lights on the CPU

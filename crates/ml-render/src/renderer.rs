@@ -429,6 +429,9 @@ impl<'a> Renderer<'a> {
             p.collect(f, &mut report);
         }
         self.reports[f] = report;
+        if report.omni_raster.is_some() {
+            stats.omni_raster = report.omni_raster;
+        }
         if report.culling.is_some() {
             stats.culling = report.culling;
         }
@@ -570,6 +573,12 @@ impl<'a> Renderer<'a> {
         }
         // SAFETY: recording state.
         unsafe { ctx.device.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")
+    }
+
+    /// The point-light shadow cubes' texels (distance / radius) as the last frame left them,
+    /// layer after layer (cube i: layers 6i … 6i + 5), row by row; for tests and tools.
+    pub fn shadow_cube_depths(&self) -> Result<Vec<f32>, VkError> {
+        self.gpu.omni.read_depths(self.ctx)
     }
 
     /// The cluster lists the GPU built for the frame `render` returned (clustered-gpu; None

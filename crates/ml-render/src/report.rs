@@ -27,6 +27,22 @@ pub struct FrameStats {
     pub gbuffer_lazily_allocated: Option<bool>,
     /// visibility: what the last frame's culling kept.
     pub culling: Option<CullStats>,
+    /// --omni-shadow compute: what the last frame's shadow raster drew.
+    pub omni_raster: Option<OmniRasterStats>,
+}
+
+/// What one frame's compute shadow raster drew (--omni-shadow compute).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OmniRasterStats {
+    /// (meshlet instance, cube face) pairs the culling kept.
+    pub pairs: u32,
+    /// Triangles drawn by one thread each; large ones (a work group each, or, past the
+    /// list's capacity, `in_place` by the thread that found them).
+    pub small: u32,
+    pub large: u32,
+    pub in_place: u32,
+    /// Texels covered (hidden ones too).
+    pub texels: u32,
 }
 
 /// What one frame's GPU culling tested and kept (visibility).
@@ -71,6 +87,7 @@ impl FrameStats {
             rerendered_frames: 0,
             gbuffer_lazily_allocated: None,
             culling: None,
+            omni_raster: None,
         }
     }
 
@@ -283,6 +300,16 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     }
     if let Some(o) = settings.omni {
         rows.push(("omni shadows", format!("{}: {} light(s), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size)));
+    }
+    if let Some(r) = stats.omni_raster {
+        let in_place = if r.in_place > 0 { format!(" ({} drawn in place: the large list was full)", r.in_place) } else { String::new() };
+        rows.push((
+            "shadow raster",
+            format!(
+                "{} (meshlet, face) pairs; {} small triangles, {} large{in_place}; {} texels covered",
+                r.pairs, r.small, r.large, r.texels
+            ),
+        ));
     }
     rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));

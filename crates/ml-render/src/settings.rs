@@ -181,10 +181,15 @@ pub enum OmniShadowMode {
     /// All six faces in one pass by layered rendering: six instances of each draw, instance i
     /// writes gl_Layer = i (shaderOutputLayer).
     Layered,
+    /// Compute shaders draw every face of every cube (meshlets culled per face, small
+    /// triangles a thread each, large ones a work group each) into a buffer of 32-bit depths,
+    /// copied into the cubes (docs/DESIGN.md#compute-shadow-raster).
+    Compute,
 }
 
 impl OmniShadowMode {
-    pub const ALL: [OmniShadowMode; 4] = [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview, OmniShadowMode::Layered];
+    pub const ALL: [OmniShadowMode; 5] =
+        [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview, OmniShadowMode::Layered, OmniShadowMode::Compute];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -192,6 +197,7 @@ impl OmniShadowMode {
             OmniShadowMode::Direct => "direct",
             OmniShadowMode::Multiview => "multiview",
             OmniShadowMode::Layered => "layered",
+            OmniShadowMode::Compute => "compute",
         }
     }
 
@@ -519,6 +525,21 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
     }
     if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
         return Err(missing("shaderOutputLayer", "direct or copy"));
+    }
+    if omni.mode == OmniShadowMode::Compute {
+        if !ctx.info.features.buffer_int64_atomics {
+            return Err(missing("shaderInt64", "layered, direct or copy"));
+        }
+        // The depths are one storage buffer, as large as the cubes.
+        if omni.bytes() > limits.max_storage_buffer_range as u64 {
+            return Err(SettingsError::ShadowBuffer {
+                lights: omni.lights,
+                size: omni.size,
+                mib: omni.bytes() >> 20,
+                device: device(),
+                max_mib: limits.max_storage_buffer_range as u64 >> 20,
+            });
+        }
     }
     Ok(())
 }

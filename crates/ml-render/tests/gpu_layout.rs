@@ -4,7 +4,7 @@
 
 use ml_cpu::gpu_types::{
     ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance,
-    LightCone, Meshlet, ObjectData, ObjectPush, OmniShadowPush, PointLight, ShadowPush, StageProbePush,
+    LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -94,6 +94,8 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<CullCounters>(&structs);
     check::<DrawIndexedCommand>(&structs);
     check::<CullPush>(&structs);
+    check::<OmniRasterPush>(&structs);
+    check::<OmniRasterCounters>(&structs);
 }
 
 /// Mistake 5 (docs/DESIGN.md#mistakes-we-avoid): the original demo's index list was a std140

@@ -59,6 +59,20 @@ pub fn memory_barrier(
     unsafe { ctx.device.cmd_pipeline_barrier(cmd, src.0, dst.0, vk::DependencyFlags::empty(), &b, &[], &[]) };
 }
 
+/// Copy the first `bytes` of `src` into `dst` (host-visible) and make the copy visible to the
+/// host (counters read back after a frame).
+pub fn copy_buffer_to_host(ctx: &Context, cmd: vk::CommandBuffer, (src, dst): (vk::Buffer, vk::Buffer), bytes: vk::DeviceSize) {
+    // SAFETY: recording state outside a render pass; the caller's buffers are alive and hold
+    // `bytes`, and the writes to `src` were made visible to transfers.
+    unsafe { ctx.device.cmd_copy_buffer(cmd, src, dst, &[vk::BufferCopy::default().size(bytes)]) };
+    memory_barrier(
+        ctx,
+        cmd,
+        (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
+        (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+    );
+}
+
 /// Copy a colour image's first level (`extent`, in TRANSFER_SRC_OPTIMAL, its writes already
 /// made visible to transfers) into `buffer`, tightly packed, and make the copy visible to the
 /// host (read-backs and screenshots).

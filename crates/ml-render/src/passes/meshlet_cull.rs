@@ -19,7 +19,7 @@ use crate::report::CullStats;
 use crate::settings::Raster;
 use crate::targets::depth_pyramid_shape;
 use ml_cpu::gpu_types::{CullCounters, CullPush};
-use ml_vk::commands::memory_barrier;
+use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{shader, vk, Context, VkError};
 
 /// Work-group size of both culling shaders.
@@ -157,16 +157,9 @@ impl Pass for MeshletCull {
                 (compute, vk::AccessFlags::SHADER_WRITE),
                 (indirect | raster | compute | transfer, indirect_read | vk::AccessFlags::INDEX_READ | rw | vk::AccessFlags::TRANSFER_READ),
             );
-            if self.phase == Phase::Late {
-                let size = std::mem::size_of::<CullCounters>() as u64;
-                d.cmd_copy_buffer(cmd, f.counters.raw, f.readback.raw, &[vk::BufferCopy::default().size(size)]);
-                memory_barrier(
-                    ctx,
-                    cmd,
-                    (transfer, vk::AccessFlags::TRANSFER_WRITE),
-                    (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
-                );
-            }
+        }
+        if self.phase == Phase::Late {
+            copy_buffer_to_host(ctx, cmd, (f.counters.raw, f.readback.raw), std::mem::size_of::<CullCounters>() as u64);
         }
     }
 

@@ -11,6 +11,7 @@ pub mod forward;
 pub mod gbuffer;
 pub mod meshlet_cull;
 pub mod omni_shadow;
+pub mod omni_shadow_compute;
 pub mod shadow_map_view;
 pub mod tone_map;
 pub mod visibility_lighting;
@@ -20,7 +21,7 @@ pub mod visibility_resolve;
 use crate::meshlet_scene::MeshletScene;
 use crate::pass::Pass;
 use crate::scene_gpu::SceneGpu;
-use crate::settings::{DebugView, Geometry, LightAssignment, LightingStage, Raster, RenderSettings, Shading, ShadingModel};
+use crate::settings::{DebugView, Geometry, LightAssignment, LightingStage, OmniShadowMode, Raster, RenderSettings, Shading, ShadingModel};
 use meshlet_cull::Phase;
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::meshlets::SceneMeshlets;
@@ -60,8 +61,12 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     let technique = s.technique;
     let clustered = technique.assignment() != LightAssignment::None;
     let raster = (a.depth_format, a.shading);
-    if a.scene.omni.active() {
-        passes.push(Box::new(omni_shadow::OmniShadowPass));
+    match s.omni {
+        Some(omni) if omni.mode == OmniShadowMode::Compute => {
+            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, omni)?));
+        }
+        Some(_) => passes.push(Box::new(omni_shadow::OmniShadowPass)),
+        None => {}
     }
     match technique.assignment() {
         LightAssignment::None => {}

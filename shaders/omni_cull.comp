@@ -1,0 +1,59 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// The compute shadow raster, step 1 (omni_raster.glsl): a thread per (meshlet instance,
+// shadowed light) tests the meshlet's bounding sphere against the light's sphere and each
+// cube face's 90° pyramid, and lists a (meshlet instance, cube layer) pair per face it may
+// reach — the per-face culling the graphics modes do per object, here per meshlet. No
+// back-face cone: shadow passes draw both faces.
+#include "common.glsl"
+
+layout(local_size_x = 64) in;
+
+#include "omni_raster.glsl"
+
+// The faces (bit i: face i) whose pyramid a sphere at `c` (relative to the light) of radius
+// `r` may reach: conservative, from the four planes that bound each pyramid
+// (ml_cpu::omni_shadow::sphere_faces).
+uint sphere_faces(vec3 c, float r) {
+    float reach = r * 1.41421356;
+    uint mask = 0u;
+    for (int face = 0; face < 6; face++) {
+        int axis = face / 2;
+        float along = (face % 2 == 0 ? 1.0 : -1.0) * c[axis];
+        bool inside = true;
+        for (int o = 0; o < 3; o++) {
+            if (o != axis && along - abs(c[o]) < -reach) {
+                inside = false;
+            }
+        }
+        if (inside) {
+            mask |= 1u << uint(face);
+        }
+    }
+    return mask;
+}
+
+void main() {
+    uint light = gl_WorkGroupID.y;
+    vec4 l = shadow_lights[light];
+    for (uint id = gl_GlobalInvocationID.x; id < omni.sizes.w; id += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
+        uvec2 object_meshlet = meshlet_instances[id];
+        Meshlet m = meshlets[object_meshlet.y];
+        vec3 c = (objects[object_meshlet.x].model * vec4(m.center_radius.xyz, 1.0)).xyz - l.xyz;
+        float r = m.center_radius.w * instances[object_meshlet.x].scale.x;
+        if (length(c) > l.w + r) {
+            continue;
+        }
+        uint faces = sphere_faces(c, r);
+        uint n = bitCount(faces);
+        if (n == 0u) {
+            continue;
+        }
+        // The list holds six pairs per meshlet instance and light: it cannot overflow.
+        uint at = atomicAdd(counters.pairs.w, n);
+        atomicMax(counters.pairs.x, min(at + n, MAX_GROUPS));
+        for (; faces != 0u; faces &= faces - 1u) {
+            pairs[at++] = uvec2(id, light * 6u + uint(findLSB(faces)));
+        }
+    }
+}

@@ -1,0 +1,73 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// The compute shadow raster, step 3 (omni_raster.glsl): a work group per large triangle (or
+// one crossing the near plane), its clipped polygon set up once. Its fan triangles are drawn
+// one after the other, a thread per 8×8-texel tile of the box: a tile the triangle does not
+// reach (tested against the three edges at its corners) costs one test, so the work follows
+// the texels covered more than the box.
+#include "common.glsl"
+
+layout(local_size_x = 256) in;
+
+#include "omni_raster.glsl"
+
+const int TILE = 8;
+
+// The triangle's clipped polygon, set up once by the first thread.
+shared ivec2 corner_s[MAX_POLYGON];
+shared vec4 corner_q[MAX_POLYGON];
+shared int corner_count;
+
+void main() {
+    uint lid = gl_LocalInvocationID.x;
+    uint count = min(counters.large.w, omni.capacity.y);
+    uint covered = 0u;
+    for (uint e = gl_WorkGroupID.x; e < count; e += gl_NumWorkGroups.x) {
+        // The last triangle's threads are done with the polygon.
+        barrier();
+        if (lid == 0u) {
+            uvec2 listed = large_triangles[e];
+            uvec2 pair = pairs[listed.x];
+            uvec2 object_meshlet = meshlet_instances[pair.x];
+            Meshlet m = meshlets[object_meshlet.y];
+            int face = int(pair.y % 6u);
+            vec4 light = shadow_lights[pair.y / 6u];
+            mat4 model = objects[object_meshlet.x].model;
+            uvec3 v = meshlet_triangle(m, listed.y);
+            vec3 ra = light_relative(v.x, model, light), rb = light_relative(v.y, model, light), rc = light_relative(v.z, model, light);
+            vec4 a = omni_face_clip(omni.projection, ra, face), b = omni_face_clip(omni.projection, rb, face);
+            vec4 c = omni_face_clip(omni.projection, rc, face);
+            Polygon p = clipped_polygon(a, b, c, ra, rb, rc);
+            corner_count = p.count;
+            for (int i = 0; i < p.count; i++) {
+                corner_s[i] = ivec2(p.s[i]);
+                corner_q[i] = p.q[i];
+            }
+        }
+        barrier();
+        uint layer = pairs[large_triangles[e].x].y;
+        int corners = corner_count;
+        for (int k = 1; k + 1 < corners; k++) {
+            FanTriangle t;
+            i64vec2 a = i64vec2(corner_s[0]), b = i64vec2(corner_s[k]), c = i64vec2(corner_s[k + 1]);
+            if (!fan_triangle(a, b, c, corner_q[0], corner_q[k], corner_q[k + 1], t)) {
+                continue;
+            }
+            ivec2 tile0 = t.first / TILE;
+            uvec2 span = uvec2(t.last / TILE - tile0 + 1);
+            for (uint i = lid; i < span.x * span.y; i += gl_WorkGroupSize.x) {
+                ivec2 lo = max((tile0 + ivec2(i % span.x, i / span.x)) * TILE, t.first);
+                ivec2 hi = min(lo - lo % TILE + TILE - 1, t.last);
+                if (!fan_reaches(t, lo, hi)) {
+                    continue;
+                }
+                for (int y = lo.y; y <= hi.y; y++) {
+                    for (int x = lo.x; x <= hi.x; x++) {
+                        covered += fan_texel(t, ivec2(x, y), layer);
+                    }
+                }
+            }
+        }
+    }
+    atomicAdd(counters.drawn.z, covered);
+}
