@@ -140,6 +140,10 @@ fn absurd_sizes_and_counts_are_refused() {
     assert_one_line_error(&omni("0", "64"), &["--shadowed-lights 0"]);
     assert_one_line_error(&omni("1", "0"), &["--cube-size 0"]);
     assert_one_line_error(&omni("64", "8192"), &["shadow cubes", "MiB"]);
+    // The compute raster's depths are one storage buffer: 2 × 6 × 2048² × 4 bytes = 192 MiB,
+    // past lavapipe's 128 MiB.
+    let compute = manylights(&["render", "--omni-shadow", "compute", "--shadowed-lights", "2", "--cube-size", "2048", "--out", p], &[]);
+    assert_one_line_error(&compute, &["--omni-shadow compute", "192 MiB", "storage buffer"]);
     assert!(!png.exists());
 }
 

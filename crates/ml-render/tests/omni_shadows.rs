@@ -205,12 +205,13 @@ fn two_shadowed_lights_read_their_own_cubes() {
     }
 }
 
-/// copy, direct and the one-pass modes fill the same cubes: the same image.
+/// copy, direct, the one-pass modes and the compute raster fill the same cubes: the same image.
 #[test]
 fn every_mode_gives_the_same_image() {
     let scene = Scene::shadow_room();
     let mut modes = vec![OmniShadowMode::Copy, OmniShadowMode::Direct];
     modes.extend(one_pass_modes());
+    modes.push(OmniShadowMode::Compute);
     let all: Vec<RenderSettings> = modes.iter().map(|&m| settings(Technique::Forward, 96, Some((m, 1)))).collect();
     let outputs = common::render_each(&scene, &all);
     for (mode, out) in modes.iter().zip(&outputs).skip(1) {
