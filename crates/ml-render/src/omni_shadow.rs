@@ -95,7 +95,7 @@ impl OmniShadows {
         let Some(settings) = self.settings else {
             return clear_stand_in(ctx, &self.cubes);
         };
-        if settings.mode == OmniShadowMode::Compute {
+        if matches!(settings.mode, OmniShadowMode::Compute { .. }) {
             // Its own pass draws the cubes and copies them in (passes/omni_shadow_compute.rs).
             return Ok(());
         }
@@ -146,7 +146,7 @@ impl OmniShadows {
                     self.add_framebuffer(ctx, view, (size, layers))?;
                 }
             }
-            OmniShadowMode::Compute => {}
+            OmniShadowMode::Compute { .. } => {}
         }
         Ok(())
     }
@@ -175,7 +175,7 @@ impl OmniShadows {
     /// Leaves the array DEPTH_STENCIL_READ_ONLY_OPTIMAL, its writes visible to fragment and
     /// compute shaders.
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
-        let Some(settings) = self.settings.filter(|s| s.mode != OmniShadowMode::Compute) else { return };
+        let Some(settings) = self.settings.filter(|s| !matches!(s.mode, OmniShadowMode::Compute { .. })) else { return };
         let d = &ctx.device;
         let size = settings.size;
         let copy = settings.mode == OmniShadowMode::Copy;

@@ -183,13 +183,18 @@ pub enum OmniShadowMode {
     Layered,
     /// Compute shaders draw every face of every cube (meshlets culled per face, small
     /// triangles a thread each, large ones a work group each) into a buffer of 32-bit depths,
-    /// copied into the cubes (docs/DESIGN.md#compute-shadow-raster).
-    Compute,
+    /// copied into the cubes (docs/DESIGN.md#compute-shadow-raster). `large_list`: large
+    /// triangles the list of its work groups holds; past it (0: always), the thread that found
+    /// one draws it itself (slower, nothing lost).
+    Compute { large_list: u32 },
 }
 
 impl OmniShadowMode {
+    /// The compute raster with its default list of large triangles (2^20: 8 MiB).
+    pub const COMPUTE: OmniShadowMode = OmniShadowMode::Compute { large_list: 1 << 20 };
+
     pub const ALL: [OmniShadowMode; 5] =
-        [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview, OmniShadowMode::Layered, OmniShadowMode::Compute];
+        [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview, OmniShadowMode::Layered, OmniShadowMode::COMPUTE];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -197,7 +202,7 @@ impl OmniShadowMode {
             OmniShadowMode::Direct => "direct",
             OmniShadowMode::Multiview => "multiview",
             OmniShadowMode::Layered => "layered",
-            OmniShadowMode::Compute => "compute",
+            OmniShadowMode::Compute { .. } => "compute",
         }
     }
 
@@ -526,7 +531,7 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
     if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
         return Err(missing("shaderOutputLayer", "direct or copy"));
     }
-    if omni.mode == OmniShadowMode::Compute {
+    if let OmniShadowMode::Compute { .. } = omni.mode {
         if !ctx.info.features.buffer_int64_atomics {
             return Err(missing("shaderInt64", "layered, direct or copy"));
         }

@@ -211,7 +211,7 @@ fn every_mode_gives_the_same_image() {
     let scene = Scene::shadow_room();
     let mut modes = vec![OmniShadowMode::Copy, OmniShadowMode::Direct];
     modes.extend(one_pass_modes());
-    modes.push(OmniShadowMode::Compute);
+    modes.push(OmniShadowMode::COMPUTE);
     let all: Vec<RenderSettings> = modes.iter().map(|&m| settings(Technique::Forward, 96, Some((m, 1)))).collect();
     let outputs = common::render_each(&scene, &all);
     for (mode, out) in modes.iter().zip(&outputs).skip(1) {
@@ -293,7 +293,8 @@ fn cubes_and_image(ctx: &Context, scene: &Scene, settings: RenderSettings) -> (V
 /// by texel: on the room (large triangles — walls and floor cross several faces, corners
 /// reach past the face's far plane), the seed scene (49 spheres: small triangles, a thread
 /// each) and a light inside an occluder's reach (triangles crossing the faces' near plane,
-/// which the compute raster clips): every texel covered by both or neither, the distances
+/// which the compute raster clips), also with the list of large triangles full: every texel
+/// covered by both or neither, the distances
 /// equal up to interpolation rounding. Its images equal the layered mode's.
 #[test]
 fn the_compute_raster_fills_the_same_cubes() {
@@ -305,14 +306,25 @@ fn the_compute_raster_fills_the_same_cubes() {
     let grey = Material { albedo: Vec3::splat(0.7), roughness: 0.7, metallic: 0.0 };
     near.objects.push(Object::placed(MeshKind::Cube, light + Vec3::new(0.25, 0.25, 0.25), 0.25, grey));
     let seed = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
-    for (name, scene, lights, cube) in [("room", Scene::shadow_room(), 1, 128), ("near plane", near, 1, 64), ("seed", seed, 2, 64)] {
+    // The list of large triangles also full at once (every one drawn by the thread that
+    // found it), and after 100.
+    let compute = OmniShadowMode::COMPUTE;
+    let in_place = |large_list| OmniShadowMode::Compute { large_list };
+    let room = Scene::shadow_room();
+    for (name, scene, lights, cube, compute) in [
+        ("room", &room, 1, 128, compute),
+        ("room, list of 100", &room, 1, 128, in_place(100)),
+        ("near plane", &near, 1, 64, compute),
+        ("near plane, no list", &near, 1, 64, in_place(0)),
+        ("seed", &seed, 2, 64, compute),
+    ] {
         let mut s = RenderSettings::new(Technique::Forward, 96, 96);
         s.shading = ShadingModel::Pbr;
         let mode = |mode| Some(OmniShadowSettings { mode, lights, size: cube });
         s.omni = mode(OmniShadowMode::Layered);
-        let (hardware, hardware_image) = cubes_and_image(&ctx, &scene, s);
-        s.omni = mode(OmniShadowMode::Compute);
-        let (compute, compute_image) = cubes_and_image(&ctx, &scene, s);
+        let (hardware, hardware_image) = cubes_and_image(&ctx, scene, s);
+        s.omni = mode(compute);
+        let (compute, compute_image) = cubes_and_image(&ctx, scene, s);
         assert_eq!(hardware.len(), compute.len());
         let reached = |d: f32| d < 1.0;
         let coverage: Vec<(usize, f32, f32)> = hardware

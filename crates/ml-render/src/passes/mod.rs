@@ -21,7 +21,9 @@ pub mod visibility_resolve;
 use crate::meshlet_scene::MeshletScene;
 use crate::pass::Pass;
 use crate::scene_gpu::SceneGpu;
-use crate::settings::{DebugView, Geometry, LightAssignment, LightingStage, OmniShadowMode, Raster, RenderSettings, Shading, ShadingModel};
+use crate::settings::{
+    DebugView, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel,
+};
 use meshlet_cull::Phase;
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::meshlets::SceneMeshlets;
@@ -62,8 +64,8 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     let clustered = technique.assignment() != LightAssignment::None;
     let raster = (a.depth_format, a.shading);
     match s.omni {
-        Some(omni) if omni.mode == OmniShadowMode::Compute => {
-            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, omni)?));
+        Some(omni @ OmniShadowSettings { mode: OmniShadowMode::Compute { large_list }, .. }) => {
+            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, (omni, large_list))?));
         }
         Some(_) => passes.push(Box::new(omni_shadow::OmniShadowPass)),
         None => {}

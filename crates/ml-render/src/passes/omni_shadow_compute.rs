@@ -29,9 +29,6 @@ const MAX_GROUPS: u32 = 65535;
 /// The largest triangle one thread draws (bounding box, texels a side); larger ones get a
 /// work group each.
 pub const SPLIT: u32 = 16;
-/// Large triangles the list holds; past it, the thread that found one draws it (slowly, but
-/// nothing is lost; the table reports how many).
-const LARGE_CAPACITY: u32 = 1 << 20;
 /// The depth of a texel nothing reaches: 1.0's bits.
 const FAR_BITS: u32 = 0x3f80_0000;
 
@@ -49,13 +46,20 @@ pub struct OmniShadowCompute {
     /// 32-bit depths, layer after layer as the cube array holds them.
     depths: Buffer,
     pair_capacity: u32,
+    /// Large triangles the list holds; past it, the thread that found one draws it (slowly,
+    /// but nothing is lost; the table reports how many).
+    large_capacity: u32,
     sets: FrameSets,
     layout: vk::PipelineLayout,
     pipelines: [vk::Pipeline; 3],
 }
 
 impl OmniShadowCompute {
-    pub fn new(ctx: &Context, scene: &ml_cpu::scene::Scene, settings: OmniShadowSettings) -> Result<OmniShadowCompute, VkError> {
+    pub fn new(
+        ctx: &Context,
+        scene: &ml_cpu::scene::Scene,
+        (settings, large_capacity): (OmniShadowSettings, u32),
+    ) -> Result<OmniShadowCompute, VkError> {
         let geometry = SceneMeshlets::build(scene).map_err(|e| VkError::Limit(e.to_string()))?;
         let shaders = [&ml_shaders::OMNI_CULL_COMP, &ml_shaders::OMNI_RASTER_COMP, &ml_shaders::OMNI_RASTER_LARGE_COMP];
         let stages = shaders.map(|s| (s, vk::ShaderStageFlags::COMPUTE));
@@ -71,6 +75,7 @@ impl OmniShadowCompute {
             large: Buffer::null(),
             depths: Buffer::null(),
             pair_capacity: u32::try_from(pairs.max(1)).map_err(|_| VkError::Limit(format!("{pairs} shadow (meshlet, face) pairs")))?,
+            large_capacity,
             sets: FrameSets::empty(),
             layout: vk::PipelineLayout::null(),
             pipelines: [vk::Pipeline::null(); 3],
@@ -90,7 +95,13 @@ impl OmniShadowCompute {
             }
             let pair_bytes = storage_bytes(ctx, "shadow (meshlet, face) pairs", p.pair_capacity as u64 * 8)?;
             p.pairs = Buffer::new(ctx, "shadow pairs", pair_bytes, storage, gpu)?;
-            p.large = Buffer::new(ctx, "shadow large triangles", LARGE_CAPACITY as u64 * 8, storage, gpu)?;
+            p.large = Buffer::new(
+                ctx,
+                "shadow large triangles",
+                storage_bytes(ctx, "shadow large triangles", large_capacity.max(1) as u64 * 8)?,
+                storage,
+                gpu,
+            )?;
             let depth_bytes = storage_bytes(ctx, "shadow cube depths", settings.bytes())?;
             p.depths = Buffer::new(ctx, "shadow cube depths", depth_bytes, storage | U::TRANSFER_SRC | U::TRANSFER_DST, gpu)?;
             p.sets = FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?;
@@ -109,7 +120,7 @@ impl OmniShadowCompute {
         OmniRasterPush {
             projection: projection.to_cols_array_2d(),
             sizes: [self.settings.size, self.settings.lights, SPLIT, self.geometry.meshlet_instance_count],
-            capacity: [self.pair_capacity, LARGE_CAPACITY, 0, 0],
+            capacity: [self.pair_capacity, self.large_capacity, 0, 0],
         }
     }
 }
