@@ -65,6 +65,7 @@ impl OmniShadowCompute {
         let stages = shaders.map(|s| (s, vk::ShaderStageFlags::COMPUTE));
         // Six faces per meshlet instance and light at most: the pair list cannot overflow.
         let pairs = geometry.meshlet_instances.len() as u64 * settings.lights as u64 * 6;
+        let pair_capacity = u32::try_from(pairs.max(1)).map_err(|_| VkError::Limit(format!("{pairs} shadow (meshlet, face) pairs")))?;
         let pass = OmniShadowCompute {
             settings,
             geometry: MeshletGeometry::upload(ctx, &geometry)?,
@@ -74,7 +75,7 @@ impl OmniShadowCompute {
             pairs: Buffer::null(),
             large: Buffer::null(),
             depths: Buffer::null(),
-            pair_capacity: u32::try_from(pairs.max(1)).map_err(|_| VkError::Limit(format!("{pairs} shadow (meshlet, face) pairs")))?,
+            pair_capacity,
             large_capacity,
             sets: FrameSets::empty(),
             layout: vk::PipelineLayout::null(),
@@ -211,7 +212,7 @@ impl Pass for OmniShadowCompute {
         let c: OmniRasterCounters = bytemuck::pod_read_unaligned(&self.readback[slot].mapped()[..size_of::<OmniRasterCounters>()]);
         report.omni_raster = Some(OmniRasterStats {
             pairs: c.pairs[3],
-            small: c.drawn[0] - c.drawn[1],
+            small: c.drawn[0].saturating_sub(c.drawn[1]),
             large: c.large[3],
             in_place: c.drawn[1],
             texels: c.drawn[2],
