@@ -83,42 +83,24 @@ void keep_nearest(uint layer, ivec2 texel, float depth) {
 // A triangle beyond the near plane whose box is at most omni.sizes.z texels a side, by this
 // thread (corners in texels, q as above); returns the texels covered.
 uint raster_small(vec2 pa, vec2 pb, vec2 pc, vec4 qa, vec4 qb, vec4 qc, uint layer) {
-    ivec2 a = ivec2(roundEven(pa * SUBPIXEL));
-    ivec2 b = ivec2(roundEven(pb * SUBPIXEL));
-    ivec2 c = ivec2(roundEven(pc * SUBPIXEL));
-    // Relative to the box's corner: at most 64 texels a side keeps every product below 2^31.
-    ivec2 lo = min(a, min(b, c)), hi = max(a, max(b, c));
-    a -= lo;
-    b -= lo;
-    c -= lo;
-    int area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    if (area == 0) {
+    // Both faces are drawn.
+    SmallTriangle t;
+    if (!small_triangle(pa, pb, pc, ivec2(omni.sizes.x), true, t)) {
         return 0u;
     }
-    // Both faces are drawn: a negative area swaps two corners, so that the interior lies on
-    // every edge's positive side.
-    if (area < 0) {
-        ivec2 t = b;
-        b = c;
-        c = t;
+    if (t.swapped) {
         vec4 u = qb;
         qb = qc;
         qc = u;
     }
-    int side = int(omni.sizes.x);
-    ivec2 first = max((lo - 128 + 255) >> 8, ivec2(0));
-    ivec2 last = min((hi - 128) >> 8, ivec2(side - 1));
-    ivec3 bias = ivec3(fill_bias(b, c), fill_bias(c, a), fill_bias(a, b));
     uint covered = 0u;
-    for (int y = first.y; y <= last.y; y++) {
-        for (int x = first.x; x <= last.x; x++) {
-            ivec2 p = ivec2(x, y) * 256 + 128 - lo;
-            ivec3 w = ivec3(edge_function(b, c, p), edge_function(c, a, p), edge_function(a, b, p));
-            if (any(lessThan(w - bias, ivec3(0)))) {
-                continue;
+    for (int y = t.first.y; y <= t.last.y; y++) {
+        for (int x = t.first.x; x <= t.last.x; x++) {
+            ivec3 w;
+            if (small_covers(t, ivec2(x, y), w)) {
+                covered++;
+                keep_nearest(layer, ivec2(x, y), interpolated_distance(vec3(w), qa, qb, qc));
             }
-            covered++;
-            keep_nearest(layer, ivec2(x, y), interpolated_distance(vec3(w), qa, qb, qc));
         }
     }
     return covered;

@@ -23,4 +23,54 @@ int fill_bias(ivec2 s, ivec2 e) {
     return d.y < 0 || (d.y == 0 && d.x > 0) ? 0 : 1;
 }
 
+// A small triangle (box at most 64 pixels a side) set up for its pixels: corners snapped and
+// taken relative to the box's corner `lo` (which keeps every product below 2^31), ordered so
+// the interior lies on every edge's positive side, the fill rule's biases, the pixel centres
+// in the box within the image.
+struct SmallTriangle {
+    ivec2 a, b, c, lo;
+    int area; // twice the area, in sub-pixel units²: positive
+    ivec3 bias;
+    ivec2 first, last;
+    bool swapped; // b and c were swapped to order it (their attributes must be too)
+};
+
+// Sets up the triangle with corners in pixels in an image of `size`; false where it covers
+// nothing: zero area, or a back face (clockwise, y down) unless `both_faces`.
+bool small_triangle(vec2 pa, vec2 pb, vec2 pc, ivec2 size, bool both_faces, out SmallTriangle t) {
+    ivec2 a = ivec2(roundEven(pa * SUBPIXEL));
+    ivec2 b = ivec2(roundEven(pb * SUBPIXEL));
+    ivec2 c = ivec2(roundEven(pc * SUBPIXEL));
+    ivec2 lo = min(a, min(b, c)), hi = max(a, max(b, c));
+    t.lo = lo;
+    t.a = a - lo;
+    t.b = b - lo;
+    t.c = c - lo;
+    t.area = (t.b.x - t.a.x) * (t.c.y - t.a.y) - (t.b.y - t.a.y) * (t.c.x - t.a.x);
+    // Front faces (counter-clockwise, y down) have a negative area: b and c swapped.
+    t.swapped = t.area < 0;
+    if (t.area == 0 || (!t.swapped && !both_faces)) {
+        return false;
+    }
+    if (t.swapped) {
+        ivec2 s = t.b;
+        t.b = t.c;
+        t.c = s;
+        t.area = -t.area;
+    }
+    // Pixel centres 256 i + 128 inside the box, within the image (>> rounds towards −∞).
+    t.first = max((lo - 128 + 255) >> 8, ivec2(0));
+    t.last = min((hi - 128) >> 8, size - 1);
+    t.bias = ivec3(fill_bias(t.b, t.c), fill_bias(t.c, t.a), fill_bias(t.a, t.b));
+    return true;
+}
+
+// Whether the triangle covers `pixel`'s centre; `w`: the edge functions there, the weights
+// of corners a, b, c (summing to t.area).
+bool small_covers(SmallTriangle t, ivec2 pixel, out ivec3 w) {
+    ivec2 p = pixel * 256 + 128 - t.lo;
+    w = ivec3(edge_function(t.b, t.c, p), edge_function(t.c, t.a, p), edge_function(t.a, t.b, p));
+    return all(greaterThanEqual(w - t.bias, ivec3(0)));
+}
+
 #endif

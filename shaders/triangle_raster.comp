@@ -58,41 +58,21 @@ uint route(vec2 pa, vec2 pb, vec2 pc) {
 // Draws the triangle — its corners in pixels, their depths z/w — with visibility id `id`;
 // returns the pixels covered.
 uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id) {
-    ivec2 a = ivec2(roundEven(pa * SUBPIXEL));
-    ivec2 b = ivec2(roundEven(pb * SUBPIXEL));
-    ivec2 c = ivec2(roundEven(pc * SUBPIXEL));
-    // Relative to the box's corner: at most 64 pixels a side keeps every product below 2^31.
-    ivec2 lo = min(a, min(b, c)), hi = max(a, max(b, c));
-    a -= lo;
-    b -= lo;
-    c -= lo;
-    int area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    // Front faces (counter-clockwise, y down) have a negative area; the pipeline culls the
-    // others, and a zero-area triangle covers nothing.
-    if (area >= 0) {
+    // The pipeline culls back faces.
+    SmallTriangle t;
+    if (!small_triangle(pa, pb, pc, ivec2(frame.viewport.xy), false, t)) {
         return 0u;
     }
-    // b and c swapped: the interior on every edge's positive side.
-    ivec2 t = b;
-    b = c;
-    c = t;
-    z = z.xzy;
-    area = -area;
-    // Pixel centres 256 i + 128 inside the box, within the image (>> rounds towards −∞).
-    ivec2 size = ivec2(frame.viewport.xy);
-    ivec2 first = max((lo - 128 + 255) >> 8, ivec2(0));
-    ivec2 last = min((hi - 128) >> 8, size - 1);
-    ivec3 bias = ivec3(fill_bias(b, c), fill_bias(c, a), fill_bias(a, b));
+    z = z.xzy; // front faces come swapped
     uint covered = 0u;
-    for (int y = first.y; y <= last.y; y++) {
-        for (int x = first.x; x <= last.x; x++) {
-            ivec2 p = ivec2(x, y) * 256 + 128 - lo;
-            ivec3 w = ivec3(edge_function(b, c, p), edge_function(c, a, p), edge_function(a, b, p));
-            if (any(lessThan(w - bias, ivec3(0)))) {
+    for (int y = t.first.y; y <= t.last.y; y++) {
+        for (int x = t.first.x; x <= t.last.x; x++) {
+            ivec3 w;
+            if (!small_covers(t, ivec2(x, y), w)) {
                 continue;
             }
             covered++;
-            float depth = dot(vec3(w), z) / float(area);
+            float depth = dot(vec3(w), z) / float(t.area);
             if (depth >= 1.0) {
                 continue;
             }

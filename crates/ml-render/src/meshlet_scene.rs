@@ -134,9 +134,6 @@ pub struct MeshletScene {
     pub frames: Vec<CullFrame>,
     /// Draws one phase may write: every meshlet instance (each is drawn at most once a frame).
     pub capacity: u32,
-    pub instance_count: u32,
-    /// Triangles of every object together.
-    pub triangles: u64,
 }
 
 /// Shared by the passes of one technique; destroyed by whichever is destroyed first.
@@ -153,8 +150,6 @@ impl MeshletScene {
             visibility: Buffer::null(),
             frames: Vec::new(),
             capacity: geometry.meshlet_instances.len().max(1) as u32,
-            instance_count: geometry.instances.len() as u32,
-            triangles: geometry.triangles,
         };
         let made = ml_vk::build(ctx, s, |s| s.create(ctx))?;
         Ok(Rc::new(RefCell::new(made)))
@@ -168,7 +163,7 @@ impl MeshletScene {
         let bits = checked("meshlet visibility", self.capacity as u64 * 4)?;
         self.visibility = Buffer::device_local_with(ctx, "meshlet visibility", &vec![0u8; bits as usize], storage)?;
         let slot_bytes = checked("draw slots", 2 * self.capacity as u64 * 16)?;
-        let triangles = self.triangles.max(1);
+        let triangles = self.geometry.triangles.max(1);
         let index_bytes = checked("compacted indices", 3 * triangles * 4)?;
         let id_bytes = checked("triangle ids", 2 * triangles * 4)?;
         for _ in 0..FRAMES_IN_FLIGHT {
@@ -190,8 +185,13 @@ impl MeshletScene {
                     MemoryLocation::GpuOnly,
                 )?;
                 f.readback = Buffer::new(ctx, "cull counters read-back", counter_bytes, U::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
-                f.visible_instances =
-                    Buffer::new(ctx, "visible instances", self.instance_count.max(1) as u64 * 4, storage, MemoryLocation::GpuOnly)?;
+                f.visible_instances = Buffer::new(
+                    ctx,
+                    "visible instances",
+                    self.geometry.instance_count.max(1) as u64 * 4,
+                    storage,
+                    MemoryLocation::GpuOnly,
+                )?;
                 f.draw_slots = Buffer::new(ctx, "draw slots", slot_bytes, storage, MemoryLocation::GpuOnly)?;
                 f.indices = Buffer::new(ctx, "compacted indices", index_bytes, storage | U::INDEX_BUFFER, MemoryLocation::GpuOnly)?;
                 f.triangle_ids = Buffer::new(ctx, "triangle ids", id_bytes, storage, MemoryLocation::GpuOnly)?;

@@ -306,12 +306,7 @@ impl OmniShadows {
             // every layer.
             unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, self.cubes.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, host.raw, &region) };
             transition(ctx, cmd, self.cubes.raw, source, sampled);
-            ml_vk::commands::memory_barrier(
-                ctx,
-                cmd,
-                (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
-                (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
-            );
+            ml_vk::commands::transfer_to_host_barrier(ctx, cmd);
         });
         let depths = copied.map(|()| bytemuck::pod_collect_to_vec(host.mapped()));
         host.destroy(ctx);

@@ -66,10 +66,6 @@ pub struct Renderer<'a> {
     depth_format: vk::Format,
 }
 
-/// Copies into host-visible buffers, then read by the CPU.
-const TRANSFER_TO_HOST: ((vk::PipelineStageFlags, vk::AccessFlags), (vk::PipelineStageFlags, vk::AccessFlags)) =
-    ((vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));
-
 /// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
 const DEFAULT_HEAT_TOP: f32 = 64.0;
 /// clustered-gpu re-renders a final frame whose lists overflowed (after growing them); if it
@@ -605,7 +601,7 @@ impl<'a> Renderer<'a> {
                 // build ended with a barrier making its writes visible to transfers.
                 unsafe { ctx.device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[vk::BufferCopy::default().size(*size)]) };
             }
-            commands::memory_barrier(ctx, cmd, TRANSFER_TO_HOST.0, TRANSFER_TO_HOST.1);
+            commands::transfer_to_host_barrier(ctx, cmd);
         });
         let lists = copied.map(|()| {
             let ranges: Vec<ClusterRange> = bytemuck::pod_collect_to_vec(host[0].mapped());

@@ -65,6 +65,11 @@ pub fn copy_buffer_to_host(ctx: &Context, cmd: vk::CommandBuffer, (src, dst): (v
     // SAFETY: recording state outside a render pass; the caller's buffers are alive and hold
     // `bytes`, and the writes to `src` were made visible to transfers.
     unsafe { ctx.device.cmd_copy_buffer(cmd, src, dst, &[vk::BufferCopy::default().size(bytes)]) };
+    transfer_to_host_barrier(ctx, cmd);
+}
+
+/// Make every copy recorded so far visible to the host (read-backs).
+pub fn transfer_to_host_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
     memory_barrier(
         ctx,
         cmd,
@@ -82,10 +87,5 @@ pub fn copy_colour_to_host(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Ima
         .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })];
     // SAFETY: recording state; the caller's image and buffer are alive and large enough.
     unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer, &region) };
-    memory_barrier(
-        ctx,
-        cmd,
-        (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
-        (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
-    );
+    transfer_to_host_barrier(ctx, cmd);
 }

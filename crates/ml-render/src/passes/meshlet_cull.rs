@@ -80,7 +80,7 @@ impl MeshletCull {
         let scene = self.scene.borrow();
         CullPush {
             mode: [u32::from(self.phase == Phase::Late), u32::from(self.culling), levels, scene.capacity],
-            triangles: [scene.triangles as u32, self.raster.split(), 0, 0],
+            triangles: [scene.geometry.triangles as u32, self.raster.split(), 0, 0],
         }
     }
 }
@@ -136,7 +136,7 @@ impl Pass for MeshletCull {
                 }
                 memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.instance_pipeline);
-                d.cmd_dispatch(cmd, scene.instance_count.div_ceil(GROUP).max(1), 1, 1);
+                d.cmd_dispatch(cmd, scene.geometry.instance_count.div_ceil(GROUP).max(1), 1, 1);
                 memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute | indirect, rw | indirect_read));
             } else {
                 // The early raster read the compacted buffers this phase appends to.
@@ -181,7 +181,7 @@ impl Pass for MeshletCull {
             triangles: [c.triangles[2], c.triangles[3], c.rasterized[0], c.rasterized[1]].iter().map(|&n| n as u64).sum(),
             compute_triangles: c.rasterized[0] as u64 + c.rasterized[1] as u64,
             compute_pixels: c.rasterized[2] as u64,
-            scene_triangles: scene.triangles,
+            scene_triangles: scene.geometry.triangles,
         });
     }
 

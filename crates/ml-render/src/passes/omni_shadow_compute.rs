@@ -30,7 +30,7 @@ const MAX_GROUPS: u32 = 65535;
 /// work group each.
 pub const SPLIT: u32 = 16;
 /// The depth of a texel nothing reaches: 1.0's bits.
-const FAR_BITS: u32 = 0x3f80_0000;
+const FAR_BITS: u32 = 1.0f32.to_bits();
 
 pub struct OmniShadowCompute {
     settings: OmniShadowSettings,

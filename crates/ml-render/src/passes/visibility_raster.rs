@@ -125,7 +125,7 @@ impl Pass for VisibilityRaster {
         // room for every triangle of the scene (late).
         let phase = usize::from(self.phase == Phase::Late);
         let draw = (std::mem::offset_of!(CullCounters, draws) + phase * std::mem::size_of::<DrawIndexedCommand>()) as u64;
-        let first_id = [phase as u32 * scene.triangles as u32, extent.width, 0, 0];
+        let first_id = [phase as u32 * scene.geometry.triangles as u32, extent.width, 0, 0];
         // SAFETY: recording state; every handle is alive until the frame's fence signals.
         unsafe {
             d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
