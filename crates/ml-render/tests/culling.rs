@@ -1,8 +1,7 @@
 //! GPU culling is never visible (docs/DESIGN.md#gpu-culling): the visibility technique with
-//! culling on and off gives the same image, frame by frame (but for up to 3 silhouette pixels
-//! in all, which lavapipe covers in some runs and not in others: `on_a_silhouette`), along 20
-//! random camera paths of 30
-//! frames — low cameras among the objects and behind walls, so that meshlets are occluded and
+//! culling on and off gives the same image, frame by frame (but for up to 3 pixels in all on
+//! the edge between two surfaces, which lavapipe gives to either in different runs:
+//! `on_an_edge`), along 20 random camera paths of 30 frames — low cameras among the objects and behind walls, so that meshlets are occluded and
 //! come out from behind occluders, back faces turn away, objects leave and enter the frustum —
 //! each path with a camera cut halfway (the early phase then draws last frame's visible set
 //! from a different place: the late phase must find everything else). Validation (with
@@ -81,25 +80,36 @@ fn path(seed: u64) -> Vec<Camera> {
         .collect()
 }
 
-/// Whether pixel `k`, which differs between `a` and `b`, is one the rasteriser may cover or
-/// not as it likes: on an object's silhouette — background in one image, the object in the
-/// other, with background and object both among its neighbours in each. Lavapipe covered
-/// such a pixel, whose centre lies on the silhouette's edge, with culling off and left it
-/// empty with culling on in some runs of the same binary and not in others — the culling's
-/// atomics order the triangles differently from run to run (measured: one pixel of one frame
-/// of these 600, in 4 of 11 runs). A culled triangle that should have been drawn leaves more
-/// than a pixel, or one away from the silhouette.
-fn on_a_silhouette(a: &RenderOutput, b: &RenderOutput, k: usize) -> bool {
+/// Whether pixel `k`, which differs between `a` and `b`, is one the rasteriser may give to
+/// either of two surfaces as it likes: its centre lies on the edge between them, and which one
+/// it shows depends on the order their triangles are drawn in — an order the culling's atomics
+/// change from run to run (lavapipe, same binary: one pixel of one frame of these 600, in 4 of
+/// 11 runs on an object's silhouette against the background, in 2 of ~18 against a wall
+/// behind it). Accepted where each image shows at the pixel a colour the other shows right
+/// next to it (within 3/255; shading varies a little along a surface), or, on a silhouette,
+/// background in one image and the object in the other with both among the neighbours in each.
+/// A culled triangle that should have been drawn leaves a colour its surroundings in the
+/// culled image do not have, or more pixels than the few the test allows in all.
+fn on_an_edge(a: &RenderOutput, b: &RenderOutput, k: usize) -> bool {
     let background = [5u8, 5, 5];
     let at = common::pixel_at;
     let (x, y) = ((k % W as usize) as i64, (k / W as usize) as i64);
-    let one_is_background = (at(a, x, y) == Some(background)) != (at(b, x, y) == Some(background));
-    let mixed = |o: &RenderOutput| {
-        let around: Vec<[u8; 3]> =
-            (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))).filter_map(|(dx, dy)| at(o, x + dx, y + dy)).collect();
-        around.contains(&background) && around.iter().any(|p| *p != background)
+    let around = |o: &RenderOutput| -> Vec<[u8; 3]> {
+        (-1..=1)
+            .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
+            .filter(|d| *d != (0, 0))
+            .filter_map(|(dx, dy)| at(o, x + dx, y + dy))
+            .collect()
     };
-    one_is_background && mixed(a) && mixed(b)
+    let near = |p: [u8; 3], q: [u8; 3]| p.iter().zip(q).all(|(u, v)| u.abs_diff(v) <= 3);
+    let (pa, pb) = (at(a, x, y).expect("inside"), at(b, x, y).expect("inside"));
+    let swapped = around(b).iter().any(|&q| near(pa, q)) && around(a).iter().any(|&q| near(pb, q));
+    let one_is_background = (pa == background) != (pb == background);
+    let mixed = |o: &RenderOutput| {
+        let n = around(o);
+        n.contains(&background) && n.iter().any(|p| *p != background)
+    };
+    swapped || (one_is_background && mixed(a) && mixed(b))
 }
 
 #[test]
@@ -111,7 +121,7 @@ fn culling_on_and_off_give_the_same_frames() {
     on.frames = 1;
     let off = RenderSettings { culling: false, ..on };
     let mut renderers = [Renderer::new(&ctx, scene.clone(), on).unwrap(), Renderer::new(&ctx, scene, off).unwrap()];
-    let (mut occluded, mut late_drawn, mut frames, mut silhouette_pixels) = (0u64, 0u64, 0, 0);
+    let (mut occluded, mut late_drawn, mut frames, mut edge_pixels) = (0u64, 0u64, 0, 0);
     for p in 0..PATHS {
         for (i, camera) in path(p).into_iter().enumerate() {
             let mut images = Vec::new();
@@ -123,9 +133,9 @@ fn culling_on_and_off_give_the_same_frames() {
             let differing: Vec<usize> =
                 a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)).enumerate().filter(|(_, (x, y))| x != y).map(|(k, _)| k).collect();
             for &k in &differing {
-                assert!(on_a_silhouette(a, b, k), "path {p} frame {i}: pixel {k} differs between culling on and off");
+                assert!(on_an_edge(a, b, k), "path {p} frame {i}: pixel {k} differs between culling on and off");
             }
-            silhouette_pixels += differing.len();
+            edge_pixels += differing.len();
             let c = a.stats.culling.expect("culling stats");
             assert_eq!(b.stats.culling.unwrap().early_drawn, b.stats.culling.unwrap().meshlet_instances, "culling off draws every meshlet");
             // Culled by occlusion or cones: tested late but neither drawn early nor late.
@@ -135,9 +145,9 @@ fn culling_on_and_off_give_the_same_frames() {
         }
     }
     println!(
-        "{frames} frames: {occluded} meshlet tests culled, {late_drawn} meshlets drawn by the late phase; {silhouette_pixels} silhouette pixels differ"
+        "{frames} frames: {occluded} meshlet tests culled, {late_drawn} meshlets drawn by the late phase; {edge_pixels} edge pixels differ"
     );
-    assert!(silhouette_pixels <= 3, "{silhouette_pixels} silhouette pixels differ in {frames} frames");
+    assert!(edge_pixels <= 3, "{edge_pixels} edge pixels differ in {frames} frames");
     // The paths must exercise both phases, or the test proves nothing.
     assert!(occluded > 0 && late_drawn > 0);
     drop(renderers);
