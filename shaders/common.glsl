@@ -147,6 +147,10 @@ const uint VERTEX_FLOATS = 12u;
 // high bits are the draw slot.
 const uint INDEX_VERTEX_BITS = 6u;
 
+// The passes that loop over lists dispatch at most this many work groups (the least
+// maxComputeWorkGroupCount a device may have).
+const uint MAX_GROUPS = 65535u;
+
 // Bits of Instance.meshlets.w.
 const uint INSTANCE_CONE_CULLING = 1u; // rotation, uniform scale, mirror: cones hold
 const uint INSTANCE_MIRRORED = 2u;     // a mirror turns the cones around
@@ -175,8 +179,22 @@ struct CullCounters {
     uvec4 meshlets[2];           // per phase: x: meshlets drawn (triangle-culling work groups), y, z: 1
     uvec4 triangles;             // x, y: triangles of the early, late phase's meshlets; z, w: of those, drawn
     uvec4 tested;                // x: meshlets tested early, y: late; z: instances tested
-    uvec4 rasterized;            // compute raster: x, y: triangles it drew early, late; z: pixels it covered
+    uvec4 rasterized;            // compute raster: x, y: triangles it drew early, late; z: pixels it
+                                 // covered; w: large triangles drawn in place (the lists full)
     DrawIndexedCommand draws[2]; // per phase: the compacted triangles (index_count = 3 × drawn)
+    uint _pad0[2];               // (where std430 would pad anyway: large is 16-byte aligned)
+    uvec4 large[2];              // compute raster, per phase: the large-triangle pass's work
+                                 // groups (bins listed, at most MAX_GROUPS), 1, 1
+    uvec4 binned;                // x, y: bins listed early, late; z, w: large triangles found early,
+                                 // late (past the lists' capacity too)
+};
+
+// A large triangle of the compute raster (visibility_polygon.glsl), clipped and set up once
+// by the thread that found it; the bins it is listed by point at it.
+struct LargeTriangle {
+    uvec4 head;       // x: corners of the clipped polygon (3 to 8); y: visibility id
+    ivec4 corners[4]; // corner 2k in xy, 2k + 1 in zw: in the image, snapped to the sub-pixel grid
+    vec4 depths[2];   // each corner's depth z/w, corner k in component k
 };
 
 // Push constants of the culling passes.
@@ -185,7 +203,8 @@ struct CullPush {
                      // z: depth-pyramid levels; w: draw capacity (late draw slots start there)
     uvec4 triangles; // x: the scene's triangles (the late phase's triangle ids start there);
                      // y: compute raster: the largest triangle it draws (bounding box, pixels a
-                     // side), 0 with the hardware raster
+                     // side), 0 with the hardware raster; z: the large triangles' bin list's
+                     // capacity; w: 1 where they are drawn in compute, 0 by the hardware
 };
 
 // Push constants of the compute shadow raster (omni_raster.glsl).

@@ -16,7 +16,7 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
 #include "omni_face.glsl"
-#include "raster_rules.glsl"
+#include "polygon_raster.glsl"
 
 // xyz: where each shadowed light is this frame; w: its radius (cube i: light i).
 layout(std430, set = 0, binding = 0) readonly buffer ShadowLightBuffer { vec4 shadow_lights[]; };
@@ -39,13 +39,6 @@ layout(push_constant) uniform OmniRasterPushBlock { OmniRasterPush omni; };
 
 #include "meshlet_geometry.glsl"
 
-// The larger work groups loop over their lists: a dispatch has at most this many.
-const uint MAX_GROUPS = 65535u;
-
-// Where clipping against the sides begins: |x|, |y| ≤ GUARD · w, a band 1.5 faces wide around
-// the face that keeps every snapped coordinate (and the edge functions' products) in range.
-const float GUARD = 4.0;
-
 // A vertex in the light's frame, in radii (as omni_shadow_vertex.glsl's model_to_light).
 vec3 light_relative(uint vertex, mat4 model, vec4 light) {
     uint b = VERTEX_FLOATS * vertex;
@@ -55,8 +48,7 @@ vec3 light_relative(uint vertex, mat4 model, vec4 light) {
 
 // The viewport transform of a face, in texels.
 vec2 face_xy(vec4 c) {
-    float half_size = float(omni.sizes.x) * 0.5;
-    return c.xy / c.w * half_size + half_size;
+    return viewport_xy(c, vec2(float(omni.sizes.x)));
 }
 
 // Whether the triangle lies wholly beyond one plane of the face's frustum.
@@ -106,158 +98,24 @@ uint raster_small(vec2 pa, vec2 pb, vec2 pc, vec4 qa, vec4 qb, vec4 qc, uint lay
     return covered;
 }
 
-int64_t edge_function64(i64vec2 s, i64vec2 e, i64vec2 p) {
-    i64vec2 d = e - s;
-    return d.x * (p.y - s.y) - d.y * (p.x - s.x);
-}
-
-const int MAX_POLYGON = 8; // a triangle clipped by five planes
-
-// Clip the triangle (clip-space corners, their q as above) against the near plane and the
-// guard band; `count` corners of the convex polygon left. A new corner on an edge is found
-// from the edge's inside end, whichever way the edge is walked: two triangles sharing that
-// edge get the same corner, so they stay watertight.
-int clip_polygon(inout vec4 clip[MAX_POLYGON], inout vec4 q[MAX_POLYGON]) {
-    const vec4 planes[5] = vec4[5](vec4(0, 0, 1, 0), vec4(-1, 0, 0, GUARD), vec4(1, 0, 0, GUARD), vec4(0, -1, 0, GUARD), vec4(0, 1, 0, GUARD));
-    int count = 3;
-    for (int p = 0; p < 5; p++) {
-        vec4 in_clip[MAX_POLYGON] = clip;
-        vec4 in_q[MAX_POLYGON] = q;
-        int kept = 0;
-        for (int i = 0; i < count; i++) {
-            int j = i + 1 == count ? 0 : i + 1;
-            float di = dot(planes[p], in_clip[i]), dj = dot(planes[p], in_clip[j]);
-            if (di >= 0.0) {
-                clip[kept] = in_clip[i];
-                q[kept] = in_q[i];
-                kept++;
-            }
-            if ((di >= 0.0) != (dj >= 0.0)) {
-                int inside = di >= 0.0 ? i : j, outside = di >= 0.0 ? j : i;
-                float d_in = di >= 0.0 ? di : dj, d_out = di >= 0.0 ? dj : di;
-                float t = d_in / (d_in - d_out);
-                clip[kept] = mix(in_clip[inside], in_clip[outside], t);
-                // Position, not 1/w: interpolated linearly in clip space, then inverted below.
-                q[kept] = vec4(mix(in_q[inside].xyz, in_q[outside].xyz, t), 0.0);
-                kept++;
-            }
-        }
-        count = kept;
-        if (count < 3) {
-            return 0;
-        }
-    }
-    return count;
-}
-
-// A large triangle's clipped polygon: its corners snapped to the sub-pixel grid, their q (as
-// above), drawn as the fan (0, k, k + 1).
-struct Polygon {
-    int count;
-    i64vec2 s[MAX_POLYGON];
-    vec4 q[MAX_POLYGON];
-};
-
-Polygon clipped_polygon(vec4 ca, vec4 cb, vec4 cc, vec3 ra, vec3 rb, vec3 rc) {
-    vec4 clip[MAX_POLYGON];
-    Polygon p;
-    clip[0] = ca;
-    clip[1] = cb;
-    clip[2] = cc;
-    p.q[0] = vec4(ra, 0.0);
-    p.q[1] = vec4(rb, 0.0);
-    p.q[2] = vec4(rc, 0.0);
-    // Most large triangles lie inside every plane: nothing to clip.
-    bool inside = true;
-    for (int i = 0; i < 3; i++) {
-        vec4 v = clip[i];
-        inside = inside && v.z >= 0.0 && abs(v.x) <= GUARD * v.w && abs(v.y) <= GUARD * v.w;
-    }
-    p.count = inside ? 3 : clip_polygon(clip, p.q);
-    for (int i = 0; i < p.count; i++) {
-        p.s[i] = i64vec2(ivec2(roundEven(face_xy(clip[i]) * SUBPIXEL)));
-        p.q[i].w = 1.0 / clip[i].w;
-    }
-    return p;
-}
-
-// One triangle of a polygon's fan, set up for its texels: corners ordered so the interior is
-// on every edge's positive side, the fill rule's biases, the texel centres in its box.
-struct FanTriangle {
-    i64vec2 a, b, c;
-    vec4 qa, qb, qc;
-    ivec3 bias;
-    ivec2 first, last;
-};
-
-// The fan triangle with corners (a, b, c), their q; false if it covers no texel centre of
-// the face (zero area, or its box misses the face).
-bool fan_triangle(i64vec2 a, i64vec2 b, i64vec2 c, vec4 qa, vec4 qb, vec4 qc, out FanTriangle t) {
-    t.a = a;
-    t.b = b;
-    t.c = c;
-    t.qa = qa;
-    t.qb = qb;
-    t.qc = qc;
-    int64_t area = (t.b.x - t.a.x) * (t.c.y - t.a.y) - (t.b.y - t.a.y) * (t.c.x - t.a.x);
-    if (area == 0l) {
-        return false;
-    }
-    if (area < 0l) {
-        i64vec2 s = t.b;
-        t.b = t.c;
-        t.c = s;
-        vec4 u = t.qb;
-        t.qb = t.qc;
-        t.qc = u;
-    }
-    ivec2 lo = ivec2(min(t.a, min(t.b, t.c))), hi = ivec2(max(t.a, max(t.b, t.c)));
-    int side = int(omni.sizes.x);
-    t.first = max((lo - 128 + 255) >> 8, ivec2(0));
-    t.last = min((hi - 128) >> 8, ivec2(side - 1));
-    t.bias = ivec3(fill_bias(ivec2(t.b), ivec2(t.c)), fill_bias(ivec2(t.c), ivec2(t.a)), fill_bias(ivec2(t.a), ivec2(t.b)));
-    return all(lessThanEqual(t.first, t.last));
-}
-
-// The three edge functions at a texel's centre (the weights of the corners opposite them).
-i64vec3 fan_edges(FanTriangle t, ivec2 texel) {
-    i64vec2 p = i64vec2(texel * 256 + 128);
-    return i64vec3(edge_function64(t.b, t.c, p), edge_function64(t.c, t.a, p), edge_function64(t.a, t.b, p));
-}
-
 // Draws the fan triangle's texel if covered; returns 1 if it was.
 uint fan_texel(FanTriangle t, ivec2 texel, uint layer) {
-    i64vec3 w = fan_edges(t, texel);
-    if (any(lessThan(w - i64vec3(t.bias), i64vec3(0)))) {
+    i64vec3 w;
+    if (!fan_covers(t, texel, w)) {
         return 0u;
     }
     keep_nearest(layer, texel, interpolated_distance(vec3(w), t.qa, t.qb, t.qc));
     return 1u;
 }
 
-// Whether any texel centre of the rectangle [lo, hi] may be covered: no edge function is
-// negative at the rectangle's corner where it is largest.
-bool fan_reaches(FanTriangle t, ivec2 lo, ivec2 hi) {
-    i64vec2 s[3] = i64vec2[3](t.b, t.c, t.a);
-    i64vec2 e[3] = i64vec2[3](t.c, t.a, t.b);
-    for (int i = 0; i < 3; i++) {
-        i64vec2 d = e[i] - s[i];
-        ivec2 corner = ivec2(d.y < 0l ? hi.x : lo.x, d.x > 0l ? hi.y : lo.y);
-        if (edge_function64(s[i], e[i], i64vec2(corner * 256 + 128)) - int64_t(t.bias[i]) < 0l) {
-            return false;
-        }
-    }
-    return true;
-}
-
 // Any triangle by this thread alone, texel by texel over each fan triangle's box (what the
 // culling's thread does when the large list is full). Returns the texels covered.
 uint raster_large_alone(vec4 ca, vec4 cb, vec4 cc, vec3 ra, vec3 rb, vec3 rc, uint layer) {
-    Polygon p = clipped_polygon(ca, cb, cc, ra, rb, rc);
+    Polygon p = clipped_polygon(ca, cb, cc, ra, rb, rc, vec2(float(omni.sizes.x)));
     uint covered = 0u;
     for (int k = 1; k + 1 < p.count; k++) {
         FanTriangle t;
-        if (!fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], t)) {
+        if (!fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(omni.sizes.x), true, t)) {
             continue;
         }
         for (int y = t.first.y; y <= t.last.y; y++) {

@@ -37,7 +37,7 @@ void main() {
             vec3 ra = light_relative(v.x, model, light), rb = light_relative(v.y, model, light), rc = light_relative(v.z, model, light);
             vec4 a = omni_face_clip(omni.projection, ra, face), b = omni_face_clip(omni.projection, rb, face);
             vec4 c = omni_face_clip(omni.projection, rc, face);
-            Polygon p = clipped_polygon(a, b, c, ra, rb, rc);
+            Polygon p = clipped_polygon(a, b, c, ra, rb, rc, vec2(float(omni.sizes.x)));
             corner_count = p.count;
             for (int i = 0; i < p.count; i++) {
                 corner_s[i] = ivec2(p.s[i]);
@@ -50,7 +50,7 @@ void main() {
         for (int k = 1; k + 1 < corners; k++) {
             FanTriangle t;
             i64vec2 a = i64vec2(corner_s[0]), b = i64vec2(corner_s[k]), c = i64vec2(corner_s[k + 1]);
-            if (!fan_triangle(a, b, c, corner_q[0], corner_q[k], corner_q[k + 1], t)) {
+            if (!fan_triangle(a, b, c, corner_q[0], corner_q[k], corner_q[k + 1], ivec2(omni.sizes.x), true, t)) {
                 continue;
             }
             ivec2 tile0 = t.first / TILE;

@@ -9,6 +9,13 @@
 // we run on (`manylights info` lists it).
 const float SUBPIXEL = 256.0;
 
+// The viewport transform (x = size/2 · x/w + size/2, y likewise) of a clip-space position
+// into an image of `size` pixels starting at 0.
+vec2 viewport_xy(vec4 c, vec2 size) {
+    vec2 half_size = size * 0.5;
+    return c.xy / c.w * half_size + half_size;
+}
+
 // The edge function of edge s → e at p (sub-pixel units): positive on the interior's side.
 int edge_function(ivec2 s, ivec2 e, ivec2 p) {
     ivec2 d = e - s;

@@ -9,8 +9,10 @@
 // vertices snapped to 1/256 pixel, integer edge functions at pixel centres, the top-left rule
 // on edges, depth interpolated from the vertices' z/w, LESS against what is there. The
 // nearest (depth << 32 | visibility id) per pixel is kept by a 64-bit atomic min. Every other
-// triangle (large, or crossing the near plane, which the hardware clips) goes to the phase's
-// indexed draw, whose fragments do the same atomic min into the same buffer.
+// triangle (large, or crossing the near plane, which the hardware clips) is either clipped
+// here and listed by the 64×64-pixel bins of its box for triangle_raster_large.comp (a work
+// group each), or — the hybrid raster — goes to the phase's indexed draw, whose fragments do
+// the same atomic min into the same buffer.
 #include "common.glsl"
 
 layout(local_size_x = 64) in;
@@ -18,23 +20,26 @@ layout(local_size_x = 64) in;
 #include "meshlet_cull.glsl"
 #include "meshlet_geometry.glsl"
 #include "triangle_cull.glsl"
-#include "raster_rules.glsl"
 
 // Per pixel, row by row: floatBitsToUint(depth) << 32 | visibility id, the nearest kept; all
 // ones where nothing was drawn (visibility_resolve.comp makes the two images of it).
 layout(std430, set = 0, binding = 14) buffer VisibilityDepthBuffer { uint64_t visibility_depth[]; };
+// The large triangles and their bins (visibility_polygon.glsl), cull.triangles.z of each.
+layout(std430, set = 0, binding = 15) writeonly buffer LargeBinBuffer { uvec2 large_bins[]; };
+layout(std430, set = 0, binding = 16) buffer LargeTriangleBuffer { LargeTriangle large_triangles[]; };
 
-const uint ROUTE_NONE = 0u;     // no pixel to draw
-const uint ROUTE_COMPUTE = 1u;  // drawn here
-const uint ROUTE_HARDWARE = 2u; // appended to the indexed draw
+#include "visibility_polygon.glsl"
+
+const uint ROUTE_NONE = 0u;    // no pixel to draw
+const uint ROUTE_COMPUTE = 1u; // drawn here
+const uint ROUTE_LARGE = 2u;   // listed by bins, or appended to the hybrid's indexed draw
 
 shared uint group_triangles;
 shared uint group_pixels;
 
-// The viewport transform (xf = width/2 · x/w + width/2, y likewise), in pixels.
+// The viewport transform, in pixels.
 vec2 framebuffer_xy(vec4 c) {
-    vec2 half_size = vec2(frame.viewport.xy) * 0.5;
-    return c.xy / c.w * half_size + half_size;
+    return viewport_xy(c, vec2(frame.viewport.xy));
 }
 
 // In front of the near plane (or behind the eye) somewhere: the hardware clips it.
@@ -46,7 +51,7 @@ bool crosses_near_plane(vec4 a, vec4 b, vec4 c) {
 uint route(vec2 pa, vec2 pb, vec2 pc) {
     vec2 lo = min(pa, min(pb, pc)), hi = max(pa, max(pb, pc));
     if (any(greaterThan(hi - lo, vec2(float(cull.triangles.y))))) {
-        return ROUTE_HARDWARE;
+        return ROUTE_LARGE;
     }
     // Off screen, with a pixel of margin for the snapping.
     if (any(lessThan(hi, vec2(-1.0))) || any(greaterThan(lo, vec2(frame.viewport.xy) + 1.0))) {
@@ -73,14 +78,51 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id) {
             }
             covered++;
             float depth = dot(vec3(w), z) / float(t.area);
-            if (depth >= 1.0) {
-                continue;
-            }
-            uint64_t value = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(id);
-            atomicMin(visibility_depth[uint(y) * frame.viewport.x + uint(x)], value);
+            keep_nearest_id(ivec2(x, y), depth, id);
         }
     }
     return covered;
+}
+
+// A large triangle (or one crossing the near plane), clipped, into the list of large
+// triangles and listed by the bins of its polygon's box; where the lists cannot hold it,
+// drawn by this thread. Returns the pixels it covered here.
+uint list_large(vec4 a, vec4 b, vec4 c, uint id) {
+    Polygon p = visibility_polygon(a, b, c);
+    if (p.count == 0) {
+        return 0u;
+    }
+    i64vec2 lo = p.s[0], hi = p.s[0];
+    for (int i = 1; i < p.count; i++) {
+        lo = min(lo, p.s[i]);
+        hi = max(hi, p.s[i]);
+    }
+    // The pixel centres inside the box, within the image (as fan_triangle finds them).
+    ivec2 first = max((ivec2(lo) - 128 + 255) >> 8, ivec2(0));
+    ivec2 last = min((ivec2(hi) - 128) >> 8, ivec2(frame.viewport.xy) - 1);
+    if (any(greaterThan(first, last))) {
+        return 0u;
+    }
+    uvec2 bin0 = uvec2(first / BIN), span = uvec2(last / BIN) - bin0 + 1u;
+    uint bins = span.x * span.y;
+    uint phase = cull.mode.x, capacity = cull.triangles.z;
+    uint triangle = atomicAdd(counters.binned[2u + phase], 1u);
+    uint at = atomicAdd(counters.binned[phase], bins);
+    bool fits = triangle < capacity && at <= capacity && bins <= capacity - at;
+    if (fits) {
+        store_large(triangle, p, id);
+    }
+    for (uint i = 0u; i < bins && at + i < capacity; i++) {
+        uvec2 bin = bin0 + uvec2(i % span.x, i / span.x);
+        large_bins[at + i] = fits ? uvec2(triangle, bin.x | (bin.y << 16u)) : uvec2(NO_BIN);
+    }
+    if (fits) {
+        atomicMax(counters.large[phase].x, min(at + bins, MAX_GROUPS));
+        counters.large[phase].yz = uvec2(1u);
+        return 0u;
+    }
+    atomicAdd(counters.rasterized.w, 1u);
+    return raster_polygon_alone(p, id);
 }
 
 void main() {
@@ -99,17 +141,22 @@ void main() {
         if (culling && !triangle_visible(a, b, c)) {
             continue;
         }
-        if (crosses_near_plane(a, b, c)) {
-            keep_triangle(t);
-            continue;
+        uint id = (d.x << VISIBILITY_TRIANGLE_BITS) | t;
+        uint r = ROUTE_LARGE;
+        vec2 pa, pb, pc;
+        if (!crosses_near_plane(a, b, c)) {
+            pa = framebuffer_xy(a);
+            pb = framebuffer_xy(b);
+            pc = framebuffer_xy(c);
+            r = route(pa, pb, pc);
         }
-        vec2 pa = framebuffer_xy(a), pb = framebuffer_xy(b), pc = framebuffer_xy(c);
-        uint r = route(pa, pb, pc);
-        if (r == ROUTE_HARDWARE) {
+        if (r == ROUTE_LARGE && cull.triangles.w == 0u) {
             keep_triangle(t);
+        } else if (r == ROUTE_LARGE) {
+            pixels += list_large(a, b, c, id);
         } else if (r == ROUTE_COMPUTE) {
             vec3 z = vec3(a.z / a.w, b.z / b.w, c.z / c.w);
-            pixels += rasterize(pa, pb, pc, z, (d.x << VISIBILITY_TRIANGLE_BITS) | t);
+            pixels += rasterize(pa, pb, pc, z, id);
             triangles++;
         }
     }

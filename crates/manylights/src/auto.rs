@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Result};
 use ml_cpu::scene::Scene;
-use ml_render::settings::{missing_compute_raster_feature, missing_meshlet_feature};
+use ml_render::settings::{missing_meshlet_feature, missing_raster_feature};
 use ml_render::stage_probe::{pick_lighting_path, quick_probe, StageTimes};
 use ml_render::{Geometry, Raster, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
@@ -56,9 +56,9 @@ pub const RASTER_PROBE_FRAMES: u32 = 4;
 
 /// The rasteriser for `settings` on `ctx`'s device and, where `auto` (`choice` None) chose it,
 /// why. Techniques without a visibility buffer keep the hardware (an explicit compute raster
-/// is refused by the settings check); a device without what the compute raster needs draws
-/// with the hardware, and says so; auto renders `scene` both ways and keeps the faster, the
-/// compute raster with `split`.
+/// is refused by the settings check); a device without what the asked-for raster needs draws
+/// with the hardware, and says so; auto renders `scene` with each rasteriser the device can
+/// run (hardware, hybrid and compute, those with `split`) and keeps the fastest.
 pub fn resolve_raster(
     ctx: &Context,
     scene: &Scene,
@@ -69,18 +69,26 @@ pub fn resolve_raster(
         return Ok((choice.unwrap_or(Raster::Hardware), None));
     }
     let device = &ctx.info.name;
-    Ok(match (choice, missing_compute_raster_feature(&ctx.info.features)) {
-        (Some(Raster::Compute { .. }), Some(feature)) => {
-            eprintln!("warning: the compute raster needs {feature}, which '{device}' lacks: drawing with the hardware");
-            (Raster::Hardware, None)
-        }
-        (Some(raster), _) => (raster, None),
-        (None, Some(feature)) => (Raster::Hardware, Some(format!("'{device}' lacks {feature}, which the compute raster needs"))),
-        (None, None) => {
-            let (raster, why) = pick_raster(ctx, scene, settings, Raster::Compute { split })?;
-            (raster, Some(why))
-        }
-    })
+    let features = &ctx.info.features;
+    if let Some(raster) = choice {
+        return Ok(match missing_raster_feature(raster, features) {
+            Some(feature) => {
+                eprintln!("warning: the {} raster needs {feature}, which '{device}' lacks: drawing with the hardware", raster.name());
+                (Raster::Hardware, None)
+            }
+            None => (raster, None),
+        });
+    }
+    let candidates: Vec<Raster> = [Raster::Hardware, Raster::hybrid(split), Raster::compute(split)]
+        .into_iter()
+        .filter(|&r| missing_raster_feature(r, features).is_none())
+        .collect();
+    if candidates.len() == 1 {
+        let feature = missing_raster_feature(Raster::compute(split), features).unwrap_or("what the compute rasters need");
+        return Ok((Raster::Hardware, Some(format!("'{device}' lacks {feature}, which the compute raster needs"))));
+    }
+    let (raster, why) = pick_raster(ctx, scene, settings, &candidates)?;
+    Ok((raster, Some(why)))
 }
 
 /// `resolve_raster` on a context of its own (the viewer makes its own for the window), which
@@ -109,10 +117,10 @@ pub fn resolve_raster_alone(
     Ok(raster)
 }
 
-/// Render `scene` with `settings` and each rasteriser for RASTER_PROBE_FRAMES frames; the one
-/// whose frames took less GPU time (wall time where the device has no timestamps), and the
-/// line that says so.
-pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, compute: Raster) -> Result<(Raster, String)> {
+/// Render `scene` with `settings` and each of `candidates` for RASTER_PROBE_FRAMES frames; the
+/// one whose frames took least GPU time (wall time where the device has no timestamps), and
+/// the line that says so.
+pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, candidates: &[Raster]) -> Result<(Raster, String)> {
     let time = |raster| -> Result<f64> {
         let s = RenderSettings { raster, frames: RASTER_PROBE_FRAMES, ..*settings };
         let out = Renderer::new(ctx, scene.clone(), s)?.render()?;
@@ -121,12 +129,14 @@ pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, comp
             None => out.stats.wall_ms_per_frame(),
         })
     };
-    let (hardware_ms, compute_ms) = (time(Raster::Hardware)?, time(compute)?);
-    let picked = if compute_ms < hardware_ms { compute } else { Raster::Hardware };
+    let timed = candidates.iter().map(|&r| Ok((r, time(r)?))).collect::<Result<Vec<(Raster, f64)>>>()?;
+    let &(picked, best) = timed.iter().min_by(|a, b| a.1.total_cmp(&b.1)).expect("at least one rasteriser");
+    let each: Vec<String> = timed.iter().map(|(r, ms)| format!("{ms:.3} ms {}", r.name())).collect();
+    let runner_up = timed.iter().filter(|(r, _)| *r != picked).map(|t| t.1).fold(f64::INFINITY, f64::min);
     let why = format!(
-        "a frame of this scene took {hardware_ms:.3} ms with the hardware raster and {compute_ms:.3} ms with the compute raster \
-         ({:.2}×; mean of {RASTER_PROBE_FRAMES} frames each)",
-        hardware_ms / compute_ms
+        "a frame of this scene took {} ({:.2}× the next; mean of {RASTER_PROBE_FRAMES} frames each)",
+        each.join(", "),
+        runner_up / best
     );
     Ok((picked, why))
 }

@@ -68,8 +68,8 @@ pub struct BenchArgs {
     /// rounds per loop length of --probe-lights — and the ratio of their times.
     #[arg(long)]
     probe: bool,
-    /// Rasterisers of the visibility technique, comma-separated: hardware, compute (each a
-    /// row of its own; the other techniques have one).
+    /// Rasterisers of the visibility technique, comma-separated: hardware, hybrid, compute
+    /// (each a row of its own; the other techniques have one).
     #[arg(long, default_value = "hardware,compute")]
     raster: String,
     /// The compute raster's largest triangle, pixels a side (render's --raster-split).
@@ -144,7 +144,7 @@ impl Variant {
     fn label(self) -> String {
         match self.raster {
             Raster::Hardware => self.technique.name().to_owned(),
-            Raster::Compute { .. } => format!("{} (compute raster)", self.technique.name()),
+            Raster::Compute { .. } => format!("{} ({} raster)", self.technique.name(), self.raster.name()),
         }
     }
 }
@@ -208,12 +208,11 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     let (auto_technique, auto_why, quick) = auto::pick(&ctx)?;
     auto::announce(auto_technique, &auto_why);
     let mut variants: Vec<Variant> = Vec::new();
-    let compute_raster = ml_render::settings::missing_compute_raster_feature(&ctx.info.features);
     for technique in choices.into_iter().map(|c| c.unwrap_or(auto_technique)) {
         let rasters = if technique.geometry() == Geometry::Meshlets { rasters.clone() } else { vec![Raster::Hardware] };
         for raster in rasters {
-            if let (Raster::Compute { .. }, Some(feature)) = (raster, compute_raster) {
-                eprintln!("warning: the compute raster needs {feature}, which '{}' lacks: not measured", ctx.info.name);
+            if let Some(feature) = ml_render::settings::missing_raster_feature(raster, &ctx.info.features) {
+                eprintln!("warning: the {} raster needs {feature}, which '{}' lacks: not measured", raster.name(), ctx.info.name);
                 continue;
             }
             let v = Variant { technique, raster };

@@ -150,10 +150,12 @@ struct SceneArgs {
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     culling: String,
     /// Who draws the visibility technique's visibility buffer: hardware (the graphics
-    /// pipeline), compute (triangles up to --raster-split pixels in a compute shader, the
-    /// others by the hardware into the same buffer) or auto (both timed on this device and
-    /// scene for a few frames, the faster kept, and said why).
-    #[arg(long, default_value = "auto", value_parser = ["hardware", "compute", "auto"])]
+    /// pipeline), compute (compute shaders only: triangles up to --raster-split pixels a
+    /// thread each, larger ones clipped and drawn by a work group per 64x64-pixel bin),
+    /// hybrid (the small ones in compute, the others by the hardware into the same buffer) or
+    /// auto (each timed on this device and scene for a few frames, the fastest kept, and said
+    /// why).
+    #[arg(long, default_value = "auto", value_parser = ["hardware", "hybrid", "compute", "auto"])]
     raster: String,
     /// The compute raster's largest triangle: bounding box up to PX pixels a side (1 to 64).
     #[arg(long, default_value_t = Raster::DEFAULT_SPLIT)]

@@ -276,10 +276,32 @@ gpu_struct!(
         /// x: meshlets tested early; y: late; z: instances tested.
         tested: [u32; 4],
         /// The compute raster's: x, y: triangles it drew in the early, late phase; z: pixels
-        /// it covered (every covered pixel of every triangle, hidden or not).
+        /// it covered (every covered pixel of every triangle, hidden or not); w: large
+        /// triangles drawn in place by the thread that found them (the lists full).
         rasterized: [u32; 4],
         /// Per phase: the compacted triangles' indexed draw.
         draws: [DrawIndexedCommand; 2],
+        /// std430 aligns the next uvec4 to 16 bytes.
+        _pad0: [u32; 2],
+        /// The compute raster, per phase: the large-triangle pass's work groups (x: bins
+        /// listed, at most 65535; y, z: 1; an indirect dispatch).
+        large: [[u32; 4]; 2],
+        /// x, y: bins listed early, late; z, w: large triangles found early, late (past the
+        /// lists' capacity too).
+        binned: [u32; 4],
+    }
+);
+
+gpu_struct!(
+    /// A large triangle of the compute raster, clipped and set up once (GPU only; mirrored
+    /// for its size, which the list is allocated by).
+    LargeTriangle {
+        /// x: corners of the clipped polygon (3 to 8); y: visibility id.
+        head: [u32; 4],
+        /// Corner 2k in xy, 2k + 1 in zw: in the image, snapped to the sub-pixel grid.
+        corners: [[i32; 4]; 4],
+        /// Each corner's depth z/w.
+        depths: [[f32; 4]; 2],
     }
 );
 
@@ -290,7 +312,9 @@ gpu_struct!(
         /// w: draw capacity (the late phase's draw slots start there).
         mode: [u32; 4],
         /// x: the scene's triangles (the late phase's triangle ids start there); y: the
-        /// compute raster's largest triangle (bounding box, pixels a side; 0: hardware raster).
+        /// compute raster's largest triangle (bounding box, pixels a side; 0: hardware raster);
+        /// z: the large triangles' bin list's capacity; w: 1 where they are drawn in compute,
+        /// 0 by the hardware.
         triangles: [u32; 4],
     }
 );

@@ -96,10 +96,14 @@ pub enum SettingsError {
     TechniqueFeature { technique: Technique, feature: &'static str, device: String },
     #[error("the compute raster draws the visibility buffer of the visibility technique, not {}'s (use --raster hardware)", technique.name())]
     RasterNeedsVisibility { technique: Technique },
-    #[error("the compute raster needs {feature}, which '{device}' lacks: use --raster hardware")]
-    RasterFeature { feature: &'static str, device: String },
+    #[error("the {raster} raster needs {feature}, which '{device}' lacks: use --raster hardware")]
+    RasterFeature { raster: &'static str, feature: &'static str, device: String },
     #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size or --raster hardware")]
     RasterBuffer { width: u32, height: u32, bytes: u64, device: String, max: u32 },
+    #[error(
+        "the compute raster's list of {bins} large triangles takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer"
+    )]
+    BinList { bins: u32, bytes: u64, device: String, max: u32 },
     #[error("frames must be at least 1")]
     NoFrames,
     #[error("time {0} is not a finite number")]

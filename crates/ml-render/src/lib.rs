@@ -27,6 +27,6 @@ pub use error::RenderError;
 pub use frame::FRAMES_IN_FLIGHT;
 pub use renderer::{FrameHook, RenderOutput, Renderer};
 pub use settings::{
-    DebugView, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel,
-    Technique, FRAME_SECONDS, TIMER_SPEED,
+    DebugView, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings,
+    Shading, ShadingModel, Technique, FRAME_SECONDS, TIMER_SPEED,
 };

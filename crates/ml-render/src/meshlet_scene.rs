@@ -12,7 +12,7 @@
 use crate::descriptors::Resource;
 use crate::frame::FRAMES_IN_FLIGHT;
 use gpu_allocator::MemoryLocation;
-use ml_cpu::gpu_types::CullCounters;
+use ml_cpu::gpu_types::{CullCounters, LargeTriangle};
 use ml_cpu::meshlets::SceneMeshlets;
 use ml_vk::{vk, Buffer, Context, VkError};
 use std::cell::RefCell;
@@ -31,6 +31,9 @@ pub struct CullFrame {
     pub indices: Buffer,
     /// A visibility id per kept triangle: early from 0, late from `triangles` on.
     pub triangle_ids: Buffer,
+    /// The compute raster's large triangles, clipped, and the bins they are listed by.
+    pub large_triangles: Buffer,
+    pub large_bins: Buffer,
 }
 
 /// The scene's meshlets on the GPU, uploaded once: what every meshlet pass reads (the
@@ -141,7 +144,9 @@ pub type SharedMeshletScene = Rc<RefCell<MeshletScene>>;
 
 impl MeshletScene {
     /// Upload `geometry`, whose instances' texture sets are `texture_sets` (per object).
-    pub fn new(ctx: &Context, mut geometry: SceneMeshlets, texture_sets: &[u32]) -> Result<SharedMeshletScene, VkError> {
+    /// The scene's meshlets with per-frame culling buffers; `bin_list`: large triangles, and
+    /// bins, the compute raster's lists hold per phase (0 where it has none).
+    pub fn new(ctx: &Context, mut geometry: SceneMeshlets, texture_sets: &[u32], bin_list: u32) -> Result<SharedMeshletScene, VkError> {
         for (instance, &set) in geometry.instances.iter_mut().zip(texture_sets) {
             instance.surface[1] = set;
         }
@@ -151,11 +156,11 @@ impl MeshletScene {
             frames: Vec::new(),
             capacity: geometry.meshlet_instances.len().max(1) as u32,
         };
-        let made = ml_vk::build(ctx, s, |s| s.create(ctx))?;
+        let made = ml_vk::build(ctx, s, |s| s.create(ctx, bin_list))?;
         Ok(Rc::new(RefCell::new(made)))
     }
 
-    fn create(&mut self, ctx: &Context) -> Result<(), VkError> {
+    fn create(&mut self, ctx: &Context, bin_list: u32) -> Result<(), VkError> {
         use vk::BufferUsageFlags as U;
         let storage = U::STORAGE_BUFFER;
         let checked = |name: &str, bytes: u64| storage_bytes(ctx, name, bytes);
@@ -166,6 +171,8 @@ impl MeshletScene {
         let triangles = self.geometry.triangles.max(1);
         let index_bytes = checked("compacted indices", 3 * triangles * 4)?;
         let id_bytes = checked("triangle ids", 2 * triangles * 4)?;
+        let bin_bytes = checked("large-triangle bins", bin_list.max(1) as u64 * 8)?;
+        let large_bytes = checked("large triangles", bin_list.max(1) as u64 * std::mem::size_of::<LargeTriangle>() as u64)?;
         for _ in 0..FRAMES_IN_FLIGHT {
             let counter_bytes = std::mem::size_of::<CullCounters>() as u64;
             let mut f = CullFrame {
@@ -175,6 +182,8 @@ impl MeshletScene {
                 draw_slots: Buffer::null(),
                 indices: Buffer::null(),
                 triangle_ids: Buffer::null(),
+                large_triangles: Buffer::null(),
+                large_bins: Buffer::null(),
             };
             let made = (|| {
                 f.counters = Buffer::new(
@@ -195,6 +204,8 @@ impl MeshletScene {
                 f.draw_slots = Buffer::new(ctx, "draw slots", slot_bytes, storage, MemoryLocation::GpuOnly)?;
                 f.indices = Buffer::new(ctx, "compacted indices", index_bytes, storage | U::INDEX_BUFFER, MemoryLocation::GpuOnly)?;
                 f.triangle_ids = Buffer::new(ctx, "triangle ids", id_bytes, storage, MemoryLocation::GpuOnly)?;
+                f.large_bins = Buffer::new(ctx, "large-triangle bins", bin_bytes, storage, MemoryLocation::GpuOnly)?;
+                f.large_triangles = Buffer::new(ctx, "large triangles", large_bytes, storage, MemoryLocation::GpuOnly)?;
                 Ok(())
             })();
             if let Err(e) = made {
@@ -219,6 +230,8 @@ impl MeshletScene {
             "DrawSlotBuffer" => &f.draw_slots,
             "CompactedIndexBuffer" => &f.indices,
             "TriangleIdBuffer" => &f.triangle_ids,
+            "LargeBinBuffer" => &f.large_bins,
+            "LargeTriangleBuffer" => &f.large_triangles,
             _ => return None,
         };
         Some(Resource::Buffer(buffer.raw))
@@ -248,6 +261,8 @@ impl CullFrame {
             &mut self.draw_slots,
             &mut self.indices,
             &mut self.triangle_ids,
+            &mut self.large_bins,
+            &mut self.large_triangles,
         ] {
             b.destroy(ctx);
         }

@@ -68,6 +68,11 @@ pub struct CullStats {
     /// the pixels they covered (hidden ones too); 0 with the hardware raster.
     pub compute_triangles: u64,
     pub compute_pixels: u64,
+    /// Compute raster (large triangles in compute): the large triangles found, the 64×64
+    /// bins of their boxes, and those drawn in place (the lists full).
+    pub large_triangles: u64,
+    pub bins: u64,
+    pub in_place: u64,
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -216,8 +221,11 @@ pub struct RenderFacts<'a> {
 pub fn raster_line(raster: crate::settings::Raster) -> String {
     match raster {
         crate::settings::Raster::Hardware => "hardware (indexed draw per culling phase)".to_owned(),
-        crate::settings::Raster::Compute { split } => format!(
-            "compute (triangles up to {split} px a side; larger ones and those crossing the near plane by the hardware; 64-bit atomic min)"
+        crate::settings::Raster::Compute { split, large: crate::settings::LargeTriangles::Hardware } => format!(
+            "hybrid (triangles up to {split} px a side in compute; larger ones and those crossing the near plane by the hardware; 64-bit atomic min)"
+        ),
+        crate::settings::Raster::Compute { split, large: crate::settings::LargeTriangles::Bins { bin_list } } => format!(
+            "compute (triangles up to {split} px a side a thread each; larger ones and those crossing the near plane clipped, a work group per 64x64 bin, list of {bin_list}; 64-bit atomic min)"
         ),
     }
 }
@@ -264,8 +272,9 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             "triangles",
             format!("{} drawn of {} ({share:.1} %); the meshlets drawn held {}", c.triangles, c.scene_triangles, c.meshlet_triangles),
         ));
-        if settings.raster != crate::settings::Raster::Hardware {
-            rows.push((
+        match settings.raster.bin_list() {
+            _ if settings.raster == crate::settings::Raster::Hardware => {}
+            None => rows.push((
                 "compute raster",
                 format!(
                     "{} triangles ({} pixels covered), {} by the hardware",
@@ -273,7 +282,14 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                     c.compute_pixels,
                     c.triangles - c.compute_triangles
                 ),
-            ));
+            )),
+            Some(_) => rows.push((
+                "compute raster",
+                format!(
+                    "{} small triangles a thread each, {} large ones in {} bins ({} drawn in place, the lists full); {} pixels covered",
+                    c.compute_triangles, c.large_triangles, c.bins, c.in_place, c.compute_pixels
+                ),
+            )),
         }
     }
     if let Some(ms) = stats.assign_ms() {

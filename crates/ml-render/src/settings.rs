@@ -239,9 +239,20 @@ pub enum Raster {
     /// The graphics pipeline: each culling phase's triangles in one indexed draw.
     Hardware,
     /// A compute shader for every triangle whose bounding box is at most `split` pixels a side
-    /// and which lies wholly beyond the near plane; the others drawn by the hardware into the
-    /// same 64-bit buffer.
-    Compute { split: u32 },
+    /// and which lies wholly beyond the near plane; the others — large ones, and those
+    /// crossing the near plane — drawn into the same 64-bit buffer as `large` says.
+    Compute { split: u32, large: LargeTriangles },
+}
+
+/// Who draws the compute raster's large triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LargeTriangles {
+    /// The hardware, in each phase's indexed draw (`--raster hybrid`).
+    Hardware,
+    /// Compute too (`--raster compute`): clipped once, and drawn by a work group per
+    /// 64×64-pixel bin of their box. `bin_list`: large triangles, and bins, the lists hold per
+    /// culling phase; past them the thread that found a triangle draws it alone.
+    Bins { bin_list: u32 },
 }
 
 impl Raster {
@@ -250,40 +261,64 @@ impl Raster {
     pub const DEFAULT_SPLIT: u32 = 16;
     /// Its largest: the edge functions of a 64-pixel box at 1/256 pixel stay in 32 bits.
     pub const MAX_SPLIT: u32 = 64;
+    /// The lists' default size: 2^16 large triangles and bins (7.5 MiB per frame in flight),
+    /// the bins of 32 screens of 3840×2160.
+    pub const DEFAULT_BIN_LIST: u32 = 1 << 16;
+
+    /// The compute raster (large triangles too) with `split`.
+    pub fn compute(split: u32) -> Raster {
+        Raster::Compute { split, large: LargeTriangles::Bins { bin_list: Raster::DEFAULT_BIN_LIST } }
+    }
+
+    /// The hybrid raster (large triangles by the hardware) with `split`.
+    pub fn hybrid(split: u32) -> Raster {
+        Raster::Compute { split, large: LargeTriangles::Hardware }
+    }
 
     pub fn name(self) -> &'static str {
         match self {
             Raster::Hardware => "hardware",
-            Raster::Compute { .. } => "compute",
+            Raster::Compute { large: LargeTriangles::Hardware, .. } => "hybrid",
+            Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => "compute",
         }
     }
 
-    /// The rasteriser `name` names (`hardware`, `compute`), the compute raster with `split`.
+    /// The rasteriser `name` names (`hardware`, `hybrid`, `compute`), those in compute with
+    /// `split`.
     pub fn from_name(name: &str, split: u32) -> Result<Raster, RenderError> {
-        [Raster::Hardware, Raster::Compute { split }].into_iter().find(|r| r.name() == name).ok_or_else(|| RenderError::UnknownName {
-            kind: Named::Raster,
-            name: name.to_owned(),
-            expected: "hardware, compute".to_owned(),
+        [Raster::Hardware, Raster::hybrid(split), Raster::compute(split)].into_iter().find(|r| r.name() == name).ok_or_else(|| {
+            RenderError::UnknownName { kind: Named::Raster, name: name.to_owned(), expected: "hardware, hybrid, compute".to_owned() }
         })
     }
 
-    /// The largest triangle drawn in compute (0: none).
+    /// The largest triangle drawn in compute by one thread (0: none).
     pub fn split(self) -> u32 {
         match self {
             Raster::Hardware => 0,
-            Raster::Compute { split } => split,
+            Raster::Compute { split, .. } => split,
+        }
+    }
+
+    /// The large triangles' bin list's size, where they are drawn in compute.
+    pub fn bin_list(self) -> Option<u32> {
+        match self {
+            Raster::Compute { large: LargeTriangles::Bins { bin_list }, .. } => Some(bin_list),
+            _ => None,
         }
     }
 }
 
-/// The first device feature the compute raster needs that `features` lacks, if any.
-pub fn missing_compute_raster_feature(features: &ml_vk::OptionalFeatures) -> Option<&'static str> {
-    [
-        (features.buffer_int64_atomics, "shaderBufferInt64Atomics (64-bit atomic min on buffers)"),
-        (features.fragment_stores_and_atomics, "fragmentStoresAndAtomics (the large triangles' fragments write the same buffer)"),
-    ]
-    .into_iter()
-    .find_map(|(has, feature)| (!has).then_some(feature))
+/// The first device feature `raster` needs that `features` lacks, if any.
+pub fn missing_raster_feature(raster: Raster, features: &ml_vk::OptionalFeatures) -> Option<&'static str> {
+    let Raster::Compute { large, .. } = raster else {
+        return None;
+    };
+    let atomics = (features.buffer_int64_atomics, "shaderInt64 and shaderBufferInt64Atomics (64-bit integers and atomic min on buffers)");
+    let fragment = (
+        features.fragment_stores_and_atomics || large != LargeTriangles::Hardware,
+        "fragmentStoresAndAtomics (the large triangles' fragments write the same buffer)",
+    );
+    [atomics, fragment].into_iter().find_map(|(has, feature)| (!has).then_some(feature))
 }
 
 /// Most memory the shadow cubes may take, whatever the device has: 16 lights at 2048² are 1.5 GiB.
@@ -455,12 +490,12 @@ impl RenderSettings {
                 return Err(SettingsError::TechniqueFeature { technique: self.technique, feature, device: device() }.into());
             }
         }
-        if let Raster::Compute { split } = self.raster {
+        if let Raster::Compute { split, .. } = self.raster {
             if self.technique.geometry() != Geometry::Meshlets {
                 return Err(SettingsError::RasterNeedsVisibility { technique: self.technique }.into());
             }
-            if let Some(feature) = missing_compute_raster_feature(&ctx.info.features) {
-                return Err(SettingsError::RasterFeature { feature, device: device() }.into());
+            if let Some(feature) = missing_raster_feature(self.raster, &ctx.info.features) {
+                return Err(SettingsError::RasterFeature { raster: self.raster.name(), feature, device: device() }.into());
             }
             if split == 0 || split > Raster::MAX_SPLIT {
                 return Err(SettingsError::OutOfRange { what: Setting::RasterSplit, value: split, max: Raster::MAX_SPLIT }.into());
@@ -470,6 +505,14 @@ impl RenderSettings {
             if bytes > limits.max_storage_buffer_range as u64 {
                 let (width, height, max) = (self.width, self.height, limits.max_storage_buffer_range);
                 return Err(SettingsError::RasterBuffer { width, height, bytes, device: device(), max }.into());
+            }
+            // So is each of the large-triangle lists (the triangles' the larger).
+            if let Some(bins) = self.raster.bin_list() {
+                let bytes = bins as u64 * std::mem::size_of::<ml_cpu::gpu_types::LargeTriangle>() as u64;
+                if bytes > limits.max_storage_buffer_range as u64 {
+                    let max = limits.max_storage_buffer_range;
+                    return Err(SettingsError::BinList { bins, bytes, device: device(), max }.into());
+                }
             }
         }
         if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {

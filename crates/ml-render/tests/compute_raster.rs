@@ -3,9 +3,12 @@
 //! object kind, the bench scene and a textured glTF scene, the visibility technique with the
 //! compute raster and with the hardware gives the same triangle id on at least 99.9 % of the
 //! covered pixels, every pixel where they differ lies where the two triangles they name
-//! meet, and the shaded images differ by more than 1/255 nowhere else. A screen-covering mesh
-//! of shared-edge triangles is drawn watertight: every pixel exactly once. Validation (with
-//! synchronization validation) stays silent.
+//! meet, and the shaded images differ by more than 1/255 nowhere else — both with the large
+//! triangles drawn in compute too (`compute`) and by the hardware (`hybrid`). A
+//! screen-covering mesh of shared-edge triangles is drawn watertight: every pixel exactly
+//! once, whichever way the compute raster splits it between threads, bins and the thread
+//! that finds a triangle when the bin list is full. Validation (with synchronization
+//! validation) stays silent.
 
 mod common;
 
@@ -18,7 +21,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::mesh::{Mesh, Vertex};
 use ml_cpu::random_scene::random_scene;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::{DebugView, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
+use ml_render::{DebugView, LargeTriangles, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use serde_json::json;
@@ -27,22 +30,18 @@ use std::sync::atomic::Ordering;
 const W: u32 = 160;
 const H: u32 = 96;
 
-/// What the two rasterisers drew: ids (the triangles view) and shaded images, hardware first.
-struct Drawn {
-    ids: [RenderOutput; 2],
-    shaded: [RenderOutput; 2],
+/// What two rasterisers drew: ids (the triangles view) and shaded images, hardware first.
+struct Drawn<'a> {
+    ids: [&'a RenderOutput; 2],
+    shaded: [&'a RenderOutput; 2],
 }
 
-fn draw_both(ctx: &Context, scene: &Scene, base: RenderSettings, split: u32) -> Drawn {
-    let compute = Raster::Compute { split };
-    let render = |raster, debug_view| {
+/// What a rasteriser drew: the triangles view and the shaded image.
+fn draw(ctx: &Context, scene: &Scene, base: RenderSettings, raster: Raster) -> [RenderOutput; 2] {
+    [DebugView::Triangles, DebugView::None].map(|debug_view| {
         let settings = RenderSettings { raster, debug_view, ..base };
         Renderer::new(ctx, scene.clone(), settings).expect("renderer").render().expect("render")
-    };
-    Drawn {
-        ids: [render(Raster::Hardware, DebugView::Triangles), render(compute, DebugView::Triangles)],
-        shaded: [render(Raster::Hardware, DebugView::None), render(compute, DebugView::None)],
-    }
+    })
 }
 
 /// Whether `colour` is one of the 8 neighbours of (x, y) in `out`.
@@ -52,7 +51,7 @@ fn next_to(out: &RenderOutput, (x, y): (i64, i64), colour: [u8; 3]) -> bool {
 
 /// Covered pixels, and those whose ids differ; panics where the differences break the rules.
 fn compare(what: &str, d: &Drawn, background: [u8; 3]) -> (usize, usize) {
-    let [hw, cp] = &d.ids;
+    let [hw, cp] = d.ids;
     let (mut covered, mut differing) = (0, 0);
     let mut stray = Vec::new();
     for y in 0..H {
@@ -60,7 +59,7 @@ fn compare(what: &str, d: &Drawn, background: [u8; 3]) -> (usize, usize) {
             let (a, b) = (common::pixel(hw, x, y), common::pixel(cp, x, y));
             covered += usize::from(a != background || b != background);
             if a == b {
-                let shaded = [common::pixel(&d.shaded[0], x, y), common::pixel(&d.shaded[1], x, y)];
+                let shaded = [common::pixel(d.shaded[0], x, y), common::pixel(d.shaded[1], x, y)];
                 let diff = shaded[0].iter().zip(shaded[1]).map(|(p, q)| p.abs_diff(q)).max().unwrap();
                 assert!(diff <= 1, "{what}: pixel ({x}, {y}) shows one triangle but its shaded colours differ by {diff}/255");
                 continue;
@@ -141,15 +140,25 @@ fn the_compute_raster_draws_the_hardwares_triangles() {
     // Its quads' triangles are ~20 pixels: the largest split draws them in compute.
     let pbr = RenderSettings { shading: ShadingModel::Pbr, ..base };
     scenes.push(("textured glTF".into(), textured_gltf_scene(), pbr, Raster::MAX_SPLIT));
-    let (mut covered, mut differing) = (0, 0);
+    let (mut covered, mut differing, mut large) = ([0; 2], [0; 2], 0);
     for (what, scene, settings, split) in &scenes {
-        let drawn = draw_both(&ctx, scene, *settings, *split);
-        let c = drawn.ids[1].stats.culling.expect("culling stats");
-        assert!(c.compute_triangles > 0, "{what}: the compute raster drew nothing");
-        let (n, d) = compare(what, &drawn, bg);
-        (covered, differing) = (covered + n, differing + d);
+        let hardware = draw(&ctx, scene, *settings, Raster::Hardware);
+        for (k, raster) in [Raster::hybrid(*split), Raster::compute(*split)].into_iter().enumerate() {
+            let other = draw(&ctx, scene, *settings, raster);
+            let drawn = Drawn { ids: [&hardware[0], &other[0]], shaded: [&hardware[1], &other[1]] };
+            let c = drawn.ids[1].stats.culling.expect("culling stats");
+            assert!(c.compute_triangles > 0, "{what}: the {} raster drew nothing in compute", raster.name());
+            large += c.large_triangles;
+            let (n, d) = compare(&format!("{what}, {} raster", raster.name()), &drawn, bg);
+            (covered[k], differing[k]) = (covered[k] + n, differing[k] + d);
+        }
     }
-    println!("all scenes: {differing} of {covered} covered pixels differ ({:.4} %)", 100.0 * differing as f64 / covered as f64);
+    for (k, name) in ["hybrid", "compute"].iter().enumerate() {
+        let (d, n) = (differing[k], covered[k]);
+        println!("all scenes, {name} raster: {d} of {n} covered pixels differ ({:.4} %)", 100.0 * d as f64 / n as f64);
+    }
+    // The random scenes' floors and the bench scene's are large and cross the near plane.
+    assert!(large > 0, "no large triangle was drawn in compute");
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
 }
@@ -216,24 +225,43 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
         scene.objects.push(Object { transform: Mat4::IDENTITY, ..Object::placed(MeshKind::Loaded(0), Vec3::ZERO, 1.0, white) });
         let base = RenderSettings { debug_view: DebugView::Triangles, ..RenderSettings::new(Technique::Visibility, W, H) };
         // Every triangle in compute: each pixel counted once, none left empty.
-        let all = Renderer::new(&ctx, scene.clone(), RenderSettings { raster: Raster::Compute { split: Raster::MAX_SPLIT }, ..base })
-            .unwrap()
-            .render()
-            .unwrap();
-        let c = all.stats.culling.unwrap();
-        let holes = (0..W * H).filter(|i| common::pixel(&all, i % W, i / W) == bg).count();
-        println!("{cells:?} cells: {} triangles drawn in compute, {} pixels covered, {holes} holes", c.compute_triangles, c.compute_pixels);
-        assert_eq!(c.compute_triangles, c.triangles, "every triangle drawn in compute");
-        assert_eq!(holes, 0, "{cells:?} cells: pixels no triangle covered");
-        assert_eq!(
-            c.compute_pixels,
-            (W * H) as u64,
-            "{cells:?} cells: pixels covered more than once (no holes, so the excess is double coverage)"
-        );
-        // Split between the rasterisers (about a cell: the jittered triangles fall on both
-        // sides): the seams between them leave no hole either.
+        // About a cell: the jittered triangles fall on both sides of it.
         let split = ((W + 16) as f32 / cells.0 as f32).max((H + 16) as f32 / cells.1 as f32).ceil() as u32;
-        let mixed = Renderer::new(&ctx, scene, RenderSettings { raster: Raster::Compute { split }, ..base }).unwrap().render().unwrap();
+        let bins = |bin_list| Raster::Compute { split, large: LargeTriangles::Bins { bin_list } };
+        // Every triangle in compute — a thread each; split between threads and bins; nearly
+        // all by bins (a split of 1 pixel); nearly all in place (a list of 3 bins): each
+        // pixel counted once, none left empty.
+        let ways = [
+            ("threads", Raster::compute(Raster::MAX_SPLIT)),
+            ("threads and bins", Raster::compute(split)),
+            ("bins", Raster::compute(1)),
+            ("in place", bins(3)),
+        ];
+        for (how, raster) in ways {
+            let out = Renderer::new(&ctx, scene.clone(), RenderSettings { raster, ..base }).unwrap().render().unwrap();
+            let c = out.stats.culling.unwrap();
+            let holes = (0..W * H).filter(|i| common::pixel(&out, i % W, i / W) == bg).count();
+            println!(
+                "{cells:?} cells, {how}: {} triangles a thread each, {} by {} bins, {} in place; {} pixels covered, {holes} holes",
+                c.compute_triangles, c.large_triangles, c.bins, c.in_place, c.compute_pixels
+            );
+            assert_eq!(c.compute_triangles + c.large_triangles, c.triangles, "every triangle drawn in compute");
+            match how {
+                "threads" => assert_eq!(c.large_triangles, 0),
+                "in place" => {
+                    assert!(c.in_place > 0 && c.in_place < c.large_triangles, "{cells:?} cells: the list's overflow path is taken")
+                }
+                _ => assert!(c.large_triangles > 0 && c.in_place == 0, "{cells:?} cells, {how}: bins are drawn"),
+            }
+            assert_eq!(holes, 0, "{cells:?} cells, {how}: pixels no triangle covered");
+            assert_eq!(
+                c.compute_pixels,
+                (W * H) as u64,
+                "{cells:?} cells, {how}: pixels covered more than once (no holes, so the excess is double coverage)"
+            );
+        }
+        // The hybrid raster: the seams between compute and hardware leave no hole either.
+        let mixed = Renderer::new(&ctx, scene, RenderSettings { raster: Raster::hybrid(split), ..base }).unwrap().render().unwrap();
         let c = mixed.stats.culling.unwrap();
         assert!(c.compute_triangles > 0 && c.compute_triangles < c.triangles, "{cells:?} cells: both rasterisers draw");
         let holes = (0..W * H).filter(|i| common::pixel(&mixed, i % W, i / W) == bg).count();

@@ -4,7 +4,8 @@
 
 use ml_cpu::gpu_types::{
     ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance,
-    LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowPush, StageProbePush,
+    LargeTriangle, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowPush,
+    StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -92,6 +93,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<Meshlet>(&structs);
     check::<Instance>(&structs);
     check::<CullCounters>(&structs);
+    check::<LargeTriangle>(&structs);
     check::<DrawIndexedCommand>(&structs);
     check::<CullPush>(&structs);
     check::<OmniRasterPush>(&structs);

@@ -136,9 +136,9 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         combo(ui, "Technique", &mut choices.technique, &Technique::ALL, |t| t.name());
         if choices.technique.geometry() == Geometry::Meshlets {
             let split = if choices.raster.split() > 0 { choices.raster.split() } else { Raster::DEFAULT_SPLIT };
-            let options = [Raster::Hardware, Raster::Compute { split }];
+            let options = [Raster::Hardware, Raster::hybrid(split), Raster::compute(split)];
             combo(ui, "Raster", &mut choices.raster, &options, |r| r.name());
-            if let Raster::Compute { split } = &mut choices.raster {
+            if let Raster::Compute { split, .. } = &mut choices.raster {
                 ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
             }
         }
@@ -231,10 +231,10 @@ mod tests {
 
     #[test]
     fn only_the_visibility_technique_takes_the_compute_raster() {
-        let compute = Choices { raster: Raster::Compute { split: 16 }, ..initial() };
+        let compute = Choices { raster: Raster::compute(16), ..initial() };
         assert_eq!(compute.settings((64, 64), None).raster, Raster::Hardware);
         let visibility = Choices { technique: Technique::Visibility, ..compute };
-        assert_eq!(visibility.settings((64, 64), None).raster, Raster::Compute { split: 16 });
+        assert_eq!(visibility.settings((64, 64), None).raster, Raster::compute(16));
     }
 
     #[test]

@@ -8,12 +8,13 @@
 //! those instances again, now also against the pyramid; the newly visible are drawn the same
 //! way, and every meshlet's visibility is kept for the next frame. The late pass copies the
 //! counters out for the report. With the compute raster, step 3 is triangle_raster.comp: the
-//! same tests, then the small triangles rasterised there and only the others appended; the
-//! early phase clears its 64-bit buffer first.
+//! same tests, then the small triangles rasterised there and the others listed by bins for
+//! the large-triangle pass (which then reads the counters back instead) or, with the hybrid
+//! raster, appended to the draw; the early phase clears its 64-bit buffer first.
 
 use crate::descriptors::FrameSets;
 use crate::frame::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::SharedMeshletScene;
+use crate::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::pass::{FrameResources, Pass, Recording, SlotReport};
 use crate::report::CullStats;
 use crate::settings::Raster;
@@ -75,13 +76,20 @@ impl MeshletCull {
         })
     }
 
-    fn push(&self, extent: vk::Extent2D) -> CullPush {
-        let (_, levels) = depth_pyramid_shape(extent);
-        let scene = self.scene.borrow();
-        CullPush {
-            mode: [u32::from(self.phase == Phase::Late), u32::from(self.culling), levels, scene.capacity],
-            triangles: [scene.geometry.triangles as u32, self.raster.split(), 0, 0],
-        }
+    /// Whether this pass reads the counters back: the late phase's, unless the compute
+    /// raster's large-triangle pass comes after it (that one does then).
+    fn reads_back(&self) -> bool {
+        self.phase == Phase::Late && self.raster.bin_list().is_none()
+    }
+}
+
+/// The culling passes' push constants (the large-triangle pass reads the same).
+pub fn cull_push(phase: Phase, culling: bool, raster: Raster, scene: &MeshletScene, extent: vk::Extent2D) -> CullPush {
+    let (_, levels) = depth_pyramid_shape(extent);
+    let bins = raster.bin_list();
+    CullPush {
+        mode: [u32::from(phase == Phase::Late), u32::from(culling), levels, scene.capacity],
+        triangles: [scene.geometry.triangles as u32, raster.split(), bins.unwrap_or(0), u32::from(bins.is_some())],
     }
 }
 
@@ -112,7 +120,7 @@ impl Pass for MeshletCull {
         let raster = vk::PipelineStageFlags::VERTEX_INPUT | vk::PipelineStageFlags::VERTEX_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         let indirect_read = vk::AccessFlags::INDIRECT_COMMAND_READ;
-        let push = self.push(rec.extent);
+        let push = cull_push(self.phase, self.culling, self.raster, &scene, rec.extent);
         let set = [self.sets.sets[slot]];
         // SAFETY: recording state outside a render pass; everything bound is alive until the
         // frame's fence signals.
@@ -139,8 +147,8 @@ impl Pass for MeshletCull {
                 d.cmd_dispatch(cmd, scene.geometry.instance_count.div_ceil(GROUP).max(1), 1, 1);
                 memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute | indirect, rw | indirect_read));
             } else {
-                // The early raster read the compacted buffers this phase appends to.
-                memory_barrier(ctx, cmd, (raster, vk::AccessFlags::empty()), (compute, vk::AccessFlags::SHADER_WRITE));
+                // The early raster read the compacted buffers (or the bins) this phase appends to.
+                memory_barrier(ctx, cmd, (raster | compute, vk::AccessFlags::empty()), (compute, vk::AccessFlags::SHADER_WRITE));
             }
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.meshlet_pipeline);
             d.cmd_dispatch_indirect(cmd, f.counters.raw, 0);
@@ -158,7 +166,7 @@ impl Pass for MeshletCull {
                 (indirect | raster | compute | transfer, indirect_read | vk::AccessFlags::INDEX_READ | rw | vk::AccessFlags::TRANSFER_READ),
             );
         }
-        if self.phase == Phase::Late {
+        if self.reads_back() {
             copy_buffer_to_host(ctx, cmd, (f.counters.raw, f.readback.raw), std::mem::size_of::<CullCounters>() as u64);
         }
     }
@@ -178,9 +186,15 @@ impl Pass for MeshletCull {
             late_tested: c.tested[1],
             late_drawn: c.meshlets[1][0],
             meshlet_triangles: c.triangles[0] as u64 + c.triangles[1] as u64,
-            triangles: [c.triangles[2], c.triangles[3], c.rasterized[0], c.rasterized[1]].iter().map(|&n| n as u64).sum(),
+            triangles: [c.triangles[2], c.triangles[3], c.rasterized[0], c.rasterized[1], c.binned[2], c.binned[3]]
+                .iter()
+                .map(|&n| n as u64)
+                .sum(),
             compute_triangles: c.rasterized[0] as u64 + c.rasterized[1] as u64,
             compute_pixels: c.rasterized[2] as u64,
+            large_triangles: c.binned[2] as u64 + c.binned[3] as u64,
+            bins: c.binned[0] as u64 + c.binned[1] as u64,
+            in_place: c.rasterized[3] as u64,
             scene_triangles: scene.geometry.triangles,
         });
     }

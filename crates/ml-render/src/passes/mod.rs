@@ -14,6 +14,7 @@ pub mod omni_shadow;
 pub mod omni_shadow_compute;
 pub mod shadow_map_view;
 pub mod tone_map;
+pub mod triangle_raster_large;
 pub mod visibility_lighting;
 pub mod visibility_raster;
 pub mod visibility_resolve;
@@ -100,16 +101,21 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
 
 /// GPU-driven geometry: early culling and raster, the depth pyramid, late culling and
 /// raster, then lighting from the visibility buffer. With the compute raster, each phase's
-/// culling also rasterises the small triangles, the hardware draws the others into the same
-/// buffer, and a resolve makes the images the passes after it read.
+/// culling also rasterises the small triangles, a compute pass (or, hybrid, the hardware)
+/// draws the others into the same buffer, and a resolve makes the images the passes after it
+/// read.
 fn add_meshlet_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> Result<(), VkError> {
     let geometry = SceneMeshlets::build(a.source).map_err(|e| VkError::Limit(e.to_string()))?;
-    let scene = MeshletScene::new(ctx, geometry, &a.scene.object_textures.set_index)?;
     let (culling, raster) = (a.settings.culling, a.settings.raster);
+    let scene = MeshletScene::new(ctx, geometry, &a.scene.object_textures.set_index, raster.bin_list().unwrap_or(0))?;
     let compute = raster != Raster::Hardware;
     for phase in [Phase::Early, Phase::Late] {
         passes.push(Box::new(meshlet_cull::MeshletCull::new(ctx, scene.clone(), phase, (culling, raster))?));
-        passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), (phase, compute), a.depth_format)?));
+        if raster.bin_list().is_some() {
+            passes.push(Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, scene.clone(), phase, raster)?));
+        } else {
+            passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), (phase, compute), a.depth_format)?));
+        }
         if compute {
             passes.push(Box::new(visibility_resolve::VisibilityResolve::new(ctx, phase)?));
         }

@@ -1,0 +1,109 @@
+//! The compute raster's large triangles (docs/DESIGN.md#compute-raster): those the phase's
+//! culling listed by the 64×64-pixel bins of their box — larger than the split, or crossing
+//! the near plane — drawn by a work group per bin (triangle_raster_large.comp), clipped as the
+//! hardware clips them, into the same 64-bit buffer as the small ones. One indirect dispatch
+//! whose size the culling wrote; in place of the hybrid raster's hardware draw.
+
+use crate::descriptors::FrameSets;
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::meshlet_scene::SharedMeshletScene;
+use crate::pass::{FrameResources, Pass, Recording};
+use crate::passes::meshlet_cull::{cull_push, Phase};
+use crate::settings::Raster;
+use ml_cpu::gpu_types::{CullCounters, CullPush};
+use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
+use ml_vk::{shader, vk, Context, VkError};
+
+pub struct TriangleRasterLarge {
+    phase: Phase,
+    raster: Raster,
+    scene: SharedMeshletScene,
+    sets: FrameSets,
+    pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+}
+
+impl TriangleRasterLarge {
+    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, raster: Raster) -> Result<TriangleRasterLarge, VkError> {
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let shader = &ml_shaders::TRIANGLE_RASTER_LARGE_COMP;
+        let pass = TriangleRasterLarge {
+            phase,
+            raster,
+            scene,
+            sets: FrameSets::new(ctx, &[(shader, compute)], 0, FRAMES_IN_FLIGHT)?,
+            pipeline_layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+        };
+        ml_vk::build(ctx, pass, |p| {
+            let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
+            p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
+            p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, &[])?;
+            Ok(())
+        })
+    }
+}
+
+impl Pass for TriangleRasterLarge {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some(match self.phase {
+            Phase::Early => "large triangles (early)",
+            Phase::Late => "large triangles (late)",
+        })
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let scene = self.scene.borrow();
+        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))
+    }
+
+    /// After the phase's culling, whose last barrier makes the bins and the dispatch visible.
+    fn record(&self, rec: &Recording) {
+        let (ctx, cmd, slot) = (rec.ctx, rec.cmd, rec.slot);
+        let d = &ctx.device;
+        let scene = self.scene.borrow();
+        let push = cull_push(self.phase, true, self.raster, &scene, rec.extent);
+        let phase = usize::from(self.phase == Phase::Late);
+        let dispatch = (std::mem::offset_of!(CullCounters, large) + phase * 16) as u64;
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        // SAFETY: recording state outside a render pass; everything bound is alive until the
+        // frame's fence signals.
+        unsafe {
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[self.sets.sets[slot]], &[]);
+            d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            d.cmd_dispatch_indirect(cmd, scene.frames[slot].counters.raw, dispatch);
+        }
+        // The resolve reads the buffer; the late phase reads the counters back (this pass
+        // adds the pixels it covered).
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        memory_barrier(
+            ctx,
+            cmd,
+            (compute, vk::AccessFlags::SHADER_WRITE),
+            (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_READ),
+        );
+        if self.phase == Phase::Late {
+            let f = &scene.frames[slot];
+            copy_buffer_to_host(ctx, cmd, (f.counters.raw, f.readback.raw), std::mem::size_of::<CullCounters>() as u64);
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the device is idle; null handles are ignored.
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+        }
+        self.pipeline = vk::Pipeline::null();
+        self.pipeline_layout = vk::PipelineLayout::null();
+        self.sets.destroy(ctx);
+        self.scene.borrow_mut().destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for TriangleRasterLarge {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
