@@ -189,6 +189,17 @@ struct CullCounters {
                                  // late (past the lists' capacity too)
 };
 
+// The compute raster's 64-bit buffer, a pixel read as uvec2: x: the visibility id; y: the
+// depth's bits, all ones where nothing was drawn (depth 1 and id 0 then, as the hardware
+// raster clears its images).
+float visibility_buffer_depth(uvec2 pixel) {
+    return pixel.y == 0xffffffffu ? 1.0 : uintBitsToFloat(pixel.y);
+}
+
+uint visibility_buffer_id(uvec2 pixel) {
+    return pixel.y == 0xffffffffu ? 0u : pixel.x;
+}
+
 // A large triangle of the compute raster (visibility_polygon.glsl), clipped and set up once
 // by the thread that found it; the bins it is listed by point at it.
 struct LargeTriangle {

@@ -120,10 +120,10 @@ pub fn visibility(depth_format: vk::Format, first: bool) -> RenderPassDesc {
     RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
 }
 
-/// The compute raster's hardware half (visibility_atomic.frag): no attachments — its
+/// The hybrid raster's hardware half (visibility_atomic.frag): no attachments — its
 /// fragments write the 64-bit visibility-depth buffer by atomic min — one subpass between the
 /// culling's writes (the draw, the compute raster's pixels) and the compute passes after it
-/// (the resolve, the late culling's raster).
+/// (the depth pyramid, the late culling's raster, the lighting).
 pub fn visibility_atomic() -> RenderPassDesc {
     let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
     let fragment = vk::PipelineStageFlags::FRAGMENT_SHADER;

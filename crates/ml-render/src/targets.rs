@@ -122,20 +122,11 @@ pub struct Targets {
     /// visibility: the depth pyramid of the late culling phase, level after level (null
     /// otherwise).
     pub depth_pyramid: Buffer,
-    /// visibility with the compute raster: 64 bits per pixel, depth and id, which both
-    /// rasterisers write by atomic min and the resolve makes into `visibility` and `depth`
-    /// (null otherwise).
+    /// visibility with the compute raster: 64 bits per pixel, depth and id, which its passes
+    /// write by atomic min and the depth pyramid and the lighting read (null otherwise; `depth`
+    /// and `visibility` are null then).
     pub visibility_depth: Buffer,
-    /// The layouts in which the passes after the raster read `depth` and `visibility`: the
-    /// render pass leaves them read-only; the compute raster's resolve writes them as storage
-    /// images and leaves them in GENERAL.
-    pub depth_layout: vk::ImageLayout,
-    pub visibility_layout: vk::ImageLayout,
 }
-
-/// Format of the depth image that the compute raster's resolve writes (a storage image,
-/// which depth formats cannot be).
-pub const COMPUTE_DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 
 /// Format of the visibility buffer: the 32-bit id (meshlets.rs).
 pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R32_UINT;
@@ -177,8 +168,6 @@ impl Targets {
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
-            depth_layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
-            visibility_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
         };
         ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), raster))
     }
@@ -205,14 +194,12 @@ impl Targets {
             }
             Output::Visibility => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::empty()),
         };
-        // The compute raster's resolve writes depth and ids as storage images.
+        // The compute raster keeps depth and ids in one buffer: no images of them.
         let compute_raster = output == Output::Visibility && raster != Raster::Hardware;
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
-        self.depth = if compute_raster {
-            Image::new_2d(ctx, "depth target", extent, COMPUTE_DEPTH_FORMAT, U::STORAGE | U::SAMPLED, colour)?
-        } else {
-            Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?
-        };
+        if !compute_raster {
+            self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
+        }
         if matches!(output, Output::GBuffer | Output::Subpasses) {
             for g in gbuffer {
                 self.gbuffer.push(Image::new_2d(ctx, g.name, extent, g.format, gbuffer_usage, colour)?);
@@ -222,8 +209,10 @@ impl Targets {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
         }
         if output == Output::Visibility {
-            let usage = if compute_raster { U::STORAGE | U::SAMPLED } else { U::COLOR_ATTACHMENT | U::SAMPLED };
-            self.visibility = Image::new_2d(ctx, "visibility buffer", extent, VISIBILITY_FORMAT, usage, colour)?;
+            if !compute_raster {
+                let usage = U::COLOR_ATTACHMENT | U::SAMPLED;
+                self.visibility = Image::new_2d(ctx, "visibility buffer", extent, VISIBILITY_FORMAT, usage, colour)?;
+            }
             let bytes = depth_pyramid_len(extent) * 4;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
             self.depth_pyramid = Buffer::new(ctx, "depth pyramid", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
@@ -232,7 +221,6 @@ impl Targets {
             let bytes = extent.width as u64 * extent.height as u64 * 8;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
             self.visibility_depth = Buffer::new(ctx, "visibility-depth buffer", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
-            (self.depth_layout, self.visibility_layout) = (vk::ImageLayout::GENERAL, vk::ImageLayout::GENERAL);
         }
         Ok(())
     }

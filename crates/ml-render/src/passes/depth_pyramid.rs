@@ -1,5 +1,6 @@
-//! The depth pyramid of the late culling phase (depth_pyramid.comp): level 0 the early
-//! raster's depth reduced 2×2 to the farthest value, each level the one below it reduced
+//! The depth pyramid of the late culling phase (depth_pyramid_pass.glsl): level 0 the early
+//! raster's depth — the hardware raster's depth image, or the compute raster's 64-bit buffer
+//! read where it lies — reduced 2×2 to the farthest value, each level the one below it reduced
 //! again, a dispatch per level, into one storage buffer (a frame target, made again with the
 //! others). A buffer rather than a mipmapped image: plain loads, no per-level views, and the
 //! same answers on every driver.
@@ -22,8 +23,9 @@ pub struct DepthPyramid {
 }
 
 impl DepthPyramid {
-    pub fn new(ctx: &Context) -> Result<DepthPyramid, VkError> {
-        let shader = &ml_shaders::DEPTH_PYRAMID_COMP;
+    /// The pyramid of the depth image, or with `from_buffer` of the compute raster's buffer.
+    pub fn new(ctx: &Context, from_buffer: bool) -> Result<DepthPyramid, VkError> {
+        let shader = if from_buffer { &ml_shaders::DEPTH_PYRAMID_BUFFER_COMP } else { &ml_shaders::DEPTH_PYRAMID_COMP };
         let p = DepthPyramid {
             sets: FrameSets::new(ctx, &[(shader, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
             sampler: vk::Sampler::null(),
@@ -47,15 +49,18 @@ impl Pass for DepthPyramid {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let t = frame.targets;
-        let depth = vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(t.depth.view).image_layout(t.depth_layout);
+        let depth = vk::DescriptorImageInfo::default()
+            .sampler(self.sampler)
+            .image_view(t.depth.view)
+            .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
         self.sets.write(ctx, frame.slot, &|name| match name {
             "depth_image" => Some(Resource::Image(depth)),
             _ => frame.buffer(name),
         })
     }
 
-    /// After the early raster (its render pass makes depth visible to compute); the late
-    /// culling reads the result.
+    /// After the early raster (its render pass, or the compute raster's last pass, makes the
+    /// depth visible to compute); the late culling reads the result.
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let d = &ctx.device;

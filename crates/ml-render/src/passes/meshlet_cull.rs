@@ -139,7 +139,7 @@ impl Pass for MeshletCull {
                 d.cmd_fill_buffer(cmd, f.counters.raw, 0, vk::WHOLE_SIZE, 0);
                 if self.raster != Raster::Hardware {
                     // Nothing drawn: all ones, above every depth-and-id (the last frame's
-                    // resolve on this slot read it).
+                    // lighting on this slot read it).
                     d.cmd_fill_buffer(cmd, rec.targets.visibility_depth.raw, 0, vk::WHOLE_SIZE, u32::MAX);
                 }
                 memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));

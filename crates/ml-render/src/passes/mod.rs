@@ -17,7 +17,6 @@ pub mod tone_map;
 pub mod triangle_raster_large;
 pub mod visibility_lighting;
 pub mod visibility_raster;
-pub mod visibility_resolve;
 
 use crate::meshlet_scene::MeshletScene;
 use crate::pass::Pass;
@@ -102,8 +101,8 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
 /// GPU-driven geometry: early culling and raster, the depth pyramid, late culling and
 /// raster, then lighting from the visibility buffer. With the compute raster, each phase's
 /// culling also rasterises the small triangles, a compute pass (or, hybrid, the hardware)
-/// draws the others into the same buffer, and a resolve makes the images the passes after it
-/// read.
+/// draws the others into the same 64-bit buffer, and the pyramid and the lighting read that
+/// buffer where it lies.
 fn add_meshlet_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> Result<(), VkError> {
     let geometry = SceneMeshlets::build(a.source).map_err(|e| VkError::Limit(e.to_string()))?;
     let (culling, raster) = (a.settings.culling, a.settings.raster);
@@ -116,13 +115,10 @@ fn add_meshlet_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass
         } else {
             passes.push(Box::new(visibility_raster::VisibilityRaster::new(ctx, scene.clone(), (phase, compute), a.depth_format)?));
         }
-        if compute {
-            passes.push(Box::new(visibility_resolve::VisibilityResolve::new(ctx, phase)?));
-        }
         if phase == Phase::Early {
-            passes.push(Box::new(depth_pyramid::DepthPyramid::new(ctx)?));
+            passes.push(Box::new(depth_pyramid::DepthPyramid::new(ctx, compute)?));
         }
     }
-    passes.push(Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, scene, a.shading)?));
+    passes.push(Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, (scene, compute), a.shading)?));
     Ok(())
 }

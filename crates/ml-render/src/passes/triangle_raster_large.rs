@@ -74,8 +74,8 @@ impl Pass for TriangleRasterLarge {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             d.cmd_dispatch_indirect(cmd, scene.frames[slot].counters.raw, dispatch);
         }
-        // The resolve reads the buffer; the late phase reads the counters back (this pass
-        // adds the pixels it covered).
+        // The depth pyramid and the lighting read the buffer; the late phase reads the
+        // counters back (this pass adds the pixels it covered).
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         memory_barrier(
             ctx,

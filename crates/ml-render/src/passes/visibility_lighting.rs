@@ -17,10 +17,18 @@ pub struct VisibilityLighting {
 }
 
 impl VisibilityLighting {
-    pub fn new(ctx: &Context, gpu: &SceneGpu, scene: SharedMeshletScene, shading: Shading) -> Result<VisibilityLighting, VkError> {
+    /// The lighting from the hardware raster's images, or with `from_buffer` from the compute
+    /// raster's 64-bit buffer.
+    pub fn new(
+        ctx: &Context,
+        gpu: &SceneGpu,
+        (scene, from_buffer): (SharedMeshletScene, bool),
+        shading: Shading,
+    ) -> Result<VisibilityLighting, VkError> {
         let model = shading.spec_constants();
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
-        let pass = ComputePass::with_push(ctx, &more_sets, (&ml_shaders::VISIBILITY_LIGHTING_COMP, &model), 16)?;
+        let shader = if from_buffer { &ml_shaders::VISIBILITY_LIGHTING_BUFFER_COMP } else { &ml_shaders::VISIBILITY_LIGHTING_COMP };
+        let pass = ComputePass::with_push(ctx, &more_sets, (shader, &model), 16)?;
         Ok(VisibilityLighting { pass, scene })
     }
 }
@@ -34,8 +42,8 @@ impl Pass for VisibilityLighting {
         let t = frame.targets;
         let scene = self.scene.borrow();
         self.pass.bind_frame(ctx, frame, &|name| match name {
-            "depth_image" => self.pass.sampled(&t.depth, t.depth_layout),
-            "visibility_image" => self.pass.sampled(&t.visibility, t.visibility_layout),
+            "depth_image" => self.pass.sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            "visibility_image" => self.pass.sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
             _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
         })
     }

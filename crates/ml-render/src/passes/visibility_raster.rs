@@ -2,7 +2,7 @@
 //! one indexed draw per phase whose count the GPU wrote (vkCmdDrawIndexedIndirect), from the
 //! compacted index buffer, vertices pulled from storage buffers; per pixel the depth and a
 //! 32-bit id (visibility.frag). The early phase clears both images, the late one draws the
-//! newly visible triangles over them. With the compute raster the same draw holds only the
+//! newly visible triangles over them. With the hybrid raster the same draw holds only the
 //! triangles it leaves to the hardware (large ones, those crossing the near plane), and
 //! their fragments write its 64-bit buffer by atomic min (visibility_atomic.frag) in a pass
 //! without attachments.
@@ -99,8 +99,9 @@ impl Pass for VisibilityRaster {
         let scene = self.scene.borrow();
         self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))?;
         let t = frame.targets;
+        // The hybrid's pass has no attachments (nor the images): the colour target's size.
         let views = if self.atomic { Vec::new() } else { vec![t.visibility.view, t.depth.view] };
-        render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.visibility.extent)
+        render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.color.extent)
     }
 
     fn record(&self, rec: &Recording) {
