@@ -134,7 +134,7 @@ pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, cand
     let each: Vec<String> = timed.iter().map(|(r, ms)| format!("{ms:.3} ms {}", r.name())).collect();
     let runner_up = timed.iter().filter(|(r, _)| *r != picked).map(|t| t.1).fold(f64::INFINITY, f64::min);
     let why = format!(
-        "a frame of this scene took {} ({:.2}× the next; mean of {RASTER_PROBE_FRAMES} frames each)",
+        "a frame of this scene took {} ({:.2}× faster than the next; mean of {RASTER_PROBE_FRAMES} frames each)",
         each.join(", "),
         runner_up / best
     );
