@@ -128,8 +128,7 @@ bool fan_triangle(i64vec2 a, i64vec2 b, i64vec2 c, vec4 qa, vec4 qb, vec4 qc, iv
         t.qc = u;
     }
     ivec2 lo = ivec2(min(t.a, min(t.b, t.c))), hi = ivec2(max(t.a, max(t.b, t.c)));
-    t.first = max((lo - 128 + 255) >> 8, ivec2(0));
-    t.last = min((hi - 128) >> 8, size - 1);
+    centres_in_box(lo, hi, size, t.first, t.last);
     t.bias = ivec3(fill_bias(ivec2(t.b), ivec2(t.c)), fill_bias(ivec2(t.c), ivec2(t.a)), fill_bias(ivec2(t.a), ivec2(t.b)));
     return all(lessThanEqual(t.first, t.last));
 }

@@ -30,6 +30,13 @@ int fill_bias(ivec2 s, ivec2 e) {
     return d.y < 0 || (d.y == 0 && d.x > 0) ? 0 : 1;
 }
 
+// The pixel centres (256 i + 128 in sub-pixel units) inside the box [lo, hi] of sub-pixel
+// corners, within an image of `size` pixels (>> rounds towards −∞): first > last where none.
+void centres_in_box(ivec2 lo, ivec2 hi, ivec2 size, out ivec2 first, out ivec2 last) {
+    first = max((lo - 128 + 255) >> 8, ivec2(0));
+    last = min((hi - 128) >> 8, size - 1);
+}
+
 // A small triangle (box at most 64 pixels a side) set up for its pixels: corners snapped and
 // taken relative to the box's corner `lo` (which keeps every product below 2^31), ordered so
 // the interior lies on every edge's positive side, the fill rule's biases, the pixel centres
@@ -65,9 +72,7 @@ bool small_triangle(vec2 pa, vec2 pb, vec2 pc, ivec2 size, bool both_faces, out 
         t.c = s;
         t.area = -t.area;
     }
-    // Pixel centres 256 i + 128 inside the box, within the image (>> rounds towards −∞).
-    t.first = max((lo - 128 + 255) >> 8, ivec2(0));
-    t.last = min((hi - 128) >> 8, size - 1);
+    centres_in_box(lo, hi, size, t.first, t.last);
     t.bias = ivec3(fill_bias(t.b, t.c), fill_bias(t.c, t.a), fill_bias(t.a, t.b));
     return true;
 }

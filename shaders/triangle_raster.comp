@@ -22,7 +22,7 @@ layout(local_size_x = 64) in;
 #include "triangle_cull.glsl"
 
 // Per pixel, row by row: floatBitsToUint(depth) << 32 | visibility id, the nearest kept; all
-// ones where nothing was drawn (visibility_resolve.comp makes the two images of it).
+// ones where nothing was drawn (the depth pyramid and the lighting read it).
 layout(std430, set = 0, binding = 14) buffer VisibilityDepthBuffer { uint64_t visibility_depth[]; };
 // The large triangles and their bins (visibility_polygon.glsl), cull.triangles.z of each.
 layout(std430, set = 0, binding = 15) writeonly buffer LargeBinBuffer { uvec2 large_bins[]; };
@@ -97,9 +97,8 @@ uint list_large(vec4 a, vec4 b, vec4 c, uint id) {
         lo = min(lo, p.s[i]);
         hi = max(hi, p.s[i]);
     }
-    // The pixel centres inside the box, within the image (as fan_triangle finds them).
-    ivec2 first = max((ivec2(lo) - 128 + 255) >> 8, ivec2(0));
-    ivec2 last = min((ivec2(hi) - 128) >> 8, ivec2(frame.viewport.xy) - 1);
+    ivec2 first, last;
+    centres_in_box(ivec2(lo), ivec2(hi), ivec2(frame.viewport.xy), first, last);
     if (any(greaterThan(first, last))) {
         return 0u;
     }

@@ -11,6 +11,7 @@
 
 use crate::descriptors::Resource;
 use crate::frame::FRAMES_IN_FLIGHT;
+use crate::pass::FrameResources;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{CullCounters, LargeTriangle};
 use ml_cpu::meshlets::SceneMeshlets;
@@ -217,9 +218,10 @@ impl MeshletScene {
         Ok(())
     }
 
-    /// The buffer a culling, raster or lighting shader calls `name`, of slot `slot`.
-    pub fn buffer(&self, slot: usize, name: &str) -> Option<Resource> {
-        let f = &self.frames[slot];
+    /// The buffer a culling, raster or lighting shader calls `name`, of `frame`'s slot: the
+    /// scene's own, else the frame's (its uniforms, targets and scene buffers).
+    pub fn buffer(&self, frame: &FrameResources, name: &str) -> Option<Resource> {
+        let f = &self.frames[frame.slot];
         if let Some(found) = self.geometry.buffer(name) {
             return Some(found);
         }
@@ -232,7 +234,7 @@ impl MeshletScene {
             "TriangleIdBuffer" => &f.triangle_ids,
             "LargeBinBuffer" => &f.large_bins,
             "LargeTriangleBuffer" => &f.large_triangles,
-            _ => return None,
+            _ => return frame.buffer(name),
         };
         Some(Resource::Buffer(buffer.raw))
     }

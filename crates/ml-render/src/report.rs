@@ -272,9 +272,10 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             "triangles",
             format!("{} drawn of {} ({share:.1} %); the meshlets drawn held {}", c.triangles, c.scene_triangles, c.meshlet_triangles),
         ));
-        match settings.raster.bin_list() {
-            _ if settings.raster == crate::settings::Raster::Hardware => {}
-            None => rows.push((
+        use crate::settings::{LargeTriangles, Raster};
+        match settings.raster {
+            Raster::Hardware => {}
+            Raster::Compute { large: LargeTriangles::Hardware, .. } => rows.push((
                 "compute raster",
                 format!(
                     "{} triangles ({} pixels covered), {} by the hardware",
@@ -283,7 +284,7 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                     c.triangles - c.compute_triangles
                 ),
             )),
-            Some(_) => rows.push((
+            Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => rows.push((
                 "compute raster",
                 format!(
                     "{} small triangles a thread each, {} large ones in {} bins ({} drawn in place, the lists full); {} pixels covered",

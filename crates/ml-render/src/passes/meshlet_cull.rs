@@ -106,7 +106,7 @@ impl Pass for MeshletCull {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let scene = self.scene.borrow();
-        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))
+        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame, name))
     }
 
     fn record(&self, rec: &Recording) {

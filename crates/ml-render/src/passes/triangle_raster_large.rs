@@ -54,7 +54,7 @@ impl Pass for TriangleRasterLarge {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let scene = self.scene.borrow();
-        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))
+        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame, name))
     }
 
     /// After the phase's culling, whose last barrier makes the bins and the dispatch visible.
@@ -62,6 +62,7 @@ impl Pass for TriangleRasterLarge {
         let (ctx, cmd, slot) = (rec.ctx, rec.cmd, rec.slot);
         let d = &ctx.device;
         let scene = self.scene.borrow();
+        // The shader reads the phase and the lists' capacity of the culling's push constants.
         let push = cull_push(self.phase, true, self.raster, &scene, rec.extent);
         let phase = usize::from(self.phase == Phase::Late);
         let dispatch = (std::mem::offset_of!(CullCounters, large) + phase * 16) as u64;

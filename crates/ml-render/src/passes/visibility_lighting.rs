@@ -44,7 +44,7 @@ impl Pass for VisibilityLighting {
         self.pass.bind_frame(ctx, frame, &|name| match name {
             "depth_image" => self.pass.sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
             "visibility_image" => self.pass.sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
-            _ => scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)),
+            _ => scene.buffer(frame, name),
         })
     }
 

@@ -97,7 +97,7 @@ impl Pass for VisibilityRaster {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let scene = self.scene.borrow();
-        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame.slot, name).or_else(|| frame.buffer(name)))?;
+        self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame, name))?;
         let t = frame.targets;
         // The hybrid's pass has no attachments (nor the images): the colour target's size.
         let views = if self.atomic { Vec::new() } else { vec![t.visibility.view, t.depth.view] };
