@@ -8,6 +8,7 @@ use crate::auto::{self, technique_choice};
 use crate::{cluster_choice, print_warnings, scene_source, shading_choice};
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
+use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
@@ -52,6 +53,9 @@ pub struct BenchArgs {
     /// Shading model (default: the scene's, else seed).
     #[arg(long)]
     shading: Option<String>,
+    /// The camera, as render's --camera: EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV].
+    #[arg(long, allow_hyphen_values = true)]
+    camera: Option<String>,
     /// Cluster grid XxYxZ, or auto (render's --clusters: scaled with each light count).
     #[arg(long, default_value = "auto")]
     clusters: String,
@@ -109,7 +113,11 @@ struct Plan {
 impl Plan {
     fn new(a: &BenchArgs, (width, height): (u32, u32)) -> Result<Plan> {
         let source = scene_source(&a.scene, MeshKind::Sphere, Material::named("gold")?, a.objects)?;
-        let scene = SceneRequest { shading: shading_choice(a.shading.as_deref())?, ..SceneRequest::new(source) };
+        let scene = SceneRequest {
+            shading: shading_choice(a.shading.as_deref())?,
+            camera: a.camera.as_deref().map(CameraSpec::parse).transpose()?,
+            ..SceneRequest::new(source)
+        };
         let settings = SettingsRequest {
             technique: Technique::Forward,
             clusters: cluster_choice(&a.clusters)?,

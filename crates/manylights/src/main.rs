@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser, Subcommand};
+use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::material::Material;
@@ -112,18 +113,24 @@ struct SceneArgs {
     #[arg(long, default_value = "gold")]
     material: String,
     /// Number of point lights (default 64; with a scene file: replaces the file's lights with
-    /// N lights of --light-layout).
+    /// N lights of --light-layout; a file without lights gets 64).
     #[arg(long)]
     lights: Option<u64>,
-    /// Light placement: grid (the seed's) or random (uniform in x,z ∈ [−20,20], y ∈ [−2,12]).
+    /// Light placement: grid (a square grid above the scene), random (uniform in the scene's
+    /// box) or surface (just above random points of the scene's surfaces, area-weighted). The
+    /// built-in scenes place them in their fixed frame (the grid over x,z ∈ [−15,15] at
+    /// y = 7.5, the box x,z ∈ [−20,20], y ∈ [−2,12]); scene and glTF files in one fitted to
+    /// their box.
     #[arg(long, default_value = "grid")]
     light_layout: String,
-    /// Seed of the random layout (and of random radii).
+    /// Seed of the random and surface layouts (and of random radii).
     #[arg(long, default_value_t = 1)]
     light_seed: u64,
-    /// Light radius R, or MIN..MAX for radii drawn per light.
-    #[arg(long, default_value = "15")]
-    light_radius: String,
+    /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene;
+    /// in a scene or glTF file the radius at which about 4 lights reach a point of the scene,
+    /// from its box and the light count.
+    #[arg(long)]
+    light_radius: Option<String>,
     /// Point-light shadows through cube maps: off, or how the cubes are rendered — copy (each
     /// face offscreen, then copied into its cube layer), direct (each face into its cube
     /// layer), multiview (all six faces in one pass), layered (one pass, each face an
@@ -141,6 +148,12 @@ struct SceneArgs {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
+    /// The camera: eye position, the point it looks at and its vertical field of view in
+    /// degrees (default 60), as EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV]; its near
+    /// and far planes fit the scene. Default: the scene's own camera. The viewer's C key
+    /// prints its camera in this form.
+    #[arg(long, allow_hyphen_values = true)]
+    camera: Option<String>,
     /// Fix the animation clock at T (otherwise it advances 1/60 s per frame from 0; in the
     /// viewer, with real time).
     #[arg(long)]
@@ -235,8 +248,9 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         lights: args.lights,
         layout: LightLayout::from_name(&args.light_layout)?,
         seed: args.light_seed,
-        radius: RadiusRange::parse(&args.light_radius)?,
+        radius: args.light_radius.as_deref().map(RadiusRange::parse).transpose()?,
         shading: shading_choice(args.shading.as_deref())?,
+        camera: args.camera.as_deref().map(CameraSpec::parse).transpose()?,
     })
 }
 
@@ -276,7 +290,7 @@ fn raster_choice(args: &SceneArgs) -> Result<Option<Raster>> {
 fn print_warnings(warnings: &[SceneWarning]) {
     for w in warnings {
         match w {
-            SceneWarning::NoLights { .. } => eprintln!("warning: {w} (--lights N adds some)"),
+            SceneWarning::DefaultRig { .. } => eprintln!("warning: {w} (--lights N, --light-layout and --light-radius choose others)"),
             _ => eprintln!("warning: {w}"),
         }
     }

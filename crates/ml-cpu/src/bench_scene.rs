@@ -4,7 +4,8 @@
 //! lights at every N: cost against N then shows the algorithm, not the light density.
 
 use crate::camera::Camera;
-use crate::lights::{LightLayout, LightParams, RadiusRange, RANDOM_BOX_MAX, RANDOM_BOX_MIN};
+pub use crate::lights::LIGHTS_PER_POINT;
+use crate::lights::{LightFrame, LightLayout, LightParams, RadiusRange, RANDOM_BOX_MAX, RANDOM_BOX_MIN};
 use crate::material::{Material, NAMED_ALBEDOS};
 use crate::mesh::MeshKind;
 use crate::scene::{Object, Scene};
@@ -16,14 +17,11 @@ use rand::{Rng, SeedableRng};
 pub const BENCH_OBJECTS: usize = 300;
 /// The most objects the bench scene places (a million-triangle mesh budget per hundred).
 pub const MAX_BENCH_OBJECTS: usize = 100_000;
-/// Lights whose spheres contain an average point of the light box.
-pub const LIGHTS_PER_POINT: f32 = 4.0;
-
 /// The radius at which `count` lights uniform in the light box reach LIGHTS_PER_POINT lights
-/// at an average point: count · (4/3)πr³ / V = LIGHTS_PER_POINT.
+/// at an average point: count · (4/3)πr³ / V = LIGHTS_PER_POINT (the random layout's default
+/// radius in the built-in frame).
 pub fn bench_radius(count: u32) -> f32 {
-    let volume = (RANDOM_BOX_MAX - RANDOM_BOX_MIN).element_product();
-    (LIGHTS_PER_POINT * volume / (count.max(1) as f32 * 4.0 / 3.0 * std::f32::consts::PI)).cbrt()
+    LightFrame::BUILT_IN.default_radius(LightLayout::Random, count, 0.0)
 }
 
 /// The scene with `count` lights (placed from `seed`) and `objects` objects. The objects never

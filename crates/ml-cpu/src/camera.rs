@@ -93,9 +93,114 @@ impl Camera {
     }
 }
 
+/// A camera's field of view when nothing says otherwise (the seed's).
+pub const DEFAULT_FOV_Y_DEG: f32 = 60.0;
+
+/// Clip planes for a perspective camera of `fov_y_deg` at `position` that sees the box
+/// [lo, hi] (a scene's): near half the gap between a framing camera and the box's bounding
+/// sphere (never under 1/2000 of the framing distance), far past the sphere's far side.
+/// Scene files and `--camera` use these where they name no planes.
+pub fn clip_planes_for(lo: Vec3, hi: Vec3, fov_y_deg: f32, position: Vec3) -> (f32, f32) {
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let distance = framing_distance(radius, fov_y_deg);
+    ((distance - radius).max(distance * 1e-3) * 0.5, position.distance(centre) + radius * 2.0)
+}
+
+/// How far from a sphere of `radius` a camera of `fov_y_deg` stands to see all of it.
+pub fn framing_distance(radius: f32, fov_y_deg: f32) -> f32 {
+    radius / (fov_y_deg.to_radians() * 0.5).sin() * 1.05
+}
+
+/// A camera as the command line gives it (`--camera EYE:TARGET[:FOV]`): where it stands,
+/// what it looks at, its vertical field of view in degrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSpec {
+    pub position: Vec3,
+    pub target: Vec3,
+    pub fov_y_deg: f32,
+}
+
+/// Why a `--camera` text is not a camera.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CameraSpecError {
+    #[error("camera '{0}' is not EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV_DEGREES] (finite numbers)")]
+    Syntax(String),
+    #[error("camera '{0}': the field of view must lie strictly between 0 and 180 degrees")]
+    FieldOfView(String),
+    #[error("camera '{0}': eye and target are the same point, so it looks nowhere")]
+    Nowhere(String),
+    #[error("camera '{0}' looks straight up or down, where its yaw is undefined: move the target sideways")]
+    Vertical(String),
+}
+
+impl CameraSpec {
+    /// Parse `EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV]` (fov in degrees, default 60).
+    pub fn parse(text: &str) -> Result<CameraSpec, CameraSpecError> {
+        let syntax = || CameraSpecError::Syntax(text.to_owned());
+        let number = |s: &str| s.trim().parse::<f32>().ok().filter(|v| v.is_finite()).ok_or_else(syntax);
+        let point = |s: &str| -> Result<Vec3, CameraSpecError> {
+            let v = s.split(',').map(number).collect::<Result<Vec<f32>, _>>()?;
+            <[f32; 3]>::try_from(v).map(Vec3::from).map_err(|_| syntax())
+        };
+        let parts: Vec<&str> = text.split(':').collect();
+        let (position, target, fov_y_deg) = match parts[..] {
+            [eye, target] => (point(eye)?, point(target)?, DEFAULT_FOV_Y_DEG),
+            [eye, target, fov] => (point(eye)?, point(target)?, number(fov)?),
+            _ => return Err(syntax()),
+        };
+        if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) {
+            return Err(CameraSpecError::FieldOfView(text.to_owned()));
+        }
+        if position.distance(target) < 1e-6 {
+            return Err(CameraSpecError::Nowhere(text.to_owned()));
+        }
+        if (target - position).normalize().y.abs() > 0.9999 {
+            return Err(CameraSpecError::Vertical(text.to_owned()));
+        }
+        Ok(CameraSpec { position, target, fov_y_deg })
+    }
+
+    /// The camera looking from `position` at `target`, its planes fitted to the box [lo, hi]
+    /// as a scene file's are.
+    pub fn camera(&self, (lo, hi): (Vec3, Vec3)) -> Camera {
+        let (near, far) = clip_planes_for(lo, hi, self.fov_y_deg, self.position);
+        Camera::looking_at(self.position, self.target, self.fov_y_deg, near, far)
+    }
+
+    /// `camera` in the form `parse` reads, its target `distance` ahead (the viewer's C key).
+    pub fn describe(camera: &Camera, distance: f32) -> String {
+        let (p, t) = (camera.position, camera.position + camera.forward() * distance);
+        format!("{},{},{}:{},{},{}:{}", p.x, p.y, p.z, t.x, t.y, t.z, camera.fov_y_deg)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn camera_specs_parse_and_bad_ones_say_why() {
+        let c = CameraSpec::parse("1,2,3:0,0,0:45").unwrap();
+        assert_eq!(c, CameraSpec { position: Vec3::new(1.0, 2.0, 3.0), target: Vec3::ZERO, fov_y_deg: 45.0 });
+        assert_eq!(CameraSpec::parse(" -1.5, 2,3 :4,5,6").unwrap().fov_y_deg, DEFAULT_FOV_Y_DEG);
+        for bad in ["", "1,2,3", "1,2:3,4,5", "1,2,3:4,5,6:7:8", "a,2,3:4,5,6", "1,2,3:4,5,nan", "1,2,3:4,5,inf"] {
+            assert!(matches!(CameraSpec::parse(bad), Err(CameraSpecError::Syntax(_))), "{bad}");
+        }
+        assert!(matches!(CameraSpec::parse("1,2,3:0,0,0:180"), Err(CameraSpecError::FieldOfView(_))));
+        assert!(matches!(CameraSpec::parse("1,2,3:0,0,0:0"), Err(CameraSpecError::FieldOfView(_))));
+        assert!(matches!(CameraSpec::parse("1,2,3:1,2,3"), Err(CameraSpecError::Nowhere(_))));
+        assert!(matches!(CameraSpec::parse("0,5,0:0,0,0"), Err(CameraSpecError::Vertical(_))));
+    }
+
+    #[test]
+    fn a_described_camera_parses_back_into_the_same_view() {
+        let seed = Camera::seed();
+        let spec = CameraSpec::parse(&CameraSpec::describe(&seed, 10.0)).unwrap();
+        let back = spec.camera((Vec3::splat(-10.0), Vec3::splat(10.0)));
+        assert!(back.position == seed.position && back.forward().abs_diff_eq(seed.forward(), 1e-5), "{back:?}");
+        assert_eq!(back.fov_y_deg, seed.fov_y_deg);
+    }
 
     #[test]
     fn projection_flips_y_and_maps_near_far_to_0_1() {

@@ -12,6 +12,8 @@ pub enum SceneError {
     LightRadius(String),
     #[error("cluster grid {0} is invalid: use XxYxZ with each at least 1 and at most {max} clusters in all", max = crate::cluster::ClusterDims::MAX_CLUSTERS)]
     Clusters(String),
+    #[error("the surface light layout needs a scene with surfaces (triangles of non-zero area)")]
+    NoSurface,
     #[error("unknown {kind} '{name}': expected one of {expected}")]
     UnknownName { kind: &'static str, name: String, expected: String },
 }

@@ -1,8 +1,12 @@
-//! Light layouts (the seed's grid, or seeded random places) and the seed's light animation.
+//! Light layouts (a grid above the scene like the seed's, seeded random places in the scene's
+//! box, or points just above its surfaces), the frame they are placed in (the built-in scenes'
+//! fixed one, or one fitted to a scene's box), the default radius that fits a count to a
+//! frame, and the seed's light animation.
 
 use crate::gpu_types::PointLight;
+use crate::surface_sampler::SurfaceSampler;
 use crate::SceneError;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rand::{Rng, SeedableRng};
 use std::f32::consts::TAU;
 
@@ -22,21 +26,32 @@ pub const SEED_RADIUS: f32 = 15.0;
 pub const RANDOM_BOX_MIN: Vec3 = Vec3::new(-20.0, -2.0, -20.0);
 pub const RANDOM_BOX_MAX: Vec3 = Vec3::new(20.0, 12.0, 20.0);
 
+/// Lights whose spheres reach an average point of the scene under a fitted default radius
+/// (`LightFrame::default_radius`); the bench scene keeps the same number at every count.
+pub const LIGHTS_PER_POINT: f32 = 4.0;
+
+/// Lights of the default rig that a scene file or glTF file without any light gets: the seed
+/// scene's 64, on a grid fitted to the scene's box.
+pub const DEFAULT_RIG_LIGHTS: u32 = 64;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightLayout {
-    /// ceil(√N)² grid over x,z ∈ [−15, 15] at y = 7.5 (the seed's).
+    /// ceil(√N)² grid over the frame's square (the seed's: x,z ∈ [−15, 15] at y = 7.5).
     Grid,
-    /// Uniform in the random box, from a seed.
+    /// Uniform in the frame's box, from a seed.
     Random,
+    /// Just above seeded random points of the scene's surfaces, area-weighted.
+    Surface,
 }
 
 impl LightLayout {
-    pub const ALL: [LightLayout; 2] = [LightLayout::Grid, LightLayout::Random];
+    pub const ALL: [LightLayout; 3] = [LightLayout::Grid, LightLayout::Random, LightLayout::Surface];
 
     pub fn name(self) -> &'static str {
         match self {
             LightLayout::Grid => "grid",
             LightLayout::Random => "random",
+            LightLayout::Surface => "surface",
         }
     }
 
@@ -78,6 +93,83 @@ impl RadiusRange {
     }
 }
 
+/// Where the layouts put lights: the grid's square (centre at its height, half-size in x and z)
+/// and the random layout's box. The built-in scenes have a fixed one (their images never
+/// change); a scene file or glTF file gets one fitted to its box, so that lights scale with
+/// the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightFrame {
+    pub grid_centre: Vec3,
+    pub grid_half_size: f32,
+    pub box_min: Vec3,
+    pub box_max: Vec3,
+}
+
+/// How far a fitted grid rises above the scene's top, as a fraction of its largest side (the
+/// seed's grid is 6.5 m above spheres spread over 17 m: 0.38; lower keeps more of a small
+/// count's light on the scene).
+const GRID_RISE: f32 = 0.25;
+/// The fitted grid's half-size over the scene's half-footprint: a little wider than the scene,
+/// so that its edges are lit from outside as well as its middle.
+const GRID_OVERHANG: f32 = 1.1;
+/// The thinnest side of a fitted box, as a fraction of its largest: a flat model (a plane)
+/// still gets a volume to place lights in.
+const MIN_BOX_SIDE: f32 = 0.25;
+
+impl LightFrame {
+    /// The built-in scenes' frame: the grid over x,z ∈ [−15, 15] at y = 7.5, the box
+    /// x,z ∈ [−20, 20], y ∈ [−2, 12].
+    pub const BUILT_IN: LightFrame = LightFrame {
+        grid_centre: Vec3::new(0.0, GRID_HEIGHT, 0.0),
+        grid_half_size: GRID_HALF_SIZE,
+        box_min: RANDOM_BOX_MIN,
+        box_max: RANDOM_BOX_MAX,
+    };
+
+    /// The frame fitted to a scene's box [lo, hi]: the grid a little wider than the scene's
+    /// footprint, GRID_RISE of the largest side above its top; the box is the scene's own,
+    /// each side at least MIN_BOX_SIDE of the largest. Scaling the scene scales the frame.
+    pub fn around(lo: Vec3, hi: Vec3) -> LightFrame {
+        let centre = (lo + hi) * 0.5;
+        let largest = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let half = ((hi - lo) * 0.5).max(Vec3::splat(largest * MIN_BOX_SIDE * 0.5));
+        let footprint = Vec2::new(hi.x - lo.x, hi.z - lo.z).max_element() * 0.5;
+        LightFrame {
+            grid_centre: Vec3::new(centre.x, hi.y + GRID_RISE * largest, centre.z),
+            grid_half_size: (footprint * GRID_OVERHANG).max(largest * MIN_BOX_SIDE * 0.5),
+            box_min: centre - half,
+            box_max: centre + half,
+        }
+    }
+
+    /// The radius at which `count` lights of `layout` reach about LIGHTS_PER_POINT lights at a
+    /// point of the scene (as the bench scene's do at every count):
+    /// - random, uniform in the box of volume V: count · (4/3)πr³ / V = k;
+    /// - grid, n lights over the square of area A at height h above the box's centre: a point
+    ///   there is reached by the lights within √(r² − h²) in the plane, n·π(r² − h²) / A = k;
+    /// - surface, n lights just above surfaces of area S: a point is reached by those within r
+    ///   along the surface, n·πr² / S = k.
+    ///
+    /// Every term scales with the scene, so the lit image does not change with its size.
+    pub fn default_radius(&self, layout: LightLayout, count: u32, surface_area: f32) -> f32 {
+        let (n, k, pi) = (count.max(1) as f32, LIGHTS_PER_POINT, std::f32::consts::PI);
+        match layout {
+            LightLayout::Random => (k * (self.box_max - self.box_min).element_product() / (n * 4.0 / 3.0 * pi)).cbrt(),
+            LightLayout::Grid => {
+                let area = (2.0 * self.grid_half_size).powi(2);
+                let h = self.grid_centre.y - (self.box_min.y + self.box_max.y) * 0.5;
+                (h * h + k * area / (n * pi)).sqrt()
+            }
+            LightLayout::Surface => (k * surface_area / (n * pi)).sqrt(),
+        }
+    }
+}
+
+/// How far the surface layout lifts a light off its surface, as a fraction of its radius:
+/// enough that the point under it is not lit at a grazing distance of zero, little enough
+/// that the light stays on its side of thin geometry.
+pub const SURFACE_LIFT: f32 = 0.05;
+
 /// Everything that decides a scene's lights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightParams {
@@ -100,26 +192,45 @@ impl LightParams {
         }
     }
 
-    /// The lights at rest (before animation).
+    /// The lights at rest (before animation) in the built-in scenes' frame; the surface
+    /// layout needs a scene (`build_in`).
     pub fn build(&self) -> Result<Vec<PointLight>, SceneError> {
+        self.build_in(&LightFrame::BUILT_IN, None)
+    }
+
+    /// The lights at rest in `frame` over `scene`'s objects (whose surfaces the surface
+    /// layout draws from).
+    pub fn build_over(&self, scene: &crate::scene::Scene, frame: &LightFrame) -> Result<Vec<PointLight>, SceneError> {
+        let surfaces = if self.layout == LightLayout::Surface { SurfaceSampler::new(scene) } else { None };
+        self.build_in(frame, surfaces.as_ref())
+    }
+
+    /// The lights at rest in `frame`; `surfaces` (the scene's, for the surface layout) lifts
+    /// each light SURFACE_LIFT of its radius off a point drawn from them.
+    pub fn build_in(&self, frame: &LightFrame, surfaces: Option<&SurfaceSampler>) -> Result<Vec<PointLight>, SceneError> {
         let n = Self::check_count(self.count as u64)? as usize;
+        let surfaces = match (self.layout, surfaces) {
+            (LightLayout::Surface, None) => return Err(SceneError::NoSurface),
+            (_, surfaces) => surfaces,
+        };
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(self.seed);
         let mut lights = Vec::with_capacity(n);
         let side = (n as f64).sqrt().ceil() as usize;
+        let (lo, hi, half) = (frame.box_min, frame.box_max, frame.grid_half_size);
         for i in 0..n {
-            let position = match self.layout {
-                LightLayout::Grid => {
-                    let step = if side > 1 { 2.0 * GRID_HALF_SIZE / (side - 1) as f32 } else { 0.0 };
-                    let origin = if side > 1 { -GRID_HALF_SIZE } else { 0.0 };
-                    Vec3::new(origin + (i % side) as f32 * step, GRID_HEIGHT, origin + (i / side) as f32 * step)
+            // Where the light goes, and the direction it is lifted along by a part of its radius
+            // (a surface's normal; zero for the other layouts).
+            let (at, lift) = match (self.layout, surfaces) {
+                (LightLayout::Grid, _) => {
+                    let step = if side > 1 { 2.0 * half / (side - 1) as f32 } else { 0.0 };
+                    let origin = if side > 1 { -half } else { 0.0 };
+                    (frame.grid_centre + Vec3::new(origin + (i % side) as f32 * step, 0.0, origin + (i / side) as f32 * step), Vec3::ZERO)
                 }
-                LightLayout::Random => Vec3::new(
-                    rng.random_range(RANDOM_BOX_MIN.x..=RANDOM_BOX_MAX.x),
-                    rng.random_range(RANDOM_BOX_MIN.y..=RANDOM_BOX_MAX.y),
-                    rng.random_range(RANDOM_BOX_MIN.z..=RANDOM_BOX_MAX.z),
-                ),
+                (LightLayout::Surface, Some(surfaces)) => surfaces.sample(&mut rng),
+                _ => (Vec3::new(rng.random_range(lo.x..=hi.x), rng.random_range(lo.y..=hi.y), rng.random_range(lo.z..=hi.z)), Vec3::ZERO),
             };
             let radius = self.radius.sample(&mut rng);
+            let position = at + lift * (radius * SURFACE_LIFT);
             let c = SEED_COLORS[i % SEED_COLORS.len()];
             lights.push(PointLight { position_radius: [position.x, position.y, position.z, radius], color: [c[0], c[1], c[2], 0.0] });
         }
@@ -167,6 +278,82 @@ mod tests {
             let pos = Vec3::from_slice(&l.position_radius[..3]);
             assert!(pos.cmpge(RANDOM_BOX_MIN).all() && pos.cmple(RANDOM_BOX_MAX).all());
             assert!((0.5..=4.0).contains(&l.position_radius[3]));
+        }
+    }
+
+    #[test]
+    fn the_built_in_frame_is_the_seed_grid_and_the_random_box() {
+        assert_eq!(LightFrame::BUILT_IN.grid_centre, Vec3::new(0.0, GRID_HEIGHT, 0.0));
+        assert_eq!((LightFrame::BUILT_IN.box_min, LightFrame::BUILT_IN.box_max), (RANDOM_BOX_MIN, RANDOM_BOX_MAX));
+        let grid = LightParams::seed_default();
+        assert_eq!(grid.build().unwrap(), grid.build_in(&LightFrame::BUILT_IN, None).unwrap());
+        assert_eq!(LightParams { layout: LightLayout::Surface, ..grid }.build(), Err(SceneError::NoSurface));
+    }
+
+    /// A scene's box scaled by s (about a point off the origin): every layout's lights scale
+    /// with it, and so does the default radius, for every layout.
+    #[test]
+    fn fitted_frames_and_radii_scale_with_the_scene() {
+        let (lo, hi) = (Vec3::new(-1.0, 0.0, -2.0), Vec3::new(3.0, 1.0, 2.0));
+        let base = LightFrame::around(lo, hi);
+        for s in [0.01f32, 100.0] {
+            let frame = LightFrame::around(lo * s, hi * s);
+            for layout in [LightLayout::Grid, LightLayout::Random] {
+                let r = base.default_radius(layout, 256, 0.0);
+                let rs = frame.default_radius(layout, 256, 0.0);
+                assert!((rs / (r * s) - 1.0).abs() < 1e-4, "{layout:?} × {s}: {rs} against {r}");
+                let p = LightParams { count: 256, layout, seed: 4, radius: RadiusRange::fixed(r) };
+                let a = p.build_in(&base, None).unwrap();
+                let b = LightParams { radius: RadiusRange::fixed(rs), ..p }.build_in(&frame, None).unwrap();
+                for (a, b) in a.iter().zip(&b) {
+                    let (pa, pb) = (Vec3::from_slice(&a.position_radius[..3]), Vec3::from_slice(&b.position_radius[..3]));
+                    assert!(pb.abs_diff_eq(pa * s, 1e-3 * s.max(1.0) * 10.0), "{layout:?} × {s}: {pb} against {}", pa * s);
+                }
+            }
+            let r = base.default_radius(LightLayout::Surface, 256, 30.0);
+            assert!((frame.default_radius(LightLayout::Surface, 256, 30.0 * s * s) / (r * s) - 1.0).abs() < 1e-4);
+        }
+        // The grid hangs over the scene, the box holds it; a flat scene's box still has depth.
+        assert!(base.grid_centre.y > hi.y && base.grid_half_size >= 2.0);
+        let flat = LightFrame::around(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0));
+        assert!((flat.box_max.y - flat.box_min.y - 0.5).abs() < 1e-6);
+    }
+
+    /// Monte Carlo: points of the scene's box (random), of its middle plane (grid) or of its
+    /// surface (surface) are reached by about LIGHTS_PER_POINT lights under the default radius.
+    #[test]
+    fn the_default_radius_brings_about_k_lights_to_a_point() {
+        use crate::camera::Camera;
+        use crate::material::Material;
+        use crate::mesh::MeshKind;
+        use crate::scene::{Object, Scene};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        // A floor of 20 × 20 m under the box (−10, 0, −10)..(10, 4, 10).
+        let floor = Object::placed(MeshKind::Plane, Vec3::ZERO, 10.0, Material::named("white").unwrap());
+        let scene = Scene::new(vec![floor], Vec::new(), Camera::seed());
+        let surfaces = SurfaceSampler::new(&scene).unwrap();
+        let frame = LightFrame::around(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 4.0, 10.0));
+        for layout in LightLayout::ALL {
+            let count = 4096;
+            let radius = frame.default_radius(layout, count, surfaces.area());
+            let lights =
+                LightParams { count, layout, seed: 2, radius: RadiusRange::fixed(radius) }.build_in(&frame, Some(&surfaces)).unwrap();
+            let mut reached = 0;
+            let samples = 300;
+            for _ in 0..samples {
+                // Away from the edges, where fewer lights are around.
+                let inner = |a: f32, b: f32, rng: &mut rand_chacha::ChaCha8Rng| rng.random_range(a * 0.6..b * 0.6);
+                let p = match layout {
+                    LightLayout::Random => {
+                        Vec3::new(inner(-10.0, 10.0, &mut rng), inner(0.0, 4.0, &mut rng) + 0.8, inner(-10.0, 10.0, &mut rng))
+                    }
+                    LightLayout::Grid => Vec3::new(inner(-10.0, 10.0, &mut rng), 2.0, inner(-10.0, 10.0, &mut rng)),
+                    LightLayout::Surface => Vec3::new(inner(-10.0, 10.0, &mut rng), 0.0, inner(-10.0, 10.0, &mut rng)),
+                };
+                reached += lights.iter().filter(|l| Vec3::from_slice(&l.position_radius[..3]).distance(p) < l.position_radius[3]).count();
+            }
+            let mean = reached as f32 / samples as f32;
+            assert!((mean - LIGHTS_PER_POINT).abs() < 1.0, "{layout:?}: {mean} lights reach a point (radius {radius})");
         }
     }
 

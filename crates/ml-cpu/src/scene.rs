@@ -3,7 +3,7 @@
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
 use crate::gpu_types::{LightCone, PointLight};
-use crate::lights::LightParams;
+use crate::lights::{LightFrame, LightParams};
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshKind};
 use crate::textures::TextureImage;
@@ -159,7 +159,9 @@ impl Scene {
                 objects.push(Object::placed(mesh, Vec3::new(at(i), 0.0, at(j)), 1.0, material));
             }
         }
-        Ok(Scene::new(objects, lights.build()?, Camera::seed()))
+        let mut scene = Scene::new(objects, Vec::new(), Camera::seed());
+        scene.lights = lights.build_over(&scene, &LightFrame::BUILT_IN)?;
+        Ok(scene)
     }
 
     /// `objects` lit by point `lights` and the seed's ambient, seen by `camera`; the

@@ -4,7 +4,7 @@
 //! ranges, counts and file size limited before anything is allocated — and every problem is
 //! one error naming the file and, where the parser knows it, the line.
 
-use crate::camera::Camera;
+use crate::camera::{clip_planes_for, framing_distance, Camera, DEFAULT_FOV_Y_DEG};
 use crate::gltf_scene::GltfError;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
@@ -434,12 +434,11 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
     let fov = match c.and_then(|c| c.fov_y_deg) {
         Some(f) if finite("[camera] fov_y_deg", f)? > 0.0 && f < 180.0 => f,
         Some(f) => return Err(Problem::FieldOfView(f)),
-        None => 60.0,
+        None => DEFAULT_FOV_Y_DEG,
     };
-    let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
     let position = match c.and_then(|c| c.position) {
         Some(p) => vec3("[camera] position", p)?,
-        None => centre + Vec3::new(0.0, 0.5, 1.0).normalize() * distance,
+        None => centre + Vec3::new(0.0, 0.5, 1.0).normalize() * framing_distance(radius, fov),
     };
     let target = match c.and_then(|c| c.target) {
         Some(t) => vec3("[camera] target", t)?,
@@ -448,9 +447,9 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
     if position.distance(target) < 1e-6 {
         return Err(Problem::CameraNowhere);
     }
-    let near =
-        c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or((distance - radius).max(distance * 1e-3) * 0.5);
-    let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(position.distance(centre) + radius * 2.0);
+    let (fitted_near, fitted_far) = clip_planes_for(lo, hi, fov, position);
+    let near = c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or(fitted_near);
+    let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(fitted_far);
     if near >= far {
         return Err(Problem::NearFar { near, far });
     }

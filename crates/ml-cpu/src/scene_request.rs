@@ -3,13 +3,15 @@
 //! as warnings, for the caller to show.
 
 use crate::bench_scene::bench_scene;
+use crate::camera::CameraSpec;
 use crate::gltf_scene::{self, GltfFileError};
-use crate::lights::{LightLayout, LightParams, RadiusRange, SEED_RADIUS};
+use crate::lights::{LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::Scene;
 use crate::scene_file::{self, SceneFileError};
 use crate::shading_model::ShadingModel;
+use crate::surface_sampler::SurfaceSampler;
 use crate::SceneError;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -38,15 +40,21 @@ pub enum SceneSource {
 pub struct SceneRequest {
     pub source: SceneSource,
     /// Point lights: None keeps the scene's own (the seed scene 64, the bench scene 1024, a
-    /// file its own); Some(n) places n lights by `layout`, `seed` and `radius` (a file's
-    /// lights and spot cones are then replaced).
+    /// file its own, or the default rig where it has none); Some(n) places n lights by
+    /// `layout`, `seed` and `radius` (a file's lights and spot cones are then replaced). The
+    /// seed scene places them in its fixed frame, a file in a frame fitted to its box.
     pub lights: Option<u64>,
     pub layout: LightLayout,
-    /// Seed of the random layout and of radii drawn from a range.
+    /// Seed of the random and surface layouts and of radii drawn from a range.
     pub seed: u64,
-    pub radius: RadiusRange,
+    /// None: the seed scene's 15, or for a file the radius fitted to its frame and the count
+    /// (`LightFrame::default_radius`).
+    pub radius: Option<RadiusRange>,
     /// The shading model; None: the file's, else the seed model.
     pub shading: Option<ShadingModel>,
+    /// Where the camera stands and looks (its planes fitted to the scene's box as a scene
+    /// file's are); None: the scene's own camera.
+    pub camera: Option<CameraSpec>,
 }
 
 /// A built scene and the shading model to render it with.
@@ -58,14 +66,16 @@ pub struct BuiltScene {
 }
 
 /// Something about a built scene its user should hear of.
-#[derive(Clone, Debug, PartialEq, Eq, Error)]
+#[derive(Clone, Debug, PartialEq, Error)]
 pub enum SceneWarning {
     /// What a file holds that is left out.
     #[error("'{}': {message}", path.display())]
     Left { path: PathBuf, message: String },
-    /// A file's scene without any light (asking for lights adds some).
-    #[error("'{}': the scene has no lights, so only ambient and emitted light show", path.display())]
-    NoLights { path: PathBuf },
+    /// A file's scene without any light, lit by the default rig instead: DEFAULT_RIG_LIGHTS
+    /// lights of the request's layout (the seed's grid unless it says otherwise) fitted to the
+    /// scene's box.
+    #[error("'{}': the scene has no lights: added {lights} point lights ({} layout, radius {radius:.3}) fitted to its box", path.display(), layout.name())]
+    DefaultRig { path: PathBuf, lights: u32, layout: LightLayout, radius: f32 },
 }
 
 /// Why a requested scene could not be built.
@@ -83,10 +93,10 @@ pub enum SceneRequestError {
 }
 
 impl SceneRequest {
-    /// `source` with the defaults: its own lights (placed as the seed's grid, seed 1, radius
-    /// 15 where a count is given), its own shading model.
+    /// `source` with the defaults: its own lights (placed as the seed's grid, seed 1, the
+    /// default radius where a count is given), its own shading model.
     pub fn new(source: SceneSource) -> SceneRequest {
-        SceneRequest { source, lights: None, layout: LightLayout::Grid, seed: 1, radius: RadiusRange::fixed(SEED_RADIUS), shading: None }
+        SceneRequest { source, lights: None, layout: LightLayout::Grid, seed: 1, radius: None, shading: None, camera: None }
     }
 
     /// Whether the scene is the seed's grid (its object and material may change).
@@ -94,21 +104,32 @@ impl SceneRequest {
         matches!(self.source, SceneSource::Seed { .. })
     }
 
-    fn lights_of(&self, count: u64) -> Result<LightParams, SceneError> {
-        Ok(LightParams { count: LightParams::check_count(count)?, layout: self.layout, seed: self.seed, radius: self.radius })
+    /// `count` lights of the request's layout with `radius` unless the request names one.
+    fn lights_of(&self, count: u64, radius: impl FnOnce(u32) -> f32) -> Result<LightParams, SceneError> {
+        let count = LightParams::check_count(count)?;
+        let radius = self.radius.unwrap_or_else(|| RadiusRange::fixed(radius(count)));
+        Ok(LightParams { count, layout: self.layout, seed: self.seed, radius })
     }
 
     pub fn build(&self) -> Result<BuiltScene, SceneRequestError> {
+        let mut built = self.build_scene()?;
+        if let Some(spec) = &self.camera {
+            built.scene.camera = spec.camera(built.scene.bounds());
+        }
+        Ok(built)
+    }
+
+    fn build_scene(&self) -> Result<BuiltScene, SceneRequestError> {
         let model = self.shading.unwrap_or(ShadingModel::Seed);
         let built = |scene| BuiltScene { scene, shading: model, warnings: Vec::new() };
         match &self.source {
             SceneSource::Room => Ok(built(Scene::shadow_room())),
             SceneSource::Bench { objects } => {
-                let count = self.lights_of(self.lights.unwrap_or(BENCH_LIGHTS))?.count;
+                let count = LightParams::check_count(self.lights.unwrap_or(BENCH_LIGHTS))?;
                 Ok(built(bench_scene(count, self.seed, *objects)?))
             }
             SceneSource::Seed { object, material } => {
-                let scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS))?)?;
+                let scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS), |_| SEED_RADIUS)?)?;
                 Ok(built(if model == ShadingModel::BlinnPhong { scene.with_floor() } else { scene }))
             }
             SceneSource::File(path) => self.build_file(path),
@@ -129,13 +150,25 @@ impl SceneRequest {
         let mut warnings: Vec<SceneWarning> =
             file.warnings.into_iter().map(|message| SceneWarning::Left { path: path.clone(), message }).collect();
         let mut scene = file.scene;
-        if let Some(n) = self.lights {
-            scene.lights = self.lights_of(n)?.build()?;
+        let unlit = scene.lights.is_empty() && scene.directional.is_empty();
+        if self.lights.is_some() || unlit {
+            let count = self.lights.unwrap_or(DEFAULT_RIG_LIGHTS as u64);
+            let (lo, hi) = scene.bounds();
+            let frame = LightFrame::around(lo, hi);
+            let surfaces = if self.layout == LightLayout::Surface { SurfaceSampler::new(&scene) } else { None };
+            let area = surfaces.as_ref().map_or(0.0, SurfaceSampler::area);
+            let params = self.lights_of(count, |n| frame.default_radius(self.layout, n, area))?;
+            scene.lights = params.build_in(&frame, surfaces.as_ref())?;
             // The file's spot cones belonged to its own lights.
             scene.cones.clear();
-        }
-        if scene.lights.is_empty() && scene.directional.is_empty() {
-            warnings.push(SceneWarning::NoLights { path: path.clone() });
+            if self.lights.is_none() {
+                warnings.push(SceneWarning::DefaultRig {
+                    path: path.clone(),
+                    lights: params.count,
+                    layout: self.layout,
+                    radius: params.radius.max,
+                });
+            }
         }
         Ok(BuiltScene { scene, shading, warnings })
     }
@@ -188,7 +221,12 @@ mod tests {
         let dark = file("dark.toml", "[shading]\nmodel = \"pbr\"\n[[objects]]\nmesh = \"sphere\"\n");
         let built = dark.build().unwrap();
         assert_eq!(built.shading, ShadingModel::Pbr);
-        assert_eq!(built.warnings, [SceneWarning::NoLights { path: dir.join("dark.toml") }]);
+        // No light in the file: the default rig, fitted to the unit sphere's box.
+        let radius = LightFrame::around(glam::Vec3::splat(-1.0), glam::Vec3::ONE).default_radius(LightLayout::Grid, 64, 0.0);
+        let rig = SceneWarning::DefaultRig { path: dir.join("dark.toml"), lights: 64, layout: LightLayout::Grid, radius };
+        assert_eq!(built.warnings, [rig]);
+        assert_eq!(built.scene.lights.len(), 64);
+        assert!(built.scene.lights.iter().all(|l| l.position_radius[1] == 1.5 && l.position_radius[3] == radius));
         let lit = SceneRequest { lights: Some(4), shading: Some(ShadingModel::Seed), ..dark }.build().unwrap();
         assert_eq!((lit.scene.lights.len(), lit.shading), (4, ShadingModel::Seed));
         assert!(lit.warnings.is_empty());

@@ -3,7 +3,7 @@
 
 use egui::{ComboBox, DragValue, Slider};
 use ml_cpu::cluster::ClusterDims;
-use ml_cpu::lights::{LightLayout, RadiusRange};
+use ml_cpu::lights::{LightLayout, RadiusRange, SEED_RADIUS};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
@@ -43,7 +43,7 @@ impl Choices {
             material,
             lights: built.scene.lights.len() as u64,
             layout: request.layout,
-            radius: request.radius.max,
+            radius: request.radius.map_or_else(|| built.scene.lights.first().map_or(SEED_RADIUS, |l| l.position_radius[3]), |r| r.max),
             clusters: settings.clusters,
             debug_view: settings.debug_view,
             omni: settings.omni,
@@ -62,7 +62,7 @@ impl Choices {
         if (self.lights, self.layout, self.radius) != (initial.lights, initial.layout, initial.radius) {
             (r.lights, r.layout) = (Some(self.lights), self.layout);
             if self.radius != initial.radius {
-                r.radius = RadiusRange::fixed(self.radius);
+                r.radius = Some(RadiusRange::fixed(self.radius));
             }
         }
         r
@@ -239,14 +239,15 @@ mod tests {
 
     #[test]
     fn a_file_keeps_its_lights_until_their_count_layout_or_radius_changes() {
-        let base = SceneRequest { radius: RadiusRange { min: 1.0, max: 3.0 }, ..SceneRequest::new(SceneSource::File("a.toml".into())) };
+        let base =
+            SceneRequest { radius: Some(RadiusRange { min: 1.0, max: 3.0 }), ..SceneRequest::new(SceneSource::File("a.toml".into())) };
         let start = initial();
         let pbr = Choices { shading: ShadingModel::Pbr, ..start.clone() };
         assert_eq!(pbr.request(&base, &start), SceneRequest { shading: Some(ShadingModel::Pbr), ..base.clone() });
         let more = Choices { lights: 9, layout: LightLayout::Random, ..start.clone() }.request(&base, &start);
         assert_eq!((more.lights, more.layout, more.radius), (Some(9), LightLayout::Random, base.radius));
         let smaller = Choices { radius: 2.0, ..start.clone() }.request(&base, &start);
-        assert_eq!((smaller.lights, smaller.radius), (Some(7), RadiusRange::fixed(2.0)));
+        assert_eq!((smaller.lights, smaller.radius), (Some(7), Some(RadiusRange::fixed(2.0))));
     }
 
     #[test]
