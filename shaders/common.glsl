@@ -49,6 +49,7 @@ struct FrameUniforms {
     // Directional lights (glTF, scene files; every model): xyz the direction the light travels.
     vec4 directional_direction[4];
     vec4 directional_color[4]; // rgb
+    vec4 exposure;             // x: the factor lit colour is multiplied by before tone map and gamma (2^EV)
 };
 
 // A radius-limited point light (set 0, binding 1, std430 array).

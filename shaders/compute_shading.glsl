@@ -12,7 +12,7 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m)
         return;
     }
     color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
-    imageStore(out_image, p, vec4(encode_output(color), 1.0));
+    imageStore(out_image, p, vec4(encode_output(color, frame.exposure.x), 1.0));
 }
 
 #endif

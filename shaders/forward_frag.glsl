@@ -34,5 +34,5 @@ void main() {
     }
     color = shade_point(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
     // The target is UNORM: the seed writes gamma-encoded values itself.
-    out_color = vec4(encode_output(color), 1.0);
+    out_color = vec4(encode_output(color, frame.exposure.x), 1.0);
 }

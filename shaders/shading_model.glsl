@@ -20,9 +20,11 @@ vec3 aces_tone_map(vec3 x) {
     return clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
 }
 
-// Linear colour → what the 8-bit target stores under the pipeline's model: pbr tone-maps its
-// HDR result, the seed models clip; then gamma 1/2.2.
-vec3 encode_output(vec3 linear) {
+// Linear colour → what the 8-bit target stores under the pipeline's model: scaled by the
+// exposure (FrameUniforms::exposure.x, 2^EV; 1 leaves every value as it was), then pbr
+// tone-maps its HDR result, the seed models clip; then gamma 1/2.2.
+vec3 encode_output(vec3 linear, float exposure) {
+    linear *= exposure;
     if (MODEL_PBR) {
         linear = aces_tone_map(linear);
     }

@@ -11,6 +11,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0) uniform sampler2D hdr_image;
 layout(set = 0, binding = 1, rgba8) uniform writeonly image2D out_image;
+layout(set = 0, binding = 2) uniform FrameBlock { FrameUniforms frame; };
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -18,5 +19,5 @@ void main() {
         return;
     }
     vec4 hdr = texelFetch(hdr_image, p, 0);
-    imageStore(out_image, p, hdr.a == 0.0 ? CLEAR_COLOR : vec4(encode_output(hdr.rgb), 1.0));
+    imageStore(out_image, p, hdr.a == 0.0 ? CLEAR_COLOR : vec4(encode_output(hdr.rgb, frame.exposure.x), 1.0));
 }

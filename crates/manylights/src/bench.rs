@@ -5,7 +5,7 @@
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
 use crate::auto::{self, technique_choice};
-use crate::{cluster_choice, print_warnings, scene_source, shading_choice};
+use crate::{cluster_choice, print_warnings, scene_source, shading_choice, Progress};
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use ml_cpu::camera::CameraSpec;
@@ -129,6 +129,7 @@ impl Plan {
             time: None,
             culling: true,
             raster: Raster::Hardware,
+            exposure: 0.0,
         };
         Ok(Plan { scene, settings, warned: false })
     }
@@ -229,8 +230,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             }
         }
     }
-    let bar = indicatif::ProgressBar::new((variants.len() * counts.len()) as u64);
-    bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("a valid template"));
+    let mut bar = Progress::new((variants.len() * counts.len()) as u64, "");
     let mut results: Vec<Measured> = Vec::new();
     for &lights in &counts {
         for &variant in &variants {
@@ -242,10 +242,10 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 .map(|m| (m.lights, m.ms_per_frame))
                 .max_by_key(|&(n, _)| n);
             results.push(measure(&ctx, a, &mut plan, (variant, lights), previous)?);
-            bar.inc(1);
+            bar.inc();
         }
     }
-    bar.finish_and_clear();
+    bar.finish();
     let device = device_json(&ctx);
     drop(ctx);
     let auto = json!({ "technique": auto_technique.name(), "why": auto_why, "probe": probe::times_json(&quick) });

@@ -46,13 +46,18 @@ enum Command {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// Frames to render; timings are averaged over them, the image is the last one.
+    /// Frames to render (1 to 100000); timings are averaged over them, the image is the last
+    /// one — or, with a # in --out, every frame's.
     #[arg(long, default_value_t = 1)]
     frames: u32,
-    /// Output PNG file.
+    /// Output PNG file; a name with a run of # (frames/####.png) is an image sequence: every
+    /// frame, the #s replaced by its number from 0, zero-padded to their count.
     #[arg(long)]
     out: PathBuf,
 }
+
+/// The most frames `render` takes: at 60 frames a second, half an hour of animation.
+const MAX_FRAMES: u32 = 100_000;
 
 #[derive(Args)]
 struct ViewArgs {
@@ -154,6 +159,9 @@ struct SceneArgs {
     /// prints its camera in this form.
     #[arg(long, allow_hyphen_values = true)]
     camera: Option<String>,
+    /// Exposure in stops (EV, -20 to 20): lit colour × 2^EV before the tone map and gamma.
+    #[arg(long, default_value = "0", allow_hyphen_values = true)]
+    exposure: String,
     /// Fix the animation clock at T (otherwise it advances 1/60 s per frame from 0; in the
     /// viewer, with real time).
     #[arg(long)]
@@ -250,7 +258,7 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         seed: args.light_seed,
         radius: args.light_radius.as_deref().map(RadiusRange::parse).transpose()?,
         shading: shading_choice(args.shading.as_deref())?,
-        camera: args.camera.as_deref().map(CameraSpec::parse).transpose()?,
+        camera: args.camera.as_deref().map(CameraSpec::parse).transpose().context("--camera")?,
     })
 }
 
@@ -273,6 +281,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         frames,
         time: args.time,
         culling: args.culling == "on",
+        exposure: ml_render::settings::parse_exposure(&args.exposure).context("--exposure")?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
     })
@@ -294,6 +303,90 @@ fn print_warnings(warnings: &[SceneWarning]) {
             _ => eprintln!("warning: {w}"),
         }
     }
+}
+
+/// `--out` with a run of # (an image sequence): the name before and after it and its length.
+/// None without a #; an error where # stands elsewhere than in one run of the file name.
+fn sequence_pattern(out: &Path) -> Result<Option<(String, String, usize)>> {
+    let text = out.to_string_lossy();
+    let Some(first) = text.find('#') else { return Ok(None) };
+    let run = text[first..].find(|c| c != '#').map_or(text.len() - first, |n| n);
+    let (before, after) = (&text[..first], &text[first + run..]);
+    if after.contains('#') || after.contains(std::path::MAIN_SEPARATOR) {
+        bail!("--out '{text}': an image sequence's name has one run of # in the file name (e.g. frames/####.png)");
+    }
+    Ok(Some((before.to_owned(), after.to_owned(), run)))
+}
+
+/// Frame `i`'s file of a sequence pattern.
+fn sequence_path((before, after, digits): &(String, String, usize), i: u32) -> PathBuf {
+    PathBuf::from(format!("{before}{i:0digits$}{after}"))
+}
+
+/// A progress bar on stderr that shows itself once the work has taken PROGRESS_AFTER, and
+/// never where stderr is not a terminal (indicatif's own rule): short runs and logs stay quiet.
+pub(crate) struct Progress {
+    bar: indicatif::ProgressBar,
+    start: std::time::Instant,
+    shown: bool,
+}
+
+/// How long work runs before its progress bar appears.
+const PROGRESS_AFTER: std::time::Duration = std::time::Duration::from_secs(2);
+
+impl Progress {
+    pub(crate) fn new(len: u64, what: &str) -> Progress {
+        let bar = indicatif::ProgressBar::with_draw_target(Some(len), indicatif::ProgressDrawTarget::hidden());
+        bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} ({eta} left)").expect("a valid template"));
+        bar.set_message(what.to_owned());
+        Progress { bar, start: std::time::Instant::now(), shown: false }
+    }
+
+    pub(crate) fn set_message(&self, message: String) {
+        self.bar.set_message(message);
+    }
+
+    /// One more step done.
+    pub(crate) fn inc(&mut self) {
+        if !self.shown && self.start.elapsed() >= PROGRESS_AFTER {
+            self.shown = true;
+            self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        self.bar.inc(1);
+    }
+
+    pub(crate) fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// What `render` does with each frame: counts it on the progress bar and, for an image
+/// sequence, writes its PNG.
+struct RenderSink {
+    progress: Progress,
+    sequence: Option<(String, String, usize)>,
+    size: (u32, u32),
+}
+
+impl ml_render::FrameSink for RenderSink {
+    fn submitted(&mut self, _i: u32) {
+        self.progress.inc();
+    }
+
+    fn wants_images(&self) -> bool {
+        self.sequence.is_some()
+    }
+
+    fn image(&mut self, i: u32, rgba: &[u8]) -> Result<(), ml_render::RenderError> {
+        let Some(pattern) = &self.sequence else { return Ok(()) };
+        let path = sequence_path(pattern, i);
+        save_png(&path, rgba, self.size).map_err(|e| ml_render::RenderError::Invalid(format!("{e:#}")))
+    }
+}
+
+fn save_png(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<()> {
+    image::save_buffer_with_format(path, rgba, width, height, image::ColorType::Rgba8, image::ImageFormat::Png)
+        .with_context(|| format!("cannot write '{}'", path.display()))
 }
 
 /// Fail before rendering if the PNG could not be written: nothing is computed for nothing.
@@ -319,9 +412,16 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let request = scene_request(args)?;
     // Every setting is checked before the GPU work; auto's technique is set once it is known.
     let wanted = settings_request(args, choice.unwrap_or(Technique::DeferredClustered), cmd.frames)?;
+    if cmd.frames > MAX_FRAMES {
+        bail!("--frames {} is out of range: use 1 to {MAX_FRAMES}", cmd.frames);
+    }
+    let sequence = sequence_pattern(&cmd.out)?;
     let built = request.build()?;
     print_warnings(&built.warnings);
-    check_output(&cmd.out)?;
+    match &sequence {
+        Some(pattern) => check_output(&sequence_path(pattern, 0))?,
+        None => check_output(&cmd.out)?,
+    }
     let mut settings = wanted.for_scene(&built.scene, built.shading);
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();
@@ -336,12 +436,16 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
-    let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render());
+    let mut sink =
+        RenderSink { progress: Progress::new(settings.frames as u64, "frames"), sequence, size: (settings.width, settings.height) };
+    let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render_into(&mut sink));
+    sink.progress.finish();
     let device = report::device_line(&ctx.info);
     drop(ctx);
     let output = result?;
-    image::save_buffer_with_format(&cmd.out, &output.rgba, output.width, output.height, image::ColorType::Rgba8, image::ImageFormat::Png)
-        .with_context(|| format!("cannot write '{}'", cmd.out.display()))?;
+    if sink.sequence.is_none() {
+        save_png(&cmd.out, &output.rgba, (output.width, output.height))?;
+    }
     let facts = report::RenderFacts {
         device: &device,
         settings: &settings,
@@ -398,4 +502,22 @@ fn info() -> Result<()> {
         println!("{}", report::table(&report::device_rows(&d)));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sequence_patterns_number_frames_in_their_run_of_hashes() {
+        let p = sequence_pattern(Path::new("frames/####.png")).unwrap().unwrap();
+        assert_eq!(sequence_path(&p, 7), PathBuf::from("frames/0007.png"));
+        assert_eq!(sequence_path(&p, 12345), PathBuf::from("frames/12345.png"));
+        let p = sequence_pattern(Path::new("turn-#.png")).unwrap().unwrap();
+        assert_eq!(sequence_path(&p, 3), PathBuf::from("turn-3.png"));
+        assert_eq!(sequence_pattern(Path::new("plain.png")).unwrap(), None);
+        for bad in ["a#b#.png", "frames#/#.png", "##x##"] {
+            assert!(sequence_pattern(Path::new(bad)).is_err(), "{bad}");
+        }
+    }
 }

@@ -25,6 +25,18 @@ pub struct PrimitiveData {
     pub material: Option<usize>,
 }
 
+/// One of our meshes (positions, normals, texture coordinates, u32 indices) as a primitive
+/// in `material`: how tests and the demo model write built-in meshes as glTF files.
+pub fn mesh_primitive(mesh: &crate::mesh::Mesh, material: Option<usize>) -> PrimitiveData {
+    PrimitiveData {
+        positions: mesh.vertices.iter().map(|v| v.position).collect(),
+        normals: Some(mesh.vertices.iter().map(|v| v.normal).collect()),
+        uvs: Some(mesh.vertices.iter().map(|v| v.uv).collect()),
+        indices: Some((mesh.indices.clone(), IndexType::U32)),
+        material,
+    }
+}
+
 /// A glTF document under construction: JSON plus one binary buffer.
 #[derive(Clone, Debug)]
 pub struct GltfWriter {

@@ -63,6 +63,8 @@ gpu_struct!(
         /// xyz: the direction each directional light travels.
         directional_direction: [[f32; 4]; 4],
         directional_color: [[f32; 4]; 4],
+        /// x: the factor lit colour is multiplied by before tone map and gamma, 2^EV.
+        exposure: [f32; 4],
     }
 );
 

@@ -112,6 +112,15 @@ const GRID_RISE: f32 = 0.25;
 /// The fitted grid's half-size over the scene's half-footprint: a little wider than the scene,
 /// so that its edges are lit from outside as well as its middle.
 const GRID_OVERHANG: f32 = 1.1;
+/// The least radius of a fitted grid's lights over their height above the scene's middle:
+/// many lights high over a flat scene would otherwise reach it only at the very end of their
+/// radius, where the falloff is near zero; with this a light straight above the middle gives
+/// it at least (1 − 1/1.25)² = 0.04.
+const GRID_REACH: f32 = 1.25;
+/// How far a fitted random box reaches past the scene's box on every side, as a fraction of
+/// its largest side: inside the scene's own box a closed model (a cube) would hold every
+/// light inside itself, lighting only its inner faces.
+const BOX_MARGIN: f32 = 0.25;
 /// The thinnest side of a fitted box, as a fraction of its largest: a flat model (a plane)
 /// still gets a volume to place lights in.
 const MIN_BOX_SIDE: f32 = 0.25;
@@ -128,11 +137,12 @@ impl LightFrame {
 
     /// The frame fitted to a scene's box [lo, hi]: the grid a little wider than the scene's
     /// footprint, GRID_RISE of the largest side above its top; the box is the scene's own,
-    /// each side at least MIN_BOX_SIDE of the largest. Scaling the scene scales the frame.
+    /// each side at least MIN_BOX_SIDE of the largest, grown by BOX_MARGIN of the largest on
+    /// every side. Scaling the scene scales the frame.
     pub fn around(lo: Vec3, hi: Vec3) -> LightFrame {
         let centre = (lo + hi) * 0.5;
         let largest = (hi - lo).max_element().max(f32::MIN_POSITIVE);
-        let half = ((hi - lo) * 0.5).max(Vec3::splat(largest * MIN_BOX_SIDE * 0.5));
+        let half = ((hi - lo) * 0.5).max(Vec3::splat(largest * MIN_BOX_SIDE * 0.5)) + largest * BOX_MARGIN;
         let footprint = Vec2::new(hi.x - lo.x, hi.z - lo.z).max_element() * 0.5;
         LightFrame {
             grid_centre: Vec3::new(centre.x, hi.y + GRID_RISE * largest, centre.z),
@@ -142,11 +152,20 @@ impl LightFrame {
         }
     }
 
+    /// How far its lights move in the animation: the seed's 0.1 in the built-in frame, and
+    /// as much of a fitted frame as that is of the built-in one (its box's largest side), so
+    /// that the motion scales with the model as the lights do.
+    pub fn motion(&self) -> f32 {
+        let side = |f: &LightFrame| (f.box_max - f.box_min).max_element();
+        SEED_MOTION * side(self) / side(&LightFrame::BUILT_IN)
+    }
+
     /// The radius at which `count` lights of `layout` reach about LIGHTS_PER_POINT lights at a
     /// point of the scene (as the bench scene's do at every count):
     /// - random, uniform in the box of volume V: count · (4/3)πr³ / V = k;
     /// - grid, n lights over the square of area A at height h above the box's centre: a point
-    ///   there is reached by the lights within √(r² − h²) in the plane, n·π(r² − h²) / A = k;
+    ///   there is reached by the lights within √(r² − h²) in the plane, n·π(r² − h²) / A = k
+    ///   (and r at least GRID_REACH·h);
     /// - surface, n lights just above surfaces of area S: a point is reached by those within r
     ///   along the surface, n·πr² / S = k.
     ///
@@ -158,7 +177,7 @@ impl LightFrame {
             LightLayout::Grid => {
                 let area = (2.0 * self.grid_half_size).powi(2);
                 let h = self.grid_centre.y - (self.box_min.y + self.box_max.y) * 0.5;
-                (h * h + k * area / (n * pi)).sqrt()
+                (h * h + k * area / (n * pi)).sqrt().max(GRID_REACH * h)
             }
             LightLayout::Surface => (k * surface_area / (n * pi)).sqrt(),
         }
@@ -238,14 +257,27 @@ impl LightParams {
     }
 }
 
+/// How far the seed's lights move in its animation.
+pub const SEED_MOTION: f32 = 0.1;
+
 /// The seed's animation: every light moves by (sin 2πt, 0, cos 2πt) · 0.1 from its rest place.
 pub fn animation_offset(t: f32) -> Vec3 {
-    Vec3::new((TAU * t).sin() * 0.1, 0.0, (TAU * t).cos() * 0.1)
+    motion_offset(t, SEED_MOTION)
 }
 
-/// Write the lights at time t into `out` (same length as `rest`).
+/// The seed's animation with another amplitude (lights fitted to a scene move by as much of
+/// their frame as the seed's move of theirs: `LightFrame::motion`).
+pub fn motion_offset(t: f32, amplitude: f32) -> Vec3 {
+    Vec3::new((TAU * t).sin() * amplitude, 0.0, (TAU * t).cos() * amplitude)
+}
+
+/// Write the lights at time t of the seed's animation into `out` (same length as `rest`).
 pub fn animate_into(rest: &[PointLight], t: f32, out: &mut [PointLight]) {
-    let d = animation_offset(t);
+    move_into(rest, animation_offset(t), out);
+}
+
+/// Write the lights moved by `d` into `out` (same length as `rest`).
+pub fn move_into(rest: &[PointLight], d: Vec3, out: &mut [PointLight]) {
     for (o, l) in out.iter_mut().zip(rest) {
         let p = l.position_radius;
         *o = PointLight { position_radius: [p[0] + d.x, p[1] + d.y, p[2] + d.z, p[3]], color: l.color };
@@ -316,7 +348,8 @@ mod tests {
         // The grid hangs over the scene, the box holds it; a flat scene's box still has depth.
         assert!(base.grid_centre.y > hi.y && base.grid_half_size >= 2.0);
         let flat = LightFrame::around(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0));
-        assert!((flat.box_max.y - flat.box_min.y - 0.5).abs() < 1e-6);
+        assert!((flat.box_max.y - flat.box_min.y - 1.5).abs() < 1e-6, "a quarter of 2 thick, and half of 2 of margin");
+        assert!(flat.box_min.x == -1.5 && flat.box_max.z == 1.5);
     }
 
     /// Monte Carlo: points of the scene's box (random), of its middle plane (grid) or of its
@@ -333,7 +366,8 @@ mod tests {
         let scene = Scene::new(vec![floor], Vec::new(), Camera::seed());
         let surfaces = SurfaceSampler::new(&scene).unwrap();
         let frame = LightFrame::around(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 4.0, 10.0));
-        for layout in LightLayout::ALL {
+        // The grid: checked below (with more than a few dozen lights GRID_REACH decides).
+        for layout in [LightLayout::Random, LightLayout::Surface] {
             let count = 4096;
             let radius = frame.default_radius(layout, count, surfaces.area());
             let lights =
@@ -347,14 +381,29 @@ mod tests {
                     LightLayout::Random => {
                         Vec3::new(inner(-10.0, 10.0, &mut rng), inner(0.0, 4.0, &mut rng) + 0.8, inner(-10.0, 10.0, &mut rng))
                     }
-                    LightLayout::Grid => Vec3::new(inner(-10.0, 10.0, &mut rng), 2.0, inner(-10.0, 10.0, &mut rng)),
-                    LightLayout::Surface => Vec3::new(inner(-10.0, 10.0, &mut rng), 0.0, inner(-10.0, 10.0, &mut rng)),
+                    _ => Vec3::new(inner(-10.0, 10.0, &mut rng), 0.0, inner(-10.0, 10.0, &mut rng)),
                 };
                 reached += lights.iter().filter(|l| Vec3::from_slice(&l.position_radius[..3]).distance(p) < l.position_radius[3]).count();
             }
             let mean = reached as f32 / samples as f32;
             assert!((mean - LIGHTS_PER_POINT).abs() < 1.0, "{layout:?}: {mean} lights reach a point (radius {radius})");
         }
+        // Many lights high over the scene: r = GRID_REACH·h, and every point of the middle plane
+        // under the grid is reached by several lights, the one straight above with falloff 0.04.
+        let h = frame.grid_centre.y - 2.0;
+        let radius = frame.default_radius(LightLayout::Grid, 4096, 0.0);
+        assert_eq!(radius, GRID_REACH * h);
+        let lights = LightParams { count: 4096, layout: LightLayout::Grid, seed: 2, radius: RadiusRange::fixed(radius) }
+            .build_in(&frame, None)
+            .unwrap();
+        for _ in 0..100 {
+            let p = Vec3::new(rng.random_range(-10.0..10.0), 2.0, rng.random_range(-10.0..10.0));
+            let reached = lights.iter().filter(|l| Vec3::from_slice(&l.position_radius[..3]).distance(p) < radius).count();
+            assert!(reached >= 4, "{p}: {reached} lights");
+        }
+        // Few lights far apart: k of them reach the middle before GRID_REACH takes over.
+        let few = frame.default_radius(LightLayout::Grid, 4, 0.0);
+        assert!(few > GRID_REACH * h && ((few * few - h * h) * std::f32::consts::PI * 4.0 / (22.0 * 22.0) - LIGHTS_PER_POINT).abs() < 1e-3);
     }
 
     #[test]

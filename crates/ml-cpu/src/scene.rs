@@ -119,6 +119,9 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Lights at rest; the renderer animates them per frame.
     pub lights: Vec<PointLight>,
+    /// How far the lights move in the seed's animation (`lights::SEED_MOTION`, or for lights
+    /// fitted to the scene `LightFrame::motion`).
+    pub light_motion: f32,
     pub camera: Camera,
     pub ambient: f32,
     /// The other lights of the blinn-phong model (the seed model ignores them).
@@ -171,6 +174,7 @@ impl Scene {
         Scene {
             objects,
             lights,
+            light_motion: crate::lights::SEED_MOTION,
             camera,
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),

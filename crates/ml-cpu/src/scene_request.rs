@@ -159,6 +159,7 @@ impl SceneRequest {
             let area = surfaces.as_ref().map_or(0.0, SurfaceSampler::area);
             let params = self.lights_of(count, |n| frame.default_radius(self.layout, n, area))?;
             scene.lights = params.build_in(&frame, surfaces.as_ref())?;
+            scene.light_motion = frame.motion();
             // The file's spot cones belonged to its own lights.
             scene.cones.clear();
             if self.lights.is_none() {

@@ -25,7 +25,7 @@ pub mod targets;
 
 pub use error::RenderError;
 pub use frame::FRAMES_IN_FLIGHT;
-pub use renderer::{FrameHook, RenderOutput, Renderer};
+pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use settings::{
     DebugView, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings,
     Shading, ShadingModel, Technique, FRAME_SECONDS, TIMER_SPEED,

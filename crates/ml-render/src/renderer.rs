@@ -16,7 +16,7 @@ use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
-use ml_cpu::lights::{animate_into, animation_offset};
+use ml_cpu::lights::{motion_offset, move_into};
 use ml_cpu::omni_shadow::shadowed_lights;
 use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, Image, VkError, VkResultExt};
@@ -29,6 +29,23 @@ pub struct RenderOutput {
     pub rgba: Vec<u8>,
     pub stats: FrameStats,
 }
+
+/// What `Renderer::render_into` tells as it renders: each frame submitted (a progress bar)
+/// and, if it wants them, each frame's image (an image sequence). `()` wants nothing.
+pub trait FrameSink {
+    /// Frame `i` (from 0) was submitted.
+    fn submitted(&mut self, _i: u32) {}
+    /// Whether every frame's image is read back and handed to `image`.
+    fn wants_images(&self) -> bool {
+        false
+    }
+    /// Frame `i`'s image, RGBA8, rows from the top.
+    fn image(&mut self, _i: u32, _rgba: &[u8]) -> Result<(), RenderError> {
+        Ok(())
+    }
+}
+
+impl FrameSink for () {}
 
 pub struct Renderer<'a> {
     ctx: &'a Context,
@@ -158,6 +175,7 @@ impl<'a> Renderer<'a> {
             debug_view: self.settings.debug_view,
             frames: self.settings.frames,
             time: self.settings.time,
+            exposure: self.settings.exposure,
             ..settings
         } == self.settings;
         if !same_pipelines {
@@ -284,14 +302,44 @@ impl<'a> Renderer<'a> {
     /// clustered-gpu, a last frame whose light lists overflowed is rendered again once the
     /// lists have grown, so the image is never one with lights missing.
     pub fn render(&mut self) -> Result<RenderOutput, RenderError> {
+        self.render_into(&mut ())
+    }
+
+    /// `render`, telling `sink` of every frame submitted and, where it wants them, handing it
+    /// every frame's image (each then waited for and, like the last, rendered again while
+    /// its light lists overflowed): an image sequence whose last image is `render`'s.
+    pub fn render_into(&mut self, sink: &mut dyn FrameSink) -> Result<RenderOutput, RenderError> {
         let mut stats = FrameStats::new(&self.pass_names());
         let start = Instant::now();
         let mut last = 0;
         for i in 0..self.settings.frames {
             last = i as usize % FRAMES_IN_FLIGHT;
             self.run_frame(last, self.settings.clock(i), &mut stats, None)?;
+            if sink.wants_images() {
+                self.collect_all(&mut stats)?;
+                last = self.complete(last, i, &mut stats)?;
+                let rgba = self.read_back(last)?;
+                sink.image(i, &rgba)?;
+            }
+            sink.submitted(i);
         }
         self.collect_all(&mut stats)?;
+        last = self.complete(last, self.settings.frames - 1, &mut stats)?;
+        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        if Output::of(self.settings.technique) == Output::Subpasses {
+            let targets = self.frames[0].targets.as_ref().expect("made with the frame");
+            stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
+        }
+        // Averages are over every frame rendered, re-renders included.
+        stats.frames = self.settings.frames + stats.rerendered_frames;
+        self.last_frame = last;
+        let rgba = self.read_back(last)?;
+        Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
+    }
+
+    /// Render frame `i` again, into the other slot, while slot `last`'s light lists overflowed
+    /// (clustered-gpu; each time they have grown); the slot that holds its complete image.
+    fn complete(&mut self, mut last: usize, i: u32, stats: &mut FrameStats) -> Result<usize, RenderError> {
         let mut rerenders = 0;
         while self.reports[last].overflowed {
             if rerenders == MAX_RERENDERS {
@@ -303,19 +351,10 @@ impl<'a> Renderer<'a> {
             rerenders += 1;
             stats.rerendered_frames += 1;
             last = (last + 1) % FRAMES_IN_FLIGHT;
-            self.run_frame(last, self.settings.clock(self.settings.frames - 1), &mut stats, None)?;
-            self.collect_all(&mut stats)?;
+            self.run_frame(last, self.settings.clock(i), stats, None)?;
+            self.collect_all(stats)?;
         }
-        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        if Output::of(self.settings.technique) == Output::Subpasses {
-            let targets = self.frames[0].targets.as_ref().expect("made with the frame");
-            stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
-        }
-        // Averages are over every frame rendered, re-renders included.
-        stats.frames = self.settings.frames + stats.rerendered_frames;
-        self.last_frame = last;
-        let rgba = self.read_back(last)?;
-        Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
+        Ok(last)
     }
 
     /// The scene's camera (where the next frame is seen from).
@@ -457,7 +496,7 @@ impl<'a> Renderer<'a> {
         let ctx = self.ctx;
         let mut grew = self.frames[f].ensure_index_capacity(ctx, self.required_indices)?;
         if !self.lights_on_gpu {
-            animate_into(&self.scene.lights, t, &mut self.animated);
+            move_into(&self.scene.lights, motion_offset(t, self.scene.light_motion), &mut self.animated);
             self.frames[f].lights.write(0, &self.animated);
         }
         let mut assign_ms = None;
@@ -475,7 +514,7 @@ impl<'a> Renderer<'a> {
             stats.index_growths += 1;
             self.bind_passes(f)?;
         }
-        let offset = animation_offset(t);
+        let offset = motion_offset(t, self.scene.light_motion);
         self.shadowed_now = self
             .shadowed
             .iter()
@@ -512,7 +551,7 @@ impl<'a> Renderer<'a> {
             viewport: [self.extent.width, self.extent.height, 0, 0],
             cluster_slices: [g.log_scale, g.log_bias, self.heat_top, 0.0],
             cluster_frustum: [g.near, g.far, g.projection.x_axis.x, g.projection.y_axis.y],
-            light_animation: animation_offset(t).extend(0.0).to_array(),
+            light_animation: motion_offset(t, self.scene.light_motion).extend(0.0).to_array(),
             cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
             shadow_view_proj: self.gpu.shadow_view_proj.to_cols_array_2d(),
             sun_direction: bp.sun_direction.extend(1.0 / self.gpu.textures.shadow_size as f32).to_array(),
@@ -526,6 +565,7 @@ impl<'a> Renderer<'a> {
                 self.scene.directional.get(i).map_or([0.0; 4], |d| d.direction.extend(0.0).to_array())
             }),
             directional_color: std::array::from_fn(|i| self.scene.directional.get(i).map_or([0.0; 4], |d| d.color.extend(0.0).to_array())),
+            exposure: [self.settings.exposure_factor(), 0.0, 0.0, 0.0],
         };
         frame.uniforms.write(0, &[uniforms]);
     }

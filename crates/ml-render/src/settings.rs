@@ -424,6 +424,22 @@ pub struct RenderSettings {
     pub culling: bool,
     /// Who draws the visibility buffer (visibility only).
     pub raster: Raster,
+    /// Exposure in EV: lit colour × 2^EV before tone map and gamma (0 changes nothing).
+    pub exposure: f32,
+}
+
+/// The most |EV| `--exposure` takes: 2^±20 is a million times brighter or darker, past any
+/// useful picture; beyond is a typo.
+pub const MAX_EXPOSURE_EV: f32 = 20.0;
+
+/// Parse `--exposure EV`: a finite number of stops within ±MAX_EXPOSURE_EV.
+pub fn parse_exposure(text: &str) -> Result<f32, RenderError> {
+    match text.trim().parse::<f32>() {
+        Ok(ev) if ev.is_finite() && ev.abs() <= MAX_EXPOSURE_EV => Ok(ev),
+        _ => Err(RenderError::Invalid(format!(
+            "exposure '{text}' is not a number of stops (EV) from -{MAX_EXPOSURE_EV} to {MAX_EXPOSURE_EV}"
+        ))),
+    }
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -446,7 +462,14 @@ impl RenderSettings {
             time: Some(0.0),
             culling: true,
             raster: Raster::Hardware,
+            exposure: 0.0,
         }
+    }
+
+    /// What lit colour is multiplied by: 2^EV (exactly 1 at EV 0, so that the default changes
+    /// no pixel).
+    pub fn exposure_factor(&self) -> f32 {
+        self.exposure.exp2()
     }
 
     /// Animation clock of frame `i`.
@@ -615,6 +638,8 @@ pub struct SettingsRequest {
     pub time: Option<f32>,
     pub culling: bool,
     pub raster: Raster,
+    /// Exposure in EV (RenderSettings::exposure).
+    pub exposure: f32,
 }
 
 impl SettingsRequest {
@@ -632,6 +657,7 @@ impl SettingsRequest {
             time: self.time,
             culling: self.culling,
             raster: self.raster,
+            exposure: self.exposure,
         }
     }
 }

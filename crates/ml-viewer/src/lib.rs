@@ -302,20 +302,21 @@ impl<'c> Session<'c> {
     }
 
     /// Apply the changed choices to the current renderer where they allow it: new lights
-    /// (count, layout, radius), objects (kind, material), cluster grid or debug view. False if
+    /// (count, layout, radius), objects (kind, material), cluster grid, debug view or exposure. False if
     /// they do not (or it failed): a new renderer then.
     fn change_in_place(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
         let (Some(renderer), Some(built)) = (&mut self.renderer, &self.built) else { return false };
         let c = &self.choices;
         let lights_only = Choices { lights: built.lights, layout: built.layout, radius: built.radius, ..c.clone() } == *built;
-        let settings_only = Choices { clusters: built.clusters, debug_view: built.debug_view, ..c.clone() } == *built;
+        let settings_only =
+            Choices { clusters: built.clusters, debug_view: built.debug_view, exposure: built.exposure, ..c.clone() } == *built;
         let objects_only = Choices { object: built.object, material: built.material, ..c.clone() } == *built;
         let done = if lights_only {
             build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_lights(scene.lights)?)).is_ok()
         } else if objects_only {
             matches!(build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_objects(&scene)?)), Ok(true))
         } else if settings_only {
-            let settings = RenderSettings { clusters: c.clusters, debug_view: c.debug_view, ..*renderer.settings() };
+            let settings = RenderSettings { clusters: c.clusters, debug_view: c.debug_view, exposure: c.exposure, ..*renderer.settings() };
             matches!(renderer.reconfigure(settings), Ok(true))
         } else {
             false
@@ -384,6 +385,12 @@ impl<'c> Session<'c> {
                     PhysicalKey::Code(KeyCode::KeyP) if down && !key.repeat => self.overlay.paused = !self.overlay.paused,
                     PhysicalKey::Code(KeyCode::F12) if down && !key.repeat => {
                         self.screenshot = Some(std::path::PathBuf::from(format!("manylights-{}.png", timestamp())));
+                    }
+                    PhysicalKey::Code(KeyCode::KeyC) if down && !key.repeat => {
+                        if let Some(camera) = self.renderer.as_ref().map(|r| r.camera()) {
+                            // The target only gives the direction: a tenth of the way to the far plane.
+                            println!("--camera {}", ml_cpu::camera::CameraSpec::describe(&camera, camera.far * 0.1));
+                        }
                     }
                     PhysicalKey::Code(KeyCode::Escape) if down => self.quit = true,
                     _ => {}

@@ -26,6 +26,8 @@ pub struct Choices {
     pub omni: Option<OmniShadowSettings>,
     /// Who draws the visibility buffer (used where the technique is visibility).
     pub raster: Raster,
+    /// Exposure in EV.
+    pub exposure: f32,
 }
 
 impl Choices {
@@ -48,6 +50,7 @@ impl Choices {
             debug_view: settings.debug_view,
             omni: settings.omni,
             raster: settings.raster,
+            exposure: settings.exposure,
         }
     }
 
@@ -83,6 +86,7 @@ impl Choices {
             culling: true,
             // Other techniques have no visibility buffer to draw.
             raster: if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware },
+            exposure: self.exposure,
         }
     }
 }
@@ -153,6 +157,7 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         }
         combo(ui, "Layout", &mut choices.layout, &LightLayout::ALL, |l| l.name());
         ui.add(Slider::new(&mut choices.radius, 0.1..=100.0).logarithmic(true).text("light radius"));
+        ui.add(Slider::new(&mut choices.exposure, -8.0..=8.0).text("exposure (EV)"));
         ui.horizontal(|ui| {
             ui.label("clusters");
             ui.add(DragValue::new(&mut choices.clusters.x).range(1..=128));
@@ -226,6 +231,7 @@ mod tests {
             debug_view: DebugView::None,
             omni: None,
             raster: Raster::Hardware,
+            exposure: 0.0,
         }
     }
 

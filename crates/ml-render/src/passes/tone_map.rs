@@ -27,7 +27,7 @@ impl Pass for ToneMap {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let hdr = self.pass.sampled(&frame.targets.hdr, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
-        self.pass.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { None })
+        self.pass.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { frame.buffer(name) })
     }
 
     /// After the render pass, whose outgoing dependency orders the HDR writes before this
