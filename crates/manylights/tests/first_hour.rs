@@ -47,7 +47,7 @@ fn scene_file(dir: &Path, name: &str, camera: &str) -> PathBuf {
     let path = dir.join(name);
     let text = format!(
         "{camera}\n[shading]\nmodel = \"pbr\"\n\n[[objects]]\nmesh = \"torusknot\"\nposition = [0.0, 1.0, 0.0]\n\n\
-         [[objects]]\nmesh = \"plane\"\nscale = 4.0\nmaterial = { name = \"white\" }\n"
+         [[objects]]\nmesh = \"plane\"\nscale = 4.0\nmaterial = {{ name = \"white\" }}\n"
     );
     std::fs::write(&path, text).unwrap();
     path
