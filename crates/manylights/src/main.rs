@@ -159,6 +159,11 @@ struct SceneArgs {
     /// prints its camera in this form.
     #[arg(long, allow_hyphen_values = true)]
     camera: Option<String>,
+    /// Draw every point light as a small cube glowing in its colour, sized by its radius and
+    /// depth-tested like any object, at the light's rest place (at most 65536 lights; not
+    /// with --omni-shadow, whose cubes would see the markers round their own lights).
+    #[arg(long)]
+    show_lights: bool,
     /// Exposure in stops (EV, -20 to 20): lit colour × 2^EV before the tone map and gamma.
     #[arg(long, default_value = "0", allow_hyphen_values = true)]
     exposure: String,
@@ -259,11 +264,15 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         radius: args.light_radius.as_deref().map(RadiusRange::parse).transpose()?,
         shading: shading_choice(args.shading.as_deref())?,
         camera: args.camera.as_deref().map(CameraSpec::parse).transpose().context("--camera")?,
+        show_lights: args.show_lights,
     })
 }
 
 /// The settings the arguments ask for, with `technique` (`--technique` itself may say auto).
 fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Result<SettingsRequest> {
+    if args.show_lights && args.omni_shadow != "off" {
+        bail!("--show-lights and --omni-shadow do not go together: each light's shadow cube would see the marker around it");
+    }
     let omni = match args.omni_shadow.as_str() {
         "off" if args.shadowed_lights != 1 || args.cube_size != OmniShadowSettings::DEFAULT_SIZE => {
             bail!("--shadowed-lights and --cube-size need point-light shadows: add --omni-shadow layered|direct|multiview|copy|compute")

@@ -64,6 +64,8 @@ fn scene(e: &SceneError) -> Option<String> {
             "--clusters {text} is invalid: use XxYxZ with each at least 1 and at most {} clusters in all",
             ml_cpu::cluster::ClusterDims::MAX_CLUSTERS
         )),
+        SceneError::TooManyMarkers(_) => Some(format!("--show-lights: {e}")),
+        SceneError::NoSurface => Some(format!("--light-layout surface: {e}")),
         _ => None,
     }
 }

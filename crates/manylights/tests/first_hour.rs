@@ -117,6 +117,8 @@ fn bad_cameras_exposures_frames_and_patterns_are_refused() {
     assert_one_line_error(&run(&["--exposure", "bright"]), &["--exposure", "'bright'"]);
     assert_one_line_error(&run(&["--frames", "1000000"]), &["--frames 1000000", "100000"]);
     assert_one_line_error(&run(&["--light-layout", "spiral"]), &["spiral", "grid, random, surface"]);
+    assert_one_line_error(&run(&["--show-lights", "--omni-shadow", "layered"]), &["--show-lights", "--omni-shadow"]);
+    assert_one_line_error(&run(&["--show-lights", "--lights", "70000"]), &["--show-lights", "70000 lights", "65536"]);
     let bad_pattern = dir.join("a#b#.png");
     assert_one_line_error(&manylights(&["render", "--frames", "2", "--out", bad_pattern.to_str().unwrap()]), &["one run of #"]);
     assert!(!out.exists());

@@ -12,6 +12,8 @@ pub enum SceneError {
     LightRadius(String),
     #[error("cluster grid {0} is invalid: use XxYxZ with each at least 1 and at most {max} clusters in all", max = crate::cluster::ClusterDims::MAX_CLUSTERS)]
     Clusters(String),
+    #[error("{0} lights are too many to show: each is drawn as an object, at most {max}", max = crate::scene::MAX_LIGHT_MARKERS)]
+    TooManyMarkers(usize),
     #[error("the surface light layout needs a scene with surfaces (triangles of non-zero area)")]
     NoSurface,
     #[error("unknown {kind} '{name}': expected one of {expected}")]

@@ -139,6 +139,13 @@ pub struct Scene {
     pub cones: Vec<LightCone>,
 }
 
+/// A light marker's half-width as a fraction of its light's radius (the seed's radius-15
+/// lights get cubes 0.6 m wide beside spheres 2 m wide).
+pub const LIGHT_MARKER_SIZE: f32 = 0.02;
+/// Most lights `--show-lights` draws: each marker is an object of its own (one draw each in
+/// the forward techniques).
+pub const MAX_LIGHT_MARKERS: usize = 65_536;
+
 /// Most directional lights a scene may have (FrameUniforms holds them).
 pub const MAX_DIRECTIONAL_LIGHTS: usize = 4;
 
@@ -213,6 +220,24 @@ impl Scene {
         Scene::new(objects, vec![light], camera)
     }
 
+    /// The scene with every point light drawn (`--show-lights`): a small cube at the light's
+    /// rest place, half as wide as LIGHT_MARKER_SIZE of its radius, black and glowing in the
+    /// light's colour (emission, which every model adds as it is and every technique draws).
+    /// Ordinary objects, so every technique depth-tests them like the rest of the scene.
+    pub fn with_light_markers(mut self) -> Result<Scene, SceneError> {
+        if self.lights.len() > MAX_LIGHT_MARKERS {
+            return Err(SceneError::TooManyMarkers(self.lights.len()));
+        }
+        let black = Material { albedo: Vec3::ZERO, roughness: 1.0, metallic: 0.0 };
+        let markers = self.lights.iter().map(|l| {
+            let [x, y, z, radius] = l.position_radius;
+            let extras = MaterialExtras { emissive: Vec3::from_slice(&l.color[..3]), ..MaterialExtras::default() };
+            Object { extras, ..Object::placed(MeshKind::Cube, Vec3::new(x, y, z), radius * LIGHT_MARKER_SIZE, black) }
+        });
+        self.objects.extend(markers.collect::<Vec<_>>());
+        Ok(self)
+    }
+
     /// World box around every object (each mesh fits [−1, 1]³ in object space).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.objects.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), o| {
@@ -268,5 +293,20 @@ mod tests {
             (lo - Vec3::new(1.0 - r, -1.0, -r)).abs().max_element() < 1e-5 && (hi - Vec3::new(1.0 + r, 1.0, r)).abs().max_element() < 1e-5
         );
         assert_eq!(o.as_placed(), None);
+    }
+
+    #[test]
+    fn light_markers_are_glowing_cubes_sized_by_their_radius() {
+        let params = LightParams { count: 5, ..LightParams::seed_default() };
+        let s = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &params).unwrap();
+        let shown = s.clone().with_light_markers().unwrap();
+        assert_eq!(shown.objects.len(), 49 + 5);
+        for (o, l) in shown.objects[49..].iter().zip(&s.lights) {
+            assert_eq!(o.as_placed(), Some((Vec3::from_slice(&l.position_radius[..3]), 15.0 * LIGHT_MARKER_SIZE)));
+            assert_eq!((o.mesh, o.extras.emissive, o.material.albedo), (MeshKind::Cube, Vec3::from_slice(&l.color[..3]), Vec3::ZERO));
+        }
+        let many = LightParams { count: MAX_LIGHT_MARKERS as u32 + 1, ..LightParams::seed_default() };
+        let crowded = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &many).unwrap();
+        assert_eq!(crowded.with_light_markers(), Err(SceneError::TooManyMarkers(MAX_LIGHT_MARKERS + 1)));
     }
 }

@@ -55,6 +55,8 @@ pub struct SceneRequest {
     /// Where the camera stands and looks (its planes fitted to the scene's box as a scene
     /// file's are); None: the scene's own camera.
     pub camera: Option<CameraSpec>,
+    /// Draw every point light as a small glowing cube (`Scene::with_light_markers`).
+    pub show_lights: bool,
 }
 
 /// A built scene and the shading model to render it with.
@@ -96,7 +98,16 @@ impl SceneRequest {
     /// `source` with the defaults: its own lights (placed as the seed's grid, seed 1, the
     /// default radius where a count is given), its own shading model.
     pub fn new(source: SceneSource) -> SceneRequest {
-        SceneRequest { source, lights: None, layout: LightLayout::Grid, seed: 1, radius: None, shading: None, camera: None }
+        SceneRequest {
+            source,
+            lights: None,
+            layout: LightLayout::Grid,
+            seed: 1,
+            radius: None,
+            shading: None,
+            camera: None,
+            show_lights: false,
+        }
     }
 
     /// Whether the scene is the seed's grid (its object and material may change).
@@ -115,6 +126,9 @@ impl SceneRequest {
         let mut built = self.build_scene()?;
         if let Some(spec) = &self.camera {
             built.scene.camera = spec.camera(built.scene.bounds());
+        }
+        if self.show_lights {
+            built.scene = built.scene.with_light_markers()?;
         }
         Ok(built)
     }

@@ -106,3 +106,41 @@ fn every_kind_at_every_size_is_lit_inside_one_band() {
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
     assert!(outside.is_empty(), "outside the band {BAND:?} or changed with the size:\n{}", outside.join("\n"));
 }
+
+/// `--show-lights` on the seed scene's 64-light grid, in every technique: at the pixel where
+/// each light's rest place projects (where its marker's centre is), the colour is the light's
+/// — the channels it has are bright, the ones it lacks dark — and without markers it is not.
+#[test]
+fn shown_lights_are_blobs_of_their_colour_in_every_technique() {
+    use ml_cpu::material::Material;
+    let source = SceneSource::Seed { object: MeshKind::Sphere, material: Material::named("gold").unwrap() };
+    // From further back and higher than the seed's camera, which sees few of the lights.
+    let camera = Some(ml_cpu::camera::CameraSpec::parse("0,30,42:0,2,0:60").unwrap());
+    let plain = SceneRequest { camera, ..SceneRequest::new(source.clone()) }.build().unwrap().scene;
+    let shown = SceneRequest { show_lights: true, camera, ..SceneRequest::new(source) }.build().unwrap().scene;
+    let (width, height) = (256u32, 144u32);
+    let techniques = Technique::ALL.to_vec();
+    let settings: Vec<RenderSettings> = techniques.iter().map(|&t| RenderSettings::new(t, width, height)).collect();
+    let with = common::render_each(&shown, &settings);
+    let without = common::render(plain.clone(), settings[0]);
+    let view_proj = plain.camera.projection(width as f32 / height as f32) * plain.camera.view();
+    let mut seen = 0;
+    for light in &plain.lights {
+        let ndc = view_proj.project_point3(glam::Vec3::from_slice(&light.position_radius[..3]));
+        if ndc.x.abs() > 0.95 || ndc.y.abs() > 0.95 || !(0.0..1.0).contains(&ndc.z) {
+            continue;
+        }
+        seen += 1;
+        let (x, y) = (((ndc.x + 1.0) * 0.5 * width as f32) as u32, ((ndc.y + 1.0) * 0.5 * height as f32) as u32);
+        let has = light.color.map(|c| c > 0.0);
+        for (out, technique) in with.iter().zip(&techniques) {
+            let p = common::pixel(out, x, y);
+            let matches = (0..3).all(|c| if has[c] { p[c] >= 200 } else { p[c] <= 60 });
+            assert!(matches, "{technique:?}: light at {:?} (colour {:?}) shows {p:?} at ({x}, {y})", light.position_radius, light.color);
+        }
+        let bare = common::pixel(&without, x, y);
+        assert!(!(0..3).all(|c| if has[c] { bare[c] >= 200 } else { bare[c] <= 60 }), "without markers: {bare:?} at ({x}, {y})");
+    }
+    println!("{seen} of 64 lights in view, each a blob of its colour in {} techniques", techniques.len());
+    assert_eq!(seen, 64, "lights out of view");
+}

@@ -152,6 +152,8 @@ struct Session<'c> {
     window_shot: Option<std::path::PathBuf>,
     quit: bool,
     counts: Counts,
+    /// Lights drawn as markers (`--show-lights`): objects that follow the lights.
+    show_lights: bool,
 }
 
 /// What a session did (printed at the end of a scripted one).
@@ -189,6 +191,7 @@ impl<'c> Session<'c> {
             ctx,
             renderer: None,
             overlay: OverlayState::new(&options.choices, options.scene.is_seed()),
+            show_lights: options.scene.show_lights,
             choices: options.choices,
             built: None,
             presenter,
@@ -312,7 +315,13 @@ impl<'c> Session<'c> {
             Choices { clusters: built.clusters, debug_view: built.debug_view, exposure: built.exposure, ..c.clone() } == *built;
         let objects_only = Choices { object: built.object, material: built.material, ..c.clone() } == *built;
         let done = if lights_only {
-            build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_lights(scene.lights)?)).is_ok()
+            // With markers shown the objects change with the lights: their markers too.
+            let markers = self.show_lights;
+            let changed = build(c, (extent.width, extent.height)).and_then(|(scene, _)| {
+                renderer.set_lights(scene.lights.clone())?;
+                Ok(!markers || renderer.set_objects(&scene)?)
+            });
+            matches!(changed, Ok(true))
         } else if objects_only {
             matches!(build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_objects(&scene)?)), Ok(true))
         } else if settings_only {
