@@ -96,15 +96,15 @@ impl Camera {
 /// A camera's field of view when nothing says otherwise (the seed's).
 pub const DEFAULT_FOV_Y_DEG: f32 = 60.0;
 
-/// Clip planes for a perspective camera of `fov_y_deg` at `position` that sees the box
-/// [lo, hi] (a scene's): near half the gap between a framing camera and the box's bounding
-/// sphere (never under 1/2000 of the framing distance), far past the sphere's far side.
-/// Scene files and `--camera` use these where they name no planes.
-pub fn clip_planes_for(lo: Vec3, hi: Vec3, fov_y_deg: f32, position: Vec3) -> (f32, f32) {
+/// Clip planes for a camera at `position` that sees the box [lo, hi] (a scene's): near half
+/// the gap between the camera and the box's bounding sphere (never under 1/2000 of the
+/// sphere's radius, for a camera inside it), far past the sphere's far side. Scene files and
+/// `--camera` use these where they name no planes.
+pub fn clip_planes_for(lo: Vec3, hi: Vec3, position: Vec3) -> (f32, f32) {
     let centre = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
-    let distance = framing_distance(radius, fov_y_deg);
-    ((distance - radius).max(distance * 1e-3) * 0.5, position.distance(centre) + radius * 2.0)
+    let distance = position.distance(centre);
+    ((distance - radius).max(radius * 1e-3) * 0.5, distance + radius * 2.0)
 }
 
 /// How far from a sphere of `radius` a camera of `fov_y_deg` stands to see all of it.
@@ -164,7 +164,7 @@ impl CameraSpec {
     /// The camera looking from `position` at `target`, its planes fitted to the box [lo, hi]
     /// as a scene file's are.
     pub fn camera(&self, (lo, hi): (Vec3, Vec3)) -> Camera {
-        let (near, far) = clip_planes_for(lo, hi, self.fov_y_deg, self.position);
+        let (near, far) = clip_planes_for(lo, hi, self.position);
         Camera::looking_at(self.position, self.target, self.fov_y_deg, near, far)
     }
 
@@ -191,6 +191,17 @@ mod tests {
         assert!(matches!(CameraSpec::parse("1,2,3:0,0,0:0"), Err(CameraSpecError::FieldOfView(_))));
         assert!(matches!(CameraSpec::parse("1,2,3:1,2,3"), Err(CameraSpecError::Nowhere(_))));
         assert!(matches!(CameraSpec::parse("0,5,0:0,0,0"), Err(CameraSpecError::Vertical(_))));
+    }
+
+    #[test]
+    fn clip_planes_hold_the_box_wherever_the_camera_stands() {
+        let (lo, hi) = (Vec3::splat(-1.0), Vec3::splat(1.0));
+        let r = 3f32.sqrt();
+        let (near, far) = clip_planes_for(lo, hi, Vec3::new(0.0, 0.0, 10.0));
+        assert!((near - (10.0 - r) * 0.5).abs() < 1e-5 && (far - (10.0 + 2.0 * r)).abs() < 1e-5);
+        // Close by, even inside the box: a small near plane, never behind the eye.
+        let (near, far) = clip_planes_for(lo, hi, Vec3::new(0.0, 0.0, 0.5));
+        assert!(near > 0.0 && near < 1e-3 && far > 2.0 * r);
     }
 
     #[test]

@@ -447,7 +447,7 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
     if position.distance(target) < 1e-6 {
         return Err(Problem::CameraNowhere);
     }
-    let (fitted_near, fitted_far) = clip_planes_for(lo, hi, fov, position);
+    let (fitted_near, fitted_far) = clip_planes_for(lo, hi, position);
     let near = c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or(fitted_near);
     let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(fitted_far);
     if near >= far {
