@@ -1,6 +1,9 @@
 //! The command line: a good render prints its table and writes its PNG; bad input gets one
 //! clear error line and a non-zero exit, never a panic.
 
+mod common;
+
+use common::assert_one_line_error;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -19,18 +22,6 @@ fn temp_png(name: &str) -> PathBuf {
     dir.join(name)
 }
 
-/// Fails unless the run failed with exactly one `error:` line mentioning every `needle`.
-fn assert_one_line_error(out: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "should fail; stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "panic: {stderr}");
-    let lines: Vec<&str> = stderr.lines().collect();
-    assert_eq!(lines.len(), 1, "expected one line, got: {stderr}");
-    assert!(lines[0].starts_with("error: "), "{stderr}");
-    for n in needles {
-        assert!(lines[0].contains(n), "'{n}' missing from: {stderr}");
-    }
-}
 
 #[test]
 fn renders_a_png_and_prints_the_table() {

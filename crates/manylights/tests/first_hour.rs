@@ -3,6 +3,9 @@
 //! image sequence writes every frame (its last the `--frames N` image), and bad values of the
 //! new options get one error line.
 
+mod common;
+
+use common::assert_one_line_error;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -26,18 +29,6 @@ fn pixels(path: &Path) -> image::RgbaImage {
     image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
 }
 
-/// Fails unless the run failed with exactly one `error:` line mentioning every `needle`.
-fn assert_one_line_error(out: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "should fail; stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "panic: {stderr}");
-    let lines: Vec<&str> = stderr.lines().collect();
-    assert_eq!(lines.len(), 1, "expected one line, got: {stderr}");
-    assert!(lines[0].starts_with("error: "), "{stderr}");
-    for n in needles {
-        assert!(lines[0].contains(n), "'{n}' missing from: {stderr}");
-    }
-}
 
 const SIZE: [&str; 4] = ["--width", "96", "--height", "64"];
 
