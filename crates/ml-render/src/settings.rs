@@ -3,7 +3,7 @@
 use crate::error::{Named, RenderError, Setting, SettingsError};
 use ml_cpu::cluster::ClusterDims;
 pub use ml_cpu::shading_model::ShadingModel;
-use ml_vk::Context;
+use ml_vk::{vk, Context};
 
 /// Lighting techniques (docs/DESIGN.md#techniques-are-two-choices). Each must give the same image as `Forward`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -233,6 +233,34 @@ impl OmniShadowSettings {
     }
 }
 
+/// Who draws the sun's shadow map (blinn-phong), once, when the scene's objects reach the GPU
+/// (docs/DESIGN.md#sun-shadow-map).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SunShadowMode {
+    /// A depth-only render pass.
+    Graphics,
+    /// The compute shadow raster, in one orthographic view (docs/DESIGN.md#compute-shadow-raster).
+    Compute,
+}
+
+impl SunShadowMode {
+    pub const ALL: [SunShadowMode; 2] = [SunShadowMode::Graphics, SunShadowMode::Compute];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SunShadowMode::Graphics => "graphics",
+            SunShadowMode::Compute => "compute",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<SunShadowMode, RenderError> {
+        SunShadowMode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
+            let expected = SunShadowMode::ALL.map(|m| m.name()).join(", ");
+            RenderError::UnknownName { kind: Named::SunShadowMode, name: name.to_owned(), expected }
+        })
+    }
+}
+
 /// Who draws the visibility buffer (technique visibility; docs/DESIGN.md#compute-raster).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Raster {
@@ -414,6 +442,8 @@ pub struct RenderSettings {
     pub debug_view: DebugView,
     /// Point-light shadow cubes (None: point lights cast no shadows).
     pub omni: Option<OmniShadowSettings>,
+    /// Who draws the sun's shadow map (blinn-phong).
+    pub sun_shadow: SunShadowMode,
     pub width: u32,
     pub height: u32,
     /// Frames to render; the image is the last one's, timings are averaged over all.
@@ -440,6 +470,7 @@ impl RenderSettings {
             clusters: ClusterDims::DEFAULT,
             debug_view: DebugView::None,
             omni: None,
+            sun_shadow: SunShadowMode::Graphics,
             width,
             height,
             frames: 1,
@@ -523,6 +554,17 @@ impl RenderSettings {
         }
         if let Some(omni) = &self.omni {
             check_omni(ctx, omni, lights)?;
+        }
+        if self.sun_shadow == SunShadowMode::Compute && self.shading == ShadingModel::BlinnPhong {
+            let features = &ctx.info.features;
+            let depth = ctx.format_supports(
+                vk::Format::D32_SFLOAT,
+                vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE,
+            );
+            let missing = [(features.buffer_int64_atomics, "shaderInt64"), (depth, "a sampled D32_SFLOAT depth format")];
+            if let Some((_, feature)) = missing.into_iter().find(|(has, _)| !has) {
+                return Err(SettingsError::SunShadowFeature { feature, device: device() }.into());
+            }
         }
         if self.frames == 0 {
             return Err(SettingsError::NoFrames.into());
@@ -609,6 +651,7 @@ pub struct SettingsRequest {
     pub clusters: Option<ClusterDims>,
     pub debug_view: DebugView,
     pub omni: Option<OmniShadowSettings>,
+    pub sun_shadow: SunShadowMode,
     pub width: u32,
     pub height: u32,
     pub frames: u32,
@@ -626,6 +669,7 @@ impl SettingsRequest {
             clusters: self.clusters.unwrap_or_else(|| ClusterDims::for_lights(scene.lights.len(), self.width, self.height)),
             debug_view: self.debug_view,
             omni: self.omni,
+            sun_shadow: self.sun_shadow,
             width: self.width,
             height: self.height,
             frames: self.frames,
