@@ -91,11 +91,16 @@ impl Technique {
     }
 
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {
-        Technique::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| {
-            let expected = Technique::ALL.map(|t| t.name()).join(", ");
-            RenderError::UnknownName { kind: Named::Technique, name: name.to_owned(), expected }
-        })
+        by_name(&Technique::ALL, Technique::name, Named::Technique, name)
     }
+}
+
+/// The one of `all` whose name (`name_of`) is `name`; else the error that lists the names.
+fn by_name<T: Copy>(all: &[T], name_of: fn(T) -> &'static str, kind: Named, name: &str) -> Result<T, RenderError> {
+    all.iter().copied().find(|&v| name_of(v) == name).ok_or_else(|| {
+        let expected = all.iter().map(|&v| name_of(v)).collect::<Vec<_>>().join(", ");
+        RenderError::UnknownName { kind, name: name.to_owned(), expected }
+    })
 }
 
 /// Where lights are assigned to clusters.
@@ -207,10 +212,7 @@ impl OmniShadowMode {
     }
 
     pub fn from_name(name: &str) -> Result<OmniShadowMode, RenderError> {
-        OmniShadowMode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
-            let expected = OmniShadowMode::ALL.map(|m| m.name()).join(", ");
-            RenderError::UnknownName { kind: Named::OmniShadowMode, name: name.to_owned(), expected }
-        })
+        by_name(&OmniShadowMode::ALL, OmniShadowMode::name, Named::OmniShadowMode, name)
     }
 }
 
@@ -254,10 +256,7 @@ impl SunShadowMode {
     }
 
     pub fn from_name(name: &str) -> Result<SunShadowMode, RenderError> {
-        SunShadowMode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
-            let expected = SunShadowMode::ALL.map(|m| m.name()).join(", ");
-            RenderError::UnknownName { kind: Named::SunShadowMode, name: name.to_owned(), expected }
-        })
+        by_name(&SunShadowMode::ALL, SunShadowMode::name, Named::SunShadowMode, name)
     }
 }
 
@@ -314,9 +313,7 @@ impl Raster {
     /// The rasteriser `name` names (`hardware`, `hybrid`, `compute`), those in compute with
     /// `split`.
     pub fn from_name(name: &str, split: u32) -> Result<Raster, RenderError> {
-        [Raster::Hardware, Raster::hybrid(split), Raster::compute(split)].into_iter().find(|r| r.name() == name).ok_or_else(|| {
-            RenderError::UnknownName { kind: Named::Raster, name: name.to_owned(), expected: "hardware, hybrid, compute".to_owned() }
-        })
+        by_name(&[Raster::Hardware, Raster::hybrid(split), Raster::compute(split)], Raster::name, Named::Raster, name)
     }
 
     /// The largest triangle drawn in compute by one thread (0: none).
@@ -405,10 +402,7 @@ impl DebugView {
     }
 
     pub fn from_name(name: &str) -> Result<DebugView, RenderError> {
-        DebugView::ALL.into_iter().find(|v| v.name() == name).ok_or_else(|| {
-            let expected = DebugView::ALL.map(|v| v.name()).join(", ");
-            RenderError::UnknownName { kind: Named::DebugView, name: name.to_owned(), expected }
-        })
+        by_name(&DebugView::ALL, DebugView::name, Named::DebugView, name)
     }
 
     /// The value shaders see (DEBUG_VIEW_* in common.glsl).
