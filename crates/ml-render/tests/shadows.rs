@@ -149,16 +149,8 @@ fn the_compute_raster_draws_the_same_sun_shadow_map() {
         let (graphics, graphics_image) = draw(SunShadowMode::Graphics);
         let (compute, compute_image) = draw(SunShadowMode::Compute);
         assert_eq!(graphics.len(), (SHADOW_MAP_SIZE * SHADOW_MAP_SIZE) as usize);
-        assert_eq!(graphics.len(), compute.len());
-        let reached = |d: f32| d < 1.0;
-        let coverage: Vec<(usize, f32, f32)> = graphics
-            .iter()
-            .zip(&compute)
-            .enumerate()
-            .filter(|(_, (g, c))| reached(**g) != reached(**c))
-            .map(|(i, (&g, &c))| (i, g, c))
-            .collect();
-        let differ = graphics.iter().zip(&compute).filter(|(g, c)| g != c).count();
+        let (coverage, differ) = common::coverage_difference(&graphics, &compute);
+        let reached = common::reached;
         let worst = graphics.iter().zip(&compute).filter(|(g, _)| reached(**g)).map(|(g, c)| (g - c).abs()).fold(0.0, f32::max);
         let (max, pixels) = common::max_difference(&graphics_image, &compute_image);
         // Our depths come from the corners snapped to 1/256 texel, the render pass's from the
