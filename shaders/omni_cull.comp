@@ -3,8 +3,8 @@
 // The compute shadow raster, step 1 (omni_raster.glsl): a thread per (meshlet instance,
 // shadowed light) tests the meshlet's bounding sphere against the light's sphere and each
 // cube face's 90° pyramid, and lists a (meshlet instance, cube layer) pair per face it may
-// reach — the per-face culling the graphics modes do per object, here per meshlet. No
-// back-face cone: shadow passes draw both faces.
+// reach — the per-face culling the graphics modes do per object, here per meshlet (with
+// ORTHO_VIEW: against the view's box). No back-face cone: shadow passes draw both faces.
 #include "common.glsl"
 
 layout(local_size_x = 64) in;
@@ -33,6 +33,14 @@ uint sphere_faces(vec3 c, float r) {
     return mask;
 }
 
+// Whether a sphere at `c` (world) of radius `r` may reach the orthographic view whose
+// view-projection is `p`: each clip axis stretches the sphere by its row's length.
+bool sphere_in_box(mat4 p, vec3 c, float r) {
+    vec3 centre = (p * vec4(c, 1.0)).xyz;
+    vec3 reach = r * vec3(length(vec3(p[0][0], p[1][0], p[2][0])), length(vec3(p[0][1], p[1][1], p[2][1])), length(vec3(p[0][2], p[1][2], p[2][2])));
+    return all(lessThanEqual(abs(centre.xy), 1.0 + reach.xy)) && centre.z >= -reach.z && centre.z <= 1.0 + reach.z;
+}
+
 void main() {
     uint light = gl_WorkGroupID.y;
     vec4 l = shadow_lights[light];
@@ -41,6 +49,14 @@ void main() {
         Meshlet m = meshlets[object_meshlet.y];
         vec3 c = (objects[object_meshlet.x].model * vec4(m.center_radius.xyz, 1.0)).xyz - l.xyz;
         float r = m.center_radius.w * instances[object_meshlet.x].scale.x;
+        if (ORTHO_VIEW) {
+            if (sphere_in_box(omni.projection, c, r)) {
+                uint at = atomicAdd(counters.pairs.w, 1u);
+                atomicMax(counters.pairs.x, min(at + 1u, MAX_GROUPS));
+                pairs[at] = uvec2(id, light);
+            }
+            continue;
+        }
         if (length(c) > l.w + r) {
             continue;
         }

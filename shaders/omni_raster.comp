@@ -22,13 +22,12 @@ void main() {
         uvec2 object_meshlet = meshlet_instances[pair.x];
         Meshlet m = meshlets[object_meshlet.y];
         uint layer = pair.y;
-        vec4 light = shadow_lights[layer / 6u];
         // The last pair's triangles are done with the shared corners.
         barrier();
         if (lid < m.triangles.w) {
-            vec3 rel = light_relative(meshlet_vertices[m.triangles.z + lid], objects[object_meshlet.x].model, light);
-            corner_rel[lid] = rel;
-            corner_clip[lid] = omni_face_clip(omni.projection, rel, int(layer % 6u));
+            vec4 clip;
+            corner_rel[lid] = view_vertex(meshlet_vertices[m.triangles.z + lid], objects[object_meshlet.x].model, layer, clip);
+            corner_clip[lid] = clip;
         }
         barrier();
         for (uint t = lid; t < m.triangles.y; t += gl_WorkGroupSize.x) {

@@ -1,13 +1,15 @@
 // The compute shadow raster (--omni-shadow compute; docs/DESIGN.md#compute-shadow-raster):
 // every shadowed light's six cube faces drawn by compute shaders into one buffer of 32-bit
-// depths, then copied into the cube array the shading passes sample. What its three shaders
+// depths, then copied into the cube array the shading passes sample; compiled with
+// ORTHO_VIEW, the same shaders draw one orthographic view (the sun's shadow map). What its three shaders
 // share: the bindings, the vertex transform and the two ways to rasterise a triangle — by one
 // thread (small ones), or by a whole work group over its clipped polygon (large ones, and
 // those crossing the near plane). Either way by Vulkan's rules as the graphics modes are
 // drawn: the same vertex positions, snapped to 1/256 texel, the top-left rule, both faces
 // (a caster need not be closed), the distance to the light over its radius interpolated as
-// the fragment shader's input is (perspective-correct), LESS against what is there: a
-// 32-bit atomic min of the depth's bits (non-negative floats order as their bits do).
+// the fragment shader's input is (perspective-correct; for an orthographic view, the depth
+// the rasteriser writes: clip z, w being 1), LESS against what is there: a 32-bit atomic min
+// of the depth's bits (non-negative floats order as their bits do).
 // Needs common.glsl.
 
 #ifndef MANYLIGHTS_OMNI_RASTER_GLSL
@@ -37,6 +39,11 @@ layout(std430, set = 0, binding = 10) buffer OmniLargeBuffer { uvec2 large_trian
 layout(std430, set = 0, binding = 11) buffer CubeDepthBuffer { uint cube_depth[]; };
 layout(push_constant) uniform OmniRasterPushBlock { OmniRasterPush omni; };
 
+// One orthographic view instead of cube faces: layer i is light i's view (the sun: one
+// light at the origin with radius 1, so positions stay world positions) and omni.projection
+// is its view-projection. Keep in sync with shadow_raster.rs SPEC_ORTHO_VIEW.
+layout(constant_id = 0) const bool ORTHO_VIEW = false;
+
 #include "meshlet_geometry.glsl"
 
 // A vertex in the light's frame, in radii (as omni_shadow_vertex.glsl's model_to_light).
@@ -44,6 +51,25 @@ vec3 light_relative(uint vertex, mat4 model, vec4 light) {
     uint b = VERTEX_FLOATS * vertex;
     vec3 world = (model * vec4(vertex_data[b], vertex_data[b + 1u], vertex_data[b + 2u], 1.0)).xyz;
     return (world - light.xyz) / light.w;
+}
+
+// The light whose view `layer` is.
+uint layer_light(uint layer) {
+    return ORTHO_VIEW ? layer : layer / 6u;
+}
+
+// Vertex `vertex` of an object (`model`) as layer `layer` sees it: its clip position, and
+// the attribute whose perspective-correct interpolation gives a texel's depth
+// (interpolated_depth) — the position relative to the light, in radii, on a cube face; the
+// clip position itself in an orthographic view.
+vec3 view_vertex(uint vertex, mat4 model, uint layer, out vec4 clip) {
+    vec3 rel = light_relative(vertex, model, shadow_lights[layer_light(layer)]);
+    if (ORTHO_VIEW) {
+        clip = omni.projection * vec4(rel, 1.0);
+        return clip.xyz;
+    }
+    clip = omni_face_clip(omni.projection, rel, int(layer % 6u));
+    return rel;
 }
 
 // The viewport transform of a face, in texels.
@@ -57,11 +83,13 @@ bool outside_face(vec4 a, vec4 b, vec4 c) {
         || (a.y < -a.w && b.y < -b.w && c.y < -c.w) || (a.z < 0.0 && b.z < 0.0 && c.z < 0.0) || (a.z > a.w && b.z > b.w && c.z > c.w);
 }
 
-// The fragment shader's depth at a texel: the interpolated position's distance to the light
-// (corners q: xyz in radii, w: 1 / clip w; weights: the edge functions opposite each).
-float interpolated_distance(vec3 weights, vec4 qa, vec4 qb, vec4 qc) {
+// The depth at a texel (corners q: xyz as view_vertex gives them, w: 1 / clip w; weights:
+// the edge functions opposite each): on a cube face the fragment shader's, the interpolated
+// position's distance to the light; in an orthographic view the rasteriser's, clip z.
+float interpolated_depth(vec3 weights, vec4 qa, vec4 qb, vec4 qc) {
     vec3 pw = weights * vec3(qa.w, qb.w, qc.w);
-    return length((pw.x * qa.xyz + pw.y * qb.xyz + pw.z * qc.xyz) / (pw.x + pw.y + pw.z));
+    vec3 p = (pw.x * qa.xyz + pw.y * qb.xyz + pw.z * qc.xyz) / (pw.x + pw.y + pw.z);
+    return ORTHO_VIEW ? p.z : length(p);
 }
 
 // LESS against what is there (and against the cleared 1.0: beyond the light's reach).
@@ -91,7 +119,7 @@ uint raster_small(vec2 pa, vec2 pb, vec2 pc, vec4 qa, vec4 qb, vec4 qc, uint lay
             ivec3 w;
             if (small_covers(t, ivec2(x, y), w)) {
                 covered++;
-                keep_nearest(layer, ivec2(x, y), interpolated_distance(vec3(w), qa, qb, qc));
+                keep_nearest(layer, ivec2(x, y), interpolated_depth(vec3(w), qa, qb, qc));
             }
         }
     }
@@ -104,7 +132,7 @@ uint fan_texel(FanTriangle t, ivec2 texel, uint layer) {
     if (!fan_covers(t, texel, w)) {
         return 0u;
     }
-    keep_nearest(layer, texel, interpolated_distance(vec3(w), t.qa, t.qb, t.qc));
+    keep_nearest(layer, texel, interpolated_depth(vec3(w), t.qa, t.qb, t.qc));
     return 1u;
 }
 

@@ -30,13 +30,10 @@ void main() {
             uvec2 pair = pairs[listed.x];
             uvec2 object_meshlet = meshlet_instances[pair.x];
             Meshlet m = meshlets[object_meshlet.y];
-            int face = int(pair.y % 6u);
-            vec4 light = shadow_lights[pair.y / 6u];
             mat4 model = objects[object_meshlet.x].model;
             uvec3 v = meshlet_triangle(m, listed.y);
-            vec3 ra = light_relative(v.x, model, light), rb = light_relative(v.y, model, light), rc = light_relative(v.z, model, light);
-            vec4 a = omni_face_clip(omni.projection, ra, face), b = omni_face_clip(omni.projection, rb, face);
-            vec4 c = omni_face_clip(omni.projection, rc, face);
+            vec4 a, b, c;
+            vec3 ra = view_vertex(v.x, model, pair.y, a), rb = view_vertex(v.y, model, pair.y, b), rc = view_vertex(v.z, model, pair.y, c);
             Polygon p = clipped_polygon(a, b, c, ra, rb, rc, vec2(float(omni.sizes.x)));
             corner_count = p.count;
             for (int i = 0; i < p.count; i++) {

@@ -15,7 +15,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, Geometry, Raster, RenderOutput, Renderer, Technique};
+use ml_render::{DebugView, Geometry, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -123,6 +123,7 @@ impl Plan {
             clusters: cluster_choice(&a.clusters)?,
             debug_view: DebugView::None,
             omni: None,
+            sun_shadow: SunShadowMode::Graphics,
             width,
             height,
             frames: 1,

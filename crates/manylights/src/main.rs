@@ -11,7 +11,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::report;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, Technique};
+use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -143,6 +143,11 @@ struct SceneArgs {
     /// shaders, meshlets culled per face).
     #[arg(long, default_value = "off")]
     omni_shadow: String,
+    /// Who draws the sun's shadow map (blinn-phong), once at start: graphics (a depth-only
+    /// render pass) or compute (the compute shadow raster of --omni-shadow compute, in one
+    /// orthographic view).
+    #[arg(long, default_value = "graphics")]
+    sun_shadow: String,
     /// How many point lights cast shadows (the strongest as seen from the camera).
     #[arg(long, default_value_t = 1)]
     shadowed_lights: u32,
@@ -285,6 +290,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         clusters: cluster_choice(&args.clusters)?,
         debug_view: DebugView::from_name(&args.debug_view)?,
         omni,
+        sun_shadow: SunShadowMode::from_name(&args.sun_shadow)?,
         width: args.width,
         height: args.height,
         frames,

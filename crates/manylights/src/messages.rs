@@ -29,6 +29,9 @@ fn with_flags(cause: &(dyn Error + 'static)) -> Option<String> {
             RenderError::UnknownName { kind: Named::OmniShadowMode, name, expected } => {
                 Some(format!("unknown --omni-shadow mode '{name}': expected one of {expected}"))
             }
+            RenderError::UnknownName { kind: Named::SunShadowMode, name, expected } => {
+                Some(format!("unknown --sun-shadow mode '{name}': expected one of {expected}"))
+            }
             RenderError::UnknownName { kind: Named::Raster, name, expected } => {
                 Some(format!("unknown rasteriser '{name}' in --raster: expected one of {expected}"))
             }
@@ -106,6 +109,9 @@ fn settings(e: &SettingsError) -> String {
         SettingsError::MissingFeature { mode, feature, device, instead } => {
             format!("--omni-shadow {} needs the {feature} feature, which '{device}' lacks: use {instead}", mode.name())
         }
+        SettingsError::SunShadowFeature { feature, device } => {
+            format!("--sun-shadow compute needs {feature}, which '{device}' lacks: use --sun-shadow graphics")
+        }
         SettingsError::BrokenMultiview { device, driver } => format!(
             "--omni-shadow multiview: '{device}' ({driver}) renders every view of a depth-only multiview pass into the first layer (measured on Mesa 22.3 lavapipe): use layered, direct or copy"
         ),
@@ -133,6 +139,8 @@ mod tests {
         );
         let e = anyhow::Error::from(SettingsError::ShadowsWithoutLights);
         assert_eq!(describe(&e), "point-light shadows need point lights, and the scene has none (--lights N adds some)");
+        let e = anyhow::Error::from(SettingsError::SunShadowFeature { feature: "shaderInt64", device: "gpu".into() });
+        assert_eq!(describe(&e), "--sun-shadow compute needs shaderInt64, which 'gpu' lacks: use --sun-shadow graphics");
         // Errors about no flag read as the library wrote them.
         let e = anyhow::Error::from(SceneError::LightRadius("0".into()));
         assert_eq!(describe(&e), format!("{:#}", anyhow::Error::from(SceneError::LightRadius("0".into()))));

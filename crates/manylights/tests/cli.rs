@@ -96,6 +96,7 @@ fn bad_names_are_refused_with_the_choices() {
     assert_one_line_error(&manylights(&["render", "--omni-shadow", "sideways", "--out", p], &[]), &["sideways", "layered"]);
     assert_one_line_error(&manylights(&["render", "--debug-view", "shadow-cube", "--out", p], &[]), &["shadow-cube", "--omni-shadow"]);
     assert_one_line_error(&manylights(&["render", "--shadowed-lights", "4", "--out", p], &[]), &["--shadowed-lights", "--omni-shadow"]);
+    assert_one_line_error(&manylights(&["render", "--sun-shadow", "raytraced", "--out", p], &[]), &["raytraced", "graphics", "compute"]);
     assert!(!png.exists());
 }
 
@@ -107,7 +108,7 @@ fn deferred_render_reports_its_gbuffer_and_passes() {
     let out = manylights(&[&args[..], &["--out", png.to_str().unwrap()]].concat(), &[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
-    for key in ["blinn-phong", "g-buffer + lighting pass", "tone map pass", "16 bytes/pixel", "transient"] {
+    for key in ["blinn-phong", "g-buffer + lighting pass", "tone map pass", "16 bytes/pixel", "transient", "shadow map by graphics"] {
         assert!(stdout.contains(key), "'{key}' missing from:\n{stdout}");
     }
 }

@@ -23,6 +23,7 @@ pub mod scene_load;
 pub mod scene_request;
 pub mod shading;
 pub mod shading_model;
+pub mod shadow_atlas;
 pub mod surface_sampler;
 mod teapot;
 pub mod textures;

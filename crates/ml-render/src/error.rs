@@ -39,6 +39,7 @@ pub enum Named {
     Technique,
     DebugView,
     OmniShadowMode,
+    SunShadowMode,
     Raster,
 }
 
@@ -48,6 +49,7 @@ impl std::fmt::Display for Named {
             Named::Technique => "technique",
             Named::DebugView => "debug view",
             Named::OmniShadowMode => "point-light shadow mode",
+            Named::SunShadowMode => "sun shadow mode",
             Named::Raster => "rasteriser",
         })
     }
@@ -104,6 +106,10 @@ pub enum SettingsError {
         "the compute raster's list of {bins} large triangles takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer"
     )]
     BinList { bins: u32, bytes: u64, device: String, max: u32 },
+    /// The sun's shadow map in compute: 64-bit integers (the large triangles' edge functions)
+    /// and a D32_SFLOAT depth image to copy the depths into.
+    #[error("the sun's shadow map drawn in compute needs {feature}, which '{device}' lacks: use the graphics sun shadow")]
+    SunShadowFeature { feature: &'static str, device: String },
     #[error("frames must be at least 1")]
     NoFrames,
     #[error("time {0} is not a finite number")]

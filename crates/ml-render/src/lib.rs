@@ -19,6 +19,7 @@ pub mod report;
 pub mod scene_gpu;
 pub mod scene_textures;
 pub mod settings;
+pub mod shadow_raster;
 pub mod stage_probe;
 pub mod sun_shadow;
 pub mod targets;
@@ -28,5 +29,5 @@ pub use frame::FRAMES_IN_FLIGHT;
 pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use settings::{
     DebugView, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings,
-    Shading, ShadingModel, Technique, FRAME_SECONDS, TIMER_SPEED,
+    Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
 };

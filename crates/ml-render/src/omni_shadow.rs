@@ -282,35 +282,7 @@ impl OmniShadows {
     /// Every texel of every layer as the last frame left it (layer after layer, row by row),
     /// copied to the host; for tests and tools, not the frame loop (it waits for the GPU).
     pub fn read_depths(&self, ctx: &Context) -> Result<Vec<f32>, VkError> {
-        let extent = self.cubes.extent;
-        let layers = self.settings.map_or(1, |s| s.lights) * 6;
-        let bytes = extent.width as u64 * extent.height as u64 * layers as u64 * 4;
-        let mut host = ml_vk::Buffer::new(
-            ctx,
-            "shadow cube read-back",
-            bytes,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            gpu_allocator::MemoryLocation::GpuToCpu,
-        )?;
-        let sampled = (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-        let source = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-        let copied = ml_vk::commands::one_shot(ctx, |cmd| {
-            transition(ctx, cmd, self.cubes.raw, sampled, source);
-            let subresource = vk::ImageSubresourceLayers::default().aspect_mask(DEPTH).layer_count(layers);
-            let region = [vk::BufferImageCopy::default().image_subresource(subresource).image_extent(vk::Extent3D {
-                width: extent.width,
-                height: extent.height,
-                depth: 1,
-            })];
-            // SAFETY: recording state; the image is in TRANSFER_SRC_OPTIMAL and the buffer holds
-            // every layer.
-            unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, self.cubes.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, host.raw, &region) };
-            transition(ctx, cmd, self.cubes.raw, source, sampled);
-            ml_vk::commands::transfer_to_host_barrier(ctx, cmd);
-        });
-        let depths = copied.map(|()| bytemuck::pod_collect_to_vec(host.mapped()));
-        host.destroy(ctx);
-        depths
+        read_depth_layers(ctx, &self.cubes, self.settings.map_or(1, |s| s.lights) * 6)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -345,7 +317,35 @@ impl ml_vk::Release for OmniShadows {
 const TRANSFER_DST: StageAccessLayout =
     (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
 
-/// A layout transition of every layer of the cube array.
+/// The first `layers` layers of a sampled 32-bit depth image (layer after layer, row by row),
+/// copied to the host; for tests and tools (it waits for the GPU).
+pub(crate) fn read_depth_layers(ctx: &Context, image: &Image, layers: u32) -> Result<Vec<f32>, VkError> {
+    let extent = image.extent;
+    let bytes = extent.width as u64 * extent.height as u64 * layers as u64 * 4;
+    let mut host =
+        ml_vk::Buffer::new(ctx, "depth read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?;
+    let sampled = (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+    let source = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+    let copied = ml_vk::commands::one_shot(ctx, |cmd| {
+        transition(ctx, cmd, image.raw, sampled, source);
+        let subresource = vk::ImageSubresourceLayers::default().aspect_mask(DEPTH).layer_count(layers);
+        let region = [vk::BufferImageCopy::default().image_subresource(subresource).image_extent(vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        })];
+        // SAFETY: recording state; the image is in TRANSFER_SRC_OPTIMAL and the buffer holds
+        // every layer.
+        unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, image.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, host.raw, &region) };
+        transition(ctx, cmd, image.raw, source, sampled);
+        ml_vk::commands::transfer_to_host_barrier(ctx, cmd);
+    });
+    let depths = copied.map(|()| bytemuck::pod_collect_to_vec(host.mapped()));
+    host.destroy(ctx);
+    depths
+}
+
+/// A layout transition of every layer of a depth image.
 fn transition(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: StageAccessLayout, to: StageAccessLayout) {
     aspect_transition(ctx, cmd, (image, DEPTH), from, to);
 }

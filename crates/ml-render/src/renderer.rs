@@ -332,6 +332,7 @@ impl<'a> Renderer<'a> {
         }
         // Averages are over every frame rendered, re-renders included.
         stats.frames = self.settings.frames + stats.rerendered_frames;
+        stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
         self.last_frame = last;
         let rgba = self.read_back(last)?;
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
@@ -615,6 +616,12 @@ impl<'a> Renderer<'a> {
     /// layer after layer (cube i: layers 6i … 6i + 5), row by row; for tests and tools.
     pub fn shadow_cube_depths(&self) -> Result<Vec<f32>, VkError> {
         self.gpu.omni.read_depths(self.ctx)
+    }
+
+    /// The sun's shadow map's texels (depth, row by row; blinn-phong, else one texel at the far
+    /// plane); for tests and tools.
+    pub fn sun_shadow_depths(&self) -> Result<Vec<f32>, VkError> {
+        self.gpu.textures.read_shadow_map(self.ctx)
     }
 
     /// The cluster lists the GPU built for the frame `render` returned (clustered-gpu; None

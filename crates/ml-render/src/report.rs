@@ -29,6 +29,8 @@ pub struct FrameStats {
     pub culling: Option<CullStats>,
     /// --omni-shadow compute: what the last frame's shadow raster drew.
     pub omni_raster: Option<OmniRasterStats>,
+    /// blinn-phong: GPU ms of the sun's shadow map, drawn once when the scene was loaded.
+    pub sun_shadow_ms: Option<f64>,
 }
 
 /// What one frame's compute shadow raster drew (--omni-shadow compute).
@@ -93,6 +95,7 @@ impl FrameStats {
             gbuffer_lazily_allocated: None,
             culling: None,
             omni_raster: None,
+            sun_shadow_ms: None,
         }
     }
 
@@ -327,6 +330,11 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                 r.pairs, r.small, r.large, r.texels
             ),
         ));
+    }
+    if let Some(ms) = stats.sun_shadow_ms {
+        let by = settings.sun_shadow.name();
+        let size = crate::scene_textures::SHADOW_MAP_SIZE;
+        rows.push(("sun shadow ms", format!("{ms:.3}  (the sun's {size}² shadow map by {by}, once at load)")));
     }
     rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));

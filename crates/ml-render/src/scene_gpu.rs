@@ -8,7 +8,7 @@ use crate::mesh_raster::object_data;
 use crate::object_textures::ObjectTextureSets;
 use crate::omni_shadow::OmniShadows;
 use crate::scene_textures::SceneTextures;
-use crate::settings::{RenderSettings, ShadingModel};
+use crate::settings::{RenderSettings, ShadingModel, SunShadowMode};
 use crate::sun_shadow;
 use crate::targets::{depth_format, Output};
 use ml_cpu::blinn_phong::shadow_view_proj;
@@ -29,17 +29,19 @@ pub struct SceneGpu {
     pub omni: OmniShadows,
     /// The sun's shadow-map view-projection (blinn-phong).
     pub shadow_view_proj: glam::Mat4,
-    /// Whether the sun's shadow map is drawn (blinn-phong).
-    sun: bool,
+    /// Whether the sun's shadow map is drawn (blinn-phong), and by whom.
+    sun: Option<SunShadowMode>,
+    /// GPU milliseconds the sun's shadow map took to draw (None: not drawn, or no timestamps).
+    pub sun_shadow_ms: Option<f64>,
 }
 
 impl SceneGpu {
     pub fn new(ctx: &Context, scene: &Scene, settings: &RenderSettings) -> Result<SceneGpu, RenderError> {
-        let sun = settings.shading == ShadingModel::BlinnPhong;
+        let sun = (settings.shading == ShadingModel::BlinnPhong).then_some(settings.sun_shadow);
         // Each of these needs the ones before it; a failure releases those.
         let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
         let mut omni = OmniShadows::new(ctx, settings.omni)?;
-        let mut textures = release_on_error(ctx, SceneTextures::new(ctx, sun, gbuffer_depth, &omni), &mut [&mut omni])?;
+        let mut textures = release_on_error(ctx, SceneTextures::new(ctx, sun.is_some(), gbuffer_depth, &omni), &mut [&mut omni])?;
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
         let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
         let mut gpu = SceneGpu {
@@ -51,6 +53,7 @@ impl SceneGpu {
             omni,
             shadow_view_proj: glam::Mat4::IDENTITY,
             sun,
+            sun_shadow_ms: None,
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
@@ -77,9 +80,10 @@ impl SceneGpu {
         self.objects = Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let (lo, hi) = scene.bounds();
         self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
-        if self.sun {
-            let inputs = sun_shadow::ShadowInputs { scene, meshes: &self.meshes, view_proj: self.shadow_view_proj };
-            self.textures.render_shadow_map(ctx, &inputs)?;
+        if let Some(mode) = self.sun {
+            let view_proj = self.shadow_view_proj;
+            let inputs = sun_shadow::ShadowInputs { scene, meshes: &self.meshes, objects: self.objects.raw, view_proj, mode };
+            self.sun_shadow_ms = self.textures.render_shadow_map(ctx, &inputs)?;
         }
         Ok(())
     }

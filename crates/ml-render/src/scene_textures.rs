@@ -5,7 +5,7 @@
 
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::omni_shadow::{self, OmniShadows};
-use crate::sun_shadow::{render_shadow_map, ShadowInputs};
+use crate::sun_shadow::{draw_shadow_map, render_shadow_map, ShadowInputs};
 use ml_cpu::textures;
 use ml_vk::descriptors::allocate_set;
 use ml_vk::image::{texture_with, ImageShape};
@@ -48,9 +48,15 @@ impl SceneTextures {
         ml_vk::build(ctx, t, |t| t.create(ctx, blinn_phong, depth_format, omni))
     }
 
-    /// Draw every object of `inputs` into the shadow map, from the sun.
-    pub fn render_shadow_map(&self, ctx: &Context, inputs: &ShadowInputs) -> Result<(), VkError> {
-        render_shadow_map(ctx, &self.images[SHADOW_IMAGE], Some(inputs))
+    /// Draw every object of `inputs` into the shadow map, from the sun; its GPU milliseconds
+    /// (None without timestamps).
+    pub fn render_shadow_map(&self, ctx: &Context, inputs: &ShadowInputs) -> Result<Option<f64>, VkError> {
+        draw_shadow_map(ctx, &self.images[SHADOW_IMAGE], inputs)
+    }
+
+    /// The sun's shadow map's texels (row by row), copied to the host; for tests and tools.
+    pub fn read_shadow_map(&self, ctx: &Context) -> Result<Vec<f32>, VkError> {
+        omni_shadow::read_depth_layers(ctx, &self.images[SHADOW_IMAGE], 1)
     }
 
     fn create(&mut self, ctx: &Context, real: bool, depth_format: vk::Format, omni: &OmniShadows) -> Result<(), VkError> {
@@ -91,7 +97,11 @@ impl SceneTextures {
         }
         self.shadow_size = if real { SHADOW_MAP_SIZE } else { 1 };
         let extent = vk::Extent2D { width: self.shadow_size, height: self.shadow_size };
-        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        // Drawn by a render pass, or copied from the compute raster's buffer; read back by tests.
+        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC;
         self.images.push(Image::new_2d(ctx, "shadow map", extent, depth_format, usage, vk::ImageAspectFlags::DEPTH)?);
         // Cleared to the far plane ("lit everywhere") until the objects are drawn into it.
         render_shadow_map(ctx, &self.images[SHADOW_IMAGE], None)?;

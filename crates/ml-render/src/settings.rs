@@ -3,7 +3,7 @@
 use crate::error::{Named, RenderError, Setting, SettingsError};
 use ml_cpu::cluster::ClusterDims;
 pub use ml_cpu::shading_model::ShadingModel;
-use ml_vk::Context;
+use ml_vk::{vk, Context};
 
 /// Lighting techniques (docs/DESIGN.md#techniques-are-two-choices). Each must give the same image as `Forward`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,11 +91,16 @@ impl Technique {
     }
 
     pub fn from_name(name: &str) -> Result<Technique, RenderError> {
-        Technique::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| {
-            let expected = Technique::ALL.map(|t| t.name()).join(", ");
-            RenderError::UnknownName { kind: Named::Technique, name: name.to_owned(), expected }
-        })
+        by_name(&Technique::ALL, Technique::name, Named::Technique, name)
     }
+}
+
+/// The one of `all` whose name (`name_of`) is `name`; else the error that lists the names.
+fn by_name<T: Copy>(all: &[T], name_of: fn(T) -> &'static str, kind: Named, name: &str) -> Result<T, RenderError> {
+    all.iter().copied().find(|&v| name_of(v) == name).ok_or_else(|| {
+        let expected = all.iter().map(|&v| name_of(v)).collect::<Vec<_>>().join(", ");
+        RenderError::UnknownName { kind, name: name.to_owned(), expected }
+    })
 }
 
 /// Where lights are assigned to clusters.
@@ -207,10 +212,7 @@ impl OmniShadowMode {
     }
 
     pub fn from_name(name: &str) -> Result<OmniShadowMode, RenderError> {
-        OmniShadowMode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
-            let expected = OmniShadowMode::ALL.map(|m| m.name()).join(", ");
-            RenderError::UnknownName { kind: Named::OmniShadowMode, name: name.to_owned(), expected }
-        })
+        by_name(&OmniShadowMode::ALL, OmniShadowMode::name, Named::OmniShadowMode, name)
     }
 }
 
@@ -230,6 +232,31 @@ impl OmniShadowSettings {
     /// Bytes of the cube array (32-bit depth).
     pub fn bytes(&self) -> u64 {
         self.lights as u64 * 6 * self.size as u64 * self.size as u64 * 4
+    }
+}
+
+/// Who draws the sun's shadow map (blinn-phong), once, when the scene's objects reach the GPU
+/// (docs/DESIGN.md#sun-shadow-map).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SunShadowMode {
+    /// A depth-only render pass.
+    Graphics,
+    /// The compute shadow raster, in one orthographic view (docs/DESIGN.md#compute-shadow-raster).
+    Compute,
+}
+
+impl SunShadowMode {
+    pub const ALL: [SunShadowMode; 2] = [SunShadowMode::Graphics, SunShadowMode::Compute];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SunShadowMode::Graphics => "graphics",
+            SunShadowMode::Compute => "compute",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<SunShadowMode, RenderError> {
+        by_name(&SunShadowMode::ALL, SunShadowMode::name, Named::SunShadowMode, name)
     }
 }
 
@@ -286,9 +313,7 @@ impl Raster {
     /// The rasteriser `name` names (`hardware`, `hybrid`, `compute`), those in compute with
     /// `split`.
     pub fn from_name(name: &str, split: u32) -> Result<Raster, RenderError> {
-        [Raster::Hardware, Raster::hybrid(split), Raster::compute(split)].into_iter().find(|r| r.name() == name).ok_or_else(|| {
-            RenderError::UnknownName { kind: Named::Raster, name: name.to_owned(), expected: "hardware, hybrid, compute".to_owned() }
-        })
+        by_name(&[Raster::Hardware, Raster::hybrid(split), Raster::compute(split)], Raster::name, Named::Raster, name)
     }
 
     /// The largest triangle drawn in compute by one thread (0: none).
@@ -377,10 +402,7 @@ impl DebugView {
     }
 
     pub fn from_name(name: &str) -> Result<DebugView, RenderError> {
-        DebugView::ALL.into_iter().find(|v| v.name() == name).ok_or_else(|| {
-            let expected = DebugView::ALL.map(|v| v.name()).join(", ");
-            RenderError::UnknownName { kind: Named::DebugView, name: name.to_owned(), expected }
-        })
+        by_name(&DebugView::ALL, DebugView::name, Named::DebugView, name)
     }
 
     /// The value shaders see (DEBUG_VIEW_* in common.glsl).
@@ -414,6 +436,8 @@ pub struct RenderSettings {
     pub debug_view: DebugView,
     /// Point-light shadow cubes (None: point lights cast no shadows).
     pub omni: Option<OmniShadowSettings>,
+    /// Who draws the sun's shadow map (blinn-phong).
+    pub sun_shadow: SunShadowMode,
     pub width: u32,
     pub height: u32,
     /// Frames to render; the image is the last one's, timings are averaged over all.
@@ -456,6 +480,7 @@ impl RenderSettings {
             clusters: ClusterDims::DEFAULT,
             debug_view: DebugView::None,
             omni: None,
+            sun_shadow: SunShadowMode::Graphics,
             width,
             height,
             frames: 1,
@@ -547,6 +572,17 @@ impl RenderSettings {
         if let Some(omni) = &self.omni {
             check_omni(ctx, omni, lights)?;
         }
+        if self.sun_shadow == SunShadowMode::Compute && self.shading == ShadingModel::BlinnPhong {
+            let features = &ctx.info.features;
+            let depth = ctx.format_supports(
+                vk::Format::D32_SFLOAT,
+                vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE,
+            );
+            let missing = [(features.buffer_int64_atomics, "shaderInt64"), (depth, "a sampled D32_SFLOAT depth format")];
+            if let Some((_, feature)) = missing.into_iter().find(|(has, _)| !has) {
+                return Err(SettingsError::SunShadowFeature { feature, device: device() }.into());
+            }
+        }
         if self.frames == 0 {
             return Err(SettingsError::NoFrames.into());
         }
@@ -632,6 +668,7 @@ pub struct SettingsRequest {
     pub clusters: Option<ClusterDims>,
     pub debug_view: DebugView,
     pub omni: Option<OmniShadowSettings>,
+    pub sun_shadow: SunShadowMode,
     pub width: u32,
     pub height: u32,
     pub frames: u32,
@@ -651,6 +688,7 @@ impl SettingsRequest {
             clusters: self.clusters.unwrap_or_else(|| ClusterDims::for_lights(scene.lights.len(), self.width, self.height)),
             debug_view: self.debug_view,
             omni: self.omni,
+            sun_shadow: self.sun_shadow,
             width: self.width,
             height: self.height,
             frames: self.frames,

@@ -1,24 +1,72 @@
 //! The sun's shadow map (blinn-phong; docs/DESIGN.md#sun-shadow-map): rendered once, when the
 //! renderer is made — the sun and the objects do not move (only the point lights do). Depth
 //! only, every object, an orthographic view along the sun fitted to the scene
-//! (ml_cpu::blinn_phong); 3×3 PCF taps read it through a comparison sampler (scene_textures.rs).
+//! (ml_cpu::blinn_phong), by a render pass or by the compute shadow raster (shadow_raster.rs);
+//! 3×3 PCF taps read it through a comparison sampler (scene_textures.rs).
 
 use crate::depth_pass::{self, DepthPassDesc};
 use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::settings::SunShadowMode;
+use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use ml_cpu::gpu_types::ShadowPush;
 use ml_cpu::scene::Scene;
-use ml_vk::{shader, vk, Context, Image, VkError, VkResultExt};
+use ml_vk::{shader, vk, Context, GpuTimer, Image, VkError, VkResultExt};
 
 /// What the sun's shadow pass draws.
 pub struct ShadowInputs<'a> {
     pub scene: &'a Scene,
     pub meshes: &'a [GpuMesh],
+    /// The scene's object buffer (the compute raster reads the transforms there).
+    pub objects: vk::Buffer,
     pub view_proj: glam::Mat4,
+    pub mode: SunShadowMode,
 }
 
-/// Clear `target` to the far plane and, given inputs, draw every object into it from the sun;
-/// leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL for the shading passes.
-pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&ShadowInputs>) -> Result<(), VkError> {
+/// Who reads the map once it is drawn.
+const READERS: vk::PipelineStageFlags =
+    vk::PipelineStageFlags::from_raw(vk::PipelineStageFlags::FRAGMENT_SHADER.as_raw() | vk::PipelineStageFlags::COMPUTE_SHADER.as_raw());
+
+/// Large triangles the compute raster lists for a work group each (the scene's floor is one);
+/// past it, the thread that found one draws it alone.
+const LARGE_LIST: u32 = 1 << 16;
+
+/// Draw every object of `inputs` into `target` from the sun as `inputs.mode` says (`target`
+/// holds the far plane until then); leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL. Returns the
+/// drawing's GPU milliseconds (None without timestamps).
+pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInputs) -> Result<Option<f64>, VkError> {
+    let mut timer = GpuTimer::new(ctx, 1)?;
+    let drawn = match inputs.mode {
+        SunShadowMode::Graphics => render_shadow_map(ctx, target, Some((inputs, &mut timer))),
+        SunShadowMode::Compute => {
+            // One orthographic view; its "light" at the origin with radius 1 leaves world
+            // positions as they are (omni_raster.glsl).
+            let views = (ShadowViews::Ortho, target.extent.width, LARGE_LIST);
+            ShadowRaster::new(ctx, inputs.scene, views, 1).and_then(|mut raster| {
+                let shadow_target = ShadowTarget { image: target.raw, readers: READERS };
+                let result = raster.bind(ctx, 0, inputs.objects).and_then(|()| {
+                    ml_vk::commands::one_shot(ctx, |cmd| {
+                        timer.reset(ctx, cmd);
+                        timer.begin(ctx, cmd, 0);
+                        // It ends with a barrier (the map's layout transition), which the
+                        // timestamp after it needs on lavapipe (GpuTimer::end).
+                        raster.record(ctx, cmd, 0, &[[0.0, 0.0, 0.0, 1.0]], inputs.view_proj, &shadow_target);
+                        timer.end(ctx, cmd, 0);
+                    })
+                });
+                raster.destroy(ctx);
+                result
+            })
+        }
+    };
+    let ms = drawn.and_then(|()| timer.read_ms(ctx));
+    timer.destroy(ctx);
+    Ok(ms?.map(|passes| passes[0]))
+}
+
+/// Clear `target` to the far plane and, given inputs, draw every object into it from the sun
+/// (timed by the timer given with them); leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL for the
+/// shading passes.
+pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&ShadowInputs, &mut GpuTimer)>) -> Result<(), VkError> {
     let d = &ctx.device;
     // The depth writes before every later shader read of the map (frames come after this
     // submission in queue order).
@@ -28,7 +76,7 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&S
             format: target.format,
             final_layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
             after: vk::PipelineStageFlags::empty(),
-            readers: (vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ),
+            readers: (READERS, vk::AccessFlags::SHADER_READ),
             view_mask: 0,
         },
     )?;
@@ -59,10 +107,15 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&S
                 .framebuffer(framebuffer)
                 .render_area(area)
                 .clear_values(&depth_pass::CLEAR_FAR);
+            let mut inputs = inputs;
+            if let Some((_, timer)) = inputs.as_mut() {
+                timer.reset(ctx, cmd);
+                timer.begin(ctx, cmd, 0);
+            }
             // SAFETY: recording state; everything used is alive until the wait in one_shot.
             unsafe {
                 d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-                if let Some(s) = inputs {
+                if let Some((s, _)) = &inputs {
                     d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
                     depth_pass::set_square_viewport(ctx, cmd, target.extent.width);
                     record_draws(
@@ -78,6 +131,9 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<&S
                     );
                 }
                 d.cmd_end_render_pass(cmd);
+            }
+            if let Some((_, timer)) = &inputs {
+                timer.end(ctx, cmd, 0);
             }
         })
     })();

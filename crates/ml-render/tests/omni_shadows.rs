@@ -325,16 +325,8 @@ fn the_compute_raster_fills_the_same_cubes() {
         let (hardware, hardware_image) = cubes_and_image(&ctx, scene, s);
         s.omni = mode(compute);
         let (compute, compute_image) = cubes_and_image(&ctx, scene, s);
-        assert_eq!(hardware.len(), compute.len());
-        let reached = |d: f32| d < 1.0;
-        let coverage: Vec<(usize, f32, f32)> = hardware
-            .iter()
-            .zip(&compute)
-            .enumerate()
-            .filter(|(_, (h, c))| reached(**h) != reached(**c))
-            .map(|(i, (&h, &c))| (i, h, c))
-            .collect();
-        let differ = hardware.iter().zip(&compute).filter(|(h, c)| h != c).count();
+        let (coverage, differ) = common::coverage_difference(&hardware, &compute);
+        let reached = common::reached;
         let worst = hardware.iter().zip(&compute).map(|(h, c)| (h - c).abs()).fold(0.0, f32::max);
         // In units of the shading's depth bias at that texel (one texel of distance).
         let bias = |d: f32| d * 2.0 / cube as f32;

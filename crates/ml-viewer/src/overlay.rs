@@ -7,7 +7,7 @@ use ml_cpu::lights::{LightLayout, RadiusRange, SEED_RADIUS};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
-use ml_render::{DebugView, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, Technique};
+use ml_render::{DebugView, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode, Technique};
 use std::collections::VecDeque;
 
 /// Everything the overlay can change that needs a new scene or renderer.
@@ -24,6 +24,8 @@ pub struct Choices {
     pub clusters: ClusterDims,
     pub debug_view: DebugView,
     pub omni: Option<OmniShadowSettings>,
+    /// Who draws the sun's shadow map (the command line's choice; blinn-phong).
+    pub sun_shadow: SunShadowMode,
     /// Who draws the visibility buffer (used where the technique is visibility).
     pub raster: Raster,
     /// Exposure in EV.
@@ -49,6 +51,7 @@ impl Choices {
             clusters: settings.clusters,
             debug_view: settings.debug_view,
             omni: settings.omni,
+            sun_shadow: settings.sun_shadow,
             raster: settings.raster,
             exposure: settings.exposure,
         }
@@ -79,6 +82,7 @@ impl Choices {
             clusters: self.clusters,
             debug_view: self.debug_view,
             omni: self.omni,
+            sun_shadow: self.sun_shadow,
             width,
             height,
             frames: 1,
@@ -230,6 +234,7 @@ mod tests {
             clusters: ClusterDims::DEFAULT,
             debug_view: DebugView::None,
             omni: None,
+            sun_shadow: SunShadowMode::Graphics,
             raster: Raster::Hardware,
             exposure: 0.0,
         }

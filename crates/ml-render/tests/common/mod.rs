@@ -70,3 +70,16 @@ pub fn pixel_at(out: &RenderOutput, x: i64, y: i64) -> Option<[u8; 3]> {
     let inside = x >= 0 && y >= 0 && x < out.width as i64 && y < out.height as i64;
     inside.then(|| pixel(out, x as u32, y as u32))
 }
+
+/// Whether a depth-map texel holds a surface (1.0: cleared, nothing in reach).
+pub fn reached(depth: f32) -> bool {
+    depth < 1.0
+}
+
+/// The texels (index, a's depth, b's depth) that one of two depth maps covers and the other
+/// does not, with how many texels differ at all.
+pub fn coverage_difference(a: &[f32], b: &[f32]) -> (Vec<(usize, f32, f32)>, usize) {
+    assert_eq!(a.len(), b.len());
+    let one_only = a.iter().zip(b).enumerate().filter(|(_, (x, y))| reached(**x) != reached(**y)).map(|(i, (&x, &y))| (i, x, y)).collect();
+    (one_only, a.iter().zip(b).filter(|(x, y)| x != y).count())
+}

@@ -1,0 +1,222 @@
+//! The shadow atlas's plan (docs/DESIGN.md#shadow-atlas), the CPU half: each frame, which cube
+//! faces of which shadowed lights a visible pixel may sample, how many texels a side each gets,
+//! and where each lies in one depth atlas of a fixed memory budget.
+//!
+//! - **Resolution** follows the light's size on screen: a face gets about as many texels a
+//!   side as the light's sphere covers pixels across (a power of two, 32 … 2048), so a shadow
+//!   texel is never much larger than a pixel of what it shades.
+//! - **Faces** whose region (the face's 90° pyramid cut at the light's radius) lies wholly
+//!   outside the view frustum get nothing: no visible pixel can sample them. The test is
+//!   conservative — it keeps a face that might be sampled (the pyramid grown by a margin for
+//!   PCF taps across a cube seam), never drops one that is.
+//! - **The budget**: if the faces do not fit, every face's side is halved together (the same
+//!   factor for every light: 1/2, 1/4 …, reported) until they do; none is dropped. If even
+//!   32² faces do not fit, the plan fails with the numbers.
+//! - **Packing**: square power-of-two tiles sorted largest first, laid out along a Z-order
+//!   (Morton) curve: each tile starts where the last ended, aligned to its own size, so they
+//!   never overlap and fill the atlas with no gap — whatever fits by area fits.
+
+use crate::camera::Camera;
+use crate::omni_shadow::face_axes;
+use glam::{Mat4, Vec3, Vec4};
+
+/// Texels a side of the smallest and the largest face.
+pub const MIN_FACE: u32 = 32;
+pub const MAX_FACE: u32 = 2048;
+/// Bytes per atlas texel (32-bit depth).
+pub const TEXEL_BYTES: u64 = 4;
+/// How far beyond its 90° pyramid a face is kept (in units of the distance along its axis):
+/// a PCF tap near a cube seam reads the neighbouring face a few texels past the edge, and at
+/// the smallest face (32 texels, 16 a half-side) 2 texels are 1/8.
+pub const SEAM_MARGIN: f32 = 0.125;
+
+/// A shadowed light as the plan sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlannedLight {
+    pub position: Vec3,
+    pub radius: f32,
+}
+
+/// One face's place in the atlas.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FaceTile {
+    /// Index into the lights the plan was made for.
+    pub light: u32,
+    /// Cube face, in `omni_shadow::face_axes` order.
+    pub face: u32,
+    /// Texels a side.
+    pub size: u32,
+    /// Top-left texel in the atlas.
+    pub origin: [u32; 2],
+}
+
+/// A frame's atlas: its extent and every face a visible pixel may sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AtlasPlan {
+    /// Texels across and down (powers of two, width = height or twice it).
+    pub extent: [u32; 2],
+    /// What every face's side was divided by to fit the budget (1: nothing).
+    pub divided_by: u32,
+    pub tiles: Vec<FaceTile>,
+}
+
+impl AtlasPlan {
+    /// Bytes the tiles use (at most the atlas's, which is at most the budget).
+    pub fn used_bytes(&self) -> u64 {
+        self.tiles.iter().map(|t| t.size as u64 * t.size as u64 * TEXEL_BYTES).sum()
+    }
+
+    pub fn atlas_bytes(&self) -> u64 {
+        self.extent[0] as u64 * self.extent[1] as u64 * TEXEL_BYTES
+    }
+}
+
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum AtlasError {
+    #[error("a shadow budget of {bytes} bytes holds no {MIN_FACE}² face")]
+    BudgetTooSmall { bytes: u64 },
+    #[error("{faces} shadow-cube faces need {needed_mib} MiB even at {MIN_FACE}² texels, more than the {budget_mib} MiB budget")]
+    TooManyFaces { faces: usize, needed_mib: u64, budget_mib: u64 },
+}
+
+/// The texels a side a light's faces get: the pixels its sphere spans across a `height`-pixel
+/// image (the eye inside it: the largest), rounded up to a power of two and clamped to
+/// `MIN_FACE` … `MAX_FACE`. Orthographic cameras: the diameter over the view's height.
+pub fn face_size(light: &PlannedLight, camera: &Camera, height: u32) -> u32 {
+    let pixels = match camera.orthographic {
+        Some(half_height) => light.radius / half_height * height as f32,
+        None => {
+            let d = light.position.distance(camera.position);
+            if d <= light.radius {
+                f32::INFINITY
+            } else {
+                // The sphere's angular radius, as a share of the half field of view.
+                let half_angle = (light.radius / d).asin();
+                half_angle.tan() / (camera.fov_y_deg.to_radians() * 0.5).tan() * height as f32
+            }
+        }
+    };
+    let pixels = pixels.clamp(MIN_FACE as f32, MAX_FACE as f32) as u32;
+    pixels.next_power_of_two().min(MAX_FACE)
+}
+
+/// The planes of `view_proj`'s frustum (Vulkan depth 0..1), each with its inside positive:
+/// left, right, top, bottom, near, far.
+pub fn frustum_planes(view_proj: Mat4) -> [Vec4; 6] {
+    let r = |i| view_proj.row(i);
+    let planes = [r(3) + r(0), r(3) - r(0), r(3) + r(1), r(3) - r(1), r(2), r(3) - r(2)];
+    planes.map(|p| p / p.truncate().length())
+}
+
+/// The faces (bit i: face i) of a light some point inside `planes` may sample: those whose
+/// region — the face's pyramid, grown by `SEAM_MARGIN`, cut at the light's radius — is not
+/// wholly outside one plane. The region lies inside the pyramid's apex and its base square at
+/// the radius (every point of the sphere is within the radius along the axis), so those five
+/// points decide.
+pub fn visible_faces(light: &PlannedLight, planes: &[Vec4; 6]) -> u32 {
+    let sphere_outside = planes.iter().any(|p| p.truncate().dot(light.position) + p.w < -light.radius);
+    if sphere_outside {
+        return 0;
+    }
+    let mut mask = 0;
+    for face in 0..6 {
+        let (forward, up) = face_axes(face);
+        let side = forward.cross(up);
+        let half = light.radius * (1.0 + SEAM_MARGIN);
+        let base = light.position + forward * light.radius;
+        let corners =
+            [light.position, base + (side + up) * half, base + (side - up) * half, base - (side + up) * half, base - (side - up) * half];
+        let outside = planes.iter().any(|p| corners.iter().all(|c| p.truncate().dot(*c) + p.w < 0.0));
+        if !outside {
+            mask |= 1 << face;
+        }
+    }
+    mask
+}
+
+/// The atlas extent a budget of `budget` bytes affords: the largest power-of-two square, or a
+/// 2:1 rectangle of squares, whose texels fit, at most `max_side` texels across.
+pub fn atlas_extent(budget: u64, max_side: u32) -> Result<[u32; 2], AtlasError> {
+    let texels = budget / TEXEL_BYTES;
+    if texels < (MIN_FACE * MIN_FACE) as u64 {
+        return Err(AtlasError::BudgetTooSmall { bytes: budget });
+    }
+    // The largest square of a power-of-two side within the budget and the device's limit.
+    let mut side = 1u32 << ((texels as f64).sqrt().log2().floor() as u32);
+    side = side.min(prev_power_of_two(max_side));
+    // Twice as wide where the budget and the limit allow.
+    if side < max_side && 2 * side as u64 * side as u64 <= texels {
+        Ok([2 * side, side])
+    } else {
+        Ok([side, side])
+    }
+}
+
+fn prev_power_of_two(n: u32) -> u32 {
+    1 << (31 - n.max(1).leading_zeros())
+}
+
+/// The frame's plan: every visible face of `lights` (seen by `camera` on a `width`×`height`
+/// image) at its size, halved together until all fit an atlas of `budget` bytes at most
+/// `max_side` texels across.
+pub fn plan(
+    lights: &[PlannedLight],
+    camera: &Camera,
+    (width, height): (u32, u32),
+    budget: u64,
+    max_side: u32,
+) -> Result<AtlasPlan, AtlasError> {
+    let extent = atlas_extent(budget, max_side)?;
+    let planes = frustum_planes(camera.projection(width as f32 / height as f32) * camera.view());
+    let mut wanted = Vec::new();
+    for (i, light) in lights.iter().enumerate() {
+        let mask = visible_faces(light, &planes);
+        let size = face_size(light, camera, height);
+        wanted.extend((0..6).filter(|f| mask & (1 << f) != 0).map(|face| (i as u32, face, size)));
+    }
+    let capacity = extent[0] as u64 * extent[1] as u64;
+    let area = |divisor: u32| wanted.iter().map(|&(_, _, s)| ((s / divisor).max(MIN_FACE) as u64).pow(2)).sum::<u64>();
+    let mut divided_by = 1;
+    while area(divided_by) > capacity {
+        if MAX_FACE / divided_by <= MIN_FACE {
+            let needed = wanted.len() as u64 * (MIN_FACE * MIN_FACE) as u64 * TEXEL_BYTES;
+            return Err(AtlasError::TooManyFaces { faces: wanted.len(), needed_mib: needed.div_ceil(1 << 20), budget_mib: budget >> 20 });
+        }
+        divided_by *= 2;
+    }
+    let mut tiles: Vec<FaceTile> = wanted
+        .into_iter()
+        .map(|(light, face, size)| FaceTile { light, face, size: (size / divided_by).max(MIN_FACE), origin: [0, 0] })
+        .collect();
+    // Largest first (ties: light, face), each at the next Z-order slot of its own size.
+    tiles.sort_by(|a, b| b.size.cmp(&a.size).then(a.light.cmp(&b.light)).then(a.face.cmp(&b.face)));
+    let square = extent[1] as u64;
+    let mut used = 0u64;
+    for t in &mut tiles {
+        let s = t.size as u64;
+        // The Z-order index of this tile among tiles of its size; a 2:1 atlas is two squares.
+        let index = used / (s * s);
+        let per_square = (square / s) * (square / s);
+        let (column, within) = (index / per_square, index % per_square);
+        let (x, y) = morton_decode(within);
+        t.origin = [(column * square + x * s) as u32, (y * s) as u32];
+        used += s * s;
+    }
+    Ok(AtlasPlan { extent, divided_by, tiles })
+}
+
+/// The (x, y) whose bits interleave (x in the even bits, y in the odd) to `index`.
+fn morton_decode(index: u64) -> (u64, u64) {
+    let compact = |mut v: u64| {
+        v &= 0x5555_5555_5555_5555;
+        v = (v | (v >> 1)) & 0x3333_3333_3333_3333;
+        v = (v | (v >> 2)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v >> 4)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v >> 8)) & 0x0000_ffff_0000_ffff;
+        (v | (v >> 16)) & 0x0000_0000_ffff_ffff
+    };
+    (compact(index), compact(index >> 1))
+}
+
+#[cfg(test)]
+mod tests;

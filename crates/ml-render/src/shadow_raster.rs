@@ -1,0 +1,252 @@
+//! The compute shadow raster (docs/DESIGN.md#compute-shadow-raster): depth-only views drawn
+//! by compute shaders into a buffer of 32-bit depths, copied into the depth image the shading
+//! passes sample. The views are every shadowed light's six cube faces (the point-light pass,
+//! passes/omni_shadow_compute.rs, each frame) or one orthographic view (the sun's shadow map,
+//! sun_shadow.rs, once). Per drawing: the lights' places and the counters are written and the
+//! depths cleared to 1.0 (beyond reach); a thread per (meshlet instance, light) lists the
+//! views the meshlet may reach (omni_cull.comp); a work group per listed pair draws its small
+//! triangles, a thread each, and lists the others (omni_raster.comp); a work group per listed
+//! large triangle draws it (omni_raster_large.comp); the buffer is copied into the image.
+
+use crate::descriptors::{FrameSets, Resource};
+use crate::meshlet_scene::{storage_bytes, MeshletGeometry};
+use gpu_allocator::MemoryLocation;
+use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush};
+use ml_cpu::meshlets::SceneMeshlets;
+use ml_vk::commands::memory_barrier;
+use ml_vk::image::aspect_transition;
+use ml_vk::{shader, vk, Buffer, Context, VkError};
+
+/// Work-group size of the culling.
+const CULL_GROUP: u32 = 64;
+/// Work groups a dispatch may have along x on every device (the shaders loop past it).
+const MAX_GROUPS: u32 = 65535;
+/// The largest triangle one thread draws (bounding box, texels a side); larger ones get a
+/// work group each.
+pub const SPLIT: u32 = 16;
+/// The depth of a texel nothing reaches: 1.0's bits.
+const FAR_BITS: u32 = 1.0f32.to_bits();
+/// constant_id of `ORTHO_VIEW` (omni_raster.glsl).
+const SPEC_ORTHO_VIEW: u32 = 0;
+
+/// What one drawing covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadowViews {
+    /// Six cube faces (90° perspective, in the light's frame in radii) for each of `lights`.
+    Cubes { lights: u32 },
+    /// One orthographic view (world space, the projection is its view-projection).
+    Ortho,
+}
+
+impl ShadowViews {
+    /// Lights (each a cube, or the one view) and the image layers they fill.
+    fn lights(self) -> u32 {
+        match self {
+            ShadowViews::Cubes { lights } => lights,
+            ShadowViews::Ortho => 1,
+        }
+    }
+
+    fn layers(self) -> u32 {
+        match self {
+            ShadowViews::Cubes { lights } => lights * 6,
+            ShadowViews::Ortho => 1,
+        }
+    }
+}
+
+/// Where the depths go: a D32_SFLOAT image whose first layers the views fill, left
+/// DEPTH_STENCIL_READ_ONLY_OPTIMAL for `readers`.
+pub struct ShadowTarget {
+    pub image: vk::Image,
+    pub readers: vk::PipelineStageFlags,
+}
+
+pub struct ShadowRaster {
+    views: ShadowViews,
+    size: u32,
+    geometry: MeshletGeometry,
+    /// The drawing's lights (vec4 each: position, radius), written by the command buffer
+    /// itself (vkCmdUpdateBuffer), so frames in flight each see their own.
+    lights: Buffer,
+    pub counters: Buffer,
+    pairs: Buffer,
+    large: Buffer,
+    /// 32-bit depths, layer after layer as the image holds them, row by row.
+    depths: Buffer,
+    pair_capacity: u32,
+    /// Large triangles the list holds; past it, the thread that found one draws it (slowly,
+    /// but nothing is lost; the table reports how many).
+    large_capacity: u32,
+    sets: FrameSets,
+    layout: vk::PipelineLayout,
+    pipelines: [vk::Pipeline; 3],
+}
+
+impl ShadowRaster {
+    /// The raster of `scene`'s objects into `views` of `size`² texels, with `slots` descriptor
+    /// sets (one per frame in flight).
+    pub fn new(
+        ctx: &Context,
+        scene: &ml_cpu::scene::Scene,
+        (views, size, large_capacity): (ShadowViews, u32, u32),
+        slots: usize,
+    ) -> Result<ShadowRaster, VkError> {
+        let geometry = SceneMeshlets::build(scene).map_err(|e| VkError::Limit(e.to_string()))?;
+        let shaders = [&ml_shaders::OMNI_CULL_COMP, &ml_shaders::OMNI_RASTER_COMP, &ml_shaders::OMNI_RASTER_LARGE_COMP];
+        let stages = shaders.map(|s| (s, vk::ShaderStageFlags::COMPUTE));
+        // Six views per meshlet instance and light at most: the pair list cannot overflow.
+        let pairs = geometry.meshlet_instances.len() as u64 * views.layers() as u64;
+        let pair_capacity = u32::try_from(pairs.max(1)).map_err(|_| VkError::Limit(format!("{pairs} shadow (meshlet, face) pairs")))?;
+        let raster = ShadowRaster {
+            views,
+            size,
+            geometry: MeshletGeometry::upload(ctx, &geometry)?,
+            lights: Buffer::null(),
+            counters: Buffer::null(),
+            pairs: Buffer::null(),
+            large: Buffer::null(),
+            depths: Buffer::null(),
+            pair_capacity,
+            large_capacity,
+            sets: FrameSets::empty(),
+            layout: vk::PipelineLayout::null(),
+            pipelines: [vk::Pipeline::null(); 3],
+        };
+        ml_vk::build(ctx, raster, |r| {
+            use vk::BufferUsageFlags as U;
+            let gpu = MemoryLocation::GpuOnly;
+            let storage = U::STORAGE_BUFFER;
+            r.lights = Buffer::new(ctx, "shadowed lights", views.lights() as u64 * 16, storage | U::TRANSFER_DST, gpu)?;
+            let counter_bytes = size_of::<OmniRasterCounters>() as u64;
+            let counter_usage = storage | U::INDIRECT_BUFFER | U::TRANSFER_DST | U::TRANSFER_SRC;
+            r.counters = Buffer::new(ctx, "shadow raster counters", counter_bytes, counter_usage, gpu)?;
+            let pair_bytes = storage_bytes(ctx, "shadow (meshlet, face) pairs", r.pair_capacity as u64 * 8)?;
+            r.pairs = Buffer::new(ctx, "shadow pairs", pair_bytes, storage, gpu)?;
+            r.large = Buffer::new(
+                ctx,
+                "shadow large triangles",
+                storage_bytes(ctx, "shadow large triangles", large_capacity.max(1) as u64 * 8)?,
+                storage,
+                gpu,
+            )?;
+            let texels = views.layers() as u64 * size as u64 * size as u64;
+            let depth_bytes = storage_bytes(ctx, "shadow depths", texels * 4)?;
+            r.depths = Buffer::new(ctx, "shadow depths", depth_bytes, storage | U::TRANSFER_SRC | U::TRANSFER_DST, gpu)?;
+            r.sets = FrameSets::new(ctx, &stages, 0, slots)?;
+            let push =
+                [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(size_of::<OmniRasterPush>() as u32)];
+            r.layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw], &push)?;
+            let ortho = [(SPEC_ORTHO_VIEW, u32::from(views == ShadowViews::Ortho))];
+            for (pipeline, s) in r.pipelines.iter_mut().zip(shaders) {
+                *pipeline = shader::compute_pipeline(ctx, s.spirv, r.layout, &ortho)?;
+            }
+            Ok(())
+        })
+    }
+
+    /// Point slot `slot`'s set at the raster's own buffers and the scene's meshlets; `objects`:
+    /// the scene's object buffer.
+    pub fn bind(&mut self, ctx: &Context, slot: usize, objects: vk::Buffer) -> Result<(), VkError> {
+        let own = |name: &str| {
+            let buffer = match name {
+                "ShadowLightBuffer" => self.lights.raw,
+                "OmniRasterCounterBuffer" => self.counters.raw,
+                "OmniPairBuffer" => self.pairs.raw,
+                "OmniLargeBuffer" => self.large.raw,
+                "CubeDepthBuffer" => self.depths.raw,
+                "ObjectBuffer" => objects,
+                _ => return None,
+            };
+            Some(Resource::Buffer(buffer))
+        };
+        self.sets.write(ctx, slot, &|name| own(name).or_else(|| self.geometry.buffer(name)))
+    }
+
+    /// Record one drawing with slot `slot`'s set: `lights` (cubes: one per cube, at most the
+    /// views' lights; the orthographic view: one, at the origin with radius 1) seen through
+    /// `projection` (omni_raster.glsl), into `target`. Layers of no light stay 1.0.
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        lights: &[[f32; 4]],
+        projection: glam::Mat4,
+        target: &ShadowTarget,
+    ) {
+        let d = &ctx.device;
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        let start = OmniRasterCounters { pairs: [0, 1, 1, 0], large: [0, 1, 1, 0], drawn: [0; 4] };
+        let push = OmniRasterPush {
+            projection: projection.to_cols_array_2d(),
+            sizes: [self.size, self.views.lights(), SPLIT, self.geometry.meshlet_instance_count],
+            capacity: [self.pair_capacity, self.large_capacity, 0, 0],
+        };
+        let depth = vk::ImageAspectFlags::DEPTH;
+        // SAFETY: recording state outside a render pass; every buffer and pipeline lives as
+        // long as this raster, the target as long as its owner, both beyond the submission.
+        unsafe {
+            // The last drawing's passes read and wrote these buffers (and its copy read them).
+            memory_barrier(
+                ctx,
+                cmd,
+                (compute | indirect | transfer, rw | vk::AccessFlags::TRANSFER_READ),
+                (transfer, vk::AccessFlags::TRANSFER_WRITE),
+            );
+            d.cmd_update_buffer(cmd, self.lights.raw, 0, bytemuck::cast_slice(lights));
+            d.cmd_update_buffer(cmd, self.counters.raw, 0, bytemuck::bytes_of(&start));
+            d.cmd_fill_buffer(cmd, self.depths.raw, 0, vk::WHOLE_SIZE, FAR_BITS);
+            memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.sets.sets[slot]], &[]);
+            d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[0]);
+            let groups = self.geometry.meshlet_instance_count.div_ceil(CULL_GROUP).clamp(1, MAX_GROUPS);
+            d.cmd_dispatch(cmd, groups, lights.len() as u32, 1);
+            let listed = (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ);
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), listed);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[1]);
+            d.cmd_dispatch_indirect(cmd, self.counters.raw, std::mem::offset_of!(OmniRasterCounters, pairs) as u64);
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), listed);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[2]);
+            d.cmd_dispatch_indirect(cmd, self.counters.raw, std::mem::offset_of!(OmniRasterCounters, large) as u64);
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
+            // Whatever the last drawing's readers read is overwritten whole.
+            let dst = (transfer, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+            let image = (target.image, depth);
+            aspect_transition(ctx, cmd, image, (target.readers, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), dst);
+            let layers = vk::ImageSubresourceLayers::default().aspect_mask(depth).base_array_layer(0).layer_count(self.views.layers());
+            let extent = vk::Extent3D { width: self.size, height: self.size, depth: 1 };
+            let region = [vk::BufferImageCopy::default().image_subresource(layers).image_extent(extent)];
+            d.cmd_copy_buffer_to_image(cmd, self.depths.raw, target.image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &region);
+            let sampled = (target.readers, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+            aspect_transition(ctx, cmd, image, dst, sampled);
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the device is idle; null handles are ignored.
+        unsafe {
+            for p in self.pipelines {
+                ctx.device.destroy_pipeline(p, None);
+            }
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+        }
+        self.pipelines = [vk::Pipeline::null(); 3];
+        self.layout = vk::PipelineLayout::null();
+        self.sets.destroy(ctx);
+        for b in [&mut self.lights, &mut self.counters, &mut self.pairs, &mut self.large, &mut self.depths] {
+            b.destroy(ctx);
+        }
+        self.geometry.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for ShadowRaster {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
