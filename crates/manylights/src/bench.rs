@@ -115,7 +115,7 @@ impl Plan {
         let source = scene_source(&a.scene, MeshKind::Sphere, Material::named("gold")?, a.objects)?;
         let scene = SceneRequest {
             shading: shading_choice(a.shading.as_deref())?,
-            camera: a.camera.as_deref().map(CameraSpec::parse).transpose()?,
+            camera: a.camera.as_deref().map(CameraSpec::parse).transpose().context("--camera")?,
             ..SceneRequest::new(source)
         };
         let settings = SettingsRequest {

@@ -22,7 +22,6 @@ fn temp_png(name: &str) -> PathBuf {
     dir.join(name)
 }
 
-
 #[test]
 fn renders_a_png_and_prints_the_table() {
     let png = temp_png("ok.png");

@@ -29,7 +29,6 @@ fn pixels(path: &Path) -> image::RgbaImage {
     image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
 }
 
-
 const SIZE: [&str; 4] = ["--width", "96", "--height", "64"];
 
 /// A scene file of a torus knot and a floor, its lights the default rig; `camera` its
@@ -108,6 +107,8 @@ fn bad_cameras_exposures_frames_and_patterns_are_refused() {
     assert_one_line_error(&run(&["--exposure", "bright"]), &["--exposure", "'bright'"]);
     assert_one_line_error(&run(&["--frames", "1000000"]), &["--frames 1000000", "100000"]);
     assert_one_line_error(&run(&["--light-layout", "spiral"]), &["spiral", "grid, random, surface"]);
+    let bench = manylights(&["bench", "--camera", "1,2,3", "--out", dir.join("bench").to_str().unwrap()]);
+    assert_one_line_error(&bench, &["--camera", "EYE_X,EYE_Y,EYE_Z"]);
     assert_one_line_error(&run(&["--show-lights", "--omni-shadow", "layered"]), &["--show-lights", "--omni-shadow"]);
     assert_one_line_error(&run(&["--show-lights", "--lights", "70000"]), &["--show-lights", "70000 lights", "65536"]);
     let bad_pattern = dir.join("a#b#.png");
