@@ -15,7 +15,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, Geometry, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
+use ml_render::{DebugView, Exposure, Geometry, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -130,7 +130,7 @@ impl Plan {
             time: None,
             culling: true,
             raster: Raster::Hardware,
-            exposure: 0.0,
+            exposure: Exposure::Ev(0.0),
         };
         Ok(Plan { scene, settings, warned: false })
     }

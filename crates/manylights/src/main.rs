@@ -11,7 +11,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::report;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
+use ml_render::{DebugView, Exposure, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -169,9 +169,11 @@ struct SceneArgs {
     /// with --omni-shadow, whose cubes would see the markers round their own lights).
     #[arg(long)]
     show_lights: bool,
-    /// Exposure in stops (EV, -20 to 20): lit colour × 2^EV before the tone map and gamma.
-    #[arg(long, default_value = "0", allow_hyphen_values = true)]
-    exposure: String,
+    /// Exposure: stops (EV, -20 to 20; lit colour × 2^EV before the tone map and gamma), or
+    /// auto (the image's log-average luminance brought to middle grey, metered on the GPU).
+    /// Default: auto for scene files and glTF files, 0 for the built-in scenes.
+    #[arg(long, allow_hyphen_values = true)]
+    exposure: Option<String>,
     /// Fix the animation clock at T (otherwise it advances 1/60 s per frame from 0; in the
     /// viewer, with real time).
     #[arg(long)]
@@ -240,7 +242,7 @@ fn scene_source(name: &str, object: MeshKind, material: Material, objects: Optio
         "seed" => SceneSource::Seed { object, material },
         "room" => SceneSource::Room,
         "bench" => SceneSource::Bench { objects: objects.unwrap_or(ml_cpu::bench_scene::BENCH_OBJECTS) },
-        path if [".toml", ".gltf", ".glb"].iter().any(|ext| path.to_lowercase().ends_with(ext)) => SceneSource::File(PathBuf::from(path)),
+        path if is_scene_file(path) => SceneSource::File(PathBuf::from(path)),
         other => bail!("unknown scene '{other}': expected seed, room, a scene file FILE.toml or a glTF file FILE.gltf|FILE.glb"),
     })
 }
@@ -296,10 +298,25 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         frames,
         time: args.time,
         culling: args.culling == "on",
-        exposure: ml_render::settings::parse_exposure(&args.exposure).context("--exposure")?,
+        exposure: exposure_choice(args)?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
     })
+}
+
+/// `--exposure` as given; else auto for a scene or glTF file (whatever its units and lights)
+/// and EV 0 for the built-in scenes (whose images stay as they were).
+fn exposure_choice(args: &SceneArgs) -> Result<Exposure> {
+    match &args.exposure {
+        Some(text) => Ok(ml_render::settings::parse_exposure(text).context("--exposure")?),
+        None if is_scene_file(&args.scene) => Ok(Exposure::Auto),
+        None => Ok(Exposure::Ev(0.0)),
+    }
+}
+
+/// Whether `--scene` names a file (scene file or glTF) rather than a built-in scene.
+fn is_scene_file(name: &str) -> bool {
+    [".toml", ".gltf", ".glb"].iter().any(|ext| name.to_lowercase().ends_with(ext))
 }
 
 /// `--raster` with `--raster-split`: a rasteriser, or None for auto.

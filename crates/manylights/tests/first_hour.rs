@@ -129,3 +129,26 @@ fn exposure_scales_the_lit_image() {
     let (a, b) = (mean(&plain), mean(&darker));
     assert!(b < a * 0.75, "EV -2 should darken the image: {b} against {a}");
 }
+
+/// A scene file is exposed automatically unless `--exposure` says otherwise; the built-in
+/// scenes are not (their images stay), and `--exposure auto` meters them too. The table says
+/// which EV auto exposure settled on.
+#[test]
+fn files_are_exposed_automatically_and_built_in_scenes_on_request() {
+    let dir = temp_dir("auto-exposure");
+    let scene = scene_file(&dir, "scene.toml", "");
+    let out = dir.join("out.png");
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "--validation", "--out", out.to_str().unwrap()];
+        args.extend(SIZE);
+        args.extend(extra);
+        let run = manylights(&args);
+        ok(&run);
+        String::from_utf8_lossy(&run.stdout).into_owned()
+    };
+    let metered = |table: &str| table.lines().any(|l| l.starts_with("exposure") && l.contains("auto:") && l.contains("EV"));
+    assert!(metered(&render(&["--scene", scene.to_str().unwrap()])), "a scene file is metered by default");
+    assert!(!metered(&render(&["--scene", scene.to_str().unwrap(), "--exposure", "0"])), "--exposure 0 fixes it");
+    assert!(!metered(&render(&[])), "the seed scene keeps EV 0");
+    assert!(metered(&render(&["--exposure", "auto", "--shading", "blinn-phong"])), "--exposure auto meters the seed scene");
+}

@@ -132,3 +132,31 @@ fn assert_render_equals(shot: &Path, args: &[&str], rendered: &Path) {
     let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
     assert!(worst <= 1, "the viewer's screenshot differs from render by {worst}/255");
 }
+
+/// Auto exposure in the window: the meter's pass through a resize (its sums made again for
+/// the new size) stays silent, and after the eased frames the screenshot shows what `render
+/// --exposure auto` settles on (both reach the EV whose image meters as itself; the render
+/// stops within 0.05 EV of it): within 2/255 (measured: 1).
+#[test]
+fn auto_exposure_eases_to_what_render_settles_on() {
+    let d = dir();
+    let (shot, rendered) = (d.join("auto-exposure-shot.png"), d.join("auto-exposure-render.png"));
+    let script = ["frames 20", "resize 200 120", "frames 100", &format!("screenshot {}", shot.display()), "quit"].join("\n");
+    let script_file = d.join("auto-exposure.txt");
+    std::fs::write(&script_file, script).unwrap();
+    let common = ["--shading", "blinn-phong", "--exposure", "auto", "--time", "0"];
+    let mut args = vec!["--validation", "--script", script_file.to_str().unwrap(), "--width", "160", "--height", "96"];
+    args.extend(common);
+    let out = view_under_xvfb(&args);
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "the session failed: {stdout}{stderr}");
+    assert!(!stderr.contains("VALIDATION") && !stderr.contains("panicked"), "{stderr}");
+    let size = ["--validation", "--width", "200", "--height", "120", "--out", rendered.to_str().unwrap()];
+    let r = Command::new(bin()).arg("render").args(size).args(common).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let (a, b) = (rgba(&shot), rgba(&rendered));
+    assert_eq!((a.0, a.1), (b.0, b.1));
+    let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    println!("auto exposure: the viewer's screenshot and render differ by at most {worst}/255");
+    assert!(worst <= 2, "the viewer's screenshot differs from render by {worst}/255");
+}

@@ -28,6 +28,6 @@ pub use error::RenderError;
 pub use frame::FRAMES_IN_FLIGHT;
 pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use settings::{
-    DebugView, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings,
-    Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
+    DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,
+    RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
 };

@@ -71,6 +71,9 @@ pub struct SlotReport {
     pub culling: Option<crate::report::CullStats>,
     /// What its compute shadow raster drew.
     pub omni_raster: Option<crate::report::OmniRasterStats>,
+    /// Auto exposure: the log2 of its image's log-average luminance before exposure (None: not
+    /// metered, or nothing but background).
+    pub log2_luminance: Option<f32>,
 }
 
 /// The CPU side of a frame, before it is recorded: a pass that assigns lights on the CPU

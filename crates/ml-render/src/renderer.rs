@@ -11,7 +11,7 @@ use crate::pass::{Pass, Recording, SlotReport, Update};
 use crate::passes::{assemble, Assembly};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene_gpu::SceneGpu;
-use crate::settings::{LightAssignment, RenderSettings};
+use crate::settings::{Exposure, LightAssignment, RenderSettings, MAX_EXPOSURE_EV};
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
@@ -81,7 +81,24 @@ pub struct Renderer<'a> {
     last_frame: usize,
     /// Format of the depth target (targets are made again on a resize).
     depth_format: vk::Format,
+    /// The EV the next frame is exposed with (auto exposure moves it), and the one each frame
+    /// slot's last frame used.
+    exposure_ev: f32,
+    slot_ev: Vec<f32>,
+    /// Auto exposure: the newest frame's log2 log-average luminance before exposure.
+    metered: Option<f32>,
 }
+
+/// Auto exposure aims the log-average luminance at middle grey.
+const EXPOSURE_KEY: f32 = 0.18;
+/// A render's last frame is rendered again, at most this often, until the EV its own image
+/// asks for is within EXPOSURE_SETTLED of the one it used (clipped pixels meter low, so the
+/// first guess from a too-bright frame falls short).
+const EXPOSURE_REPEATS: u32 = 4;
+const EXPOSURE_SETTLED: f32 = 0.05;
+/// In the viewer each frame moves the EV this share of the way to the metered one (about a
+/// third of a second to settle at 60 frames a second).
+pub const VIEWER_EXPOSURE_SMOOTHING: f32 = 0.1;
 
 /// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
 const DEFAULT_HEAT_TOP: f32 = 64.0;
@@ -130,6 +147,9 @@ impl<'a> Renderer<'a> {
             heat_top: DEFAULT_HEAT_TOP,
             last_frame: 0,
             depth_format: depth,
+            exposure_ev: fixed_ev(&settings).unwrap_or(0.0),
+            slot_ev: vec![0.0; FRAMES_IN_FLIGHT],
+            metered: None,
         };
         // Anything made before a failure is released by Drop.
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -184,12 +204,17 @@ impl<'a> Renderer<'a> {
         settings.check(self.ctx, self.scene.lights.len())?;
         self.release_frames()?;
         let (new_grid, new_view) = (settings.clusters != self.settings.clusters, settings.debug_view != self.settings.debug_view);
+        // The exposure meter is a pass of its own.
+        let new_meter = settings.meters_exposure() != self.settings.meters_exposure();
+        if let Some(ev) = fixed_ev(&settings) {
+            self.exposure_ev = ev;
+        }
         self.settings = settings;
         self.extent = vk::Extent2D { width: settings.width, height: settings.height };
         self.grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
         // The passes depend on the grid (the GPU build's sizes) and the debug view (legend,
         // tone-map curve, view passes); sizes only need new frame slots.
-        if new_grid || new_view {
+        if new_grid || new_view || new_meter {
             self.make_passes()?;
         }
         self.create_frames()?;
@@ -314,6 +339,7 @@ impl<'a> Renderer<'a> {
         let mut last = 0;
         for i in 0..self.settings.frames {
             last = i as usize % FRAMES_IN_FLIGHT;
+            self.adapt_exposure(1.0);
             self.run_frame(last, self.settings.clock(i), &mut stats, None)?;
             if sink.wants_images() {
                 self.collect_all(&mut stats)?;
@@ -325,6 +351,7 @@ impl<'a> Renderer<'a> {
         }
         self.collect_all(&mut stats)?;
         last = self.complete(last, self.settings.frames - 1, &mut stats)?;
+        last = self.settle_exposure(last, &mut stats)?;
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         if Output::of(self.settings.technique) == Output::Subpasses {
             let targets = self.frames[0].targets.as_ref().expect("made with the frame");
@@ -356,6 +383,42 @@ impl<'a> Renderer<'a> {
             self.collect_all(stats)?;
         }
         Ok(last)
+    }
+
+    /// Auto exposure: render the last frame (slot `last`) again, into the other slot, while
+    /// the EV its image asks for is not the one it used (at most EXPOSURE_REPEATS times); the
+    /// slot that holds the final image.
+    fn settle_exposure(&mut self, mut last: usize, stats: &mut FrameStats) -> Result<usize, RenderError> {
+        if !self.settings.meters_exposure() {
+            return Ok(last);
+        }
+        for _ in 0..EXPOSURE_REPEATS {
+            self.adapt_exposure(1.0);
+            if (self.exposure_ev - self.slot_ev[last]).abs() <= EXPOSURE_SETTLED {
+                break;
+            }
+            stats.exposure_repeats += 1;
+            last = (last + 1) % FRAMES_IN_FLIGHT;
+            self.run_frame(last, self.settings.clock(self.settings.frames - 1), stats, None)?;
+            self.collect_all(stats)?;
+            last = self.complete(last, self.settings.frames - 1, stats)?;
+        }
+        stats.exposure_ev = Some(self.slot_ev[last]);
+        Ok(last)
+    }
+
+    /// Auto exposure: move the next frame's EV `share` of the way to the one that brings the
+    /// newest metered frame's log-average luminance to EXPOSURE_KEY.
+    fn adapt_exposure(&mut self, share: f32) {
+        if let (Exposure::Auto, Some(log2_luminance)) = (self.settings.exposure, self.metered) {
+            let wanted = (EXPOSURE_KEY.log2() - log2_luminance).clamp(-MAX_EXPOSURE_EV, MAX_EXPOSURE_EV);
+            self.exposure_ev += (wanted - self.exposure_ev) * share;
+        }
+    }
+
+    /// The EV the next frame is exposed with.
+    pub fn exposure_ev(&self) -> f32 {
+        self.exposure_ev
     }
 
     /// The scene's camera (where the next frame is seen from).
@@ -396,6 +459,7 @@ impl<'a> Renderer<'a> {
     /// go into `stats`.
     pub fn draw(&mut self, t: f32, hook: &mut dyn FrameHook, stats: &mut FrameStats) -> Result<(), RenderError> {
         let f = (self.last_frame + 1) % FRAMES_IN_FLIGHT;
+        self.adapt_exposure(VIEWER_EXPOSURE_SMOOTHING);
         self.run_frame(f, t, stats, Some(hook))?;
         self.last_frame = f;
         Ok(())
@@ -465,6 +529,9 @@ impl<'a> Renderer<'a> {
             p.collect(f, &mut report);
         }
         self.reports[f] = report;
+        if report.log2_luminance.is_some() {
+            self.metered = report.log2_luminance;
+        }
         if report.omni_raster.is_some() {
             stats.omni_raster = report.omni_raster;
         }
@@ -537,6 +604,7 @@ impl<'a> Renderer<'a> {
         // World size of a shadow-map texel: the orthographic projection's first row is the
         // sun's x axis over the half-width it covers.
         let shadow_texel_world = 2.0 / self.gpu.shadow_view_proj.row(0).truncate().length() / self.gpu.textures.shadow_size as f32;
+        self.slot_ev[f] = self.exposure_ev;
         let frame = &mut self.frames[f];
         let uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),
@@ -566,7 +634,7 @@ impl<'a> Renderer<'a> {
                 self.scene.directional.get(i).map_or([0.0; 4], |d| d.direction.extend(0.0).to_array())
             }),
             directional_color: std::array::from_fn(|i| self.scene.directional.get(i).map_or([0.0; 4], |d| d.color.extend(0.0).to_array())),
-            exposure: [self.settings.exposure_factor(), 0.0, 0.0, 0.0],
+            exposure: [self.exposure_ev.exp2(), 0.0, 0.0, 0.0],
         };
         frame.uniforms.write(0, &[uniforms]);
     }
@@ -705,5 +773,13 @@ impl Drop for Renderer<'_> {
         // SAFETY: the device is idle; a null handle is ignored.
         unsafe { ctx.device.destroy_command_pool(self.command_pool, None) };
         self.gpu.destroy(ctx);
+    }
+}
+
+/// The EV `settings` fix, if they fix one (not auto).
+fn fixed_ev(settings: &RenderSettings) -> Option<f32> {
+    match settings.exposure {
+        Exposure::Ev(ev) => Some(ev),
+        Exposure::Auto => None,
     }
 }

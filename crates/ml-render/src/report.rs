@@ -31,6 +31,10 @@ pub struct FrameStats {
     pub omni_raster: Option<OmniRasterStats>,
     /// blinn-phong: GPU ms of the sun's shadow map, drawn once when the scene was loaded.
     pub sun_shadow_ms: Option<f64>,
+    /// Auto exposure: the EV the returned image was exposed with, and how often its frame was
+    /// rendered again for the exposure to settle.
+    pub exposure_ev: Option<f32>,
+    pub exposure_repeats: u32,
 }
 
 /// What one frame's compute shadow raster drew (--omni-shadow compute).
@@ -96,6 +100,8 @@ impl FrameStats {
             culling: None,
             omni_raster: None,
             sun_shadow_ms: None,
+            exposure_ev: None,
+            exposure_repeats: 0,
         }
     }
 
@@ -329,6 +335,13 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                 "{} (meshlet, face) pairs; {} small triangles, {} large{in_place}; {} texels covered",
                 r.pairs, r.small, r.large, r.texels
             ),
+        ));
+    }
+    if let Some(ev) = stats.exposure_ev {
+        let repeats = stats.exposure_repeats;
+        rows.push((
+            "exposure",
+            format!("auto: {ev:+.2} EV (metered on the GPU; the last frame rendered {repeats} more time(s) to settle)"),
         ));
     }
     if let Some(ms) = stats.sun_shadow_ms {

@@ -448,20 +448,34 @@ pub struct RenderSettings {
     pub culling: bool,
     /// Who draws the visibility buffer (visibility only).
     pub raster: Raster,
-    /// Exposure in EV: lit colour × 2^EV before tone map and gamma (0 changes nothing).
-    pub exposure: f32,
+    /// What lit colour is multiplied by before tone map and gamma.
+    pub exposure: Exposure,
 }
 
-/// The most |EV| `--exposure` takes: 2^±20 is a million times brighter or darker, past any
-/// useful picture; beyond is a typo.
+/// How bright the image is made (docs/DESIGN.md#exposure).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Exposure {
+    /// Lit colour × 2^EV (0 changes nothing).
+    Ev(f32),
+    /// The EV that brings the image's log-average luminance to middle grey, metered on the
+    /// GPU each frame (the exposure-meter pass) and applied to the next; a render's last frame
+    /// is rendered again until the EV it used is the one its own image asks for.
+    Auto,
+}
+
+/// The most |EV| `--exposure` takes (and auto exposure reaches): 2^±20 is a million times
+/// brighter or darker, past any useful picture; beyond is a typo.
 pub const MAX_EXPOSURE_EV: f32 = 20.0;
 
-/// Parse `--exposure EV`: a finite number of stops within ±MAX_EXPOSURE_EV.
-pub fn parse_exposure(text: &str) -> Result<f32, RenderError> {
+/// Parse `--exposure EV|auto`: auto, or a finite number of stops within ±MAX_EXPOSURE_EV.
+pub fn parse_exposure(text: &str) -> Result<Exposure, RenderError> {
+    if text.trim() == "auto" {
+        return Ok(Exposure::Auto);
+    }
     match text.trim().parse::<f32>() {
-        Ok(ev) if ev.is_finite() && ev.abs() <= MAX_EXPOSURE_EV => Ok(ev),
+        Ok(ev) if ev.is_finite() && ev.abs() <= MAX_EXPOSURE_EV => Ok(Exposure::Ev(ev)),
         _ => Err(RenderError::Invalid(format!(
-            "exposure '{text}' is not a number of stops (EV) from -{MAX_EXPOSURE_EV} to {MAX_EXPOSURE_EV}"
+            "exposure '{text}' is neither auto nor a number of stops (EV) from -{MAX_EXPOSURE_EV} to {MAX_EXPOSURE_EV}"
         ))),
     }
 }
@@ -487,14 +501,14 @@ impl RenderSettings {
             time: Some(0.0),
             culling: true,
             raster: Raster::Hardware,
-            exposure: 0.0,
+            exposure: Exposure::Ev(0.0),
         }
     }
 
-    /// What lit colour is multiplied by: 2^EV (exactly 1 at EV 0, so that the default changes
-    /// no pixel).
-    pub fn exposure_factor(&self) -> f32 {
-        self.exposure.exp2()
+    /// Whether the exposure-meter pass runs: auto exposure, on the shaded image (a debug view
+    /// shows its values as they are).
+    pub fn meters_exposure(&self) -> bool {
+        self.exposure == Exposure::Auto && self.debug_view == DebugView::None
     }
 
     /// Animation clock of frame `i`.
@@ -675,8 +689,7 @@ pub struct SettingsRequest {
     pub time: Option<f32>,
     pub culling: bool,
     pub raster: Raster,
-    /// Exposure in EV (RenderSettings::exposure).
-    pub exposure: f32,
+    pub exposure: Exposure,
 }
 
 impl SettingsRequest {

@@ -513,6 +513,7 @@ impl<'c> Session<'c> {
         }
         let renderer = self.renderer.as_mut().expect("made before a frame");
         self.overlay.gpu = stats.gpu_ms().unwrap_or_default();
+        self.overlay.exposure_ev = renderer.exposure_ev();
         if let Some(path) = self.screenshot.take() {
             let rgba = renderer.read_newest()?;
             let s = renderer.settings();

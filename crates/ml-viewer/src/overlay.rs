@@ -7,7 +7,9 @@ use ml_cpu::lights::{LightLayout, RadiusRange, SEED_RADIUS};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
-use ml_render::{DebugView, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode, Technique};
+use ml_render::{
+    DebugView, Exposure, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode, Technique,
+};
 use std::collections::VecDeque;
 
 /// Everything the overlay can change that needs a new scene or renderer.
@@ -28,8 +30,8 @@ pub struct Choices {
     pub sun_shadow: SunShadowMode,
     /// Who draws the visibility buffer (used where the technique is visibility).
     pub raster: Raster,
-    /// Exposure in EV.
-    pub exposure: f32,
+    /// Exposure: an EV, or auto (metered each frame, smoothed over frames).
+    pub exposure: Exposure,
 }
 
 impl Choices {
@@ -112,6 +114,8 @@ pub struct OverlayState {
     pub seed_scene: bool,
     /// The last settings error (shown until the next change).
     pub error: Option<String>,
+    /// The EV the newest frame was exposed with (auto exposure moves it).
+    pub exposure_ev: f32,
 }
 
 impl OverlayState {
@@ -124,6 +128,7 @@ impl OverlayState {
             lights_edit: choices.lights,
             seed_scene,
             error: None,
+            exposure_ev: 0.0,
         }
     }
 
@@ -161,7 +166,17 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         }
         combo(ui, "Layout", &mut choices.layout, &LightLayout::ALL, |l| l.name());
         ui.add(Slider::new(&mut choices.radius, 0.1..=100.0).logarithmic(true).text("light radius"));
-        ui.add(Slider::new(&mut choices.exposure, -8.0..=8.0).text("exposure (EV)"));
+        ui.horizontal(|ui| {
+            let mut auto = choices.exposure == Exposure::Auto;
+            ui.checkbox(&mut auto, "auto");
+            // Under auto the slider shows the EV the meter settled on; unticked, it starts there.
+            let mut ev = match choices.exposure {
+                Exposure::Ev(ev) => ev,
+                Exposure::Auto => state.exposure_ev,
+            };
+            ui.add_enabled(!auto, Slider::new(&mut ev, -8.0..=8.0).text("exposure (EV)"));
+            choices.exposure = if auto { Exposure::Auto } else { Exposure::Ev(ev) };
+        });
         ui.horizontal(|ui| {
             ui.label("clusters");
             ui.add(DragValue::new(&mut choices.clusters.x).range(1..=128));
@@ -236,7 +251,7 @@ mod tests {
             omni: None,
             sun_shadow: SunShadowMode::Graphics,
             raster: Raster::Hardware,
-            exposure: 0.0,
+            exposure: Exposure::Ev(0.0),
         }
     }
 

@@ -7,6 +7,7 @@ pub mod cluster_build;
 pub mod compute_lighting;
 pub mod deferred_subpass;
 pub mod depth_pyramid;
+pub mod exposure_meter;
 pub mod forward;
 pub mod gbuffer;
 pub mod meshlet_cull;
@@ -94,6 +95,9 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     }
     if matches!(s.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
         passes.push(Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view == DebugView::ShadowCube)?));
+    }
+    if s.meters_exposure() {
+        passes.push(Box::new(exposure_meter::ExposureMeter::new(ctx, s.shading == ShadingModel::Pbr)?));
     }
     Ok(())
 }

@@ -1,0 +1,100 @@
+//! Auto exposure's meter (`--exposure auto`; docs/DESIGN.md#exposure): the last pass of a
+//! frame reads the finished 8-bit image back into linear luminance and sums log2 luminance per
+//! 8×8 work group (exposure_meter.comp); the sums are copied to the host with the frame, and
+//! `collect` adds them up into the frame's log-average luminance, which the renderer turns into
+//! the next frame's EV.
+
+use crate::compute_pass::ComputePass;
+use crate::descriptors::Resource;
+use crate::frame::FRAMES_IN_FLIGHT;
+use crate::pass::{FrameResources, Pass, Recording, SlotReport};
+use crate::settings::SPEC_PBR;
+use gpu_allocator::MemoryLocation;
+use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
+use ml_vk::image::image_transition;
+use ml_vk::{vk, Buffer, Context, VkError};
+
+/// The meter's work groups are 8×8 pixels (ComputePass's size).
+const GROUP: u32 = 8;
+
+pub struct ExposureMeter {
+    pass: ComputePass,
+    /// Per frame slot: the work groups' sums on the GPU, their copy for the host, and the
+    /// groups they hold (made for the slot's image size when the slot is bound).
+    sums: Vec<Buffer>,
+    readback: Vec<Buffer>,
+    groups: Vec<u32>,
+}
+
+impl ExposureMeter {
+    /// The meter of frames shaded with pbr's tone map (`aces`) or without.
+    pub fn new(ctx: &Context, aces: bool) -> Result<ExposureMeter, VkError> {
+        let curve = [(SPEC_PBR, u32::from(aces))];
+        Ok(ExposureMeter {
+            pass: ComputePass::new(ctx, &[], (&ml_shaders::EXPOSURE_METER_COMP, &curve))?,
+            sums: (0..FRAMES_IN_FLIGHT).map(|_| Buffer::null()).collect(),
+            readback: (0..FRAMES_IN_FLIGHT).map(|_| Buffer::null()).collect(),
+            groups: vec![0; FRAMES_IN_FLIGHT],
+        })
+    }
+}
+
+impl Pass for ExposureMeter {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("exposure meter")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let extent = frame.targets.color.extent;
+        let groups = extent.width.div_ceil(GROUP) * extent.height.div_ceil(GROUP);
+        let slot = frame.slot;
+        if groups != self.groups[slot] {
+            // A new size (no frame of this slot in flight while it is bound).
+            self.sums[slot].destroy(ctx);
+            self.readback[slot].destroy(ctx);
+            self.groups[slot] = 0;
+            let bytes = groups as u64 * 8;
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC;
+            self.sums[slot] = Buffer::new(ctx, "exposure meter sums", bytes, usage, MemoryLocation::GpuOnly)?;
+            let host = vk::BufferUsageFlags::TRANSFER_DST;
+            self.readback[slot] = Buffer::new(ctx, "exposure meter read-back", bytes, host, MemoryLocation::GpuToCpu)?;
+            self.groups[slot] = groups;
+        }
+        let sums = Resource::Buffer(self.sums[slot].raw);
+        self.pass.bind_frame(ctx, frame, &|name| if name == "ExposureMeterBuffer" { Some(sums) } else { frame.buffer(name) })
+    }
+
+    /// After every pass that writes the colour target, which each leaves in
+    /// TRANSFER_SRC_OPTIMAL for the read-back (its writes ordered before transfers); it is left
+    /// so again.
+    fn record(&self, rec: &Recording) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let (compute, transfer) = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::PipelineStageFlags::TRANSFER);
+        let color = rec.targets.color.raw;
+        let source = (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        let read = (compute, vk::AccessFlags::SHADER_READ, vk::ImageLayout::GENERAL);
+        image_transition(ctx, cmd, color, source, read);
+        // The sums' last copy, two frames ago, read them (same queue).
+        memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_READ), (compute, vk::AccessFlags::SHADER_WRITE));
+        self.pass.dispatch(ctx, cmd, rec.slot, (&[], &[]), rec.extent);
+        image_transition(ctx, cmd, color, read, source);
+        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
+        copy_buffer_to_host(ctx, cmd, (self.sums[rec.slot].raw, self.readback[rec.slot].raw), self.groups[rec.slot] as u64 * 8);
+    }
+
+    fn collect(&self, slot: usize, report: &mut SlotReport) {
+        let bytes = self.groups[slot] as usize * 8;
+        let sums: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&self.readback[slot].mapped()[..bytes]);
+        let (log2_sum, pixels) = sums.iter().fold((0.0f64, 0.0f64), |(s, n), g| (s + g[0] as f64, n + g[1] as f64));
+        // A frame with no metered pixel (all background) keeps the exposure it had.
+        report.log2_luminance = (pixels > 0.0).then_some((log2_sum / pixels) as f32);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pass.destroy(ctx);
+        for b in self.sums.iter_mut().chain(&mut self.readback) {
+            b.destroy(ctx);
+        }
+        self.groups.fill(0);
+    }
+}
