@@ -106,31 +106,9 @@ fn without_a_display_view_is_one_error_line() {
 /// `render`'s image.
 #[test]
 fn the_compute_raster_views_what_it_renders() {
-    let d = dir();
-    let (shot, rendered) = (d.join("compute-raster-shot.png"), d.join("compute-raster-render.png"));
-    let script = ["frames 2", "resize 200 120", "frames 3", &format!("screenshot {}", shot.display()), "quit"].join("\n");
-    let script_file = d.join("compute-raster.txt");
-    std::fs::write(&script_file, script).unwrap();
     let common =
         ["--technique", "visibility", "--raster", "compute", "--scene", "bench", "--objects", "30", "--lights", "300", "--time", "0"];
-    let mut args = vec!["--validation", "--script", script_file.to_str().unwrap(), "--width", "160", "--height", "96"];
-    args.extend(common);
-    let out = view_under_xvfb(&args);
-    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "the session failed: {stdout}{stderr}");
-    assert!(!stderr.contains("VALIDATION") && !stderr.contains("panicked"), "{stderr}");
-    assert_render_equals(&shot, &[&["--validation", "--width", "200", "--height", "120"][..], &common].concat(), &rendered);
-}
-
-/// `render ARGS --out rendered` succeeds and its image equals the viewer's screenshot `shot`
-/// within 1/255.
-fn assert_render_equals(shot: &Path, args: &[&str], rendered: &Path) {
-    let r = Command::new(bin()).arg("render").args(args).args(["--out", rendered.to_str().unwrap()]).output().unwrap();
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (a, b) = (rgba(shot), rgba(rendered));
-    assert_eq!((a.0, a.1), (b.0, b.1));
-    let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-    assert!(worst <= 1, "the viewer's screenshot differs from render by {worst}/255");
+    resized_session_matches_render("compute-raster", &common, (3, 1));
 }
 
 /// Auto exposure in the window: the meter's pass through a resize (its sums made again for
@@ -139,24 +117,48 @@ fn assert_render_equals(shot: &Path, args: &[&str], rendered: &Path) {
 /// stops within 0.05 EV of it): within 2/255 (measured: 1).
 #[test]
 fn auto_exposure_eases_to_what_render_settles_on() {
+    resized_session_matches_render("auto-exposure", &["--shading", "blinn-phong", "--exposure", "auto", "--time", "0"], (100, 2));
+}
+
+/// A validated viewer session with `common` arguments at 160×96: two frames, a resize to
+/// 200×120, `frames` frames, a screenshot; it ends cleanly and its screenshot is within
+/// `tolerance`/255 of `render` with the same arguments at 200×120.
+fn resized_session_matches_render(name: &str, common: &[&str], (frames, tolerance): (u32, u8)) {
     let d = dir();
-    let (shot, rendered) = (d.join("auto-exposure-shot.png"), d.join("auto-exposure-render.png"));
-    let script = ["frames 20", "resize 200 120", "frames 100", &format!("screenshot {}", shot.display()), "quit"].join("\n");
-    let script_file = d.join("auto-exposure.txt");
-    std::fs::write(&script_file, script).unwrap();
-    let common = ["--shading", "blinn-phong", "--exposure", "auto", "--time", "0"];
+    let (shot, rendered) = (d.join(format!("{name}-shot.png")), d.join(format!("{name}-render.png")));
+    let script = [
+        "frames 2".to_owned(),
+        "resize 200 120".into(),
+        format!("frames {frames}"),
+        format!("screenshot {}", shot.display()),
+        "quit".into(),
+    ];
+    let script_file = d.join(format!("{name}.txt"));
+    std::fs::write(&script_file, script.join("\n")).unwrap();
     let mut args = vec!["--validation", "--script", script_file.to_str().unwrap(), "--width", "160", "--height", "96"];
     args.extend(common);
     let out = view_under_xvfb(&args);
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "the session failed: {stdout}{stderr}");
     assert!(!stderr.contains("VALIDATION") && !stderr.contains("panicked"), "{stderr}");
-    let size = ["--validation", "--width", "200", "--height", "120", "--out", rendered.to_str().unwrap()];
-    let r = Command::new(bin()).arg("render").args(size).args(common).output().unwrap();
+    let worst = render_difference(&shot, &[&["--validation", "--width", "200", "--height", "120"][..], common].concat(), &rendered);
+    println!("{name}: the viewer's screenshot and render differ by at most {worst}/255");
+    assert!(worst <= tolerance, "{name}: the viewer's screenshot differs from render by {worst}/255");
+}
+
+/// `render ARGS --out rendered` succeeds and its image equals the viewer's screenshot `shot`
+/// within 1/255.
+fn assert_render_equals(shot: &Path, args: &[&str], rendered: &Path) {
+    let worst = render_difference(shot, args, rendered);
+    assert!(worst <= 1, "the viewer's screenshot differs from render by {worst}/255");
+}
+
+/// Run `render ARGS --out rendered` (it must succeed); the largest channel difference between
+/// its image and the viewer's screenshot `shot` (of the same size).
+fn render_difference(shot: &Path, args: &[&str], rendered: &Path) -> u8 {
+    let r = Command::new(bin()).arg("render").args(args).args(["--out", rendered.to_str().unwrap()]).output().unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (a, b) = (rgba(&shot), rgba(&rendered));
+    let (a, b) = (rgba(shot), rgba(rendered));
     assert_eq!((a.0, a.1), (b.0, b.1));
-    let worst = a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-    println!("auto exposure: the viewer's screenshot and render differ by at most {worst}/255");
-    assert!(worst <= 2, "the viewer's screenshot differs from render by {worst}/255");
+    a.2.iter().zip(&b.2).map(|(x, y)| x.abs_diff(*y)).max().unwrap()
 }
