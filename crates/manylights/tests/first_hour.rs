@@ -67,26 +67,30 @@ fn camera_option_gives_the_scene_files_camera_image() {
 
 #[test]
 fn an_image_sequence_has_every_frame_and_ends_with_the_frames_image() {
-    let dir = temp_dir("sequence");
-    let pattern = dir.join("frames").join("##.png");
-    std::fs::create_dir_all(dir.join("frames")).unwrap();
-    let last = dir.join("last.png");
-    // Technique clustered-gpu: its frames are the ones that can be rendered again.
-    let render = |out: &Path| {
-        let mut args = vec!["render", "--validation", "--technique", "clustered-gpu", "--frames", "5", "--out", out.to_str().unwrap()];
-        args.extend(SIZE);
-        ok(&manylights(&args))
-    };
-    render(&pattern);
-    render(&last);
-    let mut files: Vec<String> =
-        std::fs::read_dir(dir.join("frames")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    files.sort();
-    assert_eq!(files, ["00.png", "01.png", "02.png", "03.png", "04.png"]);
-    let frames: Vec<_> = files.iter().map(|f| pixels(&dir.join("frames").join(f))).collect();
-    assert!(frames[4] == pixels(&last), "the sequence's last frame differs from the --frames 5 image");
-    // The lights move: the frames are not one image written five times.
-    assert!(frames[0] != frames[4]);
+    // Also under auto exposure, whose render settles its last frame before returning it.
+    for exposure in ["0", "auto"] {
+        let dir = temp_dir(&format!("sequence-{exposure}"));
+        let pattern = dir.join("frames").join("##.png");
+        std::fs::create_dir_all(dir.join("frames")).unwrap();
+        let last = dir.join("last.png");
+        // Technique clustered-gpu: its frames are the ones that can be rendered again.
+        let render = |out: &Path| {
+            let mut args = vec!["render", "--validation", "--technique", "clustered-gpu", "--frames", "5", "--out", out.to_str().unwrap()];
+            args.extend(SIZE);
+            args.extend(["--exposure", exposure]);
+            ok(&manylights(&args))
+        };
+        render(&pattern);
+        render(&last);
+        let mut files: Vec<String> =
+            std::fs::read_dir(dir.join("frames")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        files.sort();
+        assert_eq!(files, ["00.png", "01.png", "02.png", "03.png", "04.png"]);
+        let frames: Vec<_> = files.iter().map(|f| pixels(&dir.join("frames").join(f))).collect();
+        assert!(frames[4] == pixels(&last), "exposure {exposure}: the sequence's last frame differs from the --frames 5 image");
+        // The lights move: the frames are not one image written five times.
+        assert!(frames[0] != frames[4]);
+    }
 }
 
 #[test]

@@ -85,8 +85,6 @@ pub struct Renderer<'a> {
     /// slot's last frame used.
     exposure_ev: f32,
     slot_ev: Vec<f32>,
-    /// Auto exposure: the newest frame's log2 log-average luminance before exposure.
-    metered: Option<f32>,
 }
 
 /// Auto exposure aims the log-average luminance at middle grey.
@@ -149,7 +147,6 @@ impl<'a> Renderer<'a> {
             depth_format: depth,
             exposure_ev: fixed_ev(&settings).unwrap_or(0.0),
             slot_ev: vec![0.0; FRAMES_IN_FLIGHT],
-            metered: None,
         };
         // Anything made before a failure is released by Drop.
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -339,11 +336,19 @@ impl<'a> Renderer<'a> {
         let mut last = 0;
         for i in 0..self.settings.frames {
             last = i as usize % FRAMES_IN_FLIGHT;
-            self.adapt_exposure(1.0);
+            // Exposed from the image of the slot's previous frame (two back), whether or not
+            // the frame before was waited for (an image sequence waits for each): the same
+            // EVs, so the same images, either way.
+            self.collect(last, &mut stats)?;
+            self.adapt_exposure(1.0, last);
             self.run_frame(last, self.settings.clock(i), &mut stats, None)?;
             if sink.wants_images() {
                 self.collect_all(&mut stats)?;
                 last = self.complete(last, i, &mut stats)?;
+                // The last image is the one `render` returns: with its exposure settled.
+                if i + 1 == self.settings.frames {
+                    last = self.settle_exposure(last, &mut stats)?;
+                }
                 let rgba = self.read_back(last)?;
                 sink.image(i, &rgba)?;
             }
@@ -393,7 +398,7 @@ impl<'a> Renderer<'a> {
             return Ok(last);
         }
         for _ in 0..EXPOSURE_REPEATS {
-            self.adapt_exposure(1.0);
+            self.adapt_exposure(1.0, last);
             if (self.exposure_ev - self.slot_ev[last]).abs() <= EXPOSURE_SETTLED {
                 break;
             }
@@ -408,9 +413,9 @@ impl<'a> Renderer<'a> {
     }
 
     /// Auto exposure: move the next frame's EV `share` of the way to the one that brings the
-    /// newest metered frame's log-average luminance to EXPOSURE_KEY.
-    fn adapt_exposure(&mut self, share: f32) {
-        if let (Exposure::Auto, Some(log2_luminance)) = (self.settings.exposure, self.metered) {
+    /// log-average luminance of slot `slot`'s last frame (collected) to EXPOSURE_KEY.
+    fn adapt_exposure(&mut self, share: f32, slot: usize) {
+        if let (Exposure::Auto, Some(log2_luminance)) = (self.settings.exposure, self.reports[slot].log2_luminance) {
             let wanted = (EXPOSURE_KEY.log2() - log2_luminance).clamp(-MAX_EXPOSURE_EV, MAX_EXPOSURE_EV);
             self.exposure_ev += (wanted - self.exposure_ev) * share;
         }
@@ -459,7 +464,8 @@ impl<'a> Renderer<'a> {
     /// go into `stats`.
     pub fn draw(&mut self, t: f32, hook: &mut dyn FrameHook, stats: &mut FrameStats) -> Result<(), RenderError> {
         let f = (self.last_frame + 1) % FRAMES_IN_FLIGHT;
-        self.adapt_exposure(VIEWER_EXPOSURE_SMOOTHING);
+        // The slot's previous frame was collected by `wait_next_slot`.
+        self.adapt_exposure(VIEWER_EXPOSURE_SMOOTHING, f);
         self.run_frame(f, t, stats, Some(hook))?;
         self.last_frame = f;
         Ok(())
@@ -529,9 +535,6 @@ impl<'a> Renderer<'a> {
             p.collect(f, &mut report);
         }
         self.reports[f] = report;
-        if report.log2_luminance.is_some() {
-            self.metered = report.log2_luminance;
-        }
         if report.omni_raster.is_some() {
             stats.omni_raster = report.omni_raster;
         }
