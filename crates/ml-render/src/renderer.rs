@@ -356,7 +356,10 @@ impl<'a> Renderer<'a> {
         }
         self.collect_all(&mut stats)?;
         last = self.complete(last, self.settings.frames - 1, &mut stats)?;
-        last = self.settle_exposure(last, &mut stats)?;
+        if !sink.wants_images() {
+            // (An image sequence settled its last frame before handing it over.)
+            last = self.settle_exposure(last, &mut stats)?;
+        }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         if Output::of(self.settings.technique) == Output::Subpasses {
             let targets = self.frames[0].targets.as_ref().expect("made with the frame");
