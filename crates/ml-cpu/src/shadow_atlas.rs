@@ -12,13 +12,18 @@
 //! - **The budget**: if the faces do not fit, every face's side is halved together (the same
 //!   factor for every light: 1/2, 1/4 …, reported) until they do; none is dropped. If even
 //!   32² faces do not fit, the plan fails with the numbers.
-//! - **Packing**: square power-of-two tiles sorted largest first, laid out along a Z-order
-//!   (Morton) curve: each tile starts where the last ended, aligned to its own size, so they
-//!   never overlap and fill the atlas with no gap — whatever fits by area fits.
+//! - **Packing**: square power-of-two tiles in a quadtree of blocks (a buddy allocator along
+//!   the atlas's Z-order curve, whose texels are stored in that order too: a face is one run
+//!   of memory). Laid out afresh, largest first, they fill the atlas with no gap — whatever
+//!   fits by area fits.
+//! - **Caching**: a face keeps its block from frame to frame while its size stays; it is
+//!   drawn again only if its light moved (or the caller turns the cache off). When the kept
+//!   blocks leave no room for the new ones, all are laid out afresh and drawn.
 
 use crate::camera::Camera;
 use crate::omni_shadow::face_axes;
 use glam::{Mat4, Vec3, Vec4};
+use std::collections::{BTreeSet, HashMap};
 
 /// Texels a side of the smallest and the largest face.
 pub const MIN_FACE: u32 = 32;
@@ -46,8 +51,12 @@ pub struct FaceTile {
     pub face: u32,
     /// Texels a side.
     pub size: u32,
-    /// Top-left texel in the atlas.
+    /// Top-left texel in the atlas (its picture: the debug view).
     pub origin: [u32; 2],
+    /// Index of its texel (0, 0) in the atlas's Z-ordered texels (`morton_encode`).
+    pub base: u64,
+    /// Whether this frame draws it (a new block, a moved light, or no cache).
+    pub redraw: bool,
 }
 
 /// A frame's atlas: its extent and every face a visible pixel may sample.
@@ -61,6 +70,11 @@ pub struct AtlasPlan {
 }
 
 impl AtlasPlan {
+    /// Faces this frame draws.
+    pub fn redrawn(&self) -> usize {
+        self.tiles.iter().filter(|t| t.redraw).count()
+    }
+
     /// Bytes the tiles use (at most the atlas's, which is at most the budget).
     pub fn used_bytes(&self) -> u64 {
         self.tiles.iter().map(|t| t.size as u64 * t.size as u64 * TEXEL_BYTES).sum()
@@ -156,53 +170,192 @@ fn prev_power_of_two(n: u32) -> u32 {
     1 << (31 - n.max(1).leading_zeros())
 }
 
-/// The frame's plan: every visible face of `lights` (seen by `camera` on a `width`×`height`
-/// image) at its size, halved together until all fit an atlas of `budget` bytes at most
-/// `max_side` texels across.
-pub fn plan(
-    lights: &[PlannedLight],
-    camera: &Camera,
-    (width, height): (u32, u32),
-    budget: u64,
-    max_side: u32,
-) -> Result<AtlasPlan, AtlasError> {
-    let extent = atlas_extent(budget, max_side)?;
-    let planes = frustum_planes(camera.projection(width as f32 / height as f32) * camera.view());
-    let mut wanted = Vec::new();
-    for (i, light) in lights.iter().enumerate() {
-        let mask = visible_faces(light, &planes);
-        let size = face_size(light, camera, height);
-        wanted.extend((0..6).filter(|f| mask & (1 << f) != 0).map(|face| (i as u32, face, size)));
+/// Where faces lie in the atlas, kept from frame to frame so that a face whose light did not
+/// move keeps its texels (the cache): a quadtree of power-of-two blocks (a buddy allocator
+/// over the atlas's Z-order), in units of one `MIN_FACE`² block.
+#[derive(Clone, Debug)]
+pub struct ShadowAtlas {
+    extent: [u32; 2],
+    /// The order of the largest block (order k: (MIN_FACE·2^k)² texels).
+    top: u32,
+    /// Free blocks of each order, by first unit (lowest first: the layout is deterministic).
+    free: Vec<BTreeSet<u64>>,
+    /// Last frame's faces: (the caller's light key, face) → where, and the light as drawn.
+    placed: HashMap<(u32, u32), Placement>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Placement {
+    order: u32,
+    unit: u64,
+    drawn: PlannedLight,
+}
+
+/// Texels a side of a block of `order`.
+fn order_side(order: u32) -> u32 {
+    MIN_FACE << order
+}
+
+/// Units (MIN_FACE² blocks) in a block of `order`.
+fn order_units(order: u32) -> u64 {
+    1 << (2 * order)
+}
+
+impl ShadowAtlas {
+    /// An empty atlas of `budget` bytes at most, at most `max_side` texels across.
+    pub fn new(budget: u64, max_side: u32) -> Result<ShadowAtlas, AtlasError> {
+        let extent = atlas_extent(budget, max_side)?;
+        let square = extent[1];
+        let top = (square / MIN_FACE).trailing_zeros().min((MAX_FACE / MIN_FACE).trailing_zeros());
+        let mut atlas = ShadowAtlas { extent, top, free: Vec::new(), placed: HashMap::new() };
+        atlas.clear();
+        Ok(atlas)
     }
-    let capacity = extent[0] as u64 * extent[1] as u64;
-    let area = |divisor: u32| wanted.iter().map(|&(_, _, s)| ((s / divisor).max(MIN_FACE) as u64).pow(2)).sum::<u64>();
-    let mut divided_by = 1;
-    while area(divided_by) > capacity {
-        if MAX_FACE / divided_by <= MIN_FACE {
-            let needed = wanted.len() as u64 * (MIN_FACE * MIN_FACE) as u64 * TEXEL_BYTES;
-            return Err(AtlasError::TooManyFaces { faces: wanted.len(), needed_mib: needed.div_ceil(1 << 20), budget_mib: budget >> 20 });
+
+    pub fn extent(&self) -> [u32; 2] {
+        self.extent
+    }
+
+    pub fn bytes(&self) -> u64 {
+        self.extent[0] as u64 * self.extent[1] as u64 * TEXEL_BYTES
+    }
+
+    /// Forget every face (the casters changed): the next frame draws all of them.
+    pub fn clear(&mut self) {
+        self.placed.clear();
+        self.free = vec![BTreeSet::new(); self.top as usize + 1];
+        let units = self.extent[0] as u64 * self.extent[1] as u64 / (MIN_FACE * MIN_FACE) as u64;
+        let step = order_units(self.top);
+        self.free[self.top as usize] = (0..units / step).map(|i| i * step).collect();
+    }
+
+    fn allocate(&mut self, order: u32) -> Option<u64> {
+        let from = (order..=self.top).find(|&j| !self.free[j as usize].is_empty())?;
+        let unit = self.free[from as usize].pop_first()?;
+        // Split down: the block's first quarter goes on, the other three are free.
+        for j in (order..from).rev() {
+            for k in 1..4 {
+                self.free[j as usize].insert(unit + k * order_units(j));
+            }
         }
-        divided_by *= 2;
+        Some(unit)
     }
-    let mut tiles: Vec<FaceTile> = wanted
-        .into_iter()
-        .map(|(light, face, size)| FaceTile { light, face, size: (size / divided_by).max(MIN_FACE), origin: [0, 0] })
-        .collect();
-    // Largest first (ties: light, face), each at the next Z-order slot of its own size.
-    tiles.sort_by(|a, b| b.size.cmp(&a.size).then(a.light.cmp(&b.light)).then(a.face.cmp(&b.face)));
-    let square = extent[1] as u64;
-    let mut used = 0u64;
-    for t in &mut tiles {
-        let s = t.size as u64;
-        // The Z-order index of this tile among tiles of its size; a 2:1 atlas is two squares.
-        let index = used / (s * s);
-        let per_square = (square / s) * (square / s);
-        let (column, within) = (index / per_square, index % per_square);
-        let (x, y) = morton_decode(within);
-        t.origin = [(column * square + x * s) as u32, (y * s) as u32];
-        used += s * s;
+
+    fn release(&mut self, mut unit: u64, mut order: u32) {
+        while order < self.top {
+            let parent = unit & !(order_units(order + 1) - 1);
+            let siblings: Vec<u64> = (0..4).map(|k| parent + k * order_units(order)).filter(|&u| u != unit).collect();
+            if !siblings.iter().all(|u| self.free[order as usize].contains(u)) {
+                break;
+            }
+            for u in &siblings {
+                self.free[order as usize].remove(u);
+            }
+            unit = parent;
+            order += 1;
+        }
+        self.free[order as usize].insert(unit);
     }
-    Ok(AtlasPlan { extent, divided_by, tiles })
+
+    /// The frame's plan: every visible face of `lights` (each with the caller's key, which
+    /// names the same light from frame to frame) seen by `camera` on a `width`×`height`
+    /// image, at its size (`fixed`: every face that size instead), all halved together until
+    /// they fit. A face keeps last frame's block if its size did not change; it is drawn again
+    /// unless `cache` is on and its light is where it was drawn. When the kept blocks leave no
+    /// room for the new ones, everything is laid out afresh (and drawn).
+    pub fn plan(
+        &mut self,
+        lights: &[(u32, PlannedLight)],
+        camera: &Camera,
+        (width, height): (u32, u32),
+        fixed: Option<u32>,
+        cache: bool,
+    ) -> Result<AtlasPlan, AtlasError> {
+        let planes = frustum_planes(camera.projection(width as f32 / height as f32) * camera.view());
+        let mut wanted = Vec::new();
+        for (i, (_, light)) in lights.iter().enumerate() {
+            let mask = visible_faces(light, &planes);
+            let size = fixed.unwrap_or_else(|| face_size(light, camera, height)).clamp(MIN_FACE, MAX_FACE).next_power_of_two();
+            wanted.extend((0..6).filter(|f| mask & (1 << f) != 0).map(|face| (i as u32, face, size)));
+        }
+        let capacity = self.extent[0] as u64 * self.extent[1] as u64;
+        let area = |divisor: u32| wanted.iter().map(|&(_, _, s)| ((s / divisor).max(MIN_FACE) as u64).pow(2)).sum::<u64>();
+        let mut divided_by = 1;
+        while area(divided_by) > capacity {
+            if MAX_FACE / divided_by <= MIN_FACE {
+                let needed = wanted.len() as u64 * (MIN_FACE * MIN_FACE) as u64 * TEXEL_BYTES;
+                let budget_mib = self.bytes() >> 20;
+                return Err(AtlasError::TooManyFaces { faces: wanted.len(), needed_mib: needed.div_ceil(1 << 20), budget_mib });
+            }
+            divided_by *= 2;
+        }
+        // Largest first (ties: light, face): a fresh layout in this order fills the Z-order
+        // with no gap, so whatever fits by area fits.
+        let mut tiles: Vec<FaceTile> = wanted
+            .into_iter()
+            .map(|(light, face, size)| FaceTile { light, face, size: (size / divided_by).max(MIN_FACE), origin: [0, 0], base: 0, redraw: true })
+            .collect();
+        tiles.sort_by(|a, b| b.size.cmp(&a.size).then(a.light.cmp(&b.light)).then(a.face.cmp(&b.face)));
+        let order_of = |t: &FaceTile| (t.size / MIN_FACE).trailing_zeros();
+        let mut last = std::mem::take(&mut self.placed);
+        let mut units = vec![None; tiles.len()];
+        for (t, unit) in tiles.iter_mut().zip(&mut units) {
+            let (key, light) = lights[t.light as usize];
+            match last.remove(&(key, t.face)) {
+                Some(p) if p.order == order_of(t) => {
+                    *unit = Some(p.unit);
+                    t.redraw = !cache || p.drawn != light;
+                }
+                Some(p) => self.release(p.unit, p.order),
+                None => {}
+            }
+        }
+        for p in last.into_values() {
+            self.release(p.unit, p.order);
+        }
+        for (t, unit) in tiles.iter().zip(&mut units) {
+            if unit.is_none() {
+                *unit = self.allocate(order_of(t));
+                if unit.is_none() {
+                    break;
+                }
+            }
+        }
+        if units.iter().any(Option::is_none) {
+            // The kept blocks split the free space too finely: lay everything out again.
+            self.clear();
+            for (t, unit) in tiles.iter_mut().zip(&mut units) {
+                *unit = Some(self.allocate(order_of(t)).expect("faces that fit by area fit a fresh Z-order layout"));
+                t.redraw = true;
+            }
+        }
+        let square = self.extent[1] as u64;
+        let per_square = (square / MIN_FACE as u64).pow(2);
+        for (t, unit) in tiles.iter_mut().zip(units) {
+            let unit = unit.expect("every face placed");
+            let (x, y) = morton_decode(unit % per_square);
+            t.origin = [((unit / per_square) * square + x * MIN_FACE as u64) as u32, (y * MIN_FACE as u64) as u32];
+            t.base = unit * (MIN_FACE * MIN_FACE) as u64;
+            let (key, drawn) = lights[t.light as usize];
+            self.placed.insert((key, t.face), Placement { order: order_of(t), unit, drawn });
+        }
+        Ok(AtlasPlan { extent: self.extent, divided_by, tiles })
+    }
+}
+
+/// Where texel (x, y) of a face lies in its block: the atlas holds its texels in Z-order
+/// (Morton order: x in the even bits, y in the odd), so a face's texels are one run from its
+/// `base`, and a 3×3 filter footprint mostly shares cache lines.
+pub fn morton_encode(x: u32, y: u32) -> u64 {
+    let spread = |v: u32| {
+        let mut v = v as u64;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        (v | (v << 1)) & 0x5555_5555_5555_5555
+    };
+    spread(x) | (spread(y) << 1)
 }
 
 /// The (x, y) whose bits interleave (x in the even bits, y in the odd) to `index`.

@@ -11,6 +11,12 @@ fn camera() -> Camera {
     Camera::looking_at(Vec3::new(0.0, 2.0, 10.0), Vec3::new(0.0, 2.0, 0.0), 60.0, 0.1, 100.0)
 }
 
+/// A fresh atlas's plan for `lights` (keys: their indices) at 1920×1080.
+fn plan(lights: &[PlannedLight], c: &Camera, budget: u64) -> Result<AtlasPlan, AtlasError> {
+    let keyed: Vec<(u32, PlannedLight)> = lights.iter().enumerate().map(|(i, l)| (i as u32, *l)).collect();
+    ShadowAtlas::new(budget, 16384)?.plan(&keyed, c, (1920, 1080), None, true)
+}
+
 #[test]
 fn a_face_has_about_as_many_texels_as_its_light_covers_pixels() {
     let c = camera();
@@ -104,6 +110,10 @@ fn assert_packed(plan: &AtlasPlan) {
     for t in &plan.tiles {
         assert!(t.origin[0] + t.size <= w && t.origin[1] + t.size <= h, "{t:?} outside {w}x{h}");
         assert!(t.origin[0] % t.size == 0 && t.origin[1] % t.size == 0, "{t:?} not aligned to its size");
+        // Its run of Z-ordered texels is its square of the picture.
+        let square = h as u64;
+        let column = (t.origin[0] as u64 / square) * square * square;
+        assert_eq!(t.base, column + morton_encode(t.origin[0] % h, t.origin[1]), "{t:?}");
     }
     let mut tiles = plan.tiles.clone();
     tiles.sort_by_key(|t| (t.origin[1], t.origin[0]));
@@ -129,7 +139,7 @@ fn tiles_lie_inside_the_atlas_and_never_overlap() {
                 light(rng.random_range(-20.0..20.0), rng.random_range(0.0..6.0), rng.random_range(-30.0..8.0), rng.random_range(0.5..6.0))
             })
             .collect();
-        let plan = plan(&lights, &c, (1920, 1080), budget, 16384).unwrap();
+        let plan = plan(&lights, &c, budget).unwrap();
         assert_packed(&plan);
         assert!(plan.atlas_bytes() <= budget);
         println!(
@@ -154,7 +164,7 @@ fn four_thousand_lights_fit_the_budget_by_one_factor() {
         .collect();
     let planes = frustum_planes(c.projection(16.0 / 9.0) * c.view());
     let visible: usize = lights.iter().map(|l| visible_faces(l, &planes).count_ones() as usize).sum();
-    let planned = plan(&lights, &c, (1920, 1080), 256 * MIB, 16384).unwrap();
+    let planned = plan(&lights, &c, 256 * MIB).unwrap();
     assert_eq!(planned.tiles.len(), visible, "a visible face without a tile");
     assert!(planned.divided_by > 1, "these faces should not fit undivided");
     for t in &planned.tiles {
@@ -170,7 +180,7 @@ fn four_thousand_lights_fit_the_budget_by_one_factor() {
         planned.atlas_bytes() >> 20
     );
     // Too small for even the smallest faces: an error with the numbers, not a dropped shadow.
-    let err = plan(&lights, &c, (1920, 1080), 4 * MIB, 16384).unwrap_err();
+    let err = plan(&lights, &c, 4 * MIB).unwrap_err();
     assert!(matches!(err, AtlasError::TooManyFaces { .. }), "{err}");
 }
 
@@ -178,4 +188,60 @@ fn four_thousand_lights_fit_the_budget_by_one_factor() {
 fn morton_order_walks_squares_within_squares() {
     let cells: Vec<(u64, u64)> = (0..8).map(morton_decode).collect();
     assert_eq!(cells, [(0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (3, 0), (2, 1), (3, 1)]);
+}
+
+#[test]
+fn morton_encode_undoes_decode() {
+    for i in [0u64, 1, 2, 3, 77, 1023, 4096, 123_456, (1 << 30) - 1] {
+        let (x, y) = morton_decode(i);
+        assert_eq!(morton_encode(x as u32, y as u32), i);
+    }
+}
+
+/// Frame after frame: faces whose lights stay keep their blocks and are not drawn again; a
+/// moved light's faces are; with the cache off every face is; the layout is the same either
+/// way, and the free space is whole again when every face has gone.
+#[test]
+fn kept_faces_keep_their_blocks_and_only_moved_lights_are_drawn() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let lights: Vec<(u32, PlannedLight)> = (0..200)
+        .map(|i| (i * 3, light(rng.random_range(-8.0..8.0), rng.random_range(0.0..4.0), rng.random_range(-10.0..5.0), rng.random_range(0.5..3.0))))
+        .collect();
+    let mut cached = ShadowAtlas::new(64 * MIB, 16384).unwrap();
+    let mut uncached = cached.clone();
+    let mut eye = Vec3::new(0.0, 2.0, 10.0);
+    let mut moving = lights.clone();
+    for frame in 0..20 {
+        // The camera drifts (sizes and visible faces change now and then); every fifth
+        // frame the first ten lights move.
+        eye += Vec3::new(0.3, 0.0, -0.2);
+        let c = Camera::looking_at(eye, Vec3::new(0.0, 2.0, 0.0), 60.0, 0.1, 100.0);
+        if frame % 5 == 4 {
+            for (_, l) in &mut moving[..10] {
+                l.position.x += 0.25;
+            }
+        }
+        let a = cached.plan(&moving, &c, (1920, 1080), None, true).unwrap();
+        let b = uncached.plan(&moving, &c, (1920, 1080), None, false).unwrap();
+        assert_packed(&a);
+        let place = |p: &AtlasPlan| p.tiles.iter().map(|t| (t.light, t.face, t.size, t.base)).collect::<Vec<_>>();
+        assert_eq!(place(&a), place(&b), "frame {frame}: the cache changed the layout");
+        assert!(b.tiles.iter().all(|t| t.redraw));
+        if frame > 0 {
+            let moved = a.tiles.iter().filter(|t| t.redraw && t.light < 10).count();
+            let others = a.redrawn() - moved;
+            assert!(others < a.tiles.len() / 4, "frame {frame}: {others} of {} unmoved faces drawn again", a.tiles.len());
+            if frame % 5 == 4 {
+                assert!(a.tiles.iter().filter(|t| t.light < 10).all(|t| t.redraw), "frame {frame}: a moved light's face kept");
+            }
+        }
+    }
+    // A still camera and still lights: nothing is drawn again.
+    let c = Camera::looking_at(eye, Vec3::new(0.0, 2.0, 0.0), 60.0, 0.1, 100.0);
+    cached.plan(&moving, &c, (1920, 1080), None, true).unwrap();
+    assert_eq!(cached.plan(&moving, &c, (1920, 1080), None, true).unwrap().redrawn(), 0);
+    // No lights: every block is free again, merged back into the largest.
+    assert!(cached.plan(&[], &c, (1920, 1080), None, true).unwrap().tiles.is_empty());
+    let fresh = ShadowAtlas::new(64 * MIB, 16384).unwrap();
+    assert_eq!(cached.free, fresh.free);
 }
