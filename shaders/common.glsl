@@ -225,6 +225,7 @@ struct OmniRasterPush {
     uvec4 sizes;     // x: texels per face side; y: shadowed lights; z: the largest triangle one
                      // thread draws (bounding box, texels a side); w: meshlet instances
     uvec4 capacity;  // x: (meshlet instance, face) pairs the pair list holds; y: large triangles
+                     // (in the shadow atlas sizes.x is unused: each light's tiles say)
 };
 
 // The counts of a frame's compute shadow raster.
@@ -233,8 +234,29 @@ struct OmniRasterCounters {
     uvec4 large; // x: the large-triangle raster's work groups, likewise; y, z: 1; w: large triangles
                  // listed (those past the list's capacity are drawn by their own thread)
     uvec4 drawn; // x: triangles drawn by one thread; y: of those, large (the list was full);
-                 // z: texels covered
+                 // z: texels covered; w: (meshlet, face) pairs drawn by the culling's thread
+                 // (the pair list was full)
 };
+
+// One shadowed light's faces in the shadow atlas (omni_shadow.glsl, omni_raster.glsl): the
+// atlas holds depths in Z-order, a face's texel (x, y) at base[face] + morton(x, y).
+struct ShadowCubeTiles {
+    uint base[6]; // per cube face: its texel (0, 0) in the atlas; NO_TILE where it has none
+    uint size;    // texels a side of each of its faces
+    uint redraw;  // bit i: face i is drawn this frame (the others keep their texels)
+};
+#define NO_TILE 0xffffffffu
+
+// Where texel `t` of a face lies in the Z-ordered atlas, from the face's texel (0, 0): x in
+// the even bits, y in the odd (ml_cpu::shadow_atlas::morton_encode).
+uint atlas_texel(uint base, uvec2 t) {
+    uvec2 v = t & 0xffffu;
+    v = (v | (v << 8u)) & 0x00ff00ffu;
+    v = (v | (v << 4u)) & 0x0f0f0f0fu;
+    v = (v | (v << 2u)) & 0x33333333u;
+    v = (v | (v << 1u)) & 0x55555555u;
+    return base + (v.x | (v.y << 1u));
+}
 
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with
 // raster.rs CLEAR_COLOR.

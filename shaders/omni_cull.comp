@@ -4,7 +4,8 @@
 // shadowed light) tests the meshlet's bounding sphere against the light's sphere and each
 // cube face's 90° pyramid, and lists a (meshlet instance, cube layer) pair per face it may
 // reach — the per-face culling the graphics modes do per object, here per meshlet (with
-// ORTHO_VIEW: against the view's box). No back-face cone: shadow passes draw both faces.
+// ORTHO_VIEW: against the view's box; in the shadow atlas, only the faces drawn this frame).
+// No back-face cone: shadow passes draw both faces (a caster need not be closed).
 #include "common.glsl"
 
 layout(local_size_x = 64) in;
@@ -61,15 +62,27 @@ void main() {
             continue;
         }
         uint faces = sphere_faces(c, r);
+        if (ATLAS) {
+            // Faces the light keeps from last frame (or that no visible pixel samples) are not drawn.
+            faces &= cube_tiles[light].redraw;
+        }
         uint n = bitCount(faces);
         if (n == 0u) {
             continue;
         }
-        // The list holds six pairs per meshlet instance and light: it cannot overflow.
+        // Pairs past the list's capacity are drawn here (the cube array's list holds six per
+        // meshlet instance and light: it never fills).
         uint at = atomicAdd(counters.pairs.w, n);
-        atomicMax(counters.pairs.x, min(at + n, MAX_GROUPS));
+        atomicMax(counters.pairs.x, min(min(at + n, omni.capacity.x), MAX_GROUPS));
         for (; faces != 0u; faces &= faces - 1u) {
-            pairs[at++] = uvec2(id, light * 6u + uint(findLSB(faces)));
+            uint layer = light * 6u + uint(findLSB(faces));
+            if (at < omni.capacity.x) {
+                pairs[at] = uvec2(id, layer);
+            } else {
+                atomicAdd(counters.drawn.z, raster_meshlet_alone(id, layer));
+                atomicAdd(counters.drawn.w, 1u);
+            }
+            at++;
         }
     }
 }

@@ -38,7 +38,7 @@ void main() {
             }
             vec3 ra = corner_rel[v.x], rb = corner_rel[v.y], rc = corner_rel[v.z];
             if (a.z >= 0.0 && b.z >= 0.0 && c.z >= 0.0) {
-                vec2 pa = face_xy(a), pb = face_xy(b), pc = face_xy(c);
+                vec2 pa = face_xy(a, layer), pb = face_xy(b, layer), pc = face_xy(c, layer);
                 vec2 box = max(pa, max(pb, pc)) - min(pa, min(pb, pc));
                 if (all(lessThanEqual(box, vec2(float(omni.sizes.z))))) {
                     covered += raster_small(pa, pb, pc, vec4(ra, 1.0 / a.w), vec4(rb, 1.0 / b.w), vec4(rc, 1.0 / c.w), layer);

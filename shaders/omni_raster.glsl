@@ -37,12 +37,18 @@ layout(std430, set = 0, binding = 9) buffer OmniPairBuffer { uvec2 pairs[]; };
 layout(std430, set = 0, binding = 10) buffer OmniLargeBuffer { uvec2 large_triangles[]; };
 // Per cube layer, row by row: the nearest depth's bits; 1.0 where nothing is in reach.
 layout(std430, set = 0, binding = 11) buffer CubeDepthBuffer { uint cube_depth[]; };
+// The shadow atlas's tiles of each light (ATLAS only; a stand-in otherwise).
+layout(std430, set = 0, binding = 12) readonly buffer ShadowTileBuffer { ShadowCubeTiles cube_tiles[]; };
 layout(push_constant) uniform OmniRasterPushBlock { OmniRasterPush omni; };
 
 // One orthographic view instead of cube faces: layer i is light i's view (the sun: one
 // light at the origin with radius 1, so positions stay world positions) and omni.projection
 // is its view-projection. Keep in sync with shadow_raster.rs SPEC_ORTHO_VIEW.
 layout(constant_id = 0) const bool ORTHO_VIEW = false;
+// Cube faces into the shadow atlas instead of a cube array: each light's faces are the tiles
+// cube_tiles[light] names, of its own size, and only those it redraws are drawn. Keep in sync
+// with shadow_raster.rs SPEC_ATLAS.
+layout(constant_id = 1) const bool ATLAS = false;
 
 #include "meshlet_geometry.glsl"
 
@@ -72,9 +78,14 @@ vec3 view_vertex(uint vertex, mat4 model, uint layer, out vec4 clip) {
     return rel;
 }
 
-// The viewport transform of a face, in texels.
-vec2 face_xy(vec4 c) {
-    return viewport_xy(c, vec2(float(omni.sizes.x)));
+// Texels a side of the view `layer`.
+uint view_side(uint layer) {
+    return ATLAS ? cube_tiles[layer / 6u].size : omni.sizes.x;
+}
+
+// The viewport transform of view `layer`, in texels.
+vec2 face_xy(vec4 c, uint layer) {
+    return viewport_xy(c, vec2(float(view_side(layer))));
 }
 
 // Whether the triangle lies wholly beyond one plane of the face's frustum.
@@ -96,7 +107,8 @@ float interpolated_depth(vec3 weights, vec4 qa, vec4 qb, vec4 qc) {
 void keep_nearest(uint layer, ivec2 texel, float depth) {
     if (depth < 1.0) {
         uint side = omni.sizes.x;
-        atomicMin(cube_depth[(layer * side + uint(texel.y)) * side + uint(texel.x)], floatBitsToUint(depth));
+        uint at = ATLAS ? atlas_texel(cube_tiles[layer / 6u].base[layer % 6u], uvec2(texel)) : (layer * side + uint(texel.y)) * side + uint(texel.x);
+        atomicMin(cube_depth[at], floatBitsToUint(depth));
     }
 }
 
@@ -105,7 +117,7 @@ void keep_nearest(uint layer, ivec2 texel, float depth) {
 uint raster_small(vec2 pa, vec2 pb, vec2 pc, vec4 qa, vec4 qb, vec4 qc, uint layer) {
     // Both faces are drawn.
     SmallTriangle t;
-    if (!small_triangle(pa, pb, pc, ivec2(omni.sizes.x), true, t)) {
+    if (!small_triangle(pa, pb, pc, ivec2(view_side(layer)), true, t)) {
         return 0u;
     }
     if (t.swapped) {
@@ -139,17 +151,37 @@ uint fan_texel(FanTriangle t, ivec2 texel, uint layer) {
 // Any triangle by this thread alone, texel by texel over each fan triangle's box (what the
 // culling's thread does when the large list is full). Returns the texels covered.
 uint raster_large_alone(vec4 ca, vec4 cb, vec4 cc, vec3 ra, vec3 rb, vec3 rc, uint layer) {
-    Polygon p = clipped_polygon(ca, cb, cc, ra, rb, rc, vec2(float(omni.sizes.x)));
+    int side = int(view_side(layer));
+    Polygon p = clipped_polygon(ca, cb, cc, ra, rb, rc, vec2(float(side)));
     uint covered = 0u;
     for (int k = 1; k + 1 < p.count; k++) {
         FanTriangle t;
-        if (!fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(omni.sizes.x), true, t)) {
+        if (!fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(side), true, t)) {
             continue;
         }
         for (int y = t.first.y; y <= t.last.y; y++) {
             for (int x = t.first.x; x <= t.last.x; x++) {
                 covered += fan_texel(t, ivec2(x, y), layer);
             }
+        }
+    }
+    return covered;
+}
+
+// Every triangle of meshlet instance `instance` into view `layer`, by this thread alone (what
+// the culling's thread does when the pair list is full: slow, but nothing is lost). Returns
+// the texels covered.
+uint raster_meshlet_alone(uint instance, uint layer) {
+    uvec2 object_meshlet = meshlet_instances[instance];
+    Meshlet m = meshlets[object_meshlet.y];
+    mat4 model = objects[object_meshlet.x].model;
+    uint covered = 0u;
+    for (uint t = 0u; t < m.triangles.y; t++) {
+        uvec3 v = meshlet_triangle(m, t);
+        vec4 a, b, c;
+        vec3 ra = view_vertex(v.x, model, layer, a), rb = view_vertex(v.y, model, layer, b), rc = view_vertex(v.z, model, layer, c);
+        if (!outside_face(a, b, c)) {
+            covered += raster_large_alone(a, b, c, ra, rb, rc, layer);
         }
     }
     return covered;

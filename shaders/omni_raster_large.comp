@@ -34,7 +34,7 @@ void main() {
             uvec3 v = meshlet_triangle(m, listed.y);
             vec4 a, b, c;
             vec3 ra = view_vertex(v.x, model, pair.y, a), rb = view_vertex(v.y, model, pair.y, b), rc = view_vertex(v.z, model, pair.y, c);
-            Polygon p = clipped_polygon(a, b, c, ra, rb, rc, vec2(float(omni.sizes.x)));
+            Polygon p = clipped_polygon(a, b, c, ra, rb, rc, vec2(float(view_side(pair.y))));
             corner_count = p.count;
             for (int i = 0; i < p.count; i++) {
                 corner_s[i] = ivec2(p.s[i]);
@@ -43,11 +43,12 @@ void main() {
         }
         barrier();
         uint layer = pairs[large_triangles[e].x].y;
+        ivec2 side = ivec2(view_side(layer));
         int corners = corner_count;
         for (int k = 1; k + 1 < corners; k++) {
             FanTriangle t;
             i64vec2 a = i64vec2(corner_s[0]), b = i64vec2(corner_s[k]), c = i64vec2(corner_s[k + 1]);
-            if (!fan_triangle(a, b, c, corner_q[0], corner_q[k], corner_q[k + 1], ivec2(omni.sizes.x), true, t)) {
+            if (!fan_triangle(a, b, c, corner_q[0], corner_q[k], corner_q[k + 1], side, true, t)) {
                 continue;
             }
             ivec2 tile0 = t.first / TILE;

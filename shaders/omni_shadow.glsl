@@ -7,12 +7,66 @@
 #define MANYLIGHTS_OMNI_SHADOW_GLSL
 
 layout(constant_id = 12) const bool OMNI_SHADOWS = false;
+// The lights' faces lie in the shadow atlas (docs/DESIGN.md#shadow-atlas), not in the cube
+// array.
+layout(constant_id = 15) const bool SHADOW_ATLAS = false;
 
 // The surface point moves this many texels along its normal before the lookup (normal-offset
 // bias: a lit surface at a grazing angle to the light stays clear of its own texels)…
 const float OMNI_NORMAL_OFFSET_TEXELS = 1.5;
 // …and compares this many texels nearer than it is (the depth spread within one texel).
 const float OMNI_DEPTH_BIAS_TEXELS = 1.0;
+
+// The atlas's lookup, the cube array's filter by hand: the same biases (from the light's own
+// face size), the same face and texel as cube sampling picks (Vulkan's cube-face table), and
+// the four half-texel-apart bilinear comparisons summed — a 3×3 tent over the face's texels,
+// clamped to the face (where the cube array would read the neighbouring face's texels).
+float atlas_visibility(ShadowCubeTiles tiles, vec3 to_point, vec3 n, float dist, float radius) {
+    float size = float(tiles.size);
+    float texel_world = dist * 2.0 / size;
+    vec3 d = to_point + n * (OMNI_NORMAL_OFFSET_TEXELS * texel_world);
+    float reference = (length(d) - OMNI_DEPTH_BIAS_TEXELS * texel_world) / radius;
+    vec3 a = abs(d);
+    uint face;
+    float ma;
+    vec2 sc_tc;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = d.x >= 0.0 ? 0u : 1u;
+        ma = a.x;
+        sc_tc = vec2(d.x >= 0.0 ? -d.z : d.z, -d.y);
+    } else if (a.y >= a.z) {
+        face = d.y >= 0.0 ? 2u : 3u;
+        ma = a.y;
+        sc_tc = vec2(d.x, d.y >= 0.0 ? d.z : -d.z);
+    } else {
+        face = d.z >= 0.0 ? 4u : 5u;
+        ma = a.z;
+        sc_tc = vec2(d.z >= 0.0 ? d.x : -d.x, -d.y);
+    }
+    uint base = tiles.base[face];
+    if (base == NO_TILE) {
+        // No visible pixel samples this face (the plan keeps every face one may): lit.
+        return 1.0;
+    }
+    // Texel coordinates (texel centres at i + 0.5); the taps at ±½ texel cover texels
+    // i0 … i0 + 2 with weights (1 − f)/2, 1/2, f/2 along each axis.
+    vec2 st = (sc_tc / ma + 1.0) * 0.5 * size;
+    ivec2 i0 = ivec2(floor(st)) - 1;
+    vec2 f = fract(st);
+    vec3 wx = vec3(1.0 - f.x, 1.0, f.x) * 0.5, wy = vec3(1.0 - f.y, 1.0, f.y) * 0.5;
+    int last = int(tiles.size) - 1;
+    float lit = 0.0;
+    for (int j = 0; j < 3; j++) {
+        uint y = uint(clamp(i0.y + j, 0, last));
+        float row = 0.0;
+        for (int i = 0; i < 3; i++) {
+            uint x = uint(clamp(i0.x + i, 0, last));
+            row += reference <= atlas_depth[atlas_texel(base, uvec2(x, y))] ? wx[i] : 0.0;
+        }
+        lit += wy[j] * row;
+    }
+    return lit;
+}
 
 // Fraction of light `l` that reaches `world` (normal `n`): 1 for lights without a cube and
 // points beyond the radius. 3×3-texel tent PCF: four bilinear comparisons half a texel
@@ -25,6 +79,9 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
         float dist = length(to_point);
         if (dist >= radius) {
             return 1.0;
+        }
+        if (SHADOW_ATLAS) {
+            return atlas_visibility(atlas_tiles[uint(l.color.w) - 1u], to_point, n, dist, radius);
         }
         // World size of one texel at this distance (a face spans 90°: 2·dist across at most).
         float texel_world = dist * frame.omni_texel;
@@ -45,6 +102,7 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
             + texture(omni_shadows, vec4(d - u + v, cube), reference) + texture(omni_shadows, vec4(d + u + v, cube), reference);
         return 0.25 * lit;
     }
+
     return 1.0;
 }
 

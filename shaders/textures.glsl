@@ -13,5 +13,9 @@ layout(set = 1, binding = 4) uniform sampler2D shadow_depth;     // the shadow m
 // layers as plain depths, six per light (the shadow-cube debug view).
 layout(set = 1, binding = 5) uniform samplerCubeArrayShadow omni_shadows;
 layout(set = 1, binding = 6) uniform sampler2DArray omni_faces;
+// The shadow atlas instead of the cubes (omni_shadow.glsl with SHADOW_ATLAS): distance /
+// radius per texel in Z-order, and where each shadowed light's faces lie in it.
+layout(std430, set = 1, binding = 7) readonly buffer ShadowAtlasBuffer { float atlas_depth[]; };
+layout(std430, set = 1, binding = 8) readonly buffer ShadowAtlasTileBuffer { ShadowCubeTiles atlas_tiles[]; };
 
 #endif

@@ -1,7 +1,7 @@
 //! `manylights`: the command line. Parses arguments and calls the library; every failure
 //! ends as one `error: …` line on stderr and a non-zero exit.
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{anyhow, bail, Context as _, Result};
 use clap::{Args, Parser, Subcommand};
 use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
@@ -10,7 +10,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::report;
-use ml_render::settings::SettingsRequest;
+use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{DebugView, Exposure, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
@@ -136,11 +136,13 @@ struct SceneArgs {
     /// from its box and the light count.
     #[arg(long)]
     light_radius: Option<String>,
-    /// Point-light shadows through cube maps: off, or how the cubes are rendered — copy (each
-    /// face offscreen, then copied into its cube layer), direct (each face into its cube
-    /// layer), multiview (all six faces in one pass), layered (one pass, each face an
-    /// instance writing its layer) or compute (every face of every cube drawn by compute
-    /// shaders, meshlets culled per face).
+    /// Point-light shadows: off; through cube maps, rendered by copy (each face offscreen,
+    /// then copied into its cube layer), direct (each face into its cube layer), multiview
+    /// (all six faces in one pass), layered (one pass, each face an instance writing its
+    /// layer) or compute (every face of every cube drawn by compute shaders, meshlets culled
+    /// per face); or atlas (one shadow atlas of --shadow-budget MiB: only the faces a visible
+    /// pixel may sample, each light's as large as the light is on screen, drawn in compute,
+    /// kept while their light stays).
     #[arg(long, default_value = "off")]
     omni_shadow: String,
     /// Who draws the sun's shadow map (blinn-phong), once at start: graphics (a depth-only
@@ -148,12 +150,23 @@ struct SceneArgs {
     /// orthographic view).
     #[arg(long, default_value = "graphics")]
     sun_shadow: String,
-    /// How many point lights cast shadows (the strongest as seen from the camera).
-    #[arg(long, default_value_t = 1)]
-    shadowed_lights: u32,
-    /// Texels per side of each shadow-cube face.
-    #[arg(long, default_value_t = OmniShadowSettings::DEFAULT_SIZE)]
-    cube_size: u32,
+    /// How many point lights cast shadows: K (the strongest as seen from the camera) or all
+    /// (every light that reaches the view, the strongest 4096 at most).
+    #[arg(long, default_value = "1")]
+    shadowed_lights: String,
+    /// Texels per side of each shadow-cube face (default 1024); with --omni-shadow atlas,
+    /// every face this size (a power of two, 32 to 2048) instead of the light's size on screen.
+    #[arg(long)]
+    cube_size: Option<u32>,
+    /// MiB that point-light shadows may take with --omni-shadow atlas: the atlas, its tables
+    /// and the raster's lists. When the faces do not fit, every face shrinks by one factor
+    /// (the table reports it).
+    #[arg(long)]
+    shadow_budget: Option<u32>,
+    /// Whether atlas faces whose light did not move keep last frame's texels (on) or are
+    /// drawn again every frame (off; the same images, for comparisons).
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    shadow_cache: String,
     #[arg(long, default_value_t = 1280)]
     width: u32,
     #[arg(long, default_value_t = 720)]
@@ -281,11 +294,30 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         bail!("--show-lights and --omni-shadow do not go together: each light's shadow cube would see the marker around it");
     }
     let omni = match args.omni_shadow.as_str() {
-        "off" if args.shadowed_lights != 1 || args.cube_size != OmniShadowSettings::DEFAULT_SIZE => {
-            bail!("--shadowed-lights and --cube-size need point-light shadows: add --omni-shadow layered|direct|multiview|copy|compute")
+        "off" if args.shadowed_lights != "1" || args.cube_size.is_some() || args.shadow_budget.is_some() || args.shadow_cache != "on" => {
+            bail!(
+                "--shadowed-lights, --cube-size, --shadow-budget and --shadow-cache need point-light shadows: add --omni-shadow layered|direct|multiview|copy|compute|atlas"
+            )
         }
         "off" => None,
-        mode => Some(OmniShadowSettings { mode: OmniShadowMode::from_name(mode)?, lights: args.shadowed_lights, size: args.cube_size }),
+        mode => {
+            let mode = match OmniShadowMode::from_name(mode)? {
+                OmniShadowMode::Atlas(_) => OmniShadowMode::Atlas(AtlasSettings {
+                    budget_mib: args.shadow_budget.unwrap_or(AtlasSettings::DEFAULT.budget_mib),
+                    cache: args.shadow_cache == "on",
+                    fixed_size: args.cube_size,
+                }),
+                _ if args.shadow_budget.is_some() || args.shadow_cache != "on" => {
+                    bail!("--shadow-budget and --shadow-cache are the shadow atlas's: add --omni-shadow atlas")
+                }
+                cubes => cubes,
+            };
+            let (lights, all) = match args.shadowed_lights.trim() {
+                "all" => (MAX_SHADOWED_LIGHTS, true),
+                k => (k.parse::<u32>().map_err(|_| anyhow!("--shadowed-lights '{k}' is neither a count nor all"))?, false),
+            };
+            Some(OmniShadowSettings { mode, lights, all, size: args.cube_size.unwrap_or(OmniShadowSettings::DEFAULT_SIZE) })
+        }
     };
     Ok(SettingsRequest {
         technique,

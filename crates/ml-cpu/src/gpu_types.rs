@@ -205,10 +205,27 @@ gpu_struct!(
         /// x: the large-triangle raster's work groups; y, z: 1; w: large triangles listed.
         large: [u32; 4],
         /// x: triangles drawn by one thread; y: of those, large ones (the list was full);
-        /// z: texels covered.
+        /// z: texels covered; w: (meshlet, face) pairs the culling's thread drew (the pair
+        /// list was full).
         drawn: [u32; 4],
     }
 );
+
+gpu_struct!(
+    /// One shadowed light's faces in the shadow atlas (`ShadowCubeTiles` in common.glsl).
+    ShadowCubeTiles {
+        /// Per cube face: the index of its texel (0, 0) in the Z-ordered atlas; NO_TILE where
+        /// it has none.
+        base: [u32; 6],
+        /// Texels a side of each of its faces.
+        size: u32,
+        /// Bit i: face i is drawn this frame.
+        redraw: u32,
+    }
+);
+
+/// `ShadowCubeTiles::base` of a face without a tile.
+pub const NO_TILE: u32 = u32::MAX;
 
 gpu_struct!(
     /// Push constants of the compute-vs-fragment probe (stage_probe.glsl).

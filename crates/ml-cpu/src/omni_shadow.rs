@@ -5,7 +5,9 @@
 //! face renders a direction into is the texel cube sampling fetches for that direction (tested
 //! against `textures::cube_direction`, Vulkan's cube-map convention).
 
+use crate::camera::Camera;
 use crate::gpu_types::PointLight;
+use crate::shadow_atlas::frustum_planes;
 use crate::mesh::MeshKind;
 use crate::scene::Scene;
 use glam::{Mat4, Vec3};
@@ -51,13 +53,32 @@ pub fn sphere_faces(centre: Vec3, radius: f32) -> u32 {
 /// luminance × radius over the distance from the eye to the light's sphere (ties: lower
 /// index). Returns light indices, strongest first.
 pub fn shadowed_lights(lights: &[PointLight], k: usize, eye: Vec3) -> Vec<u32> {
+    strongest_first(lights, (0..lights.len() as u32).collect(), k, eye)
+}
+
+/// The lights that reach the view of `camera` (aspect `aspect`) wherever their animation
+/// moves them (by at most `motion` from their rest place): those whose sphere, grown by
+/// `motion`, is not wholly outside one plane of the view frustum; the strongest `k` of them
+/// (as `shadowed_lights` ranks), strongest first.
+pub fn lights_in_view(lights: &[PointLight], camera: &Camera, aspect: f32, motion: f32, k: usize) -> Vec<u32> {
+    let planes = frustum_planes(camera.projection(aspect) * camera.view());
+    let seen = (0..lights.len() as u32)
+        .filter(|&i| {
+            let p = lights[i as usize].position_radius;
+            let centre = Vec3::new(p[0], p[1], p[2]);
+            planes.iter().all(|plane| plane.truncate().dot(centre) + plane.w >= -(p[3] + motion))
+        })
+        .collect();
+    strongest_first(lights, seen, k, camera.position)
+}
+
+fn strongest_first(lights: &[PointLight], mut order: Vec<u32>, k: usize, eye: Vec3) -> Vec<u32> {
     let score = |l: &PointLight| {
         let p = l.position_radius;
         let luminance = 0.2126 * l.color[0] + 0.7152 * l.color[1] + 0.0722 * l.color[2];
         let gap = (Vec3::new(p[0], p[1], p[2]).distance(eye) - p[3]).max(0.0);
         luminance * p[3] / (1.0 + gap)
     };
-    let mut order: Vec<u32> = (0..lights.len() as u32).collect();
     order.sort_by(|&a, &b| score(&lights[b as usize]).total_cmp(&score(&lights[a as usize])).then(a.cmp(&b)));
     order.truncate(k);
     order
@@ -303,5 +324,17 @@ mod tests {
         assert_eq!(shadowed_lights(&lights, 2, Vec3::ZERO), vec![1, 3]);
         assert_eq!(shadowed_lights(&lights, 10, Vec3::ZERO).len(), 4);
         assert!(shadowed_lights(&lights, 0, Vec3::ZERO).is_empty());
+    }
+
+    #[test]
+    fn lights_in_view_are_those_whose_moving_sphere_meets_the_frustum() {
+        let light = |z: f32, r: f32| PointLight { position_radius: [0.0, 0.0, z, r], color: [1.0, 1.0, 1.0, 0.0] };
+        let camera = Camera::looking_at(Vec3::ZERO, -Vec3::Z, 60.0, 0.1, 100.0);
+        // In front; behind but reaching past the eye; behind out of reach; beyond the far
+        // plane; behind, reached only by its motion.
+        let lights = [light(-10.0, 1.0), light(3.0, 4.0), light(10.0, 1.0), light(-150.0, 10.0), light(2.5, 2.0)];
+        assert_eq!(lights_in_view(&lights, &camera, 1.0, 0.0, 10), vec![1, 0]);
+        assert_eq!(lights_in_view(&lights, &camera, 1.0, 1.0, 10), vec![1, 4, 0]);
+        assert_eq!(lights_in_view(&lights, &camera, 1.0, 1.0, 1), vec![1]);
     }
 }

@@ -59,11 +59,10 @@ pub struct FaceTile {
     pub redraw: bool,
 }
 
-/// A frame's atlas: its extent and every face a visible pixel may sample.
+/// A frame's atlas: its layout and every face a visible pixel may sample.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AtlasPlan {
-    /// Texels across and down (powers of two, width = height or twice it).
-    pub extent: [u32; 2],
+    pub blocks: AtlasBlocks,
     /// What every face's side was divided by to fit the budget (1: nothing).
     pub divided_by: u32,
     pub tiles: Vec<FaceTile>,
@@ -81,7 +80,7 @@ impl AtlasPlan {
     }
 
     pub fn atlas_bytes(&self) -> u64 {
-        self.extent[0] as u64 * self.extent[1] as u64 * TEXEL_BYTES
+        self.blocks.texels() * TEXEL_BYTES
     }
 }
 
@@ -148,26 +147,37 @@ pub fn visible_faces(light: &PlannedLight, planes: &[Vec4; 6]) -> u32 {
     mask
 }
 
-/// The atlas extent a budget of `budget` bytes affords: the largest power-of-two square, or a
-/// 2:1 rectangle of squares, whose texels fit, at most `max_side` texels across.
-pub fn atlas_extent(budget: u64, max_side: u32) -> Result<[u32; 2], AtlasError> {
-    let texels = budget / TEXEL_BYTES;
-    if texels < (MIN_FACE * MIN_FACE) as u64 {
-        return Err(AtlasError::BudgetTooSmall { bytes: budget });
-    }
-    // The largest square of a power-of-two side within the budget and the device's limit.
-    let mut side = 1u32 << ((texels as f64).sqrt().log2().floor() as u32);
-    side = side.min(prev_power_of_two(max_side));
-    // Twice as wide where the budget and the limit allow.
-    if side < max_side && 2 * side as u64 * side as u64 <= texels {
-        Ok([2 * side, side])
-    } else {
-        Ok([side, side])
-    }
+/// The atlas's layout: `count` square blocks of `side` texels (a power of two, at most
+/// MAX_FACE), pictured `columns` across.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AtlasBlocks {
+    pub side: u32,
+    pub count: u32,
+    pub columns: u32,
 }
 
-fn prev_power_of_two(n: u32) -> u32 {
-    1 << (31 - n.max(1).leading_zeros())
+impl AtlasBlocks {
+    /// The most blocks `bytes` holds: MAX_FACE² ones, or below 16 MiB one block of the
+    /// largest power-of-two side that fits.
+    pub fn for_bytes(bytes: u64) -> Result<AtlasBlocks, AtlasError> {
+        let texels = bytes / TEXEL_BYTES;
+        if texels < (MIN_FACE * MIN_FACE) as u64 {
+            return Err(AtlasError::BudgetTooSmall { bytes });
+        }
+        let side = (1u32 << ((texels as f64).sqrt().log2().floor() as u32)).min(MAX_FACE);
+        // Texel indices are 32-bit on the GPU.
+        let count = (texels / (side as u64 * side as u64)).min((1 << 32) / (side as u64 * side as u64)) as u32;
+        Ok(AtlasBlocks { side, count, columns: (count as f64).sqrt().ceil() as u32 })
+    }
+
+    /// Texels across and down of the picture.
+    pub fn extent(&self) -> [u32; 2] {
+        [self.columns * self.side, self.count.div_ceil(self.columns) * self.side]
+    }
+
+    pub fn texels(&self) -> u64 {
+        self.count as u64 * self.side as u64 * self.side as u64
+    }
 }
 
 /// Where faces lie in the atlas, kept from frame to frame so that a face whose light did not
@@ -175,7 +185,7 @@ fn prev_power_of_two(n: u32) -> u32 {
 /// over the atlas's Z-order), in units of one `MIN_FACE`² block.
 #[derive(Clone, Debug)]
 pub struct ShadowAtlas {
-    extent: [u32; 2],
+    blocks: AtlasBlocks,
     /// The order of the largest block (order k: (MIN_FACE·2^k)² texels).
     top: u32,
     /// Free blocks of each order, by first unit (lowest first: the layout is deterministic).
@@ -191,42 +201,35 @@ struct Placement {
     drawn: PlannedLight,
 }
 
-/// Texels a side of a block of `order`.
-fn order_side(order: u32) -> u32 {
-    MIN_FACE << order
-}
-
 /// Units (MIN_FACE² blocks) in a block of `order`.
 fn order_units(order: u32) -> u64 {
     1 << (2 * order)
 }
 
 impl ShadowAtlas {
-    /// An empty atlas of `budget` bytes at most, at most `max_side` texels across.
-    pub fn new(budget: u64, max_side: u32) -> Result<ShadowAtlas, AtlasError> {
-        let extent = atlas_extent(budget, max_side)?;
-        let square = extent[1];
-        let top = (square / MIN_FACE).trailing_zeros().min((MAX_FACE / MIN_FACE).trailing_zeros());
-        let mut atlas = ShadowAtlas { extent, top, free: Vec::new(), placed: HashMap::new() };
+    /// An empty atlas of at most `bytes`.
+    pub fn new(bytes: u64) -> Result<ShadowAtlas, AtlasError> {
+        let blocks = AtlasBlocks::for_bytes(bytes)?;
+        let top = (blocks.side / MIN_FACE).trailing_zeros();
+        let mut atlas = ShadowAtlas { blocks, top, free: Vec::new(), placed: HashMap::new() };
         atlas.clear();
         Ok(atlas)
     }
 
-    pub fn extent(&self) -> [u32; 2] {
-        self.extent
+    pub fn blocks(&self) -> AtlasBlocks {
+        self.blocks
     }
 
     pub fn bytes(&self) -> u64 {
-        self.extent[0] as u64 * self.extent[1] as u64 * TEXEL_BYTES
+        self.blocks.texels() * TEXEL_BYTES
     }
 
     /// Forget every face (the casters changed): the next frame draws all of them.
     pub fn clear(&mut self) {
         self.placed.clear();
         self.free = vec![BTreeSet::new(); self.top as usize + 1];
-        let units = self.extent[0] as u64 * self.extent[1] as u64 / (MIN_FACE * MIN_FACE) as u64;
         let step = order_units(self.top);
-        self.free[self.top as usize] = (0..units / step).map(|i| i * step).collect();
+        self.free[self.top as usize] = (0..self.blocks.count as u64).map(|i| i * step).collect();
     }
 
     fn allocate(&mut self, order: u32) -> Option<u64> {
@@ -278,7 +281,7 @@ impl ShadowAtlas {
             let size = fixed.unwrap_or_else(|| face_size(light, camera, height)).clamp(MIN_FACE, MAX_FACE).next_power_of_two();
             wanted.extend((0..6).filter(|f| mask & (1 << f) != 0).map(|face| (i as u32, face, size)));
         }
-        let capacity = self.extent[0] as u64 * self.extent[1] as u64;
+        let capacity = self.blocks.texels();
         let area = |divisor: u32| wanted.iter().map(|&(_, _, s)| ((s / divisor).max(MIN_FACE) as u64).pow(2)).sum::<u64>();
         let mut divided_by = 1;
         while area(divided_by) > capacity {
@@ -329,17 +332,18 @@ impl ShadowAtlas {
                 t.redraw = true;
             }
         }
-        let square = self.extent[1] as u64;
-        let per_square = (square / MIN_FACE as u64).pow(2);
+        let per_block = order_units(self.top);
+        let (side, columns) = (self.blocks.side as u64, self.blocks.columns as u64);
         for (t, unit) in tiles.iter_mut().zip(units) {
             let unit = unit.expect("every face placed");
-            let (x, y) = morton_decode(unit % per_square);
-            t.origin = [((unit / per_square) * square + x * MIN_FACE as u64) as u32, (y * MIN_FACE as u64) as u32];
+            let (block, (x, y)) = (unit / per_block, morton_decode(unit % per_block));
+            let corner = [(block % columns) * side, (block / columns) * side];
+            t.origin = [(corner[0] + x * MIN_FACE as u64) as u32, (corner[1] + y * MIN_FACE as u64) as u32];
             t.base = unit * (MIN_FACE * MIN_FACE) as u64;
             let (key, drawn) = lights[t.light as usize];
             self.placed.insert((key, t.face), Placement { order: order_of(t), unit, drawn });
         }
-        Ok(AtlasPlan { extent: self.extent, divided_by, tiles })
+        Ok(AtlasPlan { blocks: self.blocks, divided_by, tiles })
     }
 }
 

@@ -120,6 +120,12 @@ pub enum SettingsError {
     ShadowsWithoutLights,
     #[error("{value} shadowed lights is out of range: the scene has {lights} lights (use 1 to {lights})")]
     ShadowedLights { value: u32, lights: usize },
+    #[error("the shadow atlas takes at most {max} shadowed lights, not {value}")]
+    TooManyShadowed { value: u32, max: u32 },
+    #[error("a shadow budget of {mib} MiB is out of range: 1 to {max_mib} MiB (the device memory of '{device}')")]
+    ShadowBudget { mib: u32, max_mib: u64, device: String },
+    #[error("--cube-size {value} with the shadow atlas: every face's size must be a power of two from {min} to {max}")]
+    AtlasFaceSize { value: u32, min: u32, max: u32 },
     #[error("{value} shadowed lights is more than the {max} shadow cubes '{device}' holds in one array")]
     TooManyCubes { value: u32, max: u32, device: String },
     #[error("{lights} shadow cubes of {size}² take {mib} MiB, more than the {max_mib} MiB we allow")]

@@ -19,6 +19,7 @@ pub mod report;
 pub mod scene_gpu;
 pub mod scene_textures;
 pub mod settings;
+pub mod shadow_atlas;
 pub mod shadow_raster;
 pub mod stage_probe;
 pub mod sun_shadow;

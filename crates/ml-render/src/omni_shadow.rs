@@ -15,6 +15,7 @@
 use crate::depth_pass::{self, DepthPassDesc};
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::settings::{OmniShadowMode, OmniShadowSettings};
+use crate::shadow_atlas::ShadowAtlasGpu;
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
 use ml_cpu::omni_shadow::{face_view_proj, sphere_faces};
@@ -39,6 +40,8 @@ pub struct ShadowedLight {
 
 pub struct OmniShadows {
     pub settings: Option<OmniShadowSettings>,
+    /// The shadow atlas (--omni-shadow atlas; stand-ins otherwise, and the cube array is).
+    pub atlas: ShadowAtlasGpu,
     /// Six layers per shadowed light, viewed as a cube array (`cubes.view`).
     pub cubes: Image,
     /// The same layers as a 2D array (the shadow-cube debug view fetches texels).
@@ -66,6 +69,7 @@ impl OmniShadows {
         }
         let shadows = OmniShadows {
             settings,
+            atlas: ShadowAtlasGpu::new(ctx, settings)?,
             cubes: Image::null(),
             faces_view: vk::ImageView::null(),
             offscreen: Image::null(),
@@ -79,7 +83,7 @@ impl OmniShadows {
     }
 
     fn create(&mut self, ctx: &Context) -> Result<(), VkError> {
-        let (cubes, size) = self.settings.map_or((1, 1), |s| (s.lights, s.size));
+        let (cubes, size) = self.cube_settings().map_or((1, 1), |s| (s.lights, s.size));
         let layers = cubes * 6;
         let shape =
             ImageShape { extent: vk::Extent2D { width: size, height: size }, levels: 1, layers, view: vk::ImageViewType::CUBE_ARRAY };
@@ -92,7 +96,7 @@ impl OmniShadows {
             | vk::ImageUsageFlags::TRANSFER_SRC;
         self.cubes = Image::new(ctx, "shadow cubes", shape, CUBE_FORMAT, usage, DEPTH)?;
         self.faces_view = self.cubes.view_of(ctx, vk::ImageViewType::TYPE_2D_ARRAY, 0..layers, DEPTH)?;
-        let Some(settings) = self.settings else {
+        let Some(settings) = self.cube_settings() else {
             return clear_stand_in(ctx, &self.cubes);
         };
         if matches!(settings.mode, OmniShadowMode::Compute { .. }) {
@@ -146,7 +150,7 @@ impl OmniShadows {
                     self.add_framebuffer(ctx, view, (size, layers))?;
                 }
             }
-            OmniShadowMode::Compute { .. } => {}
+            OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_) => {}
         }
         Ok(())
     }
@@ -159,6 +163,11 @@ impl OmniShadows {
         let framebuffer = unsafe { ctx.device.create_framebuffer(&info, None) }.ctx("vkCreateFramebuffer")?;
         self.framebuffers.push(framebuffer);
         Ok(())
+    }
+
+    /// The settings where the shadows are in the cube array (not the atlas).
+    fn cube_settings(&self) -> Option<OmniShadowSettings> {
+        self.settings.filter(|s| s.atlas().is_none())
     }
 
     /// Whether any light casts shadows (the pass records work).
@@ -175,7 +184,7 @@ impl OmniShadows {
     /// Leaves the array DEPTH_STENCIL_READ_ONLY_OPTIMAL, its writes visible to fragment and
     /// compute shaders.
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
-        let Some(settings) = self.settings.filter(|s| !matches!(s.mode, OmniShadowMode::Compute { .. })) else { return };
+        let Some(settings) = self.cube_settings().filter(|s| !matches!(s.mode, OmniShadowMode::Compute { .. })) else { return };
         let d = &ctx.device;
         let size = settings.size;
         let copy = settings.mode == OmniShadowMode::Copy;
@@ -282,7 +291,7 @@ impl OmniShadows {
     /// Every texel of every layer as the last frame left it (layer after layer, row by row),
     /// copied to the host; for tests and tools, not the frame loop (it waits for the GPU).
     pub fn read_depths(&self, ctx: &Context) -> Result<Vec<f32>, VkError> {
-        read_depth_layers(ctx, &self.cubes, self.settings.map_or(1, |s| s.lights) * 6)
+        read_depth_layers(ctx, &self.cubes, self.cube_settings().map_or(1, |s| s.lights) * 6)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -305,6 +314,7 @@ impl OmniShadows {
         self.render_pass = vk::RenderPass::null();
         self.offscreen.destroy(ctx);
         self.cubes.destroy(ctx);
+        self.atlas.destroy(ctx);
     }
 }
 

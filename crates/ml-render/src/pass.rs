@@ -56,6 +56,8 @@ pub struct Recording<'a> {
     pub objects: &'a [ml_cpu::scene::Object],
     /// Where this frame's shadowed lights are (cube i: `shadowed[i]`).
     pub shadowed: &'a [ShadowedLight],
+    /// The shadow atlas's plan for this frame (--omni-shadow atlas).
+    pub atlas: Option<&'a ml_cpu::shadow_atlas::AtlasPlan>,
 }
 
 /// What a frame slot's finished frame told the passes (GPU light assignment feedback).

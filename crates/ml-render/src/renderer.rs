@@ -9,7 +9,7 @@ use crate::frame::{FrameInFlight, FrameSetup, SlotLists, FRAMES_IN_FLIGHT};
 use crate::omni_shadow::ShadowedLight;
 use crate::pass::{Pass, Recording, SlotReport, Update};
 use crate::passes::{assemble, Assembly};
-use crate::report::{CpuPhases, FrameStats};
+use crate::report::{AtlasStats, CpuPhases, FrameStats};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::{Exposure, LightAssignment, RenderSettings, MAX_EXPOSURE_EV};
 use crate::targets::{depth_format, Output, Targets};
@@ -17,7 +17,8 @@ use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
-use ml_cpu::omni_shadow::shadowed_lights;
+use ml_cpu::omni_shadow::{lights_in_view, shadowed_lights};
+use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
 use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, Image, VkError, VkResultExt};
 use std::time::Instant;
@@ -66,6 +67,8 @@ pub struct Renderer<'a> {
     /// The lights with a shadow cube (cube i: `shadowed[i]`), and where they are this frame.
     shadowed: Vec<u32>,
     shadowed_now: Vec<ShadowedLight>,
+    /// The shadow atlas's plan for the frame being recorded (--omni-shadow atlas).
+    atlas_plan: Option<AtlasPlan>,
     /// The cluster grid (its shader parameters are also set for techniques without one).
     grid: ClusterGrid,
     /// Light-index entries every frame recorded from now on must hold (grows when a frame
@@ -139,6 +142,7 @@ impl<'a> Renderer<'a> {
             lights_on_gpu,
             shadowed,
             shadowed_now: Vec::new(),
+            atlas_plan: None,
             required_indices: 0,
             reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
@@ -229,6 +233,8 @@ impl<'a> Renderer<'a> {
         self.release_frames()?;
         self.scene.lights = lights;
         self.shadowed = mark_shadowed(&mut self.scene, &self.settings);
+        // Other lights: the atlas's faces belong to lights that may be gone.
+        self.gpu.omni.atlas.forget();
         self.animated = if self.lights_on_gpu { Vec::new() } else { self.scene.lights.clone() };
         self.make_passes()?;
         self.create_frames()?;
@@ -264,6 +270,8 @@ impl<'a> Renderer<'a> {
         self.scene.objects = scene.objects.clone();
         self.scene.meshes = scene.meshes.clone();
         self.gpu.replace_objects(self.ctx, &self.scene)?;
+        // Other casters: every atlas face is drawn again.
+        self.gpu.omni.atlas.forget();
         self.make_passes()?;
         self.create_frames()?;
         Ok(true)
@@ -598,8 +606,32 @@ impl<'a> Renderer<'a> {
                 ShadowedLight { position: glam::Vec3::new(p[0] + offset.x, p[1] + offset.y, p[2] + offset.z), radius: p[3] }
             })
             .collect();
+        self.plan_atlas(stats)?;
         self.write_uniforms(f, t);
         Ok(assign_ms)
+    }
+
+    /// The shadow atlas's plan for this frame's shadowed lights (keys: their scene indices),
+    /// reported in `stats`.
+    fn plan_atlas(&mut self, stats: &mut FrameStats) -> Result<(), RenderError> {
+        let Some(atlas) = self.settings.omni.and_then(|o| o.atlas()) else { return Ok(()) };
+        let lights: Vec<(u32, PlannedLight)> =
+            self.shadowed.iter().zip(&self.shadowed_now).map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius })).collect();
+        let size = (self.extent.width, self.extent.height);
+        let Some(plan) = self.gpu.omni.atlas.plan(&lights, &self.scene.camera, size, atlas) else { return Ok(()) };
+        let plan = plan.map_err(|e| RenderError::Invalid(format!("shadow atlas: {e}")))?;
+        let (budget, shadow_bytes, atlas_bytes) = self.gpu.omni.atlas.memory();
+        stats.shadow_atlas = Some(AtlasStats {
+            faces: plan.tiles.len(),
+            redrawn: plan.redrawn(),
+            divided_by: plan.divided_by,
+            budget,
+            shadow_bytes,
+            atlas_bytes,
+            tile_bytes: plan.used_bytes(),
+        });
+        self.atlas_plan = Some(plan);
+        Ok(())
     }
 
     fn write_uniforms(&mut self, f: usize, t: f32) {
@@ -666,6 +698,7 @@ impl<'a> Renderer<'a> {
             scene: &self.gpu,
             objects: &self.scene.objects,
             shadowed: &self.shadowed_now,
+            atlas: self.atlas_plan.as_ref(),
         };
         let mut timed = 0;
         for pass in &self.passes {
@@ -756,7 +789,12 @@ impl<'a> Renderer<'a> {
 /// Pick the lights that get a shadow cube (the strongest as seen from the camera) and mark
 /// them: PointLight::color[3] = cube index + 1. Returns their indices, cube order.
 fn mark_shadowed(scene: &mut Scene, settings: &RenderSettings) -> Vec<u32> {
-    let shadowed = settings.omni.map_or(Vec::new(), |o| shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position));
+    let aspect = settings.width as f32 / settings.height as f32;
+    let shadowed = match settings.omni {
+        None => Vec::new(),
+        Some(o) if o.all => lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, o.lights as usize),
+        Some(o) => shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position),
+    };
     for (cube, &i) in shadowed.iter().enumerate() {
         scene.lights[i as usize].color[3] = (cube + 1) as f32;
     }

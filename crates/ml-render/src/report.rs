@@ -29,6 +29,8 @@ pub struct FrameStats {
     pub culling: Option<CullStats>,
     /// --omni-shadow compute: what the last frame's shadow raster drew.
     pub omni_raster: Option<OmniRasterStats>,
+    /// --omni-shadow atlas: the last frame's plan.
+    pub shadow_atlas: Option<AtlasStats>,
     /// blinn-phong: GPU ms of the sun's shadow map, drawn once when the scene was loaded.
     pub sun_shadow_ms: Option<f64>,
     /// Auto exposure: the EV the returned image was exposed with, and how often its frame was
@@ -49,6 +51,23 @@ pub struct OmniRasterStats {
     pub in_place: u32,
     /// Texels covered (hidden ones too).
     pub texels: u32,
+    /// (meshlet instance, face) pairs the culling's thread drew itself (the pair list was full).
+    pub pairs_in_place: u32,
+}
+
+/// The shadow atlas's plan of the last frame and its memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AtlasStats {
+    /// Faces with a tile, and those drawn this frame (the others kept their texels).
+    pub faces: usize,
+    pub redrawn: usize,
+    /// What every face's side was divided by to fit the budget (1: nothing).
+    pub divided_by: u32,
+    /// Bytes: the budget, all the atlas's buffers, the atlas itself, what its tiles use.
+    pub budget: u64,
+    pub shadow_bytes: u64,
+    pub atlas_bytes: u64,
+    pub tile_bytes: u64,
 }
 
 /// What one frame's GPU culling tested and kept (visibility).
@@ -99,6 +118,7 @@ impl FrameStats {
             gbuffer_lazily_allocated: None,
             culling: None,
             omni_raster: None,
+            shadow_atlas: None,
             sun_shadow_ms: None,
             exposure_ev: None,
             exposure_repeats: 0,
@@ -325,14 +345,49 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights per cluster")));
     }
     if let Some(o) = settings.omni {
-        rows.push(("omni shadows", format!("{}: {} light(s), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size)));
+        let which = if o.all { "every light reaching the view" } else { "the strongest" };
+        match o.atlas() {
+            Some(a) => rows.push((
+                "omni shadows",
+                format!(
+                    "atlas: {} light(s) ({which}), faces sized by the screen{}, budget {} MiB, cache {}",
+                    o.lights,
+                    a.fixed_size.map_or(String::new(), |s| format!(" (fixed: {s}²)")),
+                    a.budget_mib,
+                    if a.cache { "on" } else { "off" }
+                ),
+            )),
+            None => rows.push((
+                "omni shadows",
+                format!("{}: {} light(s) ({which}), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size),
+            )),
+        }
+    }
+    if let Some(a) = stats.shadow_atlas {
+        let mib = |b: u64| b as f64 / (1 << 20) as f64;
+        let factor = if a.divided_by > 1 { format!("every face's side ÷{} to fit the budget", a.divided_by) } else { "full size".into() };
+        rows.push((
+            "shadow atlas",
+            format!(
+                "{} faces ({} drawn, {} kept), {factor}; tiles {:.1} of the atlas's {:.1} MiB; all shadow buffers {:.1} of {:.0} MiB",
+                a.faces,
+                a.redrawn,
+                a.faces - a.redrawn,
+                mib(a.tile_bytes),
+                mib(a.atlas_bytes),
+                mib(a.shadow_bytes),
+                mib(a.budget)
+            ),
+        ));
     }
     if let Some(r) = stats.omni_raster {
         let in_place = if r.in_place > 0 { format!(" ({} drawn in place: the large list was full)", r.in_place) } else { String::new() };
+        let pairs_in_place =
+            if r.pairs_in_place > 0 { format!(" ({} drawn by the culling: the pair list was full)", r.pairs_in_place) } else { String::new() };
         rows.push((
             "shadow raster",
             format!(
-                "{} (meshlet, face) pairs; {} small triangles, {} large{in_place}; {} texels covered",
+                "{} (meshlet, face) pairs{pairs_in_place}; {} small triangles, {} large{in_place}; {} texels covered",
                 r.pairs, r.small, r.large, r.texels
             ),
         ));

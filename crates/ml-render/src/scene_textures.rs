@@ -144,7 +144,12 @@ impl SceneTextures {
                 _ => return None,
             }))
         };
-        self.set_layout.write(ctx, self.set, &image)?;
+        let resource = |name: &str| match name {
+            "ShadowAtlasBuffer" => Some(Resource::Buffer(omni.atlas.depths.raw)),
+            "ShadowAtlasTileBuffer" => Some(Resource::Buffer(omni.atlas.tiles.raw)),
+            _ => image(name),
+        };
+        self.set_layout.write(ctx, self.set, &resource)?;
         Ok(())
     }
 

@@ -149,6 +149,8 @@ fn model_spec_constants(model: ShadingModel) -> [(u32, u32); 2] {
 pub const SPEC_OMNI_SHADOWS: u32 = 12;
 pub const SPEC_OBJECT_TEXTURES: u32 = 13;
 pub const SPEC_SPOT_LIGHTS: u32 = 14;
+/// constant_id of `SHADOW_ATLAS` (omni_shadow.glsl).
+pub const SPEC_SHADOW_ATLAS: u32 = 15;
 
 /// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
 /// whether objects have textures of their own and whether there are spot lights
@@ -157,17 +159,20 @@ pub const SPEC_SPOT_LIGHTS: u32 = 14;
 pub struct Shading {
     pub model: ShadingModel,
     pub omni_shadows: bool,
+    /// The point lights' shadows are in the shadow atlas (else in the cube array).
+    pub shadow_atlas: bool,
     pub object_textures: bool,
     pub spot_lights: bool,
 }
 
 impl Shading {
-    pub fn spec_constants(self) -> [(u32, u32); 5] {
+    pub fn spec_constants(self) -> [(u32, u32); 6] {
         let [a, b] = model_spec_constants(self.model);
         [
             a,
             b,
             (SPEC_OMNI_SHADOWS, u32::from(self.omni_shadows)),
+            (SPEC_SHADOW_ATLAS, u32::from(self.shadow_atlas)),
             (SPEC_OBJECT_TEXTURES, u32::from(self.object_textures)),
             (SPEC_SPOT_LIGHTS, u32::from(self.spot_lights)),
         ]
@@ -192,14 +197,46 @@ pub enum OmniShadowMode {
     /// triangles the list of its work groups holds; past it (0: always), the thread that found
     /// one draws it itself (slower, nothing lost).
     Compute { large_list: u32 },
+    /// Every visible face of every shadowed light in one shadow atlas of a fixed budget, each
+    /// light's faces as large as it is on screen, drawn by the compute raster; faces whose
+    /// light did not move keep their texels (docs/DESIGN.md#shadow-atlas).
+    Atlas(AtlasSettings),
+}
+
+/// The shadow atlas's settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AtlasSettings {
+    /// MiB all point-light shadow memory may take: the atlas, its tables and the raster's
+    /// lists.
+    pub budget_mib: u32,
+    /// Faces whose light did not move keep last frame's texels (off: every face is drawn
+    /// every frame; the images are the same).
+    pub cache: bool,
+    /// Every face this many texels a side (before the budget's factor) instead of the
+    /// light's size on screen (for comparisons with the cube array).
+    pub fixed_size: Option<u32>,
+}
+
+impl AtlasSettings {
+    pub const DEFAULT: AtlasSettings = AtlasSettings { budget_mib: 256, cache: true, fixed_size: None };
+
+    pub fn budget_bytes(&self) -> u64 {
+        (self.budget_mib as u64) << 20
+    }
 }
 
 impl OmniShadowMode {
     /// The compute raster with its default list of large triangles (2^20: 8 MiB).
     pub const COMPUTE: OmniShadowMode = OmniShadowMode::Compute { large_list: 1 << 20 };
 
-    pub const ALL: [OmniShadowMode; 5] =
-        [OmniShadowMode::Copy, OmniShadowMode::Direct, OmniShadowMode::Multiview, OmniShadowMode::Layered, OmniShadowMode::COMPUTE];
+    pub const ALL: [OmniShadowMode; 6] = [
+        OmniShadowMode::Copy,
+        OmniShadowMode::Direct,
+        OmniShadowMode::Multiview,
+        OmniShadowMode::Layered,
+        OmniShadowMode::COMPUTE,
+        OmniShadowMode::Atlas(AtlasSettings::DEFAULT),
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -208,6 +245,7 @@ impl OmniShadowMode {
             OmniShadowMode::Multiview => "multiview",
             OmniShadowMode::Layered => "layered",
             OmniShadowMode::Compute { .. } => "compute",
+            OmniShadowMode::Atlas(_) => "atlas",
         }
     }
 
@@ -220,18 +258,37 @@ impl OmniShadowMode {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OmniShadowSettings {
     pub mode: OmniShadowMode,
-    /// Lights with a shadow cube (the strongest as seen from the camera).
+    /// Lights with a shadow cube (the strongest as seen from the camera), at most; with
+    /// `all`, the lights that reach the view (SettingsRequest::for_scene counts them).
     pub lights: u32,
-    /// Texels per side of each cube face.
+    /// Shadow every light that reaches the view (at most MAX_SHADOWED_LIGHTS), not the
+    /// `lights` strongest.
+    pub all: bool,
+    /// Texels per side of each cube face (cube array modes).
     pub size: u32,
 }
+
+/// The most lights `--shadowed-lights all` shadows (the strongest first), and the most the
+/// shadow atlas takes.
+pub const MAX_SHADOWED_LIGHTS: u32 = 4096;
 
 impl OmniShadowSettings {
     pub const DEFAULT_SIZE: u32 = 1024;
 
-    /// Bytes of the cube array (32-bit depth).
+    /// The shadow atlas's settings, if the faces go into one.
+    pub fn atlas(&self) -> Option<AtlasSettings> {
+        match self.mode {
+            OmniShadowMode::Atlas(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// Bytes of the cube array (32-bit depth; the shadow atlas's are its budget).
     pub fn bytes(&self) -> u64 {
-        self.lights as u64 * 6 * self.size as u64 * self.size as u64 * 4
+        match self.atlas() {
+            Some(a) => a.budget_bytes(),
+            None => self.lights as u64 * 6 * self.size as u64 * self.size as u64 * 4,
+        }
     }
 }
 
@@ -521,6 +578,7 @@ impl RenderSettings {
         Shading {
             model: self.shading,
             omni_shadows: self.omni.is_some(),
+            shadow_atlas: self.omni.is_some_and(|o| o.atlas().is_some()),
             object_textures: !scene.textures.is_empty(),
             spot_lights: !scene.cones.is_empty(),
         }
@@ -618,8 +676,11 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
     if lights == 0 {
         return Err(SettingsError::ShadowsWithoutLights);
     }
-    if omni.lights == 0 || omni.lights as usize > lights {
+    if omni.lights == 0 || (omni.lights as usize > lights && !omni.all) {
         return Err(SettingsError::ShadowedLights { value: omni.lights, lights });
+    }
+    if let Some(atlas) = omni.atlas() {
+        return check_atlas(ctx, omni, atlas);
     }
     let max_cubes = limits.max_image_array_layers / 6;
     if omni.lights > max_cubes {
@@ -665,6 +726,28 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
     Ok(())
 }
 
+/// Reject shadow-atlas requests the device cannot take, before allocating.
+fn check_atlas(ctx: &Context, omni: &OmniShadowSettings, atlas: AtlasSettings) -> Result<(), SettingsError> {
+    let device = || ctx.info.name.clone();
+    if omni.lights > MAX_SHADOWED_LIGHTS {
+        return Err(SettingsError::TooManyShadowed { value: omni.lights, max: MAX_SHADOWED_LIGHTS });
+    }
+    let memory_mib = ctx.device_local_bytes() >> 20;
+    if atlas.budget_mib == 0 || atlas.budget_mib as u64 > memory_mib {
+        return Err(SettingsError::ShadowBudget { mib: atlas.budget_mib, max_mib: memory_mib, device: device() });
+    }
+    if let Some(size) = atlas.fixed_size {
+        let (min, max) = (ml_cpu::shadow_atlas::MIN_FACE, ml_cpu::shadow_atlas::MAX_FACE);
+        if !size.is_power_of_two() || !(min..=max).contains(&size) {
+            return Err(SettingsError::AtlasFaceSize { value: size, min, max });
+        }
+    }
+    if !ctx.info.features.buffer_int64_atomics {
+        return Err(SettingsError::MissingFeature { mode: omni.mode, feature: "shaderInt64", device: device(), instead: "layered, direct or copy" });
+    }
+    Ok(())
+}
+
 /// Whether the driver is one that renders a depth-only multiview pass wrong: Mesa's
 /// lavapipe 22.3 (Debian 12's) draws all six views into layer 0 — found by the shadow-cube
 /// debug view; the same pass on the H100 matches `direct` exactly (docs/BENCHMARKS.md).
@@ -700,7 +783,7 @@ impl SettingsRequest {
             shading,
             clusters: self.clusters.unwrap_or_else(|| ClusterDims::for_lights(scene.lights.len(), self.width, self.height)),
             debug_view: self.debug_view,
-            omni: self.omni,
+            omni: self.omni.map(|o| OmniShadowSettings { lights: shadowed_count(&o, scene, (self.width, self.height)), ..o }),
             sun_shadow: self.sun_shadow,
             width: self.width,
             height: self.height,
@@ -711,6 +794,17 @@ impl SettingsRequest {
             exposure: self.exposure,
         }
     }
+}
+
+/// How many lights cast shadows: `--shadowed-lights all` counts those that reach the view
+/// (at least one slot, so that a view without any still renders).
+fn shadowed_count(omni: &OmniShadowSettings, scene: &ml_cpu::scene::Scene, (width, height): (u32, u32)) -> u32 {
+    if !omni.all {
+        return omni.lights;
+    }
+    let aspect = width.max(1) as f32 / height.max(1) as f32;
+    let seen = ml_cpu::omni_shadow::lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, MAX_SHADOWED_LIGHTS as usize);
+    (seen.len() as u32).max(1)
 }
 
 /// The first device feature the meshlet techniques need that `features` lacks, if any.

@@ -11,7 +11,7 @@
 use crate::descriptors::{FrameSets, Resource};
 use crate::meshlet_scene::{storage_bytes, MeshletGeometry};
 use gpu_allocator::MemoryLocation;
-use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush};
+use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush, ShadowCubeTiles};
 use ml_cpu::meshlets::SceneMeshlets;
 use ml_vk::commands::memory_barrier;
 use ml_vk::image::aspect_transition;
@@ -24,10 +24,17 @@ const MAX_GROUPS: u32 = 65535;
 /// The largest triangle one thread draws (bounding box, texels a side); larger ones get a
 /// work group each.
 pub const SPLIT: u32 = 16;
+const COMPUTE: vk::PipelineStageFlags = vk::PipelineStageFlags::COMPUTE_SHADER;
+const RW: vk::AccessFlags = vk::AccessFlags::from_raw(vk::AccessFlags::SHADER_READ.as_raw() | vk::AccessFlags::SHADER_WRITE.as_raw());
 /// The depth of a texel nothing reaches: 1.0's bits.
 const FAR_BITS: u32 = 1.0f32.to_bits();
-/// constant_id of `ORTHO_VIEW` (omni_raster.glsl).
+/// constant_id of `ORTHO_VIEW` and `ATLAS` (omni_raster.glsl).
 const SPEC_ORTHO_VIEW: u32 = 0;
+const SPEC_ATLAS: u32 = 1;
+/// Work groups that clear each face of the atlas (shadow_atlas_clear.comp's SLICES).
+const CLEAR_SLICES: u32 = 16;
+/// Bytes vkCmdUpdateBuffer writes at most at once.
+const UPDATE_LIMIT: usize = 65536;
 
 /// What one drawing covers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,20 +43,23 @@ pub enum ShadowViews {
     Cubes { lights: u32 },
     /// One orthographic view (world space, the projection is its view-projection).
     Ortho,
+    /// Six cube faces for each of `lights`, the ones the tile table says, into the shadow
+    /// atlas's `depths` (ShadowAtlasGpu); the pair list holds `pairs`.
+    Atlas { lights: u32, pairs: u32, depths: vk::Buffer, tiles: vk::Buffer },
 }
 
 impl ShadowViews {
     /// Lights (each a cube, or the one view) and the image layers they fill.
-    fn lights(self) -> u32 {
+    pub fn lights(self) -> u32 {
         match self {
-            ShadowViews::Cubes { lights } => lights,
+            ShadowViews::Cubes { lights } | ShadowViews::Atlas { lights, .. } => lights,
             ShadowViews::Ortho => 1,
         }
     }
 
     fn layers(self) -> u32 {
         match self {
-            ShadowViews::Cubes { lights } => lights * 6,
+            ShadowViews::Cubes { lights } | ShadowViews::Atlas { lights, .. } => lights * 6,
             ShadowViews::Ortho => 1,
         }
     }
@@ -72,15 +82,19 @@ pub struct ShadowRaster {
     pub counters: Buffer,
     pairs: Buffer,
     large: Buffer,
-    /// 32-bit depths, layer after layer as the image holds them, row by row.
+    /// 32-bit depths, layer after layer as the image holds them, row by row (the atlas: a
+    /// stand-in; it draws into the atlas's buffer).
     depths: Buffer,
+    /// A stand-in for the atlas's tile table (cubes and the orthographic view).
+    tiles: Buffer,
     pair_capacity: u32,
     /// Large triangles the list holds; past it, the thread that found one draws it (slowly,
     /// but nothing is lost; the table reports how many).
     large_capacity: u32,
     sets: FrameSets,
     layout: vk::PipelineLayout,
-    pipelines: [vk::Pipeline; 3],
+    /// Culling, small triangles, large triangles; the atlas's clear.
+    pipelines: [vk::Pipeline; 4],
 }
 
 impl ShadowRaster {
@@ -93,10 +107,20 @@ impl ShadowRaster {
         slots: usize,
     ) -> Result<ShadowRaster, VkError> {
         let geometry = SceneMeshlets::build(scene).map_err(|e| VkError::Limit(e.to_string()))?;
-        let shaders = [&ml_shaders::OMNI_CULL_COMP, &ml_shaders::OMNI_RASTER_COMP, &ml_shaders::OMNI_RASTER_LARGE_COMP];
+        let shaders = [
+            &ml_shaders::OMNI_CULL_COMP,
+            &ml_shaders::OMNI_RASTER_COMP,
+            &ml_shaders::OMNI_RASTER_LARGE_COMP,
+            &ml_shaders::SHADOW_ATLAS_CLEAR_COMP,
+        ];
         let stages = shaders.map(|s| (s, vk::ShaderStageFlags::COMPUTE));
-        // Six views per meshlet instance and light at most: the pair list cannot overflow.
+        // Cubes: six views per meshlet instance and light at most, the pair list cannot
+        // overflow; the atlas's is a share of its budget.
         let pairs = geometry.meshlet_instances.len() as u64 * views.layers() as u64;
+        let pairs = match views {
+            ShadowViews::Atlas { pairs: capacity, .. } => pairs.min(capacity as u64),
+            _ => pairs,
+        };
         let pair_capacity = u32::try_from(pairs.max(1)).map_err(|_| VkError::Limit(format!("{pairs} shadow (meshlet, face) pairs")))?;
         let raster = ShadowRaster {
             views,
@@ -107,11 +131,12 @@ impl ShadowRaster {
             pairs: Buffer::null(),
             large: Buffer::null(),
             depths: Buffer::null(),
+            tiles: Buffer::null(),
             pair_capacity,
             large_capacity,
             sets: FrameSets::empty(),
             layout: vk::PipelineLayout::null(),
-            pipelines: [vk::Pipeline::null(); 3],
+            pipelines: [vk::Pipeline::null(); 4],
         };
         ml_vk::build(ctx, raster, |r| {
             use vk::BufferUsageFlags as U;
@@ -130,16 +155,21 @@ impl ShadowRaster {
                 storage,
                 gpu,
             )?;
-            let texels = views.layers() as u64 * size as u64 * size as u64;
+            let atlas = matches!(views, ShadowViews::Atlas { .. });
+            let texels = if atlas { 1 } else { views.layers() as u64 * size as u64 * size as u64 };
             let depth_bytes = storage_bytes(ctx, "shadow depths", texels * 4)?;
             r.depths = Buffer::new(ctx, "shadow depths", depth_bytes, storage | U::TRANSFER_SRC | U::TRANSFER_DST, gpu)?;
+            let tile_bytes = size_of::<ml_cpu::gpu_types::ShadowCubeTiles>() as u64;
+            r.tiles = Buffer::new(ctx, "shadow tiles stand-in", tile_bytes, storage, gpu)?;
             r.sets = FrameSets::new(ctx, &stages, 0, slots)?;
             let push =
                 [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(size_of::<OmniRasterPush>() as u32)];
             r.layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw], &push)?;
-            let ortho = [(SPEC_ORTHO_VIEW, u32::from(views == ShadowViews::Ortho))];
-            for (pipeline, s) in r.pipelines.iter_mut().zip(shaders) {
-                *pipeline = shader::compute_pipeline(ctx, s.spirv, r.layout, &ortho)?;
+            let spec = [(SPEC_ORTHO_VIEW, u32::from(views == ShadowViews::Ortho)), (SPEC_ATLAS, u32::from(atlas))];
+            // The clear is the atlas's alone.
+            let used = if atlas { 4 } else { 3 };
+            for (pipeline, s) in r.pipelines.iter_mut().zip(shaders).take(used) {
+                *pipeline = shader::compute_pipeline(ctx, s.spirv, r.layout, &spec)?;
             }
             Ok(())
         })
@@ -148,13 +178,18 @@ impl ShadowRaster {
     /// Point slot `slot`'s set at the raster's own buffers and the scene's meshlets; `objects`:
     /// the scene's object buffer.
     pub fn bind(&mut self, ctx: &Context, slot: usize, objects: vk::Buffer) -> Result<(), VkError> {
+        let (depths, tiles) = match self.views {
+            ShadowViews::Atlas { depths, tiles, .. } => (depths, tiles),
+            _ => (self.depths.raw, self.tiles.raw),
+        };
         let own = |name: &str| {
             let buffer = match name {
                 "ShadowLightBuffer" => self.lights.raw,
                 "OmniRasterCounterBuffer" => self.counters.raw,
                 "OmniPairBuffer" => self.pairs.raw,
                 "OmniLargeBuffer" => self.large.raw,
-                "CubeDepthBuffer" => self.depths.raw,
+                "CubeDepthBuffer" => depths,
+                "ShadowTileBuffer" => tiles,
                 "ObjectBuffer" => objects,
                 _ => return None,
             };
@@ -176,44 +211,18 @@ impl ShadowRaster {
         target: &ShadowTarget,
     ) {
         let d = &ctx.device;
-        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;
-        let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
-        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
-        let start = OmniRasterCounters { pairs: [0, 1, 1, 0], large: [0, 1, 1, 0], drawn: [0; 4] };
-        let push = OmniRasterPush {
-            projection: projection.to_cols_array_2d(),
-            sizes: [self.size, self.views.lights(), SPLIT, self.geometry.meshlet_instance_count],
-            capacity: [self.pair_capacity, self.large_capacity, 0, 0],
-        };
+        // The last drawing's copy read the depths.
+        self.start(ctx, cmd, lights, (vk::PipelineStageFlags::empty(), vk::AccessFlags::empty()));
+        // SAFETY: recording state outside a render pass; the buffer lives as long as this raster.
+        unsafe { d.cmd_fill_buffer(cmd, self.depths.raw, 0, vk::WHOLE_SIZE, FAR_BITS) };
+        memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (COMPUTE, RW));
+        self.draw(ctx, cmd, slot, lights.len() as u32, projection);
+        memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
         let depth = vk::ImageAspectFlags::DEPTH;
-        // SAFETY: recording state outside a render pass; every buffer and pipeline lives as
-        // long as this raster, the target as long as its owner, both beyond the submission.
+        // SAFETY: recording state outside a render pass; the target lives as long as its
+        // owner, beyond the submission.
         unsafe {
-            // The last drawing's passes read and wrote these buffers (and its copy read them).
-            memory_barrier(
-                ctx,
-                cmd,
-                (compute | indirect | transfer, rw | vk::AccessFlags::TRANSFER_READ),
-                (transfer, vk::AccessFlags::TRANSFER_WRITE),
-            );
-            d.cmd_update_buffer(cmd, self.lights.raw, 0, bytemuck::cast_slice(lights));
-            d.cmd_update_buffer(cmd, self.counters.raw, 0, bytemuck::bytes_of(&start));
-            d.cmd_fill_buffer(cmd, self.depths.raw, 0, vk::WHOLE_SIZE, FAR_BITS);
-            memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
-            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.sets.sets[slot]], &[]);
-            d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[0]);
-            let groups = self.geometry.meshlet_instance_count.div_ceil(CULL_GROUP).clamp(1, MAX_GROUPS);
-            d.cmd_dispatch(cmd, groups, lights.len() as u32, 1);
-            let listed = (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ);
-            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), listed);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[1]);
-            d.cmd_dispatch_indirect(cmd, self.counters.raw, std::mem::offset_of!(OmniRasterCounters, pairs) as u64);
-            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), listed);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[2]);
-            d.cmd_dispatch_indirect(cmd, self.counters.raw, std::mem::offset_of!(OmniRasterCounters, large) as u64);
-            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
             // Whatever the last drawing's readers read is overwritten whole.
             let dst = (transfer, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
             let image = (target.image, depth);
@@ -227,6 +236,80 @@ impl ShadowRaster {
         }
     }
 
+    /// Record one frame of the shadow atlas with slot `slot`'s set: `lights` (light i: the
+    /// faces `tiles[i]` names) seen through `projection` (every face's). The faces it redraws
+    /// are cleared and drawn; the others keep their texels. Ends with the atlas's writes
+    /// visible to the shading passes (`readers`: fragment and compute shaders).
+    pub fn record_atlas(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        (lights, tiles): (&[[f32; 4]], &[ShadowCubeTiles]),
+        projection: glam::Mat4,
+        readers: vk::PipelineStageFlags,
+    ) {
+        let ShadowViews::Atlas { tiles: table, .. } = self.views else { return };
+        let d = &ctx.device;
+        // The last frame's shading read the table and the atlas.
+        self.start(ctx, cmd, lights, (readers, vk::AccessFlags::SHADER_READ));
+        // SAFETY: recording state outside a render pass; every buffer and pipeline lives as
+        // long as this raster and the atlas, beyond the submission.
+        unsafe {
+            for (i, chunk) in bytemuck::cast_slice::<_, u8>(tiles).chunks(UPDATE_LIMIT).enumerate() {
+                d.cmd_update_buffer(cmd, table, (i * UPDATE_LIMIT) as u64, chunk);
+            }
+            memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (COMPUTE, RW));
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.sets.sets[slot]], &[]);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[3]);
+            d.cmd_dispatch(cmd, lights.len() as u32, 6, CLEAR_SLICES);
+            // The culling's thread may draw (a full pair list) into what the clear cleared.
+            memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), (COMPUTE, RW));
+        }
+        self.draw(ctx, cmd, slot, lights.len() as u32, projection);
+        memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), (readers, vk::AccessFlags::SHADER_READ));
+    }
+
+    /// The start of a drawing: after the last drawing's passes (and `also`, who read what this
+    /// one writes), the lights and the counters written.
+    fn start(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[[f32; 4]], also: (vk::PipelineStageFlags, vk::AccessFlags)) {
+        let start = OmniRasterCounters { pairs: [0, 1, 1, 0], large: [0, 1, 1, 0], drawn: [0; 4] };
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let before = (COMPUTE | vk::PipelineStageFlags::DRAW_INDIRECT | transfer | also.0, RW | vk::AccessFlags::TRANSFER_READ | also.1);
+        memory_barrier(ctx, cmd, before, (transfer | COMPUTE, vk::AccessFlags::TRANSFER_WRITE | RW));
+        // SAFETY: recording state outside a render pass; both buffers live as long as this raster.
+        unsafe {
+            ctx.device.cmd_update_buffer(cmd, self.lights.raw, 0, bytemuck::cast_slice(lights));
+            ctx.device.cmd_update_buffer(cmd, self.counters.raw, 0, bytemuck::bytes_of(&start));
+        }
+    }
+
+    /// The culling and both rasters of `lights` lights, their inputs written and visible.
+    fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize, lights: u32, projection: glam::Mat4) {
+        let d = &ctx.device;
+        let push = OmniRasterPush {
+            projection: projection.to_cols_array_2d(),
+            sizes: [self.size, self.views.lights(), SPLIT, self.geometry.meshlet_instance_count],
+            capacity: [self.pair_capacity, self.large_capacity, 0, 0],
+        };
+        let listed = (COMPUTE | vk::PipelineStageFlags::DRAW_INDIRECT, RW | vk::AccessFlags::INDIRECT_COMMAND_READ);
+        // SAFETY: recording state outside a render pass; every buffer and pipeline lives as
+        // long as this raster, beyond the submission.
+        unsafe {
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.sets.sets[slot]], &[]);
+            d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[0]);
+            let groups = self.geometry.meshlet_instance_count.div_ceil(CULL_GROUP).clamp(1, MAX_GROUPS);
+            d.cmd_dispatch(cmd, groups, lights, 1);
+            memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), listed);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[1]);
+            d.cmd_dispatch_indirect(cmd, self.counters.raw, std::mem::offset_of!(OmniRasterCounters, pairs) as u64);
+            memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), listed);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[2]);
+            d.cmd_dispatch_indirect(cmd, self.counters.raw, std::mem::offset_of!(OmniRasterCounters, large) as u64);
+        }
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
@@ -235,10 +318,10 @@ impl ShadowRaster {
             }
             ctx.device.destroy_pipeline_layout(self.layout, None);
         }
-        self.pipelines = [vk::Pipeline::null(); 3];
+        self.pipelines = [vk::Pipeline::null(); 4];
         self.layout = vk::PipelineLayout::null();
         self.sets.destroy(ctx);
-        for b in [&mut self.lights, &mut self.counters, &mut self.pairs, &mut self.large, &mut self.depths] {
+        for b in [&mut self.lights, &mut self.counters, &mut self.pairs, &mut self.large, &mut self.depths, &mut self.tiles] {
             b.destroy(ctx);
         }
         self.geometry.destroy(ctx);

@@ -84,7 +84,7 @@ fn cases() -> Vec<Case> {
     let seed_lights = LightParams::seed_default();
     let seed = Scene::seed(MeshKind::Sphere, Material::named("gold").expect("named"), &seed_lights).expect("seed scene");
     let teapots = Scene::seed(MeshKind::Teapot, Material::named("copper").expect("named"), &seed_lights).expect("seed scene");
-    let omni = Some(OmniShadowSettings { mode: OmniShadowMode::Layered, lights: 1, size: 64 });
+    let omni = Some(OmniShadowSettings { mode: OmniShadowMode::Layered, lights: 1, all: false, size: 64 });
     let mut cases = vec![
         Case::new("seed", seed.clone(), ShadingModel::Seed),
         Case::new("seed-blinn-phong", teapots.clone().with_floor(), ShadingModel::BlinnPhong),

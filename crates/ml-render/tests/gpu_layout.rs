@@ -4,7 +4,7 @@
 
 use ml_cpu::gpu_types::{
     ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance,
-    LargeTriangle, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowPush,
+    LargeTriangle, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowCubeTiles, ShadowPush,
     StageProbePush,
 };
 use spirq::ty::{StructType, Type};
@@ -98,6 +98,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<CullPush>(&structs);
     check::<OmniRasterPush>(&structs);
     check::<OmniRasterCounters>(&structs);
+    check::<ShadowCubeTiles>(&structs);
 }
 
 /// Mistake 5 (docs/DESIGN.md#mistakes-we-avoid): the original demo's index list was a std140

@@ -29,7 +29,7 @@ const MARGIN_TEXELS: f32 = 4.0;
 fn settings(technique: Technique, size: u32, omni: Option<(OmniShadowMode, u32)>) -> RenderSettings {
     let mut s = RenderSettings::new(technique, size, size);
     s.shading = ShadingModel::Pbr;
-    s.omni = omni.map(|(mode, lights)| OmniShadowSettings { mode, lights, size: CUBE });
+    s.omni = omni.map(|(mode, lights)| OmniShadowSettings { mode, lights, all: false, size: CUBE });
     s
 }
 
@@ -254,7 +254,7 @@ fn shadow_cube_view_shows_each_face_in_its_cell() {
     scene.lights = vec![PointLight { position_radius: [0.0, 0.0, 0.0, 20.0], color: [3.0, 3.0, 3.0, 0.0] }];
     let (width, height) = (4 * SIZE, 3 * SIZE);
     let mut s = RenderSettings::new(Technique::Forward, width, height);
-    s.omni = Some(OmniShadowSettings { mode: OmniShadowMode::Layered, lights: 1, size: SIZE });
+    s.omni = Some(OmniShadowSettings { mode: OmniShadowMode::Layered, lights: 1, all: false, size: SIZE });
     s.debug_view = DebugView::ShadowCube;
     let out = common::render(scene, s);
     let cells = [(2, 1), (0, 1), (1, 0), (1, 2), (1, 1), (3, 1)];
@@ -320,7 +320,7 @@ fn the_compute_raster_fills_the_same_cubes() {
     ] {
         let mut s = RenderSettings::new(Technique::Forward, 96, 96);
         s.shading = ShadingModel::Pbr;
-        let mode = |mode| Some(OmniShadowSettings { mode, lights, size: cube });
+        let mode = |mode| Some(OmniShadowSettings { mode, lights, all: false, size: cube });
         s.omni = mode(OmniShadowMode::Layered);
         let (hardware, hardware_image) = cubes_and_image(&ctx, scene, s);
         s.omni = mode(compute);

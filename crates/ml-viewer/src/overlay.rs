@@ -10,6 +10,7 @@ use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
 use ml_render::{
     DebugView, Exposure, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode, Technique,
 };
+use ml_render::settings::MAX_SHADOWED_LIGHTS;
 use std::collections::VecDeque;
 
 /// Everything the overlay can change that needs a new scene or renderer.
@@ -191,11 +192,27 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
                 ui.selectable_value(&mut mode, Some(m), m.name());
             }
         });
-        let fresh = |mode| OmniShadowSettings { mode, lights: 1, size: OmniShadowSettings::DEFAULT_SIZE };
-        choices.omni = mode.map(|m| choices.omni.map_or(fresh(m), |o| OmniShadowSettings { mode: m, ..o }));
+        let fresh = |mode| OmniShadowSettings { mode, lights: 1, all: false, size: OmniShadowSettings::DEFAULT_SIZE };
+        // A mode keeps its own settings (the atlas its budget) when picked again.
+        let same = |a: OmniShadowMode, b: OmniShadowMode| a.name() == b.name();
+        choices.omni = mode.map(|m| match choices.omni {
+            Some(o) if same(o.mode, m) => o,
+            Some(o) => OmniShadowSettings { mode: m, ..o },
+            None => fresh(m),
+        });
         if let Some(o) = &mut choices.omni {
-            ui.add(DragValue::new(&mut o.lights).range(1..=64).prefix("shadowed lights "));
-            ui.add(DragValue::new(&mut o.size).range(16..=4096).prefix("cube size "));
+            // The atlas takes thousands of lights; the cube array's memory grows by 6 faces a light.
+            let max = if o.atlas().is_some() { MAX_SHADOWED_LIGHTS } else { 64 };
+            ui.add(DragValue::new(&mut o.lights).range(1..=max).prefix("shadowed lights "));
+            match &mut o.mode {
+                OmniShadowMode::Atlas(atlas) => {
+                    ui.add(DragValue::new(&mut atlas.budget_mib).range(1..=16384).prefix("shadow budget MiB "));
+                    ui.checkbox(&mut atlas.cache, "keep faces of still lights (cache)");
+                }
+                _ => {
+                    ui.add(DragValue::new(&mut o.size).range(16..=4096).prefix("cube size "));
+                }
+            }
         }
         ui.checkbox(&mut state.paused, "pause (P)");
         if let Some(e) = &state.error {

@@ -443,6 +443,14 @@ impl Context {
         props.optimal_tiling_features.contains(features)
     }
 
+    /// Bytes of the device's largest device-local memory heap.
+    pub fn device_local_bytes(&self) -> u64 {
+        // SAFETY: a physical device of this instance.
+        let props = unsafe { self.instance().get_physical_device_memory_properties(self.physical_device) };
+        let heaps = &props.memory_heaps[..props.memory_heap_count as usize];
+        heaps.iter().filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL)).map(|h| h.size).max().unwrap_or(0)
+    }
+
     /// A LAZILY_ALLOCATED memory type among `type_bits` (what an image accepts), if the device
     /// has one (tile-based GPUs; not desktop NVIDIA, not lavapipe).
     pub fn lazily_allocated_memory_type(&self, type_bits: u32) -> Option<u32> {

@@ -14,7 +14,7 @@ fn camera() -> Camera {
 /// A fresh atlas's plan for `lights` (keys: their indices) at 1920×1080.
 fn plan(lights: &[PlannedLight], c: &Camera, budget: u64) -> Result<AtlasPlan, AtlasError> {
     let keyed: Vec<(u32, PlannedLight)> = lights.iter().enumerate().map(|(i, l)| (i as u32, *l)).collect();
-    ShadowAtlas::new(budget, 16384)?.plan(&keyed, c, (1920, 1080), None, true)
+    ShadowAtlas::new(budget)?.plan(&keyed, c, (1920, 1080), None, true)
 }
 
 #[test]
@@ -94,26 +94,29 @@ fn every_visible_point_a_light_reaches_is_in_a_kept_face() {
 }
 
 #[test]
-fn the_atlas_is_the_largest_power_of_two_the_budget_holds() {
-    assert_eq!(atlas_extent(256 * MIB, 16384).unwrap(), [8192, 8192]);
-    assert_eq!(atlas_extent(128 * MIB, 16384).unwrap(), [8192, 4096]);
-    assert_eq!(atlas_extent(100 * MIB, 16384).unwrap(), [4096, 4096]);
-    assert_eq!(atlas_extent(4096 * MIB, 16384).unwrap(), [16384, 16384]);
-    assert_eq!(atlas_extent(256 * MIB, 4096).unwrap(), [4096, 4096]);
-    assert!(matches!(atlas_extent(1000, 16384), Err(AtlasError::BudgetTooSmall { .. })));
-    assert!(matches!(atlas_extent(0, 16384), Err(AtlasError::BudgetTooSmall { .. })));
+fn the_atlas_is_as_many_blocks_as_the_bytes_hold() {
+    let blocks = |mib: u64| AtlasBlocks::for_bytes(mib * MIB).map(|b| (b.side, b.count, b.extent()));
+    assert_eq!(blocks(256).unwrap(), (2048, 16, [8192, 8192]));
+    assert_eq!(blocks(200).unwrap(), (2048, 12, [8192, 6144]));
+    assert_eq!(blocks(16).unwrap(), (2048, 1, [2048, 2048]));
+    assert_eq!(blocks(8).unwrap(), (1024, 2, [2048, 1024]));
+    assert_eq!(blocks(48).unwrap(), (2048, 3, [4096, 4096]));
+    assert_eq!(blocks(1).unwrap(), (512, 1, [512, 512]));
+    assert!(matches!(AtlasBlocks::for_bytes(1000), Err(AtlasError::BudgetTooSmall { .. })));
+    assert!(matches!(AtlasBlocks::for_bytes(0), Err(AtlasError::BudgetTooSmall { .. })));
 }
 
 /// Tiles lie inside the atlas and never overlap.
 fn assert_packed(plan: &AtlasPlan) {
-    let [w, h] = plan.extent;
+    let [w, h] = plan.blocks.extent();
     for t in &plan.tiles {
         assert!(t.origin[0] + t.size <= w && t.origin[1] + t.size <= h, "{t:?} outside {w}x{h}");
         assert!(t.origin[0] % t.size == 0 && t.origin[1] % t.size == 0, "{t:?} not aligned to its size");
         // Its run of Z-ordered texels is its square of the picture.
-        let square = h as u64;
-        let column = (t.origin[0] as u64 / square) * square * square;
-        assert_eq!(t.base, column + morton_encode(t.origin[0] % h, t.origin[1]), "{t:?}");
+        let side = plan.blocks.side;
+        let block = (t.origin[1] / side) * plan.blocks.columns + t.origin[0] / side;
+        let corner = block as u64 * side as u64 * side as u64;
+        assert_eq!(t.base, corner + morton_encode(t.origin[0] % side, t.origin[1] % side), "{t:?}");
     }
     let mut tiles = plan.tiles.clone();
     tiles.sort_by_key(|t| (t.origin[1], t.origin[0]));
@@ -207,7 +210,7 @@ fn kept_faces_keep_their_blocks_and_only_moved_lights_are_drawn() {
     let lights: Vec<(u32, PlannedLight)> = (0..200)
         .map(|i| (i * 3, light(rng.random_range(-8.0..8.0), rng.random_range(0.0..4.0), rng.random_range(-10.0..5.0), rng.random_range(0.5..3.0))))
         .collect();
-    let mut cached = ShadowAtlas::new(64 * MIB, 16384).unwrap();
+    let mut cached = ShadowAtlas::new(64 * MIB).unwrap();
     let mut uncached = cached.clone();
     let mut eye = Vec3::new(0.0, 2.0, 10.0);
     let mut moving = lights.clone();
@@ -242,6 +245,6 @@ fn kept_faces_keep_their_blocks_and_only_moved_lights_are_drawn() {
     assert_eq!(cached.plan(&moving, &c, (1920, 1080), None, true).unwrap().redrawn(), 0);
     // No lights: every block is free again, merged back into the largest.
     assert!(cached.plan(&[], &c, (1920, 1080), None, true).unwrap().tiles.is_empty());
-    let fresh = ShadowAtlas::new(64 * MIB, 16384).unwrap();
+    let fresh = ShadowAtlas::new(64 * MIB).unwrap();
     assert_eq!(cached.free, fresh.free);
 }

@@ -19,6 +19,7 @@ pub mod triangle_raster_large;
 pub mod visibility_lighting;
 pub mod visibility_raster;
 
+use crate::shadow_raster::ShadowViews;
 use crate::meshlet_scene::MeshletScene;
 use crate::pass::Pass;
 use crate::scene_gpu::SceneGpu;
@@ -66,7 +67,13 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     let raster = (a.depth_format, a.shading);
     match s.omni {
         Some(omni @ OmniShadowSettings { mode: OmniShadowMode::Compute { large_list }, .. }) => {
-            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, (omni, large_list))?));
+            let views = ShadowViews::Cubes { lights: omni.lights };
+            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, (views, omni.size, large_list))?));
+        }
+        Some(omni @ OmniShadowSettings { mode: OmniShadowMode::Atlas(_), .. }) => {
+            let atlas = &a.scene.omni.atlas;
+            let views = ShadowViews::Atlas { lights: omni.lights, pairs: atlas.lists.pairs, depths: atlas.depths.raw, tiles: atlas.tiles.raw };
+            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, (views, 0, atlas.lists.large))?));
         }
         Some(_) => passes.push(Box::new(omni_shadow::OmniShadowPass)),
         None => {}

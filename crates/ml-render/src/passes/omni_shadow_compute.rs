@@ -1,15 +1,15 @@
-//! Point-light shadows drawn by compute shaders (`--omni-shadow compute`;
+//! Point-light shadows drawn by compute shaders (`--omni-shadow compute` and `atlas`;
 //! docs/DESIGN.md#compute-shadow-raster). The graphics modes are bound by filling 6 × size²
 //! texels per light on the few SMs that run graphics work; here the whole GPU draws them:
 //! each frame the compute shadow raster (shadow_raster.rs) draws every shadowed light's six
 //! faces into the cube array the shading passes sample, which ends as the graphics modes
-//! leave it.
+//! leave it — or the faces the frame's plan lists into the shadow atlas (shadow_atlas.rs).
 
 use crate::frame::FRAMES_IN_FLIGHT;
 use crate::omni_shadow::NEAR_FRACTION;
 use crate::pass::{FrameResources, Pass, Recording, SlotReport};
 use crate::report::OmniRasterStats;
-use crate::settings::OmniShadowSettings;
+use crate::shadow_atlas::tile_table;
 use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::OmniRasterCounters;
@@ -17,7 +17,7 @@ use ml_vk::commands::copy_buffer_to_host;
 use ml_vk::{vk, Buffer, Context, VkError};
 
 pub struct OmniShadowCompute {
-    settings: OmniShadowSettings,
+    views: ShadowViews,
     raster: ShadowRaster,
     /// The counters, copied out at the end of the pass, per frame slot.
     readback: Vec<Buffer>,
@@ -27,10 +27,10 @@ impl OmniShadowCompute {
     pub fn new(
         ctx: &Context,
         scene: &ml_cpu::scene::Scene,
-        (settings, large_capacity): (OmniShadowSettings, u32),
+        (views, size, large_capacity): (ShadowViews, u32, u32),
     ) -> Result<OmniShadowCompute, VkError> {
-        let views = (ShadowViews::Cubes { lights: settings.lights }, settings.size, large_capacity);
-        let pass = OmniShadowCompute { settings, raster: ShadowRaster::new(ctx, scene, views, FRAMES_IN_FLIGHT)?, readback: Vec::new() };
+        let raster = ShadowRaster::new(ctx, scene, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
+        let pass = OmniShadowCompute { views, raster, readback: Vec::new() };
         ml_vk::build(ctx, pass, |p| {
             for _ in 0..FRAMES_IN_FLIGHT {
                 let bytes = size_of::<OmniRasterCounters>() as u64;
@@ -59,17 +59,23 @@ impl Pass for OmniShadowCompute {
 
     fn record(&self, rec: &Recording) {
         let lights: Vec<[f32; 4]> =
-            rec.shadowed.iter().take(self.settings.lights as usize).map(|l| l.position.extend(l.radius).to_array()).collect();
+            rec.shadowed.iter().take(self.views.lights() as usize).map(|l| l.position.extend(l.radius).to_array()).collect();
         if lights.is_empty() {
             return;
         }
         // Every face's projection: 90°, in the light's frame in radii.
         let projection = glam::Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, NEAR_FRACTION, 1.0);
-        let target = ShadowTarget {
-            image: rec.scene.omni.cubes.raw,
-            readers: vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER,
-        };
-        self.raster.record(rec.ctx, rec.cmd, rec.slot, &lights, projection, &target);
+        let readers = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        match (self.views, rec.atlas) {
+            (ShadowViews::Atlas { .. }, Some(plan)) => {
+                let tiles = tile_table(plan, lights.len());
+                self.raster.record_atlas(rec.ctx, rec.cmd, rec.slot, (&lights, &tiles), projection, readers);
+            }
+            _ => {
+                let target = ShadowTarget { image: rec.scene.omni.cubes.raw, readers };
+                self.raster.record(rec.ctx, rec.cmd, rec.slot, &lights, projection, &target);
+            }
+        }
         let counter_bytes = size_of::<OmniRasterCounters>() as u64;
         copy_buffer_to_host(rec.ctx, rec.cmd, (self.raster.counters.raw, self.readback[rec.slot].raw), counter_bytes);
     }
@@ -82,6 +88,7 @@ impl Pass for OmniShadowCompute {
             large: c.large[3],
             in_place: c.drawn[1],
             texels: c.drawn[2],
+            pairs_in_place: c.drawn[3],
         });
     }
 
