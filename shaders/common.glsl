@@ -19,6 +19,7 @@
 #define DEBUG_VIEW_SHADOW_CUBE 7u
 #define DEBUG_VIEW_MESHLETS 8u
 #define DEBUG_VIEW_TRIANGLES 9u
+#define DEBUG_VIEW_SHADOW_ATLAS 10u
 
 // Per frame, one uniform buffer per frame in flight (set 0, binding 0).
 struct FrameUniforms {

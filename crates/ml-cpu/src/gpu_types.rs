@@ -138,6 +138,7 @@ pub const DEBUG_VIEW_SHADOW_MAP: u32 = 6;
 pub const DEBUG_VIEW_SHADOW_CUBE: u32 = 7;
 pub const DEBUG_VIEW_MESHLETS: u32 = 8;
 pub const DEBUG_VIEW_TRIANGLES: u32 = 9;
+pub const DEBUG_VIEW_SHADOW_ATLAS: u32 = 10;
 
 gpu_struct!(
     /// One object of the object buffer (std430).

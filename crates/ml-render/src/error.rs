@@ -90,8 +90,10 @@ pub enum SettingsError {
     HeatNeedsClusteredForward { technique: Technique },
     #[error("the shadow-map debug view needs the blinn-phong shading model (the seed model casts no shadows)")]
     ShadowMapNeedsBlinnPhong,
-    #[error("the shadow-cube debug view needs point-light shadows")]
+    #[error("the shadow-cube debug view needs point-light shadow cubes (--omni-shadow copy|direct|multiview|layered|compute)")]
     ShadowCubeNeedsShadows,
+    #[error("the shadow-atlas debug view needs the shadow atlas (--omni-shadow atlas)")]
+    ShadowAtlasViewNeedsAtlas,
     #[error("the {} debug view shows the meshlets of the visibility technique, not {}", view.name(), technique.name())]
     ViewNeedsMeshlets { view: DebugView, technique: Technique },
     #[error("the {} technique needs {feature}, which '{device}' lacks: use deferred-compute", technique.name())]

@@ -423,6 +423,8 @@ pub enum DebugView {
     ShadowMap,
     /// The six faces of the first shadowed point light's cube, unfolded as a cross.
     ShadowCube,
+    /// The shadow atlas, every block of it, fitted to the image (--omni-shadow atlas).
+    ShadowAtlas,
     /// A colour per meshlet instance (visibility).
     Meshlets,
     /// A colour per triangle (visibility).
@@ -430,7 +432,7 @@ pub enum DebugView {
 }
 
 impl DebugView {
-    pub const ALL: [DebugView; 10] = [
+    pub const ALL: [DebugView; 11] = [
         DebugView::None,
         DebugView::ClusterHeat,
         DebugView::GBufferAlbedo,
@@ -439,6 +441,7 @@ impl DebugView {
         DebugView::Depth,
         DebugView::ShadowMap,
         DebugView::ShadowCube,
+        DebugView::ShadowAtlas,
         DebugView::Meshlets,
         DebugView::Triangles,
     ];
@@ -453,6 +456,7 @@ impl DebugView {
             DebugView::Depth => "depth",
             DebugView::ShadowMap => "shadow-map",
             DebugView::ShadowCube => "shadow-cube",
+            DebugView::ShadowAtlas => "shadow-atlas",
             DebugView::Meshlets => "meshlets",
             DebugView::Triangles => "triangles",
         }
@@ -474,6 +478,7 @@ impl DebugView {
             DebugView::Depth => g::DEBUG_VIEW_DEPTH,
             DebugView::ShadowMap => g::DEBUG_VIEW_SHADOW_MAP,
             DebugView::ShadowCube => g::DEBUG_VIEW_SHADOW_CUBE,
+            DebugView::ShadowAtlas => g::DEBUG_VIEW_SHADOW_ATLAS,
             DebugView::Meshlets => g::DEBUG_VIEW_MESHLETS,
             DebugView::Triangles => g::DEBUG_VIEW_TRIANGLES,
         }
@@ -638,8 +643,11 @@ impl RenderSettings {
         if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
             return Err(SettingsError::ShadowMapNeedsBlinnPhong.into());
         }
-        if self.debug_view == DebugView::ShadowCube && self.omni.is_none() {
+        if self.debug_view == DebugView::ShadowCube && self.omni.is_none_or(|o| o.atlas().is_some()) {
             return Err(SettingsError::ShadowCubeNeedsShadows.into());
+        }
+        if self.debug_view == DebugView::ShadowAtlas && self.omni.is_none_or(|o| o.atlas().is_none()) {
+            return Err(SettingsError::ShadowAtlasViewNeedsAtlas.into());
         }
         if let Some(omni) = &self.omni {
             check_omni(ctx, omni, lights)?;

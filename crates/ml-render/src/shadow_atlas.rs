@@ -73,9 +73,26 @@ impl ShadowAtlasGpu {
         ml_vk::build(ctx, gpu, |g| {
             use vk::BufferUsageFlags as U;
             // Transfer source: tests and tools read the depths back.
-            g.depths = Buffer::new(ctx, "shadow atlas", depth_bytes, U::STORAGE_BUFFER | U::TRANSFER_SRC, MemoryLocation::GpuOnly)?;
+            g.depths = Buffer::new(ctx, "shadow atlas", depth_bytes, U::STORAGE_BUFFER | U::TRANSFER_SRC | U::TRANSFER_DST, MemoryLocation::GpuOnly)?;
             let tile_bytes = lights as u64 * size_of::<ShadowCubeTiles>() as u64;
             g.tiles = Buffer::new(ctx, "shadow atlas tiles", tile_bytes, U::STORAGE_BUFFER | U::TRANSFER_DST, MemoryLocation::GpuOnly)?;
+            // Free space reads "nothing in reach" (the debug view shows it black); the faces
+            // are cleared before they are drawn.
+            let (depths, tiles) = (g.depths.raw, g.tiles.raw);
+            ml_vk::commands::one_shot(ctx, |cmd| {
+                // SAFETY: recording state; both buffers are alive and nothing else uses them yet.
+                unsafe {
+                    ctx.device.cmd_fill_buffer(cmd, depths, 0, vk::WHOLE_SIZE, 1.0f32.to_bits());
+                    ctx.device.cmd_fill_buffer(cmd, tiles, 0, vk::WHOLE_SIZE, NO_TILE);
+                }
+                let shaders = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+                ml_vk::commands::memory_barrier(
+                    ctx,
+                    cmd,
+                    (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
+                    (shaders | vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::TRANSFER_WRITE),
+                );
+            })?;
             Ok(())
         })
     }
@@ -91,6 +108,11 @@ impl ShadowAtlasGpu {
     ) -> Option<Result<AtlasPlan, ml_cpu::shadow_atlas::AtlasError>> {
         let allocator = self.allocator.as_mut()?;
         Some(allocator.plan(lights, camera, size, settings.fixed_size, settings.cache))
+    }
+
+    /// The atlas's layout (None without an atlas).
+    pub fn blocks(&self) -> Option<ml_cpu::shadow_atlas::AtlasBlocks> {
+        self.allocator.as_ref().map(ShadowAtlas::blocks)
     }
 
     /// Forget every face (the casters changed): the next frame draws them all.

@@ -7,13 +7,12 @@
 
 mod common;
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use ml_cpu::camera::Camera;
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::lights::LightParams;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
-use ml_cpu::omni_shadow::{first_hit, light_sight, solids, Sight, Solid};
 use ml_cpu::scene::{Object, Scene};
 use ml_cpu::textures::cube_direction;
 use ml_render::settings::multiview_depth_is_broken;
@@ -22,9 +21,6 @@ use ml_vk::{Context, ContextDesc};
 use std::collections::HashMap;
 
 const CUBE: u32 = 512;
-/// Margin of the ray test around shadow edges, in cube texels at the point's distance: the
-/// 3×3 tent reaches 1.5 texels, the normal offset 1.5, the depth bias 1.
-const MARGIN_TEXELS: f32 = 4.0;
 
 fn settings(technique: Technique, size: u32, omni: Option<(OmniShadowMode, u32)>) -> RenderSettings {
     let mut s = RenderSettings::new(technique, size, size);
@@ -41,51 +37,6 @@ fn one_pass_modes() -> Vec<OmniShadowMode> {
         modes.push(OmniShadowMode::Multiview);
     }
     modes
-}
-
-/// The ray through sub-pixel position (x, y) of a `size`² image.
-fn ray(camera: &Camera, x: f32, y: f32, size: u32) -> (Vec3, Vec3) {
-    let inv = (camera.projection(1.0) * camera.view()).inverse();
-    let ndc = |v: f32| v / size as f32 * 2.0 - 1.0;
-    let unproject = |z: f32| {
-        let p = inv * Vec4::new(ndc(x), ndc(y), z, 1.0);
-        p.truncate() / p.w
-    };
-    let near = unproject(0.0);
-    (near, (unproject(1.0) - near).normalize())
-}
-
-/// Per pixel, where the ray test is sure: the surface point and which lights see it.
-fn sure_pixels(scene: &Scene, size: u32) -> Vec<((u32, u32), Vec<bool>)> {
-    let solids: Vec<Solid> = solids(scene).expect("scene of spheres, cubes and rooms");
-    let mut out = Vec::new();
-    for y in 0..size {
-        for x in 0..size {
-            let hit = |dx: f32, dy: f32| {
-                let (o, d) = ray(&scene.camera, x as f32 + 0.5 + dx, y as f32 + 0.5 + dy, size);
-                first_hit(&solids, o, d).map(|(i, t, n)| (i, o + d * t, n))
-            };
-            let Some((solid, point, normal)) = hit(0.0, 0.0) else { continue };
-            // Not on a silhouette or an edge: the pixel's corners see the same face.
-            let corners = [(-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)];
-            if !corners.iter().all(|&(dx, dy)| hit(dx, dy).is_some_and(|(s, _, n)| s == solid && n == normal)) {
-                continue;
-            }
-            let sights: Vec<Sight> = scene
-                .lights
-                .iter()
-                .map(|l| {
-                    let light = Vec3::from_slice(&l.position_radius[..3]);
-                    let margin = MARGIN_TEXELS * point.distance(light) * 2.0 / CUBE as f32;
-                    light_sight(&solids, point, normal, light, margin)
-                })
-                .collect();
-            if sights.iter().all(|&s| s != Sight::Unsure) {
-                out.push(((x, y), sights.iter().map(|&s| s == Sight::Lit).collect()));
-            }
-        }
-    }
-    out
 }
 
 /// The scene with only the lights in `on` lit (the rest black), no shadows.
@@ -117,7 +68,7 @@ struct RayTestResult {
 fn ray_test(scene: &Scene, size: u32, mode: OmniShadowMode) -> RayTestResult {
     let n = scene.lights.len() as u32;
     let shadowed = common::render(scene.clone(), settings(Technique::Forward, size, Some((mode, n))));
-    let pixels = sure_pixels(scene, size);
+    let pixels = common::shadow_rays::sure_pixels(scene, size, CUBE);
     let mut expected: HashMap<Vec<bool>, RenderOutput> = HashMap::new();
     let mut result = RayTestResult { lit: 0, shadowed: 0, mixed: 0, patterns: HashMap::new(), wrong: Vec::new() };
     for ((x, y), on) in pixels {

@@ -100,8 +100,8 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
             passes.push(Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?));
         }
     }
-    if matches!(s.debug_view, DebugView::ShadowMap | DebugView::ShadowCube) {
-        passes.push(Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view == DebugView::ShadowCube)?));
+    if matches!(s.debug_view, DebugView::ShadowMap | DebugView::ShadowCube | DebugView::ShadowAtlas) {
+        passes.push(Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view)?));
     }
     if s.meters_exposure() {
         passes.push(Box::new(exposure_meter::ExposureMeter::new(ctx, s.shading == ShadingModel::Pbr)?));

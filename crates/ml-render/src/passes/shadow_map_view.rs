@@ -1,9 +1,11 @@
-//! Debug views shadow-map and shadow-cube: paint the sun's shadow map (or the first shadowed
-//! light's cube, unfolded as a cross) over whatever the technique drew. Untimed.
+//! Debug views shadow-map, shadow-cube and shadow-atlas: paint the sun's shadow map (or the
+//! first shadowed light's cube, unfolded as a cross, or the shadow atlas) over whatever the
+//! technique drew. Untimed.
 
 use crate::compute_pass::ComputePass;
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::scene_gpu::SceneGpu;
+use crate::settings::DebugView;
 use ml_vk::{Context, VkError};
 
 pub struct ShadowMapView {
@@ -11,9 +13,18 @@ pub struct ShadowMapView {
 }
 
 impl ShadowMapView {
-    /// `cube`: the point-light cube instead of the sun's map (constant_id 0, CUBE).
-    pub fn new(ctx: &Context, scene: &SceneGpu, cube: bool) -> Result<ShadowMapView, VkError> {
-        let constants = [(0, u32::from(cube))];
+    /// `view`: the sun's map, the point-light cube (constant_id 0, CUBE) or the shadow atlas
+    /// (constant 1, ATLAS; 2 … 5: its blocks).
+    pub fn new(ctx: &Context, scene: &SceneGpu, view: DebugView) -> Result<ShadowMapView, VkError> {
+        let blocks = scene.omni.atlas.blocks().filter(|_| view == DebugView::ShadowAtlas);
+        let constants = [
+            (0, u32::from(view == DebugView::ShadowCube)),
+            (1, u32::from(blocks.is_some())),
+            (2, blocks.map_or(1, |b| b.count)),
+            (3, blocks.map_or(1, |b| b.side)),
+            (4, blocks.map_or(1, |b| b.columns)),
+            (5, blocks.map_or(1, |b| b.extent()[1] / b.side)),
+        ];
         let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (&ml_shaders::DEBUG_SHADOW_MAP_COMP, &constants))?;
         Ok(ShadowMapView { pass })
     }

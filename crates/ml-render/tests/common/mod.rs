@@ -4,6 +4,8 @@
 
 #![allow(dead_code)] // each test binary uses part of the harness
 
+pub mod shadow_rays;
+
 use ml_cpu::scene::Scene;
 use ml_render::{RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
