@@ -43,7 +43,7 @@ bool sphere_in_box(mat4 p, vec3 c, float r) {
 }
 
 void main() {
-    uint light = gl_WorkGroupID.y;
+    uint light = ATLAS ? redrawn_lights[gl_WorkGroupID.y] : gl_WorkGroupID.y;
     vec4 l = shadow_lights[light];
     for (uint id = gl_GlobalInvocationID.x; id < omni.sizes.w; id += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
         uvec2 object_meshlet = meshlet_instances[id];

@@ -39,6 +39,9 @@ layout(std430, set = 0, binding = 10) buffer OmniLargeBuffer { uvec2 large_trian
 layout(std430, set = 0, binding = 11) buffer CubeDepthBuffer { uint cube_depth[]; };
 // The shadow atlas's tiles of each light (ATLAS only; a stand-in otherwise).
 layout(std430, set = 0, binding = 12) readonly buffer ShadowTileBuffer { ShadowCubeTiles cube_tiles[]; };
+// The shadowed lights with faces drawn this frame (ATLAS only; a stand-in otherwise): the
+// culling and the clear run over these alone, so a frame that keeps every face costs nothing.
+layout(std430, set = 0, binding = 13) readonly buffer ShadowRedrawBuffer { uint redrawn_lights[]; };
 layout(push_constant) uniform OmniRasterPushBlock { OmniRasterPush omni; };
 
 // One orthographic view instead of cube faces: layer i is light i's view (the sun: one

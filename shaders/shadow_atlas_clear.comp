@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // The shadow atlas's step 0 (omni_raster.glsl with ATLAS): every face drawn this frame is
 // cleared to 1.0 (beyond the light's reach) before the culling lists what reaches it. A work
-// group per (light, face, sixteenth of the face): a face's texels are one run of the
+// group per (redrawn light, face, sixteenth of the face): a face's texels are one run of the
 // Z-ordered atlas, so each group writes a contiguous range. Faces kept from last frame are
 // left alone.
 #include "common.glsl"
@@ -14,7 +14,7 @@ layout(local_size_x = 256) in;
 const uint SLICES = 16u;
 
 void main() {
-    uint light = gl_WorkGroupID.x, face = gl_WorkGroupID.y;
+    uint light = redrawn_lights[gl_WorkGroupID.x], face = gl_WorkGroupID.y;
     if ((cube_tiles[light].redraw & (1u << face)) == 0u) {
         return;
     }

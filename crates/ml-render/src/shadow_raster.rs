@@ -87,6 +87,9 @@ pub struct ShadowRaster {
     depths: Buffer,
     /// A stand-in for the atlas's tile table (cubes and the orthographic view).
     tiles: Buffer,
+    /// The atlas: the lights with faces drawn this frame, written by the command buffer (a
+    /// stand-in otherwise).
+    redrawn: Buffer,
     pair_capacity: u32,
     /// Large triangles the list holds; past it, the thread that found one draws it (slowly,
     /// but nothing is lost; the table reports how many).
@@ -132,6 +135,7 @@ impl ShadowRaster {
             large: Buffer::null(),
             depths: Buffer::null(),
             tiles: Buffer::null(),
+            redrawn: Buffer::null(),
             pair_capacity,
             large_capacity,
             sets: FrameSets::empty(),
@@ -161,6 +165,8 @@ impl ShadowRaster {
             r.depths = Buffer::new(ctx, "shadow depths", depth_bytes, storage | U::TRANSFER_SRC | U::TRANSFER_DST, gpu)?;
             let tile_bytes = size_of::<ml_cpu::gpu_types::ShadowCubeTiles>() as u64;
             r.tiles = Buffer::new(ctx, "shadow tiles stand-in", tile_bytes, storage, gpu)?;
+            let redrawn_bytes = if atlas { views.lights() as u64 * 4 } else { 4 };
+            r.redrawn = Buffer::new(ctx, "redrawn shadowed lights", redrawn_bytes, storage | U::TRANSFER_DST, gpu)?;
             r.sets = FrameSets::new(ctx, &stages, 0, slots)?;
             let push =
                 [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(size_of::<OmniRasterPush>() as u32)];
@@ -190,6 +196,7 @@ impl ShadowRaster {
                 "OmniLargeBuffer" => self.large.raw,
                 "CubeDepthBuffer" => depths,
                 "ShadowTileBuffer" => tiles,
+                "ShadowRedrawBuffer" => self.redrawn.raw,
                 "ObjectBuffer" => objects,
                 _ => return None,
             };
@@ -238,8 +245,11 @@ impl ShadowRaster {
 
     /// Record one frame of the shadow atlas with slot `slot`'s set: `lights` (light i: the
     /// faces `tiles[i]` names) seen through `projection` (every face's). The faces it redraws
-    /// are cleared and drawn; the others keep their texels. Ends with the atlas's writes
-    /// visible to the shading passes (`readers`: fragment and compute shaders).
+    /// are cleared and drawn; the others keep their texels, and lights with none to redraw
+    /// cost nothing: the clear and the culling run over the others alone (a frame that keeps
+    /// every face writes the table and nothing else). Ends with the atlas's writes visible to
+    /// the shading passes (`readers`: fragment and compute shaders) and the counters' to
+    /// transfers.
     pub fn record_atlas(
         &self,
         ctx: &Context,
@@ -251,23 +261,35 @@ impl ShadowRaster {
     ) {
         let ShadowViews::Atlas { tiles: table, .. } = self.views else { return };
         let d = &ctx.device;
+        let redrawn: Vec<u32> = (0..tiles.len() as u32).filter(|&i| tiles[i as usize].redraw != 0).collect();
         // The last frame's shading read the table and the atlas.
         self.start(ctx, cmd, lights, (readers, vk::AccessFlags::SHADER_READ));
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let written = (transfer, vk::AccessFlags::TRANSFER_WRITE);
+        // The shading passes read the table and the atlas; the counters are copied out.
+        let after = (readers | transfer, vk::AccessFlags::SHADER_READ | vk::AccessFlags::TRANSFER_READ);
         // SAFETY: recording state outside a render pass; every buffer and pipeline lives as
         // long as this raster and the atlas, beyond the submission.
         unsafe {
             for (i, chunk) in bytemuck::cast_slice::<_, u8>(tiles).chunks(UPDATE_LIMIT).enumerate() {
                 d.cmd_update_buffer(cmd, table, (i * UPDATE_LIMIT) as u64, chunk);
             }
-            memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (COMPUTE, RW));
+            if redrawn.is_empty() {
+                memory_barrier(ctx, cmd, written, after);
+                return;
+            }
+            for (i, chunk) in bytemuck::cast_slice::<_, u8>(&redrawn).chunks(UPDATE_LIMIT).enumerate() {
+                d.cmd_update_buffer(cmd, self.redrawn.raw, (i * UPDATE_LIMIT) as u64, chunk);
+            }
+            memory_barrier(ctx, cmd, written, (COMPUTE, RW));
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.sets.sets[slot]], &[]);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[3]);
-            d.cmd_dispatch(cmd, lights.len() as u32, 6, CLEAR_SLICES);
+            d.cmd_dispatch(cmd, redrawn.len() as u32, 6, CLEAR_SLICES);
             // The culling's thread may draw (a full pair list) into what the clear cleared.
             memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), (COMPUTE, RW));
         }
-        self.draw(ctx, cmd, slot, lights.len() as u32, projection);
-        memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), (readers, vk::AccessFlags::SHADER_READ));
+        self.draw(ctx, cmd, slot, redrawn.len() as u32, projection);
+        memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), after);
     }
 
     /// The start of a drawing: after the last drawing's passes (and `also`, who read what this
@@ -284,7 +306,8 @@ impl ShadowRaster {
         }
     }
 
-    /// The culling and both rasters of `lights` lights, their inputs written and visible.
+    /// The culling and both rasters of `lights` lights (the atlas: of the first `lights` the
+    /// redrawn list names), their inputs written and visible.
     fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize, lights: u32, projection: glam::Mat4) {
         let d = &ctx.device;
         let push = OmniRasterPush {
@@ -321,7 +344,7 @@ impl ShadowRaster {
         self.pipelines = [vk::Pipeline::null(); 4];
         self.layout = vk::PipelineLayout::null();
         self.sets.destroy(ctx);
-        for b in [&mut self.lights, &mut self.counters, &mut self.pairs, &mut self.large, &mut self.depths, &mut self.tiles] {
+        for b in [&mut self.lights, &mut self.counters, &mut self.pairs, &mut self.large, &mut self.depths, &mut self.tiles, &mut self.redrawn] {
             b.destroy(ctx);
         }
         self.geometry.destroy(ctx);
