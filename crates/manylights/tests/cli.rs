@@ -135,6 +135,18 @@ fn absurd_sizes_and_counts_are_refused() {
     // past lavapipe's 128 MiB.
     let compute = manylights(&["render", "--omni-shadow", "compute", "--shadowed-lights", "2", "--cube-size", "2048", "--out", p], &[]);
     assert_one_line_error(&compute, &["--omni-shadow compute", "192 MiB", "storage buffer"]);
+    // The shadow atlas: budgets of nothing or more than the device has, sizes that are no
+    // face size, more lights than it takes, a budget too small for every face.
+    let atlas = |extra: &[&str]| {
+        let mut args = vec!["render", "--omni-shadow", "atlas", "--width", "64", "--height", "64", "--out", p];
+        args.extend_from_slice(extra);
+        manylights(&args, &[])
+    };
+    assert_one_line_error(&atlas(&["--shadow-budget", "0"]), &["shadow budget of 0 MiB", "out of range"]);
+    assert_one_line_error(&atlas(&["--shadow-budget", "4000000"]), &["shadow budget of 4000000 MiB", "device memory"]);
+    assert_one_line_error(&atlas(&["--cube-size", "100"]), &["--cube-size 100", "power of two"]);
+    assert_one_line_error(&atlas(&["--scene", "bench", "--lights", "5000", "--shadowed-lights", "5000"]), &["4096", "5000"]);
+    assert_one_line_error(&atlas(&["--shadowed-lights", "all", "--shadow-budget", "1"]), &["shadow atlas", "MiB"]);
     assert!(!png.exists());
 }
 

@@ -30,6 +30,8 @@ pub const MIN_FACE: u32 = 32;
 pub const MAX_FACE: u32 = 2048;
 /// Bytes per atlas texel (32-bit depth).
 pub const TEXEL_BYTES: u64 = 4;
+/// Bytes in a MiB (for messages).
+const MIB: f64 = (1u64 << 20) as f64;
 /// How far beyond its 90° pyramid a face is kept (in units of the distance along its axis):
 /// a PCF tap near a cube seam reads the neighbouring face a few texels past the edge, and at
 /// the smallest face (32 texels, 16 a half-side) 2 texels are 1/8.
@@ -88,8 +90,12 @@ impl AtlasPlan {
 pub enum AtlasError {
     #[error("a shadow budget of {bytes} bytes holds no {MIN_FACE}² face")]
     BudgetTooSmall { bytes: u64 },
-    #[error("{faces} shadow-cube faces need {needed_mib} MiB even at {MIN_FACE}² texels, more than the {budget_mib} MiB budget")]
-    TooManyFaces { faces: usize, needed_mib: u64, budget_mib: u64 },
+    #[error(
+        "{faces} shadow-cube faces need {:.1} MiB even at {MIN_FACE}² texels, more than the atlas's {:.1} MiB",
+        *needed as f64 / MIB,
+        *atlas as f64 / MIB
+    )]
+    TooManyFaces { faces: usize, needed: u64, atlas: u64 },
 }
 
 /// The texels a side a light's faces get: the pixels its sphere spans across a `height`-pixel
@@ -287,8 +293,7 @@ impl ShadowAtlas {
         while area(divided_by) > capacity {
             if MAX_FACE / divided_by <= MIN_FACE {
                 let needed = wanted.len() as u64 * (MIN_FACE * MIN_FACE) as u64 * TEXEL_BYTES;
-                let budget_mib = self.bytes() >> 20;
-                return Err(AtlasError::TooManyFaces { faces: wanted.len(), needed_mib: needed.div_ceil(1 << 20), budget_mib });
+                return Err(AtlasError::TooManyFaces { faces: wanted.len(), needed, atlas: self.bytes() });
             }
             divided_by *= 2;
         }

@@ -233,8 +233,9 @@ impl<'a> Renderer<'a> {
         self.release_frames()?;
         self.scene.lights = lights;
         self.shadowed = mark_shadowed(&mut self.scene, &self.settings);
-        // Other lights: the atlas's faces belong to lights that may be gone.
-        self.gpu.omni.atlas.forget();
+        // The atlas keeps its faces: a face is drawn again when the light of its key (the
+        // scene index) is not where it was or has another radius, which covers lights that
+        // changed, came or went.
         self.animated = if self.lights_on_gpu { Vec::new() } else { self.scene.lights.clone() };
         self.make_passes()?;
         self.create_frames()?;
@@ -619,7 +620,9 @@ impl<'a> Renderer<'a> {
             self.shadowed.iter().zip(&self.shadowed_now).map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius })).collect();
         let size = (self.extent.width, self.extent.height);
         let Some(plan) = self.gpu.omni.atlas.plan(&lights, &self.scene.camera, size, atlas) else { return Ok(()) };
-        let plan = plan.map_err(|e| RenderError::Invalid(format!("shadow atlas: {e}")))?;
+        let plan = plan.map_err(|e| {
+            RenderError::Invalid(format!("shadow atlas: {e} (a budget of {} MiB; more would hold them, or fewer shadowed lights)", atlas.budget_mib))
+        })?;
         let (budget, shadow_bytes, atlas_bytes) = self.gpu.omni.atlas.memory();
         stats.shadow_atlas = Some(AtlasStats {
             faces: plan.tiles.len(),

@@ -141,9 +141,10 @@ impl ml_vk::Release for ShadowAtlasGpu {
     }
 }
 
-/// The per-light tables: the tiles, and the raster's copy of the lights and its counters.
+/// The per-light tables: the tiles, the raster's copy of the lights (a vec4 each) and of the
+/// redrawn lights' slots (a u32 each), and its counters.
 fn tables_bytes(lights: u32) -> u64 {
-    lights as u64 * (size_of::<ShadowCubeTiles>() as u64 + 16) + size_of::<OmniRasterCounters>() as u64
+    lights as u64 * (size_of::<ShadowCubeTiles>() as u64 + 16 + 4) + size_of::<OmniRasterCounters>() as u64
 }
 
 /// The tile table of a plan for `lights` shadowed lights.
