@@ -33,8 +33,8 @@ pub const TEXEL_BYTES: u64 = 4;
 /// Bytes in a MiB (for messages).
 const MIB: f64 = (1u64 << 20) as f64;
 /// How far beyond its 90° pyramid a face is kept (in units of the distance along its axis):
-/// a PCF tap near a cube seam reads the neighbouring face a few texels past the edge, and at
-/// the smallest face (32 texels, 16 a half-side) 2 texels are 1/8.
+/// the lookup's normal offset moves a point 1.5 texels, maybe across a seam into the
+/// neighbouring face, and at the smallest face (32 texels, 16 a half-side) 2 texels are 1/8.
 pub const SEAM_MARGIN: f32 = 0.125;
 
 /// A shadowed light as the plan sees it.

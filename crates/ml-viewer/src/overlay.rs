@@ -200,10 +200,18 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
             Some(o) => OmniShadowSettings { mode: m, ..o },
             None => fresh(m),
         });
+        let scene_lights = u32::try_from(choices.lights).unwrap_or(u32::MAX).max(1);
         if let Some(o) = &mut choices.omni {
             // The atlas takes thousands of lights; the cube array's memory grows by 6 faces a light.
             let max = if o.atlas().is_some() { MAX_SHADOWED_LIGHTS } else { 64 };
-            ui.add(DragValue::new(&mut o.lights).range(1..=max).prefix("shadowed lights "));
+            ui.horizontal(|ui| {
+                ui.add_enabled(!o.all, DragValue::new(&mut o.lights).range(1..=max).prefix("shadowed lights "));
+                // As --shadowed-lights all: the lights that reach the view when it is ticked.
+                ui.checkbox(&mut o.all, "all in view");
+            });
+            if o.all {
+                o.lights = scene_lights.min(max);
+            }
             match &mut o.mode {
                 OmniShadowMode::Atlas(atlas) => {
                     ui.add(DragValue::new(&mut atlas.budget_mib).range(1..=16384).prefix("shadow budget MiB "));
