@@ -301,7 +301,14 @@ impl ShadowAtlas {
         // with no gap, so whatever fits by area fits.
         let mut tiles: Vec<FaceTile> = wanted
             .into_iter()
-            .map(|(light, face, size)| FaceTile { light, face, size: (size / divided_by).max(MIN_FACE), origin: [0, 0], base: 0, redraw: true })
+            .map(|(light, face, size)| FaceTile {
+                light,
+                face,
+                size: (size / divided_by).max(MIN_FACE),
+                origin: [0, 0],
+                base: 0,
+                redraw: true,
+            })
             .collect();
         tiles.sort_by(|a, b| b.size.cmp(&a.size).then(a.light.cmp(&b.light)).then(a.face.cmp(&b.face)));
         let order_of = |t: &FaceTile| (t.size / MIN_FACE).trailing_zeros();

@@ -18,8 +18,8 @@ use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
 use ml_cpu::omni_shadow::{lights_in_view, shadowed_lights};
-use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
 use ml_cpu::scene::Scene;
+use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
 use ml_vk::{commands, vk, Buffer, Context, Image, VkError, VkResultExt};
 use std::time::Instant;
 
@@ -616,12 +616,19 @@ impl<'a> Renderer<'a> {
     /// reported in `stats`.
     fn plan_atlas(&mut self, stats: &mut FrameStats) -> Result<(), RenderError> {
         let Some(atlas) = self.settings.omni.and_then(|o| o.atlas()) else { return Ok(()) };
-        let lights: Vec<(u32, PlannedLight)> =
-            self.shadowed.iter().zip(&self.shadowed_now).map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius })).collect();
+        let lights: Vec<(u32, PlannedLight)> = self
+            .shadowed
+            .iter()
+            .zip(&self.shadowed_now)
+            .map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius }))
+            .collect();
         let size = (self.extent.width, self.extent.height);
         let Some(plan) = self.gpu.omni.atlas.plan(&lights, &self.scene.camera, size, atlas) else { return Ok(()) };
         let plan = plan.map_err(|e| {
-            RenderError::Invalid(format!("shadow atlas: {e} (a budget of {} MiB; more would hold them, or fewer shadowed lights)", atlas.budget_mib))
+            RenderError::Invalid(format!(
+                "shadow atlas: {e} (a budget of {} MiB; more would hold them, or fewer shadowed lights)",
+                atlas.budget_mib
+            ))
         })?;
         let (budget, shadow_bytes, atlas_bytes) = self.gpu.omni.atlas.memory();
         stats.shadow_atlas = Some(AtlasStats {

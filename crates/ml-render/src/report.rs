@@ -382,8 +382,11 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     }
     if let Some(r) = stats.omni_raster {
         let in_place = if r.in_place > 0 { format!(" ({} drawn in place: the large list was full)", r.in_place) } else { String::new() };
-        let pairs_in_place =
-            if r.pairs_in_place > 0 { format!(" ({} drawn by the culling: the pair list was full)", r.pairs_in_place) } else { String::new() };
+        let pairs_in_place = if r.pairs_in_place > 0 {
+            format!(" ({} drawn by the culling: the pair list was full)", r.pairs_in_place)
+        } else {
+            String::new()
+        };
         rows.push((
             "shadow raster",
             format!(

@@ -751,7 +751,12 @@ fn check_atlas(ctx: &Context, omni: &OmniShadowSettings, atlas: AtlasSettings) -
         }
     }
     if !ctx.info.features.buffer_int64_atomics {
-        return Err(SettingsError::MissingFeature { mode: omni.mode, feature: "shaderInt64", device: device(), instead: "layered, direct or copy" });
+        return Err(SettingsError::MissingFeature {
+            mode: omni.mode,
+            feature: "shaderInt64",
+            device: device(),
+            instead: "layered, direct or copy",
+        });
     }
     Ok(())
 }

@@ -52,8 +52,13 @@ pub struct ShadowAtlasGpu {
 
 impl ShadowAtlasGpu {
     pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>) -> Result<ShadowAtlasGpu, VkError> {
-        let mut gpu =
-            ShadowAtlasGpu { depths: Buffer::null(), tiles: Buffer::null(), allocator: None, lists: AtlasLists { pairs: 1, large: 1 }, budget: 0 };
+        let mut gpu = ShadowAtlasGpu {
+            depths: Buffer::null(),
+            tiles: Buffer::null(),
+            allocator: None,
+            lists: AtlasLists { pairs: 1, large: 1 },
+            budget: 0,
+        };
         let atlas = settings.and_then(|s| s.atlas().map(|a| (s.lights, a)));
         let (lights, depth_bytes) = match atlas {
             Some((lights, a)) => {
@@ -73,7 +78,13 @@ impl ShadowAtlasGpu {
         ml_vk::build(ctx, gpu, |g| {
             use vk::BufferUsageFlags as U;
             // Transfer source: tests and tools read the depths back.
-            g.depths = Buffer::new(ctx, "shadow atlas", depth_bytes, U::STORAGE_BUFFER | U::TRANSFER_SRC | U::TRANSFER_DST, MemoryLocation::GpuOnly)?;
+            g.depths = Buffer::new(
+                ctx,
+                "shadow atlas",
+                depth_bytes,
+                U::STORAGE_BUFFER | U::TRANSFER_SRC | U::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )?;
             let tile_bytes = lights as u64 * size_of::<ShadowCubeTiles>() as u64;
             g.tiles = Buffer::new(ctx, "shadow atlas tiles", tile_bytes, U::STORAGE_BUFFER | U::TRANSFER_DST, MemoryLocation::GpuOnly)?;
             // Free space reads "nothing in reach" (the debug view shows it black); the faces

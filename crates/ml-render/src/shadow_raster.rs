@@ -344,7 +344,9 @@ impl ShadowRaster {
         self.pipelines = [vk::Pipeline::null(); 4];
         self.layout = vk::PipelineLayout::null();
         self.sets.destroy(ctx);
-        for b in [&mut self.lights, &mut self.counters, &mut self.pairs, &mut self.large, &mut self.depths, &mut self.tiles, &mut self.redrawn] {
+        for b in
+            [&mut self.lights, &mut self.counters, &mut self.pairs, &mut self.large, &mut self.depths, &mut self.tiles, &mut self.redrawn]
+        {
             b.destroy(ctx);
         }
         self.geometry.destroy(ctx);

@@ -4,8 +4,8 @@
 
 use ml_cpu::gpu_types::{
     ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance,
-    LargeTriangle, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowCubeTiles, ShadowPush,
-    StageProbePush,
+    LargeTriangle, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight,
+    ShadowCubeTiles, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;

@@ -17,8 +17,7 @@ use ml_cpu::scene::{Object, Scene};
 use ml_render::report::AtlasStats;
 use ml_render::settings::AtlasSettings;
 use ml_render::{
-    DebugView, FrameSink, OmniShadowMode, OmniShadowSettings, RenderError, RenderOutput, RenderSettings, Renderer,
-    ShadingModel, Technique,
+    DebugView, FrameSink, OmniShadowMode, OmniShadowSettings, RenderError, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique,
 };
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
@@ -77,7 +76,13 @@ fn the_atlas_gives_the_cube_arrays_image() {
         assert_eq!(stats.divided_by, 1, "the budget holds every face at {CUBE}²");
         let (beyond, wrong) = beyond_and_sure(atlas, cubes, &sure);
         let (max, _) = common::max_difference(atlas, cubes);
-        println!("{} / {}: {beyond} of {} pixels > 1/255 from the cube array (max {max}/255), {} faces", t.name(), m.name(), SIZE * SIZE, stats.faces);
+        println!(
+            "{} / {}: {beyond} of {} pixels > 1/255 from the cube array (max {max}/255), {} faces",
+            t.name(),
+            m.name(),
+            SIZE * SIZE,
+            stats.faces
+        );
         assert!(wrong.is_empty(), "{} / {}: pixels off shadow edges differ: {:?}", t.name(), m.name(), &wrong[..wrong.len().min(12)]);
         assert!(beyond * 50 <= (SIZE * SIZE) as usize, "{} / {}: {beyond} pixels differ", t.name(), m.name());
     }
@@ -195,7 +200,8 @@ fn the_cache_changes_no_pixel_while_lights_move() {
 
 /// Where the shadows straddle the light's face seams: a light in the room's middle and an
 /// occluder on each of a few seams (between two faces, and on the corner of three).
-const SEAMS: [Vec3; 5] = [Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 0.0, 1.0), Vec3::new(0.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.0, 1.0, -1.0)];
+const SEAMS: [Vec3; 5] =
+    [Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 0.0, 1.0), Vec3::new(0.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.0, 1.0, -1.0)];
 
 fn seam_room() -> Scene {
     let grey = Material { albedo: Vec3::splat(0.7), roughness: 0.7, metallic: 0.0 };
@@ -243,7 +249,11 @@ fn no_sampled_face_is_missing_with_the_camera_inside_the_light() {
             }
         }
         println!("along {along}: {} faces, {n_lit} lit and {n_dark} shadowed pixels checked, {} wrong", stats.faces, wrong.len());
-        assert!(wrong.is_empty(), "along {along}: pixels unlike the ray test (pixel, rendered, expected): {:?}", &wrong[..wrong.len().min(12)]);
+        assert!(
+            wrong.is_empty(),
+            "along {along}: pixels unlike the ray test (pixel, rendered, expected): {:?}",
+            &wrong[..wrong.len().min(12)]
+        );
         assert!(n_lit > 1000 && n_dark > 30, "along {along}: too few pixels checked");
     }
 }

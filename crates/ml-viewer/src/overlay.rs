@@ -7,10 +7,10 @@ use ml_cpu::lights::{LightLayout, RadiusRange, SEED_RADIUS};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
+use ml_render::settings::MAX_SHADOWED_LIGHTS;
 use ml_render::{
     DebugView, Exposure, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode, Technique,
 };
-use ml_render::settings::MAX_SHADOWED_LIGHTS;
 use std::collections::VecDeque;
 
 /// Everything the overlay can change that needs a new scene or renderer.

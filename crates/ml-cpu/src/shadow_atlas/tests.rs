@@ -208,7 +208,12 @@ fn morton_encode_undoes_decode() {
 fn kept_faces_keep_their_blocks_and_only_moved_lights_are_drawn() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     let lights: Vec<(u32, PlannedLight)> = (0..200)
-        .map(|i| (i * 3, light(rng.random_range(-8.0..8.0), rng.random_range(0.0..4.0), rng.random_range(-10.0..5.0), rng.random_range(0.5..3.0))))
+        .map(|i| {
+            (
+                i * 3,
+                light(rng.random_range(-8.0..8.0), rng.random_range(0.0..4.0), rng.random_range(-10.0..5.0), rng.random_range(0.5..3.0)),
+            )
+        })
         .collect();
     let mut cached = ShadowAtlas::new(64 * MIB).unwrap();
     let mut uncached = cached.clone();

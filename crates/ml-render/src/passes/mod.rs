@@ -19,13 +19,13 @@ pub mod triangle_raster_large;
 pub mod visibility_lighting;
 pub mod visibility_raster;
 
-use crate::shadow_raster::ShadowViews;
 use crate::meshlet_scene::MeshletScene;
 use crate::pass::Pass;
 use crate::scene_gpu::SceneGpu;
 use crate::settings::{
     DebugView, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel,
 };
+use crate::shadow_raster::ShadowViews;
 use meshlet_cull::Phase;
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::meshlets::SceneMeshlets;
@@ -72,7 +72,8 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
         }
         Some(omni @ OmniShadowSettings { mode: OmniShadowMode::Atlas(_), .. }) => {
             let atlas = &a.scene.omni.atlas;
-            let views = ShadowViews::Atlas { lights: omni.lights, pairs: atlas.lists.pairs, depths: atlas.depths.raw, tiles: atlas.tiles.raw };
+            let views =
+                ShadowViews::Atlas { lights: omni.lights, pairs: atlas.lists.pairs, depths: atlas.depths.raw, tiles: atlas.tiles.raw };
             passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, (views, 0, atlas.lists.large))?));
         }
         Some(_) => passes.push(Box::new(omni_shadow::OmniShadowPass)),

@@ -56,4 +56,3 @@ pub fn sure_pixels(scene: &Scene, size: u32, cube: u32) -> Vec<((u32, u32), Vec<
     }
     out
 }
-
