@@ -17,15 +17,13 @@ const float OMNI_NORMAL_OFFSET_TEXELS = 1.5;
 // …and compares this many texels nearer than it is (the depth spread within one texel).
 const float OMNI_DEPTH_BIAS_TEXELS = 1.0;
 
-// The atlas's lookup, the cube array's filter by hand: the same biases (from the light's own
-// face size), the same face and texel as cube sampling picks (Vulkan's cube-face table), and
-// the four half-texel-apart bilinear comparisons summed — a 3×3 tent over the face's texels,
-// clamped to the face (where the cube array would read the neighbouring face's texels).
-float atlas_visibility(ShadowCubeTiles tiles, vec3 to_point, vec3 n, float dist, float radius) {
+// The atlas's lookup of direction `d` (from the light, biased) against `reference`, the cube
+// array's filter by hand: the same face and texel as cube sampling picks (Vulkan's cube-face
+// table), and the four half-texel-apart bilinear comparisons summed — a 3×3 tent over the
+// face's texels, clamped to the face (where the cube array would read the neighbouring face's
+// texels).
+float atlas_visibility(ShadowCubeTiles tiles, vec3 d, float reference) {
     float size = float(tiles.size);
-    float texel_world = dist * 2.0 / size;
-    vec3 d = to_point + n * (OMNI_NORMAL_OFFSET_TEXELS * texel_world);
-    float reference = (length(d) - OMNI_DEPTH_BIAS_TEXELS * texel_world) / radius;
     vec3 a = abs(d);
     uint face;
     float ma;
@@ -80,13 +78,19 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
         if (dist >= radius) {
             return 1.0;
         }
+        // One texel of a face in face units: the cube array's, or in the atlas the light's own.
+        uint slot = uint(l.color.w) - 1u;
+        float texel = frame.omni_texel;
         if (SHADOW_ATLAS) {
-            return atlas_visibility(atlas_tiles[uint(l.color.w) - 1u], to_point, n, dist, radius);
+            texel = 2.0 / float(atlas_tiles[slot].size);
         }
         // World size of one texel at this distance (a face spans 90°: 2·dist across at most).
-        float texel_world = dist * frame.omni_texel;
+        float texel_world = dist * texel;
         vec3 d = to_point + n * (OMNI_NORMAL_OFFSET_TEXELS * texel_world);
         float reference = (length(d) - OMNI_DEPTH_BIAS_TEXELS * texel_world) / radius;
+        if (SHADOW_ATLAS) {
+            return atlas_visibility(atlas_tiles[slot], d, reference);
+        }
         vec3 a = abs(d);
         // The face's texel axes (Vulkan's cube-face table): x-faces run along z and y, y-faces
         // along x and z, z-faces along x and y. Half a texel in direction units is ma·texel/2.
@@ -102,7 +106,6 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
             + texture(omni_shadows, vec4(d - u + v, cube), reference) + texture(omni_shadows, vec4(d + u + v, cube), reference);
         return 0.25 * lit;
     }
-
     return 1.0;
 }
 

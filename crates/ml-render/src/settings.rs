@@ -717,9 +717,7 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
         return Err(missing("shaderOutputLayer", "direct or copy"));
     }
     if let OmniShadowMode::Compute { .. } = omni.mode {
-        if !ctx.info.features.buffer_int64_atomics {
-            return Err(missing("shaderInt64", "layered, direct or copy"));
-        }
+        check_compute_raster(ctx, omni)?;
         // The depths are one storage buffer, as large as the cubes.
         if omni.bytes() > limits.max_storage_buffer_range as u64 {
             return Err(SettingsError::ShadowBuffer {
@@ -750,13 +748,15 @@ fn check_atlas(ctx: &Context, omni: &OmniShadowSettings, atlas: AtlasSettings) -
             return Err(SettingsError::AtlasFaceSize { value: size, min, max });
         }
     }
+    check_compute_raster(ctx, omni)
+}
+
+/// The compute shadow raster (the compute and atlas modes) needs 64-bit integers: its edge
+/// functions are 64-bit.
+fn check_compute_raster(ctx: &Context, omni: &OmniShadowSettings) -> Result<(), SettingsError> {
     if !ctx.info.features.buffer_int64_atomics {
-        return Err(SettingsError::MissingFeature {
-            mode: omni.mode,
-            feature: "shaderInt64",
-            device: device(),
-            instead: "layered, direct or copy",
-        });
+        let device = ctx.info.name.clone();
+        return Err(SettingsError::MissingFeature { mode: omni.mode, feature: "shaderInt64", device, instead: "layered, direct or copy" });
     }
     Ok(())
 }

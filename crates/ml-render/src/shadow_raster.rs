@@ -13,7 +13,7 @@ use crate::meshlet_scene::{storage_bytes, MeshletGeometry};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush, ShadowCubeTiles};
 use ml_cpu::meshlets::SceneMeshlets;
-use ml_vk::commands::memory_barrier;
+use ml_vk::commands::{memory_barrier, update_buffer};
 use ml_vk::image::aspect_transition;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
@@ -33,8 +33,6 @@ const SPEC_ORTHO_VIEW: u32 = 0;
 const SPEC_ATLAS: u32 = 1;
 /// Work groups that clear each face of the atlas (shadow_atlas_clear.comp's SLICES).
 const CLEAR_SLICES: u32 = 16;
-/// Bytes vkCmdUpdateBuffer writes at most at once.
-const UPDATE_LIMIT: usize = 65536;
 
 /// What one drawing covers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -268,20 +266,16 @@ impl ShadowRaster {
         let written = (transfer, vk::AccessFlags::TRANSFER_WRITE);
         // The shading passes read the table and the atlas; the counters are copied out.
         let after = (readers | transfer, vk::AccessFlags::SHADER_READ | vk::AccessFlags::TRANSFER_READ);
+        update_buffer(ctx, cmd, table, bytemuck::cast_slice(tiles));
+        if redrawn.is_empty() {
+            memory_barrier(ctx, cmd, written, after);
+            return;
+        }
+        update_buffer(ctx, cmd, self.redrawn.raw, bytemuck::cast_slice(&redrawn));
+        memory_barrier(ctx, cmd, written, (COMPUTE, RW));
         // SAFETY: recording state outside a render pass; every buffer and pipeline lives as
         // long as this raster and the atlas, beyond the submission.
         unsafe {
-            for (i, chunk) in bytemuck::cast_slice::<_, u8>(tiles).chunks(UPDATE_LIMIT).enumerate() {
-                d.cmd_update_buffer(cmd, table, (i * UPDATE_LIMIT) as u64, chunk);
-            }
-            if redrawn.is_empty() {
-                memory_barrier(ctx, cmd, written, after);
-                return;
-            }
-            for (i, chunk) in bytemuck::cast_slice::<_, u8>(&redrawn).chunks(UPDATE_LIMIT).enumerate() {
-                d.cmd_update_buffer(cmd, self.redrawn.raw, (i * UPDATE_LIMIT) as u64, chunk);
-            }
-            memory_barrier(ctx, cmd, written, (COMPUTE, RW));
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.sets.sets[slot]], &[]);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[3]);
             d.cmd_dispatch(cmd, redrawn.len() as u32, 6, CLEAR_SLICES);
@@ -299,11 +293,8 @@ impl ShadowRaster {
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let before = (COMPUTE | vk::PipelineStageFlags::DRAW_INDIRECT | transfer | also.0, RW | vk::AccessFlags::TRANSFER_READ | also.1);
         memory_barrier(ctx, cmd, before, (transfer | COMPUTE, vk::AccessFlags::TRANSFER_WRITE | RW));
-        // SAFETY: recording state outside a render pass; both buffers live as long as this raster.
-        unsafe {
-            ctx.device.cmd_update_buffer(cmd, self.lights.raw, 0, bytemuck::cast_slice(lights));
-            ctx.device.cmd_update_buffer(cmd, self.counters.raw, 0, bytemuck::bytes_of(&start));
-        }
+        update_buffer(ctx, cmd, self.lights.raw, bytemuck::cast_slice(lights));
+        update_buffer(ctx, cmd, self.counters.raw, bytemuck::bytes_of(&start));
     }
 
     /// The culling and both rasters of `lights` lights (the atlas: of the first `lights` the

@@ -68,6 +68,20 @@ pub fn copy_buffer_to_host(ctx: &Context, cmd: vk::CommandBuffer, (src, dst): (v
     transfer_to_host_barrier(ctx, cmd);
 }
 
+/// The most bytes one vkCmdUpdateBuffer writes.
+const UPDATE_LIMIT: usize = 65536;
+
+/// Write `bytes` (a multiple of 4) into `buffer` from offset 0 in the command stream
+/// (vkCmdUpdateBuffer, in pieces of at most 64 KiB), so that each frame in flight sees its
+/// own; the caller makes the transfer writes visible to their readers.
+pub fn update_buffer(ctx: &Context, cmd: vk::CommandBuffer, buffer: vk::Buffer, bytes: &[u8]) {
+    for (i, chunk) in bytes.chunks(UPDATE_LIMIT).enumerate() {
+        // SAFETY: recording state outside a render pass; the caller's buffer is alive, holds
+        // `bytes` and allows transfer writes.
+        unsafe { ctx.device.cmd_update_buffer(cmd, buffer, (i * UPDATE_LIMIT) as u64, chunk) };
+    }
+}
+
 /// Make every copy recorded so far visible to the host (read-backs).
 pub fn transfer_to_host_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
     memory_barrier(
