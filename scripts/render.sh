@@ -4,5 +4,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cargo build --release --locked -q -p manylights
+if [ ! -x target/release/manylights ]; then
+    echo "Building manylights (release). The first build compiles every dependency: about 10-20 minutes on 2 cores, a few on 16; later builds take seconds." >&2
+fi
+# Without -q: cargo's progress shows while it builds.
+cargo build --release --locked -p manylights
 ./target/release/manylights render --out seed.png "$@"

@@ -20,6 +20,7 @@
 #define DEBUG_VIEW_MESHLETS 8u
 #define DEBUG_VIEW_TRIANGLES 9u
 #define DEBUG_VIEW_SHADOW_ATLAS 10u
+#define DEBUG_VIEW_ALPHA 11u
 
 // Per frame, one uniform buffer per frame in flight (set 0, binding 0).
 struct FrameUniforms {
@@ -95,7 +96,29 @@ struct ObjectData {
     vec4 albedo_roughness; // rgb: albedo, a: roughness
     vec4 material;         // x: metallic, y: occlusion strength, z: normal scale (glTF)
     vec4 emissive;         // rgb: emissive factor (glTF)
+    vec4 alpha;            // x: the alpha below which a point is cut out (OBJECT_MASKED); y: the
+                           // base colour factor's alpha (alpha_mask.glsl)
+    uvec4 alpha_texture;   // x: OBJECT_* bits; y: its alpha texture's first byte in the
+                           // alpha-mask buffer; z, w: that texture's width, height
+    vec4 uv_transform[2];  // texture coordinates as the textures see them: uv' = M·uv + t,
+                           // M's columns in [0].xy and [0].zw, t in [1].xy (transform_uv)
 };
+
+// The texture coordinates an object's textures see at mesh coordinates `uv`: its
+// ObjectData.uv_transform (glTF's texture transform) applied. Affine, so it commutes with
+// interpolation: applied per vertex, it holds for every point between.
+vec2 transform_uv(vec4 transform[2], vec2 uv) {
+    return mat2(transform[0].xy, transform[0].zw) * uv + transform[1].xy;
+}
+
+// Bits of ObjectData.alpha_texture.x (gpu_types.rs OBJECT_*).
+const uint OBJECT_MASKED = 1u;        // alpha-tested (glTF MASK, and BLEND at one half)
+const uint OBJECT_DOUBLE_SIDED = 2u;  // drawn from both sides, the normal toward the viewer
+const uint OBJECT_BLENDED = 4u;       // BLEND in the file (the alpha debug view)
+const uint OBJECT_ALPHA_TEXTURE = 8u; // its alpha comes from a texture too
+const uint OBJECT_ALPHA_WRAP_SHIFT = 8u; // wrap u (2 bits), then wrap v
+const uint OBJECT_ALPHA_NEAREST = 4096u;
+const uint OBJECT_ALPHA_BLOCK_SHIFT = 13u; // log2 of the alpha blocks' side, 4 bits
 
 // Per draw, by push constants: the object's index and, again, its material — the forward
 // fragment shaders read it here (reading it from the object buffer made the seed forward
@@ -156,6 +179,8 @@ const uint MAX_GROUPS = 65535u;
 // Bits of Instance.meshlets.w.
 const uint INSTANCE_CONE_CULLING = 1u; // rotation, uniform scale, mirror: cones hold
 const uint INSTANCE_MIRRORED = 2u;     // a mirror turns the cones around
+const uint INSTANCE_DOUBLE_SIDED = 4u; // both sides drawn: no cone or back-face culling
+const uint INSTANCE_MASKED = 8u;       // alpha-tested where drawn
 
 // An object as the meshlet culling sees it (same index as the object buffer; std430).
 struct Instance {
@@ -205,10 +230,14 @@ uint visibility_buffer_id(uvec2 pixel) {
 // A large triangle of the compute raster (visibility_polygon.glsl), clipped and set up once
 // by the thread that found it; the bins it is listed by point at it.
 struct LargeTriangle {
-    uvec4 head;       // x: corners of the clipped polygon (3 to 8); y: visibility id
+    uvec4 head;       // x: corners of the clipped polygon (3 to 8); y: visibility id; z: its
+                      // object where masked (else NOT_MASKED); w: its instance's INSTANCE_* bits
     ivec4 corners[4]; // corner 2k in xy, 2k + 1 in zw: in the image, snapped to the sub-pixel grid
     vec4 depths[2];   // each corner's depth z/w, corner k in component k
+    vec4 surface_clip[3]; // masked: the unclipped triangle's clip-space corners
+    vec4 surface_uv[2];   // masked: its corners' texture coordinates (a xy, b zw; c xy)
 };
+#define NOT_MASKED 0xffffffffu
 
 // Push constants of the culling passes.
 struct CullPush {

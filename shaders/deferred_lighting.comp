@@ -41,5 +41,5 @@ void main() {
     vec3 emissive_factor = OBJECT_TEXTURES ? texelFetch(emissive_image, p, 0).rgb : vec3(1.0);
     PointMaterial m =
         point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, texelFetch(albedo_image, p, 0), roughness_metallic, emissive_factor);
-    shade_and_store(p, frag_xy, world, n, m);
+    shade_and_store(p, frag_xy, world, n, m, objects[id].alpha_texture.x);
 }

@@ -22,7 +22,7 @@ void main() {
     // Normals by the inverse transpose (uneven scales); tangents lie in the surface, so the
     // model matrix carries them (surface.glsl makes the frame orthonormal again).
     out_normal = mat3(o.normal_matrix) * in_normal;
-    out_uv = in_uv;
+    out_uv = transform_uv(o.uv_transform, in_uv);
     out_tangent = vec4(mat3(o.model) * in_tangent.xyz, in_tangent.w);
     gl_Position = frame.proj * frame.view * vec4(world, 1.0);
 }

@@ -11,10 +11,12 @@
 #include "textures.glsl"
 #include "surface.glsl"
 #include "lighting.glsl"
+#include "mesh_coverage.glsl"
 
 layout(location = 0) out vec4 out_color;
 
 void main() {
+    vec3 normal = covered_normal();
 #ifdef CLUSTERED
     if (frame.cluster_dims.w == DEBUG_VIEW_CLUSTER_HEAT) {
         // Lights per cluster on a log scale up to cluster_slices.z.
@@ -24,11 +26,11 @@ void main() {
         return;
     }
 #endif
-    Surface s = surface_at(in_normal, in_tangent, in_uv, object.ids.y, object.material);
+    Surface s = surface_at(normal, in_tangent, in_uv, object.ids.y, object.material);
     PointMaterial m = point_material(object.albedo_roughness, object.material, object.emissive, vec4(s.albedo_factor, s.occlusion),
                                      s.roughness_metallic, s.emissive_factor);
     vec3 color;
-    if (debug_surface(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, color)) {
+    if (debug_surface(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, color)) {
         out_color = vec4(encode_gamma(color), 1.0);
         return;
     }

@@ -11,6 +11,7 @@
 #include "surface.glsl"
 
 #include "mesh_fragment_inputs.glsl"
+#include "mesh_coverage.glsl"
 
 layout(location = 0) out vec2 out_normal;
 layout(location = 1) out uint out_object;
@@ -23,7 +24,7 @@ layout(location = 4) out vec4 out_emissive;
 #endif
 
 void main() {
-    Surface s = surface_at(in_normal, in_tangent, in_uv, object.ids.y, object.material);
+    Surface s = surface_at(covered_normal(), in_tangent, in_uv, object.ids.y, object.material);
     out_normal = oct_encode(s.normal);
     out_object = object.ids.x;
     out_albedo_occlusion = vec4(s.albedo_factor, s.occlusion);

@@ -114,10 +114,16 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
 // as linear colour, which encode_gamma turns into the promised display values — albedo as
 // it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
 // False for any other view. Every shading path calls it with the values it would shade with.
-bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, out vec3 color) {
+bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, uint object_flags, out vec3 color) {
     uint view = frame.cluster_dims.w;
     vec3 display;
-    if (view == DEBUG_VIEW_GBUFFER_ALBEDO) {
+    if (view == DEBUG_VIEW_ALPHA) {
+        // Which surfaces an alpha mask cuts: opaque grey, masked green, blended (drawn as a
+        // mask) orange; double-sided ones brighter.
+        bool masked = (object_flags & OBJECT_MASKED) != 0u, blended = (object_flags & OBJECT_BLENDED) != 0u;
+        display = blended ? vec3(1.0, 0.5, 0.1) : masked ? vec3(0.2, 0.9, 0.2) : vec3(0.45);
+        display *= (object_flags & OBJECT_DOUBLE_SIDED) != 0u ? 1.0 : 0.7;
+    } else if (view == DEBUG_VIEW_GBUFFER_ALBEDO) {
         color = albedo;
         return true;
     } else if (view == DEBUG_VIEW_GBUFFER_NORMAL) {

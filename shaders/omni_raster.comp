@@ -8,6 +8,7 @@
 
 layout(local_size_x = 64) in;
 
+#define ALPHA_BOUNDS_CACHE 1
 #include "omni_raster.glsl"
 
 shared vec4 corner_clip[64];
@@ -22,6 +23,12 @@ void main() {
         uvec2 object_meshlet = meshlet_instances[pair.x];
         Meshlet m = meshlets[object_meshlet.y];
         uint layer = pair.y;
+        // A masked object's alpha bounds in shared memory for its triangles' texels.
+        uint object_flags = instances[object_meshlet.x].meshlets.w;
+        if (SURFACE_TESTS && (object_flags & INSTANCE_MASKED) != 0u) {
+            uvec4 alpha_texture = objects[object_meshlet.x].alpha_texture;
+            cache_alpha_bounds(alpha_texture, (alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u);
+        }
         // The last pair's triangles are done with the shared corners.
         barrier();
         if (lid < m.triangles.w) {
@@ -37,11 +44,12 @@ void main() {
                 continue;
             }
             vec3 ra = corner_rel[v.x], rb = corner_rel[v.y], rc = corner_rel[v.z];
+            SurfaceTest s = omni_surface_test(object_meshlet.x, meshlet_triangle(m, t), a, b, c);
             if (a.z >= 0.0 && b.z >= 0.0 && c.z >= 0.0) {
                 vec2 pa = face_xy(a, layer), pb = face_xy(b, layer), pc = face_xy(c, layer);
                 vec2 box = max(pa, max(pb, pc)) - min(pa, min(pb, pc));
                 if (all(lessThanEqual(box, vec2(float(omni.sizes.z))))) {
-                    covered += raster_small(pa, pb, pc, vec4(ra, 1.0 / a.w), vec4(rb, 1.0 / b.w), vec4(rc, 1.0 / c.w), layer);
+                    covered += raster_small(pa, pb, pc, vec4(ra, 1.0 / a.w), vec4(rb, 1.0 / b.w), vec4(rc, 1.0 / c.w), layer, s);
                     small++;
                     continue;
                 }
@@ -51,7 +59,7 @@ void main() {
                 atomicMax(counters.large.x, min(at + 1u, MAX_GROUPS));
                 large_triangles[at] = uvec2(e, t);
             } else {
-                covered += raster_large_alone(a, b, c, ra, rb, rc, layer);
+                covered += raster_large_alone(a, b, c, ra, rb, rc, layer, s);
                 in_place++;
             }
         }

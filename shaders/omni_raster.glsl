@@ -9,7 +9,9 @@
 // (a caster need not be closed), the distance to the light over its radius interpolated as
 // the fragment shader's input is (perspective-correct; for an orthographic view, the depth
 // the rasteriser writes: clip z, w being 1), LESS against what is there: a 32-bit atomic min
-// of the depth's bits (non-negative floats order as their bits do).
+// of the depth's bits (non-negative floats order as their bits do). A masked object's
+// triangle covers only the texels its alpha mask keeps (raster_surface.glsl), so a leaf's
+// shadow has the leaf's shape.
 // Needs common.glsl.
 
 #ifndef MANYLIGHTS_OMNI_RASTER_GLSL
@@ -43,6 +45,9 @@ layout(std430, set = 0, binding = 12) readonly buffer ShadowTileBuffer { ShadowC
 // culling and the clear run over these alone, so a frame that keeps every face costs nothing.
 layout(std430, set = 0, binding = 13) readonly buffer ShadowRedrawBuffer { uint redrawn_lights[]; };
 layout(push_constant) uniform OmniRasterPushBlock { OmniRasterPush omni; };
+#define ALPHA_MASK_BINDING 14
+#include "alpha_mask.glsl"
+#include "raster_surface.glsl"
 
 // One orthographic view instead of cube faces: layer i is light i's view (the sun: one
 // light at the origin with radius 1, so positions stay world positions) and omni.projection
@@ -106,18 +111,47 @@ float interpolated_depth(vec3 weights, vec4 qa, vec4 qb, vec4 qc) {
     return ORTHO_VIEW ? p.z : length(p);
 }
 
+// The surface test of triangle `t` (corners `v` in the vertex buffer, clip-space a, b, c in
+// its view) of meshlet `m` of object `object`: a masked object's alpha test, else none.
+SurfaceTest omni_surface_test(uint object, uvec3 v, vec4 a, vec4 b, vec4 c) {
+    SurfaceTest s = no_surface_test();
+    if (SURFACE_TESTS && (instances[object].meshlets.w & INSTANCE_MASKED) != 0u) {
+        s.masked = true;
+        s.alpha = objects[object].alpha;
+        s.alpha_texture = objects[object].alpha_texture;
+        s.clip[0] = a;
+        s.clip[1] = b;
+        s.clip[2] = c;
+        uvec3 f = VERTEX_FLOATS * v;
+        s.uv[0] = transform_uv(objects[object].uv_transform, vec2(vertex_data[f.x + 6u], vertex_data[f.x + 7u]));
+        s.uv[1] = transform_uv(objects[object].uv_transform, vec2(vertex_data[f.y + 6u], vertex_data[f.y + 7u]));
+        s.uv[2] = transform_uv(objects[object].uv_transform, vec2(vertex_data[f.z + 6u], vertex_data[f.z + 7u]));
+    }
+    return s;
+}
+
+// Where `texel` of view `layer` is in the depth buffer.
+uint depth_texel(uint layer, ivec2 texel) {
+    uint side = omni.sizes.x;
+    return ATLAS ? atlas_texel(cube_tiles[layer / 6u].base[layer % 6u], uvec2(texel)) : (layer * side + uint(texel.y)) * side + uint(texel.x);
+}
+
 // LESS against what is there (and against the cleared 1.0: beyond the light's reach).
 void keep_nearest(uint layer, ivec2 texel, float depth) {
     if (depth < 1.0) {
-        uint side = omni.sizes.x;
-        uint at = ATLAS ? atlas_texel(cube_tiles[layer / 6u].base[layer % 6u], uvec2(texel)) : (layer * side + uint(texel.y)) * side + uint(texel.x);
-        atomicMin(cube_depth[at], floatBitsToUint(depth));
+        atomicMin(cube_depth[depth_texel(layer, texel)], floatBitsToUint(depth));
     }
+}
+
+// Whether a covered texel is drawn: every texel of an opaque triangle, a masked one's where
+// its alpha mask keeps it.
+bool texel_kept(SurfaceTest s, uint layer, ivec2 texel) {
+    return surface_kept(s, texel, vec2(float(view_side(layer))));
 }
 
 // A triangle beyond the near plane whose box is at most omni.sizes.z texels a side, by this
 // thread (corners in texels, q as above); returns the texels covered.
-uint raster_small(vec2 pa, vec2 pb, vec2 pc, vec4 qa, vec4 qb, vec4 qc, uint layer) {
+uint raster_small(vec2 pa, vec2 pb, vec2 pc, vec4 qa, vec4 qb, vec4 qc, uint layer, SurfaceTest s) {
     // Both faces are drawn.
     SmallTriangle t;
     if (!small_triangle(pa, pb, pc, ivec2(view_side(layer)), true, t)) {
@@ -132,28 +166,36 @@ uint raster_small(vec2 pa, vec2 pb, vec2 pc, vec4 qa, vec4 qb, vec4 qc, uint lay
     for (int y = t.first.y; y <= t.last.y; y++) {
         for (int x = t.first.x; x <= t.last.x; x++) {
             ivec3 w;
-            if (small_covers(t, ivec2(x, y), w)) {
+            if (!small_covers(t, ivec2(x, y), w)) {
+                continue;
+            }
+            float depth = interpolated_depth(vec3(w), qa, qb, qc);
+            if (texel_kept(s, layer, ivec2(x, y))) {
                 covered++;
-                keep_nearest(layer, ivec2(x, y), interpolated_depth(vec3(w), qa, qb, qc));
+                keep_nearest(layer, ivec2(x, y), depth);
             }
         }
     }
     return covered;
 }
 
-// Draws the fan triangle's texel if covered; returns 1 if it was.
-uint fan_texel(FanTriangle t, ivec2 texel, uint layer) {
+// Draws the fan triangle's texel if covered (and `s` keeps it); returns 1 if it was.
+uint fan_texel(FanTriangle t, ivec2 texel, uint layer, SurfaceTest s) {
     i64vec3 w;
     if (!fan_covers(t, texel, w)) {
         return 0u;
     }
-    keep_nearest(layer, texel, interpolated_depth(vec3(w), t.qa, t.qb, t.qc));
+    float depth = interpolated_depth(vec3(w), t.qa, t.qb, t.qc);
+    if (!texel_kept(s, layer, texel)) {
+        return 0u;
+    }
+    keep_nearest(layer, texel, depth);
     return 1u;
 }
 
 // Any triangle by this thread alone, texel by texel over each fan triangle's box (what the
 // culling's thread does when the large list is full). Returns the texels covered.
-uint raster_large_alone(vec4 ca, vec4 cb, vec4 cc, vec3 ra, vec3 rb, vec3 rc, uint layer) {
+uint raster_large_alone(vec4 ca, vec4 cb, vec4 cc, vec3 ra, vec3 rb, vec3 rc, uint layer, SurfaceTest s) {
     int side = int(view_side(layer));
     Polygon p = clipped_polygon(ca, cb, cc, ra, rb, rc, vec2(float(side)));
     uint covered = 0u;
@@ -164,7 +206,7 @@ uint raster_large_alone(vec4 ca, vec4 cb, vec4 cc, vec3 ra, vec3 rb, vec3 rc, ui
         }
         for (int y = t.first.y; y <= t.last.y; y++) {
             for (int x = t.first.x; x <= t.last.x; x++) {
-                covered += fan_texel(t, ivec2(x, y), layer);
+                covered += fan_texel(t, ivec2(x, y), layer, s);
             }
         }
     }
@@ -184,7 +226,7 @@ uint raster_meshlet_alone(uint instance, uint layer) {
         vec4 a, b, c;
         vec3 ra = view_vertex(v.x, model, layer, a), rb = view_vertex(v.y, model, layer, b), rc = view_vertex(v.z, model, layer, c);
         if (!outside_face(a, b, c)) {
-            covered += raster_large_alone(a, b, c, ra, rb, rc, layer);
+            covered += raster_large_alone(a, b, c, ra, rb, rc, layer, omni_surface_test(object_meshlet.x, v, a, b, c));
         }
     }
     return covered;

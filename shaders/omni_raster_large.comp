@@ -17,6 +17,10 @@ const int TILE = 8;
 shared ivec2 corner_s[MAX_POLYGON];
 shared vec4 corner_q[MAX_POLYGON];
 shared int corner_count;
+// Its surface test (raster_surface.glsl), also set up by the first thread.
+shared bool corner_masked;
+shared vec4 corner_clip[3];
+shared vec2 corner_uv[3];
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
@@ -36,6 +40,12 @@ void main() {
             vec3 ra = view_vertex(v.x, model, pair.y, a), rb = view_vertex(v.y, model, pair.y, b), rc = view_vertex(v.z, model, pair.y, c);
             Polygon p = clipped_polygon(a, b, c, ra, rb, rc, vec2(float(view_side(pair.y))));
             corner_count = p.count;
+            SurfaceTest s = omni_surface_test(object_meshlet.x, v, a, b, c);
+            corner_masked = s.masked;
+            for (int i = 0; i < 3; i++) {
+                corner_clip[i] = s.clip[i];
+                corner_uv[i] = s.uv[i];
+            }
             for (int i = 0; i < p.count; i++) {
                 corner_s[i] = ivec2(p.s[i]);
                 corner_q[i] = p.q[i];
@@ -43,6 +53,17 @@ void main() {
         }
         barrier();
         uint layer = pairs[large_triangles[e].x].y;
+        SurfaceTest s = no_surface_test();
+        if (corner_masked) {
+            uint object = meshlet_instances[pairs[large_triangles[e].x].x].x;
+            s.masked = true;
+            s.alpha = objects[object].alpha;
+            s.alpha_texture = objects[object].alpha_texture;
+            for (int i = 0; i < 3; i++) {
+                s.clip[i] = corner_clip[i];
+                s.uv[i] = corner_uv[i];
+            }
+        }
         ivec2 side = ivec2(view_side(layer));
         int corners = corner_count;
         for (int k = 1; k + 1 < corners; k++) {
@@ -61,7 +82,7 @@ void main() {
                 }
                 for (int y = lo.y; y <= hi.y; y++) {
                     for (int x = lo.x; x <= hi.x; x++) {
-                        covered += fan_texel(t, ivec2(x, y), layer);
+                        covered += fan_texel(t, ivec2(x, y), layer, s);
                     }
                 }
             }

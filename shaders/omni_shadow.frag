@@ -1,11 +1,4 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Point-light shadow cubes: the depth stored is the distance to the light over its radius
-// (linear, so every face and the lookup agree on one scale), not the projection's depth.
-#include "common.glsl"
-
-layout(location = 0) in vec3 in_from_light; // in radii
-
-void main() {
-    gl_FragDepth = length(in_from_light);
-}
+// Point-light shadow cubes: the distance to the light over its radius (omni_shadow_frag.glsl).
+#include "omni_shadow_frag.glsl"

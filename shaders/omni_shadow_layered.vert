@@ -3,11 +3,5 @@
 #extension GL_ARB_shader_viewport_layer_array : require
 // Point-light shadow cubes, all six faces in one pass (--omni-shadow layered): each draw has
 // six instances, instance i renders face i into layer i of the light's six.
-#include "common.glsl"
+#define OMNI_LAYERED
 #include "omni_shadow_vertex.glsl"
-
-void main() {
-    out_from_light = omni_from_light();
-    gl_Layer = gl_InstanceIndex;
-    gl_Position = omni_face_clip(omni.view_proj, out_from_light, gl_InstanceIndex);
-}

@@ -21,9 +21,10 @@ void main() {
     Meshlet m = meshlets[d.w];
     transform_meshlet(m, d);
     bool culling = cull.mode.y != 0u;
+    bool both_faces = (instances[d.y].meshlets.w & INSTANCE_DOUBLE_SIDED) != 0u;
     for (uint t = gl_LocalInvocationID.x; t < m.triangles.y; t += gl_WorkGroupSize.x) {
         uvec3 v = meshlet_corners(m, t);
-        if (!culling || triangle_visible(clip[v.x], clip[v.y], clip[v.z])) {
+        if (!culling || triangle_visible(clip[v.x], clip[v.y], clip[v.z], both_faces)) {
             keep_triangle(t);
         }
     }

@@ -19,7 +19,9 @@ shared vec4 clip[64];
 shared uint kept[4]; // a bit per triangle
 shared uint group_first;
 
-bool triangle_visible(vec4 a, vec4 b, vec4 c) {
+// Whether the triangle may cover a pixel centre; back faces count where `both_faces` (a
+// double-sided object's).
+bool triangle_visible(vec4 a, vec4 b, vec4 c, bool both_faces) {
     if (a.z < 0.0 && b.z < 0.0 && c.z < 0.0) {
         return false;
     }
@@ -33,6 +35,12 @@ bool triangle_visible(vec4 a, vec4 b, vec4 c) {
     vec2 pa = (a.xy / a.w * 0.5 + 0.5) * size;
     vec2 pb = (b.xy / b.w * 0.5 + 0.5) * size;
     vec2 pc = (c.xy / c.w * 0.5 + 0.5) * size;
+    if (both_faces && cross2(pb - pa, pc - pa) > 0.0) {
+        // Seen from behind: tested as the front face it is drawn as.
+        vec2 s = pb;
+        pb = pc;
+        pc = s;
+    }
     // Framebuffer y points down: a counter-clockwise (front) face has a negative cross
     // product; the raster culls the others.
     vec3 edges = vec3(distance(pa, pb), distance(pb, pc), distance(pc, pa));

@@ -28,6 +28,9 @@ layout(std430, set = 0, binding = 14) buffer VisibilityDepthBuffer { uint64_t vi
 layout(std430, set = 0, binding = 15) writeonly buffer LargeBinBuffer { uvec2 large_bins[]; };
 layout(std430, set = 0, binding = 16) buffer LargeTriangleBuffer { LargeTriangle large_triangles[]; };
 
+#define ALPHA_MASK_BINDING 17
+#define ALPHA_BOUNDS_CACHE 1
+#include "alpha_mask.glsl"
 #include "visibility_polygon.glsl"
 
 const uint ROUTE_NONE = 0u;    // no pixel to draw
@@ -60,15 +63,17 @@ uint route(vec2 pa, vec2 pb, vec2 pc) {
     return ROUTE_COMPUTE;
 }
 
-// Draws the triangle — its corners in pixels, their depths z/w — with visibility id `id`;
-// returns the pixels covered.
-uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id) {
-    // The pipeline culls back faces.
+// Draws the triangle — its corners in pixels, their depths z/w — with visibility id `id`,
+// both faces where `both_faces` (else the front alone, as the pipeline culls back faces), the
+// pixels `s` keeps; returns the pixels covered.
+uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces, SurfaceTest s) {
     SmallTriangle t;
-    if (!small_triangle(pa, pb, pc, ivec2(frame.viewport.xy), false, t)) {
+    if (!small_triangle(pa, pb, pc, ivec2(frame.viewport.xy), both_faces, t)) {
         return 0u;
     }
-    z = z.xzy; // front faces come swapped
+    if (t.swapped) {
+        z = z.xzy; // front faces come swapped
+    }
     uint covered = 0u;
     for (int y = t.first.y; y <= t.last.y; y++) {
         for (int x = t.first.x; x <= t.last.x; x++) {
@@ -76,8 +81,11 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id) {
             if (!small_covers(t, ivec2(x, y), w)) {
                 continue;
             }
-            covered++;
             float depth = dot(vec3(w), z) / float(t.area);
+            if (!surface_kept(s, ivec2(x, y), vec2(frame.viewport.xy))) {
+                continue;
+            }
+            covered++;
             keep_nearest_id(ivec2(x, y), depth, id);
         }
     }
@@ -87,7 +95,7 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id) {
 // A large triangle (or one crossing the near plane), clipped, into the list of large
 // triangles and listed by the bins of its polygon's box; where the lists cannot hold it,
 // drawn by this thread. Returns the pixels it covered here.
-uint list_large(vec4 a, vec4 b, vec4 c, uint id) {
+uint list_large(vec4 a, vec4 b, vec4 c, uint id, uint flags, uint object, SurfaceTest s) {
     Polygon p = visibility_polygon(a, b, c);
     if (p.count == 0) {
         return 0u;
@@ -109,7 +117,7 @@ uint list_large(vec4 a, vec4 b, vec4 c, uint id) {
     uint at = atomicAdd(counters.binned[phase], bins);
     bool fits = triangle < capacity && at <= capacity && bins <= capacity - at;
     if (fits) {
-        store_large(triangle, p, id);
+        store_large(triangle, p, id, flags, object, s);
     }
     for (uint i = 0u; i < bins && at + i < capacity; i++) {
         uvec2 bin = bin0 + uvec2(i % span.x, i / span.x);
@@ -121,7 +129,21 @@ uint list_large(vec4 a, vec4 b, vec4 c, uint id) {
         return 0u;
     }
     atomicAdd(counters.rasterized.w, 1u);
-    return raster_polygon_alone(p, id);
+    return raster_polygon_alone(p, id, (flags & INSTANCE_DOUBLE_SIDED) != 0u, s);
+}
+
+// A masked meshlet's texture coordinates, its object's texture transform applied (the
+// surface tests of its triangles).
+shared vec2 corner_uv[64];
+
+// A masked meshlet's corner uvs into `corner_uv` (the whole work group, its meshlet masked).
+void load_corner_uvs(Meshlet m, uint object) {
+    uint lid = gl_LocalInvocationID.x;
+    if (lid < m.triangles.w) {
+        uint b = VERTEX_FLOATS * meshlet_vertices[m.triangles.z + lid];
+        corner_uv[lid] = transform_uv(objects[object].uv_transform, vec2(vertex_data[b + 6u], vertex_data[b + 7u]));
+    }
+    barrier();
 }
 
 void main() {
@@ -133,14 +155,34 @@ void main() {
     }
     transform_meshlet(m, d);
     bool culling = cull.mode.y != 0u;
+    uint flags = SURFACE_TESTS ? instances[d.y].meshlets.w : 0u;
+    bool both_faces = (flags & INSTANCE_DOUBLE_SIDED) != 0u;
+    // Masked: the object's alpha test, the corners' uvs in shared memory (the flags are the
+    // work group's: one meshlet, one object).
+    SurfaceTest s = no_surface_test();
+    if ((flags & INSTANCE_MASKED) != 0u) {
+        load_corner_uvs(m, d.y);
+        s.masked = true;
+        s.alpha = objects[d.y].alpha;
+        s.alpha_texture = objects[d.y].alpha_texture;
+        cache_alpha_bounds(s.alpha_texture, (s.alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u);
+    }
     uint triangles = 0u, pixels = 0u;
     for (uint t = gl_LocalInvocationID.x; t < m.triangles.y; t += gl_WorkGroupSize.x) {
         uvec3 v = meshlet_corners(m, t);
         vec4 a = clip[v.x], b = clip[v.y], c = clip[v.z];
-        if (culling && !triangle_visible(a, b, c)) {
+        if (culling && !triangle_visible(a, b, c, both_faces)) {
             continue;
         }
         uint id = (d.x << VISIBILITY_TRIANGLE_BITS) | t;
+        if (s.masked) {
+            s.clip[0] = a;
+            s.clip[1] = b;
+            s.clip[2] = c;
+            s.uv[0] = corner_uv[v.x];
+            s.uv[1] = corner_uv[v.y];
+            s.uv[2] = corner_uv[v.z];
+        }
         uint r = ROUTE_LARGE;
         vec2 pa, pb, pc;
         if (!crosses_near_plane(a, b, c)) {
@@ -152,10 +194,10 @@ void main() {
         if (r == ROUTE_LARGE && cull.triangles.w == 0u) {
             keep_triangle(t);
         } else if (r == ROUTE_LARGE) {
-            pixels += list_large(a, b, c, id);
+            pixels += list_large(a, b, c, id, flags, d.y, s);
         } else if (r == ROUTE_COMPUTE) {
             vec3 z = vec3(a.z / a.w, b.z / b.w, c.z / c.w);
-            pixels += rasterize(pa, pb, pc, z, id);
+            pixels += rasterize(pa, pb, pc, z, id, both_faces, s);
             triangles++;
         }
     }

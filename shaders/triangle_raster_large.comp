@@ -15,8 +15,11 @@ layout(std430, set = 0, binding = 1) buffer CullCounterBuffer { CullCounters cou
 layout(std430, set = 0, binding = 2) readonly buffer LargeBinBuffer { uvec2 large_bins[]; };
 layout(std430, set = 0, binding = 3) buffer LargeTriangleBuffer { LargeTriangle large_triangles[]; };
 layout(std430, set = 0, binding = 4) buffer VisibilityDepthBuffer { uint64_t visibility_depth[]; };
+layout(std430, set = 0, binding = 5) readonly buffer ObjectBuffer { ObjectData objects[]; };
 layout(push_constant) uniform CullPushBlock { CullPush cull; };
 
+#define ALPHA_MASK_BINDING 6
+#include "alpha_mask.glsl"
 #include "visibility_polygon.glsl"
 
 const int BLOCK = 8;
@@ -38,7 +41,9 @@ void main() {
             continue;
         }
         uint at = listed.x;
-        uvec2 head = large_triangles[at].head.xy;
+        uvec4 head = large_triangles[at].head;
+        SurfaceTest surface = SURFACE_TESTS ? large_surface(at, head.z) : no_surface_test();
+        bool both_faces = SURFACE_TESTS && (head.w & INSTANCE_DOUBLE_SIDED) != 0u;
         ivec2 bin = ivec2(listed.y & 0xffffu, listed.y >> 16u);
         ivec2 lo = bin * BIN + ivec2(lid % uint(BIN / BLOCK), lid / uint(BIN / BLOCK)) * BLOCK;
         ivec2 hi = lo + BLOCK - 1;
@@ -46,14 +51,14 @@ void main() {
         vec4 q0 = large_depth(at, 0);
         for (int k = 1; k + 1 < int(head.x); k++) {
             FanTriangle t;
-            if (!fan_triangle(s0, large_corner(at, k), large_corner(at, k + 1), q0, large_depth(at, k), large_depth(at, k + 1), size, false, t)) {
+            if (!fan_triangle(s0, large_corner(at, k), large_corner(at, k + 1), q0, large_depth(at, k), large_depth(at, k + 1), size, both_faces, t)) {
                 continue;
             }
             ivec2 from = max(lo, t.first), to = min(hi, t.last);
             if (any(greaterThan(from, to)) || !fan_reaches(t, from, to)) {
                 continue;
             }
-            covered += fan_block(t, from, to, head.y);
+            covered += fan_block(t, from, to, head.y, surface);
         }
     }
     barrier();

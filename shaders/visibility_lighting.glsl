@@ -100,6 +100,7 @@ void main() {
     vec4 c[3];
     for (int k = 0; k < 3; k++) {
         v[k] = vertex_at(corners[k]);
+        v[k].uv = transform_uv(o.uv_transform, v[k].uv);
         vec3 world = (o.model * vec4(v[k].position, 1.0)).xyz;
         c[k] = frame.proj * frame.view * vec4(world, 1.0);
     }
@@ -116,12 +117,18 @@ void main() {
     surface_uv_dx = uvs * barycentrics(c, q + vec2(1.0, 0.0)) - uv00;
     surface_uv_dy = uvs * barycentrics(c, q + vec2(0.0, 1.0)) - uv00;
     vec3 normal = mat3(o.normal_matrix) * (mat3(v[0].normal, v[1].normal, v[2].normal) * b);
+    // A double-sided object's back face (its corners clockwise on screen: the homogeneous
+    // determinant is the projected area's sign, also for corners behind the eye) is lit on
+    // the side the viewer sees.
+    if ((o.alpha_texture.x & OBJECT_DOUBLE_SIDED) != 0u && determinant(mat3(c[0].xyw, c[1].xyw, c[2].xyw)) > 0.0) {
+        normal = -normal;
+    }
     vec4 tangent = mat4(v[0].tangent, v[1].tangent, v[2].tangent, vec4(0.0)) * vec4(b, 0.0);
     tangent.xyz = mat3(o.model) * tangent.xyz;
     Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material);
     PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic,
                                      s.emissive_factor);
-    shade_and_store(p, frag_xy, world_from_depth(frag_xy, z), s.normal, m);
+    shade_and_store(p, frag_xy, world_from_depth(frag_xy, z), s.normal, m, o.alpha_texture.x);
 }
 
 #endif

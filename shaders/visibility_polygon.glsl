@@ -5,9 +5,10 @@
 // 64×64-pixel bins of its box; a work group per bin then draws it (triangle_raster_large.comp).
 // Past the lists' capacity the finding thread draws it alone. As the pipeline draws: back
 // faces culled, depth z/w interpolated linearly in the image, LESS against what is there by
-// the same atomic min as the small triangles.
+// the same atomic min as the small triangles — but both faces of a double-sided object's
+// triangle, and only the pixels its alpha mask keeps (raster_surface.glsl).
 // The includer declares `frame` (FrameBlock), `visibility_depth[]` (VisibilityDepthBuffer)
-// and `large_triangles[]` (LargeTriangleBuffer).
+// and `large_triangles[]` (LargeTriangleBuffer), and includes alpha_mask.glsl.
 
 #ifndef MANYLIGHTS_VISIBILITY_POLYGON_GLSL
 #define MANYLIGHTS_VISIBILITY_POLYGON_GLSL
@@ -16,6 +17,7 @@
 #extension GL_EXT_shader_atomic_int64 : require
 
 #include "polygon_raster.glsl"
+#include "raster_surface.glsl"
 
 // Bins of the large triangles: squares of this many pixels.
 const int BIN = 64;
@@ -41,9 +43,17 @@ Polygon visibility_polygon(vec4 a, vec4 b, vec4 c) {
     return p;
 }
 
-// The polygon as the large-triangle list keeps it.
-void store_large(uint at, Polygon p, uint id) {
-    large_triangles[at].head = uvec4(uint(p.count), id, 0u, 0u);
+// The polygon as the large-triangle list keeps it, with its instance's INSTANCE_* `flags`,
+// its `object` and its surface test.
+void store_large(uint at, Polygon p, uint id, uint flags, uint object, SurfaceTest s) {
+    large_triangles[at].head = uvec4(uint(p.count), id, s.masked ? object : NOT_MASKED, flags);
+    if (s.masked) {
+        large_triangles[at].surface_clip[0] = s.clip[0];
+        large_triangles[at].surface_clip[1] = s.clip[1];
+        large_triangles[at].surface_clip[2] = s.clip[2];
+        large_triangles[at].surface_uv[0] = vec4(s.uv[0], s.uv[1]);
+        large_triangles[at].surface_uv[1] = vec4(s.uv[2], 0.0, 0.0);
+    }
     for (int i = 0; i < MAX_POLYGON; i += 2) {
         ivec2 s0 = i < p.count ? ivec2(p.s[i]) : ivec2(0), s1 = i + 1 < p.count ? ivec2(p.s[i + 1]) : ivec2(0);
         large_triangles[at].corners[i >> 1] = ivec4(s0, s1);
@@ -62,9 +72,10 @@ vec4 large_depth(uint at, int k) {
     return vec4(large_triangles[at].depths[k >> 2][k & 3], 0.0, 0.0, 0.0);
 }
 
-// The pixels of [from, to] the fan triangle covers drawn with visibility id `id`, the edge
-// functions stepped from pixel to pixel (exact: integers); returns the pixels covered.
-uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id) {
+// The pixels of [from, to] the fan triangle covers (and `s` keeps) drawn with visibility id
+// `id`, the edge functions stepped from pixel to pixel (exact: integers); returns the pixels
+// covered.
+uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id, SurfaceTest s) {
     // Per pixel to the right and down, each edge function changes by −d.y and d.x sub-pixels.
     i64vec3 step_x = -256l * i64vec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
     i64vec3 step_y = 256l * i64vec3(t.c.x - t.b.x, t.a.x - t.c.x, t.b.x - t.a.x);
@@ -78,25 +89,47 @@ uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id) {
             if (any(lessThan(w - i64vec3(t.bias), i64vec3(0)))) {
                 continue;
             }
-            covered++;
             vec3 weights = vec3(w);
-            keep_nearest_id(ivec2(x, y), dot(weights, z) / (weights.x + weights.y + weights.z), id);
+            float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
+            if (!surface_kept(s, ivec2(x, y), vec2(frame.viewport.xy))) {
+                continue;
+            }
+            covered++;
+            keep_nearest_id(ivec2(x, y), depth, id);
         }
     }
     return covered;
 }
 
-// The whole polygon by this thread alone, over each fan triangle's box; returns the pixels
-// covered.
-uint raster_polygon_alone(Polygon p, uint id) {
+// The whole polygon by this thread alone, over each fan triangle's box (both faces where
+// `both_faces`); returns the pixels covered.
+uint raster_polygon_alone(Polygon p, uint id, bool both_faces, SurfaceTest s) {
     uint covered = 0u;
     for (int k = 1; k + 1 < p.count; k++) {
         FanTriangle t;
-        if (fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(frame.viewport.xy), false, t)) {
-            covered += fan_block(t, t.first, t.last, id);
+        if (fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(frame.viewport.xy), both_faces, t)) {
+            covered += fan_block(t, t.first, t.last, id, s);
         }
     }
     return covered;
+}
+
+// The surface test of listed triangle `at` (the includer declares `objects[]`).
+SurfaceTest large_surface(uint at, uint object) {
+    SurfaceTest s = no_surface_test();
+    if (object != NOT_MASKED) {
+        s.masked = true;
+        s.alpha = objects[object].alpha;
+        s.alpha_texture = objects[object].alpha_texture;
+        s.clip[0] = large_triangles[at].surface_clip[0];
+        s.clip[1] = large_triangles[at].surface_clip[1];
+        s.clip[2] = large_triangles[at].surface_clip[2];
+        vec4 uv = large_triangles[at].surface_uv[0];
+        s.uv[0] = uv.xy;
+        s.uv[1] = uv.zw;
+        s.uv[2] = large_triangles[at].surface_uv[1].xy;
+    }
+    return s;
 }
 
 #endif

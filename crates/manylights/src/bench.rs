@@ -116,6 +116,7 @@ impl Plan {
         let scene = SceneRequest {
             shading: shading_choice(a.shading.as_deref())?,
             camera: a.camera.as_deref().map(CameraSpec::parse).transpose().context("--camera")?,
+            aspect: width.max(1) as f32 / height.max(1) as f32,
             ..SceneRequest::new(source)
         };
         let settings = SettingsRequest {

@@ -33,7 +33,7 @@ enum Command {
     /// Render a scene headless (no window system) to a PNG and print a timing table.
     Render(Box<RenderArgs>),
     /// Open a window on a scene: first-person camera (WASD/QE, right-drag, wheel), an overlay
-    /// of settings and GPU times, P pause, F12 screenshot, Esc quit.
+    /// of settings and GPU times, F frame the scene, P pause, F12 screenshot, Esc quit.
     View(Box<ViewArgs>),
     /// Measure techniques × light counts: per-pass GPU time (median, p95), CPU time, lights
     /// per cluster; writes results.csv and results.json.
@@ -51,7 +51,8 @@ struct RenderArgs {
     #[arg(long, default_value_t = 1)]
     frames: u32,
     /// Output PNG file; a name with a run of # (frames/####.png) is an image sequence: every
-    /// frame, the #s replaced by its number from 0, zero-padded to their count.
+    /// frame, the #s replaced by its number from 0, zero-padded to their count, in a folder
+    /// made if it does not exist.
     #[arg(long)]
     out: PathBuf,
 }
@@ -89,10 +90,11 @@ struct SceneArgs {
     objects: Option<usize>,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
     /// deferred-compute, visibility (meshlets culled on the GPU into a visibility buffer, lit
-    /// in compute), or auto: visibility (deferred-compute on a device without its features)
-    /// where this device runs the probe's light loop (`bench --probe`) over 1.25× faster as a
-    /// compute shader than as a fragment shader, else deferred-clustered.
-    #[arg(long, default_value = "forward")]
+    /// in compute), or auto (the default): visibility (deferred-compute on a device without its
+    /// features) where this device runs the probe's light loop (`bench --probe`) over 1.25×
+    /// faster as a compute shader than as a fragment shader, else deferred-clustered. Every
+    /// technique gives forward's image.
+    #[arg(long, default_value = "auto")]
     technique: String,
     /// Shading model: seed (specular-only Cook–Torrance: GGX, Schlick–Smith, Schlick Fresnel),
     /// blinn-phong (Lambert + normalised Blinn-Phong with a shadowed sun, a spot light,
@@ -108,7 +110,8 @@ struct SceneArgs {
     /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu),
     /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (blinn-phong),
     /// shadow-cube (the first shadowed point light's cube, unfolded; needs --omni-shadow),
-    /// meshlets, triangles (a colour per meshlet or triangle; visibility).
+    /// shadow-atlas (needs --omni-shadow atlas), meshlets, triangles (a colour per meshlet or
+    /// triangle; visibility), alpha (opaque grey, alpha-masked green, blended orange).
     #[arg(long, default_value = "none")]
     debug_view: String,
     /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.
@@ -121,11 +124,13 @@ struct SceneArgs {
     /// N lights of --light-layout; a file without lights gets 64).
     #[arg(long)]
     lights: Option<u64>,
-    /// Light placement: grid (a square grid above the scene), random (uniform in the scene's
-    /// box) or surface (just above random points of the scene's surfaces, area-weighted). The
-    /// built-in scenes place them in their fixed frame (the grid over x,z ∈ [−15,15] at
-    /// y = 7.5, the box x,z ∈ [−20,20], y ∈ [−2,12]); scene and glTF files in one fitted to
-    /// their box.
+    /// Light placement: grid (a square grid above the scene; in a scene or glTF file, once the
+    /// count calls for it, layers of such grids down through the scene's box), random (uniform
+    /// in the scene's box) or surface (just above random points of the scene's surfaces,
+    /// area-weighted). The built-in scenes place them in their fixed frame (the grid over
+    /// x,z ∈ [−15,15] at y = 7.5, the box x,z ∈ [−20,20], y ∈ [−2,12]); scene and glTF files in
+    /// one fitted to their box, where every layout's default radius brings a few lights to
+    /// each point at any count.
     #[arg(long, default_value = "grid")]
     light_layout: String,
     /// Seed of the random and surface layouts (and of random radii).
@@ -285,6 +290,7 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         shading: shading_choice(args.shading.as_deref())?,
         camera: args.camera.as_deref().map(CameraSpec::parse).transpose().context("--camera")?,
         show_lights: args.show_lights,
+        aspect: args.width.max(1) as f32 / args.height.max(1) as f32,
     })
 }
 
@@ -483,7 +489,14 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let built = request.build()?;
     print_warnings(&built.warnings);
     match &sequence {
-        Some(pattern) => check_output(&sequence_path(pattern, 0))?,
+        Some(pattern) => {
+            // A sequence's folder is made for it (a single image's must exist).
+            let first = sequence_path(pattern, 0);
+            if let Some(folder) = first.parent().filter(|p| !p.as_os_str().is_empty() && !p.is_dir()) {
+                std::fs::create_dir_all(folder).with_context(|| format!("cannot make folder '{}'", folder.display()))?;
+            }
+            check_output(&first)?
+        }
         None => check_output(&cmd.out)?,
     }
     let mut settings = wanted.for_scene(&built.scene, built.shading);

@@ -23,9 +23,9 @@ fn with_flags(cause: &(dyn Error + 'static)) -> Option<String> {
             RenderError::Scene(e) => scene(e),
             RenderError::Settings(e) => Some(settings(e)),
             RenderError::Vulkan(e) => vulkan(e),
-            RenderError::ListsTooLong(e) => {
-                Some(format!("{e}: use fewer --lights or a smaller --light-radius, or a coarser --clusters grid"))
-            }
+            RenderError::ListsTooLong(e) => Some(format!(
+                "{e}: use a smaller --light-radius, fewer --lights or a coarser --clusters grid (without --light-radius, a scene file's or glTF file's lights of any --light-layout, and the bench scene's, get a radius that shrinks as their count grows)"
+            )),
             RenderError::UnknownName { kind: Named::OmniShadowMode, name, expected } => {
                 Some(format!("unknown --omni-shadow mode '{name}': expected one of {expected}"))
             }
@@ -131,11 +131,19 @@ mod tests {
         assert_eq!(describe(&e), format!("bench: --lights 0 is out of range: use 1 to {MAX_LIGHTS}"));
         let e = anyhow::Error::from(ml_vk::VkError::DeviceIndex { index: 3, count: 1 });
         assert_eq!(describe(&e), "--device 3 does not exist: 1 Vulkan device(s) found (see `manylights info`)");
-        let lists = ml_render::error::ListsTooLong { needed: 1 << 20, limit: 1 << 18, holder: "'gpu' binds as one storage buffer".into() };
+        let lists = ml_render::error::ListsTooLong {
+            needed: 1 << 20,
+            limit: 1 << 18,
+            holder: "'gpu' binds as one storage buffer".into(),
+            technique: Some(ml_render::Technique::DeferredCompute),
+        };
         let e = anyhow::Error::from(RenderError::ListsTooLong(lists));
-        assert_eq!(
-            describe(&e),
-            "the cluster light lists need at least 1048576 entries (4 MiB), more than the 1 MiB 'gpu' binds as one storage buffer: use fewer --lights or a smaller --light-radius, or a coarser --clusters grid"
+        assert!(
+            describe(&e).starts_with(
+                "deferred-compute: the cluster light lists need at least 1048576 entries (4 MiB), more than the 1 MiB 'gpu' binds as one storage buffer: use a smaller --light-radius, fewer --lights or a coarser --clusters grid"
+            ),
+            "{}",
+            describe(&e)
         );
         let e = anyhow::Error::from(SettingsError::ShadowsWithoutLights);
         assert_eq!(describe(&e), "point-light shadows need point lights, and the scene has none (--lights N adds some)");

@@ -158,6 +158,38 @@ fn unwritable_output_is_refused_before_rendering() {
     assert_one_line_error(&manylights(&["render", "--out", dir.to_str().unwrap()], &[]), &["directory"]);
 }
 
+/// Light lists that cannot fit in what the device binds are refused before any frame is
+/// drawn — in seconds, not after minutes of GPU list building — in one line that names the
+/// technique asked for and the flags that fix it.
+#[test]
+fn light_lists_that_cannot_fit_are_refused_before_any_frame() {
+    let png = temp_png("never-lists.png");
+    for technique in ["deferred-compute", "clustered-gpu", "visibility", "clustered-cpu"] {
+        let start = std::time::Instant::now();
+        let args = [
+            "render",
+            "--validation",
+            "--technique",
+            technique,
+            "--lights",
+            "200000",
+            "--light-radius",
+            "500",
+            "--width",
+            "64",
+            "--height",
+            "36",
+        ];
+        let out = manylights(&[&args[..], &["--out", png.to_str().unwrap()]].concat(), &[]);
+        let needles = [&format!("{technique}: the cluster light lists need at least")[..], "--light-radius", "--lights", "--clusters"];
+        assert_one_line_error(&out, &needles);
+        let seconds = start.elapsed().as_secs_f64();
+        println!("{technique}: refused in {seconds:.1} s");
+        assert!(seconds < 120.0, "{technique}: refused only after {seconds:.0} s");
+        assert!(!png.exists());
+    }
+}
+
 #[test]
 fn no_vulkan_driver_names_what_to_install() {
     let png = temp_png("never3.png");

@@ -49,8 +49,10 @@ fn camera_option_gives_the_scene_files_camera_image() {
     let with_camera = scene_file(&dir, "with.toml", "[camera]\nposition = [3.0, 4.0, 5.0]\ntarget = [0.0, 0.5, 0.0]\nfov_y_deg = 45.0\n");
     let without = scene_file(&dir, "without.toml", "");
     let (a, b, framed) = (dir.join("file.png"), dir.join("option.png"), dir.join("framed.png"));
+    // One technique for all three (auto's pick may differ from run to run, by 1/255 at most).
     let render = |scene: &Path, out: &Path, extra: &[&str]| {
-        let mut args = vec!["render", "--validation", "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        let mut args =
+            vec!["render", "--validation", "--technique", "forward", "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()];
         args.extend(SIZE);
         args.extend(extra);
         ok(&manylights(&args))
@@ -91,6 +93,31 @@ fn an_image_sequence_has_every_frame_and_ends_with_the_frames_image() {
         // The lights move: the frames are not one image written five times.
         assert!(frames[0] != frames[4]);
     }
+}
+
+/// Mean luma (Rec. 709 weights on the 8-bit values, 0…1) over the whole image.
+fn mean_luma(image: &image::RgbaImage) -> f64 {
+    let sum: f64 = image.pixels().map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64).sum();
+    sum / 255.0 / (image.width() * image.height()) as f64
+}
+
+/// An image sequence into folders that do not exist yet: they are made, and under auto
+/// exposure (a scene file's default) the first frame is exposed like the last, not dark.
+#[test]
+fn a_sequence_makes_its_folder_and_starts_exposed() {
+    let dir = temp_dir("new-folder");
+    let file = scene_file(&dir, "knot.toml", "");
+    let folder = dir.join("renders").join("knot");
+    assert!(!folder.exists());
+    let pattern = folder.join("###.png");
+    let mut args = vec!["render", "--validation", "--scene", file.to_str().unwrap(), "--frames", "6", "--out", pattern.to_str().unwrap()];
+    args.extend(SIZE);
+    ok(&manylights(&args));
+    let first = pixels(&folder.join("000.png"));
+    let last = pixels(&folder.join("005.png"));
+    let (a, b) = (mean_luma(&first), mean_luma(&last));
+    println!("mean luma: first frame {a:.4}, last {b:.4}");
+    assert!((a / b - 1.0).abs() <= 0.02, "the first frame's mean luma {a:.4} is not within 2 % of the last's {b:.4}");
 }
 
 #[test]

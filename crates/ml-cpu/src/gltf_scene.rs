@@ -17,11 +17,11 @@ use crate::camera::Camera;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
-use crate::scene::{DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
+use crate::scene::{AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
 use crate::scene_load::{read_capped, ReadError, SceneFile, MAX_OBJECTS};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use base64::Engine as _;
-use glam::{Mat4, Vec3};
+use glam::{Affine2, Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -36,7 +36,7 @@ pub const MAX_TEXTURE_SIZE: u32 = 16384;
 /// Deepest node hierarchy we follow.
 pub const MAX_NODE_DEPTH: usize = 256;
 /// Extensions we read (a file may require these; others it may only use, with a warning).
-const SUPPORTED_EXTENSIONS: [&str; 1] = ["KHR_lights_punctual"];
+const SUPPORTED_EXTENSIONS: [&str; 3] = ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_texture_transform"];
 
 /// A glTF file that could not be loaded: where, and what is wrong (one line).
 #[derive(Debug, Error)]
@@ -198,6 +198,12 @@ pub enum GltfError {
     Factor { material: MaterialName, factor: &'static str, value: f32 },
     #[error("material {material}: normal scale {value} is not finite")]
     NormalScale { material: MaterialName, value: f32 },
+    #[error("material {material}: alphaCutoff {value} must be finite and not negative")]
+    AlphaCutoff { material: MaterialName, value: f32 },
+    #[error("material {material}: its texture transform is not finite")]
+    TextureTransform { material: MaterialName },
+    #[error("material {material}: emissive strength {value} must be finite and not negative")]
+    EmissiveStrength { material: MaterialName, value: f32 },
     #[error("its buffer view does not exist")]
     NoImageView,
     #[error("a buffer view without a mimeType")]
@@ -283,6 +289,8 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         camera: None,
         vertices: 0,
         warnings: unread.into_iter().map(|e| format!("extension {e} is not supported; the file is read without it")).collect(),
+        blended: Default::default(),
+        mixed_transforms: Default::default(),
     };
     let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
@@ -310,7 +318,26 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     if builder.objects.is_empty() {
         return Err(GltfError::NoTriangles);
     }
-    let Builder { objects, lights, camera, meshes, warnings, textures, directional, mut cones, .. } = builder;
+    let Builder { objects, lights, camera, meshes, mut warnings, textures, directional, mut cones, blended, mixed_transforms, .. } =
+        builder;
+    if !mixed_transforms.is_empty() {
+        let names: Vec<String> = mixed_transforms.into_iter().collect();
+        warnings.push(format!(
+            "material{} {}: textures with different texture transforms (KHR_texture_transform); the base colour's is used for all",
+            if names.len() == 1 { "" } else { "s" },
+            names.join(", ")
+        ));
+    }
+    if !blended.is_empty() {
+        let names: Vec<String> = blended.into_iter().collect();
+        warnings.push(format!(
+            "material{} {} blend{} (alphaMode BLEND): drawn as a mask cut at alpha {} (no blending)",
+            if names.len() == 1 { "" } else { "s" },
+            names.join(", "),
+            if names.len() == 1 { "s" } else { "" },
+            crate::scene::BLEND_AS_MASK_CUTOFF
+        ));
+    }
     if cones.iter().all(|c| *c == LightCone::NONE) {
         cones.clear();
     }
@@ -435,6 +462,10 @@ struct Builder<'a> {
     vertices: usize,
     /// What the file holds that is left out.
     warnings: Vec<String>,
+    /// The blended materials drawn (as masks), by name.
+    blended: std::collections::BTreeSet<String>,
+    /// The materials whose textures carry different texture transforms, by name.
+    mixed_transforms: std::collections::BTreeSet<String>,
 }
 
 impl Builder<'_> {
@@ -448,7 +479,18 @@ impl Builder<'_> {
                 if self.objects.len() == MAX_OBJECTS {
                     return Err(GltfError::TooManyPrimitives);
                 }
-                let (material, extras) = material(&primitive.material()).map_err(|e| e.within(what))?;
+                let (material, extras, mixed) = material(&primitive.material()).map_err(|e| e.within(what))?;
+                let m = primitive.material();
+                let named = || match m.name() {
+                    Some(name) => format!("{} '{name}'", MaterialName(m.index())),
+                    None => MaterialName(m.index()).to_string(),
+                };
+                if extras.alpha_mode == AlphaMode::Blend {
+                    self.blended.insert(named());
+                }
+                if mixed {
+                    self.mixed_transforms.insert(named());
+                }
                 let textures = self.object_textures(&primitive.material()).map_err(|e| e.within(what))?;
                 // The mesh was stored fitted to [−1, 1]³: undo that inside the object's transform.
                 let transform = world * Mat4::from_translation(centre) * Mat4::from_scale(Vec3::splat(half));
@@ -674,11 +716,13 @@ fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, GltfError> {
     Ok(TextureImage { width, height, rgba: decoded.into_raw(), srgb, sampler: TextureSampler::default() })
 }
 
-/// glTF's metallic-roughness factors, and its emissive factor, normal scale and occlusion
-/// strength.
-fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras), GltfError> {
+/// glTF's metallic-roughness factors, and its emissive factor (times
+/// KHR_materials_emissive_strength), normal scale, occlusion strength, alpha mode, sides and
+/// texture transform; and whether its textures carry different transforms (one is used: the
+/// base colour's, else the first textured slot's).
+fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool), GltfError> {
     let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
+    let [r, g, b, a] = pbr.base_color_factor();
     let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
     let [er, eg, eb] = m.emissive_factor();
     let strength = m.occlusion_texture().map_or(1.0, |t| t.strength());
@@ -686,6 +730,7 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras), GltfError>
         ("base colour", r),
         ("base colour", g),
         ("base colour", b),
+        ("base colour alpha", a),
         ("metallic", metallic),
         ("roughness", roughness),
         ("emissive", er),
@@ -703,8 +748,52 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras), GltfError>
     if !normal_scale.is_finite() {
         return Err(GltfError::NormalScale { material, value: normal_scale });
     }
-    let extras = MaterialExtras { emissive: Vec3::new(er, eg, eb), normal_scale, occlusion_strength: strength };
-    Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras))
+    let emissive_strength = m.emissive_strength().unwrap_or(1.0);
+    if !(emissive_strength.is_finite() && emissive_strength >= 0.0) {
+        return Err(GltfError::EmissiveStrength { material, value: emissive_strength });
+    }
+    let alpha_mode = match m.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+        gltf::material::AlphaMode::Mask => {
+            let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+            if !(cutoff.is_finite() && cutoff >= 0.0) {
+                return Err(GltfError::AlphaCutoff { material, value: cutoff });
+            }
+            AlphaMode::Mask { cutoff }
+        }
+        gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+    };
+    let pbr = m.pbr_metallic_roughness();
+    let transforms: Vec<Affine2> = [pbr.base_color_texture(), pbr.metallic_roughness_texture(), m.emissive_texture()]
+        .iter()
+        .flatten()
+        .map(texture_transform)
+        .collect();
+    let uv_transform = transforms.first().copied().unwrap_or(Affine2::IDENTITY);
+    if !uv_transform.is_finite() {
+        return Err(GltfError::TextureTransform { material });
+    }
+    let mixed = transforms.iter().any(|t| *t != uv_transform);
+    let extras = MaterialExtras {
+        uv_transform,
+        emissive: Vec3::new(er, eg, eb) * emissive_strength,
+        normal_scale,
+        occlusion_strength: strength,
+        alpha_mode,
+        base_alpha: a,
+        double_sided: m.double_sided(),
+    };
+    Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras, mixed))
+}
+
+/// A texture's KHR_texture_transform as the affine map of texture coordinates it is:
+/// translation · rotation · scale, the rotation's columns (cos, sin) and (−sin, cos).
+fn texture_transform(info: &gltf::texture::Info) -> Affine2 {
+    let Some(t) = info.texture_transform() else { return Affine2::IDENTITY };
+    let (sin, cos) = t.rotation().sin_cos();
+    let [sx, sy] = t.scale();
+    let columns = glam::Mat2::from_cols(glam::Vec2::new(cos, sin) * sx, glam::Vec2::new(-sin, cos) * sy);
+    Affine2::from_mat2_translation(columns, glam::Vec2::from(t.offset()))
 }
 
 /// A glTF sampler (filters glTF leaves open: linear, trilinear between mips).
@@ -769,15 +858,11 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
     Ok(Some(Camera { orthographic, ..Camera::looking_at(position, position + forward, fov, near, far) }))
 }
 
-/// A camera that sees every object: from above and in front of the bounds' centre.
+/// A camera that sees every object, from above and in front, the model filling most of a
+/// default-sized image (`camera::frame_scene`; a render of another aspect frames it again for
+/// its own: `SceneRequest::build`).
 pub fn framing_camera(scene: &Scene) -> Camera {
-    let (lo, hi) = scene.bounds();
-    let centre = (lo + hi) * 0.5;
-    let radius = ((hi - lo).length() * 0.5).max(1e-3);
-    let fov = 60.0f32;
-    let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
-    let position = centre + Vec3::new(0.0, 0.5, 1.0).normalize() * distance;
-    Camera::looking_at(position, centre, fov, (distance - radius).max(distance * 1e-3) * 0.5, distance + radius * 2.0)
+    crate::camera::frame_scene(scene, crate::camera::DEFAULT_ASPECT, crate::camera::DEFAULT_FOV_Y_DEG)
 }
 
 /// Triangle-list indices from a list, strip or fan.

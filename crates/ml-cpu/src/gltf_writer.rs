@@ -1,8 +1,10 @@
 //! A small glTF 2.0 writer: the tests make every glTF file they load with it (no third-party
 //! assets), and it makes the fuzzers' seed files. Meshes (positions, optional normals,
 //! texture coordinates and u8/u16/u32 indices), materials (factors), nodes with a matrix or
-//! TRS and children, point/spot/directional lights (KHR_lights_punctual), cameras. The JSON is
-//! a `serde_json::Value`, so tests can break any part of it before writing.
+//! TRS and children, point/spot/directional lights (KHR_lights_punctual), cameras, alpha modes
+//! (OPAQUE, MASK with its cutoff, BLEND) and double-sided materials, and a cut-out texture with
+//! holes (`cutout`) for alpha-mask tests. The JSON is a `serde_json::Value`, so tests can break
+//! any part of it before writing.
 
 use base64::Engine as _;
 use serde_json::{json, Value};
@@ -189,6 +191,46 @@ impl GltfWriter {
         m
     }
 
+    /// Set material `material`'s `alphaMode` ("OPAQUE", "MASK" or "BLEND") and, where given,
+    /// its `alphaCutoff` (else the file leaves it out: glTF's default, 0.5).
+    pub fn alpha_mode(&mut self, material: usize, mode: &str, cutoff: Option<f32>) {
+        let m = &mut self.json["materials"][material];
+        m["alphaMode"] = json!(mode);
+        if let Some(c) = cutoff {
+            m["alphaCutoff"] = json!(c);
+        }
+    }
+
+    /// Set material `material`'s `doubleSided`.
+    pub fn double_sided(&mut self, material: usize, double_sided: bool) {
+        self.json["materials"][material]["doubleSided"] = json!(double_sided);
+    }
+
+    /// Give material `material` a `name` (what the loader's messages call it).
+    pub fn material_name(&mut self, material: usize, name: &str) {
+        self.json["materials"][material]["name"] = json!(name);
+    }
+
+    /// A material whose base colour is `base_colour` (its alpha too) × texture `texture`, with
+    /// `alphaMode` `mode` ("OPAQUE", "MASK", "BLEND"), `alphaCutoff` `cutoff` where given, and
+    /// `doubleSided`; returns its index. With a `cutout` texture and MASK: a plate with holes.
+    pub fn alpha_material(
+        &mut self,
+        texture: Option<usize>,
+        base_colour: [f32; 4],
+        mode: &str,
+        cutoff: Option<f32>,
+        double_sided: bool,
+    ) -> usize {
+        let m = self.material(base_colour, 0.0, 0.6);
+        if let Some(t) = texture {
+            self.json["materials"][m]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": t });
+        }
+        self.alpha_mode(m, mode, cutoff);
+        self.double_sided(m, double_sided);
+        m
+    }
+
     /// A node (any JSON: "mesh", "matrix", "translation", "children", …); returns its index.
     /// `root` puts it in the scene.
     pub fn node(&mut self, node: Value, root: bool) -> usize {
@@ -299,4 +341,116 @@ pub fn quarters() -> Vec<u8> {
         _ => [255, 255, 255, 255],
     };
     (0..16).flat_map(|i| colour(i % 4, i / 4)).collect()
+}
+
+/// Side of the `cutout` texture, in texels.
+pub const CUTOUT_SIZE: u32 = 64;
+/// The `cutout` texture's round holes, in texture coordinates (u right, v down): centre and
+/// radius. With `CUTOUT_SLOT` they have no symmetry — a mirrored, turned or transposed lookup
+/// puts holes where the plate is solid (`CUTOUT_SOLID`) and plate where the holes are.
+pub const CUTOUT_DISCS: [([f32; 2], f32); 2] = [([0.28, 0.28], 0.17), ([0.75, 0.3], 0.1)];
+/// Its rectangular hole: the corners (u, v) of least and greatest coordinates.
+pub const CUTOUT_SLOT: [[f32; 2]; 2] = [[0.15, 0.66], [0.45, 0.84]];
+/// Points well inside each hole (at least 0.09 from its edge), and well inside the plate.
+pub const CUTOUT_HOLE_POINTS: [[f32; 2]; 3] = [[0.28, 0.28], [0.75, 0.3], [0.3, 0.75]];
+pub const CUTOUT_SOLID: [[f32; 2]; 4] = [[0.75, 0.75], [0.5, 0.5], [0.06, 0.06], [0.75, 0.55]];
+
+/// Whether texture coordinates `uv` lie in a hole of the `cutout` texture (its texel centres
+/// are tested this way).
+pub fn in_cutout_hole(uv: [f32; 2]) -> bool {
+    let [lo, hi] = CUTOUT_SLOT;
+    let slot = (lo[0]..hi[0]).contains(&uv[0]) && (lo[1]..hi[1]).contains(&uv[1]);
+    slot || CUTOUT_DISCS.iter().any(|(c, r)| (uv[0] - c[0]).hypot(uv[1] - c[1]) < *r)
+}
+
+/// A CUTOUT_SIZE² RGBA8 texture (row 0 at the top) for alpha masks: a plate of colour `rgb`
+/// with two round holes and a rectangular one (`CUTOUT_DISCS`, `CUTOUT_SLOT`), asymmetric so
+/// that a lookup mirrored or turned anywhere shows. Alpha is 255 on the plate and 0 in the
+/// holes; the colour is `rgb` everywhere, holes included, so that filtering (and mipmaps)
+/// never bleed another colour into the plate's edges.
+pub fn cutout(rgb: [u8; 3]) -> Vec<u8> {
+    let n = CUTOUT_SIZE;
+    (0..n * n)
+        .flat_map(|i| {
+            let uv = [((i % n) as f32 + 0.5) / n as f32, ((i / n) as f32 + 0.5) / n as f32];
+            let alpha = if in_cutout_hole(uv) { 0 } else { 255 };
+            [rgb[0], rgb[1], rgb[2], alpha]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::alpha_mask::{kept, texture_alpha};
+    use crate::scene::AlphaMode;
+    use glam::Vec2;
+
+    /// The cut-out texture's holes lie where CUTOUT_DISCS and CUTOUT_SLOT say, it keeps its alpha through the
+    /// PNG and the loader, and the alpha modes, cutoffs, base alphas and sides the writer gives
+    /// materials are the ones the loader reads (BLEND with a warning naming the material).
+    #[test]
+    fn cutout_materials_round_trip_through_the_loader() {
+        let texels = cutout([200, 100, 50]);
+        assert_eq!(texels.len(), (CUTOUT_SIZE * CUTOUT_SIZE * 4) as usize);
+        let holes = texels.chunks_exact(4).filter(|t| t[3] == 0).count();
+        // π·(0.17² + 0.1²) + 0.3·0.18 of the texture's 4,096 texels: about 720.
+        assert!((690..750).contains(&holes), "{holes} hole texels");
+        // No symmetry: mirrored in u or v, turned half a turn or transposed, the holes move.
+        let alpha = |x: u32, y: u32| texels[((y * CUTOUT_SIZE + x) * 4 + 3) as usize];
+        let n = CUTOUT_SIZE - 1;
+        let moved = |f: &dyn Fn(u32, u32) -> (u32, u32)| {
+            (0..=n)
+                .flat_map(|y| (0..=n).map(move |x| (x, y)))
+                .filter(|&(x, y)| {
+                    alpha(x, y) != {
+                        let (a, b) = f(x, y);
+                        alpha(a, b)
+                    }
+                })
+                .count()
+        };
+        for (what, f) in [
+            ("u mirrored", &(|x, y| (n - x, y)) as &dyn Fn(u32, u32) -> (u32, u32)),
+            ("v mirrored", &|x, y| (x, n - y)),
+            ("turned", &|x, y| (n - x, n - y)),
+            ("transposed", &|x, y| (y, x)),
+        ] {
+            assert!(moved(f) > 200, "{what}: only {} texels change", moved(f));
+        }
+        assert!(texels.chunks_exact(4).all(|t| t[..3] == [200, 100, 50] && (t[3] == 0 || t[3] == 255)));
+        let mut w = GltfWriter::new();
+        let texture = w.texture(png(CUTOUT_SIZE, CUTOUT_SIZE, &texels), "image/png");
+        let cases = [
+            ("MASK", None, 1.0, true, AlphaMode::Mask { cutoff: 0.5 }),
+            ("MASK", Some(0.3), 0.8, false, AlphaMode::Mask { cutoff: 0.3 }),
+            ("BLEND", None, 0.6, true, AlphaMode::Blend),
+            ("OPAQUE", None, 0.2, false, AlphaMode::Opaque),
+        ];
+        for (i, &(mode, cutoff, alpha, double_sided, _)) in cases.iter().enumerate() {
+            let m = w.alpha_material(Some(texture), [1.0, 1.0, 1.0, alpha], mode, cutoff, double_sided);
+            w.material_name(m, &format!("case-{i}"));
+            let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+            w.node(json!({ "mesh": mesh, "translation": [3.0 * i as f32, 0.0, 0.0] }), true);
+        }
+        let (scene, warnings) = crate::gltf_scene::from_bytes(&w.to_glb(), None).expect("a good file");
+        assert!(warnings.len() == 1 && warnings[0].contains("'case-2'") && warnings[0].contains("BLEND"), "{warnings:?}");
+        assert_eq!(scene.objects.len(), cases.len());
+        for (o, &(_, _, alpha, double_sided, mode)) in scene.objects.iter().zip(&cases) {
+            assert_eq!((o.extras.alpha_mode, o.extras.base_alpha, o.extras.double_sided), (mode, alpha, double_sided));
+        }
+        let t = &scene.textures[scene.objects[0].textures.base_color.expect("a base colour texture") as usize];
+        assert_eq!(t.rgba.chunks_exact(4).map(|p| p[3]).collect::<Vec<_>>(), texels.chunks_exact(4).map(|p| p[3]).collect::<Vec<_>>());
+        for h in CUTOUT_HOLE_POINTS {
+            assert!(in_cutout_hole(h) && texture_alpha(t, Vec2::from(h)) == 0.0);
+            for o in &scene.objects[..3] {
+                assert!(!kept(o, &scene.textures, Vec2::from(h)), "{:?} keeps a hole", o.extras.alpha_mode);
+            }
+            assert!(kept(&scene.objects[3], &scene.textures, Vec2::from(h)), "opaque ignores alpha");
+        }
+        for s in CUTOUT_SOLID {
+            assert!(!in_cutout_hole(s) && texture_alpha(t, Vec2::from(s)) == 1.0);
+            assert!(scene.objects.iter().all(|o| kept(o, &scene.textures, Vec2::from(s))), "the plate at {s:?}");
+        }
+    }
 }

@@ -139,6 +139,7 @@ pub const DEBUG_VIEW_SHADOW_CUBE: u32 = 7;
 pub const DEBUG_VIEW_MESHLETS: u32 = 8;
 pub const DEBUG_VIEW_TRIANGLES: u32 = 9;
 pub const DEBUG_VIEW_SHADOW_ATLAS: u32 = 10;
+pub const DEBUG_VIEW_ALPHA: u32 = 11;
 
 gpu_struct!(
     /// One object of the object buffer (std430).
@@ -152,8 +153,31 @@ gpu_struct!(
         material: [f32; 4],
         /// rgb: emissive factor.
         emissive: [f32; 4],
+        /// x: the alpha below which a point is dropped (`OBJECT_MASKED`); y: the base colour
+        /// factor's alpha.
+        alpha: [f32; 4],
+        /// x: `OBJECT_*` bits; y: where its alpha texture's texel (0, 0) is in the alpha-mask
+        /// buffer (bytes); z, w: its width and height (`alpha_mask::AlphaMasks`).
+        alpha_texture: [u32; 4],
+        /// The texture transform, uv' = M·uv + t: M's columns in xy and zw of the first, t in
+        /// xy of the second.
+        uv_transform: [[f32; 4]; 2],
     }
 );
+
+/// `ObjectData::alpha_texture.x` bits (common.glsl OBJECT_*).
+pub const OBJECT_MASKED: u32 = 1;
+pub const OBJECT_DOUBLE_SIDED: u32 = 2;
+/// Blended in the file (drawn as a mask: the alpha debug view tells it apart).
+pub const OBJECT_BLENDED: u32 = 4;
+/// Its alpha comes from a texture too (else from the factor alone).
+pub const OBJECT_ALPHA_TEXTURE: u32 = 8;
+/// The alpha texture's wrap modes (`Wrap` as 0 repeat, 1 mirrored repeat, 2 clamp): u at this
+/// bit, v two bits above; and nearest filtering at `OBJECT_ALPHA_NEAREST`.
+pub const OBJECT_ALPHA_WRAP_SHIFT: u32 = 8;
+pub const OBJECT_ALPHA_NEAREST: u32 = 1 << 12;
+/// log2 of the side of the alpha texture's blocks (`alpha_mask::block_side`), 4 bits from here.
+pub const OBJECT_ALPHA_BLOCK_SHIFT: u32 = 13;
 
 gpu_struct!(
     /// Per-draw push constants (the material again: see common.glsl).
@@ -255,6 +279,10 @@ gpu_struct!(
 /// `Instance::meshlets.w` bits.
 pub const INSTANCE_CONE_CULLING: u32 = 1;
 pub const INSTANCE_MIRRORED: u32 = 2;
+/// Drawn from both sides: neither cone nor triangle back-face culling.
+pub const INSTANCE_DOUBLE_SIDED: u32 = 4;
+/// Some of its points are cut out (alpha-tested where drawn; occludes only where kept).
+pub const INSTANCE_MASKED: u32 = 8;
 
 gpu_struct!(
     /// An object as the meshlet culling sees it (same index as the object buffer; std430).
@@ -316,12 +344,17 @@ gpu_struct!(
     /// A large triangle of the compute raster, clipped and set up once (GPU only; mirrored
     /// for its size, which the list is allocated by).
     LargeTriangle {
-        /// x: corners of the clipped polygon (3 to 8); y: visibility id.
+        /// x: corners of the clipped polygon (3 to 8); y: visibility id; z: its object where
+        /// masked (else u32::MAX); w: its instance's `INSTANCE_*` bits.
         head: [u32; 4],
         /// Corner 2k in xy, 2k + 1 in zw: in the image, snapped to the sub-pixel grid.
         corners: [[i32; 4]; 4],
         /// Each corner's depth z/w.
         depths: [[f32; 4]; 2],
+        /// Masked: the unclipped triangle's clip-space corners (the alpha test's barycentrics).
+        surface_clip: [[f32; 4]; 3],
+        /// Masked: its corners' texture coordinates (a in xy, b in zw of the first; c in xy).
+        surface_uv: [[f32; 4]; 2],
     }
 );
 

@@ -2,6 +2,7 @@
 //! lights, camera), the structs shared with the shaders, and the CPU reference of each
 //! shading model that the image tests compare the GPU against.
 
+pub mod alpha_mask;
 pub mod bench_scene;
 pub mod blinn_phong;
 pub mod camera;

@@ -1,7 +1,8 @@
-//! Light layouts (a grid above the scene like the seed's, seeded random places in the scene's
-//! box, or points just above its surfaces), the frame they are placed in (the built-in scenes'
-//! fixed one, or one fitted to a scene's box), the default radius that fits a count to a
-//! frame, and the seed's light animation.
+//! Light layouts (a grid above the scene like the seed's — in a fitted frame a lattice of such
+//! grids stacked down through the scene's box once the count calls for it —, seeded random
+//! places in the scene's box, or points just above its surfaces), the frame they are placed in
+//! (the built-in scenes' fixed one, or one fitted to a scene's box), the default radius that
+//! fits a count to a frame, and the seed's light animation.
 
 use crate::gpu_types::PointLight;
 use crate::surface_sampler::SurfaceSampler;
@@ -36,7 +37,9 @@ pub const DEFAULT_RIG_LIGHTS: u32 = 64;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightLayout {
-    /// ceil(√N)² grid over the frame's square (the seed's: x,z ∈ [−15, 15] at y = 7.5).
+    /// ceil(√N)² grid over the frame's square (the seed's: x,z ∈ [−15, 15] at y = 7.5); in a
+    /// fitted frame, layers of such grids from that height down to the frame's floor, as many
+    /// as keep the lattice's steps about equal (`GridShape`).
     Grid,
     /// Uniform in the frame's box, from a seed.
     Random,
@@ -94,15 +97,29 @@ impl RadiusRange {
 }
 
 /// Where the layouts put lights: the grid's square (centre at its height, half-size in x and z)
-/// and the random layout's box. The built-in scenes have a fixed one (their images never
-/// change); a scene file or glTF file gets one fitted to its box, so that lights scale with
-/// the model.
+/// with the floor its layers may reach down to, and the random layout's box. The built-in
+/// scenes have a fixed one (their images never change); a scene file or glTF file gets one
+/// fitted to its box, so that lights scale with the model.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightFrame {
     pub grid_centre: Vec3,
     pub grid_half_size: f32,
+    /// The height of the lowest layer a grid may have: the built-in frame's is the grid's own
+    /// (one plane at every count), a fitted frame's the bottom of its box.
+    pub grid_floor: f32,
     pub box_min: Vec3,
     pub box_max: Vec3,
+}
+
+/// How a grid of some count is laid out: `layers` layers (the first at the grid's height, the
+/// last at its floor) of `side`² places each, filled in order (the last layer may be part
+/// full), `step` apart in x and z and `rise` apart in height.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridShape {
+    pub side: usize,
+    pub layers: usize,
+    pub step: f32,
+    pub rise: f32,
 }
 
 /// How far a fitted grid rises above the scene's top, as a fraction of its largest side (the
@@ -117,6 +134,11 @@ const GRID_OVERHANG: f32 = 1.1;
 /// radius, where the falloff is near zero; with this a light straight above the middle gives
 /// it at least (1 − 1/1.25)² = 0.04.
 const GRID_REACH: f32 = 1.25;
+/// The least radius of a layered grid's lights over half the diagonal of a lattice cell (the
+/// furthest a point among the lights is from the nearest): every such point then has a light
+/// within 3/4 of its radius, which gives it at least (1 − 3/4)² = 1/16. In a cubic lattice this
+/// decides, and brings about 6.5 lights to a point.
+const LATTICE_REACH: f32 = 4.0 / 3.0;
 /// How far a fitted random box reaches past the scene's box on every side, as a fraction of
 /// its largest side: inside the scene's own box a closed model (a cube) would hold every
 /// light inside itself, lighting only its inner faces.
@@ -131,14 +153,15 @@ impl LightFrame {
     pub const BUILT_IN: LightFrame = LightFrame {
         grid_centre: Vec3::new(0.0, GRID_HEIGHT, 0.0),
         grid_half_size: GRID_HALF_SIZE,
+        grid_floor: GRID_HEIGHT,
         box_min: RANDOM_BOX_MIN,
         box_max: RANDOM_BOX_MAX,
     };
 
     /// The frame fitted to a scene's box [lo, hi]: the grid a little wider than the scene's
-    /// footprint, GRID_RISE of the largest side above its top; the box is the scene's own,
-    /// each side at least MIN_BOX_SIDE of the largest, grown by BOX_MARGIN of the largest on
-    /// every side. Scaling the scene scales the frame.
+    /// footprint, GRID_RISE of the largest side above its top, its floor the bottom of the
+    /// box; the box is the scene's own, each side at least MIN_BOX_SIDE of the largest, grown
+    /// by BOX_MARGIN of the largest on every side. Scaling the scene scales the frame.
     pub fn around(lo: Vec3, hi: Vec3) -> LightFrame {
         let centre = (lo + hi) * 0.5;
         let largest = (hi - lo).max_element().max(f32::MIN_POSITIVE);
@@ -147,6 +170,7 @@ impl LightFrame {
         LightFrame {
             grid_centre: Vec3::new(centre.x, hi.y + GRID_RISE * largest, centre.z),
             grid_half_size: (footprint * GRID_OVERHANG).max(largest * MIN_BOX_SIDE * 0.5),
+            grid_floor: (centre - half).y,
             box_min: centre - half,
             box_max: centre + half,
         }
@@ -160,12 +184,40 @@ impl LightFrame {
         SEED_MOTION * side(self) / side(&LightFrame::BUILT_IN)
     }
 
+    /// How `count` grid lights are laid out. One plane of ⌈√N⌉² (the seed's grid) while the
+    /// lattice's steps would be over twice the height from the grid to its floor; more lights
+    /// stack layers down to the floor, about as far apart as the places in a layer: L layers
+    /// where a cubic lattice of N lights through the grid's volume V = A·H would have steps
+    /// s = ∛(V/N), L ≈ 1 + H/s, each layer ⌈√⌈N/L⌉⌉² places (so L grows as ∛N, and every
+    /// point of the scene keeps near lights at any count). The built-in frame has no height
+    /// to fill (its floor is the grid's height): one plane always.
+    pub fn grid_shape(&self, count: u32) -> GridShape {
+        let n = count.max(1) as usize;
+        let width = 2.0 * self.grid_half_size;
+        let height = (self.grid_centre.y - self.grid_floor).max(0.0);
+        let wanted = if height > 0.0 {
+            let s = (width * width * height / n as f32).cbrt();
+            (1.0 + (height / s).round()).clamp(1.0, n as f32) as usize
+        } else {
+            1
+        };
+        let side = ((n.div_ceil(wanted)) as f64).sqrt().ceil() as usize;
+        let layers = n.div_ceil(side * side);
+        let step = if side > 1 { width / (side - 1) as f32 } else { 0.0 };
+        let rise = if layers > 1 { height / (layers - 1) as f32 } else { 0.0 };
+        GridShape { side, layers, step, rise }
+    }
+
     /// The radius at which `count` lights of `layout` reach about LIGHTS_PER_POINT lights at a
     /// point of the scene (as the bench scene's do at every count):
     /// - random, uniform in the box of volume V: count · (4/3)πr³ / V = k;
-    /// - grid, n lights over the square of area A at height h above the box's centre: a point
-    ///   there is reached by the lights within √(r² − h²) in the plane, n·π(r² − h²) / A = k
-    ///   (and r at least GRID_REACH·h);
+    /// - grid of one plane, n lights over the square of area A at height h above the box's
+    ///   centre: a point there is reached by the lights within √(r² − h²) in the plane,
+    ///   n·π(r² − h²) / A = k (and r at least GRID_REACH·h);
+    /// - grid of layers (`grid_shape`), each light alone in a cell of volume step²·rise:
+    ///   (4/3)πr³ / cell = k, and r at least LATTICE_REACH times half the cell's diagonal, so
+    ///   that every point among the lights has one within 3/4 of its radius (a cubic lattice
+    ///   then brings about 6.5 lights to a point, whatever the count);
     /// - surface, n lights just above surfaces of area S: a point is reached by those within r
     ///   along the surface, n·πr² / S = k.
     ///
@@ -175,9 +227,18 @@ impl LightFrame {
         match layout {
             LightLayout::Random => (k * (self.box_max - self.box_min).element_product() / (n * 4.0 / 3.0 * pi)).cbrt(),
             LightLayout::Grid => {
-                let area = (2.0 * self.grid_half_size).powi(2);
-                let h = self.grid_centre.y - (self.box_min.y + self.box_max.y) * 0.5;
-                (h * h + k * area / (n * pi)).sqrt().max(GRID_REACH * h)
+                let shape = self.grid_shape(count);
+                if shape.layers == 1 {
+                    let area = (2.0 * self.grid_half_size).powi(2);
+                    let h = self.grid_centre.y - (self.box_min.y + self.box_max.y) * 0.5;
+                    (h * h + k * area / (n * pi)).sqrt().max(GRID_REACH * h)
+                } else {
+                    // One light a layer (a tiny count over a tall frame): the layer's square is its cell.
+                    let step = if shape.side > 1 { shape.step } else { 2.0 * self.grid_half_size };
+                    let cell = step * step * shape.rise;
+                    let half_diagonal = 0.5 * (2.0 * step * step + shape.rise * shape.rise).sqrt();
+                    (3.0 * k * cell / (4.0 * pi)).cbrt().max(LATTICE_REACH * half_diagonal)
+                }
             }
             LightLayout::Surface => (k * surface_area / (n * pi)).sqrt(),
         }
@@ -234,16 +295,19 @@ impl LightParams {
         };
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(self.seed);
         let mut lights = Vec::with_capacity(n);
-        let side = (n as f64).sqrt().ceil() as usize;
+        let grid = frame.grid_shape(self.count);
         let (lo, hi, half) = (frame.box_min, frame.box_max, frame.grid_half_size);
         for i in 0..n {
             // Where the light goes, and the direction it is lifted along by a part of its radius
             // (a surface's normal; zero for the other layouts).
             let (at, lift) = match (self.layout, surfaces) {
                 (LightLayout::Grid, _) => {
-                    let step = if side > 1 { 2.0 * half / (side - 1) as f32 } else { 0.0 };
+                    let GridShape { side, step, rise, .. } = grid;
                     let origin = if side > 1 { -half } else { 0.0 };
-                    (frame.grid_centre + Vec3::new(origin + (i % side) as f32 * step, 0.0, origin + (i / side) as f32 * step), Vec3::ZERO)
+                    let (layer, place) = (i / (side * side), i % (side * side));
+                    let offset =
+                        Vec3::new(origin + (place % side) as f32 * step, -(layer as f32) * rise, origin + (place / side) as f32 * step);
+                    (frame.grid_centre + offset, Vec3::ZERO)
                 }
                 (LightLayout::Surface, Some(surfaces)) => surfaces.sample(&mut rng),
                 _ => (Vec3::new(rng.random_range(lo.x..=hi.x), rng.random_range(lo.y..=hi.y), rng.random_range(lo.z..=hi.z)), Vec3::ZERO),
@@ -388,22 +452,69 @@ mod tests {
             let mean = reached as f32 / samples as f32;
             assert!((mean - LIGHTS_PER_POINT).abs() < 1.0, "{layout:?}: {mean} lights reach a point (radius {radius})");
         }
-        // Many lights high over the scene: r = GRID_REACH·h, and every point of the middle plane
-        // under the grid is reached by several lights, the one straight above with falloff 0.04.
+        // A few lights high over the scene: one plane, k of them reach the middle before
+        // GRID_REACH takes over.
         let h = frame.grid_centre.y - 2.0;
-        let radius = frame.default_radius(LightLayout::Grid, 4096, 0.0);
-        assert_eq!(radius, GRID_REACH * h);
-        let lights = LightParams { count: 4096, layout: LightLayout::Grid, seed: 2, radius: RadiusRange::fixed(radius) }
-            .build_in(&frame, None)
-            .unwrap();
-        for _ in 0..100 {
-            let p = Vec3::new(rng.random_range(-10.0..10.0), 2.0, rng.random_range(-10.0..10.0));
-            let reached = lights.iter().filter(|l| Vec3::from_slice(&l.position_radius[..3]).distance(p) < radius).count();
-            assert!(reached >= 4, "{p}: {reached} lights");
-        }
-        // Few lights far apart: k of them reach the middle before GRID_REACH takes over.
+        assert_eq!(frame.grid_shape(4).layers, 1);
         let few = frame.default_radius(LightLayout::Grid, 4, 0.0);
         assert!(few > GRID_REACH * h && ((few * few - h * h) * std::f32::consts::PI * 4.0 / (22.0 * 22.0) - LIGHTS_PER_POINT).abs() < 1e-3);
+    }
+
+    /// Lights of `layout` (default radius) within reach of each of `points`, on average.
+    fn lights_reaching(lights: &[PointLight], points: &[Vec3]) -> f32 {
+        let mut reached = 0usize;
+        for p in points {
+            for l in lights {
+                let [x, y, z, r] = l.position_radius;
+                let (dx, dy, dz) = (x - p.x, y - p.y, z - p.z);
+                reached += (dx * dx + dy * dy + dz * dz < r * r) as usize;
+            }
+        }
+        reached as f32 / points.len() as f32
+    }
+
+    /// Every layout under its default radius brings about the same number of lights to a
+    /// point of the scene at every count, from the default rig's 64 to a million: random and
+    /// surface about LIGHTS_PER_POINT, the grid (one plane for few lights, layers through the
+    /// box for more) a few more. The cost of the clustered techniques follows these numbers.
+    #[test]
+    fn lights_reaching_a_point_stay_about_constant_at_every_count() {
+        use crate::camera::Camera;
+        use crate::material::Material;
+        use crate::mesh::MeshKind;
+        use crate::scene::{Object, Scene};
+        // A cube of 2 m (its top and sides are surfaces) on a floor of 8 × 8 m.
+        let objects = vec![
+            Object::placed(MeshKind::Plane, Vec3::ZERO, 4.0, Material::named("white").unwrap()),
+            Object::placed(MeshKind::Cube, Vec3::new(0.0, 1.0, 0.0), 1.0, Material::named("white").unwrap()),
+        ];
+        let scene = Scene::new(objects, Vec::new(), Camera::seed());
+        let (lo, hi) = scene.bounds();
+        let frame = LightFrame::around(lo, hi);
+        let surfaces = SurfaceSampler::new(&scene).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        // Points of the model: in the inner part of its box (random, grid), on its surfaces (surface).
+        let inner: Vec<Vec3> = (0..48)
+            .map(|_| {
+                let t = Vec3::new(rng.random_range(0.2..0.8), rng.random_range(0.2..0.8), rng.random_range(0.2..0.8));
+                lo + (hi - lo) * t
+            })
+            .collect();
+        let on_surface: Vec<Vec3> = (0..48).map(|_| surfaces.sample(&mut rng).0).filter(|p| p.x.abs() < 3.0 && p.z.abs() < 3.0).collect();
+        for layout in LightLayout::ALL {
+            let points = if layout == LightLayout::Surface { &on_surface } else { &inner };
+            let mut seen = Vec::new();
+            for count in [64u32, 256, 4096, 65536, 1 << 20] {
+                let radius = frame.default_radius(layout, count, surfaces.area());
+                let params = LightParams { count, layout, seed: 3, radius: RadiusRange::fixed(radius) };
+                let lights = params.build_in(&frame, Some(&surfaces)).unwrap();
+                let mean = lights_reaching(&lights, points);
+                println!("{layout:?} × {count}: {mean:.2} lights reach a point (radius {radius:.4})");
+                seen.push(mean);
+            }
+            let (least, most) = seen.iter().fold((f32::MAX, 0.0f32), |(a, b), &m| (a.min(m), b.max(m)));
+            assert!(least >= 2.0 && most <= 12.0 && most <= least * 2.0, "{layout:?}: {seen:?} lights reach a point");
+        }
     }
 
     #[test]

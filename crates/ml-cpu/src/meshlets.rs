@@ -11,7 +11,7 @@
 //! (docs/DESIGN.md#visibility-buffer).
 
 use crate::geometry::{Mesh, Vertex};
-use crate::gpu_types::{Instance, Meshlet, INSTANCE_CONE_CULLING, INSTANCE_MIRRORED};
+use crate::gpu_types::{Instance, Meshlet, INSTANCE_CONE_CULLING, INSTANCE_DOUBLE_SIDED, INSTANCE_MASKED, INSTANCE_MIRRORED};
 use crate::scene::Scene;
 use glam::{Mat3, Mat4, Vec3};
 use thiserror::Error;
@@ -142,7 +142,7 @@ impl SceneMeshlets {
             s.instances.push(Instance {
                 bounds: world.extend(radius * placement.max_scale).to_array(),
                 scale: [placement.max_scale, 0.0, 0.0, 0.0],
-                meshlets: [first, n, s.meshlet_instances.len() as u32, placement.flags],
+                meshlets: [first, n, s.meshlet_instances.len() as u32, surface_flags(o, placement.flags)],
                 surface: [o.textures.bits(), 0, 0, 0],
             });
             s.meshlet_instances.extend((first..first + n).map(|m| [object as u32, m]));
@@ -155,6 +155,19 @@ impl SceneMeshlets {
     pub fn triangle(&self, meshlet: u32, t: u32) -> [u32; 3] {
         corners(&self.meshlet_vertices, &self.meshlet_triangles, &self.meshlets[meshlet as usize], t)
     }
+}
+
+/// The `INSTANCE_*` bits of object `o` placed with `placement` bits: a double-sided object's
+/// back faces are drawn, so no cone culls its meshlets.
+fn surface_flags(o: &crate::scene::Object, placement: u32) -> u32 {
+    let mut flags = placement;
+    if o.extras.double_sided {
+        flags = (flags & !INSTANCE_CONE_CULLING) | INSTANCE_DOUBLE_SIDED;
+    }
+    if o.extras.alpha_mode.cutoff().is_some() {
+        flags |= INSTANCE_MASKED;
+    }
+    flags
 }
 
 /// What an object's transform does to bounds and cones.
@@ -306,5 +319,18 @@ mod tests {
         let stretched = Mat4::from_scale(Vec3::new(1.0, 3.0, 1.0));
         assert_eq!(Placement::of(stretched).flags, 0);
         assert_eq!(Placement::of(stretched).max_scale, 3.0);
+    }
+
+    #[test]
+    fn double_sided_objects_are_never_cone_culled_and_masks_are_flagged() {
+        use crate::scene::{AlphaMode, MaterialExtras, Object};
+        let mut o = Object::placed(crate::mesh::MeshKind::Plane, Vec3::ZERO, 1.0, crate::material::Material::named("white").unwrap());
+        assert_eq!(surface_flags(&o, INSTANCE_CONE_CULLING), INSTANCE_CONE_CULLING);
+        o.extras = MaterialExtras { double_sided: true, ..MaterialExtras::default() };
+        assert_eq!(surface_flags(&o, INSTANCE_CONE_CULLING | INSTANCE_MIRRORED), INSTANCE_DOUBLE_SIDED | INSTANCE_MIRRORED);
+        o.extras = MaterialExtras { alpha_mode: AlphaMode::Mask { cutoff: 0.3 }, ..MaterialExtras::default() };
+        assert_eq!(surface_flags(&o, INSTANCE_CONE_CULLING), INSTANCE_CONE_CULLING | INSTANCE_MASKED);
+        o.extras = MaterialExtras { alpha_mode: AlphaMode::Blend, ..MaterialExtras::default() };
+        assert_eq!(surface_flags(&o, 0), INSTANCE_MASKED);
     }
 }

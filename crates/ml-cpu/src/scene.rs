@@ -70,11 +70,54 @@ pub struct MaterialExtras {
     pub normal_scale: f32,
     /// How much of the occlusion texture applies: 1 + strength · (texel − 1).
     pub occlusion_strength: f32,
+    /// What the surface's alpha (`base_alpha` × the base colour texture's alpha) does.
+    pub alpha_mode: AlphaMode,
+    /// The base colour factor's alpha.
+    pub base_alpha: f32,
+    /// Drawn from both sides, the normal turned toward the viewer (else back faces are culled).
+    pub double_sided: bool,
+    /// Maps the mesh's texture coordinates to the textures' (glTF's KHR_texture_transform):
+    /// one for all of the object's textures and its alpha mask.
+    pub uv_transform: glam::Affine2,
 }
 
 impl Default for MaterialExtras {
     fn default() -> MaterialExtras {
-        MaterialExtras { emissive: Vec3::ZERO, normal_scale: 1.0, occlusion_strength: 1.0 }
+        MaterialExtras {
+            emissive: Vec3::ZERO,
+            normal_scale: 1.0,
+            occlusion_strength: 1.0,
+            alpha_mode: AlphaMode::Opaque,
+            base_alpha: 1.0,
+            double_sided: false,
+            uv_transform: glam::Affine2::IDENTITY,
+        }
+    }
+}
+
+/// glTF's alpha modes: what a surface's alpha does to its pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: every pixel of the surface is drawn.
+    Opaque,
+    /// Cut-outs (foliage, fences, grates): a point whose alpha is below `cutoff` is not there
+    /// at all — not drawn, not in any depth, casts no shadow.
+    Mask { cutoff: f32 },
+    /// Transparency; drawn as a mask at `BLEND_AS_MASK_CUTOFF` (the renderer blends nothing).
+    Blend,
+}
+
+/// The cutoff a blended material is drawn with.
+pub const BLEND_AS_MASK_CUTOFF: f32 = 0.5;
+
+impl AlphaMode {
+    /// The alpha below which a point is dropped, if any is.
+    pub fn cutoff(self) -> Option<f32> {
+        match self {
+            AlphaMode::Opaque => None,
+            AlphaMode::Mask { cutoff } => Some(cutoff),
+            AlphaMode::Blend => Some(BLEND_AS_MASK_CUTOFF),
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 //! ranges, counts and file size limited before anything is allocated — and every problem is
 //! one error naming the file and, where the parser knows it, the line.
 
-use crate::camera::{clip_planes_for, framing_distance, Camera, DEFAULT_FOV_Y_DEG};
+use crate::camera::{clip_planes_for, frame_scene, framing_distance, Camera, DEFAULT_ASPECT, DEFAULT_FOV_Y_DEG};
 use crate::gltf_scene::GltfError;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
@@ -425,8 +425,10 @@ fn light(l: &FileLight) -> Result<Light, Problem> {
     }
 }
 
-/// The file's camera; fields it leaves out come from a camera framing every object (looking
-/// at the centre of their bounds from above and in front, the whole box in view).
+/// The file's camera; fields it leaves out come from a camera framing every object: without
+/// position and target, the one that frames the objects for a default-sized image
+/// (`camera::frame_scene`; a render of another aspect frames them again for its own), else
+/// looking at the centre of their bounds from above and in front, the whole box in view.
 fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
     let (lo, hi) = scene.bounds();
     let centre = (lo + hi) * 0.5;
@@ -436,6 +438,16 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
         Some(f) => return Err(Problem::FieldOfView(f)),
         None => DEFAULT_FOV_Y_DEG,
     };
+    if c.is_none_or(|c| c.position.is_none() && c.target.is_none()) {
+        let framed = frame_scene(scene, DEFAULT_ASPECT, fov);
+        let near = c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or(framed.near);
+        let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(framed.far);
+        if near >= far {
+            return Err(Problem::NearFar { near, far });
+        }
+        let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| positive("[camera] ortho_half_height", h)).transpose()?;
+        return Ok(Camera { near, far, orthographic, ..framed });
+    }
     let position = match c.and_then(|c| c.position) {
         Some(p) => vec3("[camera] position", p)?,
         None => centre + Vec3::new(0.0, 0.5, 1.0).normalize() * framing_distance(radius, fov),

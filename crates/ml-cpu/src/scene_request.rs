@@ -3,7 +3,7 @@
 //! as warnings, for the caller to show.
 
 use crate::bench_scene::bench_scene;
-use crate::camera::CameraSpec;
+use crate::camera::{frame_scene, CameraSpec, DEFAULT_ASPECT};
 use crate::gltf_scene::{self, GltfFileError};
 use crate::lights::{LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
@@ -57,6 +57,9 @@ pub struct SceneRequest {
     pub camera: Option<CameraSpec>,
     /// Draw every point light as a small glowing cube (`Scene::with_light_markers`).
     pub show_lights: bool,
+    /// Width over height of the image the scene is seen in: a file without a camera is framed
+    /// for it (`camera::frame_scene`).
+    pub aspect: f32,
 }
 
 /// A built scene and the shading model to render it with.
@@ -107,6 +110,7 @@ impl SceneRequest {
             shading: None,
             camera: None,
             show_lights: false,
+            aspect: DEFAULT_ASPECT,
         }
     }
 
@@ -164,6 +168,12 @@ impl SceneRequest {
         let mut warnings: Vec<SceneWarning> =
             file.warnings.into_iter().map(|message| SceneWarning::Left { path: path.clone(), message }).collect();
         let mut scene = file.scene;
+        // A file without a camera came with one framing it for a default-sized image: frame it
+        // for this one. (The loaders' framing is `frame_scene` at DEFAULT_ASPECT; a camera of the
+        // file's own is never exactly that.)
+        if self.aspect != DEFAULT_ASPECT && scene.camera == frame_scene(&scene, DEFAULT_ASPECT, scene.camera.fov_y_deg) {
+            scene.camera = frame_scene(&scene, self.aspect, scene.camera.fov_y_deg);
+        }
         let unlit = scene.lights.is_empty() && scene.directional.is_empty();
         if self.lights.is_some() || unlit {
             let count = self.lights.unwrap_or(DEFAULT_RIG_LIGHTS as u64);
@@ -241,7 +251,15 @@ mod tests {
         let rig = SceneWarning::DefaultRig { path: dir.join("dark.toml"), lights: 64, layout: LightLayout::Grid, radius };
         assert_eq!(built.warnings, [rig]);
         assert_eq!(built.scene.lights.len(), 64);
-        assert!(built.scene.lights.iter().all(|l| l.position_radius[1] == 1.5 && l.position_radius[3] == radius));
+        // The grid's first layer hangs over the sphere, the others reach down through its box.
+        assert_eq!(built.scene.lights[0].position_radius[1], 1.5);
+        assert!(built.scene.lights.iter().all(|l| l.position_radius[1] <= 1.5 && l.position_radius[3] == radius));
+        // Framed for a default-sized image; asked for another aspect, framed for that one.
+        let framed = crate::camera::frame_scene(&built.scene, DEFAULT_ASPECT, 60.0);
+        assert_eq!(built.scene.camera, framed);
+        let tall = SceneRequest { aspect: 0.5, ..dark.clone() }.build().unwrap();
+        assert_eq!(tall.scene.camera, crate::camera::frame_scene(&built.scene, 0.5, 60.0));
+        assert!(tall.scene.camera.position.distance(glam::Vec3::ZERO) > framed.position.distance(glam::Vec3::ZERO));
         let lit = SceneRequest { lights: Some(4), shading: Some(ShadingModel::Seed), ..dark }.build().unwrap();
         assert_eq!((lit.scene.lights.len(), lit.shading), (4, ShadingModel::Seed));
         assert!(lit.warnings.is_empty());

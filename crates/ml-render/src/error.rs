@@ -18,19 +18,36 @@ pub enum RenderError {
     Invalid(String),
 }
 
-/// Cluster light lists longer than what `holder` can take: `needed` entries against `limit`.
+/// Cluster light lists longer than what `holder` can take: `needed` entries against `limit`,
+/// in `technique` (named where the renderer knows it).
 #[derive(Debug, Error, PartialEq)]
-#[error("the cluster light lists need at least {needed} entries ({} MiB), more than the {} MiB {holder}", mib(*needed), mib(*limit))]
+#[error("{}the cluster light lists need at least {needed} entries ({} MiB), more than the {} MiB {holder}", technique.map_or(String::new(), |t| format!("{}: ", t.name())), mib_up(*needed), mib(*limit))]
 pub struct ListsTooLong {
     pub needed: usize,
     pub limit: usize,
     /// What the limit is, in words ("'lavapipe' binds as one storage buffer").
     pub holder: String,
+    pub technique: Option<Technique>,
+}
+
+impl RenderError {
+    /// The error, where it is about light lists that do not fit, naming `technique`.
+    pub fn in_technique(self, technique: Technique) -> RenderError {
+        match self {
+            RenderError::ListsTooLong(lists) => RenderError::ListsTooLong(ListsTooLong { technique: Some(technique), ..lists }),
+            other => other,
+        }
+    }
 }
 
 /// MiB of `entries` light indices (4 bytes each), rounded down.
 fn mib(entries: usize) -> u64 {
     (entries as u64 * 4) >> 20
+}
+
+/// MiB of `entries` light indices, rounded up (what is needed is never said smaller than it is).
+fn mib_up(entries: usize) -> u64 {
+    (entries as u64 * 4).div_ceil(1 << 20)
 }
 
 /// What a name given to `from_name` was meant to be.

@@ -83,9 +83,9 @@ impl FrameInFlight {
         Ok(())
     }
 
-    /// What slot `slot`'s passes bind: this frame's buffers and targets, the scene's `objects`
-    /// and `cones`.
-    pub fn resources(&self, slot: usize, (objects, cones): (vk::Buffer, vk::Buffer)) -> FrameResources<'_> {
+    /// What slot `slot`'s passes bind: this frame's buffers and targets, the scene's `objects`,
+    /// `cones` and `alpha_masks`.
+    pub fn resources(&self, slot: usize, (objects, cones, alpha_masks): (vk::Buffer, vk::Buffer, vk::Buffer)) -> FrameResources<'_> {
         FrameResources {
             slot,
             uniforms: self.uniforms.raw,
@@ -94,6 +94,7 @@ impl FrameInFlight {
             light_indices: self.light_indices.raw,
             objects,
             cones,
+            alpha_masks,
             targets: self.targets.as_ref().expect("made with the frame"),
         }
     }
@@ -144,7 +145,7 @@ pub fn max_index_entries(ctx: &Context) -> usize {
 
 /// The error for light lists longer than `limit` entries, which is what `holder` can take.
 pub fn lists_too_long(needed: usize, limit: usize, holder: &str) -> RenderError {
-    RenderError::ListsTooLong(ListsTooLong { needed, limit, holder: holder.into() })
+    RenderError::ListsTooLong(ListsTooLong { needed, limit, holder: holder.into(), technique: None })
 }
 
 impl ml_vk::Release for FrameInFlight {

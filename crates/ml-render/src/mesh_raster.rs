@@ -10,8 +10,10 @@ use crate::pass::{FrameResources, Recording};
 use crate::render_pass;
 use crate::settings::Shading;
 use crate::targets::{GBufferImage, Output};
+use ml_cpu::alpha_mask::AlphaMasks;
 use ml_cpu::gpu_types::{ObjectData, ObjectPush};
 use ml_cpu::scene::Object;
+use ml_cpu::textures::TextureImage;
 use ml_shaders::Shader;
 use ml_vk::{shader, vk, Context, VkError};
 
@@ -21,10 +23,53 @@ pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
 /// The kinds of draw in a raster pass.
 #[derive(Clone, Copy, PartialEq)]
 pub enum Draw {
-    /// Scene meshes: vertex buffer, depth test, back-face culling.
-    Mesh,
+    /// Scene meshes: vertex buffer, depth test, back-face culling unless double-sided.
+    Mesh(SurfaceVariant),
     /// A full-screen or screen-space draw made from the vertex index, no depth.
     Screen,
+}
+
+/// What a mesh pipeline does with its objects' surfaces (mesh_coverage.glsl): back faces
+/// culled, or drawn with the normal turned toward the viewer (double-sided); every fragment
+/// kept, or alpha-tested (masked). A pipeline each, specialised, so that the opaque,
+/// single-sided objects' pipeline has no test and no discard.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SurfaceVariant {
+    pub double_sided: bool,
+    pub masked: bool,
+}
+
+/// Specialization constants of mesh_coverage.glsl.
+pub const SPEC_MASKED_DRAW: u32 = 16;
+pub const SPEC_DOUBLE_SIDED_DRAW: u32 = 17;
+
+impl SurfaceVariant {
+    pub const OPAQUE: SurfaceVariant = SurfaceVariant { double_sided: false, masked: false };
+    const COUNT: usize = 4;
+
+    /// The variant that draws object `o`.
+    pub fn of(o: &Object) -> SurfaceVariant {
+        SurfaceVariant { double_sided: o.extras.double_sided, masked: o.extras.alpha_mode.cutoff().is_some() }
+    }
+
+    /// The variants `objects` need, the opaque one always among them.
+    pub fn needed(objects: &[Object]) -> Vec<SurfaceVariant> {
+        let mut out = vec![SurfaceVariant::OPAQUE];
+        for v in objects.iter().map(SurfaceVariant::of) {
+            if !out.contains(&v) {
+                out.push(v);
+            }
+        }
+        out
+    }
+
+    fn index(self) -> usize {
+        usize::from(self.double_sided) * 2 + usize::from(self.masked)
+    }
+
+    fn spec_constants(self) -> [(u32, u32); 2] {
+        [(SPEC_MASKED_DRAW, u32::from(self.masked)), (SPEC_DOUBLE_SIDED_DRAW, u32::from(self.double_sided))]
+    }
 }
 
 pub struct MeshRaster {
@@ -32,7 +77,8 @@ pub struct MeshRaster {
     /// Set 0 of the mesh pipeline, one per frame slot.
     sets: FrameSets,
     pub pipeline_layout: vk::PipelineLayout,
-    pipeline: vk::Pipeline,
+    /// Per `SurfaceVariant::index`: the mesh pipeline (null where the scene has no such object).
+    pipelines: [vk::Pipeline; SurfaceVariant::COUNT],
     framebuffers: Vec<vk::Framebuffer>,
     pub output: Output,
     pub gbuffer: &'static [GBufferImage],
@@ -40,12 +86,12 @@ pub struct MeshRaster {
 }
 
 impl MeshRaster {
-    /// The render pass for `output` and the mesh pipeline with `fragment`; sets 1 and 2 are
-    /// the scene's textures and the object's textures.
+    /// The render pass for `output` and the mesh pipelines with `fragment`, one per surface
+    /// variant of `variants`; sets 1 and 2 are the scene's textures and the object's textures.
     pub fn new(
         ctx: &Context,
         (depth_format, output, gbuffer): (vk::Format, Output, &'static [GBufferImage]),
-        (fragment, shading): (&Shader, Shading),
+        (fragment, shading, variants): (&Shader, Shading, &[SurfaceVariant]),
         (textures_layout, object_textures_layout): (vk::DescriptorSetLayout, vk::DescriptorSetLayout),
     ) -> Result<MeshRaster, VkError> {
         let stages = [(&ml_shaders::FORWARD_VERT, vk::ShaderStageFlags::VERTEX), (fragment, vk::ShaderStageFlags::FRAGMENT)];
@@ -53,7 +99,7 @@ impl MeshRaster {
             render_pass: vk::RenderPass::null(),
             sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
             pipeline_layout: vk::PipelineLayout::null(),
-            pipeline: vk::Pipeline::null(),
+            pipelines: [vk::Pipeline::null(); SurfaceVariant::COUNT],
             framebuffers: vec![vk::Framebuffer::null(); FRAMES_IN_FLIGHT],
             output,
             gbuffer,
@@ -65,7 +111,12 @@ impl MeshRaster {
                 .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
                 .size(std::mem::size_of::<ObjectPush>() as u32)];
             r.pipeline_layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw, textures_layout, object_textures_layout], &push)?;
-            r.pipeline = r.pipeline(ctx, (&ml_shaders::FORWARD_VERT, fragment), Draw::Mesh, (r.pipeline_layout, 0))?;
+            for &v in variants.iter().chain([&SurfaceVariant::OPAQUE]) {
+                if r.pipelines[v.index()] == vk::Pipeline::null() {
+                    r.pipelines[v.index()] =
+                        r.pipeline(ctx, (&ml_shaders::FORWARD_VERT, fragment), Draw::Mesh(v), (r.pipeline_layout, 0))?;
+                }
+            }
             Ok(())
         })();
         match made {
@@ -89,8 +140,9 @@ impl MeshRaster {
         let colour_attachments = if subpass == 0 { self.output.colour_attachments(self.gbuffer) } else { 1 };
         let bindings = [vertex_binding()];
         let attributes = vertex_attributes();
+        let mesh = matches!(draw, Draw::Mesh(_));
         let vertex_input = match draw {
-            Draw::Mesh => vk::PipelineVertexInputStateCreateInfo::default()
+            Draw::Mesh(_) => vk::PipelineVertexInputStateCreateInfo::default()
                 .vertex_binding_descriptions(&bindings)
                 .vertex_attribute_descriptions(&attributes),
             Draw::Screen => vk::PipelineVertexInputStateCreateInfo::default(),
@@ -99,14 +151,18 @@ impl MeshRaster {
         // counter-clockwise in Vulkan's framebuffer convention.
         let rasterization = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(if draw == Draw::Mesh { vk::CullModeFlags::BACK } else { vk::CullModeFlags::NONE })
+            .cull_mode(match draw {
+                Draw::Mesh(v) if !v.double_sided => vk::CullModeFlags::BACK,
+                _ => vk::CullModeFlags::NONE,
+            })
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
         let depth_stencil = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(draw == Draw::Mesh)
-            .depth_write_enable(draw == Draw::Mesh)
+            .depth_test_enable(mesh)
+            .depth_write_enable(mesh)
             .depth_compare_op(vk::CompareOp::LESS);
-        let model = self.shading.spec_constants();
+        let mut model = self.shading.spec_constants().to_vec();
+        model.extend(variant_of(draw).spec_constants());
         shader::graphics_pipeline(
             ctx,
             &shader::GraphicsPipelineDesc {
@@ -171,18 +227,31 @@ impl MeshRaster {
         // SAFETY: recording state; every handle is alive until the frame's fence signals.
         unsafe {
             d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipelines[SurfaceVariant::OPAQUE.index()]);
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[area]);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 0, &sets, &[]);
-            // Set 2 (the object's textures) changes only between objects with different ones.
+            // Set 2 (the object's textures) changes only between objects with different ones,
+            // the pipeline only between objects of different surface variants.
             let mut bound_set = None;
+            let mut bound_variant = SurfaceVariant::OPAQUE;
             record_draws(
                 ctx,
                 cmd,
                 (&scene.meshes, rec.objects),
                 |_| 1,
                 |index, o| {
+                    let variant = SurfaceVariant::of(o);
+                    if variant != bound_variant {
+                        // A variant the pass was not made for (objects replaced since) draws
+                        // as opaque and single-sided.
+                        let pipeline = match self.pipelines[variant.index()] {
+                            p if p == vk::Pipeline::null() => self.pipelines[SurfaceVariant::OPAQUE.index()],
+                            p => p,
+                        };
+                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                        bound_variant = variant;
+                    }
                     let set = scene.object_textures.per_object[index as usize];
                     if bound_set.replace(set) != Some(set) {
                         d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline_layout, 2, &[set], &[]);
@@ -201,7 +270,9 @@ impl MeshRaster {
             for fb in self.framebuffers.drain(..) {
                 ctx.device.destroy_framebuffer(fb, None);
             }
-            ctx.device.destroy_pipeline(self.pipeline, None);
+            for p in self.pipelines {
+                ctx.device.destroy_pipeline(p, None);
+            }
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
             ctx.device.destroy_render_pass(self.render_pass, None);
         }
@@ -209,11 +280,36 @@ impl MeshRaster {
     }
 }
 
-/// Object `o`'s entry in the object buffer.
-pub fn object_data(o: &Object) -> ObjectData {
+/// ObjectData::uv_transform of `t`.
+fn uv_transform_vectors(t: glam::Affine2) -> [[f32; 4]; 2] {
+    let m = t.matrix2;
+    [[m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y], [t.translation.x, t.translation.y, 0.0, 0.0]]
+}
+
+/// The surface variant of a mesh draw (screen draws: the opaque one, which they ignore).
+fn variant_of(draw: Draw) -> SurfaceVariant {
+    match draw {
+        Draw::Mesh(v) => v,
+        Draw::Screen => SurfaceVariant::OPAQUE,
+    }
+}
+
+/// Object `o`'s entry in the object buffer (`masks`, `textures`: the scene's alpha masks and
+/// textures).
+pub fn object_data(o: &Object, masks: &AlphaMasks, textures: &[TextureImage]) -> ObjectData {
     let normal = glam::Mat4::from_mat3(glam::Mat3::from_mat4(o.transform).inverse().transpose());
     let [albedo_roughness, material, emissive] = material_vectors(o);
-    ObjectData { model: o.transform.to_cols_array_2d(), normal_matrix: normal.to_cols_array_2d(), albedo_roughness, material, emissive }
+    let (alpha, alpha_texture) = masks.object_fields(o, textures);
+    ObjectData {
+        model: o.transform.to_cols_array_2d(),
+        normal_matrix: normal.to_cols_array_2d(),
+        albedo_roughness,
+        material,
+        emissive,
+        alpha,
+        alpha_texture,
+        uv_transform: uv_transform_vectors(o.extras.uv_transform),
+    }
 }
 
 /// What a draw of object `o` (at `index`) pushes.

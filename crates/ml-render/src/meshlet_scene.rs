@@ -13,7 +13,7 @@ use crate::descriptors::Resource;
 use crate::frame::FRAMES_IN_FLIGHT;
 use crate::pass::FrameResources;
 use gpu_allocator::MemoryLocation;
-use ml_cpu::gpu_types::{CullCounters, LargeTriangle};
+use ml_cpu::gpu_types::{CullCounters, LargeTriangle, INSTANCE_DOUBLE_SIDED, INSTANCE_MASKED};
 use ml_cpu::meshlets::SceneMeshlets;
 use ml_vk::{vk, Buffer, Context, VkError};
 use std::cell::RefCell;
@@ -37,6 +37,10 @@ pub struct CullFrame {
     pub large_bins: Buffer,
 }
 
+/// Specialization constant of the compute rasters (raster_surface.glsl SURFACE_TESTS): 1 where
+/// the scene has masked or double-sided objects (`MeshletGeometry::surface_tests`).
+pub const SPEC_SURFACE_TESTS: u32 = 18;
+
 /// The scene's meshlets on the GPU, uploaded once: what every meshlet pass reads (the
 /// visibility technique's culling and raster, the compute shadow raster).
 pub struct MeshletGeometry {
@@ -51,6 +55,8 @@ pub struct MeshletGeometry {
     pub instance_count: u32,
     /// Triangles of every object together.
     pub triangles: u64,
+    /// Whether some object is masked or double-sided (the rasters then test surfaces).
+    pub surface_tests: bool,
 }
 
 impl MeshletGeometry {
@@ -67,6 +73,7 @@ impl MeshletGeometry {
             meshlet_instance_count: g.meshlet_instances.len() as u32,
             instance_count: g.instances.len() as u32,
             triangles: g.triangles,
+            surface_tests: g.instances.iter().any(|i| i.meshlets[3] & (INSTANCE_DOUBLE_SIDED | INSTANCE_MASKED) != 0),
         };
         ml_vk::build(ctx, geometry, |s| {
             let upload = |name: &str, data: &[u8]| {

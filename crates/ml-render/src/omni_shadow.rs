@@ -11,8 +11,13 @@
 //! whose own pass (passes/omni_shadow_compute.rs) draws every face in compute shaders and
 //! copies the depths in. Without
 //! shadowed lights the array is a cleared 1×1 stand-in the shaders never sample.
+//!
+//! Alpha-masked objects are drawn in each pass after the others, by a pipeline of their own
+//! whose fragment shader drops what their masks cut out (depth_pass.rs MaskedPipeline), made
+//! with the others where the scene has a masked object: scenes without one never make it.
 
-use crate::depth_pass::{self, DepthPassDesc};
+use crate::depth_pass::{self, masked, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
+use crate::frame::FRAMES_IN_FLIGHT;
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::settings::{OmniShadowMode, OmniShadowSettings};
 use crate::shadow_atlas::ShadowAtlasGpu;
@@ -54,6 +59,20 @@ pub struct OmniShadows {
     render_pass: vk::RenderPass,
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
+    /// Alpha-masked objects' pipeline (None: the scene has none).
+    masked: Option<MaskedPipeline>,
+    /// Whether to make it.
+    has_masked: bool,
+}
+
+/// What the cubes are drawn from this frame.
+pub struct Casters<'a> {
+    pub meshes: &'a [GpuMesh],
+    pub objects: &'a [Object],
+    /// The scene's object buffer and alpha masks (read by the masked objects' pipeline).
+    pub buffers: (vk::Buffer, vk::Buffer),
+    /// The frame slot being recorded (the masked pipeline's set of that slot is rewritten).
+    pub slot: usize,
 }
 
 const DEPTH: vk::ImageAspectFlags = vk::ImageAspectFlags::DEPTH;
@@ -61,8 +80,9 @@ const SHADER_READERS: vk::PipelineStageFlags =
     vk::PipelineStageFlags::from_raw(vk::PipelineStageFlags::FRAGMENT_SHADER.as_raw() | vk::PipelineStageFlags::COMPUTE_SHADER.as_raw());
 
 impl OmniShadows {
-    /// The cubes for `settings` (None: the stand-in), with what renders them.
-    pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>) -> Result<OmniShadows, VkError> {
+    /// The cubes for `settings` (None: the stand-in), with what renders them; `has_masked`:
+    /// whether the scene has alpha-masked objects (they get a pipeline of their own).
+    pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>, has_masked: bool) -> Result<OmniShadows, VkError> {
         let features = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE;
         if !ctx.format_supports(CUBE_FORMAT, features) {
             return Err(VkError::Limit(format!("'{}' cannot render and sample D32_SFLOAT (point-light shadow cubes)", ctx.info.name)));
@@ -78,6 +98,8 @@ impl OmniShadows {
             render_pass: vk::RenderPass::null(),
             layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            masked: None,
+            has_masked,
         };
         ml_vk::build(ctx, shadows, |s| s.create(ctx))
     }
@@ -125,6 +147,15 @@ impl OmniShadows {
             _ => ml_shaders::OMNI_SHADOW_VERT.spirv,
         };
         self.pipeline = depth_pass::pipeline(ctx, self.render_pass, self.layout, (vertex, Some(ml_shaders::OMNI_SHADOW_FRAG.spirv)))?;
+        if self.has_masked {
+            let vertex = match settings.mode {
+                OmniShadowMode::Multiview => &ml_shaders::OMNI_SHADOW_MULTIVIEW_MASKED_VERT,
+                OmniShadowMode::Layered => &ml_shaders::OMNI_SHADOW_LAYERED_MASKED_VERT,
+                _ => &ml_shaders::OMNI_SHADOW_MASKED_VERT,
+            };
+            let shaders = (vertex, &ml_shaders::OMNI_SHADOW_MASKED_FRAG);
+            self.masked = Some(MaskedPipeline::new(ctx, self.render_pass, shaders, FRAMES_IN_FLIGHT)?);
+        }
         let extent = shape.extent;
         match settings.mode {
             OmniShadowMode::Copy => {
@@ -180,11 +211,26 @@ impl OmniShadows {
         2.0 / self.cubes.extent.width as f32
     }
 
+    /// The masked objects' pipeline where `casters` has masked objects, its set of
+    /// `casters.slot` pointed at the scene's buffers.
+    fn masked_pipeline(&self, ctx: &Context, casters: &Casters) -> Option<&MaskedPipeline> {
+        let m = self.masked.as_ref().filter(|_| casters.objects.iter().any(masked))?;
+        // The slot's previous frame has finished (its fence was waited for) and nothing this
+        // frame has bound the set yet. The write is by the names its own shaders declare,
+        // which `bind` provides: it cannot miss one.
+        m.bind(ctx, casters.slot, casters.buffers).inspect_err(|e| eprintln!("point-light shadows: {e}")).ok()?;
+        Some(m)
+    }
+
     /// Render every cube: `lights[i]` into cube i, the objects that reach into its sphere.
     /// Leaves the array DEPTH_STENCIL_READ_ONLY_OPTIMAL, its writes visible to fragment and
     /// compute shaders.
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], casters: &Casters) {
         let Some(settings) = self.cube_settings().filter(|s| !matches!(s.mode, OmniShadowMode::Compute { .. })) else { return };
+        let (meshes, objects) = (casters.meshes, casters.objects);
+        let masked_pipeline = self.masked_pipeline(ctx, casters);
+        // Which objects the masked pipeline draws (none without it).
+        let is_masked: Vec<bool> = objects.iter().map(|o| masked_pipeline.is_some() && masked(o)).collect();
         let d = &ctx.device;
         let size = settings.size;
         let copy = settings.mode == OmniShadowMode::Copy;
@@ -239,13 +285,22 @@ impl OmniShadows {
                         (_, Some(f)) => (faces[i as usize] >> f) & 1,
                         (_, None) => 0,
                     };
-                    record_draws(ctx, cmd, (meshes, objects), instances, |_, object| {
+                    let opaque = |i: u32| if is_masked[i as usize] { 0 } else { instances(i) };
+                    record_draws(ctx, cmd, (meshes, objects), opaque, |_, object| {
                         let push = OmniShadowPush {
                             view_proj: view_proj.to_cols_array_2d(),
                             model_to_light: (world_to_light * object.transform).to_cols_array_2d(),
                         };
                         d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
                     });
+                    // Then the masked objects that reach this pass's faces, by their pipeline.
+                    let cut = |i: u32| if is_masked[i as usize] { instances(i) } else { 0 };
+                    if let Some(m) = masked_pipeline.filter(|_| (0..objects.len() as u32).any(|i| cut(i) != 0)) {
+                        m.record_bind(ctx, cmd, casters.slot);
+                        record_draws(ctx, cmd, (meshes, objects), cut, |i, object| {
+                            m.push(ctx, cmd, &ShadowMaskPush::new(view_proj, world_to_light * object.transform, i));
+                        });
+                    }
                     d.cmd_end_render_pass(cmd);
                 }
                 if let (true, Some(f)) = (copy, face) {
@@ -307,6 +362,9 @@ impl OmniShadows {
             ctx.device.destroy_pipeline(self.pipeline, None);
             ctx.device.destroy_pipeline_layout(self.layout, None);
             ctx.device.destroy_render_pass(self.render_pass, None);
+        }
+        if let Some(mut m) = self.masked.take() {
+            m.destroy(ctx);
         }
         self.faces_view = vk::ImageView::null();
         self.pipeline = vk::Pipeline::null();

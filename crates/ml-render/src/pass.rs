@@ -22,6 +22,8 @@ pub struct FrameResources<'a> {
     pub light_indices: vk::Buffer,
     pub objects: vk::Buffer,
     pub cones: vk::Buffer,
+    /// The alpha of masked objects' textures (alpha_mask.glsl).
+    pub alpha_masks: vk::Buffer,
     pub targets: &'a Targets,
 }
 
@@ -37,6 +39,7 @@ impl FrameResources<'_> {
             "LightIndexBuffer" => self.light_indices,
             "ObjectBuffer" => self.objects,
             "LightConeBuffer" => self.cones,
+            "AlphaMaskBuffer" => self.alpha_masks,
             "DepthPyramidBuffer" => self.targets.depth_pyramid.raw,
             "VisibilityDepthBuffer" => self.targets.visibility_depth.raw,
             _ => return None,

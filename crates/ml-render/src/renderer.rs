@@ -5,7 +5,7 @@
 //! binds, records, times and collects from.
 
 use crate::error::RenderError;
-use crate::frame::{FrameInFlight, FrameSetup, SlotLists, FRAMES_IN_FLIGHT};
+use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists, FRAMES_IN_FLIGHT};
 use crate::omni_shadow::ShadowedLight;
 use crate::pass::{Pass, Recording, SlotReport, Update};
 use crate::passes::{assemble, Assembly};
@@ -14,7 +14,7 @@ use crate::scene_gpu::SceneGpu;
 use crate::settings::{Exposure, LightAssignment, RenderSettings, MAX_EXPOSURE_EV};
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
-use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
+use ml_cpu::cluster::{count_entries, ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
 use ml_cpu::omni_shadow::{lights_in_view, shadowed_lights};
@@ -107,6 +107,30 @@ const DEFAULT_HEAT_TOP: f32 = 64.0;
 /// still overflows this often something is wrong, and the render fails instead of lying.
 const MAX_RERENDERS: u32 = 2;
 
+/// Refuse, before anything is drawn, light lists that cannot fit in what the device binds as
+/// one storage buffer (clustered techniques): `cluster::count_entries` bounds the entries from
+/// below — the lights' spheres, less the distance they move, against the cluster grid — so a
+/// scene that fits is never refused, and one that does not is refused in milliseconds rather
+/// than after frames of GPU list building and growing.
+fn check_lists_fit(
+    ctx: &Context,
+    settings: &RenderSettings,
+    grid: &ClusterGrid,
+    lights: &[PointLight],
+    motion: f32,
+) -> Result<(), RenderError> {
+    if !settings.technique.is_clustered() {
+        return Ok(());
+    }
+    let limit = max_index_entries(ctx);
+    let needed = count_entries(grid, lights, motion, limit);
+    if needed > limit {
+        let holder = format!("'{}' binds as one storage buffer", ctx.info.name);
+        return Err(lists_too_long(needed, limit, &holder).in_technique(settings.technique));
+    }
+    Ok(())
+}
+
 /// What a window adds to each frame (the viewer): commands recorded after the frame's passes,
 /// in the same command buffer, and the semaphores its submission waits on and signals.
 pub trait FrameHook {
@@ -120,6 +144,8 @@ pub trait FrameHook {
 impl<'a> Renderer<'a> {
     pub fn new(ctx: &'a Context, mut scene: Scene, settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
         settings.check(ctx, scene.lights.len())?;
+        let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
+        check_lists_fit(ctx, &settings, &grid, &scene.lights, scene.light_motion)?;
         if !scene.cones.is_empty() && scene.cones.len() != scene.lights.len() {
             return Err(RenderError::Invalid(format!("the scene has {} spot cones for {} lights", scene.cones.len(), scene.lights.len())));
         }
@@ -130,7 +156,7 @@ impl<'a> Renderer<'a> {
         let mut r = Renderer {
             ctx,
             extent: vk::Extent2D { width: settings.width, height: settings.height },
-            grid: ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera),
+            grid,
             animated: if lights_on_gpu { Vec::new() } else { scene.lights.clone() },
             scene,
             settings,
@@ -203,6 +229,8 @@ impl<'a> Renderer<'a> {
             return Ok(false);
         }
         settings.check(self.ctx, self.scene.lights.len())?;
+        let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
+        check_lists_fit(self.ctx, &settings, &grid, &self.scene.lights, self.scene.light_motion)?;
         self.release_frames()?;
         let (new_grid, new_view) = (settings.clusters != self.settings.clusters, settings.debug_view != self.settings.debug_view);
         // The exposure meter is a pass of its own.
@@ -212,7 +240,7 @@ impl<'a> Renderer<'a> {
         }
         self.settings = settings;
         self.extent = vk::Extent2D { width: settings.width, height: settings.height };
-        self.grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
+        self.grid = grid;
         // The passes depend on the grid (the GPU build's sizes) and the debug view (legend,
         // tone-map curve, view passes); sizes only need new frame slots.
         if new_grid || new_view || new_meter {
@@ -230,6 +258,7 @@ impl<'a> Renderer<'a> {
             return Err(RenderError::Invalid("a scene with spot lights cannot change its lights in place".into()));
         }
         self.settings.check(self.ctx, lights.len())?;
+        check_lists_fit(self.ctx, &self.settings, &self.grid, &lights, self.scene.light_motion)?;
         self.release_frames()?;
         self.scene.lights = lights;
         self.shadowed = mark_shadowed(&mut self.scene, &self.settings);
@@ -313,7 +342,7 @@ impl<'a> Renderer<'a> {
 
     /// Point every pass's sets of slot `f` at its buffers and targets (the slot is idle).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
-        let resources = self.frames[f].resources(f, (self.gpu.objects.raw, self.gpu.cones.raw));
+        let resources = self.frames[f].resources(f, (self.gpu.objects.raw, self.gpu.cones.raw, self.gpu.alpha_masks.raw));
         self.passes.iter_mut().try_for_each(|p| p.bind_frame(self.ctx, &resources))
     }
 
@@ -343,7 +372,8 @@ impl<'a> Renderer<'a> {
         let mut stats = FrameStats::new(&self.pass_names());
         let start = Instant::now();
         let mut last = 0;
-        for i in 0..self.settings.frames {
+        let frames = self.settings.frames;
+        for i in 0..frames {
             last = i as usize % FRAMES_IN_FLIGHT;
             // Exposed from the image of the slot's previous frame (two back), whether or not
             // the frame before was waited for (an image sequence waits for each): the same
@@ -351,12 +381,20 @@ impl<'a> Renderer<'a> {
             self.collect(last, &mut stats)?;
             self.adapt_exposure(1.0, last);
             self.run_frame(last, self.settings.clock(i), &mut stats, None)?;
+            if i == 0 && frames > 1 && self.settings.meters_exposure() {
+                // The first frame settles its exposure as the last does: a sequence does not
+                // start dark, and later frames meter a settled image (two back). A sequence
+                // and a plain render do the same, so their last images stay equal.
+                self.collect_all(&mut stats)?;
+                last = self.complete(last, i, &mut stats)?;
+                last = self.settle_exposure(last, i, &mut stats)?;
+            }
             if sink.wants_images() {
                 self.collect_all(&mut stats)?;
                 last = self.complete(last, i, &mut stats)?;
                 // The last image is the one `render` returns: with its exposure settled.
-                if i + 1 == self.settings.frames {
-                    last = self.settle_exposure(last, &mut stats)?;
+                if i + 1 == frames {
+                    last = self.settle_exposure(last, i, &mut stats)?;
                 }
                 let rgba = self.read_back(last)?;
                 sink.image(i, &rgba)?;
@@ -367,7 +405,7 @@ impl<'a> Renderer<'a> {
         last = self.complete(last, self.settings.frames - 1, &mut stats)?;
         if !sink.wants_images() {
             // (An image sequence settled its last frame before handing it over.)
-            last = self.settle_exposure(last, &mut stats)?;
+            last = self.settle_exposure(last, frames - 1, &mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         if Output::of(self.settings.technique) == Output::Subpasses {
@@ -389,7 +427,8 @@ impl<'a> Renderer<'a> {
         while self.reports[last].overflowed {
             if rerenders == MAX_RERENDERS {
                 return Err(RenderError::Invalid(format!(
-                    "clustered-gpu: the light lists still overflowed after {MAX_RERENDERS} re-renders ({} entries needed)",
+                    "{}: the light lists still overflowed after {MAX_RERENDERS} re-renders ({} entries needed)",
+                    self.settings.technique.name(),
                     self.required_indices
                 )));
             }
@@ -402,10 +441,10 @@ impl<'a> Renderer<'a> {
         Ok(last)
     }
 
-    /// Auto exposure: render the last frame (slot `last`) again, into the other slot, while
-    /// the EV its image asks for is not the one it used (at most EXPOSURE_REPEATS times); the
-    /// slot that holds the final image.
-    fn settle_exposure(&mut self, mut last: usize, stats: &mut FrameStats) -> Result<usize, RenderError> {
+    /// Auto exposure: render frame `i` (in slot `last`) again, into the other slot, while the
+    /// EV its image asks for is not the one it used (at most EXPOSURE_REPEATS times); the slot
+    /// that holds the final image.
+    fn settle_exposure(&mut self, mut last: usize, i: u32, stats: &mut FrameStats) -> Result<usize, RenderError> {
         if !self.settings.meters_exposure() {
             return Ok(last);
         }
@@ -416,7 +455,7 @@ impl<'a> Renderer<'a> {
             }
             stats.exposure_repeats += 1;
             last = (last + 1) % FRAMES_IN_FLIGHT;
-            self.run_frame(last, self.settings.clock(self.settings.frames - 1), stats, None)?;
+            self.run_frame(last, self.settings.clock(i), stats, None)?;
             self.collect_all(stats)?;
             last = self.complete(last, self.settings.frames - 1, stats)?;
         }
@@ -436,6 +475,11 @@ impl<'a> Renderer<'a> {
     /// The EV the next frame is exposed with.
     pub fn exposure_ev(&self) -> f32 {
         self.exposure_ev
+    }
+
+    /// The scene it renders (the viewer frames it).
+    pub fn scene(&self) -> &Scene {
+        &self.scene
     }
 
     /// The scene's camera (where the next frame is seen from).
@@ -560,7 +604,8 @@ impl<'a> Renderer<'a> {
             if report.overflowed {
                 stats.overflowed_frames += 1;
                 eprintln!(
-                    "clustered-gpu: a frame needed {needed} light-index entries but its list held {}; growing the lists (that frame is re-rendered if it is the last)",
+                    "{}: a frame needed {needed} light-index entries but its list held {}; growing the lists (that frame is re-rendered if it is the last)",
+                    self.settings.technique.name(),
                     self.frames[f].index_capacity()
                 );
                 self.required_indices = self.required_indices.max(needed);
@@ -576,6 +621,12 @@ impl<'a> Renderer<'a> {
     /// Write slot `f`'s buffers for clock `t`; the milliseconds of CPU light assignment in it
     /// (None where the CPU does not assign).
     fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, RenderError> {
+        let technique = self.settings.technique;
+        self.update_slot(f, t, stats).map_err(|e| e.in_technique(technique))
+    }
+
+    /// `update_frame`'s work (its errors are said with the technique by the caller).
+    fn update_slot(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, RenderError> {
         let ctx = self.ctx;
         let mut grew = self.frames[f].ensure_index_capacity(ctx, self.required_indices)?;
         if !self.lights_on_gpu {

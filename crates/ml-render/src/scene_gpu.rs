@@ -4,13 +4,15 @@
 
 use crate::error::RenderError;
 use crate::gpu_mesh::GpuMesh;
-use crate::mesh_raster::object_data;
+use crate::mesh_raster::{object_data, SurfaceVariant};
+use crate::meshlet_scene::storage_bytes;
 use crate::object_textures::ObjectTextureSets;
 use crate::omni_shadow::OmniShadows;
 use crate::scene_textures::SceneTextures;
 use crate::settings::{RenderSettings, ShadingModel, SunShadowMode};
 use crate::sun_shadow;
 use crate::targets::{depth_format, Output};
+use ml_cpu::alpha_mask::AlphaMasks;
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::gpu_types::{LightCone, ObjectData};
 use ml_cpu::scene::Scene;
@@ -22,6 +24,11 @@ pub struct SceneGpu {
     pub objects: Buffer,
     /// Spot cones, parallel to the lights (static: only positions animate).
     pub cones: Buffer,
+    /// The alpha of every texture a masked object cuts with (ml_cpu::alpha_mask).
+    pub alpha_masks: Buffer,
+    /// The surface variants (masked, double-sided) the objects need: the mesh passes make a
+    /// pipeline for each.
+    pub surface_variants: Vec<SurfaceVariant>,
     pub textures: SceneTextures,
     pub object_textures: ObjectTextureSets,
     /// Point-light shadow cubes (a stand-in without shadowed lights): part of the scene's
@@ -40,7 +47,8 @@ impl SceneGpu {
         let sun = (settings.shading == ShadingModel::BlinnPhong).then_some(settings.sun_shadow);
         // Each of these needs the ones before it; a failure releases those.
         let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
-        let mut omni = OmniShadows::new(ctx, settings.omni)?;
+        let has_masked = scene.objects.iter().any(|o| o.extras.alpha_mode.cutoff().is_some());
+        let mut omni = OmniShadows::new(ctx, settings.omni, has_masked)?;
         let mut textures = release_on_error(ctx, SceneTextures::new(ctx, sun.is_some(), gbuffer_depth, &omni), &mut [&mut omni])?;
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
         let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
@@ -48,6 +56,8 @@ impl SceneGpu {
             meshes: Vec::new(),
             objects: Buffer::null(),
             cones: Buffer::null(),
+            alpha_masks: Buffer::null(),
+            surface_variants: SurfaceVariant::needed(&scene.objects),
             textures,
             object_textures,
             omni,
@@ -76,13 +86,24 @@ impl SceneGpu {
             let mesh = scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
             self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
         }
-        let objects: Vec<ObjectData> = scene.objects.iter().map(object_data).collect();
+        let masks = AlphaMasks::pack(scene).map_err(|e| VkError::Limit(e.to_string()))?;
+        let bytes: &[u8] = bytemuck::cast_slice(&masks.words);
+        storage_bytes(ctx, "alpha masks", bytes.len() as u64)?;
+        self.alpha_masks = Buffer::device_local_with(ctx, "alpha masks", bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        let objects: Vec<ObjectData> = scene.objects.iter().map(|o| object_data(o, &masks, &scene.textures)).collect();
         self.objects = Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let (lo, hi) = scene.bounds();
         self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
         if let Some(mode) = self.sun {
             let view_proj = self.shadow_view_proj;
-            let inputs = sun_shadow::ShadowInputs { scene, meshes: &self.meshes, objects: self.objects.raw, view_proj, mode };
+            let inputs = sun_shadow::ShadowInputs {
+                scene,
+                meshes: &self.meshes,
+                objects: self.objects.raw,
+                alpha_masks: self.alpha_masks.raw,
+                view_proj,
+                mode,
+            };
             self.sun_shadow_ms = self.textures.render_shadow_map(ctx, &inputs)?;
         }
         Ok(())
@@ -105,6 +126,7 @@ impl SceneGpu {
         }
         self.meshes.clear();
         self.objects.destroy(ctx);
+        self.alpha_masks.destroy(ctx);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

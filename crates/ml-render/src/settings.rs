@@ -429,10 +429,13 @@ pub enum DebugView {
     Meshlets,
     /// A colour per triangle (visibility).
     Triangles,
+    /// Which surfaces alpha masks cut: opaque grey, masked green, blended orange (drawn as
+    /// masks); double-sided ones brighter. Cut-out points show what lies behind them.
+    Alpha,
 }
 
 impl DebugView {
-    pub const ALL: [DebugView; 11] = [
+    pub const ALL: [DebugView; 12] = [
         DebugView::None,
         DebugView::ClusterHeat,
         DebugView::GBufferAlbedo,
@@ -444,6 +447,7 @@ impl DebugView {
         DebugView::ShadowAtlas,
         DebugView::Meshlets,
         DebugView::Triangles,
+        DebugView::Alpha,
     ];
 
     pub fn name(self) -> &'static str {
@@ -459,6 +463,7 @@ impl DebugView {
             DebugView::ShadowAtlas => "shadow-atlas",
             DebugView::Meshlets => "meshlets",
             DebugView::Triangles => "triangles",
+            DebugView::Alpha => "alpha",
         }
     }
 
@@ -481,6 +486,7 @@ impl DebugView {
             DebugView::ShadowAtlas => g::DEBUG_VIEW_SHADOW_ATLAS,
             DebugView::Meshlets => g::DEBUG_VIEW_MESHLETS,
             DebugView::Triangles => g::DEBUG_VIEW_TRIANGLES,
+            DebugView::Alpha => g::DEBUG_VIEW_ALPHA,
         }
     }
 }

@@ -9,7 +9,7 @@
 //! large triangle draws it (omni_raster_large.comp); the buffer is copied into the image.
 
 use crate::descriptors::{FrameSets, Resource};
-use crate::meshlet_scene::{storage_bytes, MeshletGeometry};
+use crate::meshlet_scene::{storage_bytes, MeshletGeometry, SPEC_SURFACE_TESTS};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush, ShadowCubeTiles};
 use ml_cpu::meshlets::SceneMeshlets;
@@ -169,7 +169,11 @@ impl ShadowRaster {
             let push =
                 [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(size_of::<OmniRasterPush>() as u32)];
             r.layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw], &push)?;
-            let spec = [(SPEC_ORTHO_VIEW, u32::from(views == ShadowViews::Ortho)), (SPEC_ATLAS, u32::from(atlas))];
+            let spec = [
+                (SPEC_ORTHO_VIEW, u32::from(views == ShadowViews::Ortho)),
+                (SPEC_ATLAS, u32::from(atlas)),
+                (SPEC_SURFACE_TESTS, u32::from(r.geometry.surface_tests)),
+            ];
             // The clear is the atlas's alone.
             let used = if atlas { 4 } else { 3 };
             for (pipeline, s) in r.pipelines.iter_mut().zip(shaders).take(used) {
@@ -179,9 +183,9 @@ impl ShadowRaster {
         })
     }
 
-    /// Point slot `slot`'s set at the raster's own buffers and the scene's meshlets; `objects`:
-    /// the scene's object buffer.
-    pub fn bind(&mut self, ctx: &Context, slot: usize, objects: vk::Buffer) -> Result<(), VkError> {
+    /// Point slot `slot`'s set at the raster's own buffers and the scene's meshlets; `objects`,
+    /// `alpha_masks`: the scene's object and alpha-mask buffers.
+    pub fn bind(&mut self, ctx: &Context, slot: usize, (objects, alpha_masks): (vk::Buffer, vk::Buffer)) -> Result<(), VkError> {
         let (depths, tiles) = match self.views {
             ShadowViews::Atlas { depths, tiles, .. } => (depths, tiles),
             _ => (self.depths.raw, self.tiles.raw),
@@ -196,6 +200,7 @@ impl ShadowRaster {
                 "ShadowTileBuffer" => tiles,
                 "ShadowRedrawBuffer" => self.redrawn.raw,
                 "ObjectBuffer" => objects,
+                "AlphaMaskBuffer" => alpha_masks,
                 _ => return None,
             };
             Some(Resource::Buffer(buffer))

@@ -2,9 +2,12 @@
 //! renderer is made — the sun and the objects do not move (only the point lights do). Depth
 //! only, every object, an orthographic view along the sun fitted to the scene
 //! (ml_cpu::blinn_phong), by a render pass or by the compute shadow raster (shadow_raster.rs);
-//! 3×3 PCF taps read it through a comparison sampler (scene_textures.rs).
+//! 3×3 PCF taps read it through a comparison sampler (scene_textures.rs). In the render pass,
+//! alpha-masked objects are drawn after the others by a pipeline of their own whose fragment
+//! shader drops what their masks cut out (depth_pass.rs MaskedPipeline; made only for scenes
+//! with masked objects).
 
-use crate::depth_pass::{self, DepthPassDesc};
+use crate::depth_pass::{self, masked, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::settings::SunShadowMode;
 use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
@@ -18,6 +21,8 @@ pub struct ShadowInputs<'a> {
     pub meshes: &'a [GpuMesh],
     /// The scene's object buffer (the compute raster reads the transforms there).
     pub objects: vk::Buffer,
+    /// The scene's alpha masks (masked objects' shadows have their shape).
+    pub alpha_masks: vk::Buffer,
     pub view_proj: glam::Mat4,
     pub mode: SunShadowMode,
 }
@@ -43,7 +48,7 @@ pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInpu
             let views = (ShadowViews::Ortho, target.extent.width, LARGE_LIST);
             ShadowRaster::new(ctx, inputs.scene, views, 1).and_then(|mut raster| {
                 let shadow_target = ShadowTarget { image: target.raw, readers: READERS };
-                let result = raster.bind(ctx, 0, inputs.objects).and_then(|()| {
+                let result = raster.bind(ctx, 0, (inputs.objects, inputs.alpha_masks)).and_then(|()| {
                     ml_vk::commands::one_shot(ctx, |cmd| {
                         timer.reset(ctx, cmd);
                         timer.begin(ctx, cmd, 0);
@@ -92,13 +97,20 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&
     let mut framebuffer = vk::Framebuffer::null();
     let mut layout = vk::PipelineLayout::null();
     let mut pipeline = vk::Pipeline::null();
+    let mut masked_pipeline: Option<MaskedPipeline> = None;
     let result = (|| {
         // SAFETY: as above.
         framebuffer = unsafe { d.create_framebuffer(&fb_info, None) }.ctx("vkCreateFramebuffer")?;
-        // Only a pass that draws needs the pipeline (a clear does not).
-        if inputs.is_some() {
+        // Only a pass that draws needs the pipeline (a clear does not), and only one that
+        // draws masked objects the masked pipeline.
+        if let Some((s, _)) = &inputs {
             layout = shader::pipeline_layout(ctx, &[], &push)?;
             pipeline = depth_pass::pipeline(ctx, render_pass, layout, (ml_shaders::SHADOW_VERT.spirv, None))?;
+            if s.scene.objects.iter().any(masked) {
+                let shaders = (&ml_shaders::SHADOW_MASKED_VERT, &ml_shaders::SHADOW_MASKED_FRAG);
+                let m = masked_pipeline.insert(MaskedPipeline::new(ctx, render_pass, shaders, 1)?);
+                m.bind(ctx, 0, (s.objects, s.alpha_masks))?;
+            }
         }
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: target.extent };
         ml_vk::commands::one_shot(ctx, |cmd| {
@@ -118,17 +130,28 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&
                 if let Some((s, _)) = &inputs {
                     d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
                     depth_pass::set_square_viewport(ctx, cmd, target.extent.width);
+                    let objects = &s.scene.objects;
                     record_draws(
                         ctx,
                         cmd,
-                        (s.meshes, &s.scene.objects),
-                        |_| 1,
+                        (s.meshes, objects),
+                        |i| u32::from(!masked(&objects[i as usize])),
                         |_, object| {
                             let push =
                                 ShadowPush { model: object.transform.to_cols_array_2d(), light_view_proj: s.view_proj.to_cols_array_2d() };
                             d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
                         },
                     );
+                    if let Some(m) = &masked_pipeline {
+                        m.record_bind(ctx, cmd, 0);
+                        record_draws(
+                            ctx,
+                            cmd,
+                            (s.meshes, objects),
+                            |i| u32::from(masked(&objects[i as usize])),
+                            |i, object| m.push(ctx, cmd, &ShadowMaskPush::new(s.view_proj, object.transform, i)),
+                        );
+                    }
                 }
                 d.cmd_end_render_pass(cmd);
             }
@@ -137,6 +160,9 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&
             }
         })
     })();
+    if let Some(m) = &mut masked_pipeline {
+        m.destroy(ctx);
+    }
     // SAFETY: one_shot waited for the GPU (or nothing was submitted); null handles are ignored.
     unsafe {
         d.destroy_pipeline(pipeline, None);

@@ -21,7 +21,7 @@ use std::sync::atomic::Ordering;
 /// covered pixels. Below: the model in pbr's ambient light alone gives 0.110 (checked: it
 /// must stay under the band, or the band would not tell lit from unlit); above: over 0.7 the
 /// lit parts are mostly white (the earlier fixed-box lights gave a big model ~0.95). Seen on
-/// lavapipe: 0.134 (sphere, random) to 0.625 (disc, grid).
+/// lavapipe: 0.130 (sphere, random) to 0.226 (cube, grid).
 const BAND: (f32, f32) = (0.125, 0.7);
 /// How far the luma of the same kind and layout may move between sizes.
 const SCALE_TOLERANCE: f32 = 0.02;
@@ -105,6 +105,65 @@ fn every_kind_at_every_size_is_lit_inside_one_band() {
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
     assert!(outside.is_empty(), "outside the band {BAND:?} or changed with the size:\n{}", outside.join("\n"));
+}
+
+/// The bounding box of the pixels not of the background colour: (x0, x1, y0, y1), inclusive.
+fn covered_box(out: &RenderOutput) -> Option<(u32, u32, u32, u32)> {
+    let mut b: Option<(u32, u32, u32, u32)> = None;
+    for (i, p) in out.rgba.chunks_exact(4).enumerate() {
+        if p[..3] != [5u8, 5, 5] {
+            let (x, y) = (i as u32 % out.width, i as u32 / out.width);
+            b = Some(b.map_or((x, x, y, y), |(x0, x1, y0, y1)| (x0.min(x), x1.max(x), y0.min(y), y1.max(y))));
+        }
+    }
+    b
+}
+
+/// A file without a camera is framed for the image it is rendered to: every built-in object
+/// kind, written as a glTF file at 0.01, 1 and 100 times its size and rendered at 16:9 and
+/// 9:16, covers at least 70 % of the image's width or height (whichever the model fills
+/// first), and none of it is cut by the image's border.
+#[test]
+fn a_file_without_a_camera_is_framed_to_fill_the_image() {
+    let dir = std::env::temp_dir().join(format!("ml-framing-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a Vulkan device with the validation layer");
+    let counter = ctx.validation_counter();
+    let mut failures = Vec::new();
+    let mut least = f32::MAX;
+    for kind in MeshKind::ALL {
+        for scale in [1.0f32, 0.01, 100.0] {
+            let path = write_kind(&dir, kind, scale);
+            for (width, height) in [(160u32, 90u32), (90, 160)] {
+                let request = SceneRequest { aspect: width as f32 / height as f32, ..SceneRequest::new(SceneSource::File(path.clone())) };
+                let built = request.build().expect("the file builds");
+                let settings = RenderSettings { shading: built.shading, ..RenderSettings::new(Technique::Forward, width, height) };
+                let out = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render()).expect("render");
+                let Some((x0, x1, y0, y1)) = covered_box(&out) else {
+                    failures.push(format!("{} × {scale} at {width}x{height}: nothing covered", kind.name()));
+                    continue;
+                };
+                let (w, h) = ((x1 - x0 + 1) as f32 / width as f32, (y1 - y0 + 1) as f32 / height as f32);
+                println!(
+                    "{:>9} × {scale:<5} {width}x{height}: covers {:.0} % of the width, {:.0} % of the height",
+                    kind.name(),
+                    w * 100.0,
+                    h * 100.0
+                );
+                least = least.min(w.max(h));
+                if w.max(h) < 0.7 {
+                    failures.push(format!("{} × {scale} at {width}x{height}: {:.0} % × {:.0} %", kind.name(), w * 100.0, h * 100.0));
+                }
+                if x0 == 0 || y0 == 0 || x1 == width - 1 || y1 == height - 1 {
+                    failures.push(format!("{} × {scale} at {width}x{height}: cut by the border ({x0}..{x1}, {y0}..{y1})", kind.name()));
+                }
+            }
+        }
+    }
+    println!("the least binding share: {:.0} %", least * 100.0);
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
+    assert!(failures.is_empty(), "badly framed:\n{}", failures.join("\n"));
 }
 
 /// `--show-lights` on the seed scene's 64-light grid, in every technique: at the pixel where

@@ -401,6 +401,16 @@ impl<'c> Session<'c> {
                             println!("--camera {}", ml_cpu::camera::CameraSpec::describe(&camera, camera.far * 0.1));
                         }
                     }
+                    PhysicalKey::Code(KeyCode::KeyF) if down && !key.repeat => {
+                        // Frame the scene for the window as it is now (a file's first view).
+                        if let Some(r) = self.renderer.as_mut() {
+                            let aspect = r.settings().width as f32 / r.settings().height.max(1) as f32;
+                            let framed = ml_cpu::camera::frame_scene(r.scene(), aspect, r.camera().fov_y_deg);
+                            if let Err(e) = r.set_camera(framed) {
+                                self.overlay.error = Some(format!("{e:#}"));
+                            }
+                        }
+                    }
                     PhysicalKey::Code(KeyCode::Escape) if down => self.quit = true,
                     _ => {}
                 }

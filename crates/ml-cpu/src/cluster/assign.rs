@@ -173,6 +173,37 @@ impl ClusterAssigner {
     }
 }
 
+/// The light-list entries `lights` need on `grid` at least, in every frame of their animation
+/// (each moves up to `motion` from its place): each light is counted with its radius less
+/// `motion` (and a hair, for rounding), a sphere that lies inside the moved one wherever it
+/// moves, so the count never exceeds what any frame's assignment — the CPU's or the GPU
+/// build's, which find the same clusters — lists. Cheap: it follows the assignment's runs of
+/// clusters and stores nothing. Counting stops once it passes `stop_above`: a scene that needs
+/// more is refused before anything is drawn, whatever more it needs.
+pub fn count_entries(grid: &ClusterGrid, lights: &[PointLight], motion: f32, stop_above: usize) -> usize {
+    let total = AtomicUsize::new(0);
+    lights.par_chunks(MIN_CHUNK).for_each(|chunk| {
+        if total.load(Ordering::Relaxed) > stop_above {
+            return;
+        }
+        // Entries since the last look at the shared total (as in `assign`).
+        let mut pending = 0usize;
+        for light in chunk {
+            if pending >= LOOK_EVERY && total.fetch_add(std::mem::take(&mut pending), Ordering::Relaxed) > stop_above {
+                return;
+            }
+            let [x, y, z, r] = light.position_radius;
+            let inner = (r - motion.max(0.0)) * (1.0 - 1e-4);
+            if inner > 0.0 {
+                let shrunk = PointLight { position_radius: [x, y, z, inner], color: light.color };
+                light_cluster_runs(grid, &shrunk, |_, count| pending += count as usize);
+            }
+        }
+        total.fetch_add(pending, Ordering::Relaxed);
+    });
+    total.into_inner()
+}
+
 /// The lists would be longer than allowed; at least this many entries were needed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ListsTooLong {

@@ -5,7 +5,7 @@
 mod assign;
 mod grid;
 
-pub use assign::{ClusterAssigner, ClusterLists, ClusterStats, ListsTooLong};
+pub use assign::{count_entries, ClusterAssigner, ClusterLists, ClusterStats, ListsTooLong};
 pub use grid::{Aabb, ClusterDims, ClusterGrid};
 
 #[cfg(test)]

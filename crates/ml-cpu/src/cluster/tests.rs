@@ -238,6 +238,41 @@ fn assignment_stops_at_its_limit_instead_of_exhausting_memory() {
     ClusterAssigner::new().assign(&grid, &lights[..2], &mut out, 10_000).unwrap();
 }
 
+/// The up-front count is what the assignment lists with no motion, never more than any moved
+/// frame's lists, and stops early past its limit.
+#[test]
+fn counted_entries_bound_every_frames_lists() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+    for seed in 0..6u64 {
+        let camera = random_camera(&mut rng);
+        let grid = ClusterGrid::new(ClusterDims::DEFAULT, W, H, &camera);
+        let lights = hostile_lights(&mut rng, &camera, 400);
+        let exact = assign(&grid, &lights).indices.len();
+        let still = count_entries(&grid, &lights, 0.0, usize::MAX);
+        assert!(still <= exact && still as f64 >= exact as f64 * 0.999, "seed {seed}: without motion {still} of {exact}");
+        let motion = 0.3;
+        let bound = count_entries(&grid, &lights, motion, usize::MAX);
+        assert!(bound <= exact, "seed {seed}");
+        for t in [0.0f32, 0.125, 0.4, 0.77] {
+            let moved: Vec<PointLight> = lights
+                .iter()
+                .map(|l| {
+                    let d = crate::lights::motion_offset(t, motion);
+                    let p = l.position_radius;
+                    PointLight { position_radius: [p[0] + d.x, p[1] + d.y, p[2] + d.z, p[3]], color: l.color }
+                })
+                .collect();
+            let listed = assign(&grid, &moved).indices.len();
+            assert!(bound <= listed, "seed {seed}, t {t}: counted {bound}, listed {listed}");
+        }
+    }
+    // Huge lights: the count stops soon after the limit.
+    let grid = seed_camera_grid(ClusterDims::DEFAULT);
+    let huge: Vec<PointLight> = (0..100_000).map(|i| light(Vec3::new(0.0, i as f32 * 1e-5, 0.0), 400.0)).collect();
+    let counted = count_entries(&grid, &huge, 0.0, 1_000_000);
+    assert!(counted > 1_000_000 && counted < 1_000_000 + 64 * 1024 * ClusterDims::DEFAULT.count(), "{counted}");
+}
+
 #[test]
 fn cluster_boxes_are_separable_by_axis() {
     // The assignment tests x, y and z extents separately; that is the box test only if every

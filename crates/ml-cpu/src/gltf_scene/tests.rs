@@ -1,5 +1,5 @@
 use super::*;
-use crate::gltf_writer::{cube_without_normals, quad, GltfWriter, IndexType, PrimitiveData};
+use crate::gltf_writer::{cube_without_normals, png, quad, GltfWriter, IndexType, PrimitiveData};
 use serde_json::json;
 
 fn load_bytes(bytes: &[u8]) -> Scene {
@@ -219,7 +219,43 @@ fn optional_extensions_we_do_not_read_are_named_in_a_warning() {
     let mut w = GltfWriter::new();
     let mesh = w.mesh(&[quad()]);
     w.node(json!({ "mesh": mesh }), true);
-    w.json["extensionsUsed"] = json!(["KHR_texture_transform"]);
+    w.json["extensionsUsed"] = json!(["KHR_materials_clearcoat", "KHR_texture_transform"]);
     let (_, warnings) = from_bytes(&w.to_glb(), None).unwrap();
-    assert_eq!(warnings, ["extension KHR_texture_transform is not supported; the file is read without it"]);
+    assert_eq!(warnings, ["extension KHR_materials_clearcoat is not supported; the file is read without it"]);
+    w.json["extensionsRequired"] = json!(["KHR_materials_clearcoat"]);
+    let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
+    assert!(err.contains("KHR_materials_clearcoat") && err.contains("nsupported extension"), "{err}");
+}
+
+/// KHR_texture_transform (translation · rotation · scale, one per material: the base
+/// colour's) and KHR_materials_emissive_strength are read.
+#[test]
+fn texture_transforms_and_emissive_strength_are_read() {
+    let mut w = GltfWriter::new();
+    let texture = w.texture(png(2, 2, &[255; 16]), "image/png");
+    let m = w.textured_material(Some(texture), None);
+    let transform = json!({ "offset": [0.5, 0.25], "rotation": std::f32::consts::FRAC_PI_2, "scale": [2.0, 3.0] });
+    w.json["materials"][m]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = json!({ "KHR_texture_transform": transform });
+    w.json["materials"][m]["emissiveFactor"] = json!([0.5, 0.25, 0.0]);
+    w.json["materials"][m]["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": 4.0 } });
+    w.json["extensionsUsed"] = json!(["KHR_texture_transform", "KHR_materials_emissive_strength"]);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(json!({ "mesh": mesh }), true);
+    let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let x = &scene.objects[0].extras;
+    assert_eq!(x.emissive, Vec3::new(2.0, 1.0, 0.0));
+    // (1, 0) scaled to (2, 0), turned a quarter counter-clockwise to (0, 2), moved by the offset.
+    let t = x.uv_transform;
+    assert!(t.transform_point2(glam::Vec2::new(1.0, 0.0)).abs_diff_eq(glam::Vec2::new(0.5, 2.25), 1e-5), "{t:?}");
+    assert!(t.transform_point2(glam::Vec2::new(0.0, 1.0)).abs_diff_eq(glam::Vec2::new(-2.5, 0.25), 1e-5), "{t:?}");
+    // Another transform on another of its textures: the base colour's is kept, with a warning.
+    w.json["materials"][m]["emissiveTexture"] = json!({ "index": texture });
+    let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert_eq!(scene.objects[0].extras.uv_transform, t);
+    assert!(warnings.len() == 1 && warnings[0].contains("different texture transforms"), "{warnings:?}");
+    // A negative strength is refused.
+    w.json["materials"][m]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = json!(-1.0);
+    let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
+    assert!(err.contains("emissive strength -1"), "{err}");
 }

@@ -13,15 +13,18 @@ fn only_objects_are_required() {
     assert_eq!(s.objects[0], Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, Material::named("white").unwrap()));
     assert!(s.lights.is_empty());
     assert_eq!(s.ambient, SEED_AMBIENT);
-    // The default camera frames the object: the sphere's centre is ahead of it, its whole
-    // bounding box inside the view.
+    // The default camera frames the object for a default-sized image: the sphere's centre is
+    // ahead of it, all of the sphere in view, filling most of the image's height.
     let c = &s.camera;
-    assert!((c.forward() - (Vec3::ZERO - c.position).normalize()).length() < 1e-5);
-    let view_proj = c.projection(1.0) * c.view();
-    for corner in [Vec3::splat(-1.0), Vec3::splat(1.0), Vec3::new(-1.0, 1.0, 1.0), Vec3::new(1.0, -1.0, -1.0)] {
-        let p = view_proj.project_point3(corner);
-        assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0 && (0.0..=1.0).contains(&p.z), "{corner} → {p}");
+    assert!((c.forward() - (Vec3::ZERO - c.position).normalize()).length() < 0.05);
+    let view_proj = c.projection(crate::camera::DEFAULT_ASPECT) * c.view();
+    let (mut y0, mut y1) = (f32::MAX, f32::MIN);
+    for v in MeshKind::Sphere.build().vertices {
+        let p = view_proj.project_point3(Vec3::from(v.position));
+        assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0 && (0.0..=1.0).contains(&p.z), "{:?} → {p}", v.position);
+        (y0, y1) = (y0.min(p.y), y1.max(p.y));
     }
+    assert!((y1 - y0) * 0.5 >= 0.7, "the sphere spans {} of the height", (y1 - y0) * 0.5);
 }
 
 #[test]

@@ -39,7 +39,8 @@ impl DeferredSubpasses {
         };
         let textures = scene.textures.set_layout.raw;
         let attachments = (depth_format, Output::Subpasses, gbuffer_images(shading.object_textures));
-        let raster = MeshRaster::new(ctx, attachments, (gbuffer, shading), (textures, scene.object_textures.set_layout))?;
+        let raster =
+            MeshRaster::new(ctx, attachments, (gbuffer, shading, &scene.surface_variants), (textures, scene.object_textures.set_layout))?;
         let stages = [(&ml_shaders::FULLSCREEN_VERT, vk::ShaderStageFlags::VERTEX), (lighting, vk::ShaderStageFlags::FRAGMENT)];
         let mut pass = DeferredSubpasses {
             raster,

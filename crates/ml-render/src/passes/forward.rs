@@ -29,7 +29,7 @@ impl Forward {
     ) -> Result<Forward, VkError> {
         let fragment = if clustered { &ml_shaders::CLUSTERED_FRAG } else { &ml_shaders::FORWARD_FRAG };
         let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
-        let raster = MeshRaster::new(ctx, (depth_format, Output::Color, &[]), (fragment, shading), layouts)?;
+        let raster = MeshRaster::new(ctx, (depth_format, Output::Color, &[]), (fragment, shading, &scene.surface_variants), layouts)?;
         let mut pass = Forward { raster, legend: vk::Pipeline::null(), name };
         if legend {
             let shaders = (&ml_shaders::HEAT_LEGEND_VERT, &ml_shaders::HEAT_LEGEND_FRAG);

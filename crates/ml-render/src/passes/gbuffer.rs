@@ -19,7 +19,7 @@ impl GBuffer {
         let fragment = if shading.object_textures { &ml_shaders::GBUFFER_TEXTURED_FRAG } else { &ml_shaders::GBUFFER_FRAG };
         let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
         let attachments = (depth_format, Output::GBuffer, gbuffer_images(shading.object_textures));
-        Ok(GBuffer { raster: MeshRaster::new(ctx, attachments, (fragment, shading), layouts)? })
+        Ok(GBuffer { raster: MeshRaster::new(ctx, attachments, (fragment, shading, &scene.surface_variants), layouts)? })
     }
 }
 

@@ -14,7 +14,7 @@
 
 use crate::descriptors::FrameSets;
 use crate::frame::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::{MeshletScene, SharedMeshletScene};
+use crate::meshlet_scene::{MeshletScene, SharedMeshletScene, SPEC_SURFACE_TESTS};
 use crate::pass::{FrameResources, Pass, Recording, SlotReport};
 use crate::report::CullStats;
 use crate::settings::Raster;
@@ -71,7 +71,8 @@ impl MeshletCull {
                 p.instance_pipeline = shader::compute_pipeline(ctx, ml_shaders::INSTANCE_CULL_COMP.spirv, p.pipeline_layout, &[])?;
             }
             p.meshlet_pipeline = shader::compute_pipeline(ctx, ml_shaders::MESHLET_CULL_COMP.spirv, p.pipeline_layout, &[])?;
-            p.triangle_pipeline = shader::compute_pipeline(ctx, triangles.spirv, p.pipeline_layout, &[])?;
+            let surface = [(SPEC_SURFACE_TESTS, u32::from(p.scene.borrow().geometry.surface_tests))];
+            p.triangle_pipeline = shader::compute_pipeline(ctx, triangles.spirv, p.pipeline_layout, &surface)?;
             Ok(())
         })
     }

@@ -3,6 +3,7 @@
 //! resource (the shading passes sample it through the scene's texture set); this pass records
 //! its rendering in the mode the settings chose (omni_shadow.rs).
 
+use crate::omni_shadow::Casters;
 use crate::pass::{FrameResources, Pass, Recording};
 use ml_vk::{Context, VkError};
 
@@ -18,7 +19,10 @@ impl Pass for OmniShadowPass {
     }
 
     fn record(&self, rec: &Recording) {
-        rec.scene.omni.record(rec.ctx, rec.cmd, rec.shadowed, (&rec.scene.meshes, rec.objects));
+        let scene = rec.scene;
+        let casters =
+            Casters { meshes: &scene.meshes, objects: rec.objects, buffers: (scene.objects.raw, scene.alpha_masks.raw), slot: rec.slot };
+        scene.omni.record(rec.ctx, rec.cmd, rec.shadowed, &casters);
     }
 
     fn destroy(&mut self, _: &Context) {}

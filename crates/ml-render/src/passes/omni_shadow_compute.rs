@@ -54,7 +54,7 @@ impl Pass for OmniShadowCompute {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        self.raster.bind(ctx, frame.slot, frame.objects)
+        self.raster.bind(ctx, frame.slot, (frame.objects, frame.alpha_masks))
     }
 
     fn record(&self, rec: &Recording) {

@@ -6,7 +6,7 @@
 
 use crate::descriptors::FrameSets;
 use crate::frame::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::SharedMeshletScene;
+use crate::meshlet_scene::{SharedMeshletScene, SPEC_SURFACE_TESTS};
 use crate::pass::{FrameResources, Pass, Recording};
 use crate::passes::meshlet_cull::{cull_push, Phase};
 use crate::settings::Raster;
@@ -38,7 +38,8 @@ impl TriangleRasterLarge {
         ml_vk::build(ctx, pass, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, &[])?;
+            let surface = [(SPEC_SURFACE_TESTS, u32::from(p.scene.borrow().geometry.surface_tests))];
+            p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, &surface)?;
             Ok(())
         })
     }

@@ -36,8 +36,14 @@ impl VisibilityRaster {
         (phase, atomic): (Phase, bool),
         depth_format: vk::Format,
     ) -> Result<VisibilityRaster, VkError> {
-        let vert = &ml_shaders::VISIBILITY_VERT;
-        let frag = if atomic { &ml_shaders::VISIBILITY_ATOMIC_FRAG } else { &ml_shaders::VISIBILITY_FRAG };
+        // Masked or double-sided objects: both sides drawn, the fragment tests its surface.
+        let surface_tests = scene.borrow().geometry.surface_tests;
+        let (vert, frag) = match (surface_tests, atomic) {
+            (false, false) => (&ml_shaders::VISIBILITY_VERT, &ml_shaders::VISIBILITY_FRAG),
+            (false, true) => (&ml_shaders::VISIBILITY_VERT, &ml_shaders::VISIBILITY_ATOMIC_FRAG),
+            (true, false) => (&ml_shaders::VISIBILITY_SURFACE_VERT, &ml_shaders::VISIBILITY_SURFACE_FRAG),
+            (true, true) => (&ml_shaders::VISIBILITY_SURFACE_VERT, &ml_shaders::VISIBILITY_ATOMIC_SURFACE_FRAG),
+        };
         let stages = [(vert, vk::ShaderStageFlags::VERTEX), (frag, vk::ShaderStageFlags::FRAGMENT)];
         let pass = VisibilityRaster {
             phase,
@@ -55,8 +61,9 @@ impl VisibilityRaster {
                     .create(ctx)?;
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::FRAGMENT).size(16)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            // The G-buffer pass's state: back faces culled (counter-clockwise fronts), depth LESS
-            // (the atomic min is the test of the compute raster's half).
+            // The G-buffer pass's state: back faces culled (counter-clockwise fronts) — or, with
+            // surface tests, by the fragment shader —, depth LESS (the atomic min is the test
+            // of the compute raster's half).
             p.pipeline = shader::graphics_pipeline(
                 ctx,
                 &shader::GraphicsPipelineDesc {
@@ -67,7 +74,7 @@ impl VisibilityRaster {
                     vertex_input: vk::PipelineVertexInputStateCreateInfo::default(),
                     rasterization: vk::PipelineRasterizationStateCreateInfo::default()
                         .polygon_mode(vk::PolygonMode::FILL)
-                        .cull_mode(vk::CullModeFlags::BACK)
+                        .cull_mode(if surface_tests { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK })
                         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
                         .line_width(1.0),
                     depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default()
