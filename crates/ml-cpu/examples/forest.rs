@@ -56,7 +56,8 @@ fn crown(leaves: u32, seed: u64) -> PrimitiveData {
             }
         }
         let centre = glam::Vec3::new(x * 2.0, 4.5 + y * 1.5, z * 2.0);
-        let turn = glam::Quat::from_euler(glam::EulerRot::YXZ, rng.next() * 6.283, rng.next() * 2.0 - 1.0, rng.next() * 1.2 - 0.6);
+        let turn =
+            glam::Quat::from_euler(glam::EulerRot::YXZ, rng.next() * std::f32::consts::TAU, rng.next() * 2.0 - 1.0, rng.next() * 1.2 - 0.6);
         let (right, up) = (turn * glam::Vec3::X * 0.25, turn * glam::Vec3::Y * 0.25);
         let normal = turn * glam::Vec3::Z;
         let first = p.positions.len() as u32;
@@ -101,7 +102,7 @@ fn main() {
     for t in 0..trees {
         let (i, j) = ((t % side) as f32, (t / side) as f32);
         let at = [(i - side as f32 * 0.5) * spacing + rng.next() * 2.0, 0.0, (j - side as f32 * 0.5) * spacing + rng.next() * 2.0];
-        let (s, c) = (rng.next() * 3.14).sin_cos();
+        let (s, c) = (rng.next() * std::f32::consts::PI).sin_cos();
         w.node(json!({ "mesh": kinds[t as usize % kinds.len()], "translation": at, "rotation": [0.0, s, 0.0, c] }), true);
         w.node(json!({ "mesh": trunk, "translation": [at[0], 1.75, at[2]], "scale": [0.15, 1.75, 0.15] }), true);
     }

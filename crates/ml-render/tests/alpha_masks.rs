@@ -29,7 +29,7 @@ use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::camera::Camera;
 use ml_cpu::gltf_writer::{cutout, png, quad, GltfWriter, PrimitiveData, CUTOUT_SIZE};
 use ml_cpu::gpu_types::PointLight;
-use ml_cpu::scene::Scene;
+use ml_cpu::scene::{AlphaMode, Scene};
 use ml_render::scene_textures::SHADOW_MAP_SIZE;
 use ml_render::settings::{multiview_depth_is_broken, AtlasSettings};
 use ml_render::{
@@ -341,18 +341,24 @@ fn albedo_view(a: Vec3) -> [u8; 3] {
 /// At every sure pixel where the CPU sees an object, the albedo view shows its albedo (within
 /// 2/255): holes show what is behind them, plates their quad. Returns the pixels checked.
 fn assert_albedo_is_the_cpus(what: &str, scene: &Scene, out: &RenderOutput, cpu: &CpuView) -> usize {
+    assert_view_is_the_cpus(what, out, cpu, |object| albedo_view(scene.objects[object].material.albedo))
+}
+
+/// At every sure pixel where the CPU sees an object, the image shows `view(object)` (within
+/// 2/255). Returns the pixels checked.
+fn assert_view_is_the_cpus(what: &str, out: &RenderOutput, cpu: &CpuView, view: impl Fn(usize) -> [u8; 3]) -> usize {
     let mut wrong = Vec::new();
     let mut checked = 0;
     for (x, y) in cpu.pixels().filter(|&(x, y)| cpu.sure(x, y)) {
         let Some(object) = cpu.object(x, y) else { continue };
-        let want = albedo_view(scene.objects[object].material.albedo);
+        let want = view(object);
         let got = common::pixel(out, x, y);
         checked += 1;
         if got.iter().zip(want).any(|(g, w)| g.abs_diff(w) > 2) {
             wrong.push(((x, y), object, got, want));
         }
     }
-    println!("{what}: albedo view checked at {checked} sure pixels, {} wrong", wrong.len());
+    println!("{what}: checked at {checked} sure pixels, {} wrong", wrong.len());
     assert!(
         wrong.is_empty(),
         "{what}: {} sure pixels show another surface than the CPU's ((x, y), object, shown, expected): {:?}",
@@ -460,12 +466,42 @@ fn b_every_sure_pixel_shows_what_the_cpu_sees() {
     }
 }
 
+/// The alpha debug view colours each surface by its alpha mode (opaque grey, masked green,
+/// blended orange; double-sided brighter) at every sure pixel, in every technique and raster.
+#[test]
+fn the_alpha_view_shows_each_surfaces_mode() {
+    let (scene, _) = grid_scene();
+    let tracer = Tracer::new(&scene);
+    let cpu = CpuView::new(&tracer, (GRID_W, GRID_H), true, false);
+    let expected = |object: usize| {
+        let x = &scene.objects[object].extras;
+        let display = match x.alpha_mode {
+            AlphaMode::Blend => Vec3::new(1.0, 0.5, 0.1),
+            AlphaMode::Mask { .. } => Vec3::new(0.2, 0.9, 0.2),
+            AlphaMode::Opaque => Vec3::splat(0.45),
+        } * if x.double_sided { 1.0 } else { 0.7 };
+        display.to_array().map(|c| (c * 255.0).round() as u8)
+    };
+    let kinds: std::collections::BTreeSet<String> = scene.objects.iter().map(|o| format!("{:?}", o.extras.alpha_mode)).collect();
+    assert!(kinds.len() >= 3, "the grid should hold opaque, masked and blended surfaces: {kinds:?}");
+    let mut settings: Vec<RenderSettings> =
+        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Pbr, DebugView::Alpha, (GRID_W, GRID_H))).collect();
+    let vis = *settings.last().unwrap();
+    settings.push(RenderSettings { raster: Raster::compute(Raster::DEFAULT_SPLIT), ..vis });
+    for (o, s) in common::render_each(&scene, &settings).iter().zip(&settings) {
+        let checked = assert_view_is_the_cpus(&format!("alpha view {} {:?}", s.technique.name(), s.raster), o, &cpu, expected);
+        assert!(checked > 5000, "only {checked} pixels checked");
+    }
+}
+
 const ROW_W: u32 = 240;
 const ROW_H: u32 = 80;
 
-/// What each quad of the row is: (name, alphaMode, alphaCutoff, factor alpha, whether it has
-/// the cut-out texture, whether it is drawn at all, whether it has holes).
-const ROW: [(&str, &str, Option<f32>, f32, bool, bool, bool); 7] = [
+/// What a quad of the row is: (name, alphaMode, alphaCutoff, factor alpha, whether it has the
+/// cut-out texture, whether it is drawn at all, whether it has holes).
+type RowQuad = (&'static str, &'static str, Option<f32>, f32, bool, bool, bool);
+
+const ROW: [RowQuad; 7] = [
     ("mask", "MASK", None, 1.0, true, true, true),
     ("mask-faint", "MASK", None, 0.45, true, false, false),
     ("mask-low-cutoff", "MASK", Some(0.3), 0.45, true, true, true),
