@@ -71,8 +71,21 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces, Surf
     if (!small_triangle(pa, pb, pc, ivec2(frame.viewport.xy), both_faces, t)) {
         return 0u;
     }
+    // A masked triangle's texture coordinates: perspective-correct from the edge functions
+    // (each corner's weight over its w), as the hardware interpolates; per corner uv/w and 1/w.
+    vec3 inv_w = vec3(0.0);
+    vec3 u_w = vec3(0.0), v_w = vec3(0.0);
+    if (s.masked) {
+        inv_w = 1.0 / vec3(s.clip[0].w, s.clip[1].w, s.clip[2].w);
+        u_w = vec3(s.uv[0].x, s.uv[1].x, s.uv[2].x) * inv_w;
+        v_w = vec3(s.uv[0].y, s.uv[1].y, s.uv[2].y) * inv_w;
+    }
     if (t.swapped) {
-        z = z.xzy; // front faces come swapped
+        // Front faces come swapped: corners b and c.
+        z = z.xzy;
+        inv_w = inv_w.xzy;
+        u_w = u_w.xzy;
+        v_w = v_w.xzy;
     }
     uint covered = 0u;
     for (int y = t.first.y; y <= t.last.y; y++) {
@@ -82,7 +95,8 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces, Surf
                 continue;
             }
             float depth = dot(vec3(w), z) / float(t.area);
-            if (!surface_kept(s, ivec2(x, y), vec2(frame.viewport.xy))) {
+            vec3 weights = vec3(w);
+            if (s.masked && !alpha_kept(s.alpha, s.alpha_texture, vec2(dot(weights, u_w), dot(weights, v_w)) / dot(weights, inv_w))) {
                 continue;
             }
             covered++;
