@@ -116,16 +116,12 @@ float interpolated_depth(vec3 weights, vec4 qa, vec4 qb, vec4 qc) {
 SurfaceTest omni_surface_test(uint object, uvec3 v, vec4 a, vec4 b, vec4 c) {
     SurfaceTest s = no_surface_test();
     if (SURFACE_TESTS && (instances[object].meshlets.w & INSTANCE_MASKED) != 0u) {
-        s.masked = true;
-        s.alpha = objects[object].alpha;
-        s.alpha_texture = objects[object].alpha_texture;
-        s.clip[0] = a;
-        s.clip[1] = b;
-        s.clip[2] = c;
         uvec3 f = VERTEX_FLOATS * v;
-        s.uv[0] = transform_uv(objects[object].uv_transform, vec2(vertex_data[f.x + 6u], vertex_data[f.x + 7u]));
-        s.uv[1] = transform_uv(objects[object].uv_transform, vec2(vertex_data[f.y + 6u], vertex_data[f.y + 7u]));
-        s.uv[2] = transform_uv(objects[object].uv_transform, vec2(vertex_data[f.z + 6u], vertex_data[f.z + 7u]));
+        vec4 t[2] = objects[object].uv_transform;
+        vec2 ua = transform_uv(t, vec2(vertex_data[f.x + 6u], vertex_data[f.x + 7u]));
+        vec2 ub = transform_uv(t, vec2(vertex_data[f.y + 6u], vertex_data[f.y + 7u]));
+        vec2 uc = transform_uv(t, vec2(vertex_data[f.z + 6u], vertex_data[f.z + 7u]));
+        s = masked_surface(objects[object].alpha, objects[object].alpha_texture, a, b, c, ua, ub, uc);
     }
     return s;
 }

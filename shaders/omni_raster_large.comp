@@ -56,13 +56,8 @@ void main() {
         SurfaceTest s = no_surface_test();
         if (corner_masked) {
             uint object = meshlet_instances[pairs[large_triangles[e].x].x].x;
-            s.masked = true;
-            s.alpha = objects[object].alpha;
-            s.alpha_texture = objects[object].alpha_texture;
-            for (int i = 0; i < 3; i++) {
-                s.clip[i] = corner_clip[i];
-                s.uv[i] = corner_uv[i];
-            }
+            s = masked_surface(objects[object].alpha, objects[object].alpha_texture, corner_clip[0], corner_clip[1], corner_clip[2],
+                               corner_uv[0], corner_uv[1], corner_uv[2]);
         }
         ivec2 side = ivec2(view_side(layer));
         int corners = corner_count;

@@ -43,6 +43,22 @@ bool surface_kept(SurfaceTest s, ivec2 pixel, vec2 size) {
     return alpha_kept(s.alpha, s.alpha_texture, l.x * s.uv[0] + l.y * s.uv[1] + l.z * s.uv[2]);
 }
 
+// The test of a masked object's triangle: the object's ObjectData `alpha` and
+// `alpha_texture`, the triangle's clip-space corners a, b, c and their texture coordinates.
+SurfaceTest masked_surface(vec4 alpha, uvec4 alpha_texture, vec4 a, vec4 b, vec4 c, vec2 ua, vec2 ub, vec2 uc) {
+    SurfaceTest s;
+    s.masked = true;
+    s.alpha = alpha;
+    s.alpha_texture = alpha_texture;
+    s.clip[0] = a;
+    s.clip[1] = b;
+    s.clip[2] = c;
+    s.uv[0] = ua;
+    s.uv[1] = ub;
+    s.uv[2] = uc;
+    return s;
+}
+
 // No test: every pixel kept.
 SurfaceTest no_surface_test() {
     SurfaceTest s;

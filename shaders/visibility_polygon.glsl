@@ -118,16 +118,10 @@ uint raster_polygon_alone(Polygon p, uint id, bool both_faces, SurfaceTest s) {
 SurfaceTest large_surface(uint at, uint object) {
     SurfaceTest s = no_surface_test();
     if (object != NOT_MASKED) {
-        s.masked = true;
-        s.alpha = objects[object].alpha;
-        s.alpha_texture = objects[object].alpha_texture;
-        s.clip[0] = large_triangles[at].surface_clip[0];
-        s.clip[1] = large_triangles[at].surface_clip[1];
-        s.clip[2] = large_triangles[at].surface_clip[2];
         vec4 uv = large_triangles[at].surface_uv[0];
-        s.uv[0] = uv.xy;
-        s.uv[1] = uv.zw;
-        s.uv[2] = large_triangles[at].surface_uv[1].xy;
+        s = masked_surface(objects[object].alpha, objects[object].alpha_texture, large_triangles[at].surface_clip[0],
+                           large_triangles[at].surface_clip[1], large_triangles[at].surface_clip[2], uv.xy, uv.zw,
+                           large_triangles[at].surface_uv[1].xy);
     }
     return s;
 }
