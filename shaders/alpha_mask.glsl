@@ -14,7 +14,11 @@ layout(std430, set = 0, binding = ALPHA_MASK_BINDING) readonly buffer AlphaMaskB
 // exact for the sizes and offsets a texture has, and cheaper than an integer division).
 int floor_mod(int i, int n) {
     // Powers of two, most textures' sizes: a mask (two's complement keeps it right for i < 0).
-    return (n & (n - 1)) == 0 ? i & (n - 1) : int(mod(float(i), float(n)));
+    // A branch, not a select: the division is not computed where the mask does.
+    if ((n & (n - 1)) == 0) {
+        return i & (n - 1);
+    }
+    return int(mod(float(i), float(n)));
 }
 
 // Texel i of a row or column of `size` under wrap mode `mode` (0 repeat, 1 mirrored repeat,
