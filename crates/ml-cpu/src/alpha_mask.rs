@@ -64,7 +64,7 @@ impl AlphaMasks {
     pub fn pack(scene: &Scene) -> Result<AlphaMasks, TooMuchAlpha> {
         let mut masks = AlphaMasks::default();
         let mut bytes: Vec<u8> = Vec::new();
-        for o in scene.objects.iter().filter(|o| o.extras.alpha_mode.cutoff().is_some()) {
+        for o in scene.objects.iter().filter(|o| o.extras.masked()) {
             let Some(t) = o.textures.base_color else { continue };
             let Some(image) = scene.textures.get(t as usize) else { continue };
             if masks.first.contains_key(&t) {

@@ -164,7 +164,7 @@ fn surface_flags(o: &crate::scene::Object, placement: u32) -> u32 {
     if o.extras.double_sided {
         flags = (flags & !INSTANCE_CONE_CULLING) | INSTANCE_DOUBLE_SIDED;
     }
-    if o.extras.alpha_mode.cutoff().is_some() {
+    if o.extras.masked() {
         flags |= INSTANCE_MASKED;
     }
     flags

@@ -95,6 +95,13 @@ impl Default for MaterialExtras {
     }
 }
 
+impl MaterialExtras {
+    /// Whether an alpha mask cuts points out of the surface (MASK, and BLEND drawn as a mask).
+    pub fn masked(&self) -> bool {
+        self.alpha_mode.cutoff().is_some()
+    }
+}
+
 /// glTF's alpha modes: what a surface's alpha does to its pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AlphaMode {

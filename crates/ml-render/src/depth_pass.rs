@@ -9,7 +9,6 @@
 use crate::descriptors::{FrameSets, Resource};
 use crate::gpu_mesh::{vertex_attributes, vertex_binding};
 use glam::Mat4;
-use ml_cpu::scene::Object;
 use ml_shaders::Shader;
 use ml_vk::{shader, vk, Context, VkError, VkResultExt};
 
@@ -127,11 +126,6 @@ pub fn set_square_viewport(ctx: &Context, cmd: vk::CommandBuffer, size: u32) {
 
 /// The clear value: the far plane.
 pub const CLEAR_FAR: [vk::ClearValue; 1] = [vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } }];
-
-/// Whether object `o` is alpha-masked: its shadow is drawn by the masked pipeline.
-pub fn masked(o: &Object) -> bool {
-    o.extras.alpha_mode.cutoff().is_some()
-}
 
 /// Push constants of the masked pipelines (shadow_mask.glsl `ShadowMaskPush`; keep in sync):
 /// the pass's view-projection, the object's (affine) model matrix as its three rows, and the

@@ -49,7 +49,7 @@ impl SurfaceVariant {
 
     /// The variant that draws object `o`.
     pub fn of(o: &Object) -> SurfaceVariant {
-        SurfaceVariant { double_sided: o.extras.double_sided, masked: o.extras.alpha_mode.cutoff().is_some() }
+        SurfaceVariant { double_sided: o.extras.double_sided, masked: o.extras.masked() }
     }
 
     /// The variants `objects` need, the opaque one always among them.
@@ -243,13 +243,9 @@ impl MeshRaster {
                 |index, o| {
                     let variant = SurfaceVariant::of(o);
                     if variant != bound_variant {
-                        // A variant the pass was not made for (objects replaced since) draws
-                        // as opaque and single-sided.
-                        let pipeline = match self.pipelines[variant.index()] {
-                            p if p == vk::Pipeline::null() => self.pipelines[SurfaceVariant::OPAQUE.index()],
-                            p => p,
-                        };
-                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                        // Made for every variant the scene's objects have (SceneGpu refuses
+                        // replaced objects of another).
+                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipelines[variant.index()]);
                         bound_variant = variant;
                     }
                     let set = scene.object_textures.per_object[index as usize];

@@ -76,10 +76,7 @@ impl MeshletGeometry {
             surface_tests: g.instances.iter().any(|i| i.meshlets[3] & (INSTANCE_DOUBLE_SIDED | INSTANCE_MASKED) != 0),
         };
         ml_vk::build(ctx, geometry, |s| {
-            let upload = |name: &str, data: &[u8]| {
-                storage_bytes(ctx, name, data.len() as u64)?;
-                Buffer::device_local_with(ctx, name, data, vk::BufferUsageFlags::STORAGE_BUFFER)
-            };
+            let upload = |name: &str, data: &[u8]| storage_buffer_with(ctx, name, data);
             s.vertices = upload("vertices", bytemuck::cast_slice(&g.vertices))?;
             s.meshlet_vertices = upload("meshlet vertices", bytemuck::cast_slice(&g.meshlet_vertices))?;
             s.meshlet_triangles = upload("meshlet triangles", bytemuck::cast_slice(&g.meshlet_triangles))?;
@@ -136,6 +133,13 @@ pub fn storage_bytes(ctx: &Context, name: &str, bytes: u64) -> Result<u64, VkErr
         )));
     }
     Ok(bytes)
+}
+
+/// A device-local storage buffer holding `data` (`name` is the scene's, for the error), no
+/// larger than the device binds as one storage buffer.
+pub fn storage_buffer_with(ctx: &Context, name: &str, data: &[u8]) -> Result<Buffer, VkError> {
+    storage_bytes(ctx, name, data.len() as u64)?;
+    Buffer::device_local_with(ctx, name, data, vk::BufferUsageFlags::STORAGE_BUFFER)
 }
 
 pub struct MeshletScene {

@@ -14,10 +14,11 @@
 //!
 //! Alpha-masked objects are drawn in each pass after the others, by a pipeline of their own
 //! whose fragment shader drops what their masks cut out (depth_pass.rs MaskedPipeline), made
-//! with the others where the scene has a masked object: scenes without one never make it.
+//! with the others where the scene has a masked object (scenes without one never make it),
+//! its set pointed at the scene's object buffer and alpha masks whenever those are made
+//! (`bind_casters`).
 
-use crate::depth_pass::{self, masked, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
-use crate::frame::FRAMES_IN_FLIGHT;
+use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::settings::{OmniShadowMode, OmniShadowSettings};
 use crate::shadow_atlas::ShadowAtlasGpu;
@@ -63,16 +64,6 @@ pub struct OmniShadows {
     masked: Option<MaskedPipeline>,
     /// Whether to make it.
     has_masked: bool,
-}
-
-/// What the cubes are drawn from this frame.
-pub struct Casters<'a> {
-    pub meshes: &'a [GpuMesh],
-    pub objects: &'a [Object],
-    /// The scene's object buffer and alpha masks (read by the masked objects' pipeline).
-    pub buffers: (vk::Buffer, vk::Buffer),
-    /// The frame slot being recorded (the masked pipeline's set of that slot is rewritten).
-    pub slot: usize,
 }
 
 const DEPTH: vk::ImageAspectFlags = vk::ImageAspectFlags::DEPTH;
@@ -154,7 +145,8 @@ impl OmniShadows {
                 _ => &ml_shaders::OMNI_SHADOW_MASKED_VERT,
             };
             let shaders = (vertex, &ml_shaders::OMNI_SHADOW_MASKED_FRAG);
-            self.masked = Some(MaskedPipeline::new(ctx, self.render_pass, shaders, FRAMES_IN_FLIGHT)?);
+            // One set: it points at the scene's buffers, which change only between frames.
+            self.masked = Some(MaskedPipeline::new(ctx, self.render_pass, shaders, 1)?);
         }
         let extent = shape.extent;
         match settings.mode {
@@ -211,26 +203,20 @@ impl OmniShadows {
         2.0 / self.cubes.extent.width as f32
     }
 
-    /// The masked objects' pipeline where `casters` has masked objects, its set of
-    /// `casters.slot` pointed at the scene's buffers.
-    fn masked_pipeline(&self, ctx: &Context, casters: &Casters) -> Option<&MaskedPipeline> {
-        let m = self.masked.as_ref().filter(|_| casters.objects.iter().any(masked))?;
-        // The slot's previous frame has finished (its fence was waited for) and nothing this
-        // frame has bound the set yet. The write is by the names its own shaders declare,
-        // which `bind` provides: it cannot miss one.
-        m.bind(ctx, casters.slot, casters.buffers).inspect_err(|e| eprintln!("point-light shadows: {e}")).ok()?;
-        Some(m)
+    /// Point the masked objects' pipeline (if any) at the scene's object buffer and alpha
+    /// masks (no frame in flight).
+    pub fn bind_casters(&self, ctx: &Context, buffers: (vk::Buffer, vk::Buffer)) -> Result<(), VkError> {
+        self.masked.as_ref().map_or(Ok(()), |m| m.bind(ctx, 0, buffers))
     }
 
     /// Render every cube: `lights[i]` into cube i, the objects that reach into its sphere.
     /// Leaves the array DEPTH_STENCIL_READ_ONLY_OPTIMAL, its writes visible to fragment and
     /// compute shaders.
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], casters: &Casters) {
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
         let Some(settings) = self.cube_settings().filter(|s| !matches!(s.mode, OmniShadowMode::Compute { .. })) else { return };
-        let (meshes, objects) = (casters.meshes, casters.objects);
-        let masked_pipeline = self.masked_pipeline(ctx, casters);
+        let masked_pipeline = self.masked.as_ref();
         // Which objects the masked pipeline draws (none without it).
-        let is_masked: Vec<bool> = objects.iter().map(|o| masked_pipeline.is_some() && masked(o)).collect();
+        let is_masked: Vec<bool> = objects.iter().map(|o| masked_pipeline.is_some() && o.extras.masked()).collect();
         let d = &ctx.device;
         let size = settings.size;
         let copy = settings.mode == OmniShadowMode::Copy;
@@ -296,7 +282,7 @@ impl OmniShadows {
                     // Then the masked objects that reach this pass's faces, by their pipeline.
                     let cut = |i: u32| if is_masked[i as usize] { instances(i) } else { 0 };
                     if let Some(m) = masked_pipeline.filter(|_| (0..objects.len() as u32).any(|i| cut(i) != 0)) {
-                        m.record_bind(ctx, cmd, casters.slot);
+                        m.record_bind(ctx, cmd, 0);
                         record_draws(ctx, cmd, (meshes, objects), cut, |i, object| {
                             m.push(ctx, cmd, &ShadowMaskPush::new(view_proj, world_to_light * object.transform, i));
                         });

@@ -5,7 +5,7 @@
 use crate::error::RenderError;
 use crate::gpu_mesh::GpuMesh;
 use crate::mesh_raster::{object_data, SurfaceVariant};
-use crate::meshlet_scene::storage_bytes;
+use crate::meshlet_scene::storage_buffer_with;
 use crate::object_textures::ObjectTextureSets;
 use crate::omni_shadow::OmniShadows;
 use crate::scene_textures::SceneTextures;
@@ -47,7 +47,7 @@ impl SceneGpu {
         let sun = (settings.shading == ShadingModel::BlinnPhong).then_some(settings.sun_shadow);
         // Each of these needs the ones before it; a failure releases those.
         let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
-        let has_masked = scene.objects.iter().any(|o| o.extras.alpha_mode.cutoff().is_some());
+        let has_masked = scene.objects.iter().any(|o| o.extras.masked());
         let mut omni = OmniShadows::new(ctx, settings.omni, has_masked)?;
         let mut textures = release_on_error(ctx, SceneTextures::new(ctx, sun.is_some(), gbuffer_depth, &omni), &mut [&mut omni])?;
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
@@ -87,11 +87,10 @@ impl SceneGpu {
             self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
         }
         let masks = AlphaMasks::pack(scene).map_err(|e| VkError::Limit(e.to_string()))?;
-        let bytes: &[u8] = bytemuck::cast_slice(&masks.words);
-        storage_bytes(ctx, "alpha masks", bytes.len() as u64)?;
-        self.alpha_masks = Buffer::device_local_with(ctx, "alpha masks", bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        self.alpha_masks = storage_buffer_with(ctx, "alpha masks", bytemuck::cast_slice(&masks.words))?;
         let objects: Vec<ObjectData> = scene.objects.iter().map(|o| object_data(o, &masks, &scene.textures)).collect();
         self.objects = Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        self.omni.bind_casters(ctx, (self.objects.raw, self.alpha_masks.raw))?;
         let (lo, hi) = scene.bounds();
         self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
         if let Some(mode) = self.sun {
@@ -113,6 +112,11 @@ impl SceneGpu {
     /// sun shadow map. Only for scenes without object textures (every object binds the one
     /// set of stand-ins).
     pub fn replace_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), VkError> {
+        // The passes were made for the surface variants (and the masked shadow pipeline) of the
+        // objects before.
+        if let Some(v) = SurfaceVariant::needed(&scene.objects).into_iter().find(|v| !self.surface_variants.contains(v)) {
+            return Err(VkError::Limit(format!("replaced objects need a surface the renderer was not made for ({v:?})")));
+        }
         self.release_objects(ctx);
         let stand_ins = self.object_textures.sets[0];
         self.object_textures.per_object = vec![stand_ins; scene.objects.len()];

@@ -7,7 +7,7 @@
 //! shader drops what their masks cut out (depth_pass.rs MaskedPipeline; made only for scenes
 //! with masked objects).
 
-use crate::depth_pass::{self, masked, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
+use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::settings::SunShadowMode;
 use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
@@ -106,7 +106,7 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&
         if let Some((s, _)) = &inputs {
             layout = shader::pipeline_layout(ctx, &[], &push)?;
             pipeline = depth_pass::pipeline(ctx, render_pass, layout, (ml_shaders::SHADOW_VERT.spirv, None))?;
-            if s.scene.objects.iter().any(masked) {
+            if s.scene.objects.iter().any(|o| o.extras.masked()) {
                 let shaders = (&ml_shaders::SHADOW_MASKED_VERT, &ml_shaders::SHADOW_MASKED_FRAG);
                 let m = masked_pipeline.insert(MaskedPipeline::new(ctx, render_pass, shaders, 1)?);
                 m.bind(ctx, 0, (s.objects, s.alpha_masks))?;
@@ -135,7 +135,7 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&
                         ctx,
                         cmd,
                         (s.meshes, objects),
-                        |i| u32::from(!masked(&objects[i as usize])),
+                        |i| u32::from(!objects[i as usize].extras.masked()),
                         |_, object| {
                             let push =
                                 ShadowPush { model: object.transform.to_cols_array_2d(), light_view_proj: s.view_proj.to_cols_array_2d() };
@@ -148,7 +148,7 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&
                             ctx,
                             cmd,
                             (s.meshes, objects),
-                            |i| u32::from(masked(&objects[i as usize])),
+                            |i| u32::from(objects[i as usize].extras.masked()),
                             |i, object| m.push(ctx, cmd, &ShadowMaskPush::new(s.view_proj, object.transform, i)),
                         );
                     }

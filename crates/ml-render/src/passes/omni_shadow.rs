@@ -3,7 +3,6 @@
 //! resource (the shading passes sample it through the scene's texture set); this pass records
 //! its rendering in the mode the settings chose (omni_shadow.rs).
 
-use crate::omni_shadow::Casters;
 use crate::pass::{FrameResources, Pass, Recording};
 use ml_vk::{Context, VkError};
 
@@ -19,10 +18,7 @@ impl Pass for OmniShadowPass {
     }
 
     fn record(&self, rec: &Recording) {
-        let scene = rec.scene;
-        let casters =
-            Casters { meshes: &scene.meshes, objects: rec.objects, buffers: (scene.objects.raw, scene.alpha_masks.raw), slot: rec.slot };
-        scene.omni.record(rec.ctx, rec.cmd, rec.shadowed, &casters);
+        rec.scene.omni.record(rec.ctx, rec.cmd, rec.shadowed, (&rec.scene.meshes, rec.objects));
     }
 
     fn destroy(&mut self, _: &Context) {}
