@@ -344,7 +344,10 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     let mut scene = Scene { meshes, textures, directional, cones, ..Scene::new(objects, lights, Camera::seed()) };
     scene.camera = match camera {
         Some(c) => c,
-        None => framing_camera(&scene),
+        None => {
+            scene.camera_framed = true;
+            framing_camera(&scene)
+        }
     };
     Ok((scene, warnings))
 }

@@ -173,6 +173,9 @@ pub struct Scene {
     /// fitted to the scene `LightFrame::motion`).
     pub light_motion: f32,
     pub camera: Camera,
+    /// Whether `camera` is the one framing the scene for a default-sized image (a file without
+    /// a camera of its own): a render of another aspect frames the scene again for its own.
+    pub camera_framed: bool,
     pub ambient: f32,
     /// The other lights of the blinn-phong model (the seed model ignores them).
     pub blinn_phong: BlinnPhongLights,
@@ -233,6 +236,7 @@ impl Scene {
             lights,
             light_motion: crate::lights::SEED_MOTION,
             camera,
+            camera_framed: false,
             ambient: SEED_AMBIENT,
             blinn_phong: BlinnPhongLights::default(),
             meshes: Vec::new(),

@@ -271,7 +271,7 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
         cones: if cones.iter().all(|c| *c == LightCone::NONE) { Vec::new() } else { cones },
         ..Scene::new(objects, lights, Camera::seed())
     };
-    scene.camera = camera(file.camera.as_ref(), &scene)?;
+    (scene.camera, scene.camera_framed) = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading, warnings })
 }
 
@@ -428,8 +428,9 @@ fn light(l: &FileLight) -> Result<Light, Problem> {
 /// The file's camera; fields it leaves out come from a camera framing every object: without
 /// position and target, the one that frames the objects for a default-sized image
 /// (`camera::frame_scene`; a render of another aspect frames them again for its own), else
-/// looking at the centre of their bounds from above and in front, the whole box in view.
-fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
+/// looking at the centre of their bounds from above and in front, the whole box in view. And
+/// whether it is that framing camera unchanged (`Scene::camera_framed`).
+fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<(Camera, bool), Problem> {
     let (lo, hi) = scene.bounds();
     let centre = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
@@ -446,7 +447,8 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
             return Err(Problem::NearFar { near, far });
         }
         let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| positive("[camera] ortho_half_height", h)).transpose()?;
-        return Ok(Camera { near, far, orthographic, ..framed });
+        let camera = Camera { near, far, orthographic, ..framed };
+        return Ok((camera, camera == framed));
     }
     let position = match c.and_then(|c| c.position) {
         Some(p) => vec3("[camera] position", p)?,
@@ -470,7 +472,7 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<Camera, Problem> {
         return Err(Problem::CameraVertical);
     }
     let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| positive("[camera] ortho_half_height", h)).transpose()?;
-    Ok(Camera { orthographic, ..Camera::looking_at(position, target, fov, near, far) })
+    Ok((Camera { orthographic, ..Camera::looking_at(position, target, fov, near, far) }, false))
 }
 
 /// `scene` as a scene file (built-in meshes only), every field written out: what `load` reads

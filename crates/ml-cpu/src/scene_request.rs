@@ -130,6 +130,7 @@ impl SceneRequest {
         let mut built = self.build_scene()?;
         if let Some(spec) = &self.camera {
             built.scene.camera = spec.camera(built.scene.bounds());
+            built.scene.camera_framed = false;
         }
         if self.show_lights {
             built.scene = built.scene.with_light_markers()?;
@@ -169,9 +170,8 @@ impl SceneRequest {
             file.warnings.into_iter().map(|message| SceneWarning::Left { path: path.clone(), message }).collect();
         let mut scene = file.scene;
         // A file without a camera came with one framing it for a default-sized image: frame it
-        // for this one. (The loaders' framing is `frame_scene` at DEFAULT_ASPECT; a camera of the
-        // file's own is never exactly that.)
-        if self.aspect != DEFAULT_ASPECT && scene.camera == frame_scene(&scene, DEFAULT_ASPECT, scene.camera.fov_y_deg) {
+        // for this one (unless `--camera` replaces it anyway).
+        if scene.camera_framed && self.aspect != DEFAULT_ASPECT && self.camera.is_none() {
             scene.camera = frame_scene(&scene, self.aspect, scene.camera.fov_y_deg);
         }
         let unlit = scene.lights.is_empty() && scene.directional.is_empty();
