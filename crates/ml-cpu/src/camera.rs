@@ -183,8 +183,13 @@ pub fn frame_points(points: &[Vec3], aspect: f32, fov_y_deg: f32) -> Camera {
             }
             far *= 2.0;
         }
-        for _ in 0..64 {
+        // Down to a millionth of the distance (each step is a pass over every point): `far`
+        // always fits.
+        while far - near > far.abs() * 1e-6 {
             let mid = 0.5 * (near + far);
+            if mid <= near || mid >= far {
+                break;
+            }
             if fits(mid, shift) {
                 far = mid;
             } else {
