@@ -40,7 +40,9 @@ layout(location = 1) in vec2 in_uv;
 // Drops the fragment where the object's mask cuts it out.
 void shadow_mask_test() {
     uint o = shadow_mask.object.x;
-    if (!alpha_kept(objects[o].alpha, objects[o].alpha_texture, in_uv)) {
+    // The texture transform per fragment: it is affine, so this equals transforming the
+    // corners' coordinates before they are interpolated.
+    if (!alpha_kept(objects[o].alpha, objects[o].alpha_texture, transform_uv(objects[o].uv_transform, in_uv))) {
         discard;
     }
 }

@@ -151,6 +151,9 @@ fn grid_scene() -> (Scene, Vec<String>) {
             _ => w.alpha_material(Some(nearest), [c[0], c[1], c[2], 1.0], "MASK", None, true),
         };
         w.material_name(m, &format!("plate-{i}"));
+        if i == 8 {
+            transform_texture(&mut w, m);
+        }
         let (col, row) = ((i % 3) as f32 - 1.0, (i / 3) as f32 - 1.0);
         add_quad(&mut w, m, Vec3::new(col * 3.0, 1.3, row * 3.0), standing(yaw), Vec3::ONE);
     }
@@ -618,11 +621,20 @@ const SHADOW_SIZE: u32 = 96;
 
 /// A floor, and a masked plate (single-sided, facing up) at `plate_y` above it, `half` to a
 /// side (hole radius 0.3125 · half).
+/// Give material `m`'s base colour texture a KHR_texture_transform (moved, turned a little,
+/// its holes shifted: every pass must cut where the CPU, which applies it, says).
+fn transform_texture(w: &mut GltfWriter, m: usize) {
+    let transform = json!({ "offset": [0.1, 0.05], "rotation": 0.2, "scale": [1.1, 0.95] });
+    w.json["materials"][m]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = json!({ "KHR_texture_transform": transform });
+    w.json["extensionsUsed"] = json!(["KHR_texture_transform"]);
+}
+
 fn plate_scene(camera: Camera, lights: Vec<PointLight>, plate_y: f32, half: f32, floor: f32) -> Scene {
     let mut w = GltfWriter::new();
     let texture = cutout_texture(&mut w);
     add_floor(&mut w, [0.8, 0.8, 0.8], floor);
     let m = w.alpha_material(Some(texture), [0.9, 0.4, 0.2, 1.0], "MASK", None, false);
+    transform_texture(&mut w, m);
     add_quad(&mut w, m, Vec3::new(0.0, plate_y, 0.0), Quat::IDENTITY, Vec3::new(half, 1.0, half));
     load(&w, camera, lights).0
 }
