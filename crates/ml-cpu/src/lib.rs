@@ -8,6 +8,7 @@ pub mod blinn_phong;
 pub mod camera;
 pub mod cluster;
 pub mod error;
+pub mod files;
 mod geometry;
 pub mod gltf_scene;
 pub mod gltf_writer;
