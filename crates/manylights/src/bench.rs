@@ -407,15 +407,17 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
     write_file(a, "results.json", &serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
     let series = frame_times(results, skip);
     if series.iter().any(|(_, points)| !points.is_empty()) {
-        plot(&a.out.join("results.png"), &series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
+        let (size, rgb) = plot(&series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
+        let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
+        ml_cpu::files::write_png(&a.out.join("results.png"), &rgba, size)?;
     }
     print!("{csv}");
     Ok(())
 }
 
+/// Write `name` in the output folder, replacing an earlier run's only once complete.
 fn write_file(a: &BenchArgs, name: &str, text: &str) -> Result<()> {
-    let path = a.out.join(name);
-    std::fs::write(&path, text).with_context(|| format!("cannot write '{}'", path.display()))
+    Ok(ml_cpu::files::write_bytes_replacing(&a.out.join(name), text.as_bytes())?)
 }
 
 /// The raster column: the visibility technique's rasteriser, empty for the others.
@@ -443,7 +445,11 @@ fn frame_times(results: &[Measured], skip: usize) -> Vec<(Variant, Vec<(f64, f64
 
 /// results.png: GPU ms per frame against lights, log-log, a line per technique (the text in
 /// egui's embedded Ubuntu font: no system fonts needed).
-fn plot(path: &std::path::Path, series: &[(Variant, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
+/// The frame-time plot: its size and RGB8 pixels (written by the caller, which replaces the
+/// previous plot only with a complete one).
+type Plot = ((u32, u32), Vec<u8>);
+
+fn plot(series: &[(Variant, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<Plot, Box<dyn std::error::Error>> {
     use plotters::prelude::*;
     static FONT: std::sync::Once = std::sync::Once::new();
     FONT.call_once(|| {
@@ -457,7 +463,9 @@ fn plot(path: &std::path::Path, series: &[(Variant, Vec<(f64, f64)>)], (w, h): (
     let decades =
         |lo: f64, hi: f64| (10f64.powf(lo.log10().floor()), 10f64.powf(hi.log10().ceil()).max(10f64.powf(lo.log10().floor() + 1.0)));
     let ((x0, x1), (y0, y1)) = (decades(x0, x1), decades(y0, y1));
-    let root = BitMapBackend::new(path, (960, 600)).into_drawing_area();
+    const SIZE: (u32, u32) = (960, 600);
+    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(format!("GPU ms per frame at {w}x{h} (median)"), ("sans-serif", 24))
@@ -491,7 +499,9 @@ fn plot(path: &std::path::Path, series: &[(Variant, Vec<(f64, f64)>)], (w, h): (
         .border_style(BLACK)
         .draw()?;
     root.present()?;
-    Ok(())
+    drop(chart);
+    drop(root);
+    Ok((SIZE, rgb))
 }
 
 /// 1000 → 1k, 1000000 → 1M (axis labels).

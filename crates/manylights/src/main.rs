@@ -13,13 +13,14 @@ use ml_render::report;
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{DebugView, Exposure, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
 mod auto;
 mod bench;
 mod messages;
+mod output;
 
 #[derive(Parser)]
 #[command(name = "manylights", version, about = "A Vulkan renderer for scenes lit by many lights")]
@@ -375,24 +376,6 @@ fn print_warnings(warnings: &[SceneWarning]) {
     }
 }
 
-/// `--out` with a run of # (an image sequence): the name before and after it and its length.
-/// None without a #; an error where # stands elsewhere than in one run of the file name.
-fn sequence_pattern(out: &Path) -> Result<Option<(String, String, usize)>> {
-    let text = out.to_string_lossy();
-    let Some(first) = text.find('#') else { return Ok(None) };
-    let run = text[first..].find(|c| c != '#').map_or(text.len() - first, |n| n);
-    let (before, after) = (&text[..first], &text[first + run..]);
-    if after.contains('#') || after.contains(std::path::MAIN_SEPARATOR) {
-        bail!("--out '{text}': an image sequence's name has one run of # in the file name (e.g. frames/####.png)");
-    }
-    Ok(Some((before.to_owned(), after.to_owned(), run)))
-}
-
-/// Frame `i`'s file of a sequence pattern.
-fn sequence_path((before, after, digits): &(String, String, usize), i: u32) -> PathBuf {
-    PathBuf::from(format!("{before}{i:0digits$}{after}"))
-}
-
 /// A progress bar on stderr that shows itself once the work has taken PROGRESS_AFTER, and
 /// never where stderr is not a terminal (indicatif's own rule): short runs and logs stay quiet.
 pub(crate) struct Progress {
@@ -434,7 +417,7 @@ impl Progress {
 /// sequence, writes its PNG.
 struct RenderSink {
     progress: Progress,
-    sequence: Option<(String, String, usize)>,
+    sequence: Option<output::SequencePattern>,
     size: (u32, u32),
 }
 
@@ -449,31 +432,8 @@ impl ml_render::FrameSink for RenderSink {
 
     fn image(&mut self, i: u32, rgba: &[u8]) -> Result<(), ml_render::RenderError> {
         let Some(pattern) = &self.sequence else { return Ok(()) };
-        let path = sequence_path(pattern, i);
-        save_png(&path, rgba, self.size).map_err(|e| ml_render::RenderError::Invalid(format!("{e:#}")))
+        output::save_png(&output::sequence_path(pattern, i), rgba, self.size).map_err(|e| ml_render::RenderError::Invalid(e.to_string()))
     }
-}
-
-fn save_png(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<()> {
-    image::save_buffer_with_format(path, rgba, width, height, image::ColorType::Rgba8, image::ImageFormat::Png)
-        .with_context(|| format!("cannot write '{}'", path.display()))
-}
-
-/// Fail before rendering if the PNG could not be written: nothing is computed for nothing.
-fn check_output(path: &Path) -> Result<()> {
-    if path.is_dir() {
-        bail!("cannot write '{}': it is a directory", path.display());
-    }
-    let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        bail!("cannot write '{}': folder '{}' does not exist", path.display(), parent.display());
-    }
-    let existed = path.exists();
-    std::fs::OpenOptions::new().append(true).create(true).open(path).with_context(|| format!("cannot write '{}'", path.display()))?;
-    if !existed {
-        let _ = std::fs::remove_file(path);
-    }
-    Ok(())
 }
 
 fn render(cmd: &RenderArgs) -> Result<()> {
@@ -485,20 +445,10 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     if cmd.frames > MAX_FRAMES {
         bail!("--frames {} is out of range: use 1 to {MAX_FRAMES}", cmd.frames);
     }
-    let sequence = sequence_pattern(&cmd.out)?;
+    let sequence = output::sequence_pattern(&cmd.out)?;
     let built = request.build()?;
     print_warnings(&built.warnings);
-    match &sequence {
-        Some(pattern) => {
-            // A sequence's folder is made for it (a single image's must exist).
-            let first = sequence_path(pattern, 0);
-            if let Some(folder) = first.parent().filter(|p| !p.as_os_str().is_empty() && !p.is_dir()) {
-                std::fs::create_dir_all(folder).with_context(|| format!("cannot make folder '{}'", folder.display()))?;
-            }
-            check_output(&first)?
-        }
-        None => check_output(&cmd.out)?,
-    }
+    output::prepare(&cmd.out, sequence.as_ref())?;
     let mut settings = wanted.for_scene(&built.scene, built.shading);
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();
@@ -521,7 +471,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     drop(ctx);
     let output = result?;
     if sink.sequence.is_none() {
-        save_png(&cmd.out, &output.rgba, (output.width, output.height))?;
+        output::save_png(&cmd.out, &output.rgba, (output.width, output.height))?;
     }
     let facts = report::RenderFacts {
         device: &device,
@@ -579,22 +529,4 @@ fn info() -> Result<()> {
         println!("{}", report::table(&report::device_rows(&d)));
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sequence_patterns_number_frames_in_their_run_of_hashes() {
-        let p = sequence_pattern(Path::new("frames/####.png")).unwrap().unwrap();
-        assert_eq!(sequence_path(&p, 7), PathBuf::from("frames/0007.png"));
-        assert_eq!(sequence_path(&p, 12345), PathBuf::from("frames/12345.png"));
-        let p = sequence_pattern(Path::new("turn-#.png")).unwrap().unwrap();
-        assert_eq!(sequence_path(&p, 3), PathBuf::from("turn-3.png"));
-        assert_eq!(sequence_pattern(Path::new("plain.png")).unwrap(), None);
-        for bad in ["a#b#.png", "frames#/#.png", "##x##"] {
-            assert!(sequence_pattern(Path::new(bad)).is_err(), "{bad}");
-        }
-    }
 }

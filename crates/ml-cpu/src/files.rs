@@ -86,6 +86,18 @@ pub fn write_bytes_replacing(path: &Path, bytes: &[u8]) -> Result<(), WriteError
     write_replacing(path, |out| out.write_all(bytes))
 }
 
+/// An RGBA8 image of `width` × `height` as a PNG at `path`, replacing it only once complete.
+pub fn write_png(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<(), WriteError> {
+    // (The encoder asserts this; a mistake must be an error, not a panic.)
+    if (width as usize).checked_mul(height as usize).and_then(|n| n.checked_mul(4)) != Some(rgba.len()) {
+        return Err(WriteError::refused(path, format!("{} bytes are not a {width}×{height} RGBA image", rgba.len())));
+    }
+    write_replacing(path, |out| {
+        image::write_buffer_with_format(out, rgba, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
+            .map_err(io::Error::other)
+    })
+}
+
 /// The folder `path` is in ("." for a bare name).
 fn parent_folder(path: &Path) -> &Path {
     path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."))
@@ -162,6 +174,19 @@ mod tests {
         assert!(output_target(&d.join("no/such/out.png")).unwrap_err().to_string().contains("does not exist"));
         assert!(check_writable(&d.join("fine.png")).is_ok());
         assert_eq!(entries(&d), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_png_decodes_to_what_was_written() {
+        let d = dir("png");
+        let path = d.join("image.png");
+        let rgba: Vec<u8> = (0..4 * 3 * 2).map(|i| i as u8 * 9).collect();
+        write_png(&path, &rgba, (3, 2)).unwrap();
+        let back = image::open(&path).unwrap().to_rgba8();
+        assert_eq!((back.width(), back.height(), back.into_raw()), (3, 2, rgba));
+        // A size that disagrees with the pixels fails and leaves nothing.
+        assert!(write_png(&d.join("bad.png"), &[0; 5], (3, 2)).is_err());
+        assert_eq!(entries(&d), ["image.png"]);
     }
 
     #[cfg(unix)]

@@ -543,9 +543,9 @@ fn egui_renderer_free(presenter: &mut Presenter, ids: &[egui::TextureId]) -> Res
     renderer.free_textures(ids).map_err(|e| anyhow::anyhow!("the overlay's textures: {e}"))
 }
 
+/// A screenshot replaces a file of its name only once complete.
 fn save_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
-    image::save_buffer_with_format(path, rgba, width, height, image::ColorType::Rgba8, image::ImageFormat::Png)
-        .with_context(|| format!("cannot write '{}'", path.display()))
+    Ok(ml_cpu::files::write_png(path, rgba, (width, height))?)
 }
 
 /// Seconds since the Unix epoch (screenshot names).
