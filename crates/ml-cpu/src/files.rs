@@ -1,9 +1,11 @@
 //! Files written so that nothing is lost: an output is made beside its target under a
 //! temporary name and renamed over it only once it is complete, so a full disk, a killed
 //! process or an encoder error leaves the previous file byte-identical and no partial file.
+//! And files read so that a hostile one cannot hang or exhaust us: regular files only, never
+//! more bytes than a cap (`read_regular`).
 
 use std::fs::{File, OpenOptions};
-use std::io::{self, BufWriter, Write};
+use std::io::{self, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -120,6 +122,125 @@ fn create_temporary(shown: &Path, target: &Path) -> Result<(File, PathBuf), Writ
     Err(WriteError::Io { path: shown.to_owned(), source: last.expect("sixteen attempts made") })
 }
 
+/// Why a file could not be read (the path is named by whoever asked for it).
+#[derive(Debug, Error)]
+pub enum ReadError {
+    #[error("cannot read it: {0}")]
+    Io(io::Error),
+    #[error("it is a directory, not a file")]
+    Directory,
+    #[error("it is not a regular file (a device, pipe or socket)")]
+    NotRegular,
+    #[error("{bytes} bytes is more than the {max} we read")]
+    TooLarge { bytes: u64, max: u64 },
+    /// More bytes arrived than its size said (it grew while read).
+    #[error("it holds more than the {max} bytes we read")]
+    TooLong { max: u64 },
+}
+
+/// The open flag that makes opening a pipe return at once instead of waiting for a writer (a
+/// regular file reads as ever with it). std names no such flag: these are the platforms' values
+/// (libc's O_NONBLOCK). Where it is not known a pipe is still refused before it is opened; only
+/// one put in the file's place between that check and the opening would be waited on.
+#[cfg(unix)]
+const O_NONBLOCK: i32 = if cfg!(any(target_os = "linux", target_os = "android")) {
+    if cfg!(any(target_arch = "mips", target_arch = "mips64")) {
+        0x80
+    } else if cfg!(target_arch = "sparc64") {
+        0x4000
+    } else {
+        0o4000
+    }
+} else if cfg!(any(target_vendor = "apple", target_os = "freebsd", target_os = "openbsd", target_os = "netbsd", target_os = "dragonfly")) {
+    0x4
+} else {
+    0
+};
+
+/// `path` opened for reading, at once even where it is a pipe no one writes to.
+fn open_without_waiting(path: &Path) -> io::Result<File> {
+    let mut options = OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, O_NONBLOCK);
+    options.open(path)
+}
+
+/// Directories and anything that is not a regular file: a device never ends (/dev/zero), a
+/// pipe blocks until someone writes to it.
+fn check_regular(meta: &std::fs::Metadata) -> Result<(), ReadError> {
+    match meta {
+        m if m.is_dir() => Err(ReadError::Directory),
+        m if !m.is_file() => Err(ReadError::NotRegular),
+        _ => Ok(()),
+    }
+}
+
+/// The whole of the regular file at `path` (a link to one is followed), at most `max` bytes.
+/// Anything else is refused before it is opened; the file is opened without waiting (so a
+/// pipe put in its place since is refused too, not waited on), checked again as opened, and
+/// read through a cap on the bytes that actually arrive, whatever its size said.
+pub fn read_regular(path: &Path, max: u64) -> Result<Vec<u8>, ReadError> {
+    let check = |meta: &std::fs::Metadata| {
+        check_regular(meta)?;
+        if meta.len() > max {
+            return Err(ReadError::TooLarge { bytes: meta.len(), max });
+        }
+        Ok(())
+    };
+    check(&std::fs::metadata(path).map_err(ReadError::Io)?)?;
+    let file = open_without_waiting(path).map_err(ReadError::Io)?;
+    let meta = file.metadata().map_err(ReadError::Io)?;
+    check(&meta)?;
+    // The size said is only a hint for the allocation; the cap is on what is read.
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(max.saturating_add(1)).read_to_end(&mut bytes).map_err(ReadError::Io)?;
+    if bytes.len() as u64 > max {
+        return Err(ReadError::TooLong { max });
+    }
+    Ok(bytes)
+}
+
+/// What the loaders' tests of hostile files share.
+#[cfg(all(test, unix))]
+pub(crate) mod hostile {
+    use std::path::{Path, PathBuf};
+
+    /// A new empty folder of the system's temporary one, for test `name`.
+    pub fn folder(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("ml-hostile-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// A named pipe `name` in `d` (made by mkfifo(1): std cannot make one), no one writing.
+    pub fn fifo(d: &Path, name: &str) -> PathBuf {
+        let path = d.join(name);
+        let made = std::process::Command::new("mkfifo").arg(&path).status().expect("mkfifo runs");
+        assert!(made.success(), "mkfifo {}", path.display());
+        path
+    }
+
+    /// A symbolic link `name` in `d` to `target`.
+    pub fn link(d: &Path, name: &str, target: impl AsRef<Path>) -> PathBuf {
+        let path = d.join(name);
+        std::os::unix::fs::symlink(target, &path).unwrap();
+        path
+    }
+
+    /// `load` refuses within a second, with an error that says `expected`.
+    pub fn refused_at_once<E: std::fmt::Display>(what: &str, expected: &str, load: impl FnOnce() -> Result<(), E>) {
+        let start = std::time::Instant::now();
+        let error = match load() {
+            Ok(()) => panic!("{what}: loaded"),
+            Err(e) => e.to_string(),
+        };
+        assert!(start.elapsed().as_secs_f32() < 1.0, "{what}: {:?}", start.elapsed());
+        assert!(error.contains(expected), "{what}: '{expected}' missing from: {error}");
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,5 +320,68 @@ mod tests {
         write_bytes_replacing(&link, b"new").unwrap();
         assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
         assert_eq!(std::fs::read(&file).unwrap(), b"new");
+    }
+
+    #[test]
+    fn a_regular_file_is_read_whole_up_to_its_cap() {
+        let d = dir("read");
+        let path = d.join("scene.toml");
+        std::fs::write(&path, b"twelve bytes").unwrap();
+        assert_eq!(read_regular(&path, 12).unwrap(), b"twelve bytes");
+        let e = read_regular(&path, 11).unwrap_err();
+        assert!(matches!(e, ReadError::TooLarge { bytes: 12, max: 11 }), "{e}");
+        assert_eq!(e.to_string(), "12 bytes is more than the 11 we read");
+        // A link to a regular file is followed.
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&path, d.join("link.toml")).unwrap();
+            assert_eq!(read_regular(&d.join("link.toml"), 100).unwrap(), b"twelve bytes");
+        }
+        assert!(read_regular(&d.join("missing"), 100).unwrap_err().to_string().starts_with("cannot read it: "));
+        assert_eq!(read_regular(&d, 100).unwrap_err().to_string(), "it is a directory, not a file");
+    }
+
+    /// Devices, pipes and links to them are refused at once: read whole, /dev/zero would fill
+    /// the memory, and a pipe no one writes to would wait forever.
+    #[cfg(unix)]
+    #[test]
+    fn devices_and_pipes_are_refused_at_once() {
+        let d = dir("devices");
+        let pipe = hostile::fifo(&d, "scene.toml");
+        let zero_link = d.join("zero.glb");
+        std::os::unix::fs::symlink("/dev/zero", &zero_link).unwrap();
+        for path in [Path::new("/dev/zero"), Path::new("/dev/urandom"), Path::new("/dev/null"), &pipe, &zero_link] {
+            let start = std::time::Instant::now();
+            let e = read_regular(path, 1 << 30).unwrap_err();
+            assert!(start.elapsed().as_secs_f32() < 1.0, "{}: {:?}", path.display(), start.elapsed());
+            assert!(matches!(e, ReadError::NotRegular), "{}: {e}", path.display());
+            assert_eq!(e.to_string(), "it is not a regular file (a device, pipe or socket)");
+        }
+    }
+
+    /// A pipe put in a file's place after the check is opened without waiting for a writer,
+    /// and refused as opened.
+    #[cfg(unix)]
+    #[test]
+    fn a_pipe_is_opened_without_waiting_and_refused_as_opened() {
+        let d = dir("swapped");
+        let pipe = hostile::fifo(&d, "buffer.bin");
+        let start = std::time::Instant::now();
+        let file = open_without_waiting(&pipe).unwrap();
+        assert!(matches!(check_regular(&file.metadata().unwrap()), Err(ReadError::NotRegular)));
+        assert!(start.elapsed().as_secs_f32() < 1.0, "{:?}", start.elapsed());
+    }
+
+    /// The cap is on the bytes read, not on the size the file claims: a file of /proc says it
+    /// has 0 bytes and holds more.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn the_cap_holds_whatever_size_the_file_claims() {
+        let status = Path::new("/proc/self/status");
+        assert_eq!(std::fs::metadata(status).unwrap().len(), 0);
+        let e = read_regular(status, 16).unwrap_err();
+        assert!(matches!(e, ReadError::TooLong { max: 16 }), "{e}");
+        assert_eq!(e.to_string(), "it holds more than the 16 bytes we read");
+        assert!(read_regular(status, 1 << 20).unwrap().starts_with(b"Name:"));
     }
 }

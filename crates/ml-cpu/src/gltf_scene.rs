@@ -14,11 +14,12 @@
 //! MAX_DIRECTIONAL_LIGHTS. Cameras: perspective or orthographic.
 
 use crate::camera::Camera;
+use crate::files::{read_regular, ReadError};
 use crate::gpu_types::{LightCone, PointLight};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
 use crate::scene::{AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
-use crate::scene_load::{read_capped, ReadError, SceneFile, MAX_OBJECTS};
+use crate::scene_load::{read_reference, ReferenceError, SceneFile, MAX_OBJECTS};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use base64::Engine as _;
 use glam::{Affine2, Mat4, Vec3};
@@ -27,8 +28,14 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-/// Largest glTF or GLB file, and largest external buffer, we read.
+/// Largest glTF or GLB file, and largest buffer (all of a file's buffers together too), we read.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// Largest image file (PNG or JPEG) a glTF may name; the decoded image is capped apart
+/// (MAX_TEXTURE_SIZE, and 1 GiB of memory).
+pub const MAX_IMAGE_BYTES: u64 = 256 << 20;
+/// How much longer than its byteLength a buffer's data may be: the padding that ends a GLB's
+/// binary chunk at a multiple of 4 bytes.
+const BUFFER_PADDING: u64 = 3;
 /// Most vertices (after un-indexing for flat normals) and triangles of a whole scene.
 pub const MAX_VERTICES: usize = 1 << 26;
 /// Widest and tallest texture we decode.
@@ -140,6 +147,12 @@ pub enum GltfError {
     NoBinaryChunk,
     #[error("holds {holds} bytes but claims {claims}")]
     BufferShort { holds: usize, claims: u64 },
+    #[error("holds {holds} bytes but claims {claims} (more than 3 bytes of padding)")]
+    BufferLong { holds: u64, claims: u64 },
+    #[error("only the first buffer may be the GLB binary chunk (it has no uri)")]
+    BinaryChunkNotFirst,
+    #[error("'{0}' is not a valid URI (a % not followed by two hexadecimal digits, or not UTF-8 once decoded)")]
+    BadUri(String),
     #[error("a data URI that is not base64")]
     NotBase64,
     #[error("bad base64 data: {0}")]
@@ -148,9 +161,9 @@ pub enum GltfError {
     Remote(String),
     #[error("external files are not allowed here")]
     NoFolder,
-    /// A file beside the glTF (a buffer or an image) that cannot be read.
-    #[error("'{}': {problem}", path.display())]
-    External { path: PathBuf, problem: ReadError },
+    /// A file the glTF names (a buffer or an image) that is not let read or cannot be.
+    #[error("'{reference}': {problem}")]
+    External { reference: String, problem: ReferenceError },
     #[error("more than {max} drawn primitives", max = MAX_OBJECTS)]
     TooManyPrimitives,
     #[error("has no POSITION")]
@@ -254,7 +267,7 @@ fn describe_invalid(errors: &[(gltf::json::Path, gltf::json::validation::Error)]
 /// Load the glTF or GLB file at `path` (external buffers relative to its folder).
 pub fn load(path: &Path) -> Result<SceneFile, GltfFileError> {
     let fail = |problem: GltfError| GltfFileError { path: path.to_path_buf(), problem };
-    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
+    let bytes = read_regular(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
     let (scene, warnings) = from_bytes(&bytes, path.parent()).map_err(fail)?;
     Ok(SceneFile { scene, shading: Some("pbr".into()), warnings })
 }
@@ -406,7 +419,8 @@ fn describe_gltf_error(e: gltf::Error) -> GltfError {
     }
 }
 
-/// Every buffer's bytes, each at least as long as the file says it is.
+/// Every buffer's bytes, each as long as the file says it is, give or take the up to 3 bytes
+/// of padding that end a GLB's binary chunk (its length is a multiple of 4).
 fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, GltfError> {
     let mut out = Vec::new();
     let mut total = 0u64;
@@ -417,30 +431,76 @@ fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, 
         if length > MAX_FILE_BYTES || total > MAX_FILE_BYTES {
             return Err(GltfError::BufferTooLarge { claimed: length }.within(what));
         }
+        let most = length + BUFFER_PADDING;
         let data = match buffer.source() {
+            // glTF: only the first buffer may be the binary chunk (each other one would be
+            // another copy of it).
+            gltf::buffer::Source::Bin if buffer.index() > 0 => return Err(GltfError::BinaryChunkNotFirst.within(what)),
             gltf::buffer::Source::Bin => gltf.blob.as_ref().ok_or_else(|| GltfError::NoBinaryChunk.within(what))?.clone(),
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, base).map_err(|e| e.within(what))?,
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, base, most).map_err(|e| {
+                // A file longer than its buffer: said as the mismatch it is.
+                match e {
+                    GltfError::External { problem: ReferenceError::Read(ReadError::TooLarge { bytes, .. }), .. } => {
+                        GltfError::BufferLong { holds: bytes, claims: length }
+                    }
+                    other => other,
+                }
+                .within(what)
+            })?,
         };
-        if (data.len() as u64) < length {
+        let holds = data.len() as u64;
+        if holds < length {
             return Err(GltfError::BufferShort { holds: data.len(), claims: length }.within(what));
+        }
+        if holds > most {
+            return Err(GltfError::BufferLong { holds, claims: length }.within(what));
         }
         out.push(data);
     }
     Ok(out)
 }
 
-/// A buffer's data: a base64 data URI or a file beside the glTF.
-fn read_uri(uri: &str, base: Option<&Path>) -> Result<Vec<u8>, GltfError> {
+/// A buffer's or an image's data, at most `max` bytes: a base64 data URI, or a file the
+/// (percent-encoded) URI names relative to the glTF's folder, inside it (`read_reference`).
+/// URIs with a scheme name files elsewhere, or on the network.
+fn read_uri(uri: &str, base: Option<&Path>, max: u64) -> Result<Vec<u8>, GltfError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, data) = rest.split_once(";base64,").ok_or(GltfError::NotBase64)?;
         return base64::engine::general_purpose::STANDARD.decode(data).map_err(GltfError::Base64);
     }
-    if uri.contains("://") {
+    if has_scheme(uri) {
         return Err(GltfError::Remote(uri.to_owned()));
     }
+    let path = percent_decoded(uri).ok_or_else(|| GltfError::BadUri(uri.to_owned()))?;
     let base = base.ok_or(GltfError::NoFolder)?;
-    let path = base.join(uri);
-    read_capped(&path, MAX_FILE_BYTES).map_err(|problem| GltfError::External { path, problem })
+    read_reference(base, Path::new(&path), max).map_err(|problem| GltfError::External { reference: uri.to_owned(), problem })
+}
+
+/// Whether `uri` starts with a scheme (RFC 3986: a letter, then letters, digits, `+`, `-`
+/// or `.`, then `:` before any `/`, `?` or `#`), as `file:` and `https:` do.
+fn has_scheme(uri: &str) -> bool {
+    let Some(end) = uri.find([':', '/', '?', '#']).filter(|&i| uri[i..].starts_with(':')) else { return false };
+    let scheme = &uri[..end];
+    scheme.starts_with(|c: char| c.is_ascii_alphabetic()) && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+}
+
+/// `uri` with every `%XX` replaced by the byte it encodes; None where a `%` is not followed by
+/// two hexadecimal digits or the bytes are not UTF-8.
+fn percent_decoded(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = bytes.get(i + 1..i + 3).filter(|h| h.iter().all(u8::is_ascii_hexdigit))?;
+            out.push(u8::from_str_radix(std::str::from_utf8(hex).ok()?, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
 }
 
 struct Builder<'a> {
@@ -640,7 +700,7 @@ impl Builder<'_> {
     fn image(&self, index: usize, srgb: bool) -> Result<TextureImage, GltfError> {
         let json = &self.doc.as_json().images[index];
         let bytes: Vec<u8> = match (&json.uri, &json.buffer_view, &json.mime_type) {
-            (Some(uri), None, _) => read_uri(uri, self.base)?,
+            (Some(uri), None, _) => read_uri(uri, self.base, MAX_IMAGE_BYTES)?,
             (None, Some(view), Some(_)) => {
                 let view = self.doc.views().nth(view.value()).ok_or(GltfError::NoImageView)?;
                 view_bytes(&self.buffers, &view, "its data")?.to_vec()

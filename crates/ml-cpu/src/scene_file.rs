@@ -5,13 +5,14 @@
 //! one error naming the file and, where the parser knows it, the line.
 
 use crate::camera::{clip_planes_for, frame_scene, framing_distance, Camera, DEFAULT_ASPECT, DEFAULT_FOV_Y_DEG};
+use crate::files::{read_regular, ReadError};
 use crate::gltf_scene::GltfError;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::{DirectionalLight, Object, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
-use crate::scene_load::{read_capped, ReadError};
+use crate::scene_load::{read_reference, ReferenceError};
 pub use crate::scene_load::{SceneFile, MAX_OBJECTS};
 use crate::SceneError;
 use glam::Vec3;
@@ -91,6 +92,9 @@ pub enum SceneFileProblem {
     /// A `gltf = "file"` object whose file does not load.
     #[error("'{file}': {problem}")]
     Gltf { file: String, problem: GltfError },
+    /// A `gltf = "file"` object whose file is not let read or cannot be.
+    #[error("'{file}': {problem}")]
+    Reference { file: String, problem: ReferenceError },
     #[error("a point light has no direction or cone (kind = \"spot\" or \"directional\"?)")]
     PointWithDirection,
     /// A light without a field its kind needs ("a spot light needs a direction").
@@ -200,7 +204,7 @@ struct FileMaterial {
 /// Read and check the scene file at `path`.
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
     let fail = |problem: Problem| SceneFileError { path: path.to_path_buf(), problem };
-    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
+    let bytes = read_regular(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
     let text = String::from_utf8(bytes).map_err(|e| fail(Problem::NotUtf8(e.utf8_error().valid_up_to())))?;
     parse_in(&text, path.parent()).map_err(fail)
 }
@@ -356,11 +360,12 @@ fn gltf_object(
         return Err(Problem::GltfMaterial);
     }
     let base = base.ok_or(Problem::NoFolder)?;
-    let path = base.join(gltf);
-    let (scene, warnings) = read_capped(&path, crate::gltf_scene::MAX_FILE_BYTES)
-        .map_err(GltfError::Read)
-        .and_then(|bytes| crate::gltf_scene::from_bytes(&bytes, path.parent()))
-        .map_err(|problem| Problem::Gltf { file: gltf.to_owned(), problem })?;
+    let bytes = read_reference(base, Path::new(gltf), crate::gltf_scene::MAX_FILE_BYTES)
+        .map_err(|problem| Problem::Reference { file: gltf.to_owned(), problem })?;
+    // Its buffers and images are named relative to its own folder.
+    let folder = base.join(gltf).parent().map(Path::to_path_buf).unwrap_or_default();
+    let (scene, warnings) =
+        crate::gltf_scene::from_bytes(&bytes, Some(&folder)).map_err(|problem| Problem::Gltf { file: gltf.to_owned(), problem })?;
     let position = o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
     let scale = o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0);
     let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);

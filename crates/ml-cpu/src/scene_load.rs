@@ -1,8 +1,9 @@
-//! What the scene-file and glTF loaders share: reading a file of bounded size, and what a
-//! loaded file gives.
+//! What the scene-file and glTF loaders share: reading the files they name, never outside
+//! their folder, and what a loaded file gives.
 
+use crate::files::{read_regular, ReadError};
 use crate::scene::Scene;
-use std::path::Path;
+use std::path::{Component, Path};
 use thiserror::Error;
 
 /// Most objects a scene may hold, whichever file it came from.
@@ -18,25 +19,40 @@ pub struct SceneFile {
     pub warnings: Vec<String>,
 }
 
-/// Why a file could not be read (the path is named by whoever opened it).
+/// Why a file named by a scene file or glTF file (a glTF model, a buffer, an image) could not
+/// be read. The reference is named by whoever followed it; a file it was not let read is never
+/// described (its size or content would tell about a file outside the model's folder).
 #[derive(Debug, Error)]
-pub enum ReadError {
-    #[error("cannot read it: {0}")]
-    Io(std::io::Error),
-    #[error("it is a directory, not a file")]
-    Directory,
-    #[error("{bytes} bytes is more than the {max} we read")]
-    TooLarge { bytes: u64, max: u64 },
+pub enum ReferenceError {
+    #[error("an absolute path: files are named relative to the folder of the file that names them")]
+    Absolute,
+    #[error("it leads out of the folder of the file that names it")]
+    OutsideFolder,
+    #[error(transparent)]
+    Read(#[from] ReadError),
 }
 
-/// Read a whole file of at most `max` bytes, refusing directories and missing files.
-pub fn read_capped(path: &Path, max: u64) -> Result<Vec<u8>, ReadError> {
-    let meta = std::fs::metadata(path).map_err(ReadError::Io)?;
-    if meta.is_dir() {
-        return Err(ReadError::Directory);
+/// The file `reference` names, relative to `folder` (the folder of the file that names it),
+/// read whole if it is a regular file of at most `max` bytes. Only files inside `folder` are
+/// read: an absolute path is refused, and so is a `..` that climbs out of it; symbolic links
+/// are followed where they end inside `folder` (a model may link to its textures), so the
+/// path is checked again with every link resolved.
+pub fn read_reference(folder: &Path, reference: &Path, max: u64) -> Result<Vec<u8>, ReferenceError> {
+    let mut depth = 0usize;
+    for part in reference.components() {
+        match part {
+            Component::Prefix(_) | Component::RootDir => return Err(ReferenceError::Absolute),
+            Component::CurDir => {}
+            Component::ParentDir => depth = depth.checked_sub(1).ok_or(ReferenceError::OutsideFolder)?,
+            Component::Normal(_) => depth += 1,
+        }
     }
-    if meta.len() > max {
-        return Err(ReadError::TooLarge { bytes: meta.len(), max });
+    // A file named without a folder is in the current one.
+    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
+    let io = |e| ReferenceError::Read(ReadError::Io(e));
+    let (inside, resolved) = (folder.canonicalize().map_err(io)?, folder.join(reference).canonicalize().map_err(io)?);
+    if !resolved.starts_with(&inside) {
+        return Err(ReferenceError::OutsideFolder);
     }
-    std::fs::read(path).map_err(ReadError::Io)
+    Ok(read_regular(&resolved, max)?)
 }

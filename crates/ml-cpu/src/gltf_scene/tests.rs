@@ -259,3 +259,120 @@ fn texture_transforms_and_emissive_strength_are_read() {
     let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
     assert!(err.contains("emissive strength -1"), "{err}");
 }
+
+/// `good` with its buffer in the file `name` of `folder` (and the JSON naming it as `uri`).
+fn with_external_buffer(good: &GltfWriter, folder: &Path, name: &str, uri: &str) -> Vec<u8> {
+    std::fs::write(folder.join(name), &good.bin).unwrap();
+    let mut w = GltfWriter { json: good.json.clone(), bin: good.bin.clone() };
+    w.json["buffers"] = json!([{ "byteLength": good.bin.len(), "uri": uri }]);
+    w.to_gltf()
+}
+
+/// A quad with a base-colour texture whose image is the file `uri` names.
+fn textured_by_uri(uri: &str) -> Vec<u8> {
+    let mut w = GltfWriter::new();
+    let t = w.texture(png(1, 1, &[255; 4]), "image/png");
+    w.json["images"][0] = json!({ "uri": uri });
+    let m = w.textured_material(Some(t), None);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(json!({ "mesh": mesh }), true);
+    w.to_gltf()
+}
+
+fn quad_writer() -> GltfWriter {
+    let mut w = GltfWriter::new();
+    let mesh = w.mesh(&[quad()]);
+    w.node(json!({ "mesh": mesh }), true);
+    w
+}
+
+/// A GLB, a glTF's buffer or an image that is a device or a pipe is refused at once, with
+/// the line that says so: read whole, /dev/zero would fill the memory, and a pipe no one
+/// writes to would wait forever.
+#[cfg(unix)]
+#[test]
+fn devices_and_pipes_are_refused_at_once_as_file_buffer_or_image() {
+    use crate::files::hostile::{fifo, folder, link, refused_at_once};
+    let d = folder("gltf-devices");
+    let not_regular = "not a regular file (a device, pipe or socket)";
+    for file in [fifo(&d, "pipe.glb"), link(&d, "zero.glb", "/dev/zero"), PathBuf::from("/dev/zero"), PathBuf::from("/dev/urandom")] {
+        refused_at_once(&file.display().to_string(), not_regular, || load(&file).map(drop));
+    }
+    fifo(&d, "pipe.bin");
+    fifo(&d, "pipe.png");
+    let good = quad_writer();
+    let buffer = |uri: &str| from_bytes(&with_external_buffer(&good, &d, "ok.bin", uri), Some(&d)).map(drop);
+    refused_at_once("pipe buffer", &format!("buffer 0: 'pipe.bin': it is {not_regular}"), || buffer("pipe.bin"));
+    refused_at_once("image pipe", &format!("image 0: 'pipe.png': it is {not_regular}"), || {
+        from_bytes(&textured_by_uri("pipe.png"), Some(&d)).map(drop)
+    });
+    // A link inside the folder to a device leads out of it.
+    link(&d, "zero.bin", "/dev/zero");
+    refused_at_once("link to /dev/zero", "'zero.bin': it leads out of the folder", || buffer("zero.bin"));
+    // The file itself, inside, is read.
+    assert!(buffer("ok.bin").is_ok());
+}
+
+/// Buffers and images are read only inside the glTF's folder: absolute paths, `..` that
+/// climbs out (percent-encoded too) and links that end outside are refused, naming the
+/// reference and nothing of the file outside; URIs with a scheme are never followed.
+#[cfg(unix)]
+#[test]
+fn references_stay_inside_the_model_folder() {
+    use crate::files::hostile::{folder, link};
+    let d = folder("gltf-references");
+    let model = d.join("model");
+    std::fs::create_dir_all(model.join("data")).unwrap();
+    // Outside: 12,345 bytes an error must not tell of.
+    std::fs::write(d.join("secret.bin"), vec![7u8; 12_345]).unwrap();
+    link(&model, "out.bin", d.join("secret.bin"));
+    let good = quad_writer();
+    let buffer = |uri: &str| from_bytes(&with_external_buffer(&good, &model, "data/quad bin.bin", uri), Some(&model)).map(drop);
+    for (uri, expected) in [
+        ("../secret.bin", "'../secret.bin': it leads out of the folder of the file that names it"),
+        ("data/../../secret.bin", "it leads out of the folder"),
+        ("%2E%2E/secret.bin", "'%2E%2E/secret.bin': it leads out of the folder"),
+        ("out.bin", "'out.bin': it leads out of the folder"),
+        ("/etc/passwd", "'/etc/passwd': an absolute path"),
+        ("%2Fetc%2Fpasswd", "an absolute path"),
+        ("file:///etc/passwd", "never downloads"),
+        ("file:/etc/passwd", "never downloads"),
+        ("data/%zz.bin", "'data/%zz.bin' is not a valid URI"),
+    ] {
+        let e = buffer(uri).unwrap_err().to_string();
+        assert!(e.contains(expected) && !e.contains("12345"), "{uri}: {e}");
+    }
+    let e = from_bytes(&textured_by_uri("../secret.bin"), Some(&model)).unwrap_err().to_string();
+    assert!(e.contains("image 0: '../secret.bin': it leads out of the folder"), "{e}");
+    // Inside, by any path and through links that stay inside: read.
+    link(&model, "inside.bin", model.join("data/quad bin.bin"));
+    for uri in ["data/quad%20bin.bin", "./data/../data/quad%20bin.bin", "inside.bin"] {
+        buffer(uri).unwrap_or_else(|e| panic!("{uri}: {e}"));
+    }
+}
+
+/// A buffer's data must be as long as its byteLength says, give or take the GLB binary chunk's
+/// padding to 4 bytes; only the first buffer may be that chunk.
+#[test]
+fn buffers_must_be_as_long_as_they_claim() {
+    let d = std::env::temp_dir().join(format!("ml-gltf-buffer-lengths-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let good = quad_writer();
+    let json = |length: usize| {
+        let mut w = GltfWriter { json: good.json.clone(), bin: good.bin.clone() };
+        w.json["buffers"] = json!([{ "byteLength": length, "uri": "quad.bin" }]);
+        w.to_gltf()
+    };
+    let mut long = good.bin.clone();
+    long.extend([0; 4]);
+    std::fs::write(d.join("quad.bin"), &long).unwrap();
+    let n = good.bin.len();
+    assert!(from_bytes(&json(n + 1), Some(&d)).is_ok(), "3 bytes of padding");
+    let e = from_bytes(&json(n), Some(&d)).unwrap_err().to_string();
+    assert_eq!(e, format!("buffer 0: holds {} bytes but claims {n} (more than 3 bytes of padding)", n + 4));
+    let mut two = GltfWriter { json: good.json.clone(), bin: good.bin.clone() };
+    two.json["buffers"] = json!([{ "byteLength": n }, { "byteLength": 4 }]);
+    let e = from_bytes(&two.to_glb(), None).unwrap_err().to_string();
+    assert!(e.contains("buffer 1: only the first buffer may be the GLB binary chunk"), "{e}");
+    std::fs::remove_dir_all(&d).unwrap();
+}

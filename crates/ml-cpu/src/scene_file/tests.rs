@@ -188,3 +188,59 @@ fn spot_and_directional_lights_survive_a_round_trip() {
     }
     assert_eq!(again.cones.len(), 2);
 }
+
+/// A scene file, or a glTF it names, that is a device or a pipe is refused at once with the
+/// line that says so (read whole, /dev/zero would fill the memory; a pipe no one writes to
+/// would wait forever).
+#[cfg(unix)]
+#[test]
+fn devices_and_pipes_are_refused_at_once() {
+    use crate::files::hostile::{fifo, folder, link, refused_at_once};
+    let d = folder("scene-devices");
+    let not_regular = "it is not a regular file (a device, pipe or socket)";
+    for file in [fifo(&d, "pipe.toml"), link(&d, "zero.toml", "/dev/zero"), PathBuf::from("/dev/zero")] {
+        refused_at_once(&file.display().to_string(), &format!("scene file '{}': {not_regular}", file.display()), || load(&file).map(drop));
+    }
+    fifo(&d, "pipe.glb");
+    std::fs::write(d.join("scene.toml"), "[[objects]]\ngltf = \"pipe.glb\"\n").unwrap();
+    refused_at_once("a glTF on a pipe", &format!("objects[0]: 'pipe.glb': {not_regular}"), || load(&d.join("scene.toml")).map(drop));
+}
+
+/// The glTF files a scene file names are read only inside its folder: absolute paths, `..`
+/// that climbs out and links that end outside are refused, naming the reference and nothing
+/// of the file outside.
+#[cfg(unix)]
+#[test]
+fn gltf_objects_stay_inside_the_scene_folder() {
+    use crate::files::hostile::{folder, link};
+    use crate::gltf_writer::{quad, GltfWriter};
+    let d = folder("scene-references");
+    let scenes = d.join("scenes");
+    std::fs::create_dir_all(scenes.join("models")).unwrap();
+    let mut w = GltfWriter::new();
+    let mesh = w.mesh(&[quad()]);
+    w.node(serde_json::json!({ "mesh": mesh }), true);
+    std::fs::write(scenes.join("models/quad.glb"), w.to_glb()).unwrap();
+    std::fs::write(d.join("outside.glb"), w.to_glb()).unwrap();
+    link(&scenes, "out.glb", d.join("outside.glb"));
+    link(&scenes, "zero.glb", "/dev/zero");
+    link(&scenes, "in.glb", scenes.join("models/quad.glb"));
+    let scene = |gltf: &str| {
+        std::fs::write(scenes.join("scene.toml"), format!("[[objects]]\ngltf = \"{gltf}\"\n")).unwrap();
+        load(&scenes.join("scene.toml")).map(drop)
+    };
+    let size = std::fs::metadata(d.join("outside.glb")).unwrap().len().to_string();
+    for (gltf, expected) in [
+        ("../outside.glb", "objects[0]: '../outside.glb': it leads out of the folder of the file that names it"),
+        ("models/../../outside.glb", "it leads out of the folder"),
+        ("out.glb", "'out.glb': it leads out of the folder"),
+        ("zero.glb", "'zero.glb': it leads out of the folder"),
+        ("/dev/zero", "'/dev/zero': an absolute path"),
+    ] {
+        let e = scene(gltf).unwrap_err().to_string();
+        assert!(e.contains(expected) && !e.contains(&size), "{gltf}: {e}");
+    }
+    for gltf in ["models/quad.glb", "./models/../models/quad.glb", "in.glb"] {
+        scene(gltf).unwrap_or_else(|e| panic!("{gltf}: {e}"));
+    }
+}
