@@ -11,6 +11,10 @@ use std::sync::atomic::Ordering;
 
 pub const AUTO: &str = "auto";
 
+/// Every technique auto may pick (`pick_lighting_path`): an option that applies to none of
+/// them is refused before the probe.
+pub const CANDIDATES: [Technique; 3] = [Technique::Visibility, Technique::DeferredCompute, Technique::DeferredClustered];
+
 /// `name` as a technique, None for `auto` (checked before any GPU work).
 pub fn technique_choice(name: &str) -> Result<Option<Technique>> {
     if name == AUTO {
@@ -144,6 +148,20 @@ pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, cand
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Compute faster or not, with and without the meshlet features.
+    #[test]
+    fn auto_picks_only_its_candidates() {
+        use ml_render::report::Spread;
+        let ms = |median| Spread { median, p95: median, mean: median };
+        for (fragment, compute) in [(1.0, 10.0), (10.0, 1.0), (1.0, 1.0)] {
+            let times = StageTimes { lights: 16, pixels: 64, fragment: ms(fragment), compute: ms(compute), timestamps: true };
+            for meshlets in [true, false] {
+                let (t, _) = pick_lighting_path(&times, meshlets);
+                assert!(CANDIDATES.contains(&t), "{t:?}");
+            }
+        }
+    }
 
     #[test]
     fn auto_is_a_choice_and_unknown_names_say_so() {

@@ -5,7 +5,10 @@
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
 use crate::auto::{self, technique_choice};
-use crate::{cluster_choice, print_warnings, scene_source, shading_choice, Progress};
+use crate::{
+    check_rules, cluster_choice, draws_meshlets, objects_rule, print_warnings, scene_source, shading_choice, Auto, Given, Progress, Rule,
+    Techniques, Whole, CLUSTER_GRID, VISIBILITY_BUFFER,
+};
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use ml_cpu::camera::CameraSpec;
@@ -23,45 +26,57 @@ use std::sync::atomic::Ordering;
 
 mod probe;
 
+/// Each option's help ends with its default: clap's `[default: X]`, or a sentence "Default: …"
+/// where the scene decides it.
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Scene: bench (a floor, --objects objects, lights whose radius shrinks as N^(−1/3)),
-    /// seed, room, FILE.toml, FILE.gltf|FILE.glb.
+    /// Scene, as render's --scene: bench (a floor, --objects objects, lights whose radius
+    /// shrinks as their count grows), seed, room, FILE.toml, FILE.gltf|FILE.glb.
     #[arg(long, default_value = "bench")]
     scene: String,
-    /// Objects of the bench scene (default 300): more on the same floor, denser.
-    #[arg(long)]
-    objects: Option<usize>,
-    /// Techniques, comma-separated (auto: the one `--technique auto` picks on this device).
+    /// Objects of the bench scene (0 to 100000): more on the same floor, denser.
+    #[arg(long, default_value_t = ml_cpu::bench_scene::BENCH_OBJECTS, value_parser = crate::OBJECTS, allow_negative_numbers = true)]
+    objects: usize,
+    /// Techniques, comma-separated: forward, clustered-cpu, clustered-gpu, deferred,
+    /// deferred-clustered, deferred-compute, visibility, or auto (the one `--technique auto`
+    /// picks on this device).
     #[arg(long, default_value = "forward,clustered-cpu,clustered-gpu,deferred,deferred-clustered,deferred-compute,visibility")]
     techniques: String,
     /// Light counts, comma-separated; k and M multiply by 1,000 and 1,000,000.
     #[arg(long, default_value = "1k,16k,256k,1M")]
     lights: String,
+    /// Image size WxH of every combination, and of the probe's passes (each side 1 to 16384,
+    /// and at most the device's largest image).
     #[arg(long, default_value = "1920x1080")]
     resolution: String,
-    /// Measured frames per combination.
-    #[arg(long, default_value_t = 300)]
+    /// Measured frames per combination (with --probe: rounds per loop length), 1 to 100000.
+    #[arg(long, default_value_t = 300, value_parser = Whole::<u32>::new(1, MAX_FRAMES as u64), allow_negative_numbers = true)]
     frames: u32,
-    /// Frames rendered first and not measured.
-    #[arg(long, default_value_t = 60)]
+    /// Frames rendered first and not measured (with --probe: rounds), 0 to 100000.
+    #[arg(long, default_value_t = 60, value_parser = Whole::<u32>::new(0, MAX_FRAMES as u64), allow_negative_numbers = true)]
     warmup: u32,
     /// Skip a combination whose frames would take longer than this many seconds (estimated
     /// from one frame).
-    #[arg(long, default_value_t = 120.0)]
+    #[arg(long, default_value_t = 120.0, allow_negative_numbers = true)]
     budget_s: f64,
-    /// Shading model (default: the scene's, else seed).
+    /// Shading model, as render's --shading: seed, blinn-phong or pbr. Default: the scene
+    /// file's [shading] model, else seed.
     #[arg(long)]
     shading: Option<String>,
     /// The camera, as render's --camera: EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV].
+    /// Default: the scene's own camera.
     #[arg(long, allow_hyphen_values = true)]
     camera: Option<String>,
-    /// Cluster grid XxYxZ, or auto (render's --clusters: scaled with each light count).
+    /// Cluster grid XxYxZ of the techniques that have one, or auto (as render's --clusters:
+    /// scaled with each light count).
     #[arg(long, default_value = "auto")]
     clusters: String,
+    /// Enable the Khronos validation layer with synchronization validation; any message
+    /// makes the run fail.
     #[arg(long)]
     validation: bool,
-    #[arg(long)]
+    /// Vulkan device index (see `manylights info`). Default: the best one (discrete first).
+    #[arg(long, value_parser = crate::DEVICE, allow_negative_numbers = true)]
     device: Option<usize>,
     /// Folder for results.csv, results.json and results.png (with --probe: probe.csv and
     /// probe.json), made if missing.
@@ -76,12 +91,54 @@ pub struct BenchArgs {
     /// (each a row of its own; the other techniques have one).
     #[arg(long, default_value = "hardware,compute")]
     raster: String,
-    /// The compute raster's largest triangle, pixels a side (render's --raster-split).
-    #[arg(long, default_value_t = Raster::DEFAULT_SPLIT)]
+    /// The compute and hybrid rasters' largest triangle drawn by one thread, pixels a side (1
+    /// to 64; render's --raster-split).
+    #[arg(long, default_value_t = Raster::DEFAULT_SPLIT, value_parser = crate::RASTER_SPLIT, allow_negative_numbers = true)]
     raster_split: u32,
-    /// Loop lengths (lights every pixel sums) of --probe, comma-separated.
+    /// Loop lengths (lights every pixel sums) of --probe, comma-separated, each at most 65536.
     #[arg(long, default_value = "16,64,256,1024")]
     probe_lights: String,
+    /// The options given on the command line (the others keep their defaults).
+    #[arg(skip)]
+    pub(crate) given: Given,
+}
+
+/// The most measured frames, and the most warm-up frames, of a combination (or probe length):
+/// as many as `render --frames` takes.
+const MAX_FRAMES: u32 = crate::MAX_FRAMES;
+
+impl BenchArgs {
+    /// Frames (or probe rounds) rendered per combination: warm-up and measured.
+    fn rounds(&self) -> Result<u32> {
+        self.warmup
+            .checked_add(self.frames)
+            .with_context(|| format!("--warmup {} with --frames {} is too many frames", self.warmup, self.frames))
+    }
+
+    /// The options that apply only with some techniques, rasterisers or with (or without)
+    /// --probe.
+    pub(crate) fn rules(&self, rasters: &[Raster]) -> Vec<Rule> {
+        let probe_only = |id| Rule::setting(id, Some(self.probe), "bench without --probe", "--probe");
+        let not_probe = |id| Rule::setting(id, Some(!self.probe), "bench --probe", "bench without --probe, which renders the techniques");
+        let mut rules: Vec<Rule> = ["techniques", "lights", "scene", "objects", "shading", "camera", "clusters", "raster", "raster_split"]
+            .into_iter()
+            .map(not_probe)
+            .collect();
+        rules.extend([
+            probe_only("probe_lights"),
+            objects_rule(&self.scene),
+            Rule::technique("clusters", CLUSTER_GRID, Technique::is_clustered),
+            Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
+            Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
+            Rule::setting(
+                "raster_split",
+                Some(rasters.iter().any(|r| *r != Raster::Hardware)),
+                "--raster hardware",
+                "a rasteriser in compute (--raster compute or hybrid)",
+            ),
+        ]);
+        rules
+    }
 }
 
 /// `123`, `16k`, `1M`.
@@ -96,9 +153,16 @@ fn parse_count(text: &str) -> Result<u64> {
     n.checked_mul(factor).filter(|&n| n > 0).with_context(|| format!("light count '{text}' is out of range"))
 }
 
+/// `--resolution WxH`, each side 1 to MAX_DIMENSION (the device may allow less: checked once
+/// it is known).
 fn parse_resolution(text: &str) -> Result<(u32, u32)> {
-    let (w, h) = text.split_once('x').with_context(|| format!("resolution '{text}': expected WxH, e.g. 1920x1080"))?;
-    Ok((w.trim().parse().context("resolution width")?, h.trim().parse().context("resolution height")?))
+    let (w, h) = text.split_once('x').with_context(|| format!("--resolution '{text}': expected WxH, e.g. 1920x1080"))?;
+    let max = ml_render::settings::MAX_DIMENSION;
+    let side = |s: &str| s.trim().parse::<u32>().ok().filter(|n| (1..=max).contains(n));
+    match (side(w), side(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => bail!("--resolution {text}: each side must be 1 to {max}"),
+    }
 }
 
 /// What every combination renders: the scene (its light count set per combination) and the
@@ -192,13 +256,15 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     counts.sort_unstable();
     counts.dedup();
     let resolution = parse_resolution(&a.resolution)?;
-    if a.frames == 0 {
-        bail!("--frames must be at least 1");
-    }
+    a.rounds()?;
     if a.budget_s.is_nan() || a.budget_s <= 0.0 {
-        bail!("--budget-s must be greater than 0");
+        bail!("--budget-s {} must be greater than 0", a.budget_s);
     }
     let rasters = raster_list(a)?;
+    let rules = a.rules(&rasters);
+    let named: Vec<Technique> = choices.iter().flatten().copied().collect();
+    let auto = if choices.contains(&None) { Auto::Pending } else { Auto::No };
+    check_rules(&rules, &a.given, &Techniques { flag: "--techniques", named: named.clone(), auto })?;
     let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Plan::new(a, resolution)?) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
     let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
@@ -217,6 +283,9 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     };
     // Every run records the quick probe and what auto makes of it.
     let (auto_technique, auto_why, quick) = auto::pick(&ctx)?;
+    if auto == Auto::Pending {
+        check_rules(&rules, &a.given, &Techniques { flag: "--techniques", named, auto: Auto::Picked(auto_technique) })?;
+    }
     auto::announce(auto_technique, &auto_why);
     let mut variants: Vec<Variant> = Vec::new();
     for technique in choices.into_iter().map(|c| c.unwrap_or(auto_technique)) {
@@ -298,7 +367,7 @@ type Previous = Option<(u64, f64)>;
 
 fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Variant, u64), previous: Previous) -> Result<Measured> {
     let technique = variant.technique;
-    let frames = a.warmup + a.frames;
+    let frames = a.rounds()?;
     let skip = |ms: f64, how: &str| {
         let estimate_s = ms * frames as f64 / 1e3;
         (estimate_s > a.budget_s).then(|| {
@@ -524,6 +593,9 @@ mod tests {
 
     #[test]
     fn counts_and_resolutions_parse() {
+        for bad in ["0x10", "10x0", "16385x10", "-1x10", "x"] {
+            assert!(parse_resolution(bad).is_err(), "{bad}");
+        }
         assert_eq!(["64", "16k", "1M", "2m"].map(|t| parse_count(t).unwrap()), [64, 16_000, 1_000_000, 2_000_000]);
         for bad in ["", "0", "k", "1.5k", "-3"] {
             assert!(parse_count(bad).is_err(), "{bad}");

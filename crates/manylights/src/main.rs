@@ -1,14 +1,16 @@
 //! `manylights`: the command line. Parses arguments and calls the library; every failure
-//! ends as one `error: …` line on stderr and a non-zero exit.
+//! ends as one `error: …` line on stderr and a non-zero exit (2 for arguments clap refuses).
 
 use anyhow::{anyhow, bail, Context as _, Result};
-use clap::{Args, Parser, Subcommand};
+use clap::error::ErrorKind;
+use clap::parser::ValueSource;
+use clap::{ArgMatches, Args, CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
-use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
+use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource, SceneWarning};
 use ml_render::report;
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{DebugView, Exposure, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
@@ -48,8 +50,8 @@ struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Frames to render (1 to 100000); timings are averaged over them, the image is the last
-    /// one — or, with a # in --out, every frame's.
-    #[arg(long, default_value_t = 1)]
+    /// one's — or, with a # in --out, every frame's.
+    #[arg(long, default_value_t = 1, value_parser = Whole::<u32>::new(1, MAX_FRAMES as u64), allow_negative_numbers = true)]
     frames: u32,
     /// Output PNG file; a name with a run of # (frames/####.png) is an image sequence: every
     /// frame, the #s replaced by its number from 0, zero-padded to their count, in a folder
@@ -69,32 +71,34 @@ struct ViewArgs {
     /// system has them).
     #[arg(long)]
     no_vsync: bool,
-    /// Run a scripted session (README: "Viewer"): frames, technique and light changes,
-    /// resizes, screenshots, quit.
+    /// Run a scripted session (its commands: docs/usage.md, "`view`: the window"): frames,
+    /// technique and light changes, resizes, screenshots, quit.
     #[arg(long)]
     script: Option<PathBuf>,
 }
 
-/// What `render` and `view` share: the scene, technique and their settings.
+/// What `render` and `view` share: the scene, technique and their settings. Each option's
+/// help ends with its default: clap's `[default: X]` where it is one value, a sentence
+/// "Default: …" where the scene decides it.
 #[derive(Args)]
 struct SceneArgs {
-    /// Scene to render: seed (built in), room (a closed room with a pillar and one point light,
-    /// for point-light shadows), bench (a floor, --objects objects, --lights N (default 1024)
-    /// lights whose radius shrinks as N^(−1/3): the benchmark's), a scene file FILE.toml
-    /// (docs/scenes.md) or a glTF 2.0 file FILE.gltf|FILE.glb (rendered with pbr unless
-    /// --shading says otherwise).
+    /// Scene: seed (built in: a grid of --object in --material), room (a closed room with a
+    /// pillar and one point light, for point-light shadows), bench (a floor, --objects
+    /// objects and lights whose radius shrinks as their count grows: the benchmark's), a
+    /// scene file FILE.toml (docs/scenes.md) or a glTF 2.0 file FILE.gltf|FILE.glb (rendered
+    /// with pbr unless --shading says otherwise).
     #[arg(long, default_value = "seed")]
     scene: String,
-    /// Objects of the bench scene (default 300): more objects on the same floor, denser; the
+    /// Objects of the bench scene (0 to 100000): more objects on the same floor, denser; the
     /// first 300 are always the same.
-    #[arg(long)]
-    objects: Option<usize>,
+    #[arg(long, default_value_t = ml_cpu::bench_scene::BENCH_OBJECTS, value_parser = OBJECTS, allow_negative_numbers = true)]
+    objects: usize,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
     /// deferred-compute, visibility (meshlets culled on the GPU into a visibility buffer, lit
-    /// in compute), or auto (the default): visibility (deferred-compute on a device without its
-    /// features) where this device runs the probe's light loop (`bench --probe`) over 1.25×
-    /// faster as a compute shader than as a fragment shader, else deferred-clustered. Every
-    /// technique gives forward's image.
+    /// in compute), or auto: visibility (deferred-compute on a device without its features)
+    /// where this device runs the probe's light loop (`bench --probe`) over 1.25× faster as a
+    /// compute shader than as a fragment shader, else deferred-clustered. Every technique
+    /// gives forward's image.
     #[arg(long, default_value = "auto")]
     technique: String,
     /// Shading model: seed (specular-only Cook–Torrance: GGX, Schlick–Smith, Schlick Fresnel),
@@ -103,43 +107,48 @@ struct SceneArgs {
     /// diffuse, ACES tone map). Default: the scene file's [shading] model, else seed.
     #[arg(long)]
     shading: Option<String>,
-    /// Cluster grid XxYxZ of the clustered techniques (the seed's was 4x4x2), or auto:
-    /// 16x9x24 scaled by 1, 2 or 4 on every axis as ∛(lights / 4096) rounds (32x18x48 from
-    /// ~11.6k lights, 64x36x96 from ~93k), so that lights per cluster stay few as lights shrink.
+    /// Cluster grid XxYxZ of the techniques that have one (all but forward and deferred), or
+    /// auto: 16x9x24 scaled by 1, 2 or 4 on every axis as ∛(lights / 4096) rounds (32x18x48
+    /// from ~11.6k lights, 64x36x96 from ~93k), so that lights per cluster stay few as lights
+    /// shrink.
     #[arg(long, default_value = "auto")]
     clusters: String,
     /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu),
-    /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (blinn-phong),
-    /// shadow-cube (the first shadowed point light's cube, unfolded; needs --omni-shadow),
-    /// shadow-atlas (needs --omni-shadow atlas), meshlets, triangles (a colour per meshlet or
-    /// triangle; visibility), alpha (opaque grey, alpha-masked green, blended orange).
+    /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (the sun's;
+    /// blinn-phong), shadow-cube (the first shadowed point light's cube, unfolded; a cube mode
+    /// of --omni-shadow), shadow-atlas (--omni-shadow atlas), meshlets, triangles (a colour per
+    /// meshlet or triangle; visibility), alpha (opaque grey, alpha-masked green, blended
+    /// orange).
     #[arg(long, default_value = "none")]
     debug_view: String,
-    /// Object kind of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.
+    /// Object of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.
     #[arg(long, default_value = "sphere")]
     object: String,
-    /// Material: gold, copper, chromium, nickel, titanium, cobalt, platinum, white, red, blue, black.
+    /// Material of the seed scene's objects: gold, copper, chromium, nickel, titanium, cobalt,
+    /// platinum, white, red, blue, black.
     #[arg(long, default_value = "gold")]
     material: String,
-    /// Number of point lights (default 64; with a scene file: replaces the file's lights with
-    /// N lights of --light-layout; a file without lights gets 64).
-    #[arg(long)]
+    /// Point lights (1 to 16777216); in a scene file, N lights of --light-layout replace the
+    /// file's own. Default: 64 in the seed scene, 1024 in the bench scene, a scene file's own
+    /// lights (64 where it has none); the room keeps its one light.
+    #[arg(long, value_parser = Whole::<u64>::new(1, ml_cpu::lights::MAX_LIGHTS), allow_negative_numbers = true)]
     lights: Option<u64>,
     /// Light placement: grid (a square grid above the scene; in a scene or glTF file, once the
     /// count calls for it, layers of such grids down through the scene's box), random (uniform
     /// in the scene's box) or surface (just above random points of the scene's surfaces,
-    /// area-weighted). The built-in scenes place them in their fixed frame (the grid over
+    /// area-weighted). The seed scene places them in its fixed frame (the grid over
     /// x,z ∈ [−15,15] at y = 7.5, the box x,z ∈ [−20,20], y ∈ [−2,12]); scene and glTF files in
-    /// one fitted to their box, where every layout's default radius brings a few lights to
-    /// each point at any count.
+    /// one fitted to their box, where every layout's fitted radius brings a few lights to each
+    /// point at any count. The bench scene's lights are always random.
     #[arg(long, default_value = "grid")]
     light_layout: String,
-    /// Seed of the random and surface layouts (and of random radii).
-    #[arg(long, default_value_t = 1)]
+    /// Seed of the random and surface layouts, of radii drawn from a --light-radius range and
+    /// of the bench scene's lights.
+    #[arg(long, default_value_t = 1, value_parser = Whole::<u64>::new(0, u64::MAX), allow_negative_numbers = true)]
     light_seed: u64,
-    /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene;
-    /// in a scene or glTF file the radius at which about 4 lights reach a point of the scene,
-    /// from its box and the light count.
+    /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene; in
+    /// a scene or glTF file the radius at which about 4 lights reach a point of the scene, from
+    /// its box and the light count.
     #[arg(long)]
     light_radius: Option<String>,
     /// Point-light shadows: off; through cube maps, rendered by copy (each face offscreen,
@@ -156,31 +165,34 @@ struct SceneArgs {
     /// orthographic view).
     #[arg(long, default_value = "graphics")]
     sun_shadow: String,
-    /// How many point lights cast shadows: K (the strongest as seen from the camera) or all
-    /// (every light that reaches the view, the strongest 4096 at most).
-    #[arg(long, default_value = "1")]
+    /// How many point lights cast shadows (with --omni-shadow): K (the strongest as seen from
+    /// the camera) or all (every light that reaches the view, the strongest 4096 at most).
+    #[arg(long, default_value = "1", allow_negative_numbers = true)]
     shadowed_lights: String,
-    /// Texels per side of each shadow-cube face (default 1024); with --omni-shadow atlas,
-    /// every face this size (a power of two, 32 to 2048) instead of the light's size on screen.
-    #[arg(long)]
+    /// Texels per side of each shadow-cube face (with --omni-shadow; 1 to 16384, and at most
+    /// the device's largest cube); with --omni-shadow atlas, every face this size (a power of
+    /// two, 32 to 2048). Default: 1024; with --omni-shadow atlas, each light's size on screen.
+    #[arg(long, value_parser = Whole::<u32>::new(1, ml_render::settings::MAX_DIMENSION as u64), allow_negative_numbers = true)]
     cube_size: Option<u32>,
-    /// MiB that point-light shadows may take with --omni-shadow atlas: the atlas, its tables
-    /// and the raster's lists. When the faces do not fit, every face shrinks by one factor
-    /// (the table reports it).
-    #[arg(long)]
-    shadow_budget: Option<u32>,
+    /// MiB that point-light shadows may take with --omni-shadow atlas (1 to the device's
+    /// memory): the atlas, its tables and the raster's lists. When the faces do not fit, every
+    /// face shrinks by one factor (the table reports it).
+    #[arg(long, default_value_t = AtlasSettings::DEFAULT.budget_mib, value_parser = SHADOW_BUDGET, allow_negative_numbers = true)]
+    shadow_budget: u32,
     /// Whether atlas faces whose light did not move keep last frame's texels (on) or are
     /// drawn again every frame (off; the same images, for comparisons).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     shadow_cache: String,
-    #[arg(long, default_value_t = 1280)]
+    /// Image width in pixels (1 to 16384, and at most the device's largest image).
+    #[arg(long, default_value_t = 1280, value_parser = SIDE, allow_negative_numbers = true)]
     width: u32,
-    #[arg(long, default_value_t = 720)]
+    /// Image height in pixels (1 to 16384, and at most the device's largest image).
+    #[arg(long, default_value_t = 720, value_parser = SIDE, allow_negative_numbers = true)]
     height: u32,
     /// The camera: eye position, the point it looks at and its vertical field of view in
-    /// degrees (default 60), as EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV]; its near
-    /// and far planes fit the scene. Default: the scene's own camera. The viewer's C key
-    /// prints its camera in this form.
+    /// degrees (60 where left out), as EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV]; its
+    /// near and far planes fit the scene. The viewer's C key prints its camera in this form.
+    /// Default: the scene's own camera.
     #[arg(long, allow_hyphen_values = true)]
     camera: Option<String>,
     /// Draw every point light as a small cube glowing in its colour, sized by its radius and
@@ -189,13 +201,14 @@ struct SceneArgs {
     #[arg(long)]
     show_lights: bool,
     /// Exposure: stops (EV, -20 to 20; lit colour × 2^EV before the tone map and gamma), or
-    /// auto (the image's log-average luminance brought to middle grey, metered on the GPU).
-    /// Default: auto for scene files and glTF files, 0 for the built-in scenes.
+    /// auto (the image's log-average luminance brought to middle grey, metered on the GPU); not
+    /// with a --debug-view, whose values are shown as they are. Default: auto for scene files
+    /// and glTF files, 0 for the built-in scenes.
     #[arg(long, allow_hyphen_values = true)]
     exposure: Option<String>,
-    /// Fix the animation clock at T (otherwise it advances 1/60 s per frame from 0; in the
-    /// viewer, with real time).
-    #[arg(long)]
+    /// Fix the animation clock at T seconds. Default: the clock advances 1/60 s per frame from
+    /// 0 (in the viewer, with real time).
+    #[arg(long, allow_negative_numbers = true)]
     time: Option<f32>,
     /// GPU culling of the visibility technique: on, or off (every meshlet drawn; the image
     /// must not change).
@@ -209,32 +222,111 @@ struct SceneArgs {
     /// why).
     #[arg(long, default_value = "auto", value_parser = ["hardware", "hybrid", "compute", "auto"])]
     raster: String,
-    /// The compute raster's largest triangle: bounding box up to PX pixels a side (1 to 64).
-    #[arg(long, default_value_t = Raster::DEFAULT_SPLIT)]
+    /// The compute and hybrid rasters' largest triangle drawn by one thread: bounding box up to
+    /// PX pixels a side (1 to 64).
+    #[arg(long, default_value_t = Raster::DEFAULT_SPLIT, value_parser = RASTER_SPLIT, allow_negative_numbers = true)]
     raster_split: u32,
     /// Enable the Khronos validation layer with synchronization validation; any message
     /// makes the run fail.
     #[arg(long)]
     validation: bool,
-    /// Vulkan device index (see `manylights info`); default: the best one (discrete first).
-    #[arg(long)]
+    /// Vulkan device index (see `manylights info`). Default: the best one (discrete first).
+    #[arg(long, value_parser = DEVICE, allow_negative_numbers = true)]
     device: Option<usize>,
+    /// The options given on the command line (the others keep their defaults).
+    #[arg(skip)]
+    given: Given,
+}
+
+/// The ranges of the counts and sizes `render`, `view` and `bench` share.
+const OBJECTS: Whole<usize> = Whole::new(0, ml_cpu::bench_scene::MAX_BENCH_OBJECTS as u64);
+const SIDE: Whole<u32> = Whole::new(1, ml_render::settings::MAX_DIMENSION as u64);
+const RASTER_SPLIT: Whole<u32> = Whole::new(1, Raster::MAX_SPLIT as u64);
+const SHADOW_BUDGET: Whole<u32> = Whole::checked_later(u32::MAX as u64, "1 to the device's memory in MiB");
+const DEVICE: Whole<usize> = Whole::checked_later(u32::MAX as u64, "0 to the last device `manylights info` lists");
+
+/// A whole number for a flag, from `min` to `max`. It is read as a signed number of any size
+/// first, so that a negative or huge value gets the range in its message ("--width -100 is out
+/// of range: use 1 to 16384") instead of being taken for no number; its flags take
+/// `allow_negative_numbers`, so that clap hands it a negative value instead of taking it for
+/// another flag.
+pub(crate) struct Whole<T> {
+    min: u64,
+    max: u64,
+    /// The range in words, where the device decides it (checked once it is known); the parser
+    /// then refuses only what the type cannot hold.
+    range: Option<&'static str>,
+    value: std::marker::PhantomData<fn() -> T>,
+}
+
+// Not derived: a derive would ask `T` to be Clone and Copy too.
+impl<T> Clone for Whole<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Whole<T> {}
+
+impl<T> Whole<T> {
+    pub(crate) const fn new(min: u64, max: u64) -> Whole<T> {
+        Whole { min, max, range: None, value: std::marker::PhantomData }
+    }
+
+    /// Any value from 0 to `max` (the type's), the range `range` checked later.
+    pub(crate) const fn checked_later(max: u64, range: &'static str) -> Whole<T> {
+        Whole { min: 0, max, range: Some(range), value: std::marker::PhantomData }
+    }
+}
+
+impl<T: TryFrom<u64> + Clone + Send + Sync + 'static> clap::builder::TypedValueParser for Whole<T> {
+    type Value = T;
+
+    fn parse_ref(&self, _: &clap::Command, arg: Option<&clap::Arg>, value: &std::ffi::OsStr) -> Result<T, clap::Error> {
+        let flag = arg.and_then(clap::Arg::get_long).map_or_else(|| "the value".to_owned(), |long| format!("--{long}"));
+        let text = value.to_string_lossy();
+        let refuse = |why: String| clap::Error::raw(ErrorKind::ValueValidation, format!("{flag} {why}\n"));
+        let out_of_range = || {
+            let range = self.range.map_or_else(|| format!("{} to {}", self.min, self.max), str::to_owned);
+            refuse(format!("{text} is out of range: use {range}"))
+        };
+        match text.trim().parse::<i128>() {
+            Ok(n) => u64::try_from(n)
+                .ok()
+                .filter(|n| (self.min..=self.max).contains(n))
+                .and_then(|n| T::try_from(n).ok())
+                .ok_or_else(out_of_range),
+            Err(e) if matches!(e.kind(), std::num::IntErrorKind::PosOverflow | std::num::IntErrorKind::NegOverflow) => Err(out_of_range()),
+            Err(_) => Err(refuse(format!("'{text}' is not a whole number"))),
+        }
+    }
+}
+
+/// The options of a command given on the command line, by clap's id (the field's name): the
+/// others keep their defaults, which never make an option refused as not applying.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Given(Vec<String>);
+
+impl Given {
+    fn of(matches: &ArgMatches) -> Given {
+        Given(
+            matches
+                .ids()
+                .filter(|id| matches.value_source(id.as_str()) == Some(ValueSource::CommandLine))
+                .map(|id| id.to_string())
+                .collect(),
+        )
+    }
+
+    pub(crate) fn has(&self, id: &str) -> bool {
+        self.0.iter().any(|given| given == id)
+    }
 }
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match parse_arguments() {
         Ok(cli) => cli,
-        Err(e) if !e.use_stderr() => {
-            // --help, --version
-            let _ = e.print();
-            return ExitCode::SUCCESS;
-        }
-        Err(e) => {
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
-            eprintln!("error: {first} (see `manylights --help`)");
-            return ExitCode::from(2);
-        }
+        Err(code) => return code,
     };
     let result = match cli.command {
         Command::Render(args) => render(&args),
@@ -251,18 +343,55 @@ fn main() -> ExitCode {
     }
 }
 
-/// What `--scene` names: the seed scene (of `object` in `material`), room, bench (of `objects`
-/// objects, which no other scene takes), or a file.
-fn scene_source(name: &str, object: MeshKind, material: Material, objects: Option<usize>) -> Result<SceneSource> {
-    if objects.is_some() && name != "bench" {
-        bail!("--objects sets the bench scene's object count: use it with --scene bench");
+/// The command line, each command knowing which options it was given; else the exit code
+/// once --help or --version is printed, or an argument error (on one line).
+fn parse_arguments() -> Result<Cli, ExitCode> {
+    let matches = Cli::command().try_get_matches().map_err(argument_error)?;
+    let mut cli = Cli::from_arg_matches(&matches).map_err(argument_error)?;
+    if let Some((_, options)) = matches.subcommand() {
+        let given = Given::of(options);
+        match &mut cli.command {
+            Command::Render(args) => args.scene.given = given,
+            Command::View(args) => args.scene.given = given,
+            Command::Bench(args) => args.given = given,
+            Command::Info => {}
+        }
     }
+    Ok(cli)
+}
+
+/// What clap's `e` ends the run with: --help and --version print and succeed; a bare
+/// `manylights` prints the help and, on stderr, the line naming the commands; anything else
+/// is clap's whole message on one line. Exit code 2 for errors.
+fn argument_error(e: clap::Error) -> ExitCode {
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            let mut cli = Cli::command();
+            println!("{}", cli.render_help());
+            let commands: Vec<&str> = cli.get_subcommands().map(clap::Command::get_name).filter(|&name| name != "help").collect();
+            eprintln!("error: manylights needs a command: {} (the help above says what each does)", commands.join(", "));
+            ExitCode::from(2)
+        }
+        _ => {
+            eprintln!("error: {}", messages::argument_error(&e.to_string()));
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// What `--scene` names: the seed scene (of `object` in `material`), room, bench (of `objects`
+/// objects), or a file.
+fn scene_source(name: &str, object: MeshKind, material: Material, objects: usize) -> Result<SceneSource> {
     Ok(match name {
         "seed" => SceneSource::Seed { object, material },
         "room" => SceneSource::Room,
-        "bench" => SceneSource::Bench { objects: objects.unwrap_or(ml_cpu::bench_scene::BENCH_OBJECTS) },
+        "bench" => SceneSource::Bench { objects },
         path if is_scene_file(path) => SceneSource::File(PathBuf::from(path)),
-        other => bail!("unknown scene '{other}': expected seed, room, a scene file FILE.toml or a glTF file FILE.gltf|FILE.glb"),
+        other => bail!("unknown scene '{other}': expected seed, room, bench, a scene file FILE.toml or a glTF file FILE.gltf|FILE.glb"),
     })
 }
 
@@ -300,28 +429,28 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
     if args.show_lights && args.omni_shadow != "off" {
         bail!("--show-lights and --omni-shadow do not go together: each light's shadow cube would see the marker around it");
     }
+    // Options of the shadows asked for without them are refused by `check_options_apply`.
     let omni = match args.omni_shadow.as_str() {
-        "off" if args.shadowed_lights != "1" || args.cube_size.is_some() || args.shadow_budget.is_some() || args.shadow_cache != "on" => {
-            bail!(
-                "--shadowed-lights, --cube-size, --shadow-budget and --shadow-cache need point-light shadows: add --omni-shadow layered|direct|multiview|copy|compute|atlas"
-            )
-        }
         "off" => None,
         mode => {
             let mode = match OmniShadowMode::from_name(mode)? {
                 OmniShadowMode::Atlas(_) => OmniShadowMode::Atlas(AtlasSettings {
-                    budget_mib: args.shadow_budget.unwrap_or(AtlasSettings::DEFAULT.budget_mib),
+                    budget_mib: args.shadow_budget,
                     cache: args.shadow_cache == "on",
                     fixed_size: args.cube_size,
                 }),
-                _ if args.shadow_budget.is_some() || args.shadow_cache != "on" => {
-                    bail!("--shadow-budget and --shadow-cache are the shadow atlas's: add --omni-shadow atlas")
-                }
                 cubes => cubes,
             };
             let (lights, all) = match args.shadowed_lights.trim() {
                 "all" => (MAX_SHADOWED_LIGHTS, true),
-                k => (k.parse::<u32>().map_err(|_| anyhow!("--shadowed-lights '{k}' is neither a count nor all"))?, false),
+                k => match k.parse::<i128>() {
+                    Ok(n) => (
+                        u32::try_from(n)
+                            .map_err(|_| anyhow!("--shadowed-lights {k} is out of range: use 1 to the scene's lights, or all"))?,
+                        false,
+                    ),
+                    Err(_) => bail!("--shadowed-lights '{k}' is neither a count nor all"),
+                },
             };
             Some(OmniShadowSettings { mode, lights, all, size: args.cube_size.unwrap_or(OmniShadowSettings::DEFAULT_SIZE) })
         }
@@ -364,6 +493,254 @@ fn raster_choice(args: &SceneArgs) -> Result<Option<Raster>> {
         "auto" => Ok(None),
         name => Ok(Some(Raster::from_name(name, args.raster_split)?)),
     }
+}
+
+/// An option given on the command line that does nothing with the technique, the scene or the
+/// other settings asked for: refused in one line naming it, what it does not apply to and
+/// what it needs (docs/usage.md, "Options that do not apply"). Defaults never are.
+#[derive(Debug)]
+pub(crate) struct NotApplying {
+    option: String,
+    to: String,
+    needs: String,
+}
+
+impl std::fmt::Display for NotApplying {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} does not apply to {}: it needs {}", self.option, self.to, self.needs)
+    }
+}
+
+impl std::error::Error for NotApplying {}
+
+/// An option that applies only with some techniques, settings or scenes.
+pub(crate) struct Rule {
+    /// clap's id of the option (its field's name): the rule holds where it was given.
+    id: &'static str,
+    /// The option as the user wrote it: `--culling`, `--debug-view cluster-heat`.
+    option: String,
+    need: Need,
+}
+
+pub(crate) enum Need {
+    /// One of the techniques `applies` accepts; `what` says what they have in common.
+    Technique { what: &'static str, applies: fn(Technique) -> bool },
+    /// A setting or scene: whether the ones asked for are it (None: not known yet: a scene
+    /// file's shading model and lights before it is loaded), what they are instead, and what
+    /// the option needs.
+    Setting { holds: Option<bool>, instead: String, needs: String },
+}
+
+impl Rule {
+    pub(crate) fn technique(id: &'static str, what: &'static str, applies: fn(Technique) -> bool) -> Rule {
+        Rule { id, option: flag(id), need: Need::Technique { what, applies } }
+    }
+
+    pub(crate) fn setting(id: &'static str, holds: Option<bool>, instead: impl Into<String>, needs: impl Into<String>) -> Rule {
+        Rule { id, option: flag(id), need: Need::Setting { holds, instead: instead.into(), needs: needs.into() } }
+    }
+
+    /// The rule of one value of the option (`--debug-view shadow-cube`).
+    fn of_value(self, value: &str) -> Rule {
+        Rule { option: format!("{} {value}", self.option), ..self }
+    }
+}
+
+/// `--raster-split` for the id `raster_split`.
+fn flag(id: &str) -> String {
+    format!("--{}", id.replace('_', "-"))
+}
+
+/// What the techniques that have a cluster grid (the clustered ones) have in common.
+pub(crate) const CLUSTER_GRID: &str = "the techniques with a cluster grid";
+/// … and the technique whose visibility buffer the rasterisers draw.
+pub(crate) const VISIBILITY_BUFFER: &str = "the technique with a visibility buffer";
+
+pub(crate) fn draws_meshlets(t: Technique) -> bool {
+    t.geometry() == ml_render::Geometry::Meshlets
+}
+
+/// The techniques a command renders with, as far as they are known: those named and, with
+/// auto, its pick on this device; before the probe, any technique auto may pick.
+pub(crate) struct Techniques {
+    /// `--technique` or `--techniques`.
+    pub(crate) flag: &'static str,
+    pub(crate) named: Vec<Technique>,
+    pub(crate) auto: Auto,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+pub(crate) enum Auto {
+    /// Not asked for.
+    No,
+    /// Asked for, not probed yet.
+    Pending,
+    Picked(Technique),
+}
+
+impl Techniques {
+    /// `--technique`'s choice (None: auto, not yet probed).
+    fn chosen(choice: Option<Technique>) -> Techniques {
+        match choice {
+            Some(t) => Techniques { flag: "--technique", named: vec![t], auto: Auto::No },
+            None => Techniques { flag: "--technique", named: Vec::new(), auto: Auto::Pending },
+        }
+    }
+
+    /// Refused unless one of the techniques (before auto's probe, one it may pick) is one
+    /// that `applies` accepts.
+    fn check(&self, option: &str, what: &str, applies: fn(Technique) -> bool) -> Result<(), NotApplying> {
+        let auto: &[Technique] = match &self.auto {
+            Auto::No => &[],
+            Auto::Pending => &auto::CANDIDATES,
+            Auto::Picked(t) => std::slice::from_ref(t),
+        };
+        if self.named.iter().chain(auto).any(|&t| applies(t)) {
+            return Ok(());
+        }
+        let mut to: Vec<String> = self.named.iter().map(|t| t.name().to_owned()).collect();
+        match self.auto {
+            Auto::No => {}
+            Auto::Pending => to.push(format!("auto (which picks {})", or_list(auto.iter().map(|t| t.name())))),
+            Auto::Picked(t) => to.push(format!("{}, which auto picked on this device", t.name())),
+        }
+        let which = or_list(Technique::ALL.into_iter().filter(|&t| applies(t)).map(Technique::name));
+        let mut needs = format!("{} {which} ({what})", self.flag);
+        if self.auto != Auto::No {
+            needs += &format!("; name one with {} rather than auto", self.flag);
+        }
+        Err(NotApplying { option: option.to_owned(), to: to.join(" and "), needs })
+    }
+}
+
+/// `a`, `a or b`, `a, b or c`.
+fn or_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let names: Vec<&str> = names.collect();
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => names.join(""),
+    }
+}
+
+/// Refuse the first of `rules` whose option was given and does not apply to `techniques` (as
+/// far as they are known) or to the settings and scene asked for (as far as they are known).
+pub(crate) fn check_rules(rules: &[Rule], given: &Given, techniques: &Techniques) -> Result<(), NotApplying> {
+    for rule in rules.iter().filter(|r| given.has(r.id)) {
+        match &rule.need {
+            Need::Technique { what, applies } => techniques.check(&rule.option, what, *applies)?,
+            Need::Setting { holds: Some(false), instead, needs } => {
+                return Err(NotApplying { option: rule.option.clone(), to: instead.clone(), needs: needs.clone() });
+            }
+            Need::Setting { .. } => {}
+        }
+    }
+    Ok(())
+}
+
+/// `--objects`, of `render`, `view` and `bench`.
+pub(crate) fn objects_rule(scene: &str) -> Rule {
+    Rule::setting("objects", Some(scene == "bench"), format!("--scene {scene}"), "the bench scene (--scene bench)")
+}
+
+/// The options of `render` and `view` that apply only with some techniques, settings or
+/// scenes: `source` is the scene asked for, `built` the scene once it is (which tells a scene
+/// file's shading model and whether it keeps its own lights).
+fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene>) -> Vec<Rule> {
+    let scene = format!("--scene {}", args.scene);
+    let (seed, room, bench, file) = (
+        matches!(source, SceneSource::Seed { .. }),
+        matches!(source, SceneSource::Room),
+        matches!(source, SceneSource::Bench { .. }),
+        matches!(source, SceneSource::File(_)),
+    );
+    let placed =
+        "lights placed by layout (--scene seed or a scene or glTF file; the bench scene's are random, the room keeps its one light)";
+    let random = args.light_layout != "grid" || args.light_radius.as_deref().is_some_and(|r| r.contains(".."));
+    let random_lights = "random lights (--light-layout random or surface, a --light-radius range MIN..MAX, or --scene bench)";
+    // A file that has lights keeps them unless --lights replaces them.
+    let own_lights =
+        built.map(|b| file && args.lights.is_none() && !b.warnings.iter().any(|w| matches!(w, SceneWarning::DefaultRig { .. })));
+    let own = |id| {
+        Rule::setting(id, own_lights.map(|own| !own), format!("the lights of '{}'", args.scene), "--lights N, whose lights replace them")
+    };
+    let omni = args.omni_shadow.as_str();
+    let cube_modes = OmniShadowMode::ALL.into_iter().filter(|m| !matches!(m, OmniShadowMode::Atlas(_))).map(OmniShadowMode::name);
+    let cubes = format!("point-light shadow cubes (--omni-shadow {})", or_list(cube_modes));
+    let shadows = format!("point-light shadows (--omni-shadow {})", or_list(OmniShadowMode::ALL.into_iter().map(OmniShadowMode::name)));
+    let atlas = "the shadow atlas (--omni-shadow atlas)";
+    let model = built.map(|b| b.shading);
+    let sun = |id| {
+        Rule::setting(
+            id,
+            model.map(|m| m == ShadingModel::BlinnPhong),
+            format!("the {} shading model", model.map_or("", ShadingModel::name)),
+            "the blinn-phong model's sun (--shading blinn-phong)",
+        )
+    };
+    let mut rules = vec![
+        objects_rule(&args.scene),
+        Rule::setting("object", Some(seed), &scene, "the seed scene (--scene seed)"),
+        Rule::setting("material", Some(seed), &scene, "the seed scene (--scene seed)"),
+        Rule::setting(
+            "lights",
+            Some(!room),
+            &scene,
+            "a scene whose lights are placed (--scene seed, bench or a file; the room keeps its one light)",
+        ),
+        Rule::setting("light_layout", Some(seed || file), &scene, placed),
+        Rule::setting("light_radius", Some(seed || file), &scene, placed),
+        Rule::setting("light_seed", Some(!room), &scene, random_lights),
+        Rule::setting("light_seed", Some(bench || random), "--light-layout grid of one --light-radius", random_lights),
+        own("light_layout"),
+        own("light_radius"),
+        own("light_seed"),
+        Rule::setting("shadowed_lights", Some(omni != "off"), "--omni-shadow off", &shadows),
+        Rule::setting("cube_size", Some(omni != "off"), "--omni-shadow off", &shadows),
+        Rule::setting("shadow_budget", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas),
+        Rule::setting("shadow_cache", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas),
+        sun("sun_shadow"),
+        Rule::setting(
+            "exposure",
+            Some(args.debug_view == "none"),
+            format!("--debug-view {}", args.debug_view),
+            "the shaded image (--debug-view none; debug views show their values as they are)",
+        ),
+        Rule::technique("clusters", CLUSTER_GRID, Technique::is_clustered),
+        Rule::technique("culling", "the technique that culls meshlets on the GPU", draws_meshlets),
+        Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
+        Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
+        Rule::setting(
+            "raster_split",
+            Some(args.raster != "hardware"),
+            "--raster hardware",
+            "a rasteriser in compute (--raster compute, hybrid or auto)",
+        ),
+    ];
+    let view = args.debug_view.as_str();
+    rules.extend(
+        match DebugView::from_name(view).unwrap_or(DebugView::None) {
+            DebugView::ClusterHeat => {
+                Some(Rule::technique("debug_view", "the clustered forward techniques", Technique::draws_cluster_heat))
+            }
+            DebugView::Meshlets | DebugView::Triangles => {
+                Some(Rule::technique("debug_view", "the technique drawn in meshlets", draws_meshlets))
+            }
+            DebugView::ShadowMap => Some(sun("debug_view")),
+            DebugView::ShadowCube => {
+                Some(Rule::setting("debug_view", Some(omni != "off" && omni != "atlas"), format!("--omni-shadow {omni}"), cubes))
+            }
+            DebugView::ShadowAtlas => Some(Rule::setting("debug_view", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas)),
+            _ => None,
+        }
+        .map(|rule| rule.of_value(view)),
+    );
+    rules
+}
+
+/// Refuse an option of `render` or `view` given on the command line that does not apply to
+/// `techniques`, the scene or the other settings, as far as they are known.
+fn check_options_apply(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene>, techniques: &Techniques) -> Result<()> {
+    Ok(check_rules(&scene_rules(args, source, built), &args.given, techniques)?)
 }
 
 /// A built scene's warnings, one line each.
@@ -442,12 +819,11 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let request = scene_request(args)?;
     // Every setting is checked before the GPU work; auto's technique is set once it is known.
     let wanted = settings_request(args, choice.unwrap_or(Technique::DeferredClustered), cmd.frames)?;
-    if cmd.frames > MAX_FRAMES {
-        bail!("--frames {} is out of range: use 1 to {MAX_FRAMES}", cmd.frames);
-    }
+    let mut techniques = Techniques::chosen(choice);
+    check_options_apply(args, &request.source, None, &techniques)?;
     let sequence = output::sequence_pattern(&cmd.out)?;
     let built = request.build()?;
-    print_warnings(&built.warnings);
+    check_options_apply(args, &request.source, Some(&built), &techniques)?;
     output::prepare(&cmd.out, sequence.as_ref())?;
     let mut settings = wanted.for_scene(&built.scene, built.shading);
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
@@ -457,9 +833,13 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         None => {
             let (t, why, _) = auto::pick(&ctx)?;
             settings.technique = t;
+            techniques.auto = Auto::Picked(t);
+            check_options_apply(args, &request.source, Some(&built), &techniques)?;
             Some(why)
         }
     };
+    // Once every option is known to apply, so that a refusal stays the only line.
+    print_warnings(&built.warnings);
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
@@ -499,13 +879,20 @@ fn view(cmd: &ViewArgs) -> Result<()> {
         }
         None => None,
     };
-    // Checked once up front, so that a bad argument fails before a window opens.
-    auto::technique_choice(&args.technique)?;
+    // Checked up front, so that a bad argument fails before a window opens.
+    let choice = auto::technique_choice(&args.technique)?;
     let request = scene_request(args)?;
     let wanted = settings_request(args, Technique::Forward, 1)?;
+    let mut techniques = Techniques::chosen(choice);
+    check_options_apply(args, &request.source, None, &techniques)?;
     let built = request.build()?;
-    print_warnings(&built.warnings);
+    check_options_apply(args, &request.source, Some(&built), &techniques)?;
     let technique = auto::resolve_alone(&args.technique, args.validation, args.device)?;
+    if choice.is_none() {
+        techniques.auto = Auto::Picked(technique);
+        check_options_apply(args, &request.source, Some(&built), &techniques)?;
+    }
+    print_warnings(&built.warnings);
     let mut first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
     first.raster =
         auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args)?, args.raster_split), (args.validation, args.device))?;
@@ -529,4 +916,39 @@ fn info() -> Result<()> {
         println!("{}", report::table(&report::device_rows(&d)));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ids of `command`'s options.
+    fn ids(command: &str) -> Vec<String> {
+        let cli = Cli::command();
+        let sub = cli.find_subcommand(command).expect("the command");
+        sub.get_arguments().map(|a| a.get_id().to_string()).collect()
+    }
+
+    /// A rule whose id names no option would never hold.
+    #[test]
+    fn every_rule_names_an_option() {
+        for view in DebugView::ALL {
+            let Command::Render(args) = Cli::parse_from(["manylights", "render", "--debug-view", view.name(), "--out", "a.png"]).command
+            else {
+                unreachable!()
+            };
+            for rule in scene_rules(&args.scene, &SceneSource::Room, None) {
+                assert!(ids("render").contains(&rule.id.to_owned()) && ids("view").contains(&rule.id.to_owned()), "{}", rule.id);
+            }
+        }
+        let Command::Bench(args) = Cli::parse_from(["manylights", "bench"]).command else { unreachable!() };
+        for rule in args.rules(&[]) {
+            assert!(ids("bench").contains(&rule.id.to_owned()), "{}", rule.id);
+        }
+    }
+
+    #[test]
+    fn lists_read_as_prose() {
+        assert_eq!([&["a"][..], &["a", "b"], &["a", "b", "c"]].map(|l| or_list(l.iter().copied())), ["a", "a or b", "a, b or c"]);
+    }
 }

@@ -10,6 +10,22 @@ use ml_render::RenderError;
 use ml_vk::VkError;
 use std::error::Error;
 
+/// clap's message about the arguments in one line, after `error: `: what is missing or wrong,
+/// the tip and the usage, each of its lines trimmed and the blank ones dropped, a line that
+/// ends in a colon continued by the next (`not provided: --out <OUT>`), the others joined by
+/// "; ".
+pub fn argument_error(text: &str) -> String {
+    let mut line = String::new();
+    for part in text.lines().map(str::trim).filter(|l| !l.is_empty()) {
+        let part = part.strip_prefix("error: ").unwrap_or(part);
+        if !line.is_empty() {
+            line += if line.ends_with(':') { " " } else { "; " };
+        }
+        line += part;
+    }
+    line
+}
+
 /// The error and its causes in one line, as anyhow's `{:#}` writes it, each cause that is
 /// about a flag's value said with that flag.
 pub fn describe(e: &anyhow::Error) -> String {
@@ -122,6 +138,20 @@ fn settings(e: &SettingsError) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn argument_errors_keep_every_line() {
+        let clap = "error: unexpected argument '--lihgts' found\n\n  tip: a similar argument exists: '--lights'\n\nUsage: manylights render --lights <LIGHTS> --out <OUT>\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            argument_error(clap),
+            "unexpected argument '--lihgts' found; tip: a similar argument exists: '--lights'; Usage: manylights render --lights <LIGHTS> --out <OUT>; For more information, try '--help'."
+        );
+        let missing = "error: the following required arguments were not provided:\n  --out <OUT>\n\nUsage: manylights render --out <OUT>\n";
+        assert_eq!(
+            argument_error(missing),
+            "the following required arguments were not provided: --out <OUT>; Usage: manylights render --out <OUT>"
+        );
+    }
 
     #[test]
     fn setting_errors_name_their_flags_and_context_stays() {

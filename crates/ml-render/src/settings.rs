@@ -80,6 +80,12 @@ impl Technique {
         self.assignment() != LightAssignment::None
     }
 
+    /// Whether it draws the cluster-heat debug view: the clustered forward fragment shader
+    /// does.
+    pub fn draws_cluster_heat(self) -> bool {
+        self.is_clustered() && self.lighting_stage() == LightingStage::Forward
+    }
+
     /// Whether the lighting runs in the second subpass of the raster pass.
     pub fn lights_in_subpass(self) -> bool {
         self.lighting_stage() == LightingStage::Subpass
@@ -609,8 +615,7 @@ impl RenderSettings {
                 return Err(SettingsError::OutOfRange { what, value, max }.into());
             }
         }
-        // The heat view is drawn by the clustered forward fragment shader.
-        if self.debug_view == DebugView::ClusterHeat && !matches!(self.technique, Technique::ClusteredCpu | Technique::ClusteredGpu) {
+        if self.debug_view == DebugView::ClusterHeat && !self.technique.draws_cluster_heat() {
             return Err(SettingsError::HeatNeedsClusteredForward { technique: self.technique }.into());
         }
         if matches!(self.debug_view, DebugView::Meshlets | DebugView::Triangles) && self.technique.geometry() != Geometry::Meshlets {

@@ -31,7 +31,7 @@ pub fn run(ctx: &Context, a: &BenchArgs, (w, h): (u32, u32), lengths: &[u32]) ->
 }
 
 fn measure_all(ctx: &Context, a: &BenchArgs, probe: &mut StageProbe, lengths: &[u32]) -> Result<Vec<ProbeRow>> {
-    let rounds = a.warmup + a.frames;
+    let rounds = a.rounds()?;
     let bar = indicatif::ProgressBar::new(lengths.len() as u64);
     bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("a valid template"));
     let mut rows = Vec::new();
