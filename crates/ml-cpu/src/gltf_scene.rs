@@ -19,10 +19,13 @@ use crate::gpu_types::{LightCone, PointLight};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
 use crate::scene::{AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
-use crate::scene_load::{read_reference, ReferenceError, SceneFile, MAX_OBJECTS};
+use crate::scene_load::{
+    check_extent, read_reference, ExtentError, Number, ReferenceError, SceneFile, LENGTHS, MAX_COORDINATE, MAX_INTENSITY, MAX_OBJECTS,
+    SCALES,
+};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use base64::Engine as _;
-use glam::{Affine2, Mat4, Vec3};
+use glam::{Affine2, Mat3, Mat4, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -134,8 +137,28 @@ pub enum GltfError {
     RequiredExtension(String),
     #[error("the node hierarchy is deeper than {max} (or has a cycle) at node {0}", max = MAX_NODE_DEPTH)]
     TooDeep(usize),
+    #[error("node {0} is its own ancestor: glTF's nodes form trees (here no deeper than {max}), without cycles", max = MAX_NODE_DEPTH)]
+    Cycle(usize),
+    #[error("node {node} is a child of both node {first} and node {second}: glTF's nodes form trees, each node one parent")]
+    TwoParents { node: usize, first: usize, second: usize },
+    #[error("scene {scene}: node {node} is one of its roots and a child of node {parent}")]
+    RootWithParent { scene: usize, node: usize, parent: usize },
+    #[error("scene {scene}: node {node} is named twice among its roots")]
+    RootTwice { scene: usize, node: usize },
+    #[error("asset.version '{0}' is not glTF 2.x")]
+    Version(String),
+    #[error("asset.minVersion '{0}': manylights reads glTF 2.0")]
+    MinVersion(String),
     #[error("node {0}: its transform is not finite")]
     NodeTransform(usize),
+    #[error("node {0}: its matrix's last row is not (0, 0, 0, 1) (glTF: a matrix is a translation, rotation and scale)")]
+    NodeProjective(usize),
+    #[error("node {0}: its transform is singular (it flattens the node to a plane, a line or a point)")]
+    NodeSingular(usize),
+    #[error("node {node}: its transform scales an axis by {}, outside {} to {}", Number(*scale), Number(*SCALES.start()), Number(*SCALES.end()))]
+    NodeScale { node: usize, scale: f32 },
+    #[error(transparent)]
+    Extent(#[from] ExtentError),
     #[error("the scene has no triangles to draw")]
     NoTriangles,
     /// A primitive's attribute naming an accessor that does not exist.
@@ -201,6 +224,12 @@ pub enum GltfError {
     ComponentType { ty: DataType, normalized: bool },
     #[error("element {index} is not finite ({value})")]
     NotFinite { index: usize, value: f32 },
+    #[error("element {index} is {}, beyond ±{}", Number(*value), Number(MAX_COORDINATE))]
+    TooFar { index: usize, value: f32 },
+    #[error(
+        "byteOffset {offset} (in a buffer view at {view_offset}, stride {stride}) is not a multiple of its components' {component} bytes"
+    )]
+    Misaligned { offset: usize, view_offset: usize, stride: usize, component: usize },
     #[error("expected scalars, found {0:?}")]
     NotScalar(Dimensions),
     #[error("component type {0:?} is not an index type")]
@@ -215,7 +244,7 @@ pub enum GltfError {
     AlphaCutoff { material: MaterialName, value: f32 },
     #[error("material {material}: its texture transform is not finite")]
     TextureTransform { material: MaterialName },
-    #[error("material {material}: emissive strength {value} must be finite and not negative")]
+    #[error("material {material}: emissive strength {} must be finite, not negative and at most {}", Number(*value), Number(MAX_INTENSITY))]
     EmissiveStrength { material: MaterialName, value: f32 },
     #[error("its buffer view does not exist")]
     NoImageView,
@@ -228,7 +257,7 @@ pub enum GltfError {
     ImageFormat(std::io::Error),
     #[error("cannot decode it: {0}")]
     Decode(image::ImageError),
-    #[error("a directional light needs a usable node direction and a finite, non-negative colour × intensity")]
+    #[error("a directional light needs a usable node direction and a colour × intensity in [0, {}]", Number(MAX_INTENSITY))]
     Directional,
     #[error("more than {max} directional lights", max = MAX_DIRECTIONAL_LIGHTS)]
     TooManyDirectional,
@@ -236,17 +265,17 @@ pub enum GltfError {
     SpotCone { inner: f32, outer: f32 },
     #[error("its node's transform collapses the spot's direction")]
     SpotDirection,
-    #[error("colour × intensity must be finite and not negative")]
+    #[error("colour × intensity must be finite, not negative and at most {}", Number(MAX_INTENSITY))]
     LightColor,
-    #[error("range {0} must be finite and > 0")]
+    #[error("range {} must lie in [{}, {}]", Number(*.0), Number(*LENGTHS.start()), Number(*LENGTHS.end()))]
     Range(f32),
-    #[error("its node's position is not finite")]
+    #[error("its node's position is not finite or lies beyond ±{}", Number(MAX_COORDINATE))]
     LightPosition,
-    #[error("yfov {yfov} rad, znear {znear}, zfar {zfar}: need 0 < yfov < π and 0 < znear < zfar")]
+    #[error("yfov {} rad, znear {}, zfar {}: need 0 < yfov < π and 0 < znear < zfar, both in [{}, {}]", Number(*yfov), Number(*znear), Number(*zfar), Number(*LENGTHS.start()), Number(*LENGTHS.end()))]
     Perspective { yfov: f32, znear: f32, zfar: f32 },
-    #[error("ymag {ymag}, znear {znear}, zfar {zfar}: need ymag > 0 and 0 ≤ znear < zfar")]
+    #[error("ymag {}, znear {}, zfar {}: need ymag > 0 and 0 ≤ znear < zfar, ymag and zfar in [{}, {}]", Number(*ymag), Number(*znear), Number(*zfar), Number(*LENGTHS.start()), Number(*LENGTHS.end()))]
     Orthographic { ymag: f32, znear: f32, zfar: f32 },
-    #[error("its node's transform is not usable (not finite, or it collapses the view direction)")]
+    #[error("its node's transform is not usable (not finite, beyond ±{}, or it collapses the view direction)", Number(MAX_COORDINATE))]
     CameraTransform,
 }
 
@@ -305,13 +334,14 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         blended: Default::default(),
         mixed_transforms: Default::default(),
     };
+    let parents = node_parents(&gltf.document)?;
     let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
-        Some(scene) => scene.nodes().collect(),
-        None => {
-            // No scene: every node nobody names as a child.
-            let children: std::collections::HashSet<usize> = gltf.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
-            gltf.nodes().filter(|n| !children.contains(&n.index())).collect()
+        Some(scene) => {
+            check_roots(&scene, &parents)?;
+            scene.nodes().collect()
         }
+        // No scene: every node nobody names as a child.
+        None => gltf.nodes().filter(|n| parents[n.index()].is_none()).collect(),
     };
     // Depth first in document order (objects and lights keep the file's order).
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY, 0)).collect();
@@ -324,6 +354,10 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
             return Err(GltfError::NodeTransform(node.index()));
         }
         let world = parent * local;
+        check_node_transform(node.index(), &world)?;
+        if local.row(3) != Vec4::W {
+            return Err(GltfError::NodeProjective(node.index()));
+        }
         builder.node(&node, world)?;
         let children: Vec<gltf::Node> = node.children().collect();
         stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
@@ -355,6 +389,8 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         cones.clear();
     }
     let mut scene = Scene { meshes, textures, directional, cones, ..Scene::new(objects, lights, Camera::seed()) };
+    // The framing camera and the lights fitted to the scene are made from its box.
+    check_extent(&scene)?;
     scene.camera = match camera {
         Some(c) => c,
         None => {
@@ -373,6 +409,7 @@ fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
     let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
     let blob = raw.blob;
     let root = raw.document.into_json();
+    check_version(&root.asset)?;
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             for (semantic, index) in &primitive.attributes {
@@ -393,6 +430,8 @@ fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
 
 /// A GLB's 12-byte header, checked before the gltf crate reads it: its length field less the
 /// header is computed unchecked there (gltf 1.4.1, binary.rs — an overflow found by the fuzzer).
+/// The length must be the file's: glTF says it is, and a file longer than it says holds bytes
+/// nothing reads.
 fn check_glb_header(bytes: &[u8]) -> Result<(), GltfError> {
     if !bytes.starts_with(b"glTF") {
         return Ok(());
@@ -404,8 +443,93 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), GltfError> {
     if version != 2 {
         return Err(GltfError::Glb(GlbHeader::Version(version)));
     }
-    if (length as usize) < 12 + 8 || length as usize > bytes.len() {
+    if (length as usize) < 12 + 8 || length as usize != bytes.len() {
         return Err(GltfError::Glb(GlbHeader::Length { claimed: length, actual: bytes.len() }));
+    }
+    Ok(())
+}
+
+/// glTF 2.x (its version "major.minor"; a later minor version reads as 2.0, what it adds
+/// unread), and no minVersion above 2.0: a file that needs more than glTF 2.0 is refused.
+fn check_version(asset: &gltf::json::Asset) -> Result<(), GltfError> {
+    let parse = |v: &str| -> Option<(u64, u64)> {
+        let (major, minor) = v.split_once('.')?;
+        let number = |d: &str| d.bytes().all(|b| b.is_ascii_digit()).then(|| d.parse().ok()).flatten();
+        Some((number(major)?, number(minor)?))
+    };
+    if !matches!(parse(&asset.version), Some((2, _))) {
+        return Err(GltfError::Version(asset.version.clone()));
+    }
+    match &asset.min_version {
+        Some(min) if parse(min) != Some((2, 0)) => Err(GltfError::MinVersion(min.clone())),
+        _ => Ok(()),
+    }
+}
+
+/// Each node's parent. glTF's nodes form disjoint trees: a node named as a child twice (by
+/// two nodes, or twice by one) is refused — followed from each parent, a chain of such nodes
+/// would be drawn 2ⁿ times — and so is a cycle (nodes no root leads to), named by a node in it.
+fn node_parents(doc: &gltf::Document) -> Result<Vec<Option<usize>>, GltfError> {
+    let mut parents: Vec<Option<usize>> = vec![None; doc.nodes().len()];
+    for node in doc.nodes() {
+        for child in node.children() {
+            let slot = &mut parents[child.index()];
+            if let Some(first) = *slot {
+                return Err(GltfError::TwoParents { node: child.index(), first, second: node.index() });
+            }
+            *slot = Some(node.index());
+        }
+    }
+    // Every node a root leads to; with one parent each, the others hang from a cycle.
+    let mut reached = vec![false; parents.len()];
+    let mut stack: Vec<gltf::Node> = doc.nodes().filter(|n| parents[n.index()].is_none()).collect();
+    while let Some(node) = stack.pop() {
+        reached[node.index()] = true;
+        stack.extend(node.children());
+    }
+    if let Some(mut node) = reached.iter().position(|r| !r) {
+        // Up as many parents as there are nodes: inside the cycle.
+        for _ in 0..parents.len() {
+            node = parents[node].unwrap_or(node);
+        }
+        return Err(GltfError::Cycle(node));
+    }
+    Ok(parents)
+}
+
+/// A scene's roots: each a root (no parent), each named once.
+fn check_roots(scene: &gltf::Scene, parents: &[Option<usize>]) -> Result<(), GltfError> {
+    let mut seen = std::collections::HashSet::new();
+    for node in scene.nodes().map(|n| n.index()) {
+        if let Some(parent) = parents[node] {
+            return Err(GltfError::RootWithParent { scene: scene.index(), node, parent });
+        }
+        if !seen.insert(node) {
+            return Err(GltfError::RootTwice { scene: scene.index(), node });
+        }
+    }
+    Ok(())
+}
+
+/// How much of a cube's volume a transform's axes may lose to shear before it counts as
+/// flattening it: |det| over the product of the axes' lengths (1 at right angles).
+const LEAST_AXES_VOLUME: f64 = 1e-6;
+
+/// A node's transform in the world: every axis scaled within SCALES, and not flat (a singular
+/// matrix, an all-zero one among them, has no normal matrix and draws nothing).
+fn check_node_transform(node: usize, world: &Mat4) -> Result<(), GltfError> {
+    // In f64: the squares of an f32 axis of 1e38 would overflow.
+    let m = Mat3::from_mat4(*world).as_dmat3();
+    let scales = [m.x_axis.length(), m.y_axis.length(), m.z_axis.length()];
+    let volume = m.determinant().abs();
+    if volume == 0.0 || scales.contains(&0.0) {
+        return Err(GltfError::NodeSingular(node));
+    }
+    if let Some(scale) = scales.into_iter().find(|&s| !SCALES.contains(&(s as f32))) {
+        return Err(GltfError::NodeScale { node, scale: scale as f32 });
+    }
+    if volume < LEAST_AXES_VOLUME * scales.iter().product::<f64>() {
+        return Err(GltfError::NodeSingular(node));
     }
     Ok(())
 }
@@ -583,6 +707,11 @@ impl Builder<'_> {
         }
         let position = primitive.get(&gltf::Semantic::Positions).ok_or(GltfError::NoPositions)?;
         let positions = read_floats::<3>(&self.buffers, &position, "POSITION")?;
+        let far =
+            positions.iter().enumerate().find_map(|(index, p)| p.iter().find(|x| x.abs() > MAX_COORDINATE).map(|&value| (index, value)));
+        if let Some((index, value)) = far {
+            return Err(GltfError::TooFar { index, value }.within(Part::Data("POSITION")));
+        }
         let count = positions.len();
         self.vertices += count;
         if self.vertices > MAX_VERTICES {
@@ -722,7 +851,7 @@ impl Builder<'_> {
             // The node's −Z, in lux: colour × intensity.
             let direction = world.transform_vector3(-Vec3::Z).normalize_or_zero();
             let color = Vec3::from(light.color()) * light.intensity();
-            if direction == Vec3::ZERO || !direction.is_finite() || !color.is_finite() || color.min_element() < 0.0 {
+            if direction == Vec3::ZERO || !direction.is_finite() || !light_color(color) {
                 return Err(GltfError::Directional);
             }
             if self.directional.len() == MAX_DIRECTIONAL_LIGHTS {
@@ -746,24 +875,35 @@ impl Builder<'_> {
             }
         };
         let color = Vec3::from(light.color()) * light.intensity();
-        if !color.is_finite() || color.min_element() < 0.0 {
+        if !light_color(color) {
             return Err(GltfError::LightColor);
         }
         // Our lights end at a radius. glTF's range is one; without it, the distance where
         // intensity / d² falls to 1/256 (about what an 8-bit image still shows).
         let radius = match light.range() {
-            Some(r) if r.is_finite() && r > 0.0 => r,
+            Some(r) if LENGTHS.contains(&r) => r,
             Some(r) => return Err(GltfError::Range(r)),
             None => (light.intensity().max(0.0) * 256.0).sqrt().max(1e-3),
         };
         let position = world.transform_point3(Vec3::ZERO);
-        if !position.is_finite() {
+        if !within_reach(position) {
             return Err(GltfError::LightPosition);
         }
         self.lights.push(PointLight { position_radius: position.extend(radius).to_array(), color: color.extend(0.0).to_array() });
         self.cones.push(cone);
         Ok(())
     }
+}
+
+/// A light's colour × intensity: finite, not negative, at most MAX_INTENSITY.
+fn light_color(color: Vec3) -> bool {
+    // (glam's min and max pass over NaN: finiteness is its own test.)
+    color.is_finite() && color.min_element() >= 0.0 && color.max_element() <= MAX_INTENSITY
+}
+
+/// A place within ±MAX_COORDINATE.
+fn within_reach(p: Vec3) -> bool {
+    p.is_finite() && p.abs().max_element() <= MAX_COORDINATE
 }
 
 /// PNG or JPEG bytes as an RGBA8 texture, its size and memory capped before decoding.
@@ -812,7 +952,7 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool), Gltf
         return Err(GltfError::NormalScale { material, value: normal_scale });
     }
     let emissive_strength = m.emissive_strength().unwrap_or(1.0);
-    if !(emissive_strength.is_finite() && emissive_strength >= 0.0) {
+    if !(0.0..=MAX_INTENSITY).contains(&emissive_strength) {
         return Err(GltfError::EmissiveStrength { material, value: emissive_strength });
     }
     let alpha_mode = match m.alpha_mode() {
@@ -889,7 +1029,7 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
         gltf::camera::Projection::Perspective(p) => {
             let (fov, near) = (p.yfov().to_degrees(), p.znear());
             let far = p.zfar().unwrap_or(near * 1e5);
-            let sane = fov > 0.0 && fov < 180.0 && near > 0.0 && near.is_finite() && far > near && far.is_finite();
+            let sane = fov > 0.0 && fov < 180.0 && LENGTHS.contains(&near) && far > near && LENGTHS.contains(&far);
             if !sane {
                 return Err(GltfError::Perspective { yfov: p.yfov(), znear: near, zfar: far });
             }
@@ -897,7 +1037,7 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
         }
         gltf::camera::Projection::Orthographic(o) => {
             let (ymag, near, far) = (o.ymag(), o.znear(), o.zfar());
-            let sane = ymag > 0.0 && ymag.is_finite() && near >= 0.0 && far > near && far.is_finite();
+            let sane = LENGTHS.contains(&ymag) && near >= 0.0 && far > near && LENGTHS.contains(&far);
             if !sane {
                 return Err(GltfError::Orthographic { ymag, znear: near, zfar: far });
             }
@@ -911,7 +1051,7 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
     };
     let position = world.transform_point3(Vec3::ZERO);
     let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
-    if !position.is_finite() || forward == Vec3::ZERO {
+    if !within_reach(position) || forward == Vec3::ZERO {
         return Err(GltfError::CameraTransform);
     }
     if forward.y.abs() > 0.9999 {
@@ -963,6 +1103,11 @@ fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &'static str) 
             if stride < element {
                 return Err(fail(GltfError::Stride { stride, element }));
             }
+            let component = accessor.data_type().size();
+            if !aligned(view.offset(), accessor.offset(), component) || !stride.is_multiple_of(component) {
+                let (offset, view_offset) = (accessor.offset(), view.offset());
+                return Err(fail(GltfError::Misaligned { offset, view_offset, stride, component }));
+            }
             let needed = match count {
                 0 => Some(0),
                 n => (n - 1).checked_mul(stride).and_then(|x| x.checked_add(accessor.offset())).and_then(|x| x.checked_add(element)),
@@ -996,6 +1141,14 @@ fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &'static str) 
                 .map(|end| data[offset..end].to_vec())
                 .ok_or_else(|| fail(GltfError::SparseOutside { part, len, offset }))
         };
+        for (view, offset, size) in
+            [(indices.view(), indices.offset(), index_size), (values.view(), values.offset(), accessor.data_type().size())]
+        {
+            if !aligned(view.offset(), offset, size) {
+                let stride = view.stride().unwrap_or(size);
+                return Err(fail(GltfError::Misaligned { offset, view_offset: view.offset(), stride, component: size }));
+            }
+        }
         let index_bytes = range(view_bytes(buffers, &indices.view(), what)?, indices.offset(), n * index_size, "indices")?;
         let value_bytes = range(view_bytes(buffers, &values.view(), what)?, values.offset(), n * element, "values")?;
         let mut previous = None;
@@ -1009,6 +1162,12 @@ fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &'static str) 
         }
     }
     Ok((out, accessor.data_type()))
+}
+
+/// Whether data `offset` bytes into a buffer view that starts `view_offset` bytes into its
+/// buffer is aligned to its `component`-byte components, in the view and in the buffer (glTF).
+fn aligned(view_offset: usize, offset: usize, component: usize) -> bool {
+    offset.is_multiple_of(component) && view_offset.is_multiple_of(component)
 }
 
 /// The bytes of buffer view `view`, checked against its buffer.

@@ -12,11 +12,14 @@ use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::{DirectionalLight, Object, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
-use crate::scene_load::{read_reference, ReferenceError};
+use crate::scene_load::{
+    check_extent, read_reference, ExtentError, Number, ReferenceError, LENGTHS, MAX_COORDINATE, MAX_INTENSITY, SCALES,
+};
 pub use crate::scene_load::{SceneFile, MAX_OBJECTS};
 use crate::SceneError;
 use glam::Vec3;
-use serde::Deserialize;
+use serde::{de, Deserialize, Deserializer};
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -78,6 +81,10 @@ pub enum SceneFileProblem {
     Negative { what: &'static str, value: f32 },
     #[error("{what} {value} must lie in [0, 1]")]
     NotUnit { what: &'static str, value: f32 },
+    #[error("{what} {} is out of range: use {} to {}", Number(*value), Number(*range.start()), Number(*range.end()))]
+    OutOfRange { what: &'static str, value: f32, range: RangeInclusive<f32> },
+    #[error(transparent)]
+    Extent(#[from] ExtentError),
     /// An unknown mesh or material name.
     #[error(transparent)]
     Name(#[from] SceneError),
@@ -129,6 +136,36 @@ impl SceneFileProblem {
 
 type Problem = SceneFileProblem;
 
+/// Three numbers (a position, direction or colour): exactly three, where serde's arrays would
+/// let the TOML reader pass over any that follow (a position of 3,000,000 numbers read as its
+/// first three).
+#[derive(Clone, Copy)]
+struct Triple([f32; 3]);
+
+impl<'de> Deserialize<'de> for Triple {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Triple, D::Error> {
+        struct Three;
+        impl<'de> de::Visitor<'de> for Three {
+            type Value = Triple;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an array of exactly 3 numbers")
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> Result<Triple, A::Error> {
+                let mut out = [0.0; 3];
+                for (i, slot) in out.iter_mut().enumerate() {
+                    *slot = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                // The fourth is where reading stops: nothing more is read of a longer array.
+                if seq.next_element::<de::IgnoredAny>()?.is_some() {
+                    return Err(de::Error::custom("more than 3 numbers: expected an array of exactly 3 numbers"));
+                }
+                Ok(Triple(out))
+            }
+        }
+        d.deserialize_seq(Three)
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FileScene {
@@ -142,8 +179,8 @@ struct FileScene {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FileCamera {
-    position: Option<[f32; 3]>,
-    target: Option<[f32; 3]>,
+    position: Option<Triple>,
+    target: Option<Triple>,
     fov_y_deg: Option<f32>,
     /// Makes the camera orthographic: world units seen above and below its axis.
     ortho_half_height: Option<f32>,
@@ -163,11 +200,11 @@ struct FileShading {
 struct FileLight {
     kind: Option<String>,
     /// Point lights.
-    position: Option<[f32; 3]>,
-    color: Option<[f32; 3]>,
+    position: Option<Triple>,
+    color: Option<Triple>,
     radius: Option<f32>,
     /// Directional and spot lights: where the light travels / points.
-    direction: Option<[f32; 3]>,
+    direction: Option<Triple>,
     /// Spot lights: full light within the inner angle of the axis, none beyond the outer
     /// (degrees; defaults 0 and 45, glTF's).
     inner_deg: Option<f32>,
@@ -185,7 +222,7 @@ enum Light {
 struct FileObject {
     mesh: Option<String>,
     gltf: Option<String>,
-    position: Option<[f32; 3]>,
+    position: Option<Triple>,
     scale: Option<f32>,
     material: Option<FileMaterial>,
 }
@@ -196,7 +233,7 @@ struct FileMaterial {
     /// A built-in material's name (its albedo, roughness and metallic), overridden field by
     /// field by the others.
     name: Option<String>,
-    albedo: Option<[f32; 3]>,
+    albedo: Option<Triple>,
     roughness: Option<f32>,
     metallic: Option<f32>,
 }
@@ -263,7 +300,7 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
         }
     }
     let (shading, ambient) = match &file.shading {
-        Some(s) => (s.model.clone(), s.ambient.map(|a| non_negative("[shading] ambient", a)).transpose()?),
+        Some(s) => (s.model.clone(), s.ambient.map(|a| intensity("[shading] ambient", a)).transpose()?),
         None => (None, None),
     };
     let mut scene = Scene {
@@ -275,6 +312,8 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
         cones: if cones.iter().all(|c| *c == LightCone::NONE) { Vec::new() } else { cones },
         ..Scene::new(objects, lights, Camera::seed())
     };
+    // The camera and the lights fitted to the scene are made from its box.
+    check_extent(&scene)?;
     (scene.camera, scene.camera_framed) = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading, warnings })
 }
@@ -287,11 +326,45 @@ fn finite(what: &'static str, value: f32) -> Result<f32, Problem> {
     }
 }
 
-fn vec3(what: &'static str, v: [f32; 3]) -> Result<Vec3, Problem> {
+/// Three finite numbers.
+fn vec3(what: &'static str, Triple(v): Triple) -> Result<Vec3, Problem> {
     for x in v {
         finite(what, x)?;
     }
     Ok(Vec3::from(v))
+}
+
+/// `value`, refused outside `range` (finite already).
+fn within(what: &'static str, value: f32, range: RangeInclusive<f32>) -> Result<f32, Problem> {
+    if range.contains(&value) {
+        Ok(value)
+    } else {
+        Err(Problem::OutOfRange { what, value, range })
+    }
+}
+
+/// A place or a direction: each coordinate within ±MAX_COORDINATE.
+fn coordinates(what: &'static str, v: Triple) -> Result<Vec3, Problem> {
+    let v = vec3(what, v)?;
+    for x in v.to_array() {
+        within(what, x, -MAX_COORDINATE..=MAX_COORDINATE)?;
+    }
+    Ok(v)
+}
+
+/// A radius, a clip plane, a half-height: positive, in LENGTHS.
+fn length(what: &'static str, value: f32) -> Result<f32, Problem> {
+    within(what, positive(what, value)?, LENGTHS)
+}
+
+/// An object's scale: positive, in SCALES.
+fn scale(value: f32) -> Result<f32, Problem> {
+    within("scale", positive("scale", value)?, SCALES)
+}
+
+/// A light's colour or the ambient term: not negative, at most MAX_INTENSITY.
+fn intensity(what: &'static str, value: f32) -> Result<f32, Problem> {
+    within(what, non_negative(what, value)?, 0.0..=MAX_INTENSITY)
 }
 
 fn positive(what: &'static str, value: f32) -> Result<f32, Problem> {
@@ -328,8 +401,8 @@ fn object(o: &FileObject) -> Result<Object, Problem> {
         }
         if let Some(a) = m.albedo {
             material.albedo = vec3("material albedo", a)?;
-            for x in a {
-                non_negative("material albedo", x)?;
+            for x in a.0 {
+                unit("material albedo", non_negative("material albedo", x)?)?;
             }
         }
         if let Some(r) = m.roughness {
@@ -339,9 +412,14 @@ fn object(o: &FileObject) -> Result<Object, Problem> {
             material.metallic = unit("material metallic", v)?;
         }
     }
-    let position = o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
-    let scale = o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0);
+    let (position, scale) = placement(o)?;
     Ok(Object::placed(mesh, position, scale, material))
+}
+
+/// An object's position and scale (defaults: the origin, 1).
+fn placement(o: &FileObject) -> Result<(Vec3, f32), Problem> {
+    let position = o.position.map(|p| coordinates("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
+    Ok((position, o.scale.map(scale).transpose()?.unwrap_or(1.0)))
 }
 
 /// A `gltf = "path"` object: every drawn primitive of that file, its materials, placed by the
@@ -366,8 +444,7 @@ fn gltf_object(
     let folder = base.join(gltf).parent().map(Path::to_path_buf).unwrap_or_default();
     let (scene, warnings) =
         crate::gltf_scene::from_bytes(&bytes, Some(&folder)).map_err(|problem| Problem::Gltf { file: gltf.to_owned(), problem })?;
-    let position = o.position.map(|p| vec3("position", p)).transpose()?.unwrap_or(Vec3::ZERO);
-    let scale = o.scale.map(|s| positive("scale", s)).transpose()?.unwrap_or(1.0);
+    let (position, scale) = placement(o)?;
     let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);
     let offset = meshes.len() as u32;
     meshes.extend(scene.meshes);
@@ -391,7 +468,7 @@ fn gltf_object(
 fn light(l: &FileLight) -> Result<Light, Problem> {
     let color = l.color.map(|c| vec3("color", c)).transpose()?.unwrap_or(Vec3::ONE);
     for x in color.to_array() {
-        non_negative("color", x)?;
+        intensity("color", x)?;
     }
     match l.kind.as_deref() {
         kind @ (None | Some("point") | Some("spot")) => {
@@ -399,13 +476,13 @@ fn light(l: &FileLight) -> Result<Light, Problem> {
             if !spot && (l.direction.is_some() || l.inner_deg.is_some() || l.outer_deg.is_some()) {
                 return Err(Problem::PointWithDirection);
             }
-            let p = vec3("position", l.position.ok_or(Problem::Missing { light: "point or spot", field: "position" })?)?;
-            let radius = l.radius.map(|r| positive("radius", r)).transpose()?.unwrap_or(SEED_RADIUS);
+            let p = coordinates("position", l.position.ok_or(Problem::Missing { light: "point or spot", field: "position" })?)?;
+            let radius = l.radius.map(|r| length("radius", r)).transpose()?.unwrap_or(SEED_RADIUS);
             let point = PointLight { position_radius: p.extend(radius).to_array(), color: color.extend(0.0).to_array() };
             if !spot {
                 return Ok(Light::Point(point, LightCone::NONE));
             }
-            let axis = vec3("direction", l.direction.ok_or(Problem::Missing { light: "spot", field: "direction" })?)?;
+            let axis = coordinates("direction", l.direction.ok_or(Problem::Missing { light: "spot", field: "direction" })?)?;
             if axis.length() < 1e-6 {
                 return Err(Problem::ZeroDirection);
             }
@@ -420,7 +497,7 @@ fn light(l: &FileLight) -> Result<Light, Problem> {
             if l.position.is_some() || l.radius.is_some() {
                 return Err(Problem::DirectionalWithPosition);
             }
-            let d = vec3("direction", l.direction.ok_or(Problem::Missing { light: "directional", field: "direction" })?)?;
+            let d = coordinates("direction", l.direction.ok_or(Problem::Missing { light: "directional", field: "direction" })?)?;
             if d.length() < 1e-6 {
                 return Err(Problem::ZeroDirection);
             }
@@ -446,29 +523,29 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<(Camera, bool), Probl
     };
     if c.is_none_or(|c| c.position.is_none() && c.target.is_none()) {
         let framed = frame_scene(scene, DEFAULT_ASPECT, fov);
-        let near = c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or(framed.near);
-        let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(framed.far);
+        let near = c.and_then(|c| c.near).map(|n| length("[camera] near", n)).transpose()?.unwrap_or(framed.near);
+        let far = c.and_then(|c| c.far).map(|f| length("[camera] far", f)).transpose()?.unwrap_or(framed.far);
         if near >= far {
             return Err(Problem::NearFar { near, far });
         }
-        let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| positive("[camera] ortho_half_height", h)).transpose()?;
+        let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| length("[camera] ortho_half_height", h)).transpose()?;
         let camera = Camera { near, far, orthographic, ..framed };
         return Ok((camera, camera == framed));
     }
     let position = match c.and_then(|c| c.position) {
-        Some(p) => vec3("[camera] position", p)?,
+        Some(p) => coordinates("[camera] position", p)?,
         None => centre + Vec3::new(0.0, 0.5, 1.0).normalize() * framing_distance(radius, fov),
     };
     let target = match c.and_then(|c| c.target) {
-        Some(t) => vec3("[camera] target", t)?,
+        Some(t) => coordinates("[camera] target", t)?,
         None => centre,
     };
     if position.distance(target) < 1e-6 {
         return Err(Problem::CameraNowhere);
     }
     let (fitted_near, fitted_far) = clip_planes_for(lo, hi, position);
-    let near = c.and_then(|c| c.near).map(|n| positive("[camera] near", n)).transpose()?.unwrap_or(fitted_near);
-    let far = c.and_then(|c| c.far).map(|f| positive("[camera] far", f)).transpose()?.unwrap_or(fitted_far);
+    let near = c.and_then(|c| c.near).map(|n| length("[camera] near", n)).transpose()?.unwrap_or(fitted_near);
+    let far = c.and_then(|c| c.far).map(|f| length("[camera] far", f)).transpose()?.unwrap_or(fitted_far);
     if near >= far {
         return Err(Problem::NearFar { near, far });
     }
@@ -476,7 +553,7 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<(Camera, bool), Probl
     if dir.y.abs() > 0.9999 {
         return Err(Problem::CameraVertical);
     }
-    let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| positive("[camera] ortho_half_height", h)).transpose()?;
+    let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| length("[camera] ortho_half_height", h)).transpose()?;
     Ok((Camera { orthographic, ..Camera::looking_at(position, target, fov, near, far) }, false))
 }
 

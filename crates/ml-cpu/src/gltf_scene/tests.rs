@@ -376,3 +376,149 @@ fn buffers_must_be_as_long_as_they_claim() {
     assert!(e.contains("buffer 1: only the first buffer may be the GLB binary chunk"), "{e}");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// What the gltf crate's validation lets through and glTF forbids, or a file that does not
+/// render: each refused with one line naming the node, accessor, light or camera.
+#[test]
+fn files_that_break_gltf_rules_or_ranges_are_refused() {
+    let edit = |f: &dyn Fn(&mut GltfWriter)| {
+        let mut w = quad_writer();
+        f(&mut w);
+        w
+    };
+    let gltf = |f: &dyn Fn(&mut GltfWriter)| edit(f).to_gltf();
+    let light = |light: serde_json::Value, node: serde_json::Value| {
+        gltf(&|w| {
+            let l = w.light(light.clone());
+            let mut n = node.clone();
+            n["extensions"] = json!({ "KHR_lights_punctual": { "light": l } });
+            w.node(n, true);
+        })
+    };
+    let mut longer_glb = quad_writer().to_glb();
+    longer_glb.extend([0; 8]);
+    let mut same_point = quad_writer();
+    for corner in 1..4 {
+        let at = corner * 12;
+        let first: [u8; 12] = same_point.bin[..12].try_into().unwrap();
+        same_point.bin[at..at + 12].copy_from_slice(&first);
+    }
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        // Alignment: an f32 accessor two bytes into its view, a view two bytes into its buffer,
+        // a stride that is no multiple of 4.
+        (
+            gltf(&|w| w.json["accessors"][0]["byteOffset"] = json!(2)),
+            "byteOffset 2 (in a buffer view at 0, stride 12) is not a multiple of its components' 4 bytes",
+        ),
+        (gltf(&|w| w.json["bufferViews"][0]["byteOffset"] = json!(2)), "in a buffer view at 2"),
+        (gltf(&|w| w.json["bufferViews"][0]["byteStride"] = json!(14)), "stride 14) is not a multiple"),
+        (longer_glb, "the GLB header says"),
+        (gltf(&|w| w.json["asset"]["version"] = json!("3.0")), "asset.version '3.0' is not glTF 2.x"),
+        (gltf(&|w| w.json["asset"]["version"] = json!("2")), "asset.version '2' is not glTF 2.x"),
+        (gltf(&|w| w.json["asset"]["version"] = json!("+2.0")), "is not glTF 2.x"),
+        (gltf(&|w| w.json["asset"]["minVersion"] = json!("2.1")), "asset.minVersion '2.1'"),
+        // Nodes: two parents, a root that is a child, a root named twice, cycles.
+        (
+            gltf(&|w| {
+                let child = w.node(json!({}), false);
+                w.json["nodes"][0]["children"] = json!([child]);
+                w.node(json!({ "children": [child] }), true);
+            }),
+            "node 1 is a child of both node 0 and node 2",
+        ),
+        (gltf(&|w| w.json["nodes"][0]["children"] = json!([0, 0])), "node 0 is a child of both node 0 and node 0"),
+        (
+            gltf(&|w| {
+                let child = w.node(json!({}), true);
+                w.json["nodes"][0]["children"] = json!([child]);
+            }),
+            "scene 0: node 1 is one of its roots and a child of node 0",
+        ),
+        (gltf(&|w| w.json["scenes"][0]["nodes"] = json!([0, 0])), "scene 0: node 0 is named twice"),
+        (
+            gltf(&|w| {
+                let a = w.node(json!({}), false);
+                let b = w.node(json!({ "children": [a] }), false);
+                w.json["nodes"][a]["children"] = json!([b]);
+            }),
+            "is its own ancestor",
+        ),
+        // Transforms: all zero, projective, scales out of range.
+        (gltf(&|w| w.json["nodes"][0]["matrix"] = json!([0.0f32; 16].to_vec())), "node 0: its transform is singular"),
+        (
+            gltf(&|w| w.json["nodes"][0]["matrix"] = json!([1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])),
+            "node 0: its transform is singular",
+        ),
+        (gltf(&|w| w.json["nodes"][0]["matrix"] = json!([1, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])), "last row is not (0, 0, 0, 1)"),
+        (gltf(&|w| w.json["nodes"][0]["scale"] = json!([1e38, 1.0, 1.0])), "node 0: its transform scales an axis by 1e38"),
+        (gltf(&|w| w.json["nodes"][0]["scale"] = json!([1.0, 1e-38, 1.0])), "scales an axis by 1e-38"),
+        // Places and sizes.
+        (
+            gltf(&|w| w.bin[0..4].copy_from_slice(&1e38f32.to_le_bytes())),
+            "mesh 0 primitive 0: POSITION: element 0 is 1e38, beyond ±1000000",
+        ),
+        (
+            gltf(&|w| w.json["nodes"][0]["translation"] = json!([999_999.5, 0.0, 0.0])),
+            "the scene's objects reach 1000000.5, beyond ±1000000",
+        ),
+        (same_point.to_gltf(), "too small to render"),
+        // Lights, cameras, materials.
+        (
+            light(json!({ "type": "point", "intensity": 1e38 }), json!({})),
+            "light 0: colour × intensity must be finite, not negative and at most 1e7",
+        ),
+        (light(json!({ "type": "point", "range": 1e-38 }), json!({})), "light 0: range 1e-38 must lie in [1e-6, 1e7]"),
+        (
+            light(json!({ "type": "point" }), json!({ "translation": [1e38, 0.0, 0.0] })),
+            "light 0: its node's position is not finite or lies beyond",
+        ),
+        (light(json!({ "type": "directional", "intensity": 1e38 }), json!({})), "light 0: a directional light needs"),
+        (
+            gltf(&|w| {
+                let c = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 1e-38, "zfar": 80.0 } }));
+                w.node(json!({ "camera": c }), true);
+            }),
+            "camera 0: yfov 0.8 rad, znear 1e-38, zfar 80: need 0 < yfov < π and 0 < znear < zfar, both in [1e-6, 1e7]",
+        ),
+        (
+            gltf(&|w| {
+                let c = w.camera(json!({ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.1 } }));
+                w.node(json!({ "camera": c, "translation": [0.0, 0.0, 1e38] }), true);
+            }),
+            "camera 0: its node's transform is not usable",
+        ),
+        (
+            gltf(&|w| {
+                let m = w.material([1.0; 4], 0.0, 0.5);
+                w.json["materials"][m]["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": 1e38 } });
+                w.json["meshes"][0]["primitives"][0]["material"] = json!(m);
+            }),
+            "emissive strength 1e38 must be finite, not negative and at most 1e7",
+        ),
+    ];
+    for (i, (bytes, expected)) in cases.into_iter().enumerate() {
+        match from_bytes(&bytes, None) {
+            Ok(_) => panic!("case {i} ('{expected}'): loaded"),
+            Err(e) => assert!(e.to_string().contains(expected), "case {i}: '{expected}' missing from: {e}"),
+        }
+    }
+}
+
+/// A chain of nodes each named twice as a child, which drawn from every parent would be 2⁴⁰
+/// quads, is refused at once; versions 2.x and a minVersion of 2.0 are read.
+#[test]
+fn shared_children_are_refused_at_once_and_later_minor_versions_read() {
+    let mut w = quad_writer();
+    let mut below = 0;
+    for _ in 0..40 {
+        below = w.node(json!({ "children": [below, below] }), false);
+    }
+    w.json["scenes"][0]["nodes"] = json!([below]);
+    let start = std::time::Instant::now();
+    let e = from_bytes(&w.to_gltf(), None).unwrap_err().to_string();
+    assert!(e.contains("node 0 is a child of both node 1 and node 1"), "{e}");
+    assert!(start.elapsed().as_secs_f32() < 1.0);
+    let mut w = quad_writer();
+    w.json["asset"] = json!({ "version": "2.1", "minVersion": "2.0" });
+    from_bytes(&w.to_gltf(), None).unwrap_or_else(|e| panic!("{e}"));
+}

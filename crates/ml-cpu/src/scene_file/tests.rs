@@ -244,3 +244,50 @@ fn gltf_objects_stay_inside_the_scene_folder() {
         scene(gltf).unwrap_or_else(|e| panic!("{gltf}: {e}"));
     }
 }
+
+/// Values a scene file used to pass silently, each refused with one line naming the field:
+/// arrays of more than three numbers, and numbers finite but out of the range that renders.
+#[test]
+fn values_out_of_range_are_refused_naming_the_field() {
+    let sphere = "[[objects]]\nmesh = \"sphere\"\n";
+    let light = |field: &str| format!("{sphere}[[lights]]\nposition = [0.0, 3.0, 0.0]\n{field}\n");
+    let cases = [
+        (format!("{sphere}position = [1.0, 2.0, 3.0, 4.0]\n"), "line 3: more than 3 numbers"),
+        (format!("{sphere}scale = 1e38\n"), "objects[0]: scale 1e38 is out of range: use 1e-6 to 1000000"),
+        (format!("{sphere}scale = 1e-38\n"), "objects[0]: scale 1e-38 is out of range"),
+        (format!("{sphere}position = [1e38, 0.0, 0.0]\n"), "objects[0]: position 1e38 is out of range: use -1000000 to 1000000"),
+        (format!("{sphere}position = [900000.0, 0.0, 0.0]\nscale = 200000.0\n"), "the scene's objects reach 1100000, beyond ±1000000"),
+        (format!("{sphere}position = [1000000.0, 0.0, 0.0]\nscale = 0.000001\n"), "too small to render"),
+        (format!("{sphere}material = {{ albedo = [2.0, 0.0, 0.0] }}\n"), "material albedo 2 must lie in [0, 1]"),
+        (light("color = [1e38, 0.0, 0.0]"), "lights[0]: color 1e38 is out of range: use 0 to 1e7"),
+        (light("radius = 1e38"), "lights[0]: radius 1e38 is out of range"),
+        (light("radius = 1e-38"), "lights[0]: radius 1e-38 is out of range"),
+        (format!("{sphere}[[lights]]\nposition = [0.0, 1e38, 0.0]\n"), "lights[0]: position 1e38 is out of range"),
+        (format!("{sphere}[[lights]]\nkind = \"directional\"\ndirection = [1e38, -1e38, 0.0]\n"), "direction 1e38 is out of range"),
+        (format!("{sphere}[shading]\nambient = 1e38\n"), "[shading] ambient 1e38 is out of range"),
+        (format!("{sphere}[camera]\nnear = 1e-38\n"), "[camera] near 1e-38 is out of range"),
+        (format!("{sphere}[camera]\nfar = 1e38\n"), "[camera] far 1e38 is out of range"),
+        (format!("{sphere}[camera]\northo_half_height = 1e38\n"), "[camera] ortho_half_height 1e38 is out of range"),
+        (format!("{sphere}[camera]\nposition = [1e38, 1.0, 1.0]\n"), "[camera] position 1e38 is out of range"),
+    ];
+    for (text, expected) in cases {
+        match parse(&text) {
+            Ok(_) => panic!("accepted:\n{text}"),
+            Err(e) => assert!(e.to_string().contains(expected), "'{expected}' missing from: {e}\n{text}"),
+        }
+    }
+    // At the ends of the ranges: read.
+    let edges = format!("{sphere}position = [999999.0, 0.0, 0.0]\n[[lights]]\nposition = [0.0, 1.0, 0.0]\nradius = 0.000001\ncolor = [10000000.0, 0.0, 0.0]\n");
+    parse(&edges).unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// A position of 3,000,000 numbers is refused at its fourth, at once.
+#[test]
+fn a_huge_array_is_refused_at_its_fourth_number() {
+    let numbers = vec!["0.5"; 3_000_000].join(", ");
+    let text = format!("[[objects]]\nmesh = \"sphere\"\nposition = [{numbers}]\n");
+    let start = std::time::Instant::now();
+    let e = parse(&text).unwrap_err().to_string();
+    assert!(e.contains("line 3: more than 3 numbers"), "{}", &e[..e.len().min(200)]);
+    assert!(start.elapsed().as_secs_f32() < 5.0, "{:?}", start.elapsed());
+}
