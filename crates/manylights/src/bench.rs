@@ -43,11 +43,11 @@ pub struct BenchArgs {
     #[arg(long, default_value = "forward,clustered-cpu,clustered-gpu,deferred,deferred-clustered,deferred-compute,visibility")]
     techniques: String,
     /// Light counts, comma-separated; k and M multiply by 1,000 and 1,000,000.
-    #[arg(long, default_value = "1k,16k,256k,1M")]
+    #[arg(long, default_value = "1k,16k,256k,1M", allow_hyphen_values = true)]
     lights: String,
     /// Image size WxH of every combination, and of the probe's passes (each side 1 to 16384,
     /// and at most the device's largest image).
-    #[arg(long, default_value = "1920x1080")]
+    #[arg(long, default_value = "1920x1080", allow_hyphen_values = true)]
     resolution: String,
     /// Measured frames per combination (with --probe: rounds per loop length), 1 to 100000.
     #[arg(long, default_value_t = 300, value_parser = Whole::<u32>::new(1, MAX_FRAMES as u64), allow_negative_numbers = true)]
@@ -96,7 +96,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = Raster::DEFAULT_SPLIT, value_parser = crate::RASTER_SPLIT, allow_negative_numbers = true)]
     raster_split: u32,
     /// Loop lengths (lights every pixel sums) of --probe, comma-separated, each at most 65536.
-    #[arg(long, default_value = "16,64,256,1024")]
+    #[arg(long, default_value = "16,64,256,1024", allow_hyphen_values = true)]
     probe_lights: String,
     /// The options given on the command line (the others keep their defaults).
     #[arg(skip)]
