@@ -16,6 +16,8 @@ pub enum SceneError {
     TooManyMarkers(usize),
     #[error("the surface light layout needs a scene with surfaces (triangles of non-zero area)")]
     NoSurface,
+    #[error("the lights fitted to the scene's box would get radius {}: the box has no usable size", crate::scene_load::Number(*.0))]
+    FittedRadius(f32),
     #[error("unknown {kind} '{name}': expected one of {expected}")]
     UnknownName { kind: &'static str, name: String, expected: String },
 }

@@ -197,7 +197,8 @@ impl LightFrame {
         let height = (self.grid_centre.y - self.grid_floor).max(0.0);
         let wanted = if height > 0.0 {
             let s = (width * width * height / n as f32).cbrt();
-            (1.0 + (height / s).round()).clamp(1.0, n as f32) as usize
+            // (At least 1 also where a box without end makes this NaN.)
+            ((1.0 + (height / s).round()).clamp(1.0, n as f32) as usize).max(1)
         } else {
             1
         };
@@ -241,6 +242,20 @@ impl LightFrame {
                 }
             }
             LightLayout::Surface => (k * surface_area / (n * pi)).sqrt(),
+        }
+    }
+}
+
+impl LightFrame {
+    /// `default_radius`, refused where no light can have it: a box of no size (or none at all)
+    /// fits lights of radius 0 (or inf), which light nothing (or overflow the light lists).
+    /// The loaders refuse such boxes first (`scene_load::check_extent`); this is the last word.
+    pub fn fitted_radius(&self, layout: LightLayout, count: u32, surface_area: f32) -> Result<f32, SceneError> {
+        let radius = self.default_radius(layout, count, surface_area);
+        if crate::scene_load::LENGTHS.contains(&radius) {
+            Ok(radius)
+        } else {
+            Err(SceneError::FittedRadius(radius))
         }
     }
 }
@@ -515,6 +530,23 @@ mod tests {
             let (least, most) = seen.iter().fold((f32::MAX, 0.0f32), |(a, b), &m| (a.min(m), b.max(m)));
             assert!(least >= 2.0 && most <= 12.0 && most <= least * 2.0, "{layout:?}: {seen:?} lights reach a point");
         }
+    }
+
+    /// A box of no size, or of infinite size, fits no radius: an error, not lights of radius 0
+    /// or inf.
+    #[test]
+    fn degenerate_boxes_fit_no_radius() {
+        let point = LightFrame::around(Vec3::ONE, Vec3::ONE);
+        let endless = LightFrame::around(Vec3::splat(f32::MIN), Vec3::splat(f32::MAX));
+        for layout in [LightLayout::Grid, LightLayout::Random] {
+            for frame in [&point, &endless] {
+                let e = frame.fitted_radius(layout, 64, 0.0).unwrap_err();
+                assert!(e.to_string().starts_with("the lights fitted to the scene's box would get radius"), "{e}");
+            }
+        }
+        assert_eq!(point.fitted_radius(LightLayout::Surface, 64, 0.0), Err(SceneError::FittedRadius(0.0)));
+        let unit = LightFrame::around(Vec3::splat(-1.0), Vec3::ONE);
+        assert_eq!(unit.fitted_radius(LightLayout::Grid, 64, 0.0), Ok(unit.default_radius(LightLayout::Grid, 64, 0.0)));
     }
 
     #[test]

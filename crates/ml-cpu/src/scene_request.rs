@@ -95,6 +95,9 @@ pub enum SceneRequestError {
     /// A file naming a shading model that does not exist.
     #[error("'{}': shading model: {problem}", path.display())]
     FileShading { path: PathBuf, problem: SceneError },
+    /// A file whose box fits its lights no radius.
+    #[error("'{}': {problem}", path.display())]
+    FileLights { path: PathBuf, problem: SceneError },
 }
 
 impl SceneRequest {
@@ -120,9 +123,12 @@ impl SceneRequest {
     }
 
     /// `count` lights of the request's layout with `radius` unless the request names one.
-    fn lights_of(&self, count: u64, radius: impl FnOnce(u32) -> f32) -> Result<LightParams, SceneError> {
+    fn lights_of(&self, count: u64, radius: impl FnOnce(u32) -> Result<f32, SceneError>) -> Result<LightParams, SceneError> {
         let count = LightParams::check_count(count)?;
-        let radius = self.radius.unwrap_or_else(|| RadiusRange::fixed(radius(count)));
+        let radius = match self.radius {
+            Some(range) => range,
+            None => RadiusRange::fixed(radius(count)?),
+        };
         Ok(LightParams { count, layout: self.layout, seed: self.seed, radius })
     }
 
@@ -148,7 +154,7 @@ impl SceneRequest {
                 Ok(built(bench_scene(count, self.seed, *objects)?))
             }
             SceneSource::Seed { object, material } => {
-                let scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS), |_| SEED_RADIUS)?)?;
+                let scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS), |_| Ok(SEED_RADIUS))?)?;
                 Ok(built(if model == ShadingModel::BlinnPhong { scene.with_floor() } else { scene }))
             }
             SceneSource::File(path) => self.build_file(path),
@@ -181,7 +187,10 @@ impl SceneRequest {
             let frame = LightFrame::around(lo, hi);
             let surfaces = if self.layout == LightLayout::Surface { SurfaceSampler::new(&scene) } else { None };
             let area = surfaces.as_ref().map_or(0.0, SurfaceSampler::area);
-            let params = self.lights_of(count, |n| frame.default_radius(self.layout, n, area))?;
+            let params = self.lights_of(count, |n| frame.fitted_radius(self.layout, n, area)).map_err(|problem| match problem {
+                SceneError::FittedRadius(_) => SceneRequestError::FileLights { path: path.clone(), problem },
+                other => other.into(),
+            })?;
             scene.lights = params.build_in(&frame, surfaces.as_ref())?;
             scene.light_motion = frame.motion();
             // The file's spot cones belonged to its own lights.
