@@ -242,8 +242,14 @@ struct FileMaterial {
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
     let fail = |problem: Problem| SceneFileError { path: path.to_path_buf(), problem };
     let bytes = read_regular(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
-    let text = String::from_utf8(bytes).map_err(|e| fail(Problem::NotUtf8(e.utf8_error().valid_up_to())))?;
-    parse_in(&text, path.parent()).map_err(fail)
+    from_bytes(&bytes, path.parent()).map_err(fail)
+}
+
+/// A scene file's bytes (UTF-8 text), its `gltf` paths relative to `folder` (None: glTF
+/// objects are refused); the error is the problem, without the file's name.
+pub fn from_bytes(bytes: &[u8], folder: Option<&Path>) -> Result<SceneFile, SceneFileProblem> {
+    let text = std::str::from_utf8(bytes).map_err(|e| Problem::NotUtf8(e.valid_up_to()))?;
+    parse_in(text, folder)
 }
 
 /// Parse scene-file text (glTF objects are refused: they need the file's folder); the error
