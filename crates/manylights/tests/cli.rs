@@ -567,3 +567,28 @@ fn raster_auto_keeps_the_faster_and_says_why() {
     let out = manylights(&[&huge[..], &["--out", png.to_str().unwrap()]].concat(), &[]);
     assert_one_line_error(&out, &["16384x16384", "bytes", "--raster hardware"]);
 }
+
+/// A scene that never ends or never comes — a link x.glb to /dev/zero, z.gltf to /dev/urandom,
+/// a named pipe y.toml no one writes to — ends the run at once with one error line naming it:
+/// read whole, a device would fill the memory, and a pipe would wait forever.
+#[cfg(unix)]
+#[test]
+fn scenes_on_devices_and_pipes_are_refused_at_once() {
+    let dir = temp_png("devices-and-pipes");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (zero, random, pipe) = (dir.join("x.glb"), dir.join("z.gltf"), dir.join("y.toml"));
+    std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+    std::os::unix::fs::symlink("/dev/urandom", &random).unwrap();
+    assert!(Command::new("mkfifo").arg(&pipe).status().expect("mkfifo runs").success());
+    let png = dir.join("never.png");
+    for scene in [&zero, &random, &pipe] {
+        let start = std::time::Instant::now();
+        let out = manylights(&["render", "--scene", scene.to_str().unwrap(), "--out", png.to_str().unwrap()], &[]);
+        let took = start.elapsed();
+        assert!(took.as_secs_f32() < 5.0, "{}: {took:?}", scene.display());
+        assert_one_line_error(&out, &[scene.to_str().unwrap(), "it is not a regular file (a device, pipe or socket)"]);
+        assert_eq!(out.status.code(), Some(1), "{}", scene.display());
+    }
+    assert!(!png.exists());
+}
