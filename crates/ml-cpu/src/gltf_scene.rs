@@ -43,6 +43,9 @@ const BUFFER_PADDING: u64 = 3;
 pub const MAX_VERTICES: usize = 1 << 26;
 /// Widest and tallest texture we decode.
 pub const MAX_TEXTURE_SIZE: u32 = 16384;
+/// Most elements of an accessor without a buffer view (zeros but for its sparse
+/// substitutions): its count is all a few bytes of JSON would need to claim gigabytes.
+pub const MAX_VIEWLESS_ELEMENTS: usize = 1 << 20;
 /// Deepest node hierarchy we follow.
 pub const MAX_NODE_DEPTH: usize = 256;
 /// Extensions we read (a file may require these; others it may only use, with a warning).
@@ -209,6 +212,8 @@ pub enum GltfError {
     ViewTooShort { count: usize, element: usize, stride: usize, offset: usize, needed: usize, view: usize, length: usize },
     #[error("accessor {0} has no buffer view")]
     NoView(usize),
+    #[error("{0} elements without a buffer view: more than the {max} such an accessor may have", max = MAX_VIEWLESS_ELEMENTS)]
+    TooManyZeros(usize),
     #[error("{substitutions} sparse substitutions for {count} elements")]
     TooManySparse { substitutions: usize, count: usize },
     /// `part`: the sparse "indices" or "values".
@@ -248,6 +253,8 @@ pub enum GltfError {
     EmissiveStrength { material: MaterialName, value: f32 },
     #[error("its buffer view does not exist")]
     NoImageView,
+    #[error("{0} bytes is more than the {max} an image may have", max = MAX_IMAGE_BYTES)]
+    ImageTooLarge(usize),
     #[error("a buffer view without a mimeType")]
     NoMimeType,
     #[error("needs either a uri or a bufferView")]
@@ -837,6 +844,10 @@ impl Builder<'_> {
             (None, Some(_), None) => return Err(GltfError::NoMimeType),
             _ => return Err(GltfError::NoImageSource),
         };
+        // (A file is capped as it is read; a data URI or a buffer view only here.)
+        if bytes.len() as u64 > MAX_IMAGE_BYTES {
+            return Err(GltfError::ImageTooLarge(bytes.len()));
+        }
         decode_image(&bytes, srgb)
     }
 
@@ -1120,7 +1131,12 @@ fn elements(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &'static str) 
             let data = view_bytes(buffers, &view, what)?;
             (0..count).flat_map(|i| &data[accessor.offset() + i * stride..][..element]).copied().collect()
         }
-        None if accessor.sparse().is_some() => vec![0; count * element],
+        None if accessor.sparse().is_some() => {
+            if count > MAX_VIEWLESS_ELEMENTS {
+                return Err(fail(GltfError::TooManyZeros(count)));
+            }
+            vec![0; count * element]
+        }
         None => return Err(fail(GltfError::NoView(accessor.index()))),
     };
     if let Some(sparse) = accessor.sparse() {

@@ -403,7 +403,13 @@ fn files_that_break_gltf_rules_or_ranges_are_refused() {
         let first: [u8; 12] = same_point.bin[..12].try_into().unwrap();
         same_point.bin[at..at + 12].copy_from_slice(&first);
     }
+    // An accessor of zeros but for one substitution, claiming 50 million of them.
+    let mut zeros = quad_writer();
+    zeros.sparse(0, &[1], &[[2.0, 0.0, 0.0]]);
+    zeros.json["accessors"][0].as_object_mut().unwrap().remove("bufferView");
+    zeros.json["accessors"][0]["count"] = json!(50_000_000);
     let cases: Vec<(Vec<u8>, &str)> = vec![
+        (zeros.to_gltf(), "POSITION: 50000000 elements without a buffer view: more than the 1048576"),
         // Alignment: an f32 accessor two bytes into its view, a view two bytes into its buffer,
         // a stride that is no multiple of 4.
         (
