@@ -4,11 +4,9 @@
 //! would take longer than the budget is skipped and says so: brute force estimated from a smaller
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
+use crate::applies::{check_rules, draws_meshlets, objects_rule, Auto, Given, Rule, Techniques, CLUSTER_GRID, VISIBILITY_BUFFER};
 use crate::auto::{self, technique_choice};
-use crate::{
-    check_rules, cluster_choice, draws_meshlets, objects_rule, print_warnings, scene_source, shading_choice, Auto, Given, Progress, Rule,
-    Techniques, Whole, CLUSTER_GRID, VISIBILITY_BUFFER,
-};
+use crate::{cluster_choice, print_warnings, scene_source, shading_choice, Progress, Whole};
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use ml_cpu::camera::CameraSpec;
@@ -284,7 +282,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     // Every run records the quick probe and what auto makes of it.
     let (auto_technique, auto_why, quick) = auto::pick(&ctx)?;
     if auto == Auto::Pending {
-        check_rules(&rules, &a.given, &Techniques { flag: "--techniques", named, auto: Auto::Picked(auto_technique) })?;
+        check_rules(&rules, &a.given, &Techniques { flag: "--techniques", named, auto: Auto::Picked(auto_technique) })?.warn();
     }
     auto::announce(auto_technique, &auto_why);
     let mut variants: Vec<Variant> = Vec::new();

@@ -3,14 +3,13 @@
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::error::ErrorKind;
-use clap::parser::ValueSource;
-use clap::{ArgMatches, Args, CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
+use clap::{Args, CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
-use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource, SceneWarning};
+use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::report;
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{DebugView, Exposure, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
@@ -19,8 +18,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
+mod applies;
 mod auto;
 mod bench;
+use applies::{check_options_apply, Auto, Given, Techniques};
 mod messages;
 mod output;
 
@@ -302,27 +303,6 @@ impl<T: TryFrom<u64> + Clone + Send + Sync + 'static> clap::builder::TypedValueP
     }
 }
 
-/// The options of a command given on the command line, by clap's id (the field's name): the
-/// others keep their defaults, which never make an option refused as not applying.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Given(Vec<String>);
-
-impl Given {
-    fn of(matches: &ArgMatches) -> Given {
-        Given(
-            matches
-                .ids()
-                .filter(|id| matches.value_source(id.as_str()) == Some(ValueSource::CommandLine))
-                .map(|id| id.to_string())
-                .collect(),
-        )
-    }
-
-    pub(crate) fn has(&self, id: &str) -> bool {
-        self.0.iter().any(|given| given == id)
-    }
-}
-
 fn main() -> ExitCode {
     let cli = match parse_arguments() {
         Ok(cli) => cli,
@@ -495,254 +475,6 @@ fn raster_choice(args: &SceneArgs) -> Result<Option<Raster>> {
     }
 }
 
-/// An option given on the command line that does nothing with the technique, the scene or the
-/// other settings asked for: refused in one line naming it, what it does not apply to and
-/// what it needs (docs/usage.md, "Options that do not apply"). Defaults never are.
-#[derive(Debug)]
-pub(crate) struct NotApplying {
-    option: String,
-    to: String,
-    needs: String,
-}
-
-impl std::fmt::Display for NotApplying {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{} does not apply to {}: it needs {}", self.option, self.to, self.needs)
-    }
-}
-
-impl std::error::Error for NotApplying {}
-
-/// An option that applies only with some techniques, settings or scenes.
-pub(crate) struct Rule {
-    /// clap's id of the option (its field's name): the rule holds where it was given.
-    id: &'static str,
-    /// The option as the user wrote it: `--culling`, `--debug-view cluster-heat`.
-    option: String,
-    need: Need,
-}
-
-pub(crate) enum Need {
-    /// One of the techniques `applies` accepts; `what` says what they have in common.
-    Technique { what: &'static str, applies: fn(Technique) -> bool },
-    /// A setting or scene: whether the ones asked for are it (None: not known yet: a scene
-    /// file's shading model and lights before it is loaded), what they are instead, and what
-    /// the option needs.
-    Setting { holds: Option<bool>, instead: String, needs: String },
-}
-
-impl Rule {
-    pub(crate) fn technique(id: &'static str, what: &'static str, applies: fn(Technique) -> bool) -> Rule {
-        Rule { id, option: flag(id), need: Need::Technique { what, applies } }
-    }
-
-    pub(crate) fn setting(id: &'static str, holds: Option<bool>, instead: impl Into<String>, needs: impl Into<String>) -> Rule {
-        Rule { id, option: flag(id), need: Need::Setting { holds, instead: instead.into(), needs: needs.into() } }
-    }
-
-    /// The rule of one value of the option (`--debug-view shadow-cube`).
-    fn of_value(self, value: &str) -> Rule {
-        Rule { option: format!("{} {value}", self.option), ..self }
-    }
-}
-
-/// `--raster-split` for the id `raster_split`.
-fn flag(id: &str) -> String {
-    format!("--{}", id.replace('_', "-"))
-}
-
-/// What the techniques that have a cluster grid (the clustered ones) have in common.
-pub(crate) const CLUSTER_GRID: &str = "the techniques with a cluster grid";
-/// … and the technique whose visibility buffer the rasterisers draw.
-pub(crate) const VISIBILITY_BUFFER: &str = "the technique with a visibility buffer";
-
-pub(crate) fn draws_meshlets(t: Technique) -> bool {
-    t.geometry() == ml_render::Geometry::Meshlets
-}
-
-/// The techniques a command renders with, as far as they are known: those named and, with
-/// auto, its pick on this device; before the probe, any technique auto may pick.
-pub(crate) struct Techniques {
-    /// `--technique` or `--techniques`.
-    pub(crate) flag: &'static str,
-    pub(crate) named: Vec<Technique>,
-    pub(crate) auto: Auto,
-}
-
-#[derive(Clone, Copy, PartialEq)]
-pub(crate) enum Auto {
-    /// Not asked for.
-    No,
-    /// Asked for, not probed yet.
-    Pending,
-    Picked(Technique),
-}
-
-impl Techniques {
-    /// `--technique`'s choice (None: auto, not yet probed).
-    fn chosen(choice: Option<Technique>) -> Techniques {
-        match choice {
-            Some(t) => Techniques { flag: "--technique", named: vec![t], auto: Auto::No },
-            None => Techniques { flag: "--technique", named: Vec::new(), auto: Auto::Pending },
-        }
-    }
-
-    /// Refused unless one of the techniques (before auto's probe, one it may pick) is one
-    /// that `applies` accepts.
-    fn check(&self, option: &str, what: &str, applies: fn(Technique) -> bool) -> Result<(), NotApplying> {
-        let auto: &[Technique] = match &self.auto {
-            Auto::No => &[],
-            Auto::Pending => &auto::CANDIDATES,
-            Auto::Picked(t) => std::slice::from_ref(t),
-        };
-        if self.named.iter().chain(auto).any(|&t| applies(t)) {
-            return Ok(());
-        }
-        let mut to: Vec<String> = self.named.iter().map(|t| t.name().to_owned()).collect();
-        match self.auto {
-            Auto::No => {}
-            Auto::Pending => to.push(format!("auto (which picks {})", or_list(auto.iter().map(|t| t.name())))),
-            Auto::Picked(t) => to.push(format!("{}, which auto picked on this device", t.name())),
-        }
-        let which = or_list(Technique::ALL.into_iter().filter(|&t| applies(t)).map(Technique::name));
-        let mut needs = format!("{} {which} ({what})", self.flag);
-        if self.auto != Auto::No {
-            needs += &format!("; name one with {} rather than auto", self.flag);
-        }
-        Err(NotApplying { option: option.to_owned(), to: to.join(" and "), needs })
-    }
-}
-
-/// `a`, `a or b`, `a, b or c`.
-fn or_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
-    let names: Vec<&str> = names.collect();
-    match names.split_last() {
-        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
-        _ => names.join(""),
-    }
-}
-
-/// Refuse the first of `rules` whose option was given and does not apply to `techniques` (as
-/// far as they are known) or to the settings and scene asked for (as far as they are known).
-pub(crate) fn check_rules(rules: &[Rule], given: &Given, techniques: &Techniques) -> Result<(), NotApplying> {
-    for rule in rules.iter().filter(|r| given.has(r.id)) {
-        match &rule.need {
-            Need::Technique { what, applies } => techniques.check(&rule.option, what, *applies)?,
-            Need::Setting { holds: Some(false), instead, needs } => {
-                return Err(NotApplying { option: rule.option.clone(), to: instead.clone(), needs: needs.clone() });
-            }
-            Need::Setting { .. } => {}
-        }
-    }
-    Ok(())
-}
-
-/// `--objects`, of `render`, `view` and `bench`.
-pub(crate) fn objects_rule(scene: &str) -> Rule {
-    Rule::setting("objects", Some(scene == "bench"), format!("--scene {scene}"), "the bench scene (--scene bench)")
-}
-
-/// The options of `render` and `view` that apply only with some techniques, settings or
-/// scenes: `source` is the scene asked for, `built` the scene once it is (which tells a scene
-/// file's shading model and whether it keeps its own lights).
-fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene>) -> Vec<Rule> {
-    let scene = format!("--scene {}", args.scene);
-    let (seed, room, bench, file) = (
-        matches!(source, SceneSource::Seed { .. }),
-        matches!(source, SceneSource::Room),
-        matches!(source, SceneSource::Bench { .. }),
-        matches!(source, SceneSource::File(_)),
-    );
-    let placed =
-        "lights placed by layout (--scene seed or a scene or glTF file; the bench scene's are random, the room keeps its one light)";
-    let random = args.light_layout != "grid" || args.light_radius.as_deref().is_some_and(|r| r.contains(".."));
-    let random_lights = "random lights (--light-layout random or surface, a --light-radius range MIN..MAX, or --scene bench)";
-    // A file that has lights keeps them unless --lights replaces them.
-    let own_lights =
-        built.map(|b| file && args.lights.is_none() && !b.warnings.iter().any(|w| matches!(w, SceneWarning::DefaultRig { .. })));
-    let own = |id| {
-        Rule::setting(id, own_lights.map(|own| !own), format!("the lights of '{}'", args.scene), "--lights N, whose lights replace them")
-    };
-    let omni = args.omni_shadow.as_str();
-    let cube_modes = OmniShadowMode::ALL.into_iter().filter(|m| !matches!(m, OmniShadowMode::Atlas(_))).map(OmniShadowMode::name);
-    let cubes = format!("point-light shadow cubes (--omni-shadow {})", or_list(cube_modes));
-    let shadows = format!("point-light shadows (--omni-shadow {})", or_list(OmniShadowMode::ALL.into_iter().map(OmniShadowMode::name)));
-    let atlas = "the shadow atlas (--omni-shadow atlas)";
-    let model = built.map(|b| b.shading);
-    let sun = |id| {
-        Rule::setting(
-            id,
-            model.map(|m| m == ShadingModel::BlinnPhong),
-            format!("the {} shading model", model.map_or("", ShadingModel::name)),
-            "the blinn-phong model's sun (--shading blinn-phong)",
-        )
-    };
-    let mut rules = vec![
-        objects_rule(&args.scene),
-        Rule::setting("object", Some(seed), &scene, "the seed scene (--scene seed)"),
-        Rule::setting("material", Some(seed), &scene, "the seed scene (--scene seed)"),
-        Rule::setting(
-            "lights",
-            Some(!room),
-            &scene,
-            "a scene whose lights are placed (--scene seed, bench or a file; the room keeps its one light)",
-        ),
-        Rule::setting("light_layout", Some(seed || file), &scene, placed),
-        Rule::setting("light_radius", Some(seed || file), &scene, placed),
-        Rule::setting("light_seed", Some(!room), &scene, random_lights),
-        Rule::setting("light_seed", Some(bench || random), "--light-layout grid of one --light-radius", random_lights),
-        own("light_layout"),
-        own("light_radius"),
-        own("light_seed"),
-        Rule::setting("shadowed_lights", Some(omni != "off"), "--omni-shadow off", &shadows),
-        Rule::setting("cube_size", Some(omni != "off"), "--omni-shadow off", &shadows),
-        Rule::setting("shadow_budget", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas),
-        Rule::setting("shadow_cache", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas),
-        sun("sun_shadow"),
-        Rule::setting(
-            "exposure",
-            Some(args.debug_view == "none"),
-            format!("--debug-view {}", args.debug_view),
-            "the shaded image (--debug-view none; debug views show their values as they are)",
-        ),
-        Rule::technique("clusters", CLUSTER_GRID, Technique::is_clustered),
-        Rule::technique("culling", "the technique that culls meshlets on the GPU", draws_meshlets),
-        Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
-        Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
-        Rule::setting(
-            "raster_split",
-            Some(args.raster != "hardware"),
-            "--raster hardware",
-            "a rasteriser in compute (--raster compute, hybrid or auto)",
-        ),
-    ];
-    let view = args.debug_view.as_str();
-    rules.extend(
-        match DebugView::from_name(view).unwrap_or(DebugView::None) {
-            DebugView::ClusterHeat => {
-                Some(Rule::technique("debug_view", "the clustered forward techniques", Technique::draws_cluster_heat))
-            }
-            DebugView::Meshlets | DebugView::Triangles => {
-                Some(Rule::technique("debug_view", "the technique drawn in meshlets", draws_meshlets))
-            }
-            DebugView::ShadowMap => Some(sun("debug_view")),
-            DebugView::ShadowCube => {
-                Some(Rule::setting("debug_view", Some(omni != "off" && omni != "atlas"), format!("--omni-shadow {omni}"), cubes))
-            }
-            DebugView::ShadowAtlas => Some(Rule::setting("debug_view", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas)),
-            _ => None,
-        }
-        .map(|rule| rule.of_value(view)),
-    );
-    rules
-}
-
-/// Refuse an option of `render` or `view` given on the command line that does not apply to
-/// `techniques`, the scene or the other settings, as far as they are known.
-fn check_options_apply(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene>, techniques: &Techniques) -> Result<()> {
-    Ok(check_rules(&scene_rules(args, source, built), &args.given, techniques)?)
-}
-
 /// A built scene's warnings, one line each.
 fn print_warnings(warnings: &[SceneWarning]) {
     for w in warnings {
@@ -834,7 +566,12 @@ fn render(cmd: &RenderArgs) -> Result<()> {
             let (t, why, _) = auto::pick(&ctx)?;
             settings.technique = t;
             techniques.auto = Auto::Picked(t);
-            check_options_apply(args, &request.source, Some(&built), &techniques)?;
+            let unused = check_options_apply(args, &request.source, Some(&built), &techniques)?;
+            unused.warn();
+            // A debug view the pick does not have: the shaded image, as the warning says.
+            if unused.has("debug_view") {
+                settings.debug_view = DebugView::None;
+            }
             Some(why)
         }
     };
@@ -888,12 +625,18 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     let built = request.build()?;
     check_options_apply(args, &request.source, Some(&built), &techniques)?;
     let technique = auto::resolve_alone(&args.technique, args.validation, args.device)?;
+    let mut unused = Default::default();
     if choice.is_none() {
         techniques.auto = Auto::Picked(technique);
-        check_options_apply(args, &request.source, Some(&built), &techniques)?;
+        unused = check_options_apply(args, &request.source, Some(&built), &techniques)?;
     }
     print_warnings(&built.warnings);
+    unused.warn();
     let mut first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
+    // A debug view the pick does not have: the shaded image, as the warning says.
+    if unused.has("debug_view") {
+        first.debug_view = DebugView::None;
+    }
     first.raster =
         auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args)?, args.raster_split), (args.validation, args.device))?;
     let options = ml_viewer::ViewerOptions {
@@ -916,39 +659,4 @@ fn info() -> Result<()> {
         println!("{}", report::table(&report::device_rows(&d)));
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The ids of `command`'s options.
-    fn ids(command: &str) -> Vec<String> {
-        let cli = Cli::command();
-        let sub = cli.find_subcommand(command).expect("the command");
-        sub.get_arguments().map(|a| a.get_id().to_string()).collect()
-    }
-
-    /// A rule whose id names no option would never hold.
-    #[test]
-    fn every_rule_names_an_option() {
-        for view in DebugView::ALL {
-            let Command::Render(args) = Cli::parse_from(["manylights", "render", "--debug-view", view.name(), "--out", "a.png"]).command
-            else {
-                unreachable!()
-            };
-            for rule in scene_rules(&args.scene, &SceneSource::Room, None) {
-                assert!(ids("render").contains(&rule.id.to_owned()) && ids("view").contains(&rule.id.to_owned()), "{}", rule.id);
-            }
-        }
-        let Command::Bench(args) = Cli::parse_from(["manylights", "bench"]).command else { unreachable!() };
-        for rule in args.rules(&[]) {
-            assert!(ids("bench").contains(&rule.id.to_owned()), "{}", rule.id);
-        }
-    }
-
-    #[test]
-    fn lists_read_as_prose() {
-        assert_eq!([&["a"][..], &["a", "b"], &["a", "b", "c"]].map(|l| or_list(l.iter().copied())), ["a", "a or b", "a, b or c"]);
-    }
 }
