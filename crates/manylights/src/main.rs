@@ -607,11 +607,16 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The largest viewer script read (a script of a million lines is far past any session).
+const MAX_SCRIPT_BYTES: u64 = 16 << 20;
+
 fn view(cmd: &ViewArgs) -> Result<()> {
     let args = &cmd.scene;
     let script = match &cmd.script {
         Some(path) => {
-            let text = std::fs::read_to_string(path).with_context(|| format!("cannot read script '{}'", path.display()))?;
+            let bytes =
+                ml_cpu::files::read_regular(path, MAX_SCRIPT_BYTES).with_context(|| format!("cannot read script '{}'", path.display()))?;
+            let text = String::from_utf8(bytes).map_err(|_| anyhow!("script '{}' is not UTF-8 text", path.display()))?;
             Some(ml_viewer::script::parse(&text).map_err(|e| anyhow::anyhow!("script '{}': {e}", path.display()))?)
         }
         None => None,

@@ -89,6 +89,18 @@ fn a_broken_script_is_one_error_line() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.lines().count() == 1 && stderr.contains("line 2") && stderr.contains("teleport"), "{stderr}");
+    // A script that never ends (a device) or never comes (a pipe no one writes to): refused
+    // before it is read, at once.
+    let pipe = d.join("script.fifo");
+    assert!(Command::new("mkfifo").arg(&pipe).status().unwrap().success());
+    for never in [Path::new("/dev/zero"), &pipe] {
+        let start = std::time::Instant::now();
+        let out = Command::new(bin()).args(["view", "--script", never.to_str().unwrap()]).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.lines().count() == 1 && stderr.contains("not a regular file"), "{stderr}");
+        assert!(start.elapsed().as_secs() < 5, "{:?}", start.elapsed());
+    }
 }
 
 /// No window system: one error line saying what to do, not a panic.

@@ -138,31 +138,14 @@ pub enum ReadError {
     TooLong { max: u64 },
 }
 
-/// The open flag that makes opening a pipe return at once instead of waiting for a writer (a
-/// regular file reads as ever with it). std names no such flag: these are the platforms' values
-/// (libc's O_NONBLOCK). Where it is not known a pipe is still refused before it is opened; only
-/// one put in the file's place between that check and the opening would be waited on.
-#[cfg(unix)]
-const O_NONBLOCK: i32 = if cfg!(any(target_os = "linux", target_os = "android")) {
-    if cfg!(any(target_arch = "mips", target_arch = "mips64")) {
-        0x80
-    } else if cfg!(target_arch = "sparc64") {
-        0x4000
-    } else {
-        0o4000
-    }
-} else if cfg!(any(target_vendor = "apple", target_os = "freebsd", target_os = "openbsd", target_os = "netbsd", target_os = "dragonfly")) {
-    0x4
-} else {
-    0
-};
-
-/// `path` opened for reading, at once even where it is a pipe no one writes to.
+/// `path` opened for reading, at once even where it is a pipe no one writes to (O_NONBLOCK:
+/// a regular file reads as ever with it; a pipe put in the file's place since it was checked
+/// is then refused as opened, not waited on).
 fn open_without_waiting(path: &Path) -> io::Result<File> {
     let mut options = OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
-    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, O_NONBLOCK);
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
     options.open(path)
 }
 
