@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Every test: CPU unit tests and GPU image tests on whatever Vulkan device is present
-# (lavapipe in CI), with the validation layers and synchronization validation on.
+# Every test: the lint gates (scripts/lint.sh: fmt, clippy, docs), then CPU unit tests and GPU
+# image tests on whatever Vulkan device is present (lavapipe in CI), with the validation layers
+# and synchronization validation on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+bash scripts/lint.sh
 cargo test --workspace --locked "$@"

@@ -1,6 +1,10 @@
 //! `manylights`: the command line. Parses arguments and calls the library; every failure
 //! ends as one `error: …` line on stderr and a non-zero exit (2 for arguments clap refuses).
 
+// The argument structs' doc comments are the --help text, written for a terminal: their
+// brackets ([shading], [:FOV]) are literal, not links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::error::ErrorKind;
 use clap::{Args, CommandFactory as _, FromArgMatches as _, Parser, Subcommand};

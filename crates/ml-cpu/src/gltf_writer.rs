@@ -97,8 +97,8 @@ impl GltfWriter {
         self.accessor(bytes, values.len(), 5126, kind, extra)
     }
 
-    /// Make accessor `accessor` (of VEC3 floats) sparse: element indices[k] is replaced by
-    /// values[k] (u16 indices).
+    /// Make accessor `accessor` (of VEC3 floats) sparse: element `indices[k]` is replaced by
+    /// `values[k]` (u16 indices).
     pub fn sparse(&mut self, accessor: usize, indices: &[u16], values: &[[f32; 3]]) {
         let mut view = |bytes: Vec<u8>| {
             while !self.bin.len().is_multiple_of(4) {

@@ -45,7 +45,7 @@ gpu_struct!(
         viewport: [u32; 4],
         /// x, y: slice = ⌊ln(depth)·x + y⌋; z: lights per cluster at the top of the heat map.
         cluster_slices: [f32; 4],
-        /// near, far, projection[0][0], projection[1][1].
+        /// near, far, `projection[0][0]`, `projection[1][1]`.
         cluster_frustum: [f32; 4],
         /// xyz: the offset every light moves by this frame (animated on the GPU by clustered-gpu).
         light_animation: [f32; 4],
