@@ -289,7 +289,7 @@ uint atlas_texel(uint base, uvec2 t) {
 }
 
 // Background of pixels no object covers, as stored in the 8-bit target. Keep in sync with
-// raster.rs CLEAR_COLOR.
+// mesh_raster.rs CLEAR_COLOR.
 const vec4 CLEAR_COLOR = vec4(0.02, 0.02, 0.02, 1.0);
 
 // Linear colour → what the 8-bit target stores: the seed's gamma 1/2.2 (values above 1 clip).

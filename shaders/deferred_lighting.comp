@@ -35,7 +35,7 @@ void main() {
     vec3 world = world_from_depth(frag_xy, z);
     vec3 n = oct_decode(texelFetch(normal_image, p, 0).xy);
     uint id = texelFetch(object_image, p, 0).r;
-    // Without OBJECT_TEXTURES the G-buffer has no material and emissive images (deferred.rs
+    // Without OBJECT_TEXTURES the G-buffer has no material and emissive images (the pass
     // binds stand-ins that are never read).
     vec2 roughness_metallic = OBJECT_TEXTURES ? texelFetch(roughness_metallic_image, p, 0).xy : vec2(1.0);
     vec3 emissive_factor = OBJECT_TEXTURES ? texelFetch(emissive_image, p, 0).rgb : vec3(1.0);

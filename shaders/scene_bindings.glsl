@@ -1,6 +1,6 @@
 // Set 0 as every shading path sees it: the frame's uniforms, the lights, the objects and, with
-// CLUSTERED defined, the cluster lists (raster.rs BINDING_*, deferred.rs BINDING_* use the
-// same numbers).
+// CLUSTERED defined, the cluster lists. Rust binds them by these names, reflected from the
+// SPIR-V (descriptors.rs).
 
 #ifndef MANYLIGHTS_SCENE_BINDINGS_GLSL
 #define MANYLIGHTS_SCENE_BINDINGS_GLSL

@@ -1,5 +1,6 @@
-// Which shading model a pipeline is built for: specialization constants (set by raster.rs,
-// deferred.rs and tonemap.rs from --shading), so each pipeline carries only its model's code.
+// Which shading model a pipeline is built for: specialization constants (set from --shading
+// by settings.rs model_spec_constants for every pass that shades or tone-maps), so each
+// pipeline carries only its model's code.
 // A uniform switch cost the seed model's fragment shaders 1.3–1.4× on the H100 (measured):
 // the other models' code still took registers.
 

@@ -1,6 +1,8 @@
 //! The passes a frame is made of, one file each, and `assemble`, which turns a technique's
-//! choices into the ordered list the renderer records. Adding a pass adds a file here and a
-//! line in `assemble`; the renderer does not change.
+//! choices into the ordered list the renderer records. Adding a pass without CPU work of its
+//! own adds a file here and a line in `assemble`; one with a per-frame CPU step (the shadow
+//! atlas's plan, the exposure meter's EV) also touches the renderer (docs/architecture.md has
+//! the checklist).
 
 pub mod cluster_assign_cpu;
 pub mod cluster_build;
