@@ -29,7 +29,7 @@ fn renders_a_png_and_prints_the_table() {
         manylights(&["render", "--validation", "--width", "64", "--height", "36", "--time", "0", "--out", png.to_str().unwrap()], &[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
-    for key in ["device", "resolution", "64x36", "lights", "gpu ms", "cpu ms/frame"] {
+    for key in ["device", "resolution", "64x36", "lights", "gpu ms", "memory", "MiB in", "cpu ms/frame"] {
         assert!(stdout.contains(key), "'{key}' missing from:\n{stdout}");
     }
     let img = image::open(&png).expect("a PNG").to_rgba8();

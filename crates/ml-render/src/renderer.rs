@@ -415,6 +415,7 @@ impl<'a> Renderer<'a> {
         // Averages are over every frame rendered, re-renders included.
         stats.frames = self.settings.frames + stats.rerendered_frames;
         stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
+        stats.memory = Some(self.ctx.memory_use());
         self.last_frame = last;
         let rgba = self.read_back(last)?;
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })

@@ -37,6 +37,8 @@ pub struct FrameStats {
     /// rendered again for the exposure to settle.
     pub exposure_ev: Option<f32>,
     pub exposure_repeats: u32,
+    /// What the renderer had allocated when the last frame finished.
+    pub memory: Option<ml_vk::context::MemoryUse>,
 }
 
 /// What one frame's compute shadow raster drew (--omni-shadow compute).
@@ -122,6 +124,7 @@ impl FrameStats {
             sun_shadow_ms: None,
             exposure_ev: None,
             exposure_repeats: 0,
+            memory: None,
         }
     }
 
@@ -406,6 +409,18 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         let by = settings.sun_shadow.name();
         let size = crate::scene_textures::SHADOW_MAP_SIZE;
         rows.push(("sun shadow ms", format!("{ms:.3}  (the sun's {size}² shadow map by {by}, once at load)")));
+    }
+    if let Some(m) = stats.memory {
+        let mib = |b: u64| b as f64 / (1 << 20) as f64;
+        rows.push((
+            "memory",
+            format!(
+                "{:.1} MiB in {} buffers and images ({:.1} MiB of blocks reserved from Vulkan; device-local and host-visible)",
+                mib(m.allocated),
+                m.allocations,
+                mib(m.reserved)
+            ),
+        ));
     }
     rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));

@@ -303,6 +303,15 @@ unsafe extern "system" fn debug_callback(
 }
 
 /// The device everything renders with.
+/// Memory the allocator holds for a context: what its buffers and images take, and the
+/// blocks it reserved from Vulkan to sub-allocate them from (device-local and host-visible).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MemoryUse {
+    pub allocated: u64,
+    pub allocations: usize,
+    pub reserved: u64,
+}
+
 pub struct Context {
     parts: InstanceParts,
     pub physical_device: vk::PhysicalDevice,
@@ -435,6 +444,13 @@ impl Context {
         // A poisoned lock only means another thread panicked mid-allocation; the allocator's
         // own state is still consistent for freeing.
         self.allocator.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// What the allocator holds now: every buffer and image (but lazily allocated
+    /// attachments, which tilers back only as they are drawn).
+    pub fn memory_use(&self) -> MemoryUse {
+        let report = self.allocator().generate_report();
+        MemoryUse { allocated: report.total_allocated_bytes, allocations: report.allocations.len(), reserved: report.total_capacity_bytes }
     }
 
     pub fn format_supports(&self, format: vk::Format, features: vk::FormatFeatureFlags) -> bool {
