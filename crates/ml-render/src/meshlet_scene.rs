@@ -1,5 +1,7 @@
 //! The scene as the GPU-driven passes draw it (technique visibility; docs/DESIGN.md#gpu-culling):
-//! the meshlet geometry, uploaded once; per frame slot, the culling's buffers (counters with
+//! the meshlet geometry, uploaded once per scene and owned by the scene's GPU resources
+//! (SceneGpu), which every meshlet pass borrows — the visibility technique's culling and
+//! rasters, the compute shadow raster of the point lights and the sun; per frame slot, the culling's buffers (counters with
 //! the indirect dispatches and draws, the visible-instance list, the draw slots, the
 //! compacted indices and triangle ids, a read-back of the counters); and, shared by the
 //! slots, each meshlet instance's visibility at the end of the last frame (frames run in
@@ -41,8 +43,8 @@ pub struct CullFrame {
 /// the scene has masked or double-sided objects (`MeshletGeometry::surface_tests`).
 pub const SPEC_SURFACE_TESTS: u32 = 18;
 
-/// The scene's meshlets on the GPU, uploaded once: what every meshlet pass reads (the
-/// visibility technique's culling and raster, the compute shadow raster).
+/// The scene's meshlets on the GPU, uploaded once per scene (SceneGpu owns it): what every
+/// meshlet pass reads, through a `MeshletGeometryView`.
 pub struct MeshletGeometry {
     pub vertices: Buffer,
     pub meshlet_vertices: Buffer,
@@ -59,7 +61,49 @@ pub struct MeshletGeometry {
     pub surface_tests: bool,
 }
 
+/// The buffers and counts of the scene's `MeshletGeometry`, for the passes that read it: it
+/// owns nothing, and outlives no pass (the scene's GPU resources are released after them).
+#[derive(Clone, Copy, Debug)]
+pub struct MeshletGeometryView {
+    vertices: vk::Buffer,
+    meshlet_vertices: vk::Buffer,
+    meshlet_triangles: vk::Buffer,
+    meshlets: vk::Buffer,
+    instances: vk::Buffer,
+    meshlet_instances: vk::Buffer,
+    pub meshlet_instance_count: u32,
+    pub instance_count: u32,
+    pub triangles: u64,
+    pub surface_tests: bool,
+}
+
+impl MeshletGeometryView {
+    /// The buffer a meshlet shader calls `name`, if it is one of these.
+    pub fn buffer(&self, name: &str) -> Option<Resource> {
+        let buffer = match name {
+            "VertexBuffer" => self.vertices,
+            "MeshletVertexBuffer" => self.meshlet_vertices,
+            "MeshletTriangleBuffer" => self.meshlet_triangles,
+            "MeshletBuffer" => self.meshlets,
+            "InstanceBuffer" => self.instances,
+            "MeshletInstanceBuffer" => self.meshlet_instances,
+            _ => return None,
+        };
+        Some(Resource::Buffer(buffer))
+    }
+}
+
 impl MeshletGeometry {
+    /// `scene`'s meshlets, built and uploaded, each instance naming its object's texture set
+    /// (`texture_sets`, per object: the visibility lighting binds it).
+    pub fn build(ctx: &Context, scene: &ml_cpu::scene::Scene, texture_sets: &[u32]) -> Result<MeshletGeometry, VkError> {
+        let mut geometry = SceneMeshlets::build(scene).map_err(|e| VkError::Limit(e.to_string()))?;
+        for (instance, &set) in geometry.instances.iter_mut().zip(texture_sets) {
+            instance.surface[1] = set;
+        }
+        MeshletGeometry::upload(ctx, &geometry)
+    }
+
     /// Upload `g`; every buffer is bound whole as a storage buffer, so one larger than the
     /// device binds is an error, never a shortened scene.
     pub fn upload(ctx: &Context, g: &SceneMeshlets) -> Result<MeshletGeometry, VkError> {
@@ -87,18 +131,20 @@ impl MeshletGeometry {
         })
     }
 
-    /// The buffer a meshlet shader calls `name`, if it is one of these.
-    pub fn buffer(&self, name: &str) -> Option<Resource> {
-        let buffer = match name {
-            "VertexBuffer" => &self.vertices,
-            "MeshletVertexBuffer" => &self.meshlet_vertices,
-            "MeshletTriangleBuffer" => &self.meshlet_triangles,
-            "MeshletBuffer" => &self.meshlets,
-            "InstanceBuffer" => &self.instances,
-            "MeshletInstanceBuffer" => &self.meshlet_instances,
-            _ => return None,
-        };
-        Some(Resource::Buffer(buffer.raw))
+    /// What the passes read of it.
+    pub fn view(&self) -> MeshletGeometryView {
+        MeshletGeometryView {
+            vertices: self.vertices.raw,
+            meshlet_vertices: self.meshlet_vertices.raw,
+            meshlet_triangles: self.meshlet_triangles.raw,
+            meshlets: self.meshlets.raw,
+            instances: self.instances.raw,
+            meshlet_instances: self.meshlet_instances.raw,
+            meshlet_instance_count: self.meshlet_instance_count,
+            instance_count: self.instance_count,
+            triangles: self.triangles,
+            surface_tests: self.surface_tests,
+        }
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -143,7 +189,8 @@ pub fn storage_buffer_with(ctx: &Context, name: &str, data: &[u8]) -> Result<Buf
 }
 
 pub struct MeshletScene {
-    pub geometry: MeshletGeometry,
+    /// The scene's meshlets (SceneGpu's).
+    pub geometry: MeshletGeometryView,
     /// Per meshlet instance: 1 where it was visible at the end of the last frame.
     pub visibility: Buffer,
     pub frames: Vec<CullFrame>,
@@ -155,19 +202,10 @@ pub struct MeshletScene {
 pub type SharedMeshletScene = Rc<RefCell<MeshletScene>>;
 
 impl MeshletScene {
-    /// Upload `geometry`, whose instances' texture sets are `texture_sets` (per object).
-    /// The scene's meshlets with per-frame culling buffers; `bin_list`: large triangles, and
-    /// bins, the compute raster's lists hold per phase (0 where it has none).
-    pub fn new(ctx: &Context, mut geometry: SceneMeshlets, texture_sets: &[u32], bin_list: u32) -> Result<SharedMeshletScene, VkError> {
-        for (instance, &set) in geometry.instances.iter_mut().zip(texture_sets) {
-            instance.surface[1] = set;
-        }
-        let s = MeshletScene {
-            geometry: MeshletGeometry::upload(ctx, &geometry)?,
-            visibility: Buffer::null(),
-            frames: Vec::new(),
-            capacity: geometry.meshlet_instances.len().max(1) as u32,
-        };
+    /// The scene's meshlets `geometry` with per-frame culling buffers; `bin_list`: large
+    /// triangles, and bins, the compute raster's lists hold per phase (0 where it has none).
+    pub fn new(ctx: &Context, geometry: MeshletGeometryView, bin_list: u32) -> Result<SharedMeshletScene, VkError> {
+        let s = MeshletScene { geometry, visibility: Buffer::null(), frames: Vec::new(), capacity: geometry.meshlet_instance_count.max(1) };
         let made = ml_vk::build(ctx, s, |s| s.create(ctx, bin_list))?;
         Ok(Rc::new(RefCell::new(made)))
     }
@@ -256,7 +294,6 @@ impl MeshletScene {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        self.geometry.destroy(ctx);
         self.visibility.destroy(ctx);
         for f in &mut self.frames {
             f.destroy(ctx);

@@ -5,7 +5,7 @@
 use crate::error::RenderError;
 use crate::gpu_mesh::GpuMesh;
 use crate::mesh_raster::{object_data, SurfaceVariant};
-use crate::meshlet_scene::storage_buffer_with;
+use crate::meshlet_scene::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
 use crate::object_textures::ObjectTextureSets;
 use crate::omni_shadow::OmniShadows;
 use crate::scene_textures::SceneTextures;
@@ -40,6 +40,11 @@ pub struct SceneGpu {
     sun: Option<SunShadowMode>,
     /// GPU milliseconds the sun's shadow map took to draw (None: not drawn, or no timestamps).
     pub sun_shadow_ms: Option<f64>,
+    /// The scene's meshlets, built once for every pass that draws them (the visibility
+    /// technique, the compute shadow rasters of the point lights and the sun); None where
+    /// the settings have no such pass.
+    meshlets: Option<MeshletGeometry>,
+    wants_meshlets: bool,
 }
 
 impl SceneGpu {
@@ -64,6 +69,8 @@ impl SceneGpu {
             shadow_view_proj: glam::Mat4::IDENTITY,
             sun,
             sun_shadow_ms: None,
+            meshlets: None,
+            wants_meshlets: draws_meshlets(settings),
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
@@ -91,6 +98,9 @@ impl SceneGpu {
         let objects: Vec<ObjectData> = scene.objects.iter().map(|o| object_data(o, &masks, &scene.textures)).collect();
         self.objects = Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         self.omni.bind_casters(ctx, (self.objects.raw, self.alpha_masks.raw))?;
+        if self.wants_meshlets {
+            self.meshlets = Some(MeshletGeometry::build(ctx, scene, &self.object_textures.set_index)?);
+        }
         let (lo, hi) = scene.bounds();
         self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
         if let Some(mode) = self.sun {
@@ -102,6 +112,7 @@ impl SceneGpu {
                 alpha_masks: self.alpha_masks.raw,
                 view_proj,
                 mode,
+                meshlets: self.meshlets.as_ref().map(MeshletGeometry::view),
             };
             self.sun_shadow_ms = self.textures.render_shadow_map(ctx, &inputs)?;
         }
@@ -131,6 +142,17 @@ impl SceneGpu {
         self.meshes.clear();
         self.objects.destroy(ctx);
         self.alpha_masks.destroy(ctx);
+        if let Some(mut meshlets) = self.meshlets.take() {
+            meshlets.destroy(ctx);
+        }
+    }
+
+    /// The scene's meshlets, for a pass that draws them.
+    pub fn meshlets(&self) -> Result<MeshletGeometryView, VkError> {
+        self.meshlets
+            .as_ref()
+            .map(MeshletGeometry::view)
+            .ok_or_else(|| VkError::Limit("the scene's meshlets were not built for these settings".into()))
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -140,4 +162,12 @@ impl SceneGpu {
         self.object_textures.destroy(ctx);
         self.omni.destroy(ctx);
     }
+}
+
+/// Whether `settings` have a pass that draws the scene's meshlets.
+fn draws_meshlets(settings: &RenderSettings) -> bool {
+    use crate::settings::{Geometry, OmniShadowMode};
+    let omni_compute = settings.omni.is_some_and(|o| matches!(o.mode, OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_)));
+    let sun_compute = settings.shading == ShadingModel::BlinnPhong && settings.sun_shadow == SunShadowMode::Compute;
+    settings.technique.geometry() == Geometry::Meshlets || omni_compute || sun_compute
 }

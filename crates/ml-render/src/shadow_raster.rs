@@ -9,10 +9,9 @@
 //! large triangle draws it (omni_raster_large.comp); the buffer is copied into the image.
 
 use crate::descriptors::{FrameSets, Resource};
-use crate::meshlet_scene::{storage_bytes, MeshletGeometry, SPEC_SURFACE_TESTS};
+use crate::meshlet_scene::{storage_bytes, MeshletGeometryView, SPEC_SURFACE_TESTS};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush, ShadowCubeTiles};
-use ml_cpu::meshlets::SceneMeshlets;
 use ml_vk::commands::{memory_barrier, update_buffer};
 use ml_vk::image::aspect_transition;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
@@ -73,7 +72,8 @@ pub struct ShadowTarget {
 pub struct ShadowRaster {
     views: ShadowViews,
     size: u32,
-    geometry: MeshletGeometry,
+    /// The scene's meshlets (SceneGpu's).
+    geometry: MeshletGeometryView,
     /// The drawing's lights (vec4 each: position, radius), written by the command buffer
     /// itself (vkCmdUpdateBuffer), so frames in flight each see their own.
     lights: Buffer,
@@ -99,15 +99,14 @@ pub struct ShadowRaster {
 }
 
 impl ShadowRaster {
-    /// The raster of `scene`'s objects into `views` of `size`² texels, with `slots` descriptor
-    /// sets (one per frame in flight).
+    /// The raster of the scene's meshlets `geometry` into `views` of `size`² texels, with
+    /// `slots` descriptor sets (one per frame in flight).
     pub fn new(
         ctx: &Context,
-        scene: &ml_cpu::scene::Scene,
+        geometry: MeshletGeometryView,
         (views, size, large_capacity): (ShadowViews, u32, u32),
         slots: usize,
     ) -> Result<ShadowRaster, VkError> {
-        let geometry = SceneMeshlets::build(scene).map_err(|e| VkError::Limit(e.to_string()))?;
         let shaders = [
             &ml_shaders::OMNI_CULL_COMP,
             &ml_shaders::OMNI_RASTER_COMP,
@@ -117,7 +116,7 @@ impl ShadowRaster {
         let stages = shaders.map(|s| (s, vk::ShaderStageFlags::COMPUTE));
         // Cubes: six views per meshlet instance and light at most, the pair list cannot
         // overflow; the atlas's is a share of its budget.
-        let pairs = geometry.meshlet_instances.len() as u64 * views.layers() as u64;
+        let pairs = geometry.meshlet_instance_count as u64 * views.layers() as u64;
         let pairs = match views {
             ShadowViews::Atlas { pairs: capacity, .. } => pairs.min(capacity as u64),
             _ => pairs,
@@ -126,7 +125,7 @@ impl ShadowRaster {
         let raster = ShadowRaster {
             views,
             size,
-            geometry: MeshletGeometry::upload(ctx, &geometry)?,
+            geometry,
             lights: Buffer::null(),
             counters: Buffer::null(),
             pairs: Buffer::null(),
@@ -345,7 +344,6 @@ impl ShadowRaster {
         {
             b.destroy(ctx);
         }
-        self.geometry.destroy(ctx);
     }
 }
 

@@ -9,6 +9,7 @@
 
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::meshlet_scene::MeshletGeometryView;
 use crate::settings::SunShadowMode;
 use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use ml_cpu::gpu_types::ShadowPush;
@@ -25,6 +26,8 @@ pub struct ShadowInputs<'a> {
     pub alpha_masks: vk::Buffer,
     pub view_proj: glam::Mat4,
     pub mode: SunShadowMode,
+    /// The scene's meshlets (the compute raster draws them; SceneGpu builds them for it).
+    pub meshlets: Option<MeshletGeometryView>,
 }
 
 /// Who reads the map once it is drawn.
@@ -46,7 +49,8 @@ pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInpu
             // One orthographic view; its "light" at the origin with radius 1 leaves world
             // positions as they are (omni_raster.glsl).
             let views = (ShadowViews::Ortho, target.extent.width, LARGE_LIST);
-            ShadowRaster::new(ctx, inputs.scene, views, 1).and_then(|mut raster| {
+            let meshlets = inputs.meshlets.ok_or_else(|| VkError::Limit("the sun's compute shadow raster has no meshlets".into()))?;
+            ShadowRaster::new(ctx, meshlets, views, 1).and_then(|mut raster| {
                 let shadow_target = ShadowTarget { image: target.raw, readers: READERS };
                 let result = raster.bind(ctx, 0, (inputs.objects, inputs.alpha_masks)).and_then(|()| {
                     ml_vk::commands::one_shot(ctx, |cmd| {

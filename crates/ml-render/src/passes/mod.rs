@@ -30,7 +30,6 @@ use crate::settings::{
 use crate::shadow_raster::ShadowViews;
 use meshlet_cull::Phase;
 use ml_cpu::gpu_types::PointLight;
-use ml_cpu::meshlets::SceneMeshlets;
 use ml_cpu::scene::Scene;
 use ml_vk::{vk, Context, VkError};
 
@@ -70,13 +69,13 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     match s.omni {
         Some(omni @ OmniShadowSettings { mode: OmniShadowMode::Compute { large_list }, .. }) => {
             let views = ShadowViews::Cubes { lights: omni.lights };
-            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, (views, omni.size, large_list))?));
+            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.scene.meshlets()?, (views, omni.size, large_list))?));
         }
         Some(omni @ OmniShadowSettings { mode: OmniShadowMode::Atlas(_), .. }) => {
             let atlas = &a.scene.omni.atlas;
             let views =
                 ShadowViews::Atlas { lights: omni.lights, pairs: atlas.lists.pairs, depths: atlas.depths.raw, tiles: atlas.tiles.raw };
-            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.source, (views, 0, atlas.lists.large))?));
+            passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.scene.meshlets()?, (views, 0, atlas.lists.large))?));
         }
         Some(_) => passes.push(Box::new(omni_shadow::OmniShadowPass)),
         None => {}
@@ -118,9 +117,8 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
 /// draws the others into the same 64-bit buffer, and the pyramid and the lighting read that
 /// buffer where it lies.
 fn add_meshlet_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> Result<(), VkError> {
-    let geometry = SceneMeshlets::build(a.source).map_err(|e| VkError::Limit(e.to_string()))?;
     let (culling, raster) = (a.settings.culling, a.settings.raster);
-    let scene = MeshletScene::new(ctx, geometry, &a.scene.object_textures.set_index, raster.bin_list().unwrap_or(0))?;
+    let scene = MeshletScene::new(ctx, a.scene.meshlets()?, raster.bin_list().unwrap_or(0))?;
     let compute = raster != Raster::Hardware;
     for phase in [Phase::Early, Phase::Late] {
         passes.push(Box::new(meshlet_cull::MeshletCull::new(ctx, scene.clone(), phase, (culling, raster))?));

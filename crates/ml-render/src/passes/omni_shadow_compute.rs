@@ -6,6 +6,7 @@
 //! leave it — or the faces the frame's plan lists into the shadow atlas (shadow_atlas.rs).
 
 use crate::frame::FRAMES_IN_FLIGHT;
+use crate::meshlet_scene::MeshletGeometryView;
 use crate::omni_shadow::NEAR_FRACTION;
 use crate::pass::{FrameResources, Pass, Recording, SlotReport};
 use crate::report::OmniRasterStats;
@@ -26,10 +27,10 @@ pub struct OmniShadowCompute {
 impl OmniShadowCompute {
     pub fn new(
         ctx: &Context,
-        scene: &ml_cpu::scene::Scene,
+        geometry: MeshletGeometryView,
         (views, size, large_capacity): (ShadowViews, u32, u32),
     ) -> Result<OmniShadowCompute, VkError> {
-        let raster = ShadowRaster::new(ctx, scene, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
+        let raster = ShadowRaster::new(ctx, geometry, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
         let pass = OmniShadowCompute { views, raster, readback: Vec::new() };
         ml_vk::build(ctx, pass, |p| {
             for _ in 0..FRAMES_IN_FLIGHT {
