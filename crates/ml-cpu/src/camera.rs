@@ -333,6 +333,14 @@ impl CameraSpec {
     }
 }
 
+/// The planes of `view_proj`'s frustum (Vulkan depth 0..1), each with its inside positive:
+/// left, right, top, bottom, near, far.
+pub fn frustum_planes(view_proj: Mat4) -> [Vec4; 6] {
+    let r = |i| view_proj.row(i);
+    let planes = [r(3) + r(0), r(3) - r(0), r(3) + r(1), r(3) - r(1), r(2), r(3) - r(2)];
+    planes.map(|p| p / p.truncate().length())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,7 +9,7 @@ use crate::camera::Camera;
 use crate::gpu_types::PointLight;
 use crate::mesh::MeshKind;
 use crate::scene::Scene;
-use crate::shadow_atlas::frustum_planes;
+use crate::camera::frustum_planes;
 use glam::{Mat4, Vec3};
 
 /// Forward and up of cube face `face` (+X, −X, +Y, −Y, +Z, −Z: Vulkan's layer order).

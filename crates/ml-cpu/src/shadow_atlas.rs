@@ -20,9 +20,9 @@
 //!   drawn again only if its light moved (or the caller turns the cache off). When the kept
 //!   blocks leave no room for the new ones, all are laid out afresh and drawn.
 
-use crate::camera::Camera;
+use crate::camera::{frustum_planes, Camera};
 use crate::omni_shadow::face_axes;
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use std::collections::{BTreeSet, HashMap};
 
 /// Texels a side of the smallest and the largest face.
@@ -117,14 +117,6 @@ pub fn face_size(light: &PlannedLight, camera: &Camera, height: u32) -> u32 {
     };
     let pixels = pixels.clamp(MIN_FACE as f32, MAX_FACE as f32) as u32;
     pixels.next_power_of_two().min(MAX_FACE)
-}
-
-/// The planes of `view_proj`'s frustum (Vulkan depth 0..1), each with its inside positive:
-/// left, right, top, bottom, near, far.
-pub fn frustum_planes(view_proj: Mat4) -> [Vec4; 6] {
-    let r = |i| view_proj.row(i);
-    let planes = [r(3) + r(0), r(3) - r(0), r(3) + r(1), r(3) - r(1), r(2), r(3) - r(2)];
-    planes.map(|p| p / p.truncate().length())
 }
 
 /// The faces (bit i: face i) of a light some point inside `planes` may sample: those whose
