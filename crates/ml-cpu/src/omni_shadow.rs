@@ -5,11 +5,11 @@
 //! face renders a direction into is the texel cube sampling fetches for that direction (tested
 //! against `textures::cube_direction`, Vulkan's cube-map convention).
 
+use crate::camera::frustum_planes;
 use crate::camera::Camera;
 use crate::gpu_types::PointLight;
 use crate::mesh::MeshKind;
 use crate::scene::Scene;
-use crate::camera::frustum_planes;
 use glam::{Mat4, Vec3};
 
 /// Forward and up of cube face `face` (+X, −X, +Y, −Y, +Z, −Z: Vulkan's layer order).
