@@ -6,18 +6,12 @@
 
 mod common;
 
-use common::assert_one_line_error;
+use common::{assert_one_line_error, manylights};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn manylights(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_manylights")).args(args).output().expect("run manylights")
-}
+use std::process::Output;
 
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("manylights-arguments-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::temp_dir("arguments", name)
 }
 
 /// One error line with every needle, and exit code 2: an argument clap refused.

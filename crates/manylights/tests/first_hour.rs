@@ -5,18 +5,12 @@
 
 mod common;
 
-use common::assert_one_line_error;
+use common::{assert_one_line_error, manylights};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn manylights(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_manylights")).args(args).output().expect("run manylights")
-}
+use std::process::Output;
 
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("manylights-first-hour-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::temp_dir("first-hour", name)
 }
 
 fn ok(out: &Output) -> String {

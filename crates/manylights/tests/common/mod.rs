@@ -1,6 +1,22 @@
 //! What the command-line tests share.
 
-use std::process::Output;
+// Each test file compiles this module on its own and uses a part of it.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// Run the binary with `args`.
+pub fn manylights(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_manylights")).args(args).output().expect("run manylights")
+}
+
+/// A folder of the system's temporary one for test `name` of `suite` (made if missing).
+pub fn temp_dir(suite: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("manylights-{suite}-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
 
 /// Fails unless the run failed with exactly one `error:` line mentioning every `needle`.
 pub fn assert_one_line_error(out: &Output, needles: &[&str]) {
