@@ -529,13 +529,8 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<(Camera, bool), Probl
     };
     if c.is_none_or(|c| c.position.is_none() && c.target.is_none()) {
         let framed = frame_scene(scene, DEFAULT_ASPECT, fov);
-        let near = c.and_then(|c| c.near).map(|n| length("[camera] near", n)).transpose()?.unwrap_or(framed.near);
-        let far = c.and_then(|c| c.far).map(|f| length("[camera] far", f)).transpose()?.unwrap_or(framed.far);
-        if near >= far {
-            return Err(Problem::NearFar { near, far });
-        }
-        let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| length("[camera] ortho_half_height", h)).transpose()?;
-        let camera = Camera { near, far, orthographic, ..framed };
+        let (near, far) = clip_planes(c, (framed.near, framed.far))?;
+        let camera = Camera { near, far, orthographic: orthographic(c)?, ..framed };
         return Ok((camera, camera == framed));
     }
     let position = match c.and_then(|c| c.position) {
@@ -549,18 +544,27 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<(Camera, bool), Probl
     if position.distance(target) < 1e-6 {
         return Err(Problem::CameraNowhere);
     }
-    let (fitted_near, fitted_far) = clip_planes_for(lo, hi, position);
+    let (near, far) = clip_planes(c, clip_planes_for(lo, hi, position))?;
+    let dir = (target - position).normalize();
+    if dir.y.abs() > 0.9999 {
+        return Err(Problem::CameraVertical);
+    }
+    Ok((Camera { orthographic: orthographic(c)?, ..Camera::looking_at(position, target, fov, near, far) }, false))
+}
+
+/// The camera's near and far planes: the file's, else `fitted`; near before far.
+fn clip_planes(c: Option<&FileCamera>, (fitted_near, fitted_far): (f32, f32)) -> Result<(f32, f32), Problem> {
     let near = c.and_then(|c| c.near).map(|n| length("[camera] near", n)).transpose()?.unwrap_or(fitted_near);
     let far = c.and_then(|c| c.far).map(|f| length("[camera] far", f)).transpose()?.unwrap_or(fitted_far);
     if near >= far {
         return Err(Problem::NearFar { near, far });
     }
-    let dir = (target - position).normalize();
-    if dir.y.abs() > 0.9999 {
-        return Err(Problem::CameraVertical);
-    }
-    let orthographic = c.and_then(|c| c.ortho_half_height).map(|h| length("[camera] ortho_half_height", h)).transpose()?;
-    Ok((Camera { orthographic, ..Camera::looking_at(position, target, fov, near, far) }, false))
+    Ok((near, far))
+}
+
+/// The file's orthographic half-height, if it makes the camera orthographic.
+fn orthographic(c: Option<&FileCamera>) -> Result<Option<f32>, Problem> {
+    c.and_then(|c| c.ortho_half_height).map(|h| length("[camera] ortho_half_height", h)).transpose()
 }
 
 /// `scene` as a scene file (built-in meshes only), every field written out: what `load` reads
