@@ -545,7 +545,8 @@ impl ml_render::FrameSink for RenderSink {
 
     fn image(&mut self, i: u32, rgba: &[u8]) -> Result<(), ml_render::RenderError> {
         let Some(pattern) = &self.sequence else { return Ok(()) };
-        output::save_png(&output::sequence_path(pattern, i), rgba, self.size).map_err(|e| ml_render::RenderError::Invalid(e.to_string()))
+        ml_cpu::files::write_png(&output::sequence_path(pattern, i), rgba, self.size)
+            .map_err(|e| ml_render::RenderError::Invalid(e.to_string()))
     }
 }
 
@@ -592,7 +593,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     drop(ctx);
     let output = result?;
     if sink.sequence.is_none() {
-        output::save_png(&cmd.out, &output.rgba, (output.width, output.height))?;
+        ml_cpu::files::write_png(&cmd.out, &output.rgba, (output.width, output.height))?;
     }
     let facts = report::RenderFacts {
         device: &device,

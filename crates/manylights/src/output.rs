@@ -1,5 +1,5 @@
 //! Where `render` writes: one PNG, or an image sequence of them, each replaced only once it
-//! is complete (ml_cpu::files), after the path was checked before any GPU work.
+//! is complete (ml_cpu::files::write_png), after the path was checked before any GPU work.
 
 use anyhow::{bail, Context as _, Result};
 use ml_cpu::files;
@@ -40,11 +40,6 @@ pub fn prepare(out: &Path, sequence: Option<&SequencePattern>) -> Result<()> {
         std::fs::create_dir_all(folder).with_context(|| format!("cannot make folder '{}'", folder.display()))?;
     }
     Ok(files::check_writable(&first)?)
-}
-
-/// Write one image, replacing `path` only once the PNG is complete.
-pub fn save_png(path: &Path, rgba: &[u8], size: (u32, u32)) -> Result<(), files::WriteError> {
-    files::write_png(path, rgba, size)
 }
 
 #[cfg(test)]
