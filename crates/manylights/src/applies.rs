@@ -10,7 +10,7 @@ use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::ArgMatches;
 use ml_cpu::scene_request::{BuiltScene, SceneSource, SceneWarning};
-use ml_render::{DebugView, OmniShadowMode, ShadingModel, Technique};
+use ml_render::{DebugView, OmniShadowMode, RenderSettings, ShadingModel, Technique};
 
 /// The options of a command given on the command line, by clap's id (the field's name): the
 /// others keep their defaults, which never make an option refused as not applying.
@@ -196,7 +196,16 @@ impl Unused {
         }
     }
 
-    pub(crate) fn has(&self, id: &str) -> bool {
+    /// Warn, and leave out of `settings` what the pick cannot take: a debug view it does not
+    /// have gives the shaded image, as the warning says (the other options are inert there).
+    pub(crate) fn take_effect(&self, settings: &mut RenderSettings) {
+        self.warn();
+        if self.has("debug_view") {
+            settings.debug_view = DebugView::None;
+        }
+    }
+
+    fn has(&self, id: &str) -> bool {
         self.0.iter().any(|(unused, _)| *unused == id)
     }
 }

@@ -571,12 +571,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
             let (t, why, _) = auto::pick(&ctx)?;
             settings.technique = t;
             techniques.auto = Auto::Picked(t);
-            let unused = check_options_apply(args, &request.source, Some(&built), &techniques)?;
-            unused.warn();
-            // A debug view the pick does not have: the shaded image, as the warning says.
-            if unused.has("debug_view") {
-                settings.debug_view = DebugView::None;
-            }
+            check_options_apply(args, &request.source, Some(&built), &techniques)?.take_effect(&mut settings);
             Some(why)
         }
     };
@@ -641,12 +636,8 @@ fn view(cmd: &ViewArgs) -> Result<()> {
         unused = check_options_apply(args, &request.source, Some(&built), &techniques)?;
     }
     print_warnings(&built.warnings);
-    unused.warn();
     let mut first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
-    // A debug view the pick does not have: the shaded image, as the warning says.
-    if unused.has("debug_view") {
-        first.debug_view = DebugView::None;
-    }
+    unused.take_effect(&mut first);
     first.raster =
         auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args)?, args.raster_split), (args.validation, args.device))?;
     let options = ml_viewer::ViewerOptions {
