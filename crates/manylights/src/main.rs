@@ -629,6 +629,8 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     check_options_apply(args, &request.source, None, &techniques)?;
     let built = request.build()?;
     check_options_apply(args, &request.source, Some(&built), &techniques)?;
+    // Before auto's probes: without a display, that is the one line, at once.
+    let windows = ml_viewer::connect()?;
     let technique = auto::resolve_alone(&args.technique, args.validation, args.device)?;
     let mut unused = Default::default();
     if choice.is_none() {
@@ -651,7 +653,7 @@ fn view(cmd: &ViewArgs) -> Result<()> {
         time: args.time,
         script,
     };
-    ml_viewer::run(options)
+    ml_viewer::run(windows, options)
 }
 
 fn info() -> Result<()> {

@@ -103,14 +103,23 @@ fn a_broken_script_is_one_error_line() {
     }
 }
 
-/// No window system: one error line saying what to do, not a panic.
+/// No window system: one error line saying what to do, not a panic, before any GPU work (with
+/// auto's technique, and with the visibility technique's raster probe, whose renders would
+/// print their own lines first).
 #[test]
 fn without_a_display_view_is_one_error_line() {
-    let out =
-        Command::new(bin()).arg("view").env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY").env_remove("WAYLAND_SOCKET").output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(stderr.lines().count() == 1 && stderr.contains("cannot open a window") && stderr.contains("xvfb-run"), "{stderr}");
+    for args in [&["view"][..], &["view", "--technique", "visibility", "--raster", "auto"]] {
+        let out = Command::new(bin())
+            .args(args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .env_remove("WAYLAND_SOCKET")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.lines().count() == 1 && stderr.contains("cannot open a window") && stderr.contains("xvfb-run"), "{stderr}");
+    }
 }
 
 /// The visibility technique with the compute raster in the window: through a resize (new

@@ -54,8 +54,17 @@ pub struct ViewerOptions {
 /// Makes the scene and settings for a set of choices at a size.
 type Build<'a> = dyn Fn(&Choices, (u32, u32)) -> Result<(Scene, RenderSettings)> + 'a;
 
-/// Open the window and run until it is closed, Esc is pressed or the script quits.
-pub fn run(options: ViewerOptions) -> Result<()> {
+/// The connection to the window system the viewer's window opens on. Made before any GPU
+/// work (`auto`'s probes), so that a machine without a display says so at once.
+pub struct WindowSystem(EventLoop<()>);
+
+/// Connect to the window system (one error line where there is none).
+pub fn connect() -> Result<WindowSystem> {
+    EventLoop::new().context("cannot open a window (no display? set DISPLAY, or run under xvfb-run)").map(WindowSystem)
+}
+
+/// Open the window on `windows` and run until it is closed, Esc is pressed or the script quits.
+pub fn run(windows: WindowSystem, options: ViewerOptions) -> Result<()> {
     // What the request builds is what `render` would show. A rebuilt scene's warnings are
     // dropped: its file gave them when the viewer started.
     let (initial, base, time) = (options.choices.clone(), options.scene.clone(), options.time);
@@ -63,11 +72,10 @@ pub fn run(options: ViewerOptions) -> Result<()> {
         let built = c.request(&base, &initial).build()?;
         Ok((built.scene, c.settings(size, time)))
     };
-    run_with(options, &build)
+    run_with(windows, options, &build)
 }
 
-fn run_with(options: ViewerOptions, build: &Build) -> Result<()> {
-    let mut event_loop = EventLoop::new().context("cannot open a window (no display? set DISPLAY, or run under xvfb-run)")?;
+fn run_with(WindowSystem(mut event_loop): WindowSystem, options: ViewerOptions, build: &Build) -> Result<()> {
     let mut events = Events { size: (options.width, options.height), ..Events::default() };
     while events.window.is_none() {
         if let PumpStatus::Exit(_) = event_loop.pump_app_events(Some(Duration::from_millis(10)), &mut events) {
