@@ -102,8 +102,7 @@ fn settings(e: &SettingsError) -> String {
     match e {
         SettingsError::OutOfRange { what, value, max } => format!("{} {value} is out of range: use 1 to {max}", flag(*what)),
         SettingsError::HeatNeedsClusteredForward { technique } => format!(
-            "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}",
-            technique.name()
+            "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {technique}"
         ),
         SettingsError::ShadowMapNeedsBlinnPhong => {
             "--debug-view shadow-map needs --shading blinn-phong (the seed model casts no shadows)".into()
@@ -123,7 +122,7 @@ fn settings(e: &SettingsError) -> String {
             format!("--omni-shadow compute: {e}: use fewer --shadowed-lights, a smaller --cube-size or --omni-shadow layered")
         }
         SettingsError::MissingFeature { mode, feature, device, instead } => {
-            format!("--omni-shadow {} needs the {feature} feature, which '{device}' lacks: use {instead}", mode.name())
+            format!("--omni-shadow {mode} needs the {feature} feature, which '{device}' lacks: use {instead}")
         }
         SettingsError::SunShadowFeature { feature, device } => {
             format!("--sun-shadow compute needs {feature}, which '{device}' lacks: use --sun-shadow graphics")
@@ -165,7 +164,7 @@ mod tests {
             needed: 1 << 20,
             limit: 1 << 18,
             holder: "'gpu' binds as one storage buffer".into(),
-            technique: Some(ml_render::Technique::DeferredCompute),
+            technique: Some(ml_render::Technique::DeferredCompute.name()),
         };
         let e = anyhow::Error::from(RenderError::ListsTooLong(lists));
         assert!(

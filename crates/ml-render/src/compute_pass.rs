@@ -3,8 +3,8 @@
 //! declares it), a fetch sampler for its inputs.
 
 use crate::descriptors::{FrameSets, Resource};
-use crate::frame::FRAMES_IN_FLIGHT;
-use crate::pass::FrameResources;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
 use ml_vk::image::{fetch_sampler, image_transition};

@@ -1,4 +1,6 @@
-use crate::settings::{DebugView, OmniShadowMode, Technique};
+//! The renderer's errors. Settings errors carry the names of the choices they are about
+//! (`Technique::name`, ...) rather than the choices, so this module depends on no settings.
+
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -21,18 +23,20 @@ pub enum RenderError {
 /// Cluster light lists longer than what `holder` can take: `needed` entries against `limit`,
 /// in `technique` (named where the renderer knows it).
 #[derive(Debug, Error, PartialEq)]
-#[error("{}the cluster light lists need at least {needed} entries ({} MiB), more than the {} MiB {holder}", technique.map_or(String::new(), |t| format!("{}: ", t.name())), mib_up(*needed), mib(*limit))]
+#[error("{}the cluster light lists need at least {needed} entries ({} MiB), more than the {} MiB {holder}", technique.map_or(String::new(), |t| format!("{t}: ")), mib_up(*needed), mib(*limit))]
 pub struct ListsTooLong {
     pub needed: usize,
     pub limit: usize,
     /// What the limit is, in words ("'lavapipe' binds as one storage buffer").
     pub holder: String,
-    pub technique: Option<Technique>,
+    /// The technique's name.
+    pub technique: Option<&'static str>,
 }
 
 impl RenderError {
-    /// The error, where it is about light lists that do not fit, naming `technique`.
-    pub fn in_technique(self, technique: Technique) -> RenderError {
+    /// The error, where it is about light lists that do not fit, naming the technique (its
+    /// `name`).
+    pub fn in_technique(self, technique: &'static str) -> RenderError {
         match self {
             RenderError::ListsTooLong(lists) => RenderError::ListsTooLong(ListsTooLong { technique: Some(technique), ..lists }),
             other => other,
@@ -103,20 +107,20 @@ pub enum SettingsError {
     #[error("{what} {value} is out of range: use 1 to {max}")]
     OutOfRange { what: Setting, value: u32, max: u32 },
     /// The cluster-heat debug view is drawn by the clustered forward techniques only.
-    #[error("the cluster-heat debug view needs a clustered forward technique (clustered-cpu, clustered-gpu), not {}", technique.name())]
-    HeatNeedsClusteredForward { technique: Technique },
+    #[error("the cluster-heat debug view needs a clustered forward technique (clustered-cpu, clustered-gpu), not {technique}")]
+    HeatNeedsClusteredForward { technique: &'static str },
     #[error("the shadow-map debug view needs the blinn-phong shading model (the seed model casts no shadows)")]
     ShadowMapNeedsBlinnPhong,
     #[error("the shadow-cube debug view needs point-light shadow cubes (--omni-shadow copy|direct|multiview|layered|compute)")]
     ShadowCubeNeedsShadows,
     #[error("the shadow-atlas debug view needs the shadow atlas (--omni-shadow atlas)")]
     ShadowAtlasViewNeedsAtlas,
-    #[error("the {} debug view shows the meshlets of the visibility technique, not {}", view.name(), technique.name())]
-    ViewNeedsMeshlets { view: DebugView, technique: Technique },
-    #[error("the {} technique needs {feature}, which '{device}' lacks: use deferred-compute", technique.name())]
-    TechniqueFeature { technique: Technique, feature: &'static str, device: String },
-    #[error("the compute raster draws the visibility buffer of the visibility technique, not {}'s (use --raster hardware)", technique.name())]
-    RasterNeedsVisibility { technique: Technique },
+    #[error("the {view} debug view shows the meshlets of the visibility technique, not {technique}")]
+    ViewNeedsMeshlets { view: &'static str, technique: &'static str },
+    #[error("the {technique} technique needs {feature}, which '{device}' lacks: use deferred-compute")]
+    TechniqueFeature { technique: &'static str, feature: &'static str, device: String },
+    #[error("the compute raster draws the visibility buffer of the visibility technique, not {technique}'s (use --raster hardware)")]
+    RasterNeedsVisibility { technique: &'static str },
     #[error("the {raster} raster needs {feature}, which '{device}' lacks: use --raster hardware")]
     RasterFeature { raster: &'static str, feature: &'static str, device: String },
     #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size or --raster hardware")]
@@ -153,8 +157,8 @@ pub enum SettingsError {
     ShadowBuffer { lights: u32, size: u32, mib: u64, device: String, max_mib: u64 },
     /// A way of rendering the cubes that needs a feature the device lacks; `instead`: the
     /// modes to use.
-    #[error("{} point-light shadows need the {feature} feature, which '{device}' lacks: use {instead}", mode.name())]
-    MissingFeature { mode: OmniShadowMode, feature: &'static str, device: String, instead: &'static str },
+    #[error("{mode} point-light shadows need the {feature} feature, which '{device}' lacks: use {instead}")]
+    MissingFeature { mode: &'static str, feature: &'static str, device: String, instead: &'static str },
     /// A depth-only multiview pass that the driver renders wrong (multiview_depth_is_broken).
     #[error("multiview point-light shadows: '{device}' ({driver}) renders every view of a depth-only multiview pass into the first layer (measured on Mesa 22.3 lavapipe): use layered, direct or copy")]
     BrokenMultiview { device: String, driver: String },

@@ -4,14 +4,13 @@
 //! buffers grow when a frame needs more; nothing is ever dropped.
 
 use crate::error::{ListsTooLong, RenderError};
-use crate::pass::{FrameResources, ListUpload};
+use crate::frame_resources::FrameResources;
+use crate::pass::ListUpload;
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::cluster::ClusterLists;
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
 use ml_vk::{vk, Buffer, Context, GpuTimer, VkError, VkResultExt};
-
-pub const FRAMES_IN_FLIGHT: usize = 2;
 
 pub struct FrameInFlight {
     pub cmd: vk::CommandBuffer,
@@ -83,20 +82,18 @@ impl FrameInFlight {
         Ok(())
     }
 
-    /// What slot `slot`'s passes bind: this frame's buffers and targets, the scene's `objects`,
-    /// `cones` and `alpha_masks`.
-    pub fn resources(&self, slot: usize, (objects, cones, alpha_masks): (vk::Buffer, vk::Buffer, vk::Buffer)) -> FrameResources<'_> {
-        FrameResources {
-            slot,
-            uniforms: self.uniforms.raw,
-            lights: self.lights.raw,
-            cluster_ranges: self.cluster_ranges.raw,
-            light_indices: self.light_indices.raw,
-            objects,
-            cones,
-            alpha_masks,
-            targets: self.targets.as_ref().expect("made with the frame"),
-        }
+    /// What slot `slot`'s passes bind: this frame's buffers and targets under their shader
+    /// names, with the scene's `scene` added.
+    pub fn resources(&self, slot: usize, scene: &[(&'static str, vk::Buffer)]) -> FrameResources<'_> {
+        let targets = self.targets.as_ref().expect("made with the frame");
+        FrameResources::new(slot, targets)
+            .with(&[
+                ("FrameBlock", self.uniforms.raw),
+                ("LightBuffer", self.lights.raw),
+                ("ClusterRangeBuffer", self.cluster_ranges.raw),
+                ("LightIndexBuffer", self.light_indices.raw),
+            ])
+            .with(scene)
     }
 
     /// Entries the light-index list holds.

@@ -6,9 +6,11 @@ pub mod depth_pass;
 pub mod descriptors;
 pub mod error;
 pub mod frame;
+pub mod frame_resources;
 pub mod gpu_mesh;
 pub mod mesh_raster;
 pub mod meshlet_scene;
+pub mod object_data;
 pub mod object_textures;
 pub mod omni_shadow;
 pub mod pass;
@@ -26,7 +28,7 @@ pub mod sun_shadow;
 pub mod targets;
 
 pub use error::RenderError;
-pub use frame::FRAMES_IN_FLIGHT;
+pub use frame_resources::FRAMES_IN_FLIGHT;
 pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use settings::{
     DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,

@@ -4,16 +4,15 @@
 //! what is its own (the heat legend, the lighting subpass).
 
 use crate::descriptors::FrameSets;
-use crate::frame::FRAMES_IN_FLIGHT;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding};
-use crate::pass::{FrameResources, Recording};
+use crate::object_data::{object_push, SurfaceVariant};
+use crate::pass::Recording;
 use crate::render_pass;
 use crate::settings::Shading;
 use crate::targets::{GBufferImage, Output};
-use ml_cpu::alpha_mask::AlphaMasks;
-use ml_cpu::gpu_types::{ObjectData, ObjectPush};
-use ml_cpu::scene::Object;
-use ml_cpu::textures::TextureImage;
+use ml_cpu::gpu_types::ObjectPush;
 use ml_shaders::Shader;
 use ml_vk::{shader, vk, Context, VkError};
 
@@ -27,49 +26,6 @@ pub enum Draw {
     Mesh(SurfaceVariant),
     /// A full-screen or screen-space draw made from the vertex index, no depth.
     Screen,
-}
-
-/// What a mesh pipeline does with its objects' surfaces (mesh_coverage.glsl): back faces
-/// culled, or drawn with the normal turned toward the viewer (double-sided); every fragment
-/// kept, or alpha-tested (masked). A pipeline each, specialised, so that the opaque,
-/// single-sided objects' pipeline has no test and no discard.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SurfaceVariant {
-    pub double_sided: bool,
-    pub masked: bool,
-}
-
-/// Specialization constants of mesh_coverage.glsl.
-pub const SPEC_MASKED_DRAW: u32 = 16;
-pub const SPEC_DOUBLE_SIDED_DRAW: u32 = 17;
-
-impl SurfaceVariant {
-    pub const OPAQUE: SurfaceVariant = SurfaceVariant { double_sided: false, masked: false };
-    const COUNT: usize = 4;
-
-    /// The variant that draws object `o`.
-    pub fn of(o: &Object) -> SurfaceVariant {
-        SurfaceVariant { double_sided: o.extras.double_sided, masked: o.extras.masked() }
-    }
-
-    /// The variants `objects` need, the opaque one always among them.
-    pub fn needed(objects: &[Object]) -> Vec<SurfaceVariant> {
-        let mut out = vec![SurfaceVariant::OPAQUE];
-        for v in objects.iter().map(SurfaceVariant::of) {
-            if !out.contains(&v) {
-                out.push(v);
-            }
-        }
-        out
-    }
-
-    fn index(self) -> usize {
-        usize::from(self.double_sided) * 2 + usize::from(self.masked)
-    }
-
-    fn spec_constants(self) -> [(u32, u32); 2] {
-        [(SPEC_MASKED_DRAW, u32::from(self.masked)), (SPEC_DOUBLE_SIDED_DRAW, u32::from(self.double_sided))]
-    }
 }
 
 pub struct MeshRaster {
@@ -276,47 +232,10 @@ impl MeshRaster {
     }
 }
 
-/// ObjectData::uv_transform of `t`.
-fn uv_transform_vectors(t: glam::Affine2) -> [[f32; 4]; 2] {
-    let m = t.matrix2;
-    [[m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y], [t.translation.x, t.translation.y, 0.0, 0.0]]
-}
-
 /// The surface variant of a mesh draw (screen draws: the opaque one, which they ignore).
 fn variant_of(draw: Draw) -> SurfaceVariant {
     match draw {
         Draw::Mesh(v) => v,
         Draw::Screen => SurfaceVariant::OPAQUE,
     }
-}
-
-/// Object `o`'s entry in the object buffer (`masks`, `textures`: the scene's alpha masks and
-/// textures).
-pub fn object_data(o: &Object, masks: &AlphaMasks, textures: &[TextureImage]) -> ObjectData {
-    let normal = glam::Mat4::from_mat3(glam::Mat3::from_mat4(o.transform).inverse().transpose());
-    let [albedo_roughness, material, emissive] = material_vectors(o);
-    let (alpha, alpha_texture) = masks.object_fields(o, textures);
-    ObjectData {
-        model: o.transform.to_cols_array_2d(),
-        normal_matrix: normal.to_cols_array_2d(),
-        albedo_roughness,
-        material,
-        emissive,
-        alpha,
-        alpha_texture,
-        uv_transform: uv_transform_vectors(o.extras.uv_transform),
-    }
-}
-
-/// What a draw of object `o` (at `index`) pushes.
-pub fn object_push(o: &Object, index: u32) -> ObjectPush {
-    let [albedo_roughness, material, emissive] = material_vectors(o);
-    ObjectPush { ids: [index, o.textures.bits(), 0, 0], albedo_roughness, material, emissive }
-}
-
-/// The material as the shaders read it: (albedo, roughness), (metallic, occlusion strength,
-/// normal scale, 0), (emissive, 0).
-fn material_vectors(o: &Object) -> [[f32; 4]; 3] {
-    let (m, x) = (&o.material, &o.extras);
-    [m.albedo.extend(m.roughness).to_array(), [m.metallic, x.occlusion_strength, x.normal_scale, 0.0], x.emissive.extend(0.0).to_array()]
 }

@@ -12,8 +12,8 @@
 //! at most once a frame (early or late), so that is their worst case — culling off.
 
 use crate::descriptors::Resource;
-use crate::frame::FRAMES_IN_FLIGHT;
-use crate::pass::FrameResources;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{CullCounters, LargeTriangle, INSTANCE_DOUBLE_SIDED, INSTANCE_MASKED};
 use ml_cpu::meshlets::SceneMeshlets;

@@ -3,50 +3,14 @@
 //! knows no pass by name. Each pass owns its pipelines, its per-frame descriptor sets (and
 //! framebuffers) and rewrites them when a frame slot's buffers or targets change.
 
-use crate::descriptors::Resource;
 use crate::error::RenderError;
+use crate::frame_resources::FrameResources;
 use crate::omni_shadow::ShadowedLight;
 use crate::scene_gpu::SceneGpu;
 use crate::targets::Targets;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists};
 use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context, VkError};
-
-/// One frame slot's shared buffers and targets, and the scene's, as passes bind them: by the
-/// names the shaders give them.
-pub struct FrameResources<'a> {
-    pub slot: usize,
-    pub uniforms: vk::Buffer,
-    pub lights: vk::Buffer,
-    pub cluster_ranges: vk::Buffer,
-    pub light_indices: vk::Buffer,
-    pub objects: vk::Buffer,
-    pub cones: vk::Buffer,
-    /// The alpha of masked objects' textures (alpha_mask.glsl).
-    pub alpha_masks: vk::Buffer,
-    pub targets: &'a Targets,
-}
-
-impl FrameResources<'_> {
-    /// The buffers every shading shader may declare (scene_bindings.glsl's blocks), and the
-    /// visibility technique's buffer targets (the depth pyramid, the compute raster's
-    /// depth-and-id buffer).
-    pub fn buffer(&self, name: &str) -> Option<Resource> {
-        let buffer = match name {
-            "FrameBlock" => self.uniforms,
-            "LightBuffer" => self.lights,
-            "ClusterRangeBuffer" => self.cluster_ranges,
-            "LightIndexBuffer" => self.light_indices,
-            "ObjectBuffer" => self.objects,
-            "LightConeBuffer" => self.cones,
-            "AlphaMaskBuffer" => self.alpha_masks,
-            "DepthPyramidBuffer" => self.targets.depth_pyramid.raw,
-            "VisibilityDepthBuffer" => self.targets.visibility_depth.raw,
-            _ => return None,
-        };
-        Some(Resource::Buffer(buffer))
-    }
-}
 
 /// What a pass records with.
 pub struct Recording<'a> {

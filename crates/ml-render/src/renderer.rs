@@ -5,7 +5,8 @@
 //! binds, records, times and collects from.
 
 use crate::error::RenderError;
-use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists, FRAMES_IN_FLIGHT};
+use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::omni_shadow::ShadowedLight;
 use crate::pass::{Pass, Recording, SlotReport, Update};
 use crate::passes::{assemble, Assembly};
@@ -126,7 +127,7 @@ fn check_lists_fit(
     let needed = count_entries(grid, lights, motion, limit);
     if needed > limit {
         let holder = format!("'{}' binds as one storage buffer", ctx.info.name);
-        return Err(lists_too_long(needed, limit, &holder).in_technique(settings.technique));
+        return Err(lists_too_long(needed, limit, &holder).in_technique(settings.technique.name()));
     }
     Ok(())
 }
@@ -342,7 +343,7 @@ impl<'a> Renderer<'a> {
 
     /// Point every pass's sets of slot `f` at its buffers and targets (the slot is idle).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
-        let resources = self.frames[f].resources(f, (self.gpu.objects.raw, self.gpu.cones.raw, self.gpu.alpha_masks.raw));
+        let resources = self.frames[f].resources(f, &self.gpu.named_buffers());
         self.passes.iter_mut().try_for_each(|p| p.bind_frame(self.ctx, &resources))
     }
 
@@ -623,7 +624,7 @@ impl<'a> Renderer<'a> {
     /// (None where the CPU does not assign).
     fn update_frame(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, RenderError> {
         let technique = self.settings.technique;
-        self.update_slot(f, t, stats).map_err(|e| e.in_technique(technique))
+        self.update_slot(f, t, stats).map_err(|e| e.in_technique(technique.name()))
     }
 
     /// `update_frame`'s work (its errors are said with the technique by the caller).

@@ -4,8 +4,8 @@
 
 use crate::error::RenderError;
 use crate::gpu_mesh::GpuMesh;
-use crate::mesh_raster::{object_data, SurfaceVariant};
 use crate::meshlet_scene::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
+use crate::object_data::{object_data, SurfaceVariant};
 use crate::object_textures::ObjectTextureSets;
 use crate::omni_shadow::OmniShadows;
 use crate::scene_textures::SceneTextures;
@@ -145,6 +145,12 @@ impl SceneGpu {
         if let Some(mut meshlets) = self.meshlets.take() {
             meshlets.destroy(ctx);
         }
+    }
+
+    /// The scene's buffers that shaders bind, under their blocks' names (a frame's table of
+    /// resources holds them).
+    pub fn named_buffers(&self) -> [(&'static str, vk::Buffer); 3] {
+        [("ObjectBuffer", self.objects.raw), ("LightConeBuffer", self.cones.raw), ("AlphaMaskBuffer", self.alpha_masks.raw)]
     }
 
     /// The scene's meshlets, for a pass that draws them.

@@ -616,19 +616,19 @@ impl RenderSettings {
             }
         }
         if self.debug_view == DebugView::ClusterHeat && !self.technique.draws_cluster_heat() {
-            return Err(SettingsError::HeatNeedsClusteredForward { technique: self.technique }.into());
+            return Err(SettingsError::HeatNeedsClusteredForward { technique: self.technique.name() }.into());
         }
         if matches!(self.debug_view, DebugView::Meshlets | DebugView::Triangles) && self.technique.geometry() != Geometry::Meshlets {
-            return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view, technique: self.technique }.into());
+            return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view.name(), technique: self.technique.name() }.into());
         }
         if self.technique.geometry() == Geometry::Meshlets {
             if let Some(feature) = missing_meshlet_feature(&ctx.info.features) {
-                return Err(SettingsError::TechniqueFeature { technique: self.technique, feature, device: device() }.into());
+                return Err(SettingsError::TechniqueFeature { technique: self.technique.name(), feature, device: device() }.into());
             }
         }
         if let Raster::Compute { split, .. } = self.raster {
             if self.technique.geometry() != Geometry::Meshlets {
-                return Err(SettingsError::RasterNeedsVisibility { technique: self.technique }.into());
+                return Err(SettingsError::RasterNeedsVisibility { technique: self.technique.name() }.into());
             }
             if let Some(feature) = missing_raster_feature(self.raster, &ctx.info.features) {
                 return Err(SettingsError::RasterFeature { raster: self.raster.name(), feature, device: device() }.into());
@@ -717,7 +717,7 @@ fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result
             max_mib: MAX_OMNI_BYTES >> 20,
         });
     }
-    let missing = |feature, instead| SettingsError::MissingFeature { mode: omni.mode, feature, device: device(), instead };
+    let missing = |feature, instead| SettingsError::MissingFeature { mode: omni.mode.name(), feature, device: device(), instead };
     if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
         return Err(missing("multiview", "layered, direct or copy"));
     }
@@ -767,7 +767,12 @@ fn check_atlas(ctx: &Context, omni: &OmniShadowSettings, atlas: AtlasSettings) -
 fn check_compute_raster(ctx: &Context, omni: &OmniShadowSettings) -> Result<(), SettingsError> {
     if !ctx.info.features.buffer_int64_atomics {
         let device = ctx.info.name.clone();
-        return Err(SettingsError::MissingFeature { mode: omni.mode, feature: "shaderInt64", device, instead: "layered, direct or copy" });
+        return Err(SettingsError::MissingFeature {
+            mode: omni.mode.name(),
+            feature: "shaderInt64",
+            device,
+            instead: "layered, direct or copy",
+        });
     }
     Ok(())
 }

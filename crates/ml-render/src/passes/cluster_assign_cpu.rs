@@ -5,7 +5,8 @@
 
 use crate::error::RenderError;
 use crate::frame::lists_too_long;
-use crate::pass::{FrameResources, Pass, Recording, Update};
+use crate::frame_resources::FrameResources;
+use crate::pass::{Pass, Recording, Update};
 use ml_cpu::cluster::{ClusterAssigner, ClusterLists, ClusterStats};
 use ml_vk::{Context, VkError};
 use std::time::Instant;

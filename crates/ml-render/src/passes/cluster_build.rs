@@ -12,8 +12,9 @@
 //! the list for every later frame (the renderer grows it from `SlotReport`).
 
 use crate::descriptors::{FrameSets, Resource};
-use crate::frame::FRAMES_IN_FLIGHT;
-use crate::pass::{FrameResources, Pass, Recording, SlotReport};
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
+use crate::pass::{Pass, Recording, SlotReport};
 use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};

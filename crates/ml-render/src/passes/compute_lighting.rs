@@ -5,7 +5,8 @@
 //! like the forward pass's.
 
 use crate::compute_pass::ComputePass;
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::frame_resources::FrameResources;
+use crate::pass::{Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Shading;
 use crate::targets::GBUFFER;

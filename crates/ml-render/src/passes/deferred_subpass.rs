@@ -5,9 +5,10 @@
 //! over the pixel's cluster — which the tone-map pass turns into the colour target.
 
 use crate::descriptors::{FrameSets, Resource};
-use crate::frame::FRAMES_IN_FLIGHT;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::mesh_raster::{Draw, MeshRaster};
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::pass::{Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Shading;
 use crate::targets::{gbuffer_images, Output};

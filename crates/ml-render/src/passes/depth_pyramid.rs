@@ -6,8 +6,9 @@
 //! same answers on every driver.
 
 use crate::descriptors::{FrameSets, Resource};
-use crate::frame::FRAMES_IN_FLIGHT;
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
+use crate::pass::{Pass, Recording};
 use crate::targets::{depth_pyramid_level, depth_pyramid_shape};
 use ml_vk::commands::memory_barrier;
 use ml_vk::image::fetch_sampler;

@@ -6,8 +6,9 @@
 
 use crate::compute_pass::ComputePass;
 use crate::descriptors::Resource;
-use crate::frame::FRAMES_IN_FLIGHT;
-use crate::pass::{FrameResources, Pass, Recording, SlotReport};
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
+use crate::pass::{Pass, Recording, SlotReport};
 use crate::settings::SPEC_PBR;
 use gpu_allocator::MemoryLocation;
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};

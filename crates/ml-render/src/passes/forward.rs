@@ -3,8 +3,9 @@
 //! over the lights of the fragment's cluster (docs/DESIGN.md#clustered-light-assignment).
 //! Leaves the colour target in TRANSFER_SRC_OPTIMAL for the read-back.
 
+use crate::frame_resources::FrameResources;
 use crate::mesh_raster::{Draw, MeshRaster};
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::pass::{Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Shading;
 use crate::targets::Output;

@@ -3,8 +3,9 @@
 //! object textures, roughness-metallic and emissive) and depth, read next by the compute
 //! lighting pass.
 
+use crate::frame_resources::FrameResources;
 use crate::mesh_raster::MeshRaster;
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::pass::{Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Shading;
 use crate::targets::{gbuffer_images, Output};

@@ -13,9 +13,10 @@
 //! raster, appended to the draw; the early phase clears its 64-bit buffer first.
 
 use crate::descriptors::FrameSets;
-use crate::frame::FRAMES_IN_FLIGHT;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::{MeshletScene, SharedMeshletScene, SPEC_SURFACE_TESTS};
-use crate::pass::{FrameResources, Pass, Recording, SlotReport};
+use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::CullStats;
 use crate::settings::Raster;
 use crate::targets::depth_pyramid_shape;

@@ -3,7 +3,8 @@
 //! resource (the shading passes sample it through the scene's texture set); this pass records
 //! its rendering in the mode the settings chose (omni_shadow.rs).
 
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::frame_resources::FrameResources;
+use crate::pass::{Pass, Recording};
 use ml_vk::{Context, VkError};
 
 pub struct OmniShadowPass;

@@ -5,10 +5,11 @@
 //! faces into the cube array the shading passes sample, which ends as the graphics modes
 //! leave it — or the faces the frame's plan lists into the shadow atlas (shadow_atlas.rs).
 
-use crate::frame::FRAMES_IN_FLIGHT;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::MeshletGeometryView;
 use crate::omni_shadow::NEAR_FRACTION;
-use crate::pass::{FrameResources, Pass, Recording, SlotReport};
+use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::OmniRasterStats;
 use crate::shadow_atlas::tile_table;
 use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
@@ -55,7 +56,8 @@ impl Pass for OmniShadowCompute {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        self.raster.bind(ctx, frame.slot, (frame.objects, frame.alpha_masks))
+        let named = |name| frame.raw_buffer(name).expect("the scene's buffers are in every frame's table");
+        self.raster.bind(ctx, frame.slot, (named("ObjectBuffer"), named("AlphaMaskBuffer")))
     }
 
     fn record(&self, rec: &Recording) {

@@ -3,7 +3,8 @@
 //! technique drew. Untimed.
 
 use crate::compute_pass::ComputePass;
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::frame_resources::FrameResources;
+use crate::pass::{Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::DebugView;
 use ml_vk::{Context, VkError};

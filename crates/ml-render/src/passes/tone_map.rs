@@ -3,7 +3,8 @@
 //! (tonemap.comp). A compute pass: on H100/H200 it runs on every SM.
 
 use crate::compute_pass::ComputePass;
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::frame_resources::FrameResources;
+use crate::pass::{Pass, Recording};
 use crate::settings::SPEC_PBR;
 use ml_vk::{vk, Context, VkError};
 

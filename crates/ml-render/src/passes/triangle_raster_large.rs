@@ -5,9 +5,10 @@
 //! whose size the culling wrote; in place of the hybrid raster's hardware draw.
 
 use crate::descriptors::FrameSets;
-use crate::frame::FRAMES_IN_FLIGHT;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::{SharedMeshletScene, SPEC_SURFACE_TESTS};
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::pass::{Pass, Recording};
 use crate::passes::meshlet_cull::{cull_push, Phase};
 use crate::settings::Raster;
 use ml_cpu::gpu_types::{CullCounters, CullPush};

@@ -5,8 +5,9 @@
 //! target, left in TRANSFER_SRC_OPTIMAL like the other lighting passes'.
 
 use crate::compute_pass::ComputePass;
+use crate::frame_resources::FrameResources;
 use crate::meshlet_scene::SharedMeshletScene;
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::pass::{Pass, Recording};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Shading;
 use ml_vk::{vk, Context, VkError};

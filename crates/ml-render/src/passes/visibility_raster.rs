@@ -8,9 +8,10 @@
 //! without attachments.
 
 use crate::descriptors::FrameSets;
-use crate::frame::FRAMES_IN_FLIGHT;
+use crate::frame_resources::FrameResources;
+use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::SharedMeshletScene;
-use crate::pass::{FrameResources, Pass, Recording};
+use crate::pass::{Pass, Recording};
 use crate::passes::meshlet_cull::Phase;
 use crate::render_pass;
 use ml_cpu::gpu_types::{CullCounters, DrawIndexedCommand};
