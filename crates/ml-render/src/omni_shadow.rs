@@ -24,8 +24,10 @@ use crate::settings::{OmniShadowMode, OmniShadowSettings};
 use crate::shadow_atlas::ShadowAtlasGpu;
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
+use ml_cpu::gpu_types::PointLight;
 use ml_cpu::omni_shadow::{face_view_proj, sphere_faces};
-use ml_cpu::scene::Object;
+use ml_cpu::omni_shadow::{lights_in_view, shadowed_lights};
+use ml_cpu::scene::{Object, Scene};
 use ml_vk::image::{aspect_transition, full_range, StageAccessLayout};
 use ml_vk::{shader, vk, Context, Image, ImageShape, VkError, VkResultExt};
 
@@ -46,6 +48,10 @@ pub struct ShadowedLight {
 
 pub struct OmniShadows {
     pub settings: Option<OmniShadowSettings>,
+    /// The lights that cast shadows (scene indices; cube or atlas slot i: `chosen[i]`), and
+    /// where they are in the frame being prepared.
+    chosen: Vec<u32>,
+    placed: Vec<ShadowedLight>,
     /// The shadow atlas (--omni-shadow atlas; stand-ins otherwise, and the cube array is).
     pub atlas: ShadowAtlasGpu,
     /// Six layers per shadowed light, viewed as a cube array (`cubes.view`).
@@ -80,6 +86,8 @@ impl OmniShadows {
         }
         let shadows = OmniShadows {
             settings,
+            chosen: Vec::new(),
+            placed: Vec::new(),
             atlas: ShadowAtlasGpu::new(ctx, settings)?,
             cubes: Image::null(),
             faces_view: vk::ImageView::null(),
@@ -93,6 +101,43 @@ impl OmniShadows {
             has_masked,
         };
         ml_vk::build(ctx, shadows, |s| s.create(ctx))
+    }
+
+    /// Choose the lights that cast shadows (`--shadowed-lights`: the strongest as seen from
+    /// the camera, or all that reach the view of an `aspect` image) and mark them in `scene`:
+    /// PointLight::color[3] = slot + 1, which the shading passes read.
+    pub fn choose(&mut self, scene: &mut Scene, aspect: f32) {
+        self.chosen = match self.settings {
+            None => Vec::new(),
+            Some(o) if o.all => lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, o.lights as usize),
+            Some(o) => shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position),
+        };
+        for (slot, &i) in self.chosen.iter().enumerate() {
+            scene.lights[i as usize].color[3] = (slot + 1) as f32;
+        }
+    }
+
+    /// Place the chosen lights for a frame: `lights` at rest moved by the animation's
+    /// `offset` (the same sum the light buffer holds, on the CPU or the GPU).
+    pub fn place(&mut self, lights: &[PointLight], offset: Vec3) {
+        self.placed = self
+            .chosen
+            .iter()
+            .map(|&i| {
+                let p = lights[i as usize].position_radius;
+                ShadowedLight { position: Vec3::new(p[0] + offset.x, p[1] + offset.y, p[2] + offset.z), radius: p[3] }
+            })
+            .collect();
+    }
+
+    /// The chosen lights' scene indices, slot order.
+    pub fn chosen(&self) -> &[u32] {
+        &self.chosen
+    }
+
+    /// Where the chosen lights are in the frame being prepared (slot order).
+    pub fn placed(&self) -> &[ShadowedLight] {
+        &self.placed
     }
 
     fn create(&mut self, ctx: &Context) -> Result<(), VkError> {

@@ -5,10 +5,11 @@
 
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
-use crate::omni_shadow::ShadowedLight;
+use crate::report::FrameStats;
 use crate::scene_gpu::SceneGpu;
 use crate::targets::Targets;
-use ml_cpu::cluster::{ClusterGrid, ClusterLists};
+use ml_cpu::camera::Camera;
+use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context, VkError};
 
@@ -21,10 +22,6 @@ pub struct Recording<'a> {
     pub targets: &'a Targets,
     pub scene: &'a SceneGpu,
     pub objects: &'a [ml_cpu::scene::Object],
-    /// Where this frame's shadowed lights are (cube i: `shadowed[i]`).
-    pub shadowed: &'a [ShadowedLight],
-    /// The shadow atlas's plan for this frame (--omni-shadow atlas).
-    pub atlas: Option<&'a ml_cpu::shadow_atlas::AtlasPlan>,
 }
 
 /// What a frame slot's finished frame told the passes (GPU light assignment feedback).
@@ -45,15 +42,27 @@ pub struct SlotReport {
     pub log2_luminance: Option<f32>,
 }
 
-/// The CPU side of a frame, before it is recorded: a pass that assigns lights on the CPU
-/// writes the slot's lists here.
-pub struct Update<'a> {
+/// The CPU side of a frame, before it is recorded (`Pass::prepare`): what a pass's CPU step
+/// reads (the frame's camera, lights and grid) and may change (the slot's light lists, the
+/// scene's GPU state such as the shadow atlas's cache, the frame's statistics).
+pub struct Prepare<'a> {
     pub ctx: &'a Context,
     pub grid: &'a ClusterGrid,
-    /// This frame's (animated) lights.
+    pub camera: &'a Camera,
+    pub extent: vk::Extent2D,
+    /// The scene's lights at rest, and how far the animation moves them this frame (every
+    /// light by the same offset).
+    pub rest_lights: &'a [PointLight],
+    pub light_offset: glam::Vec3,
+    /// This frame's animated lights where the CPU animates them (empty where the GPU does).
     pub lights: &'a [PointLight],
     /// The slot's lists (written, grown by the renderer where they are too short).
     pub lists: &'a mut dyn ListUpload,
+    pub scene: &'a mut SceneGpu,
+    pub stats: &'a mut FrameStats,
+    /// A CPU light assignment's milliseconds and what it built (the renderer reports the
+    /// time as its own CPU phase and scales the cluster heat map by the fullest cluster).
+    pub assigned: Option<(f64, ClusterStats)>,
 }
 
 /// Where a CPU assignment's lists go: the frame slot's buffers.
@@ -75,10 +84,11 @@ pub trait Pass {
     /// Record the pass into a frame's command buffer.
     fn record(&self, rec: &Recording);
 
-    /// CPU work of a frame before it is recorded (lights assigned on the CPU); returns its
-    /// milliseconds where it did some.
-    fn update(&mut self, _update: &mut Update) -> Result<Option<(f64, ml_cpu::cluster::ClusterStats)>, RenderError> {
-        Ok(None)
+    /// The pass's CPU step for a frame, before the frame is recorded (lights assigned on the
+    /// CPU, the shadowed lights placed and the shadow atlas planned): what `record` then
+    /// draws from.
+    fn prepare(&mut self, _prepare: &mut Prepare) -> Result<(), RenderError> {
+        Ok(())
     }
 
     /// Read what slot `slot`'s finished frame reports (its fence has signalled).

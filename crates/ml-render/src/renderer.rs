@@ -7,10 +7,9 @@
 use crate::error::RenderError;
 use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::omni_shadow::ShadowedLight;
-use crate::pass::{Pass, Recording, SlotReport, Update};
+use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::passes::{assemble, Assembly};
-use crate::report::{AtlasStats, CpuPhases, FrameStats};
+use crate::report::{CpuPhases, FrameStats};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::{Exposure, LightAssignment, RenderSettings, MAX_EXPOSURE_EV};
 use crate::targets::{depth_format, Output, Targets};
@@ -18,9 +17,7 @@ use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{count_entries, ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
-use ml_cpu::omni_shadow::{lights_in_view, shadowed_lights};
 use ml_cpu::scene::Scene;
-use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
 use ml_vk::{commands, vk, Buffer, Context, Image, VkError, VkResultExt};
 use std::time::Instant;
 
@@ -65,11 +62,6 @@ pub struct Renderer<'a> {
     /// `animated`, which every frame uploads.
     lights_on_gpu: bool,
     animated: Vec<PointLight>,
-    /// The lights with a shadow cube (cube i: `shadowed[i]`), and where they are this frame.
-    shadowed: Vec<u32>,
-    shadowed_now: Vec<ShadowedLight>,
-    /// The shadow atlas's plan for the frame being recorded (--omni-shadow atlas).
-    atlas_plan: Option<AtlasPlan>,
     /// The cluster grid (its shader parameters are also set for techniques without one).
     grid: ClusterGrid,
     /// Light-index entries every frame recorded from now on must hold (grows when a frame
@@ -150,10 +142,10 @@ impl<'a> Renderer<'a> {
         if !scene.cones.is_empty() && scene.cones.len() != scene.lights.len() {
             return Err(RenderError::Invalid(format!("the scene has {} spot cones for {} lights", scene.cones.len(), scene.lights.len())));
         }
-        let shadowed = mark_shadowed(&mut scene, &settings);
         let depth = depth_format(ctx, Output::of(settings.technique))?;
         let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
-        let gpu = SceneGpu::new(ctx, &scene, &settings)?;
+        let mut gpu = SceneGpu::new(ctx, &scene, &settings)?;
+        gpu.omni.choose(&mut scene, settings.aspect());
         let mut r = Renderer {
             ctx,
             extent: vk::Extent2D { width: settings.width, height: settings.height },
@@ -167,9 +159,6 @@ impl<'a> Renderer<'a> {
             frames: Vec::new(),
             readback: None,
             lights_on_gpu,
-            shadowed,
-            shadowed_now: Vec::new(),
-            atlas_plan: None,
             required_indices: 0,
             reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
@@ -262,7 +251,7 @@ impl<'a> Renderer<'a> {
         check_lists_fit(self.ctx, &self.settings, &self.grid, &lights, self.scene.light_motion)?;
         self.release_frames()?;
         self.scene.lights = lights;
-        self.shadowed = mark_shadowed(&mut self.scene, &self.settings);
+        self.gpu.omni.choose(&mut self.scene, self.settings.aspect());
         // The atlas keeps its faces: a face is drawn again when the light of its key (the
         // scene index) is not where it was or has another radius, which covers lights that
         // changed, came or went.
@@ -635,66 +624,36 @@ impl<'a> Renderer<'a> {
             move_into(&self.scene.lights, motion_offset(t, self.scene.light_motion), &mut self.animated);
             self.frames[f].lights.write(0, &self.animated);
         }
-        let mut assign_ms = None;
         let mut lists = SlotLists { frame: &mut self.frames[f], grew: false };
-        let mut update = Update { ctx, grid: &self.grid, lights: &self.animated, lists: &mut lists };
+        let mut prepare = Prepare {
+            ctx,
+            grid: &self.grid,
+            camera: &self.scene.camera,
+            extent: self.extent,
+            rest_lights: &self.scene.lights,
+            light_offset: motion_offset(t, self.scene.light_motion),
+            lights: &self.animated,
+            lists: &mut lists,
+            scene: &mut self.gpu,
+            stats,
+            assigned: None,
+        };
         for p in &mut self.passes {
-            if let Some((ms, cluster_stats)) = p.update(&mut update)? {
-                assign_ms = Some(ms);
-                self.heat_top = cluster_stats.max_lights.max(1) as f32;
-                stats.clusters = Some(cluster_stats);
-            }
+            p.prepare(&mut prepare)?;
+        }
+        let assigned = prepare.assigned;
+        let assign_ms = assigned.map(|(ms, _)| ms);
+        if let Some((_, cluster_stats)) = assigned {
+            self.heat_top = cluster_stats.max_lights.max(1) as f32;
+            stats.clusters = Some(cluster_stats);
         }
         grew |= lists.grew;
         if grew {
             stats.index_growths += 1;
             self.bind_passes(f)?;
         }
-        let offset = motion_offset(t, self.scene.light_motion);
-        self.shadowed_now = self
-            .shadowed
-            .iter()
-            .map(|&i| {
-                let p = self.scene.lights[i as usize].position_radius;
-                // The same sum the light buffer (CPU or GPU animation) holds for this light.
-                ShadowedLight { position: glam::Vec3::new(p[0] + offset.x, p[1] + offset.y, p[2] + offset.z), radius: p[3] }
-            })
-            .collect();
-        self.plan_atlas(stats)?;
         self.write_uniforms(f, t);
         Ok(assign_ms)
-    }
-
-    /// The shadow atlas's plan for this frame's shadowed lights (keys: their scene indices),
-    /// reported in `stats`.
-    fn plan_atlas(&mut self, stats: &mut FrameStats) -> Result<(), RenderError> {
-        let Some(atlas) = self.settings.omni.and_then(|o| o.atlas()) else { return Ok(()) };
-        let lights: Vec<(u32, PlannedLight)> = self
-            .shadowed
-            .iter()
-            .zip(&self.shadowed_now)
-            .map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius }))
-            .collect();
-        let size = (self.extent.width, self.extent.height);
-        let Some(plan) = self.gpu.omni.atlas.plan(&lights, &self.scene.camera, size, atlas) else { return Ok(()) };
-        let plan = plan.map_err(|e| {
-            RenderError::Invalid(format!(
-                "shadow atlas: {e} (a budget of {} MiB; more would hold them, or fewer shadowed lights)",
-                atlas.budget_mib
-            ))
-        })?;
-        let (budget, shadow_bytes, atlas_bytes) = self.gpu.omni.atlas.memory();
-        stats.shadow_atlas = Some(AtlasStats {
-            faces: plan.tiles.len(),
-            redrawn: plan.redrawn(),
-            divided_by: plan.divided_by,
-            budget,
-            shadow_bytes,
-            atlas_bytes,
-            tile_bytes: plan.used_bytes(),
-        });
-        self.atlas_plan = Some(plan);
-        Ok(())
     }
 
     fn write_uniforms(&mut self, f: usize, t: f32) {
@@ -752,17 +711,7 @@ impl<'a> Renderer<'a> {
         }
         frame.timer.reset(ctx, cmd);
         let targets = frame.targets.as_ref().expect("made with the frame");
-        let rec = Recording {
-            ctx,
-            cmd,
-            slot: f,
-            extent: self.extent,
-            targets,
-            scene: &self.gpu,
-            objects: &self.scene.objects,
-            shadowed: &self.shadowed_now,
-            atlas: self.atlas_plan.as_ref(),
-        };
+        let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects };
         let mut timed = 0;
         for pass in &self.passes {
             match pass.timer_name() {
@@ -847,21 +796,6 @@ impl<'a> Renderer<'a> {
         commands::one_shot(ctx, |cmd| commands::copy_colour_to_host(ctx, cmd, image, extent, buffer.raw))?;
         Ok(buffer.mapped().to_vec())
     }
-}
-
-/// Pick the lights that get a shadow cube (the strongest as seen from the camera) and mark
-/// them: PointLight::color[3] = cube index + 1. Returns their indices, cube order.
-fn mark_shadowed(scene: &mut Scene, settings: &RenderSettings) -> Vec<u32> {
-    let aspect = settings.width as f32 / settings.height as f32;
-    let shadowed = match settings.omni {
-        None => Vec::new(),
-        Some(o) if o.all => lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, o.lights as usize),
-        Some(o) => shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position),
-    };
-    for (cube, &i) in shadowed.iter().enumerate() {
-        scene.lights[i as usize].color[3] = (cube + 1) as f32;
-    }
-    shadowed
 }
 
 impl Drop for Renderer<'_> {

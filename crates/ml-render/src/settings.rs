@@ -579,6 +579,11 @@ impl RenderSettings {
         }
     }
 
+    /// The image's width over its height.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
     /// Whether the exposure-meter pass runs: auto exposure, on the shaded image (a debug view
     /// shows its values as they are).
     pub fn meters_exposure(&self) -> bool {

@@ -6,8 +6,8 @@
 use crate::error::RenderError;
 use crate::frame::lists_too_long;
 use crate::frame_resources::FrameResources;
-use crate::pass::{Pass, Recording, Update};
-use ml_cpu::cluster::{ClusterAssigner, ClusterLists, ClusterStats};
+use crate::pass::{Pass, Prepare, Recording};
+use ml_cpu::cluster::{ClusterAssigner, ClusterLists};
 use ml_vk::{Context, VkError};
 use std::time::Instant;
 
@@ -32,7 +32,7 @@ impl Pass for CpuClusterAssign {
 
     fn record(&self, _: &Recording) {}
 
-    fn update(&mut self, up: &mut Update) -> Result<Option<(f64, ClusterStats)>, RenderError> {
+    fn prepare(&mut self, up: &mut Prepare) -> Result<(), RenderError> {
         let start = Instant::now();
         // The CPU also holds the lists (and their pairs) in memory: cap what it builds.
         let limit = up.lists.max_entries(up.ctx).min(MAX_CPU_LIST_ENTRIES);
@@ -41,7 +41,8 @@ impl Pass for CpuClusterAssign {
             .map_err(|e| lists_too_long(e.at_least, limit, "the CPU assignment builds (or the device binds)"))?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         up.lists.upload(up.ctx, &self.lists)?;
-        Ok(Some((ms, self.lists.stats())))
+        up.assigned = Some((ms, self.lists.stats()));
+        Ok(())
     }
 
     fn destroy(&mut self, _: &Context) {}

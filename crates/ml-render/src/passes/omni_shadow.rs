@@ -3,8 +3,9 @@
 //! resource (the shading passes sample it through the scene's texture set); this pass records
 //! its rendering in the mode the settings chose (omni_shadow.rs).
 
+use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
-use crate::pass::{Pass, Recording};
+use crate::pass::{Pass, Prepare, Recording};
 use ml_vk::{Context, VkError};
 
 pub struct OmniShadowPass;
@@ -18,8 +19,14 @@ impl Pass for OmniShadowPass {
         Ok(())
     }
 
+    fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
+        p.scene.omni.place(p.rest_lights, p.light_offset);
+        Ok(())
+    }
+
     fn record(&self, rec: &Recording) {
-        rec.scene.omni.record(rec.ctx, rec.cmd, rec.shadowed, (&rec.scene.meshes, rec.objects));
+        let omni = &rec.scene.omni;
+        omni.record(rec.ctx, rec.cmd, omni.placed(), (&rec.scene.meshes, rec.objects));
     }
 
     fn destroy(&mut self, _: &Context) {}

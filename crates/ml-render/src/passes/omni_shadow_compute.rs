@@ -5,16 +5,18 @@
 //! faces into the cube array the shading passes sample, which ends as the graphics modes
 //! leave it — or the faces the frame's plan lists into the shadow atlas (shadow_atlas.rs).
 
+use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::meshlet_scene::MeshletGeometryView;
 use crate::omni_shadow::NEAR_FRACTION;
-use crate::pass::{Pass, Recording, SlotReport};
-use crate::report::OmniRasterStats;
+use crate::pass::{Pass, Prepare, Recording, SlotReport};
+use crate::report::{AtlasStats, OmniRasterStats};
 use crate::shadow_atlas::tile_table;
 use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::OmniRasterCounters;
+use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
 use ml_vk::commands::copy_buffer_to_host;
 use ml_vk::{vk, Buffer, Context, VkError};
 
@@ -23,6 +25,8 @@ pub struct OmniShadowCompute {
     raster: ShadowRaster,
     /// The counters, copied out at the end of the pass, per frame slot.
     readback: Vec<Buffer>,
+    /// The shadow atlas's plan for the frame being recorded (the atlas views).
+    plan: Option<AtlasPlan>,
 }
 
 impl OmniShadowCompute {
@@ -32,7 +36,7 @@ impl OmniShadowCompute {
         (views, size, large_capacity): (ShadowViews, u32, u32),
     ) -> Result<OmniShadowCompute, VkError> {
         let raster = ShadowRaster::new(ctx, geometry, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
-        let pass = OmniShadowCompute { views, raster, readback: Vec::new() };
+        let pass = OmniShadowCompute { views, raster, readback: Vec::new(), plan: None };
         ml_vk::build(ctx, pass, |p| {
             for _ in 0..FRAMES_IN_FLIGHT {
                 let bytes = size_of::<OmniRasterCounters>() as u64;
@@ -60,16 +64,24 @@ impl Pass for OmniShadowCompute {
         self.raster.bind(ctx, frame.slot, (named("ObjectBuffer"), named("AlphaMaskBuffer")))
     }
 
+    fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
+        p.scene.omni.place(p.rest_lights, p.light_offset);
+        if let ShadowViews::Atlas { .. } = self.views {
+            self.plan = plan_atlas(p)?;
+        }
+        Ok(())
+    }
+
     fn record(&self, rec: &Recording) {
         let lights: Vec<[f32; 4]> =
-            rec.shadowed.iter().take(self.views.lights() as usize).map(|l| l.position.extend(l.radius).to_array()).collect();
+            rec.scene.omni.placed().iter().take(self.views.lights() as usize).map(|l| l.position.extend(l.radius).to_array()).collect();
         if lights.is_empty() {
             return;
         }
         // Every face's projection: 90°, in the light's frame in radii.
         let projection = glam::Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, NEAR_FRACTION, 1.0);
         let readers = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
-        match (self.views, rec.atlas) {
+        match (self.views, &self.plan) {
             (ShadowViews::Atlas { .. }, Some(plan)) => {
                 let tiles = tile_table(plan, lights.len());
                 self.raster.record_atlas(rec.ctx, rec.cmd, rec.slot, (&lights, &tiles), projection, readers);
@@ -102,6 +114,34 @@ impl Pass for OmniShadowCompute {
         }
         self.readback.clear();
     }
+}
+
+/// The shadow atlas's plan for the frame's placed lights (keys: their scene indices), its
+/// figures reported in the frame's statistics; None without an atlas.
+fn plan_atlas(p: &mut Prepare) -> Result<Option<AtlasPlan>, RenderError> {
+    let omni = &mut p.scene.omni;
+    let Some(atlas) = omni.settings.and_then(|o| o.atlas()) else { return Ok(None) };
+    let lights: Vec<(u32, PlannedLight)> =
+        omni.chosen().iter().zip(omni.placed()).map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius })).collect();
+    let size = (p.extent.width, p.extent.height);
+    let Some(plan) = omni.atlas.plan(&lights, p.camera, size, atlas) else { return Ok(None) };
+    let plan = plan.map_err(|e| {
+        RenderError::Invalid(format!(
+            "shadow atlas: {e} (a budget of {} MiB; more would hold them, or fewer shadowed lights)",
+            atlas.budget_mib
+        ))
+    })?;
+    let (budget, shadow_bytes, atlas_bytes) = omni.atlas.memory();
+    p.stats.shadow_atlas = Some(AtlasStats {
+        faces: plan.tiles.len(),
+        redrawn: plan.redrawn(),
+        divided_by: plan.divided_by,
+        budget,
+        shadow_bytes,
+        atlas_bytes,
+        tile_bytes: plan.used_bytes(),
+    });
+    Ok(Some(plan))
 }
 
 impl ml_vk::Release for OmniShadowCompute {
