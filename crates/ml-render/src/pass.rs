@@ -6,7 +6,7 @@
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::report::FrameStats;
-use crate::scene_gpu::SceneGpu;
+use crate::scene::SceneGpu;
 use crate::targets::Targets;
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};

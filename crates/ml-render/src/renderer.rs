@@ -4,13 +4,13 @@
 //! the technique's choices give an ordered list of passes (`passes::assemble`) that it
 //! binds, records, times and collects from.
 
+use crate::assembly::{assemble, Assembly};
 use crate::error::RenderError;
 use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
-use crate::passes::{assemble, Assembly};
 use crate::report::{CpuPhases, FrameStats};
-use crate::scene_gpu::SceneGpu;
+use crate::scene::SceneGpu;
 use crate::settings::{Exposure, LightAssignment, RenderSettings, MAX_EXPOSURE_EV};
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;

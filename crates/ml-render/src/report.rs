@@ -407,7 +407,7 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     }
     if let Some(ms) = stats.sun_shadow_ms {
         let by = settings.sun_shadow.name();
-        let size = crate::scene_textures::SHADOW_MAP_SIZE;
+        let size = crate::scene::textures::SHADOW_MAP_SIZE;
         rows.push(("sun shadow ms", format!("{ms:.3}  (the sun's {size}² shadow map by {by}, once at load)")));
     }
     if let Some(m) = stats.memory {

@@ -4,8 +4,8 @@
 //! samples. The layout is textures.glsl's set 1, as reflected from the shaders.
 
 use crate::descriptors::{self, Resource, SetLayout};
-use crate::omni_shadow::{self, OmniShadows};
-use crate::sun_shadow::{draw_shadow_map, render_shadow_map, ShadowInputs};
+use crate::scene::omni_shadow::{self, OmniShadows};
+use crate::scene::sun_shadow::{draw_shadow_map, render_shadow_map, ShadowInputs};
 use ml_cpu::textures;
 use ml_vk::descriptors::allocate_set;
 use ml_vk::image::{texture_with, ImageShape};

@@ -2,15 +2,23 @@
 //! buffers, the scene's textures (set 1 of every shading pipeline: the sun's shadow map, the
 //! sky, material maps, the point-light shadow cubes) and each object's own textures (set 2).
 
+pub mod meshlets;
+pub mod object_data;
+pub mod object_textures;
+pub mod omni_shadow;
+pub mod shadow_atlas;
+pub mod shadow_raster;
+pub mod sun_shadow;
+pub mod textures;
+
 use crate::error::RenderError;
 use crate::gpu_mesh::GpuMesh;
-use crate::meshlet_scene::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
-use crate::object_data::{object_data, SurfaceVariant};
-use crate::object_textures::ObjectTextureSets;
-use crate::omni_shadow::OmniShadows;
-use crate::scene_textures::SceneTextures;
+use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
+use crate::scene::object_data::{object_data, SurfaceVariant};
+use crate::scene::object_textures::ObjectTextureSets;
+use crate::scene::omni_shadow::OmniShadows;
+use crate::scene::textures::SceneTextures;
 use crate::settings::{RenderSettings, ShadingModel, SunShadowMode};
-use crate::sun_shadow;
 use crate::targets::{depth_format, Output};
 use ml_cpu::alpha_mask::AlphaMasks;
 use ml_cpu::blinn_phong::shadow_view_proj;

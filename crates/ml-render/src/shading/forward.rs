@@ -4,10 +4,10 @@
 //! Leaves the colour target in TRANSFER_SRC_OPTIMAL for the read-back.
 
 use crate::frame_resources::FrameResources;
-use crate::mesh_raster::{Draw, MeshRaster};
 use crate::pass::{Pass, Recording};
-use crate::scene_gpu::SceneGpu;
+use crate::scene::SceneGpu;
 use crate::settings::Shading;
+use crate::shading::mesh_raster::{Draw, MeshRaster};
 use crate::targets::Output;
 use ml_vk::{vk, Context, VkError};
 

@@ -8,12 +8,12 @@
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::MeshletGeometryView;
-use crate::omni_shadow::NEAR_FRACTION;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::report::{AtlasStats, OmniRasterStats};
-use crate::shadow_atlas::tile_table;
-use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
+use crate::scene::meshlets::MeshletGeometryView;
+use crate::scene::omni_shadow::NEAR_FRACTION;
+use crate::scene::shadow_atlas::tile_table;
+use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::OmniRasterCounters;
 use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};

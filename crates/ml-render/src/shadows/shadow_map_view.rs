@@ -5,7 +5,7 @@
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
-use crate::scene_gpu::SceneGpu;
+use crate::scene::SceneGpu;
 use crate::settings::DebugView;
 use ml_vk::{Context, VkError};
 

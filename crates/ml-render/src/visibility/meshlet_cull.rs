@@ -15,11 +15,12 @@
 use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::{MeshletScene, SharedMeshletScene, SPEC_SURFACE_TESTS};
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::CullStats;
+use crate::scene::meshlets::SPEC_SURFACE_TESTS;
 use crate::settings::Raster;
 use crate::targets::depth_pyramid_shape;
+use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{shader, vk, Context, VkError};

@@ -7,10 +7,11 @@
 use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::{SharedMeshletScene, SPEC_SURFACE_TESTS};
 use crate::pass::{Pass, Recording};
-use crate::passes::meshlet_cull::{cull_push, Phase};
+use crate::scene::meshlets::SPEC_SURFACE_TESTS;
 use crate::settings::Raster;
+use crate::visibility::meshlet_cull::{cull_push, Phase};
+use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{shader, vk, Context, VkError};

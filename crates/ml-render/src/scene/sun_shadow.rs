@@ -9,9 +9,9 @@
 
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::gpu_mesh::{record_draws, GpuMesh};
-use crate::meshlet_scene::MeshletGeometryView;
+use crate::scene::meshlets::MeshletGeometryView;
+use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use crate::settings::SunShadowMode;
-use crate::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use ml_cpu::gpu_types::ShadowPush;
 use ml_cpu::scene::Scene;
 use ml_vk::{shader, vk, Context, GpuTimer, Image, VkError, VkResultExt};

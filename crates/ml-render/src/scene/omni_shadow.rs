@@ -20,8 +20,8 @@
 
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::scene::shadow_atlas::ShadowAtlasGpu;
 use crate::settings::{OmniShadowMode, OmniShadowSettings};
-use crate::shadow_atlas::ShadowAtlasGpu;
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
 use ml_cpu::gpu_types::PointLight;
@@ -105,7 +105,7 @@ impl OmniShadows {
 
     /// Choose the lights that cast shadows (`--shadowed-lights`: the strongest as seen from
     /// the camera, or all that reach the view of an `aspect` image) and mark them in `scene`:
-    /// PointLight::color[3] = slot + 1, which the shading passes read.
+    /// `PointLight::color[3] = slot + 1`, which the shading passes read.
     pub fn choose(&mut self, scene: &mut Scene, aspect: f32) {
         self.chosen = match self.settings {
             None => Vec::new(),

@@ -7,10 +7,10 @@
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::mesh_raster::{Draw, MeshRaster};
 use crate::pass::{Pass, Recording};
-use crate::scene_gpu::SceneGpu;
+use crate::scene::SceneGpu;
 use crate::settings::Shading;
+use crate::shading::mesh_raster::{Draw, MeshRaster};
 use crate::targets::{gbuffer_images, Output};
 use ml_vk::{shader, vk, Context, VkError};
 

@@ -6,10 +6,10 @@
 
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
-use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{Pass, Recording};
-use crate::scene_gpu::SceneGpu;
+use crate::scene::SceneGpu;
 use crate::settings::Shading;
+use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};
 
 pub struct VisibilityLighting {

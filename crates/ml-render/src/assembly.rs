@@ -4,31 +4,19 @@
 //! atlas's plan, the exposure meter's EV) also touches the renderer (docs/architecture.md has
 //! the checklist).
 
-pub mod cluster_assign_cpu;
-pub mod cluster_build;
-pub mod compute_lighting;
-pub mod deferred_subpass;
-pub mod depth_pyramid;
-pub mod exposure_meter;
-pub mod forward;
-pub mod gbuffer;
-pub mod meshlet_cull;
-pub mod omni_shadow;
-pub mod omni_shadow_compute;
-pub mod shadow_map_view;
-pub mod tone_map;
-pub mod triangle_raster_large;
-pub mod visibility_lighting;
-pub mod visibility_raster;
-
-use crate::meshlet_scene::MeshletScene;
+use crate::clusters::{cluster_assign_cpu, cluster_build};
+use crate::exposure::{exposure_meter, tone_map};
 use crate::pass::Pass;
-use crate::scene_gpu::SceneGpu;
+use crate::scene::shadow_raster::ShadowViews;
+use crate::scene::SceneGpu;
 use crate::settings::{
     DebugView, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel,
 };
-use crate::shadow_raster::ShadowViews;
-use meshlet_cull::Phase;
+use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
+use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
+use crate::visibility::meshlet_cull::Phase;
+use crate::visibility::meshlet_scene::MeshletScene;
+use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::scene::Scene;
 use ml_vk::{vk, Context, VkError};
@@ -77,7 +65,7 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
                 ShadowViews::Atlas { lights: omni.lights, pairs: atlas.lists.pairs, depths: atlas.depths.raw, tiles: atlas.tiles.raw };
             passes.push(Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.scene.meshlets()?, (views, 0, atlas.lists.large))?));
         }
-        Some(_) => passes.push(Box::new(omni_shadow::OmniShadowPass)),
+        Some(_) => passes.push(Box::new(omni_shadow_pass::OmniShadowPass)),
         None => {}
     }
     match technique.assignment() {

@@ -9,7 +9,7 @@
 //! large triangle draws it (omni_raster_large.comp); the buffer is copied into the image.
 
 use crate::descriptors::{FrameSets, Resource};
-use crate::meshlet_scene::{storage_bytes, MeshletGeometryView, SPEC_SURFACE_TESTS};
+use crate::scene::meshlets::{storage_bytes, MeshletGeometryView, SPEC_SURFACE_TESTS};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush, ShadowCubeTiles};
 use ml_vk::commands::{memory_barrier, update_buffer};

@@ -10,10 +10,10 @@
 use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::meshlet_scene::SharedMeshletScene;
 use crate::pass::{Pass, Recording};
-use crate::passes::meshlet_cull::Phase;
 use crate::render_pass;
+use crate::visibility::meshlet_cull::Phase;
+use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_cpu::gpu_types::{CullCounters, DrawIndexedCommand};
 use ml_vk::{shader, vk, Context, VkError};
 

@@ -4,10 +4,10 @@
 //! lighting pass.
 
 use crate::frame_resources::FrameResources;
-use crate::mesh_raster::MeshRaster;
 use crate::pass::{Pass, Recording};
-use crate::scene_gpu::SceneGpu;
+use crate::scene::SceneGpu;
 use crate::settings::Shading;
+use crate::shading::mesh_raster::MeshRaster;
 use crate::targets::{gbuffer_images, Output};
 use ml_vk::{vk, Context, VkError};
 
