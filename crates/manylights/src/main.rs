@@ -136,7 +136,7 @@ struct SceneArgs {
     /// Point lights (1 to 16777216); in a scene file, N lights of --light-layout replace the
     /// file's own. Default: 64 in the seed scene, 1024 in the bench scene, a scene file's own
     /// lights (64 where it has none); the room keeps its one light.
-    #[arg(long, value_parser = Whole::<u64>::new(1, ml_cpu::lights::MAX_LIGHTS), allow_negative_numbers = true)]
+    #[arg(long, value_parser = Whole::<u64>::new(1, ml_cpu::limits::MAX_LIGHTS), allow_negative_numbers = true)]
     lights: Option<u64>,
     /// Light placement: grid (a square grid above the scene; in a scene or glTF file, once the
     /// count calls for it, layers of such grids down through the scene's box), random (uniform
@@ -244,7 +244,7 @@ struct SceneArgs {
 }
 
 /// The ranges of the counts and sizes `render`, `view` and `bench` share.
-const OBJECTS: Whole<usize> = Whole::new(0, ml_cpu::bench_scene::MAX_BENCH_OBJECTS as u64);
+const OBJECTS: Whole<usize> = Whole::new(0, ml_cpu::limits::MAX_BENCH_OBJECTS as u64);
 const SIDE: Whole<u32> = Whole::new(1, ml_render::settings::MAX_DIMENSION as u64);
 const RASTER_SPLIT: Whole<u32> = Whole::new(1, Raster::MAX_SPLIT as u64);
 const SHADOW_BUDGET: Whole<u32> = Whole::checked_later(u32::MAX as u64, "1 to the device's memory in MiB");

@@ -2,7 +2,7 @@
 //! 0 is out of range"); on the command line the user gave it as a flag, so the line names the
 //! flag instead ("--width 0 is out of range").
 
-use ml_cpu::lights::MAX_LIGHTS;
+use ml_cpu::limits::{MAX_BENCH_OBJECTS, MAX_CLUSTERS, MAX_LIGHTS};
 use ml_cpu::scene_request::SceneRequestError;
 use ml_cpu::SceneError;
 use ml_render::error::{Named, Setting, SettingsError};
@@ -78,11 +78,10 @@ fn vulkan(e: &VkError) -> Option<String> {
 fn scene(e: &SceneError) -> Option<String> {
     match e {
         SceneError::LightCount(n) => Some(format!("--lights {n} is out of range: use 1 to {MAX_LIGHTS}")),
-        SceneError::ObjectCount(n) => Some(format!("--objects {n} is out of range: use 0 to {}", ml_cpu::bench_scene::MAX_BENCH_OBJECTS)),
-        SceneError::Clusters(text) => Some(format!(
-            "--clusters {text} is invalid: use XxYxZ with each at least 1 and at most {} clusters in all",
-            ml_cpu::cluster::ClusterDims::MAX_CLUSTERS
-        )),
+        SceneError::ObjectCount(n) => Some(format!("--objects {n} is out of range: use 0 to {MAX_BENCH_OBJECTS}")),
+        SceneError::Clusters(text) => {
+            Some(format!("--clusters {text} is invalid: use XxYxZ with each at least 1 and at most {MAX_CLUSTERS} clusters in all"))
+        }
         SceneError::TooManyMarkers(_) => Some(format!("--show-lights: {e}")),
         SceneError::NoSurface => Some(format!("--light-layout surface: {e}")),
         _ => None,

@@ -6,6 +6,7 @@
 use crate::camera::Camera;
 pub use crate::lights::LIGHTS_PER_POINT;
 use crate::lights::{LightFrame, LightLayout, LightParams, RadiusRange, RANDOM_BOX_MAX, RANDOM_BOX_MIN};
+use crate::limits::MAX_BENCH_OBJECTS;
 use crate::material::{Material, NAMED_ALBEDOS};
 use crate::mesh::MeshKind;
 use crate::scene::{Object, Scene};
@@ -15,8 +16,6 @@ use rand::{Rng, SeedableRng};
 
 /// Objects on the floor besides the floor itself, unless asked otherwise.
 pub const BENCH_OBJECTS: usize = 300;
-/// The most objects the bench scene places (a million-triangle mesh budget per hundred).
-pub const MAX_BENCH_OBJECTS: usize = 100_000;
 /// The radius at which `count` lights uniform in the light box reach LIGHTS_PER_POINT lights
 /// at an average point: count · (4/3)πr³ / V = LIGHTS_PER_POINT (the random layout's default
 /// radius in the built-in frame).

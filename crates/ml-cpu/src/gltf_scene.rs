@@ -14,15 +14,14 @@
 //! MAX_DIRECTIONAL_LIGHTS. Cameras: perspective or orthographic.
 
 use crate::camera::Camera;
+use crate::error::Number;
 use crate::files::{read_regular, ReadError};
 use crate::gpu_types::{LightCone, PointLight};
+use crate::limits::{LENGTHS, MAX_COORDINATE, MAX_INTENSITY, MAX_OBJECTS, SCALES};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
 use crate::scene::{AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
-use crate::scene_load::{
-    check_extent, read_reference, ExtentError, Number, ReferenceError, SceneFile, LENGTHS, MAX_COORDINATE, MAX_INTENSITY, MAX_OBJECTS,
-    SCALES,
-};
+use crate::scene_load::{check_extent, read_reference, ExtentError, ReferenceError, SceneFile};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use base64::Engine as _;
 use glam::{Affine2, Mat3, Mat4, Vec3, Vec4};
@@ -1073,10 +1072,10 @@ fn camera_at(camera: &gltf::Camera, world: Mat4, warnings: &mut Vec<String>) -> 
 }
 
 /// A camera that sees every object, from above and in front, the model filling most of a
-/// default-sized image (`camera::frame_scene`; a render of another aspect frames it again for
+/// default-sized image (`framing::frame_scene`; a render of another aspect frames it again for
 /// its own: `SceneRequest::build`).
 pub fn framing_camera(scene: &Scene) -> Camera {
-    crate::camera::frame_scene(scene, crate::camera::DEFAULT_ASPECT, crate::camera::DEFAULT_FOV_Y_DEG)
+    crate::framing::frame_scene(scene, crate::framing::DEFAULT_ASPECT, crate::camera::DEFAULT_FOV_Y_DEG)
 }
 
 /// Triangle-list indices from a list, strip or fan.

@@ -5,15 +5,12 @@
 //! fits a count to a frame, and the seed's light animation.
 
 use crate::gpu_types::PointLight;
+use crate::limits::{LENGTHS, MAX_LIGHTS};
 use crate::surface_sampler::SurfaceSampler;
 use crate::SceneError;
 use glam::{Vec2, Vec3};
 use rand::{Rng, SeedableRng};
 use std::f32::consts::TAU;
-
-/// The most lights a scene may hold (16.7 M × 32 B = 512 MiB of light data). Above a million
-/// is what the clustered techniques are built for; beyond this is a typo, not a workload.
-pub const MAX_LIGHTS: u64 = 1 << 24;
 
 /// The seed's light colours, cycled by index.
 pub const SEED_COLORS: [[f32; 3]; 4] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.0]];
@@ -252,7 +249,7 @@ impl LightFrame {
     /// The loaders refuse such boxes first (`scene_load::check_extent`); this is the last word.
     pub fn fitted_radius(&self, layout: LightLayout, count: u32, surface_area: f32) -> Result<f32, SceneError> {
         let radius = self.default_radius(layout, count, surface_area);
-        if crate::scene_load::LENGTHS.contains(&radius) {
+        if LENGTHS.contains(&radius) {
             Ok(radius)
         } else {
             Err(SceneError::FittedRadius(radius))
@@ -288,16 +285,9 @@ impl LightParams {
     }
 
     /// The lights at rest (before animation) in the built-in scenes' frame; the surface
-    /// layout needs a scene (`build_in`).
+    /// layout needs a scene's surfaces (`build_in`, `Scene::build_lights`).
     pub fn build(&self) -> Result<Vec<PointLight>, SceneError> {
         self.build_in(&LightFrame::BUILT_IN, None)
-    }
-
-    /// The lights at rest in `frame` over `scene`'s objects (whose surfaces the surface
-    /// layout draws from).
-    pub fn build_over(&self, scene: &crate::scene::Scene, frame: &LightFrame) -> Result<Vec<PointLight>, SceneError> {
-        let surfaces = if self.layout == LightLayout::Surface { SurfaceSampler::new(scene) } else { None };
-        self.build_in(frame, surfaces.as_ref())
     }
 
     /// The lights at rest in `frame`; `surfaces` (the scene's, for the surface layout) lifts
@@ -443,7 +433,7 @@ mod tests {
         // A floor of 20 × 20 m under the box (−10, 0, −10)..(10, 4, 10).
         let floor = Object::placed(MeshKind::Plane, Vec3::ZERO, 10.0, Material::named("white").unwrap());
         let scene = Scene::new(vec![floor], Vec::new(), Camera::seed());
-        let surfaces = SurfaceSampler::new(&scene).unwrap();
+        let surfaces = scene.surfaces().unwrap();
         let frame = LightFrame::around(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 4.0, 10.0));
         // The grid: checked below (with more than a few dozen lights GRID_REACH decides).
         for layout in [LightLayout::Random, LightLayout::Surface] {
@@ -506,7 +496,7 @@ mod tests {
         let scene = Scene::new(objects, Vec::new(), Camera::seed());
         let (lo, hi) = scene.bounds();
         let frame = LightFrame::around(lo, hi);
-        let surfaces = SurfaceSampler::new(&scene).unwrap();
+        let surfaces = scene.surfaces().unwrap();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         // Points of the model: in the inner part of its box (random, grid), on its surfaces (surface).
         let inner: Vec<Vec3> = (0..48)

@@ -3,12 +3,15 @@
 use crate::blinn_phong::BlinnPhongLights;
 use crate::camera::Camera;
 use crate::gpu_types::{LightCone, PointLight};
-use crate::lights::{LightFrame, LightParams};
+use crate::lights::{LightFrame, LightLayout, LightParams};
+use crate::limits::MAX_LIGHT_MARKERS;
 use crate::material::Material;
 use crate::mesh::{Mesh, MeshKind};
+use crate::surface_sampler::SurfaceSampler;
 use crate::textures::TextureImage;
 use crate::SceneError;
 use glam::{Mat4, Quat, Vec3};
+use std::collections::HashMap;
 
 /// The seed's ambient factor: colour = albedo · 0.02 + Lo.
 pub const SEED_AMBIENT: f32 = 0.02;
@@ -195,9 +198,6 @@ pub struct Scene {
 /// A light marker's half-width as a fraction of its light's radius (the seed's radius-15
 /// lights get cubes 0.6 m wide beside spheres 2 m wide).
 pub const LIGHT_MARKER_SIZE: f32 = 0.02;
-/// Most lights `--show-lights` draws: each marker is an object of its own (one draw each in
-/// the forward techniques).
-pub const MAX_LIGHT_MARKERS: usize = 65_536;
 
 /// Most directional lights a scene may have (FrameUniforms holds them).
 pub const MAX_DIRECTIONAL_LIGHTS: usize = 4;
@@ -223,7 +223,7 @@ impl Scene {
             }
         }
         let mut scene = Scene::new(objects, Vec::new(), Camera::seed());
-        scene.lights = lights.build_over(&scene, &LightFrame::BUILT_IN)?;
+        scene.lights = scene.build_lights(lights, &LightFrame::BUILT_IN)?;
         Ok(scene)
     }
 
@@ -306,6 +306,25 @@ impl Scene {
             MeshKind::Loaded(i) => self.meshes.get(i as usize).cloned(),
             builtin => Some(builtin.build()),
         }
+    }
+
+    /// Its surfaces to draw points from (the surface light layout): every triangle of every
+    /// object in world space; None when they have no area at all.
+    pub fn surfaces(&self) -> Option<SurfaceSampler> {
+        // Each mesh built (or cloned) once, however many objects draw it.
+        let mut meshes = HashMap::new();
+        for o in &self.objects {
+            meshes.entry(o.mesh).or_insert_with(|| self.mesh(o.mesh).unwrap_or_default());
+        }
+        SurfaceSampler::new(self.objects.iter().map(|o| (&meshes[&o.mesh], o.transform)))
+    }
+
+    /// The lights `params` asks for, at rest in `frame` over this scene's objects (whose
+    /// surfaces the surface layout draws from). A method of the scene, not of `LightParams`:
+    /// scenes hold lights, so lights.rs takes no scene (the two modules would import each other).
+    pub fn build_lights(&self, params: &LightParams, frame: &LightFrame) -> Result<Vec<PointLight>, SceneError> {
+        let surfaces = if params.layout == LightLayout::Surface { self.surfaces() } else { None };
+        params.build_in(frame, surfaces.as_ref())
     }
 
     /// The distinct meshes this scene draws, in first-use order.

@@ -4,18 +4,20 @@
 //! ranges, counts and file size limited before anything is allocated — and every problem is
 //! one error naming the file and, where the parser knows it, the line.
 
-use crate::camera::{clip_planes_for, frame_scene, framing_distance, Camera, DEFAULT_ASPECT, DEFAULT_FOV_Y_DEG};
+use crate::camera::{clip_planes_for, Camera, DEFAULT_FOV_Y_DEG};
+use crate::error::Number;
 use crate::files::{read_regular, ReadError};
+use crate::framing::{frame_scene, framing_distance, DEFAULT_ASPECT};
 use crate::gltf_scene::GltfError;
 use crate::gpu_types::{LightCone, PointLight};
-use crate::lights::{MAX_LIGHTS, SEED_RADIUS};
+use crate::lights::SEED_RADIUS;
+pub use crate::limits::MAX_OBJECTS;
+use crate::limits::{LENGTHS, MAX_COORDINATE, MAX_INTENSITY, MAX_LIGHTS, SCALES};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::{DirectionalLight, Object, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
-use crate::scene_load::{
-    check_extent, read_reference, ExtentError, Number, ReferenceError, LENGTHS, MAX_COORDINATE, MAX_INTENSITY, SCALES,
-};
-pub use crate::scene_load::{SceneFile, MAX_OBJECTS};
+pub use crate::scene_load::SceneFile;
+use crate::scene_load::{check_extent, read_reference, ExtentError, ReferenceError};
 use crate::SceneError;
 use glam::Vec3;
 use serde::{de, Deserialize, Deserializer};
@@ -515,7 +517,7 @@ fn light(l: &FileLight) -> Result<Light, Problem> {
 
 /// The file's camera; fields it leaves out come from a camera framing every object: without
 /// position and target, the one that frames the objects for a default-sized image
-/// (`camera::frame_scene`; a render of another aspect frames them again for its own), else
+/// (`framing::frame_scene`; a render of another aspect frames them again for its own), else
 /// looking at the centre of their bounds from above and in front, the whole box in view. And
 /// whether it is that framing camera unchanged (`Scene::camera_framed`).
 fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<(Camera, bool), Problem> {

@@ -1,46 +1,17 @@
 //! What the scene-file and glTF loaders share: reading the files they name, never outside
 //! their folder, and what a loaded file gives.
 
+use crate::error::Number;
 use crate::files::{read_regular, ReadError};
+use crate::limits::{LENGTHS, MAX_COORDINATE};
 use crate::scene::Scene;
-use std::ops::RangeInclusive;
 use std::path::{Component, Path};
 use thiserror::Error;
 
-/// Most objects a scene may hold, whichever file it came from.
-pub const MAX_OBJECTS: usize = 1 << 20;
-
-/// Largest |coordinate| of anything a file places (objects' boxes, lights, the camera): a
-/// thousand kilometres in metres, a kilometre in millimetres. Beyond, f32 keeps too few digits
-/// for the model, and its depth range for the camera.
-pub const MAX_COORDINATE: f32 = 1e6;
-/// Lengths a file gives: light radii, near and far planes, an orthographic camera's half-height.
-pub const LENGTHS: RangeInclusive<f32> = 1e-6..=1e7;
-/// Scales: a scene file's objects, each axis of a glTF node's transform.
-pub const SCALES: RangeInclusive<f32> = 1e-6..=1e6;
-/// Largest light colour (glTF: colour × intensity, sunlight being about 1e5 lux), ambient
-/// term and emissive strength.
-pub const MAX_INTENSITY: f32 = 1e7;
 /// The least size of a scene's box (its largest side) over its distance from the origin: f32
 /// keeps about 7 digits, so a model smaller than this for where it is would be crushed by
 /// rounding (and the lights fitted to its box would have no size).
 const LEAST_RELATIVE_SIZE: f32 = 1e-6;
-
-/// A number as an error shows it: as written for everyday sizes, in exponent form for the very
-/// large and very small ("1e38", not thirty-nine digits).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Number(pub f32);
-
-impl std::fmt::Display for Number {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        let size = self.0.abs();
-        if size == 0.0 || (1e-4..1e7).contains(&size) || !size.is_finite() {
-            write!(f, "{}", self.0)
-        } else {
-            write!(f, "{:e}", self.0)
-        }
-    }
-}
 
 /// A scene whose box cannot be rendered.
 #[derive(Debug, Error, PartialEq)]

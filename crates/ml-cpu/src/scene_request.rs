@@ -3,7 +3,8 @@
 //! as warnings, for the caller to show.
 
 use crate::bench_scene::bench_scene;
-use crate::camera::{frame_scene, CameraSpec, DEFAULT_ASPECT};
+use crate::camera::CameraSpec;
+use crate::framing::{frame_scene, DEFAULT_ASPECT};
 use crate::gltf_scene::{self, GltfFileError};
 use crate::lights::{LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
@@ -58,7 +59,7 @@ pub struct SceneRequest {
     /// Draw every point light as a small glowing cube (`Scene::with_light_markers`).
     pub show_lights: bool,
     /// Width over height of the image the scene is seen in: a file without a camera is framed
-    /// for it (`camera::frame_scene`).
+    /// for it (`framing::frame_scene`).
     pub aspect: f32,
 }
 
@@ -185,7 +186,7 @@ impl SceneRequest {
             let count = self.lights.unwrap_or(DEFAULT_RIG_LIGHTS as u64);
             let (lo, hi) = scene.bounds();
             let frame = LightFrame::around(lo, hi);
-            let surfaces = if self.layout == LightLayout::Surface { SurfaceSampler::new(&scene) } else { None };
+            let surfaces = if self.layout == LightLayout::Surface { scene.surfaces() } else { None };
             let area = surfaces.as_ref().map_or(0.0, SurfaceSampler::area);
             let params = self.lights_of(count, |n| frame.fitted_radius(self.layout, n, area)).map_err(|problem| match problem {
                 SceneError::FittedRadius(_) => SceneRequestError::FileLights { path: path.clone(), problem },
@@ -264,10 +265,10 @@ mod tests {
         assert_eq!(built.scene.lights[0].position_radius[1], 1.5);
         assert!(built.scene.lights.iter().all(|l| l.position_radius[1] <= 1.5 && l.position_radius[3] == radius));
         // Framed for a default-sized image; asked for another aspect, framed for that one.
-        let framed = crate::camera::frame_scene(&built.scene, DEFAULT_ASPECT, 60.0);
+        let framed = crate::framing::frame_scene(&built.scene, DEFAULT_ASPECT, 60.0);
         assert_eq!(built.scene.camera, framed);
         let tall = SceneRequest { aspect: 0.5, ..dark.clone() }.build().unwrap();
-        assert_eq!(tall.scene.camera, crate::camera::frame_scene(&built.scene, 0.5, 60.0));
+        assert_eq!(tall.scene.camera, crate::framing::frame_scene(&built.scene, 0.5, 60.0));
         assert!(tall.scene.camera.position.distance(glam::Vec3::ZERO) > framed.position.distance(glam::Vec3::ZERO));
         let lit = SceneRequest { lights: Some(4), shading: Some(ShadingModel::Seed), ..dark }.build().unwrap();
         assert_eq!((lit.scene.lights.len(), lit.shading), (4, ShadingModel::Seed));

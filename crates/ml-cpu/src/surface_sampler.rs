@@ -1,11 +1,12 @@
 //! Area-weighted random points on a scene's surfaces (the `surface` light layout): every
 //! triangle of every object in world space, drawn with probability proportional to its area,
-//! a point uniform inside it.
+//! a point uniform inside it. It takes meshes with their object-to-world transforms rather
+//! than a scene, since scenes are built with the lights placed from it (`Scene::surfaces`
+//! hands over a scene's objects).
 
-use crate::scene::Scene;
-use glam::Vec3;
+use crate::mesh::Mesh;
+use glam::{Mat4, Vec3};
 use rand::Rng;
-use std::collections::HashMap;
 
 /// A scene's world-space triangles and their running area, to draw points from.
 pub struct SurfaceSampler {
@@ -16,13 +17,12 @@ pub struct SurfaceSampler {
 }
 
 impl SurfaceSampler {
-    /// The scene's triangles; None when they have no area at all.
-    pub fn new(scene: &Scene) -> Option<SurfaceSampler> {
-        let mut meshes = HashMap::new();
+    /// The triangles of each mesh moved into the world by its transform (an object's); None
+    /// when they have no area at all.
+    pub fn new<'a>(placed: impl IntoIterator<Item = (&'a Mesh, Mat4)>) -> Option<SurfaceSampler> {
         let (mut triangles, mut cumulative, mut total) = (Vec::new(), Vec::new(), 0.0f32);
-        for object in &scene.objects {
-            let mesh = meshes.entry(object.mesh).or_insert_with(|| scene.mesh(object.mesh).unwrap_or_default());
-            let world: Vec<Vec3> = mesh.vertices.iter().map(|v| object.transform.transform_point3(Vec3::from(v.position))).collect();
+        for (mesh, transform) in placed {
+            let world: Vec<Vec3> = mesh.vertices.iter().map(|v| transform.transform_point3(Vec3::from(v.position))).collect();
             for t in mesh.indices.chunks_exact(3) {
                 let corners = [world[t[0] as usize], world[t[1] as usize], world[t[2] as usize]];
                 let area = (corners[1] - corners[0]).cross(corners[2] - corners[0]).length() * 0.5;
@@ -62,7 +62,7 @@ mod tests {
     use crate::camera::Camera;
     use crate::material::Material;
     use crate::mesh::MeshKind;
-    use crate::scene::Object;
+    use crate::scene::{Object, Scene};
     use rand::SeedableRng;
 
     #[test]
@@ -77,7 +77,7 @@ mod tests {
             Vec::new(),
             Camera::seed(),
         );
-        let sampler = SurfaceSampler::new(&scene).unwrap();
+        let sampler = scene.surfaces().unwrap();
         assert!((sampler.area() - 40.0).abs() < 1e-3, "{}", sampler.area());
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         let mut high = 0;
@@ -100,7 +100,7 @@ mod tests {
             transform: glam::Mat4::from_scale(Vec3::ZERO),
             ..Object::placed(MeshKind::Cube, Vec3::ZERO, 1.0, Material::named("white").unwrap())
         };
-        assert!(SurfaceSampler::new(&Scene::new(vec![flat], Vec::new(), Camera::seed())).is_none());
-        assert!(SurfaceSampler::new(&Scene::new(Vec::new(), Vec::new(), Camera::seed())).is_none());
+        assert!(Scene::new(vec![flat], Vec::new(), Camera::seed()).surfaces().is_none());
+        assert!(Scene::new(Vec::new(), Vec::new(), Camera::seed()).surfaces().is_none());
     }
 }

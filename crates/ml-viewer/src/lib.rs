@@ -413,7 +413,7 @@ impl<'c> Session<'c> {
                         // Frame the scene for the window as it is now (a file's first view).
                         if let Some(r) = self.renderer.as_mut() {
                             let aspect = r.settings().width as f32 / r.settings().height.max(1) as f32;
-                            let framed = ml_cpu::camera::frame_scene(r.scene(), aspect, r.camera().fov_y_deg);
+                            let framed = ml_cpu::framing::frame_scene(r.scene(), aspect, r.camera().fov_y_deg);
                             if let Err(e) = r.set_camera(framed) {
                                 self.overlay.error = Some(format!("{e:#}"));
                             }

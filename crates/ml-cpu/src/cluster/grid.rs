@@ -10,6 +10,7 @@
 //! perspective projection crowds almost every depth into the last few slices.
 
 use crate::camera::Camera;
+use crate::limits::MAX_CLUSTERS;
 use glam::{Mat4, Vec3, Vec3A};
 
 /// Grid size X×Y×Z.
@@ -23,9 +24,6 @@ pub struct ClusterDims {
 impl ClusterDims {
     /// The default: 16×9 tiles (16:9 screens get square-ish tiles), 24 slices.
     pub const DEFAULT: ClusterDims = ClusterDims { x: 16, y: 9, z: 24 };
-    /// The largest grid we accept (a million clusters; the GPU scan handles 1024 blocks of
-    /// 1024, see cluster_scan.comp).
-    pub const MAX_CLUSTERS: u64 = 1 << 20;
 
     /// Parse `XxYxZ`, e.g. `16x9x24`.
     pub fn parse(text: &str) -> Result<ClusterDims, crate::SceneError> {
@@ -33,7 +31,7 @@ impl ClusterDims {
         let parts: Vec<u32> = text.split('x').map(|p| p.trim().parse::<u32>().map_err(|_| bad())).collect::<Result<_, _>>()?;
         let [x, y, z] = parts[..] else { return Err(bad()) };
         let total = x as u64 * y as u64 * z as u64;
-        if x == 0 || y == 0 || z == 0 || total > Self::MAX_CLUSTERS {
+        if x == 0 || y == 0 || z == 0 || total > MAX_CLUSTERS {
             return Err(bad());
         }
         Ok(ClusterDims { x, y, z })

@@ -309,5 +309,5 @@ fn auto_grids_grow_with_the_cube_root_of_the_light_count() {
     // Tiles stay at least 16 px when scaling up, and never fall below the default grid.
     assert_eq!(auto(1_000_000, 640, 360), (40, 22, 96));
     assert_eq!(auto(1_000_000, 64, 64), (16, 9, 96));
-    assert!(ClusterDims::for_lights(usize::MAX, u32::MAX, u32::MAX).count() as u64 <= ClusterDims::MAX_CLUSTERS);
+    assert!(ClusterDims::for_lights(usize::MAX, u32::MAX, u32::MAX).count() as u64 <= crate::limits::MAX_CLUSTERS);
 }

@@ -17,7 +17,7 @@ fn only_objects_are_required() {
     // ahead of it, all of the sphere in view, filling most of the image's height.
     let c = &s.camera;
     assert!((c.forward() - (Vec3::ZERO - c.position).normalize()).length() < 0.05);
-    let view_proj = c.projection(crate::camera::DEFAULT_ASPECT) * c.view();
+    let view_proj = c.projection(crate::framing::DEFAULT_ASPECT) * c.view();
     let (mut y0, mut y1) = (f32::MAX, f32::MIN);
     for v in MeshKind::Sphere.build().vertices {
         let p = view_proj.project_point3(Vec3::from(v.position));

@@ -21,7 +21,7 @@ use ml_vk::{shader, vk, Buffer, Context, VkError};
 
 const BUILD_GROUP: u32 = 128;
 const BOUNDS_GROUP: u32 = 64;
-/// Clusters per scan block (cluster_scan.comp); ClusterDims::MAX_CLUSTERS = SCAN_BLOCK² so the
+/// Clusters per scan block (cluster_scan.comp); ml_cpu::limits::MAX_CLUSTERS = SCAN_BLOCK² so the
 /// block totals fit one workgroup.
 const SCAN_BLOCK: u32 = 1024;
 

@@ -1,0 +1,37 @@
+//! The limits and value ranges that more than one module checks or names: how much a request
+//! may ask for (lights, bench objects, clusters, light markers) and what a scene file or glTF
+//! file may give (objects, coordinates, lengths, scales, intensities). A leaf, it uses nothing
+//! of the crate: `SceneError`'s messages name these limits, and the modules that check them
+//! return `SceneError`, so the limits cannot live in those modules without a circle.
+
+use std::ops::RangeInclusive;
+
+/// The most lights a scene may hold (16.7 M × 32 B = 512 MiB of light data). Above a million
+/// is what the clustered techniques are built for; beyond this is a typo, not a workload.
+pub const MAX_LIGHTS: u64 = 1 << 24;
+
+/// The most objects the bench scene places (a million-triangle mesh budget per hundred).
+pub const MAX_BENCH_OBJECTS: usize = 100_000;
+
+/// The largest cluster grid we accept (a million clusters; the GPU scan handles 1024 blocks of
+/// 1024, see cluster_scan.comp).
+pub const MAX_CLUSTERS: u64 = 1 << 20;
+
+/// Most lights `--show-lights` draws: each marker is an object of its own (one draw each in
+/// the forward techniques).
+pub const MAX_LIGHT_MARKERS: usize = 65_536;
+
+/// Most objects a scene may hold, whichever file it came from.
+pub const MAX_OBJECTS: usize = 1 << 20;
+
+/// Largest |coordinate| of anything a file places (objects' boxes, lights, the camera): a
+/// thousand kilometres in metres, a kilometre in millimetres. Beyond, f32 keeps too few digits
+/// for the model, and its depth range for the camera.
+pub const MAX_COORDINATE: f32 = 1e6;
+/// Lengths a file gives: light radii, near and far planes, an orthographic camera's half-height.
+pub const LENGTHS: RangeInclusive<f32> = 1e-6..=1e7;
+/// Scales: a scene file's objects, each axis of a glTF node's transform.
+pub const SCALES: RangeInclusive<f32> = 1e-6..=1e6;
+/// Largest light colour (glTF: colour × intensity, sunlight being about 1e5 lux), ambient
+/// term and emissive strength.
+pub const MAX_INTENSITY: f32 = 1e7;
