@@ -3,7 +3,7 @@
 
 use crate::SceneError;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ShadingModel {
     /// Specular-only Cook–Torrance, an ambient factor, gamma.
     Seed,

@@ -12,6 +12,7 @@ pub mod frame;
 pub mod frame_resources;
 pub mod gpu_mesh;
 pub mod pass;
+pub mod plan;
 pub mod render_pass;
 pub mod renderer;
 pub mod report;

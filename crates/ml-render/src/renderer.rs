@@ -198,42 +198,31 @@ impl<'a> Renderer<'a> {
         Ok(())
     }
 
-    /// Render with `settings` from now on where they differ from the current ones only in
-    /// what the pipelines do not depend on — size, cluster grid, debug view, frames, clock —
-    /// and say so (true); false, changing nothing, for anything else (make a new renderer).
-    /// New frame slots (targets, per-frame buffers, the passes' sets), cluster grid, and new
-    /// passes for a new grid or debug view; meshes, textures and the scene's buffers stay (the
-    /// viewer's resizes and overlay).
+    /// Render with `settings` from now on where their pipeline key's renderer part is the
+    /// current one's (`PipelineKey::renderer_part`: the scene's GPU resources are made for
+    /// it), and say so (true); false, changing nothing, for anything else (make a new
+    /// renderer). New frame slots (targets, per-frame buffers, the passes' sets) and cluster
+    /// grid, and new passes where the key changed (grid, debug view, exposure meter); meshes,
+    /// textures and the scene's buffers stay (the viewer's resizes and overlay).
     pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<bool, RenderError> {
-        let same_pipelines = RenderSettings {
-            width: self.settings.width,
-            height: self.settings.height,
-            clusters: self.settings.clusters,
-            debug_view: self.settings.debug_view,
-            frames: self.settings.frames,
-            time: self.settings.time,
-            exposure: self.settings.exposure,
-            ..settings
-        } == self.settings;
-        if !same_pipelines {
+        let (key, new_key) = (self.settings.pipeline_key(), settings.pipeline_key());
+        if key.renderer_part() != new_key.renderer_part() {
             return Ok(false);
         }
         settings.check(self.ctx, self.scene.lights.len())?;
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
         check_lists_fit(self.ctx, &settings, &grid, &self.scene.lights, self.scene.light_motion)?;
         self.release_frames()?;
-        let (new_grid, new_view) = (settings.clusters != self.settings.clusters, settings.debug_view != self.settings.debug_view);
-        // The exposure meter is a pass of its own.
-        let new_meter = settings.meters_exposure() != self.settings.meters_exposure();
         if let Some(ev) = fixed_ev(&settings) {
             self.exposure_ev = ev;
         }
         self.settings = settings;
         self.extent = vk::Extent2D { width: settings.width, height: settings.height };
         self.grid = grid;
-        // The passes depend on the grid (the GPU build's sizes) and the debug view (legend,
-        // tone-map curve, view passes); sizes only need new frame slots.
-        if new_grid || new_view || new_meter {
+        // The passes depend on the grid (the GPU build's sizes), the debug view (legend,
+        // tone-map curve, view passes) and the exposure meter; the view only needs new frame
+        // slots.
+        if new_key != key {
             self.make_passes()?;
         }
         self.create_frames()?;

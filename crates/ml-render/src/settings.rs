@@ -6,7 +6,7 @@ pub use ml_cpu::shading_model::ShadingModel;
 use ml_vk::{vk, Context};
 
 /// Lighting techniques (docs/DESIGN.md#techniques-are-two-choices). Each must give the same image as `Forward`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Technique {
     /// Brute force: every fragment loops over every light.
     Forward,
@@ -186,7 +186,7 @@ impl Shading {
 }
 
 /// How point-light shadow cubes are rendered (docs/DESIGN.md#point-light-shadows).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum OmniShadowMode {
     /// The classic way: each face into one offscreen depth target, then copied into the cube.
     Copy,
@@ -210,7 +210,7 @@ pub enum OmniShadowMode {
 }
 
 /// The shadow atlas's settings.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct AtlasSettings {
     /// MiB all point-light shadow memory may take: the atlas, its tables and the raster's
     /// lists.
@@ -261,7 +261,7 @@ impl OmniShadowMode {
 }
 
 /// Point-light shadows: how the cubes are made, for how many lights, how large.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct OmniShadowSettings {
     pub mode: OmniShadowMode,
     /// Lights with a shadow cube (the strongest as seen from the camera), at most; with
@@ -300,7 +300,7 @@ impl OmniShadowSettings {
 
 /// Who draws the sun's shadow map (blinn-phong), once, when the scene's objects reach the GPU
 /// (docs/DESIGN.md#sun-shadow-map).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SunShadowMode {
     /// A depth-only render pass.
     Graphics,
@@ -324,7 +324,7 @@ impl SunShadowMode {
 }
 
 /// Who draws the visibility buffer (technique visibility; docs/DESIGN.md#compute-raster).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Raster {
     /// The graphics pipeline: each culling phase's triangles in one indexed draw.
     Hardware,
@@ -335,7 +335,7 @@ pub enum Raster {
 }
 
 /// Who draws the compute raster's large triangles.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum LargeTriangles {
     /// The hardware, in each phase's indexed draw (`--raster hybrid`).
     Hardware,
@@ -413,7 +413,7 @@ pub fn missing_raster_feature(raster: Raster, features: &ml_vk::OptionalFeatures
 pub const MAX_OMNI_BYTES: u64 = 4 << 30;
 
 /// What the image shows instead of the shaded scene.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DebugView {
     None,
     /// Lights per cluster as a heat map (clustered forward techniques).

@@ -14,7 +14,7 @@ use crate::limits::MAX_CLUSTERS;
 use glam::{Mat4, Vec3, Vec3A};
 
 /// Grid size X×Y×Z.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ClusterDims {
     pub x: u32,
     pub y: u32,

@@ -16,6 +16,7 @@ use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
+use crate::plan::Phase;
 use crate::report::CullStats;
 use crate::scene::meshlets::SPEC_SURFACE_TESTS;
 use crate::settings::Raster;
@@ -27,12 +28,6 @@ use ml_vk::{shader, vk, Context, VkError};
 
 /// Work-group size of both culling shaders.
 const GROUP: u32 = 64;
-
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub enum Phase {
-    Early,
-    Late,
-}
 
 pub struct MeshletCull {
     phase: Phase,

@@ -1,0 +1,284 @@
+//! Which passes a frame is made of, as plain data: the settings that make pipelines (a
+//! `PipelineKey`) → the ordered list of pass kinds the renderer records (`plan`). No Vulkan
+//! here, so the unit tests below check every technique's list — the frames
+//! docs/architecture.md draws — without a GPU; `assembly` then makes each kind's pass.
+//!
+//! Settings fall in three groups by what a change to them costs: the pipeline key (new
+//! passes, or a new renderer where the scene's GPU resources depend on it), the view (new
+//! frame slots: size, exposure value) and the run (nothing: frame count, clock).
+
+use crate::settings::{
+    DebugView, Exposure, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings,
+    ShadingModel, SunShadowMode, Technique,
+};
+use ml_cpu::cluster::ClusterDims;
+
+/// The early or the late phase of the visibility technique's culling and raster.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum Phase {
+    Early,
+    Late,
+}
+
+/// A pass of a frame, as data.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum PassKind {
+    /// Point-light shadow cubes by a graphics mode (copy, direct, multiview, layered).
+    OmniShadows,
+    /// Point-light shadow cubes by the compute shadow raster.
+    OmniShadowsCompute,
+    /// The frame's shadow atlas faces by the compute shadow raster.
+    ShadowAtlas,
+    /// Light assignment on the CPU, before the frame is recorded (no GPU work).
+    ClusterAssignCpu,
+    /// Light assignment on the GPU.
+    ClusterBuild,
+    /// Forward shading, every light or through the cluster lists, with the heat map's legend.
+    Forward { clustered: bool, heat_legend: bool },
+    /// The deferred render pass: G-buffer subpass, lighting subpass.
+    DeferredSubpasses { clustered: bool },
+    /// HDR → colour target after the deferred subpasses, with pbr's curve or as it is.
+    ToneMap { curve: bool },
+    /// deferred-compute's G-buffer.
+    GBuffer,
+    /// deferred-compute's lighting of the G-buffer.
+    ComputeLighting,
+    /// The visibility technique's culling of a phase.
+    MeshletCull(Phase),
+    /// The compute raster's large triangles of a phase (by bins).
+    TriangleRasterLarge(Phase),
+    /// A phase's kept triangles drawn by the hardware (all, or the large ones of the hybrid).
+    VisibilityRaster(Phase),
+    /// The depth pyramid the late culling tests against.
+    DepthPyramid,
+    /// Lighting from the visibility buffer.
+    VisibilityLighting,
+    /// The shadow-map, shadow-cube and shadow-atlas debug views.
+    ShadowMapView,
+    /// Auto exposure's meter, reading the finished image (with pbr's curve or without).
+    ExposureMeter { curve: bool },
+}
+
+/// What the passes and their pipelines are made for. A change in `technique`, `shading`,
+/// `omni`, `sun_shadow`, `raster` or `culling` needs a new renderer (the scene's GPU
+/// resources depend on them); in `clusters`, `debug_view` or `meters_exposure` new passes.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub struct PipelineKey {
+    pub technique: Technique,
+    pub shading: ShadingModel,
+    pub omni: Option<OmniShadowSettings>,
+    pub sun_shadow: SunShadowMode,
+    pub raster: Raster,
+    pub culling: bool,
+    pub clusters: ClusterDims,
+    pub debug_view: DebugView,
+    /// Auto exposure meters the image (auto exposure, no debug view).
+    pub meters_exposure: bool,
+}
+
+impl PipelineKey {
+    /// The part of the key the renderer's scene resources are made for: equal parts, the
+    /// renderer can change its passes in place.
+    pub fn renderer_part(&self) -> (Technique, ShadingModel, Option<OmniShadowSettings>, SunShadowMode, Raster, bool) {
+        (self.technique, self.shading, self.omni, self.sun_shadow, self.raster, self.culling)
+    }
+}
+
+/// What the frame slots are made for: a change makes new slots, not new passes.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub struct ViewConfig {
+    pub width: u32,
+    pub height: u32,
+    pub exposure: Exposure,
+}
+
+/// What a render runs: changes cost nothing.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub struct RunParams {
+    pub frames: u32,
+    pub time: Option<f32>,
+}
+
+impl RenderSettings {
+    pub fn pipeline_key(&self) -> PipelineKey {
+        PipelineKey {
+            technique: self.technique,
+            shading: self.shading,
+            omni: self.omni,
+            sun_shadow: self.sun_shadow,
+            raster: self.raster,
+            culling: self.culling,
+            clusters: self.clusters,
+            debug_view: self.debug_view,
+            meters_exposure: self.meters_exposure(),
+        }
+    }
+
+    pub fn view_config(&self) -> ViewConfig {
+        ViewConfig { width: self.width, height: self.height, exposure: self.exposure }
+    }
+
+    pub fn run_params(&self) -> RunParams {
+        RunParams { frames: self.frames, time: self.time }
+    }
+}
+
+/// The passes of a frame in recording order: point-light shadows, light assignment, the
+/// raster pass and lighting after it, then debug views and the exposure meter over the
+/// result.
+pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
+    let mut kinds = Vec::new();
+    let technique = key.technique;
+    match key.omni.map(|o| o.mode) {
+        Some(OmniShadowMode::Compute { .. }) => kinds.push(PassKind::OmniShadowsCompute),
+        Some(OmniShadowMode::Atlas(_)) => kinds.push(PassKind::ShadowAtlas),
+        Some(_) => kinds.push(PassKind::OmniShadows),
+        None => {}
+    }
+    match technique.assignment() {
+        LightAssignment::None => {}
+        LightAssignment::Cpu => kinds.push(PassKind::ClusterAssignCpu),
+        LightAssignment::Gpu => kinds.push(PassKind::ClusterBuild),
+    }
+    let clustered = technique.assignment() != LightAssignment::None;
+    match (technique.geometry(), technique.lighting_stage()) {
+        (Geometry::Meshlets, _) => {
+            for phase in [Phase::Early, Phase::Late] {
+                kinds.push(PassKind::MeshletCull(phase));
+                kinds.push(match key.raster {
+                    Raster::Compute { .. } if key.raster.bin_list().is_some() => PassKind::TriangleRasterLarge(phase),
+                    _ => PassKind::VisibilityRaster(phase),
+                });
+                if phase == Phase::Early {
+                    kinds.push(PassKind::DepthPyramid);
+                }
+            }
+            kinds.push(PassKind::VisibilityLighting);
+        }
+        (Geometry::Meshes, LightingStage::Forward) => {
+            kinds.push(PassKind::Forward { clustered, heat_legend: key.debug_view == DebugView::ClusterHeat });
+        }
+        (Geometry::Meshes, LightingStage::Subpass) => {
+            kinds.push(PassKind::DeferredSubpasses { clustered });
+            // pbr's curve, not for surface views (their values are shown as they are).
+            let surface_view = !matches!(key.debug_view, DebugView::None | DebugView::ClusterHeat);
+            kinds.push(PassKind::ToneMap { curve: key.shading == ShadingModel::Pbr && !surface_view });
+        }
+        (Geometry::Meshes, LightingStage::Compute) => {
+            kinds.push(PassKind::GBuffer);
+            kinds.push(PassKind::ComputeLighting);
+        }
+    }
+    if matches!(key.debug_view, DebugView::ShadowMap | DebugView::ShadowCube | DebugView::ShadowAtlas) {
+        kinds.push(PassKind::ShadowMapView);
+    }
+    if key.meters_exposure {
+        kinds.push(PassKind::ExposureMeter { curve: key.shading == ShadingModel::Pbr });
+    }
+    kinds
+}
+
+#[cfg(test)]
+mod tests {
+    use super::PassKind::*;
+    use super::*;
+    use crate::settings::{AtlasSettings, LargeTriangles};
+
+    /// The key of `technique` with the binary's defaults: pbr, auto exposure.
+    fn key(technique: Technique) -> PipelineKey {
+        RenderSettings { shading: ShadingModel::Pbr, exposure: Exposure::Auto, ..RenderSettings::new(technique, 64, 64) }.pipeline_key()
+    }
+
+    fn shadowed(mut k: PipelineKey, mode: OmniShadowMode) -> PipelineKey {
+        k.omni = Some(OmniShadowSettings { mode, lights: 4, all: false, size: 64 });
+        k
+    }
+
+    #[test]
+    fn each_technique_gets_the_frame_the_architecture_draws() {
+        let cases: [(Technique, &[PassKind]); 6] = [
+            (Technique::Forward, &[Forward { clustered: false, heat_legend: false }]),
+            (Technique::ClusteredCpu, &[ClusterAssignCpu, Forward { clustered: true, heat_legend: false }]),
+            (Technique::ClusteredGpu, &[ClusterBuild, Forward { clustered: true, heat_legend: false }]),
+            (Technique::Deferred, &[DeferredSubpasses { clustered: false }, ToneMap { curve: true }]),
+            (Technique::DeferredClustered, &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, ToneMap { curve: true }]),
+            (Technique::DeferredCompute, &[ClusterBuild, GBuffer, ComputeLighting]),
+        ];
+        for (technique, expected) in cases {
+            let mut k = key(technique);
+            k.meters_exposure = false;
+            assert_eq!(plan(&k), expected, "{}", technique.name());
+        }
+    }
+
+    #[test]
+    fn visibility_culls_and_draws_in_two_phases_around_the_pyramid() {
+        let mut k = key(Technique::Visibility);
+        k.meters_exposure = false;
+        let phases = |raster: fn(Phase) -> PassKind| {
+            vec![
+                ClusterBuild,
+                MeshletCull(Phase::Early),
+                raster(Phase::Early),
+                DepthPyramid,
+                MeshletCull(Phase::Late),
+                raster(Phase::Late),
+                VisibilityLighting,
+            ]
+        };
+        k.raster = Raster::Hardware;
+        assert_eq!(plan(&k), phases(VisibilityRaster));
+        k.raster = Raster::hybrid(64);
+        assert_eq!(plan(&k), phases(VisibilityRaster), "hybrid: large triangles by the hardware");
+        k.raster = Raster::compute(64);
+        assert!(matches!(k.raster, Raster::Compute { large: LargeTriangles::Bins { .. }, .. }));
+        assert_eq!(plan(&k), phases(TriangleRasterLarge));
+    }
+
+    #[test]
+    fn shadows_come_first_and_views_and_the_meter_last() {
+        let forward = Forward { clustered: false, heat_legend: false };
+        let k = key(Technique::Forward);
+        assert!(k.meters_exposure, "auto exposure is the default");
+        assert_eq!(plan(&k), [forward, ExposureMeter { curve: true }]);
+        for (mode, first) in [
+            (OmniShadowMode::Layered, OmniShadows),
+            (OmniShadowMode::COMPUTE, OmniShadowsCompute),
+            (OmniShadowMode::Atlas(AtlasSettings::DEFAULT), ShadowAtlas),
+        ] {
+            let mut k = shadowed(key(Technique::Forward), mode);
+            k.debug_view = DebugView::ShadowCube;
+            k.meters_exposure = false;
+            assert_eq!(plan(&k), [first, forward, ShadowMapView], "{}", mode.name());
+        }
+        let mut k = key(Technique::ClusteredGpu);
+        k.debug_view = DebugView::ClusterHeat;
+        k.meters_exposure = false;
+        assert_eq!(plan(&k), [ClusterBuild, Forward { clustered: true, heat_legend: true }]);
+    }
+
+    #[test]
+    fn surface_views_skip_the_tone_curve_and_blinn_phong_has_none() {
+        let mut k = key(Technique::Deferred);
+        k.meters_exposure = false;
+        k.debug_view = DebugView::GBufferNormal;
+        assert_eq!(plan(&k)[1], ToneMap { curve: false });
+        k.debug_view = DebugView::None;
+        k.shading = ShadingModel::BlinnPhong;
+        assert_eq!(plan(&k)[1], ToneMap { curve: false });
+    }
+
+    #[test]
+    fn the_key_leaves_out_what_does_not_make_pipelines() {
+        let a = RenderSettings::new(Technique::Visibility, 64, 64);
+        let b = RenderSettings { width: 128, height: 32, frames: 9, time: Some(1.0), exposure: Exposure::Ev(2.0), ..a };
+        assert_eq!(a.pipeline_key(), b.pipeline_key());
+        assert_ne!(a.view_config(), b.view_config());
+        assert_ne!(a.run_params(), b.run_params());
+        let auto = RenderSettings { exposure: Exposure::Auto, ..a };
+        assert_ne!(a.pipeline_key(), auto.pipeline_key(), "auto exposure adds the meter");
+        // Hashable: a cache of pipelines may be keyed by it.
+        let set: std::collections::HashSet<PipelineKey> = [a.pipeline_key(), b.pipeline_key()].into();
+        assert_eq!(set.len(), 1);
+    }
+}
