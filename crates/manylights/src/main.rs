@@ -14,7 +14,6 @@ use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
-use ml_render::report;
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{DebugView, Exposure, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
@@ -28,6 +27,7 @@ mod bench;
 use applies::{check_options_apply, Auto, Given, Techniques};
 mod messages;
 mod output;
+mod tables;
 
 #[derive(Parser)]
 #[command(name = "manylights", version, about = "A Vulkan renderer for scenes lit by many lights")]
@@ -584,13 +584,13 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         RenderSink { progress: Progress::new(settings.frames as u64, "frames"), sequence, size: (settings.width, settings.height) };
     let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render_into(&mut sink));
     sink.progress.finish();
-    let device = report::device_line(&ctx.info);
+    let device = tables::device_line(&ctx.info);
     drop(ctx);
     let output = result?;
     if sink.sequence.is_none() {
         ml_cpu::files::write_png(&cmd.out, &output.rgba, (output.width, output.height))?;
     }
-    let facts = report::RenderFacts {
+    let facts = tables::RenderFacts {
         device: &device,
         settings: &settings,
         lights,
@@ -599,7 +599,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         raster_auto: raster_why.as_deref(),
         output: &cmd.out,
     };
-    print!("{}", report::table(&report::render_rows(&facts, &output.stats)));
+    print!("{}", tables::table(&tables::render_rows(&facts, &output.stats)));
     let count = messages.load(Ordering::SeqCst);
     if count > 0 {
         bail!("the validation layer reported {count} message(s) (printed above)");
@@ -659,7 +659,7 @@ fn view(cmd: &ViewArgs) -> Result<()> {
 fn info() -> Result<()> {
     let devices = ml_vk::context::list_devices()?;
     for d in devices {
-        println!("{}", report::table(&report::device_rows(&d)));
+        println!("{}", tables::table(&tables::device_rows(&d)));
     }
     Ok(())
 }

@@ -1,0 +1,314 @@
+//! The tables `render` and `info` print: a finished render's settings and measurements
+//! (`render_rows`), a device's facts (`device_rows`), as rows of a two-column table.
+
+use ml_render::report::FrameStats;
+use ml_render::settings::{DebugView, Geometry, LargeTriangles, Raster, RenderSettings};
+use ml_render::targets::{gbuffer_bytes_per_pixel, gbuffer_images};
+use ml_vk::DeviceInfo;
+use std::path::Path;
+
+/// Rows as a table: keys in a column as wide as the widest, then the values.
+pub fn table(rows: &[(&str, String)]) -> String {
+    let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+    rows.iter().map(|(k, v)| format!("{k:<width$}  {v}\n")).collect()
+}
+
+/// A device and its driver in one line.
+pub fn device_line(info: &DeviceInfo) -> String {
+    format!("{} ({}, {} {})", info.name, info.type_name(), info.driver_name, info.driver_info)
+}
+
+/// What a finished render is reported with besides its frame measurements.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderFacts<'a> {
+    /// `device_line` of the device it ran on.
+    pub device: &'a str,
+    /// The settings it ran with (the technique `auto` picked, where it picked).
+    pub settings: &'a RenderSettings,
+    /// Point lights of the scene.
+    pub lights: usize,
+    /// Whether the scene's objects have textures of their own (they widen the G-buffer).
+    pub object_textures: bool,
+    /// Why `auto` picked the technique; None where it was asked for by name.
+    pub auto: Option<&'a str>,
+    /// Why `--raster auto` picked the rasteriser; None where it was asked for by name.
+    pub raster_auto: Option<&'a str>,
+    /// Where the image was written.
+    pub output: &'a Path,
+}
+
+/// Who drew the visibility buffer, in words.
+pub fn raster_line(raster: Raster) -> String {
+    match raster {
+        Raster::Hardware => "hardware (indexed draw per culling phase)".to_owned(),
+        Raster::Compute { split, large: LargeTriangles::Hardware } => format!(
+            "hybrid (triangles up to {split} px a side in compute; larger ones and those crossing the near plane by the hardware; 64-bit atomic min)"
+        ),
+        Raster::Compute { split, large: LargeTriangles::Bins { bin_list } } => format!(
+            "compute (triangles up to {split} px a side a thread each; larger ones and those crossing the near plane clipped, a work group per 64x64 bin, list of {bin_list}; 64-bit atomic min)"
+        ),
+    }
+}
+
+/// The rows of the table `render` prints (`table`).
+pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str, String)> {
+    let settings = facts.settings;
+    let technique = settings.technique;
+    let mut rows = vec![
+        ("device", facts.device.to_owned()),
+        ("resolution", format!("{}x{}", settings.width, settings.height)),
+        ("technique", technique.name().to_owned() + if facts.auto.is_some() { " (auto)" } else { "" }),
+        ("shading", settings.shading.name().to_owned()),
+        ("lights", facts.lights.to_string()),
+        ("frames", stats.frames.to_string()),
+    ];
+    if let Some(why) = facts.auto {
+        rows.push(("auto", why.to_owned()));
+    }
+    match stats.gpu_ms() {
+        Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
+        None => rows.push(("gpu ms", "n/a (device has no timestamp queries)".into())),
+    }
+    if technique.geometry() == Geometry::Meshlets {
+        rows.push(("visibility", "4 bytes/pixel + depth (meshlet instance << 7 | triangle, u32)".to_owned()));
+        rows.push(("raster", raster_line(settings.raster) + if facts.raster_auto.is_some() { " (auto)" } else { "" }));
+        if let Some(why) = facts.raster_auto {
+            rows.push(("auto raster", why.to_owned()));
+        }
+    } else if technique.lights_in_subpass() || technique.lights_in_compute() {
+        rows.push(("g-buffer", gbuffer_line(facts.object_textures, stats.gbuffer_lazily_allocated)));
+    }
+    if let Some(c) = stats.culling {
+        rows.push(("instances", format!("{} submitted, {} in the frustum", c.instances, c.visible_instances)));
+        rows.push((
+            "meshlets",
+            format!(
+                "{} in the scene; early: {} tested, {} drawn; late: {} tested, {} drawn",
+                c.meshlet_instances, c.early_tested, c.early_drawn, c.late_tested, c.late_drawn
+            ),
+        ));
+        let share = 100.0 * c.triangles as f64 / c.scene_triangles.max(1) as f64;
+        rows.push((
+            "triangles",
+            format!("{} drawn of {} ({share:.1} %); the meshlets drawn held {}", c.triangles, c.scene_triangles, c.meshlet_triangles),
+        ));
+        use {LargeTriangles, Raster};
+        match settings.raster {
+            Raster::Hardware => {}
+            Raster::Compute { large: LargeTriangles::Hardware, .. } => rows.push((
+                "compute raster",
+                format!(
+                    "{} triangles ({} pixels covered), {} by the hardware",
+                    c.compute_triangles,
+                    c.compute_pixels,
+                    c.triangles - c.compute_triangles
+                ),
+            )),
+            Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => rows.push((
+                "compute raster",
+                format!(
+                    "{} small triangles a thread each, {} large ones in {} bins ({} drawn in place, the lists full); {} pixels covered",
+                    c.compute_triangles, c.large_triangles, c.bins, c.in_place, c.compute_pixels
+                ),
+            )),
+        }
+    }
+    if let Some(ms) = stats.assign_ms() {
+        rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
+    }
+    if let Some(c) = stats.clusters {
+        let d = settings.clusters;
+        rows.push(("clusters", format!("{}x{}x{} = {}", d.x, d.y, d.z, d.count())));
+        rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
+        rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
+    }
+    if stats.overflowed_frames > 0 {
+        rows.push((
+            "overflows",
+            format!(
+                "{} frame(s) outgrew their light lists; {} re-rendered at the grown size",
+                stats.overflowed_frames, stats.rerendered_frames
+            ),
+        ));
+    }
+    if settings.debug_view == DebugView::ClusterHeat {
+        let top = stats.clusters.map_or(1, |c| c.max_lights.max(1));
+        rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights per cluster")));
+    }
+    if let Some(o) = settings.omni {
+        let which = if o.all { "every light reaching the view" } else { "the strongest" };
+        match o.atlas() {
+            Some(a) => rows.push((
+                "omni shadows",
+                format!(
+                    "atlas: {} light(s) ({which}), faces sized by the screen{}, budget {} MiB, cache {}",
+                    o.lights,
+                    a.fixed_size.map_or(String::new(), |s| format!(" (fixed: {s}²)")),
+                    a.budget_mib,
+                    if a.cache { "on" } else { "off" }
+                ),
+            )),
+            None => rows.push((
+                "omni shadows",
+                format!("{}: {} light(s) ({which}), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size),
+            )),
+        }
+    }
+    if let Some(a) = stats.shadow_atlas {
+        let mib = |b: u64| b as f64 / (1 << 20) as f64;
+        let factor = if a.divided_by > 1 { format!("every face's side ÷{} to fit the budget", a.divided_by) } else { "full size".into() };
+        rows.push((
+            "shadow atlas",
+            format!(
+                "{} faces ({} drawn, {} kept), {factor}; tiles {:.1} of the atlas's {:.1} MiB; all shadow buffers {:.1} of {:.0} MiB",
+                a.faces,
+                a.redrawn,
+                a.faces - a.redrawn,
+                mib(a.tile_bytes),
+                mib(a.atlas_bytes),
+                mib(a.shadow_bytes),
+                mib(a.budget)
+            ),
+        ));
+    }
+    if let Some(r) = stats.omni_raster {
+        let in_place = if r.in_place > 0 { format!(" ({} drawn in place: the large list was full)", r.in_place) } else { String::new() };
+        let pairs_in_place = if r.pairs_in_place > 0 {
+            format!(" ({} drawn by the culling: the pair list was full)", r.pairs_in_place)
+        } else {
+            String::new()
+        };
+        rows.push((
+            "shadow raster",
+            format!(
+                "{} (meshlet, face) pairs{pairs_in_place}; {} small triangles, {} large{in_place}; {} texels covered",
+                r.pairs, r.small, r.large, r.texels
+            ),
+        ));
+    }
+    if let Some(ev) = stats.exposure_ev {
+        let repeats = stats.exposure_repeats;
+        rows.push((
+            "exposure",
+            format!("auto: {ev:+.2} EV (metered on the GPU; the last frame rendered {repeats} more time(s) to settle)"),
+        ));
+    }
+    if let Some(ms) = stats.sun_shadow_ms {
+        let by = settings.sun_shadow.name();
+        let size = ml_render::scene::textures::SHADOW_MAP_SIZE;
+        rows.push(("sun shadow ms", format!("{ms:.3}  (the sun's {size}² shadow map by {by}, once at load)")));
+    }
+    if let Some(m) = stats.memory {
+        let mib = |b: u64| b as f64 / (1 << 20) as f64;
+        rows.push((
+            "memory",
+            format!(
+                "{:.1} MiB in {} buffers and images ({:.1} MiB of blocks reserved from Vulkan; device-local and host-visible)",
+                mib(m.allocated),
+                m.allocations,
+                mib(m.reserved)
+            ),
+        ));
+    }
+    rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
+    rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
+    rows.push(("output", facts.output.display().to_string()));
+    rows
+}
+
+/// The G-buffer of a scene (with object textures or not): its size, its images, and whether
+/// it got lazily allocated memory (None: it lives outside a render pass).
+fn gbuffer_line(object_textures: bool, lazily_allocated: Option<bool>) -> String {
+    let memory = match lazily_allocated {
+        Some(true) => "; transient, lazily allocated",
+        Some(false) => "; transient (this device has no lazily allocated memory)",
+        None => "",
+    };
+    let layout: Vec<&str> = gbuffer_images(object_textures).iter().map(|g| g.layout).collect();
+    format!("{} bytes/pixel + depth ({}){memory}", gbuffer_bytes_per_pixel(object_textures), layout.join(", "))
+}
+
+/// The rows `info` prints for a device: what it is and the limits manylights depends on.
+pub fn device_rows(d: &DeviceInfo) -> Vec<(&'static str, String)> {
+    let l = &d.limits;
+    vec![
+        ("device", format!("{}: {} ({})", d.index, d.name, d.type_name())),
+        ("vulkan", d.api_version_string()),
+        ("driver", format!("{} {}", d.driver_name, d.driver_info)),
+        ("usable", if d.suitable { "yes".into() } else { "no (needs Vulkan 1.2 and a graphics queue)".to_string() }),
+        ("maxImageDimension2D", l.max_image_dimension2_d.to_string()),
+        ("maxStorageBufferRange", l.max_storage_buffer_range.to_string()),
+        ("maxUniformBufferRange", l.max_uniform_buffer_range.to_string()),
+        ("maxPushConstantsSize", l.max_push_constants_size.to_string()),
+        ("maxComputeWorkGroupInvocations", l.max_compute_work_group_invocations.to_string()),
+        ("maxComputeSharedMemorySize", l.max_compute_shared_memory_size.to_string()),
+        ("timestampPeriod (ns)", l.timestamp_period.to_string()),
+        ("timestampComputeAndGraphics", (l.timestamp_compute_and_graphics != 0).to_string()),
+        ("maxImageArrayLayers", l.max_image_array_layers.to_string()),
+        ("imageCubeArray", d.features.image_cube_array.to_string()),
+        ("multiview", d.features.multiview.to_string()),
+        ("shaderOutputLayer", d.features.shader_output_layer.to_string()),
+        ("fullDrawIndexUint32", d.features.full_draw_index_uint32.to_string()),
+        ("sampledImageArrayDynamicIndexing", d.features.sampled_image_array_indexing.to_string()),
+        ("shaderBufferInt64Atomics", d.features.buffer_int64_atomics.to_string()),
+        ("geometryShader", d.features.geometry_shader.to_string()),
+        ("fragmentStoresAndAtomics", d.features.fragment_stores_and_atomics.to_string()),
+        ("subPixelPrecisionBits", l.sub_pixel_precision_bits.to_string()),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn render_rows_follow_the_technique_and_describe_the_gbuffer_from_its_images() {
+        use ml_render::settings::{RenderSettings, Technique};
+        let settings = RenderSettings::new(Technique::DeferredClustered, 64, 36);
+        let mut facts = RenderFacts {
+            device: "gpu",
+            settings: &settings,
+            lights: 5,
+            object_textures: false,
+            auto: None,
+            raster_auto: None,
+            output: Path::new("a.png"),
+        };
+        let mut stats = FrameStats::new(&["g-buffer + lighting"]);
+        stats.frames = 1;
+        stats.gbuffer_lazily_allocated = Some(true);
+        let rows = render_rows(&facts, &stats);
+        let keys: Vec<&str> = rows.iter().map(|(k, _)| *k).collect();
+        assert_eq!(
+            keys,
+            [
+                "device",
+                "resolution",
+                "technique",
+                "shading",
+                "lights",
+                "frames",
+                "gpu ms",
+                "g-buffer",
+                "cpu ms/frame",
+                "wall ms/frame",
+                "output"
+            ]
+        );
+        let value = |rows: &[(&str, String)], key: &str| rows.iter().find(|(k, _)| *k == key).map(|(_, v)| v.clone()).unwrap();
+        assert_eq!(value(&rows, "resolution"), "64x36");
+        assert_eq!(value(&rows, "gpu ms"), "n/a (device has no timestamp queries)");
+        assert_eq!(
+            value(&rows, "g-buffer"),
+            "16 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8); transient, lazily allocated"
+        );
+        facts.object_textures = true;
+        facts.auto = Some("it was faster");
+        let rows = render_rows(&facts, &stats);
+        assert!(value(&rows, "g-buffer").starts_with("22 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8, roughness-metallic RG8, emissive RGBA8)"));
+        assert_eq!((value(&rows, "technique").as_str(), value(&rows, "auto").as_str()), ("deferred-clustered (auto)", "it was faster"));
+        let forward = RenderSettings::new(Technique::Forward, 64, 36);
+        let rows = render_rows(&RenderFacts { settings: &forward, ..facts }, &stats);
+        assert!(rows.iter().all(|(k, _)| *k != "g-buffer"));
+    }
+}
