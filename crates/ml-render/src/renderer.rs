@@ -6,12 +6,13 @@
 
 use crate::assembly::{assemble, Assembly};
 use crate::error::RenderError;
+use crate::exposure::auto_exposure::{self, AutoExposure};
 use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
-use crate::settings::{Exposure, LightAssignment, RenderSettings, MAX_EXPOSURE_EV};
+use crate::settings::{LightAssignment, RenderSettings};
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{count_entries, ClusterGrid, ClusterLists, ClusterStats};
@@ -77,22 +78,9 @@ pub struct Renderer<'a> {
     last_frame: usize,
     /// Format of the depth target (targets are made again on a resize).
     depth_format: vk::Format,
-    /// The EV the next frame is exposed with (auto exposure moves it), and the one each frame
-    /// slot's last frame used.
-    exposure_ev: f32,
-    slot_ev: Vec<f32>,
+    /// The EV the next frame is exposed with (auto exposure moves it).
+    exposure: AutoExposure,
 }
-
-/// Auto exposure aims the log-average luminance at middle grey.
-const EXPOSURE_KEY: f32 = 0.18;
-/// A render's last frame is rendered again, at most this often, until the EV its own image
-/// asks for is within EXPOSURE_SETTLED of the one it used (clipped pixels meter low, so the
-/// first guess from a too-bright frame falls short).
-const EXPOSURE_REPEATS: u32 = 4;
-const EXPOSURE_SETTLED: f32 = 0.05;
-/// In the viewer each frame moves the EV this share of the way to the metered one (about a
-/// third of a second to settle at 60 frames a second).
-pub const VIEWER_EXPOSURE_SMOOTHING: f32 = 0.1;
 
 /// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
 const DEFAULT_HEAT_TOP: f32 = 64.0;
@@ -165,8 +153,7 @@ impl<'a> Renderer<'a> {
             heat_top: DEFAULT_HEAT_TOP,
             last_frame: 0,
             depth_format: depth,
-            exposure_ev: fixed_ev(&settings).unwrap_or(0.0),
-            slot_ev: vec![0.0; FRAMES_IN_FLIGHT],
+            exposure: AutoExposure::new(settings.exposure),
         };
         // Anything made before a failure is released by Drop.
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -213,9 +200,7 @@ impl<'a> Renderer<'a> {
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
         check_lists_fit(self.ctx, &settings, &grid, &self.scene.lights, self.scene.light_motion)?;
         self.release_frames()?;
-        if let Some(ev) = fixed_ev(&settings) {
-            self.exposure_ev = ev;
-        }
+        self.exposure.set_mode(settings.exposure);
         self.settings = settings;
         self.extent = vk::Extent2D { width: settings.width, height: settings.height };
         self.grid = grid;
@@ -422,15 +407,15 @@ impl<'a> Renderer<'a> {
     }
 
     /// Auto exposure: render frame `i` (in slot `last`) again, into the other slot, while the
-    /// EV its image asks for is not the one it used (at most EXPOSURE_REPEATS times); the slot
+    /// EV its image asks for is not the one it used (at most `auto_exposure::REPEATS` times); the slot
     /// that holds the final image.
     fn settle_exposure(&mut self, mut last: usize, i: u32, stats: &mut FrameStats) -> Result<usize, RenderError> {
         if !self.settings.meters_exposure() {
             return Ok(last);
         }
-        for _ in 0..EXPOSURE_REPEATS {
+        for _ in 0..auto_exposure::REPEATS {
             self.adapt_exposure(1.0, last);
-            if (self.exposure_ev - self.slot_ev[last]).abs() <= EXPOSURE_SETTLED {
+            if self.exposure.settled(last) {
                 break;
             }
             stats.exposure_repeats += 1;
@@ -439,22 +424,19 @@ impl<'a> Renderer<'a> {
             self.collect_all(stats)?;
             last = self.complete(last, self.settings.frames - 1, stats)?;
         }
-        stats.exposure_ev = Some(self.slot_ev[last]);
+        stats.exposure_ev = Some(self.exposure.slot_ev(last));
         Ok(last)
     }
 
     /// Auto exposure: move the next frame's EV `share` of the way to the one that brings the
-    /// log-average luminance of slot `slot`'s last frame (collected) to EXPOSURE_KEY.
+    /// log-average luminance of slot `slot`'s last frame (collected) to middle grey.
     fn adapt_exposure(&mut self, share: f32, slot: usize) {
-        if let (Exposure::Auto, Some(log2_luminance)) = (self.settings.exposure, self.reports[slot].log2_luminance) {
-            let wanted = (EXPOSURE_KEY.log2() - log2_luminance).clamp(-MAX_EXPOSURE_EV, MAX_EXPOSURE_EV);
-            self.exposure_ev += (wanted - self.exposure_ev) * share;
-        }
+        self.exposure.adapt(share, self.reports[slot].log2_luminance);
     }
 
     /// The EV the next frame is exposed with.
     pub fn exposure_ev(&self) -> f32 {
-        self.exposure_ev
+        self.exposure.ev()
     }
 
     /// The scene it renders (the viewer frames it).
@@ -501,7 +483,7 @@ impl<'a> Renderer<'a> {
     pub fn draw(&mut self, t: f32, hook: &mut dyn FrameHook, stats: &mut FrameStats) -> Result<(), RenderError> {
         let f = (self.last_frame + 1) % FRAMES_IN_FLIGHT;
         // The slot's previous frame was collected by `wait_next_slot`.
-        self.adapt_exposure(VIEWER_EXPOSURE_SMOOTHING, f);
+        self.adapt_exposure(auto_exposure::VIEWER_SMOOTHING, f);
         self.run_frame(f, t, stats, Some(hook))?;
         self.last_frame = f;
         Ok(())
@@ -653,7 +635,7 @@ impl<'a> Renderer<'a> {
         // World size of a shadow-map texel: the orthographic projection's first row is the
         // sun's x axis over the half-width it covers.
         let shadow_texel_world = 2.0 / self.gpu.shadow_view_proj.row(0).truncate().length() / self.gpu.textures.shadow_size as f32;
-        self.slot_ev[f] = self.exposure_ev;
+        let exposure = self.exposure.expose(f);
         let frame = &mut self.frames[f];
         let uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),
@@ -683,7 +665,7 @@ impl<'a> Renderer<'a> {
                 self.scene.directional.get(i).map_or([0.0; 4], |d| d.direction.extend(0.0).to_array())
             }),
             directional_color: std::array::from_fn(|i| self.scene.directional.get(i).map_or([0.0; 4], |d| d.color.extend(0.0).to_array())),
-            exposure: [self.exposure_ev.exp2(), 0.0, 0.0, 0.0],
+            exposure: [exposure, 0.0, 0.0, 0.0],
         };
         frame.uniforms.write(0, &[uniforms]);
     }
@@ -803,13 +785,5 @@ impl Drop for Renderer<'_> {
         // SAFETY: the device is idle; a null handle is ignored.
         unsafe { ctx.device.destroy_command_pool(self.command_pool, None) };
         self.gpu.destroy(ctx);
-    }
-}
-
-/// The EV `settings` fix, if they fix one (not auto).
-fn fixed_ev(settings: &RenderSettings) -> Option<f32> {
-    match settings.exposure {
-        Exposure::Ev(ev) => Some(ev),
-        Exposure::Auto => None,
     }
 }
