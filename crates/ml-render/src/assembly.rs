@@ -4,6 +4,7 @@
 //! (docs/architecture.md has the checklist).
 
 use crate::clusters::{cluster_assign_cpu, cluster_build};
+use crate::error::RenderError;
 use crate::exposure::{exposure_meter, tone_map};
 use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
@@ -16,7 +17,7 @@ use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::scene::Scene;
-use ml_vk::{vk, Context, VkError};
+use ml_vk::{vk, Context};
 
 /// What the passes of a technique are made for.
 pub struct Assembly<'a> {
@@ -33,7 +34,7 @@ pub struct Assembly<'a> {
 
 /// The technique's passes in recording order: point-light shadows, light assignment, the
 /// raster pass, lighting after it, then debug views over the result.
-pub fn assemble(ctx: &Context, a: &Assembly) -> Result<Vec<Box<dyn Pass>>, VkError> {
+pub fn assemble(ctx: &Context, a: &Assembly) -> Result<Vec<Box<dyn Pass>>, RenderError> {
     let mut passes: Vec<Box<dyn Pass>> = Vec::new();
     match add_passes(ctx, a, &mut passes) {
         Ok(()) => Ok(passes),
@@ -46,7 +47,7 @@ pub fn assemble(ctx: &Context, a: &Assembly) -> Result<Vec<Box<dyn Pass>>, VkErr
     }
 }
 
-fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> Result<(), VkError> {
+fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> Result<(), RenderError> {
     // The visibility passes share the culling's buffers: made with the first that needs them.
     let mut meshlets: Option<SharedMeshletScene> = None;
     for kind in plan(&a.settings.pipeline_key()) {
@@ -56,12 +57,12 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
 }
 
 /// The pass of `kind` for the assembly's scene and settings.
-fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<SharedMeshletScene>) -> Result<Box<dyn Pass>, VkError> {
+fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<SharedMeshletScene>) -> Result<Box<dyn Pass>, RenderError> {
     let s = a.settings;
     let raster = (a.depth_format, a.shading);
     // With the compute or hybrid raster, the pyramid and the lighting read the 64-bit buffer.
     let compute = s.raster != Raster::Hardware;
-    let mut shared = || -> Result<SharedMeshletScene, VkError> {
+    let mut shared = || -> Result<SharedMeshletScene, RenderError> {
         if meshlets.is_none() {
             *meshlets = Some(MeshletScene::new(ctx, a.scene.meshlets()?, s.raster.bin_list().unwrap_or(0))?);
         }

@@ -81,7 +81,7 @@ pub fn vk_type(kind: DescriptorKind) -> vk::DescriptorType {
 impl SetLayout {
     /// Set `set` of the pipeline whose stages are `stages`.
     pub fn new(ctx: &Context, stages: &[(&Shader, vk::ShaderStageFlags)], set: u32) -> Result<SetLayout, VkError> {
-        let bindings = merge(stages, set).map_err(|e| VkError::Limit(format!("shader interface: {e}")))?;
+        let bindings = merge(stages, set).map_err(|e| VkError::Interface(e.to_string()))?;
         let raw_bindings: Vec<vk::DescriptorSetLayoutBinding> = bindings
             .iter()
             .map(|(b, stages)| {
@@ -107,7 +107,7 @@ impl SetLayout {
     pub fn write(&self, ctx: &Context, set: vk::DescriptorSet, lookup: &dyn Fn(&str) -> Option<Resource>) -> Result<(), VkError> {
         for (b, _) in &self.bindings {
             let resource = lookup(b.name)
-                .ok_or_else(|| VkError::Limit(format!("shader binding '{}' (binding {}) has nothing to point at", b.name, b.binding)))?;
+                .ok_or_else(|| VkError::Interface(format!("binding '{}' (binding {}) has nothing to point at", b.name, b.binding)))?;
             let ty = vk_type(b.kind);
             match resource {
                 Resource::Buffer(buffer) => ml_vk::descriptors::write_buffer(ctx, set, b.binding, ty, buffer),

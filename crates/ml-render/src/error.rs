@@ -16,8 +16,12 @@ pub enum RenderError {
     UnknownName { kind: Named, name: String, expected: String },
     #[error("{0}: use fewer or smaller lights, or a coarser cluster grid")]
     ListsTooLong(ListsTooLong),
+    /// What the scene or the settings ask for cannot be done (one line saying why).
     #[error("{0}")]
     Invalid(String),
+    /// A bug: something the renderer should have made first is not there.
+    #[error("internal error (a bug in manylights): {0}")]
+    Internal(String),
 }
 
 /// Cluster light lists longer than what `holder` can take: `needed` entries against `limit`,

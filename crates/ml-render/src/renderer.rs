@@ -167,7 +167,7 @@ impl<'a> Renderer<'a> {
     }
 
     /// The technique's passes for the current scene and settings (replacing any).
-    fn make_passes(&mut self) -> Result<(), VkError> {
+    fn make_passes(&mut self) -> Result<(), RenderError> {
         for p in &mut self.passes {
             p.destroy(self.ctx);
         }

@@ -200,7 +200,7 @@ impl FrameHook for PresentFrame<'_> {
         unsafe { ctx.device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE) };
         if let Some(egui) = &mut p.egui {
             egui.cmd_draw(cmd, extent, self.pixels_per_point, self.primitives)
-                .map_err(|e| VkError::Limit(format!("the overlay could not be drawn: {e}")))?;
+                .map_err(|e| VkError::Library { name: "the overlay's renderer (egui-ash)", message: e.to_string() })?;
         }
         // SAFETY: inside the render pass begun above.
         unsafe { ctx.device.cmd_end_render_pass(cmd) };

@@ -16,8 +16,19 @@ pub enum VkError {
         "validation was requested but the layer VK_LAYER_KHRONOS_validation is not installed: `apt-get install vulkan-validationlayers`"
     )]
     NoValidationLayer,
+    /// More than the device allows (a buffer larger than it binds, ...); says what.
     #[error("{0}")]
-    Limit(String),
+    DeviceLimit(String),
+    /// A swapchain asked of a context made without a window surface.
+    #[error("the Vulkan context has no window surface")]
+    NoSurface,
+    /// The shaders' interface and what Rust binds to it disagree (a bug, found when the
+    /// pipeline is made).
+    #[error("shader interface: {0}")]
+    Interface(String),
+    /// A library that records Vulkan commands for us failed (the overlay's renderer).
+    #[error("{name}: {message}")]
+    Library { name: &'static str, message: String },
     #[error("device '{device}' lacks {what}")]
     Unsupported { device: String, what: String },
     #[error("{what} failed: {result}")]

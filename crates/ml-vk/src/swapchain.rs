@@ -29,7 +29,7 @@ impl Swapchain {
     /// 8-bit UNORM (the renderer writes gamma-encoded values itself) and can be blitted to,
     /// drawn to and copied from (screenshots). `old` is retired into the new one.
     pub fn new(ctx: &Context, size: vk::Extent2D, vsync: bool, old: vk::SwapchainKHR) -> Result<Swapchain> {
-        let surface = ctx.surface().ok_or_else(|| VkError::Limit("the context has no window surface".into()))?;
+        let surface = ctx.surface().ok_or(VkError::NoSurface)?;
         let pd = ctx.physical_device;
         // SAFETY: queries on our physical device and surface.
         let (caps, formats, modes) = unsafe {
@@ -45,11 +45,13 @@ impl Swapchain {
                     .ctx("vkGetPhysicalDeviceSurfacePresentModesKHR")?,
             )
         };
-        let format = formats
-            .iter()
-            .find(|f| matches!(f.format, vk::Format::B8G8R8A8_UNORM | vk::Format::R8G8B8A8_UNORM))
-            .copied()
-            .ok_or_else(|| VkError::Limit(format!("the window surface offers no 8-bit UNORM format ({formats:?})")))?;
+        let format =
+            formats.iter().find(|f| matches!(f.format, vk::Format::B8G8R8A8_UNORM | vk::Format::R8G8B8A8_UNORM)).copied().ok_or_else(
+                || VkError::Unsupported {
+                    device: ctx.info.name.clone(),
+                    what: format!("a window surface format of 8-bit UNORM colour (it offers {formats:?})"),
+                },
+            )?;
         let present_mode = if vsync {
             vk::PresentModeKHR::FIFO
         } else {
@@ -73,7 +75,10 @@ impl Swapchain {
         }
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC;
         if !caps.supported_usage_flags.contains(usage) {
-            return Err(VkError::Limit(format!("the window surface's images lack {usage:?} (they have {:?})", caps.supported_usage_flags)));
+            return Err(VkError::Unsupported {
+                device: ctx.info.name.clone(),
+                what: format!("window surface images with {usage:?} (they have {:?})", caps.supported_usage_flags),
+            });
         }
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(surface.raw)

@@ -4,6 +4,7 @@
 //! lights and the sun. A light-count change does not rebuild it.
 
 use crate::descriptors::Resource;
+use crate::error::RenderError;
 use ml_cpu::gpu_types::{INSTANCE_DOUBLE_SIDED, INSTANCE_MASKED};
 use ml_cpu::meshlets::SceneMeshlets;
 use ml_vk::{vk, Buffer, Context, VkError};
@@ -65,12 +66,12 @@ impl MeshletGeometryView {
 impl MeshletGeometry {
     /// `scene`'s meshlets, built and uploaded, each instance naming its object's texture set
     /// (`texture_sets`, per object: the visibility lighting binds it).
-    pub fn build(ctx: &Context, scene: &ml_cpu::scene::Scene, texture_sets: &[u32]) -> Result<MeshletGeometry, VkError> {
-        let mut geometry = SceneMeshlets::build(scene).map_err(|e| VkError::Limit(e.to_string()))?;
+    pub fn build(ctx: &Context, scene: &ml_cpu::scene::Scene, texture_sets: &[u32]) -> Result<MeshletGeometry, RenderError> {
+        let mut geometry = SceneMeshlets::build(scene).map_err(|e| RenderError::Invalid(e.to_string()))?;
         for (instance, &set) in geometry.instances.iter_mut().zip(texture_sets) {
             instance.surface[1] = set;
         }
-        MeshletGeometry::upload(ctx, &geometry)
+        Ok(MeshletGeometry::upload(ctx, &geometry)?)
     }
 
     /// Upload `g`; every buffer is bound whole as a storage buffer, so one larger than the
@@ -140,7 +141,7 @@ impl ml_vk::Release for MeshletGeometry {
 pub fn storage_bytes(ctx: &Context, name: &str, bytes: u64) -> Result<u64, VkError> {
     let max = ctx.info.limits.max_storage_buffer_range as u64;
     if bytes > max {
-        return Err(VkError::Limit(format!(
+        return Err(VkError::DeviceLimit(format!(
             "the scene's {name} take {} MiB, more than the {} MiB '{}' binds as one storage buffer",
             bytes >> 20,
             max >> 20,

@@ -24,7 +24,7 @@ use ml_cpu::alpha_mask::AlphaMasks;
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::gpu_types::{LightCone, ObjectData};
 use ml_cpu::scene::Scene;
-use ml_vk::{release_on_error, vk, Buffer, Context, VkError};
+use ml_vk::{release_on_error, vk, Buffer, Context};
 
 pub struct SceneGpu {
     pub meshes: Vec<GpuMesh>,
@@ -83,25 +83,26 @@ impl SceneGpu {
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
         let made = Buffer::device_local_with(ctx, "light cones", bytemuck::cast_slice(&cones), vk::BufferUsageFlags::STORAGE_BUFFER)
+            .map_err(RenderError::from)
             .and_then(|cones| {
                 gpu.cones = cones;
                 gpu.upload_objects(ctx, scene)
             });
         if let Err(e) = made {
             gpu.destroy(ctx);
-            return Err(e.into());
+            return Err(e);
         }
         Ok(gpu)
     }
 
     /// The scene's objects on the GPU: its meshes, the object buffer, and (blinn-phong) the
     /// sun's shadow map of them.
-    fn upload_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), VkError> {
+    fn upload_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), RenderError> {
         for kind in scene.mesh_kinds() {
-            let mesh = scene.mesh(kind).ok_or_else(|| VkError::Limit(format!("the scene has no mesh {kind:?}")))?;
+            let mesh = scene.mesh(kind).ok_or_else(|| RenderError::Internal(format!("the scene has no mesh {kind:?}")))?;
             self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
         }
-        let masks = AlphaMasks::pack(scene).map_err(|e| VkError::Limit(e.to_string()))?;
+        let masks = AlphaMasks::pack(scene).map_err(|e| RenderError::Invalid(e.to_string()))?;
         self.alpha_masks = storage_buffer_with(ctx, "alpha masks", bytemuck::cast_slice(&masks.words))?;
         let objects: Vec<ObjectData> = scene.objects.iter().map(|o| object_data(o, &masks, &scene.textures)).collect();
         self.objects = Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?;
@@ -130,11 +131,11 @@ impl SceneGpu {
     /// Draw `scene`'s objects from now on (no frame in flight): new meshes, object buffer and
     /// sun shadow map. Only for scenes without object textures (every object binds the one
     /// set of stand-ins).
-    pub fn replace_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), VkError> {
+    pub fn replace_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), RenderError> {
         // The passes were made for the surface variants (and the masked shadow pipeline) of the
         // objects before.
         if let Some(v) = SurfaceVariant::needed(&scene.objects).into_iter().find(|v| !self.surface_variants.contains(v)) {
-            return Err(VkError::Limit(format!("replaced objects need a surface the renderer was not made for ({v:?})")));
+            return Err(RenderError::Internal(format!("replaced objects need a surface the renderer was not made for ({v:?})")));
         }
         self.release_objects(ctx);
         let stand_ins = self.object_textures.sets[0];
@@ -162,11 +163,11 @@ impl SceneGpu {
     }
 
     /// The scene's meshlets, for a pass that draws them.
-    pub fn meshlets(&self) -> Result<MeshletGeometryView, VkError> {
+    pub fn meshlets(&self) -> Result<MeshletGeometryView, RenderError> {
         self.meshlets
             .as_ref()
             .map(MeshletGeometry::view)
-            .ok_or_else(|| VkError::Limit("the scene's meshlets were not built for these settings".into()))
+            .ok_or_else(|| RenderError::Internal("the scene's meshlets were not built for these settings".into()))
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -19,6 +19,7 @@
 //! (`bind_casters`).
 
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
+use crate::error::RenderError;
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::scene::shadow_atlas::ShadowAtlasGpu;
 use crate::settings::{OmniShadowMode, OmniShadowSettings};
@@ -79,10 +80,14 @@ const SHADER_READERS: vk::PipelineStageFlags =
 impl OmniShadows {
     /// The cubes for `settings` (None: the stand-in), with what renders them; `has_masked`:
     /// whether the scene has alpha-masked objects (they get a pipeline of their own).
-    pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>, has_masked: bool) -> Result<OmniShadows, VkError> {
+    pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>, has_masked: bool) -> Result<OmniShadows, RenderError> {
         let features = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE;
         if !ctx.format_supports(CUBE_FORMAT, features) {
-            return Err(VkError::Limit(format!("'{}' cannot render and sample D32_SFLOAT (point-light shadow cubes)", ctx.info.name)));
+            return Err(VkError::Unsupported {
+                device: ctx.info.name.clone(),
+                what: "D32_SFLOAT depth images it renders and samples (point-light shadow cubes)".into(),
+            }
+            .into());
         }
         let shadows = OmniShadows {
             settings,
@@ -100,7 +105,7 @@ impl OmniShadows {
             masked: None,
             has_masked,
         };
-        ml_vk::build(ctx, shadows, |s| s.create(ctx))
+        Ok(ml_vk::build(ctx, shadows, |s| s.create(ctx))?)
     }
 
     /// Choose the lights that cast shadows (`--shadowed-lights`: the strongest as seen from

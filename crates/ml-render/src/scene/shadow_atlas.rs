@@ -7,12 +7,13 @@
 //! atlas, the table and the raster's lists — fits the budget. Without an atlas both buffers
 //! are small stand-ins the shaders never read.
 
+use crate::error::RenderError;
 use crate::settings::{AtlasSettings, OmniShadowSettings};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::camera::Camera;
 use ml_cpu::gpu_types::{OmniRasterCounters, ShadowCubeTiles, NO_TILE};
 use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight, ShadowAtlas, MIN_FACE};
-use ml_vk::{vk, Buffer, Context, VkError};
+use ml_vk::{vk, Buffer, Context};
 
 /// Bytes of one (meshlet instance, face) pair and of one large triangle in the raster's lists.
 const LIST_ENTRY: u64 = 8;
@@ -51,7 +52,7 @@ pub struct ShadowAtlasGpu {
 }
 
 impl ShadowAtlasGpu {
-    pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>) -> Result<ShadowAtlasGpu, VkError> {
+    pub fn new(ctx: &Context, settings: Option<OmniShadowSettings>) -> Result<ShadowAtlasGpu, RenderError> {
         let mut gpu = ShadowAtlasGpu {
             depths: Buffer::null(),
             tiles: Buffer::null(),
@@ -67,7 +68,7 @@ impl ShadowAtlasGpu {
                 let others = gpu.lists.bytes() + tables_bytes(lights);
                 let room = gpu.budget.saturating_sub(others).min(ctx.info.limits.max_storage_buffer_range as u64);
                 let allocator = ShadowAtlas::new(room).map_err(|e| {
-                    VkError::Limit(format!("a shadow budget of {} MiB leaves {room} bytes for the atlas: {e}", a.budget_mib))
+                    RenderError::Invalid(format!("a shadow budget of {} MiB leaves {room} bytes for the atlas: {e}", a.budget_mib))
                 })?;
                 let bytes = allocator.bytes();
                 gpu.allocator = Some(allocator);

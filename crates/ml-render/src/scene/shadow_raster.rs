@@ -9,6 +9,7 @@
 //! large triangle draws it (omni_raster_large.comp); the buffer is copied into the image.
 
 use crate::descriptors::{FrameSets, Resource};
+use crate::error::RenderError;
 use crate::scene::meshlets::{storage_bytes, MeshletGeometryView, SPEC_SURFACE_TESTS};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush, ShadowCubeTiles};
@@ -106,7 +107,7 @@ impl ShadowRaster {
         geometry: MeshletGeometryView,
         (views, size, large_capacity): (ShadowViews, u32, u32),
         slots: usize,
-    ) -> Result<ShadowRaster, VkError> {
+    ) -> Result<ShadowRaster, RenderError> {
         let shaders = [
             &ml_shaders::OMNI_CULL_COMP,
             &ml_shaders::OMNI_RASTER_COMP,
@@ -121,7 +122,8 @@ impl ShadowRaster {
             ShadowViews::Atlas { pairs: capacity, .. } => pairs.min(capacity as u64),
             _ => pairs,
         };
-        let pair_capacity = u32::try_from(pairs.max(1)).map_err(|_| VkError::Limit(format!("{pairs} shadow (meshlet, face) pairs")))?;
+        let pair_capacity = u32::try_from(pairs.max(1))
+            .map_err(|_| RenderError::Invalid(format!("{pairs} shadow (meshlet, face) pairs are more than one list holds")))?;
         let raster = ShadowRaster {
             views,
             size,

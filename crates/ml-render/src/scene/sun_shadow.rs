@@ -8,6 +8,7 @@
 //! with masked objects).
 
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
+use crate::error::RenderError;
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::scene::meshlets::MeshletGeometryView;
 use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
@@ -41,15 +42,16 @@ const LARGE_LIST: u32 = 1 << 16;
 /// Draw every object of `inputs` into `target` from the sun as `inputs.mode` says (`target`
 /// holds the far plane until then); leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL. Returns the
 /// drawing's GPU milliseconds (None without timestamps).
-pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInputs) -> Result<Option<f64>, VkError> {
+pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInputs) -> Result<Option<f64>, RenderError> {
     let mut timer = GpuTimer::new(ctx, 1)?;
     let drawn = match inputs.mode {
-        SunShadowMode::Graphics => render_shadow_map(ctx, target, Some((inputs, &mut timer))),
+        SunShadowMode::Graphics => render_shadow_map(ctx, target, Some((inputs, &mut timer))).map_err(RenderError::from),
         SunShadowMode::Compute => {
             // One orthographic view; its "light" at the origin with radius 1 leaves world
             // positions as they are (omni_raster.glsl).
             let views = (ShadowViews::Ortho, target.extent.width, LARGE_LIST);
-            let meshlets = inputs.meshlets.ok_or_else(|| VkError::Limit("the sun's compute shadow raster has no meshlets".into()))?;
+            let meshlets =
+                inputs.meshlets.ok_or_else(|| RenderError::Internal("the sun's compute shadow raster has no meshlets".into()))?;
             ShadowRaster::new(ctx, meshlets, views, 1).and_then(|mut raster| {
                 let shadow_target = ShadowTarget { image: target.raw, readers: READERS };
                 let result = raster.bind(ctx, 0, (inputs.objects, inputs.alpha_masks)).and_then(|()| {
@@ -63,11 +65,11 @@ pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInpu
                     })
                 });
                 raster.destroy(ctx);
-                result
+                Ok(result?)
             })
         }
     };
-    let ms = drawn.and_then(|()| timer.read_ms(ctx));
+    let ms = drawn.and_then(|()| Ok(timer.read_ms(ctx)?));
     timer.destroy(ctx);
     Ok(ms?.map(|passes| passes[0]))
 }

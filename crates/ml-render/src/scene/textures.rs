@@ -4,6 +4,7 @@
 //! samples. The layout is textures.glsl's set 1, as reflected from the shaders.
 
 use crate::descriptors::{self, Resource, SetLayout};
+use crate::error::RenderError;
 use crate::scene::omni_shadow::{self, OmniShadows};
 use crate::scene::sun_shadow::{draw_shadow_map, render_shadow_map, ShadowInputs};
 use ml_cpu::textures;
@@ -50,7 +51,7 @@ impl SceneTextures {
 
     /// Draw every object of `inputs` into the shadow map, from the sun; its GPU milliseconds
     /// (None without timestamps).
-    pub fn render_shadow_map(&self, ctx: &Context, inputs: &ShadowInputs) -> Result<Option<f64>, VkError> {
+    pub fn render_shadow_map(&self, ctx: &Context, inputs: &ShadowInputs) -> Result<Option<f64>, RenderError> {
         draw_shadow_map(ctx, &self.images[SHADOW_IMAGE], inputs)
     }
 

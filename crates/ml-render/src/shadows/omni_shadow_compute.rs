@@ -34,7 +34,7 @@ impl OmniShadowCompute {
         ctx: &Context,
         geometry: MeshletGeometryView,
         (views, size, large_capacity): (ShadowViews, u32, u32),
-    ) -> Result<OmniShadowCompute, VkError> {
+    ) -> Result<OmniShadowCompute, RenderError> {
         let raster = ShadowRaster::new(ctx, geometry, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
         let pass = OmniShadowCompute { views, raster, readback: Vec::new(), plan: None };
         ml_vk::build(ctx, pass, |p| {
