@@ -59,6 +59,9 @@ pub struct Renderer<'a> {
     command_pool: vk::CommandPool,
     frames: Vec<FrameInFlight>,
     readback: Option<Buffer>,
+    /// The scene's lights at rest as the GPU reads them: shadowed ones marked with their
+    /// shadow slots (`OmniShadows::mark`).
+    lights: Vec<PointLight>,
     /// Whether lights are animated on the GPU (by the cluster build), else on the CPU into
     /// `animated`, which every frame uploads.
     lights_on_gpu: bool,
@@ -123,7 +126,7 @@ pub trait FrameHook {
 }
 
 impl<'a> Renderer<'a> {
-    pub fn new(ctx: &'a Context, mut scene: Scene, settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
+    pub fn new(ctx: &'a Context, scene: Scene, settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
         settings.check(ctx, scene.lights.len())?;
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
         check_lists_fit(ctx, &settings, &grid, &scene.lights, scene.light_motion)?;
@@ -133,12 +136,14 @@ impl<'a> Renderer<'a> {
         let depth = depth_format(ctx, Output::of(settings.technique))?;
         let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
         let mut gpu = SceneGpu::new(ctx, &scene, &settings)?;
-        gpu.omni.choose(&mut scene, settings.aspect());
+        gpu.omni.choose(&scene, settings.aspect());
+        let lights = gpu_lights(&scene, &gpu);
         let mut r = Renderer {
             ctx,
             extent: vk::Extent2D { width: settings.width, height: settings.height },
             grid,
-            animated: if lights_on_gpu { Vec::new() } else { scene.lights.clone() },
+            animated: if lights_on_gpu { Vec::new() } else { lights.clone() },
+            lights,
             scene,
             settings,
             gpu,
@@ -176,7 +181,7 @@ impl<'a> Renderer<'a> {
         let assembly = Assembly {
             settings: &self.settings,
             shading: self.settings.lighting(&self.scene),
-            lights: &self.scene.lights,
+            lights: &self.lights,
             scene: &self.gpu,
             source: &self.scene,
             depth_format: self.depth_format,
@@ -225,11 +230,12 @@ impl<'a> Renderer<'a> {
         check_lists_fit(self.ctx, &self.settings, &self.grid, &lights, self.scene.light_motion)?;
         self.release_frames()?;
         self.scene.lights = lights;
-        self.gpu.omni.choose(&mut self.scene, self.settings.aspect());
+        self.gpu.omni.choose(&self.scene, self.settings.aspect());
+        self.lights = gpu_lights(&self.scene, &self.gpu);
         // The atlas keeps its faces: a face is drawn again when the light of its key (the
         // scene index) is not where it was or has another radius, which covers lights that
         // changed, came or went.
-        self.animated = if self.lights_on_gpu { Vec::new() } else { self.scene.lights.clone() };
+        self.animated = if self.lights_on_gpu { Vec::new() } else { self.lights.clone() };
         self.make_passes()?;
         self.create_frames()?;
         Ok(())
@@ -592,7 +598,7 @@ impl<'a> Renderer<'a> {
         let ctx = self.ctx;
         let mut grew = self.frames[f].ensure_index_capacity(ctx, self.required_indices)?;
         if !self.lights_on_gpu {
-            move_into(&self.scene.lights, motion_offset(t, self.scene.light_motion), &mut self.animated);
+            move_into(&self.lights, motion_offset(t, self.scene.light_motion), &mut self.animated);
             self.frames[f].lights.write(0, &self.animated);
         }
         let mut lists = SlotLists { frame: &mut self.frames[f], grew: false };
@@ -601,7 +607,7 @@ impl<'a> Renderer<'a> {
             grid: &self.grid,
             camera: &self.scene.camera,
             extent: self.extent,
-            rest_lights: &self.scene.lights,
+            rest_lights: &self.lights,
             light_offset: motion_offset(t, self.scene.light_motion),
             lights: &self.animated,
             lists: &mut lists,
@@ -767,6 +773,13 @@ impl<'a> Renderer<'a> {
         commands::one_shot(ctx, |cmd| commands::copy_colour_to_host(ctx, cmd, image, extent, buffer.raw))?;
         Ok(buffer.mapped().to_vec())
     }
+}
+
+/// `scene`'s lights as the GPU reads them: marked with the shadow slots `gpu` chose.
+fn gpu_lights(scene: &Scene, gpu: &SceneGpu) -> Vec<PointLight> {
+    let mut lights = scene.lights.clone();
+    gpu.omni.mark(&mut lights);
+    lights
 }
 
 impl Drop for Renderer<'_> {

@@ -109,16 +109,21 @@ impl OmniShadows {
     }
 
     /// Choose the lights that cast shadows (`--shadowed-lights`: the strongest as seen from
-    /// the camera, or all that reach the view of an `aspect` image) and mark them in `scene`:
-    /// `PointLight::color[3] = slot + 1`, which the shading passes read.
-    pub fn choose(&mut self, scene: &mut Scene, aspect: f32) {
+    /// the camera, or all that reach the view of an `aspect` image).
+    pub fn choose(&mut self, scene: &Scene, aspect: f32) {
         self.chosen = match self.settings {
             None => Vec::new(),
             Some(o) if o.all => lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, o.lights as usize),
             Some(o) => shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position),
         };
+    }
+
+    /// Mark the chosen lights in `lights` (the scene's, as the GPU is to read them) with
+    /// their shadow slots: `PointLight::color[3] = slot + 1`, which the shading passes read.
+    /// The scene's own lights stay as they were loaded.
+    pub fn mark(&self, lights: &mut [PointLight]) {
         for (slot, &i) in self.chosen.iter().enumerate() {
-            scene.lights[i as usize].color[3] = (slot + 1) as f32;
+            lights[i as usize].color[3] = (slot + 1) as f32;
         }
     }
 
