@@ -3,7 +3,7 @@
 
 use ml_render::report::FrameStats;
 use ml_render::settings::{DebugView, Geometry, LargeTriangles, Raster, RenderSettings};
-use ml_render::targets::{gbuffer_bytes_per_pixel, gbuffer_images};
+use ml_render::{gbuffer_bytes_per_pixel, gbuffer_images};
 use ml_vk::DeviceInfo;
 use std::path::Path;
 
@@ -195,7 +195,7 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     }
     if let Some(ms) = stats.sun_shadow_ms {
         let by = settings.sun_shadow.name();
-        let size = ml_render::scene::textures::SHADOW_MAP_SIZE;
+        let size = ml_render::SHADOW_MAP_SIZE;
         rows.push(("sun shadow ms", format!("{ms:.3}  (the sun's {size}² shadow map by {by}, once at load)")));
     }
     if let Some(m) = stats.memory {

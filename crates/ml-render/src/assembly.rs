@@ -16,7 +16,6 @@ use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
-use ml_cpu::scene::Scene;
 use ml_vk::{vk, Context};
 
 /// What the passes of a technique are made for.
@@ -26,8 +25,6 @@ pub struct Assembly<'a> {
     /// The scene's lights at rest (the GPU build animates them).
     pub lights: &'a [PointLight],
     pub scene: &'a SceneGpu,
-    /// The scene as loaded (the meshlet techniques build their geometry from it).
-    pub source: &'a Scene,
     /// Depth format of the technique's raster pass.
     pub depth_format: vk::Format,
 }

@@ -183,7 +183,6 @@ impl<'a> Renderer<'a> {
             shading: self.settings.lighting(&self.scene),
             lights: &self.lights,
             scene: &self.gpu,
-            source: &self.scene,
             depth_format: self.depth_format,
         };
         self.passes = assemble(self.ctx, &assembly)?;

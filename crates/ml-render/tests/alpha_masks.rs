@@ -30,8 +30,8 @@ use ml_cpu::camera::Camera;
 use ml_cpu::gltf_writer::{cutout, png, quad, GltfWriter, PrimitiveData, CUTOUT_SIZE};
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::scene::{AlphaMode, Scene};
-use ml_render::scene::textures::SHADOW_MAP_SIZE;
 use ml_render::settings::{multiview_depth_is_broken, AtlasSettings};
+use ml_render::SHADOW_MAP_SIZE;
 use ml_render::{
     DebugView, OmniShadowMode, OmniShadowSettings, Raster, RenderOutput, RenderSettings, ShadingModel, SunShadowMode, Technique,
 };

@@ -9,7 +9,7 @@ use gpu_allocator::MemoryLocation;
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterDims, ClusterGrid};
 use ml_cpu::gpu_types::FrameUniforms;
-use ml_render::descriptors::{FrameSets, Resource};
+use ml_render::internals::{FrameSets, Resource};
 use ml_vk::{commands, shader, Buffer, Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;

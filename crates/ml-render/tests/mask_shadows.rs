@@ -15,7 +15,7 @@ use ml_cpu::camera::Camera;
 use ml_cpu::gltf_writer::{png, quad, GltfWriter, PrimitiveData};
 use ml_cpu::gpu_types::{GpuLayout, PointLight};
 use ml_cpu::scene::Scene;
-use ml_render::depth_pass::ShadowMaskPush;
+use ml_render::internals::ShadowMaskPush;
 use ml_render::settings::multiview_depth_is_broken;
 use ml_render::{OmniShadowMode, OmniShadowSettings, RenderOutput, RenderSettings, ShadingModel, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};

@@ -13,7 +13,7 @@ use ml_cpu::gpu_types::PointLight;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::scene::textures::SHADOW_MAP_SIZE;
+use ml_render::SHADOW_MAP_SIZE;
 use ml_render::{RenderOutput, RenderSettings, ShadingModel, Technique};
 
 const BALL_CENTRE: Vec3 = Vec3::new(0.0, 2.0, 0.0);

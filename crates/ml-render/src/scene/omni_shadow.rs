@@ -248,11 +248,6 @@ impl OmniShadows {
         self.settings.filter(|s| s.atlas().is_none())
     }
 
-    /// Whether any light casts shadows (the pass records work).
-    pub fn active(&self) -> bool {
-        self.settings.is_some()
-    }
-
     /// One texel of a face in face units (FrameUniforms::omni_texel).
     pub fn texel(&self) -> f32 {
         2.0 / self.cubes.extent.width as f32
