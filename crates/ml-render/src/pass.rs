@@ -24,7 +24,9 @@ pub struct Recording<'a> {
     pub objects: &'a [ml_cpu::scene::Object],
 }
 
-/// What a frame slot's finished frame told the passes (GPU light assignment feedback).
+/// What a frame slot's finished frame tells the frame loop: the GPU light assignment's
+/// feedback (the lists grow, an overflowed last frame is rendered again) and the exposure
+/// meter's reading (the next frame's EV). Statistics go to `FrameStats` directly.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SlotReport {
     /// Light-index entries the frame needed.
@@ -33,10 +35,6 @@ pub struct SlotReport {
     pub max_lights: Option<u32>,
     /// Whether its light-index list was too short (some lists were cut).
     pub overflowed: bool,
-    /// What its GPU culling kept (visibility).
-    pub culling: Option<crate::report::CullStats>,
-    /// What its compute shadow raster drew.
-    pub omni_raster: Option<crate::report::OmniRasterStats>,
     /// Auto exposure: the log2 of its image's log-average luminance before exposure (None: not
     /// metered, or nothing but background).
     pub log2_luminance: Option<f32>,
@@ -91,8 +89,9 @@ pub trait Pass {
         Ok(())
     }
 
-    /// Read what slot `slot`'s finished frame reports (its fence has signalled).
-    fn collect(&self, _slot: usize, _report: &mut SlotReport) {}
+    /// Read what slot `slot`'s finished frame reports (its fence has signalled): feedback for
+    /// the frame loop into `report`, the pass's own figures into `stats`.
+    fn collect(&self, _slot: usize, _report: &mut SlotReport, _stats: &mut FrameStats) {}
 
     /// The projection or image size changed; slot 0's uniforms hold the new ones and no frame
     /// is in flight.

@@ -555,15 +555,9 @@ impl<'a> Renderer<'a> {
         }
         let mut report = SlotReport::default();
         for p in &self.passes {
-            p.collect(f, &mut report);
+            p.collect(f, &mut report, stats);
         }
         self.reports[f] = report;
-        if report.omni_raster.is_some() {
-            stats.omni_raster = report.omni_raster;
-        }
-        if report.culling.is_some() {
-            stats.culling = report.culling;
-        }
         if let (Some(needed), Some(max_lights)) = (report.index_entries, report.max_lights) {
             let clusters = self.settings.clusters.count();
             stats.clusters = Some(ClusterStats { mean_lights: needed as f64 / clusters as f64, max_lights, index_len: needed });

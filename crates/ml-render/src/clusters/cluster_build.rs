@@ -15,6 +15,7 @@ use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
+use crate::report::FrameStats;
 use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
@@ -259,7 +260,7 @@ impl Pass for ClusterBuild {
         self.record_build(rec.ctx, rec.cmd, rec.slot);
     }
 
-    fn collect(&self, slot: usize, report: &mut SlotReport) {
+    fn collect(&self, slot: usize, report: &mut SlotReport, _: &mut FrameStats) {
         let f = self.frames[slot].feedback();
         report.index_entries = Some(f.needed as usize);
         report.max_lights = Some(f.max_count);

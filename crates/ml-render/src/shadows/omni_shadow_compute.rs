@@ -9,7 +9,7 @@ use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
-use crate::report::{AtlasStats, OmniRasterStats};
+use crate::report::{AtlasStats, FrameStats, OmniRasterStats};
 use crate::scene::meshlets::MeshletGeometryView;
 use crate::scene::omni_shadow::NEAR_FRACTION;
 use crate::scene::shadow_atlas::tile_table;
@@ -95,9 +95,9 @@ impl Pass for OmniShadowCompute {
         copy_buffer_to_host(rec.ctx, rec.cmd, (self.raster.counters.raw, self.readback[rec.slot].raw), counter_bytes);
     }
 
-    fn collect(&self, slot: usize, report: &mut SlotReport) {
+    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
         let c: OmniRasterCounters = bytemuck::pod_read_unaligned(&self.readback[slot].mapped()[..size_of::<OmniRasterCounters>()]);
-        report.omni_raster = Some(OmniRasterStats {
+        stats.omni_raster = Some(OmniRasterStats {
             pairs: c.pairs[3],
             small: c.drawn[0].saturating_sub(c.drawn[1]),
             large: c.large[3],

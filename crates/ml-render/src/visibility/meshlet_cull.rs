@@ -17,7 +17,7 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::plan::Phase;
-use crate::report::CullStats;
+use crate::report::{CullStats, FrameStats};
 use crate::scene::meshlets::SPEC_SURFACE_TESTS;
 use crate::settings::Raster;
 use crate::targets::depth_pyramid_shape;
@@ -169,13 +169,13 @@ impl Pass for MeshletCull {
         }
     }
 
-    fn collect(&self, slot: usize, report: &mut SlotReport) {
+    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
         if self.phase != Phase::Late {
             return;
         }
         let scene = self.scene.borrow();
         let c = scene.counters(slot);
-        report.culling = Some(CullStats {
+        stats.culling = Some(CullStats {
             instances: c.tested[2],
             visible_instances: c.dispatch[0],
             meshlet_instances: scene.capacity,
