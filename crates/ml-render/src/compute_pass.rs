@@ -5,9 +5,10 @@
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
+use crate::sync::{Use, COLOUR_TARGET};
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
-use ml_vk::image::{fetch_sampler, image_transition};
+use ml_vk::image::fetch_sampler;
 use ml_vk::{shader, vk, Context, Image, VkError};
 
 /// Work-group size of these passes (8×8 in the shaders).
@@ -66,9 +67,15 @@ impl ComputePass {
         Some(Resource::Image(vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(image.view).image_layout(layout)))
     }
 
+    /// How a pass that writes the colour target through this pass uses it (`Pass::uses`): as
+    /// a storage image in GENERAL, every texel written.
+    pub fn colour_use() -> Use {
+        Use::overwriting(COLOUR_TARGET, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), vk::ImageLayout::GENERAL)
+    }
+
     /// Run over `extent` with slot `slot`'s set 0 and `more_sets` after it, writing `color` as a
-    /// storage image, and leave it as the forward pass leaves its own target: in
-    /// TRANSFER_SRC_OPTIMAL, ready for the read-back.
+    /// storage image (in GENERAL: the barrier before the pass, from its `colour_use`, put it
+    /// there).
     pub fn record_into_colour_target(
         &self,
         ctx: &Context,
@@ -89,20 +96,15 @@ impl ComputePass {
         cmd: vk::CommandBuffer,
         slot: usize,
         runs: &[(Vec<vk::DescriptorSet>, Vec<u8>)],
-        (color, extent): (vk::Image, vk::Extent2D),
+        (_, extent): (vk::Image, vk::Extent2D),
     ) {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
-        let transfer = vk::PipelineStageFlags::TRANSFER;
-        // The colour image was last read by a copy two frames ago (same queue).
-        let storage = (compute, vk::AccessFlags::SHADER_WRITE, vk::ImageLayout::GENERAL);
-        image_transition(ctx, cmd, color, (transfer, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), storage);
         for (i, (more_sets, push)) in runs.iter().enumerate() {
             if i > 0 {
                 memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_WRITE));
             }
             self.dispatch(ctx, cmd, slot, (more_sets, push), extent);
         }
-        image_transition(ctx, cmd, color, storage, (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL));
     }
 
     /// One dispatch over `extent` with slot `slot`'s set 0, `more_sets` after it and `push`

@@ -6,6 +6,7 @@
 use crate::error::{ListsTooLong, RenderError};
 use crate::frame_resources::FrameResources;
 use crate::pass::ListUpload;
+use crate::sync::SyncStates;
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::cluster::ClusterLists;
@@ -21,6 +22,8 @@ pub struct FrameInFlight {
     pub light_indices: Buffer,
     pub timer: GpuTimer,
     pub targets: Option<Targets>,
+    /// Its named resources' states between passes, from frame to frame (`sync`).
+    pub sync: SyncStates,
     /// Where lights and cluster lists live: host-visible (written by the CPU) or device-local
     /// (written by the GPU build).
     location: MemoryLocation,
@@ -57,6 +60,7 @@ impl FrameInFlight {
             light_indices: Buffer::null(),
             timer: GpuTimer::null(),
             targets: None,
+            sync: SyncStates::default(),
             location: if setup.written_by_gpu { MemoryLocation::GpuOnly } else { MemoryLocation::CpuToGpu },
         };
         // On failure everything made so far is released (null parts are skipped).

@@ -49,6 +49,7 @@ mod renderer;
 mod scene;
 mod shading;
 mod shadows;
+mod sync;
 mod targets;
 mod visibility;
 

@@ -7,6 +7,7 @@ use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
+use crate::sync::Use;
 use crate::targets::Targets;
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
@@ -78,6 +79,13 @@ pub trait Pass {
     /// and targets: when the slot is made and when its buffers grow. Only while the slot is
     /// not in flight.
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError>;
+
+    /// What the pass reads and writes of the frame's named resources, and in which stages:
+    /// before the pass the renderer records the barrier that orders these after their
+    /// earlier uses (`sync`). A use not declared is ordered by the pass itself.
+    fn uses(&self) -> Vec<Use> {
+        Vec::new()
+    }
 
     /// Record the pass into a frame's command buffer.
     fn record(&self, rec: &Recording);

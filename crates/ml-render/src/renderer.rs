@@ -13,6 +13,7 @@ use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
 use crate::settings::{LightAssignment, RenderSettings};
+use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{count_entries, ClusterGrid, ClusterLists, ClusterStats};
@@ -119,7 +120,8 @@ fn check_lists_fit(
 /// in the same command buffer, and the semaphores its submission waits on and signals.
 pub trait FrameHook {
     /// Record after the frame's passes; `colour` is the frame's colour target (the image a
-    /// headless render reads back), in TRANSFER_SRC_OPTIMAL, and stays so.
+    /// headless render reads back), in TRANSFER_SRC_OPTIMAL with its writes visible to
+    /// transfers (`sync::frame_end`), and stays so.
     fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer, colour: &Image) -> Result<(), VkError>;
     /// The semaphore the submission waits on (and at which stage), and the one it signals.
     fn semaphores(&self) -> (Option<(vk::Semaphore, vk::PipelineStageFlags)>, Option<vk::Semaphore>);
@@ -683,17 +685,23 @@ impl<'a> Renderer<'a> {
         let targets = frame.targets.as_ref().expect("made with the frame");
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects };
         let mut timed = 0;
+        let image = |name: &str| targets.named_image(name);
         for pass in &self.passes {
-            match pass.timer_name() {
-                Some(_) => {
-                    frame.timer.begin(ctx, cmd, timed);
-                    pass.record(&rec);
-                    frame.timer.end(ctx, cmd, timed);
-                    timed += 1;
-                }
-                None => pass.record(&rec),
+            // The barrier that orders the pass's declared uses is part of its time, as the
+            // barriers it records itself are.
+            let timer = pass.timer_name().map(|_| timed);
+            if let Some(t) = timer {
+                frame.timer.begin(ctx, cmd, t);
+            }
+            frame.sync.barrier(ctx, cmd, &pass.uses(), &image);
+            pass.record(&rec);
+            if let Some(t) = timer {
+                frame.timer.end(ctx, cmd, t);
+                timed += 1;
             }
         }
+        // The colour target as the read-back and a window's blit take it.
+        frame.sync.barrier(ctx, cmd, &[sync::frame_end()], &image);
         if let Some(hook) = hook {
             hook.record(ctx, cmd, &targets.color)?;
         }
@@ -756,8 +764,9 @@ impl<'a> Renderer<'a> {
         lists.map(Some)
     }
 
-    /// Copy frame `f`'s colour target (left in TRANSFER_SRC_OPTIMAL by the render pass, whose
-    /// outgoing dependency orders this copy after the colour writes) into host memory.
+    /// Copy frame `f`'s colour target (left in TRANSFER_SRC_OPTIMAL by the frame's last
+    /// barrier, `sync::frame_end`, which orders later transfers after the colour writes) into
+    /// host memory.
     fn read_back(&mut self, f: usize) -> Result<Vec<u8>, VkError> {
         let ctx = self.ctx;
         let image = self.frames[f].targets.as_ref().expect("made with the frame").color.raw;

@@ -153,6 +153,12 @@ pub fn depth_pyramid_len(extent: vk::Extent2D) -> u64 {
 }
 
 impl Targets {
+    /// The target called `name` and its aspect, for the barriers between passes (`sync`):
+    /// the colour target.
+    pub fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+        (name == crate::sync::COLOUR_TARGET).then_some((self.color.raw, vk::ImageAspectFlags::COLOR))
+    }
+
     pub fn new(
         ctx: &Context,
         extent: vk::Extent2D,

@@ -169,7 +169,7 @@ impl FrameHook for PresentFrame<'_> {
             .dst_subresource(layers)
             .dst_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])];
         // SAFETY: recording state; the colour target is in TRANSFER_SRC_OPTIMAL with its writes
-        // made visible to transfers by the passes (their own barriers).
+        // made visible to transfers by the frame's last barrier (the renderer's).
         unsafe {
             ctx.device.cmd_blit_image(
                 cmd,

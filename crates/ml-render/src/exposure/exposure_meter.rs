@@ -11,9 +11,9 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
 use crate::settings::SPEC_PBR;
+use crate::sync::{Use, COLOUR_TARGET};
 use gpu_allocator::MemoryLocation;
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
-use ml_vk::image::image_transition;
 use ml_vk::{vk, Buffer, Context, VkError};
 
 /// The meter's work groups are 8×8 pixels (ComputePass's size).
@@ -66,20 +66,18 @@ impl Pass for ExposureMeter {
         self.pass.bind_frame(ctx, frame, &|name| if name == "ExposureMeterBuffer" { Some(sums) } else { frame.buffer(name) })
     }
 
-    /// After every pass that writes the colour target, which each leaves in
-    /// TRANSFER_SRC_OPTIMAL for the read-back (its writes ordered before transfers); it is left
-    /// so again.
+    /// After every pass that writes the colour target: it reads the finished image.
+    fn uses(&self) -> Vec<Use> {
+        let read = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
+        vec![Use::at(COLOUR_TARGET, read, Some(vk::ImageLayout::GENERAL))]
+    }
+
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let (compute, transfer) = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::PipelineStageFlags::TRANSFER);
-        let color = rec.targets.color.raw;
-        let source = (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-        let read = (compute, vk::AccessFlags::SHADER_READ, vk::ImageLayout::GENERAL);
-        image_transition(ctx, cmd, color, source, read);
         // The sums' last copy, two frames ago, read them (same queue).
         memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_READ), (compute, vk::AccessFlags::SHADER_WRITE));
         self.pass.dispatch(ctx, cmd, rec.slot, (&[], &[]), rec.extent);
-        image_transition(ctx, cmd, color, read, source);
         memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
         copy_buffer_to_host(ctx, cmd, (self.sums[rec.slot].raw, self.readback[rec.slot].raw), self.groups[rec.slot] as u64 * 8);
     }

@@ -6,6 +6,7 @@ use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::settings::SPEC_PBR;
+use crate::sync::Use;
 use ml_vk::{vk, Context, VkError};
 
 pub struct ToneMap {
@@ -33,6 +34,10 @@ impl Pass for ToneMap {
 
     /// After the render pass, whose outgoing dependency orders the HDR writes before this
     /// pass's reads.
+    fn uses(&self) -> Vec<Use> {
+        vec![ComputePass::colour_use()]
+    }
+
     fn record(&self, rec: &Recording) {
         self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &[]), rec.targets.color.raw, rec.extent);
     }

@@ -9,6 +9,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::Shading;
+use crate::sync::Use;
 use crate::targets::GBUFFER;
 use ml_vk::{vk, Context, VkError};
 
@@ -50,6 +51,10 @@ impl Pass for ComputeLighting {
     }
 
     /// After the G-buffer pass and the cluster build.
+    fn uses(&self) -> Vec<Use> {
+        vec![ComputePass::colour_use()]
+    }
+
     fn record(&self, rec: &Recording) {
         let sets = [rec.scene.textures.set];
         self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &sets), rec.targets.color.raw, rec.extent);

@@ -8,6 +8,7 @@ use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::Shading;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
+use crate::sync::{Entry, Exit, Use, COLOUR_TARGET};
 use crate::targets::Output;
 use ml_vk::{vk, Context, VkError};
 
@@ -53,6 +54,28 @@ impl Pass for Forward {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         self.raster.bind_frame(ctx, frame)
+    }
+
+    /// The colour target is its render pass's attachment: the pass's external dependencies
+    /// order it after the transfers that read it last (the read-back, a window's blit) and
+    /// before the transfers after it, and its final layout is TRANSFER_SRC_OPTIMAL
+    /// (render_pass.rs).
+    fn uses(&self) -> Vec<Use> {
+        let attachments = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
+            | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
+            | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        vec![Use {
+            name: COLOUR_TARGET,
+            entry: Entry::Chained { stages: attachments | transfer },
+            exit: Exit {
+                stages: transfer,
+                writes: vk::AccessFlags::empty(),
+                wrote: true,
+                visible: vk::AccessFlags::TRANSFER_READ,
+                layout: Some(vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+            },
+        }]
     }
 
     fn record(&self, rec: &Recording) {

@@ -7,6 +7,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::DebugView;
+use crate::sync::Use;
 use ml_vk::{Context, VkError};
 
 pub struct ShadowMapView {
@@ -38,6 +39,10 @@ impl Pass for ShadowMapView {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         self.pass.bind_frame(ctx, frame, &|_| None)
+    }
+
+    fn uses(&self) -> Vec<Use> {
+        vec![ComputePass::colour_use()]
     }
 
     fn record(&self, rec: &Recording) {

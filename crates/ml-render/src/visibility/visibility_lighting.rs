@@ -9,6 +9,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::Shading;
+use crate::sync::Use;
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};
 
@@ -50,6 +51,10 @@ impl Pass for VisibilityLighting {
     }
 
     /// After the late raster and the cluster build.
+    fn uses(&self) -> Vec<Use> {
+        vec![ComputePass::colour_use()]
+    }
+
     fn record(&self, rec: &Recording) {
         let sets = &rec.scene.object_textures.sets;
         let runs: Vec<(Vec<vk::DescriptorSet>, Vec<u8>)> = (0u32..)

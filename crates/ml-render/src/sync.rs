@@ -1,0 +1,349 @@
+//! Barriers between passes, derived from what each pass declares of the frame's named
+//! resources (`Pass::uses`) instead of written by hand inside each pass on assumptions about
+//! its neighbours. The renderer keeps each resource's state — who touched it last, in which
+//! stages, with which writes not yet made visible, in which layout — and before a pass
+//! records one barrier that orders every declared use after the earlier ones: a read after a
+//! write waits for the write and makes it visible; a write (or a layout change) after reads
+//! waits for the reads. The pass list stays linear: no reordering, no aliasing.
+//!
+//! Barriers between a pass's own dispatches stay in the pass. A render pass orders its
+//! attachments itself (its external subpass dependencies, which also make their layout
+//! transitions): it declares where those dependencies begin (`Entry::Chained`), and the
+//! renderer only makes sure earlier uses end in those stages.
+
+use ml_vk::vk;
+
+/// How a pass starts using a resource.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Entry {
+    /// It touches it at `stages` with `access`; an image in `layout` — `discard`: every
+    /// texel is written before any is read, so what was there need not be kept.
+    Barrier { stages: vk::PipelineStageFlags, access: vk::AccessFlags, layout: Option<vk::ImageLayout>, discard: bool },
+    /// It orders itself after earlier uses that end in `stages` (a render pass's incoming
+    /// external dependency, which also changes the layout).
+    Chained { stages: vk::PipelineStageFlags },
+}
+
+/// What a pass leaves behind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Exit {
+    /// Where a later barrier chains from.
+    pub stages: vk::PipelineStageFlags,
+    /// Writes not yet made available (a later reader's barrier makes them visible).
+    pub writes: vk::AccessFlags,
+    /// Whether it wrote (a later read needs a barrier even where `writes` were made
+    /// available already, as a render pass's outgoing dependency does).
+    pub wrote: bool,
+    /// Accesses at `stages` that already see its writes (a render pass's outgoing
+    /// dependency's destination).
+    pub visible: vk::AccessFlags,
+    pub layout: Option<vk::ImageLayout>,
+}
+
+/// A pass's use of one of the frame's named resources.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Use {
+    pub name: &'static str,
+    pub entry: Entry,
+    pub exit: Exit,
+}
+
+const WRITES: vk::AccessFlags = vk::AccessFlags::from_raw(
+    vk::AccessFlags::SHADER_WRITE.as_raw()
+        | vk::AccessFlags::COLOR_ATTACHMENT_WRITE.as_raw()
+        | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw()
+        | vk::AccessFlags::TRANSFER_WRITE.as_raw()
+        | vk::AccessFlags::HOST_WRITE.as_raw()
+        | vk::AccessFlags::MEMORY_WRITE.as_raw(),
+);
+
+impl Use {
+    /// A use in `stages` with `access` (reads, writes or both), a buffer's or, with
+    /// `layout`, an image's; what it writes is left to the next use to make visible.
+    pub fn at(name: &'static str, (stages, access): (vk::PipelineStageFlags, vk::AccessFlags), layout: Option<vk::ImageLayout>) -> Use {
+        let writes = access & WRITES;
+        let entry = Entry::Barrier { stages, access, layout, discard: false };
+        Use { name, entry, exit: Exit { stages, writes, wrote: !writes.is_empty(), visible: vk::AccessFlags::empty(), layout } }
+    }
+
+    /// `at`, for an image whose texels the pass all writes before reading any.
+    pub fn overwriting(name: &'static str, (stages, access): (vk::PipelineStageFlags, vk::AccessFlags), layout: vk::ImageLayout) -> Use {
+        let mut u = Use::at(name, (stages, access), Some(layout));
+        if let Entry::Barrier { discard, .. } = &mut u.entry {
+            *discard = true;
+        }
+        u
+    }
+}
+
+/// A resource's state between passes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct State {
+    /// Stages of the last write (or of the dependency that finished it).
+    write_stages: vk::PipelineStageFlags,
+    /// Its writes not yet made available.
+    writes: vk::AccessFlags,
+    /// Whether there was a write since the resource was made (reads need it visible).
+    written: bool,
+    /// Stages and accesses that see the last write.
+    visible_stages: vk::PipelineStageFlags,
+    visible: vk::AccessFlags,
+    /// Stages of the reads since the last write.
+    read_stages: vk::PipelineStageFlags,
+    /// An image's layout; None: not known yet (undefined).
+    layout: Option<vk::ImageLayout>,
+}
+
+/// What one use needs before it: an execution and memory dependency, and for an image the
+/// layout change with it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Dependency {
+    pub src_stages: vk::PipelineStageFlags,
+    pub src_access: vk::AccessFlags,
+    pub dst_stages: vk::PipelineStageFlags,
+    pub dst_access: vk::AccessFlags,
+    /// (old, new) where the image changes layout.
+    pub layout: Option<(vk::ImageLayout, vk::ImageLayout)>,
+}
+
+impl State {
+    /// What `u` needs after this state (None: nothing).
+    pub fn before(&self, u: &Use) -> Option<Dependency> {
+        match u.entry {
+            Entry::Chained { stages } => {
+                // Earlier uses must end where the pass's own dependency begins.
+                let earlier = self.write_stages | self.read_stages;
+                (!earlier.is_empty() && !stages.contains(earlier)).then_some(Dependency {
+                    src_stages: earlier,
+                    src_access: self.writes,
+                    dst_stages: stages,
+                    dst_access: vk::AccessFlags::empty(),
+                    layout: None,
+                })
+            }
+            Entry::Barrier { stages, access, layout, discard } => {
+                let old = if discard { vk::ImageLayout::UNDEFINED } else { self.layout.unwrap_or(vk::ImageLayout::UNDEFINED) };
+                let transition = layout.filter(|&new| Some(new) != self.layout || (discard && self.layout.is_some())).map(|new| (old, new));
+                let reads = !(access & !WRITES).is_empty();
+                let writes = !(access & WRITES).is_empty() || transition.is_some();
+                let unseen = self.written && !(self.visible_stages.contains(stages) && self.visible.contains(access & !WRITES));
+                let mut d = Dependency { layout: transition, ..Dependency::default() };
+                // A read (or a write, or a layout change) after a write: wait for it; a read
+                // also needs it visible.
+                if self.written && (writes || (reads && unseen)) {
+                    d.src_stages |= self.write_stages;
+                    d.src_access |= self.writes;
+                    d.dst_access |= if reads { access & !WRITES } else { vk::AccessFlags::empty() } | (access & WRITES);
+                }
+                // A write (or a layout change) after reads: wait for them.
+                if writes {
+                    d.src_stages |= self.read_stages;
+                }
+                if d.src_stages.is_empty() && transition.is_none() {
+                    return None;
+                }
+                d.dst_stages = stages;
+                if transition.is_some() {
+                    d.dst_access |= access;
+                }
+                Some(d)
+            }
+        }
+    }
+
+    /// The state after `u` (its dependency recorded before it).
+    pub fn after(&self, u: &Use) -> State {
+        let e = u.exit;
+        let layout = e.layout.or(self.layout);
+        // A layout change waited for every earlier use and made the writes available: what
+        // comes next needs to wait for `u` alone (a later reader chains through its stages).
+        let base = match self.before(u) {
+            Some(Dependency { layout: Some(_), dst_stages, .. }) => State {
+                write_stages: if self.written { dst_stages } else { vk::PipelineStageFlags::empty() },
+                writes: vk::AccessFlags::empty(),
+                read_stages: vk::PipelineStageFlags::empty(),
+                ..*self
+            },
+            _ => *self,
+        };
+        if e.wrote {
+            return State {
+                write_stages: e.stages,
+                writes: e.writes,
+                written: true,
+                visible_stages: if e.visible.is_empty() { vk::PipelineStageFlags::empty() } else { e.stages },
+                visible: e.visible,
+                read_stages: vk::PipelineStageFlags::empty(),
+                layout,
+            };
+        }
+        // A read: the write it waited for is now available, and visible where it read.
+        let (stages, access) = match u.entry {
+            Entry::Barrier { stages, access, .. } => (stages, access),
+            Entry::Chained { stages } => (stages, vk::AccessFlags::empty()),
+        };
+        State {
+            writes: vk::AccessFlags::empty(),
+            visible_stages: base.visible_stages | stages,
+            visible: base.visible | access,
+            read_stages: base.read_stages | e.stages,
+            layout,
+            ..base
+        }
+    }
+}
+
+/// The name of a frame slot's colour target (the image `render` reads back and a window
+/// presents) in the frame's resources.
+pub const COLOUR_TARGET: &str = "colour target";
+
+/// How the frame leaves its colour target: read by transfers (the read-back, a window's
+/// blit) in TRANSFER_SRC_OPTIMAL.
+pub fn frame_end() -> Use {
+    Use::at(COLOUR_TARGET, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ), Some(vk::ImageLayout::TRANSFER_SRC_OPTIMAL))
+}
+
+/// The state of every named resource of a frame slot (buffers and images the slot and the
+/// scene hold), from frame to frame; new frame slots start with none known.
+#[derive(Debug, Default)]
+pub struct SyncStates(std::collections::HashMap<&'static str, State>);
+
+impl SyncStates {
+    /// Record one barrier ordering `uses` after every earlier use of their resources, and
+    /// note them. `image` gives an image's handle and aspect (None: a buffer, ordered by a
+    /// global memory barrier).
+    pub fn barrier(
+        &mut self,
+        ctx: &ml_vk::Context,
+        cmd: vk::CommandBuffer,
+        uses: &[Use],
+        image: &dyn Fn(&str) -> Option<(vk::Image, vk::ImageAspectFlags)>,
+    ) {
+        let (mut src, mut dst) = (vk::PipelineStageFlags::empty(), vk::PipelineStageFlags::empty());
+        let mut global = vk::MemoryBarrier::default();
+        let mut images = Vec::new();
+        for u in uses {
+            let state = self.0.get(u.name).copied().unwrap_or_default();
+            if let Some(d) = state.before(u) {
+                src |= d.src_stages;
+                dst |= d.dst_stages;
+                match (d.layout, image(u.name)) {
+                    (Some((old, new)), Some((raw, aspect))) => images.push(
+                        vk::ImageMemoryBarrier::default()
+                            .src_access_mask(d.src_access)
+                            .dst_access_mask(d.dst_access)
+                            .old_layout(old)
+                            .new_layout(new)
+                            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .image(raw)
+                            .subresource_range(ml_vk::image::full_range(aspect)),
+                    ),
+                    _ => {
+                        global.src_access_mask |= d.src_access;
+                        global.dst_access_mask |= d.dst_access;
+                    }
+                }
+            }
+            self.0.insert(u.name, state.after(u));
+        }
+        if dst.is_empty() {
+            return;
+        }
+        // Nothing earlier to wait for (a first use): the layout change alone.
+        let src = if src.is_empty() { vk::PipelineStageFlags::TOP_OF_PIPE } else { src };
+        let globals =
+            if global.src_access_mask.is_empty() && global.dst_access_mask.is_empty() { &[][..] } else { std::slice::from_ref(&global) };
+        // SAFETY: recording state, outside a render pass; the images are the frame's, alive.
+        unsafe { ctx.device.cmd_pipeline_barrier(cmd, src, dst, vk::DependencyFlags::empty(), globals, &[], &images) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vk::AccessFlags as A;
+    use vk::ImageLayout as L;
+    use vk::PipelineStageFlags as S;
+
+    const COLOUR: &str = COLOUR_TARGET;
+
+    fn run(uses: &[Use]) -> Vec<Option<Dependency>> {
+        let mut state = State::default();
+        uses.iter()
+            .map(|u| {
+                let d = state.before(u);
+                state = state.after(u);
+                d
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_compute_write_then_a_compute_read_then_the_read_back() {
+        let write = Use::overwriting(COLOUR, (S::COMPUTE_SHADER, A::SHADER_WRITE), L::GENERAL);
+        let meter = Use::at(COLOUR, (S::COMPUTE_SHADER, A::SHADER_READ), Some(L::GENERAL));
+        let copy = Use::at(COLOUR, (S::TRANSFER, A::TRANSFER_READ), Some(L::TRANSFER_SRC_OPTIMAL));
+        let d = run(&[write, meter, copy, write]);
+        // First use: only the layout, from undefined.
+        assert_eq!(d[0].unwrap().layout, Some((L::UNDEFINED, L::GENERAL)));
+        assert_eq!(d[0].unwrap().src_stages, S::empty());
+        // The read waits for the write and sees it; no layout change.
+        let m = d[1].unwrap();
+        assert_eq!(
+            (m.src_stages, m.src_access, m.dst_stages, m.dst_access, m.layout),
+            (S::COMPUTE_SHADER, A::SHADER_WRITE, S::COMPUTE_SHADER, A::SHADER_READ, None)
+        );
+        // The copy: after the reads (its layout change writes) and made visible to transfers.
+        let c = d[2].unwrap();
+        assert!(c.src_stages.contains(S::COMPUTE_SHADER));
+        assert_eq!(c.layout, Some((L::GENERAL, L::TRANSFER_SRC_OPTIMAL)));
+        assert!(c.dst_access.contains(A::TRANSFER_READ));
+        // The next frame's write waits for the copy and throws the old texels away.
+        let w = d[3].unwrap();
+        assert!(w.src_stages.contains(S::TRANSFER));
+        assert_eq!(w.layout, Some((L::UNDEFINED, L::GENERAL)));
+    }
+
+    #[test]
+    fn two_reads_of_one_write_in_the_same_stages_need_one_barrier() {
+        let write = Use::at("lists", (S::COMPUTE_SHADER, A::SHADER_WRITE), None);
+        let read = Use::at("lists", (S::COMPUTE_SHADER | S::FRAGMENT_SHADER, A::SHADER_READ), None);
+        let d = run(&[write, read, read]);
+        assert!(d[1].is_some());
+        assert_eq!(d[2], None, "already visible to these readers");
+        // A write after the reads waits for them (no memory to make visible).
+        let d = run(&[write, read, write]);
+        let w = d[2].unwrap();
+        assert_eq!(w.src_stages, S::COMPUTE_SHADER | S::FRAGMENT_SHADER);
+    }
+
+    #[test]
+    fn a_render_pass_chains_itself_and_leaves_its_writes_visible_to_transfers() {
+        let copy = Use::at(COLOUR, (S::TRANSFER, A::TRANSFER_READ), Some(L::TRANSFER_SRC_OPTIMAL));
+        let forward = Use {
+            name: COLOUR,
+            entry: Entry::Chained { stages: S::COLOR_ATTACHMENT_OUTPUT | S::TRANSFER },
+            exit: Exit {
+                stages: S::TRANSFER,
+                writes: A::empty(),
+                wrote: true,
+                visible: A::TRANSFER_READ,
+                layout: Some(L::TRANSFER_SRC_OPTIMAL),
+            },
+        };
+        let meter = Use::at(COLOUR, (S::COMPUTE_SHADER, A::SHADER_READ), Some(L::GENERAL));
+        let d = run(&[copy, forward, copy]);
+        assert_eq!(d[1], None, "the copy ends where the render pass's dependency begins");
+        assert_eq!(d[2], None, "the render pass's outgoing dependency made it visible to the copy");
+        let d = run(&[forward, meter, copy]);
+        let m = d[1].unwrap();
+        assert_eq!((m.src_stages, m.dst_stages, m.layout), (S::TRANSFER, S::COMPUTE_SHADER, Some((L::TRANSFER_SRC_OPTIMAL, L::GENERAL))));
+        let c = d[2].unwrap();
+        assert!(c.src_stages.contains(S::COMPUTE_SHADER));
+        assert_eq!(c.layout, Some((L::GENERAL, L::TRANSFER_SRC_OPTIMAL)));
+        // A compute use before a render pass that does not wait for compute: chained.
+        let d = run(&[meter, forward]);
+        assert_eq!(d[1].unwrap().src_stages, S::COMPUTE_SHADER);
+    }
+}
