@@ -740,9 +740,12 @@ impl<'a> Renderer<'a> {
             )?);
         }
         let copied = commands::one_shot(ctx, |cmd| {
+            // After the build's writes (earlier submissions of this queue).
+            let written = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE);
+            commands::memory_barrier(ctx, cmd, written, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ));
             for ((src, size), dst) in copies.iter().zip(&host) {
-                // SAFETY: recording state; both buffers are alive and large enough. The frame's
-                // build ended with a barrier making its writes visible to transfers.
+                // SAFETY: recording state; both buffers are alive and large enough, the build's
+                // writes visible to transfers.
                 unsafe { ctx.device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[vk::BufferCopy::default().size(*size)]) };
             }
             commands::transfer_to_host_barrier(ctx, cmd);

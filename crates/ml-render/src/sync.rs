@@ -197,6 +197,15 @@ impl State {
 /// presents) in the frame's resources.
 pub const COLOUR_TARGET: &str = "colour target";
 
+/// The frame slot's lights and cluster lists, as their shader blocks name them: written by
+/// the GPU cluster build (or by the host), read by every shading pass.
+pub const LIGHT_LISTS: [&str; 3] = ["LightBuffer", "ClusterRangeBuffer", "LightIndexBuffer"];
+
+/// How a shading pass reads the lights and lists: in `stages`.
+pub fn light_list_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
+    LIGHT_LISTS.iter().map(|&name| Use::at(name, (stages, vk::AccessFlags::SHADER_READ), None)).collect()
+}
+
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.
 pub fn frame_end() -> Use {

@@ -16,6 +16,7 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
+use crate::sync::{Use, LIGHT_LISTS};
 use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
@@ -134,21 +135,19 @@ impl ClusterBuild {
         })
     }
 
-    /// Record the frame's build. Afterwards the lights, ranges and index list are visible to
-    /// fragment and compute shaders and the feedback to the host.
+    /// Record the frame's build: the lights, ranges and index list (ordered with their readers
+    /// by the barriers its `uses` give), and its own buffers; afterwards the feedback is
+    /// visible to the host.
     fn record_build(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
         let (frame, set) = (&self.frames[slot], self.sets.sets[slot]);
         let d = &ctx.device;
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
-        // This frame's buffers were last used two submissions ago (shading reads, build writes).
+        // Its own buffers were last used by this slot's build two submissions ago.
         memory_barrier(
             ctx,
             cmd,
-            (
-                compute | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-            ),
+            (compute | vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE),
             (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE),
         );
         let light_groups = (self.light_count as u64 * self.lanes as u64).div_ceil(BUILD_GROUP as u64) as u32;
@@ -173,15 +172,7 @@ impl ClusterBuild {
                 d.cmd_dispatch(cmd, groups, 1, 1);
             }
         }
-        memory_barrier(
-            ctx,
-            cmd,
-            (compute, vk::AccessFlags::SHADER_WRITE),
-            (
-                vk::PipelineStageFlags::FRAGMENT_SHADER | compute | vk::PipelineStageFlags::HOST | vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::SHADER_READ | vk::AccessFlags::HOST_READ | vk::AccessFlags::TRANSFER_READ,
-            ),
-        );
+        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));
     }
 
     /// A frame slot's build buffers.
@@ -254,6 +245,11 @@ impl Pass for ClusterBuild {
             };
             Some(Resource::Buffer(buffer))
         })
+    }
+
+    fn uses(&self) -> Vec<Use> {
+        let rw = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+        LIGHT_LISTS.iter().map(|&name| Use::at(name, rw, None)).collect()
     }
 
     fn record(&self, rec: &Recording) {

@@ -11,6 +11,7 @@ use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::Shading;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
+use crate::sync::{light_list_reads, Use};
 use crate::targets::{gbuffer_images, Output};
 use ml_vk::{shader, vk, Context, VkError};
 
@@ -84,6 +85,10 @@ impl Pass for DeferredSubpasses {
             "depth_input" => input(t.depth.view, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
             _ => t.gbuffer_image(name.trim_end_matches("_input")).and_then(|g| input(g.view, read_only)),
         })
+    }
+
+    fn uses(&self) -> Vec<Use> {
+        light_list_reads(vk::PipelineStageFlags::FRAGMENT_SHADER)
     }
 
     fn record(&self, rec: &Recording) {

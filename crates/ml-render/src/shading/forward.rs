@@ -8,7 +8,7 @@ use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::Shading;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
-use crate::sync::{Entry, Exit, Use, COLOUR_TARGET};
+use crate::sync::{light_list_reads, Entry, Exit, Use, COLOUR_TARGET};
 use crate::targets::Output;
 use ml_vk::{vk, Context, VkError};
 
@@ -65,7 +65,8 @@ impl Pass for Forward {
             | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
             | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
         let transfer = vk::PipelineStageFlags::TRANSFER;
-        vec![Use {
+        let mut uses = light_list_reads(vk::PipelineStageFlags::FRAGMENT_SHADER);
+        uses.push(Use {
             name: COLOUR_TARGET,
             entry: Entry::Chained { stages: attachments | transfer },
             exit: Exit {
@@ -75,7 +76,8 @@ impl Pass for Forward {
                 visible: vk::AccessFlags::TRANSFER_READ,
                 layout: Some(vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
             },
-        }]
+        });
+        uses
     }
 
     fn record(&self, rec: &Recording) {

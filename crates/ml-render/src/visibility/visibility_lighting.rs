@@ -9,7 +9,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::Shading;
-use crate::sync::Use;
+use crate::sync::{light_list_reads, Use};
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};
 
@@ -52,7 +52,9 @@ impl Pass for VisibilityLighting {
 
     /// After the late raster and the cluster build.
     fn uses(&self) -> Vec<Use> {
-        vec![ComputePass::colour_use()]
+        let mut uses = light_list_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
+        uses.push(ComputePass::colour_use());
+        uses
     }
 
     fn record(&self, rec: &Recording) {
