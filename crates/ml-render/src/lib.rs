@@ -20,6 +20,7 @@ pub mod scene;
 pub mod settings;
 pub mod shading;
 pub mod shadows;
+pub mod specialization;
 pub mod stage_probe;
 pub mod targets;
 pub mod visibility;
