@@ -8,11 +8,11 @@
 //! rasterisers alike, which draw triangles of many objects in one dispatch and so cannot bind
 //! each object's texture. So the alpha of every texture a masked object cuts with is copied,
 //! one byte a texel (base level), into one storage buffer, and one function
-//! (`shaders/alpha_mask.glsl`, its CPU twin `texture_alpha` here) filters it by hand with the
-//! texture's wrap modes: bilinear, or nearest where the sampler magnifies that way. The base
-//! level everywhere, rather than a mip chosen per pixel, so that the techniques and the shadows
-//! cut exactly the same shape (mips would thin foliage with distance, and each raster would
-//! choose its level from derivatives of its own).
+//! (`shaders/common/alpha_mask.glsl`, its CPU twin `texture_alpha` here) filters it by hand
+//! with the texture's wrap modes: bilinear, or nearest where the sampler magnifies that way.
+//! The base level everywhere, rather than a mip chosen per pixel, so that the techniques and
+//! the shadows cut exactly the same shape (mips would thin foliage with distance, and each
+//! raster would choose its level from derivatives of its own).
 //!
 //! Most points of a cut-out texture lie well inside or well outside its shape, so after each
 //! texture's texels come the alpha bounds of its 4×4-texel blocks: the least and the greatest

@@ -1,5 +1,5 @@
-//! Rust mirrors of the structs in `shaders/common.glsl`. Field names equal the GLSL member
-//! names so that the `gpu_layout` test can match them against SPIR-V reflection.
+//! Rust mirrors of the structs in `shaders/common/common.glsl`. Field names equal the GLSL
+//! member names so that the `gpu_layout` test can match them against SPIR-V reflection.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -39,7 +39,8 @@ gpu_struct!(
         omni_texel: f32,
         /// Lights in `directional_*`.
         directional_count: u32,
-        /// xyz: cluster grid size; w: debug view (DEBUG_VIEW_*).
+        /// xyz: cluster grid size; w: debug view (DEBUG_VIEW_* in common.glsl, generated as
+        /// ml_shaders::debug_view).
         cluster_dims: [u32; 4],
         /// xy: image size in pixels.
         viewport: [u32; 4],
@@ -126,20 +127,6 @@ gpu_struct!(
         _pad0: u32,
     }
 );
-
-/// `DEBUG_VIEW_*` in common.glsl.
-pub const DEBUG_VIEW_NONE: u32 = 0;
-pub const DEBUG_VIEW_CLUSTER_HEAT: u32 = 1;
-pub const DEBUG_VIEW_GBUFFER_ALBEDO: u32 = 2;
-pub const DEBUG_VIEW_GBUFFER_NORMAL: u32 = 3;
-pub const DEBUG_VIEW_GBUFFER_MATERIAL: u32 = 4;
-pub const DEBUG_VIEW_DEPTH: u32 = 5;
-pub const DEBUG_VIEW_SHADOW_MAP: u32 = 6;
-pub const DEBUG_VIEW_SHADOW_CUBE: u32 = 7;
-pub const DEBUG_VIEW_MESHLETS: u32 = 8;
-pub const DEBUG_VIEW_TRIANGLES: u32 = 9;
-pub const DEBUG_VIEW_SHADOW_ATLAS: u32 = 10;
-pub const DEBUG_VIEW_ALPHA: u32 = 11;
 
 gpu_struct!(
     /// One object of the object buffer (std430).
@@ -240,7 +227,7 @@ gpu_struct!(
     /// One shadowed light's faces in the shadow atlas (`ShadowCubeTiles` in common.glsl).
     ShadowCubeTiles {
         /// Per cube face: the index of its texel (0, 0) in the Z-ordered atlas; NO_TILE where
-        /// it has none.
+        /// it has none (common.glsl, generated as ml_shaders::common::NO_TILE).
         base: [u32; 6],
         /// Texels a side of each of its faces.
         size: u32,
@@ -248,9 +235,6 @@ gpu_struct!(
         redraw: u32,
     }
 );
-
-/// `ShadowCubeTiles::base` of a face without a tile.
-pub const NO_TILE: u32 = u32::MAX;
 
 gpu_struct!(
     /// Push constants of the compute-vs-fragment probe (stage_probe.glsl).

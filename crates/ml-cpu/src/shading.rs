@@ -1,6 +1,6 @@
 //! CPU reference of the shading models, formula for formula the same as the GLSL
-//! (`shaders/seed_brdf.glsl`; keep in sync). Image tests shade analytically known surface
-//! points with these and compare the GPU's pixels.
+//! (`shaders/common/seed_brdf.glsl`; keep in sync). Image tests shade analytically known
+//! surface points with these and compare the GPU's pixels.
 
 use crate::gpu_types::PointLight;
 use crate::material::Material;

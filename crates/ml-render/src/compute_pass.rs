@@ -5,29 +5,30 @@
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
+use crate::specialization;
 use crate::sync::{Use, COLOUR_TARGET};
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
 use ml_vk::image::fetch_sampler;
 use ml_vk::{shader, vk, Context, Image, VkError};
 
-/// Work-group size of these passes (8×8 in the shaders).
-const GROUP: u32 = 8;
-
 pub struct ComputePass {
     sets: FrameSets,
     pub sampler: vk::Sampler,
     pipeline_layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
+    /// The shader's work-group size, a thread per pixel: a dispatch over an image divides
+    /// its size by this.
+    workgroup_size: [u32; 3],
 }
 
 impl ComputePass {
-    /// The pass of `shader` (with specialization `constants`: id, value); set 0 as the shader
-    /// declares it, further sets of `more_sets`.
+    /// The pass of `shader` (with specialization `constants`: name, value); set 0 as the
+    /// shader declares it, further sets of `more_sets`.
     pub fn new(
         ctx: &Context,
         more_sets: &[vk::DescriptorSetLayout],
-        (shader, constants): (&Shader, &[(u32, u32)]),
+        (shader, constants): (&Shader, &[(&str, u32)]),
     ) -> Result<ComputePass, VkError> {
         ComputePass::with_push(ctx, more_sets, (shader, constants), 0)
     }
@@ -36,7 +37,7 @@ impl ComputePass {
     pub fn with_push(
         ctx: &Context,
         more_sets: &[vk::DescriptorSetLayout],
-        (shader, constants): (&Shader, &[(u32, u32)]),
+        (shader, constants): (&Shader, &[(&str, u32)]),
         push_bytes: u32,
     ) -> Result<ComputePass, VkError> {
         let p = ComputePass {
@@ -44,15 +45,21 @@ impl ComputePass {
             sampler: vk::Sampler::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            workgroup_size: shader.workgroup_size,
         };
         ml_vk::build(ctx, p, |p| {
             let layouts: Vec<vk::DescriptorSetLayout> = std::iter::once(p.sets.layout.raw).chain(more_sets.iter().copied()).collect();
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(push_bytes)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &layouts, if push_bytes > 0 { &push } else { &[] })?;
-            p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, constants)?;
+            p.pipeline = specialization::compute_pipeline(ctx, shader, p.pipeline_layout, constants)?;
             p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })
+    }
+
+    /// The work groups of a dispatch over `extent` (x, y).
+    pub fn groups(&self, extent: vk::Extent2D) -> (u32, u32) {
+        (extent.width.div_ceil(self.workgroup_size[0]), extent.height.div_ceil(self.workgroup_size[1]))
     }
 
     /// Point slot `frame.slot`'s set 0 at the colour target (`out_image`, which every such
@@ -126,7 +133,8 @@ impl ComputePass {
             if !push.is_empty() {
                 d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
-            d.cmd_dispatch(cmd, extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP), 1);
+            let (x, y) = self.groups(extent);
+            d.cmd_dispatch(cmd, x, y, 1);
         }
     }
 

@@ -3,8 +3,8 @@
 //! plane: nothing there) and stored.
 //!
 //! Alpha-masked objects (glTF MASK, BLEND as a mask) cast shadows of their shape through a
-//! pipeline of their own (`MaskedPipeline`, shaders/shadow_mask.glsl), made only where a
-//! scene has such objects; every other object keeps the depth-only pipeline.
+//! pipeline of their own (`MaskedPipeline`, shaders/shadows/shadow_mask.glsl), made only where
+//! a scene has such objects; every other object keeps the depth-only pipeline.
 
 use crate::descriptors::{FrameSets, Resource};
 use crate::gpu_mesh::{vertex_attributes, vertex_binding};
@@ -92,6 +92,7 @@ fn depth_pipeline(
         ctx,
         &shader::GraphicsPipelineDesc {
             vertex,
+            vertex_constants: &[],
             fragment,
             fragment_constants: &[],
             vertex_input: vk::PipelineVertexInputStateCreateInfo::default()

@@ -201,9 +201,9 @@ mod tests {
     const FRAME: Binding = Binding { set: 0, binding: 0, kind: DescriptorKind::UniformBuffer, count: 1, name: "FrameBlock" };
     const LIGHTS: Binding = Binding { set: 0, binding: 1, kind: DescriptorKind::StorageBuffer, count: 1, name: "LightBuffer" };
     const IMAGE: Binding = Binding { set: 0, binding: 1, kind: DescriptorKind::CombinedImageSampler, count: 1, name: "depth_image" };
-    const VERT: Shader = Shader { file: "a.vert", spirv: &[], bindings: &[FRAME] };
-    const FRAG: Shader = Shader { file: "a.frag", spirv: &[], bindings: &[FRAME, LIGHTS] };
-    const OTHER: Shader = Shader { file: "b.frag", spirv: &[], bindings: &[FRAME, IMAGE] };
+    const VERT: Shader = Shader { file: "a.vert", spirv: &[], bindings: &[FRAME], spec_constants: &[], workgroup_size: [1; 3] };
+    const FRAG: Shader = Shader { file: "a.frag", spirv: &[], bindings: &[FRAME, LIGHTS], spec_constants: &[], workgroup_size: [1; 3] };
+    const OTHER: Shader = Shader { file: "b.frag", spirv: &[], bindings: &[FRAME, IMAGE], spec_constants: &[], workgroup_size: [1; 3] };
 
     #[test]
     fn stages_share_a_binding_and_add_theirs() {

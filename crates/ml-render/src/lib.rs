@@ -49,6 +49,7 @@ mod renderer;
 mod scene;
 mod shading;
 mod shadows;
+mod specialization;
 mod sync;
 mod targets;
 mod visibility;

@@ -140,24 +140,6 @@ pub enum Geometry {
     Meshlets,
 }
 
-/// constant_id of `MODEL_BLINN_PHONG` and `MODEL_PBR` in shading_model.glsl.
-pub const SPEC_BLINN_PHONG: u32 = 10;
-pub const SPEC_PBR: u32 = 11;
-
-/// Specialization constants (id, value) that compile a pipeline for `model`
-/// (shading_model.glsl).
-fn model_spec_constants(model: ShadingModel) -> [(u32, u32); 2] {
-    [(SPEC_BLINN_PHONG, u32::from(model == ShadingModel::BlinnPhong)), (SPEC_PBR, u32::from(model == ShadingModel::Pbr))]
-}
-
-/// constant_id of `OMNI_SHADOWS` (omni_shadow.glsl), `OBJECT_TEXTURES` (surface.glsl) and
-/// `SPOT_LIGHTS` (lighting.glsl).
-pub const SPEC_OMNI_SHADOWS: u32 = 12;
-pub const SPEC_OBJECT_TEXTURES: u32 = 13;
-pub const SPEC_SPOT_LIGHTS: u32 = 14;
-/// constant_id of `SHADOW_ATLAS` (omni_shadow.glsl).
-pub const SPEC_SHADOW_ATLAS: u32 = 15;
-
 /// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
 /// whether objects have textures of their own and whether there are spot lights
 /// (specialization constants, so each pipeline carries only what it runs).
@@ -172,15 +154,29 @@ pub struct Shading {
 }
 
 impl Shading {
-    pub fn spec_constants(self) -> [(u32, u32); 6] {
-        let [a, b] = model_spec_constants(self.model);
+    /// The specialization constants (name, value) of a pipeline that reads surfaces without
+    /// lighting them (the G-buffer's): `MODEL_BLINN_PHONG`, `MODEL_PBR` and `OBJECT_TEXTURES`
+    /// (common/shading_model.glsl).
+    pub fn surface_constants(self) -> [(&'static str, u32); 3] {
         [
-            a,
-            b,
-            (SPEC_OMNI_SHADOWS, u32::from(self.omni_shadows)),
-            (SPEC_SHADOW_ATLAS, u32::from(self.shadow_atlas)),
-            (SPEC_OBJECT_TEXTURES, u32::from(self.object_textures)),
-            (SPEC_SPOT_LIGHTS, u32::from(self.spot_lights)),
+            ("MODEL_BLINN_PHONG", u32::from(self.model == ShadingModel::BlinnPhong)),
+            ("MODEL_PBR", u32::from(self.model == ShadingModel::Pbr)),
+            ("OBJECT_TEXTURES", u32::from(self.object_textures)),
+        ]
+    }
+
+    /// The specialization constants (name, value) of a lighting pipeline: the surface's,
+    /// `OMNI_SHADOWS` and `SHADOW_ATLAS` (shadows/omni_shadow.glsl) and `SPOT_LIGHTS`
+    /// (common/lighting.glsl).
+    pub fn lighting_constants(self) -> [(&'static str, u32); 6] {
+        let [model_a, model_b, textures] = self.surface_constants();
+        [
+            model_a,
+            model_b,
+            textures,
+            ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
+            ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
+            ("SPOT_LIGHTS", u32::from(self.spot_lights)),
         ]
     }
 }
@@ -477,22 +473,22 @@ impl DebugView {
         by_name(&DebugView::ALL, DebugView::name, Named::DebugView, name)
     }
 
-    /// The value shaders see (DEBUG_VIEW_* in common.glsl).
+    /// The value shaders see: `DEBUG_VIEW_*` in common/common.glsl, generated from there.
     pub fn code(self) -> u32 {
-        use ml_cpu::gpu_types as g;
+        use ml_shaders::debug_view as v;
         match self {
-            DebugView::None => g::DEBUG_VIEW_NONE,
-            DebugView::ClusterHeat => g::DEBUG_VIEW_CLUSTER_HEAT,
-            DebugView::GBufferAlbedo => g::DEBUG_VIEW_GBUFFER_ALBEDO,
-            DebugView::GBufferNormal => g::DEBUG_VIEW_GBUFFER_NORMAL,
-            DebugView::GBufferMaterial => g::DEBUG_VIEW_GBUFFER_MATERIAL,
-            DebugView::Depth => g::DEBUG_VIEW_DEPTH,
-            DebugView::ShadowMap => g::DEBUG_VIEW_SHADOW_MAP,
-            DebugView::ShadowCube => g::DEBUG_VIEW_SHADOW_CUBE,
-            DebugView::ShadowAtlas => g::DEBUG_VIEW_SHADOW_ATLAS,
-            DebugView::Meshlets => g::DEBUG_VIEW_MESHLETS,
-            DebugView::Triangles => g::DEBUG_VIEW_TRIANGLES,
-            DebugView::Alpha => g::DEBUG_VIEW_ALPHA,
+            DebugView::None => v::NONE,
+            DebugView::ClusterHeat => v::CLUSTER_HEAT,
+            DebugView::GBufferAlbedo => v::GBUFFER_ALBEDO,
+            DebugView::GBufferNormal => v::GBUFFER_NORMAL,
+            DebugView::GBufferMaterial => v::GBUFFER_MATERIAL,
+            DebugView::Depth => v::DEPTH,
+            DebugView::ShadowMap => v::SHADOW_MAP,
+            DebugView::ShadowCube => v::SHADOW_CUBE,
+            DebugView::ShadowAtlas => v::SHADOW_ATLAS,
+            DebugView::Meshlets => v::MESHLETS,
+            DebugView::Triangles => v::TRIANGLES,
+            DebugView::Alpha => v::ALPHA,
         }
     }
 }

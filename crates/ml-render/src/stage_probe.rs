@@ -8,6 +8,7 @@
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::report::Spread;
 use crate::settings::Technique;
+use crate::specialization::compute_pipeline;
 use ml_cpu::gpu_types::{PointLight, StageProbePush};
 use ml_shaders::{FULLSCREEN_VERT, STAGE_PROBE_COMP, STAGE_PROBE_FRAG};
 use ml_vk::commands::{copy_colour_to_host, one_shot};
@@ -18,8 +19,6 @@ use std::time::Instant;
 
 /// Both halves write this 8-bit format, so their images can be compared byte for byte.
 const FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
-/// Work-group size of stage_probe.comp (8×8).
-const GROUP: u32 = 8;
 
 /// One kind of pass's time for one loop length.
 #[derive(Clone, Copy, Debug)]
@@ -172,11 +171,12 @@ impl StageProbe {
         let push = |stage| [vk::PushConstantRange::default().stage_flags(stage).size(std::mem::size_of::<StageProbePush>() as u32)];
         self.fragment_layout = shader::pipeline_layout(ctx, &[self.fragment_set_layout.raw], &push(vk::ShaderStageFlags::FRAGMENT))?;
         self.compute_layout = shader::pipeline_layout(ctx, &[self.compute_set_layout.raw], &push(vk::ShaderStageFlags::COMPUTE))?;
-        self.compute_pipeline = shader::compute_pipeline(ctx, STAGE_PROBE_COMP.spirv, self.compute_layout, &[])?;
+        self.compute_pipeline = compute_pipeline(ctx, &STAGE_PROBE_COMP, self.compute_layout, &[])?;
         self.fragment_pipeline = shader::graphics_pipeline(
             ctx,
             &shader::GraphicsPipelineDesc {
                 vertex: FULLSCREEN_VERT.spirv,
+                vertex_constants: &[],
                 fragment: Some(STAGE_PROBE_FRAG.spirv),
                 fragment_constants: &[],
                 vertex_input: vk::PipelineVertexInputStateCreateInfo::default(),
@@ -259,7 +259,8 @@ impl StageProbe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.compute_pipeline);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.compute_layout, 0, &[self.compute_set], &[]);
             d.cmd_push_constants(cmd, self.compute_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&self.push(lights)));
-            d.cmd_dispatch(cmd, self.extent.width.div_ceil(GROUP), self.extent.height.div_ceil(GROUP), 1);
+            let [x, y, _] = STAGE_PROBE_COMP.groups([self.extent.width, self.extent.height, 1]);
+            d.cmd_dispatch(cmd, x, y, 1);
         }
         let readable = (transfer, vk::AccessFlags::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
         image_transition(ctx, cmd, self.compute_target.raw, storage, readable);

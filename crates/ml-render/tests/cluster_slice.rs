@@ -1,8 +1,8 @@
 //! The slice formula is written once in Rust (`ClusterGrid::slice`) and once in GLSL
-//! (`cluster_slice` in shaders/cluster.glsl). On 10⁵ random depths the GPU's slices must equal
-//! the CPU's, except for depths within 1e-4 slices of a boundary, where f32 `log` may round
-//! either way — and there they may differ by one slice only (the cluster boxes carry slack
-//! for exactly that).
+//! (`cluster_slice` in shaders/clusters/cluster.glsl). On 10⁵ random depths the GPU's slices
+//! must equal the CPU's, except for depths within 1e-4 slices of a boundary, where f32 `log`
+//! may round either way — and there they may differ by one slice only (the cluster boxes
+//! carry slack for exactly that).
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -51,7 +51,8 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
         unsafe {
             ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
             ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, pipeline_layout, 0, &[set], &[]);
-            ctx.device.cmd_dispatch(cmd, depths.len().div_ceil(64) as u32, 1, 1);
+            let [groups, ..] = probe.groups([depths.len() as u32, 1, 1]);
+            ctx.device.cmd_dispatch(cmd, groups, 1, 1);
         }
         commands::memory_barrier(
             ctx,

@@ -12,6 +12,8 @@ pub fn module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
 }
 
 /// Map entries and data of 32-bit specialization constants (id, value; a GLSL bool is 0 or 1).
+/// The ids are the module's own: ml-render resolves the names Rust uses against the shader's
+/// reflection before it calls here.
 fn specialization(constants: &[(u32, u32)]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {
     let entries = constants
         .iter()
@@ -44,6 +46,8 @@ pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout,
 /// triangle lists, dynamic viewport and scissor, one sample, colour written unblended.
 pub struct GraphicsPipelineDesc<'a> {
     pub vertex: &'a [u8],
+    /// Specialization constants (id, value) of the vertex stage.
+    pub vertex_constants: &'a [(u32, u32)],
     /// None: depth only.
     pub fragment: Option<&'a [u8]>,
     /// Specialization constants (id, value) of the fragment stage.
@@ -68,9 +72,15 @@ pub fn graphics_pipeline(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<v
             return Err(e);
         }
     };
+    let (vertex_entries, vertex_data) = specialization(desc.vertex_constants);
+    let vertex_spec = vk::SpecializationInfo::default().map_entries(&vertex_entries).data(&vertex_data);
     let (entries, data) = specialization(desc.fragment_constants);
     let spec = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
-    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main")];
+    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::VERTEX)
+        .module(vert)
+        .name(c"main")
+        .specialization_info(&vertex_spec)];
     if let Some(frag) = frag {
         stages.push(
             vk::PipelineShaderStageCreateInfo::default()

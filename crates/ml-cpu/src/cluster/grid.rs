@@ -5,9 +5,10 @@
 //! (px·X / width, py·Y / height) in integer arithmetic, exactly as the shader computes it.
 //! Slices: slice = ⌊ln(z/near) / ln(far/near) · Z⌋ for view depth z (distance along −Z), written
 //! as ⌊ln(z)·scale + bias⌋ with scale and bias computed here in f32 and handed to the shader,
-//! so both sides evaluate the same expression (keep in sync with `shaders/cluster.glsl`).
-//! The seed took the slice from NDC z as if it were linear (mistake 2): NDC z of a
-//! perspective projection crowds almost every depth into the last few slices.
+//! so both sides evaluate the same expression (keep in sync with
+//! `shaders/clusters/cluster.glsl`). The seed took the slice from NDC z as if it were linear
+//! (mistake 2): NDC z of a perspective projection crowds almost every depth into the last few
+//! slices.
 
 use crate::camera::Camera;
 use crate::limits::MAX_CLUSTERS;

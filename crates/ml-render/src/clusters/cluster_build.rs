@@ -16,13 +16,12 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
+use crate::specialization::compute_pipeline;
 use crate::sync::{Use, LIGHT_LISTS};
 use ml_cpu::gpu_types::{ClusterBounds, ClusterFeedback, PointLight};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
-const BUILD_GROUP: u32 = 128;
-const BOUNDS_GROUP: u32 = 64;
 /// Clusters per scan block (cluster_scan.comp); ml_cpu::limits::MAX_CLUSTERS = SCAN_BLOCK² so the
 /// block totals fit one workgroup.
 const SCAN_BLOCK: u32 = 1024;
@@ -96,14 +95,12 @@ impl ClusterBuild {
 
     fn create(&mut self, ctx: &Context, rest_lights: &[PointLight]) -> Result<(), VkError> {
         self.pipeline_layout = shader::pipeline_layout(ctx, &[self.sets.layout.raw], &[])?;
-        self.bounds_pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BOUNDS_COMP.spirv, self.pipeline_layout, &[])?;
-        // Specialization constants: 0 = FILL, 1 = LANES (cluster_build.comp); 0 = STEP (scan).
-        self.count_pipeline =
-            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP.spirv, self.pipeline_layout, &[(0, 0), (1, self.lanes)])?;
-        self.fill_pipeline =
-            shader::compute_pipeline(ctx, ml_shaders::CLUSTER_BUILD_COMP.spirv, self.pipeline_layout, &[(0, 1), (1, self.lanes)])?;
+        self.bounds_pipeline = compute_pipeline(ctx, &ml_shaders::CLUSTER_BOUNDS_COMP, self.pipeline_layout, &[])?;
+        let build = &ml_shaders::CLUSTER_BUILD_COMP;
+        self.count_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 0), ("LANES", self.lanes)])?;
+        self.fill_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 1), ("LANES", self.lanes)])?;
         for (step, pipeline) in self.scan_pipelines.iter_mut().enumerate() {
-            *pipeline = shader::compute_pipeline(ctx, ml_shaders::CLUSTER_SCAN_COMP.spirv, self.pipeline_layout, &[(0, step as u32)])?;
+            *pipeline = compute_pipeline(ctx, &ml_shaders::CLUSTER_SCAN_COMP, self.pipeline_layout, &[("STEP", step as u32)])?;
         }
         self.rest_lights =
             Buffer::device_local_with(ctx, "lights at rest", bytemuck::cast_slice(rest_lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
@@ -128,7 +125,8 @@ impl ClusterBuild {
             unsafe {
                 ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.bounds_pipeline);
                 ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
-                ctx.device.cmd_dispatch(cmd, self.cluster_count.div_ceil(BOUNDS_GROUP), 1, 1);
+                let [groups, ..] = ml_shaders::CLUSTER_BOUNDS_COMP.groups([self.cluster_count, 1, 1]);
+                ctx.device.cmd_dispatch(cmd, groups, 1, 1);
             }
             let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
             memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
@@ -150,7 +148,8 @@ impl ClusterBuild {
             (compute | vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE),
             (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE),
         );
-        let light_groups = (self.light_count as u64 * self.lanes as u64).div_ceil(BUILD_GROUP as u64) as u32;
+        let build_group = ml_shaders::CLUSTER_BUILD_COMP.workgroup_size[0];
+        let light_groups = (self.light_count as u64 * self.lanes as u64).div_ceil(build_group as u64) as u32;
         let blocks = self.cluster_count.div_ceil(SCAN_BLOCK);
         let steps = [
             (self.count_pipeline, light_groups),
@@ -276,5 +275,17 @@ impl Pass for ClusterBuild {
 impl ml_vk::Release for GpuClusterFrame {
     fn release(&mut self, ctx: &Context) {
         self.destroy(ctx);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Step 0 of the scan runs a work group per block, an invocation per cluster, and step 1
+    /// one group over the blocks' totals: the block is the scan shader's work group, and
+    /// MAX_CLUSTERS at most SCAN_BLOCK².
+    #[test]
+    fn scan_block_is_the_scan_shaders_work_group() {
+        assert_eq!(ml_shaders::CLUSTER_SCAN_COMP.workgroup_size, [super::SCAN_BLOCK, 1, 1]);
+        assert!(u64::from(super::SCAN_BLOCK).pow(2) >= ml_cpu::limits::MAX_CLUSTERS);
     }
 }

@@ -10,14 +10,10 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
-use crate::settings::SPEC_PBR;
 use crate::sync::{Use, COLOUR_TARGET};
 use gpu_allocator::MemoryLocation;
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{vk, Buffer, Context, VkError};
-
-/// The meter's work groups are 8×8 pixels (ComputePass's size).
-const GROUP: u32 = 8;
 
 pub struct ExposureMeter {
     pass: ComputePass,
@@ -31,7 +27,7 @@ pub struct ExposureMeter {
 impl ExposureMeter {
     /// The meter of frames shaded with pbr's tone map (`aces`) or without.
     pub fn new(ctx: &Context, aces: bool) -> Result<ExposureMeter, VkError> {
-        let curve = [(SPEC_PBR, u32::from(aces))];
+        let curve = [("MODEL_PBR", u32::from(aces))];
         Ok(ExposureMeter {
             pass: ComputePass::new(ctx, &[], (&ml_shaders::EXPOSURE_METER_COMP, &curve))?,
             sums: (0..FRAMES_IN_FLIGHT).map(|_| Buffer::null()).collect(),
@@ -48,7 +44,9 @@ impl Pass for ExposureMeter {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let extent = frame.targets.color.extent;
-        let groups = extent.width.div_ceil(GROUP) * extent.height.div_ceil(GROUP);
+        // A sum per work group of the pass's dispatch.
+        let (x, y) = self.pass.groups(extent);
+        let groups = x * y;
         let slot = frame.slot;
         if groups != self.groups[slot] {
             // A new size (no frame of this slot in flight while it is bound).

@@ -5,7 +5,6 @@
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
-use crate::settings::SPEC_PBR;
 use crate::sync::Use;
 use ml_vk::{vk, Context, VkError};
 
@@ -17,7 +16,7 @@ impl ToneMap {
     /// `aces`: apply pbr's tone-mapping curve before gamma (not for debug views, whose
     /// values are shown as they are).
     pub fn new(ctx: &Context, aces: bool) -> Result<ToneMap, VkError> {
-        let curve = [(SPEC_PBR, u32::from(aces))];
+        let curve = [("MODEL_PBR", u32::from(aces))];
         Ok(ToneMap { pass: ComputePass::new(ctx, &[], (&ml_shaders::TONEMAP_COMP, &curve))? })
     }
 }

@@ -9,10 +9,6 @@ use ml_cpu::gpu_types::{INSTANCE_DOUBLE_SIDED, INSTANCE_MASKED};
 use ml_cpu::meshlets::SceneMeshlets;
 use ml_vk::{vk, Buffer, Context, VkError};
 
-/// Specialization constant of the compute rasters (raster_surface.glsl SURFACE_TESTS): 1 where
-/// the scene has masked or double-sided objects (`MeshletGeometry::surface_tests`).
-pub const SPEC_SURFACE_TESTS: u32 = 18;
-
 /// The scene's meshlets on the GPU, uploaded once per scene (SceneGpu owns it): what every
 /// meshlet pass reads, through a `MeshletGeometryView`.
 pub struct MeshletGeometry {
@@ -27,7 +23,8 @@ pub struct MeshletGeometry {
     pub instance_count: u32,
     /// Triangles of every object together.
     pub triangles: u64,
-    /// Whether some object is masked or double-sided (the rasters then test surfaces).
+    /// Whether some object is masked or double-sided (the rasters then test surfaces: their
+    /// specialization constant `SURFACE_TESTS`, visibility/raster_surface.glsl).
     pub surface_tests: bool,
 }
 
@@ -60,6 +57,11 @@ impl MeshletGeometryView {
             _ => return None,
         };
         Some(Resource::Buffer(buffer))
+    }
+
+    /// The compute rasters' specialization constant `SURFACE_TESTS` (name, value).
+    pub fn surface_tests_constant(&self) -> (&'static str, u32) {
+        ("SURFACE_TESTS", u32::from(self.surface_tests))
     }
 }
 

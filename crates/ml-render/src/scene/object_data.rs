@@ -17,10 +17,6 @@ pub struct SurfaceVariant {
     pub masked: bool,
 }
 
-/// Specialization constants of mesh_coverage.glsl.
-pub const SPEC_MASKED_DRAW: u32 = 16;
-pub const SPEC_DOUBLE_SIDED_DRAW: u32 = 17;
-
 impl SurfaceVariant {
     pub const OPAQUE: SurfaceVariant = SurfaceVariant { double_sided: false, masked: false };
     pub(crate) const COUNT: usize = 4;
@@ -45,8 +41,9 @@ impl SurfaceVariant {
         usize::from(self.double_sided) * 2 + usize::from(self.masked)
     }
 
-    pub(crate) fn spec_constants(self) -> [(u32, u32); 2] {
-        [(SPEC_MASKED_DRAW, u32::from(self.masked)), (SPEC_DOUBLE_SIDED_DRAW, u32::from(self.double_sided))]
+    /// Its specialization constants (name, value) in shading/mesh_coverage.glsl.
+    pub(crate) fn spec_constants(self) -> [(&'static str, u32); 2] {
+        [("MASKED_DRAW", u32::from(self.masked)), ("DOUBLE_SIDED_DRAW", u32::from(self.double_sided))]
     }
 }
 

@@ -11,8 +11,9 @@ use crate::error::RenderError;
 use crate::settings::{AtlasSettings, OmniShadowSettings};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::camera::Camera;
-use ml_cpu::gpu_types::{OmniRasterCounters, ShadowCubeTiles, NO_TILE};
+use ml_cpu::gpu_types::{OmniRasterCounters, ShadowCubeTiles};
 use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight, ShadowAtlas, MIN_FACE};
+use ml_shaders::common::NO_TILE;
 use ml_vk::{vk, Buffer, Context};
 
 /// Bytes of one (meshlet instance, face) pair and of one large triangle in the raster's lists.

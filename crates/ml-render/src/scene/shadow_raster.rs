@@ -10,15 +10,14 @@
 
 use crate::descriptors::{FrameSets, Resource};
 use crate::error::RenderError;
-use crate::scene::meshlets::{storage_bytes, MeshletGeometryView, SPEC_SURFACE_TESTS};
+use crate::scene::meshlets::{storage_bytes, MeshletGeometryView};
+use crate::specialization::compute_pipeline;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{OmniRasterCounters, OmniRasterPush, ShadowCubeTiles};
 use ml_vk::commands::{memory_barrier, update_buffer};
 use ml_vk::image::aspect_transition;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
-/// Work-group size of the culling.
-const CULL_GROUP: u32 = 64;
 /// Work groups a dispatch may have along x on every device (the shaders loop past it).
 const MAX_GROUPS: u32 = 65535;
 /// The largest triangle one thread draws (bounding box, texels a side); larger ones get a
@@ -28,9 +27,6 @@ const COMPUTE: vk::PipelineStageFlags = vk::PipelineStageFlags::COMPUTE_SHADER;
 const RW: vk::AccessFlags = vk::AccessFlags::from_raw(vk::AccessFlags::SHADER_READ.as_raw() | vk::AccessFlags::SHADER_WRITE.as_raw());
 /// The depth of a texel nothing reaches: 1.0's bits.
 const FAR_BITS: u32 = 1.0f32.to_bits();
-/// constant_id of `ORTHO_VIEW` and `ATLAS` (omni_raster.glsl).
-const SPEC_ORTHO_VIEW: u32 = 0;
-const SPEC_ATLAS: u32 = 1;
 /// Work groups that clear each face of the atlas (shadow_atlas_clear.comp's SLICES).
 const CLEAR_SLICES: u32 = 16;
 
@@ -170,15 +166,13 @@ impl ShadowRaster {
             let push =
                 [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(size_of::<OmniRasterPush>() as u32)];
             r.layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw], &push)?;
-            let spec = [
-                (SPEC_ORTHO_VIEW, u32::from(views == ShadowViews::Ortho)),
-                (SPEC_ATLAS, u32::from(atlas)),
-                (SPEC_SURFACE_TESTS, u32::from(r.geometry.surface_tests)),
-            ];
+            // Every step includes shadows/omni_raster.glsl, which declares them all.
+            let spec =
+                [("ORTHO_VIEW", u32::from(views == ShadowViews::Ortho)), ("ATLAS", u32::from(atlas)), r.geometry.surface_tests_constant()];
             // The clear is the atlas's alone.
             let used = if atlas { 4 } else { 3 };
             for (pipeline, s) in r.pipelines.iter_mut().zip(shaders).take(used) {
-                *pipeline = shader::compute_pipeline(ctx, s.spirv, r.layout, &spec)?;
+                *pipeline = compute_pipeline(ctx, s, r.layout, &spec)?;
             }
             Ok(())
         })
@@ -319,7 +313,8 @@ impl ShadowRaster {
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.sets.sets[slot]], &[]);
             d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[0]);
-            let groups = self.geometry.meshlet_instance_count.div_ceil(CULL_GROUP).clamp(1, MAX_GROUPS);
+            let [groups, ..] = ml_shaders::OMNI_CULL_COMP.groups([self.geometry.meshlet_instance_count, 1, 1]);
+            let groups = groups.clamp(1, MAX_GROUPS);
             d.cmd_dispatch(cmd, groups, lights, 1);
             memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), listed);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipelines[1]);

@@ -20,7 +20,7 @@ pub struct ComputeLighting {
 impl ComputeLighting {
     pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading) -> Result<ComputeLighting, VkError> {
         // Set 1: the scene's textures (blinn-phong's shadow map and sky, the shadow cubes).
-        let model = shading.spec_constants();
+        let model = shading.lighting_constants();
         let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (&ml_shaders::DEFERRED_LIGHTING_COMP, &model))?;
         Ok(ComputeLighting { pass })
     }

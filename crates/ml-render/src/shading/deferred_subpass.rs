@@ -56,7 +56,9 @@ impl DeferredSubpasses {
             pass.input_sets = FrameSets::new(ctx, &stages, 2, FRAMES_IN_FLIGHT)?;
             let layouts = [pass.lighting_sets.layout.raw, textures, pass.input_sets.layout.raw];
             pass.lighting_layout = shader::pipeline_layout(ctx, &layouts, &[])?;
-            pass.lighting = pass.raster.pipeline(ctx, (&ml_shaders::FULLSCREEN_VERT, lighting), Draw::Screen, (pass.lighting_layout, 1))?;
+            let shaders = (&ml_shaders::FULLSCREEN_VERT, lighting);
+            let constants = shading.lighting_constants();
+            pass.lighting = pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.lighting_layout, 1), &constants)?;
             Ok(())
         })();
         match made {

@@ -35,7 +35,7 @@ impl Forward {
         let mut pass = Forward { raster, legend: vk::Pipeline::null(), name };
         if legend {
             let shaders = (&ml_shaders::HEAT_LEGEND_VERT, &ml_shaders::HEAT_LEGEND_FRAG);
-            match pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.raster.pipeline_layout, 0)) {
+            match pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.raster.pipeline_layout, 0), &[]) {
                 Ok(p) => pass.legend = p,
                 Err(e) => {
                     pass.destroy(ctx);

@@ -11,6 +11,7 @@ use crate::pass::Recording;
 use crate::render_pass;
 use crate::scene::object_data::{object_push, SurfaceVariant};
 use crate::settings::Shading;
+use crate::specialization;
 use crate::targets::{GBufferImage, Output};
 use ml_cpu::gpu_types::ObjectPush;
 use ml_shaders::Shader;
@@ -38,7 +39,6 @@ pub struct MeshRaster {
     framebuffers: Vec<vk::Framebuffer>,
     pub output: Output,
     pub gbuffer: &'static [GBufferImage],
-    pub shading: Shading,
 }
 
 impl MeshRaster {
@@ -59,7 +59,6 @@ impl MeshRaster {
             framebuffers: vec![vk::Framebuffer::null(); FRAMES_IN_FLIGHT],
             output,
             gbuffer,
-            shading,
         };
         let made = (|| {
             r.render_pass = render_pass::describe(depth_format, output, gbuffer).create(ctx)?;
@@ -67,10 +66,16 @@ impl MeshRaster {
                 .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
                 .size(std::mem::size_of::<ObjectPush>() as u32)];
             r.pipeline_layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw, textures_layout, object_textures_layout], &push)?;
+            // Drawn into the colour target, meshes are lit where they are drawn; into a
+            // G-buffer, only their surfaces are read.
+            let constants = match output {
+                Output::Color => shading.lighting_constants().to_vec(),
+                _ => shading.surface_constants().to_vec(),
+            };
             for &v in variants.iter().chain([&SurfaceVariant::OPAQUE]) {
                 if r.pipelines[v.index()] == vk::Pipeline::null() {
                     r.pipelines[v.index()] =
-                        r.pipeline(ctx, (&ml_shaders::FORWARD_VERT, fragment), Draw::Mesh(v), (r.pipeline_layout, 0))?;
+                        r.pipeline(ctx, (&ml_shaders::FORWARD_VERT, fragment), Draw::Mesh(v), (r.pipeline_layout, 0), &constants)?;
                 }
             }
             Ok(())
@@ -84,14 +89,15 @@ impl MeshRaster {
         }
     }
 
-    /// A pipeline of this pass: `draw` kind, in `subpass` with `layout`, compiled for the
-    /// shading (specialization constants; screen draws ignore them where they do not shade).
+    /// A pipeline of this pass: `draw` kind, in `subpass` with `layout`, specialised by
+    /// `constants` (name, value) and, for a mesh draw, by its surface variant's.
     pub fn pipeline(
         &self,
         ctx: &Context,
         (vertex, fragment): (&Shader, &Shader),
         draw: Draw,
         (layout, subpass): (vk::PipelineLayout, u32),
+        constants: &[(&str, u32)],
     ) -> Result<vk::Pipeline, VkError> {
         let colour_attachments = if subpass == 0 { self.output.colour_attachments(self.gbuffer) } else { 1 };
         let bindings = [vertex_binding()];
@@ -117,14 +123,18 @@ impl MeshRaster {
             .depth_test_enable(mesh)
             .depth_write_enable(mesh)
             .depth_compare_op(vk::CompareOp::LESS);
-        let mut model = self.shading.spec_constants().to_vec();
-        model.extend(variant_of(draw).spec_constants());
+        let mut constants = constants.to_vec();
+        if let Draw::Mesh(v) = draw {
+            constants.extend(v.spec_constants());
+        }
+        let [vertex_constants, fragment_constants] = specialization::resolve([vertex, fragment], &constants)?;
         shader::graphics_pipeline(
             ctx,
             &shader::GraphicsPipelineDesc {
                 vertex: vertex.spirv,
+                vertex_constants: &vertex_constants,
                 fragment: Some(fragment.spirv),
-                fragment_constants: &model,
+                fragment_constants: &fragment_constants,
                 vertex_input,
                 rasterization,
                 depth_stencil,
@@ -229,13 +239,5 @@ impl MeshRaster {
             ctx.device.destroy_render_pass(self.render_pass, None);
         }
         self.sets.destroy(ctx);
-    }
-}
-
-/// The surface variant of a mesh draw (screen draws: the opaque one, which they ignore).
-fn variant_of(draw: Draw) -> SurfaceVariant {
-    match draw {
-        Draw::Mesh(v) => v,
-        Draw::Screen => SurfaceVariant::OPAQUE,
     }
 }

@@ -15,17 +15,17 @@ pub struct ShadowMapView {
 }
 
 impl ShadowMapView {
-    /// `view`: the sun's map, the point-light cube (constant_id 0, CUBE) or the shadow atlas
-    /// (constant 1, ATLAS; 2 … 5: its blocks).
+    /// `view`: the sun's map, the point-light cube (constant CUBE) or the shadow atlas
+    /// (ATLAS, and its blocks: ATLAS_BLOCKS, ATLAS_SIDE, ATLAS_COLUMNS, ATLAS_ROWS).
     pub fn new(ctx: &Context, scene: &SceneGpu, view: DebugView) -> Result<ShadowMapView, VkError> {
         let blocks = scene.omni.atlas.blocks().filter(|_| view == DebugView::ShadowAtlas);
         let constants = [
-            (0, u32::from(view == DebugView::ShadowCube)),
-            (1, u32::from(blocks.is_some())),
-            (2, blocks.map_or(1, |b| b.count)),
-            (3, blocks.map_or(1, |b| b.side)),
-            (4, blocks.map_or(1, |b| b.columns)),
-            (5, blocks.map_or(1, |b| b.extent()[1] / b.side)),
+            ("CUBE", u32::from(view == DebugView::ShadowCube)),
+            ("ATLAS", u32::from(blocks.is_some())),
+            ("ATLAS_BLOCKS", blocks.map_or(1, |b| b.count)),
+            ("ATLAS_SIDE", blocks.map_or(1, |b| b.side)),
+            ("ATLAS_COLUMNS", blocks.map_or(1, |b| b.columns)),
+            ("ATLAS_ROWS", blocks.map_or(1, |b| b.extent()[1] / b.side)),
         ];
         let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (&ml_shaders::DEBUG_SHADOW_MAP_COMP, &constants))?;
         Ok(ShadowMapView { pass })

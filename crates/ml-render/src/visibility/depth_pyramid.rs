@@ -9,18 +9,20 @@ use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
+use crate::specialization::compute_pipeline;
 use crate::targets::{depth_pyramid_level, depth_pyramid_shape};
+use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
 use ml_vk::image::fetch_sampler;
 use ml_vk::{shader, vk, Context, VkError};
-
-const GROUP: u32 = 8;
 
 pub struct DepthPyramid {
     sets: FrameSets,
     sampler: vk::Sampler,
     pipeline_layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
+    /// Its dispatches cover a level by the shader's work groups.
+    shader: &'static Shader,
 }
 
 impl DepthPyramid {
@@ -32,11 +34,12 @@ impl DepthPyramid {
             sampler: vk::Sampler::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            shader,
         };
         ml_vk::build(ctx, p, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(16)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, &[])?;
+            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &[])?;
             p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })
@@ -81,7 +84,8 @@ impl Pass for DepthPyramid {
                 let push = [level, rec.extent.width, rec.extent.height, 0];
                 d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::cast_slice(&push));
                 let size = depth_pyramid_level(rec.extent, level);
-                d.cmd_dispatch(cmd, size.width.div_ceil(GROUP), size.height.div_ceil(GROUP), 1);
+                let [x, y, _] = self.shader.groups([size.width, size.height, 1]);
+                d.cmd_dispatch(cmd, x, y, 1);
             }
         }
         memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));

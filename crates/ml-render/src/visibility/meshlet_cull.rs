@@ -18,16 +18,13 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::plan::Phase;
 use crate::report::{CullStats, FrameStats};
-use crate::scene::meshlets::SPEC_SURFACE_TESTS;
 use crate::settings::Raster;
+use crate::specialization::compute_pipeline;
 use crate::targets::depth_pyramid_shape;
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{shader, vk, Context, VkError};
-
-/// Work-group size of both culling shaders.
-const GROUP: u32 = 64;
 
 pub struct MeshletCull {
     phase: Phase,
@@ -65,11 +62,16 @@ impl MeshletCull {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             if phase == Phase::Early {
-                p.instance_pipeline = shader::compute_pipeline(ctx, ml_shaders::INSTANCE_CULL_COMP.spirv, p.pipeline_layout, &[])?;
+                p.instance_pipeline = compute_pipeline(ctx, &ml_shaders::INSTANCE_CULL_COMP, p.pipeline_layout, &[])?;
             }
-            p.meshlet_pipeline = shader::compute_pipeline(ctx, ml_shaders::MESHLET_CULL_COMP.spirv, p.pipeline_layout, &[])?;
-            let surface = [(SPEC_SURFACE_TESTS, u32::from(p.scene.borrow().geometry.surface_tests))];
-            p.triangle_pipeline = shader::compute_pipeline(ctx, triangles.spirv, p.pipeline_layout, &surface)?;
+            p.meshlet_pipeline = compute_pipeline(ctx, &ml_shaders::MESHLET_CULL_COMP, p.pipeline_layout, &[])?;
+            // Only the compute raster's triangle pass draws, so only it tests surfaces: the
+            // hardware raster's culling (triangle_cull.comp) declares no SURFACE_TESTS.
+            let surface = match raster {
+                Raster::Hardware => None,
+                Raster::Compute { .. } => Some(p.scene.borrow().geometry.surface_tests_constant()),
+            };
+            p.triangle_pipeline = compute_pipeline(ctx, triangles, p.pipeline_layout, surface.as_slice())?;
             Ok(())
         })
     }
@@ -142,7 +144,8 @@ impl Pass for MeshletCull {
                 }
                 memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.instance_pipeline);
-                d.cmd_dispatch(cmd, scene.geometry.instance_count.div_ceil(GROUP).max(1), 1, 1);
+                let [groups, ..] = ml_shaders::INSTANCE_CULL_COMP.groups([scene.geometry.instance_count, 1, 1]);
+                d.cmd_dispatch(cmd, groups.max(1), 1, 1);
                 memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute | indirect, rw | indirect_read));
             } else {
                 // The early raster read the compacted buffers (or the bins) this phase appends to.

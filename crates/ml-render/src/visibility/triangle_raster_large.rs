@@ -9,8 +9,8 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::plan::Phase;
-use crate::scene::meshlets::SPEC_SURFACE_TESTS;
 use crate::settings::Raster;
+use crate::specialization::compute_pipeline;
 use crate::visibility::meshlet_cull::cull_push;
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_cpu::gpu_types::{CullCounters, CullPush};
@@ -41,8 +41,8 @@ impl TriangleRasterLarge {
         ml_vk::build(ctx, pass, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            let surface = [(SPEC_SURFACE_TESTS, u32::from(p.scene.borrow().geometry.surface_tests))];
-            p.pipeline = shader::compute_pipeline(ctx, shader.spirv, p.pipeline_layout, &surface)?;
+            let surface = [p.scene.borrow().geometry.surface_tests_constant()];
+            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &surface)?;
             Ok(())
         })
     }

@@ -27,7 +27,7 @@ impl VisibilityLighting {
         (scene, from_buffer): (SharedMeshletScene, bool),
         shading: Shading,
     ) -> Result<VisibilityLighting, VkError> {
-        let model = shading.spec_constants();
+        let model = shading.lighting_constants();
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
         let shader = if from_buffer { &ml_shaders::VISIBILITY_LIGHTING_BUFFER_COMP } else { &ml_shaders::VISIBILITY_LIGHTING_COMP };
         let pass = ComputePass::with_push(ctx, &more_sets, (shader, &model), 16)?;

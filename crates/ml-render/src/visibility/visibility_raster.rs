@@ -69,6 +69,7 @@ impl VisibilityRaster {
                 ctx,
                 &shader::GraphicsPipelineDesc {
                     vertex: vert.spirv,
+                    vertex_constants: &[],
                     fragment: Some(frag.spirv),
                     fragment_constants: &[],
                     // Vertices are pulled from storage buffers by index.

@@ -1,0 +1,158 @@
+// The light loop every shading path shares (forward and clustered fragment shaders, the
+// deferred lighting subpass, the deferred-compute pass): one BRDF source, one summation order
+// (ascending light index), so culling and deferring change no pixel.
+//
+// The includer includes scene_bindings.glsl (`frame`, `lights[]`, with CLUSTERED the lists)
+// and textures.glsl.
+
+#ifndef MANYLIGHTS_LIGHTING_GLSL
+#define MANYLIGHTS_LIGHTING_GLSL
+
+#include "common/shading_model.glsl"
+#include "common/seed_brdf.glsl"
+#include "common/blinn_phong.glsl"
+#include "clusters/cluster.glsl"
+#include "shadows/omni_shadow.glsl"
+
+// Sum LIGHT(light) over every light that may reach the point: the cluster's lights in
+// ascending index order, or all of them. A macro, so that each shading model gets its own
+// loop: a model switch inside the loop made the seed model's fragment shader 1.4–1.8× slower
+// on the H100 (measured).
+#ifdef CLUSTERED
+#define SUM_LIGHTS(sum, LIGHT)                                                   \
+    {                                                                            \
+        float depth_ = -(frame.view * vec4(world, 1.0)).z;                       \
+        ClusterRange range_ = cluster_ranges[cluster_of(frame, frag_xy, depth_)]; \
+        for (uint k_ = 0u; k_ < range_.count; ++k_) {                           \
+            uint i_ = light_indices[range_.offset + k_];                         \
+            sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);         \
+        }                                                                        \
+    }
+#else
+#define SUM_LIGHTS(sum, LIGHT)                                         \
+    for (uint i_ = 0u; i_ < frame.light_count; ++i_) {               \
+        sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);   \
+    }
+#endif
+
+// Scenes with spot lights (a specialization constant: the others run the loop they always ran).
+layout(constant_id = 14) const bool SPOT_LIGHTS = false;
+
+// How much of light `i`'s cone reaches `world` (1 for point lights and scenes without spots).
+float spot_cone(uint i, PointLight l, vec3 world) {
+    if (SPOT_LIGHTS) {
+        LightCone c = light_cones[i];
+        float cos_to_axis = dot(normalize(world - l.position_radius.xyz), c.direction_scale.xyz);
+        float f = clamp(cos_to_axis * c.direction_scale.w + c.offset.x, 0.0, 1.0);
+        return f * f;
+    }
+    return 1.0;
+}
+
+// Add LIGHT(light) for every directional light: each as a point light 10 km away with a
+// radius of 10³⁰ m, so every model's own point-light code applies with a falloff of exactly 1
+// (1 − 10⁴/10³⁰ rounds to 1) and a direction off by under 10⁻⁷ rad.
+#define SUM_DIRECTIONAL(sum, LIGHT)                                                                   \
+    for (uint d_ = 0u; d_ < frame.directional_count; ++d_) {                                           \
+        PointLight far_ = PointLight(vec4(world - frame.directional_direction[d_].xyz * 1e4, 1e30),   \
+                                     vec4(frame.directional_color[d_].rgb, 0.0));                      \
+        sum += LIGHT(far_);                                                                            \
+    }
+
+// What a surface point is shaded with: the object's material (ObjectData's or ObjectPush's
+// vectors) times the factors its textures give (Surface, or their copy in the G-buffer).
+struct PointMaterial {
+    vec3 albedo;
+    float roughness;
+    float metallic;
+    float occlusion;
+    vec3 emission;
+};
+
+PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive, vec4 albedo_occlusion, vec2 roughness_metallic,
+                             vec3 emissive_factor) {
+    PointMaterial m;
+    m.albedo = albedo_roughness.rgb * albedo_occlusion.rgb;
+    m.roughness = albedo_roughness.a * roughness_metallic.x;
+    m.metallic = material.x * roughness_metallic.y;
+    m.occlusion = albedo_occlusion.a;
+    m.emission = emissive.rgb * emissive_factor;
+    return m;
+}
+
+// Linear colour of a surface point: every light that reaches it plus what the model adds
+// (seed, pbr: ambient, times `occlusion`; blinn-phong: ambient, sun, spot, reflection) plus
+// the light it gives off (`emission`). `frag_xy` is the pixel centre (gl_FragCoord.xy),
+// which picks the cluster.
+vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, float occlusion, vec3 emission, vec2 frag_xy) {
+    // Towards the eye; an orthographic camera looks along its axis everywhere (the view
+    // matrix's third row is the eye's +Z, its back, in world space).
+    vec3 back = vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
+    vec3 v = frame.camera_pos.w != 0.0 ? normalize(frame.camera_pos.xyz - world) : back;
+    vec3 lo = vec3(0.0);
+    if (MODEL_BLINN_PHONG) {
+        vec3 r0 = mix(vec3(0.04), albedo, metallic);
+        float shininess = 1.0 - roughness;
+#define BP_LIGHT(l) (bp_point_light(l, world, n, v, albedo, r0, shininess) * omni_visibility(l, world, n))
+        SUM_LIGHTS(lo, BP_LIGHT)
+        SUM_DIRECTIONAL(lo, BP_LIGHT)
+        return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo + emission;
+    }
+    if (MODEL_PBR) {
+#define PBR_LIGHT(l) (pbr_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
+        SUM_LIGHTS(lo, PBR_LIGHT)
+        SUM_DIRECTIONAL(lo, PBR_LIGHT)
+        return albedo * frame.ambient * occlusion + lo + emission;
+    }
+#define SEED_LIGHT(l) (seed_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
+    SUM_LIGHTS(lo, SEED_LIGHT)
+    SUM_DIRECTIONAL(lo, SEED_LIGHT)
+    return albedo * frame.ambient * occlusion + lo + emission;
+}
+
+// The surface debug views (G-buffer channels, depth): what the view shows at a surface point
+// as linear colour, which encode_gamma turns into the promised display values — albedo as
+// it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
+// False for any other view. Every shading path calls it with the values it would shade with.
+bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, uint object_flags, out vec3 color) {
+    uint view = frame.cluster_dims.w;
+    vec3 display;
+    if (view == DEBUG_VIEW_ALPHA) {
+        // Which surfaces an alpha mask cuts: opaque grey, masked green, blended (drawn as a
+        // mask) orange; double-sided ones brighter.
+        bool masked = (object_flags & OBJECT_MASKED) != 0u, blended = (object_flags & OBJECT_BLENDED) != 0u;
+        display = blended ? vec3(1.0, 0.5, 0.1) : masked ? vec3(0.2, 0.9, 0.2) : vec3(0.45);
+        display *= (object_flags & OBJECT_DOUBLE_SIDED) != 0u ? 1.0 : 0.7;
+    } else if (view == DEBUG_VIEW_GBUFFER_ALBEDO) {
+        color = albedo;
+        return true;
+    } else if (view == DEBUG_VIEW_GBUFFER_NORMAL) {
+        display = n * 0.5 + 0.5;
+    } else if (view == DEBUG_VIEW_GBUFFER_MATERIAL) {
+        display = vec3(roughness, metallic, 0.0);
+    } else if (view == DEBUG_VIEW_DEPTH) {
+        float depth = -(frame.view * vec4(world, 1.0)).z;
+        display = vec3(log(depth / frame.cluster_frustum.x) / log(frame.cluster_frustum.y / frame.cluster_frustum.x));
+    } else {
+        return false;
+    }
+    color = pow(clamp(display, 0.0, 1.0), vec3(2.2));
+    return true;
+}
+
+// Lights in the fragment's cluster (the cluster-heat debug view).
+#ifdef CLUSTERED
+uint cluster_light_count(vec3 world, vec2 frag_xy) {
+    float depth = -(frame.view * vec4(world, 1.0)).z;
+    return cluster_ranges[cluster_of(frame, frag_xy, depth)].count;
+}
+#endif
+
+// World position of the pixel centre `frag_xy` at depth-buffer value `z` (deferred paths).
+vec3 world_from_depth(vec2 frag_xy, float z) {
+    vec2 ndc = frag_xy / vec2(frame.viewport.xy) * 2.0 - 1.0;
+    vec4 w = frame.inv_view_proj * vec4(ndc, z, 1.0);
+    return w.xyz / w.w;
+}
+
+#endif

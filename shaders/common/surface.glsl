@@ -1,0 +1,92 @@
+// What the rasterised surface contributes before lighting (forward fragment shaders and the
+// G-buffer pass alike): an object's own base-colour texture and normal map (glTF), and
+// blinn-phong's albedo texture and normal map; normal maps perturb the normal through the
+// tangent frame (TBN); glTF's metallic-roughness, occlusion and emissive textures. The seed
+// model's built-in objects use none.
+// Needs common.glsl, scene_bindings.glsl and textures.glsl. In a fragment shader textures
+// are sampled with the implicit derivatives; a compute shader defines SURFACE_GRADIENTS and
+// sets surface_uv_dx and surface_uv_dy (∂uv/∂x, ∂uv/∂y at the pixel) before surface_at.
+
+#ifndef MANYLIGHTS_SURFACE_GLSL
+#define MANYLIGHTS_SURFACE_GLSL
+
+#include "common/shading_model.glsl"
+
+// Sample `t` at `uv`, whose texture coordinates are `m` times the surface's.
+#ifdef SURFACE_GRADIENTS
+vec2 surface_uv_dx;
+vec2 surface_uv_dy;
+#define SURFACE_SAMPLE(t, uv, m) textureGrad(t, uv, (m) * surface_uv_dx, (m) * surface_uv_dy)
+#else
+#define SURFACE_SAMPLE(t, uv, m) texture(t, uv)
+#endif
+
+// Set 2 of the mesh pipelines, bound per draw: the object's own textures (glTF), or white
+// stand-ins where ObjectPush.ids.y says it has none (object_textures.rs). A set per draw,
+// not an array indexed per draw: lavapipe has no dynamic indexing of sampler arrays.
+layout(set = 2, binding = 0) uniform sampler2D object_base_color;         // sRGB
+layout(set = 2, binding = 1) uniform sampler2D object_normal_map;         // n·0.5 + 0.5
+layout(set = 2, binding = 2) uniform sampler2D object_metallic_roughness; // g: roughness, b: metallic
+layout(set = 2, binding = 3) uniform sampler2D object_occlusion;          // r
+layout(set = 2, binding = 4) uniform sampler2D object_emissive;           // sRGB
+// Bits of ObjectPush.ids.y (ObjectTextures::bits).
+const uint TEXTURE_BASE_COLOR = 1u;
+const uint TEXTURE_NORMAL = 2u;
+const uint TEXTURE_METALLIC_ROUGHNESS = 4u;
+const uint TEXTURE_OCCLUSION = 8u;
+const uint TEXTURE_EMISSIVE = 16u;
+
+// What the textures make of the object's material: factors that multiply its own values.
+struct Surface {
+    vec3 normal;                // unit, world space
+    vec3 albedo_factor;         // multiplies the object's albedo
+    vec2 roughness_metallic;    // multiply its roughness and metallic
+    float occlusion;            // of ambient light (1: none)
+    vec3 emissive_factor;       // multiplies its emissive factor
+};
+
+// `n` perturbed by a tangent-space normal-map texel (n·0.5 + 0.5 encoded), its x and y
+// scaled by `scale` (glTF's normalTexture.scale).
+vec3 perturb_normal(vec3 n, vec4 tangent, vec3 texel, float scale) {
+    vec3 t = normalize(tangent.xyz - dot(tangent.xyz, n) * n);
+    vec3 b = tangent.w * cross(n, t);
+    vec3 m = (texel * 2.0 - 1.0) * vec3(scale, scale, 1.0);
+    return normalize(m.x * t + m.y * b + m.z * n);
+}
+
+// `textures`: which textures the object has of its own (TEXTURE_* bits); `material`: its
+// ObjectData.material (y: occlusion strength, z: normal scale).
+Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, vec4 material) {
+    Surface s;
+    s.normal = normalize(geometric_normal);
+    s.albedo_factor = vec3(1.0);
+    s.roughness_metallic = vec2(1.0);
+    s.occlusion = 1.0;
+    s.emissive_factor = vec3(1.0);
+    if (OBJECT_TEXTURES) {
+        if ((textures & TEXTURE_BASE_COLOR) != 0u) {
+            s.albedo_factor = SURFACE_SAMPLE(object_base_color, uv, mat2(1.0)).rgb;
+        }
+        if ((textures & TEXTURE_NORMAL) != 0u) {
+            s.normal = perturb_normal(s.normal, tangent, SURFACE_SAMPLE(object_normal_map, uv, mat2(1.0)).xyz, material.z);
+        }
+        if ((textures & TEXTURE_METALLIC_ROUGHNESS) != 0u) {
+            s.roughness_metallic = SURFACE_SAMPLE(object_metallic_roughness, uv, mat2(1.0)).gb;
+        }
+        if ((textures & TEXTURE_OCCLUSION) != 0u) {
+            s.occlusion = 1.0 + material.y * (SURFACE_SAMPLE(object_occlusion, uv, mat2(1.0)).r - 1.0);
+        }
+        if ((textures & TEXTURE_EMISSIVE) != 0u) {
+            s.emissive_factor = SURFACE_SAMPLE(object_emissive, uv, mat2(1.0)).rgb;
+        }
+    }
+    if (MODEL_BLINN_PHONG) {
+        mat2 st_transform = mat2(frame.texture_transform.xy, frame.texture_transform.zw);
+        vec2 st = st_transform * uv;
+        s.albedo_factor *= SURFACE_SAMPLE(albedo_map, st, st_transform).rgb;
+        s.normal = perturb_normal(s.normal, tangent, SURFACE_SAMPLE(normal_map, st, st_transform).xyz, 1.0);
+    }
+    return s;
+}
+
+#endif

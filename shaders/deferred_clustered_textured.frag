@@ -1,6 +1,0 @@
-#version 450
-#extension GL_GOOGLE_include_directive : require
-// Technique `deferred-clustered` in scenes whose objects have textures of their own.
-#define CLUSTERED 1
-#define GBUFFER_MATERIAL 1
-#include "deferred_frag.glsl"

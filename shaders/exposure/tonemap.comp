@@ -1,0 +1,23 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// After the deferred render pass: HDR (RGBA16F, linear) → the 8-bit output, with the same
+// encoding the forward path applies in its fragment shader (MODEL_PBR: tone-map first; not set
+// for debug views, whose values are shown as they are). Alpha 0 marks pixels no object
+// covers (the lighting subpass discards them): they get the background colour.
+#include "common/common.glsl"
+#include "common/shading_model.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform sampler2D hdr_image;
+layout(set = 0, binding = 1, rgba8) uniform writeonly image2D out_image;
+layout(set = 0, binding = 2) uniform FrameBlock { FrameUniforms frame; };
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, textureSize(hdr_image, 0)))) {
+        return;
+    }
+    vec4 hdr = texelFetch(hdr_image, p, 0);
+    imageStore(out_image, p, hdr.a == 0.0 ? CLEAR_COLOR : vec4(encode_output(hdr.rgb, frame.exposure.x), 1.0));
+}

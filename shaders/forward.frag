@@ -1,4 +1,0 @@
-#version 450
-#extension GL_GOOGLE_include_directive : require
-// Technique `forward`: brute force, every fragment loops over every light.
-#include "forward_frag.glsl"

@@ -1,0 +1,6 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Technique `deferred-clustered` in scenes whose objects have textures of their own.
+#define CLUSTERED 1
+#define GBUFFER_MATERIAL 1
+#include "shading/deferred_frag.glsl"

@@ -1,0 +1,40 @@
+// Fragment shader of the forward techniques. `forward.frag` loops over every light;
+// `clustered.frag` defines CLUSTERED and loops over its cluster's lights only. Everything
+// else — inputs, BRDF, summation order (ascending light index) — is shared (lighting.glsl),
+// so the two give the same image when culling is correct.
+
+#include "common/common.glsl"
+
+#include "shading/mesh_fragment_inputs.glsl"
+#include "common/scene_bindings.glsl"
+
+#include "common/textures.glsl"
+#include "common/surface.glsl"
+#include "common/lighting.glsl"
+#include "shading/mesh_coverage.glsl"
+
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    vec3 normal = covered_normal();
+#ifdef CLUSTERED
+    if (frame.cluster_dims.w == DEBUG_VIEW_CLUSTER_HEAT) {
+        // Lights per cluster on a log scale up to cluster_slices.z.
+        uint count = cluster_light_count(in_world_pos, gl_FragCoord.xy);
+        float t = log2(1.0 + float(count)) / log2(1.0 + frame.cluster_slices.z);
+        out_color = vec4(heat(t), 1.0);
+        return;
+    }
+#endif
+    Surface s = surface_at(normal, in_tangent, in_uv, object.ids.y, object.material);
+    PointMaterial m = point_material(object.albedo_roughness, object.material, object.emissive, vec4(s.albedo_factor, s.occlusion),
+                                     s.roughness_metallic, s.emissive_factor);
+    vec3 color;
+    if (debug_surface(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, color)) {
+        out_color = vec4(encode_gamma(color), 1.0);
+        return;
+    }
+    color = shade_point(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
+    // The target is UNORM: the seed writes gamma-encoded values itself.
+    out_color = vec4(encode_output(color, frame.exposure.x), 1.0);
+}

@@ -1,0 +1,70 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+// The compute raster's large triangles (visibility_polygon.glsl): a work group per listed
+// 64×64-pixel bin of a triangle's box, so a triangle covering the screen is spread over the
+// whole GPU. The triangle was clipped and snapped once, when it was found; here each thread
+// takes an 8×8-pixel block of the bin and draws it for every fan triangle that reaches it.
+#include "common/common.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+layout(std430, set = 0, binding = 1) buffer CullCounterBuffer { CullCounters counters; };
+layout(std430, set = 0, binding = 2) readonly buffer LargeBinBuffer { uvec2 large_bins[]; };
+layout(std430, set = 0, binding = 3) buffer LargeTriangleBuffer { LargeTriangle large_triangles[]; };
+layout(std430, set = 0, binding = 4) buffer VisibilityDepthBuffer { uint64_t visibility_depth[]; };
+layout(std430, set = 0, binding = 5) readonly buffer ObjectBuffer { ObjectData objects[]; };
+layout(push_constant) uniform CullPushBlock { CullPush cull; };
+
+#define ALPHA_MASK_BINDING 6
+#include "common/alpha_mask.glsl"
+#include "visibility/visibility_polygon.glsl"
+
+const int BLOCK = 8;
+
+shared uint group_pixels;
+
+void main() {
+    uint lid = gl_LocalInvocationID.x;
+    uint phase = cull.mode.x;
+    uint count = min(counters.binned[phase], cull.triangles.z);
+    ivec2 size = ivec2(frame.viewport.xy);
+    if (lid == 0u) {
+        group_pixels = 0u;
+    }
+    uint covered = 0u;
+    for (uint e = gl_WorkGroupID.x; e < count; e += gl_NumWorkGroups.x) {
+        uvec2 listed = large_bins[e];
+        if (listed.x == NO_BIN) {
+            continue;
+        }
+        uint at = listed.x;
+        uvec4 head = large_triangles[at].head;
+        SurfaceTest surface = SURFACE_TESTS ? large_surface(at, head.z) : no_surface_test();
+        bool both_faces = SURFACE_TESTS && (head.w & INSTANCE_DOUBLE_SIDED) != 0u;
+        ivec2 bin = ivec2(listed.y & 0xffffu, listed.y >> 16u);
+        ivec2 lo = bin * BIN + ivec2(lid % uint(BIN / BLOCK), lid / uint(BIN / BLOCK)) * BLOCK;
+        ivec2 hi = lo + BLOCK - 1;
+        i64vec2 s0 = large_corner(at, 0);
+        vec4 q0 = large_depth(at, 0);
+        for (int k = 1; k + 1 < int(head.x); k++) {
+            FanTriangle t;
+            if (!fan_triangle(s0, large_corner(at, k), large_corner(at, k + 1), q0, large_depth(at, k), large_depth(at, k + 1), size, both_faces, t)) {
+                continue;
+            }
+            ivec2 from = max(lo, t.first), to = min(hi, t.last);
+            if (any(greaterThan(from, to)) || !fan_reaches(t, from, to)) {
+                continue;
+            }
+            covered += fan_block(t, from, to, head.y, surface);
+        }
+    }
+    barrier();
+    atomicAdd(group_pixels, covered);
+    barrier();
+    if (lid == 0u) {
+        atomicAdd(counters.rasterized.z, group_pixels);
+    }
+}

@@ -1,0 +1,134 @@
+// Lighting from the visibility buffer (technique visibility; docs/DESIGN.md#visibility-buffer):
+// per pixel, the id names the meshlet instance and the triangle; its three vertices are
+// fetched and transformed as the raster transformed them, the pixel's perspective-correct
+// barycentrics rebuilt, the attributes interpolated, the material evaluated (textures with
+// the derivatives a fragment shader would have had), then the clustered light loop of the
+// other paths. Position comes from depth, as in deferred-compute.
+//
+// Objects' own textures are bound per texture set (set 2): one dispatch per set, each
+// shading the pixels of its objects (lavapipe cannot index sampler arrays per pixel).
+//
+// Whichever raster drew the visibility buffer: the includer (visibility_lighting.comp,
+// visibility_lighting_buffer.comp) defines CLUSTERED and SURFACE_GRADIENTS, includes
+// common.glsl and scene_bindings.glsl, and says where the depth and ids are: `float
+// raster_depth(ivec2 pixel)`, `uint raster_id(ivec2 pixel)`.
+
+#ifndef MANYLIGHTS_VISIBILITY_LIGHTING_GLSL
+#define MANYLIGHTS_VISIBILITY_LIGHTING_GLSL
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
+// Every mesh's vertices (geometry.rs Vertex: position, normal, uv, tangent; 12 floats).
+layout(std430, set = 0, binding = 13) readonly buffer VertexBuffer { float vertex_data[]; };
+layout(std430, set = 0, binding = 14) readonly buffer MeshletVertexBuffer { uint meshlet_vertices[]; };
+layout(std430, set = 0, binding = 18) readonly buffer MeshletTriangleBuffer { uint meshlet_triangles[]; };
+layout(std430, set = 0, binding = 15) readonly buffer MeshletBuffer { Meshlet meshlets[]; };
+layout(std430, set = 0, binding = 16) readonly buffer MeshletInstanceBuffer { uvec2 meshlet_instances[]; };
+layout(std430, set = 0, binding = 17) readonly buffer InstanceBuffer { Instance instances[]; };
+layout(push_constant) uniform ShadingSetPushBlock { uvec4 texture_set; }; // x: the set this dispatch shades
+#include "common/textures.glsl"
+#include "common/surface.glsl"
+#include "common/lighting.glsl"
+#include "shading/compute_shading.glsl"
+#include "visibility/meshlet_geometry.glsl"
+
+struct Attributes {
+    vec3 position;
+    vec3 normal;
+    vec2 uv;
+    vec4 tangent;
+};
+
+Attributes vertex_at(uint i) {
+    uint b = VERTEX_FLOATS * i;
+#define F(k) vertex_data[b + k]
+    return Attributes(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), vec2(F(6u), F(7u)), vec4(F(8u), F(9u), F(10u), F(11u)));
+#undef F
+}
+
+// Perspective-correct barycentrics at pixel position `xy` of the triangle whose clip-space
+// vertices are `c`: screen-space weights from the 2D edge functions, each divided by its
+// vertex's w, normalised — what the rasteriser interpolates with.
+vec3 barycentrics(vec4 c[3], vec2 xy) {
+    vec2 ndc = xy / vec2(frame.viewport.xy) * 2.0 - 1.0;
+    vec2 s0 = c[0].xy / c[0].w, s1 = c[1].xy / c[1].w, s2 = c[2].xy / c[2].w;
+    float area = cross2(s1 - s0, s2 - s0);
+    float l0 = cross2(s1 - ndc, s2 - ndc) / area;
+    float l1 = cross2(s2 - ndc, s0 - ndc) / area;
+    vec3 w = vec3(l0, l1, 1.0 - l0 - l1) / vec3(c[0].w, c[1].w, c[2].w);
+    return w / (w.x + w.y + w.z);
+}
+
+// A colour per id (the meshlets and triangles debug views).
+vec3 id_color(uint x) {
+    x = x * 747796405u + 2891336453u;
+    x = ((x >> ((x >> 28u) + 4u)) ^ x) * 277803737u;
+    x = (x >> 22u) ^ x;
+    return vec3(uvec3(x, x >> 8u, x >> 16u) & 255u) / 255.0;
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
+        return;
+    }
+    float z = raster_depth(p);
+    if (z >= 1.0) {
+        // The background, once: by the first set's dispatch.
+        if (texture_set.x == 0u) {
+            imageStore(out_image, p, CLEAR_COLOR);
+        }
+        return;
+    }
+    uint id = raster_id(p);
+    uint meshlet_instance = id >> VISIBILITY_TRIANGLE_BITS;
+    uvec2 object_meshlet = meshlet_instances[meshlet_instance];
+    uint object = object_meshlet.x;
+    Instance inst = instances[object];
+    if (inst.surface.y != texture_set.x) {
+        return;
+    }
+    uint view = frame.cluster_dims.w;
+    if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
+        imageStore(out_image, p, vec4(id_color(view == DEBUG_VIEW_MESHLETS ? meshlet_instance : id), 1.0));
+        return;
+    }
+    uvec3 corners = meshlet_triangle(meshlets[object_meshlet.y], id & ((1u << VISIBILITY_TRIANGLE_BITS) - 1u));
+    ObjectData o = objects[object];
+    Attributes v[3];
+    vec4 c[3];
+    for (int k = 0; k < 3; k++) {
+        v[k] = vertex_at(corners[k]);
+        v[k].uv = transform_uv(o.uv_transform, v[k].uv);
+        vec3 world = (o.model * vec4(v[k].position, 1.0)).xyz;
+        c[k] = frame.proj * frame.view * vec4(world, 1.0);
+    }
+    vec2 frag_xy = vec2(p) + 0.5;
+    vec3 b = barycentrics(c, frag_xy);
+    // Texture derivatives as a fragment shader's: differences across its 2×2 quad, the
+    // triangle's attributes taken at the quad's pixels (extrapolated where the triangle does
+    // not cover them, as helper invocations do) — the quad's first row and column, as
+    // lavapipe derives them (coarse derivatives: one pair for the whole quad).
+    mat3x2 uvs = mat3x2(v[0].uv, v[1].uv, v[2].uv);
+    vec2 uv = uvs * b;
+    vec2 q = vec2(p & ~1) + 0.5;
+    vec2 uv00 = uvs * barycentrics(c, q);
+    surface_uv_dx = uvs * barycentrics(c, q + vec2(1.0, 0.0)) - uv00;
+    surface_uv_dy = uvs * barycentrics(c, q + vec2(0.0, 1.0)) - uv00;
+    vec3 normal = mat3(o.normal_matrix) * (mat3(v[0].normal, v[1].normal, v[2].normal) * b);
+    // A double-sided object's back face (its corners clockwise on screen: the homogeneous
+    // determinant is the projected area's sign, also for corners behind the eye) is lit on
+    // the side the viewer sees.
+    if ((o.alpha_texture.x & OBJECT_DOUBLE_SIDED) != 0u && determinant(mat3(c[0].xyw, c[1].xyw, c[2].xyw)) > 0.0) {
+        normal = -normal;
+    }
+    vec4 tangent = mat4(v[0].tangent, v[1].tangent, v[2].tangent, vec4(0.0)) * vec4(b, 0.0);
+    tangent.xyz = mat3(o.model) * tangent.xyz;
+    Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material);
+    PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic,
+                                     s.emissive_factor);
+    shade_and_store(p, frag_xy, world_from_depth(frag_xy, z), s.normal, m, o.alpha_texture.x);
+}
+
+#endif

@@ -1,0 +1,32 @@
+// The hardware visibility raster's surface tests. In scenes with masked or double-sided
+// objects (SURFACE_TESTS) the pipeline draws both sides of every triangle and the fragment
+// decides: a single-sided object's back face is dropped — by the rasteriser's own facing,
+// so exactly the fragments back-face culling would drop — and so is a point an alpha mask
+// cuts out (alpha_mask.glsl). Elsewhere nothing is tested and nothing discarded.
+// Needs common.glsl.
+
+#ifndef MANYLIGHTS_VISIBILITY_SURFACE_GLSL
+#define MANYLIGHTS_VISIBILITY_SURFACE_GLSL
+
+#ifdef SURFACE_TESTS
+layout(std430, set = 0, binding = 1) readonly buffer ObjectBuffer { ObjectData objects[]; };
+#define ALPHA_MASK_BINDING 7
+#include "common/alpha_mask.glsl"
+
+layout(location = 0) flat in uint in_object;
+layout(location = 1) in vec2 in_uv;
+
+bool surface_there() {
+    uvec4 alpha_texture = objects[in_object].alpha_texture;
+    if (!gl_FrontFacing && (alpha_texture.x & OBJECT_DOUBLE_SIDED) == 0u) {
+        return false;
+    }
+    return alpha_kept(objects[in_object].alpha, alpha_texture, in_uv);
+}
+#else
+bool surface_there() {
+    return true;
+}
+#endif
+
+#endif
