@@ -206,6 +206,10 @@ pub fn light_list_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     LIGHT_LISTS.iter().map(|&name| Use::at(name, (stages, vk::AccessFlags::SHADER_READ), None)).collect()
 }
 
+/// The frame slot's depth pyramid (its shader block's name): written by the depth pyramid
+/// pass, read by the culling.
+pub const DEPTH_PYRAMID: &str = "DepthPyramidBuffer";
+
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.
 pub fn frame_end() -> Use {

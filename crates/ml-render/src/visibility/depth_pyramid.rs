@@ -10,6 +10,7 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::specialization::compute_pipeline;
+use crate::sync::{Use, DEPTH_PYRAMID};
 use crate::targets::{depth_pyramid_level, depth_pyramid_shape};
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
@@ -63,16 +64,21 @@ impl Pass for DepthPyramid {
         })
     }
 
+    /// Its levels, written (and read, each from the one before) in compute; the culling reads
+    /// them, the late phase this frame's, the early one the last frame's on this slot.
+    fn uses(&self) -> Vec<Use> {
+        let rw = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+        vec![Use::at(DEPTH_PYRAMID, rw, None)]
+    }
+
     /// After the early raster (its render pass, or the compute raster's last pass, makes the
-    /// depth visible to compute); the late culling reads the result.
+    /// depth visible to compute).
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let d = &ctx.device;
         let (_, levels) = depth_pyramid_shape(rec.extent);
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
-        // The last frame's late culling read this slot's pyramid two frames ago.
-        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_READ), (compute, rw));
         // SAFETY: recording state outside a render pass; everything bound is alive.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
@@ -88,7 +94,6 @@ impl Pass for DepthPyramid {
                 d.cmd_dispatch(cmd, x, y, 1);
             }
         }
-        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
     }
 
     fn destroy(&mut self, ctx: &Context) {

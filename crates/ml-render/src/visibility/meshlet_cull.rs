@@ -20,6 +20,7 @@ use crate::plan::Phase;
 use crate::report::{CullStats, FrameStats};
 use crate::settings::Raster;
 use crate::specialization::compute_pipeline;
+use crate::sync::{Use, DEPTH_PYRAMID};
 use crate::targets::depth_pyramid_shape;
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use ml_cpu::gpu_types::{CullCounters, CullPush};
@@ -107,6 +108,11 @@ impl Pass for MeshletCull {
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let scene = self.scene.borrow();
         self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame, name))
+    }
+
+    /// The depth pyramid its shaders read (the late phase tests against it).
+    fn uses(&self) -> Vec<Use> {
+        vec![Use::at(DEPTH_PYRAMID, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None)]
     }
 
     fn record(&self, rec: &Recording) {
