@@ -1,6 +1,6 @@
 //! What every pass of a frame is to the renderer. A technique is an ordered list of passes
-//! (`passes::assemble`); the renderer loops over it to bind, record, time and collect, and
-//! knows no pass by name. Each pass owns its pipelines, its per-frame descriptor sets (and
+//! (`plan::plan`, made by `assembly::assemble`); the renderer loops over it to bind,
+//! prepare, order (`uses`), record, time and collect, and knows no pass by name. Each pass owns its pipelines, its per-frame descriptor sets (and
 //! framebuffers) and rewrites them when a frame slot's buffers or targets change.
 
 use crate::error::RenderError;
@@ -82,7 +82,8 @@ pub trait Pass {
 
     /// What the pass reads and writes of the frame's named resources, and in which stages:
     /// before the pass the renderer records the barrier that orders these after their
-    /// earlier uses (`sync`). A use not declared is ordered by the pass itself.
+    /// earlier uses (`sync`). A resource is either declared by every pass that uses it or by
+    /// none (each then orders its own uses, as the culling's buffers still are).
     fn uses(&self) -> Vec<Use> {
         Vec::new()
     }

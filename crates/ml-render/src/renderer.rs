@@ -1,8 +1,9 @@
 //! The renderer: the scene on the GPU, the frames in flight and the technique's passes.
 //! Headless (offscreen targets, a read-back of the last frame, no window system) or under a
 //! window (the viewer adds its commands through a `FrameHook`). It knows no pass by name:
-//! the technique's choices give an ordered list of passes (`passes::assemble`) that it
-//! binds, records, times and collects from.
+//! the technique's choices give an ordered list of passes (`plan::plan`, made by
+//! `assembly::assemble`) that it binds, prepares, records with the barriers their declared
+//! uses need (`sync`), times and collects from.
 
 use crate::assembly::{assemble, Assembly};
 use crate::error::RenderError;

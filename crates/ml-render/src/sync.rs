@@ -10,6 +10,11 @@
 //! attachments itself (its external subpass dependencies, which also make their layout
 //! transitions): it declares where those dependencies begin (`Entry::Chained`), and the
 //! renderer only makes sure earlier uses end in those stages.
+//!
+//! A resource is ordered this way only if every pass that touches it declares it: the state
+//! knows nothing of an undeclared use, and would, say, take an image another pass just wrote
+//! for undefined. Resources not yet moved over (the culling's buffers, the shadow stores)
+//! are declared by none of their passes, which order them by hand as before.
 
 use ml_vk::vk;
 
