@@ -107,7 +107,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let settings = RenderSettings { exposure: Exposure::Auto, frames: 1, ..RenderSettings::new(Technique::ClusteredGpu, width, height) };
     let mut renderer = Renderer::new(&ctx, scene, settings)?;
     let acquired = (0..FRAMES_IN_FLIGHT).map(|_| semaphore(&ctx)).collect::<Result<Vec<_>, _>>()?;
-    let rendered = swapchain.images.iter().map(|_| semaphore(&ctx)).collect::<Result<Vec<_>, _>>()?;
+    let mut rendered = swapchain.images.iter().map(|_| semaphore(&ctx)).collect::<Result<Vec<_>, _>>()?;
     let start = Instant::now();
     let mut drawn = 0;
     while frames.is_none_or(|n| drawn < n) {
@@ -118,11 +118,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             break;
         }
         if std::mem::take(&mut events.resized) {
-            // New swapchain images of the same count, new frame slots at the new size.
+            // New swapchain images (a semaphore each: their count may change), new frame slots
+            // at the new size.
             ctx.wait_idle()?;
             let size = window.inner_size();
             let fresh = Swapchain::new(&ctx, vk::Extent2D { width: size.width.max(1), height: size.height.max(1) }, true, swapchain.raw)?;
             std::mem::replace(&mut swapchain, fresh).destroy(&ctx);
+            while rendered.len() < swapchain.images.len() {
+                rendered.push(semaphore(&ctx)?);
+            }
             let (width, height) = (swapchain.extent.width, swapchain.extent.height);
             renderer.reconfigure(RenderSettings { width, height, ..*renderer.settings() })?;
         }
