@@ -63,8 +63,7 @@ float texture_alpha(uvec4 texture_fields, vec2 uv) {
 }
 
 // The alpha bounds of a texture's blocks (alpha_mask.rs): a byte pair (least, greatest) per
-// block, from the first even byte after its texels; at most ALPHA_CACHE_PAIRS of them.
-const uint ALPHA_CACHE_PAIRS = 2048u;
+// block, from the first even byte after its texels.
 
 // Where texture `texture_fields`' bounds start (bytes).
 uint alpha_bounds_start(uvec4 texture_fields) {
@@ -72,46 +71,20 @@ uint alpha_bounds_start(uvec4 texture_fields) {
     return texture_fields.y + texels + (texels & 1u);
 }
 
-#ifdef ALPHA_BOUNDS_CACHE
-// A compute raster's copy of one texture's bounds in shared memory: every pixel of a masked
-// triangle reads its block's pair, and a read from shared memory keeps the loop from waiting
-// on memory at every pixel. From the word holding its first pair; NO_ALPHA_CACHE: none held.
-shared uint alpha_cache[ALPHA_CACHE_PAIRS / 2u + 1u];
-shared uint alpha_cache_word;
-const uint NO_ALPHA_CACHE = 0xffffffffu;
-
-// Copy texture `texture_fields`' bounds into the cache (the whole work group, in uniform
-// control flow; `cache` false empties it).
-void cache_alpha_bounds(uvec4 texture_fields, bool cache) {
-    uint w = texture_fields.z, h = texture_fields.w, side = 1u << ((texture_fields.x >> OBJECT_ALPHA_BLOCK_SHIFT) & 15u);
-    uint first = alpha_bounds_start(texture_fields) >> 2u;
-    uint words = (alpha_bounds_start(texture_fields) + 2u * ((w + side - 1u) / side) * ((h + side - 1u) / side) + 3u) / 4u - first;
-    barrier();
-    for (uint i = gl_LocalInvocationIndex; cache && i < words; i += gl_WorkGroupSize.x * gl_WorkGroupSize.y * gl_WorkGroupSize.z) {
-        alpha_cache[i] = alpha_bytes[first + i];
-    }
-    if (gl_LocalInvocationIndex == 0u) {
-        alpha_cache_word = cache ? first : NO_ALPHA_CACHE;
-    }
-    barrier();
-}
-#endif
-
 // The pair at byte `at` of the alpha-mask buffer: least in the low byte, greatest above.
 uint alpha_bounds_pair(uint at) {
-#ifdef ALPHA_BOUNDS_CACHE
-    if (alpha_cache_word != NO_ALPHA_CACHE) {
-        return alpha_cache[(at >> 2u) - alpha_cache_word] >> ((at & 3u) * 8u);
-    }
-#endif
     return alpha_bytes[at >> 2u] >> ((at & 3u) * 8u);
 }
 
-// Whether `factor` × the texture's alpha at `uv` reaches `cutoff`: the bounds of the block
-// the point's first tap is in decide where both lie on one side of the cutoff (one read);
-// only points near the cut-out's edge are filtered. Keep in sync with alpha_mask.rs
-// texture_kept.
-bool texture_kept(uvec4 texture_fields, vec2 uv, float factor, float cutoff) {
+// What a point's block bounds say of it: dropped, kept, or filter it (alpha_verdict).
+const uint ALPHA_DROPPED = 0u;
+const uint ALPHA_KEPT = 1u;
+const uint ALPHA_FILTER = 2u;
+
+// Whether `factor` × the texture's alpha at `uv` reaches `cutoff`, as far as the bounds of the
+// block the point's first tap is in decide (one read): ALPHA_FILTER where they lie on both
+// sides of the cutoff, which happens only near the cut-out's edge.
+uint texture_bounds_verdict(uvec4 texture_fields, vec2 uv, float factor, float cutoff) {
     uint flags = texture_fields.x;
     int w = int(texture_fields.z), h = int(texture_fields.w);
     vec2 p = uv * vec2(w, h) - 0.5;
@@ -121,23 +94,49 @@ bool texture_kept(uvec4 texture_fields, vec2 uv, float factor, float cutoff) {
     uint row = (uint(w) + (1u << shift) - 1u) >> shift;
     uint pair = alpha_bounds_pair(alpha_bounds_start(texture_fields) + 2u * ((y >> shift) * row + (x >> shift)));
     if (factor * (float(pair & 0xffu) / 255.0) >= cutoff) {
-        return true;
+        return ALPHA_KEPT;
     }
     if (factor * (float((pair >> 8u) & 0xffu) / 255.0) < cutoff) {
-        return false;
+        return ALPHA_DROPPED;
+    }
+    return ALPHA_FILTER;
+}
+
+// Whether `factor` × the texture's alpha at `uv` reaches `cutoff`: the block bounds decide
+// where they can, the filtered texture elsewhere. Keep in sync with alpha_mask.rs
+// texture_kept.
+bool texture_kept(uvec4 texture_fields, vec2 uv, float factor, float cutoff) {
+    uint verdict = texture_bounds_verdict(texture_fields, uv, factor, cutoff);
+    if (verdict != ALPHA_FILTER) {
+        return verdict == ALPHA_KEPT;
     }
     return factor * texture_alpha(texture_fields, uv) >= cutoff;
 }
 
-// Whether the point at `uv` of the object with ObjectData `alpha` and `alpha_texture` is there.
-bool alpha_kept(vec4 alpha, uvec4 alpha_texture, vec2 uv) {
+// alpha_kept's answer as far as one read decides: ALPHA_FILTER where only
+// `alpha_filtered_kept` can tell.
+uint alpha_verdict(vec4 alpha, uvec4 alpha_texture, vec2 uv) {
     if ((alpha_texture.x & OBJECT_MASKED) == 0u) {
-        return true;
+        return ALPHA_KEPT;
     }
     if ((alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u) {
-        return texture_kept(alpha_texture, uv, alpha.y, alpha.x);
+        return texture_bounds_verdict(alpha_texture, uv, alpha.y, alpha.x);
     }
-    return alpha.y >= alpha.x;
+    return alpha.y >= alpha.x ? ALPHA_KEPT : ALPHA_DROPPED;
+}
+
+// alpha_kept where alpha_verdict said ALPHA_FILTER.
+bool alpha_filtered_kept(vec4 alpha, uvec4 alpha_texture, vec2 uv) {
+    return alpha.y * texture_alpha(alpha_texture, uv) >= alpha.x;
+}
+
+// Whether the point at `uv` of the object with ObjectData `alpha` and `alpha_texture` is there.
+bool alpha_kept(vec4 alpha, uvec4 alpha_texture, vec2 uv) {
+    uint verdict = alpha_verdict(alpha, alpha_texture, uv);
+    if (verdict != ALPHA_FILTER) {
+        return verdict == ALPHA_KEPT;
+    }
+    return alpha_filtered_kept(alpha, alpha_texture, uv);
 }
 
 #endif

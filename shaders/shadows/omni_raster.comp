@@ -8,7 +8,6 @@
 
 layout(local_size_x = 64) in;
 
-#define ALPHA_BOUNDS_CACHE 1
 #include "shadows/omni_raster.glsl"
 
 shared vec4 corner_clip[64];
@@ -23,12 +22,6 @@ void main() {
         uvec2 object_meshlet = meshlet_instances[pair.x];
         Meshlet m = meshlets[object_meshlet.y];
         uint layer = pair.y;
-        // A masked object's alpha bounds in shared memory for its triangles' texels.
-        uint object_flags = instances[object_meshlet.x].meshlets.w;
-        if (SURFACE_TESTS && (object_flags & INSTANCE_MASKED) != 0u) {
-            uvec4 alpha_texture = objects[object_meshlet.x].alpha_texture;
-            cache_alpha_bounds(alpha_texture, (alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u);
-        }
         // The last pair's triangles are done with the shared corners.
         barrier();
         if (lid < m.triangles.w) {

@@ -115,7 +115,7 @@ float interpolated_depth(vec3 weights, vec4 qa, vec4 qb, vec4 qc) {
 // its view) of meshlet `m` of object `object`: a masked object's alpha test, else none.
 SurfaceTest omni_surface_test(uint object, uvec3 v, vec4 a, vec4 b, vec4 c) {
     SurfaceTest s = no_surface_test();
-    if (SURFACE_TESTS && (instances[object].meshlets.w & INSTANCE_MASKED) != 0u) {
+    if (MASK_TESTS && (instances[object].meshlets.w & INSTANCE_MASKED) != 0u) {
         uvec3 f = VERTEX_FLOATS * v;
         vec4 t[2] = objects[object].uv_transform;
         vec2 ua = transform_uv(t, vec2(vertex_data[f.x + 6u], vertex_data[f.x + 7u]));

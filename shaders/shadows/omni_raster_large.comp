@@ -54,7 +54,9 @@ void main() {
         barrier();
         uint layer = pairs[large_triangles[e].x].y;
         SurfaceTest s = no_surface_test();
-        if (corner_masked) {
+        // SURFACE_TESTS first: a flag read back from shared memory does not fold away, and the
+        // masked path's registers would cost every scene's texel loop.
+        if (MASK_TESTS && corner_masked) {
             uint object = meshlet_instances[pairs[large_triangles[e].x].x].x;
             s = masked_surface(objects[object].alpha, objects[object].alpha_texture, corner_clip[0], corner_clip[1], corner_clip[2],
                                corner_uv[0], corner_uv[1], corner_uv[2]);

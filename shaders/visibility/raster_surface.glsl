@@ -10,9 +10,13 @@
 #define MANYLIGHTS_RASTER_SURFACE_GLSL
 
 // Whether the scene has masked or double-sided objects at all (meshlets.rs
-// surface_tests_constant): without, every surface test compiles away and the rasters are the
+// surface_constants): without, every surface test compiles away and the rasters are the
 // opaque ones, register for register.
 layout(constant_id = 18) const bool SURFACE_TESTS = true;
+// Whether it has masked objects (meshlets.rs, the second of surface_constants): without, the
+// alpha tests — and the shared memory the masked paths hold — compile away while double-sided
+// objects keep their tests.
+layout(constant_id = 19) const bool MASK_TESTS = true;
 
 // A masked triangle's test (masked false: every pixel is kept).
 struct SurfaceTest {
@@ -35,12 +39,13 @@ vec3 clip_barycentrics(vec4 a, vec4 b, vec4 c, vec2 ndc) {
 
 // Whether the centre of `pixel` (in an image of `size` pixels) is drawn.
 bool surface_kept(SurfaceTest s, ivec2 pixel, vec2 size) {
-    if (!s.masked) {
-        return true;
+    // (Not `!MASK_TESTS || …`: the reflection cannot evaluate a negated constant.)
+    if (MASK_TESTS && s.masked) {
+        vec2 ndc = (vec2(pixel) + 0.5) / size * 2.0 - 1.0;
+        vec3 l = clip_barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
+        return alpha_kept(s.alpha, s.alpha_texture, l.x * s.uv[0] + l.y * s.uv[1] + l.z * s.uv[2]);
     }
-    vec2 ndc = (vec2(pixel) + 0.5) / size * 2.0 - 1.0;
-    vec3 l = clip_barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
-    return alpha_kept(s.alpha, s.alpha_texture, l.x * s.uv[0] + l.y * s.uv[1] + l.z * s.uv[2]);
+    return true;
 }
 
 // The test of a masked object's triangle: the object's ObjectData `alpha` and

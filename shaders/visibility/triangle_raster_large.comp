@@ -42,7 +42,7 @@ void main() {
         }
         uint at = listed.x;
         uvec4 head = large_triangles[at].head;
-        SurfaceTest surface = SURFACE_TESTS ? large_surface(at, head.z) : no_surface_test();
+        SurfaceTest surface = MASK_TESTS ? large_surface(at, head.z) : no_surface_test();
         bool both_faces = SURFACE_TESTS && (head.w & INSTANCE_DOUBLE_SIDED) != 0u;
         ivec2 bin = ivec2(listed.y & 0xffffu, listed.y >> 16u);
         ivec2 lo = bin * BIN + ivec2(lid % uint(BIN / BLOCK), lid / uint(BIN / BLOCK)) * BLOCK;

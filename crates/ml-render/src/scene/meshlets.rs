@@ -26,6 +26,8 @@ pub struct MeshletGeometry {
     /// Whether some object is masked or double-sided (the rasters then test surfaces: their
     /// specialization constant `SURFACE_TESTS`, visibility/raster_surface.glsl).
     pub surface_tests: bool,
+    /// Whether some object is masked (`MASK_TESTS`).
+    pub mask_tests: bool,
 }
 
 /// The buffers and counts of the scene's `MeshletGeometry`, for the passes that read it: it
@@ -42,6 +44,7 @@ pub struct MeshletGeometryView {
     pub instance_count: u32,
     pub triangles: u64,
     pub surface_tests: bool,
+    pub mask_tests: bool,
 }
 
 impl MeshletGeometryView {
@@ -59,9 +62,10 @@ impl MeshletGeometryView {
         Some(Resource::Buffer(buffer))
     }
 
-    /// The compute rasters' specialization constant `SURFACE_TESTS` (name, value).
-    pub fn surface_tests_constant(&self) -> (&'static str, u32) {
-        ("SURFACE_TESTS", u32::from(self.surface_tests))
+    /// The compute rasters' specialization constants `SURFACE_TESTS` and `MASK_TESTS`
+    /// (name, value).
+    pub fn surface_constants(&self) -> [(&'static str, u32); 2] {
+        [("SURFACE_TESTS", u32::from(self.surface_tests)), ("MASK_TESTS", u32::from(self.mask_tests))]
     }
 }
 
@@ -90,6 +94,7 @@ impl MeshletGeometry {
             instance_count: g.instances.len() as u32,
             triangles: g.triangles,
             surface_tests: g.instances.iter().any(|i| i.meshlets[3] & (INSTANCE_DOUBLE_SIDED | INSTANCE_MASKED) != 0),
+            mask_tests: g.instances.iter().any(|i| i.meshlets[3] & INSTANCE_MASKED != 0),
         };
         ml_vk::build(ctx, geometry, |s| {
             let upload = |name: &str, data: &[u8]| storage_buffer_with(ctx, name, data);
@@ -116,6 +121,7 @@ impl MeshletGeometry {
             instance_count: self.instance_count,
             triangles: self.triangles,
             surface_tests: self.surface_tests,
+            mask_tests: self.mask_tests,
         }
     }
 

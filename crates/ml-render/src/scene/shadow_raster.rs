@@ -167,8 +167,8 @@ impl ShadowRaster {
                 [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(size_of::<OmniRasterPush>() as u32)];
             r.layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw], &push)?;
             // Every step includes shadows/omni_raster.glsl, which declares them all.
-            let spec =
-                [("ORTHO_VIEW", u32::from(views == ShadowViews::Ortho)), ("ATLAS", u32::from(atlas)), r.geometry.surface_tests_constant()];
+            let [surface, mask] = r.geometry.surface_constants();
+            let spec = [("ORTHO_VIEW", u32::from(views == ShadowViews::Ortho)), ("ATLAS", u32::from(atlas)), surface, mask];
             // The clear is the atlas's alone.
             let used = if atlas { 4 } else { 3 };
             for (pipeline, s) in r.pipelines.iter_mut().zip(shaders).take(used) {

@@ -43,8 +43,11 @@ pub struct MeshletCull {
 impl MeshletCull {
     pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, (culling, raster): (bool, Raster)) -> Result<MeshletCull, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
+        // Scenes with masked objects get the compute raster that draws their pixels from
+        // shared memory (its shared memory would cost the others occupancy).
         let triangles = match raster {
             Raster::Hardware => &ml_shaders::TRIANGLE_CULL_COMP,
+            Raster::Compute { .. } if scene.borrow().geometry.mask_tests => &ml_shaders::TRIANGLE_RASTER_MASKED_COMP,
             Raster::Compute { .. } => &ml_shaders::TRIANGLE_RASTER_COMP,
         };
         let stages = [(&ml_shaders::INSTANCE_CULL_COMP, compute), (&ml_shaders::MESHLET_CULL_COMP, compute), (triangles, compute)];
@@ -70,9 +73,9 @@ impl MeshletCull {
             // hardware raster's culling (triangle_cull.comp) declares no SURFACE_TESTS.
             let surface = match raster {
                 Raster::Hardware => None,
-                Raster::Compute { .. } => Some(p.scene.borrow().geometry.surface_tests_constant()),
+                Raster::Compute { .. } => Some(p.scene.borrow().geometry.surface_constants()),
             };
-            p.triangle_pipeline = compute_pipeline(ctx, triangles, p.pipeline_layout, surface.as_slice())?;
+            p.triangle_pipeline = compute_pipeline(ctx, triangles, p.pipeline_layout, surface.as_ref().map_or(&[], |s| s.as_slice()))?;
             Ok(())
         })
     }

@@ -41,7 +41,7 @@ impl TriangleRasterLarge {
         ml_vk::build(ctx, pass, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            let surface = [p.scene.borrow().geometry.surface_tests_constant()];
+            let surface = p.scene.borrow().geometry.surface_constants();
             p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &surface)?;
             Ok(())
         })
