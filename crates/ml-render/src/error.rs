@@ -167,3 +167,11 @@ pub enum SettingsError {
     #[error("multiview point-light shadows: '{device}' ({driver}) renders every view of a depth-only multiview pass into the first layer (measured on Mesa 22.3 lavapipe): use layered, direct or copy")]
     BrokenMultiview { device: String, driver: String },
 }
+
+/// The one of `all` whose name (`name_of`) is `name`; else the error that lists the names.
+pub(crate) fn by_name<T: Copy>(all: &[T], name_of: fn(T) -> &'static str, kind: Named, name: &str) -> Result<T, RenderError> {
+    all.iter().copied().find(|&v| name_of(v) == name).ok_or_else(|| {
+        let expected = all.iter().map(|&v| name_of(v)).collect::<Vec<_>>().join(", ");
+        RenderError::UnknownName { kind, name: name.to_owned(), expected }
+    })
+}

@@ -52,6 +52,7 @@ mod shadows;
 mod specialization;
 mod sync;
 mod targets;
+mod technique;
 mod visibility;
 
 pub use error::RenderError;

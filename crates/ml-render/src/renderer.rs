@@ -138,7 +138,7 @@ impl<'a> Renderer<'a> {
         }
         let depth = depth_format(ctx, Output::of(settings.technique))?;
         let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
-        let mut gpu = SceneGpu::new(ctx, &scene, &settings)?;
+        let mut gpu = SceneGpu::new(ctx, &scene, settings.scene_config())?;
         gpu.omni.choose(&scene, settings.aspect());
         let lights = gpu_lights(&scene, &gpu);
         let mut r = Renderer {

@@ -7,8 +7,8 @@
 
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::report::Spread;
-use crate::settings::Technique;
 use crate::specialization::compute_pipeline;
+use crate::technique::Technique;
 use ml_cpu::gpu_types::{PointLight, StageProbePush};
 use ml_shaders::{FULLSCREEN_VERT, STAGE_PROBE_COMP, STAGE_PROBE_FRAG};
 use ml_vk::commands::{copy_colour_to_host, one_shot};

@@ -2,7 +2,7 @@
 //! buffer, the G-buffer and the HDR image of the deferred techniques. The raster passes make
 //! their framebuffers over them.
 
-use crate::settings::{Geometry, LightingStage, Raster, Technique};
+use crate::technique::{Geometry, LightingStage, Raster, Technique};
 use ml_vk::{vk, Buffer, Context, Image, VkError};
 
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.

@@ -4,8 +4,8 @@
 //! renderer asks it whether a render's last image has settled (else that frame is rendered
 //! again), and writes `multiplier` into the frame's uniforms.
 
+use crate::exposure::{Exposure, MAX_EXPOSURE_EV};
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::settings::{Exposure, MAX_EXPOSURE_EV};
 
 /// Auto exposure aims the log-average luminance at middle grey.
 const KEY: f32 = 0.18;

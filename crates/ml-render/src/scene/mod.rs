@@ -8,6 +8,7 @@ pub mod object_textures;
 pub mod omni_shadow;
 pub mod shadow_atlas;
 pub mod shadow_raster;
+pub mod shadow_settings;
 pub mod sun_shadow;
 pub mod textures;
 
@@ -17,8 +18,8 @@ use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeomet
 use crate::scene::object_data::{object_data, SurfaceVariant};
 use crate::scene::object_textures::ObjectTextureSets;
 use crate::scene::omni_shadow::OmniShadows;
+use crate::scene::shadow_settings::{OmniShadowSettings, SunShadowMode};
 use crate::scene::textures::SceneTextures;
-use crate::settings::{RenderSettings, ShadingModel, SunShadowMode};
 use crate::targets::{depth_format, Output};
 use ml_cpu::alpha_mask::AlphaMasks;
 use ml_cpu::blinn_phong::shadow_view_proj;
@@ -56,12 +57,12 @@ pub struct SceneGpu {
 }
 
 impl SceneGpu {
-    pub fn new(ctx: &Context, scene: &Scene, settings: &RenderSettings) -> Result<SceneGpu, RenderError> {
-        let sun = (settings.shading == ShadingModel::BlinnPhong).then_some(settings.sun_shadow);
+    pub fn new(ctx: &Context, scene: &Scene, config: SceneConfig) -> Result<SceneGpu, RenderError> {
+        let sun = config.sun;
         // Each of these needs the ones before it; a failure releases those.
         let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
         let has_masked = scene.objects.iter().any(|o| o.extras.masked());
-        let mut omni = OmniShadows::new(ctx, settings.omni, has_masked)?;
+        let mut omni = OmniShadows::new(ctx, config.omni, has_masked)?;
         let mut textures = release_on_error(ctx, SceneTextures::new(ctx, sun.is_some(), gbuffer_depth, &omni), &mut [&mut omni])?;
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
         let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
@@ -78,7 +79,7 @@ impl SceneGpu {
             sun,
             sun_shadow_ms: None,
             meshlets: None,
-            wants_meshlets: draws_meshlets(settings),
+            wants_meshlets: config.meshlets,
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
@@ -179,10 +180,14 @@ impl SceneGpu {
     }
 }
 
-/// Whether `settings` have a pass that draws the scene's meshlets.
-fn draws_meshlets(settings: &RenderSettings) -> bool {
-    use crate::settings::{Geometry, OmniShadowMode};
-    let omni_compute = settings.omni.is_some_and(|o| matches!(o.mode, OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_)));
-    let sun_compute = settings.shading == ShadingModel::BlinnPhong && settings.sun_shadow == SunShadowMode::Compute;
-    settings.technique.geometry() == Geometry::Meshlets || omni_compute || sun_compute
+/// What the scene's GPU resources are made for (the render settings' `scene_config`): which
+/// shadow stores, and whether some pass draws the scene's meshlets.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneConfig {
+    /// Whether the sun's shadow map is drawn (blinn-phong), and by whom.
+    pub sun: Option<SunShadowMode>,
+    /// Point-light shadows (None: the stand-in).
+    pub omni: Option<OmniShadowSettings>,
+    /// Whether a pass draws the scene's meshlets.
+    pub meshlets: bool,
 }

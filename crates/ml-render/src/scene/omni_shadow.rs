@@ -22,7 +22,7 @@ use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::error::RenderError;
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::scene::shadow_atlas::ShadowAtlasGpu;
-use crate::settings::{OmniShadowMode, OmniShadowSettings};
+use crate::scene::shadow_settings::{OmniShadowMode, OmniShadowSettings};
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
 use ml_cpu::gpu_types::PointLight;

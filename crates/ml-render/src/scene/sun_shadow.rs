@@ -12,7 +12,7 @@ use crate::error::RenderError;
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::scene::meshlets::MeshletGeometryView;
 use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
-use crate::settings::SunShadowMode;
+use crate::scene::shadow_settings::SunShadowMode;
 use ml_cpu::gpu_types::ShadowPush;
 use ml_cpu::scene::Scene;
 use ml_vk::{shader, vk, Context, GpuTimer, Image, VkError, VkResultExt};

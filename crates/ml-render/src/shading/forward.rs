@@ -6,8 +6,8 @@
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
-use crate::settings::Shading;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
+use crate::shading::Shading;
 use crate::sync::{light_list_reads, Entry, Exit, Use, COLOUR_TARGET};
 use crate::targets::Output;
 use ml_vk::{vk, Context, VkError};

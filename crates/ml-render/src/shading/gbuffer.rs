@@ -6,8 +6,8 @@
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
-use crate::settings::Shading;
 use crate::shading::mesh_raster::MeshRaster;
+use crate::shading::Shading;
 use crate::targets::{gbuffer_images, Output};
 use ml_vk::{vk, Context, VkError};
 

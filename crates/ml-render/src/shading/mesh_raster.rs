@@ -10,7 +10,7 @@ use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding};
 use crate::pass::Recording;
 use crate::render_pass;
 use crate::scene::object_data::{object_push, SurfaceVariant};
-use crate::settings::Shading;
+use crate::shading::Shading;
 use crate::specialization;
 use crate::targets::{GBufferImage, Output};
 use ml_cpu::gpu_types::ObjectPush;

@@ -7,3 +7,46 @@ pub mod deferred_subpass;
 pub mod forward;
 pub mod gbuffer;
 pub mod mesh_raster;
+
+use ml_cpu::shading_model::ShadingModel;
+
+/// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
+/// whether objects have textures of their own and whether there are spot lights
+/// (specialization constants, so each pipeline carries only what it runs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shading {
+    pub model: ShadingModel,
+    pub omni_shadows: bool,
+    /// The point lights' shadows are in the shadow atlas (else in the cube array).
+    pub shadow_atlas: bool,
+    pub object_textures: bool,
+    pub spot_lights: bool,
+}
+
+impl Shading {
+    /// The specialization constants (name, value) of a pipeline that reads surfaces without
+    /// lighting them (the G-buffer's): `MODEL_BLINN_PHONG`, `MODEL_PBR` and `OBJECT_TEXTURES`
+    /// (common/shading_model.glsl).
+    pub fn surface_constants(self) -> [(&'static str, u32); 3] {
+        [
+            ("MODEL_BLINN_PHONG", u32::from(self.model == ShadingModel::BlinnPhong)),
+            ("MODEL_PBR", u32::from(self.model == ShadingModel::Pbr)),
+            ("OBJECT_TEXTURES", u32::from(self.object_textures)),
+        ]
+    }
+
+    /// The specialization constants (name, value) of a lighting pipeline: the surface's,
+    /// `OMNI_SHADOWS` and `SHADOW_ATLAS` (shadows/omni_shadow.glsl) and `SPOT_LIGHTS`
+    /// (common/lighting.glsl).
+    pub fn lighting_constants(self) -> [(&'static str, u32); 6] {
+        let [model_a, model_b, textures] = self.surface_constants();
+        [
+            model_a,
+            model_b,
+            textures,
+            ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
+            ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
+            ("SPOT_LIGHTS", u32::from(self.spot_lights)),
+        ]
+    }
+}

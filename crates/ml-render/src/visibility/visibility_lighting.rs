@@ -8,7 +8,7 @@ use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
-use crate::settings::Shading;
+use crate::shading::Shading;
 use crate::sync::{light_list_reads, Use};
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};

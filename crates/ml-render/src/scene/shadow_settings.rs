@@ -1,0 +1,144 @@
+//! The shadow stores' settings: how point-light shadows are made (cube array modes or the
+//! shadow atlas), for how many lights, how large, and who draws the sun's map. Here, beside
+//! the stores they shape, so that the scene's GPU resources need nothing of the render
+//! settings above them.
+
+use crate::error::{by_name, Named, RenderError};
+
+/// How point-light shadow cubes are rendered (docs/DESIGN.md#point-light-shadows).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum OmniShadowMode {
+    /// The classic way: each face into one offscreen depth target, then copied into the cube.
+    Copy,
+    /// Each face straight into its cube layer (a framebuffer per layer).
+    Direct,
+    /// All six faces in one pass (VK_KHR_multiview, view i = face i).
+    Multiview,
+    /// All six faces in one pass by layered rendering: six instances of each draw, instance i
+    /// writes gl_Layer = i (shaderOutputLayer).
+    Layered,
+    /// Compute shaders draw every face of every cube (meshlets culled per face, small
+    /// triangles a thread each, large ones a work group each) into a buffer of 32-bit depths,
+    /// copied into the cubes (docs/DESIGN.md#compute-shadow-raster). `large_list`: large
+    /// triangles the list of its work groups holds; past it (0: always), the thread that found
+    /// one draws it itself (slower, nothing lost).
+    Compute { large_list: u32 },
+    /// Every visible face of every shadowed light in one shadow atlas of a fixed budget, each
+    /// light's faces as large as it is on screen, drawn by the compute raster; faces whose
+    /// light did not move keep their texels (docs/DESIGN.md#shadow-atlas).
+    Atlas(AtlasSettings),
+}
+
+/// The shadow atlas's settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct AtlasSettings {
+    /// MiB all point-light shadow memory may take: the atlas, its tables and the raster's
+    /// lists.
+    pub budget_mib: u32,
+    /// Faces whose light did not move keep last frame's texels (off: every face is drawn
+    /// every frame; the images are the same).
+    pub cache: bool,
+    /// Every face this many texels a side (before the budget's factor) instead of the
+    /// light's size on screen (for comparisons with the cube array).
+    pub fixed_size: Option<u32>,
+}
+
+impl AtlasSettings {
+    pub const DEFAULT: AtlasSettings = AtlasSettings { budget_mib: 256, cache: true, fixed_size: None };
+
+    pub fn budget_bytes(&self) -> u64 {
+        (self.budget_mib as u64) << 20
+    }
+}
+
+impl OmniShadowMode {
+    /// The compute raster with its default list of large triangles (2^20: 8 MiB).
+    pub const COMPUTE: OmniShadowMode = OmniShadowMode::Compute { large_list: 1 << 20 };
+
+    pub const ALL: [OmniShadowMode; 6] = [
+        OmniShadowMode::Copy,
+        OmniShadowMode::Direct,
+        OmniShadowMode::Multiview,
+        OmniShadowMode::Layered,
+        OmniShadowMode::COMPUTE,
+        OmniShadowMode::Atlas(AtlasSettings::DEFAULT),
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OmniShadowMode::Copy => "copy",
+            OmniShadowMode::Direct => "direct",
+            OmniShadowMode::Multiview => "multiview",
+            OmniShadowMode::Layered => "layered",
+            OmniShadowMode::Compute { .. } => "compute",
+            OmniShadowMode::Atlas(_) => "atlas",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<OmniShadowMode, RenderError> {
+        by_name(&OmniShadowMode::ALL, OmniShadowMode::name, Named::OmniShadowMode, name)
+    }
+}
+
+/// Point-light shadows: how the cubes are made, for how many lights, how large.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct OmniShadowSettings {
+    pub mode: OmniShadowMode,
+    /// Lights with a shadow cube (the strongest as seen from the camera), at most; with
+    /// `all`, the lights that reach the view (SettingsRequest::for_scene counts them).
+    pub lights: u32,
+    /// Shadow every light that reaches the view (at most MAX_SHADOWED_LIGHTS), not the
+    /// `lights` strongest.
+    pub all: bool,
+    /// Texels per side of each cube face (cube array modes).
+    pub size: u32,
+}
+
+/// The most lights `--shadowed-lights all` shadows (the strongest first), and the most the
+/// shadow atlas takes.
+pub const MAX_SHADOWED_LIGHTS: u32 = 4096;
+
+impl OmniShadowSettings {
+    pub const DEFAULT_SIZE: u32 = 1024;
+
+    /// The shadow atlas's settings, if the faces go into one.
+    pub fn atlas(&self) -> Option<AtlasSettings> {
+        match self.mode {
+            OmniShadowMode::Atlas(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// Bytes of the cube array (32-bit depth; the shadow atlas's are its budget).
+    pub fn bytes(&self) -> u64 {
+        match self.atlas() {
+            Some(a) => a.budget_bytes(),
+            None => self.lights as u64 * 6 * self.size as u64 * self.size as u64 * 4,
+        }
+    }
+}
+
+/// Who draws the sun's shadow map (blinn-phong), once, when the scene's objects reach the GPU
+/// (docs/DESIGN.md#sun-shadow-map).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SunShadowMode {
+    /// A depth-only render pass.
+    Graphics,
+    /// The compute shadow raster, in one orthographic view (docs/DESIGN.md#compute-shadow-raster).
+    Compute,
+}
+
+impl SunShadowMode {
+    pub const ALL: [SunShadowMode; 2] = [SunShadowMode::Graphics, SunShadowMode::Compute];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SunShadowMode::Graphics => "graphics",
+            SunShadowMode::Compute => "compute",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<SunShadowMode, RenderError> {
+        by_name(&SunShadowMode::ALL, SunShadowMode::name, Named::SunShadowMode, name)
+    }
+}
