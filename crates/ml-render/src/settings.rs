@@ -2,18 +2,18 @@
 
 use crate::error::{by_name, Named, RenderError, Setting, SettingsError};
 pub use crate::exposure::{parse_exposure, Exposure, MAX_EXPOSURE_EV};
-pub use crate::scene::shadow_settings::{AtlasSettings, OmniShadowMode, OmniShadowSettings, SunShadowMode, MAX_SHADOWED_LIGHTS};
+pub use crate::scene::shadow_settings::{
+    multiview_depth_is_broken, AtlasSettings, OmniShadowMode, OmniShadowSettings, SunShadowMode, MAX_OMNI_BYTES, MAX_SHADOWED_LIGHTS,
+};
 use crate::scene::SceneConfig;
 pub use crate::shading::Shading;
+pub use crate::targets::MAX_DIMENSION;
 pub use crate::technique::{
     missing_meshlet_feature, missing_raster_feature, Geometry, LargeTriangles, LightAssignment, LightingStage, Raster, Technique,
 };
 use ml_cpu::cluster::ClusterDims;
 pub use ml_cpu::shading_model::ShadingModel;
 use ml_vk::{vk, Context};
-
-/// Most memory the shadow cubes may take, whatever the device has: 16 lights at 2048² are 1.5 GiB.
-pub const MAX_OMNI_BYTES: u64 = 4 << 30;
 
 /// What the image shows instead of the shaded scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -99,10 +99,6 @@ impl DebugView {
         }
     }
 }
-
-/// Size of the biggest image we agree to render, whatever the device allows: 16384² RGBA8 is
-/// 1 GiB of colour alone, per frame in flight.
-pub const MAX_DIMENSION: u32 = 16384;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -251,7 +247,7 @@ impl RenderSettings {
             return Err(SettingsError::ShadowAtlasViewNeedsAtlas.into());
         }
         if let Some(omni) = &self.omni {
-            check_omni(ctx, omni, lights)?;
+            omni.check(ctx, lights)?;
         }
         if self.sun_shadow == SunShadowMode::Compute && self.shading == ShadingModel::BlinnPhong {
             let features = &ctx.info.features;
@@ -276,103 +272,6 @@ impl RenderSettings {
         }
         Ok(())
     }
-}
-
-/// Reject shadow-cube requests the device or the scene cannot take, before allocating.
-fn check_omni(ctx: &Context, omni: &OmniShadowSettings, lights: usize) -> Result<(), SettingsError> {
-    let limits = &ctx.info.limits;
-    let device = || ctx.info.name.clone();
-    if lights == 0 {
-        return Err(SettingsError::ShadowsWithoutLights);
-    }
-    if omni.lights == 0 || (omni.lights as usize > lights && !omni.all) {
-        return Err(SettingsError::ShadowedLights { value: omni.lights, lights });
-    }
-    if let Some(atlas) = omni.atlas() {
-        return check_atlas(ctx, omni, atlas);
-    }
-    let max_cubes = limits.max_image_array_layers / 6;
-    if omni.lights > max_cubes {
-        return Err(SettingsError::TooManyCubes { value: omni.lights, max: max_cubes, device: device() });
-    }
-    let max_size = limits.max_image_dimension_cube.min(MAX_DIMENSION);
-    if omni.size == 0 || omni.size > max_size {
-        return Err(SettingsError::OutOfRange { what: Setting::CubeSize, value: omni.size, max: max_size });
-    }
-    if omni.bytes() > MAX_OMNI_BYTES {
-        return Err(SettingsError::ShadowMemory {
-            lights: omni.lights,
-            size: omni.size,
-            mib: omni.bytes() >> 20,
-            max_mib: MAX_OMNI_BYTES >> 20,
-        });
-    }
-    let missing = |feature, instead| SettingsError::MissingFeature { mode: omni.mode.name(), feature, device: device(), instead };
-    if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
-        return Err(missing("multiview", "layered, direct or copy"));
-    }
-    if omni.mode == OmniShadowMode::Multiview && multiview_depth_is_broken(ctx) {
-        return Err(SettingsError::BrokenMultiview { device: device(), driver: ctx.info.driver_info.clone() });
-    }
-    if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
-        return Err(missing("shaderOutputLayer", "direct or copy"));
-    }
-    if let OmniShadowMode::Compute { .. } = omni.mode {
-        check_compute_raster(ctx, omni)?;
-        // The depths are one storage buffer, as large as the cubes.
-        if omni.bytes() > limits.max_storage_buffer_range as u64 {
-            return Err(SettingsError::ShadowBuffer {
-                lights: omni.lights,
-                size: omni.size,
-                mib: omni.bytes() >> 20,
-                device: device(),
-                max_mib: limits.max_storage_buffer_range as u64 >> 20,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Reject shadow-atlas requests the device cannot take, before allocating.
-fn check_atlas(ctx: &Context, omni: &OmniShadowSettings, atlas: AtlasSettings) -> Result<(), SettingsError> {
-    let device = || ctx.info.name.clone();
-    if omni.lights > MAX_SHADOWED_LIGHTS {
-        return Err(SettingsError::TooManyShadowed { value: omni.lights, max: MAX_SHADOWED_LIGHTS });
-    }
-    let memory_mib = ctx.device_local_bytes() >> 20;
-    if atlas.budget_mib == 0 || atlas.budget_mib as u64 > memory_mib {
-        return Err(SettingsError::ShadowBudget { mib: atlas.budget_mib, max_mib: memory_mib, device: device() });
-    }
-    if let Some(size) = atlas.fixed_size {
-        let (min, max) = (ml_cpu::shadow_atlas::MIN_FACE, ml_cpu::shadow_atlas::MAX_FACE);
-        if !size.is_power_of_two() || !(min..=max).contains(&size) {
-            return Err(SettingsError::AtlasFaceSize { value: size, min, max });
-        }
-    }
-    check_compute_raster(ctx, omni)
-}
-
-/// The compute shadow raster (the compute and atlas modes) needs 64-bit integers: its edge
-/// functions are 64-bit.
-fn check_compute_raster(ctx: &Context, omni: &OmniShadowSettings) -> Result<(), SettingsError> {
-    if !ctx.info.features.buffer_int64_atomics {
-        let device = ctx.info.name.clone();
-        return Err(SettingsError::MissingFeature {
-            mode: omni.mode.name(),
-            feature: "shaderInt64",
-            device,
-            instead: "layered, direct or copy",
-        });
-    }
-    Ok(())
-}
-
-/// Whether the driver is one that renders a depth-only multiview pass wrong: Mesa's
-/// lavapipe 22.3 (Debian 12's) draws all six views into layer 0 — found by the shadow-cube
-/// debug view; the same pass on the H100 matches `direct` exactly (docs/BENCHMARKS.md).
-/// Later Mesa releases are not known to be fixed, so every lavapipe refuses it.
-pub fn multiview_depth_is_broken(ctx: &Context) -> bool {
-    ctx.info.name.starts_with("llvmpipe")
 }
 
 /// The settings a command asks for, before the scene is known: its cluster grid may be left

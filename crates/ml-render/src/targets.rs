@@ -5,6 +5,10 @@
 use crate::technique::{Geometry, LightingStage, Raster, Technique};
 use ml_vk::{vk, Buffer, Context, Image, VkError};
 
+/// Size of the biggest image we agree to render, whatever the device allows: 16384² RGBA8 is
+/// 1 GiB of colour alone, per frame in flight.
+pub const MAX_DIMENSION: u32 = 16384;
+
 /// Colour target format: the seed writes gamma-encoded values itself, so plain UNORM.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// What the deferred lighting subpass writes: linear HDR colour, tone-mapped after.

@@ -3,7 +3,9 @@
 //! the stores they shape, so that the scene's GPU resources need nothing of the render
 //! settings above them.
 
-use crate::error::{by_name, Named, RenderError};
+use crate::error::{by_name, Named, RenderError, Setting, SettingsError};
+use crate::targets::MAX_DIMENSION;
+use ml_vk::Context;
 
 /// How point-light shadow cubes are rendered (docs/DESIGN.md#point-light-shadows).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -141,4 +143,108 @@ impl SunShadowMode {
     pub fn from_name(name: &str) -> Result<SunShadowMode, RenderError> {
         by_name(&SunShadowMode::ALL, SunShadowMode::name, Named::SunShadowMode, name)
     }
+}
+
+/// Most memory the shadow cubes may take, whatever the device has: 16 lights at 2048² are 1.5 GiB.
+pub const MAX_OMNI_BYTES: u64 = 4 << 30;
+
+impl OmniShadowSettings {
+    /// Reject point-light shadow requests the device or the scene's `lights` cannot take,
+    /// before allocating.
+    pub(crate) fn check(&self, ctx: &Context, lights: usize) -> Result<(), SettingsError> {
+        let omni = self;
+        let limits = &ctx.info.limits;
+        let device = || ctx.info.name.clone();
+        if lights == 0 {
+            return Err(SettingsError::ShadowsWithoutLights);
+        }
+        if omni.lights == 0 || (omni.lights as usize > lights && !omni.all) {
+            return Err(SettingsError::ShadowedLights { value: omni.lights, lights });
+        }
+        if let Some(atlas) = omni.atlas() {
+            return check_atlas(ctx, omni, atlas);
+        }
+        let max_cubes = limits.max_image_array_layers / 6;
+        if omni.lights > max_cubes {
+            return Err(SettingsError::TooManyCubes { value: omni.lights, max: max_cubes, device: device() });
+        }
+        let max_size = limits.max_image_dimension_cube.min(MAX_DIMENSION);
+        if omni.size == 0 || omni.size > max_size {
+            return Err(SettingsError::OutOfRange { what: Setting::CubeSize, value: omni.size, max: max_size });
+        }
+        if omni.bytes() > MAX_OMNI_BYTES {
+            return Err(SettingsError::ShadowMemory {
+                lights: omni.lights,
+                size: omni.size,
+                mib: omni.bytes() >> 20,
+                max_mib: MAX_OMNI_BYTES >> 20,
+            });
+        }
+        let missing = |feature, instead| SettingsError::MissingFeature { mode: omni.mode.name(), feature, device: device(), instead };
+        if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
+            return Err(missing("multiview", "layered, direct or copy"));
+        }
+        if omni.mode == OmniShadowMode::Multiview && multiview_depth_is_broken(ctx) {
+            return Err(SettingsError::BrokenMultiview { device: device(), driver: ctx.info.driver_info.clone() });
+        }
+        if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
+            return Err(missing("shaderOutputLayer", "direct or copy"));
+        }
+        if let OmniShadowMode::Compute { .. } = omni.mode {
+            check_compute_raster(ctx, omni)?;
+            // The depths are one storage buffer, as large as the cubes.
+            if omni.bytes() > limits.max_storage_buffer_range as u64 {
+                return Err(SettingsError::ShadowBuffer {
+                    lights: omni.lights,
+                    size: omni.size,
+                    mib: omni.bytes() >> 20,
+                    device: device(),
+                    max_mib: limits.max_storage_buffer_range as u64 >> 20,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Reject shadow-atlas requests the device cannot take, before allocating.
+fn check_atlas(ctx: &Context, omni: &OmniShadowSettings, atlas: AtlasSettings) -> Result<(), SettingsError> {
+    let device = || ctx.info.name.clone();
+    if omni.lights > MAX_SHADOWED_LIGHTS {
+        return Err(SettingsError::TooManyShadowed { value: omni.lights, max: MAX_SHADOWED_LIGHTS });
+    }
+    let memory_mib = ctx.device_local_bytes() >> 20;
+    if atlas.budget_mib == 0 || atlas.budget_mib as u64 > memory_mib {
+        return Err(SettingsError::ShadowBudget { mib: atlas.budget_mib, max_mib: memory_mib, device: device() });
+    }
+    if let Some(size) = atlas.fixed_size {
+        let (min, max) = (ml_cpu::shadow_atlas::MIN_FACE, ml_cpu::shadow_atlas::MAX_FACE);
+        if !size.is_power_of_two() || !(min..=max).contains(&size) {
+            return Err(SettingsError::AtlasFaceSize { value: size, min, max });
+        }
+    }
+    check_compute_raster(ctx, omni)
+}
+
+/// The compute shadow raster (the compute and atlas modes) needs 64-bit integers: its edge
+/// functions are 64-bit.
+fn check_compute_raster(ctx: &Context, omni: &OmniShadowSettings) -> Result<(), SettingsError> {
+    if !ctx.info.features.buffer_int64_atomics {
+        let device = ctx.info.name.clone();
+        return Err(SettingsError::MissingFeature {
+            mode: omni.mode.name(),
+            feature: "shaderInt64",
+            device,
+            instead: "layered, direct or copy",
+        });
+    }
+    Ok(())
+}
+
+/// Whether the driver is one that renders a depth-only multiview pass wrong: Mesa's
+/// lavapipe 22.3 (Debian 12's) draws all six views into layer 0 — found by the shadow-cube
+/// debug view; the same pass on the H100 matches `direct` exactly (docs/BENCHMARKS.md).
+/// Later Mesa releases are not known to be fixed, so every lavapipe refuses it.
+pub fn multiview_depth_is_broken(ctx: &Context) -> bool {
+    ctx.info.name.starts_with("llvmpipe")
 }
