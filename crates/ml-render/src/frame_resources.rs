@@ -4,6 +4,7 @@
 //! a pass looks up the names its shaders declare and knows nothing of who made them.
 
 use crate::descriptors::Resource;
+use crate::sync::{DEPTH_PYRAMID, VISIBILITY_DEPTH};
 use crate::targets::Targets;
 use ml_vk::vk;
 
@@ -21,7 +22,7 @@ impl<'a> FrameResources<'a> {
     /// Slot `slot`'s table: its targets' buffers (the depth pyramid, the compute raster's
     /// depth-and-id buffer) and, added by `with`, everyone else's.
     pub fn new(slot: usize, targets: &'a Targets) -> FrameResources<'a> {
-        let buffers = vec![("DepthPyramidBuffer", targets.depth_pyramid.raw), ("VisibilityDepthBuffer", targets.visibility_depth.raw)];
+        let buffers = vec![(DEPTH_PYRAMID, targets.depth_pyramid.raw), (VISIBILITY_DEPTH, targets.visibility_depth.raw)];
         FrameResources { slot, buffers, targets }
     }
 

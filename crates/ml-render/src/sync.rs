@@ -13,8 +13,10 @@
 //!
 //! A resource is ordered this way only if every pass that touches it declares it: the state
 //! knows nothing of an undeclared use, and would, say, take an image another pass just wrote
-//! for undefined. Resources not yet moved over (the culling's buffers, the shadow stores)
-//! are declared by none of their passes, which order them by hand as before.
+//! for undefined. Resources not yet moved over — the shadow stores, the meshlet visibility
+//! (shared by the frame slots, whose states are the slots' own) and the hardware raster's
+//! images (ordered by its render pass) — are declared by none of their passes, which order
+//! them by hand as before.
 
 use ml_vk::vk;
 
@@ -214,6 +216,11 @@ pub fn light_list_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
 /// The frame slot's depth pyramid (its shader block's name): written by the depth pyramid
 /// pass, read by the culling.
 pub const DEPTH_PYRAMID: &str = "DepthPyramidBuffer";
+
+/// The frame slot's 64-bit visibility-depth buffer (the compute and hybrid rasters'; its
+/// shader block's name): cleared and written by the culling passes, the large triangles and
+/// the hybrid's fragments, read by the depth pyramid and the lighting.
+pub const VISIBILITY_DEPTH: &str = "VisibilityDepthBuffer";
 
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.

@@ -10,7 +10,7 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::specialization::compute_pipeline;
-use crate::sync::{Use, DEPTH_PYRAMID};
+use crate::sync::{Use, DEPTH_PYRAMID, VISIBILITY_DEPTH};
 use crate::targets::{depth_pyramid_level, depth_pyramid_shape};
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
@@ -24,6 +24,8 @@ pub struct DepthPyramid {
     pipeline: vk::Pipeline,
     /// Its dispatches cover a level by the shader's work groups.
     shader: &'static Shader,
+    /// It reads the compute raster's 64-bit buffer (else the depth image).
+    from_buffer: bool,
 }
 
 impl DepthPyramid {
@@ -36,6 +38,7 @@ impl DepthPyramid {
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             shader,
+            from_buffer,
         };
         ml_vk::build(ctx, p, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(16)];
@@ -65,14 +68,19 @@ impl Pass for DepthPyramid {
     }
 
     /// Its levels, written (and read, each from the one before) in compute; the culling reads
-    /// them, the late phase this frame's, the early one the last frame's on this slot.
+    /// them, the late phase this frame's, the early one the last frame's on this slot. And the
+    /// compute raster's 64-bit buffer it reads.
     fn uses(&self) -> Vec<Use> {
         let rw = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-        vec![Use::at(DEPTH_PYRAMID, rw, None)]
+        let mut uses = vec![Use::at(DEPTH_PYRAMID, rw, None)];
+        if self.from_buffer {
+            uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
+        }
+        uses
     }
 
-    /// After the early raster (its render pass, or the compute raster's last pass, makes the
-    /// depth visible to compute).
+    /// After the early raster: the hardware raster's render pass makes its depth image
+    /// visible to compute; the compute raster's buffer is a declared use.
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let d = &ctx.device;

@@ -19,10 +19,13 @@ use crate::pass::{Pass, Recording, SlotReport};
 use crate::plan::Phase;
 use crate::report::{CullStats, FrameStats};
 use crate::specialization::compute_pipeline;
-use crate::sync::{Use, DEPTH_PYRAMID};
+use crate::sync::{Use, DEPTH_PYRAMID, VISIBILITY_DEPTH};
 use crate::targets::depth_pyramid_shape;
 use crate::technique::Raster;
-use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
+use crate::visibility::meshlet_scene::{
+    MeshletScene, SharedMeshletScene, COMPACTED_INDICES, CULL_COUNTERS, DRAW_SLOTS, LARGE_BINS, LARGE_TRIANGLES, TRIANGLE_IDS,
+    VISIBLE_INSTANCES,
+};
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{shader, vk, Context, VkError};
@@ -113,9 +116,39 @@ impl Pass for MeshletCull {
         self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame, name))
     }
 
-    /// The depth pyramid its shaders read (the late phase tests against it).
+    /// The depth pyramid its shaders read (the late phase tests against it); the culling's
+    /// buffers of the slot, which it clears (early), fills, dispatches from and, where it
+    /// reads the counters back, copies; the compute raster's lists and 64-bit buffer.
     fn uses(&self) -> Vec<Use> {
-        vec![Use::at(DEPTH_PYRAMID, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None)]
+        use vk::AccessFlags as A;
+        use vk::PipelineStageFlags as S;
+        let rw = A::SHADER_READ | A::SHADER_WRITE;
+        let compute = (S::COMPUTE_SHADER, rw);
+        let early = self.phase == Phase::Early;
+        let mut counters = (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ);
+        if early {
+            counters = (counters.0 | S::TRANSFER, counters.1 | A::TRANSFER_WRITE);
+        }
+        if self.reads_back() {
+            counters = (counters.0 | S::TRANSFER, counters.1 | A::TRANSFER_READ);
+        }
+        let mut uses = vec![
+            Use::at(DEPTH_PYRAMID, (S::COMPUTE_SHADER, A::SHADER_READ), None),
+            Use::at(CULL_COUNTERS, counters, None),
+            Use::at(VISIBLE_INSTANCES, compute, None),
+            Use::at(DRAW_SLOTS, compute, None),
+            Use::at(COMPACTED_INDICES, compute, None),
+            Use::at(TRIANGLE_IDS, compute, None),
+        ];
+        if self.raster != Raster::Hardware {
+            // Cleared by a transfer in the early phase.
+            let depth = if early { (S::COMPUTE_SHADER | S::TRANSFER, rw | A::TRANSFER_WRITE) } else { compute };
+            uses.push(Use::at(VISIBILITY_DEPTH, depth, None));
+        }
+        if self.raster.bin_list().is_some() {
+            uses.extend([Use::at(LARGE_BINS, compute, None), Use::at(LARGE_TRIANGLES, compute, None)]);
+        }
+        uses
     }
 
     fn record(&self, rec: &Recording) {
@@ -126,7 +159,6 @@ impl Pass for MeshletCull {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
-        let raster = vk::PipelineStageFlags::VERTEX_INPUT | vk::PipelineStageFlags::VERTEX_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         let indirect_read = vk::AccessFlags::INDIRECT_COMMAND_READ;
         let push = cull_push(self.phase, self.culling, self.raster, &scene, rec.extent);
@@ -137,14 +169,9 @@ impl Pass for MeshletCull {
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
             d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             if self.phase == Phase::Early {
-                // This slot's buffers were last used two frames ago (draws, indices and ids read,
-                // counters copied), the visibility written by the last frame's late phase.
-                memory_barrier(
-                    ctx,
-                    cmd,
-                    (compute | indirect | transfer | raster, vk::AccessFlags::SHADER_WRITE),
-                    (compute | transfer, rw | vk::AccessFlags::TRANSFER_WRITE),
-                );
+                // The meshlet visibility, written by the last frame's late phase (in another
+                // slot's commands: the declared uses order the slot's own buffers).
+                memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
                 d.cmd_fill_buffer(cmd, f.counters.raw, 0, vk::WHOLE_SIZE, 0);
                 if self.raster != Raster::Hardware {
                     // Nothing drawn: all ones, above every depth-and-id (the last frame's
@@ -156,9 +183,6 @@ impl Pass for MeshletCull {
                 let [groups, ..] = ml_shaders::INSTANCE_CULL_COMP.groups([scene.geometry.instance_count, 1, 1]);
                 d.cmd_dispatch(cmd, groups.max(1), 1, 1);
                 memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute | indirect, rw | indirect_read));
-            } else {
-                // The early raster read the compacted buffers (or the bins) this phase appends to.
-                memory_barrier(ctx, cmd, (raster | compute, vk::AccessFlags::empty()), (compute, vk::AccessFlags::SHADER_WRITE));
             }
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.meshlet_pipeline);
             d.cmd_dispatch_indirect(cmd, f.counters.raw, 0);
@@ -168,15 +192,10 @@ impl Pass for MeshletCull {
             let phase = usize::from(self.phase == Phase::Late);
             let meshlets = (std::mem::offset_of!(CullCounters, meshlets) + phase * 16) as u64;
             d.cmd_dispatch_indirect(cmd, f.counters.raw, meshlets);
-            // The raster reads the draw, indices, slots and ids; the late culling the counts.
-            memory_barrier(
-                ctx,
-                cmd,
-                (compute, vk::AccessFlags::SHADER_WRITE),
-                (indirect | raster | compute | transfer, indirect_read | vk::AccessFlags::INDEX_READ | rw | vk::AccessFlags::TRANSFER_READ),
-            );
         }
+        // The passes after it are ordered by their declared uses; the read-back is this pass's.
         if self.reads_back() {
+            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
             copy_buffer_to_host(ctx, cmd, (f.counters.raw, f.readback.raw), std::mem::size_of::<CullCounters>() as u64);
         }
     }

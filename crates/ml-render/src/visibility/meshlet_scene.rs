@@ -19,6 +19,17 @@ use ml_vk::{vk, Buffer, Context, VkError};
 use std::cell::RefCell;
 use std::rc::Rc;
 
+/// The culling's per-slot buffers, by their shader blocks' names: every pass that touches one
+/// declares it (`Pass::uses`), and the barriers between those passes are derived (`sync`).
+/// The meshlet visibility, shared by the slots, is ordered by hand (MeshletCull).
+pub const CULL_COUNTERS: &str = "CullCounterBuffer";
+pub const VISIBLE_INSTANCES: &str = "VisibleInstanceBuffer";
+pub const DRAW_SLOTS: &str = "DrawSlotBuffer";
+pub const COMPACTED_INDICES: &str = "CompactedIndexBuffer";
+pub const TRIANGLE_IDS: &str = "TriangleIdBuffer";
+pub const LARGE_BINS: &str = "LargeBinBuffer";
+pub const LARGE_TRIANGLES: &str = "LargeTriangleBuffer";
+
 /// The culling's buffers of one frame slot.
 pub struct CullFrame {
     /// CullCounters: counts, the indirect dispatches and the two phases' draws.
@@ -125,13 +136,13 @@ impl MeshletScene {
         }
         let buffer = match name {
             "MeshletVisibilityBuffer" => &self.visibility,
-            "VisibleInstanceBuffer" => &f.visible_instances,
-            "CullCounterBuffer" => &f.counters,
-            "DrawSlotBuffer" => &f.draw_slots,
-            "CompactedIndexBuffer" => &f.indices,
-            "TriangleIdBuffer" => &f.triangle_ids,
-            "LargeBinBuffer" => &f.large_bins,
-            "LargeTriangleBuffer" => &f.large_triangles,
+            VISIBLE_INSTANCES => &f.visible_instances,
+            CULL_COUNTERS => &f.counters,
+            DRAW_SLOTS => &f.draw_slots,
+            COMPACTED_INDICES => &f.indices,
+            TRIANGLE_IDS => &f.triangle_ids,
+            LARGE_BINS => &f.large_bins,
+            LARGE_TRIANGLES => &f.large_triangles,
             _ => return frame.buffer(name),
         };
         Some(Resource::Buffer(buffer.raw))

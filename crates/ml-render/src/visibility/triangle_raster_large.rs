@@ -10,9 +10,10 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::plan::Phase;
 use crate::specialization::compute_pipeline;
+use crate::sync::{Use, VISIBILITY_DEPTH};
 use crate::technique::Raster;
 use crate::visibility::meshlet_cull::cull_push;
-use crate::visibility::meshlet_scene::SharedMeshletScene;
+use crate::visibility::meshlet_scene::{SharedMeshletScene, CULL_COUNTERS, LARGE_BINS, LARGE_TRIANGLES};
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{shader, vk, Context, VkError};
@@ -61,7 +62,25 @@ impl Pass for TriangleRasterLarge {
         self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame, name))
     }
 
-    /// After the phase's culling, whose last barrier makes the bins and the dispatch visible.
+    /// The phase's bins and large triangles, its dispatch (the counters, to which it adds the
+    /// pixels it covered and which the late phase reads back), the 64-bit buffer it draws
+    /// into.
+    fn uses(&self) -> Vec<Use> {
+        use vk::AccessFlags as A;
+        use vk::PipelineStageFlags as S;
+        let rw = A::SHADER_READ | A::SHADER_WRITE;
+        let mut counters = (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ);
+        if self.phase == Phase::Late {
+            counters = (counters.0 | S::TRANSFER, counters.1 | A::TRANSFER_READ);
+        }
+        vec![
+            Use::at(CULL_COUNTERS, counters, None),
+            Use::at(LARGE_BINS, (S::COMPUTE_SHADER, A::SHADER_READ), None),
+            Use::at(LARGE_TRIANGLES, (S::COMPUTE_SHADER, rw), None),
+            Use::at(VISIBILITY_DEPTH, (S::COMPUTE_SHADER, rw), None),
+        ]
+    }
+
     fn record(&self, rec: &Recording) {
         let (ctx, cmd, slot) = (rec.ctx, rec.cmd, rec.slot);
         let d = &ctx.device;
@@ -79,16 +98,15 @@ impl Pass for TriangleRasterLarge {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             d.cmd_dispatch_indirect(cmd, scene.frames[slot].counters.raw, dispatch);
         }
-        // The depth pyramid and the lighting read the buffer; the late phase reads the
-        // counters back (this pass adds the pixels it covered).
-        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
-        memory_barrier(
-            ctx,
-            cmd,
-            (compute, vk::AccessFlags::SHADER_WRITE),
-            (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_READ),
-        );
+        // The late phase reads the counters back (this pass adds the pixels it covered); the
+        // passes after it are ordered by their declared uses.
         if self.phase == Phase::Late {
+            memory_barrier(
+                ctx,
+                cmd,
+                (compute, vk::AccessFlags::SHADER_WRITE),
+                (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
+            );
             let f = &scene.frames[slot];
             copy_buffer_to_host(ctx, cmd, (f.counters.raw, f.readback.raw), std::mem::size_of::<CullCounters>() as u64);
         }

@@ -9,13 +9,15 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{light_list_reads, Use};
+use crate::sync::{light_list_reads, Use, VISIBILITY_DEPTH};
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};
 
 pub struct VisibilityLighting {
     pass: ComputePass,
     scene: SharedMeshletScene,
+    /// It reads the compute raster's 64-bit buffer (else the raster's images).
+    from_buffer: bool,
 }
 
 impl VisibilityLighting {
@@ -31,7 +33,7 @@ impl VisibilityLighting {
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
         let shader = if from_buffer { &ml_shaders::VISIBILITY_LIGHTING_BUFFER_COMP } else { &ml_shaders::VISIBILITY_LIGHTING_COMP };
         let pass = ComputePass::with_push(ctx, &more_sets, (shader, &model), 16)?;
-        Ok(VisibilityLighting { pass, scene })
+        Ok(VisibilityLighting { pass, scene, from_buffer })
     }
 }
 
@@ -54,6 +56,9 @@ impl Pass for VisibilityLighting {
     fn uses(&self) -> Vec<Use> {
         let mut uses = light_list_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::colour_use());
+        if self.from_buffer {
+            uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
+        }
         uses
     }
 

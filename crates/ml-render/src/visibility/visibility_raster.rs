@@ -13,7 +13,8 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::plan::Phase;
 use crate::render_pass;
-use crate::visibility::meshlet_scene::SharedMeshletScene;
+use crate::sync::{Use, VISIBILITY_DEPTH};
+use crate::visibility::meshlet_scene::{SharedMeshletScene, COMPACTED_INDICES, CULL_COUNTERS, DRAW_SLOTS, TRIANGLE_IDS};
 use ml_cpu::gpu_types::{CullCounters, DrawIndexedCommand};
 use ml_vk::{shader, vk, Context, VkError};
 
@@ -102,6 +103,24 @@ impl Pass for VisibilityRaster {
             Phase::Early => "raster (early)",
             Phase::Late => "raster (late)",
         })
+    }
+
+    /// The phase's draw (in the counters), its indices, draw slots and triangle ids — made
+    /// visible by a barrier before the render pass, whose own dependencies order its
+    /// attachments — and the hybrid's 64-bit buffer, which its fragments write.
+    fn uses(&self) -> Vec<Use> {
+        use vk::AccessFlags as A;
+        use vk::PipelineStageFlags as S;
+        let mut uses = vec![
+            Use::at(CULL_COUNTERS, (S::DRAW_INDIRECT, A::INDIRECT_COMMAND_READ), None),
+            Use::at(COMPACTED_INDICES, (S::VERTEX_INPUT, A::INDEX_READ), None),
+            Use::at(DRAW_SLOTS, (S::VERTEX_SHADER, A::SHADER_READ), None),
+            Use::at(TRIANGLE_IDS, (S::FRAGMENT_SHADER, A::SHADER_READ), None),
+        ];
+        if self.atomic {
+            uses.push(Use::at(VISIBILITY_DEPTH, (S::FRAGMENT_SHADER, A::SHADER_READ | A::SHADER_WRITE), None));
+        }
+        uses
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
