@@ -60,6 +60,9 @@ pub struct Renderer<'a> {
     passes: Vec<Box<dyn Pass>>,
     command_pool: vk::CommandPool,
     frames: Vec<FrameInFlight>,
+    /// The states of the named resources the frame slots share (`sync::SCENE_WIDE`), from
+    /// frame to frame across the slots.
+    shared_sync: sync::SyncStates,
     readback: Option<Buffer>,
     /// The scene's lights at rest as the GPU reads them: shadowed ones marked with their
     /// shadow slots (`OmniShadows::mark`).
@@ -153,6 +156,7 @@ impl<'a> Renderer<'a> {
             passes: Vec::new(),
             command_pool: vk::CommandPool::null(),
             frames: Vec::new(),
+            shared_sync: sync::SyncStates::default(),
             readback: None,
             lights_on_gpu,
             required_indices: 0,
@@ -694,7 +698,7 @@ impl<'a> Renderer<'a> {
             if let Some(t) = timer {
                 frame.timer.begin(ctx, cmd, t);
             }
-            frame.sync.barrier(ctx, cmd, &pass.uses(), &image);
+            frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &pass.uses(), &image);
             pass.record(&rec);
             if let Some(t) = timer {
                 frame.timer.end(ctx, cmd, t);
@@ -702,7 +706,7 @@ impl<'a> Renderer<'a> {
             }
         }
         // The colour target as the read-back and a window's blit take it.
-        frame.sync.barrier(ctx, cmd, &[sync::frame_end()], &image);
+        frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &[sync::frame_end()], &image);
         if let Some(hook) = hook {
             hook.record(ctx, cmd, &targets.color)?;
         }

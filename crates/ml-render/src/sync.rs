@@ -13,8 +13,8 @@
 //!
 //! A resource is ordered this way only if every pass that touches it declares it: the state
 //! knows nothing of an undeclared use, and would, say, take an image another pass just wrote
-//! for undefined. Resources not yet moved over — the shadow stores, the meshlet visibility
-//! (shared by the frame slots, whose states are the slots' own) and the hardware raster's
+//! for undefined. A resource the frame slots share keeps one state for all of them
+//! (`SCENE_WIDE`). Resources not yet moved over — the shadow stores and the hardware raster's
 //! images (ordered by its render pass) — are declared by none of their passes, which order
 //! them by hand as before.
 
@@ -222,25 +222,36 @@ pub const DEPTH_PYRAMID: &str = "DepthPyramidBuffer";
 /// the hybrid's fragments, read by the depth pyramid and the lighting.
 pub const VISIBILITY_DEPTH: &str = "VisibilityDepthBuffer";
 
+/// Each meshlet instance's visibility at the end of the last frame (its shader block's name):
+/// read by the early culling, written by the late one. The frame slots share it.
+pub const MESHLET_VISIBILITY: &str = "MeshletVisibilityBuffer";
+
+/// The resources the frame slots share (the scene's): their states are the renderer's, not a
+/// slot's. Frames are recorded in the order they are submitted, so a frame's first use of one
+/// follows the last frame's, whichever slot that frame ran in.
+pub const SCENE_WIDE: [&str; 1] = [MESHLET_VISIBILITY];
+
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.
 pub fn frame_end() -> Use {
     Use::at(COLOUR_TARGET, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ), Some(vk::ImageLayout::TRANSFER_SRC_OPTIMAL))
 }
 
-/// The state of every named resource of a frame slot (buffers and images the slot and the
-/// scene hold), from frame to frame; new frame slots start with none known.
+/// The state of every named resource of a frame slot (buffers and images the slot holds) or,
+/// for the renderer, of those the slots share (SCENE_WIDE), from frame to frame; new ones
+/// start with none known.
 #[derive(Debug, Default)]
 pub struct SyncStates(std::collections::HashMap<&'static str, State>);
 
 impl SyncStates {
     /// Record one barrier ordering `uses` after every earlier use of their resources, and
-    /// note them. `image` gives an image's handle and aspect (None: a buffer, ordered by a
-    /// global memory barrier).
+    /// note them: in `self`, a frame slot's states, or in `scene`, the states of the resources
+    /// the slots share. `image` gives an image's handle and aspect (None: a buffer, ordered by
+    /// a global memory barrier).
     pub fn barrier(
         &mut self,
-        ctx: &ml_vk::Context,
-        cmd: vk::CommandBuffer,
+        scene: &mut SyncStates,
+        (ctx, cmd): (&ml_vk::Context, vk::CommandBuffer),
         uses: &[Use],
         image: &dyn Fn(&str) -> Option<(vk::Image, vk::ImageAspectFlags)>,
     ) {
@@ -248,7 +259,8 @@ impl SyncStates {
         let mut global = vk::MemoryBarrier::default();
         let mut images = Vec::new();
         for u in uses {
-            let state = self.0.get(u.name).copied().unwrap_or_default();
+            let states = if SCENE_WIDE.contains(&u.name) { &mut scene.0 } else { &mut self.0 };
+            let state = states.get(u.name).copied().unwrap_or_default();
             if let Some(d) = state.before(u) {
                 src |= d.src_stages;
                 dst |= d.dst_stages;
@@ -270,7 +282,7 @@ impl SyncStates {
                     }
                 }
             }
-            self.0.insert(u.name, state.after(u));
+            states.insert(u.name, state.after(u));
         }
         if dst.is_empty() {
             return;

@@ -19,7 +19,7 @@ use crate::pass::{Pass, Recording, SlotReport};
 use crate::plan::Phase;
 use crate::report::{CullStats, FrameStats};
 use crate::specialization::compute_pipeline;
-use crate::sync::{Use, DEPTH_PYRAMID, VISIBILITY_DEPTH};
+use crate::sync::{Use, DEPTH_PYRAMID, MESHLET_VISIBILITY, VISIBILITY_DEPTH};
 use crate::targets::depth_pyramid_shape;
 use crate::technique::Raster;
 use crate::visibility::meshlet_scene::{
@@ -116,9 +116,10 @@ impl Pass for MeshletCull {
         self.sets.write(ctx, frame.slot, &|name| scene.buffer(frame, name))
     }
 
-    /// The depth pyramid its shaders read (the late phase tests against it); the culling's
-    /// buffers of the slot, which it clears (early), fills, dispatches from and, where it
-    /// reads the counters back, copies; the compute raster's lists and 64-bit buffer.
+    /// The depth pyramid its shaders read (the late phase tests against it); the meshlet
+    /// visibility; the culling's buffers of the slot, which it clears (early), fills,
+    /// dispatches from and, where it reads the counters back, copies; the compute raster's
+    /// lists and 64-bit buffer.
     fn uses(&self) -> Vec<Use> {
         use vk::AccessFlags as A;
         use vk::PipelineStageFlags as S;
@@ -132,8 +133,11 @@ impl Pass for MeshletCull {
         if self.reads_back() {
             counters = (counters.0 | S::TRANSFER, counters.1 | A::TRANSFER_READ);
         }
+        // The early phase reads which meshlets the last frame saw, the late one writes it.
+        let visibility = if early { (S::COMPUTE_SHADER, A::SHADER_READ) } else { compute };
         let mut uses = vec![
             Use::at(DEPTH_PYRAMID, (S::COMPUTE_SHADER, A::SHADER_READ), None),
+            Use::at(MESHLET_VISIBILITY, visibility, None),
             Use::at(CULL_COUNTERS, counters, None),
             Use::at(VISIBLE_INSTANCES, compute, None),
             Use::at(DRAW_SLOTS, compute, None),
@@ -169,9 +173,6 @@ impl Pass for MeshletCull {
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &set, &[]);
             d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             if self.phase == Phase::Early {
-                // The meshlet visibility, written by the last frame's late phase (in another
-                // slot's commands: the declared uses order the slot's own buffers).
-                memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
                 d.cmd_fill_buffer(cmd, f.counters.raw, 0, vk::WHOLE_SIZE, 0);
                 if self.raster != Raster::Hardware {
                     // Nothing drawn: all ones, above every depth-and-id (the last frame's

@@ -13,6 +13,7 @@ use crate::descriptors::Resource;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::scene::meshlets::{storage_bytes, MeshletGeometryView};
+use crate::sync::MESHLET_VISIBILITY;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{CullCounters, LargeTriangle};
 use ml_vk::{vk, Buffer, Context, VkError};
@@ -20,8 +21,8 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 /// The culling's per-slot buffers, by their shader blocks' names: every pass that touches one
-/// declares it (`Pass::uses`), and the barriers between those passes are derived (`sync`).
-/// The meshlet visibility, shared by the slots, is ordered by hand (MeshletCull).
+/// declares it (`Pass::uses`), and the barriers between those passes are derived (`sync`);
+/// so is the meshlet visibility the slots share (`sync::MESHLET_VISIBILITY`).
 pub const CULL_COUNTERS: &str = "CullCounterBuffer";
 pub const VISIBLE_INSTANCES: &str = "VisibleInstanceBuffer";
 pub const DRAW_SLOTS: &str = "DrawSlotBuffer";
@@ -135,7 +136,7 @@ impl MeshletScene {
             return Some(found);
         }
         let buffer = match name {
-            "MeshletVisibilityBuffer" => &self.visibility,
+            MESHLET_VISIBILITY => &self.visibility,
             VISIBLE_INSTANCES => &f.visible_instances,
             CULL_COUNTERS => &f.counters,
             DRAW_SLOTS => &f.draw_slots,
