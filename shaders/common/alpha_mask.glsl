@@ -83,7 +83,8 @@ const uint ALPHA_FILTER = 2u;
 
 // Whether `factor` × the texture's alpha at `uv` reaches `cutoff`, as far as the bounds of the
 // block the point's first tap is in decide (one read): ALPHA_FILTER where they lie on both
-// sides of the cutoff, which happens only near the cut-out's edge.
+// sides of the cutoff, which happens only near the cut-out's edge. With alpha_filtered_kept,
+// keep in sync with alpha_mask.rs texture_kept.
 uint texture_bounds_verdict(uvec4 texture_fields, vec2 uv, float factor, float cutoff) {
     uint flags = texture_fields.x;
     int w = int(texture_fields.z), h = int(texture_fields.w);
@@ -100,17 +101,6 @@ uint texture_bounds_verdict(uvec4 texture_fields, vec2 uv, float factor, float c
         return ALPHA_DROPPED;
     }
     return ALPHA_FILTER;
-}
-
-// Whether `factor` × the texture's alpha at `uv` reaches `cutoff`: the block bounds decide
-// where they can, the filtered texture elsewhere. Keep in sync with alpha_mask.rs
-// texture_kept.
-bool texture_kept(uvec4 texture_fields, vec2 uv, float factor, float cutoff) {
-    uint verdict = texture_bounds_verdict(texture_fields, uv, factor, cutoff);
-    if (verdict != ALPHA_FILTER) {
-        return verdict == ALPHA_KEPT;
-    }
-    return factor * texture_alpha(texture_fields, uv) >= cutoff;
 }
 
 // alpha_kept's answer as far as one read decides: ALPHA_FILTER where only

@@ -54,7 +54,7 @@ void main() {
         barrier();
         uint layer = pairs[large_triangles[e].x].y;
         SurfaceTest s = no_surface_test();
-        // SURFACE_TESTS first: a flag read back from shared memory does not fold away, and the
+        // MASK_TESTS first: a flag read back from shared memory does not fold away, and the
         // masked path's registers would cost every scene's texel loop.
         if (MASK_TESTS && corner_masked) {
             uint object = meshlet_instances[pairs[large_triangles[e].x].x].x;

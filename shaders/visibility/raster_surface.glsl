@@ -14,8 +14,8 @@
 // opaque ones, register for register.
 layout(constant_id = 18) const bool SURFACE_TESTS = true;
 // Whether it has masked objects (meshlets.rs, the second of surface_constants): without, the
-// alpha tests — and the shared memory the masked paths hold — compile away while double-sided
-// objects keep their tests.
+// alpha tests compile away while double-sided objects keep their tests. (Shared memory does
+// not: a masked path that holds any is a shader module of its own, triangle_raster.glsl.)
 layout(constant_id = 19) const bool MASK_TESTS = true;
 
 // A masked triangle's test (masked false: every pixel is kept).

@@ -118,6 +118,62 @@ impl OmniShadowSettings {
             None => self.lights as u64 * 6 * self.size as u64 * self.size as u64 * 4,
         }
     }
+
+    /// Reject point-light shadow requests the device or the scene's `lights` cannot take,
+    /// before allocating.
+    pub(crate) fn check(&self, ctx: &Context, lights: usize) -> Result<(), SettingsError> {
+        let limits = &ctx.info.limits;
+        let device = || ctx.info.name.clone();
+        if lights == 0 {
+            return Err(SettingsError::ShadowsWithoutLights);
+        }
+        if self.lights == 0 || (self.lights as usize > lights && !self.all) {
+            return Err(SettingsError::ShadowedLights { value: self.lights, lights });
+        }
+        if let Some(atlas) = self.atlas() {
+            return check_atlas(ctx, self, atlas);
+        }
+        let max_cubes = limits.max_image_array_layers / 6;
+        if self.lights > max_cubes {
+            return Err(SettingsError::TooManyCubes { value: self.lights, max: max_cubes, device: device() });
+        }
+        let max_size = limits.max_image_dimension_cube.min(MAX_DIMENSION);
+        if self.size == 0 || self.size > max_size {
+            return Err(SettingsError::OutOfRange { what: Setting::CubeSize, value: self.size, max: max_size });
+        }
+        if self.bytes() > MAX_OMNI_BYTES {
+            return Err(SettingsError::ShadowMemory {
+                lights: self.lights,
+                size: self.size,
+                mib: self.bytes() >> 20,
+                max_mib: MAX_OMNI_BYTES >> 20,
+            });
+        }
+        let missing = |feature, instead| SettingsError::MissingFeature { mode: self.mode.name(), feature, device: device(), instead };
+        if self.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
+            return Err(missing("multiview", "layered, direct or copy"));
+        }
+        if self.mode == OmniShadowMode::Multiview && multiview_depth_is_broken(ctx) {
+            return Err(SettingsError::BrokenMultiview { device: device(), driver: ctx.info.driver_info.clone() });
+        }
+        if self.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
+            return Err(missing("shaderOutputLayer", "direct or copy"));
+        }
+        if let OmniShadowMode::Compute { .. } = self.mode {
+            check_compute_raster(ctx, self)?;
+            // The depths are one storage buffer, as large as the cubes.
+            if self.bytes() > limits.max_storage_buffer_range as u64 {
+                return Err(SettingsError::ShadowBuffer {
+                    lights: self.lights,
+                    size: self.size,
+                    mib: self.bytes() >> 20,
+                    device: device(),
+                    max_mib: limits.max_storage_buffer_range as u64 >> 20,
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Who draws the sun's shadow map (blinn-phong), once, when the scene's objects reach the GPU
@@ -147,65 +203,6 @@ impl SunShadowMode {
 
 /// Most memory the shadow cubes may take, whatever the device has: 16 lights at 2048² are 1.5 GiB.
 pub const MAX_OMNI_BYTES: u64 = 4 << 30;
-
-impl OmniShadowSettings {
-    /// Reject point-light shadow requests the device or the scene's `lights` cannot take,
-    /// before allocating.
-    pub(crate) fn check(&self, ctx: &Context, lights: usize) -> Result<(), SettingsError> {
-        let omni = self;
-        let limits = &ctx.info.limits;
-        let device = || ctx.info.name.clone();
-        if lights == 0 {
-            return Err(SettingsError::ShadowsWithoutLights);
-        }
-        if omni.lights == 0 || (omni.lights as usize > lights && !omni.all) {
-            return Err(SettingsError::ShadowedLights { value: omni.lights, lights });
-        }
-        if let Some(atlas) = omni.atlas() {
-            return check_atlas(ctx, omni, atlas);
-        }
-        let max_cubes = limits.max_image_array_layers / 6;
-        if omni.lights > max_cubes {
-            return Err(SettingsError::TooManyCubes { value: omni.lights, max: max_cubes, device: device() });
-        }
-        let max_size = limits.max_image_dimension_cube.min(MAX_DIMENSION);
-        if omni.size == 0 || omni.size > max_size {
-            return Err(SettingsError::OutOfRange { what: Setting::CubeSize, value: omni.size, max: max_size });
-        }
-        if omni.bytes() > MAX_OMNI_BYTES {
-            return Err(SettingsError::ShadowMemory {
-                lights: omni.lights,
-                size: omni.size,
-                mib: omni.bytes() >> 20,
-                max_mib: MAX_OMNI_BYTES >> 20,
-            });
-        }
-        let missing = |feature, instead| SettingsError::MissingFeature { mode: omni.mode.name(), feature, device: device(), instead };
-        if omni.mode == OmniShadowMode::Multiview && !ctx.info.features.multiview {
-            return Err(missing("multiview", "layered, direct or copy"));
-        }
-        if omni.mode == OmniShadowMode::Multiview && multiview_depth_is_broken(ctx) {
-            return Err(SettingsError::BrokenMultiview { device: device(), driver: ctx.info.driver_info.clone() });
-        }
-        if omni.mode == OmniShadowMode::Layered && !ctx.info.features.shader_output_layer {
-            return Err(missing("shaderOutputLayer", "direct or copy"));
-        }
-        if let OmniShadowMode::Compute { .. } = omni.mode {
-            check_compute_raster(ctx, omni)?;
-            // The depths are one storage buffer, as large as the cubes.
-            if omni.bytes() > limits.max_storage_buffer_range as u64 {
-                return Err(SettingsError::ShadowBuffer {
-                    lights: omni.lights,
-                    size: omni.size,
-                    mib: omni.bytes() >> 20,
-                    device: device(),
-                    max_mib: limits.max_storage_buffer_range as u64 >> 20,
-                });
-            }
-        }
-        Ok(())
-    }
-}
 
 /// Reject shadow-atlas requests the device cannot take, before allocating.
 fn check_atlas(ctx: &Context, omni: &OmniShadowSettings, atlas: AtlasSettings) -> Result<(), SettingsError> {
