@@ -209,11 +209,9 @@ shared uint mask_filter[MASK_FILTER_CAPACITY];
 shared uint mask_filtered;
 const uint MASK_PIXEL_FILTER = 2u;
 
-// Pixel `n` of triangle i's box (n from 0), tested and drawn where covered and kept; returns
-// 1 if drawn, 0 if not, MASK_PIXEL_FILTER where the texture must be filtered to tell and
-// `filter_now` is false.
-uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) {
-    SmallTriangle t;
+// Pixel `n` of triangle i's box (n from 0): the triangle `t` set up, the pixel, and whether
+// the triangle covers it (`w`: its edge functions there).
+bool masked_covers(uint i, uint n, out SmallTriangle t, out ivec2 pixel, out ivec3 w) {
     ivec4 edges = mask_edges[i], box = mask_box[i];
     t.a = ivec2(edges.x & 0xffff, edges.x >> 16);
     t.b = ivec2(edges.y & 0xffff, edges.y >> 16);
@@ -226,11 +224,18 @@ uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) 
     // pixels a side), so n + 0.5 lies at least 0.5 / width from a multiple of width, far more
     // than the float's rounding.
     int row = int((float(n) + 0.5) / float(width));
-    ivec2 pixel = ivec2(box.z & 0xffff, box.z >> 16) + ivec2(int(n) - row * width, row);
+    pixel = ivec2(box.z & 0xffff, box.z >> 16) + ivec2(int(n) - row * width, row);
+    return small_covers(t, pixel, w);
+}
+
+// Pixel `n` of triangle i's box, which the triangle covers, drawn where its alpha keeps it;
+// returns 1 if drawn, 0 if not, MASK_PIXEL_FILTER where the texture must be filtered to tell
+// and `filter_now` is false.
+uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) {
+    SmallTriangle t;
+    ivec2 pixel;
     ivec3 w;
-    if (!small_covers(t, pixel, w)) {
-        return 0u;
-    }
+    masked_covers(i, n, t, pixel, w);
     vec3 weights = vec3(w);
     vec4 z_inv_w = mask_z_inv_w[i], uv_w = mask_uv_w[i], uv_w_rest = mask_uv_w_rest[i];
     float depth = dot(weights, z_inv_w.xyz) / float(t.area);
@@ -245,6 +250,29 @@ uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) 
     }
     keep_nearest_id(pixel, depth, id);
     return 1u;
+}
+
+// Covered pixels (triangle << 16 | pixel number in its box) queued per subgroup, two
+// subgroups' width each: about half of a box's pixels are outside its triangle, and a lane
+// that tests the alpha of a covered pixel while its neighbours hold uncovered ones would run
+// at half the subgroup's width. So the subgroup tests coverage (cheap) for the pixels dealt
+// to it, queues the covered ones, and tests the alpha a full subgroup of them at a time.
+shared uint mask_queue[2u * gl_WorkGroupSize.x];
+
+// Queue entry `e` of the meshlet's batch from triangle `first` drawn (draw_masked_pixel), or
+// listed to be filtered later; returns the pixels drawn.
+uint draw_queued(uint e, uint first, uvec4 d, SurfaceTest s) {
+    uint i = e >> 16u, n = e & 0xffffu;
+    uint drawn = draw_masked_pixel(i, n, (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i), s, false);
+    if (drawn != MASK_PIXEL_FILTER) {
+        return drawn;
+    }
+    uint at = atomicAdd(mask_filtered, 1u);
+    if (at < MASK_FILTER_CAPACITY) {
+        mask_filter[at] = e;
+        return 0u;
+    }
+    return draw_masked_pixel(i, n, (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i), s, true);
 }
 
 // The meshlet's triangles, its object masked (`flags`: its instance's), by the whole work
@@ -299,28 +327,48 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
         barrier();
         uint total = mask_box_end[15].w;
         // Each thread's numbers grow, so the four triangles whose ends it reads only move on.
-        uint j = 0u;
-        for (uint n = lid; n < total; n += gl_WorkGroupSize.x) {
-            while (mask_box_end[j].w <= n) {
-                j++;
-            }
-            uvec4 ends = mask_box_end[j];
-            uint before = j == 0u ? 0u : mask_box_end[j - 1u].w;
-            bvec3 past = lessThanEqual(ends.xyz, uvec3(n));
-            uint i = 4u * j + uint(past.x) + uint(past.y) + uint(past.z);
-            uint start = past.z ? ends.z : past.y ? ends.y : past.x ? ends.x : before;
-            uint id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
-            uint drawn = draw_masked_pixel(i, n - start, id, s, false);
-            if (drawn == MASK_PIXEL_FILTER) {
-                uint at = atomicAdd(mask_filtered, 1u);
-                if (at < MASK_FILTER_CAPACITY) {
-                    mask_filter[at] = (i << 16u) | (n - start);
-                    drawn = 0u;
-                } else {
-                    drawn = draw_masked_pixel(i, n - start, id, s, true);
+        // The loop is the same for every thread (a subgroup's ballots need all its lanes).
+        uint j = 0u, queue = 2u * gl_SubgroupID * gl_SubgroupSize, lane = gl_SubgroupInvocationID;
+        uint queued = 0u;
+        for (uint n0 = 0u; n0 < total; n0 += gl_WorkGroupSize.x) {
+            uint n = n0 + lid, entry = 0u;
+            bool covered = false;
+            if (n < total) {
+                while (mask_box_end[j].w <= n) {
+                    j++;
                 }
+                uvec4 ends = mask_box_end[j];
+                uint before = j == 0u ? 0u : mask_box_end[j - 1u].w;
+                bvec3 past = lessThanEqual(ends.xyz, uvec3(n));
+                uint i = 4u * j + uint(past.x) + uint(past.y) + uint(past.z);
+                uint start = past.z ? ends.z : past.y ? ends.y : past.x ? ends.x : before;
+                SmallTriangle t;
+                ivec2 pixel;
+                ivec3 w;
+                covered = masked_covers(i, n - start, t, pixel, w);
+                entry = (i << 16u) | (n - start);
             }
-            pixels += drawn;
+            uvec4 ballot = subgroupBallot(covered);
+            if (covered) {
+                mask_queue[queue + queued + subgroupBallotExclusiveBitCount(ballot)] = entry;
+            }
+            queued += subgroupBallotBitCount(ballot);
+            if (queued >= gl_SubgroupSize) {
+                subgroupMemoryBarrierShared();
+                subgroupBarrier();
+                pixels += draw_queued(mask_queue[queue + lane], first, d, s);
+                uint rest = mask_queue[queue + gl_SubgroupSize + lane];
+                subgroupBarrier();
+                mask_queue[queue + lane] = rest;
+                queued -= gl_SubgroupSize;
+                subgroupMemoryBarrierShared();
+                subgroupBarrier();
+            }
+        }
+        subgroupMemoryBarrierShared();
+        subgroupBarrier();
+        if (lane < queued) {
+            pixels += draw_queued(mask_queue[queue + lane], first, d, s);
         }
         barrier();
         uint filtered = min(mask_filtered, MASK_FILTER_CAPACITY);

@@ -253,6 +253,7 @@ pub fn device_rows(d: &DeviceInfo) -> Vec<(&'static str, String)> {
         ("shaderBufferInt64Atomics", d.features.buffer_int64_atomics.to_string()),
         ("geometryShader", d.features.geometry_shader.to_string()),
         ("fragmentStoresAndAtomics", d.features.fragment_stores_and_atomics.to_string()),
+        ("subgroup ballot in compute", d.features.compute_subgroup_ballot.to_string()),
         ("subPixelPrecisionBits", l.sub_pixel_precision_bits.to_string()),
     ]
 }

@@ -214,7 +214,8 @@ pub fn missing_raster_feature(raster: Raster, features: &ml_vk::OptionalFeatures
         features.fragment_stores_and_atomics || large != LargeTriangles::Hardware,
         "fragmentStoresAndAtomics (the large triangles' fragments write the same buffer)",
     );
-    [atomics, fragment].into_iter().find_map(|(has, feature)| (!has).then_some(feature))
+    let ballot = (features.compute_subgroup_ballot, "subgroup ballot in compute shaders (the masked raster gathers covered pixels)");
+    [atomics, fragment, ballot].into_iter().find_map(|(has, feature)| (!has).then_some(feature))
 }
 
 /// The first device feature the meshlet techniques need that `features` lacks, if any.

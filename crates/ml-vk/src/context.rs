@@ -77,6 +77,9 @@ pub struct OptionalFeatures {
     /// fragmentStoresAndAtomics (core 1.0): fragment shaders write storage buffers (the
     /// compute rasteriser's large triangles, drawn by the hardware into its 64-bit buffer).
     pub fragment_stores_and_atomics: bool,
+    /// Subgroup ballots in compute shaders (Vulkan 1.1 subgroup properties): the masked compute
+    /// raster gathers the covered pixels of a subgroup before testing their alpha.
+    pub compute_subgroup_ballot: bool,
 }
 
 impl DeviceInfo {
@@ -214,8 +217,9 @@ impl InstanceParts {
         // SAFETY: queries on a physical device of this instance.
         let props = unsafe { self.instance.get_physical_device_properties(pd) };
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         if props.api_version >= MIN_API {
-            let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+            let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver).push_next(&mut subgroup);
             // SAFETY: core in 1.1+, and the device reports 1.2+.
             unsafe { self.instance.get_physical_device_properties2(pd, &mut props2) };
         }
@@ -237,6 +241,8 @@ impl InstanceParts {
                 buffer_int64_atomics: on(core.shader_int64) && on(v12.shader_buffer_int64_atomics),
                 geometry_shader: on(core.geometry_shader),
                 fragment_stores_and_atomics: on(core.fragment_stores_and_atomics),
+                compute_subgroup_ballot: subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
+                    && subgroup.supported_operations.contains(vk::SubgroupFeatureFlags::BALLOT),
             };
         }
         let name = c_text(props.device_name_as_c_str());
