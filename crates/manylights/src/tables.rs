@@ -78,41 +78,8 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     } else if technique.lights_in_subpass() || technique.lights_in_compute() {
         rows.push(("g-buffer", gbuffer_line(facts.object_textures, stats.gbuffer_lazily_allocated)));
     }
-    if let Some(c) = stats.culling {
-        rows.push(("instances", format!("{} submitted, {} in the frustum", c.instances, c.visible_instances)));
-        rows.push((
-            "meshlets",
-            format!(
-                "{} in the scene; early: {} tested, {} drawn; late: {} tested, {} drawn",
-                c.meshlet_instances, c.early_tested, c.early_drawn, c.late_tested, c.late_drawn
-            ),
-        ));
-        let share = 100.0 * c.triangles as f64 / c.scene_triangles.max(1) as f64;
-        rows.push((
-            "triangles",
-            format!("{} drawn of {} ({share:.1} %); the meshlets drawn held {}", c.triangles, c.scene_triangles, c.meshlet_triangles),
-        ));
-        use {LargeTriangles, Raster};
-        match settings.raster {
-            Raster::Hardware => {}
-            Raster::Compute { large: LargeTriangles::Hardware, .. } => rows.push((
-                "compute raster",
-                format!(
-                    "{} triangles ({} pixels covered), {} by the hardware",
-                    c.compute_triangles,
-                    c.compute_pixels,
-                    c.triangles - c.compute_triangles
-                ),
-            )),
-            Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => rows.push((
-                "compute raster",
-                format!(
-                    "{} small triangles a thread each, {} large ones in {} bins ({} drawn in place, the lists full); {} pixels covered",
-                    c.compute_triangles, c.large_triangles, c.bins, c.in_place, c.compute_pixels
-                ),
-            )),
-        }
-    }
+    // What the features' passes counted (the culling, the shadow raster, the atlas).
+    rows.extend(stats.feature_rows());
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
     }
@@ -153,38 +120,6 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                 format!("{}: {} light(s) ({which}), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size),
             )),
         }
-    }
-    if let Some(a) = stats.shadow_atlas {
-        let mib = |b: u64| b as f64 / (1 << 20) as f64;
-        let factor = if a.divided_by > 1 { format!("every face's side ÷{} to fit the budget", a.divided_by) } else { "full size".into() };
-        rows.push((
-            "shadow atlas",
-            format!(
-                "{} faces ({} drawn, {} kept), {factor}; tiles {:.1} of the atlas's {:.1} MiB; all shadow buffers {:.1} of {:.0} MiB",
-                a.faces,
-                a.redrawn,
-                a.faces - a.redrawn,
-                mib(a.tile_bytes),
-                mib(a.atlas_bytes),
-                mib(a.shadow_bytes),
-                mib(a.budget)
-            ),
-        ));
-    }
-    if let Some(r) = stats.omni_raster {
-        let in_place = if r.in_place > 0 { format!(" ({} drawn in place: the large list was full)", r.in_place) } else { String::new() };
-        let pairs_in_place = if r.pairs_in_place > 0 {
-            format!(" ({} drawn by the culling: the pair list was full)", r.pairs_in_place)
-        } else {
-            String::new()
-        };
-        rows.push((
-            "shadow raster",
-            format!(
-                "{} (meshlet, face) pairs{pairs_in_place}; {} small triangles, {} large{in_place}; {} texels covered",
-                r.pairs, r.small, r.large, r.texels
-            ),
-        ));
     }
     if let Some(ev) = stats.exposure_ev {
         let repeats = stats.exposure_repeats;

@@ -66,7 +66,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         Ok(meshlets.clone().expect("made above"))
     };
     Ok(match kind {
-        PassKind::OmniShadows => Box::new(omni_shadow_pass::OmniShadowPass),
+        PassKind::OmniShadows => Box::new(omni_shadow_pass::OmniShadowPass::new(&a.scene.omni)),
         PassKind::OmniShadowsCompute => {
             let omni = s.omni.expect("planned with point-light shadows");
             let OmniShadowMode::Compute { large_list } = omni.mode else { unreachable!("planned for the compute mode") };

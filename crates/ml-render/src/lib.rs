@@ -63,7 +63,9 @@ pub use settings::{
     DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,
     RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
 };
+pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage};
+pub use visibility::meshlet_cull::CullStats;
 
 /// What this crate's GPU tests inspect inside the renderer (render pass descriptions, set
 /// layouts, push-constant layouts, target formats). Not part of the library's surface.

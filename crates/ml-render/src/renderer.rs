@@ -144,6 +144,10 @@ impl<'a> Renderer<'a> {
         let mut gpu = SceneGpu::new(ctx, &scene, settings.scene_config())?;
         gpu.omni.choose(&scene, settings.aspect());
         let lights = gpu_lights(&scene, &gpu);
+        let mut shared_sync = sync::SyncStates::default();
+        if let Some(layout) = gpu.omni.initial_cube_layout() {
+            shared_sync.know(sync::SHADOW_CUBES, layout);
+        }
         let mut r = Renderer {
             ctx,
             extent: vk::Extent2D { width: settings.width, height: settings.height },
@@ -156,7 +160,7 @@ impl<'a> Renderer<'a> {
             passes: Vec::new(),
             command_pool: vk::CommandPool::null(),
             frames: Vec::new(),
-            shared_sync: sync::SyncStates::default(),
+            shared_sync,
             readback: None,
             lights_on_gpu,
             required_indices: 0,
@@ -690,7 +694,7 @@ impl<'a> Renderer<'a> {
         let targets = frame.targets.as_ref().expect("made with the frame");
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects };
         let mut timed = 0;
-        let image = |name: &str| targets.named_image(name);
+        let image = |name: &str| targets.named_image(name).or_else(|| self.gpu.named_image(name));
         for pass in &self.passes {
             // The barrier that orders the pass's declared uses is part of its time, as the
             // barriers it records itself are.

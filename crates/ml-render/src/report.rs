@@ -1,5 +1,19 @@
-//! Frame measurements: per-pass GPU times, CPU phases, and what passes count (culling, the
-//! shadow raster, the atlas, light lists, exposure, device memory). The binary prints them.
+//! Frame measurements: per-pass GPU times, CPU phases, light lists, exposure, device memory,
+//! and what each feature's passes count (`FeatureStats`, defined by the feature). The binary
+//! prints them.
+
+use std::any::Any;
+use std::sync::Arc;
+
+/// What a feature's passes counted in a frame, defined by the feature (the culling's, the
+/// shadow raster's, the atlas's): kept in `FrameStats` without the report knowing the type,
+/// read back typed (`FrameStats::feature`) or as the rows a table shows.
+pub trait FeatureStats: Any + std::fmt::Debug + Send + Sync {
+    /// Its rows: a label and its text each.
+    fn rows(&self) -> Vec<(&'static str, String)>;
+
+    fn as_any(&self) -> &dyn Any;
+}
 
 /// Per-pass GPU times (timestamp queries) and CPU times of every frame.
 #[derive(Clone, Debug)]
@@ -21,12 +35,10 @@ pub struct FrameStats {
     /// deferred, deferred-clustered: whether the transient G-buffer got lazily allocated
     /// memory (only devices that have such memory, i.e. tilers, give it).
     pub gbuffer_lazily_allocated: Option<bool>,
-    /// visibility: what the last frame's culling kept.
-    pub culling: Option<CullStats>,
-    /// --omni-shadow compute: what the last frame's shadow raster drew.
-    pub omni_raster: Option<OmniRasterStats>,
-    /// --omni-shadow atlas: the last frame's plan.
-    pub shadow_atlas: Option<AtlasStats>,
+    /// What the features' passes counted in the last frame (the culling, the shadow
+    /// raster, the atlas's plan), each as its feature defines it: `feature` reads one back,
+    /// `feature_rows` gives them all as rows of a table. One of each type.
+    features: Vec<Arc<dyn FeatureStats>>,
     /// blinn-phong: GPU ms of the sun's shadow map, drawn once when the scene was loaded.
     pub sun_shadow_ms: Option<f64>,
     /// Auto exposure: the EV the returned image was exposed with, and how often its frame was
@@ -35,67 +47,6 @@ pub struct FrameStats {
     pub exposure_repeats: u32,
     /// What the renderer had allocated when the last frame finished.
     pub memory: Option<ml_vk::context::MemoryUse>,
-}
-
-/// What one frame's compute shadow raster drew (--omni-shadow compute).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct OmniRasterStats {
-    /// (meshlet instance, cube face) pairs the culling kept.
-    pub pairs: u32,
-    /// Triangles drawn by one thread each; large ones (a work group each, or, past the
-    /// list's capacity, `in_place` by the thread that found them).
-    pub small: u32,
-    pub large: u32,
-    pub in_place: u32,
-    /// Texels covered (hidden ones too).
-    pub texels: u32,
-    /// (meshlet instance, face) pairs the culling's thread drew itself (the pair list was full).
-    pub pairs_in_place: u32,
-}
-
-/// The shadow atlas's plan of the last frame and its memory.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct AtlasStats {
-    /// Faces with a tile, and those drawn this frame (the others kept their texels).
-    pub faces: usize,
-    pub redrawn: usize,
-    /// What every face's side was divided by to fit the budget (1: nothing).
-    pub divided_by: u32,
-    /// Bytes: the budget, all the atlas's buffers, the atlas itself, what its tiles use.
-    pub budget: u64,
-    pub shadow_bytes: u64,
-    pub atlas_bytes: u64,
-    pub tile_bytes: u64,
-}
-
-/// What one frame's GPU culling tested and kept (visibility).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CullStats {
-    /// Instances (objects) tested, and those inside the frustum.
-    pub instances: u32,
-    pub visible_instances: u32,
-    /// Meshlet instances of the scene (objects × meshlets of their meshes).
-    pub meshlet_instances: u32,
-    /// Early phase: meshlets visible last frame, tested; those drawn.
-    pub early_tested: u32,
-    pub early_drawn: u32,
-    /// Late phase: every meshlet of the instances in the frustum, tested; those newly drawn.
-    pub late_tested: u32,
-    pub late_drawn: u32,
-    /// Triangles of the meshlets drawn (both phases); of those, the triangles drawn (the rest
-    /// culled one by one); the triangles of every object together.
-    pub meshlet_triangles: u64,
-    pub triangles: u64,
-    pub scene_triangles: u64,
-    /// Compute raster: of the triangles drawn, those it drew (the rest by the hardware), and
-    /// the pixels they covered (hidden ones too); 0 with the hardware raster.
-    pub compute_triangles: u64,
-    pub compute_pixels: u64,
-    /// Compute raster (large triangles in compute): the large triangles found, the 64×64
-    /// bins of their boxes, and those drawn in place (the lists full).
-    pub large_triangles: u64,
-    pub bins: u64,
-    pub in_place: u64,
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -114,14 +65,32 @@ impl FrameStats {
             overflowed_frames: 0,
             rerendered_frames: 0,
             gbuffer_lazily_allocated: None,
-            culling: None,
-            omni_raster: None,
-            shadow_atlas: None,
+            features: Vec::new(),
             sun_shadow_ms: None,
             exposure_ev: None,
             exposure_repeats: 0,
             memory: None,
         }
+    }
+
+    /// A feature's figures of the last frame, in place of its earlier ones.
+    pub fn set_feature<T: FeatureStats>(&mut self, stats: T) {
+        let stats: Arc<dyn FeatureStats> = Arc::new(stats);
+        match self.features.iter_mut().find(|f| f.as_any().is::<T>()) {
+            Some(f) => *f = stats,
+            None => self.features.push(stats),
+        }
+    }
+
+    /// The last frame's figures of the feature whose stats type is `T` (None: it did not
+    /// run or report).
+    pub fn feature<T: FeatureStats>(&self) -> Option<&T> {
+        self.features.iter().find_map(|f| f.as_any().downcast_ref::<T>())
+    }
+
+    /// Every feature's rows (label, text), in the order the features first reported.
+    pub fn feature_rows(&self) -> Vec<(&'static str, String)> {
+        self.features.iter().flat_map(|f| f.rows()).collect()
     }
 
     pub fn add_gpu(&mut self, ms: &[f64]) {
@@ -218,6 +187,44 @@ impl Spread {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[derive(Debug, PartialEq)]
+    struct Counted(u32);
+
+    impl FeatureStats for Counted {
+        fn rows(&self) -> Vec<(&'static str, String)> {
+            vec![("counted", self.0.to_string())]
+        }
+
+        fn as_any(&self) -> &dyn Any {
+            self
+        }
+    }
+
+    #[derive(Debug)]
+    struct Other;
+
+    impl FeatureStats for Other {
+        fn rows(&self) -> Vec<(&'static str, String)> {
+            vec![("other", "a".into()), ("other", "b".into())]
+        }
+
+        fn as_any(&self) -> &dyn Any {
+            self
+        }
+    }
+
+    #[test]
+    fn a_feature_s_figures_replace_its_last_ones_and_keep_their_place() {
+        let mut stats = FrameStats::new(&[]);
+        assert_eq!(stats.feature::<Counted>(), None);
+        stats.set_feature(Counted(1));
+        stats.set_feature(Other);
+        stats.set_feature(Counted(2));
+        assert_eq!(stats.feature::<Counted>(), Some(&Counted(2)));
+        let rows: Vec<String> = stats.feature_rows().into_iter().map(|(l, t)| format!("{l} {t}")).collect();
+        assert_eq!(rows, ["counted 2", "other a", "other b"]);
+    }
 
     #[test]
     fn spreads_take_nearest_ranks_and_skip_the_warm_up() {

@@ -14,9 +14,10 @@
 //! A resource is ordered this way only if every pass that touches it declares it: the state
 //! knows nothing of an undeclared use, and would, say, take an image another pass just wrote
 //! for undefined. A resource the frame slots share keeps one state for all of them
-//! (`SCENE_WIDE`). Resources not yet moved over — the shadow stores and the hardware raster's
-//! images (ordered by its render pass) — are declared by none of their passes, which order
-//! them by hand as before.
+//! (`SCENE_WIDE`); one that work outside the frames left in a layout starts from it
+//! (`SyncStates::know`). Declared by none of their passes, and ordered by hand: the hardware
+//! visibility raster's images (its render pass orders them) and the sun's shadow map (drawn
+//! once, outside the frames, when the scene is loaded).
 
 use ml_vk::vk;
 
@@ -226,10 +227,34 @@ pub const VISIBILITY_DEPTH: &str = "VisibilityDepthBuffer";
 /// read by the early culling, written by the late one. The frame slots share it.
 pub const MESHLET_VISIBILITY: &str = "MeshletVisibilityBuffer";
 
+/// The point-light shadow cubes (the scene's depth cube array): written by the point-light
+/// shadow pass in every mode but the atlas, sampled by the shading passes in
+/// DEPTH_STENCIL_READ_ONLY_OPTIMAL (where there are no cubes, by its stand-in).
+pub const SHADOW_CUBES: &str = "shadow cubes";
+
+/// The shadow atlas and its tile table (the scene's buffers, as the shading shaders name
+/// them): written by the atlas's pass, read by the shading passes.
+pub const SHADOW_ATLAS: [&str; 2] = ["ShadowAtlasBuffer", "ShadowAtlasTileBuffer"];
+
+/// How a pass that shades reads the point-light shadows (cubes and atlas): in `stages`.
+pub fn shadow_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
+    let read = (stages, vk::AccessFlags::SHADER_READ);
+    let cubes = Use::at(SHADOW_CUBES, read, Some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
+    std::iter::once(cubes).chain(SHADOW_ATLAS.iter().map(|&name| Use::at(name, read, None))).collect()
+}
+
+/// How a pass that shades reads what the frame lit it with: the lights and their lists, and
+/// the point-light shadows.
+pub fn shading_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
+    let mut uses = light_list_reads(stages);
+    uses.extend(shadow_reads(stages));
+    uses
+}
+
 /// The resources the frame slots share (the scene's): their states are the renderer's, not a
 /// slot's. Frames are recorded in the order they are submitted, so a frame's first use of one
 /// follows the last frame's, whichever slot that frame ran in.
-pub const SCENE_WIDE: [&str; 1] = [MESHLET_VISIBILITY];
+pub const SCENE_WIDE: [&str; 4] = [MESHLET_VISIBILITY, SHADOW_CUBES, SHADOW_ATLAS[0], SHADOW_ATLAS[1]];
 
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.
@@ -244,6 +269,12 @@ pub fn frame_end() -> Use {
 pub struct SyncStates(std::collections::HashMap<&'static str, State>);
 
 impl SyncStates {
+    /// Start image `name` from `layout`, where work outside the frames left it (finished, its
+    /// writes visible to every later use), instead of undefined.
+    pub fn know(&mut self, name: &'static str, layout: vk::ImageLayout) {
+        self.0.insert(name, State { layout: Some(layout), ..State::default() });
+    }
+
     /// Record one barrier ordering `uses` after every earlier use of their resources, and
     /// note them: in `self`, a frame slot's states, or in `scene`, the states of the resources
     /// the slots share. `image` gives an image's handle and aspect (None: a buffer, ordered by
@@ -340,6 +371,28 @@ mod tests {
         let w = d[3].unwrap();
         assert!(w.src_stages.contains(S::TRANSFER));
         assert_eq!(w.layout, Some((L::UNDEFINED, L::GENERAL)));
+    }
+
+    #[test]
+    fn shadow_cubes_copied_in_every_frame_or_a_known_stand_in() {
+        let shading = shadow_reads(S::FRAGMENT_SHADER | S::COMPUTE_SHADER)[0];
+        let copy = Use::overwriting(SHADOW_CUBES, (S::TRANSFER, A::TRANSFER_WRITE), L::TRANSFER_DST_OPTIMAL);
+        // The stand-in, cleared and left read-only before the frames: nothing to wait for,
+        // its texels kept.
+        let stand_in = State { layout: Some(L::DEPTH_STENCIL_READ_ONLY_OPTIMAL), ..State::default() };
+        assert_eq!(stand_in.before(&shading), None);
+        // Copied in, then sampled, then the next frame's copy after the sampling.
+        let d = run(&[copy, shading, shading, copy]);
+        assert_eq!(d[0].unwrap().layout, Some((L::UNDEFINED, L::TRANSFER_DST_OPTIMAL)));
+        let s = d[1].unwrap();
+        assert_eq!(
+            (s.src_stages, s.src_access, s.layout),
+            (S::TRANSFER, A::TRANSFER_WRITE, Some((L::TRANSFER_DST_OPTIMAL, L::DEPTH_STENCIL_READ_ONLY_OPTIMAL)))
+        );
+        assert!(s.dst_access.contains(A::SHADER_READ));
+        assert_eq!(d[2], None);
+        let c = d[3].unwrap();
+        assert_eq!((c.src_stages, c.layout), (S::FRAGMENT_SHADER | S::COMPUTE_SHADER, Some((L::UNDEFINED, L::TRANSFER_DST_OPTIMAL))));
     }
 
     #[test]

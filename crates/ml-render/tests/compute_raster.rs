@@ -21,7 +21,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::mesh::{Mesh, Vertex};
 use ml_cpu::random_scene::random_scene;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::{DebugView, LargeTriangles, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
+use ml_render::{CullStats, DebugView, LargeTriangles, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use serde_json::json;
@@ -146,7 +146,7 @@ fn the_compute_raster_draws_the_hardwares_triangles() {
         for (k, raster) in [Raster::hybrid(*split), Raster::compute(*split)].into_iter().enumerate() {
             let other = draw(&ctx, scene, *settings, raster);
             let drawn = Drawn { ids: [&hardware[0], &other[0]], shaded: [&hardware[1], &other[1]] };
-            let c = drawn.ids[1].stats.culling.expect("culling stats");
+            let c = *drawn.ids[1].stats.feature::<CullStats>().expect("culling stats");
             assert!(c.compute_triangles > 0, "{what}: the {} raster drew nothing in compute", raster.name());
             large += c.large_triangles;
             let (n, d) = compare(&format!("{what}, {} raster", raster.name()), &drawn, bg);
@@ -239,7 +239,7 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
         ];
         for (how, raster) in ways {
             let out = Renderer::new(&ctx, scene.clone(), RenderSettings { raster, ..base }).unwrap().render().unwrap();
-            let c = out.stats.culling.unwrap();
+            let c = *out.stats.feature::<CullStats>().unwrap();
             let holes = (0..W * H).filter(|i| common::pixel(&out, i % W, i / W) == bg).count();
             println!(
                 "{cells:?} cells, {how}: {} triangles a thread each, {} by {} bins, {} in place; {} pixels covered, {holes} holes",
@@ -262,7 +262,7 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
         }
         // The hybrid raster: the seams between compute and hardware leave no hole either.
         let mixed = Renderer::new(&ctx, scene, RenderSettings { raster: Raster::hybrid(split), ..base }).unwrap().render().unwrap();
-        let c = mixed.stats.culling.unwrap();
+        let c = *mixed.stats.feature::<CullStats>().unwrap();
         assert!(c.compute_triangles > 0 && c.compute_triangles < c.triangles, "{cells:?} cells: both rasterisers draw");
         let holes = (0..W * H).filter(|i| common::pixel(&mixed, i % W, i / W) == bg).count();
         assert_eq!(holes, 0, "{cells:?} cells: pixels neither rasteriser covered");

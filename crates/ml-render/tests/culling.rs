@@ -15,7 +15,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::random_scene::random_scene;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::{RenderOutput, RenderSettings, Renderer, Technique};
+use ml_render::{CullStats, RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
@@ -136,8 +136,12 @@ fn culling_on_and_off_give_the_same_frames() {
                 assert!(on_an_edge(a, b, k), "path {p} frame {i}: pixel {k} differs between culling on and off");
             }
             edge_pixels += differing.len();
-            let c = a.stats.culling.expect("culling stats");
-            assert_eq!(b.stats.culling.unwrap().early_drawn, b.stats.culling.unwrap().meshlet_instances, "culling off draws every meshlet");
+            let c = *a.stats.feature::<CullStats>().expect("culling stats");
+            assert_eq!(
+                b.stats.feature::<CullStats>().unwrap().early_drawn,
+                b.stats.feature::<CullStats>().unwrap().meshlet_instances,
+                "culling off draws every meshlet"
+            );
             // Culled by occlusion or cones: tested late but neither drawn early nor late.
             occluded += (c.late_tested - c.early_drawn - c.late_drawn) as u64;
             late_drawn += c.late_drawn as u64;

@@ -14,8 +14,8 @@ use ml_cpu::gpu_types::PointLight;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::report::AtlasStats;
 use ml_render::settings::AtlasSettings;
+use ml_render::AtlasStats;
 use ml_render::{
     DebugView, FrameSink, OmniShadowMode, OmniShadowSettings, RenderError, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique,
 };
@@ -72,7 +72,7 @@ fn the_atlas_gives_the_cube_arrays_image() {
     let outputs = common::render_each(&scene, &all);
     for (i, (t, m)) in cases.iter().enumerate() {
         let (cubes, atlas) = (&outputs[2 * i], &outputs[2 * i + 1]);
-        let stats = atlas.stats.shadow_atlas.expect("the atlas reports");
+        let stats = *atlas.stats.feature::<AtlasStats>().expect("the atlas reports");
         assert_eq!(stats.divided_by, 1, "the budget holds every face at {CUBE}²");
         let (beyond, wrong) = beyond_and_sure(atlas, cubes, &sure);
         let (max, _) = common::max_difference(atlas, cubes);
@@ -109,7 +109,7 @@ fn with_pair(scene: &Scene, mut base: RenderSettings, budget_mib: u32, f: impl F
 }
 
 fn atlas_stats(out: &RenderOutput) -> AtlasStats {
-    out.stats.shadow_atlas.expect("the atlas reports")
+    *out.stats.feature::<AtlasStats>().expect("the atlas reports")
 }
 
 /// Static lights, a camera walking round the room and turning: the faces come, go and change

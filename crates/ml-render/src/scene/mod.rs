@@ -163,6 +163,11 @@ impl SceneGpu {
         [("ObjectBuffer", self.objects.raw), ("LightConeBuffer", self.cones.raw), ("AlphaMaskBuffer", self.alpha_masks.raw)]
     }
 
+    /// The scene's images that passes declare (`sync`), under their names: the shadow cubes.
+    pub fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+        (name == crate::sync::SHADOW_CUBES).then_some((self.omni.cubes.raw, vk::ImageAspectFlags::DEPTH))
+    }
+
     /// The scene's meshlets, for a pass that draws them.
     pub fn meshlets(&self) -> Result<MeshletGeometryView, RenderError> {
         self.meshlets

@@ -23,6 +23,7 @@ use crate::error::RenderError;
 use crate::gpu_mesh::{record_draws, GpuMesh};
 use crate::scene::shadow_atlas::ShadowAtlasGpu;
 use crate::scene::shadow_settings::{OmniShadowMode, OmniShadowSettings};
+use crate::sync::{Entry, Exit, Use, SHADOW_CUBES};
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
 use ml_cpu::gpu_types::PointLight;
@@ -248,6 +249,37 @@ impl OmniShadows {
         self.settings.filter(|s| s.atlas().is_none())
     }
 
+    /// What a frame's cube drawing by the graphics modes does to the cube array (`sync`):
+    /// copy overwrites it by transfers and leaves it TRANSFER_DST_OPTIMAL; direct, multiview
+    /// and layered render into it, ordered by their render passes' external dependencies
+    /// (after the shaders that read it last; their writes visible to shaders, left
+    /// DEPTH_STENCIL_READ_ONLY_OPTIMAL). None where no graphics mode draws it.
+    pub fn cube_use(&self) -> Option<Use> {
+        let settings = self.cube_settings()?;
+        let read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+        match settings.mode {
+            OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_) => None,
+            OmniShadowMode::Copy => Some(Use::overwriting(SHADOW_CUBES, (TRANSFER_DST.0, TRANSFER_DST.1), TRANSFER_DST.2)),
+            OmniShadowMode::Direct | OmniShadowMode::Multiview | OmniShadowMode::Layered => Some(Use {
+                name: SHADOW_CUBES,
+                entry: Entry::Chained { stages: SHADER_READERS },
+                exit: Exit {
+                    stages: SHADER_READERS,
+                    writes: vk::AccessFlags::empty(),
+                    wrote: true,
+                    visible: vk::AccessFlags::SHADER_READ,
+                    layout: Some(read_only),
+                },
+            }),
+        }
+    }
+
+    /// The layout the cube array is in before the first frame: the stand-in's, cleared when
+    /// it was made; None (undefined) where the frames draw it.
+    pub fn initial_cube_layout(&self) -> Option<vk::ImageLayout> {
+        self.cube_settings().is_none().then_some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)
+    }
+
     /// One texel of a face in face units (FrameUniforms::omni_texel).
     pub fn texel(&self) -> f32 {
         2.0 / self.cubes.extent.width as f32
@@ -260,8 +292,8 @@ impl OmniShadows {
     }
 
     /// Render every cube: `lights[i]` into cube i, the objects that reach into its sphere.
-    /// Leaves the array DEPTH_STENCIL_READ_ONLY_OPTIMAL, its writes visible to fragment and
-    /// compute shaders.
+    /// The cube array as `cube_use` declares it: copy takes it in TRANSFER_DST_OPTIMAL and
+    /// leaves it so; the other modes' render passes order it themselves.
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
         let Some(settings) = self.cube_settings().filter(|s| !matches!(s.mode, OmniShadowMode::Compute { .. })) else { return };
         let masked_pipeline = self.masked.as_ref();
@@ -270,10 +302,6 @@ impl OmniShadows {
         let d = &ctx.device;
         let size = settings.size;
         let copy = settings.mode == OmniShadowMode::Copy;
-        if copy {
-            // Whatever the previous frame's shading read is overwritten by copies.
-            transition(ctx, cmd, self.cubes.raw, (SHADER_READERS, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), TRANSFER_DST);
-        }
         for (cube, light) in lights.iter().enumerate().take(settings.lights as usize) {
             // Objects are drawn into the faces their bounding sphere reaches (none when it
             // misses the light's sphere): per object, once per light.
@@ -343,15 +371,6 @@ impl OmniShadows {
                     self.copy_face(ctx, cmd, cube as u32 * 6 + f);
                 }
             }
-        }
-        if copy {
-            transition(
-                ctx,
-                cmd,
-                self.cubes.raw,
-                TRANSFER_DST,
-                (SHADER_READERS, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-            );
         }
     }
 

@@ -59,11 +59,14 @@ impl ShadowViews {
     }
 }
 
-/// Where the depths go: a D32_SFLOAT image whose first layers the views fill, left
-/// DEPTH_STENCIL_READ_ONLY_OPTIMAL for `readers`.
+/// Where the depths go: a D32_SFLOAT image whose first layers the views fill by a copy.
 pub struct ShadowTarget {
     pub image: vk::Image,
-    pub readers: vk::PipelineStageFlags,
+    /// Drawn outside the frames (the sun's map, once): the stages that read it after, for
+    /// which the drawing transitions it by hand (from undefined to
+    /// DEPTH_STENCIL_READ_ONLY_OPTIMAL). None: a frame's pass, whose declared use took it in
+    /// TRANSFER_DST_OPTIMAL and which leaves it so (`sync` orders it for the readers).
+    pub readers: Option<vk::PipelineStageFlags>,
 }
 
 pub struct ShadowRaster {
@@ -218,7 +221,7 @@ impl ShadowRaster {
         let d = &ctx.device;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         // The last drawing's copy read the depths.
-        self.start(ctx, cmd, lights, (vk::PipelineStageFlags::empty(), vk::AccessFlags::empty()));
+        self.start(ctx, cmd, lights);
         // SAFETY: recording state outside a render pass; the buffer lives as long as this raster.
         unsafe { d.cmd_fill_buffer(cmd, self.depths.raw, 0, vk::WHOLE_SIZE, FAR_BITS) };
         memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_WRITE), (COMPUTE, RW));
@@ -228,16 +231,19 @@ impl ShadowRaster {
         // SAFETY: recording state outside a render pass; the target lives as long as its
         // owner, beyond the submission.
         unsafe {
-            // Whatever the last drawing's readers read is overwritten whole.
             let dst = (transfer, vk::AccessFlags::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
             let image = (target.image, depth);
-            aspect_transition(ctx, cmd, image, (target.readers, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), dst);
+            if let Some(readers) = target.readers {
+                aspect_transition(ctx, cmd, image, (readers, vk::AccessFlags::empty(), vk::ImageLayout::UNDEFINED), dst);
+            }
             let layers = vk::ImageSubresourceLayers::default().aspect_mask(depth).base_array_layer(0).layer_count(self.views.layers());
             let extent = vk::Extent3D { width: self.size, height: self.size, depth: 1 };
             let region = [vk::BufferImageCopy::default().image_subresource(layers).image_extent(extent)];
             d.cmd_copy_buffer_to_image(cmd, self.depths.raw, target.image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &region);
-            let sampled = (target.readers, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-            aspect_transition(ctx, cmd, image, dst, sampled);
+            if let Some(readers) = target.readers {
+                let sampled = (readers, vk::AccessFlags::SHADER_READ, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+                aspect_transition(ctx, cmd, image, dst, sampled);
+            }
         }
     }
 
@@ -245,9 +251,9 @@ impl ShadowRaster {
     /// faces `tiles[i]` names) seen through `projection` (every face's). The faces it redraws
     /// are cleared and drawn; the others keep their texels, and lights with none to redraw
     /// cost nothing: the clear and the culling run over the others alone (a frame that keeps
-    /// every face writes the table and nothing else). Ends with the atlas's writes visible to
-    /// the shading passes (`readers`: fragment and compute shaders) and the counters' to
-    /// transfers.
+    /// every face writes the table and nothing else). The table (by transfers) and the
+    /// atlas (by compute shaders) as the pass declares them (`sync` orders them after the
+    /// last shading and for the next); ends with the counters' writes visible to transfers.
     pub fn record_atlas(
         &self,
         ctx: &Context,
@@ -255,17 +261,15 @@ impl ShadowRaster {
         slot: usize,
         (lights, tiles): (&[[f32; 4]], &[ShadowCubeTiles]),
         projection: glam::Mat4,
-        readers: vk::PipelineStageFlags,
     ) {
         let ShadowViews::Atlas { tiles: table, .. } = self.views else { return };
         let d = &ctx.device;
         let redrawn: Vec<u32> = (0..tiles.len() as u32).filter(|&i| tiles[i as usize].redraw != 0).collect();
-        // The last frame's shading read the table and the atlas.
-        self.start(ctx, cmd, lights, (readers, vk::AccessFlags::SHADER_READ));
+        self.start(ctx, cmd, lights);
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let written = (transfer, vk::AccessFlags::TRANSFER_WRITE);
-        // The shading passes read the table and the atlas; the counters are copied out.
-        let after = (readers | transfer, vk::AccessFlags::SHADER_READ | vk::AccessFlags::TRANSFER_READ);
+        // The counters are copied out.
+        let after = (transfer, vk::AccessFlags::TRANSFER_READ);
         update_buffer(ctx, cmd, table, bytemuck::cast_slice(tiles));
         if redrawn.is_empty() {
             memory_barrier(ctx, cmd, written, after);
@@ -286,12 +290,12 @@ impl ShadowRaster {
         memory_barrier(ctx, cmd, (COMPUTE, vk::AccessFlags::SHADER_WRITE), after);
     }
 
-    /// The start of a drawing: after the last drawing's passes (and `also`, who read what this
-    /// one writes), the lights and the counters written.
-    fn start(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[[f32; 4]], also: (vk::PipelineStageFlags, vk::AccessFlags)) {
+    /// The start of a drawing: after the last drawing's passes, the lights and the counters
+    /// written.
+    fn start(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[[f32; 4]]) {
         let start = OmniRasterCounters { pairs: [0, 1, 1, 0], large: [0, 1, 1, 0], drawn: [0; 4] };
         let transfer = vk::PipelineStageFlags::TRANSFER;
-        let before = (COMPUTE | vk::PipelineStageFlags::DRAW_INDIRECT | transfer | also.0, RW | vk::AccessFlags::TRANSFER_READ | also.1);
+        let before = (COMPUTE | vk::PipelineStageFlags::DRAW_INDIRECT | transfer, RW | vk::AccessFlags::TRANSFER_READ);
         memory_barrier(ctx, cmd, before, (transfer | COMPUTE, vk::AccessFlags::TRANSFER_WRITE | RW));
         update_buffer(ctx, cmd, self.lights.raw, bytemuck::cast_slice(lights));
         update_buffer(ctx, cmd, self.counters.raw, bytemuck::bytes_of(&start));

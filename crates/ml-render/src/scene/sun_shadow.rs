@@ -53,7 +53,7 @@ pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInpu
             let meshlets =
                 inputs.meshlets.ok_or_else(|| RenderError::Internal("the sun's compute shadow raster has no meshlets".into()))?;
             ShadowRaster::new(ctx, meshlets, views, 1).and_then(|mut raster| {
-                let shadow_target = ShadowTarget { image: target.raw, readers: READERS };
+                let shadow_target = ShadowTarget { image: target.raw, readers: Some(READERS) };
                 let result = raster.bind(ctx, 0, (inputs.objects, inputs.alpha_masks)).and_then(|()| {
                     ml_vk::commands::one_shot(ctx, |cmd| {
                         timer.reset(ctx, cmd);

@@ -9,7 +9,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{light_list_reads, Use};
+use crate::sync::{shading_reads, Use};
 use crate::targets::GBUFFER;
 use ml_vk::{vk, Context, VkError};
 
@@ -50,9 +50,9 @@ impl Pass for ComputeLighting {
         })
     }
 
-    /// After the G-buffer pass and the cluster build.
+    /// After the G-buffer pass, the cluster build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
-        let mut uses = light_list_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
+        let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::colour_use());
         uses
     }

@@ -11,7 +11,7 @@ use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
 use crate::shading::Shading;
-use crate::sync::{light_list_reads, Use};
+use crate::sync::{shading_reads, Use};
 use crate::targets::{gbuffer_images, Output};
 use ml_vk::{shader, vk, Context, VkError};
 
@@ -90,7 +90,7 @@ impl Pass for DeferredSubpasses {
     }
 
     fn uses(&self) -> Vec<Use> {
-        light_list_reads(vk::PipelineStageFlags::FRAGMENT_SHADER)
+        shading_reads(vk::PipelineStageFlags::FRAGMENT_SHADER)
     }
 
     fn record(&self, rec: &Recording) {

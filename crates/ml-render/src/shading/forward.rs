@@ -8,7 +8,7 @@ use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
 use crate::shading::Shading;
-use crate::sync::{light_list_reads, Entry, Exit, Use, COLOUR_TARGET};
+use crate::sync::{shading_reads, Entry, Exit, Use, COLOUR_TARGET};
 use crate::targets::Output;
 use ml_vk::{vk, Context, VkError};
 
@@ -65,7 +65,7 @@ impl Pass for Forward {
             | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
             | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
         let transfer = vk::PipelineStageFlags::TRANSFER;
-        let mut uses = light_list_reads(vk::PipelineStageFlags::FRAGMENT_SHADER);
+        let mut uses = shading_reads(vk::PipelineStageFlags::FRAGMENT_SHADER);
         uses.push(Use {
             name: COLOUR_TARGET,
             entry: Entry::Chained { stages: attachments | transfer },

@@ -9,11 +9,12 @@ use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
-use crate::report::{AtlasStats, FrameStats, OmniRasterStats};
+use crate::report::{FeatureStats, FrameStats};
 use crate::scene::meshlets::MeshletGeometryView;
 use crate::scene::omni_shadow::NEAR_FRACTION;
 use crate::scene::shadow_atlas::tile_table;
 use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
+use crate::sync::{Use, SHADOW_ATLAS, SHADOW_CUBES};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::OmniRasterCounters;
 use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
@@ -64,6 +65,20 @@ impl Pass for OmniShadowCompute {
         self.raster.bind(ctx, frame.slot, (named("ObjectBuffer"), named("AlphaMaskBuffer")))
     }
 
+    /// The cubes, overwritten by a copy (left TRANSFER_DST_OPTIMAL); or the atlas's table,
+    /// written by transfers, and the atlas, cleared and drawn by compute shaders.
+    fn uses(&self) -> Vec<Use> {
+        let transfer = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE);
+        match self.views {
+            ShadowViews::Atlas { .. } => {
+                let [atlas, table] = SHADOW_ATLAS;
+                let compute = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+                vec![Use::at(table, transfer, None), Use::at(atlas, compute, None)]
+            }
+            _ => vec![Use::overwriting(SHADOW_CUBES, transfer, vk::ImageLayout::TRANSFER_DST_OPTIMAL)],
+        }
+    }
+
     fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
         p.scene.omni.place(p.rest_lights, p.light_offset);
         if let ShadowViews::Atlas { .. } = self.views {
@@ -80,14 +95,13 @@ impl Pass for OmniShadowCompute {
         }
         // Every face's projection: 90°, in the light's frame in radii.
         let projection = glam::Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, NEAR_FRACTION, 1.0);
-        let readers = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
         match (self.views, &self.plan) {
             (ShadowViews::Atlas { .. }, Some(plan)) => {
                 let tiles = tile_table(plan, lights.len());
-                self.raster.record_atlas(rec.ctx, rec.cmd, rec.slot, (&lights, &tiles), projection, readers);
+                self.raster.record_atlas(rec.ctx, rec.cmd, rec.slot, (&lights, &tiles), projection);
             }
             _ => {
-                let target = ShadowTarget { image: rec.scene.omni.cubes.raw, readers };
+                let target = ShadowTarget { image: rec.scene.omni.cubes.raw, readers: None };
                 self.raster.record(rec.ctx, rec.cmd, rec.slot, &lights, projection, &target);
             }
         }
@@ -97,7 +111,7 @@ impl Pass for OmniShadowCompute {
 
     fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
         let c: OmniRasterCounters = bytemuck::pod_read_unaligned(&self.readback[slot].mapped()[..size_of::<OmniRasterCounters>()]);
-        stats.omni_raster = Some(OmniRasterStats {
+        stats.set_feature(OmniRasterStats {
             pairs: c.pairs[3],
             small: c.drawn[0].saturating_sub(c.drawn[1]),
             large: c.large[3],
@@ -132,7 +146,7 @@ fn plan_atlas(p: &mut Prepare) -> Result<Option<AtlasPlan>, RenderError> {
         ))
     })?;
     let (budget, shadow_bytes, atlas_bytes) = omni.atlas.memory();
-    p.stats.shadow_atlas = Some(AtlasStats {
+    p.stats.set_feature(AtlasStats {
         faces: plan.tiles.len(),
         redrawn: plan.redrawn(),
         divided_by: plan.divided_by,
@@ -147,5 +161,84 @@ fn plan_atlas(p: &mut Prepare) -> Result<Option<AtlasPlan>, RenderError> {
 impl ml_vk::Release for OmniShadowCompute {
     fn release(&mut self, ctx: &Context) {
         self.destroy(ctx);
+    }
+}
+
+/// What one frame's compute shadow raster drew (--omni-shadow compute and atlas).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OmniRasterStats {
+    /// (meshlet instance, cube face) pairs the culling kept.
+    pub pairs: u32,
+    /// Triangles drawn by one thread each; large ones (a work group each, or, past the
+    /// list's capacity, `in_place` by the thread that found them).
+    pub small: u32,
+    pub large: u32,
+    pub in_place: u32,
+    /// Texels covered (hidden ones too).
+    pub texels: u32,
+    /// (meshlet instance, face) pairs the culling's thread drew itself (the pair list was full).
+    pub pairs_in_place: u32,
+}
+
+impl FeatureStats for OmniRasterStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let r = self;
+        let in_place = if r.in_place > 0 { format!(" ({} drawn in place: the large list was full)", r.in_place) } else { String::new() };
+        let pairs_in_place = if r.pairs_in_place > 0 {
+            format!(" ({} drawn by the culling: the pair list was full)", r.pairs_in_place)
+        } else {
+            String::new()
+        };
+        vec![(
+            "shadow raster",
+            format!(
+                "{} (meshlet, face) pairs{pairs_in_place}; {} small triangles, {} large{in_place}; {} texels covered",
+                r.pairs, r.small, r.large, r.texels
+            ),
+        )]
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// The shadow atlas's plan of the last frame and its memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AtlasStats {
+    /// Faces with a tile, and those drawn this frame (the others kept their texels).
+    pub faces: usize,
+    pub redrawn: usize,
+    /// What every face's side was divided by to fit the budget (1: nothing).
+    pub divided_by: u32,
+    /// Bytes: the budget, all the atlas's buffers, the atlas itself, what its tiles use.
+    pub budget: u64,
+    pub shadow_bytes: u64,
+    pub atlas_bytes: u64,
+    pub tile_bytes: u64,
+}
+
+impl FeatureStats for AtlasStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let a = self;
+        let mib = |b: u64| b as f64 / (1 << 20) as f64;
+        let factor = if a.divided_by > 1 { format!("every face's side ÷{} to fit the budget", a.divided_by) } else { "full size".into() };
+        vec![(
+            "shadow atlas",
+            format!(
+                "{} faces ({} drawn, {} kept), {factor}; tiles {:.1} of the atlas's {:.1} MiB; all shadow buffers {:.1} of {:.0} MiB",
+                a.faces,
+                a.redrawn,
+                a.faces - a.redrawn,
+                mib(a.tile_bytes),
+                mib(a.atlas_bytes),
+                mib(a.shadow_bytes),
+                mib(a.budget)
+            ),
+        )]
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

@@ -6,13 +6,28 @@
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Prepare, Recording};
+use crate::scene::omni_shadow::OmniShadows;
+use crate::sync::Use;
 use ml_vk::{Context, VkError};
 
-pub struct OmniShadowPass;
+pub struct OmniShadowPass {
+    /// What its drawing does to the cube array (OmniShadows::cube_use).
+    cubes: Option<Use>,
+}
+
+impl OmniShadowPass {
+    pub fn new(omni: &OmniShadows) -> OmniShadowPass {
+        OmniShadowPass { cubes: omni.cube_use() }
+    }
+}
 
 impl Pass for OmniShadowPass {
     fn timer_name(&self) -> Option<&'static str> {
         Some("omni shadows")
+    }
+
+    fn uses(&self) -> Vec<Use> {
+        self.cubes.into_iter().collect()
     }
 
     fn bind_frame(&mut self, _: &Context, _: &FrameResources) -> Result<(), VkError> {

@@ -7,8 +7,8 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::settings::DebugView;
-use crate::sync::Use;
-use ml_vk::{Context, VkError};
+use crate::sync::{shadow_reads, Use};
+use ml_vk::{vk, Context, VkError};
 
 pub struct ShadowMapView {
     pass: ComputePass,
@@ -42,7 +42,9 @@ impl Pass for ShadowMapView {
     }
 
     fn uses(&self) -> Vec<Use> {
-        vec![ComputePass::colour_use()]
+        let mut uses = shadow_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
+        uses.push(ComputePass::colour_use());
+        uses
     }
 
     fn record(&self, rec: &Recording) {

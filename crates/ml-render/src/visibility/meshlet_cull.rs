@@ -17,11 +17,11 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::plan::Phase;
-use crate::report::{CullStats, FrameStats};
+use crate::report::{FeatureStats, FrameStats};
 use crate::specialization::compute_pipeline;
 use crate::sync::{Use, DEPTH_PYRAMID, MESHLET_VISIBILITY, VISIBILITY_DEPTH};
 use crate::targets::depth_pyramid_shape;
-use crate::technique::Raster;
+use crate::technique::{LargeTriangles, Raster};
 use crate::visibility::meshlet_scene::{
     MeshletScene, SharedMeshletScene, COMPACTED_INDICES, CULL_COUNTERS, DRAW_SLOTS, LARGE_BINS, LARGE_TRIANGLES, TRIANGLE_IDS,
     VISIBLE_INSTANCES,
@@ -207,7 +207,8 @@ impl Pass for MeshletCull {
         }
         let scene = self.scene.borrow();
         let c = scene.counters(slot);
-        stats.culling = Some(CullStats {
+        stats.set_feature(CullStats {
+            raster: self.raster,
             instances: c.tested[2],
             visible_instances: c.dispatch[0],
             meshlet_instances: scene.capacity,
@@ -249,5 +250,82 @@ impl Pass for MeshletCull {
 impl ml_vk::Release for MeshletCull {
     fn release(&mut self, ctx: &Context) {
         self.destroy(ctx);
+    }
+}
+
+/// What one frame's GPU culling tested and kept, and what its raster drew.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CullStats {
+    /// The raster it drew with.
+    pub raster: Raster,
+    /// Instances (objects) tested, and those inside the frustum.
+    pub instances: u32,
+    pub visible_instances: u32,
+    /// Meshlet instances of the scene (objects × meshlets of their meshes).
+    pub meshlet_instances: u32,
+    /// Early phase: meshlets visible last frame, tested; those drawn.
+    pub early_tested: u32,
+    pub early_drawn: u32,
+    /// Late phase: every meshlet of the instances in the frustum, tested; those newly drawn.
+    pub late_tested: u32,
+    pub late_drawn: u32,
+    /// Triangles of the meshlets drawn (both phases); of those, the triangles drawn (the rest
+    /// culled one by one); the triangles of every object together.
+    pub meshlet_triangles: u64,
+    pub triangles: u64,
+    pub scene_triangles: u64,
+    /// Compute raster: of the triangles drawn, those it drew (the rest by the hardware), and
+    /// the pixels they covered (hidden ones too); 0 with the hardware raster.
+    pub compute_triangles: u64,
+    pub compute_pixels: u64,
+    /// Compute raster (large triangles in compute): the large triangles found, the 64×64
+    /// bins of their boxes, and those drawn in place (the lists full).
+    pub large_triangles: u64,
+    pub bins: u64,
+    pub in_place: u64,
+}
+
+impl FeatureStats for CullStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let c = self;
+        let share = 100.0 * c.triangles as f64 / c.scene_triangles.max(1) as f64;
+        let mut rows = vec![
+            ("instances", format!("{} submitted, {} in the frustum", c.instances, c.visible_instances)),
+            (
+                "meshlets",
+                format!(
+                    "{} in the scene; early: {} tested, {} drawn; late: {} tested, {} drawn",
+                    c.meshlet_instances, c.early_tested, c.early_drawn, c.late_tested, c.late_drawn
+                ),
+            ),
+            (
+                "triangles",
+                format!("{} drawn of {} ({share:.1} %); the meshlets drawn held {}", c.triangles, c.scene_triangles, c.meshlet_triangles),
+            ),
+        ];
+        match c.raster {
+            Raster::Hardware => {}
+            Raster::Compute { large: LargeTriangles::Hardware, .. } => rows.push((
+                "compute raster",
+                format!(
+                    "{} triangles ({} pixels covered), {} by the hardware",
+                    c.compute_triangles,
+                    c.compute_pixels,
+                    c.triangles - c.compute_triangles
+                ),
+            )),
+            Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => rows.push((
+                "compute raster",
+                format!(
+                    "{} small triangles a thread each, {} large ones in {} bins ({} drawn in place, the lists full); {} pixels covered",
+                    c.compute_triangles, c.large_triangles, c.bins, c.in_place, c.compute_pixels
+                ),
+            )),
+        }
+        rows
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

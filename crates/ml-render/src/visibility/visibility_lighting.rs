@@ -9,7 +9,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{light_list_reads, Use, VISIBILITY_DEPTH};
+use crate::sync::{shading_reads, Use, VISIBILITY_DEPTH};
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};
 
@@ -52,9 +52,9 @@ impl Pass for VisibilityLighting {
         })
     }
 
-    /// After the late raster and the cluster build.
+    /// After the late raster, the cluster build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
-        let mut uses = light_list_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
+        let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::colour_use());
         if self.from_buffer {
             uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
