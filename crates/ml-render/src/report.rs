@@ -11,8 +11,6 @@ use std::sync::Arc;
 pub trait FeatureStats: Any + std::fmt::Debug + Send + Sync {
     /// Its rows: a label and its text each.
     fn rows(&self) -> Vec<(&'static str, String)>;
-
-    fn as_any(&self) -> &dyn Any;
 }
 
 /// Per-pass GPU times (timestamp queries) and CPU times of every frame.
@@ -76,7 +74,7 @@ impl FrameStats {
     /// A feature's figures of the last frame, in place of its earlier ones.
     pub fn set_feature<T: FeatureStats>(&mut self, stats: T) {
         let stats: Arc<dyn FeatureStats> = Arc::new(stats);
-        match self.features.iter_mut().find(|f| f.as_any().is::<T>()) {
+        match self.features.iter_mut().find(|f| (&***f as &dyn Any).is::<T>()) {
             Some(f) => *f = stats,
             None => self.features.push(stats),
         }
@@ -85,7 +83,7 @@ impl FrameStats {
     /// The last frame's figures of the feature whose stats type is `T` (None: it did not
     /// run or report).
     pub fn feature<T: FeatureStats>(&self) -> Option<&T> {
-        self.features.iter().find_map(|f| f.as_any().downcast_ref::<T>())
+        self.features.iter().find_map(|f| (&**f as &dyn Any).downcast_ref::<T>())
     }
 
     /// Every feature's rows (label, text), in the order the features first reported.
@@ -195,10 +193,6 @@ mod tests {
         fn rows(&self) -> Vec<(&'static str, String)> {
             vec![("counted", self.0.to_string())]
         }
-
-        fn as_any(&self) -> &dyn Any {
-            self
-        }
     }
 
     #[derive(Debug)]
@@ -207,10 +201,6 @@ mod tests {
     impl FeatureStats for Other {
         fn rows(&self) -> Vec<(&'static str, String)> {
             vec![("other", "a".into()), ("other", "b".into())]
-        }
-
-        fn as_any(&self) -> &dyn Any {
-            self
         }
     }
 

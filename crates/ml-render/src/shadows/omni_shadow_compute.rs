@@ -197,10 +197,6 @@ impl FeatureStats for OmniRasterStats {
             ),
         )]
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// The shadow atlas's plan of the last frame and its memory.
@@ -236,9 +232,5 @@ impl FeatureStats for AtlasStats {
                 mib(a.budget)
             ),
         )]
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

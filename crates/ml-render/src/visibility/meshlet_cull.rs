@@ -324,8 +324,4 @@ impl FeatureStats for CullStats {
         }
         rows
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
