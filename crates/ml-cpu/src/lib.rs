@@ -31,5 +31,6 @@ pub mod shadow_atlas;
 pub mod surface_sampler;
 mod teapot;
 pub mod textures;
+pub mod transparency;
 
 pub use error::SceneError;
