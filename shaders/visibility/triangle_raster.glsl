@@ -166,8 +166,8 @@ void load_corner_uvs(Meshlet m, uint object) {
 // triangle it falls in, so every thread has the same number of pixels to test. The points
 // whose alpha the block bounds leave open are filtered after the others, together.
 shared uvec4 mask_box_end[16];  // where the numbers of triangle i's box pixels end: [i / 4][i % 4]
-shared ivec4 mask_edges[64];    // corners a, b, c snapped, relative to the box's corner lo (x | y << 16 each); twice the area
-shared ivec4 mask_box[64];      // lo, first pixel (x | y << 16), box width | fill biases (a bit each) << 16
+shared ivec4 mask_edges[64];    // corners a, b, c snapped, relative to the first pixel's centre (16-bit x | y << 16 each); box width | fill biases (a bit each) << 16
+shared ivec2 mask_box[64];      // first pixel (x | y << 16), twice the area
 shared vec4 mask_z_inv_w[64];   // the corners' z/w, and 1/w of a
 shared vec4 mask_uv_w[64];      // 1/w of b and c, u/w of a and b
 shared vec4 mask_uv_w_rest[64]; // u/w of c, v/w of a, b, c
@@ -192,9 +192,14 @@ uint set_up_masked(uint lid, vec2 pa, vec2 pb, vec2 pc, vec3 z, bool both_faces,
         v_w = v_w.xzy;
     }
     ivec2 size = t.last - t.first + 1;
-    // Corners relative to the box: within 17 pixels, so 16 bits hold each coordinate.
-    mask_edges[lid] = ivec4(t.a.x | (t.a.y << 16), t.b.x | (t.b.y << 16), t.c.x | (t.c.y << 16), t.area);
-    mask_box[lid] = ivec4(t.lo, t.first.x | (t.first.y << 16), size.x | ((t.bias.x | (t.bias.y << 1) | (t.bias.z << 2)) << 16));
+    // Corners relative to the first pixel's centre (edge functions do not change when the
+    // origin moves): a box is at most 65 pixels a side, so 16 signed bits hold each
+    // coordinate, and a pixel's coverage needs one read of shared memory.
+    ivec2 origin = t.first * 256 + 128 - t.lo;
+    ivec2 a = t.a - origin, b = t.b - origin, c = t.c - origin;
+    int bias = t.bias.x | (t.bias.y << 1) | (t.bias.z << 2);
+    mask_edges[lid] = ivec4((a.x & 0xffff) | (a.y << 16), (b.x & 0xffff) | (b.y << 16), (c.x & 0xffff) | (c.y << 16), size.x | (bias << 16));
+    mask_box[lid] = ivec2(t.first.x | (t.first.y << 16), t.area);
     mask_z_inv_w[lid] = vec4(z, inv_w.x);
     mask_uv_w[lid] = vec4(inv_w.yz, u_w.xy);
     mask_uv_w_rest[lid] = vec4(u_w.z, v_w);
@@ -209,36 +214,38 @@ shared uint mask_filter[MASK_FILTER_CAPACITY];
 shared uint mask_filtered;
 const uint MASK_PIXEL_FILTER = 2u;
 
-// Pixel `n` of triangle i's box (n from 0): the triangle `t` set up, the pixel, and whether
-// the triangle covers it (`w`: its edge functions there).
-bool masked_covers(uint i, uint n, out SmallTriangle t, out ivec2 pixel, out ivec3 w) {
-    ivec4 edges = mask_edges[i], box = mask_box[i];
-    t.a = ivec2(edges.x & 0xffff, edges.x >> 16);
-    t.b = ivec2(edges.y & 0xffff, edges.y >> 16);
-    t.c = ivec2(edges.z & 0xffff, edges.z >> 16);
-    t.area = edges.w;
-    t.lo = box.xy;
-    int width = box.w & 0xffff, bias = box.w >> 16;
-    t.bias = ivec3(bias & 1, (bias >> 1) & 1, bias >> 2);
+// A corner as set_up_masked packs it: x in the low 16 bits, y in the high, both signed.
+ivec2 unpack_corner(int packed) {
+    return ivec2((packed << 16) >> 16, packed >> 16);
+}
+
+// Pixel `n` of triangle i's box (n from 0): whether the triangle covers it, `cell` its place
+// from the box's first pixel and `w` the edge functions there.
+bool masked_covers(uint i, uint n, out ivec2 cell, out ivec3 w) {
+    ivec4 edges = mask_edges[i];
+    int width = edges.w & 0xffff, bias = edges.w >> 16;
     // n / width without an integer division: n and width are small (a box is at most 65
     // pixels a side), so n + 0.5 lies at least 0.5 / width from a multiple of width, far more
     // than the float's rounding.
     int row = int((float(n) + 0.5) / float(width));
-    pixel = ivec2(box.z & 0xffff, box.z >> 16) + ivec2(int(n) - row * width, row);
-    return small_covers(t, pixel, w);
+    cell = ivec2(int(n) - row * width, row);
+    ivec2 a = unpack_corner(edges.x), b = unpack_corner(edges.y), c = unpack_corner(edges.z), p = cell * 256;
+    w = ivec3(edge_function(b, c, p), edge_function(c, a, p), edge_function(a, b, p));
+    return all(greaterThanEqual(w - ivec3(bias & 1, (bias >> 1) & 1, bias >> 2), ivec3(0)));
 }
 
 // Pixel `n` of triangle i's box, which the triangle covers, drawn where its alpha keeps it;
 // returns 1 if drawn, 0 if not, MASK_PIXEL_FILTER where the texture must be filtered to tell
 // and `filter_now` is false.
 uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) {
-    SmallTriangle t;
-    ivec2 pixel;
+    ivec2 cell;
     ivec3 w;
-    masked_covers(i, n, t, pixel, w);
+    masked_covers(i, n, cell, w);
+    ivec2 box = mask_box[i];
+    ivec2 pixel = ivec2(box.x & 0xffff, box.x >> 16) + cell;
     vec3 weights = vec3(w);
     vec4 z_inv_w = mask_z_inv_w[i], uv_w = mask_uv_w[i], uv_w_rest = mask_uv_w_rest[i];
-    float depth = dot(weights, z_inv_w.xyz) / float(t.area);
+    float depth = dot(weights, z_inv_w.xyz) / float(box.y);
     vec3 inv_w = vec3(z_inv_w.w, uv_w.xy), u_w = vec3(uv_w.zw, uv_w_rest.x), v_w = uv_w_rest.yzw;
     vec2 uv = vec2(dot(weights, u_w), dot(weights, v_w)) / dot(weights, inv_w);
     uint verdict = alpha_verdict(s.alpha, s.alpha_texture, uv);
@@ -342,10 +349,9 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
                 bvec3 past = lessThanEqual(ends.xyz, uvec3(n));
                 uint i = 4u * j + uint(past.x) + uint(past.y) + uint(past.z);
                 uint start = past.z ? ends.z : past.y ? ends.y : past.x ? ends.x : before;
-                SmallTriangle t;
-                ivec2 pixel;
+                ivec2 cell;
                 ivec3 w;
-                covered = masked_covers(i, n - start, t, pixel, w);
+                covered = masked_covers(i, n - start, cell, w);
                 entry = (i << 16u) | (n - start);
             }
             uvec4 ballot = subgroupBallot(covered);
