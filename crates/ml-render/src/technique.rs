@@ -227,3 +227,26 @@ pub fn missing_meshlet_feature(features: &ml_vk::OptionalFeatures) -> Option<&'s
     .into_iter()
     .find_map(|(has, feature)| (!has).then_some(feature))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_compute_rasters_name_the_first_feature_a_device_lacks() {
+        let all = ml_vk::OptionalFeatures {
+            buffer_int64_atomics: true,
+            fragment_stores_and_atomics: true,
+            compute_subgroup_ballot: true,
+            ..ml_vk::OptionalFeatures::default()
+        };
+        assert_eq!(missing_raster_feature(Raster::compute(16), &all), None);
+        let no_ballot = ml_vk::OptionalFeatures { compute_subgroup_ballot: false, ..all };
+        let missing = missing_raster_feature(Raster::compute(16), &no_ballot).expect("the ballot is needed");
+        assert!(missing.contains("subgroup ballot"), "{missing}");
+        let none = ml_vk::OptionalFeatures::default();
+        assert!(missing_raster_feature(Raster::compute(16), &none).is_some_and(|m| m.contains("shaderInt64")));
+        // The hardware raster needs none of them.
+        assert_eq!(missing_raster_feature(Raster::Hardware, &none), None);
+    }
+}
