@@ -100,6 +100,8 @@ impl Pass for OmniShadowCompute {
                 let tiles = tile_table(plan, lights.len());
                 self.raster.record_atlas(rec.ctx, rec.cmd, rec.slot, (&lights, &tiles), projection);
             }
+            // No plan, no face to draw (the atlas keeps what it holds).
+            (ShadowViews::Atlas { .. }, None) => return,
             _ => {
                 let target = ShadowTarget { image: rec.scene.omni.cubes.raw, readers: None };
                 self.raster.record(rec.ctx, rec.cmd, rec.slot, &lights, projection, &target);
