@@ -269,8 +269,8 @@ shared uint mask_queue[2u * gl_WorkGroupSize.x];
 // Queue entry `e` of the meshlet's batch from triangle `first` drawn (draw_masked_pixel), or
 // listed to be filtered later; returns the pixels drawn.
 uint draw_queued(uint e, uint first, uvec4 d, SurfaceTest s) {
-    uint i = e >> 16u, n = e & 0xffffu;
-    uint drawn = draw_masked_pixel(i, n, (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i), s, false);
+    uint i = e >> 16u, n = e & 0xffffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
+    uint drawn = draw_masked_pixel(i, n, id, s, false);
     if (drawn != MASK_PIXEL_FILTER) {
         return drawn;
     }
@@ -279,7 +279,7 @@ uint draw_queued(uint e, uint first, uvec4 d, SurfaceTest s) {
         mask_filter[at] = e;
         return 0u;
     }
-    return draw_masked_pixel(i, n, (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i), s, true);
+    return draw_masked_pixel(i, n, id, s, true);
 }
 
 // The meshlet's triangles, its object masked (`flags`: its instance's), by the whole work
