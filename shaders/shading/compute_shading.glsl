@@ -5,6 +5,10 @@
 #ifndef MANYLIGHTS_COMPUTE_SHADING_GLSL
 #define MANYLIGHTS_COMPUTE_SHADING_GLSL
 
+// The transparent layers, blended where the pixel is shaded (TRANSPARENT_LAYERS).
+#define LAYER_BINDING 20
+#include "transparency/layers.glsl"
+
 // `object_flags`: the object's OBJECT_* bits (the alpha debug view).
 void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags) {
     vec3 color;
@@ -13,7 +17,12 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m,
         return;
     }
     color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
-    imageStore(out_image, p, vec4(encode_output(color, frame.exposure.x), 1.0));
+    imageStore(out_image, p, layered_output(p, frag_xy, color, false, frame.exposure.x));
+}
+
+// A pixel no opaque surface covers: the background, under the transparent layers.
+void store_background(ivec2 p) {
+    imageStore(out_image, p, layered_output(p, vec2(p) + 0.5, vec3(0.0), true, frame.exposure.x));
 }
 
 #endif

@@ -28,7 +28,7 @@ void main() {
     }
     float z = texelFetch(depth_image, p, 0).r;
     if (z >= 1.0) {
-        imageStore(out_image, p, CLEAR_COLOR);
+        store_background(p);
         return;
     }
     vec2 frag_xy = vec2(p) + 0.5;

@@ -15,6 +15,11 @@
 
 layout(location = 0) out vec4 out_color;
 
+// The scene has transparent layers (transparency/layers.glsl): the pass writes linear HDR
+// colour (alpha 1 where a surface is; the clear leaves 0), which the transparent resolve
+// blends the layers over and encodes.
+layout(constant_id = 40) const bool TRANSPARENT_LAYERS = false;
+
 void main() {
     vec3 normal = covered_normal();
 #ifdef CLUSTERED
@@ -36,5 +41,5 @@ void main() {
     }
     color = shade_point(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
     // The target is UNORM: the seed writes gamma-encoded values itself.
-    out_color = vec4(encode_output(color, frame.exposure.x), 1.0);
+    out_color = vec4(TRANSPARENT_LAYERS ? color : encode_output(color, frame.exposure.x), 1.0);
 }

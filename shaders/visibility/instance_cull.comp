@@ -7,6 +7,9 @@
 
 layout(local_size_x = 64) in;
 
+// Transparent objects are blended in layers (transparency/layers.glsl), not drawn here.
+layout(constant_id = 20) const bool SKIP_BLENDED = false;
+
 #include "visibility/meshlet_cull.glsl"
 
 void main() {
@@ -24,6 +27,9 @@ void main() {
         return;
     }
     atomicAdd(counters.tested.z, 1u);
+    if (SKIP_BLENDED && (objects[i].alpha_texture.x & OBJECT_BLENDED) != 0u) {
+        return;
+    }
     vec4 b = instances[i].bounds;
     if (cull.mode.y == 0u || sphere_in_frustum(b.xyz, b.w)) {
         visible_instances[atomicAdd(counters.dispatch.x, 1u)] = i;

@@ -77,7 +77,7 @@ void main() {
     if (z >= 1.0) {
         // The background, once: by the first set's dispatch.
         if (texture_set.x == 0u) {
-            imageStore(out_image, p, CLEAR_COLOR);
+            store_background(p);
         }
         return;
     }

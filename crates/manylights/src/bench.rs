@@ -35,6 +35,18 @@ pub struct BenchArgs {
     /// Objects of the bench scene (0 to 100000): more on the same floor, denser.
     #[arg(long, default_value_t = ml_cpu::bench_scene::BENCH_OBJECTS, value_parser = crate::OBJECTS, allow_negative_numbers = true)]
     objects: usize,
+    /// Percent of the scene's objects made transparent (alphaMode BLEND, alpha one half),
+    /// spread evenly through it (0 to 100).
+    #[arg(long, default_value_t = 0, value_parser = crate::PERCENT, allow_negative_numbers = true)]
+    transparent_objects: u32,
+    /// Panes of faint glass added across the whole view in front of the scene, a transparent
+    /// layer on every pixel each (0 to 256): a stress test of transparency.
+    #[arg(long, default_value_t = 0, value_parser = crate::GLASS_LAYERS, allow_negative_numbers = true)]
+    glass_layers: u32,
+    /// Transparent objects: the per-pixel layers' memory, in nodes of 32 bytes per pixel on
+    /// average (1 to 256).
+    #[arg(long, default_value_t = ml_render::DEFAULT_TRANSPARENCY_BUDGET, value_parser = crate::TRANSPARENCY_BUDGET, allow_negative_numbers = true)]
+    transparency_budget: u32,
     /// Techniques, comma-separated: forward, clustered-cpu, clustered-gpu, deferred,
     /// deferred-clustered, deferred-compute, visibility, or auto (the one `--technique auto`
     /// picks on this device).
@@ -179,6 +191,8 @@ impl Plan {
             shading: shading_choice(a.shading.as_deref())?,
             camera: a.camera.as_deref().map(CameraSpec::parse).transpose().context("--camera")?,
             aspect: width.max(1) as f32 / height.max(1) as f32,
+            transparent_percent: a.transparent_objects,
+            glass_layers: a.glass_layers,
             ..SceneRequest::new(source)
         };
         let settings = SettingsRequest {
@@ -194,6 +208,7 @@ impl Plan {
             culling: true,
             raster: Raster::Hardware,
             exposure: Exposure::Ev(0.0),
+            transparency: ml_render::TransparencySettings { budget: a.transparency_budget },
         };
         Ok(Plan { scene, settings, warned: false })
     }

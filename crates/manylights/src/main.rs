@@ -98,6 +98,14 @@ struct SceneArgs {
     /// first 300 are always the same.
     #[arg(long, default_value_t = ml_cpu::bench_scene::BENCH_OBJECTS, value_parser = OBJECTS, allow_negative_numbers = true)]
     objects: usize,
+    /// Percent of the scene's objects made transparent (alphaMode BLEND, alpha one half),
+    /// spread evenly through it (0 to 100).
+    #[arg(long, default_value_t = 0, value_parser = PERCENT, allow_negative_numbers = true)]
+    transparent_objects: u32,
+    /// Panes of faint glass added across the whole view in front of the scene, a transparent
+    /// layer on every pixel each (0 to 256): a stress test of transparency.
+    #[arg(long, default_value_t = 0, value_parser = GLASS_LAYERS, allow_negative_numbers = true)]
+    glass_layers: u32,
     /// Lighting technique: forward, clustered-cpu, clustered-gpu, deferred, deferred-clustered,
     /// deferred-compute, visibility (meshlets culled on the GPU into a visibility buffer, lit
     /// in compute), or auto: visibility (deferred-compute on a device without its features)
@@ -188,6 +196,11 @@ struct SceneArgs {
     /// drawn again every frame (off; the same images, for comparisons).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     shadow_cache: String,
+    /// Transparent (alphaMode BLEND) objects: the per-pixel layers' memory, in nodes of 32
+    /// bytes per pixel on average (1 to 256; the pool is one storage buffer). Fragments beyond
+    /// it are dropped and counted (the table and a warning say how many).
+    #[arg(long, default_value_t = ml_render::DEFAULT_TRANSPARENCY_BUDGET, value_parser = TRANSPARENCY_BUDGET, allow_negative_numbers = true)]
+    transparency_budget: u32,
     /// Image width in pixels (1 to 16384, and at most the device's largest image).
     #[arg(long, default_value_t = 1280, value_parser = SIDE, allow_negative_numbers = true)]
     width: u32,
@@ -245,6 +258,10 @@ struct SceneArgs {
 
 /// The ranges of the counts and sizes `render`, `view` and `bench` share.
 const OBJECTS: Whole<usize> = Whole::new(0, ml_cpu::limits::MAX_BENCH_OBJECTS as u64);
+const PERCENT: Whole<u32> = Whole::new(0, 100);
+const GLASS_LAYERS: Whole<u32> = Whole::new(0, ml_cpu::transparency::MAX_GLASS_LAYERS as u64);
+/// `--transparency-budget`'s range.
+const TRANSPARENCY_BUDGET: Whole<u32> = Whole::new(1, ml_render::MAX_TRANSPARENCY_BUDGET as u64);
 const SIDE: Whole<u32> = Whole::new(1, ml_render::settings::MAX_DIMENSION as u64);
 const RASTER_SPLIT: Whole<u32> = Whole::new(1, Raster::MAX_SPLIT as u64);
 const SHADOW_BUDGET: Whole<u32> = Whole::checked_later(u32::MAX as u64, "1 to the device's memory in MiB");
@@ -405,6 +422,8 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         camera: args.camera.as_deref().map(CameraSpec::parse).transpose().context("--camera")?,
         show_lights: args.show_lights,
         aspect: args.width.max(1) as f32 / args.height.max(1) as f32,
+        transparent_percent: args.transparent_objects,
+        glass_layers: args.glass_layers,
     })
 }
 
@@ -453,6 +472,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         exposure: exposure_choice(args)?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
+        transparency: ml_render::TransparencySettings { budget: args.transparency_budget },
     })
 }
 

@@ -94,6 +94,7 @@ fn flag(s: Setting) -> &'static str {
         Setting::Height => "--height",
         Setting::CubeSize => "--cube-size",
         Setting::RasterSplit => "--raster-split",
+        Setting::TransparencyBudget => "--transparency-budget",
     }
 }
 

@@ -113,11 +113,13 @@ pub enum AlphaMode {
     /// Cut-outs (foliage, fences, grates): a point whose alpha is below `cutoff` is not there
     /// at all — not drawn, not in any depth, casts no shadow.
     Mask { cutoff: f32 },
-    /// Transparency; drawn as a mask at `BLEND_AS_MASK_CUTOFF` (the renderer blends nothing).
+    /// Transparency: blended over what lies behind by its alpha, in per-pixel layers
+    /// (`transparency`); shadows, and renders with transparency off, take it as a mask at
+    /// `BLEND_AS_MASK_CUTOFF`.
     Blend,
 }
 
-/// The cutoff a blended material is drawn with.
+/// The cutoff a blended material is drawn (and casts shadows) with as a mask.
 pub const BLEND_AS_MASK_CUTOFF: f32 = 0.5;
 
 impl AlphaMode {
@@ -212,6 +214,11 @@ pub struct DirectionalLight {
 }
 
 impl Scene {
+    /// Whether some object is transparent (glTF `alphaMode: BLEND`).
+    pub fn has_blended_objects(&self) -> bool {
+        self.objects.iter().any(|o| o.extras.alpha_mode == AlphaMode::Blend)
+    }
+
     /// The built-in `seed` scene (docs/DESIGN.md#the-seed-scene): a 7×7 grid of one object kind at
     /// x,z = (i − 3.5)·2.5, y = 0, in one material.
     pub fn seed(mesh: MeshKind, material: Material, lights: &LightParams) -> Result<Scene, SceneError> {

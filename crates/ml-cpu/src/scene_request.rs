@@ -61,6 +61,10 @@ pub struct SceneRequest {
     /// Width over height of the image the scene is seen in: a file without a camera is framed
     /// for it (`framing::frame_scene`).
     pub aspect: f32,
+    /// Percent of the scene's objects made transparent (`transparency::make_transparent`).
+    pub transparent_percent: u32,
+    /// Panes of glass added across the whole view (`transparency::add_glass_layers`).
+    pub glass_layers: u32,
 }
 
 /// A built scene and the shading model to render it with.
@@ -115,6 +119,8 @@ impl SceneRequest {
             camera: None,
             show_lights: false,
             aspect: DEFAULT_ASPECT,
+            transparent_percent: 0,
+            glass_layers: 0,
         }
     }
 
@@ -142,6 +148,8 @@ impl SceneRequest {
         if self.show_lights {
             built.scene = built.scene.with_light_markers()?;
         }
+        crate::transparency::make_transparent(&mut built.scene, self.transparent_percent);
+        crate::transparency::add_glass_layers(&mut built.scene, self.glass_layers, self.aspect);
         Ok(built)
     }
 

@@ -9,7 +9,10 @@
 //! colour is their α-weighted mean. The merge is order-independent too, exact where it holds
 //! one layer and an approximation beyond, so a renderer counts the pixels it merged.
 
-use glam::Vec3;
+use crate::material::Material;
+use crate::mesh::MeshKind;
+use crate::scene::{AlphaMode, Object, Scene};
+use glam::{Mat4, Quat, Vec3};
 
 /// One transparent surface in front of a pixel: its depth (nearer is smaller), an id that
 /// orders surfaces at the same depth, its lit colour (linear) and its coverage.
@@ -62,6 +65,56 @@ pub fn composite(under: Vec3, layers: &[Layer], keep: usize) -> Composite {
     Composite { color, merged: far.len() }
 }
 
+/// The most transparent layers `add_glass_layers` adds.
+pub const MAX_GLASS_LAYERS: u32 = 256;
+
+/// `percent` % of `scene`'s objects made transparent (BLEND, alpha one half), spread evenly
+/// through its list: the benchmark's transparent share.
+pub fn make_transparent(scene: &mut Scene, percent: u32) {
+    let percent = percent.min(100) as usize;
+    for (i, o) in scene.objects.iter_mut().enumerate() {
+        // Object i is chosen where the running share crosses a whole number.
+        if (i + 1) * percent / 100 > i * percent / 100 {
+            o.extras.alpha_mode = AlphaMode::Blend;
+            o.extras.base_alpha = 0.5;
+        }
+    }
+}
+
+/// `count` panes of faint tinted glass (alpha 0.08) across the whole view, one behind the
+/// other from 1.5 times the near plane's distance to a tenth of the way to the scene's box
+/// (or to three times the near plane's distance, where the camera is inside the box), so
+/// that nothing opaque stands in front of them: a stress test of transparency, `count`
+/// layers on every pixel.
+pub fn add_glass_layers(scene: &mut Scene, count: u32, aspect: f32) {
+    let camera = scene.camera;
+    let forward = camera.forward();
+    let (lo, hi) = scene.bounds();
+    // The nearest the scene's box comes (0 where the camera is inside it).
+    let nearest = (camera.position - camera.position.clamp(lo, hi)).length();
+    let first = camera.near * 1.5;
+    let last = (nearest * 0.1).max(first * 2.0);
+    // Facing the camera: the plane mesh's +Y normal turned to −forward.
+    let rotation = Quat::from_rotation_arc(Vec3::Y, -forward);
+    let half_tan = (camera.fov_y_deg.to_radians() * 0.5).tan();
+    for i in 0..count.min(MAX_GLASS_LAYERS) {
+        let t = if count > 1 { i as f32 / (count - 1) as f32 } else { 0.0 };
+        let distance = first + (last - first) * t;
+        // Room to spare: the view's half height and width at that distance, by 1.5.
+        let (half_h, half_w) = (distance * half_tan * 1.5, distance * half_tan * aspect * 1.5);
+        let hue = i as f32 * 0.61803;
+        let albedo =
+            Vec3::new(0.5 + 0.5 * (hue * 6.283).cos(), 0.5 + 0.5 * (hue * 6.283 + 2.094).cos(), 0.5 + 0.5 * (hue * 6.283 + 4.189).cos());
+        let mut pane = Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, Material { albedo, roughness: 0.5, metallic: 0.0 });
+        pane.transform =
+            Mat4::from_scale_rotation_translation(Vec3::new(half_w, 1.0, half_h), rotation, camera.position + forward * distance);
+        pane.extras.alpha_mode = AlphaMode::Blend;
+        pane.extras.base_alpha = 0.08;
+        pane.extras.double_sided = true;
+        scene.objects.push(pane);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,6 +125,24 @@ mod tests {
 
     fn glass() -> [Layer; 3] {
         [layer(0.3, 7, [1.0, 0.1, 0.1], 0.5), layer(0.5, 2, [0.1, 1.0, 0.1], 0.4), layer(0.4, 9, [0.1, 0.1, 1.0], 0.6)]
+    }
+
+    #[test]
+    fn a_share_of_the_objects_becomes_transparent_evenly() {
+        let mut scene = crate::scene::Scene::seed(MeshKind::Sphere, Material::built_in()[0], &crate::lights::LightParams::seed_default())
+            .expect("the seed scene");
+        make_transparent(&mut scene, 10);
+        let blended: Vec<usize> = (0..49).filter(|&i| scene.objects[i].extras.alpha_mode == AlphaMode::Blend).collect();
+        assert_eq!(blended, [9, 19, 29, 39]);
+        add_glass_layers(&mut scene, 24, 16.0 / 9.0);
+        assert_eq!(scene.objects.len(), 49 + 24);
+        // Each pane faces the camera and lies in front of the scene.
+        let eye = scene.camera.position;
+        for pane in &scene.objects[49..] {
+            let normal = pane.transform.transform_vector3(Vec3::Y).normalize();
+            assert!(normal.dot(scene.camera.forward()) < -0.999);
+            assert!((pane.position() - eye).length() < 10.0);
+        }
     }
 
     #[test]

@@ -13,6 +13,7 @@ use crate::scene::SceneGpu;
 use crate::settings::{OmniShadowMode, Raster, RenderSettings, Shading};
 use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
 use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
+use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
@@ -89,7 +90,9 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::ToneMap { curve } => Box::new(tone_map::ToneMap::new(ctx, curve)?),
         PassKind::GBuffer => Box::new(gbuffer::GBuffer::new(ctx, a.scene, raster)?),
         PassKind::ComputeLighting => Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?),
-        PassKind::MeshletCull(phase) => Box::new(meshlet_cull::MeshletCull::new(ctx, shared()?, phase, (s.culling, s.raster))?),
+        PassKind::MeshletCull(phase) => {
+            Box::new(meshlet_cull::MeshletCull::new(ctx, shared()?, phase, (s.culling, s.raster, a.shading.transparency))?)
+        }
         PassKind::TriangleRasterLarge(phase) => Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, s.raster)?),
         PassKind::VisibilityRaster(phase) => {
             Box::new(visibility_raster::VisibilityRaster::new(ctx, shared()?, (phase, compute), a.depth_format)?)
@@ -100,5 +103,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         }
         PassKind::ShadowMapView => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
+        PassKind::TransparentBuild { depth_buffer } => Box::new(TransparentBuild::new(ctx, a.scene, a.shading, depth_buffer)?),
+        PassKind::TransparentResolve { clustered } => Box::new(TransparentResolve::new(ctx, a.scene, a.shading, clustered)?),
     })
 }

@@ -89,6 +89,8 @@ pub enum Setting {
     CubeSize,
     /// The compute raster's largest triangle (pixels a side of its bounding box).
     RasterSplit,
+    /// Transparent nodes per pixel (`--transparency-budget`).
+    TransparencyBudget,
 }
 
 impl std::fmt::Display for Setting {
@@ -98,6 +100,7 @@ impl std::fmt::Display for Setting {
             Setting::Height => "height",
             Setting::CubeSize => "cube size",
             Setting::RasterSplit => "raster split",
+            Setting::TransparencyBudget => "transparency budget",
         })
     }
 }
@@ -117,6 +120,8 @@ pub enum SettingsError {
     ShadowMapNeedsBlinnPhong,
     #[error("the shadow-cube debug view needs point-light shadow cubes (--omni-shadow copy|direct|multiview|layered|compute)")]
     ShadowCubeNeedsShadows,
+    #[error("the transparency-layers debug view needs transparent objects (a scene with alphaMode BLEND materials)")]
+    LayerViewNeedsTransparency,
     #[error("the shadow-atlas debug view needs the shadow atlas (--omni-shadow atlas)")]
     ShadowAtlasViewNeedsAtlas,
     #[error("the {view} debug view shows the meshlets of the visibility technique, not {technique}")]
@@ -129,6 +134,10 @@ pub enum SettingsError {
     RasterFeature { raster: &'static str, feature: &'static str, device: String },
     #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size or --raster hardware")]
     RasterBuffer { width: u32, height: u32, bytes: u64, device: String, max: u32 },
+    #[error(
+        "a transparency budget of {budget} nodes per pixel at {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: lower --transparency-budget"
+    )]
+    TransparencyPool { budget: u32, width: u32, height: u32, bytes: u64, device: String, max: u32 },
     #[error(
         "the compute raster's list of {bins} large triangles takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer"
     )]

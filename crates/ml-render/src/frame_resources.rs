@@ -20,9 +20,11 @@ pub struct FrameResources<'a> {
 
 impl<'a> FrameResources<'a> {
     /// Slot `slot`'s table: its targets' buffers (the depth pyramid, the compute raster's
-    /// depth-and-id buffer) and, added by `with`, everyone else's.
+    /// depth-and-id buffer, the transparent layers' lists) and, added by `with`, everyone
+    /// else's.
     pub fn new(slot: usize, targets: &'a Targets) -> FrameResources<'a> {
-        let buffers = vec![(DEPTH_PYRAMID, targets.depth_pyramid.raw), (VISIBILITY_DEPTH, targets.visibility_depth.raw)];
+        let mut buffers = vec![(DEPTH_PYRAMID, targets.depth_pyramid.raw), (VISIBILITY_DEPTH, targets.visibility_depth.raw)];
+        buffers.extend(targets.layers.named());
         FrameResources { slot, buffers, targets }
     }
 

@@ -25,7 +25,7 @@
 //! ```
 //!
 //! Inside, a frame is a list of passes planned as data ([`plan::plan`]) and made by feature:
-//! `shadows/`, `visibility/`, `clusters/`, `exposure/`, `shading/`, over the scene's GPU
+//! `shadows/`, `visibility/`, `clusters/`, `exposure/`, `shading/`, `transparency/`, over the scene's GPU
 //! resources (`scene/`); docs/architecture.md maps every file.
 
 pub mod error;
@@ -53,6 +53,7 @@ mod specialization;
 mod sync;
 mod targets;
 mod technique;
+mod transparency;
 mod visibility;
 
 pub use error::RenderError;
@@ -65,6 +66,10 @@ pub use settings::{
 };
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage};
+pub use transparency::{
+    TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,
+    MAX_BUDGET as MAX_TRANSPARENCY_BUDGET,
+};
 pub use visibility::meshlet_cull::CullStats;
 
 /// What this crate's GPU tests inspect inside the renderer (render pass descriptions, set

@@ -100,7 +100,8 @@ pub trait Pass {
 
     /// Read what slot `slot`'s finished frame reports (its fence has signalled): feedback for
     /// the frame loop into `report`, the pass's own figures into `stats`.
-    fn collect(&self, _slot: usize, _report: &mut SlotReport, _stats: &mut FrameStats) {}
+    /// `targets`: the slot's, as the frame left them.
+    fn collect(&self, _slot: usize, _targets: &Targets, _report: &mut SlotReport, _stats: &mut FrameStats) {}
 
     /// The projection or image size changed; slot 0's uniforms hold the new ones and no frame
     /// is in flight.

@@ -57,6 +57,12 @@ pub enum PassKind {
     ShadowMapView,
     /// Auto exposure's meter, reading the finished image (with pbr's curve or without).
     ExposureMeter { curve: bool },
+    /// The transparent objects' fragments into per-pixel lists, tested against the opaque
+    /// depth (`depth_buffer`: the compute raster's buffer, else the depth target).
+    TransparentBuild { depth_buffer: bool },
+    /// The layers lit and blended over the opaque HDR image, encoded into the colour target
+    /// (forward and deferred techniques; the compute lighting passes blend them themselves).
+    TransparentResolve { clustered: bool },
 }
 
 /// What the passes and their pipelines are made for. A change in `technique`, `shading`,
@@ -74,6 +80,8 @@ pub struct PipelineKey {
     pub debug_view: DebugView,
     /// Auto exposure meters the image (auto exposure, no debug view).
     pub meters_exposure: bool,
+    /// Transparent objects are blended in per-pixel layers (`RenderSettings::blends_layers`).
+    pub layers: bool,
 }
 
 impl PipelineKey {
@@ -111,6 +119,7 @@ impl RenderSettings {
             clusters: self.clusters,
             debug_view: self.debug_view,
             meters_exposure: self.meters_exposure(),
+            layers: self.blends_layers(),
         }
     }
 
@@ -141,6 +150,10 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
         LightAssignment::Gpu => kinds.push(PassKind::ClusterBuild),
     }
     let clustered = technique.assignment() != LightAssignment::None;
+    // Transparent layers: built after the opaque depth is known; the compute lighting passes
+    // blend them, the others leave linear HDR to a resolve.
+    let build = PassKind::TransparentBuild { depth_buffer: technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware };
+    let resolve = [build, PassKind::TransparentResolve { clustered }];
     match (technique.geometry(), technique.lighting_stage()) {
         (Geometry::Meshlets, _) => {
             for phase in [Phase::Early, Phase::Late] {
@@ -153,19 +166,28 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
                     kinds.push(PassKind::DepthPyramid);
                 }
             }
+            kinds.extend(key.layers.then_some(build));
             kinds.push(PassKind::VisibilityLighting);
         }
         (Geometry::Meshes, LightingStage::Forward) => {
             kinds.push(PassKind::Forward { clustered, heat_legend: key.debug_view == DebugView::ClusterHeat });
+            if key.layers {
+                kinds.extend(resolve);
+            }
         }
         (Geometry::Meshes, LightingStage::Subpass) => {
             kinds.push(PassKind::DeferredSubpasses { clustered });
-            // pbr's curve, not for surface views (their values are shown as they are).
-            let surface_view = !matches!(key.debug_view, DebugView::None | DebugView::ClusterHeat);
-            kinds.push(PassKind::ToneMap { curve: key.shading == ShadingModel::Pbr && !surface_view });
+            if key.layers {
+                kinds.extend(resolve);
+            } else {
+                // pbr's curve, not for surface views (their values are shown as they are).
+                let surface_view = !matches!(key.debug_view, DebugView::None | DebugView::ClusterHeat);
+                kinds.push(PassKind::ToneMap { curve: key.shading == ShadingModel::Pbr && !surface_view });
+            }
         }
         (Geometry::Meshes, LightingStage::Compute) => {
             kinds.push(PassKind::GBuffer);
+            kinds.extend(key.layers.then_some(build));
             kinds.push(PassKind::ComputeLighting);
         }
     }

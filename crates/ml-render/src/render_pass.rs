@@ -42,6 +42,8 @@ fn reference(attachment: u32, layout: vk::ImageLayout) -> vk::AttachmentReferenc
 }
 
 const COLOUR_OUT: vk::PipelineStageFlags = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT;
+/// The transparent layers' build samples the opaque depth in its fragment shader.
+const FRAGMENT: vk::PipelineStageFlags = vk::PipelineStageFlags::FRAGMENT_SHADER;
 const FRAGMENT_TESTS: vk::PipelineStageFlags = vk::PipelineStageFlags::from_raw(
     vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS.as_raw(),
 );
@@ -62,13 +64,24 @@ fn dependency(
 }
 
 /// The render pass the raster pass uses for `output`, with `gbuffer`'s images (targets.rs
-/// gbuffer_images) where it writes a G-buffer.
-pub fn describe(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage]) -> RenderPassDesc {
+/// gbuffer_images) where it writes a G-buffer. With transparent `layers`, whose build
+/// samples the opaque depth after the pass, depth is stored and the forward pass writes
+/// linear HDR for their resolve.
+pub fn describe(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage], layers: bool) -> RenderPassDesc {
     match output {
-        Output::Color | Output::GBuffer => one_subpass(depth_format, output, gbuffer),
-        Output::Subpasses => two_subpasses(depth_format, gbuffer),
+        Output::Color | Output::GBuffer => one_subpass(depth_format, output, gbuffer, layers),
+        Output::Subpasses => two_subpasses(depth_format, gbuffer, layers),
         Output::Visibility => visibility(depth_format, true),
+        Output::Layers { .. } => transparent_layers(),
     }
+}
+
+/// The transparent layers' build: no attachments — its fragments test the opaque depth and
+/// append to the lists themselves — between the opaque raster (its depth, by the raster's
+/// own outgoing dependency; the lists' clearing, by the build's barrier) and the passes that
+/// blend the lists, ordered by their declared uses.
+fn transparent_layers() -> RenderPassDesc {
+    RenderPassDesc { attachments: Vec::new(), subpasses: vec![Subpass::default()], dependencies: Vec::new() }
 }
 
 /// The visibility raster's pass: the visibility buffer and depth, cleared by the early phase
@@ -103,7 +116,7 @@ pub fn visibility(depth_format: vk::Format, first: bool) -> RenderPassDesc {
         // The earlier frame's (or, late, the pyramid's) readers of the attachments, the culling's
         // writes of the draws.
         dependency(
-            (vk::SUBPASS_EXTERNAL, COLOUR_OUT | FRAGMENT_TESTS | compute, ATTACHMENT_WRITES | vk::AccessFlags::SHADER_WRITE),
+            (vk::SUBPASS_EXTERNAL, COLOUR_OUT | FRAGMENT_TESTS | compute | FRAGMENT, ATTACHMENT_WRITES | vk::AccessFlags::SHADER_WRITE),
             (
                 0,
                 COLOUR_OUT | FRAGMENT_TESTS | draws,
@@ -114,7 +127,7 @@ pub fn visibility(depth_format: vk::Format, first: bool) -> RenderPassDesc {
         // loads them again.
         dependency(
             (0, COLOUR_OUT | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS, ATTACHMENT_WRITES),
-            (vk::SUBPASS_EXTERNAL, compute | COLOUR_OUT | FRAGMENT_TESTS, vk::AccessFlags::SHADER_READ | ATTACHMENT_WRITES),
+            (vk::SUBPASS_EXTERNAL, compute | COLOUR_OUT | FRAGMENT_TESTS | FRAGMENT, vk::AccessFlags::SHADER_READ | ATTACHMENT_WRITES),
         ),
     ];
     RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
@@ -140,9 +153,12 @@ pub fn visibility_atomic() -> RenderPassDesc {
     RenderPassDesc { attachments: Vec::new(), subpasses: vec![Subpass::default()], dependencies }
 }
 
-fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage]) -> RenderPassDesc {
+fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage], layers: bool) -> RenderPassDesc {
     let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+    let depth_read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
     let attachments = match output {
+        // Linear HDR and depth for the transparent layers' build and resolve.
+        Output::Color if layers => vec![attachment(HDR_FORMAT, true, read_only), attachment(depth_format, true, depth_read_only)],
         // The colour result is copied out; depth is not needed afterwards.
         Output::Color => vec![
             attachment(COLOR_FORMAT, true, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
@@ -161,10 +177,11 @@ fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage
         depth: Some(reference(colour_count, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
         inputs: Vec::new(),
     };
-    // Who uses the attachments after the pass: the read-back copy, or the lighting compute pass.
+    // Who uses the attachments after the pass: the read-back copy, or the lighting compute pass
+    // (and the transparent layers' build, in fragment shaders).
     let after = match output {
-        Output::Color => (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
-        _ => (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ),
+        Output::Color if !layers => (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
+        _ => (vk::PipelineStageFlags::COMPUTE_SHADER | FRAGMENT, vk::AccessFlags::SHADER_READ),
     };
     let dependencies = vec![
         // The targets are reused every other frame: wait for the earlier frame's attachment
@@ -181,7 +198,7 @@ fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage
     RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
 }
 
-fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage]) -> RenderPassDesc {
+fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage], layers: bool) -> RenderPassDesc {
     let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
     let depth_read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
     let colour = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
@@ -190,7 +207,7 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage]) -> RenderPa
     let attachments: Vec<vk::AttachmentDescription> = gbuffer
         .iter()
         .map(|image| attachment(image.format, false, read_only))
-        .chain([attachment(depth_format, false, depth_read_only), attachment(HDR_FORMAT, true, read_only)])
+        .chain([attachment(depth_format, layers, depth_read_only), attachment(HDR_FORMAT, true, read_only)])
         .collect();
     let subpasses = vec![
         Subpass {
@@ -209,7 +226,7 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage]) -> RenderPa
     let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
     let colour_write = vk::AccessFlags::COLOR_ATTACHMENT_WRITE;
     let external = vk::SUBPASS_EXTERNAL;
-    let dependencies = vec![
+    let mut dependencies = vec![
         // The targets are reused every other frame: the G-buffer was last written by that
         // frame's subpass 0 and read by its subpass 1 ...
         dependency(
@@ -225,6 +242,15 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage]) -> RenderPa
         // HDR writes before the tone map reads them.
         dependency((1, COLOUR_OUT, colour_write), (external, compute, vk::AccessFlags::SHADER_READ)),
     ];
+    if layers {
+        // Depth before the transparent layers' build samples it: written by subpass 0, stored
+        // at the end of subpass 1 (its last user: the store is a depth write there).
+        let tests = vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
+        let depth_write = vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
+        for subpass in [0, 1] {
+            dependencies.push(dependency((subpass, tests, depth_write), (external, FRAGMENT, vk::AccessFlags::SHADER_READ)));
+        }
+    }
     RenderPassDesc { attachments, subpasses, dependencies }
 }
 

@@ -132,7 +132,11 @@ pub trait FrameHook {
 }
 
 impl<'a> Renderer<'a> {
-    pub fn new(ctx: &'a Context, scene: Scene, settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
+    pub fn new(ctx: &'a Context, scene: Scene, mut settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
+        // Transparency only where there is something transparent.
+        if !scene.has_blended_objects() {
+            settings.transparency = None;
+        }
         settings.check(ctx, scene.lights.len())?;
         let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
         check_lists_fit(ctx, &settings, &grid, &scene.lights, scene.light_motion)?;
@@ -295,7 +299,8 @@ impl<'a> Renderer<'a> {
         let technique = self.settings.technique;
         let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
         let raster = self.settings.raster;
-        let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), raster);
+        let layers = self.settings.transparency.filter(|_| self.settings.blends_layers());
+        let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers));
         let setup = FrameSetup {
             pool: self.command_pool,
             light_count: self.scene.lights.len(),
@@ -565,8 +570,9 @@ impl<'a> Renderer<'a> {
             stats.add_gpu(&ms);
         }
         let mut report = SlotReport::default();
+        let targets = self.frames[f].targets.as_ref().expect("made with the frame");
         for p in &self.passes {
-            p.collect(f, &mut report, stats);
+            p.collect(f, targets, &mut report, stats);
         }
         self.reports[f] = report;
         if let (Some(needed), Some(max_lights)) = (report.index_entries, report.max_lights) {
@@ -709,8 +715,9 @@ impl<'a> Renderer<'a> {
                 timed += 1;
             }
         }
-        // The colour target as the read-back and a window's blit take it.
-        frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &[sync::frame_end()], &image);
+        // The colour target as the read-back and a window's blit take it; the transparent
+        // layers' counters as the host reads them.
+        frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &[sync::frame_end(), crate::transparency::counts_to_host()], &image);
         if let Some(hook) = hook {
             hook.record(ctx, cmd, &targets.color)?;
         }

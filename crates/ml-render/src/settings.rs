@@ -11,6 +11,7 @@ pub use crate::targets::MAX_DIMENSION;
 pub use crate::technique::{
     missing_meshlet_feature, missing_raster_feature, Geometry, LargeTriangles, LightAssignment, LightingStage, Raster, Technique,
 };
+pub use crate::transparency::TransparencySettings;
 use ml_cpu::cluster::ClusterDims;
 pub use ml_cpu::shading_model::ShadingModel;
 use ml_vk::{vk, Context};
@@ -41,10 +42,13 @@ pub enum DebugView {
     /// Which surfaces alpha masks cut: opaque grey, masked green, blended orange (drawn as
     /// masks); double-sided ones brighter. Cut-out points show what lies behind them.
     Alpha,
+    /// Transparent layers per pixel as a heat map up to the 32 a pixel blends exactly; white
+    /// where more were merged (scenes with transparent objects).
+    TransparencyLayers,
 }
 
 impl DebugView {
-    pub const ALL: [DebugView; 12] = [
+    pub const ALL: [DebugView; 13] = [
         DebugView::None,
         DebugView::ClusterHeat,
         DebugView::GBufferAlbedo,
@@ -57,6 +61,7 @@ impl DebugView {
         DebugView::Meshlets,
         DebugView::Triangles,
         DebugView::Alpha,
+        DebugView::TransparencyLayers,
     ];
 
     pub fn name(self) -> &'static str {
@@ -73,6 +78,7 @@ impl DebugView {
             DebugView::Meshlets => "meshlets",
             DebugView::Triangles => "triangles",
             DebugView::Alpha => "alpha",
+            DebugView::TransparencyLayers => "transparency-layers",
         }
     }
 
@@ -96,6 +102,7 @@ impl DebugView {
             DebugView::Meshlets => v::MESHLETS,
             DebugView::Triangles => v::TRIANGLES,
             DebugView::Alpha => v::ALPHA,
+            DebugView::TransparencyLayers => v::TRANSPARENCY_LAYERS,
         }
     }
 }
@@ -123,6 +130,9 @@ pub struct RenderSettings {
     pub raster: Raster,
     /// What lit colour is multiplied by before tone map and gamma.
     pub exposure: Exposure,
+    /// Transparent (BLEND) objects blended in per-pixel layers, with this budget; None: drawn
+    /// as masks at alpha one half (and so where the scene has none).
+    pub transparency: Option<TransparencySettings>,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -157,6 +167,7 @@ impl RenderSettings {
             culling: true,
             raster: Raster::Hardware,
             exposure: Exposure::Ev(0.0),
+            transparency: None,
         }
     }
 
@@ -169,6 +180,12 @@ impl RenderSettings {
     /// shows its values as they are).
     pub fn meters_exposure(&self) -> bool {
         self.exposure == Exposure::Auto && self.debug_view == DebugView::None
+    }
+
+    /// Whether the transparent layers are built and blended: transparency on, and the image
+    /// shaded (or the layer view); a surface debug view shows the opaque surfaces only.
+    pub fn blends_layers(&self) -> bool {
+        self.transparency.is_some() && matches!(self.debug_view, DebugView::None | DebugView::TransparencyLayers)
     }
 
     /// Animation clock of frame `i`.
@@ -184,6 +201,7 @@ impl RenderSettings {
             shadow_atlas: self.omni.is_some_and(|o| o.atlas().is_some()),
             object_textures: !scene.textures.is_empty(),
             spot_lights: !scene.cones.is_empty(),
+            transparency: self.blends_layers(),
         }
     }
 
@@ -249,6 +267,12 @@ impl RenderSettings {
         if let Some(omni) = &self.omni {
             omni.check(ctx, lights)?;
         }
+        if self.debug_view == DebugView::TransparencyLayers && self.transparency.is_none() {
+            return Err(SettingsError::LayerViewNeedsTransparency.into());
+        }
+        if let Some(t) = &self.transparency {
+            t.check(ctx, self.width, self.height)?;
+        }
         if self.sun_shadow == SunShadowMode::Compute && self.shading == ShadingModel::BlinnPhong {
             let features = &ctx.info.features;
             let depth = ctx.format_supports(
@@ -291,6 +315,8 @@ pub struct SettingsRequest {
     pub culling: bool,
     pub raster: Raster,
     pub exposure: Exposure,
+    /// How transparent objects are blended, where the scene has any.
+    pub transparency: TransparencySettings,
 }
 
 impl SettingsRequest {
@@ -310,6 +336,7 @@ impl SettingsRequest {
             culling: self.culling,
             raster: self.raster,
             exposure: self.exposure,
+            transparency: scene.has_blended_objects().then_some(self.transparency),
         }
     }
 }

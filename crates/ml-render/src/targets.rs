@@ -3,6 +3,7 @@
 //! their framebuffers over them.
 
 use crate::technique::{Geometry, LightingStage, Raster, Technique};
+use crate::transparency::{LayerBuffers, TransparencySettings};
 use ml_vk::{vk, Buffer, Context, Image, VkError};
 
 /// Size of the biggest image we agree to render, whatever the device allows: 16384² RGBA8 is
@@ -73,6 +74,10 @@ pub enum Output {
     /// A visibility buffer (an id per pixel) and depth, which a compute pass lights
     /// (visibility).
     Visibility,
+    /// Nothing: the transparent objects' fragments go to per-pixel lists (transparency/);
+    /// `depth_buffer`: the opaque depth they are tested against is the compute raster's
+    /// buffer (else the depth target).
+    Layers { depth_buffer: bool },
 }
 
 impl Output {
@@ -90,6 +95,7 @@ impl Output {
         match self {
             Output::Color | Output::Visibility => 1,
             Output::GBuffer | Output::Subpasses => gbuffer.len(),
+            Output::Layers { .. } => 0,
         }
     }
 }
@@ -119,7 +125,8 @@ pub struct Targets {
     pub depth: Image,
     /// Deferred techniques: the scene's G-buffer images (`gbuffer_images`; empty otherwise).
     pub gbuffer: Vec<Image>,
-    /// deferred, deferred-clustered: the lighting subpass's HDR output (null otherwise).
+    /// deferred, deferred-clustered: the lighting subpass's HDR output; forward techniques
+    /// with transparent layers: the forward pass's (null otherwise).
     pub hdr: Image,
     /// visibility: the visibility buffer (null otherwise).
     pub visibility: Image,
@@ -130,6 +137,8 @@ pub struct Targets {
     /// write by atomic min and the depth pyramid and the lighting read (null otherwise; `depth`
     /// and `visibility` are null then).
     pub visibility_depth: Buffer,
+    /// The transparent layers' lists (stand-ins without transparency).
+    pub layers: LayerBuffers,
 }
 
 /// Format of the visibility buffer: the 32-bit id (meshlets.rs).
@@ -168,7 +177,7 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        raster: Raster,
+        (raster, transparency): (Raster, Option<TransparencySettings>),
     ) -> Result<Targets, VkError> {
         let t = Targets {
             color: Image::null(),
@@ -178,8 +187,9 @@ impl Targets {
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
+            layers: LayerBuffers::new(ctx, extent, transparency)?,
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), raster))
+        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, transparency.is_some())))
     }
 
     fn create(
@@ -188,21 +198,25 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        raster: Raster,
+        (raster, layers): (Raster, bool),
     ) -> Result<(), VkError> {
         use vk::ImageUsageFlags as U;
         let colour = vk::ImageAspectFlags::COLOR;
         // The subpass G-buffer never leaves the render pass: TRANSIENT lets a tiler keep it in
         // tile memory (the device still backs it with ordinary memory where it has no lazy kind).
         let inside_pass = U::INPUT_ATTACHMENT | U::TRANSIENT_ATTACHMENT;
+        // With transparent layers, their build samples the opaque depth.
+        let layer_depth = if layers { U::SAMPLED } else { U::empty() };
         let (color_usage, depth_usage, gbuffer_usage) = match output {
             // STORAGE: the shadow-map debug view paints over it with a compute pass.
-            Output::Color => (U::COLOR_ATTACHMENT | U::TRANSFER_SRC | U::STORAGE, U::DEPTH_STENCIL_ATTACHMENT, U::empty()),
+            Output::Color => (U::COLOR_ATTACHMENT | U::TRANSFER_SRC | U::STORAGE, U::DEPTH_STENCIL_ATTACHMENT | layer_depth, U::empty()),
             Output::GBuffer => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::COLOR_ATTACHMENT | U::SAMPLED),
             Output::Subpasses => {
-                (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | inside_pass, U::COLOR_ATTACHMENT | inside_pass)
+                let depth = if layers { U::INPUT_ATTACHMENT | U::SAMPLED } else { inside_pass };
+                (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | depth, U::COLOR_ATTACHMENT | inside_pass)
             }
             Output::Visibility => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::empty()),
+            Output::Layers { .. } => unreachable!("no technique's raster writes only layers"),
         };
         // The compute raster keeps depth and ids in one buffer: no images of them.
         let compute_raster = output == Output::Visibility && raster != Raster::Hardware;
@@ -215,7 +229,7 @@ impl Targets {
                 self.gbuffer.push(Image::new_2d(ctx, g.name, extent, g.format, gbuffer_usage, colour)?);
             }
         }
-        if output == Output::Subpasses {
+        if output == Output::Subpasses || (output == Output::Color && layers) {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
         }
         if output == Output::Visibility {
@@ -251,6 +265,7 @@ impl Targets {
         self.visibility.destroy(ctx);
         self.depth_pyramid.destroy(ctx);
         self.visibility_depth.destroy(ctx);
+        self.layers.destroy(ctx);
     }
 }
 

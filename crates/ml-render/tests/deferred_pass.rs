@@ -33,7 +33,7 @@ fn deferred_pass_has_two_subpasses_joined_by_input_attachments() {
 fn check_two_subpasses(object_textures: bool) {
     let images = gbuffer_images(object_textures);
     assert_eq!(images.len(), if object_textures { 5 } else { 3 });
-    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, images);
+    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, images, false);
     assert_eq!(d.subpasses.len(), 2);
     let (gbuffer, lighting) = (&d.subpasses[0], &d.subpasses[1]);
     // Subpass 1 reads exactly what subpass 0 wrote: its colour attachments and its depth.
@@ -75,7 +75,7 @@ fn lighting_shaders_load_the_gbuffer_as_input_attachments() {
         ("deferred_textured.frag", DEFERRED_TEXTURED_FRAG, true),
         ("deferred_clustered_textured.frag", DEFERRED_CLUSTERED_TEXTURED_FRAG, true),
     ] {
-        let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(object_textures));
+        let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(object_textures), false);
         let inputs = d.subpasses[1].inputs.len() as u32;
         let words: Vec<u32> = spirv.spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         let entries = ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().expect("reflect");

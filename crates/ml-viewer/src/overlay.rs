@@ -33,6 +33,8 @@ pub struct Choices {
     pub raster: Raster,
     /// Exposure: an EV, or auto (metered each frame, smoothed over frames).
     pub exposure: Exposure,
+    /// The scene's transparent layers (None: it has no transparent objects).
+    pub transparency: Option<ml_render::TransparencySettings>,
 }
 
 impl Choices {
@@ -57,6 +59,7 @@ impl Choices {
             sun_shadow: settings.sun_shadow,
             raster: settings.raster,
             exposure: settings.exposure,
+            transparency: settings.transparency,
         }
     }
 
@@ -94,6 +97,7 @@ impl Choices {
             // Other techniques have no visibility buffer to draw.
             raster: if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware },
             exposure: self.exposure,
+            transparency: self.transparency,
         }
     }
 }
@@ -277,6 +281,7 @@ mod tests {
             sun_shadow: SunShadowMode::Graphics,
             raster: Raster::Hardware,
             exposure: Exposure::Ev(0.0),
+            transparency: None,
         }
     }
 

@@ -15,14 +15,16 @@ use ml_vk::{vk, Context, VkError};
 
 pub struct ComputeLighting {
     pass: ComputePass,
+    /// It blends the transparent layers.
+    layers: bool,
 }
 
 impl ComputeLighting {
     pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading) -> Result<ComputeLighting, VkError> {
         // Set 1: the scene's textures (blinn-phong's shadow map and sky, the shadow cubes).
-        let model = shading.lighting_constants();
+        let model = shading.layered_lighting_constants();
         let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (&ml_shaders::DEFERRED_LIGHTING_COMP, &model))?;
-        Ok(ComputeLighting { pass })
+        Ok(ComputeLighting { pass, layers: shading.transparency })
     }
 }
 
@@ -53,6 +55,9 @@ impl Pass for ComputeLighting {
     /// After the G-buffer pass, the cluster build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
+        if self.layers {
+            uses.extend(crate::transparency::layer_reads(vk::PipelineStageFlags::COMPUTE_SHADER));
+        }
         uses.push(ComputePass::colour_use());
         uses
     }

@@ -17,6 +17,8 @@ pub struct Forward {
     /// Draws the cluster-heat legend over the image (debug view cluster-heat; else null).
     legend: vk::Pipeline,
     name: &'static str,
+    /// It writes linear HDR for the transparent layers' resolve instead of the colour target.
+    layers: bool,
 }
 
 impl Forward {
@@ -32,7 +34,7 @@ impl Forward {
         let fragment = if clustered { &ml_shaders::CLUSTERED_FRAG } else { &ml_shaders::FORWARD_FRAG };
         let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
         let raster = MeshRaster::new(ctx, (depth_format, Output::Color, &[]), (fragment, shading, &scene.surface_variants), layouts)?;
-        let mut pass = Forward { raster, legend: vk::Pipeline::null(), name };
+        let mut pass = Forward { raster, legend: vk::Pipeline::null(), name, layers: shading.transparency };
         if legend {
             let shaders = (&ml_shaders::HEAT_LEGEND_VERT, &ml_shaders::HEAT_LEGEND_FRAG);
             match pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.raster.pipeline_layout, 0), &[]) {
@@ -59,13 +61,17 @@ impl Pass for Forward {
     /// The colour target is its render pass's attachment: the pass's external dependencies
     /// order it after the transfers that read it last (the read-back, a window's blit) and
     /// before the transfers after it, and its final layout is TRANSFER_SRC_OPTIMAL
-    /// (render_pass.rs).
+    /// (render_pass.rs). With transparent layers it writes the HDR image instead, which only
+    /// the resolve after it reads (ordered by the render pass's dependencies likewise).
     fn uses(&self) -> Vec<Use> {
         let attachments = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
             | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
             | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let mut uses = shading_reads(vk::PipelineStageFlags::FRAGMENT_SHADER);
+        if self.layers {
+            return uses;
+        }
         uses.push(Use {
             name: COLOUR_TARGET,
             entry: Entry::Chained { stages: attachments | transfer },

@@ -3,7 +3,7 @@
 //! and framebuffer, and the recording of every object with its push constants. Each pass adds
 //! what is its own (the heat legend, the lighting subpass).
 
-use crate::descriptors::FrameSets;
+use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::gpu_mesh::{record_draws, vertex_attributes, vertex_binding};
@@ -39,6 +39,9 @@ pub struct MeshRaster {
     framebuffers: Vec<vk::Framebuffer>,
     pub output: Output,
     pub gbuffer: &'static [GBufferImage],
+    /// The scene's transparent objects are blended in layers: the opaque passes skip them and
+    /// the forward pass writes linear HDR (else they are drawn as masks with the rest).
+    layers: bool,
 }
 
 impl MeshRaster {
@@ -59,20 +62,24 @@ impl MeshRaster {
             framebuffers: vec![vk::Framebuffer::null(); FRAMES_IN_FLIGHT],
             output,
             gbuffer,
+            layers: shading.transparency,
         };
         let made = (|| {
-            r.render_pass = render_pass::describe(depth_format, output, gbuffer).create(ctx)?;
+            r.render_pass = render_pass::describe(depth_format, output, gbuffer, shading.transparency).create(ctx)?;
             let push = [vk::PushConstantRange::default()
                 .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
                 .size(std::mem::size_of::<ObjectPush>() as u32)];
             r.pipeline_layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw, textures_layout, object_textures_layout], &push)?;
             // Drawn into the colour target, meshes are lit where they are drawn; into a
             // G-buffer, only their surfaces are read.
+            // Into the transparent layers, only their surfaces, unlit.
             let constants = match output {
-                Output::Color => shading.lighting_constants().to_vec(),
+                Output::Color => shading.layered_lighting_constants().to_vec(),
+                Output::Layers { .. } => [&shading.surface_constants()[..], &[("TRANSPARENT_LAYERS", 1)]].concat(),
                 _ => shading.surface_constants().to_vec(),
             };
-            for &v in variants.iter().chain([&SurfaceVariant::OPAQUE]) {
+            let drawn: Vec<SurfaceVariant> = variants.iter().chain([&SurfaceVariant::OPAQUE]).map(|&v| r.drawn_as(v)).collect();
+            for v in drawn {
                 if r.pipelines[v.index()] == vk::Pipeline::null() {
                     r.pipelines[v.index()] =
                         r.pipeline(ctx, (&ml_shaders::FORWARD_VERT, fragment), Draw::Mesh(v), (r.pipeline_layout, 0), &constants)?;
@@ -86,6 +93,25 @@ impl MeshRaster {
                 r.destroy(ctx);
                 Err(e)
             }
+        }
+    }
+
+    /// How this pass draws an object of variant `v`: transparent layers are not cut by their
+    /// alpha but weighted by it.
+    fn drawn_as(&self, v: SurfaceVariant) -> SurfaceVariant {
+        match self.output {
+            Output::Layers { .. } => SurfaceVariant { masked: false, ..v },
+            _ => v,
+        }
+    }
+
+    /// Whether this pass draws `o`: the transparent layers' build only the transparent
+    /// objects; with layers, the opaque passes all others; without, every object.
+    fn draws(&self, o: &ml_cpu::scene::Object) -> bool {
+        let blended = o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend;
+        match self.output {
+            Output::Layers { .. } => blended,
+            _ => !(self.layers && blended),
         }
     }
 
@@ -119,9 +145,11 @@ impl MeshRaster {
             })
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
+        // The layers' build has no depth attachment (it compares the opaque depth itself).
+        let depth = mesh && !matches!(self.output, Output::Layers { .. });
         let depth_stencil = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(mesh)
-            .depth_write_enable(mesh)
+            .depth_test_enable(depth)
+            .depth_write_enable(depth)
             .depth_compare_op(vk::CompareOp::LESS);
         let mut constants = constants.to_vec();
         if let Draw::Mesh(v) = draw {
@@ -149,13 +177,27 @@ impl MeshRaster {
     /// Slot `frame.slot`'s framebuffer over `frame.targets` (attachment order: render_pass.rs)
     /// and its set 0.
     pub fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        self.sets.write(ctx, frame.slot, &|name| frame.buffer(name))?;
+        self.bind_frame_with(ctx, frame, &|_| None)
+    }
+
+    /// `bind_frame`, with set-0 resources of the pass's own that `extra` names (images).
+    pub fn bind_frame_with(
+        &mut self,
+        ctx: &Context,
+        frame: &FrameResources,
+        extra: &dyn Fn(&str) -> Option<Resource>,
+    ) -> Result<(), VkError> {
+        self.sets.write(ctx, frame.slot, &|name| extra(name).or_else(|| frame.buffer(name)))?;
         let t = frame.targets;
         let mut views: Vec<vk::ImageView> = match self.output {
+            Output::Color if self.layers => vec![t.hdr.view],
             Output::Color => vec![t.color.view],
+            Output::Layers { .. } => Vec::new(),
             _ => t.gbuffer.iter().map(|g| g.view).collect(),
         };
-        views.push(t.depth.view);
+        if !matches!(self.output, Output::Layers { .. }) {
+            views.push(t.depth.view);
+        }
         if self.output == Output::Subpasses {
             views.push(t.hdr.view);
         }
@@ -163,8 +205,8 @@ impl MeshRaster {
     }
 
     /// Begin the render pass (colour to the background, the G-buffer to zeros, depth to the far
-    /// plane, HDR to alpha 0 — "no object here", see tonemap.comp) and draw every object with its
-    /// push constants; the caller records the rest and ends the pass.
+    /// plane, HDR to alpha 0 — "no object here", see tonemap.comp) and draw every object it
+    /// draws (`draws`) with its push constants; the caller records the rest and ends the pass.
     pub fn begin_and_draw_meshes(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let d = &ctx.device;
@@ -172,10 +214,14 @@ impl MeshRaster {
         let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
         let mut clear: Vec<vk::ClearValue> = match self.output {
+            Output::Color if self.layers => vec![zero],
             Output::Color | Output::Visibility => vec![colour],
             Output::GBuffer | Output::Subpasses => vec![zero; self.gbuffer.len()],
+            Output::Layers { .. } => Vec::new(),
         };
-        clear.push(depth);
+        if !matches!(self.output, Output::Layers { .. }) {
+            clear.push(depth);
+        }
         if self.output == Output::Subpasses {
             clear.push(zero);
         }
@@ -205,9 +251,9 @@ impl MeshRaster {
                 ctx,
                 cmd,
                 (&scene.meshes, rec.objects),
-                |_| 1,
+                |index| u32::from(self.draws(&rec.objects[index as usize])),
                 |index, o| {
-                    let variant = SurfaceVariant::of(o);
+                    let variant = self.drawn_as(SurfaceVariant::of(o));
                     if variant != bound_variant {
                         // Made for every variant the scene's objects have (SceneGpu refuses
                         // replaced objects of another).

@@ -21,6 +21,8 @@ pub struct Shading {
     pub shadow_atlas: bool,
     pub object_textures: bool,
     pub spot_lights: bool,
+    /// Transparent objects are blended in per-pixel layers (the opaque passes skip them).
+    pub transparency: bool,
 }
 
 impl Shading {
@@ -48,5 +50,13 @@ impl Shading {
             ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
             ("SPOT_LIGHTS", u32::from(self.spot_lights)),
         ]
+    }
+
+    /// `lighting_constants` and `TRANSPARENT_LAYERS` (transparency/layers.glsl), for the
+    /// passes that leave the image to the transparent layers: the compute lighting passes
+    /// blend them where they shade, the forward pass then writes linear HDR for a resolve.
+    pub fn layered_lighting_constants(self) -> [(&'static str, u32); 7] {
+        let [a, b, c, d, e, f] = self.lighting_constants();
+        [a, b, c, d, e, f, ("TRANSPARENT_LAYERS", u32::from(self.transparency))]
     }
 }

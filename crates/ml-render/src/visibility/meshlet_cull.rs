@@ -44,7 +44,13 @@ pub struct MeshletCull {
 }
 
 impl MeshletCull {
-    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, (culling, raster): (bool, Raster)) -> Result<MeshletCull, VkError> {
+    /// `layers`: the transparent objects are blended in layers, not drawn into the buffer.
+    pub fn new(
+        ctx: &Context,
+        scene: SharedMeshletScene,
+        phase: Phase,
+        (culling, raster, layers): (bool, Raster, bool),
+    ) -> Result<MeshletCull, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
         // Scenes with masked objects get the compute raster that draws their pixels from
         // shared memory (its shared memory would cost the others occupancy).
@@ -69,7 +75,8 @@ impl MeshletCull {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             if phase == Phase::Early {
-                p.instance_pipeline = compute_pipeline(ctx, &ml_shaders::INSTANCE_CULL_COMP, p.pipeline_layout, &[])?;
+                let skip = [("SKIP_BLENDED", u32::from(layers))];
+                p.instance_pipeline = compute_pipeline(ctx, &ml_shaders::INSTANCE_CULL_COMP, p.pipeline_layout, &skip)?;
             }
             p.meshlet_pipeline = compute_pipeline(ctx, &ml_shaders::MESHLET_CULL_COMP, p.pipeline_layout, &[])?;
             // Only the compute raster's triangle pass draws, so only it tests surfaces: the
@@ -201,7 +208,7 @@ impl Pass for MeshletCull {
         }
     }
 
-    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
+    fn collect(&self, slot: usize, _: &crate::targets::Targets, _: &mut SlotReport, stats: &mut FrameStats) {
         if self.phase != Phase::Late {
             return;
         }

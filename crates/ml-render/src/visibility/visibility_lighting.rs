@@ -18,6 +18,8 @@ pub struct VisibilityLighting {
     scene: SharedMeshletScene,
     /// It reads the compute raster's 64-bit buffer (else the raster's images).
     from_buffer: bool,
+    /// It blends the transparent layers.
+    layers: bool,
 }
 
 impl VisibilityLighting {
@@ -29,11 +31,11 @@ impl VisibilityLighting {
         (scene, from_buffer): (SharedMeshletScene, bool),
         shading: Shading,
     ) -> Result<VisibilityLighting, VkError> {
-        let model = shading.lighting_constants();
+        let model = shading.layered_lighting_constants();
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
         let shader = if from_buffer { &ml_shaders::VISIBILITY_LIGHTING_BUFFER_COMP } else { &ml_shaders::VISIBILITY_LIGHTING_COMP };
         let pass = ComputePass::with_push(ctx, &more_sets, (shader, &model), 16)?;
-        Ok(VisibilityLighting { pass, scene, from_buffer })
+        Ok(VisibilityLighting { pass, scene, from_buffer, layers: shading.transparency })
     }
 }
 
@@ -55,6 +57,9 @@ impl Pass for VisibilityLighting {
     /// After the late raster, the cluster build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
+        if self.layers {
+            uses.extend(crate::transparency::layer_reads(vk::PipelineStageFlags::COMPUTE_SHADER));
+        }
         uses.push(ComputePass::colour_use());
         if self.from_buffer {
             uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));

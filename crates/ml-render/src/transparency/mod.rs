@@ -1,0 +1,193 @@
+//! Transparency (glTF `alphaMode: BLEND`): the transparent objects' fragments in front of the
+//! opaque surfaces kept per pixel in linked lists (`transparent_build`), then lit and blended
+//! back to front where each pixel is finally shaded — fused into the compute lighting passes
+//! (deferred-compute, visibility), or a pass of its own over the opaque HDR image (forward and
+//! deferred techniques, `transparent_resolve`). The rule a pixel follows, and its reference,
+//! is ml-cpu `transparency`; the shaders are under `shaders/transparency/`.
+//!
+//! Memory is a fixed budget set by an option: a pool of nodes, `budget` per pixel on average,
+//! and a head per pixel. What does not fit is counted and reported, never silently lost:
+//! fragments that find the pool full are dropped, and pixels with more than `LAYER_KEEP`
+//! layers merge their farthest ones (`TransparencyStats`).
+
+pub mod transparent_build;
+pub mod transparent_resolve;
+
+use crate::error::{RenderError, Setting, SettingsError};
+use crate::report::FeatureStats;
+use crate::sync::Use;
+use ml_vk::{vk, Buffer, Context, VkError};
+
+/// A list's end (layers.glsl LAYER_END): what the heads are cleared to.
+pub const LAYER_END: u32 = 0xffff_ffff;
+/// Bytes of a node: two uvec4 (layers.glsl).
+pub const NODE_BYTES: u64 = 32;
+/// Layers a pixel blends exactly (layers.glsl LAYER_KEEP); farther ones are merged.
+pub const LAYER_KEEP: u32 = 32;
+/// Nodes per pixel on average, unless the option says otherwise.
+pub const DEFAULT_BUDGET: u32 = 4;
+/// The most nodes per pixel the option takes.
+pub const MAX_BUDGET: u32 = 256;
+
+/// The shaders' names of the per-frame buffers: heads, nodes, counters.
+pub const LAYER_BUFFERS: [&str; 3] = ["TransparentHeadBuffer", "TransparentNodeBuffer", "TransparentCountBuffer"];
+
+/// How transparent objects are drawn: the node pool's size, in nodes per pixel on average.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TransparencySettings {
+    pub budget: u32,
+}
+
+impl Default for TransparencySettings {
+    fn default() -> Self {
+        TransparencySettings { budget: DEFAULT_BUDGET }
+    }
+}
+
+impl TransparencySettings {
+    /// Nodes of the pool at `width`×`height`.
+    pub fn nodes(&self, width: u32, height: u32) -> u64 {
+        width as u64 * height as u64 * self.budget as u64
+    }
+
+    /// The budget in range, and the pool one storage buffer the device binds.
+    pub fn check(&self, ctx: &Context, width: u32, height: u32) -> Result<(), RenderError> {
+        if self.budget == 0 || self.budget > MAX_BUDGET {
+            return Err(SettingsError::OutOfRange { what: Setting::TransparencyBudget, value: self.budget, max: MAX_BUDGET }.into());
+        }
+        let bytes = self.nodes(width, height) * NODE_BYTES;
+        let max = ctx.info.limits.max_storage_buffer_range;
+        if bytes > max as u64 {
+            let budget = self.budget;
+            return Err(SettingsError::TransparencyPool { budget, width, height, bytes, device: ctx.info.name.clone(), max }.into());
+        }
+        Ok(())
+    }
+}
+
+/// A frame slot's lists: heads, node pool, counters (host-visible: the build pass reads them
+/// when the frame is done). Without transparency, 16-byte stand-ins for the lighting
+/// passes' bindings, which their shaders then never read.
+pub struct LayerBuffers {
+    pub heads: Buffer,
+    pub nodes: Buffer,
+    pub counts: Buffer,
+}
+
+impl LayerBuffers {
+    pub fn new(ctx: &Context, extent: vk::Extent2D, settings: Option<TransparencySettings>) -> Result<LayerBuffers, VkError> {
+        let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null() };
+        ml_vk::build(ctx, b, |b| {
+            use gpu_allocator::MemoryLocation as M;
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let (heads, nodes) = match settings {
+                Some(s) => (extent.width as u64 * extent.height as u64 * 4, s.nodes(extent.width, extent.height) * NODE_BYTES),
+                None => (16, NODE_BYTES),
+            };
+            b.heads = Buffer::new(ctx, "transparent heads", heads, usage, M::GpuOnly)?;
+            b.nodes = Buffer::new(ctx, "transparent nodes", nodes, usage, M::GpuOnly)?;
+            b.counts = Buffer::new(ctx, "transparent counters", 16, usage, M::GpuToCpu)?;
+            Ok(())
+        })
+    }
+
+    /// The buffers under their shader names.
+    pub fn named(&self) -> [(&'static str, vk::Buffer); 3] {
+        [(LAYER_BUFFERS[0], self.heads.raw), (LAYER_BUFFERS[1], self.nodes.raw), (LAYER_BUFFERS[2], self.counts.raw)]
+    }
+
+    /// Nodes in the pool.
+    pub fn capacity(&self) -> u64 {
+        self.nodes.size / NODE_BYTES
+    }
+
+    /// The counters as the slot's last frame left them: nodes asked for, pixels that merged.
+    pub fn counts(&self) -> [u32; 2] {
+        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counts.mapped()[..16]);
+        [c[0], c[1]]
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.heads.destroy(ctx);
+        self.nodes.destroy(ctx);
+        self.counts.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for LayerBuffers {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
+
+/// How a pass that blends the layers uses the lists (`Pass::uses`): reads heads and nodes,
+/// counts merged pixels.
+pub fn layer_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
+    let read = (stages, vk::AccessFlags::SHADER_READ);
+    vec![
+        Use::at(LAYER_BUFFERS[0], read, None),
+        Use::at(LAYER_BUFFERS[1], read, None),
+        Use::at(LAYER_BUFFERS[2], (stages, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE), None),
+    ]
+}
+
+/// The counters as the host reads them once the frame is done (after every pass).
+pub fn counts_to_host() -> Use {
+    Use::at(LAYER_BUFFERS[2], (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ), None)
+}
+
+/// The transparent layers of the last frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TransparencyStats {
+    /// Transparent fragments in front of the opaque surfaces (kept or dropped).
+    pub fragments: u64,
+    /// Nodes the pool holds.
+    pub capacity: u64,
+    /// Pixels of the image.
+    pub pixels: u64,
+    /// Pixels with more than `LAYER_KEEP` layers, whose farthest ones were merged.
+    pub merged_pixels: u64,
+}
+
+impl TransparencyStats {
+    /// Fragments the full pool dropped.
+    pub fn dropped(&self) -> u64 {
+        self.fragments.saturating_sub(self.capacity)
+    }
+
+    /// Bytes per pixel of the lists (heads and the pool).
+    pub fn bytes_per_pixel(&self) -> f64 {
+        4.0 + (self.capacity * NODE_BYTES) as f64 / self.pixels.max(1) as f64
+    }
+
+    /// Whether something was dropped or merged (the frame is not exact).
+    pub fn overflowed(&self) -> bool {
+        self.dropped() > 0 || self.merged_pixels > 0
+    }
+}
+
+impl FeatureStats for TransparencyStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let s = self;
+        vec![
+            (
+                "transparent layers",
+                format!(
+                    "{} fragments ({:.2} a pixel), pool {} nodes ({:.0} B/pixel with heads)",
+                    s.fragments,
+                    s.fragments as f64 / s.pixels.max(1) as f64,
+                    s.capacity,
+                    s.bytes_per_pixel()
+                ),
+            ),
+            (
+                "transparent overflow",
+                format!(
+                    "{} fragments dropped (pool full), {} pixels merged layers beyond the nearest {LAYER_KEEP}",
+                    s.dropped(),
+                    s.merged_pixels
+                ),
+            ),
+        ]
+    }
+}

@@ -1,0 +1,208 @@
+//! Transparency (glTF `alphaMode: BLEND`): transparent surfaces lit by the same lights as the
+//! opaque ones and blended back to front per pixel, in every technique.
+//!
+//! - three overlapping coloured glass quads in front of a lit wall, under point lights: every
+//!   technique's image equals a CPU reference — each surface the pixel's ray meets shaded by
+//!   the seed model's CPU reference (`shade_seed`), the glass layers blended over the wall by
+//!   `ml_cpu::transparency::composite` — within 2/255, but at counted edge pixels (where the
+//!   ray of a neighbouring pixel meets another set of surfaces);
+//! - the order in which the quads are listed does not change a byte (all six orders);
+//! - a budget smaller than the depth complexity drops fragments and says how many; more
+//!   layers than a pixel blends exactly are merged and counted.
+
+mod common;
+
+use glam::{Mat4, Quat, Vec3};
+use ml_cpu::camera::Camera;
+use ml_cpu::gpu_types::PointLight;
+use ml_cpu::material::Material;
+use ml_cpu::mesh::MeshKind;
+use ml_cpu::scene::{AlphaMode, Object, Scene};
+use ml_cpu::shading::{encode_gamma_unorm8, shade_seed};
+use ml_cpu::transparency::{composite, Layer};
+use ml_render::{Raster, RenderOutput, RenderSettings, Technique, TransparencySettings, TransparencyStats, LAYER_KEEP};
+
+const W: u32 = 160;
+const H: u32 = 120;
+/// Allowed difference from the reference, in 8-bit steps.
+const MAX_DIFF: u8 = 2;
+/// Most edge pixels an image may have beyond the tolerance (quad borders: a pixel whose
+/// neighbour's ray meets another set of surfaces).
+const MAX_EDGE_PIXELS: usize = 400;
+
+/// A quad facing +Z (the camera): the plane mesh (±1 in x and z, normal +Y) stood up, centred
+/// at `at`, `half` to each side.
+fn quad(at: Vec3, half: (f32, f32), albedo: [f32; 3], alpha: Option<f32>) -> Object {
+    let rotation = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let mut o = Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, Material { albedo: Vec3::from(albedo), roughness: 0.6, metallic: 0.0 });
+    o.transform = Mat4::from_scale_rotation_translation(Vec3::new(half.0, 1.0, half.1), rotation, at);
+    if let Some(a) = alpha {
+        o.extras.alpha_mode = AlphaMode::Blend;
+        o.extras.base_alpha = a;
+    }
+    o
+}
+
+fn light(p: [f32; 3], radius: f32, c: [f32; 3]) -> PointLight {
+    PointLight { position_radius: [p[0], p[1], p[2], radius], color: [c[0], c[1], c[2], 0.0] }
+}
+
+/// The three glass quads (red, green, blue; alpha 0.5, 0.4, 0.6), overlapping in the middle.
+fn glass() -> [Object; 3] {
+    [
+        quad(Vec3::new(-0.5, 0.3, 0.9), (1.0, 0.8), [0.9, 0.15, 0.1], Some(0.5)),
+        quad(Vec3::new(0.45, 0.2, 0.6), (0.9, 1.0), [0.1, 0.85, 0.2], Some(0.4)),
+        quad(Vec3::new(0.0, -0.45, 0.3), (1.2, 0.7), [0.15, 0.2, 0.95], Some(0.6)),
+    ]
+}
+
+/// The wall at z = 0 behind them, filling the view, then the glass in `order`, lit by
+/// four lights in front (one of them crossing the glass).
+fn scene(order: [usize; 3]) -> Scene {
+    let panes = glass();
+    let mut objects = vec![quad(Vec3::ZERO, (6.0, 6.0), [0.8, 0.75, 0.7], None)];
+    objects.extend(order.iter().map(|&i| panes[i]));
+    let lights = vec![
+        light([1.5, 1.2, 2.0], 5.0, [1.0, 0.9, 0.8]),
+        light([-1.8, -0.6, 1.6], 4.0, [0.6, 0.7, 1.0]),
+        light([0.2, 0.1, 0.7], 1.5, [1.0, 0.6, 0.3]),
+        light([0.0, -1.5, 3.0], 5.0, [0.5, 0.5, 0.5]),
+    ];
+    let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 50.0, 0.1, 20.0);
+    let mut s = Scene::new(objects, lights, camera);
+    s.light_motion = 0.0;
+    s
+}
+
+/// Where the ray (o, d) meets the quad `q` (facing +Z): the distance along it.
+fn hit(q: &Object, (o, d): (Vec3, Vec3)) -> Option<f32> {
+    let at = q.position();
+    let half = (q.transform.x_axis.length(), q.transform.z_axis.length());
+    let t = (at.z - o.z) / d.z;
+    let p = o + d * t;
+    (t > 0.0 && (p.x - at.x).abs() <= half.0 && (p.y - at.y).abs() <= half.1).then_some(t)
+}
+
+/// The surfaces a pixel's ray meets: the objects' indices.
+fn met(scene: &Scene, x: u32, y: u32) -> Vec<usize> {
+    let ray = scene.camera.pixel_ray(x, y, W, H);
+    (0..scene.objects.len()).filter(|&i| hit(&scene.objects[i], ray).is_some()).collect()
+}
+
+/// The CPU reference image: each surface the ray meets shaded, the glass blended over the wall.
+fn reference(scene: &Scene) -> Vec<[u8; 3]> {
+    let eye = scene.camera.position;
+    let mut out = Vec::new();
+    for y in 0..H {
+        for x in 0..W {
+            let ray = scene.camera.pixel_ray(x, y, W, H);
+            let shade = |o: &Object, t: f32| shade_seed(ray.0 + ray.1 * t, Vec3::Z, eye, &o.material, &scene.lights, scene.ambient);
+            let wall = &scene.objects[0];
+            let under = hit(wall, ray).map(|t| shade(wall, t)).expect("the wall fills the view");
+            let layers: Vec<Layer> = (1..scene.objects.len())
+                .filter_map(|i| {
+                    let o = &scene.objects[i];
+                    hit(o, ray).map(|t| Layer { depth: t, id: i as u32, color: shade(o, t), alpha: o.extras.base_alpha })
+                })
+                .collect();
+            out.push(encode_gamma_unorm8(composite(under, &layers, LAYER_KEEP as usize).color));
+        }
+    }
+    out
+}
+
+/// Whether pixel (x, y)'s neighbours' rays meet other surfaces than its own.
+fn edge(scene: &Scene, x: u32, y: u32) -> bool {
+    let own = met(scene, x, y);
+    (-1i32..=1).any(|dy| {
+        (-1i32..=1).any(|dx| {
+            let (nx, ny) = (x as i32 + dx, y as i32 + dy);
+            (0..W as i32).contains(&nx) && (0..H as i32).contains(&ny) && met(scene, nx as u32, ny as u32) != own
+        })
+    })
+}
+
+fn settings(technique: Technique) -> RenderSettings {
+    let mut s = RenderSettings::new(technique, W, H);
+    s.transparency = Some(TransparencySettings::default());
+    if technique == Technique::Visibility {
+        s.raster = Raster::compute(Raster::DEFAULT_SPLIT);
+    }
+    s
+}
+
+fn stats(out: &RenderOutput) -> TransparencyStats {
+    *out.stats.feature::<TransparencyStats>().expect("the layers' figures")
+}
+
+#[test]
+fn glass_over_a_wall_equals_the_cpu_blend_in_every_technique() {
+    let scene = scene([0, 1, 2]);
+    let want = reference(&scene);
+    let mut all: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| settings(t)).collect();
+    all.push(RenderSettings { raster: Raster::Hardware, ..settings(Technique::Visibility) });
+    let outs = common::render_each(&scene, &all);
+    for (s, out) in all.iter().zip(&outs) {
+        let (mut edges, mut worst) = (0, 0u8);
+        for y in 0..H {
+            for x in 0..W {
+                let got = common::pixel(out, x, y);
+                let w = want[(y * W + x) as usize];
+                let d = (0..3).map(|c| got[c].abs_diff(w[c])).max().unwrap();
+                if d > MAX_DIFF {
+                    assert!(
+                        edge(&scene, x, y),
+                        "{} ({}): pixel ({x}, {y}) is {got:?}, the CPU blend {w:?}",
+                        s.technique.name(),
+                        s.raster.name()
+                    );
+                    edges += 1;
+                } else {
+                    worst = worst.max(d);
+                }
+            }
+        }
+        assert!(edges <= MAX_EDGE_PIXELS, "{}: {edges} edge pixels differ", s.technique.name());
+        let st = stats(out);
+        assert!(!st.overflowed(), "{}: {st:?}", s.technique.name());
+        assert!(st.fragments > (W * H / 2) as u64, "{}: only {} transparent fragments", s.technique.name(), st.fragments);
+        println!(
+            "{} ({}): {edges} edge pixels beyond {MAX_DIFF}/255, others within {worst}/255; {st:?}",
+            s.technique.name(),
+            s.raster.name()
+        );
+    }
+}
+
+#[test]
+fn the_order_the_quads_are_listed_in_changes_nothing() {
+    let orders = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+    for technique in [Technique::Forward, Technique::DeferredCompute, Technique::Visibility] {
+        let outs: Vec<RenderOutput> = orders.iter().map(|&o| common::render(scene(o), settings(technique))).collect();
+        for (o, out) in orders.iter().zip(&outs).skip(1) {
+            assert!(out.rgba == outs[0].rgba, "{}: the order {o:?} gives another image", technique.name());
+        }
+    }
+}
+
+#[test]
+fn a_budget_below_the_depth_complexity_is_reported() {
+    // 40 faint panes, one behind the other over a third of the image: more layers than a pixel
+    // blends exactly (merged beyond the nearest 32), and more fragments than a budget of one
+    // node per pixel holds (dropped).
+    let mut deep = scene([0, 1, 2]);
+    deep.objects.truncate(1);
+    for i in 0..40 {
+        deep.objects.push(quad(Vec3::new(0.0, 0.0, 0.05 + 0.05 * i as f32), (0.8, 0.8), [0.5, 0.5, 0.9], Some(0.1)));
+    }
+    let mut s = settings(Technique::DeferredCompute);
+    s.transparency = Some(TransparencySettings { budget: 1 });
+    let st = stats(&common::render(deep.clone(), s));
+    assert!(st.dropped() > 0 && st.overflowed(), "{st:?}");
+    assert_eq!(st.capacity, (W * H) as u64);
+    let mut s = settings(Technique::Visibility);
+    s.transparency = Some(TransparencySettings { budget: 16 });
+    let st = stats(&common::render(deep, s));
+    assert_eq!(st.dropped(), 0, "{st:?}");
+    assert!(st.merged_pixels > 100, "{st:?}");
+}
