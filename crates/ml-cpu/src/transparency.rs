@@ -102,9 +102,10 @@ pub fn add_glass_layers(scene: &mut Scene, count: u32, aspect: f32) {
         let distance = first + (last - first) * t;
         // Room to spare: the view's half height and width at that distance, by 1.5.
         let (half_h, half_w) = (distance * half_tan * 1.5, distance * half_tan * aspect * 1.5);
-        let hue = i as f32 * 0.61803;
-        let albedo =
-            Vec3::new(0.5 + 0.5 * (hue * 6.283).cos(), 0.5 + 0.5 * (hue * 6.283 + 2.094).cos(), 0.5 + 0.5 * (hue * 6.283 + 4.189).cos());
+        // Tints around the colour wheel, a golden-ratio step apart.
+        let hue = i as f32 * 0.618_034 * std::f32::consts::TAU;
+        let third = std::f32::consts::TAU / 3.0;
+        let albedo = Vec3::new(hue.cos(), (hue + third).cos(), (hue + 2.0 * third).cos()) * 0.5 + 0.5;
         let mut pane = Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, Material { albedo, roughness: 0.5, metallic: 0.0 });
         pane.transform =
             Mat4::from_scale_rotation_translation(Vec3::new(half_w, 1.0, half_h), rotation, camera.position + forward * distance);
