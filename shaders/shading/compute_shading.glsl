@@ -1,13 +1,18 @@
-// The end of both compute lighting passes (deferred_lighting.comp from the G-buffer,
-// visibility_lighting.comp from the visibility buffer): a surface point shaded — or shown
-// by a surface debug view — and stored. Needs lighting.glsl and `out_image`.
+// The end of both compute lighting passes (deferred_lighting.glsl from the G-buffer,
+// visibility_lighting.glsl from the visibility buffer): a surface point shaded — or shown
+// by a surface debug view — and stored into `out_image`: the colour target, or with
+// LINEAR_OUTPUT (scenes with transparent layers) linear HDR with alpha 1 where a surface is
+// and 0 for the background, which the transparent resolve blends the layers over and
+// encodes. Needs lighting.glsl.
 
 #ifndef MANYLIGHTS_COMPUTE_SHADING_GLSL
 #define MANYLIGHTS_COMPUTE_SHADING_GLSL
 
-// The transparent layers, blended where the pixel is shaded (TRANSPARENT_LAYERS).
-#define LAYER_BINDING 20
-#include "transparency/layers.glsl"
+#ifdef LINEAR_OUTPUT
+layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D out_image;
+#else
+layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
+#endif
 
 // `object_flags`: the object's OBJECT_* bits (the alpha debug view).
 void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags) {
@@ -17,12 +22,20 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m,
         return;
     }
     color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
-    imageStore(out_image, p, layered_output(p, frag_xy, color, false, frame.exposure.x));
+#ifdef LINEAR_OUTPUT
+    imageStore(out_image, p, vec4(color, 1.0));
+#else
+    imageStore(out_image, p, vec4(encode_output(color, frame.exposure.x), 1.0));
+#endif
 }
 
-// A pixel no opaque surface covers: the background, under the transparent layers.
+// A pixel no opaque surface covers.
 void store_background(ivec2 p) {
-    imageStore(out_image, p, layered_output(p, vec2(p) + 0.5, vec3(0.0), true, frame.exposure.x));
+#ifdef LINEAR_OUTPUT
+    imageStore(out_image, p, vec4(0.0));
+#else
+    imageStore(out_image, p, CLEAR_COLOR);
+#endif
 }
 
 #endif

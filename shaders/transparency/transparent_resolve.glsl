@@ -1,8 +1,7 @@
-// The transparent resolve of the forward and deferred techniques: their opaque pass left
-// linear HDR (alpha 0 where no surface is); per pixel the transparent layers are lit and
-// blended over it back to front (layers.glsl) and the result encoded into the colour target,
-// as tonemap.comp would have. The compute lighting techniques blend in their lighting pass.
-// The includer defines CLUSTERED where the technique has cluster lists.
+// The transparent resolve: the opaque pass left linear HDR (alpha 0 where no surface is);
+// per pixel the transparent layers are lit and blended over it back to front (layers.glsl)
+// and the result encoded into the colour target, as tonemap.comp would have. The includer
+// defines CLUSTERED where the technique has cluster lists.
 #include "common/common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -18,7 +18,6 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 // Every mesh's vertices (geometry.rs Vertex: position, normal, uv, tangent; 12 floats).
 layout(std430, set = 0, binding = 13) readonly buffer VertexBuffer { float vertex_data[]; };
 layout(std430, set = 0, binding = 14) readonly buffer MeshletVertexBuffer { uint meshlet_vertices[]; };

@@ -100,15 +100,16 @@ pub fn add_glass_layers(scene: &mut Scene, count: u32, aspect: f32) {
     for i in 0..count.min(MAX_GLASS_LAYERS) {
         let t = if count > 1 { i as f32 / (count - 1) as f32 } else { 0.0 };
         let distance = first + (last - first) * t;
-        // Room to spare: the view's half height and width at that distance, by 1.5.
-        let (half_h, half_w) = (distance * half_tan * 1.5, distance * half_tan * aspect * 1.5);
+        // A square whose inscribed circle holds the view's corners at that distance (the
+        // pane's turn about its normal is arbitrary), with room to spare.
+        let (half_h, half_w) = (distance * half_tan, distance * half_tan * aspect);
+        let half = (half_h * half_h + half_w * half_w).sqrt() * 1.2;
         // Tints around the colour wheel, a golden-ratio step apart.
         let hue = i as f32 * 0.618_034 * std::f32::consts::TAU;
         let third = std::f32::consts::TAU / 3.0;
         let albedo = Vec3::new(hue.cos(), (hue + third).cos(), (hue + 2.0 * third).cos()) * 0.5 + 0.5;
         let mut pane = Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, Material { albedo, roughness: 0.5, metallic: 0.0 });
-        pane.transform =
-            Mat4::from_scale_rotation_translation(Vec3::new(half_w, 1.0, half_h), rotation, camera.position + forward * distance);
+        pane.transform = Mat4::from_scale_rotation_translation(Vec3::new(half, 1.0, half), rotation, camera.position + forward * distance);
         pane.extras.alpha_mode = AlphaMode::Blend;
         pane.extras.base_alpha = 0.08;
         pane.extras.double_sided = true;

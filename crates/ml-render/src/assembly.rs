@@ -104,6 +104,8 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::ShadowMapView => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
         PassKind::TransparentBuild { depth_buffer } => Box::new(TransparentBuild::new(ctx, a.scene, a.shading, depth_buffer)?),
-        PassKind::TransparentResolve { clustered } => Box::new(TransparentResolve::new(ctx, a.scene, a.shading, clustered)?),
+        PassKind::TransparentResolve { clustered, after_compute } => {
+            Box::new(TransparentResolve::new(ctx, a.scene, a.shading, (clustered, after_compute))?)
+        }
     })
 }

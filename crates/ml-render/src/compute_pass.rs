@@ -6,7 +6,7 @@ use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::specialization;
-use crate::sync::{Use, COLOUR_TARGET};
+use crate::sync::{Use, COLOUR_TARGET, HDR_TARGET};
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
 use ml_vk::image::fetch_sampler;
@@ -65,7 +65,18 @@ impl ComputePass {
     /// Point slot `frame.slot`'s set 0 at the colour target (`out_image`, which every such
     /// pass writes) and at what `lookup` names.
     pub fn bind_frame(&self, ctx: &Context, frame: &FrameResources, lookup: &dyn Fn(&str) -> Option<Resource>) -> Result<(), VkError> {
-        let out = vk::DescriptorImageInfo::default().image_view(frame.targets.color.view).image_layout(vk::ImageLayout::GENERAL);
+        self.bind_frame_to(ctx, frame, &frame.targets.color, lookup)
+    }
+
+    /// `bind_frame` with `out` as `out_image` (the compute lighting's linear HDR image).
+    pub fn bind_frame_to(
+        &self,
+        ctx: &Context,
+        frame: &FrameResources,
+        out: &Image,
+        lookup: &dyn Fn(&str) -> Option<Resource>,
+    ) -> Result<(), VkError> {
+        let out = vk::DescriptorImageInfo::default().image_view(out.view).image_layout(vk::ImageLayout::GENERAL);
         self.sets.write(ctx, frame.slot, &|name| if name == "out_image" { Some(Resource::Image(out)) } else { lookup(name) })
     }
 
@@ -77,7 +88,14 @@ impl ComputePass {
     /// How a pass that writes the colour target through this pass uses it (`Pass::uses`): as
     /// a storage image in GENERAL, every texel written.
     pub fn colour_use() -> Use {
-        Use::overwriting(COLOUR_TARGET, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), vk::ImageLayout::GENERAL)
+        ComputePass::output_use(false)
+    }
+
+    /// `colour_use`, or with `hdr` the same use of the HDR target (the compute lighting's output
+    /// where transparent layers are resolved after it).
+    pub fn output_use(hdr: bool) -> Use {
+        let name = if hdr { HDR_TARGET } else { COLOUR_TARGET };
+        Use::overwriting(name, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), vk::ImageLayout::GENERAL)
     }
 
     /// Run over `extent` with slot `slot`'s set 0 and `more_sets` after it, writing `color` as a

@@ -60,9 +60,9 @@ pub enum PassKind {
     /// The transparent objects' fragments into per-pixel lists, tested against the opaque
     /// depth (`depth_buffer`: the compute raster's buffer, else the depth target).
     TransparentBuild { depth_buffer: bool },
-    /// The layers lit and blended over the opaque HDR image, encoded into the colour target
-    /// (forward and deferred techniques; the compute lighting passes blend them themselves).
-    TransparentResolve { clustered: bool },
+    /// The layers lit and blended over the opaque HDR image, encoded into the colour target;
+    /// `after_compute`: a compute lighting pass wrote that image (else a render pass).
+    TransparentResolve { clustered: bool, after_compute: bool },
 }
 
 /// What the passes and their pipelines are made for. A change in `technique`, `shading`,
@@ -150,10 +150,11 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
         LightAssignment::Gpu => kinds.push(PassKind::ClusterBuild),
     }
     let clustered = technique.assignment() != LightAssignment::None;
-    // Transparent layers: built after the opaque depth is known; the compute lighting passes
-    // blend them, the others leave linear HDR to a resolve.
+    // Transparent layers: built once the opaque depth is known, resolved over the opaque
+    // pass's linear HDR output.
     let build = PassKind::TransparentBuild { depth_buffer: technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware };
-    let resolve = [build, PassKind::TransparentResolve { clustered }];
+    let after_compute = technique.lighting_stage() == LightingStage::Compute;
+    let resolve = PassKind::TransparentResolve { clustered, after_compute };
     match (technique.geometry(), technique.lighting_stage()) {
         (Geometry::Meshlets, _) => {
             for phase in [Phase::Early, Phase::Late] {
@@ -168,17 +169,18 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
             }
             kinds.extend(key.layers.then_some(build));
             kinds.push(PassKind::VisibilityLighting);
+            kinds.extend(key.layers.then_some(resolve));
         }
         (Geometry::Meshes, LightingStage::Forward) => {
             kinds.push(PassKind::Forward { clustered, heat_legend: key.debug_view == DebugView::ClusterHeat });
             if key.layers {
-                kinds.extend(resolve);
+                kinds.extend([build, resolve]);
             }
         }
         (Geometry::Meshes, LightingStage::Subpass) => {
             kinds.push(PassKind::DeferredSubpasses { clustered });
             if key.layers {
-                kinds.extend(resolve);
+                kinds.extend([build, resolve]);
             } else {
                 // pbr's curve, not for surface views (their values are shown as they are).
                 let surface_view = !matches!(key.debug_view, DebugView::None | DebugView::ClusterHeat);
@@ -189,6 +191,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
             kinds.push(PassKind::GBuffer);
             kinds.extend(key.layers.then_some(build));
             kinds.push(PassKind::ComputeLighting);
+            kinds.extend(key.layers.then_some(resolve));
         }
     }
     if matches!(key.debug_view, DebugView::ShadowMap | DebugView::ShadowCube | DebugView::ShadowAtlas) {
@@ -277,6 +280,33 @@ mod tests {
         k.debug_view = DebugView::ClusterHeat;
         k.meters_exposure = false;
         assert_eq!(plan(&k), [ClusterBuild, Forward { clustered: true, heat_legend: true }]);
+    }
+
+    #[test]
+    fn transparent_layers_are_built_after_the_opaque_depth_and_resolved_over_its_light() {
+        let build = TransparentBuild { depth_buffer: false };
+        let resolve = |clustered, after_compute| TransparentResolve { clustered, after_compute };
+        let cases: [(Technique, &[PassKind]); 4] = [
+            (Technique::Forward, &[Forward { clustered: false, heat_legend: false }, build, resolve(false, false)]),
+            (Technique::ClusteredGpu, &[ClusterBuild, Forward { clustered: true, heat_legend: false }, build, resolve(true, false)]),
+            (Technique::DeferredClustered, &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, build, resolve(true, false)]),
+            (Technique::DeferredCompute, &[ClusterBuild, GBuffer, build, ComputeLighting, resolve(true, true)]),
+        ];
+        for (technique, expected) in cases {
+            let mut k = key(technique);
+            k.layers = true;
+            k.meters_exposure = false;
+            assert_eq!(plan(&k), expected, "{}", technique.name());
+        }
+        let mut k = key(Technique::Visibility);
+        (k.layers, k.meters_exposure, k.raster) = (true, false, Raster::compute(64));
+        assert_eq!(plan(&k)[6..], [TransparentBuild { depth_buffer: true }, VisibilityLighting, resolve(true, true)]);
+        // A surface view shows the opaque surfaces only; the layers' own view keeps them.
+        let mut s = RenderSettings { transparency: Some(Default::default()), ..RenderSettings::new(Technique::Forward, 64, 64) };
+        s.debug_view = DebugView::GBufferAlbedo;
+        assert!(!s.pipeline_key().layers);
+        s.debug_view = DebugView::TransparencyLayers;
+        assert!(s.pipeline_key().layers);
     }
 
     #[test]

@@ -205,6 +205,10 @@ impl State {
 /// presents) in the frame's resources.
 pub const COLOUR_TARGET: &str = "colour target";
 
+/// The HDR target where a compute pass writes it (the compute lighting's linear output, read
+/// by the transparent resolve); the render passes that write it order it themselves.
+pub const HDR_TARGET: &str = "hdr target";
+
 /// The frame slot's lights and cluster lists, as their shader blocks name them: written by
 /// the GPU cluster build (or by the host), read by every shading pass.
 pub const LIGHT_LISTS: [&str; 3] = ["LightBuffer", "ClusterRangeBuffer", "LightIndexBuffer"];

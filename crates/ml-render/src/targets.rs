@@ -125,8 +125,8 @@ pub struct Targets {
     pub depth: Image,
     /// Deferred techniques: the scene's G-buffer images (`gbuffer_images`; empty otherwise).
     pub gbuffer: Vec<Image>,
-    /// deferred, deferred-clustered: the lighting subpass's HDR output; forward techniques
-    /// with transparent layers: the forward pass's (null otherwise).
+    /// deferred, deferred-clustered: the lighting subpass's HDR output; with transparent
+    /// layers, the forward or compute lighting pass's linear output (null otherwise).
     pub hdr: Image,
     /// visibility: the visibility buffer (null otherwise).
     pub visibility: Image,
@@ -169,7 +169,11 @@ impl Targets {
     /// The target called `name` and its aspect, for the barriers between passes (`sync`):
     /// the colour target.
     pub fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
-        (name == crate::sync::COLOUR_TARGET).then_some((self.color.raw, vk::ImageAspectFlags::COLOR))
+        match name {
+            crate::sync::COLOUR_TARGET => Some((self.color.raw, vk::ImageAspectFlags::COLOR)),
+            crate::sync::HDR_TARGET => Some((self.hdr.raw, vk::ImageAspectFlags::COLOR)),
+            _ => None,
+        }
     }
 
     pub fn new(
@@ -231,6 +235,9 @@ impl Targets {
         }
         if output == Output::Subpasses || (output == Output::Color && layers) {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
+        } else if layers {
+            // The compute lighting's linear output, which the transparent resolve reads.
+            self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::STORAGE | U::SAMPLED, colour)?;
         }
         if output == Output::Visibility {
             if !compute_raster {

@@ -15,15 +15,17 @@ use ml_vk::{vk, Context, VkError};
 
 pub struct ComputeLighting {
     pass: ComputePass,
-    /// It blends the transparent layers.
+    /// It writes linear HDR for the transparent layers' resolve (else the colour target).
     layers: bool,
 }
 
 impl ComputeLighting {
     pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading) -> Result<ComputeLighting, VkError> {
         // Set 1: the scene's textures (blinn-phong's shadow map and sky, the shadow cubes).
-        let model = shading.layered_lighting_constants();
-        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (&ml_shaders::DEFERRED_LIGHTING_COMP, &model))?;
+        let model = shading.lighting_constants();
+        // With transparent layers, linear HDR for their resolve.
+        let shader = if shading.transparency { &ml_shaders::DEFERRED_LIGHTING_LINEAR_COMP } else { &ml_shaders::DEFERRED_LIGHTING_COMP };
+        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &model))?;
         Ok(ComputeLighting { pass, layers: shading.transparency })
     }
 }
@@ -36,7 +38,8 @@ impl Pass for ComputeLighting {
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let t = frame.targets;
         let sampled = |image, layout| self.pass.sampled(image, layout);
-        self.pass.bind_frame(ctx, frame, &|name| match name {
+        let out = if self.layers { &t.hdr } else { &t.color };
+        self.pass.bind_frame_to(ctx, frame, out, &|name| match name {
             "depth_image" => sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
             // A G-buffer without the material and emissive images (a scene without object
             // textures) binds the albedo image in their place: the shader, specialised for such
@@ -55,10 +58,7 @@ impl Pass for ComputeLighting {
     /// After the G-buffer pass, the cluster build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
-        if self.layers {
-            uses.extend(crate::transparency::layer_reads(vk::PipelineStageFlags::COMPUTE_SHADER));
-        }
-        uses.push(ComputePass::colour_use());
+        uses.push(ComputePass::output_use(self.layers));
         uses
     }
 

@@ -1,9 +1,8 @@
 //! Transparency (glTF `alphaMode: BLEND`): the transparent objects' fragments in front of the
 //! opaque surfaces kept per pixel in linked lists (`transparent_build`), then lit and blended
-//! back to front where each pixel is finally shaded — fused into the compute lighting passes
-//! (deferred-compute, visibility), or a pass of its own over the opaque HDR image (forward and
-//! deferred techniques, `transparent_resolve`). The rule a pixel follows, and its reference,
-//! is ml-cpu `transparency`; the shaders are under `shaders/transparency/`.
+//! back to front over the opaque pass's linear HDR output (`transparent_resolve`), in every
+//! technique. The rule a pixel follows, and its reference, is ml-cpu `transparency`; the
+//! shaders are under `shaders/transparency/`.
 //!
 //! Memory is a fixed budget set by an option: a pool of nodes, `budget` per pixel on average,
 //! and a head per pixel. What does not fit is counted and reported, never silently lost:

@@ -1,8 +1,8 @@
-//! The transparent resolve of the forward and deferred techniques: a compute pass over their
-//! opaque pass's linear HDR image that lights each pixel's transparent layers, blends them
-//! back to front over it and encodes the result into the colour target
-//! (transparent_resolve.comp; in place of the deferred techniques' tone map). The compute
-//! lighting techniques blend their layers in their lighting pass instead.
+//! The transparent resolve: a compute pass over the opaque pass's linear HDR image (the
+//! forward pass's, the lighting subpass's, the compute lighting's) that lights each pixel's
+//! transparent layers, blends them back to front over it and encodes the result into the
+//! colour target (transparent_resolve.comp; in place of the deferred techniques' tone map).
+//! Every technique's layers are lit and blended here, by one shader.
 
 use super::layer_reads;
 use crate::compute_pass::ComputePass;
@@ -10,19 +10,28 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{shading_reads, Use};
+use crate::sync::{shading_reads, Use, HDR_TARGET};
 use ml_vk::{vk, Context, VkError};
 
 pub struct TransparentResolve {
     pass: ComputePass,
+    /// A compute lighting pass wrote the HDR image (declared, in GENERAL) — else a render
+    /// pass, whose dependencies order it and leave it SHADER_READ_ONLY_OPTIMAL.
+    after_compute: bool,
 }
 
 impl TransparentResolve {
-    /// `clustered`: the layers are lit by their clusters' lights (else by every light).
-    pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading, clustered: bool) -> Result<TransparentResolve, VkError> {
+    /// `clustered`: the layers are lit by their clusters' lights (else by every light);
+    /// `after_compute`: the HDR image is the compute lighting's.
+    pub fn new(
+        ctx: &Context,
+        scene: &SceneGpu,
+        shading: Shading,
+        (clustered, after_compute): (bool, bool),
+    ) -> Result<TransparentResolve, VkError> {
         let shader = if clustered { &ml_shaders::TRANSPARENT_RESOLVE_CLUSTERED_COMP } else { &ml_shaders::TRANSPARENT_RESOLVE_COMP };
         let constants = shading.layered_lighting_constants();
-        Ok(TransparentResolve { pass: ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &constants))? })
+        Ok(TransparentResolve { pass: ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &constants))?, after_compute })
     }
 }
 
@@ -36,12 +45,15 @@ impl Pass for TransparentResolve {
         self.pass.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { frame.buffer(name) })
     }
 
-    /// After the layers' build and the opaque render pass (whose outgoing dependency orders
-    /// the HDR writes before compute reads).
+    /// After the layers' build and the opaque pass that wrote the HDR image.
     fn uses(&self) -> Vec<Use> {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let mut uses = shading_reads(compute);
         uses.extend(layer_reads(compute));
+        if self.after_compute {
+            let layout = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+            uses.push(Use::at(HDR_TARGET, (compute, vk::AccessFlags::SHADER_READ), Some(layout)));
+        }
         uses.push(ComputePass::colour_use());
         uses
     }

@@ -18,7 +18,7 @@ pub struct VisibilityLighting {
     scene: SharedMeshletScene,
     /// It reads the compute raster's 64-bit buffer (else the raster's images).
     from_buffer: bool,
-    /// It blends the transparent layers.
+    /// It writes linear HDR for the transparent layers' resolve (else the colour target).
     layers: bool,
 }
 
@@ -31,9 +31,15 @@ impl VisibilityLighting {
         (scene, from_buffer): (SharedMeshletScene, bool),
         shading: Shading,
     ) -> Result<VisibilityLighting, VkError> {
-        let model = shading.layered_lighting_constants();
+        let model = shading.lighting_constants();
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
-        let shader = if from_buffer { &ml_shaders::VISIBILITY_LIGHTING_BUFFER_COMP } else { &ml_shaders::VISIBILITY_LIGHTING_COMP };
+        // With transparent layers, linear HDR for their resolve.
+        let shader = match (from_buffer, shading.transparency) {
+            (true, false) => &ml_shaders::VISIBILITY_LIGHTING_BUFFER_COMP,
+            (true, true) => &ml_shaders::VISIBILITY_LIGHTING_BUFFER_LINEAR_COMP,
+            (false, false) => &ml_shaders::VISIBILITY_LIGHTING_COMP,
+            (false, true) => &ml_shaders::VISIBILITY_LIGHTING_LINEAR_COMP,
+        };
         let pass = ComputePass::with_push(ctx, &more_sets, (shader, &model), 16)?;
         Ok(VisibilityLighting { pass, scene, from_buffer, layers: shading.transparency })
     }
@@ -47,7 +53,8 @@ impl Pass for VisibilityLighting {
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let t = frame.targets;
         let scene = self.scene.borrow();
-        self.pass.bind_frame(ctx, frame, &|name| match name {
+        let out = if self.layers { &t.hdr } else { &t.color };
+        self.pass.bind_frame_to(ctx, frame, out, &|name| match name {
             "depth_image" => self.pass.sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
             "visibility_image" => self.pass.sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
             _ => scene.buffer(frame, name),
@@ -57,10 +64,7 @@ impl Pass for VisibilityLighting {
     /// After the late raster, the cluster build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
-        if self.layers {
-            uses.extend(crate::transparency::layer_reads(vk::PipelineStageFlags::COMPUTE_SHADER));
-        }
-        uses.push(ComputePass::colour_use());
+        uses.push(ComputePass::output_use(self.layers));
         if self.from_buffer {
             uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
         }

@@ -1,0 +1,43 @@
+// deferred-compute: the clustered lighting of lighting.glsl as a compute shader over the
+// G-buffer (on H100/H200 compute runs on all SMs, fragment shading on 4 of 132). Same BRDF,
+// same cluster lookup, same light order as the fragment paths; position rebuilt from depth.
+// The includer (deferred_lighting.comp, deferred_lighting_linear.comp) says what it writes.
+#define CLUSTERED 1
+#include "common/common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "common/scene_bindings.glsl"
+layout(set = 0, binding = 5) uniform sampler2D depth_image;
+layout(set = 0, binding = 6) uniform sampler2D normal_image;
+layout(set = 0, binding = 7) uniform usampler2D object_image;
+layout(set = 0, binding = 9) uniform sampler2D albedo_image;
+layout(set = 0, binding = 11) uniform sampler2D roughness_metallic_image;
+layout(set = 0, binding = 12) uniform sampler2D emissive_image;
+#include "common/textures.glsl"
+
+#include "common/lighting.glsl"
+#include "shading/compute_shading.glsl"
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
+        return;
+    }
+    float z = texelFetch(depth_image, p, 0).r;
+    if (z >= 1.0) {
+        store_background(p);
+        return;
+    }
+    vec2 frag_xy = vec2(p) + 0.5;
+    vec3 world = world_from_depth(frag_xy, z);
+    vec3 n = oct_decode(texelFetch(normal_image, p, 0).xy);
+    uint id = texelFetch(object_image, p, 0).r;
+    // Without OBJECT_TEXTURES the G-buffer has no material and emissive images (the pass
+    // binds stand-ins that are never read).
+    vec2 roughness_metallic = OBJECT_TEXTURES ? texelFetch(roughness_metallic_image, p, 0).xy : vec2(1.0);
+    vec3 emissive_factor = OBJECT_TEXTURES ? texelFetch(emissive_image, p, 0).rgb : vec3(1.0);
+    PointMaterial m =
+        point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, texelFetch(albedo_image, p, 0), roughness_metallic, emissive_factor);
+    shade_and_store(p, frag_xy, world, n, m, objects[id].alpha_texture.x);
+}

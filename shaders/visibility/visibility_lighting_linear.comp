@@ -1,0 +1,5 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Lighting from the visibility buffer as the hardware raster's images, into linear HDR for the transparent resolve.
+#define LINEAR_OUTPUT 1
+#include "visibility/raster_image_lighting.glsl"
