@@ -8,19 +8,30 @@
 //!   ray of a neighbouring pixel meets another set of surfaces);
 //! - the order in which the quads are listed does not change a byte (all six orders);
 //! - a budget smaller than the depth complexity drops fragments and says how many; more
-//!   layers than a pixel blends exactly are merged and counted.
+//!   layers than a pixel blends exactly are merged and counted;
+//! - foliage: leaves (quads of a glTF file written here, BLEND, double-sided, a texture whose
+//!   alpha is 0 in a round hole, 1 in a ring round it and fades to 0 over soft bands on both
+//!   sides) over a lit floor: every technique gives forward's image within 1/255 but at
+//!   counted edge pixels; the hole shows exactly what the scene without the leaves shows, and
+//!   the soft bands blend: their pixels lie between the leafless image and the one with the
+//!   leaves opaque;
+//! - the transparency-layers debug view counts each pixel's layers.
 
 mod common;
 
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec3, Vec4};
 use ml_cpu::camera::Camera;
+use ml_cpu::gltf_writer::{png, quad as gltf_quad, GltfWriter, PrimitiveData};
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{AlphaMode, Object, Scene};
 use ml_cpu::shading::{encode_gamma_unorm8, shade_seed};
 use ml_cpu::transparency::{composite, Layer};
-use ml_render::{Raster, RenderOutput, RenderSettings, Technique, TransparencySettings, TransparencyStats, LAYER_KEEP};
+use ml_render::{
+    DebugView, Raster, RenderOutput, RenderSettings, ShadingModel, Technique, TransparencySettings, TransparencyStats, LAYER_KEEP,
+};
+use serde_json::json;
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -205,4 +216,142 @@ fn a_budget_below_the_depth_complexity_is_reported() {
     let st = stats(&common::render(deep, s));
     assert_eq!(st.dropped(), 0, "{st:?}");
     assert!(st.merged_pixels > 100, "{st:?}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Foliage
+// ---------------------------------------------------------------------------------------------
+
+const LEAF_TEXELS: u32 = 64;
+
+/// The leaf's alpha at texture coordinate distance `r` from its centre (in texels of a
+/// 64-texel side): a hole to 9, rising to 1 by 13, 1 to 24, fading to 0 by 31.
+fn leaf_alpha(r: f32) -> f32 {
+    ((r - 9.0) / 4.0).clamp(0.0, 1.0) * ((31.0 - r) / 7.0).clamp(0.0, 1.0)
+}
+
+fn leaf_png() -> Vec<u8> {
+    let n = LEAF_TEXELS;
+    let rgba: Vec<u8> = (0..n * n)
+        .flat_map(|i| {
+            let (x, y) = ((i % n) as f32 + 0.5 - n as f32 / 2.0, (i / n) as f32 + 0.5 - n as f32 / 2.0);
+            [255, 255, 255, (leaf_alpha((x * x + y * y).sqrt()) * 255.0).round() as u8]
+        })
+        .collect();
+    png(n, n, &rgba)
+}
+
+/// Leaf i's place: standing, facing the camera (on +Z), turned a little, one behind another.
+fn leaf_at(i: usize) -> (Vec3, Quat) {
+    let at = Vec3::new(-1.6 + 1.1 * i as f32, 1.2 + 0.25 * (i % 2) as f32, 0.6 - 0.5 * i as f32);
+    (at, Quat::from_rotation_y((10.0 * i as f32 - 15.0).to_radians()) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2))
+}
+
+const LEAVES: usize = 4;
+
+/// A lit floor and LEAVES leaves of `mode` ("BLEND", or "OPAQUE" for their colour without
+/// alpha; None: no leaves), loaded from a GLB written here.
+fn foliage(mode: Option<&str>) -> Scene {
+    let mut w = GltfWriter::new();
+    let floor = w.material([0.6, 0.55, 0.5, 1.0], 0.0, 0.8);
+    let floor_mesh = w.mesh(&[PrimitiveData { material: Some(floor), ..gltf_quad() }]);
+    w.node(json!({ "mesh": floor_mesh, "scale": [6.0, 6.0, 6.0] }), true);
+    // A back wall, so that every pixel has an opaque surface or the leaves' colour behind.
+    let upright = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2).to_array();
+    w.node(json!({ "mesh": floor_mesh, "translation": [0.0, 3.0, -3.0], "rotation": upright, "scale": [6.0, 6.0, 6.0] }), true);
+    if let Some(mode) = mode {
+        let texture = w.texture(leaf_png(), "image/png");
+        let colours = [[0.3, 0.8, 0.2, 1.0], [0.5, 0.9, 0.1, 0.9], [0.2, 0.6, 0.3, 1.0], [0.7, 0.8, 0.2, 0.8]];
+        for (i, c) in colours.iter().enumerate().take(LEAVES) {
+            let m = w.alpha_material(Some(texture), *c, mode, None, true);
+            let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..gltf_quad() }]);
+            let (at, rotation) = leaf_at(i);
+            w.node(json!({ "mesh": mesh, "translation": at.to_array(), "rotation": rotation.to_array(), "scale": [0.8, 0.8, 0.8] }), true);
+        }
+    }
+    let (mut scene, _) = ml_cpu::gltf_scene::from_bytes(&w.to_glb(), None).expect("a good file");
+    scene.camera = Camera::looking_at(Vec3::new(0.3, 2.2, 5.0), Vec3::new(0.0, 1.1, 0.0), 45.0, 0.1, 30.0);
+    scene.lights = vec![
+        light([1.0, 2.0, 2.5], 6.0, [4.0, 3.6, 3.2]),
+        light([-2.0, 1.5, 2.0], 5.0, [2.0, 2.4, 4.0]),
+        light([0.5, 0.6, -0.8], 3.0, [4.0, 2.8, 1.6]),
+        light([0.0, 3.0, -2.0], 5.0, [2.4, 2.4, 2.4]),
+    ];
+    scene.cones.clear();
+    scene.light_motion = 0.0;
+    scene
+}
+
+/// Where a world point lands in the image (pixel coordinates).
+fn project(scene: &Scene, p: Vec3) -> (u32, u32) {
+    let clip = scene.camera.projection(W as f32 / H as f32) * scene.camera.view() * Vec4::from((p, 1.0));
+    let ndc = clip.truncate() / clip.w;
+    (((ndc.x + 1.0) * 0.5 * W as f32) as u32, ((ndc.y + 1.0) * 0.5 * H as f32) as u32)
+}
+
+fn diff(a: [u8; 3], b: [u8; 3]) -> u8 {
+    (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap()
+}
+
+#[test]
+fn foliage_shows_the_background_through_its_holes_and_blends_its_soft_edges_alike_in_every_technique() {
+    let scene = foliage(Some("BLEND"));
+    assert!(scene.has_blended_objects());
+    let pbr = |t| RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
+    let mut all: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| pbr(t)).collect();
+    all.push(RenderSettings { raster: Raster::Hardware, ..pbr(Technique::Visibility) });
+    let outs = common::render_each(&scene, &all);
+    let forward = &outs[0];
+    for (s, out) in all.iter().zip(&outs).skip(1) {
+        let edges = common::pixels_beyond(forward, out, 1);
+        assert!(
+            edges <= (W * H / 100) as usize,
+            "{} ({}): {edges} pixels differ from forward by more than 1/255",
+            s.technique.name(),
+            s.raster.name()
+        );
+        println!("{} ({}): {edges} edge pixels beyond 1/255 of forward", s.technique.name(), s.raster.name());
+    }
+    let bare = common::render(foliage(None), pbr(Technique::Forward));
+    let mut opaque = pbr(Technique::Forward);
+    opaque.transparency = None;
+    let opaque = common::render(foliage(Some("OPAQUE")), opaque);
+    // Through each leaf's hole: the scene without leaves.
+    for i in 0..LEAVES {
+        let (x, y) = project(&scene, leaf_at(i).0);
+        for out in &outs {
+            let (got, want) = (common::pixel(out, x, y), common::pixel(&bare, x, y));
+            assert!(diff(got, want) <= 1, "leaf {i}'s hole at ({x}, {y}): {got:?}, without leaves {want:?}");
+        }
+        assert!(diff(common::pixel(&opaque, x, y), common::pixel(&bare, x, y)) > 8, "leaf {i}: the opaque leaf covers its hole");
+    }
+    // The soft bands: between the leafless and the opaque-leaf images, apart from both.
+    let between = (0..H)
+        .flat_map(|y| (0..W).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let (g, b, o) = (common::pixel(forward, x, y), common::pixel(&bare, x, y), common::pixel(&opaque, x, y));
+            diff(g, b) >= 4 && diff(g, o) >= 4 && (0..3).all(|c| g[c].clamp(b[c].min(o[c]), b[c].max(o[c])) == g[c])
+        })
+        .count();
+    assert!(between > 300, "only {between} pixels blend the leaves' soft edges");
+    println!("{between} pixels blend a soft edge");
+}
+
+#[test]
+fn the_layer_view_counts_each_pixels_layers() {
+    let mut s = settings(Technique::Visibility);
+    s.debug_view = DebugView::TransparencyLayers;
+    let scene = scene([0, 1, 2]);
+    let out = common::render(scene.clone(), s);
+    // No layer: black; more layers: hotter colours, never black.
+    for y in (0..H).step_by(7) {
+        for x in (0..W).step_by(7) {
+            let layers = met(&scene, x, y).len() - 1;
+            let got = common::pixel(&out, x, y);
+            if edge(&scene, x, y) {
+                continue;
+            }
+            assert_eq!(got == [0, 0, 0], layers == 0, "({x}, {y}) with {layers} layers shows {got:?}");
+        }
+    }
 }
