@@ -289,6 +289,22 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
             "a rasteriser in compute (--raster compute, hybrid or auto)",
         ),
     ];
+    // Transparency needs transparent objects (a file's, or made by the two options), and
+    // the shaded image or the layers' own view.
+    let transparent = built.map(|b| b.scene.has_blended_objects());
+    let needs_transparent = "transparent objects (alphaMode BLEND in a glTF file, --transparent-objects or --glass-layers)";
+    rules.push(Rule::setting(
+        "transparency_budget",
+        transparent,
+        format!("'{}', which has no transparent objects", args.scene),
+        needs_transparent,
+    ));
+    rules.push(Rule::setting(
+        "transparency_budget",
+        Some(matches!(args.debug_view.as_str(), "none" | "transparency-layers")),
+        format!("--debug-view {}", args.debug_view),
+        "the shaded image or --debug-view transparency-layers (surface views show the opaque surfaces only)",
+    ));
     let view = args.debug_view.as_str();
     rules.extend(
         match DebugView::from_name(view).unwrap_or(DebugView::None) {
@@ -303,6 +319,12 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
                 Some(Rule::setting("debug_view", Some(omni != "off" && omni != "atlas"), format!("--omni-shadow {omni}"), cubes))
             }
             DebugView::ShadowAtlas => Some(Rule::setting("debug_view", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas)),
+            DebugView::TransparencyLayers => Some(Rule::setting(
+                "debug_view",
+                transparent,
+                format!("'{}', which has no transparent objects", args.scene),
+                needs_transparent,
+            )),
             _ => None,
         }
         .map(|rule| rule.of_value(view)),

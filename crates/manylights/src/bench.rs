@@ -130,13 +130,33 @@ impl BenchArgs {
     pub(crate) fn rules(&self, rasters: &[Raster]) -> Vec<Rule> {
         let probe_only = |id| Rule::setting(id, Some(self.probe), "bench without --probe", "--probe");
         let not_probe = |id| Rule::setting(id, Some(!self.probe), "bench --probe", "bench without --probe, which renders the techniques");
-        let mut rules: Vec<Rule> = ["techniques", "lights", "scene", "objects", "shading", "camera", "clusters", "raster", "raster_split"]
-            .into_iter()
-            .map(not_probe)
-            .collect();
+        let mut rules: Vec<Rule> = [
+            "techniques",
+            "lights",
+            "scene",
+            "objects",
+            "shading",
+            "camera",
+            "clusters",
+            "raster",
+            "raster_split",
+            "transparent_objects",
+            "glass_layers",
+            "transparency_budget",
+        ]
+        .into_iter()
+        .map(not_probe)
+        .collect();
         rules.extend([
             probe_only("probe_lights"),
             objects_rule(&self.scene),
+            // A file may have transparent objects of its own (known once it is loaded).
+            Rule::setting(
+                "transparency_budget",
+                (self.transparent_objects == 0 && self.glass_layers == 0 && !crate::is_scene_file(&self.scene)).then_some(false),
+                "a scene without transparent objects",
+                "transparent objects (alphaMode BLEND in a glTF file, --transparent-objects or --glass-layers)",
+            ),
             Rule::technique("clusters", CLUSTER_GRID, Technique::is_clustered),
             Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
             Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),

@@ -131,7 +131,8 @@ struct SceneArgs {
     /// blinn-phong), shadow-cube (the first shadowed point light's cube, unfolded; a cube mode
     /// of --omni-shadow), shadow-atlas (--omni-shadow atlas), meshlets, triangles (a colour per
     /// meshlet or triangle; visibility), alpha (opaque grey, alpha-masked green, blended
-    /// orange).
+    /// orange), transparency-layers (transparent layers per pixel, white where some were
+    /// merged; scenes with transparent objects).
     #[arg(long, default_value = "none")]
     debug_view: String,
     /// Object of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.
@@ -620,6 +621,15 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         output: &cmd.out,
     };
     print!("{}", tables::table(&tables::render_rows(&facts, &output.stats)));
+    if let Some(t) = output.stats.feature::<ml_render::TransparencyStats>().filter(|t| t.overflowed()) {
+        eprintln!(
+            "warning: the transparent layers did not fit: {} fragments dropped (pool of {} nodes full; raise --transparency-budget), {} pixels merged layers beyond the nearest {}",
+            t.dropped(),
+            t.capacity,
+            t.merged_pixels,
+            ml_render::LAYER_KEEP
+        );
+    }
     let count = messages.load(Ordering::SeqCst);
     if count > 0 {
         bail!("the validation layer reported {count} message(s) (printed above)");

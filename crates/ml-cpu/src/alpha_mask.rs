@@ -1,4 +1,4 @@
-//! Alpha masks (glTF `alphaMode: MASK`, and `BLEND` drawn as a mask): which points of a
+//! Alpha masks (glTF `alphaMode: MASK`, and `BLEND` where it is drawn as a mask: shadows): which points of a
 //! surface are there. A point's alpha is the base colour factor's alpha times the base colour
 //! texture's alpha at its texture coordinates; below the material's cutoff the point is cut
 //! out — no colour, no depth, no shadow.

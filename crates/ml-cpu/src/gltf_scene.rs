@@ -337,7 +337,6 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         camera: None,
         vertices: 0,
         warnings: unread.into_iter().map(|e| format!("extension {e} is not supported; the file is read without it")).collect(),
-        blended: Default::default(),
         mixed_transforms: Default::default(),
     };
     let parents = node_parents(&gltf.document)?;
@@ -371,24 +370,13 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     if builder.objects.is_empty() {
         return Err(GltfError::NoTriangles);
     }
-    let Builder { objects, lights, camera, meshes, mut warnings, textures, directional, mut cones, blended, mixed_transforms, .. } =
-        builder;
+    let Builder { objects, lights, camera, meshes, mut warnings, textures, directional, mut cones, mixed_transforms, .. } = builder;
     if !mixed_transforms.is_empty() {
         let names: Vec<String> = mixed_transforms.into_iter().collect();
         warnings.push(format!(
             "material{} {}: textures with different texture transforms (KHR_texture_transform); the base colour's is used for all",
             if names.len() == 1 { "" } else { "s" },
             names.join(", ")
-        ));
-    }
-    if !blended.is_empty() {
-        let names: Vec<String> = blended.into_iter().collect();
-        warnings.push(format!(
-            "material{} {} blend{} (alphaMode BLEND): drawn as a mask cut at alpha {} (no blending)",
-            if names.len() == 1 { "" } else { "s" },
-            names.join(", "),
-            if names.len() == 1 { "s" } else { "" },
-            crate::scene::BLEND_AS_MASK_CUTOFF
         ));
     }
     if cones.iter().all(|c| *c == LightCone::NONE) {
@@ -655,8 +643,6 @@ struct Builder<'a> {
     vertices: usize,
     /// What the file holds that is left out.
     warnings: Vec<String>,
-    /// The blended materials drawn (as masks), by name.
-    blended: std::collections::BTreeSet<String>,
     /// The materials whose textures carry different texture transforms, by name.
     mixed_transforms: std::collections::BTreeSet<String>,
 }
@@ -678,9 +664,6 @@ impl Builder<'_> {
                     Some(name) => format!("{} '{name}'", MaterialName(m.index())),
                     None => MaterialName(m.index()).to_string(),
                 };
-                if extras.alpha_mode == AlphaMode::Blend {
-                    self.blended.insert(named());
-                }
                 if mixed {
                     self.mixed_transforms.insert(named());
                 }

@@ -155,7 +155,8 @@ gpu_struct!(
 /// `ObjectData::alpha_texture.x` bits (common.glsl OBJECT_*).
 pub const OBJECT_MASKED: u32 = 1;
 pub const OBJECT_DOUBLE_SIDED: u32 = 2;
-/// Blended in the file (drawn as a mask: the alpha debug view tells it apart).
+/// BLEND in the file: blended in per-pixel layers where the render blends them (then the
+/// opaque passes skip it), else, and in every shadow, cut as a mask at one half.
 pub const OBJECT_BLENDED: u32 = 4;
 /// Its alpha comes from a texture too (else from the factor alone).
 pub const OBJECT_ALPHA_TEXTURE: u32 = 8;

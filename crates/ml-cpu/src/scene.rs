@@ -99,7 +99,8 @@ impl Default for MaterialExtras {
 }
 
 impl MaterialExtras {
-    /// Whether an alpha mask cuts points out of the surface (MASK, and BLEND drawn as a mask).
+    /// Whether an alpha mask cuts points out of the surface (MASK, and BLEND where it is drawn
+    /// as a mask: in shadows, and in renders that do not blend it).
     pub fn masked(&self) -> bool {
         self.alpha_mode.cutoff().is_some()
     }

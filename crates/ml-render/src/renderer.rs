@@ -299,7 +299,7 @@ impl<'a> Renderer<'a> {
         let technique = self.settings.technique;
         let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
         let raster = self.settings.raster;
-        let layers = self.settings.transparency.filter(|_| self.settings.blends_layers());
+        let layers = self.settings.transparency.filter(|_| self.settings.blends_layers()).map(|t| t.nodes(extent.width, extent.height));
         let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers));
         let setup = FrameSetup {
             pool: self.command_pool,

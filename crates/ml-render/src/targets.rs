@@ -3,7 +3,6 @@
 //! their framebuffers over them.
 
 use crate::technique::{Geometry, LightingStage, Raster, Technique};
-use crate::transparency::{LayerBuffers, TransparencySettings};
 use ml_vk::{vk, Buffer, Context, Image, VkError};
 
 /// Size of the biggest image we agree to render, whatever the device allows: 16384² RGBA8 is
@@ -141,6 +140,69 @@ pub struct Targets {
     pub layers: LayerBuffers,
 }
 
+/// Bytes of a transparent layer's node: two uvec4 (transparency/layers.glsl).
+pub const NODE_BYTES: u64 = 32;
+
+/// A frame slot's lists: heads, node pool, counters (host-visible: the build pass reads them
+/// when the frame is done). Without transparency, 16-byte stand-ins for the lighting
+/// passes' bindings, which their shaders then never read.
+pub struct LayerBuffers {
+    pub heads: Buffer,
+    pub nodes: Buffer,
+    pub counts: Buffer,
+}
+
+impl LayerBuffers {
+    /// `nodes`: the pool's size (None: stand-ins).
+    pub fn new(ctx: &Context, extent: vk::Extent2D, nodes: Option<u64>) -> Result<LayerBuffers, VkError> {
+        let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null() };
+        ml_vk::build(ctx, b, |b| {
+            use gpu_allocator::MemoryLocation as M;
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let (heads, nodes) = match nodes {
+                Some(n) => (extent.width as u64 * extent.height as u64 * 4, n * NODE_BYTES),
+                None => (16, NODE_BYTES),
+            };
+            b.heads = Buffer::new(ctx, "transparent heads", heads, usage, M::GpuOnly)?;
+            b.nodes = Buffer::new(ctx, "transparent nodes", nodes, usage, M::GpuOnly)?;
+            b.counts = Buffer::new(ctx, "transparent counters", 16, usage, M::GpuToCpu)?;
+            Ok(())
+        })
+    }
+
+    /// The buffers under their shader names.
+    pub fn named(&self) -> [(&'static str, vk::Buffer); 3] {
+        [
+            (crate::sync::LAYER_BUFFERS[0], self.heads.raw),
+            (crate::sync::LAYER_BUFFERS[1], self.nodes.raw),
+            (crate::sync::LAYER_BUFFERS[2], self.counts.raw),
+        ]
+    }
+
+    /// Nodes in the pool.
+    pub fn capacity(&self) -> u64 {
+        self.nodes.size / NODE_BYTES
+    }
+
+    /// The counters as the slot's last frame left them: nodes asked for, pixels that merged.
+    pub fn counts(&self) -> [u32; 2] {
+        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counts.mapped()[..16]);
+        [c[0], c[1]]
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.heads.destroy(ctx);
+        self.nodes.destroy(ctx);
+        self.counts.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for LayerBuffers {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
+
 /// Format of the visibility buffer: the 32-bit id (meshlets.rs).
 pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R32_UINT;
 
@@ -181,7 +243,7 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        (raster, transparency): (Raster, Option<TransparencySettings>),
+        (raster, layer_nodes): (Raster, Option<u64>),
     ) -> Result<Targets, VkError> {
         let t = Targets {
             color: Image::null(),
@@ -191,9 +253,9 @@ impl Targets {
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
-            layers: LayerBuffers::new(ctx, extent, transparency)?,
+            layers: LayerBuffers::new(ctx, extent, layer_nodes)?,
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, transparency.is_some())))
+        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layer_nodes.is_some())))
     }
 
     fn create(

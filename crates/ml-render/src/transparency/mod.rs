@@ -15,21 +15,18 @@ pub mod transparent_resolve;
 use crate::error::{RenderError, Setting, SettingsError};
 use crate::report::FeatureStats;
 use crate::sync::Use;
-use ml_vk::{vk, Buffer, Context, VkError};
+pub use crate::sync::LAYER_BUFFERS;
+pub use crate::targets::NODE_BYTES;
+use ml_vk::{vk, Context};
 
 /// A list's end (layers.glsl LAYER_END): what the heads are cleared to.
 pub const LAYER_END: u32 = 0xffff_ffff;
-/// Bytes of a node: two uvec4 (layers.glsl).
-pub const NODE_BYTES: u64 = 32;
 /// Layers a pixel blends exactly (layers.glsl LAYER_KEEP); farther ones are merged.
 pub const LAYER_KEEP: u32 = 32;
 /// Nodes per pixel on average, unless the option says otherwise.
 pub const DEFAULT_BUDGET: u32 = 4;
 /// The most nodes per pixel the option takes.
 pub const MAX_BUDGET: u32 = 256;
-
-/// The shaders' names of the per-frame buffers: heads, nodes, counters.
-pub const LAYER_BUFFERS: [&str; 3] = ["TransparentHeadBuffer", "TransparentNodeBuffer", "TransparentCountBuffer"];
 
 /// How transparent objects are drawn: the node pool's size, in nodes per pixel on average.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -61,61 +58,6 @@ impl TransparencySettings {
             return Err(SettingsError::TransparencyPool { budget, width, height, bytes, device: ctx.info.name.clone(), max }.into());
         }
         Ok(())
-    }
-}
-
-/// A frame slot's lists: heads, node pool, counters (host-visible: the build pass reads them
-/// when the frame is done). Without transparency, 16-byte stand-ins for the lighting
-/// passes' bindings, which their shaders then never read.
-pub struct LayerBuffers {
-    pub heads: Buffer,
-    pub nodes: Buffer,
-    pub counts: Buffer,
-}
-
-impl LayerBuffers {
-    pub fn new(ctx: &Context, extent: vk::Extent2D, settings: Option<TransparencySettings>) -> Result<LayerBuffers, VkError> {
-        let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null() };
-        ml_vk::build(ctx, b, |b| {
-            use gpu_allocator::MemoryLocation as M;
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-            let (heads, nodes) = match settings {
-                Some(s) => (extent.width as u64 * extent.height as u64 * 4, s.nodes(extent.width, extent.height) * NODE_BYTES),
-                None => (16, NODE_BYTES),
-            };
-            b.heads = Buffer::new(ctx, "transparent heads", heads, usage, M::GpuOnly)?;
-            b.nodes = Buffer::new(ctx, "transparent nodes", nodes, usage, M::GpuOnly)?;
-            b.counts = Buffer::new(ctx, "transparent counters", 16, usage, M::GpuToCpu)?;
-            Ok(())
-        })
-    }
-
-    /// The buffers under their shader names.
-    pub fn named(&self) -> [(&'static str, vk::Buffer); 3] {
-        [(LAYER_BUFFERS[0], self.heads.raw), (LAYER_BUFFERS[1], self.nodes.raw), (LAYER_BUFFERS[2], self.counts.raw)]
-    }
-
-    /// Nodes in the pool.
-    pub fn capacity(&self) -> u64 {
-        self.nodes.size / NODE_BYTES
-    }
-
-    /// The counters as the slot's last frame left them: nodes asked for, pixels that merged.
-    pub fn counts(&self) -> [u32; 2] {
-        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counts.mapped()[..16]);
-        [c[0], c[1]]
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        self.heads.destroy(ctx);
-        self.nodes.destroy(ctx);
-        self.counts.destroy(ctx);
-    }
-}
-
-impl ml_vk::Release for LayerBuffers {
-    fn release(&mut self, ctx: &Context) {
-        self.destroy(ctx);
     }
 }
 
