@@ -1,8 +1,9 @@
 // Transparent layers (glTF alphaMode BLEND): every transparent fragment in front of the
-// opaque surface is kept, per pixel, as a node of a linked list — its depth, coverage and
-// surface, unlit — and blended back to front where the pixel is finally shaded. Lighting
-// the nodes there, in compute, gives them the opaque surfaces' lights, cluster lists,
-// shading model and shadows, in every technique.
+// opaque surface is kept, per pixel, as a node of a linked list — its depth, pixel, coverage
+// and surface, unlit. Then, in compute, a thread per node lights it (`light_layer`: the
+// opaque surfaces' lights, cluster lists, shading model and shadows, in every technique; the
+// nodes lie in the order their fragments were drawn, so neighbouring threads share clusters)
+// and a thread per pixel blends its layers back to front (`blend_layers`).
 //
 // Memory is a fixed budget: a pool of nodes (`--transparency-budget` per pixel on average)
 // and a head per pixel. A fragment that finds the pool full is dropped and counted. A pixel
@@ -11,7 +12,7 @@
 // the pixel is counted. ml-cpu transparency.rs is the same rule on the CPU.
 //
 // Needs common.glsl; the includer defines LAYER_BINDING, the first of its three set-0
-// bindings. Blending (blend_layers) also needs lighting.glsl and world_from_depth.
+// bindings. Lighting (light_layer) also needs lighting.glsl; blending, LAYER_BLENDING.
 
 #ifndef MANYLIGHTS_LAYERS_GLSL
 #define MANYLIGHTS_LAYERS_GLSL
@@ -26,9 +27,10 @@ const uint LAYER_KEEP = 32u;
 
 // Per pixel (row-major): its nearest-drawn node, LAYER_END for none.
 layout(std430, set = 0, binding = LAYER_BINDING) buffer TransparentHeadBuffer { uint layer_heads[]; };
-// Two uvec4 a node: (depth, next, object, alpha) and the surface (octahedral normal snorm
-// 2×16, albedo factor and occlusion unorm 4×8, roughness and metallic factors unorm 2×16,
-// emissive factor unorm 4×8).
+// Two uvec4 a node: (depth, next, object, pixel y << 16 | x), then the surface (octahedral
+// normal snorm 2×16, albedo factor and occlusion unorm 4×8, roughness and metallic factors
+// unorm 2×8 with alpha unorm 16 above them, emissive factor unorm 4×8), which lighting
+// replaces by (lit colour rgb, alpha) as floats.
 layout(std430, set = 0, binding = LAYER_BINDING + 1) buffer TransparentNodeBuffer { uvec4 layer_nodes[]; };
 // x: nodes asked for this frame (beyond the pool's size: dropped); y: pixels that merged
 // layers; z, w: unused.
@@ -38,32 +40,53 @@ uint layer_pixel(ivec2 p) {
     return uint(p.y) * frame.viewport.x + uint(p.x);
 }
 
+// Nodes in the pool.
+uint layer_capacity() {
+    return uint(layer_nodes.length()) / 2u;
+}
+
+// The surface of a node as the build packs it (`alpha` in [0, 1]).
+uvec4 pack_layer_surface(vec3 normal, vec4 albedo_occlusion, vec2 roughness_metallic, float alpha, vec3 emissive_factor) {
+    uint material = packUnorm4x8(vec4(roughness_metallic, 0.0, 0.0)) & 0xffffu;
+    return uvec4(packSnorm2x16(oct_encode(normal)), packUnorm4x8(albedo_occlusion), material | (packUnorm2x16(vec2(alpha, 0.0)) << 16),
+                 packUnorm4x8(vec4(emissive_factor, 0.0)));
+}
+
 // Keep a transparent fragment of pixel `p`: false where the pool is full (it is counted).
-bool store_layer(ivec2 p, float depth, uint object, float alpha, uvec4 surface) {
+bool store_layer(ivec2 p, float depth, uint object, uvec4 surface) {
     uint node = atomicAdd(layer_counts.x, 1u);
-    if (node >= uint(layer_nodes.length()) / 2u) {
+    if (node >= layer_capacity()) {
         return false;
     }
     uint next = atomicExchange(layer_heads[layer_pixel(p)], node);
-    layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, object, floatBitsToUint(alpha));
+    layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, object, uint(p.y) << 16 | uint(p.x));
     layer_nodes[2u * node + 1u] = surface;
     return true;
 }
 
 #ifdef MANYLIGHTS_LIGHTING_GLSL
 
-// A node's lit colour at the pixel centre `frag_xy`.
-vec3 shade_layer(uint node, vec2 frag_xy) {
+// Light node `node` where it lies and keep its colour and alpha in place of its surface.
+void light_layer(uint node) {
     uvec4 a = layer_nodes[2u * node];
     uvec4 b = layer_nodes[2u * node + 1u];
+    vec2 frag_xy = vec2(a.w & 0xffffu, a.w >> 16) + 0.5;
     vec3 world = world_from_depth(frag_xy, uintBitsToFloat(a.x));
     vec3 n = oct_decode(unpackSnorm2x16(b.x));
     ObjectData o = objects[a.z];
-    vec2 roughness_metallic = OBJECT_TEXTURES ? unpackUnorm2x16(b.z) : vec2(1.0);
+    vec2 roughness_metallic = OBJECT_TEXTURES ? unpackUnorm4x8(b.z).xy : vec2(1.0);
     vec3 emissive_factor = OBJECT_TEXTURES ? unpackUnorm4x8(b.w).rgb : vec3(1.0);
     PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, unpackUnorm4x8(b.y), roughness_metallic, emissive_factor);
-    return shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+    vec3 color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+    float alpha = unpackUnorm2x16(b.z).y;
+    layer_nodes[2u * node + 1u] = uvec4(floatBitsToUint(color), floatBitsToUint(alpha));
 }
+
+#endif
+
+// Blending, for the resolve (which defines LAYER_BLENDING and includes shading_model.glsl
+// and clusters/cluster.glsl, for `encode_output` and `heat`).
+#ifdef LAYER_BLENDING
 
 // Whether node x lies in front of node y (nearer, or as near and of a lower object).
 bool layer_before(uvec2 x, uvec2 y) {
@@ -71,9 +94,14 @@ bool layer_before(uvec2 x, uvec2 y) {
     return dx < dy || (dx == dy && x.y < y.y);
 }
 
-// Pixel `p`'s layers blended over `under` (linear; black for the background) back to front;
-// `transmittance`: how much of `under` still shows, `count`: its layers.
-vec3 blend_layers(ivec2 p, vec2 frag_xy, vec3 under, out float transmittance, out uint count) {
+// A lit node's colour and alpha.
+vec4 layer_color(uint node) {
+    return uintBitsToFloat(layer_nodes[2u * node + 1u]);
+}
+
+// Pixel `p`'s lit layers blended over `under` (linear; black for the background) back to
+// front; `transmittance`: how much of `under` still shows, `count`: its layers.
+vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) {
     transmittance = 1.0;
     count = 0u;
     uint head = layer_heads[layer_pixel(p)];
@@ -87,7 +115,7 @@ vec3 blend_layers(ivec2 p, vec2 frag_xy, vec3 under, out float transmittance, ou
     // What is merged behind them: Π(1 − α), Σα, Σα·colour.
     float uncovered = 1.0, weight = 0.0;
     vec3 weighted = vec3(0.0);
-    uint capacity = uint(layer_nodes.length()) / 2u;
+    uint capacity = layer_capacity();
     for (uint node = head; node != LAYER_END && count < capacity; count++) {
         uvec4 a = layer_nodes[2u * node];
         uvec2 key = a.xz;
@@ -113,10 +141,10 @@ vec3 blend_layers(ivec2 p, vec2 frag_xy, vec3 under, out float transmittance, ou
             kept++;
         }
         if (merged_node != LAYER_END) {
-            float alpha = uintBitsToFloat(layer_nodes[2u * merged_node].w);
-            uncovered *= 1.0 - alpha;
-            weight += alpha;
-            weighted += alpha * shade_layer(merged_node, frag_xy);
+            vec4 c = layer_color(merged_node);
+            uncovered *= 1.0 - c.a;
+            weight += c.a;
+            weighted += c.a * c.rgb;
         }
         node = a.y;
     }
@@ -128,10 +156,9 @@ vec3 blend_layers(ivec2 p, vec2 frag_xy, vec3 under, out float transmittance, ou
         transmittance = uncovered;
     }
     for (uint i = kept; i > 0u; i--) {
-        uint node = nodes[i - 1u];
-        float alpha = uintBitsToFloat(layer_nodes[2u * node].w);
-        color = shade_layer(node, frag_xy) * alpha + color * (1.0 - alpha);
-        transmittance *= 1.0 - alpha;
+        vec4 c = layer_color(nodes[i - 1u]);
+        color = c.rgb * c.a + color * (1.0 - c.a);
+        transmittance *= 1.0 - c.a;
     }
     return color;
 }
@@ -148,14 +175,14 @@ vec4 layer_count_color(uint count) {
 // What the colour target shows at pixel `p` whose opaque surface has lit colour `under`
 // (`background`: none; the background colour is a backdrop in the output's encoding, not
 // light in the scene, so the layers are blended over black and laid over it there).
-vec4 layered_output(ivec2 p, vec2 frag_xy, vec3 under, bool background, float exposure) {
+vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
     float transmittance = 1.0;
     uint count = 0u;
     vec3 color = under;
     // (Not `!TRANSPARENT_LAYERS`: a negated specialization constant is an expression that
     // the build's reflection does not evaluate.)
     if (TRANSPARENT_LAYERS) {
-        color = blend_layers(p, frag_xy, background ? vec3(0.0) : under, transmittance, count);
+        color = blend_layers(p, background ? vec3(0.0) : under, transmittance, count);
     } else {
         return background ? CLEAR_COLOR : vec4(encode_output(under, exposure), 1.0);
     }

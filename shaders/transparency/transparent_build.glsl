@@ -42,7 +42,6 @@ void main() {
         return;
     }
     Surface s = surface_at(covered_normal(), in_tangent, in_uv, object.ids.y, object.material);
-    uvec4 surface = uvec4(packSnorm2x16(oct_encode(s.normal)), packUnorm4x8(vec4(s.albedo_factor, s.occlusion)),
-                          packUnorm2x16(s.roughness_metallic), packUnorm4x8(vec4(s.emissive_factor, 0.0)));
-    store_layer(p, gl_FragCoord.z, o, min(alpha, 1.0), surface);
+    uvec4 surface = pack_layer_surface(s.normal, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, min(alpha, 1.0), s.emissive_factor);
+    store_layer(p, gl_FragCoord.z, o, surface);
 }

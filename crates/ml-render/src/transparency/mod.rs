@@ -1,7 +1,7 @@
 //! Transparency (glTF `alphaMode: BLEND`): the transparent objects' fragments in front of the
-//! opaque surfaces kept per pixel in linked lists (`transparent_build`), then lit and blended
-//! back to front over the opaque pass's linear HDR output (`transparent_resolve`), in every
-//! technique. The rule a pixel follows, and its reference, is ml-cpu `transparency`; the
+//! opaque surfaces kept per pixel in linked lists (`transparent_build`), then lit a node at a
+//! time and blended back to front over the opaque pass's linear HDR output
+//! (`transparent_resolve`), in every technique. The rule a pixel follows, and its reference, is ml-cpu `transparency`; the
 //! shaders are under `shaders/transparency/`.
 //!
 //! Memory is a fixed budget set by an option: a pool of nodes, `budget` per pixel on average,
@@ -61,15 +61,12 @@ impl TransparencySettings {
     }
 }
 
-/// How a pass that blends the layers uses the lists (`Pass::uses`): reads heads and nodes,
-/// counts merged pixels.
-pub fn layer_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
+/// How the resolve uses the lists (`Pass::uses`): reads the heads, lights the nodes in place,
+/// counts the pixels that merged layers.
+pub fn layer_uses(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let read = (stages, vk::AccessFlags::SHADER_READ);
-    vec![
-        Use::at(LAYER_BUFFERS[0], read, None),
-        Use::at(LAYER_BUFFERS[1], read, None),
-        Use::at(LAYER_BUFFERS[2], (stages, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE), None),
-    ]
+    let read_write = (stages, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+    vec![Use::at(LAYER_BUFFERS[0], read, None), Use::at(LAYER_BUFFERS[1], read_write, None), Use::at(LAYER_BUFFERS[2], read_write, None)]
 }
 
 /// The counters as the host reads them once the frame is done (after every pass).

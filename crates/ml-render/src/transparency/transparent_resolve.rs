@@ -1,20 +1,27 @@
-//! The transparent resolve: a compute pass over the opaque pass's linear HDR image (the
-//! forward pass's, the lighting subpass's, the compute lighting's) that lights each pixel's
-//! transparent layers, blends them back to front over it and encodes the result into the
-//! colour target (transparent_resolve.comp; in place of the deferred techniques' tone map).
-//! Every technique's layers are lit and blended here, by one shader.
+//! The transparent resolve, in two compute dispatches: the layers lit, a thread per node in the
+//! order their fragments were drawn (transparent_lighting.comp: the same lights, lists, model
+//! and shadows as the opaque surfaces), then per pixel sorted and blended back to front over
+//! the opaque pass's linear HDR output (the forward pass's, the lighting subpass's, the compute
+//! lighting's) and encoded into the colour target (transparent_blend.comp; in place of the
+//! deferred techniques' tone map). One pair of shaders for every technique.
 
-use super::layer_reads;
+use super::layer_uses;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
 use crate::sync::{shading_reads, Use, HDR_TARGET};
+use ml_vk::commands::memory_barrier;
 use ml_vk::{vk, Context, VkError};
 
+/// Work groups of the lighting dispatch at most: they stride through the nodes (a thread a
+/// node at a time), enough to fill any GPU.
+const LIGHTING_GROUPS: u32 = 4096;
+
 pub struct TransparentResolve {
-    pass: ComputePass,
+    lighting: ComputePass,
+    blend: ComputePass,
     /// A compute lighting pass wrote the HDR image (declared, in GENERAL) — else a render
     /// pass, whose dependencies order it and leave it SHADER_READ_ONLY_OPTIMAL.
     after_compute: bool,
@@ -29,9 +36,18 @@ impl TransparentResolve {
         shading: Shading,
         (clustered, after_compute): (bool, bool),
     ) -> Result<TransparentResolve, VkError> {
-        let shader = if clustered { &ml_shaders::TRANSPARENT_RESOLVE_CLUSTERED_COMP } else { &ml_shaders::TRANSPARENT_RESOLVE_COMP };
-        let constants = shading.layered_lighting_constants();
-        Ok(TransparentResolve { pass: ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &constants))?, after_compute })
+        let shader = if clustered { &ml_shaders::TRANSPARENT_LIGHTING_CLUSTERED_COMP } else { &ml_shaders::TRANSPARENT_LIGHTING_COMP };
+        let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &shading.layered_lighting_constants()))?;
+        let [blinn_phong, pbr, _] = shading.surface_constants();
+        let blend_constants = [blinn_phong, pbr, ("TRANSPARENT_LAYERS", 1)];
+        match ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_COMP, &blend_constants)) {
+            Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute }),
+            Err(e) => {
+                let mut lighting = lighting;
+                lighting.destroy(ctx);
+                Err(e)
+            }
+        }
     }
 }
 
@@ -41,15 +57,16 @@ impl Pass for TransparentResolve {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        let hdr = self.pass.sampled(&frame.targets.hdr, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
-        self.pass.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { frame.buffer(name) })
+        self.lighting.bind_frame(ctx, frame, &|name| frame.buffer(name))?;
+        let hdr = self.blend.sampled(&frame.targets.hdr, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+        self.blend.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { frame.buffer(name) })
     }
 
     /// After the layers' build and the opaque pass that wrote the HDR image.
     fn uses(&self) -> Vec<Use> {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let mut uses = shading_reads(compute);
-        uses.extend(layer_reads(compute));
+        uses.extend(layer_uses(compute));
         if self.after_compute {
             let layout = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
             uses.push(Use::at(HDR_TARGET, (compute, vk::AccessFlags::SHADER_READ), Some(layout)));
@@ -59,11 +76,17 @@ impl Pass for TransparentResolve {
     }
 
     fn record(&self, rec: &Recording) {
-        let sets = [rec.scene.textures.set];
-        self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &sets), rec.targets.color.raw, rec.extent);
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let nodes = rec.targets.layers.capacity().min(LIGHTING_GROUPS as u64 * 64) as u32;
+        let threads = vk::Extent2D { width: nodes.max(1), height: 1 };
+        self.lighting.dispatch(ctx, cmd, rec.slot, (&[rec.scene.textures.set], &[]), threads);
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
+        self.blend.record_into_colour_target(ctx, cmd, (rec.slot, &[]), rec.targets.color.raw, rec.extent);
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        self.pass.destroy(ctx);
+        self.lighting.destroy(ctx);
+        self.blend.destroy(ctx);
     }
 }
