@@ -22,7 +22,7 @@
 layout(constant_id = 40) const bool TRANSPARENT_LAYERS = false;
 
 const uint LAYER_END = 0xffffffffu;
-// Layers a pixel blends exactly (a register array per thread); beyond, merged.
+// Layers a pixel blends exactly (an array per thread); beyond, merged.
 const uint LAYER_KEEP = 32u;
 
 // Per pixel (row-major): its nearest-drawn node, LAYER_END for none.
@@ -108,10 +108,14 @@ vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) 
     if (head == LAYER_END) {
         return under;
     }
-    // The nearest LAYER_KEEP, sorted: (depth bits, object) keys and node indices.
-    uvec2 keys[LAYER_KEEP];
-    uint nodes[LAYER_KEEP];
-    uint kept = 0u;
+    // The nearest LAYER_KEEP, sorted, in [lo, hi) of a double-ended array that starts in its
+    // middle: (depth bits, object) keys and node indices. A list holds its pixel's layers in
+    // the reverse of the order they were drawn, so they often come nearest-first or
+    // farthest-first; either way each one goes to an end, without moving the others (an array
+    // filled from one end would move them all for one of the two).
+    uvec2 keys[2u * LAYER_KEEP];
+    uint nodes[2u * LAYER_KEEP];
+    uint lo = LAYER_KEEP, hi = LAYER_KEEP;
     // What is merged behind them: Π(1 − α), Σα, Σα·colour.
     float uncovered = 1.0, weight = 0.0;
     vec3 weighted = vec3(0.0);
@@ -120,25 +124,45 @@ vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) 
         uvec4 a = layer_nodes[2u * node];
         uvec2 key = a.xz;
         uint merged_node = LAYER_END;
-        if (kept == LAYER_KEEP) {
-            if (layer_before(key, keys[LAYER_KEEP - 1u])) {
-                merged_node = nodes[LAYER_KEEP - 1u];
-                kept--;
+        if (hi - lo == LAYER_KEEP) {
+            if (layer_before(key, keys[hi - 1u])) {
+                hi--;
+                merged_node = nodes[hi];
             } else {
                 merged_node = node;
             }
         }
         if (merged_node != node) {
-            // Insertion: shift the farther ones back.
-            uint i = kept;
-            while (i > 0u && layer_before(key, keys[i - 1u])) {
-                keys[i] = keys[i - 1u];
-                nodes[i] = nodes[i - 1u];
+            // Its place i: keys[lo, i) before it, keys[i, hi) not. The ends first.
+            uint i = hi;
+            if (lo != hi && layer_before(key, keys[hi - 1u])) {
+                if (layer_before(key, keys[lo])) {
+                    i = lo;
+                } else {
+                    i = hi - 1u;
+                    while (layer_before(key, keys[i - 1u])) {
+                        i--;
+                    }
+                }
+            }
+            // Make room on the shorter side that has it (one always has: at most
+            // LAYER_KEEP - 1 layers are kept here, and lo never passes the middle).
+            if (hi < 2u * LAYER_KEEP && (lo == 0u || hi - i <= i - lo)) {
+                for (uint k = hi; k > i; k--) {
+                    keys[k] = keys[k - 1u];
+                    nodes[k] = nodes[k - 1u];
+                }
+                hi++;
+            } else {
+                for (uint k = lo; k < i; k++) {
+                    keys[k - 1u] = keys[k];
+                    nodes[k - 1u] = nodes[k];
+                }
+                lo--;
                 i--;
             }
             keys[i] = key;
             nodes[i] = node;
-            kept++;
         }
         if (merged_node != LAYER_END) {
             vec4 c = layer_color(merged_node);
@@ -155,7 +179,7 @@ vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) 
         color = mix(color, mean, 1.0 - uncovered);
         transmittance = uncovered;
     }
-    for (uint i = kept; i > 0u; i--) {
+    for (uint i = hi; i > lo; i--) {
         vec4 c = layer_color(nodes[i - 1u]);
         color = c.rgb * c.a + color * (1.0 - c.a);
         transmittance *= 1.0 - c.a;

@@ -6,7 +6,7 @@
 // where the technique has cluster lists.
 #include "common/common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = 256) in;
 
 #include "common/scene_bindings.glsl"
 #include "common/textures.glsl"

@@ -57,6 +57,11 @@ impl ComputePass {
         })
     }
 
+    /// The shader's work-group size.
+    pub fn workgroup_size(&self) -> [u32; 3] {
+        self.workgroup_size
+    }
+
     /// The work groups of a dispatch over `extent` (x, y).
     pub fn groups(&self, extent: vk::Extent2D) -> (u32, u32) {
         (extent.width.div_ceil(self.workgroup_size[0]), extent.height.div_ceil(self.workgroup_size[1]))

@@ -198,13 +198,16 @@ fn the_order_the_quads_are_listed_in_changes_nothing() {
 
 #[test]
 fn a_budget_below_the_depth_complexity_is_reported() {
-    // 40 faint panes, one behind the other over a third of the image: more layers than a pixel
-    // blends exactly (merged beyond the nearest 32), and more fragments than a budget of one
-    // node per pixel holds (dropped).
+    // 40 faint panes one behind another over a third of the image, listed out of depth order
+    // (each in its own colour and coverage): more layers than a pixel blends exactly —
+    // merged beyond the nearest 32 as the CPU rule merges them — and more fragments than a
+    // budget of one node per pixel holds (dropped).
     let mut deep = scene([0, 1, 2]);
     deep.objects.truncate(1);
-    for i in 0..40 {
-        deep.objects.push(quad(Vec3::new(0.0, 0.0, 0.05 + 0.05 * i as f32), (0.8, 0.8), [0.5, 0.5, 0.9], Some(0.1)));
+    for k in 0..40 {
+        let i = (k * 17) % 40;
+        let c = [0.2 + 0.02 * i as f32, 0.9 - 0.02 * i as f32, 0.3 + 0.3 * (i % 3) as f32];
+        deep.objects.push(quad(Vec3::new(0.0, 0.0, 0.05 + 0.05 * i as f32), (0.8, 0.8), c, Some(0.05 + 0.004 * i as f32)));
     }
     let mut s = settings(Technique::DeferredCompute);
     s.transparency = Some(TransparencySettings { budget: 1 });
@@ -213,9 +216,22 @@ fn a_budget_below_the_depth_complexity_is_reported() {
     assert_eq!(st.capacity, (W * H) as u64);
     let mut s = settings(Technique::Visibility);
     s.transparency = Some(TransparencySettings { budget: 16 });
-    let st = stats(&common::render(deep, s));
+    let out = common::render(deep.clone(), s);
+    let st = stats(&out);
     assert_eq!(st.dropped(), 0, "{st:?}");
     assert!(st.merged_pixels > 100, "{st:?}");
+    let want = reference(&deep);
+    let mut edges = 0;
+    for y in 0..H {
+        for x in 0..W {
+            let (got, w) = (common::pixel(&out, x, y), want[(y * W + x) as usize]);
+            if diff(got, w) > MAX_DIFF {
+                assert!(edge(&deep, x, y), "pixel ({x}, {y}) is {got:?}, the CPU blend {w:?}");
+                edges += 1;
+            }
+        }
+    }
+    assert!(edges <= MAX_EDGE_PIXELS, "{edges} edge pixels differ");
 }
 
 // ---------------------------------------------------------------------------------------------

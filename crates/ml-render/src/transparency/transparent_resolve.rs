@@ -15,9 +15,9 @@ use crate::sync::{shading_reads, Use, HDR_TARGET};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{vk, Context, VkError};
 
-/// Work groups of the lighting dispatch at most: they stride through the nodes (a thread a
-/// node at a time), enough to fill any GPU.
-const LIGHTING_GROUPS: u32 = 4096;
+/// Work groups of the lighting dispatch at most (the least maxComputeWorkGroupCount[0] Vulkan
+/// allows): a thread a node, striding on where the pool holds more.
+const LIGHTING_GROUPS: u32 = 65535;
 
 pub struct TransparentResolve {
     lighting: ComputePass,
@@ -77,7 +77,7 @@ impl Pass for TransparentResolve {
 
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let nodes = rec.targets.layers.capacity().min(LIGHTING_GROUPS as u64 * 64) as u32;
+        let nodes = rec.targets.layers.capacity().min(LIGHTING_GROUPS as u64 * self.lighting.workgroup_size()[0] as u64) as u32;
         let threads = vk::Extent2D { width: nodes.max(1), height: 1 };
         self.lighting.dispatch(ctx, cmd, rec.slot, (&[rec.scene.textures.set], &[]), threads);
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
