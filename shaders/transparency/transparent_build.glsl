@@ -30,18 +30,20 @@ float opaque_depth_at(ivec2 p) {
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    if (gl_FragCoord.z >= opaque_depth_at(p)) {
-        return;
-    }
     uint o = object.ids.x;
+    // The textures first, sampled with their implicit derivatives while the whole quad still
+    // runs (after a fragment of it returns they are undefined); and every read this fragment
+    // needs issued together, before the test that waits on the opaque depth.
+    Surface s = surface_at(covered_normal(), in_tangent, in_uv, object.ids.y, object.material);
     float alpha = objects[o].alpha.y;
-    if ((objects[o].alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u) {
-        alpha *= texture_alpha(objects[o].alpha_texture, in_uv);
+    uvec4 alpha_texture = objects[o].alpha_texture;
+    float opaque = opaque_depth_at(p);
+    if ((alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u) {
+        alpha *= texture_alpha(alpha_texture, in_uv);
     }
-    if (alpha <= 0.0) {
+    if (gl_FragCoord.z >= opaque || alpha <= 0.0) {
         return;
     }
-    Surface s = surface_at(covered_normal(), in_tangent, in_uv, object.ids.y, object.material);
     uvec4 surface = pack_layer_surface(s.normal, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, min(alpha, 1.0), s.emissive_factor);
     store_layer(p, gl_FragCoord.z, o, surface);
 }
