@@ -14,19 +14,7 @@
 #define LAYER_BINDING 14
 #include "transparency/layers.glsl"
 
-// The opaque depth: the raster's depth image, or (OPAQUE_DEPTH_BUFFER) the compute raster's
-// 64-bit buffer (depth in the high word).
-#ifdef OPAQUE_DEPTH_BUFFER
-layout(std430, set = 0, binding = 13) readonly buffer VisibilityDepthBuffer { uvec2 visibility_depth[]; };
-float opaque_depth_at(ivec2 p) {
-    return visibility_buffer_depth(visibility_depth[layer_pixel(p)]);
-}
-#else
-layout(set = 0, binding = 12) uniform sampler2D opaque_depth;
-float opaque_depth_at(ivec2 p) {
-    return texelFetch(opaque_depth, p, 0).r;
-}
-#endif
+#include "transparency/opaque_depth.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);

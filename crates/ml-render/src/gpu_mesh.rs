@@ -13,9 +13,15 @@ pub struct GpuMesh {
 
 impl GpuMesh {
     pub fn upload(ctx: &Context, kind: MeshKind, mesh: &Mesh) -> Result<GpuMesh, VkError> {
-        let mut vertices =
-            Buffer::device_local_with(ctx, "vertices", bytemuck::cast_slice(&mesh.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-        match Buffer::device_local_with(ctx, "indices", bytemuck::cast_slice(&mesh.indices), vk::BufferUsageFlags::INDEX_BUFFER) {
+        // STORAGE too: the transparent layers' compute build reads small meshes as buffers.
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let mut vertices = Buffer::device_local_with(
+            ctx,
+            "vertices",
+            bytemuck::cast_slice(&mesh.vertices),
+            vk::BufferUsageFlags::VERTEX_BUFFER | storage,
+        )?;
+        match Buffer::device_local_with(ctx, "indices", bytemuck::cast_slice(&mesh.indices), vk::BufferUsageFlags::INDEX_BUFFER | storage) {
             Ok(indices) => Ok(GpuMesh { kind, vertices, indices, index_count: mesh.indices.len() as u32 }),
             Err(e) => {
                 vertices.destroy(ctx);
@@ -28,6 +34,17 @@ impl GpuMesh {
         self.vertices.destroy(ctx);
         self.indices.destroy(ctx);
     }
+}
+
+/// Transparent objects of at most this many triangles have their layers built in compute
+/// (transparent_build_compute.glsl), the others by the hardware raster.
+pub const COMPUTE_LAYER_TRIANGLES: u32 = 64;
+
+/// Whether `o` is a transparent object whose layers are built in compute (its mesh among
+/// `meshes` has few triangles: a pane, a card).
+pub fn layers_in_compute(o: &Object, meshes: &[GpuMesh]) -> bool {
+    o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend
+        && meshes.iter().find(|m| m.kind == o.mesh).is_some_and(|m| m.index_count / 3 <= COMPUTE_LAYER_TRIANGLES)
 }
 
 /// The vertex buffer's binding (one, per vertex) as pipelines read it.

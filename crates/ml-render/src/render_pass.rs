@@ -248,7 +248,8 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage], layers: boo
         let tests = vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
         let depth_write = vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
         for subpass in [0, 1] {
-            dependencies.push(dependency((subpass, tests, depth_write), (external, FRAGMENT, vk::AccessFlags::SHADER_READ)));
+            let build = FRAGMENT | vk::PipelineStageFlags::COMPUTE_SHADER;
+            dependencies.push(dependency((subpass, tests, depth_write), (external, build, vk::AccessFlags::SHADER_READ)));
         }
     }
     RenderPassDesc { attachments, subpasses, dependencies }

@@ -268,6 +268,36 @@ const LEAVES: usize = 4;
 /// A lit floor and LEAVES leaves of `mode` ("BLEND", or "OPAQUE" for their colour without
 /// alpha; None: no leaves), loaded from a GLB written here.
 fn foliage(mode: Option<&str>) -> Scene {
+    foliage_of(mode, gltf_quad())
+}
+
+/// The quad as a grid of 12×12 cells (288 triangles, more than the compute build takes: the
+/// hardware raster builds its layers).
+fn fine_quad() -> PrimitiveData {
+    let n = 12u32;
+    let at = |i: u32| i as f32 / n as f32;
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            positions.push([at(i) * 2.0 - 1.0, 0.0, at(j) * 2.0 - 1.0]);
+            uvs.push([at(i), at(j)]);
+        }
+    }
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    let indices = (0..n)
+        .flat_map(|j| (0..n).flat_map(move |i| [v(i, j), v(i, j + 1), v(i + 1, j), v(i + 1, j), v(i, j + 1), v(i + 1, j + 1)]))
+        .collect();
+    PrimitiveData {
+        normals: Some(vec![[0.0, 1.0, 0.0]; positions.len()]),
+        positions,
+        uvs: Some(uvs),
+        indices: Some((indices, ml_cpu::gltf_writer::IndexType::U32)),
+        material: None,
+    }
+}
+
+fn foliage_of(mode: Option<&str>, leaf: PrimitiveData) -> Scene {
     let mut w = GltfWriter::new();
     let floor = w.material([0.6, 0.55, 0.5, 1.0], 0.0, 0.8);
     let floor_mesh = w.mesh(&[PrimitiveData { material: Some(floor), ..gltf_quad() }]);
@@ -280,7 +310,7 @@ fn foliage(mode: Option<&str>) -> Scene {
         let colours = [[0.3, 0.8, 0.2, 1.0], [0.5, 0.9, 0.1, 0.9], [0.2, 0.6, 0.3, 1.0], [0.7, 0.8, 0.2, 0.8]];
         for (i, c) in colours.iter().enumerate().take(LEAVES) {
             let m = w.alpha_material(Some(texture), *c, mode, None, true);
-            let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..gltf_quad() }]);
+            let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..leaf.clone() }]);
             let (at, rotation) = leaf_at(i);
             w.node(json!({ "mesh": mesh, "translation": at.to_array(), "rotation": rotation.to_array(), "scale": [0.8, 0.8, 0.8] }), true);
         }
@@ -369,5 +399,21 @@ fn the_layer_view_counts_each_pixels_layers() {
             }
             assert_eq!(got == [0, 0, 0], layers == 0, "({x}, {y}) with {layers} layers shows {got:?}");
         }
+    }
+}
+
+#[test]
+fn the_compute_build_and_the_hardware_raster_build_agree() {
+    // The leaves as two triangles each (built in compute) and as 288 (built by the hardware
+    // raster): the same image but at edge pixels and where the two pick texture levels apart.
+    let pbr = |t| RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
+    for technique in [Technique::Forward, Technique::Visibility] {
+        let coarse = common::render(foliage(Some("BLEND")), pbr(technique));
+        let fine = common::render(foliage_of(Some("BLEND"), fine_quad()), pbr(technique));
+        let (a, b) = (stats(&coarse), stats(&fine));
+        assert!(a.fragments.abs_diff(b.fragments) <= a.fragments / 100, "{a:?} against {b:?}");
+        let beyond = common::pixels_beyond(&coarse, &fine, 2);
+        assert!(beyond <= (W * H / 100) as usize, "{}: {beyond} pixels differ by more than 2/255", technique.name());
+        println!("{}: {beyond} pixels beyond 2/255; fragments {} and {}", technique.name(), a.fragments, b.fragments);
     }
 }

@@ -106,11 +106,12 @@ impl MeshRaster {
     }
 
     /// Whether this pass draws `o`: the transparent layers' build only the transparent
-    /// objects; with layers, the opaque passes all others; without, every object.
-    fn draws(&self, o: &ml_cpu::scene::Object) -> bool {
+    /// objects it does not build in compute; with layers, the opaque passes all others;
+    /// without, every object.
+    fn draws(&self, o: &ml_cpu::scene::Object, meshes: &[crate::gpu_mesh::GpuMesh]) -> bool {
         let blended = o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend;
         match self.output {
-            Output::Layers { .. } => blended,
+            Output::Layers { .. } => blended && !crate::gpu_mesh::layers_in_compute(o, meshes),
             _ => !(self.layers && blended),
         }
     }
@@ -251,7 +252,7 @@ impl MeshRaster {
                 ctx,
                 cmd,
                 (&scene.meshes, rec.objects),
-                |index| u32::from(self.draws(&rec.objects[index as usize])),
+                |index| u32::from(self.draws(&rec.objects[index as usize], &scene.meshes)),
                 |index, o| {
                     let variant = self.drawn_as(SurfaceVariant::of(o));
                     if variant != bound_variant {
