@@ -1,7 +1,7 @@
 // The transparent layers' build in compute, for transparent objects of few triangles (glass
 // panes, windows, cards): the H100 runs fragment shaders on 4 of its 132 SMs, so a pane across
-// the view appended through them costs 2M fragments at that rate. A dispatch per object, a
-// work group per 8×8 pixels: its threads set up up to 64 of the object's triangles at a time
+// the view appended through them costs 2M fragments at that rate. A dispatch per object over
+// the pixels its box may cover (found on the CPU), a work group per 8×8 pixels: its threads set up up to 64 of the object's triangles at a time
 // (clip-space positions, attributes) in shared memory, then each pixel tests them all.
 //
 // Triangles are rasterised in homogeneous coordinates (no clipping: a triangle crossing the
@@ -32,7 +32,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // three indices a triangle.
 layout(std430, set = 3, binding = 0) readonly buffer MeshVertexBuffer { float mesh_vertices[]; };
 layout(std430, set = 3, binding = 1) readonly buffer MeshIndexBuffer { uint mesh_indices[]; };
-// ObjectPush (ids.z: the mesh's triangles).
+// ObjectPush (ids.z: the mesh's triangles; ids.w: the first pixel of the object's screen
+// rectangle, y << 16 | x, which the dispatch covers).
 layout(push_constant) uniform PushBlock { ObjectPush object; };
 
 const uint CHUNK = 64u;
@@ -66,7 +67,7 @@ bool edge_owns(float e, vec2 c) {
 }
 
 void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy) + ivec2(object.ids.w & 0xffffu, object.ids.w >> 16);
     bool in_image = p.x < int(frame.viewport.x) && p.y < int(frame.viewport.y);
     uint o = object.ids.x;
     ObjectData od = objects[o];

@@ -23,6 +23,8 @@ pub struct Recording<'a> {
     pub targets: &'a Targets,
     pub scene: &'a SceneGpu,
     pub objects: &'a [ml_cpu::scene::Object],
+    /// The frame's camera, world → clip (the uniforms' `proj · view`).
+    pub view_proj: glam::Mat4,
 }
 
 /// What a frame slot's finished frame tells the frame loop: the GPU light assignment's

@@ -698,7 +698,8 @@ impl<'a> Renderer<'a> {
         }
         frame.timer.reset(ctx, cmd);
         let targets = frame.targets.as_ref().expect("made with the frame");
-        let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects };
+        let view_proj = self.grid.projection * self.grid.view;
+        let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
         let image = |name: &str| targets.named_image(name).or_else(|| self.gpu.named_image(name));
         for pass in &self.passes {

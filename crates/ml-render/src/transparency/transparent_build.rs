@@ -86,6 +86,36 @@ impl TransparentBuild {
     }
 }
 
+/// The pixels an object whose world box is `(lo, hi)` may cover in an image of `extent` seen
+/// through `view_proj`: the box's corners projected, a pixel of margin, clamped to the image
+/// (the whole image where the box reaches behind the eye); None where it covers none (wholly
+/// behind the eye, or outside the image).
+fn screen_rect((lo, hi): (glam::Vec3, glam::Vec3), view_proj: glam::Mat4, extent: vk::Extent2D) -> Option<((u32, u32), vk::Extent2D)> {
+    let size = glam::Vec2::new(extent.width as f32, extent.height as f32);
+    let corners = (0..8).map(|i| {
+        let corner = glam::Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][(i >> 2) & 1]);
+        view_proj * corner.extend(1.0)
+    });
+    let behind = corners.clone().filter(|c| c.w <= 1e-6).count();
+    let (mut min, mut max) = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
+    match behind {
+        8 => return None,
+        0 => {
+            for clip in corners {
+                let pixel = (clip.truncate().truncate() / clip.w + 1.0) * 0.5 * size;
+                (min, max) = (min.min(pixel), max.max(pixel));
+            }
+        }
+        _ => (min, max) = (glam::Vec2::ZERO, size),
+    }
+    let min = (min - 1.0).floor().max(glam::Vec2::ZERO);
+    let max = (max + 1.0).ceil().min(size);
+    (max.x > min.x && max.y > min.y).then(|| {
+        let origin = (min.x as u32, min.y as u32);
+        (origin, vk::Extent2D { width: max.x as u32 - origin.0, height: max.y as u32 - origin.1 })
+    })
+}
+
 impl Pass for TransparentBuild {
     fn timer_name(&self) -> Option<&'static str> {
         Some("transparent layers")
@@ -129,10 +159,12 @@ impl Pass for TransparentBuild {
         let scene = rec.scene;
         for (index, o) in rec.objects.iter().enumerate().filter(|(_, o)| layers_in_compute(o, &scene.meshes)) {
             let Some(m) = scene.meshes.iter().position(|m| m.kind == o.mesh) else { continue };
+            let Some((origin, size)) = screen_rect(o.bounds(), rec.view_proj, rec.extent) else { continue };
             let mut push = object_push(o, index as u32);
             push.ids[2] = scene.meshes[m].index_count / 3;
+            push.ids[3] = origin.1 << 16 | origin.0;
             let sets = [scene.textures.set, scene.object_textures.per_object[index], self.mesh_sets.sets[m]];
-            self.compute.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), rec.extent);
+            self.compute.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), size);
         }
         // The compute build's appends before the raster's (both swap list heads).
         memory_barrier(ctx, cmd, (compute, rw), (fragment, rw));
@@ -160,5 +192,26 @@ impl Pass for TransparentBuild {
         self.compute.destroy(ctx);
         self.mesh_sets.destroy(ctx);
         self.raster.destroy(ctx);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat4, Vec3};
+
+    #[test]
+    fn an_objects_screen_rectangle_holds_its_box_and_no_more_than_the_image() {
+        let extent = vk::Extent2D { width: 200, height: 100 };
+        let camera = ml_cpu::camera::Camera::looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, 60.0, 0.1, 50.0);
+        let vp: Mat4 = camera.projection(2.0) * camera.view();
+        // A small box ahead: a rectangle round the middle of the image.
+        let ((x, y), size) = screen_rect((Vec3::splat(-0.5), Vec3::splat(0.5)), vp, extent).expect("in view");
+        assert!(x > 50 && x < 100 && y > 20 && y < 50 && size.width < 100 && size.height < 60, "{x} {y} {size:?}");
+        assert!(x + size.width > 100 && y + size.height > 50);
+        // Reaching behind the eye: the whole image; wholly behind it, or off to a side: nothing.
+        assert_eq!(screen_rect((Vec3::splat(-1.0), Vec3::new(1.0, 1.0, 9.0)), vp, extent), Some(((0, 0), extent)));
+        assert_eq!(screen_rect((Vec3::new(-1.0, -1.0, 6.0), Vec3::new(1.0, 1.0, 9.0)), vp, extent), None);
+        assert_eq!(screen_rect((Vec3::new(40.0, -1.0, -1.0), Vec3::new(41.0, 1.0, 1.0)), vp, extent), None);
     }
 }
