@@ -70,8 +70,11 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy) + ivec2(object.ids.w & 0xffffu, object.ids.w >> 16);
     bool in_image = p.x < int(frame.viewport.x) && p.y < int(frame.viewport.y);
     uint o = object.ids.x;
-    ObjectData od = objects[o];
-    bool double_sided = (od.alpha_texture.x & OBJECT_DOUBLE_SIDED) != 0u;
+    // Only the fields each step needs (the whole ObjectData per thread would be 240 bytes of
+    // reads in every dispatch).
+    float base_alpha = objects[o].alpha.y;
+    uvec4 alpha_texture = objects[o].alpha_texture;
+    bool double_sided = (alpha_texture.x & OBJECT_DOUBLE_SIDED) != 0u;
     mat4 view_proj = frame.proj * frame.view;
     vec2 to_ndc = 2.0 / vec2(frame.viewport.xy);
     vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0);
@@ -80,14 +83,16 @@ void main() {
     for (uint base = 0u; base < triangles; base += CHUNK) {
         uint t = base + gl_LocalInvocationIndex;
         if (t < triangles) {
-            Vtx v[3];
+            mat4 model = objects[o].model;
+            mat3 normal_matrix = mat3(objects[o].normal_matrix);
+            vec4 uv_transform[2] = objects[o].uv_transform;
             for (uint k = 0u; k < 3u; k++) {
-                v[k] = mesh_vertex(mesh_indices[3u * t + k]);
-                vec3 world = (od.model * vec4(v[k].position, 1.0)).xyz;
+                Vtx v = mesh_vertex(mesh_indices[3u * t + k]);
+                vec3 world = (model * vec4(v.position, 1.0)).xyz;
                 tri_clip[gl_LocalInvocationIndex][k] = view_proj * vec4(world, 1.0);
-                tri_normal[gl_LocalInvocationIndex][k] = mat3(od.normal_matrix) * v[k].normal;
-                tri_uv[gl_LocalInvocationIndex][k] = vec4(transform_uv(od.uv_transform, v[k].uv), 0.0, 0.0);
-                tri_tangent[gl_LocalInvocationIndex][k] = vec4(mat3(od.model) * v[k].tangent.xyz, v[k].tangent.w);
+                tri_normal[gl_LocalInvocationIndex][k] = normal_matrix * v.normal;
+                tri_uv[gl_LocalInvocationIndex][k] = vec4(transform_uv(uv_transform, v.uv), 0.0, 0.0);
+                tri_tangent[gl_LocalInvocationIndex][k] = vec4(mat3(model) * v.tangent.xyz, v.tangent.w);
             }
         }
         barrier();
@@ -119,9 +124,9 @@ void main() {
                 continue;
             }
             vec2 uv = w.x * tri_uv[i][0].xy + w.y * tri_uv[i][1].xy + w.z * tri_uv[i][2].xy;
-            float alpha = od.alpha.y;
-            if ((od.alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u) {
-                alpha *= texture_alpha(od.alpha_texture, uv);
+            float alpha = base_alpha;
+            if ((alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u) {
+                alpha *= texture_alpha(alpha_texture, uv);
             }
             if (alpha <= 0.0) {
                 continue;
