@@ -228,9 +228,10 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage], layers: boo
     let external = vk::SUBPASS_EXTERNAL;
     let mut dependencies = vec![
         // The targets are reused every other frame: the G-buffer was last written by that
-        // frame's subpass 0 and read by its subpass 1 ...
+        // frame's subpass 0 and read by its subpass 1 (and depth, with transparent layers, by
+        // their build's fragment or compute shaders) ...
         dependency(
-            (external, COLOUR_OUT | FRAGMENT_TESTS | fragment, ATTACHMENT_WRITES),
+            (external, COLOUR_OUT | FRAGMENT_TESTS | fragment | compute, ATTACHMENT_WRITES),
             (0, COLOUR_OUT | FRAGMENT_TESTS, ATTACHMENT_WRITES | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
         ),
         // ... and the HDR image written by its subpass 1 and read by its tone map.
