@@ -143,9 +143,9 @@ pub struct Targets {
 /// Bytes of a transparent layer's node: two uvec4 (transparency/layers.glsl).
 pub const NODE_BYTES: u64 = 32;
 
-/// A frame slot's lists: heads, node pool, counters (host-visible: the build pass reads them
-/// when the frame is done). Without transparency, 16-byte stand-ins for the lighting
-/// passes' bindings, which their shaders then never read.
+/// A frame slot's transparent layers (transparency/): heads, node pool, counters
+/// (host-visible: the build pass reads them when the frame is done). Without transparency,
+/// stand-ins of a few bytes that no pass binds.
 pub struct LayerBuffers {
     pub heads: Buffer,
     pub nodes: Buffer,

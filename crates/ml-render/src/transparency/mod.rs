@@ -1,8 +1,8 @@
 //! Transparency (glTF `alphaMode: BLEND`): the transparent objects' fragments in front of the
 //! opaque surfaces kept per pixel in linked lists (`transparent_build`), then lit a node at a
 //! time and blended back to front over the opaque pass's linear HDR output
-//! (`transparent_resolve`), in every technique. The rule a pixel follows, and its reference, is ml-cpu `transparency`; the
-//! shaders are under `shaders/transparency/`.
+//! (`transparent_resolve`), in every technique. The rule a pixel follows, and its reference,
+//! is ml-cpu `transparency`; the shaders are under `shaders/transparency/`.
 //!
 //! Memory is a fixed budget set by an option: a pool of nodes, `budget` per pixel on average,
 //! and a head per pixel. What does not fit is counted and reported, never silently lost:
