@@ -17,10 +17,6 @@
 #ifndef MANYLIGHTS_LAYERS_GLSL
 #define MANYLIGHTS_LAYERS_GLSL
 
-// Whether the scene's transparent layers are built and blended (else these buffers are
-// stand-ins and nothing reads them).
-layout(constant_id = 40) const bool TRANSPARENT_LAYERS = false;
-
 const uint LAYER_END = 0xffffffffu;
 // Layers a pixel blends exactly (an array per thread); beyond, merged.
 const uint LAYER_KEEP = 32u;
@@ -200,16 +196,9 @@ vec4 layer_count_color(uint count) {
 // (`background`: none; the background colour is a backdrop in the output's encoding, not
 // light in the scene, so the layers are blended over black and laid over it there).
 vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
-    float transmittance = 1.0;
-    uint count = 0u;
-    vec3 color = under;
-    // (Not `!TRANSPARENT_LAYERS`: a negated specialization constant is an expression that
-    // the build's reflection does not evaluate.)
-    if (TRANSPARENT_LAYERS) {
-        color = blend_layers(p, background ? vec3(0.0) : under, transmittance, count);
-    } else {
-        return background ? CLEAR_COLOR : vec4(encode_output(under, exposure), 1.0);
-    }
+    float transmittance;
+    uint count;
+    vec3 color = blend_layers(p, background ? vec3(0.0) : under, transmittance, count);
     if (frame.cluster_dims.w == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
         return layer_count_color(count);
     }

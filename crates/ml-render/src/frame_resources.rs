@@ -24,7 +24,7 @@ impl<'a> FrameResources<'a> {
     /// else's.
     pub fn new(slot: usize, targets: &'a Targets) -> FrameResources<'a> {
         let mut buffers = vec![(DEPTH_PYRAMID, targets.depth_pyramid.raw), (VISIBILITY_DEPTH, targets.visibility_depth.raw)];
-        buffers.extend(targets.layers.named());
+        buffers.extend(targets.layers.iter().flat_map(|l| l.named()));
         FrameResources { slot, buffers, targets }
     }
 

@@ -40,11 +40,13 @@ impl GpuMesh {
 /// (transparent_build_compute.glsl), the others by the hardware raster.
 pub const COMPUTE_LAYER_TRIANGLES: u32 = 64;
 
-/// Whether `o` is a transparent object whose layers are built in compute (its mesh among
-/// `meshes` has few triangles: a pane, a card).
-pub fn layers_in_compute(o: &Object, meshes: &[GpuMesh]) -> bool {
-    o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend
-        && meshes.iter().find(|m| m.kind == o.mesh).is_some_and(|m| m.index_count / 3 <= COMPUTE_LAYER_TRIANGLES)
+/// Where `o` is a transparent object whose layers are built in compute (its mesh has few
+/// triangles: a pane, a card), the index of its mesh among `meshes`.
+pub fn compute_layer_mesh(o: &Object, meshes: &[GpuMesh]) -> Option<usize> {
+    if o.extras.alpha_mode != ml_cpu::scene::AlphaMode::Blend {
+        return None;
+    }
+    meshes.iter().position(|m| m.kind == o.mesh).filter(|&m| meshes[m].index_count / 3 <= COMPUTE_LAYER_TRIANGLES)
 }
 
 /// The vertex buffer's binding (one, per vertex) as pipelines read it.

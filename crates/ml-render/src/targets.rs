@@ -136,16 +136,15 @@ pub struct Targets {
     /// write by atomic min and the depth pyramid and the lighting read (null otherwise; `depth`
     /// and `visibility` are null then).
     pub visibility_depth: Buffer,
-    /// The transparent layers' lists (stand-ins without transparency).
-    pub layers: LayerBuffers,
+    /// The transparent layers' lists (None without transparency).
+    pub layers: Option<LayerBuffers>,
 }
 
 /// Bytes of a transparent layer's node: two uvec4 (transparency/layers.glsl).
 pub const NODE_BYTES: u64 = 32;
 
 /// A frame slot's transparent layers (transparency/): heads, node pool, counters
-/// (host-visible: the build pass reads them when the frame is done). Without transparency,
-/// stand-ins of a few bytes that no pass binds.
+/// (host-visible: the build pass reads them when the frame is done).
 pub struct LayerBuffers {
     pub heads: Buffer,
     pub nodes: Buffer,
@@ -153,16 +152,13 @@ pub struct LayerBuffers {
 }
 
 impl LayerBuffers {
-    /// `nodes`: the pool's size (None: stand-ins).
-    pub fn new(ctx: &Context, extent: vk::Extent2D, nodes: Option<u64>) -> Result<LayerBuffers, VkError> {
+    /// `nodes`: the pool's size.
+    pub fn new(ctx: &Context, extent: vk::Extent2D, nodes: u64) -> Result<LayerBuffers, VkError> {
         let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null() };
         ml_vk::build(ctx, b, |b| {
             use gpu_allocator::MemoryLocation as M;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-            let (heads, nodes) = match nodes {
-                Some(n) => (extent.width as u64 * extent.height as u64 * 4, n * NODE_BYTES),
-                None => (16, NODE_BYTES),
-            };
+            let (heads, nodes) = (extent.width as u64 * extent.height as u64 * 4, nodes * NODE_BYTES);
             b.heads = Buffer::new(ctx, "transparent heads", heads, usage, M::GpuOnly)?;
             b.nodes = Buffer::new(ctx, "transparent nodes", nodes, usage, M::GpuOnly)?;
             b.counts = Buffer::new(ctx, "transparent counters", 16, usage, M::GpuToCpu)?;
@@ -253,9 +249,9 @@ impl Targets {
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
-            layers: LayerBuffers::new(ctx, extent, layer_nodes)?,
+            layers: None,
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layer_nodes.is_some())))
+        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layer_nodes)))
     }
 
     fn create(
@@ -264,9 +260,13 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        (raster, layers): (Raster, bool),
+        (raster, layer_nodes): (Raster, Option<u64>),
     ) -> Result<(), VkError> {
         use vk::ImageUsageFlags as U;
+        let layers = layer_nodes.is_some();
+        if let Some(nodes) = layer_nodes {
+            self.layers = Some(LayerBuffers::new(ctx, extent, nodes)?);
+        }
         let colour = vk::ImageAspectFlags::COLOR;
         // The subpass G-buffer never leaves the render pass: TRANSIENT lets a tiler keep it in
         // tile memory (the device still backs it with ordinary memory where it has no lazy kind).
@@ -334,7 +334,9 @@ impl Targets {
         self.visibility.destroy(ctx);
         self.depth_pyramid.destroy(ctx);
         self.visibility_depth.destroy(ctx);
-        self.layers.destroy(ctx);
+        if let Some(mut layers) = self.layers.take() {
+            layers.destroy(ctx);
+        }
     }
 }
 

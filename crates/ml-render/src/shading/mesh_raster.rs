@@ -75,7 +75,7 @@ impl MeshRaster {
             // Into the transparent layers, only their surfaces, unlit.
             let constants = match output {
                 Output::Color => shading.layered_lighting_constants().to_vec(),
-                Output::Layers { .. } => [&shading.surface_constants()[..], &[("TRANSPARENT_LAYERS", 1)]].concat(),
+                Output::Layers { .. } => shading.surface_constants().to_vec(),
                 _ => shading.surface_constants().to_vec(),
             };
             let drawn: Vec<SurfaceVariant> = variants.iter().chain([&SurfaceVariant::OPAQUE]).map(|&v| r.drawn_as(v)).collect();
@@ -111,7 +111,7 @@ impl MeshRaster {
     fn draws(&self, o: &ml_cpu::scene::Object, meshes: &[crate::gpu_mesh::GpuMesh]) -> bool {
         let blended = o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend;
         match self.output {
-            Output::Layers { .. } => blended && !crate::gpu_mesh::layers_in_compute(o, meshes),
+            Output::Layers { .. } => blended && crate::gpu_mesh::compute_layer_mesh(o, meshes).is_none(),
             _ => !(self.layers && blended),
         }
     }

@@ -52,9 +52,8 @@ impl Shading {
         ]
     }
 
-    /// `lighting_constants` and `TRANSPARENT_LAYERS` (transparency/layers.glsl), for the
-    /// passes that leave the image to the transparent layers: the compute lighting passes
-    /// blend them where they shade, the forward pass then writes linear HDR for a resolve.
+    /// `lighting_constants` and `TRANSPARENT_LAYERS` (shading/forward_frag.glsl): the forward
+    /// pass of a scene with transparent layers writes linear HDR for their resolve.
     pub fn layered_lighting_constants(self) -> [(&'static str, u32); 7] {
         let [a, b, c, d, e, f] = self.lighting_constants();
         [a, b, c, d, e, f, ("TRANSPARENT_LAYERS", u32::from(self.transparency))]

@@ -9,7 +9,7 @@ use super::{TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
-use crate::gpu_mesh::layers_in_compute;
+use crate::gpu_mesh::compute_layer_mesh;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
 use crate::scene::object_data::object_push;
@@ -53,7 +53,7 @@ impl TransparentBuild {
                 return Err(e);
             }
         };
-        let constants = [&shading.surface_constants()[..], &[("TRANSPARENT_LAYERS", 1)]].concat();
+        let constants = shading.surface_constants();
         let more = [layouts.0, layouts.1, mesh_sets.layout.raw];
         let push = std::mem::size_of::<ObjectPush>() as u32;
         let compute = match ComputePass::with_push(ctx, &more, (kernel, &constants), push) {
@@ -147,7 +147,7 @@ impl Pass for TransparentBuild {
 
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let layers = &rec.targets.layers;
+        let layers = rec.targets.layers.as_ref().expect("targets made with the layers the plan builds");
         // SAFETY: recording state outside a render pass; the buffers are alive.
         unsafe {
             ctx.device.cmd_fill_buffer(cmd, layers.heads.raw, 0, vk::WHOLE_SIZE, super::LAYER_END);
@@ -157,8 +157,8 @@ impl Pass for TransparentBuild {
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute | fragment, rw));
         let scene = rec.scene;
-        for (index, o) in rec.objects.iter().enumerate().filter(|(_, o)| layers_in_compute(o, &scene.meshes)) {
-            let Some(m) = scene.meshes.iter().position(|m| m.kind == o.mesh) else { continue };
+        for (index, o) in rec.objects.iter().enumerate() {
+            let Some(m) = compute_layer_mesh(o, &scene.meshes) else { continue };
             let Some((origin, size)) = screen_rect(o.bounds(), rec.view_proj, rec.extent) else { continue };
             let mut push = object_push(o, index as u32);
             push.ids[2] = scene.meshes[m].index_count / 3;
@@ -174,7 +174,7 @@ impl Pass for TransparentBuild {
     }
 
     fn collect(&self, _slot: usize, targets: &Targets, _: &mut SlotReport, stats: &mut FrameStats) {
-        let layers = &targets.layers;
+        let layers = targets.layers.as_ref().expect("targets made with the layers the plan builds");
         let [fragments, merged] = layers.counts();
         let extent = targets.color.extent;
         stats.set_feature(TransparencyStats {

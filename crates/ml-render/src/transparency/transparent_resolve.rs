@@ -37,9 +37,9 @@ impl TransparentResolve {
         (clustered, after_compute): (bool, bool),
     ) -> Result<TransparentResolve, VkError> {
         let shader = if clustered { &ml_shaders::TRANSPARENT_LIGHTING_CLUSTERED_COMP } else { &ml_shaders::TRANSPARENT_LIGHTING_COMP };
-        let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &shading.layered_lighting_constants()))?;
+        let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &shading.lighting_constants()))?;
         let [blinn_phong, pbr, _] = shading.surface_constants();
-        let blend_constants = [blinn_phong, pbr, ("TRANSPARENT_LAYERS", 1)];
+        let blend_constants = [blinn_phong, pbr];
         match ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_COMP, &blend_constants)) {
             Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute }),
             Err(e) => {
@@ -77,7 +77,9 @@ impl Pass for TransparentResolve {
 
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let nodes = rec.targets.layers.capacity().min(LIGHTING_GROUPS as u64 * self.lighting.workgroup_size()[0] as u64) as u32;
+        let nodes =
+            rec.targets.layers.as_ref().map_or(0, |l| l.capacity()).min(LIGHTING_GROUPS as u64 * self.lighting.workgroup_size()[0] as u64)
+                as u32;
         let threads = vk::Extent2D { width: nodes.max(1), height: 1 };
         self.lighting.dispatch(ctx, cmd, rec.slot, (&[rec.scene.textures.set], &[]), threads);
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
