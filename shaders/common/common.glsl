@@ -133,6 +133,15 @@ struct ObjectPush {
     vec4 emissive;
 };
 
+// A transparent object whose layers the compute build makes this frame
+// (transparency/transparent_build_compute.glsl).
+struct LayerObject {
+    uvec4 ids;   // x: index in the object buffer; y: its own textures (ObjectPush.ids.y); z: its
+                 // mesh's first index in the build's index buffer; w: its triangles
+    uvec4 place; // x: its mesh's first vertex in the build's vertex buffer; y, z: the first
+                 // pixel and the end of the rectangle its box may cover (y << 16 | x); w: unused
+};
+
 // Push constants of the sun's shadow pass (blinn-phong): the object's and the light's matrix.
 struct ShadowPush {
     mat4 model;

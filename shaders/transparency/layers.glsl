@@ -48,6 +48,12 @@ uvec4 pack_layer_surface(vec3 normal, vec4 albedo_occlusion, vec2 roughness_meta
                  packUnorm4x8(vec4(emissive_factor, 0.0)));
 }
 
+// Node `node` (of the pool) made pixel `p`'s fragment at `depth` of `object`, before `next`.
+void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uvec4 surface) {
+    layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, object, uint(p.y) << 16 | uint(p.x));
+    layer_nodes[2u * node + 1u] = surface;
+}
+
 // Keep a transparent fragment of pixel `p`: false where the pool is full (it is counted).
 bool store_layer(ivec2 p, float depth, uint object, uvec4 surface) {
     uint node = atomicAdd(layer_counts.x, 1u);
@@ -55,8 +61,7 @@ bool store_layer(ivec2 p, float depth, uint object, uvec4 surface) {
         return false;
     }
     uint next = atomicExchange(layer_heads[layer_pixel(p)], node);
-    layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, object, uint(p.y) << 16 | uint(p.x));
-    layer_nodes[2u * node + 1u] = surface;
+    write_layer(node, p, depth, next, object, surface);
     return true;
 }
 

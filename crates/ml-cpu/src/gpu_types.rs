@@ -180,6 +180,18 @@ gpu_struct!(
 );
 
 gpu_struct!(
+    /// A transparent object whose layers the compute build makes this frame (see common.glsl).
+    LayerObject {
+        /// Its index in the object buffer, its own textures (`ObjectTextures::bits`), its
+        /// mesh's first index in the build's index buffer, its triangles.
+        ids: [u32; 4],
+        /// Its mesh's first vertex in the build's vertex buffer; the first pixel and the end of
+        /// the rectangle its box may cover (`y << 16 | x`); unused.
+        place: [u32; 4],
+    }
+);
+
+gpu_struct!(
     /// Push constants of the sun's shadow pass (blinn-phong).
     ShadowPush {
         model: [[f32; 4]; 4],

@@ -13,15 +13,11 @@ pub struct GpuMesh {
 
 impl GpuMesh {
     pub fn upload(ctx: &Context, kind: MeshKind, mesh: &Mesh) -> Result<GpuMesh, VkError> {
-        // STORAGE too: the transparent layers' compute build reads small meshes as buffers.
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let mut vertices = Buffer::device_local_with(
-            ctx,
-            "vertices",
-            bytemuck::cast_slice(&mesh.vertices),
-            vk::BufferUsageFlags::VERTEX_BUFFER | storage,
-        )?;
-        match Buffer::device_local_with(ctx, "indices", bytemuck::cast_slice(&mesh.indices), vk::BufferUsageFlags::INDEX_BUFFER | storage) {
+        // The transparent layers' compute build copies the small meshes into buffers of its own.
+        let copied = vk::BufferUsageFlags::TRANSFER_SRC;
+        let mut vertices =
+            Buffer::device_local_with(ctx, "vertices", bytemuck::cast_slice(&mesh.vertices), vk::BufferUsageFlags::VERTEX_BUFFER | copied)?;
+        match Buffer::device_local_with(ctx, "indices", bytemuck::cast_slice(&mesh.indices), vk::BufferUsageFlags::INDEX_BUFFER | copied) {
             Ok(indices) => Ok(GpuMesh { kind, vertices, indices, index_count: mesh.indices.len() as u32 }),
             Err(e) => {
                 vertices.destroy(ctx);

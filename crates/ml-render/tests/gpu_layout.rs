@@ -4,7 +4,7 @@
 
 use ml_cpu::gpu_types::{
     ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance,
-    LargeTriangle, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight,
+    LargeTriangle, LayerObject, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight,
     ShadowCubeTiles, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
@@ -82,6 +82,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<FrameUniforms>(&structs);
     check::<PointLight>(&structs);
     check::<ObjectPush>(&structs);
+    check::<LayerObject>(&structs);
     check::<ShadowPush>(&structs);
     check::<OmniShadowPush>(&structs);
     check::<StageProbePush>(&structs);

@@ -1,34 +1,39 @@
 //! The transparent layers' build: each fragment of a transparent object in front of the opaque
 //! depth appended to its pixel's list (layers.glsl). Objects of few triangles (panes, cards)
-//! are rasterised in compute, a dispatch each (transparent_build_compute.glsl: the H100 runs
-//! fragment shaders on 4 of its 132 SMs); the others are drawn by the hardware raster with no
-//! attachments (transparent_build.frag). Runs after the opaque raster, before the resolve;
-//! clears the slot's lists first.
+//! are rasterised in compute, one dispatch over the tiles their screen rectangles meet
+//! (transparent_build_compute.glsl: the H100 runs fragment shaders on 4 of its 132 SMs); the
+//! others are drawn by the hardware raster with no attachments (transparent_build.frag). Runs
+//! after the opaque raster, before the resolve; clears the slot's lists first.
 
 use super::{TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
-use crate::frame_resources::FrameResources;
-use crate::gpu_mesh::compute_layer_mesh;
+use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
+use crate::gpu_mesh::{compute_layer_mesh, GpuMesh};
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
-use crate::scene::object_data::object_push;
 use crate::scene::SceneGpu;
 use crate::shading::mesh_raster::MeshRaster;
 use crate::shading::Shading;
 use crate::sync::{Use, VISIBILITY_DEPTH};
 use crate::targets::{Output, Targets};
-use ml_cpu::gpu_types::ObjectPush;
-use ml_vk::commands::memory_barrier;
+use ml_cpu::gpu_types::LayerObject;
+use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
 use ml_vk::image::fetch_sampler;
-use ml_vk::{vk, Context, VkError};
+use ml_vk::{vk, Buffer, Context, MemoryLocation, VkError};
 
 pub struct TransparentBuild {
     raster: MeshRaster,
     /// The compute build of small transparent objects.
     compute: ComputePass,
-    /// Set 3 of the compute build: each mesh's vertices and indices, by the mesh's index.
+    /// Set 3 of the compute build, per frame slot: the small meshes and the slot's object list.
     mesh_sets: FrameSets,
+    /// The small meshes (at most `COMPUTE_LAYER_TRIANGLES` triangles) one after another, and
+    /// where each mesh of the scene's starts in them.
+    small_meshes: SmallMeshes,
+    /// Per frame slot, the frame's compute-built objects (`LayerObject`), written as its
+    /// commands are recorded: room for every object of the scene.
+    object_lists: Vec<Buffer>,
     /// Reads the opaque depth image.
     sampler: vk::Sampler,
     /// The opaque depth is the compute raster's 64-bit buffer (else the depth target).
@@ -46,7 +51,7 @@ impl TransparentBuild {
         // No depth attachment: the format is not used.
         let output = (vk::Format::UNDEFINED, Output::Layers { depth_buffer }, &[][..]);
         let mut raster = MeshRaster::new(ctx, output, (fragment, shading, &scene.surface_variants), layouts)?;
-        let mut mesh_sets = match FrameSets::new(ctx, &[(kernel, vk::ShaderStageFlags::COMPUTE)], 3, scene.meshes.len().max(1)) {
+        let mut mesh_sets = match FrameSets::new(ctx, &[(kernel, vk::ShaderStageFlags::COMPUTE)], 3, FRAMES_IN_FLIGHT) {
             Ok(sets) => sets,
             Err(e) => {
                 raster.destroy(ctx);
@@ -55,7 +60,7 @@ impl TransparentBuild {
         };
         let constants = shading.surface_constants();
         let more = [layouts.0, layouts.1, mesh_sets.layout.raw];
-        let push = std::mem::size_of::<ObjectPush>() as u32;
+        let push = std::mem::size_of::<[u32; 4]>() as u32;
         let compute = match ComputePass::with_push(ctx, &more, (kernel, &constants), push) {
             Ok(c) => c,
             Err(e) => {
@@ -64,12 +69,28 @@ impl TransparentBuild {
                 return Err(e);
             }
         };
-        let mut pass = TransparentBuild { raster, compute, mesh_sets, sampler: vk::Sampler::null(), depth_buffer };
+        let mut pass = TransparentBuild {
+            raster,
+            compute,
+            mesh_sets,
+            small_meshes: SmallMeshes { vertices: Buffer::null(), indices: Buffer::null(), places: Vec::new() },
+            object_lists: Vec::new(),
+            sampler: vk::Sampler::null(),
+            depth_buffer,
+        };
         let made = (|| {
-            for (i, mesh) in scene.meshes.iter().enumerate() {
-                pass.mesh_sets.write(ctx, i, &|name| match name {
-                    "MeshVertexBuffer" => Some(Resource::Buffer(mesh.vertices.raw)),
-                    "MeshIndexBuffer" => Some(Resource::Buffer(mesh.indices.raw)),
+            pass.small_meshes = SmallMeshes::new(ctx, &scene.meshes)?;
+            let objects = scene.object_textures.per_object.len().max(1);
+            let bytes = (objects * std::mem::size_of::<LayerObject>()) as u64;
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            for slot in 0..FRAMES_IN_FLIGHT {
+                pass.object_lists.push(Buffer::new(ctx, "transparent objects", bytes, usage, MemoryLocation::GpuOnly)?);
+                let (vertices, indices, objects) =
+                    (pass.small_meshes.vertices.raw, pass.small_meshes.indices.raw, pass.object_lists[slot].raw);
+                pass.mesh_sets.write(ctx, slot, &|name| match name {
+                    "MeshVertexBuffer" => Some(Resource::Buffer(vertices)),
+                    "MeshIndexBuffer" => Some(Resource::Buffer(indices)),
+                    "LayerObjectBuffer" => Some(Resource::Buffer(objects)),
                     _ => None,
                 })?;
             }
@@ -83,6 +104,146 @@ impl TransparentBuild {
                 Err(e)
             }
         }
+    }
+
+    /// The frame's compute-built objects, those of one texture set side by side, and per
+    /// texture set its objects' range in the list and the rectangle they may cover.
+    fn object_list(&self, rec: &Recording) -> (Vec<LayerObject>, Vec<ObjectGroup>) {
+        let scene = rec.scene;
+        let mut listed: Vec<(u32, LayerObject)> = Vec::new();
+        for (index, o) in rec.objects.iter().enumerate() {
+            let Some(m) = compute_layer_mesh(o, &scene.meshes) else { continue };
+            let Some(((x, y), size)) = screen_rect(o.bounds(), rec.view_proj, rec.extent) else { continue };
+            let (first_vertex, first_index) = self.small_meshes.places[m].expect("a compute-built object's mesh is small");
+            let end = (y + size.height) << 16 | (x + size.width);
+            let ids = [index as u32, o.textures.bits(), first_index, scene.meshes[m].index_count / 3];
+            listed.push((scene.object_textures.set_index[index], LayerObject { ids, place: [first_vertex, y << 16 | x, end, 0] }));
+        }
+        listed.sort_by_key(|(set, _)| *set);
+        let groups = object_groups(&listed);
+        (listed.into_iter().map(|(_, entry)| entry).collect(), groups)
+    }
+
+    /// Record the compute build: the slot's object list written, a dispatch per texture set
+    /// over the tiles its objects' rectangles span.
+    fn record_compute(&self, rec: &Recording) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let (entries, groups) = self.object_list(rec);
+        if entries.is_empty() {
+            return;
+        }
+        update_buffer(ctx, cmd, self.object_lists[rec.slot].raw, bytemuck::cast_slice(&entries));
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        memory_barrier(
+            ctx,
+            cmd,
+            (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
+            (compute, vk::AccessFlags::SHADER_READ),
+        );
+        let [tile_x, tile_y, _] = self.compute.workgroup_size();
+        for (i, g) in groups.iter().enumerate() {
+            if i > 0 {
+                // Each dispatch stores its tiles' list heads without atomics.
+                let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+                memory_barrier(ctx, cmd, (compute, rw), (compute, rw));
+            }
+            // Tiles aligned with the resolve's (a pixel's nodes then lie together).
+            let origin = (g.lo.0 / tile_x * tile_x, g.lo.1 / tile_y * tile_y);
+            let size = vk::Extent2D { width: g.end.0 - origin.0, height: g.end.1 - origin.1 };
+            let push = [g.first, g.count, origin.1 << 16 | origin.0, 0];
+            let sets = [rec.scene.textures.set, rec.scene.object_textures.sets[g.set as usize], self.mesh_sets.sets[rec.slot]];
+            self.compute.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), size);
+        }
+    }
+}
+
+/// The compute-built objects of one texture set: their range in the frame's list and the
+/// rectangle they may cover (first pixel, end).
+#[derive(Debug, PartialEq)]
+struct ObjectGroup {
+    set: u32,
+    first: u32,
+    count: u32,
+    lo: (u32, u32),
+    end: (u32, u32),
+}
+
+/// The groups of `listed` (texture set, object), sorted by texture set.
+fn object_groups(listed: &[(u32, LayerObject)]) -> Vec<ObjectGroup> {
+    let corner = |packed: u32| (packed & 0xffff, packed >> 16);
+    let mut groups: Vec<ObjectGroup> = Vec::new();
+    for (i, (set, entry)) in listed.iter().enumerate() {
+        let (lo, end) = (corner(entry.place[1]), corner(entry.place[2]));
+        match groups.last_mut() {
+            Some(g) if g.set == *set => {
+                g.count += 1;
+                g.lo = (g.lo.0.min(lo.0), g.lo.1.min(lo.1));
+                g.end = (g.end.0.max(end.0), g.end.1.max(end.1));
+            }
+            _ => groups.push(ObjectGroup { set: *set, first: i as u32, count: 1, lo, end }),
+        }
+    }
+    groups
+}
+
+/// The scene's small meshes (compute-built layers) in one vertex and one index buffer.
+struct SmallMeshes {
+    vertices: Buffer,
+    indices: Buffer,
+    /// Per mesh of the scene: where it starts in them (first vertex, first index), if small.
+    places: Vec<Option<(u32, u32)>>,
+}
+
+impl SmallMeshes {
+    /// Copied on the GPU from the scene's meshes.
+    fn new(ctx: &Context, meshes: &[GpuMesh]) -> Result<SmallMeshes, VkError> {
+        let vertex_bytes = std::mem::size_of::<ml_cpu::mesh::Vertex>() as u64;
+        let small = |m: &GpuMesh| m.index_count / 3 <= crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES;
+        let (mut vertex_count, mut index_count) = (0u64, 0u64);
+        let mut places = Vec::new();
+        for m in meshes {
+            places.push(small(m).then_some((vertex_count as u32, index_count as u32)));
+            if small(m) {
+                vertex_count += m.vertices.size / vertex_bytes;
+                index_count += u64::from(m.index_count);
+            }
+        }
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        let mut made = SmallMeshes { vertices: Buffer::null(), indices: Buffer::null(), places };
+        // Vulkan has no empty buffers: one vertex and index where no mesh is small.
+        let result = (|| {
+            made.vertices = Buffer::new(ctx, "small mesh vertices", vertex_count.max(1) * vertex_bytes, usage, MemoryLocation::GpuOnly)?;
+            made.indices = Buffer::new(ctx, "small mesh indices", index_count.max(1) * 4, usage, MemoryLocation::GpuOnly)?;
+            if vertex_count == 0 {
+                return Ok(());
+            }
+            one_shot(ctx, |cmd| {
+                for (m, place) in meshes.iter().zip(&made.places) {
+                    let Some((first_vertex, first_index)) = *place else { continue };
+                    let vertices = [vk::BufferCopy::default().dst_offset(u64::from(first_vertex) * vertex_bytes).size(m.vertices.size)];
+                    let indices = [vk::BufferCopy::default().dst_offset(u64::from(first_index) * 4).size(u64::from(m.index_count) * 4)];
+                    // SAFETY: recording; the buffers are alive and hold these ranges.
+                    unsafe {
+                        ctx.device.cmd_copy_buffer(cmd, m.vertices.raw, made.vertices.raw, &vertices);
+                        ctx.device.cmd_copy_buffer(cmd, m.indices.raw, made.indices.raw, &indices);
+                    }
+                }
+                let shaders = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
+                memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), shaders);
+            })
+        })();
+        match result {
+            Ok(()) => Ok(made),
+            Err(e) => {
+                made.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.vertices.destroy(ctx);
+        self.indices.destroy(ctx);
     }
 }
 
@@ -156,16 +317,7 @@ impl Pass for TransparentBuild {
         let (compute, fragment) = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::PipelineStageFlags::FRAGMENT_SHADER);
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute | fragment, rw));
-        let scene = rec.scene;
-        for (index, o) in rec.objects.iter().enumerate() {
-            let Some(m) = compute_layer_mesh(o, &scene.meshes) else { continue };
-            let Some((origin, size)) = screen_rect(o.bounds(), rec.view_proj, rec.extent) else { continue };
-            let mut push = object_push(o, index as u32);
-            push.ids[2] = scene.meshes[m].index_count / 3;
-            push.ids[3] = origin.1 << 16 | origin.0;
-            let sets = [scene.textures.set, scene.object_textures.per_object[index], self.mesh_sets.sets[m]];
-            self.compute.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), size);
-        }
+        self.record_compute(rec);
         // The compute build's appends before the raster's (both swap list heads).
         memory_barrier(ctx, cmd, (compute, rw), (fragment, rw));
         self.raster.begin_and_draw_meshes(rec);
@@ -191,6 +343,11 @@ impl Pass for TransparentBuild {
         self.sampler = vk::Sampler::null();
         self.compute.destroy(ctx);
         self.mesh_sets.destroy(ctx);
+        self.small_meshes.destroy(ctx);
+        for list in &mut self.object_lists {
+            list.destroy(ctx);
+        }
+        self.object_lists.clear();
         self.raster.destroy(ctx);
     }
 }
@@ -199,6 +356,20 @@ impl Pass for TransparentBuild {
 mod tests {
     use super::*;
     use glam::{Mat4, Vec3};
+
+    #[test]
+    fn objects_of_one_texture_set_make_one_dispatch_over_their_rectangles() {
+        let entry = |lo: (u32, u32), end: (u32, u32)| LayerObject { ids: [0; 4], place: [0, lo.1 << 16 | lo.0, end.1 << 16 | end.0, 0] };
+        let listed = [(0, entry((10, 20), (30, 40))), (0, entry((5, 30), (20, 50))), (2, entry((100, 0), (120, 16)))];
+        assert_eq!(
+            object_groups(&listed),
+            [
+                ObjectGroup { set: 0, first: 0, count: 2, lo: (5, 20), end: (30, 50) },
+                ObjectGroup { set: 2, first: 2, count: 1, lo: (100, 0), end: (120, 16) }
+            ]
+        );
+        assert!(object_groups(&[]).is_empty());
+    }
 
     #[test]
     fn an_objects_screen_rectangle_holds_its_box_and_no_more_than_the_image() {
