@@ -306,10 +306,12 @@ fn foliage_of(mode: Option<&str>, leaf: PrimitiveData) -> Scene {
     let upright = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2).to_array();
     w.node(json!({ "mesh": floor_mesh, "translation": [0.0, 3.0, -3.0], "rotation": upright, "scale": [6.0, 6.0, 6.0] }), true);
     if let Some(mode) = mode {
-        let texture = w.texture(leaf_png(), "image/png");
+        // The same leaf as two textures: leaves of two texture sets (the compute build
+        // dispatches once per set).
+        let textures = [w.texture(leaf_png(), "image/png"), w.texture(leaf_png(), "image/png")];
         let colours = [[0.3, 0.8, 0.2, 1.0], [0.5, 0.9, 0.1, 0.9], [0.2, 0.6, 0.3, 1.0], [0.7, 0.8, 0.2, 0.8]];
         for (i, c) in colours.iter().enumerate().take(LEAVES) {
-            let m = w.alpha_material(Some(texture), *c, mode, None, true);
+            let m = w.alpha_material(Some(textures[i % 2]), *c, mode, None, true);
             let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..leaf.clone() }]);
             let (at, rotation) = leaf_at(i);
             w.node(json!({ "mesh": mesh, "translation": at.to_array(), "rotation": rotation.to_array(), "scale": [0.8, 0.8, 0.8] }), true);
@@ -408,7 +410,9 @@ fn the_compute_build_and_the_hardware_raster_build_agree() {
     // raster): the same image but at edge pixels and where the two pick texture levels apart.
     let pbr = |t| RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
     for technique in [Technique::Forward, Technique::Visibility] {
-        let coarse = common::render(foliage(Some("BLEND")), pbr(technique));
+        let leaves = foliage(Some("BLEND"));
+        assert_eq!(leaves.textures.len(), 2, "leaves of two texture sets");
+        let coarse = common::render(leaves, pbr(technique));
         let fine = common::render(foliage_of(Some("BLEND"), fine_quad()), pbr(technique));
         let (a, b) = (stats(&coarse), stats(&fine));
         assert!(a.fragments.abs_diff(b.fragments) <= a.fragments / 100, "{a:?} against {b:?}");
