@@ -66,6 +66,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         }
         Ok(meshlets.clone().expect("made above"))
     };
+    let transparency = || s.transparency.expect("planned with transparency");
     Ok(match kind {
         PassKind::OmniShadows => Box::new(omni_shadow_pass::OmniShadowPass::new(&a.scene.omni)),
         PassKind::OmniShadowsCompute => {
@@ -103,9 +104,11 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         }
         PassKind::ShadowMapView => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
-        PassKind::TransparentBuild { depth_buffer } => Box::new(TransparentBuild::new(ctx, a.scene, a.shading, depth_buffer)?),
+        PassKind::TransparentBuild { depth_buffer } => {
+            Box::new(TransparentBuild::new(ctx, a.scene, (a.shading, transparency()), depth_buffer)?)
+        }
         PassKind::TransparentResolve { clustered, after_compute } => {
-            Box::new(TransparentResolve::new(ctx, a.scene, a.shading, (clustered, after_compute))?)
+            Box::new(TransparentResolve::new(ctx, a.scene, (a.shading, transparency()), (clustered, after_compute))?)
         }
     })
 }

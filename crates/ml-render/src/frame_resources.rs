@@ -20,11 +20,10 @@ pub struct FrameResources<'a> {
 
 impl<'a> FrameResources<'a> {
     /// Slot `slot`'s table: its targets' buffers (the depth pyramid, the compute raster's
-    /// depth-and-id buffer, the transparent layers' lists) and, added by `with`, everyone
-    /// else's.
+    /// depth-and-id buffer) and, added by `with`, everyone else's (the slot's, the scene's,
+    /// the passes' own).
     pub fn new(slot: usize, targets: &'a Targets) -> FrameResources<'a> {
-        let mut buffers = vec![(DEPTH_PYRAMID, targets.depth_pyramid.raw), (VISIBILITY_DEPTH, targets.visibility_depth.raw)];
-        buffers.extend(targets.layers.iter().flat_map(|l| l.named()));
+        let buffers = vec![(DEPTH_PYRAMID, targets.depth_pyramid.raw), (VISIBILITY_DEPTH, targets.visibility_depth.raw)];
         FrameResources { slot, buffers, targets }
     }
 

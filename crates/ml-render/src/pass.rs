@@ -100,10 +100,27 @@ pub trait Pass {
         Ok(())
     }
 
+    /// Make the pass's own buffers of frame slot `slot` for images of `extent`, replacing any
+    /// it had (no frame in flight): when the renderer makes the slot, before any pass binds it.
+    fn create_slot(&mut self, _ctx: &Context, _slot: usize, _extent: vk::Extent2D) -> Result<(), VkError> {
+        Ok(())
+    }
+
+    /// The pass's own buffers of slot `slot` under the names the shaders give them: the slot's
+    /// table of resources holds them for every pass (`FrameResources`).
+    fn slot_buffers(&self, _slot: usize) -> Vec<(&'static str, vk::Buffer)> {
+        Vec::new()
+    }
+
+    /// What the host reads of the pass's resources once the frame is done (in `collect`),
+    /// declared as uses at the frame's end: after every pass, the renderer orders them.
+    fn host_reads(&self) -> Vec<Use> {
+        Vec::new()
+    }
+
     /// Read what slot `slot`'s finished frame reports (its fence has signalled): feedback for
     /// the frame loop into `report`, the pass's own figures into `stats`.
-    /// `targets`: the slot's, as the frame left them.
-    fn collect(&self, _slot: usize, _targets: &Targets, _report: &mut SlotReport, _stats: &mut FrameStats) {}
+    fn collect(&self, _slot: usize, _report: &mut SlotReport, _stats: &mut FrameStats) {}
 
     /// The projection or image size changed; slot 0's uniforms hold the new ones and no frame
     /// is in flight.

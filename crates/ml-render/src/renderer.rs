@@ -299,7 +299,7 @@ impl<'a> Renderer<'a> {
         let technique = self.settings.technique;
         let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
         let raster = self.settings.raster;
-        let layers = self.settings.transparency.filter(|_| self.settings.blends_layers()).map(|t| t.nodes(extent.width, extent.height));
+        let layers = self.settings.blends_layers();
         let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers));
         let setup = FrameSetup {
             pool: self.command_pool,
@@ -312,8 +312,11 @@ impl<'a> Renderer<'a> {
             make_targets: &make_targets,
             written_by_gpu: self.lights_on_gpu,
         };
-        for _ in 0..FRAMES_IN_FLIGHT {
+        for f in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
+            for p in &mut self.passes {
+                p.create_slot(ctx, f, extent)?;
+            }
         }
         for f in 0..FRAMES_IN_FLIGHT {
             self.bind_passes(f)?;
@@ -325,9 +328,11 @@ impl<'a> Renderer<'a> {
         Ok(())
     }
 
-    /// Point every pass's sets of slot `f` at its buffers and targets (the slot is idle).
+    /// Point every pass's sets of slot `f` at its buffers and targets, the scene's and the
+    /// passes' own (the slot is idle).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
-        let resources = self.frames[f].resources(f, &self.gpu.named_buffers());
+        let owned: Vec<(&'static str, vk::Buffer)> = self.passes.iter().flat_map(|p| p.slot_buffers(f)).collect();
+        let resources = self.frames[f].resources(f, &self.gpu.named_buffers()).with(&owned);
         self.passes.iter_mut().try_for_each(|p| p.bind_frame(self.ctx, &resources))
     }
 
@@ -570,9 +575,8 @@ impl<'a> Renderer<'a> {
             stats.add_gpu(&ms);
         }
         let mut report = SlotReport::default();
-        let targets = self.frames[f].targets.as_ref().expect("made with the frame");
         for p in &self.passes {
-            p.collect(f, targets, &mut report, stats);
+            p.collect(f, &mut report, stats);
         }
         self.reports[f] = report;
         if let (Some(needed), Some(max_lights)) = (report.index_entries, report.max_lights) {
@@ -716,9 +720,10 @@ impl<'a> Renderer<'a> {
                 timed += 1;
             }
         }
-        // The colour target as the read-back and a window's blit take it; the transparent
-        // layers' counters as the host reads them.
-        frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &[sync::frame_end(), crate::transparency::counts_to_host()], &image);
+        // The colour target as the read-back and a window's blit take it; what the passes'
+        // `collect` reads, as the host reads it.
+        let frame_end: Vec<sync::Use> = std::iter::once(sync::frame_end()).chain(self.passes.iter().flat_map(|p| p.host_reads())).collect();
+        frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &frame_end, &image);
         if let Some(hook) = hook {
             hook.record(ctx, cmd, &targets.color)?;
         }

@@ -205,10 +205,6 @@ impl State {
 /// presents) in the frame's resources.
 pub const COLOUR_TARGET: &str = "colour target";
 
-/// The transparent layers' per-frame buffers, by their shader names: heads, nodes, counters
-/// (transparency/layers.glsl).
-pub const LAYER_BUFFERS: [&str; 3] = ["TransparentHeadBuffer", "TransparentNodeBuffer", "TransparentCountBuffer"];
-
 /// The HDR target where a compute pass writes it (the compute lighting's linear output, read
 /// by the transparent resolve); the render passes that write it order it themselves.
 pub const HDR_TARGET: &str = "hdr target";

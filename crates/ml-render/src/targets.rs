@@ -136,67 +136,6 @@ pub struct Targets {
     /// write by atomic min and the depth pyramid and the lighting read (null otherwise; `depth`
     /// and `visibility` are null then).
     pub visibility_depth: Buffer,
-    /// The transparent layers' lists (None without transparency).
-    pub layers: Option<LayerBuffers>,
-}
-
-/// Bytes of a transparent layer's node: two uvec4 (transparency/layers.glsl).
-pub const NODE_BYTES: u64 = 32;
-
-/// A frame slot's transparent layers (transparency/): heads, node pool, counters
-/// (host-visible: the build pass reads them when the frame is done).
-pub struct LayerBuffers {
-    pub heads: Buffer,
-    pub nodes: Buffer,
-    pub counts: Buffer,
-}
-
-impl LayerBuffers {
-    /// `nodes`: the pool's size.
-    pub fn new(ctx: &Context, extent: vk::Extent2D, nodes: u64) -> Result<LayerBuffers, VkError> {
-        let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null() };
-        ml_vk::build(ctx, b, |b| {
-            use gpu_allocator::MemoryLocation as M;
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-            let (heads, nodes) = (extent.width as u64 * extent.height as u64 * 4, nodes * NODE_BYTES);
-            b.heads = Buffer::new(ctx, "transparent heads", heads, usage, M::GpuOnly)?;
-            b.nodes = Buffer::new(ctx, "transparent nodes", nodes, usage, M::GpuOnly)?;
-            b.counts = Buffer::new(ctx, "transparent counters", 16, usage, M::GpuToCpu)?;
-            Ok(())
-        })
-    }
-
-    /// The buffers under their shader names.
-    pub fn named(&self) -> [(&'static str, vk::Buffer); 3] {
-        [
-            (crate::sync::LAYER_BUFFERS[0], self.heads.raw),
-            (crate::sync::LAYER_BUFFERS[1], self.nodes.raw),
-            (crate::sync::LAYER_BUFFERS[2], self.counts.raw),
-        ]
-    }
-
-    /// Nodes in the pool.
-    pub fn capacity(&self) -> u64 {
-        self.nodes.size / NODE_BYTES
-    }
-
-    /// The counters as the slot's last frame left them: nodes asked for, pixels that merged.
-    pub fn counts(&self) -> [u32; 2] {
-        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counts.mapped()[..16]);
-        [c[0], c[1]]
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        self.heads.destroy(ctx);
-        self.nodes.destroy(ctx);
-        self.counts.destroy(ctx);
-    }
-}
-
-impl ml_vk::Release for LayerBuffers {
-    fn release(&mut self, ctx: &Context) {
-        self.destroy(ctx);
-    }
 }
 
 /// Format of the visibility buffer: the 32-bit id (meshlets.rs).
@@ -234,12 +173,14 @@ impl Targets {
         }
     }
 
+    /// `layers`: transparent layers are blended over the opaque pass (their build samples the
+    /// opaque depth; the opaque pass writes linear HDR).
     pub fn new(
         ctx: &Context,
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        (raster, layer_nodes): (Raster, Option<u64>),
+        (raster, layers): (Raster, bool),
     ) -> Result<Targets, VkError> {
         let t = Targets {
             color: Image::null(),
@@ -249,9 +190,8 @@ impl Targets {
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
-            layers: None,
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layer_nodes)))
+        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layers)))
     }
 
     fn create(
@@ -260,13 +200,9 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        (raster, layer_nodes): (Raster, Option<u64>),
+        (raster, layers): (Raster, bool),
     ) -> Result<(), VkError> {
         use vk::ImageUsageFlags as U;
-        let layers = layer_nodes.is_some();
-        if let Some(nodes) = layer_nodes {
-            self.layers = Some(LayerBuffers::new(ctx, extent, nodes)?);
-        }
         let colour = vk::ImageAspectFlags::COLOR;
         // The subpass G-buffer never leaves the render pass: TRANSIENT lets a tiler keep it in
         // tile memory (the device still backs it with ordinary memory where it has no lazy kind).
@@ -334,9 +270,6 @@ impl Targets {
         self.visibility.destroy(ctx);
         self.depth_pyramid.destroy(ctx);
         self.visibility_depth.destroy(ctx);
-        if let Some(mut layers) = self.layers.take() {
-            layers.destroy(ctx);
-        }
     }
 }
 

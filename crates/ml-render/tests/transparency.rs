@@ -29,9 +29,11 @@ use ml_cpu::scene::{AlphaMode, Object, Scene};
 use ml_cpu::shading::{encode_gamma_unorm8, shade_seed};
 use ml_cpu::transparency::{composite, Layer};
 use ml_render::{
-    DebugView, Raster, RenderOutput, RenderSettings, ShadingModel, Technique, TransparencySettings, TransparencyStats, LAYER_KEEP,
+    DebugView, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings, TransparencyStats, LAYER_KEEP,
 };
+use ml_vk::{Context, ContextDesc};
 use serde_json::json;
+use std::sync::atomic::Ordering;
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -194,6 +196,29 @@ fn the_order_the_quads_are_listed_in_changes_nothing() {
             assert!(out.rgba == outs[0].rgba, "{}: the order {o:?} gives another image", technique.name());
         }
     }
+}
+
+#[test]
+fn a_resized_renderer_draws_the_layers_as_a_fresh_one_does() {
+    // The lists are the build pass's own buffers of each frame slot, made again for the new
+    // size when the viewer resizes.
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a Vulkan device with validation");
+    let counter = ctx.validation_counter();
+    for technique in [Technique::Forward, Technique::Visibility] {
+        let small = RenderSettings { frames: 2, ..settings(technique) };
+        let large = RenderSettings { width: W + 24, height: H + 16, ..small };
+        let mut live = Renderer::new(&ctx, scene([0, 1, 2]), small).expect("renderer");
+        live.render().expect("render");
+        assert!(live.reconfigure(large).expect("resize"), "a new size keeps the passes");
+        let resized = live.render().expect("render after the resize");
+        drop(live);
+        let fresh = Renderer::new(&ctx, scene([0, 1, 2]), large).and_then(|mut r| r.render()).expect("fresh render");
+        assert_eq!((resized.width, resized.height), (W + 24, H + 16));
+        assert!(resized.rgba == fresh.rgba, "{}: the resized renderer's layers differ from a fresh one's", technique.name());
+        assert_eq!(stats(&resized), stats(&fresh), "{}", technique.name());
+    }
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
 }
 
 #[test]

@@ -255,7 +255,7 @@ impl Pass for ClusterBuild {
         self.record_build(rec.ctx, rec.cmd, rec.slot);
     }
 
-    fn collect(&self, slot: usize, _: &crate::targets::Targets, report: &mut SlotReport, _: &mut FrameStats) {
+    fn collect(&self, slot: usize, report: &mut SlotReport, _: &mut FrameStats) {
         let f = self.frames[slot].feedback();
         report.index_entries = Some(f.needed as usize);
         report.max_lights = Some(f.max_count);

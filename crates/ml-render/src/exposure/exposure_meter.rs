@@ -80,7 +80,7 @@ impl Pass for ExposureMeter {
         copy_buffer_to_host(ctx, cmd, (self.sums[rec.slot].raw, self.readback[rec.slot].raw), self.groups[rec.slot] as u64 * 8);
     }
 
-    fn collect(&self, slot: usize, _: &crate::targets::Targets, report: &mut SlotReport, _: &mut FrameStats) {
+    fn collect(&self, slot: usize, report: &mut SlotReport, _: &mut FrameStats) {
         let bytes = self.groups[slot] as usize * 8;
         let sums: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&self.readback[slot].mapped()[..bytes]);
         let (log2_sum, pixels) = sums.iter().fold((0.0f64, 0.0f64), |(s, n), g| (s + g[0] as f64, n + g[1] as f64));

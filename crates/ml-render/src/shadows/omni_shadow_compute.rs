@@ -111,7 +111,7 @@ impl Pass for OmniShadowCompute {
         copy_buffer_to_host(rec.ctx, rec.cmd, (self.raster.counters.raw, self.readback[rec.slot].raw), counter_bytes);
     }
 
-    fn collect(&self, slot: usize, _: &crate::targets::Targets, _: &mut SlotReport, stats: &mut FrameStats) {
+    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
         let c: OmniRasterCounters = bytemuck::pod_read_unaligned(&self.readback[slot].mapped()[..size_of::<OmniRasterCounters>()]);
         stats.set_feature(OmniRasterStats {
             pairs: c.pairs[3],

@@ -9,14 +9,14 @@
 //! fragments that find the pool full are dropped, and pixels with more than `LAYER_KEEP`
 //! layers merge their farthest ones (`TransparencyStats`).
 
+mod layer_buffers;
 pub mod transparent_build;
 pub mod transparent_resolve;
 
 use crate::error::{RenderError, Setting, SettingsError};
 use crate::report::FeatureStats;
 use crate::sync::Use;
-pub use crate::sync::LAYER_BUFFERS;
-pub use crate::targets::NODE_BYTES;
+pub use layer_buffers::{LayerBuffers, LAYER_BUFFERS, NODE_BYTES};
 use ml_vk::{vk, Context};
 
 /// A list's end (layers.glsl LAYER_END): what the heads are cleared to.

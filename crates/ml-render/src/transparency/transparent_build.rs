@@ -5,7 +5,7 @@
 //! others are drawn by the hardware raster with no attachments (transparent_build.frag). Runs
 //! after the opaque raster, before the resolve; clears the slot's lists first.
 
-use super::{TransparencyStats, LAYER_BUFFERS};
+use super::{counts_to_host, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
@@ -16,7 +16,7 @@ use crate::scene::SceneGpu;
 use crate::shading::mesh_raster::MeshRaster;
 use crate::shading::Shading;
 use crate::sync::{Use, VISIBILITY_DEPTH};
-use crate::targets::{Output, Targets};
+use crate::targets::Output;
 use ml_cpu::gpu_types::LayerObject;
 use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
 use ml_vk::image::fetch_sampler;
@@ -34,6 +34,11 @@ pub struct TransparentBuild {
     /// Per frame slot, the frame's compute-built objects (`LayerObject`), written as its
     /// commands are recorded: room for every object of the scene.
     object_lists: Vec<Buffer>,
+    /// The lists' pool size, per pixel.
+    settings: TransparencySettings,
+    /// Per frame slot, the lists (made with the slot, for its image size), which the frame's
+    /// table names for the resolve.
+    layers: Vec<Option<LayerBuffers>>,
     /// Reads the opaque depth image.
     sampler: vk::Sampler,
     /// The opaque depth is the compute raster's 64-bit buffer (else the depth target).
@@ -41,7 +46,12 @@ pub struct TransparentBuild {
 }
 
 impl TransparentBuild {
-    pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading, depth_buffer: bool) -> Result<TransparentBuild, VkError> {
+    pub fn new(
+        ctx: &Context,
+        scene: &SceneGpu,
+        (shading, settings): (Shading, TransparencySettings),
+        depth_buffer: bool,
+    ) -> Result<TransparentBuild, VkError> {
         let (fragment, kernel) = if depth_buffer {
             (&ml_shaders::TRANSPARENT_BUILD_BUFFER_FRAG, &ml_shaders::TRANSPARENT_BUILD_COMPUTE_BUFFER_COMP)
         } else {
@@ -75,6 +85,8 @@ impl TransparentBuild {
             mesh_sets,
             small_meshes: SmallMeshes { vertices: Buffer::null(), indices: Buffer::null(), places: Vec::new() },
             object_lists: Vec::new(),
+            settings,
+            layers: (0..FRAMES_IN_FLIGHT).map(|_| None).collect(),
             sampler: vk::Sampler::null(),
             depth_buffer,
         };
@@ -282,6 +294,22 @@ impl Pass for TransparentBuild {
         Some("transparent layers")
     }
 
+    fn create_slot(&mut self, ctx: &Context, slot: usize, extent: vk::Extent2D) -> Result<(), VkError> {
+        if let Some(mut old) = self.layers[slot].take() {
+            old.destroy(ctx);
+        }
+        self.layers[slot] = Some(LayerBuffers::new(ctx, extent, self.settings.nodes(extent.width, extent.height))?);
+        Ok(())
+    }
+
+    fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
+        self.layers[slot].as_ref().map_or_else(Vec::new, |l| l.named().to_vec())
+    }
+
+    fn host_reads(&self) -> Vec<Use> {
+        vec![counts_to_host()]
+    }
+
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let depth = vk::DescriptorImageInfo::default()
             .sampler(self.sampler)
@@ -308,7 +336,7 @@ impl Pass for TransparentBuild {
 
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let layers = rec.targets.layers.as_ref().expect("targets made with the layers the plan builds");
+        let layers = self.layers[rec.slot].as_ref().expect("the slot's lists made with the slot");
         // SAFETY: recording state outside a render pass; the buffers are alive.
         unsafe {
             ctx.device.cmd_fill_buffer(cmd, layers.heads.raw, 0, vk::WHOLE_SIZE, super::LAYER_END);
@@ -325,14 +353,13 @@ impl Pass for TransparentBuild {
         unsafe { ctx.device.cmd_end_render_pass(cmd) };
     }
 
-    fn collect(&self, _slot: usize, targets: &Targets, _: &mut SlotReport, stats: &mut FrameStats) {
-        let layers = targets.layers.as_ref().expect("targets made with the layers the plan builds");
+    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
+        let Some(layers) = self.layers[slot].as_ref() else { return };
         let [fragments, merged] = layers.counts();
-        let extent = targets.color.extent;
         stats.set_feature(TransparencyStats {
             fragments: fragments as u64,
             capacity: layers.capacity(),
-            pixels: extent.width as u64 * extent.height as u64,
+            pixels: layers.pixels(),
             merged_pixels: merged as u64,
         });
     }
@@ -348,6 +375,9 @@ impl Pass for TransparentBuild {
             list.destroy(ctx);
         }
         self.object_lists.clear();
+        for mut layers in self.layers.iter_mut().filter_map(Option::take) {
+            layers.destroy(ctx);
+        }
         self.raster.destroy(ctx);
     }
 }

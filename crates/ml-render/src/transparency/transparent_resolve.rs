@@ -5,7 +5,7 @@
 //! lighting's) and encoded into the colour target (transparent_blend.comp; in place of the
 //! deferred techniques' tone map). One pair of shaders for every technique.
 
-use super::layer_uses;
+use super::{layer_uses, TransparencySettings};
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
@@ -25,6 +25,8 @@ pub struct TransparentResolve {
     /// A compute lighting pass wrote the HDR image (declared, in GENERAL) — else a render
     /// pass, whose dependencies order it and leave it SHADER_READ_ONLY_OPTIMAL.
     after_compute: bool,
+    /// The pool's size per pixel (the lighting dispatch covers the pool).
+    settings: TransparencySettings,
 }
 
 impl TransparentResolve {
@@ -33,7 +35,7 @@ impl TransparentResolve {
     pub fn new(
         ctx: &Context,
         scene: &SceneGpu,
-        shading: Shading,
+        (shading, settings): (Shading, TransparencySettings),
         (clustered, after_compute): (bool, bool),
     ) -> Result<TransparentResolve, VkError> {
         let shader = if clustered { &ml_shaders::TRANSPARENT_LIGHTING_CLUSTERED_COMP } else { &ml_shaders::TRANSPARENT_LIGHTING_COMP };
@@ -41,7 +43,7 @@ impl TransparentResolve {
         let [blinn_phong, pbr, _] = shading.surface_constants();
         let blend_constants = [blinn_phong, pbr];
         match ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_COMP, &blend_constants)) {
-            Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute }),
+            Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute, settings }),
             Err(e) => {
                 let mut lighting = lighting;
                 lighting.destroy(ctx);
@@ -77,9 +79,8 @@ impl Pass for TransparentResolve {
 
     fn record(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let nodes =
-            rec.targets.layers.as_ref().map_or(0, |l| l.capacity()).min(LIGHTING_GROUPS as u64 * self.lighting.workgroup_size()[0] as u64)
-                as u32;
+        let pool = self.settings.nodes(rec.extent.width, rec.extent.height);
+        let nodes = pool.min(LIGHTING_GROUPS as u64 * self.lighting.workgroup_size()[0] as u64) as u32;
         let threads = vk::Extent2D { width: nodes.max(1), height: 1 };
         self.lighting.dispatch(ctx, cmd, rec.slot, (&[rec.scene.textures.set], &[]), threads);
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;

@@ -208,7 +208,7 @@ impl Pass for MeshletCull {
         }
     }
 
-    fn collect(&self, slot: usize, _: &crate::targets::Targets, _: &mut SlotReport, stats: &mut FrameStats) {
+    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
         if self.phase != Phase::Late {
             return;
         }

@@ -1,0 +1,68 @@
+//! The transparent layers' buffers of a frame slot (layers.glsl), owned by the build pass and
+//! named to the frame's table of resources, where the resolve finds them.
+
+use ml_vk::{vk, Buffer, Context, VkError};
+
+/// The transparent layers' per-frame buffers, by their shader names: heads, nodes, counters
+/// (transparency/layers.glsl).
+pub const LAYER_BUFFERS: [&str; 3] = ["TransparentHeadBuffer", "TransparentNodeBuffer", "TransparentCountBuffer"];
+
+/// Bytes of a transparent layer's node: two uvec4 (transparency/layers.glsl).
+pub const NODE_BYTES: u64 = 32;
+
+/// A frame slot's transparent layers: heads, node pool, counters (host-visible: the build pass
+/// reads them when the frame is done). The build owns them; the frame's table names them.
+pub struct LayerBuffers {
+    pub heads: Buffer,
+    pub nodes: Buffer,
+    pub counts: Buffer,
+}
+
+impl LayerBuffers {
+    /// `nodes`: the pool's size.
+    pub fn new(ctx: &Context, extent: vk::Extent2D, nodes: u64) -> Result<LayerBuffers, VkError> {
+        let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null() };
+        ml_vk::build(ctx, b, |b| {
+            use gpu_allocator::MemoryLocation as M;
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let (heads, nodes) = (extent.width as u64 * extent.height as u64 * 4, nodes * NODE_BYTES);
+            b.heads = Buffer::new(ctx, "transparent heads", heads, usage, M::GpuOnly)?;
+            b.nodes = Buffer::new(ctx, "transparent nodes", nodes, usage, M::GpuOnly)?;
+            b.counts = Buffer::new(ctx, "transparent counters", 16, usage, M::GpuToCpu)?;
+            Ok(())
+        })
+    }
+
+    /// The buffers under their shader names.
+    pub fn named(&self) -> [(&'static str, vk::Buffer); 3] {
+        [(LAYER_BUFFERS[0], self.heads.raw), (LAYER_BUFFERS[1], self.nodes.raw), (LAYER_BUFFERS[2], self.counts.raw)]
+    }
+
+    /// Pixels of the image the lists are for (a head each).
+    pub fn pixels(&self) -> u64 {
+        self.heads.size / 4
+    }
+
+    /// Nodes in the pool.
+    pub fn capacity(&self) -> u64 {
+        self.nodes.size / NODE_BYTES
+    }
+
+    /// The counters as the slot's last frame left them: nodes asked for, pixels that merged.
+    pub fn counts(&self) -> [u32; 2] {
+        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counts.mapped()[..16]);
+        [c[0], c[1]]
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.heads.destroy(ctx);
+        self.nodes.destroy(ctx);
+        self.counts.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for LayerBuffers {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
+}
