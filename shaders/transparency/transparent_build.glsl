@@ -14,7 +14,7 @@
 #define LAYER_BINDING 14
 #include "transparency/layers.glsl"
 
-#include "transparency/opaque_depth.glsl"
+#include "common/opaque_depth.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);

@@ -35,7 +35,7 @@ layout(local_size_x = 16, local_size_y = 16) in;
 #include "common/alpha_mask.glsl"
 #define LAYER_BINDING 14
 #include "transparency/layers.glsl"
-#include "transparency/opaque_depth.glsl"
+#include "common/opaque_depth.glsl"
 
 // The small meshes one after another (gpu_mesh.rs: 12 floats a vertex, position, normal, uv,
 // tangent; three indices a triangle, each from its mesh's first vertex), and this frame's

@@ -229,6 +229,7 @@ impl Plan {
             raster: Raster::Hardware,
             exposure: Exposure::Ev(0.0),
             transparency: ml_render::TransparencySettings { budget: a.transparency_budget },
+            light_stats: false,
         };
         Ok(Plan { scene, settings, warned: false })
     }

@@ -63,6 +63,11 @@ struct RenderArgs {
     /// made if it does not exist.
     #[arg(long)]
     out: PathBuf,
+    /// Count, after the lighting, the lights the light loop tests per pixel and those that
+    /// reach the pixel's surface (a table row; an untimed extra pass each frame). For the
+    /// compute-lit techniques: deferred-compute, visibility.
+    #[arg(long)]
+    light_stats: bool,
 }
 
 /// The most frames `render` takes: at 60 frames a second, half an hour of animation.
@@ -474,6 +479,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
         transparency: ml_render::TransparencySettings { budget: args.transparency_budget },
+        light_stats: false,
     })
 }
 
@@ -577,6 +583,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let request = scene_request(args)?;
     // Every setting is checked before the GPU work; auto's technique is set once it is known.
     let wanted = settings_request(args, choice.unwrap_or(Technique::DeferredClustered), cmd.frames)?;
+    let wanted = SettingsRequest { light_stats: cmd.light_stats, ..wanted };
     let mut techniques = Techniques::chosen(choice);
     check_options_apply(args, &request.source, None, &techniques)?;
     let sequence = output::sequence_pattern(&cmd.out)?;

@@ -613,3 +613,21 @@ fn transparent_layers_report_their_memory_and_what_did_not_fit() {
         assert_one_line_error(&out, &["no transparent objects", option[0]]);
     }
 }
+
+#[test]
+fn light_stats_print_a_row_where_the_lighting_is_in_compute() {
+    let png = temp_png("light_stats.png");
+    let args = |technique: &'static str| {
+        ["render", "--validation", "--width", "64", "--height", "36", "--scene", "bench", "--lights", "2048", "--light-stats"]
+            .into_iter()
+            .chain(["--technique", technique, "--out", png.to_str().unwrap()])
+            .collect::<Vec<&str>>()
+    };
+    let out = manylights(&args("deferred-compute"), &[]);
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{stdout}{stderr}");
+    let row = stdout.lines().find(|l| l.starts_with("lights per pixel")).unwrap_or_else(|| panic!("no light row in:\n{stdout}"));
+    assert!(row.contains(" tested, ") && row.contains(" reaching (") && row.contains("pixels with a surface)"), "{row}");
+    // The fragment techniques' loops are not counted: refused in one line.
+    assert_one_line_error(&manylights(&args("forward"), &[]), &["--light-stats", "forward"]);
+}

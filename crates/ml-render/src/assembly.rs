@@ -6,6 +6,7 @@
 use crate::clusters::{cluster_assign_cpu, cluster_build};
 use crate::error::RenderError;
 use crate::exposure::{exposure_meter, tone_map};
+use crate::light_stats::light_count::LightCount;
 use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
 use crate::scene::shadow_raster::ShadowViews;
@@ -110,5 +111,6 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::TransparentResolve { clustered, after_compute } => {
             Box::new(TransparentResolve::new(ctx, a.scene, (a.shading, transparency()), (clustered, after_compute))?)
         }
+        PassKind::LightCount { depth_buffer } => Box::new(LightCount::new(ctx, a.scene, a.shading, depth_buffer)?),
     })
 }

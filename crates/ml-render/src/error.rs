@@ -124,6 +124,8 @@ pub enum SettingsError {
     LayerViewNeedsTransparency,
     #[error("the shadow-atlas debug view needs the shadow atlas (--omni-shadow atlas)")]
     ShadowAtlasViewNeedsAtlas,
+    #[error("--light-stats counts the light loop of the compute-lit techniques (deferred-compute, visibility), not {technique}'s")]
+    LightStatsNeedCompute { technique: &'static str },
     #[error("the {view} debug view shows the meshlets of the visibility technique, not {technique}")]
     ViewNeedsMeshlets { view: &'static str, technique: &'static str },
     #[error("the {technique} technique needs {feature}, which '{device}' lacks: use deferred-compute")]

@@ -63,6 +63,9 @@ pub enum PassKind {
     /// The layers lit and blended over the opaque HDR image, encoded into the colour target;
     /// `after_compute`: a compute lighting pass wrote that image (else a render pass).
     TransparentResolve { clustered: bool, after_compute: bool },
+    /// Lights tested and reaching per pixel, counted after the lighting (`depth_buffer`: from
+    /// the compute raster's buffer, else the depth target).
+    LightCount { depth_buffer: bool },
 }
 
 /// What the passes and their pipelines are made for. A change in `technique`, `shading`,
@@ -82,6 +85,8 @@ pub struct PipelineKey {
     pub meters_exposure: bool,
     /// Transparent objects are blended in per-pixel layers (`RenderSettings::blends_layers`).
     pub layers: bool,
+    /// The lights tested and reaching per pixel are counted (`RenderSettings::light_stats`).
+    pub light_stats: bool,
 }
 
 impl PipelineKey {
@@ -120,6 +125,7 @@ impl RenderSettings {
             debug_view: self.debug_view,
             meters_exposure: self.meters_exposure(),
             layers: self.blends_layers(),
+            light_stats: self.light_stats,
         }
     }
 
@@ -152,7 +158,9 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     let clustered = technique.assignment() != LightAssignment::None;
     // Transparent layers: built once the opaque depth is known, resolved over the opaque
     // pass's linear HDR output.
-    let build = PassKind::TransparentBuild { depth_buffer: technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware };
+    // The opaque depth after the raster: the compute raster's buffer, or the depth target.
+    let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
+    let build = PassKind::TransparentBuild { depth_buffer: opaque_depth_buffer };
     let after_compute = technique.lighting_stage() == LightingStage::Compute;
     let resolve = PassKind::TransparentResolve { clustered, after_compute };
     match (technique.geometry(), technique.lighting_stage()) {
@@ -193,6 +201,9 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
             kinds.push(PassKind::ComputeLighting);
             kinds.extend(key.layers.then_some(resolve));
         }
+    }
+    if key.light_stats {
+        kinds.push(PassKind::LightCount { depth_buffer: opaque_depth_buffer });
     }
     if matches!(key.debug_view, DebugView::ShadowMap | DebugView::ShadowCube | DebugView::ShadowAtlas) {
         kinds.push(PassKind::ShadowMapView);
@@ -307,6 +318,18 @@ mod tests {
         assert!(!s.pipeline_key().layers);
         s.debug_view = DebugView::TransparencyLayers;
         assert!(s.pipeline_key().layers);
+    }
+
+    #[test]
+    fn the_light_counts_follow_the_lighting_and_precede_the_meter() {
+        let mut k = key(Technique::DeferredCompute);
+        k.light_stats = true;
+        assert_eq!(plan(&k), [ClusterBuild, GBuffer, ComputeLighting, LightCount { depth_buffer: false }, ExposureMeter { curve: true }]);
+        let mut k = key(Technique::Visibility);
+        (k.light_stats, k.meters_exposure, k.raster) = (true, false, Raster::compute(64));
+        assert_eq!(plan(&k)[6..], [VisibilityLighting, LightCount { depth_buffer: true }]);
+        let s = RenderSettings { light_stats: true, ..RenderSettings::new(Technique::Visibility, 64, 64) };
+        assert!(s.pipeline_key().light_stats);
     }
 
     #[test]

@@ -133,6 +133,9 @@ pub struct RenderSettings {
     /// Transparent (BLEND) objects blended in per-pixel layers, with this budget; None: drawn
     /// as masks at alpha one half (and so where the scene has none).
     pub transparency: Option<TransparencySettings>,
+    /// Count the lights tested and reaching per pixel after the lighting (`LightStats`; the
+    /// compute-lit techniques, deferred-compute and visibility).
+    pub light_stats: bool,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -168,6 +171,7 @@ impl RenderSettings {
             raster: Raster::Hardware,
             exposure: Exposure::Ev(0.0),
             transparency: None,
+            light_stats: false,
         }
     }
 
@@ -221,6 +225,9 @@ impl RenderSettings {
         }
         if self.debug_view == DebugView::ClusterHeat && !self.technique.draws_cluster_heat() {
             return Err(SettingsError::HeatNeedsClusteredForward { technique: self.technique.name() }.into());
+        }
+        if self.light_stats && self.technique.lighting_stage() != LightingStage::Compute {
+            return Err(SettingsError::LightStatsNeedCompute { technique: self.technique.name() }.into());
         }
         if matches!(self.debug_view, DebugView::Meshlets | DebugView::Triangles) && self.technique.geometry() != Geometry::Meshlets {
             return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view.name(), technique: self.technique.name() }.into());
@@ -317,6 +324,8 @@ pub struct SettingsRequest {
     pub exposure: Exposure,
     /// How transparent objects are blended, where the scene has any.
     pub transparency: TransparencySettings,
+    /// Count the lights tested and reaching per pixel.
+    pub light_stats: bool,
 }
 
 impl SettingsRequest {
@@ -337,6 +346,7 @@ impl SettingsRequest {
             raster: self.raster,
             exposure: self.exposure,
             transparency: scene.has_blended_objects().then_some(self.transparency),
+            light_stats: self.light_stats,
         }
     }
 }

@@ -118,7 +118,7 @@ fn every_debug_view_define_is_generated() {
 
 #[test]
 fn files_lie_in_feature_folders_and_names_are_unique() {
-    let folders = ["common", "shading", "visibility", "shadows", "clusters", "exposure", "probe", "transparency"];
+    let folders = ["common", "shading", "visibility", "shadows", "clusters", "exposure", "probe", "transparency", "light_stats"];
     let mut names: Vec<&str> = Vec::new();
     for shader in ALL {
         let (folder, name) = shader.file.split_once('/').unwrap_or_else(|| panic!("{} is in no folder", shader.file));

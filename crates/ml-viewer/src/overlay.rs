@@ -98,6 +98,8 @@ impl Choices {
             raster: if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware },
             exposure: self.exposure,
             transparency: self.transparency,
+            // The viewer's overlay shows times, not light counts.
+            light_stats: false,
         }
     }
 }

@@ -1,15 +1,16 @@
-// What the transparent layers' builds test their fragments against (transparent_build.glsl,
-// transparent_build_compute.glsl). Needs layers.glsl (layer_pixel) and common.glsl.
+// The opaque surfaces' depth at a pixel, for compute and fragment passes that run after the
+// opaque raster and test against it or rebuild positions from it (the transparent layers'
+// builds, the light counts). Needs common.glsl (FrameBlock bound as `frame`).
 
 #ifndef MANYLIGHTS_OPAQUE_DEPTH_GLSL
 #define MANYLIGHTS_OPAQUE_DEPTH_GLSL
 
 // The opaque depth: the raster's depth image, or (OPAQUE_DEPTH_BUFFER) the compute raster's
-// 64-bit buffer (depth in the high word).
+// 64-bit buffer (depth in the high word). 1 where nothing was drawn.
 #ifdef OPAQUE_DEPTH_BUFFER
 layout(std430, set = 0, binding = 13) readonly buffer VisibilityDepthBuffer { uvec2 visibility_depth[]; };
 float opaque_depth_at(ivec2 p) {
-    return visibility_buffer_depth(visibility_depth[layer_pixel(p)]);
+    return visibility_buffer_depth(visibility_depth[uint(p.y) * frame.viewport.x + uint(p.x)]);
 }
 #else
 layout(set = 0, binding = 12) uniform sampler2D opaque_depth;

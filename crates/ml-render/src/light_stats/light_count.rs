@@ -1,0 +1,99 @@
+//! The light counts' pass: after the lighting, a thread per pixel walks the light loop of its
+//! surface point as the lighting did (the cluster's list) and counts the lights it tests and
+//! those that reach the point (light_count.glsl); a sum per 8×4 work group lands in a
+//! host-visible buffer of the frame slot, which `collect` adds up. Untimed: it measures the
+//! frame, it is not part of it.
+
+use super::LightStats;
+use crate::compute_pass::ComputePass;
+use crate::descriptors::Resource;
+use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
+use crate::pass::{Pass, Recording, SlotReport};
+use crate::report::FrameStats;
+use crate::scene::SceneGpu;
+use crate::shading::Shading;
+use crate::sync::{light_list_reads, Use, VISIBILITY_DEPTH};
+use gpu_allocator::MemoryLocation;
+use ml_vk::{vk, Buffer, Context, VkError};
+
+/// The per-group sums' name in the shaders (and in the frame's declared uses).
+const LIGHT_COUNTS: &str = "LightCountBuffer";
+
+pub struct LightCount {
+    pass: ComputePass,
+    /// Per frame slot: the work groups' sums (pixels, tested, reached), host-visible.
+    counts: Vec<Buffer>,
+    /// The opaque depth is the compute raster's 64-bit buffer (else the depth target).
+    depth_buffer: bool,
+}
+
+impl LightCount {
+    pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading, depth_buffer: bool) -> Result<LightCount, VkError> {
+        let shader = if depth_buffer { &ml_shaders::LIGHT_COUNT_BUFFER_COMP } else { &ml_shaders::LIGHT_COUNT_COMP };
+        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &shading.lighting_constants()))?;
+        Ok(LightCount { pass, counts: (0..FRAMES_IN_FLIGHT).map(|_| Buffer::null()).collect(), depth_buffer })
+    }
+}
+
+impl Pass for LightCount {
+    fn timer_name(&self) -> Option<&'static str> {
+        None
+    }
+
+    fn create_slot(&mut self, ctx: &Context, slot: usize, extent: vk::Extent2D) -> Result<(), VkError> {
+        self.counts[slot].destroy(ctx);
+        let (x, y) = self.pass.groups(extent);
+        let bytes = x as u64 * y as u64 * 16;
+        self.counts[slot] = Buffer::new(ctx, "light counts", bytes, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu)?;
+        Ok(())
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let counts = Resource::Buffer(self.counts[frame.slot].raw);
+        let depth = self.pass.sampled(&frame.targets.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        self.pass.bind_frame(ctx, frame, &|name| match name {
+            LIGHT_COUNTS => Some(counts),
+            "opaque_depth" => depth,
+            _ => frame.buffer(name),
+        })
+    }
+
+    /// Reads the lights and lists as the lighting did, and the opaque depth (the compute
+    /// raster's buffer; the depth target is ordered by the raster's render pass, whose
+    /// outgoing dependency reaches compute shaders); writes its sums.
+    fn uses(&self) -> Vec<Use> {
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let mut uses = light_list_reads(compute);
+        if self.depth_buffer {
+            uses.push(Use::at(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ), None));
+        }
+        uses.push(Use::at(LIGHT_COUNTS, (compute, vk::AccessFlags::SHADER_WRITE), None));
+        uses
+    }
+
+    fn host_reads(&self) -> Vec<Use> {
+        vec![Use::at(LIGHT_COUNTS, (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ), None)]
+    }
+
+    fn record(&self, rec: &Recording) {
+        self.pass.dispatch(rec.ctx, rec.cmd, rec.slot, (&[rec.scene.textures.set], &[]), rec.extent);
+    }
+
+    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
+        let groups: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(self.counts[slot].mapped());
+        let mut sum = LightStats::default();
+        for [pixels, tested, reached, _] in groups {
+            sum.pixels += u64::from(pixels);
+            sum.tested += u64::from(tested);
+            sum.reached += u64::from(reached);
+        }
+        stats.set_feature(sum);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pass.destroy(ctx);
+        for b in &mut self.counts {
+            b.destroy(ctx);
+        }
+    }
+}
