@@ -4,9 +4,9 @@
 // - lists the objects whose screen rectangle (found on the CPU) meets the tile, 64 at a time;
 // - sets their triangles up, 64 at a time, a thread each, in shared memory (clip-space edge
 //   functions, attributes, the object's alpha and material);
-// - counts its pixels' fragments of them, takes room for all with one atomic on the pool, then
-//   finds the fragments again and writes their nodes, neighbours of one triangle side by side
-//   (the resolve's lighting reads them a thread each, in that order);
+// - counts its pixels' fragments of them (a bit per triangle and pixel), takes room for all with
+//   one atomic on the pool, then writes the nodes of those bits, neighbours of one triangle side
+//   by side (the resolve's lighting reads them a thread each, in that order);
 // - links each pixel's new nodes in front of its list in a register and stores the head once.
 // So a fragment costs no global atomic and no read of its head, and a tile's setup is paid
 // once for every object over it. The tile is large because the setup's shared memory, not the
@@ -235,14 +235,18 @@ void main() {
             }
             barrier();
             uint count = min(CHUNK, triangles - base);
-            uint mine = 0u;
+            // Which of the chunk's triangles leave a fragment here, a bit each: the writes below
+            // follow these bits, not a second test, so they take exactly the room counted
+            // (a compiler may evaluate two copies of a test with different rounding).
+            uvec2 hits = uvec2(0u);
             vec3 w;
             float depth, alpha;
             for (uint i = 0u; i < count && in_image; i++) {
                 if (layer_fragment(i, q, opaque, w, depth, alpha)) {
-                    mine++;
+                    hits[i >> 5] |= 1u << (i & 31u);
                 }
             }
+            uint mine = uint(bitCount(hits.x) + bitCount(hits.y));
             if (mine > 0u) {
                 atomicAdd(tile_fragments, mine);
             }
@@ -252,7 +256,10 @@ void main() {
             }
             barrier();
             for (uint i = 0u; i < count && mine > 0u; i++) {
-                if (layer_fragment(i, q, opaque, w, depth, alpha)) {
+                if ((hits[i >> 5] & (1u << (i & 31u))) != 0u) {
+                    // Its barycentrics, depth and coverage again (not kept from the count: 64
+                    // triangles' worth of registers).
+                    layer_fragment(i, q, opaque, w, depth, alpha);
                     uint node = tile_first_node + atomicAdd(tile_taken, 1u);
                     if (node < capacity) {
                         write_layer(node, p, depth, head, tri_object[i].x, layer_surface(i, q, w, alpha, to_ndc));
