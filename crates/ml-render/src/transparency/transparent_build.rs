@@ -346,7 +346,7 @@ impl Pass for TransparentBuild {
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute | fragment, rw));
         self.record_compute(rec);
-        // The compute build's appends before the raster's (both swap list heads).
+        // The compute build's nodes and heads before the raster's appends (which swap heads).
         memory_barrier(ctx, cmd, (compute, rw), (fragment, rw));
         self.raster.begin_and_draw_meshes(rec);
         // SAFETY: recording inside the render pass begun above.
