@@ -231,7 +231,8 @@ impl SmallMeshes {
             }
             one_shot(ctx, |cmd| {
                 for (m, place) in meshes.iter().zip(&made.places) {
-                    let Some((first_vertex, first_index)) = *place else { continue };
+                    // Vulkan copies nothing empty (a mesh without triangles draws nothing anyway).
+                    let Some((first_vertex, first_index)) = place.filter(|_| m.vertices.size > 0 && m.index_count > 0) else { continue };
                     let vertices = [vk::BufferCopy::default().dst_offset(u64::from(first_vertex) * vertex_bytes).size(m.vertices.size)];
                     let indices = [vk::BufferCopy::default().dst_offset(u64::from(first_index) * 4).size(u64::from(m.index_count) * 4)];
                     // SAFETY: recording; the buffers are alive and hold these ranges.
