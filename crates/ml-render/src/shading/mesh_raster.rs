@@ -71,11 +71,9 @@ impl MeshRaster {
                 .size(std::mem::size_of::<ObjectPush>() as u32)];
             r.pipeline_layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw, textures_layout, object_textures_layout], &push)?;
             // Drawn into the colour target, meshes are lit where they are drawn; into a
-            // G-buffer, only their surfaces are read.
-            // Into the transparent layers, only their surfaces, unlit.
+            // G-buffer or the transparent layers, only their surfaces are read (unlit).
             let constants = match output {
                 Output::Color => shading.layered_lighting_constants().to_vec(),
-                Output::Layers { .. } => shading.surface_constants().to_vec(),
                 _ => shading.surface_constants().to_vec(),
             };
             let drawn: Vec<SurfaceVariant> = variants.iter().chain([&SurfaceVariant::OPAQUE]).map(|&v| r.drawn_as(v)).collect();
