@@ -44,14 +44,14 @@ impl DeferredSubpasses {
         let raster =
             MeshRaster::new(ctx, attachments, (gbuffer, shading, &scene.surface_variants), (textures, scene.object_textures.set_layout))?;
         let stages = [(&ml_shaders::FULLSCREEN_VERT, vk::ShaderStageFlags::VERTEX), (lighting, vk::ShaderStageFlags::FRAGMENT)];
-        let mut pass = DeferredSubpasses {
+        let pass = DeferredSubpasses {
             raster,
             lighting_sets: FrameSets::empty(),
             input_sets: FrameSets::empty(),
             lighting_layout: vk::PipelineLayout::null(),
             lighting: vk::Pipeline::null(),
         };
-        let made = (|| {
+        ml_vk::build(ctx, pass, |pass| {
             pass.lighting_sets = FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?;
             pass.input_sets = FrameSets::new(ctx, &stages, 2, FRAMES_IN_FLIGHT)?;
             let layouts = [pass.lighting_sets.layout.raw, textures, pass.input_sets.layout.raw];
@@ -60,14 +60,7 @@ impl DeferredSubpasses {
             let constants = shading.lighting_constants();
             pass.lighting = pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.lighting_layout, 1), &constants)?;
             Ok(())
-        })();
-        match made {
-            Ok(()) => Ok(pass),
-            Err(e) => {
-                pass.destroy(ctx);
-                Err(e)
-            }
-        }
+        })
     }
 }
 
@@ -116,5 +109,11 @@ impl Pass for DeferredSubpasses {
         self.lighting_sets.destroy(ctx);
         self.input_sets.destroy(ctx);
         self.raster.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for DeferredSubpasses {
+    fn release(&mut self, ctx: &Context) {
+        Pass::destroy(self, ctx);
     }
 }

@@ -54,7 +54,7 @@ impl MeshRaster {
         (textures_layout, object_textures_layout): (vk::DescriptorSetLayout, vk::DescriptorSetLayout),
     ) -> Result<MeshRaster, VkError> {
         let stages = [(&ml_shaders::FORWARD_VERT, vk::ShaderStageFlags::VERTEX), (fragment, vk::ShaderStageFlags::FRAGMENT)];
-        let mut r = MeshRaster {
+        let r = MeshRaster {
             render_pass: vk::RenderPass::null(),
             sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
             pipeline_layout: vk::PipelineLayout::null(),
@@ -64,7 +64,7 @@ impl MeshRaster {
             gbuffer,
             layers: shading.transparency,
         };
-        let made = (|| {
+        ml_vk::build(ctx, r, |r| {
             r.render_pass = render_pass::describe(depth_format, output, gbuffer, shading.transparency).create(ctx)?;
             let push = [vk::PushConstantRange::default()
                 .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
@@ -84,14 +84,7 @@ impl MeshRaster {
                 }
             }
             Ok(())
-        })();
-        match made {
-            Ok(()) => Ok(r),
-            Err(e) => {
-                r.destroy(ctx);
-                Err(e)
-            }
-        }
+        })
     }
 
     /// How this pass draws an object of variant `v`: transparent layers are not cut by their
@@ -284,5 +277,11 @@ impl MeshRaster {
             ctx.device.destroy_render_pass(self.render_pass, None);
         }
         self.sets.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for MeshRaster {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
     }
 }

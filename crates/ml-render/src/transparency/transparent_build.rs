@@ -79,7 +79,7 @@ impl TransparentBuild {
                 return Err(e);
             }
         };
-        let mut pass = TransparentBuild {
+        let pass = TransparentBuild {
             raster,
             compute,
             mesh_sets,
@@ -90,7 +90,7 @@ impl TransparentBuild {
             sampler: vk::Sampler::null(),
             depth_buffer,
         };
-        let made = (|| {
+        ml_vk::build(ctx, pass, |pass| {
             pass.small_meshes = SmallMeshes::new(ctx, &scene.meshes)?;
             let objects = scene.object_textures.per_object.len().max(1);
             let bytes = (objects * std::mem::size_of::<LayerObject>()) as u64;
@@ -108,14 +108,7 @@ impl TransparentBuild {
             }
             pass.sampler = fetch_sampler(ctx)?;
             Ok(())
-        })();
-        match made {
-            Ok(()) => Ok(pass),
-            Err(e) => {
-                pass.destroy(ctx);
-                Err(e)
-            }
-        }
+        })
     }
 
     /// The frame's compute-built objects, those of one texture set side by side, and per
@@ -221,9 +214,9 @@ impl SmallMeshes {
             }
         }
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-        let mut made = SmallMeshes { vertices: Buffer::null(), indices: Buffer::null(), places };
+        let made = SmallMeshes { vertices: Buffer::null(), indices: Buffer::null(), places };
         // Vulkan has no empty buffers: one vertex and index where no mesh is small.
-        let result = (|| {
+        ml_vk::build(ctx, made, |made| {
             made.vertices = Buffer::new(ctx, "small mesh vertices", vertex_count.max(1) * vertex_bytes, usage, MemoryLocation::GpuOnly)?;
             made.indices = Buffer::new(ctx, "small mesh indices", index_count.max(1) * 4, usage, MemoryLocation::GpuOnly)?;
             if vertex_count == 0 {
@@ -244,17 +237,12 @@ impl SmallMeshes {
                 let shaders = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
                 memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), shaders);
             })
-        })();
-        match result {
-            Ok(()) => Ok(made),
-            Err(e) => {
-                made.destroy(ctx);
-                Err(e)
-            }
-        }
+        })
     }
+}
 
-    fn destroy(&mut self, ctx: &Context) {
+impl ml_vk::Release for SmallMeshes {
+    fn release(&mut self, ctx: &Context) {
         self.vertices.destroy(ctx);
         self.indices.destroy(ctx);
     }
@@ -371,7 +359,7 @@ impl Pass for TransparentBuild {
         self.sampler = vk::Sampler::null();
         self.compute.destroy(ctx);
         self.mesh_sets.destroy(ctx);
-        self.small_meshes.destroy(ctx);
+        ml_vk::Release::release(&mut self.small_meshes, ctx);
         for list in &mut self.object_lists {
             list.destroy(ctx);
         }
@@ -380,6 +368,12 @@ impl Pass for TransparentBuild {
             layers.destroy(ctx);
         }
         self.raster.destroy(ctx);
+    }
+}
+
+impl ml_vk::Release for TransparentBuild {
+    fn release(&mut self, ctx: &Context) {
+        Pass::destroy(self, ctx);
     }
 }
 
