@@ -38,7 +38,11 @@ struct FrameUniforms {
     vec4 cluster_slices; // x, y: slice = floor(log(depth) * x + y); z: heat-map top (lights)
     vec4 cluster_frustum; // x: near, y: far, z: proj[0][0], w: proj[1][1] (symmetric perspective)
     vec4 light_animation; // xyz: offset every light moves by this frame (the seed's animation)
-    uvec4 cluster_build;  // x: light-index capacity (entries) of this frame's list
+    uvec4 cluster_build;  // x: light-index capacity (entries) of this frame's list (clustered-cpu)
+    // The light grid (GPU techniques; light_grid/light_grid.glsl).
+    vec4 light_grid_origin; // xyz: corner of cell (0, 0, 0) this frame; w: 1 / cell edge
+    uvec4 light_grid_dims;  // xyz: cells per axis; w: cells in all (the wide lights' list)
+    vec4 light_grid_reach;  // x: largest radius of a light in the cells
     // The blinn-phong model's other lights (docs/DESIGN.md#shading-models); the seed model
     // ignores them.
     mat4 shadow_view_proj;     // world → the sun's shadow-map clip space (depth 0..1)
@@ -75,17 +79,11 @@ struct ClusterRange {
     uint count;
 };
 
-// A cluster's view-space bounding box (clustered-gpu; w unused).
-struct ClusterBounds {
-    vec4 min_corner;
-    vec4 max_corner;
-};
-
-// What the GPU cluster build tells the CPU after the frame (host-visible).
-struct ClusterFeedback {
-    uint needed;     // light-index entries this frame needed
-    uint overflowed; // 1 when needed > capacity: the frame's lists were cut short
-    uint max_count;  // most lights in one cluster
+// What the light grid's build tells the CPU after the frame (host-visible).
+struct LightGridFeedback {
+    uint listed;    // lights in the lists (every light: a check)
+    uint wide;      // lights every point tests
+    uint max_count; // most lights in one cell
     uint _pad0;
 };
 

@@ -2,8 +2,8 @@
 // deferred lighting subpass, the deferred-compute pass): one BRDF source, one summation order
 // (ascending light index), so culling and deferring change no pixel.
 //
-// The includer includes scene_bindings.glsl (`frame`, `lights[]`, with CLUSTERED the lists)
-// and textures.glsl.
+// The includer includes scene_bindings.glsl (`frame`, `lights[]`, with CLUSTERED the cluster
+// lists, with LIGHT_GRID the light grid's) and textures.glsl.
 
 #ifndef MANYLIGHTS_LIGHTING_GLSL
 #define MANYLIGHTS_LIGHTING_GLSL
@@ -13,9 +13,12 @@
 #include "common/blinn_phong.glsl"
 #include "clusters/cluster.glsl"
 #include "shadows/omni_shadow.glsl"
+#ifdef LIGHT_GRID
+#include "light_grid/light_grid.glsl"
+#endif
 
 // Sum LIGHT(light) over every light that may reach the point: the cluster's lights in
-// ascending index order, or all of them. A macro, so that each shading model gets its own
+// ascending index order, the light grid's near the point, or all of them. A macro, so that each shading model gets its own
 // loop: a model switch inside the loop made the seed model's fragment shader 1.4–1.8× slower
 // on the H100 (measured).
 #ifdef CLUSTERED
@@ -28,6 +31,8 @@
             sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);         \
         }                                                                        \
     }
+#elif defined(LIGHT_GRID)
+#define SUM_LIGHTS(sum, LIGHT) GRID_FOR_LIGHTS(sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);)
 #else
 #define SUM_LIGHTS(sum, LIGHT)                                         \
     for (uint i_ = 0u; i_ < frame.light_count; ++i_) {               \
@@ -140,11 +145,18 @@ bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metal
     return true;
 }
 
-// Lights in the fragment's cluster (the cluster-heat debug view).
+// Lights the fragment tests: its cluster's, or the light grid's near it (the cluster-heat
+// debug view).
 #ifdef CLUSTERED
 uint cluster_light_count(vec3 world, vec2 frag_xy) {
     float depth = -(frame.view * vec4(world, 1.0)).z;
     return cluster_ranges[cluster_of(frame, frag_xy, depth)].count;
+}
+#elif defined(LIGHT_GRID)
+uint cluster_light_count(vec3 world, vec2 frag_xy) {
+    uint count = 0u;
+    GRID_FOR_LIGHTS(count += 1u;)
+    return count;
 }
 #endif
 

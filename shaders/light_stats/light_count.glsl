@@ -1,12 +1,12 @@
 // The light counts (`render --light-stats`): for every pixel with a surface, how many lights
-// the light loop tests there — its cluster's list, walked by the lighting's own loop
-// (SUM_LIGHTS) — and how many of them reach the point (it lies inside the light's sphere).
+// the light loop tests there — the light grid's lists near it, walked by the lighting's own
+// loop (SUM_LIGHTS) — and how many of them reach the point (it lies inside the light's sphere).
 // Their ratio is what light culling wastes; a thread per pixel, the sums per 8×4 work group
 // for the host (light_stats/light_count.rs adds them up): 32 pixels of at most 2^26 lights
 // each (the most `--lights` takes) fit one 32-bit word.
 //
 // The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer.
-#define CLUSTERED 1
+#define LIGHT_GRID 1
 #include "common/common.glsl"
 
 layout(local_size_x = 8, local_size_y = 4) in;

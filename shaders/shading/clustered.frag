@@ -1,5 +1,5 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Techniques `clustered-*`: every fragment loops over its cluster's lights only.
+// Technique `clustered-cpu`: every fragment loops over its cluster's lights only.
 #define CLUSTERED 1
 #include "shading/forward_frag.glsl"

@@ -1,8 +1,8 @@
-// deferred-compute: the clustered lighting of lighting.glsl as a compute shader over the
-// G-buffer (on H100/H200 compute runs on all SMs, fragment shading on 4 of 132). Same BRDF,
-// same cluster lookup, same light order as the fragment paths; position rebuilt from depth.
+// deferred-compute: the lighting of lighting.glsl over the light grid as a compute shader over
+// the G-buffer (on H100/H200 compute runs on all SMs, fragment shading on 4 of 132). Same BRDF
+// and light loop as the fragment paths; position rebuilt from depth.
 // The includer (deferred_lighting.comp, deferred_lighting_linear.comp) says what it writes.
-#define CLUSTERED 1
+#define LIGHT_GRID 1
 #include "common/common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -1,5 +1,6 @@
 // Fragment shader of the forward techniques. `forward.frag` loops over every light;
-// `clustered.frag` defines CLUSTERED and loops over its cluster's lights only. Everything
+// `clustered.frag` defines CLUSTERED and loops over its cluster's lights only, `forward_grid.frag`
+// defines LIGHT_GRID and loops over the light grid's lights near the point. Everything
 // else — inputs, BRDF, summation order (ascending light index) — is shared (lighting.glsl),
 // so the two give the same image when culling is correct.
 
@@ -22,9 +23,9 @@ layout(constant_id = 40) const bool TRANSPARENT_LAYERS = false;
 
 void main() {
     vec3 normal = covered_normal();
-#ifdef CLUSTERED
+#if defined(CLUSTERED) || defined(LIGHT_GRID)
     if (frame.cluster_dims.w == DEBUG_VIEW_CLUSTER_HEAT) {
-        // Lights per cluster on a log scale up to cluster_slices.z.
+        // Lights tested on a log scale up to cluster_slices.z.
         uint count = cluster_light_count(in_world_pos, gl_FragCoord.xy);
         float t = log2(1.0 + float(count)) / log2(1.0 + frame.cluster_slices.z);
         out_color = vec4(heat(t), 1.0);

@@ -3,7 +3,7 @@
 // as the opaque surfaces. The nodes lie in the order their fragments were drawn, so a
 // subgroup's nodes are neighbours on one surface and share their clusters' lights; the work
 // groups stride through however many nodes the build kept. The includer defines CLUSTERED
-// where the technique has cluster lists.
+// where the technique has cluster lists, LIGHT_GRID where it has the light grid.
 #include "common/common.glsl"
 
 layout(local_size_x = 256) in;

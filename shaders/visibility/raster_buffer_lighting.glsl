@@ -1,6 +1,6 @@
 // Lighting from the visibility buffer (visibility_lighting.glsl) as the compute raster left
 // it: depth and id per pixel in one 64-bit buffer, read where it lies.
-#define CLUSTERED 1
+#define LIGHT_GRID 1
 #define SURFACE_GRADIENTS 1
 #include "common/common.glsl"
 #include "common/scene_bindings.glsl"

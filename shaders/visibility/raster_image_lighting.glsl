@@ -1,6 +1,6 @@
 // Lighting from the visibility buffer (visibility_lighting.glsl) as the hardware raster left
 // it: a depth image and an image of ids.
-#define CLUSTERED 1
+#define LIGHT_GRID 1
 #define SURFACE_GRADIENTS 1
 #include "common/common.glsl"
 #include "common/scene_bindings.glsl"

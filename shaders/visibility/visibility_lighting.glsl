@@ -9,7 +9,7 @@
 // shading the pixels of its objects (lavapipe cannot index sampler arrays per pixel).
 //
 // Whichever raster drew the visibility buffer: the includer (visibility_lighting.comp,
-// visibility_lighting_buffer.comp) defines CLUSTERED and SURFACE_GRADIENTS, includes
+// visibility_lighting_buffer.comp) defines LIGHT_GRID and SURFACE_GRADIENTS, includes
 // common.glsl and scene_bindings.glsl, and says where the depth and ids are: `float
 // raster_depth(ivec2 pixel)`, `uint raster_id(ivec2 pixel)`.
 

@@ -50,8 +50,15 @@ gpu_struct!(
         cluster_frustum: [f32; 4],
         /// xyz: the offset every light moves by this frame (animated on the GPU by clustered-gpu).
         light_animation: [f32; 4],
-        /// x: light-index capacity (entries) of this frame's list (clustered-gpu).
+        /// x: light-index capacity (entries) of this frame's list (clustered-cpu).
         cluster_build: [u32; 4],
+        /// The light grid (`light_grid`): xyz the corner of cell (0, 0, 0) this frame, w
+        /// 1 / cell edge.
+        light_grid_origin: [f32; 4],
+        /// xyz: cells per axis; w: cells in all (the index of the wide lights' list).
+        light_grid_dims: [u32; 4],
+        /// x: the largest radius of a light in the cells.
+        light_grid_reach: [f32; 4],
         /// The blinn-phong model's other lights; see common.glsl.
         shadow_view_proj: [[f32; 4]; 4],
         sun_direction: [f32; 4],
@@ -111,18 +118,13 @@ gpu_struct!(
 );
 
 gpu_struct!(
-    /// A cluster's view-space box as the GPU builds it (clustered-gpu).
-    ClusterBounds {
-        min_corner: [f32; 4],
-        max_corner: [f32; 4],
-    }
-);
-
-gpu_struct!(
-    /// What the GPU cluster build reports back after a frame.
-    ClusterFeedback {
-        needed: u32,
-        overflowed: u32,
+    /// What the light grid's build reports back after a frame.
+    LightGridFeedback {
+        /// Lights in the lists (every light).
+        listed: u32,
+        /// Lights every point tests.
+        wide: u32,
+        /// Most lights in one cell.
         max_count: u32,
         _pad0: u32,
     }

@@ -14,6 +14,7 @@ mod geometry;
 pub mod gltf_scene;
 pub mod gltf_writer;
 pub mod gpu_types;
+pub mod light_grid;
 pub mod lights;
 pub mod limits;
 pub mod material;

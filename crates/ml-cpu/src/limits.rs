@@ -6,9 +6,10 @@
 
 use std::ops::RangeInclusive;
 
-/// The most lights a scene may hold (16.7 M × 32 B = 512 MiB of light data). Above a million
-/// is what the clustered techniques are built for; beyond this is a typo, not a workload.
-pub const MAX_LIGHTS: u64 = 1 << 24;
+/// The most lights a scene may hold (67.1 M × 32 B = 2 GiB of light data, where the device
+/// binds that much). Millions are what the light grid is built for; beyond this is a typo,
+/// not a workload.
+pub const MAX_LIGHTS: u64 = 1 << 26;
 
 /// The most objects the bench scene places (a million-triangle mesh budget per hundred).
 pub const MAX_BENCH_OBJECTS: usize = 100_000;

@@ -3,9 +3,10 @@
 //! in its feature's folder, a `PassKind` with its place in `plan`, and its line here
 //! (docs/architecture.md has the checklist).
 
-use crate::clusters::{cluster_assign_cpu, cluster_build};
+use crate::clusters::cluster_assign_cpu;
 use crate::error::RenderError;
 use crate::exposure::{exposure_meter, tone_map};
+use crate::light_grid::light_grid_build::LightGridBuild;
 use crate::light_stats::light_count::LightCount;
 use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
@@ -84,9 +85,9 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
             Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.scene.meshlets()?, (views, 0, atlas.lists.large))?)
         }
         PassKind::ClusterAssignCpu => Box::<cluster_assign_cpu::CpuClusterAssign>::default(),
-        PassKind::ClusterBuild => Box::new(cluster_build::ClusterBuild::new(ctx, a.lights, s.clusters.count())?),
-        PassKind::Forward { clustered, heat_legend } => {
-            Box::new(forward::Forward::new(ctx, a.scene, raster, (clustered, heat_legend), s.technique.name())?)
+        PassKind::LightGridBuild => Box::new(LightGridBuild::new(ctx, a.lights)?),
+        PassKind::Forward { lights, heat_legend } => {
+            Box::new(forward::Forward::new(ctx, a.scene, raster, (lights, heat_legend), s.technique.name())?)
         }
         PassKind::DeferredSubpasses { clustered } => Box::new(deferred_subpass::DeferredSubpasses::new(ctx, a.scene, raster, clustered)?),
         PassKind::ToneMap { curve } => Box::new(tone_map::ToneMap::new(ctx, curve)?),
@@ -108,8 +109,8 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::TransparentBuild { depth_buffer } => {
             Box::new(TransparentBuild::new(ctx, a.scene, (a.shading, transparency()), depth_buffer)?)
         }
-        PassKind::TransparentResolve { clustered, after_compute } => {
-            Box::new(TransparentResolve::new(ctx, a.scene, (a.shading, transparency()), (clustered, after_compute))?)
+        PassKind::TransparentResolve { lights, after_compute } => {
+            Box::new(TransparentResolve::new(ctx, a.scene, (a.shading, transparency()), (lights, after_compute))?)
         }
         PassKind::LightCount { depth_buffer } => Box::new(LightCount::new(ctx, a.scene, a.shading, depth_buffer)?),
     })

@@ -25,7 +25,7 @@
 //! ```
 //!
 //! Inside, a frame is a list of passes planned as data ([`plan::plan`]) and made by feature:
-//! `shadows/`, `visibility/`, `clusters/`, `exposure/`, `shading/`, `transparency/`, `light_stats/`, over the scene's GPU
+//! `shadows/`, `visibility/`, `clusters/`, `light_grid/`, `exposure/`, `shading/`, `transparency/`, `light_stats/`, over the scene's GPU
 //! resources (`scene/`); docs/architecture.md maps every file.
 
 pub mod error;
@@ -43,6 +43,7 @@ mod exposure;
 mod frame;
 mod frame_resources;
 mod gpu_mesh;
+mod light_grid;
 mod light_stats;
 mod pass;
 mod render_pass;
@@ -59,6 +60,7 @@ mod visibility;
 
 pub use error::RenderError;
 pub use frame_resources::FRAMES_IN_FLIGHT;
+pub use light_grid::LightGridStats;
 pub use light_stats::LightStats;
 pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use scene::textures::SHADOW_MAP_SIZE;

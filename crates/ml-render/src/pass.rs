@@ -122,6 +122,10 @@ pub trait Pass {
     /// the frame loop into `report`, the pass's own figures into `stats`.
     fn collect(&self, _slot: usize, _report: &mut SlotReport, _stats: &mut FrameStats) {}
 
+    /// Fill the frame's uniforms that the pass owns (the light grid's placement), the lights
+    /// moved by `light_offset` this frame.
+    fn frame_uniforms(&self, _uniforms: &mut ml_cpu::gpu_types::FrameUniforms, _light_offset: glam::Vec3) {}
+
     /// The projection or image size changed; slot 0's uniforms hold the new ones and no frame
     /// is in flight.
     fn projection_changed(&mut self, _ctx: &Context) -> Result<(), VkError> {

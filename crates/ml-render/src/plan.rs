@@ -31,10 +31,11 @@ pub enum PassKind {
     ShadowAtlas,
     /// Light assignment on the CPU, before the frame is recorded (no GPU work).
     ClusterAssignCpu,
-    /// Light assignment on the GPU.
-    ClusterBuild,
-    /// Forward shading, every light or through the cluster lists, with the heat map's legend.
-    Forward { clustered: bool, heat_legend: bool },
+    /// Light assignment on the GPU: the light grid's build.
+    LightGridBuild,
+    /// Forward shading, every light or through the technique's light lists (`lights`: who
+    /// assigns them), with the heat map's legend.
+    Forward { lights: LightAssignment, heat_legend: bool },
     /// The deferred render pass: G-buffer subpass, lighting subpass.
     DeferredSubpasses { clustered: bool },
     /// HDR → colour target after the deferred subpasses, with pbr's curve or as it is.
@@ -62,7 +63,7 @@ pub enum PassKind {
     TransparentBuild { depth_buffer: bool },
     /// The layers lit and blended over the opaque HDR image, encoded into the colour target;
     /// `after_compute`: a compute lighting pass wrote that image (else a render pass).
-    TransparentResolve { clustered: bool, after_compute: bool },
+    TransparentResolve { lights: LightAssignment, after_compute: bool },
     /// Lights tested and reaching per pixel, counted after the lighting (`depth_buffer`: from
     /// the compute raster's buffer, else the depth target).
     LightCount { depth_buffer: bool },
@@ -153,16 +154,17 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     match technique.assignment() {
         LightAssignment::None => {}
         LightAssignment::Cpu => kinds.push(PassKind::ClusterAssignCpu),
-        LightAssignment::Gpu => kinds.push(PassKind::ClusterBuild),
+        LightAssignment::Gpu => kinds.push(PassKind::LightGridBuild),
     }
-    let clustered = technique.assignment() != LightAssignment::None;
+    let lights = technique.assignment();
+    let clustered = lights == LightAssignment::Cpu;
     // Transparent layers: built once the opaque depth is known, resolved over the opaque
     // pass's linear HDR output.
     // The opaque depth after the raster: the compute raster's buffer, or the depth target.
     let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
     let build = PassKind::TransparentBuild { depth_buffer: opaque_depth_buffer };
     let after_compute = technique.lighting_stage() == LightingStage::Compute;
-    let resolve = PassKind::TransparentResolve { clustered, after_compute };
+    let resolve = PassKind::TransparentResolve { lights, after_compute };
     match (technique.geometry(), technique.lighting_stage()) {
         (Geometry::Meshlets, _) => {
             for phase in [Phase::Early, Phase::Late] {
@@ -180,7 +182,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
             kinds.extend(key.layers.then_some(resolve));
         }
         (Geometry::Meshes, LightingStage::Forward) => {
-            kinds.push(PassKind::Forward { clustered, heat_legend: key.debug_view == DebugView::ClusterHeat });
+            kinds.push(PassKind::Forward { lights, heat_legend: key.debug_view == DebugView::ClusterHeat });
             if key.layers {
                 kinds.extend([build, resolve]);
             }
@@ -233,12 +235,12 @@ mod tests {
     #[test]
     fn each_technique_gets_the_frame_the_architecture_draws() {
         let cases: [(Technique, &[PassKind]); 6] = [
-            (Technique::Forward, &[Forward { clustered: false, heat_legend: false }]),
-            (Technique::ClusteredCpu, &[ClusterAssignCpu, Forward { clustered: true, heat_legend: false }]),
-            (Technique::ClusteredGpu, &[ClusterBuild, Forward { clustered: true, heat_legend: false }]),
+            (Technique::Forward, &[Forward { lights: LightAssignment::None, heat_legend: false }]),
+            (Technique::ClusteredCpu, &[ClusterAssignCpu, Forward { lights: LightAssignment::Cpu, heat_legend: false }]),
+            (Technique::ClusteredGpu, &[LightGridBuild, Forward { lights: LightAssignment::Gpu, heat_legend: false }]),
             (Technique::Deferred, &[DeferredSubpasses { clustered: false }, ToneMap { curve: true }]),
             (Technique::DeferredClustered, &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, ToneMap { curve: true }]),
-            (Technique::DeferredCompute, &[ClusterBuild, GBuffer, ComputeLighting]),
+            (Technique::DeferredCompute, &[LightGridBuild, GBuffer, ComputeLighting]),
         ];
         for (technique, expected) in cases {
             let mut k = key(technique);
@@ -253,7 +255,7 @@ mod tests {
         k.meters_exposure = false;
         let phases = |raster: fn(Phase) -> PassKind| {
             vec![
-                ClusterBuild,
+                LightGridBuild,
                 MeshletCull(Phase::Early),
                 raster(Phase::Early),
                 DepthPyramid,
@@ -273,7 +275,7 @@ mod tests {
 
     #[test]
     fn shadows_come_first_and_views_and_the_meter_last() {
-        let forward = Forward { clustered: false, heat_legend: false };
+        let forward = Forward { lights: LightAssignment::None, heat_legend: false };
         let k = key(Technique::Forward);
         assert!(k.meters_exposure, "auto exposure is the default");
         assert_eq!(plan(&k), [forward, ExposureMeter { curve: true }]);
@@ -290,18 +292,32 @@ mod tests {
         let mut k = key(Technique::ClusteredGpu);
         k.debug_view = DebugView::ClusterHeat;
         k.meters_exposure = false;
-        assert_eq!(plan(&k), [ClusterBuild, Forward { clustered: true, heat_legend: true }]);
+        assert_eq!(plan(&k), [LightGridBuild, Forward { lights: LightAssignment::Gpu, heat_legend: true }]);
     }
 
     #[test]
     fn transparent_layers_are_built_after_the_opaque_depth_and_resolved_over_its_light() {
         let build = TransparentBuild { depth_buffer: false };
-        let resolve = |clustered, after_compute| TransparentResolve { clustered, after_compute };
+        let resolve = |lights, after_compute| TransparentResolve { lights, after_compute };
         let cases: [(Technique, &[PassKind]); 4] = [
-            (Technique::Forward, &[Forward { clustered: false, heat_legend: false }, build, resolve(false, false)]),
-            (Technique::ClusteredGpu, &[ClusterBuild, Forward { clustered: true, heat_legend: false }, build, resolve(true, false)]),
-            (Technique::DeferredClustered, &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, build, resolve(true, false)]),
-            (Technique::DeferredCompute, &[ClusterBuild, GBuffer, build, ComputeLighting, resolve(true, true)]),
+            (
+                Technique::Forward,
+                &[Forward { lights: LightAssignment::None, heat_legend: false }, build, resolve(LightAssignment::None, false)],
+            ),
+            (
+                Technique::ClusteredGpu,
+                &[
+                    LightGridBuild,
+                    Forward { lights: LightAssignment::Gpu, heat_legend: false },
+                    build,
+                    resolve(LightAssignment::Gpu, false),
+                ],
+            ),
+            (
+                Technique::DeferredClustered,
+                &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, build, resolve(LightAssignment::Cpu, false)],
+            ),
+            (Technique::DeferredCompute, &[LightGridBuild, GBuffer, build, ComputeLighting, resolve(LightAssignment::Gpu, true)]),
         ];
         for (technique, expected) in cases {
             let mut k = key(technique);
@@ -311,7 +327,7 @@ mod tests {
         }
         let mut k = key(Technique::Visibility);
         (k.layers, k.meters_exposure, k.raster) = (true, false, Raster::compute(64));
-        assert_eq!(plan(&k)[6..], [TransparentBuild { depth_buffer: true }, VisibilityLighting, resolve(true, true)]);
+        assert_eq!(plan(&k)[6..], [TransparentBuild { depth_buffer: true }, VisibilityLighting, resolve(LightAssignment::Gpu, true)]);
         // A surface view shows the opaque surfaces only; the layers' own view keeps them.
         let mut s = RenderSettings { transparency: Some(Default::default()), ..RenderSettings::new(Technique::Forward, 64, 64) };
         s.debug_view = DebugView::GBufferAlbedo;
@@ -324,7 +340,7 @@ mod tests {
     fn the_light_counts_follow_the_lighting_and_precede_the_meter() {
         let mut k = key(Technique::DeferredCompute);
         k.light_stats = true;
-        assert_eq!(plan(&k), [ClusterBuild, GBuffer, ComputeLighting, LightCount { depth_buffer: false }, ExposureMeter { curve: true }]);
+        assert_eq!(plan(&k), [LightGridBuild, GBuffer, ComputeLighting, LightCount { depth_buffer: false }, ExposureMeter { curve: true }]);
         let mut k = key(Technique::Visibility);
         (k.light_stats, k.meters_exposure, k.raster) = (true, false, Raster::compute(64));
         assert_eq!(plan(&k)[6..], [VisibilityLighting, LightCount { depth_buffer: true }]);

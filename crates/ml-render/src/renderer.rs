@@ -17,8 +17,8 @@ use crate::settings::{LightAssignment, RenderSettings};
 use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
-use ml_cpu::cluster::{count_entries, ClusterGrid, ClusterLists, ClusterStats};
-use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
+use ml_cpu::cluster::{count_entries, ClusterGrid, ClusterStats};
+use ml_cpu::gpu_types::{FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
 use ml_cpu::scene::Scene;
 use ml_vk::{commands, vk, Buffer, Context, Image, VkError, VkResultExt};
@@ -108,7 +108,7 @@ fn check_lists_fit(
     lights: &[PointLight],
     motion: f32,
 ) -> Result<(), RenderError> {
-    if !settings.technique.is_clustered() {
+    if settings.technique.assignment() != LightAssignment::Cpu {
         return Ok(());
     }
     let limit = max_index_entries(ctx);
@@ -300,14 +300,15 @@ impl<'a> Renderer<'a> {
         let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
         let raster = self.settings.raster;
         let layers = self.settings.blends_layers();
+        let cpu_lists = technique.assignment() == LightAssignment::Cpu;
         let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers));
         let setup = FrameSetup {
             pool: self.command_pool,
             light_count: self.scene.lights.len(),
-            cluster_count: self.settings.clusters.count(),
-            // Clustered techniques start with room for 16 entries per light (grown on demand);
-            // forward never reads the list.
-            initial_indices: if technique.is_clustered() { self.scene.lights.len() * 16 } else { 1 },
+            // The CPU's cluster lists (the GPU techniques' light grid keeps its own).
+            cluster_count: if cpu_lists { self.settings.clusters.count() } else { 1 },
+            // Room for 16 entries per light to start with (grown on demand).
+            initial_indices: if cpu_lists { self.scene.lights.len() * 16 } else { 1 },
             passes: self.pass_names().len() as u32,
             make_targets: &make_targets,
             written_by_gpu: self.lights_on_gpu,
@@ -579,10 +580,12 @@ impl<'a> Renderer<'a> {
             p.collect(f, &mut report, stats);
         }
         self.reports[f] = report;
+        if let Some(max_lights) = report.max_lights {
+            self.heat_top = max_lights.max(1) as f32;
+        }
         if let (Some(needed), Some(max_lights)) = (report.index_entries, report.max_lights) {
             let clusters = self.settings.clusters.count();
             stats.clusters = Some(ClusterStats { mean_lights: needed as f64 / clusters as f64, max_lights, index_len: needed });
-            self.heat_top = max_lights.max(1) as f32;
             if report.overflowed {
                 stats.overflowed_frames += 1;
                 eprintln!(
@@ -657,7 +660,8 @@ impl<'a> Renderer<'a> {
         let shadow_texel_world = 2.0 / self.gpu.shadow_view_proj.row(0).truncate().length() / self.gpu.textures.shadow_size as f32;
         let exposure = self.exposure.expose(f);
         let frame = &mut self.frames[f];
-        let uniforms = FrameUniforms {
+        let light_offset = motion_offset(t, self.scene.light_motion);
+        let mut uniforms = FrameUniforms {
             view: g.view.to_cols_array_2d(),
             proj: g.projection.to_cols_array_2d(),
             inv_view_proj: (g.projection * g.view).inverse().to_cols_array_2d(),
@@ -671,7 +675,7 @@ impl<'a> Renderer<'a> {
             viewport: [self.extent.width, self.extent.height, 0, 0],
             cluster_slices: [g.log_scale, g.log_bias, self.heat_top, 0.0],
             cluster_frustum: [g.near, g.far, g.projection.x_axis.x, g.projection.y_axis.y],
-            light_animation: motion_offset(t, self.scene.light_motion).extend(0.0).to_array(),
+            light_animation: light_offset.extend(0.0).to_array(),
             cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
             shadow_view_proj: self.gpu.shadow_view_proj.to_cols_array_2d(),
             sun_direction: bp.sun_direction.extend(1.0 / self.gpu.textures.shadow_size as f32).to_array(),
@@ -686,7 +690,11 @@ impl<'a> Renderer<'a> {
             }),
             directional_color: std::array::from_fn(|i| self.scene.directional.get(i).map_or([0.0; 4], |d| d.color.extend(0.0).to_array())),
             exposure: [exposure, 0.0, 0.0, 0.0],
+            ..FrameUniforms::default()
         };
+        for p in &self.passes {
+            p.frame_uniforms(&mut uniforms, light_offset);
+        }
         frame.uniforms.write(0, &[uniforms]);
     }
 
@@ -741,52 +749,6 @@ impl<'a> Renderer<'a> {
     /// plane); for tests and tools.
     pub fn sun_shadow_depths(&self) -> Result<Vec<f32>, VkError> {
         self.gpu.textures.read_shadow_map(self.ctx)
-    }
-
-    /// The cluster lists the GPU built for the frame `render` returned (clustered-gpu; None
-    /// otherwise), copied to the host. Lists are sorted per cluster (the GPU's order is not
-    /// deterministic); for tests and tools, not the frame loop.
-    pub fn gpu_cluster_lists(&self) -> Result<Option<ClusterLists>, VkError> {
-        let Some(needed) = self.reports[self.last_frame].index_entries.map(|n| n as u64) else { return Ok(None) };
-        let ctx = self.ctx;
-        let frame = &self.frames[self.last_frame];
-        let copies = [(&frame.cluster_ranges, frame.cluster_ranges.size), (&frame.light_indices, (needed * 4).max(4))];
-        let mut host = Vec::new();
-        for (_, size) in copies {
-            host.push(Buffer::new(
-                ctx,
-                "cluster read-back",
-                size,
-                vk::BufferUsageFlags::TRANSFER_DST,
-                gpu_allocator::MemoryLocation::GpuToCpu,
-            )?);
-        }
-        let copied = commands::one_shot(ctx, |cmd| {
-            // After the build's writes (earlier submissions of this queue).
-            let written = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE);
-            commands::memory_barrier(ctx, cmd, written, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ));
-            for ((src, size), dst) in copies.iter().zip(&host) {
-                // SAFETY: recording state; both buffers are alive and large enough, the build's
-                // writes visible to transfers.
-                unsafe { ctx.device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[vk::BufferCopy::default().size(*size)]) };
-            }
-            commands::transfer_to_host_barrier(ctx, cmd);
-        });
-        let lists = copied.map(|()| {
-            let ranges: Vec<ClusterRange> = bytemuck::pod_collect_to_vec(host[0].mapped());
-            let all: Vec<u32> = bytemuck::pod_collect_to_vec(host[1].mapped());
-            let mut indices = Vec::with_capacity(needed as usize);
-            for r in &ranges {
-                let mut list = all[r.offset as usize..(r.offset + r.count) as usize].to_vec();
-                list.sort_unstable();
-                indices.extend(list);
-            }
-            ClusterLists { ranges, indices }
-        });
-        for mut b in host {
-            b.destroy(ctx);
-        }
-        lists.map(Some)
     }
 
     /// Copy frame `f`'s colour target (left in TRANSFER_SRC_OPTIMAL by the frame's last

@@ -210,12 +210,18 @@ pub const COLOUR_TARGET: &str = "colour target";
 pub const HDR_TARGET: &str = "hdr target";
 
 /// The frame slot's lights and cluster lists, as their shader blocks name them: written by
-/// the GPU cluster build (or by the host), read by every shading pass.
+/// the host (the CPU assignment), read by every shading pass.
 pub const LIGHT_LISTS: [&str; 3] = ["LightBuffer", "ClusterRangeBuffer", "LightIndexBuffer"];
 
-/// How a shading pass reads the lights and lists: in `stages`.
+/// The frame slot's lights and light-grid lists: written by the light grid's build, read by
+/// every shading pass.
+pub const LIGHT_GRID_LISTS: [&str; 4] = ["LightBuffer", "LightGridCellBuffer", "LightGridBlockBuffer", "LightGridIndexBuffer"];
+
+/// How a shading pass reads the lights and lists (whichever the technique has): in `stages`.
 pub fn light_list_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
-    LIGHT_LISTS.iter().map(|&name| Use::at(name, (stages, vk::AccessFlags::SHADER_READ), None)).collect()
+    let mut names = LIGHT_LISTS.to_vec();
+    names.extend(&LIGHT_GRID_LISTS[1..]);
+    names.into_iter().map(|name| Use::at(name, (stages, vk::AccessFlags::SHADER_READ), None)).collect()
 }
 
 /// The frame slot's depth pyramid (its shader block's name): written by the depth pyramid

@@ -11,18 +11,19 @@ pub enum Technique {
     Forward,
     /// Cluster grid with lights assigned on the CPU every frame.
     ClusteredCpu,
-    /// Cluster grid built by compute shaders every frame; lights animated on the GPU.
+    /// The light grid (world-space cells of the lights' size) built by compute shaders every
+    /// frame, lights moved on the GPU; every fragment walks the cells near it.
     ClusteredGpu,
     /// One render pass, G-buffer subpass → lighting subpass (input attachments),
     /// every light per pixel, into an HDR target; then a tone-map pass.
     Deferred,
     /// `Deferred` with the lighting subpass looping over its cluster's lights (CPU-assigned).
     DeferredClustered,
-    /// clustered-gpu's lists, with the lighting as a compute pass over a G-buffer.
+    /// clustered-gpu's light grid, with the lighting as a compute pass over a G-buffer.
     DeferredCompute,
     /// GPU-driven: meshlets culled on the GPU (frustum, back-face cones, occlusion in two
     /// phases), drawn indirectly into a visibility buffer, lit by a compute pass through
-    /// clustered-gpu's lists.
+    /// clustered-gpu's light grid.
     Visibility,
 }
 
@@ -100,14 +101,14 @@ impl Technique {
     }
 }
 
-/// Where lights are assigned to clusters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Where lights are assigned to lists, and so which lists the light loop walks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum LightAssignment {
     /// Nowhere: every pixel loops over every light.
     None,
-    /// On the CPU every frame, uploaded into the frame's lists.
+    /// To the cluster grid on the CPU every frame, uploaded into the frame's lists.
     Cpu,
-    /// By compute shaders every frame (which also animate the lights).
+    /// To the light grid by compute shaders every frame (which also move the lights).
     Gpu,
 }
 

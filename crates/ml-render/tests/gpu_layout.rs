@@ -3,9 +3,9 @@
 //! docs/DESIGN.md#mistakes-we-avoid). A field moved on either side fails here.
 
 use ml_cpu::gpu_types::{
-    ClusterBounds, ClusterFeedback, ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance,
-    LargeTriangle, LayerObject, LightCone, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight,
-    ShadowCubeTiles, ShadowPush, StageProbePush,
+    ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance, LargeTriangle, LayerObject, LightCone,
+    LightGridFeedback, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowCubeTiles,
+    ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -89,8 +89,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<ObjectData>(&structs);
     check::<LightCone>(&structs);
     check::<ClusterRange>(&structs);
-    check::<ClusterBounds>(&structs);
-    check::<ClusterFeedback>(&structs);
+    check::<LightGridFeedback>(&structs);
     check::<Meshlet>(&structs);
     check::<Instance>(&structs);
     check::<CullCounters>(&structs);

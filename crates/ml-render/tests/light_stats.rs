@@ -1,16 +1,16 @@
 //! The light counts (`RenderSettings::light_stats`): on a wall that fills the view under
 //! random lights (crossing the near plane, behind the camera and the wall, tiny and huge
-//! radii), the lights tested per pixel equal the sum of the GPU-built lists of the pixels'
-//! clusters, and the lights reaching equal a CPU count over every light at each pixel's point
-//! on the wall — in both compute-lit techniques (and the visibility technique's two rasters),
+//! radii), the lights tested per pixel equal what the CPU model of the light grid
+//! (`ml_cpu::light_grid`) lists in the cells each pixel's point walks, and the lights reaching
+//! equal a CPU count over every light at each pixel's point on the wall — in both compute-lit techniques (and the visibility technique's two rasters),
 //! with validation on.
 
 mod common;
 
 use glam::{Mat4, Quat, Vec3};
 use ml_cpu::camera::Camera;
-use ml_cpu::cluster::ClusterGrid;
 use ml_cpu::gpu_types::PointLight;
+use ml_cpu::light_grid::{cell_budget, cpu_lists, tested_at, LightGridShape};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
@@ -45,18 +45,17 @@ fn wall_scene(count: usize, seed: u64) -> Scene {
     s
 }
 
-/// The CPU's counts: per pixel, its point on the wall (z = 0), the GPU list of its cluster
-/// (tested) and every light whose sphere holds the point (reaching).
-fn cpu_counts(scene: &Scene, grid: &ClusterGrid, lists: &ml_cpu::cluster::ClusterLists) -> LightStats {
+/// The CPU's counts: per pixel, its point on the wall (z = 0), the lights of the grid's
+/// cells it walks (tested) and every light whose sphere holds the point (reaching).
+fn cpu_counts(scene: &Scene, grid: &LightGridShape) -> LightStats {
     let mut s = LightStats::default();
-    let view = scene.camera.view();
+    let lists = cpu_lists(grid, &scene.lights, Vec3::ZERO);
     for y in 0..H {
         for x in 0..W {
             let (o, d) = scene.camera.pixel_ray(x, y, W, H);
             let p = o + d * (-o.z / d.z);
-            let depth = -(view * p.extend(1.0)).z;
             s.pixels += 1;
-            s.tested += lists.lights_of(grid.cluster_of(x, y, depth)).len() as u64;
+            s.tested += tested_at(grid, &lists, Vec3::ZERO, p) as u64;
             s.reached +=
                 scene.lights.iter().filter(|l| (Vec3::from_slice(&l.position_radius[..3]) - p).length() < l.position_radius[3]).count()
                     as u64;
@@ -80,14 +79,14 @@ fn the_counts_equal_the_lists_and_a_cpu_count_of_the_lights_reaching() {
             let settings = RenderSettings { light_stats: true, raster, ..RenderSettings::new(technique, W, H) };
             let mut renderer = Renderer::new(&ctx, scene.clone(), settings).expect("renderer");
             let out = renderer.render().expect("render");
-            let lists = renderer.gpu_cluster_lists().expect("read back").expect("GPU-built lists");
             drop(renderer);
             let got = *out.stats.feature::<LightStats>().expect("the light counts");
-            let grid = ClusterGrid::new(settings.clusters, W, H, &scene.camera);
-            let want = cpu_counts(&scene, &grid, &lists);
+            let bindable = u64::from(ctx.info.limits.max_storage_buffer_range) / 4;
+            let grid = LightGridShape::fit(&scene.lights, cell_budget(scene.lights.len(), bindable));
+            let want = cpu_counts(&scene, &grid);
             let name = format!("{} ({}), scene {seed}", technique.name(), raster.name());
             assert_eq!(got.pixels, want.pixels, "{name}: every pixel has the wall");
-            // A pixel whose point lies within float rounding of a slice's boundary or a sphere
+            // A pixel whose point lies within float rounding of a cell's boundary or a sphere
             // may land on the other side on the GPU: at most a few.
             let near = |a: u64, b: u64| a.abs_diff(b) as f64 <= 0.002 * b as f64 + 2.0;
             assert!(near(got.tested, want.tested), "{name}: tested {} against the lists' {}", got.tested, want.tested);

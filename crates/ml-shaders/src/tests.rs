@@ -77,11 +77,11 @@ fn every_shader_reflects_what_its_glsl_declares() {
 
 #[test]
 fn known_shaders_have_their_glsl_numbers() {
-    // cluster_build.comp: local_size_x = 128; constant_id 0 FILL, 1 LANES.
-    assert_eq!(CLUSTER_BUILD_COMP.file, "clusters/cluster_build.comp");
-    assert_eq!(CLUSTER_BUILD_COMP.workgroup_size, [128, 1, 1]);
-    assert_eq!(CLUSTER_BUILD_COMP.spec_constants, &[SpecConstant { name: "FILL", id: 0 }, SpecConstant { name: "LANES", id: 1 }]);
-    assert_eq!(CLUSTER_BUILD_COMP.spec_id("STEP"), None);
+    // light_grid_build.comp: local_size_x = 256; constant_id 0 FILL.
+    assert_eq!(LIGHT_GRID_BUILD_COMP.file, "light_grid/light_grid_build.comp");
+    assert_eq!(LIGHT_GRID_BUILD_COMP.workgroup_size, [256, 1, 1]);
+    assert_eq!(LIGHT_GRID_BUILD_COMP.spec_constants, &[SpecConstant { name: "FILL", id: 0 }]);
+    assert_eq!(LIGHT_GRID_BUILD_COMP.spec_id("STEP"), None);
     // tonemap.comp: 8×8, and the shading model's constants from common/shading_model.glsl.
     assert_eq!(TONEMAP_COMP.workgroup_size, [8, 8, 1]);
     assert_eq!(TONEMAP_COMP.spec_id("MODEL_PBR"), Some(11));
@@ -118,7 +118,8 @@ fn every_debug_view_define_is_generated() {
 
 #[test]
 fn files_lie_in_feature_folders_and_names_are_unique() {
-    let folders = ["common", "shading", "visibility", "shadows", "clusters", "exposure", "probe", "transparency", "light_stats"];
+    let folders =
+        ["common", "shading", "visibility", "shadows", "clusters", "exposure", "probe", "transparency", "light_stats", "light_grid"];
     let mut names: Vec<&str> = Vec::new();
     for shader in ALL {
         let (folder, name) = shader.file.split_once('/').unwrap_or_else(|| panic!("{} is in no folder", shader.file));

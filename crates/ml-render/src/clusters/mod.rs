@@ -1,6 +1,5 @@
-//! Light assignment to the cluster grid: on the CPU each frame (clustered-cpu,
-//! deferred-clustered) or built on the GPU (clustered-gpu, deferred-compute, visibility)
-//! (docs/DESIGN.md#clustered-light-assignment).
+//! Light assignment to the cluster grid on the CPU each frame (clustered-cpu,
+//! deferred-clustered; docs/DESIGN.md#clustered-light-assignment). The GPU techniques use
+//! the light grid (`crate::light_grid`).
 
 pub mod cluster_assign_cpu;
-pub mod cluster_build;

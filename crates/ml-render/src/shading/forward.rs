@@ -6,6 +6,7 @@
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
+use crate::settings::LightAssignment;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
 use crate::shading::Shading;
 use crate::sync::{shading_reads, Entry, Exit, Use, COLOUR_TARGET};
@@ -22,16 +23,20 @@ pub struct Forward {
 }
 
 impl Forward {
-    /// `clustered`: loop over the fragment's cluster; `legend`: draw the heat legend; `name`:
-    /// the timer's (the technique's).
+    /// `lights`: loop over every light, the fragment's cluster (CPU lists) or the light grid
+    /// near it (GPU); `legend`: draw the heat legend; `name`: the timer's (the technique's).
     pub fn new(
         ctx: &Context,
         scene: &SceneGpu,
         (depth_format, shading): (vk::Format, Shading),
-        (clustered, legend): (bool, bool),
+        (lights, legend): (LightAssignment, bool),
         name: &'static str,
     ) -> Result<Forward, VkError> {
-        let fragment = if clustered { &ml_shaders::CLUSTERED_FRAG } else { &ml_shaders::FORWARD_FRAG };
+        let fragment = match lights {
+            LightAssignment::None => &ml_shaders::FORWARD_FRAG,
+            LightAssignment::Cpu => &ml_shaders::CLUSTERED_FRAG,
+            LightAssignment::Gpu => &ml_shaders::FORWARD_GRID_FRAG,
+        };
         let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
         let raster = MeshRaster::new(ctx, (depth_format, Output::Color, &[]), (fragment, shading, &scene.surface_variants), layouts)?;
         let mut pass = Forward { raster, legend: vk::Pipeline::null(), name, layers: shading.transparency };

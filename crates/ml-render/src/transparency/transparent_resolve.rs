@@ -10,6 +10,7 @@ use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
+use crate::settings::LightAssignment;
 use crate::shading::Shading;
 use crate::sync::{shading_reads, Use, HDR_TARGET};
 use ml_vk::commands::memory_barrier;
@@ -30,15 +31,20 @@ pub struct TransparentResolve {
 }
 
 impl TransparentResolve {
-    /// `clustered`: the layers are lit by their clusters' lights (else by every light);
+    /// `lights`: the layers are lit by every light, their clusters' (CPU lists) or the light
+    /// grid's near them (GPU);
     /// `after_compute`: the HDR image is the compute lighting's.
     pub fn new(
         ctx: &Context,
         scene: &SceneGpu,
         (shading, settings): (Shading, TransparencySettings),
-        (clustered, after_compute): (bool, bool),
+        (lights, after_compute): (LightAssignment, bool),
     ) -> Result<TransparentResolve, VkError> {
-        let shader = if clustered { &ml_shaders::TRANSPARENT_LIGHTING_CLUSTERED_COMP } else { &ml_shaders::TRANSPARENT_LIGHTING_COMP };
+        let shader = match lights {
+            LightAssignment::None => &ml_shaders::TRANSPARENT_LIGHTING_COMP,
+            LightAssignment::Cpu => &ml_shaders::TRANSPARENT_LIGHTING_CLUSTERED_COMP,
+            LightAssignment::Gpu => &ml_shaders::TRANSPARENT_LIGHTING_GRID_COMP,
+        };
         let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &shading.lighting_constants()))?;
         let [blinn_phong, pbr, _] = shading.surface_constants();
         let blend_constants = [blinn_phong, pbr];

@@ -1,0 +1,36 @@
+//! The light grid (docs/DESIGN.md#the-light-grid): the light assignment of the GPU techniques
+//! (clustered-gpu, deferred-compute, visibility). Lights are listed per cell of a world-space
+//! grid with cells about the lights' radius, rebuilt by compute shaders every frame from the
+//! moved lights (`light_grid_build`); a surface point walks the rows of cells within reach of
+//! it (shaders/light_grid/light_grid.glsl). What a pixel tests then follows the lights near
+//! it, not the lights in the scene; the cells' shape is `ml_cpu::light_grid`'s.
+
+pub mod light_grid_build;
+
+use crate::report::FeatureStats;
+
+/// What the last frame's build listed.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightGridStats {
+    /// Cells per axis and their edge (m).
+    pub dims: [u32; 3],
+    pub cell: f32,
+    /// Lights listed (every light of the scene), of them wide (tested by every point).
+    pub listed: u32,
+    pub wide: u32,
+    /// Most lights in one cell.
+    pub max_per_cell: u32,
+}
+
+impl FeatureStats for LightGridStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let [x, y, z] = self.dims;
+        vec![(
+            "light grid",
+            format!(
+                "{x}x{y}x{z} cells of {:.3} m; {} lights listed, {} wide; at most {} in a cell",
+                self.cell, self.listed, self.wide, self.max_per_cell
+            ),
+        )]
+    }
+}
