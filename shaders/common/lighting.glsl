@@ -32,7 +32,8 @@
         }                                                                        \
     }
 #elif defined(LIGHT_GRID)
-#define SUM_LIGHTS(sum, LIGHT) GRID_FOR_LIGHTS(sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);)
+#define SUM_LIGHTS(sum, LIGHT)                                                            \
+    GRID_FOR_LIGHTS(PointLight l_ = grid_light(i_); sum += LIGHT(l_) * spot_cone(SPOT_LIGHTS ? grid_order[i_] : i_, l_, world);)
 #else
 #define SUM_LIGHTS(sum, LIGHT)                                         \
     for (uint i_ = 0u; i_ < frame.light_count; ++i_) {               \

@@ -6,7 +6,14 @@
 #define MANYLIGHTS_SCENE_BINDINGS_GLSL
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+#ifdef LIGHT_GRID
+// The light grid's copy of the lights at rest, in the order of their cells (light_grid.glsl
+// grid_light moves them), and where each was in the scene's order (its spot cone's index).
+layout(std430, set = 0, binding = 24) readonly buffer LightGridLightBuffer { PointLight lights[]; };
+layout(std430, set = 0, binding = 23) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
+#else
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer { PointLight lights[]; };
+#endif
 layout(std430, set = 0, binding = 4) readonly buffer ObjectBuffer { ObjectData objects[]; };
 layout(std430, set = 0, binding = 10) readonly buffer LightConeBuffer { LightCone light_cones[]; };
 #ifdef CLUSTERED

@@ -13,6 +13,13 @@ const uint GRID_BLOCK = 1024u;
 // Relative margin on the reach (light_grid.rs GRID_MARGIN).
 const float GRID_MARGIN = 1e-4;
 
+// The grid's light j as it is this frame: at rest, moved by the frame's offset.
+PointLight grid_light(uint j) {
+    PointLight l = lights[j];
+    l.position_radius.xyz += frame.light_animation.xyz;
+    return l;
+}
+
 // Where list c (a cell, or frame.light_grid_dims.w: the wide lights) ends and starts.
 uint grid_end(uint c) {
     return grid_blocks[c / GRID_BLOCK].x + grid_cell_ends[c];
@@ -64,7 +71,7 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
     return uvec2(grid_start(row + x0), grid_end(row + x1));
 }
 
-// Sum BODY(i_) over the light indices `i_` a point at `world` tests: the wide lights, then
+// Run BODY for each light `i_` (the grid's order: grid_light(i_)) a point at `world` tests: the wide lights, then
 // the rows of cells within reach.
 #define GRID_FOR_LIGHTS(BODY)                                                   \
     {                                                                           \

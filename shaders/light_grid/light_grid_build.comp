@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // The light grid's build, one invocation per light, run twice around the scan
 // (light_grid_scan.comp):
-//   COUNT: animate the light, write it for shading, find its list (its cell, or the wide
+//   COUNT: move the light by the frame's offset, find its list (its cell, or the wide
 //          lights' when wider than the reach) and count it there;
 //   FILL:  after the scan, take the next place of its list and write its index there. The
 //          lists' counters end as each cell's end (light_grid.glsl reads them so).
@@ -13,8 +13,9 @@ layout(local_size_x = 256) in;
 layout(constant_id = 0) const bool FILL = false;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
-layout(std430, set = 0, binding = 1) readonly buffer RestLightBuffer { PointLight rest_lights[]; };
-layout(std430, set = 0, binding = 2) writeonly buffer LightBuffer { PointLight lights[]; };
+// The lights at rest in the grid's order (that of their cells at rest, so that neighbouring
+// invocations count into neighbouring cells): xyz position, w radius.
+layout(std430, set = 0, binding = 1) readonly buffer LightGridRestBuffer { vec4 rest_positions[]; };
 // Per list: COUNT its count; after the scan its start, after FILL its end (block-relative).
 layout(std430, set = 0, binding = 3) buffer LightGridCellBuffer { uint grid_cell_ends[]; };
 // Per block of lists: x its start in the index list.
@@ -37,12 +38,11 @@ void main() {
         grid_lights[slot] = i;
         return;
     }
-    PointLight light = rest_lights[i];
-    light.position_radius.xyz += frame.light_animation.xyz;
-    lights[i] = light;
+    vec4 light = rest_positions[i];
+    light.xyz += frame.light_animation.xyz;
     uint list = frame.light_grid_dims.w;
-    if (light.position_radius.w <= frame.light_grid_reach.x) {
-        vec3 g = (light.position_radius.xyz - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
+    if (light.w <= frame.light_grid_reach.x) {
+        vec3 g = (light.xyz - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
         uvec3 c = uvec3(clamp(floor(g), vec3(0.0), vec3(frame.light_grid_dims.xyz - 1u)));
         list = (c.z * frame.light_grid_dims.y + c.y) * frame.light_grid_dims.x + c.x;
     }

@@ -154,6 +154,27 @@ pub fn grid_reach(lights: &[PointLight]) -> f32 {
     *radii.select_nth_unstable_by(k, f32::total_cmp).1
 }
 
+/// The lights in the order of their lists at rest (cell after cell, the wide lights last;
+/// within a list in the scene's order): the order the GPU keeps them in, so that the build's
+/// neighbouring threads count into neighbouring cells and a cell's lights lie side by side.
+/// Returns, per place, the light's index in `lights`.
+pub fn grid_order(shape: &LightGridShape, lights: &[PointLight]) -> Vec<u32> {
+    let lists: Vec<u32> = lights.iter().map(|l| shape.list_of(shape.origin, l)).collect();
+    let mut start = vec![0u32; shape.cells() as usize + 2];
+    for &l in &lists {
+        start[l as usize + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut order = vec![0u32; lights.len()];
+    for (i, &l) in lists.iter().enumerate() {
+        order[start[l as usize] as usize] = i as u32;
+        start[l as usize] += 1;
+    }
+    order
+}
+
 /// A CPU build of the lists for lights moved by `offset`: per list (every cell, then the
 /// wide lights) the indices of its lights in ascending order.
 pub fn cpu_lists(shape: &LightGridShape, lights: &[PointLight], offset: Vec3) -> Vec<Vec<u32>> {
@@ -259,6 +280,21 @@ mod tests {
         }
         let ratio = tested as f64 / reached as f64;
         assert!(ratio < 6.0, "{tested} tested for {reached} reaching: {ratio:.2}");
+    }
+
+    #[test]
+    fn the_grid_order_lists_cell_after_cell() {
+        let mut next = rng(3);
+        let lights: Vec<PointLight> =
+            (0..2000).map(|i| light(Vec3::new(next(), next(), next()) * 10.0, if i == 5 { 50.0 } else { 0.4 })).collect();
+        let shape = LightGridShape::fit(&lights, 4000);
+        let order = grid_order(&shape, &lights);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..2000).collect::<Vec<u32>>(), "a permutation");
+        let lists: Vec<u32> = order.iter().map(|&i| shape.list_of(shape.origin, &lights[i as usize])).collect();
+        assert!(lists.windows(2).all(|w| w[0] <= w[1]), "in list order");
+        assert_eq!(*lists.last().unwrap(), shape.cells(), "the wide light last");
     }
 
     #[test]

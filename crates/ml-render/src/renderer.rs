@@ -304,7 +304,8 @@ impl<'a> Renderer<'a> {
         let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers));
         let setup = FrameSetup {
             pool: self.command_pool,
-            light_count: self.scene.lights.len(),
+            // The light grid keeps its own copy of the lights (GPU techniques).
+            light_count: if self.lights_on_gpu { 1 } else { self.scene.lights.len() },
             // The CPU's cluster lists (the GPU techniques' light grid keeps its own).
             cluster_count: if cpu_lists { self.settings.clusters.count() } else { 1 },
             // Room for 16 entries per light to start with (grown on demand).

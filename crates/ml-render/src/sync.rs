@@ -213,14 +213,14 @@ pub const HDR_TARGET: &str = "hdr target";
 /// the host (the CPU assignment), read by every shading pass.
 pub const LIGHT_LISTS: [&str; 3] = ["LightBuffer", "ClusterRangeBuffer", "LightIndexBuffer"];
 
-/// The frame slot's lights and light-grid lists: written by the light grid's build, read by
-/// every shading pass.
-pub const LIGHT_GRID_LISTS: [&str; 4] = ["LightBuffer", "LightGridCellBuffer", "LightGridBlockBuffer", "LightGridIndexBuffer"];
+/// The frame slot's light-grid lists: written by the light grid's build, read by every
+/// shading pass (the grid's lights themselves are uploaded once, before any frame).
+pub const LIGHT_GRID_LISTS: [&str; 3] = ["LightGridCellBuffer", "LightGridBlockBuffer", "LightGridIndexBuffer"];
 
 /// How a shading pass reads the lights and lists (whichever the technique has): in `stages`.
 pub fn light_list_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let mut names = LIGHT_LISTS.to_vec();
-    names.extend(&LIGHT_GRID_LISTS[1..]);
+    names.extend(&LIGHT_GRID_LISTS);
     names.into_iter().map(|name| Use::at(name, (stages, vk::AccessFlags::SHADER_READ), None)).collect()
 }
 

@@ -2,10 +2,15 @@
 //! lights at rest and the frame's motion, with no per-light CPU work and no read-back in the
 //! frame:
 //!
-//! clear the counts → COUNT (a thread per light: move it, write it for shading, count it into
-//! its list — its cell, or the wide lights') → SCAN (per block of 1024 lists, then the
-//! blocks) → FILL (each light writes its index at its list's next place) → the shading passes
-//! walk the rows of cells near their points.
+//! clear the counts → COUNT (a thread per light: move it, count it into its list — its cell,
+//! or the wide lights') → SCAN (per block of 1024 lists, then the blocks) → FILL (each light
+//! writes its index at its list's next place) → the shading passes walk the rows of cells
+//! near their points, reading the lights at rest and moving them as the build did.
+//!
+//! The lights are uploaded once in the order of their cells at rest (`grid_order`): the
+//! build's neighbouring threads then count into neighbouring cells, and a cell's lights lie
+//! side by side for the shading — memory traffic in order instead of scattered, which is what
+//! the build costs at millions of lights.
 //!
 //! Every light is listed exactly once, so the index list has one entry per light and can
 //! never overflow; the feedback (lights listed, wide, the fullest cell) is only reported.
@@ -19,7 +24,7 @@ use crate::report::FrameStats;
 use crate::specialization::compute_pipeline;
 use crate::sync::{Use, LIGHT_GRID_LISTS};
 use ml_cpu::gpu_types::{FrameUniforms, LightGridFeedback, PointLight};
-use ml_cpu::light_grid::{cell_budget, LightGridShape};
+use ml_cpu::light_grid::{cell_budget, grid_order, LightGridShape};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
@@ -33,6 +38,8 @@ const GROUPS_PER_ROW: u32 = 32_768;
 const CELLS: &str = "LightGridCellBuffer";
 const BLOCKS: &str = "LightGridBlockBuffer";
 const INDICES: &str = "LightGridIndexBuffer";
+const LIGHTS: &str = "LightGridLightBuffer";
+const ORDER: &str = "LightGridOrderBuffer";
 
 pub struct LightGridBuild {
     /// The build's set per frame slot (one layout for every step: the union of the shaders').
@@ -44,8 +51,12 @@ pub struct LightGridBuild {
     /// The scan's two steps (block scans, then the blocks).
     scan_pipelines: [vk::Pipeline; 2],
     fill_pipeline: vk::Pipeline,
-    /// Lights at rest, uploaded once (device-local); COUNT moves them.
-    rest_lights: Buffer,
+    /// The lights at rest in the grid's order (device-local, uploaded once; the shading
+    /// moves them), their positions and radii alone (what the build reads), and per place
+    /// the light's index in the scene (its spot cone's).
+    lights: Buffer,
+    positions: Buffer,
+    order: Buffer,
     shape: LightGridShape,
     light_count: u32,
 }
@@ -122,7 +133,9 @@ impl LightGridBuild {
             count_pipeline: vk::Pipeline::null(),
             scan_pipelines: [vk::Pipeline::null(); 2],
             fill_pipeline: vk::Pipeline::null(),
-            rest_lights: Buffer::null(),
+            lights: Buffer::null(),
+            positions: Buffer::null(),
+            order: Buffer::null(),
             shape,
             light_count: rest_lights.len() as u32,
         };
@@ -137,8 +150,14 @@ impl LightGridBuild {
         for (step, pipeline) in self.scan_pipelines.iter_mut().enumerate() {
             *pipeline = compute_pipeline(ctx, &ml_shaders::LIGHT_GRID_SCAN_COMP, self.pipeline_layout, &[("STEP", step as u32)])?;
         }
-        self.rest_lights =
-            Buffer::device_local_with(ctx, "lights at rest", bytemuck::cast_slice(rest_lights), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        let order = grid_order(&self.shape, rest_lights);
+        let sorted: Vec<PointLight> = order.iter().map(|&i| rest_lights[i as usize]).collect();
+        let positions: Vec<[f32; 4]> = sorted.iter().map(|l| l.position_radius).collect();
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let order = if order.is_empty() { vec![0] } else { order };
+        self.lights = Buffer::device_local_with(ctx, "light grid lights", bytemuck::cast_slice(&sorted), storage)?;
+        self.positions = Buffer::device_local_with(ctx, "light grid positions", bytemuck::cast_slice(&positions), storage)?;
+        self.order = Buffer::device_local_with(ctx, "light grid order", bytemuck::cast_slice(&order), storage)?;
         for _ in 0..FRAMES_IN_FLIGHT {
             self.slots.push(GridSlot::new(ctx, u64::from(self.light_count.max(1)), self.lists())?);
         }
@@ -194,7 +213,9 @@ impl LightGridBuild {
             ml_vk::Release::release(s, ctx);
         }
         self.sets.destroy(ctx);
-        self.rest_lights.destroy(ctx);
+        for b in [&mut self.lights, &mut self.positions, &mut self.order] {
+            b.destroy(ctx);
+        }
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
             for p in [self.count_pipeline, self.fill_pipeline].into_iter().chain(self.scan_pipelines) {
@@ -218,14 +239,14 @@ impl Pass for LightGridBuild {
 
     fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
         let s = &self.slots[slot];
-        vec![(CELLS, s.cells.raw), (BLOCKS, s.blocks.raw), (INDICES, s.indices.raw)]
+        vec![(CELLS, s.cells.raw), (BLOCKS, s.blocks.raw), (INDICES, s.indices.raw), (LIGHTS, self.lights.raw), (ORDER, self.order.raw)]
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let own = &self.slots[frame.slot];
         self.sets.write(ctx, frame.slot, &|name| {
             let buffer = match name {
-                "RestLightBuffer" => self.rest_lights.raw,
+                "LightGridRestBuffer" => self.positions.raw,
                 "LightGridListOfBuffer" => own.list_of.raw,
                 "LightGridFeedbackBuffer" => own.feedback.raw,
                 _ => return frame.buffer(name),
