@@ -42,7 +42,7 @@ struct FrameUniforms {
     // The light grid (GPU techniques; light_grid/light_grid.glsl).
     vec4 light_grid_origin; // xyz: corner of cell (0, 0, 0) this frame; w: 1 / cell edge
     uvec4 light_grid_dims;  // xyz: cells per axis; w: cells in all (the wide lights' list)
-    vec4 light_grid_reach;  // x: largest radius of a light in the cells
+    vec4 light_grid_reach;  // x: largest radius of a light in the cells; y: lights wider (0: none)
     // The blinn-phong model's other lights (docs/DESIGN.md#shading-models); the seed model
     // ignores them.
     mat4 shadow_view_proj;     // world → the sun's shadow-map clip space (depth 0..1)

@@ -75,10 +75,12 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
 // the rows of cells within reach.
 #define GRID_FOR_LIGHTS(BODY)                                                   \
     {                                                                           \
-        uint wide_ = frame.light_grid_dims.w;                                   \
-        for (uint k_ = grid_start(wide_); k_ < grid_end(wide_); ++k_) {         \
-            uint i_ = grid_lights[k_];                                          \
-            BODY                                                                \
+        if (frame.light_grid_reach.y > 0.0) {                                   \
+            uint wide_ = frame.light_grid_dims.w;                               \
+            for (uint k_ = grid_start(wide_); k_ < grid_end(wide_); ++k_) {     \
+                uint i_ = grid_lights[k_];                                      \
+                BODY                                                            \
+            }                                                                   \
         }                                                                       \
         GridWalk w_ = grid_walk(world);                                         \
         for (uint z_ = w_.lo.z; z_ <= w_.hi.z; ++z_) {                          \

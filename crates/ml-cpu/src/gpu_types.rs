@@ -57,7 +57,8 @@ gpu_struct!(
         light_grid_origin: [f32; 4],
         /// xyz: cells per axis; w: cells in all (the index of the wide lights' list).
         light_grid_dims: [u32; 4],
-        /// x: the largest radius of a light in the cells.
+        /// x: the largest radius of a light in the cells; y: lights wider than it (every point
+        /// tests them; 0: none).
         light_grid_reach: [f32; 4],
         /// The blinn-phong model's other lights; see common.glsl.
         shadow_view_proj: [[f32; 4]; 4],

@@ -24,8 +24,8 @@ pub const WIDE_SHARE: usize = 64;
 /// nothing, so a wider walk only tests a few more lights.
 pub const GRID_MARGIN: f32 = 1e-4;
 
-/// The most lists (cells and the wide lights') a grid has: the GPU scan's second step walks
-/// the blocks of 1024 lists in one work group, 1024 blocks at a time.
+/// The most lists (cells and the wide lights') a grid has: 2^27 × 4 B of counts, within what
+/// a device binds as one storage buffer (the GPU scan takes up to 2^30).
 pub const MAX_LISTS: u64 = 1 << 27;
 
 /// The most cells a grid of `lights` lights gets where the device binds `bindable_lists`
@@ -47,6 +47,8 @@ pub struct LightGridShape {
     pub dims: UVec3,
     /// The largest radius of a light in the cells: a point tests the cells within it.
     pub reach: f32,
+    /// Lights wider than `reach`, which every point tests.
+    pub wide: u32,
 }
 
 impl LightGridShape {
@@ -69,7 +71,8 @@ impl LightGridShape {
         loop {
             let dims = (extent / cell).floor().as_uvec3() + UVec3::ONE;
             if dims.as_u64vec3().element_product() <= max_cells {
-                return LightGridShape { origin: lo, cell, dims, reach };
+                let wide = lights.iter().filter(|l| l.position_radius[3] > reach).count() as u32;
+                return LightGridShape { origin: lo, cell, dims, reach, wide };
             }
             cell *= 1.26;
         }

@@ -3,7 +3,8 @@
 //! frame:
 //!
 //! clear the counts → COUNT (a thread per light: move it, count it into its list — its cell,
-//! or the wide lights') → SCAN (per block of 1024 lists, then the blocks) → FILL (each light
+//! or the wide lights') → SCAN (per block of 1024 lists, per 1024 blocks, over those, then
+//! back down; every step but one wide) → FILL (each light
 //! writes its index at its list's next place) → the shading passes walk the rows of cells
 //! near their points, reading the lights at rest and moving them as the build did.
 //!
@@ -48,8 +49,8 @@ pub struct LightGridBuild {
     slots: Vec<GridSlot>,
     pipeline_layout: vk::PipelineLayout,
     count_pipeline: vk::Pipeline,
-    /// The scan's two steps (block scans, then the blocks).
-    scan_pipelines: [vk::Pipeline; 2],
+    /// The scan's four steps (blocks, super-blocks, their starts, the blocks' starts).
+    scan_pipelines: [vk::Pipeline; 4],
     fill_pipeline: vk::Pipeline,
     /// The lights at rest in the grid's order (device-local, uploaded once; the shading
     /// moves them), their positions and radii alone (what the build reads), and per place
@@ -67,6 +68,8 @@ struct GridSlot {
     cells: Buffer,
     /// Per block of lists: its start in the index list (and its largest count).
     blocks: Buffer,
+    /// Per 1024 blocks: the same, for the scan.
+    supers: Buffer,
     /// The light indices, list after list.
     indices: Buffer,
     /// Per light: its list, from COUNT to FILL.
@@ -79,6 +82,7 @@ impl GridSlot {
         let slot = GridSlot {
             cells: Buffer::null(),
             blocks: Buffer::null(),
+            supers: Buffer::null(),
             indices: Buffer::null(),
             list_of: Buffer::null(),
             feedback: Buffer::null(),
@@ -87,7 +91,9 @@ impl GridSlot {
         let gpu = gpu_allocator::MemoryLocation::GpuOnly;
         ml_vk::build(ctx, slot, |s| {
             s.cells = Buffer::new(ctx, "light grid cells", lists * 4, storage | vk::BufferUsageFlags::TRANSFER_DST, gpu)?;
-            s.blocks = Buffer::new(ctx, "light grid blocks", lists.div_ceil(SCAN_BLOCK.into()) * 8, storage, gpu)?;
+            let blocks = lists.div_ceil(SCAN_BLOCK.into());
+            s.blocks = Buffer::new(ctx, "light grid blocks", blocks * 8, storage, gpu)?;
+            s.supers = Buffer::new(ctx, "light grid super-blocks", blocks.div_ceil(SCAN_BLOCK.into()) * 8, storage, gpu)?;
             s.indices = Buffer::new(ctx, "light grid indices", lights * 4, storage, gpu)?;
             s.list_of = Buffer::new(ctx, "light grid list of", lights * 4, storage, gpu)?;
             let feedback = size_of::<LightGridFeedback>() as u64;
@@ -103,7 +109,7 @@ impl GridSlot {
 
 impl ml_vk::Release for GridSlot {
     fn release(&mut self, ctx: &Context) {
-        for b in [&mut self.cells, &mut self.blocks, &mut self.indices, &mut self.list_of, &mut self.feedback] {
+        for b in [&mut self.cells, &mut self.blocks, &mut self.supers, &mut self.indices, &mut self.list_of, &mut self.feedback] {
             b.destroy(ctx);
         }
     }
@@ -131,7 +137,7 @@ impl LightGridBuild {
             slots: Vec::new(),
             pipeline_layout: vk::PipelineLayout::null(),
             count_pipeline: vk::Pipeline::null(),
-            scan_pipelines: [vk::Pipeline::null(); 2],
+            scan_pipelines: [vk::Pipeline::null(); 4],
             fill_pipeline: vk::Pipeline::null(),
             lights: Buffer::null(),
             positions: Buffer::null(),
@@ -186,10 +192,13 @@ impl LightGridBuild {
         );
         let light_groups = self.light_count.div_ceil(ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0]);
         let blocks = self.lists().div_ceil(SCAN_BLOCK.into()) as u32;
+        let supers = blocks.div_ceil(SCAN_BLOCK);
         let steps = [
             (self.count_pipeline, dispatch_grid(light_groups)),
             (self.scan_pipelines[0], dispatch_grid(blocks)),
-            (self.scan_pipelines[1], (1, 1)),
+            (self.scan_pipelines[1], dispatch_grid(supers)),
+            (self.scan_pipelines[2], (1, 1)),
+            (self.scan_pipelines[3], dispatch_grid(supers)),
             (self.fill_pipeline, dispatch_grid(light_groups)),
         ];
         // SAFETY: recording state outside a render pass; all bound objects are alive.
@@ -248,6 +257,7 @@ impl Pass for LightGridBuild {
             let buffer = match name {
                 "LightGridRestBuffer" => self.positions.raw,
                 "LightGridListOfBuffer" => own.list_of.raw,
+                "LightGridSuperBuffer" => own.supers.raw,
                 "LightGridFeedbackBuffer" => own.feedback.raw,
                 _ => return frame.buffer(name),
             };
@@ -264,7 +274,7 @@ impl Pass for LightGridBuild {
         let s = &self.shape;
         uniforms.light_grid_origin = s.origin_at(light_offset).extend(1.0 / s.cell).to_array();
         uniforms.light_grid_dims = s.dims.extend(s.cells()).to_array();
-        uniforms.light_grid_reach = [s.reach, 0.0, 0.0, 0.0];
+        uniforms.light_grid_reach = [s.reach, s.wide as f32, 0.0, 0.0];
     }
 
     fn record(&self, rec: &Recording) {
