@@ -2,17 +2,18 @@
 #extension GL_GOOGLE_include_directive : require
 // The light grid's scan, between COUNT and FILL (light_grid_build.comp), over the lists
 // (every cell, then the wide lights), in four steps, each wide but the third:
+// A work group scans 1024 counts, four per invocation, as sums of four over its invocations.
 //   STEP 0, a work group per block of 1024 lists: each count becomes its list's start
 //           relative to the block; the block keeps its total and largest count;
 //   STEP 1, a work group per 1024 blocks (a super-block): each block's total becomes its
 //           start relative to the super-block, which keeps its total and largest count;
 //   STEP 2, one work group: the super-blocks' totals become their starts (at most 1024
 //           super-blocks: 2^30 lists), and the frame's totals go to the host-visible feedback;
-//   STEP 3, an invocation per block: its start becomes absolute.
+//   STEP 3, wide again: each block's start becomes absolute.
 // The lists' starts stay relative to their block (light_grid.glsl adds the block's).
 #include "common/common.glsl"
 
-layout(local_size_x = 1024) in;
+layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint STEP = 0u;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
@@ -24,12 +25,14 @@ layout(std430, set = 0, binding = 8) buffer LightGridSuperBuffer { uvec2 grid_su
 layout(std430, set = 0, binding = 7) writeonly buffer LightGridFeedbackBuffer { LightGridFeedback feedback; };
 
 const uint BLOCK = 1024u;
-shared uint scan[BLOCK];
-shared uint most[BLOCK];
+const uint THREADS = 256u;
+const uint PER = BLOCK / THREADS;
+shared uint scan[THREADS];
+shared uint most[THREADS];
 
 // Inclusive Hillis-Steele scan of scan[] and max-reduction of most[] over the work group.
 void scan_workgroup(uint t) {
-    for (uint step = 1u; step < BLOCK; step <<= 1u) {
+    for (uint step = 1u; step < THREADS; step <<= 1u) {
         uint add = t >= step ? scan[t - step] : 0u;
         uint m = t >= step ? most[t - step] : 0u;
         barrier();
@@ -44,35 +47,48 @@ uint group_index() {
     return gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
 }
 
-// Scan a group of counts: the lists of block g (STEP 0), or the blocks of super-block g
-// (STEP 1).
-void scan_counts(uint g, uint t, uint n, uint blocks, bool of_blocks) {
-    uint size = of_blocks ? blocks : n;
-    if (g * BLOCK >= size) {
-        return;
+// The count (and largest count) of item i of a scan over lists (level 0), blocks (1) or
+// super-blocks (2); zero beyond `size`.
+uvec2 item(uint level, uint i, uint size) {
+    if (i >= size) {
+        return uvec2(0u);
     }
-    uint i = g * BLOCK + t;
-    uvec2 count = uvec2(0u);
-    if (i < size) {
-        count = of_blocks ? grid_blocks[i] : uvec2(grid_cell_ends[i]);
+    return level == 0u ? uvec2(grid_cell_ends[i]) : level == 1u ? grid_blocks[i] : grid_supers[i];
+}
+
+void set_start(uint level, uint i, uint start) {
+    if (level == 0u) {
+        grid_cell_ends[i] = start;
+    } else if (level == 1u) {
+        grid_blocks[i].x = start;
+    } else {
+        grid_supers[i].x = start;
     }
-    scan[t] = count.x;
-    most[t] = count.y;
+}
+
+// Scan the 1024 items of group g at `level` (each count becomes its start relative to the
+// group); the group's total and largest count stay in scan[THREADS - 1], most[THREADS - 1].
+void scan_group(uint level, uint g, uint t, uint size) {
+    uint first = g * BLOCK + t * PER;
+    uint counts[PER];
+    uint sum = 0u;
+    uint m = 0u;
+    for (uint k = 0u; k < PER; ++k) {
+        uvec2 c = item(level, first + k, size);
+        counts[k] = c.x;
+        sum += c.x;
+        m = max(m, c.y);
+    }
+    scan[t] = sum;
+    most[t] = m;
     barrier();
     scan_workgroup(t);
-    if (i < size) {
-        if (of_blocks) {
-            grid_blocks[i].x = scan[t] - count.x;
-        } else {
-            grid_cell_ends[i] = scan[t] - count.x;
+    uint start = scan[t] - sum;
+    for (uint k = 0u; k < PER; ++k) {
+        if (first + k < size) {
+            set_start(level, first + k, start);
         }
-    }
-    if (t == BLOCK - 1u) {
-        if (of_blocks) {
-            grid_supers[g] = uvec2(scan[t], most[t]);
-        } else {
-            grid_blocks[g] = uvec2(scan[t], most[t]);
-        }
+        start += counts[k];
     }
 }
 
@@ -84,30 +100,37 @@ void main() {
     uint t = gl_LocalInvocationID.x;
     uint g = group_index();
     if (STEP == 0u) {
-        scan_counts(g, t, n, blocks, false);
-    } else if (STEP == 1u) {
-        scan_counts(g, t, n, blocks, true);
-    } else if (STEP == 2u) {
-        uvec2 s = t < supers ? grid_supers[t] : uvec2(0u);
-        scan[t] = s.x;
-        most[t] = s.y;
-        barrier();
-        scan_workgroup(t);
-        if (t < supers) {
-            grid_supers[t].x = scan[t] - s.x;
+        if (g < blocks) {
+            scan_group(0u, g, t, n);
+            if (t == THREADS - 1u) {
+                grid_blocks[g] = uvec2(scan[t], most[t]);
+            }
         }
-        // The wide lights' list is the last: its super-block's invocation reports.
-        uint last = n - 1u;
-        uint block = last / BLOCK;
-        if (t == block / BLOCK) {
-            uint total = scan[BLOCK - 1u];
-            uint wide_start = scan[t] - s.x + grid_blocks[block].x + grid_cell_ends[last];
-            feedback = LightGridFeedback(total, total - wide_start, most[BLOCK - 1u], 0u);
+    } else if (STEP == 1u) {
+        if (g < supers) {
+            scan_group(1u, g, t, blocks);
+            if (t == THREADS - 1u) {
+                grid_supers[g] = uvec2(scan[t], most[t]);
+            }
+        }
+    } else if (STEP == 2u) {
+        scan_group(2u, 0u, t, supers);
+        // The wide lights' list is the last: one invocation reports, once every start is written.
+        memoryBarrierBuffer();
+        barrier();
+        if (t == 0u) {
+            uint last = n - 1u;
+            uint block = last / BLOCK;
+            uint total = scan[THREADS - 1u];
+            uint wide_start = grid_supers[block / BLOCK].x + grid_blocks[block].x + grid_cell_ends[last];
+            feedback = LightGridFeedback(total, total - wide_start, most[THREADS - 1u], 0u);
         }
     } else {
-        uint b = g * BLOCK + t;
-        if (b < blocks) {
-            grid_blocks[b].x += grid_supers[b / BLOCK].x;
+        for (uint k = 0u; k < PER; ++k) {
+            uint b = g * BLOCK + t * PER + k;
+            if (b < blocks) {
+                grid_blocks[b].x += grid_supers[b / BLOCK].x;
+            }
         }
     }
 }

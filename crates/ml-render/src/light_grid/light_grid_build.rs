@@ -29,7 +29,8 @@ use ml_cpu::light_grid::{cell_budget, grid_order, LightGridShape};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
-/// Lists per scan block (light_grid_scan.comp's work group, light_grid.glsl GRID_BLOCK).
+/// Lists per scan block (what light_grid_scan.comp's work group takes, light_grid.glsl
+/// GRID_BLOCK).
 const SCAN_BLOCK: u32 = 1024;
 /// Work groups a dispatch puts along x before it adds rows along y (a device may take no more
 /// than 65,535 along one axis).
@@ -301,10 +302,10 @@ impl Pass for LightGridBuild {
 
 #[cfg(test)]
 mod tests {
-    /// The scan's block is its work group and the walk's GRID_BLOCK.
+    /// The scan's work group takes a block (four counts an invocation), the walk's GRID_BLOCK.
     #[test]
-    fn scan_block_is_the_scan_shaders_work_group() {
-        assert_eq!(ml_shaders::LIGHT_GRID_SCAN_COMP.workgroup_size, [super::SCAN_BLOCK, 1, 1]);
+    fn scan_block_is_what_the_scan_shaders_work_group_takes() {
+        assert_eq!(ml_shaders::LIGHT_GRID_SCAN_COMP.workgroup_size, [super::SCAN_BLOCK / 4, 1, 1]);
     }
 
     #[test]
