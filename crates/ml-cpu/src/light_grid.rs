@@ -33,7 +33,7 @@ pub const MAX_LISTS: u64 = 1 << 27;
 /// of uniform lights come to about one per light, so two per light keeps the scan and its
 /// memory in proportion to the lights.
 pub fn cell_budget(lights: usize, bindable_lists: u64) -> u64 {
-    (2 * lights as u64 + 64).min(bindable_lists.saturating_sub(1)).min(MAX_LISTS - 1).max(1)
+    (2 * lights as u64 + 64).min(bindable_lists.saturating_sub(1)).clamp(1, MAX_LISTS - 1)
 }
 
 /// Where the grid lies and how it is cut (for lights at rest; a frame moves it with them).
