@@ -278,7 +278,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
             format!("--debug-view {}", args.debug_view),
             "the shaded image (--debug-view none; debug views show their values as they are)",
         ),
-        Rule::technique("clusters", CLUSTER_GRID, Technique::is_clustered),
+        Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
         Rule::technique("culling", "the technique that culls meshlets on the GPU", draws_meshlets),
         Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
         Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),

@@ -157,7 +157,7 @@ impl BenchArgs {
                 "a scene without transparent objects",
                 "transparent objects (alphaMode BLEND in a glTF file, --transparent-objects or --glass-layers)",
             ),
-            Rule::technique("clusters", CLUSTER_GRID, Technique::is_clustered),
+            Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
             Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
             Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
             Rule::setting(
@@ -433,7 +433,7 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Va
     }
     settings.frames = frames;
     let output = Renderer::new(ctx, scene, settings).and_then(|mut r| r.render())?;
-    let grid = technique.is_clustered().then_some(settings.clusters);
+    let grid = technique.has_cluster_grid().then_some(settings.clusters);
     let ms_per_frame = output.stats.wall_ms_per_frame();
     Ok(Measured { variant, lights, skipped: None, output: Some(output), grid, ms_per_frame })
 }

@@ -125,13 +125,15 @@ struct SceneArgs {
     /// diffuse, ACES tone map). Default: the scene file's [shading] model, else seed.
     #[arg(long)]
     shading: Option<String>,
-    /// Cluster grid XxYxZ of the techniques that have one (all but forward and deferred), or
+    /// Cluster grid XxYxZ of the techniques that assign lights on the CPU (clustered-cpu,
+    /// deferred-clustered; the GPU techniques' light grid fits itself to the lights), or
     /// auto: 16x9x24 scaled by 1, 2 or 4 on every axis as ∛(lights / 4096) rounds (32x18x48
     /// from ~11.6k lights, 64x36x96 from ~93k), so that lights per cluster stay few as lights
     /// shrink.
     #[arg(long, default_value = "auto")]
     clusters: String,
-    /// Debug view: none, cluster-heat (lights per cluster; clustered-cpu, clustered-gpu),
+    /// Debug view: none, cluster-heat (lights each fragment tests: its cluster's in
+    /// clustered-cpu, the light grid's near it in clustered-gpu),
     /// gbuffer-albedo, gbuffer-normal, gbuffer-material, depth, shadow-map (the sun's;
     /// blinn-phong), shadow-cube (the first shadowed point light's cube, unfolded; a cube mode
     /// of --omni-shadow), shadow-atlas (--omni-shadow atlas), meshlets, triangles (a colour per
@@ -147,7 +149,7 @@ struct SceneArgs {
     /// platinum, white, red, blue, black.
     #[arg(long, default_value = "gold")]
     material: String,
-    /// Point lights (1 to 16777216); in a scene file, N lights of --light-layout replace the
+    /// Point lights (1 to 67108864, where the device binds their buffer); in a scene file, N lights of --light-layout replace the
     /// file's own. Default: 64 in the seed scene, 1024 in the bench scene, a scene file's own
     /// lights (64 where it has none); the room keeps its one light.
     #[arg(long, value_parser = Whole::<u64>::new(1, ml_cpu::limits::MAX_LIGHTS), allow_negative_numbers = true)]

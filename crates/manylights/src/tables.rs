@@ -89,18 +89,10 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
         rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
     }
-    if stats.overflowed_frames > 0 {
-        rows.push((
-            "overflows",
-            format!(
-                "{} frame(s) outgrew their light lists; {} re-rendered at the grown size",
-                stats.overflowed_frames, stats.rerendered_frames
-            ),
-        ));
-    }
     if settings.debug_view == DebugView::ClusterHeat {
-        let top = stats.clusters.map_or(1, |c| c.max_lights.max(1));
-        rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights per cluster")));
+        let grid = stats.feature::<ml_render::LightGridStats>().map(|g| g.heat_top());
+        let top = stats.clusters.map(|c| c.max_lights).or(grid).unwrap_or(1).max(1);
+        rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights tested")));
     }
     if let Some(o) = settings.omni {
         let which = if o.all { "every light reaching the view" } else { "the strongest" };

@@ -43,7 +43,7 @@ fn negative_and_huge_counts_get_their_range() {
     let render = |flag: &str, value: &str| manylights(&["render", flag, value, "--out", "a.png"]);
     assert_argument_error(&render("--width", "-100"), &["--width -100 is out of range: use 1 to 16384"]);
     assert_argument_error(&render("--height", "99999999999999999999999"), &["--height 99999999999999999999999 is out of range"]);
-    assert_argument_error(&render("--lights", "-5"), &["--lights -5 is out of range: use 1 to 16777216"]);
+    assert_argument_error(&render("--lights", "-5"), &["--lights -5 is out of range: use 1 to 67108864"]);
     assert_argument_error(&render("--frames", "-1"), &["--frames -1 is out of range: use 1 to 100000"]);
     assert_argument_error(&render("--raster-split", "-8"), &["--raster-split -8 is out of range: use 1 to 64"]);
     assert_argument_error(&render("--light-seed", "-1"), &["--light-seed -1 is out of range"]);
@@ -78,7 +78,11 @@ fn options_that_do_not_apply_are_refused() {
     let png = dir.join("never.png");
     let render = |args: &[&str]| manylights(&[&["render", "--out", png.to_str().unwrap()], args].concat());
     let cases: &[(&[&str], &[&str])] = &[
-        (&["--technique", "forward", "--clusters", "4x4x2"], &["--clusters does not apply to forward", "clustered-cpu", "visibility"]),
+        (
+            &["--technique", "forward", "--clusters", "4x4x2"],
+            &["--clusters does not apply to forward", "clustered-cpu", "deferred-clustered"],
+        ),
+        (&["--technique", "visibility", "--clusters", "4x4x2"], &["--clusters does not apply to visibility"]),
         (&["--technique", "deferred", "--clusters", "auto"], &["--clusters does not apply to deferred"]),
         (&["--technique", "forward", "--culling", "off"], &["--culling does not apply to forward", "--technique visibility"]),
         // Given explicitly, even with the default's value.

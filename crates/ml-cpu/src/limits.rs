@@ -14,8 +14,8 @@ pub const MAX_LIGHTS: u64 = 1 << 26;
 /// The most objects the bench scene places (a million-triangle mesh budget per hundred).
 pub const MAX_BENCH_OBJECTS: usize = 100_000;
 
-/// The largest cluster grid we accept (a million clusters; the GPU scan handles 1024 blocks of
-/// 1024, see cluster_scan.comp).
+/// The largest cluster grid we accept (a million clusters: the CPU assignment's lists are
+/// rebuilt and uploaded every frame).
 pub const MAX_CLUSTERS: u64 = 1 << 20;
 
 /// Most lights `--show-lights` draws: each marker is an object of its own (one draw each in

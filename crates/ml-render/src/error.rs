@@ -14,7 +14,7 @@ pub enum RenderError {
     /// A name that is none of `kind`'s; `expected` lists them.
     #[error("unknown {kind} '{name}': expected one of {expected}")]
     UnknownName { kind: Named, name: String, expected: String },
-    #[error("{0}: use fewer or smaller lights, or a coarser cluster grid")]
+    #[error("{0}: use fewer or smaller lights, a coarser cluster grid, or a technique with the light grid (clustered-gpu, deferred-compute, visibility)")]
     ListsTooLong(ListsTooLong),
     /// What the scene or the settings ask for cannot be done (one line saying why).
     #[error("{0}")]

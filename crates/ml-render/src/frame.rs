@@ -1,7 +1,8 @@
 //! One frame in flight (two of them: docs/DESIGN.md#frames-in-flight): its command buffer and
-//! fence, its own persistently mapped uniform buffer, its light and cluster-list buffers, its
-//! timer and its render targets. The passes point their own per-frame sets at these. Cluster
-//! buffers grow when a frame needs more; nothing is ever dropped.
+//! fence, its own persistently mapped uniform buffer, the light and cluster-list buffers the
+//! CPU writes (a placeholder each where the light grid keeps the lights), its timer and its
+//! render targets. The passes point their own per-frame sets at these. Cluster buffers grow
+//! when a frame needs more; nothing is ever dropped.
 
 use crate::error::{ListsTooLong, RenderError};
 use crate::frame_resources::FrameResources;
@@ -24,9 +25,6 @@ pub struct FrameInFlight {
     pub targets: Option<Targets>,
     /// Its named resources' states between passes, from frame to frame (`sync`).
     pub sync: SyncStates,
-    /// Where lights and cluster lists live: host-visible (written by the CPU) or device-local
-    /// (written by the GPU build).
-    location: MemoryLocation,
 }
 
 /// Everything `FrameInFlight::new` needs from the renderer.
@@ -38,15 +36,11 @@ pub struct FrameSetup<'a> {
     pub initial_indices: usize,
     pub passes: u32,
     pub make_targets: &'a dyn Fn() -> Result<Targets, VkError>,
-    /// Whether the GPU writes lights and lists (the GPU cluster build), else the CPU does.
-    pub written_by_gpu: bool,
 }
 
-/// Storage buffer for lights or cluster lists. Device-local ones can also be copied out
-/// (tests read the GPU's lists back).
-fn list_buffer(ctx: &Context, name: &str, bytes: usize, location: MemoryLocation) -> Result<Buffer, VkError> {
-    let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC;
-    Buffer::new(ctx, name, bytes as u64, usage, location)
+/// Storage buffer for lights or cluster lists, written by the CPU.
+fn list_buffer(ctx: &Context, name: &str, bytes: usize) -> Result<Buffer, VkError> {
+    Buffer::new(ctx, name, bytes as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu)
 }
 
 impl FrameInFlight {
@@ -61,7 +55,6 @@ impl FrameInFlight {
             timer: GpuTimer::null(),
             targets: None,
             sync: SyncStates::default(),
-            location: if setup.written_by_gpu { MemoryLocation::GpuOnly } else { MemoryLocation::CpuToGpu },
         };
         // On failure everything made so far is released (null parts are skipped).
         ml_vk::build(ctx, frame, |f| f.create(ctx, setup))
@@ -75,12 +68,11 @@ impl FrameInFlight {
         // SAFETY: as above.
         self.fence =
             unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }.ctx("vkCreateFence")?;
-        let at = self.location;
         let uniform_bytes = size_of::<FrameUniforms>() as u64;
         self.uniforms = Buffer::new(ctx, "frame uniforms", uniform_bytes, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;
-        self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>(), at)?;
-        self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>(), at)?;
-        self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.clamp(1, max_index_entries(ctx)) * 4, at)?;
+        self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>())?;
+        self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>())?;
+        self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.clamp(1, max_index_entries(ctx)) * 4)?;
         self.timer = GpuTimer::new(ctx, setup.passes)?;
         self.targets = Some((setup.make_targets)()?);
         Ok(())
@@ -119,7 +111,7 @@ impl FrameInFlight {
             return Err(lists_too_long(needed, limit, &format!("'{}' binds as one storage buffer", ctx.info.name)));
         }
         let entries = (needed + needed / 2).min(limit);
-        let bigger = list_buffer(ctx, "light indices", entries * 4, self.location)?;
+        let bigger = list_buffer(ctx, "light indices", entries * 4)?;
         let mut old = std::mem::replace(&mut self.light_indices, bigger);
         old.destroy(ctx);
         Ok(true)

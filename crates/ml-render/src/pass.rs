@@ -27,17 +27,13 @@ pub struct Recording<'a> {
     pub view_proj: glam::Mat4,
 }
 
-/// What a frame slot's finished frame tells the frame loop: the GPU light assignment's
-/// feedback (the lists grow, an overflowed last frame is rendered again) and the exposure
-/// meter's reading (the next frame's EV). Statistics go to `FrameStats` directly.
+/// What a frame slot's finished frame tells the frame loop: the GPU light assignment's top of
+/// the heat map and the exposure meter's reading (the next frame's EV). Statistics go to
+/// `FrameStats` directly.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SlotReport {
-    /// Light-index entries the frame needed.
-    pub index_entries: Option<usize>,
-    /// Most lights in one cluster.
+    /// The most lights a fragment may test (the cluster-heat view's top).
     pub max_lights: Option<u32>,
-    /// Whether its light-index list was too short (some lists were cut).
-    pub overflowed: bool,
     /// Auto exposure: the log2 of its image's log-average luminance before exposure (None: not
     /// metered, or nothing but background).
     pub log2_luminance: Option<f32>,

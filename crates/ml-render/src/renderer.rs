@@ -17,7 +17,7 @@ use crate::settings::{LightAssignment, RenderSettings};
 use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
-use ml_cpu::cluster::{count_entries, ClusterGrid, ClusterStats};
+use ml_cpu::cluster::{count_entries, ClusterGrid};
 use ml_cpu::gpu_types::{FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
 use ml_cpu::scene::Scene;
@@ -75,7 +75,6 @@ pub struct Renderer<'a> {
     grid: ClusterGrid,
     /// Light-index entries every frame recorded from now on must hold (grows when a frame
     /// reports it needed more).
-    required_indices: usize,
     /// Per frame slot: what its last frame reported (GPU light assignment).
     reports: Vec<SlotReport>,
     /// Per frame slot: whether it has been submitted since its results were last collected.
@@ -92,9 +91,6 @@ pub struct Renderer<'a> {
 
 /// Heat-map top before any frame has reported its maximum (clustered-gpu's first frames).
 const DEFAULT_HEAT_TOP: f32 = 64.0;
-/// clustered-gpu re-renders a final frame whose lists overflowed (after growing them); if it
-/// still overflows this often something is wrong, and the render fails instead of lying.
-const MAX_RERENDERS: u32 = 2;
 
 /// Refuse, before anything is drawn, light lists that cannot fit in what the device binds as
 /// one storage buffer (clustered techniques): `cluster::count_entries` bounds the entries from
@@ -167,7 +163,6 @@ impl<'a> Renderer<'a> {
             shared_sync,
             readback: None,
             lights_on_gpu,
-            required_indices: 0,
             reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
             heat_top: DEFAULT_HEAT_TOP,
@@ -192,7 +187,6 @@ impl<'a> Renderer<'a> {
             p.destroy(self.ctx);
         }
         self.passes.clear();
-        self.required_indices = 0;
         let assembly = Assembly {
             settings: &self.settings,
             shading: self.settings.lighting(&self.scene),
@@ -312,7 +306,6 @@ impl<'a> Renderer<'a> {
             initial_indices: if cpu_lists { self.scene.lights.len() * 16 } else { 1 },
             passes: self.pass_names().len() as u32,
             make_targets: &make_targets,
-            written_by_gpu: self.lights_on_gpu,
         };
         for f in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
@@ -350,16 +343,14 @@ impl<'a> Renderer<'a> {
         self.passes.iter().filter_map(|p| p.timer_name()).collect()
     }
 
-    /// Render `settings.frames` frames, two in flight, and read back the last one. With
-    /// clustered-gpu, a last frame whose light lists overflowed is rendered again once the
-    /// lists have grown, so the image is never one with lights missing.
+    /// Render `settings.frames` frames, two in flight, and read back the last one.
     pub fn render(&mut self) -> Result<RenderOutput, RenderError> {
         self.render_into(&mut ())
     }
 
     /// `render`, telling `sink` of every frame submitted and, where it wants them, handing it
-    /// every frame's image (each then waited for and, like the last, rendered again while
-    /// its light lists overflowed): an image sequence whose last image is `render`'s.
+    /// every frame's image (each then waited for): an image sequence whose last image is
+    /// `render`'s.
     pub fn render_into(&mut self, sink: &mut dyn FrameSink) -> Result<RenderOutput, RenderError> {
         let mut stats = FrameStats::new(&self.pass_names());
         let start = Instant::now();
@@ -378,12 +369,10 @@ impl<'a> Renderer<'a> {
                 // start dark, and later frames meter a settled image (two back). A sequence
                 // and a plain render do the same, so their last images stay equal.
                 self.collect_all(&mut stats)?;
-                last = self.complete(last, i, &mut stats)?;
                 last = self.settle_exposure(last, i, &mut stats)?;
             }
             if sink.wants_images() {
                 self.collect_all(&mut stats)?;
-                last = self.complete(last, i, &mut stats)?;
                 // The last image is the one `render` returns: with its exposure settled.
                 if i + 1 == frames {
                     last = self.settle_exposure(last, i, &mut stats)?;
@@ -394,7 +383,6 @@ impl<'a> Renderer<'a> {
             sink.submitted(i);
         }
         self.collect_all(&mut stats)?;
-        last = self.complete(last, self.settings.frames - 1, &mut stats)?;
         if !sink.wants_images() {
             // (An image sequence settled its last frame before handing it over.)
             last = self.settle_exposure(last, frames - 1, &mut stats)?;
@@ -404,34 +392,12 @@ impl<'a> Renderer<'a> {
             let targets = self.frames[0].targets.as_ref().expect("made with the frame");
             stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
         }
-        // Averages are over every frame rendered, re-renders included.
-        stats.frames = self.settings.frames + stats.rerendered_frames;
+        stats.frames = self.settings.frames;
         stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
         stats.memory = Some(self.ctx.memory_use());
         self.last_frame = last;
         let rgba = self.read_back(last)?;
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
-    }
-
-    /// Render frame `i` again, into the other slot, while slot `last`'s light lists overflowed
-    /// (clustered-gpu; each time they have grown); the slot that holds its complete image.
-    fn complete(&mut self, mut last: usize, i: u32, stats: &mut FrameStats) -> Result<usize, RenderError> {
-        let mut rerenders = 0;
-        while self.reports[last].overflowed {
-            if rerenders == MAX_RERENDERS {
-                return Err(RenderError::Invalid(format!(
-                    "{}: the light lists still overflowed after {MAX_RERENDERS} re-renders ({} entries needed)",
-                    self.settings.technique.name(),
-                    self.required_indices
-                )));
-            }
-            rerenders += 1;
-            stats.rerendered_frames += 1;
-            last = (last + 1) % FRAMES_IN_FLIGHT;
-            self.run_frame(last, self.settings.clock(i), stats, None)?;
-            self.collect_all(stats)?;
-        }
-        Ok(last)
     }
 
     /// Auto exposure: render frame `i` (in slot `last`) again, into the other slot, while the
@@ -450,7 +416,6 @@ impl<'a> Renderer<'a> {
             last = (last + 1) % FRAMES_IN_FLIGHT;
             self.run_frame(last, self.settings.clock(i), stats, None)?;
             self.collect_all(stats)?;
-            last = self.complete(last, self.settings.frames - 1, stats)?;
         }
         stats.exposure_ev = Some(self.exposure.slot_ev(last));
         Ok(last)
@@ -584,19 +549,6 @@ impl<'a> Renderer<'a> {
         if let Some(max_lights) = report.max_lights {
             self.heat_top = max_lights.max(1) as f32;
         }
-        if let (Some(needed), Some(max_lights)) = (report.index_entries, report.max_lights) {
-            let clusters = self.settings.clusters.count();
-            stats.clusters = Some(ClusterStats { mean_lights: needed as f64 / clusters as f64, max_lights, index_len: needed });
-            if report.overflowed {
-                stats.overflowed_frames += 1;
-                eprintln!(
-                    "{}: a frame needed {needed} light-index entries but its list held {}; growing the lists (that frame is re-rendered if it is the last)",
-                    self.settings.technique.name(),
-                    self.frames[f].index_capacity()
-                );
-                self.required_indices = self.required_indices.max(needed);
-            }
-        }
         Ok(())
     }
 
@@ -614,7 +566,6 @@ impl<'a> Renderer<'a> {
     /// `update_frame`'s work (its errors are said with the technique by the caller).
     fn update_slot(&mut self, f: usize, t: f32, stats: &mut FrameStats) -> Result<Option<f64>, RenderError> {
         let ctx = self.ctx;
-        let mut grew = self.frames[f].ensure_index_capacity(ctx, self.required_indices)?;
         if !self.lights_on_gpu {
             move_into(&self.lights, motion_offset(t, self.scene.light_motion), &mut self.animated);
             self.frames[f].lights.write(0, &self.animated);
@@ -642,7 +593,7 @@ impl<'a> Renderer<'a> {
             self.heat_top = cluster_stats.max_lights.max(1) as f32;
             stats.clusters = Some(cluster_stats);
         }
-        grew |= lists.grew;
+        let grew = lists.grew;
         if grew {
             stats.index_growths += 1;
             self.bind_passes(f)?;

@@ -26,10 +26,6 @@ pub struct FrameStats {
     pub clusters: Option<ml_cpu::cluster::ClusterStats>,
     /// How often a frame's light-index buffer had to grow.
     pub index_growths: u32,
-    /// clustered-gpu: frames whose light lists overflowed (reported, never shown as final).
-    pub overflowed_frames: u32,
-    /// clustered-gpu: extra frames rendered because the last one overflowed.
-    pub rerendered_frames: u32,
     /// deferred, deferred-clustered: whether the transient G-buffer got lazily allocated
     /// memory (only devices that have such memory, i.e. tilers, give it).
     pub gbuffer_lazily_allocated: Option<bool>,
@@ -60,8 +56,6 @@ impl FrameStats {
             wall_ms: 0.0,
             clusters: None,
             index_growths: 0,
-            overflowed_frames: 0,
-            rerendered_frames: 0,
             gbuffer_lazily_allocated: None,
             features: Vec::new(),
             sun_shadow_ms: None,

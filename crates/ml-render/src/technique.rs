@@ -76,8 +76,14 @@ impl Technique {
         }
     }
 
+    /// Whether lights are assigned to lists (cluster lists or the light grid), not all looped.
     pub fn is_clustered(self) -> bool {
         self.assignment() != LightAssignment::None
+    }
+
+    /// Whether it has the cluster grid (`--clusters`): the techniques that assign on the CPU.
+    pub fn has_cluster_grid(self) -> bool {
+        self.assignment() == LightAssignment::Cpu
     }
 
     /// Whether it draws the cluster-heat debug view: the clustered forward fragment shader

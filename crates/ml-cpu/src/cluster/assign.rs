@@ -176,8 +176,7 @@ impl ClusterAssigner {
 /// The light-list entries `lights` need on `grid` at least, in every frame of their animation
 /// (each moves up to `motion` from its place): each light is counted with its radius less
 /// `motion` (and a hair, for rounding), a sphere that lies inside the moved one wherever it
-/// moves, so the count never exceeds what any frame's assignment — the CPU's or the GPU
-/// build's, which find the same clusters — lists. Cheap: it follows the assignment's runs of
+/// moves, so the count never exceeds what any frame's assignment lists. Cheap: it follows the assignment's runs of
 /// clusters and stores nothing. Counting stops once it passes `stop_above`: a scene that needs
 /// more is refused before anything is drawn, whatever more it needs.
 pub fn count_entries(grid: &ClusterGrid, lights: &[PointLight], motion: f32, stop_above: usize) -> usize {
@@ -266,7 +265,7 @@ fn light_cluster_runs(grid: &ClusterGrid, light: &PointLight, mut emit: impl FnM
             continue;
         }
         // A light within one slice: its slab is (nearly) all of it, so its whole rectangle
-        // serves (cluster_build.comp does the same).
+        // serves.
         let ((x0, x1), (y0, y1)) = if k0 == k1 {
             (whole_x, whole_y)
         } else {

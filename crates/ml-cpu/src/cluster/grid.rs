@@ -155,7 +155,6 @@ pub struct ClusterGrid {
     tile_of_row: Vec<u32>,
 }
 
-/// Keep in sync with `CLUSTER_SLACK` in cluster.glsl.
 /// Relative slack added to every cluster's box so that a fragment whose slice or tile was
 /// rounded into a neighbour (f32 `log`, interpolation) is still covered. It only ever adds
 /// lights whose contribution at the fragment is below (slack)²·(radius terms), i.e. nothing.
@@ -291,7 +290,6 @@ impl ClusterGrid {
 
     fn compute_bounds(&self) -> Vec<Aabb> {
         // The view-space point of a pixel position at a depth: ndc = p·v / w, w = a·depth + b.
-        // Keep in sync with cluster_bounds.comp.
         let (p00, p11) = (self.projection.x_axis.x, self.projection.y_axis.y);
         let (a, b) = self.w_of_depth;
         let point = |px: f32, py: f32, depth: f32| {

@@ -284,15 +284,15 @@ impl Pass for LightGridBuild {
 
     fn collect(&self, slot: usize, report: &mut SlotReport, stats: &mut FrameStats) {
         let f = self.slots[slot].feedback();
-        // The heat map's top: the wide lights and a point's 27 cells at their fullest.
-        report.max_lights = Some(f.wide + 27 * f.max_count);
-        stats.set_feature(LightGridStats {
+        let grid = LightGridStats {
             dims: self.shape.dims.to_array(),
             cell: self.shape.cell,
             listed: f.listed,
             wide: f.wide,
             max_per_cell: f.max_count,
-        });
+        };
+        report.max_lights = Some(grid.heat_top());
+        stats.set_feature(grid);
     }
 
     fn destroy(&mut self, ctx: &Context) {

@@ -22,6 +22,14 @@ pub struct LightGridStats {
     pub max_per_cell: u32,
 }
 
+impl LightGridStats {
+    /// The most lights a point may test, about: the wide lights and its 27 nearest cells at
+    /// their fullest (the cluster-heat view's top).
+    pub fn heat_top(&self) -> u32 {
+        self.wide + 27 * self.max_per_cell
+    }
+}
+
 impl FeatureStats for LightGridStats {
     fn rows(&self) -> Vec<(&'static str, String)> {
         let [x, y, z] = self.dims;
