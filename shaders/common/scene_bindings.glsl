@@ -9,8 +9,8 @@ layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 #ifdef LIGHT_GRID
 // The light grid's copy of the lights at rest, in the order of their cells (light_grid.glsl
 // grid_light moves them), and where each was in the scene's order (its spot cone's index).
-layout(std430, set = 0, binding = 24) readonly buffer LightGridLightBuffer { PointLight lights[]; };
-layout(std430, set = 0, binding = 23) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
+layout(std430, set = 0, binding = 34) readonly buffer LightGridLightBuffer { PointLight lights[]; };
+layout(std430, set = 0, binding = 33) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
 #else
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer { PointLight lights[]; };
 #endif
@@ -21,9 +21,9 @@ layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { Cluste
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };
 #endif
 #ifdef LIGHT_GRID
-layout(std430, set = 0, binding = 20) readonly buffer LightGridCellBuffer { uint grid_cell_ends[]; };
-layout(std430, set = 0, binding = 21) readonly buffer LightGridBlockBuffer { uvec2 grid_blocks[]; };
-layout(std430, set = 0, binding = 22) readonly buffer LightGridIndexBuffer { uint grid_lights[]; };
+layout(std430, set = 0, binding = 30) readonly buffer LightGridCellBuffer { uint grid_cell_ends[]; };
+layout(std430, set = 0, binding = 31) readonly buffer LightGridBlockBuffer { uvec2 grid_blocks[]; };
+layout(std430, set = 0, binding = 32) readonly buffer LightGridIndexBuffer { uint grid_lights[]; };
 #endif
 
 #endif

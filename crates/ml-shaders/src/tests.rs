@@ -116,6 +116,46 @@ fn every_debug_view_define_is_generated() {
     assert_eq!(common::NO_TILE, u32::MAX);
 }
 
+/// (set, binding) of every variable the SPIR-V decorates with both (OpDecorate DescriptorSet
+/// and Binding), read from the words themselves: reflection keeps one resource per binding.
+fn decorated_bindings(spirv: &[u8]) -> Vec<(u32, u32)> {
+    let words: Vec<u32> = spirv.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
+    let (mut sets, mut bindings) = (BTreeMap::new(), BTreeMap::new());
+    let mut at = 5; // after the header
+    while at < words.len() {
+        let (count, opcode) = ((words[at] >> 16) as usize, words[at] & 0xffff);
+        // OpDecorate target decoration literal: DescriptorSet 34, Binding 33.
+        if opcode == 71 && count == 4 {
+            let (target, decoration, value) = (words[at + 1], words[at + 2], words[at + 3]);
+            match decoration {
+                34 => {
+                    sets.insert(target, value);
+                }
+                33 => {
+                    bindings.insert(target, value);
+                }
+                _ => {}
+            }
+        }
+        at += count.max(1);
+    }
+    bindings.iter().filter_map(|(target, &binding)| Some((*sets.get(target)?, binding))).collect()
+}
+
+/// Two resources of one shader at one binding alias each other: a header's binding numbers
+/// that collide with an includer's are a bug the compiler does not report.
+#[test]
+fn no_shader_declares_two_resources_at_one_binding() {
+    for shader in ALL {
+        let mut decorated = decorated_bindings(shader.spirv);
+        assert!(!decorated.is_empty() || shader.bindings.is_empty(), "{}: no bindings read", shader.file);
+        decorated.sort_unstable();
+        for pair in decorated.windows(2) {
+            assert_ne!(pair[0], pair[1], "{}: two resources at set {} binding {}", shader.file, pair[0].0, pair[0].1);
+        }
+    }
+}
+
 #[test]
 fn files_lie_in_feature_folders_and_names_are_unique() {
     let folders =
