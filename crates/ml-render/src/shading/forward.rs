@@ -6,11 +6,11 @@
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
-use crate::settings::LightAssignment;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
 use crate::shading::Shading;
 use crate::sync::{shading_reads, Entry, Exit, Use, COLOUR_TARGET};
 use crate::targets::Output;
+use crate::technique::LightAssignment;
 use ml_vk::{vk, Context, VkError};
 
 pub struct Forward {

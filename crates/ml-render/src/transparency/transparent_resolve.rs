@@ -10,9 +10,9 @@ use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
-use crate::settings::LightAssignment;
 use crate::shading::Shading;
 use crate::sync::{shading_reads, Use, HDR_TARGET};
+use crate::technique::LightAssignment;
 use ml_vk::commands::memory_barrier;
 use ml_vk::{vk, Context, VkError};
 
