@@ -1,6 +1,8 @@
 // The light loop every shading path shares (forward and clustered fragment shaders, the
-// deferred lighting subpass, the deferred-compute pass): one BRDF source, one summation order
-// (ascending light index), so culling and deferring change no pixel.
+// deferred lighting subpass, the deferred-compute pass): one BRDF source and, for every path
+// but the light grid's, one summation order (ascending light index), so culling and deferring
+// change no pixel; the light grid sums a cell's lights in the order its build's atomics left
+// them, which moves a pixel by at most a rounding step.
 //
 // The includer includes scene_bindings.glsl (`frame`, `lights[]`, with CLUSTERED the cluster
 // lists, with LIGHT_GRID the light grid's) and textures.glsl.
@@ -18,8 +20,8 @@
 #endif
 
 // Sum LIGHT(light) over every light that may reach the point: the cluster's lights in
-// ascending index order, the light grid's near the point, or all of them. A macro, so that each shading model gets its own
-// loop: a model switch inside the loop made the seed model's fragment shader 1.4–1.8× slower
+// ascending index order, the light grid's near the point, or all of them. A macro, so that
+// each shading model gets its own loop: a model switch inside the loop made the seed model's fragment shader 1.4–1.8× slower
 // on the H100 (measured).
 #ifdef CLUSTERED
 #define SUM_LIGHTS(sum, LIGHT)                                                   \

@@ -71,8 +71,8 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
     return uvec2(grid_start(row + x0), grid_end(row + x1));
 }
 
-// Run BODY for each light `i_` (the grid's order: grid_light(i_)) a point at `world` tests: the wide lights, then
-// the rows of cells within reach.
+// Run BODY for each light `i_` (in the grid's order: grid_light(i_)) that a point at `world`
+// tests: the wide lights, then the rows of cells within reach.
 #define GRID_FOR_LIGHTS(BODY)                                                   \
     {                                                                           \
         if (frame.light_grid_reach.y > 0.0) {                                   \
