@@ -67,7 +67,7 @@ pub struct Renderer<'a> {
     /// The scene's lights at rest as the GPU reads them: shadowed ones marked with their
     /// shadow slots (`OmniShadows::mark`).
     lights: Vec<PointLight>,
-    /// Whether lights are animated on the GPU (by the cluster build), else on the CPU into
+    /// Whether lights are moved on the GPU (by the light grid), else on the CPU into
     /// `animated`, which every frame uploads.
     lights_on_gpu: bool,
     animated: Vec<PointLight>,

@@ -55,7 +55,7 @@ impl Pass for ComputeLighting {
         })
     }
 
-    /// After the G-buffer pass, the cluster build and the point-light shadows.
+    /// After the G-buffer pass, the light grid build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::output_use(self.layers));

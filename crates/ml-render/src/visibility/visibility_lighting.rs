@@ -61,7 +61,7 @@ impl Pass for VisibilityLighting {
         })
     }
 
-    /// After the late raster, the cluster build and the point-light shadows.
+    /// After the late raster, the light grid build and the point-light shadows.
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::output_use(self.layers));
