@@ -73,9 +73,7 @@ pub struct Renderer<'a> {
     animated: Vec<PointLight>,
     /// The cluster grid (its shader parameters are also set for techniques without one).
     grid: ClusterGrid,
-    /// Light-index entries every frame recorded from now on must hold (grows when a frame
-    /// reports it needed more).
-    /// Per frame slot: what its last frame reported (GPU light assignment).
+    /// Per frame slot: what its last frame reported (the heat map's top, the exposure meter).
     reports: Vec<SlotReport>,
     /// Per frame slot: whether it has been submitted since its results were last collected.
     pending: Vec<bool>,
@@ -104,7 +102,7 @@ fn check_lists_fit(
     lights: &[PointLight],
     motion: f32,
 ) -> Result<(), RenderError> {
-    if settings.technique.assignment() != LightAssignment::Cpu {
+    if !settings.technique.has_cluster_grid() {
         return Ok(());
     }
     let limit = max_index_entries(ctx);
@@ -294,7 +292,7 @@ impl<'a> Renderer<'a> {
         let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
         let raster = self.settings.raster;
         let layers = self.settings.blends_layers();
-        let cpu_lists = technique.assignment() == LightAssignment::Cpu;
+        let cpu_lists = technique.has_cluster_grid();
         let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers));
         let setup = FrameSetup {
             pool: self.command_pool,
@@ -593,8 +591,7 @@ impl<'a> Renderer<'a> {
             self.heat_top = cluster_stats.max_lights.max(1) as f32;
             stats.clusters = Some(cluster_stats);
         }
-        let grew = lists.grew;
-        if grew {
+        if lists.grew {
             stats.index_growths += 1;
             self.bind_passes(f)?;
         }

@@ -176,9 +176,8 @@ impl LightGridBuild {
         u64::from(self.shape.cells()) + 1
     }
 
-    /// Record the frame's build: the moved lights and the lists (ordered with their readers by
-    /// the barriers its `uses` give), and its own buffers; afterwards the feedback is visible
-    /// to the host.
+    /// Record the frame's build: the lists (ordered with their readers by the barriers its
+    /// `uses` give) and its own buffers; afterwards the feedback is visible to the host.
     fn record_build(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
         let (own, set) = (&self.slots[slot], self.sets.sets[slot]);
         let d = &ctx.device;
