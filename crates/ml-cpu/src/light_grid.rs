@@ -66,7 +66,7 @@ impl LightGridShape {
         }
         let extent = hi - lo;
         let max_cells = max_cells.max(1);
-        // Never finer than the extent over 2^20 per axis (dims stay far below u32).
+        // Never finer than a millionth of the extent per axis (dims stay far below u32).
         let mut cell = reach.max(extent.max_element() * 1e-6).max(f32::MIN_POSITIVE);
         loop {
             let dims = (extent / cell).floor().as_uvec3() + UVec3::ONE;
