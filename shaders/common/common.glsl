@@ -81,10 +81,21 @@ struct ClusterRange {
 
 // What the light grid's build tells the CPU after the frame (host-visible).
 struct LightGridFeedback {
-    uint listed;    // lights in the lists (every light: a check)
-    uint wide;      // lights every point tests
-    uint max_count; // most lights in one cell
+    uint listed;       // lights in the lists (those within reach of a marked cell, and the wide)
+    uint wide;         // lights every point tests
+    uint max_count;    // most lights in one cell
+    uint cells_marked; // cells that may hold a light a surface point tests
+};
+
+// The light grid's lists this frame and the work groups of the scan over them (device-local:
+// the scan's indirect dispatches). Written by the scan over the marked cells.
+struct LightGridDispatch {
+    uint lists;          // the wide lights' list and one per marked cell
     uint _pad0;
+    uint _pad1;
+    uint _pad2;
+    uvec4 block_groups;  // xyz: work groups over the lists' blocks (rows of 32768 along x)
+    uvec4 super_groups;  // xyz: work groups over the blocks' super-blocks
 };
 
 // Per object (set 0, binding 4, std430 array, every shading path): where it is and what it

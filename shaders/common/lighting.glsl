@@ -15,6 +15,7 @@
 #include "common/blinn_phong.glsl"
 #include "clusters/cluster.glsl"
 #include "shadows/omni_shadow.glsl"
+#include "common/world_from_depth.glsl"
 #ifdef LIGHT_GRID
 #include "light_grid/light_grid.glsl"
 #endif
@@ -35,7 +36,7 @@
     }
 #elif defined(LIGHT_GRID)
 #define SUM_LIGHTS(sum, LIGHT)                                                            \
-    GRID_FOR_LIGHTS(PointLight l_ = grid_light(i_); sum += LIGHT(l_) * spot_cone(SPOT_LIGHTS ? grid_order[i_] : i_, l_, world);)
+    GRID_FOR_LIGHTS(PointLight l_ = grid_lights[k_]; sum += LIGHT(l_) * spot_cone(SPOT_LIGHTS ? grid_scene_index[k_] : 0u, l_, world);)
 #else
 #define SUM_LIGHTS(sum, LIGHT)                                         \
     for (uint i_ = 0u; i_ < frame.light_count; ++i_) {               \
@@ -162,12 +163,5 @@ uint cluster_light_count(vec3 world, vec2 frag_xy) {
     return count;
 }
 #endif
-
-// World position of the pixel centre `frag_xy` at depth-buffer value `z` (deferred paths).
-vec3 world_from_depth(vec2 frag_xy, float z) {
-    vec2 ndc = frag_xy / vec2(frame.viewport.xy) * 2.0 - 1.0;
-    vec4 w = frame.inv_view_proj * vec4(ndc, z, 1.0);
-    return w.xyz / w.w;
-}
 
 #endif

@@ -7,10 +7,10 @@
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 #ifdef LIGHT_GRID
-// The light grid's copy of the lights at rest, in the order of their cells (light_grid.glsl
-// grid_light moves them), and where each was in the scene's order (its spot cone's index).
-layout(std430, set = 0, binding = 34) readonly buffer LightGridLightBuffer { PointLight lights[]; };
-layout(std430, set = 0, binding = 33) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
+// The light grid's lists: each light as it is this frame, list after list
+// (light_grid/light_grid.glsl), and its index in the scene (its spot cone's).
+layout(std430, set = 0, binding = 34) readonly buffer LightGridLightBuffer { PointLight grid_lights[]; };
+layout(std430, set = 0, binding = 32) readonly buffer LightGridIndexBuffer { uint grid_scene_index[]; };
 #else
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer { PointLight lights[]; };
 #endif
@@ -21,9 +21,8 @@ layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { Cluste
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };
 #endif
 #ifdef LIGHT_GRID
-layout(std430, set = 0, binding = 30) readonly buffer LightGridCellBuffer { uint grid_cell_ends[]; };
-layout(std430, set = 0, binding = 31) readonly buffer LightGridBlockBuffer { uvec2 grid_blocks[]; };
-layout(std430, set = 0, binding = 32) readonly buffer LightGridIndexBuffer { uint grid_lights[]; };
+layout(std430, set = 0, binding = 30) readonly buffer LightGridListBuffer { uint grid_list_ends[]; };
+layout(std430, set = 0, binding = 31) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 #endif
 
 #endif

@@ -1,58 +1,31 @@
 // The light grid's walk (docs/DESIGN.md#the-light-grid): the lights a surface point tests.
 // Keep in sync with crates/ml-cpu/src/light_grid.rs (LightGridShape::rows_near).
 //
-// The lists, as the build leaves them: the cells' lights one run after another in cell order
-// (x fastest), then the wide lights; `grid_cell_ends[c]` is where cell c's run ends relative
-// to its block of GRID_BLOCK cells, `grid_blocks[b].x` where block b starts. A row of cells
-// along x is then one contiguous run of the list.
+// The lists, as the build leaves them: list 0 holds the wide lights, then one list per marked
+// cell (a cell within reach of a surface point of the frame, light_grid_mark.glsl; every cell
+// where nothing marks) in cell order (x fastest), each light a copy moved to where it is this
+// frame. `grid_list_ends[l]` is where list l ends; `grid_occupancy[c / 32]` has the marked bits
+// of 32 cells and the list of its first marked cell. The cells a point walks are all marked,
+// so a row of them along x is one contiguous run of the lists.
 
 #ifndef MANYLIGHTS_LIGHT_GRID_GLSL
 #define MANYLIGHTS_LIGHT_GRID_GLSL
 
-const uint GRID_BLOCK = 1024u;
-// Relative margin on the reach (light_grid.rs GRID_MARGIN).
-const float GRID_MARGIN = 1e-4;
+#include "light_grid/light_grid_walk.glsl"
 
-// The grid's light j as it is this frame: at rest, moved by the frame's offset.
-PointLight grid_light(uint j) {
-    PointLight l = lights[j];
-    l.position_radius.xyz += frame.light_animation.xyz;
-    return l;
+// The list of marked cell c (of an unmarked cell: the next marked cell's).
+uint grid_list(uint c) {
+    uvec2 o = grid_occupancy[c >> 5u];
+    return o.y + bitCount(o.x & ((1u << (c & 31u)) - 1u));
 }
 
-// Where list c (a cell, or frame.light_grid_dims.w: the wide lights) ends and starts.
-uint grid_end(uint c) {
-    return grid_blocks[c / GRID_BLOCK].x + grid_cell_ends[c];
+// Where list l ends and starts.
+uint grid_end(uint l) {
+    return grid_list_ends[l];
 }
 
-uint grid_start(uint c) {
-    return c == 0u ? 0u : grid_end(c - 1u);
-}
-
-// A point's walk: its place in cell units, the reach in cell units and the cells it spans.
-struct GridWalk {
-    vec3 g;
-    float r;
-    uvec3 lo;
-    uvec3 hi;
-};
-
-GridWalk grid_walk(vec3 world) {
-    GridWalk w;
-    w.g = (world - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
-    w.r = frame.light_grid_reach.x * frame.light_grid_origin.w * (1.0 + GRID_MARGIN);
-    vec3 top = vec3(frame.light_grid_dims.xyz - 1u);
-    w.lo = uvec3(clamp(floor(w.g - w.r), vec3(0.0), top));
-    w.hi = uvec3(clamp(floor(w.g + w.r), vec3(0.0), top));
-    return w;
-}
-
-// Distance in cells from g to the slab of cell c along an axis of n cells, border cells
-// reaching to infinity (they hold the lights beyond the grid).
-float grid_slab_distance(float g, uint c, uint n) {
-    float below = c == 0u ? 0.0 : float(c) - g;
-    float above = c + 1u == n ? 0.0 : g - float(c + 1u);
-    return max(max(below, above), 0.0);
+uint grid_start(uint l) {
+    return l == 0u ? 0u : grid_list_ends[l - 1u];
 }
 
 // The run of the list that row (y, z) gives the walk (empty where the row is out of reach).
@@ -68,26 +41,23 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
     uint row = (z * frame.light_grid_dims.y + y) * frame.light_grid_dims.x;
     uint x0 = uint(clamp(floor(w.g.x - h), 0.0, top));
     uint x1 = uint(clamp(floor(w.g.x + h), 0.0, top));
-    return uvec2(grid_start(row + x0), grid_end(row + x1));
+    return uvec2(grid_start(grid_list(row + x0)), grid_end(grid_list(row + x1)));
 }
 
-// Run BODY for each light `i_` (in the grid's order: grid_light(i_)) that a point at `world`
-// tests: the wide lights, then the rows of cells within reach.
+// Run BODY for each place `k_` of the lists (the light grid_lights[k_], its scene index
+// grid_scene_index[k_]) that a point at `world` tests: the wide lights, then the rows of
+// cells within reach.
 #define GRID_FOR_LIGHTS(BODY)                                                   \
     {                                                                           \
-        if (frame.light_grid_reach.y > 0.0) {                                   \
-            uint wide_ = frame.light_grid_dims.w;                               \
-            for (uint k_ = grid_start(wide_); k_ < grid_end(wide_); ++k_) {     \
-                uint i_ = grid_lights[k_];                                      \
-                BODY                                                            \
-            }                                                                   \
+        uint wide_end_ = grid_end(0u);                                          \
+        for (uint k_ = 0u; k_ < wide_end_; ++k_) {                              \
+            BODY                                                                \
         }                                                                       \
         GridWalk w_ = grid_walk(world);                                         \
         for (uint z_ = w_.lo.z; z_ <= w_.hi.z; ++z_) {                          \
             for (uint y_ = w_.lo.y; y_ <= w_.hi.y; ++y_) {                      \
                 uvec2 run_ = grid_row(w_, y_, z_);                              \
                 for (uint k_ = run_.x; k_ < run_.y; ++k_) {                     \
-                    uint i_ = grid_lights[k_];                                  \
                     BODY                                                        \
                 }                                                               \
             }                                                                   \

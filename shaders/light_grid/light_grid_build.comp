@@ -1,11 +1,14 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// The light grid's build, one invocation per light, run twice around the scan
+// The light grid's build, one invocation per light, run twice around the scan of the lists
 // (light_grid_scan.comp):
-//   COUNT: move the light by the frame's offset, find its list (its cell, or the wide
-//          lights' when wider than the reach) and count it there;
-//   FILL:  after the scan, take the next place of its list and write its index there. The
-//          lists' counters end as each cell's end (light_grid.glsl reads them so).
+//   COUNT: move the light by the frame's offset and find its list: the wide lights' (list 0)
+//          when wider than the reach, else its cell's if the cell is marked
+//          (light_grid_mark.glsl; otherwise no pixel tests it and it is left out). Count it
+//          there and keep (light, list) in the work group's part of the kept lights;
+//   FILL:  after the scan, each kept light takes the next place of its list and writes itself
+//          there, moved, with its index in the scene. The lists' counters end as each list's
+//          end (light_grid.glsl reads them so).
 // Keep the list choice in sync with crates/ml-cpu/src/light_grid.rs (list_of).
 #include "common/common.glsl"
 
@@ -14,38 +17,66 @@ layout(constant_id = 0) const bool FILL = false;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 // The lights at rest in the grid's order (that of their cells at rest, so that neighbouring
-// invocations count into neighbouring cells): xyz position, w radius.
+// invocations count into neighbouring cells): xyz position, w radius; and whole.
 layout(std430, set = 0, binding = 1) readonly buffer LightGridRestBuffer { vec4 rest_positions[]; };
-// Per list: COUNT its count; after the scan its start, after FILL its end (block-relative).
-layout(std430, set = 0, binding = 3) buffer LightGridCellBuffer { uint grid_cell_ends[]; };
-// Per block of lists: x its start in the index list.
-layout(std430, set = 0, binding = 4) readonly buffer LightGridBlockBuffer { uvec2 grid_blocks[]; };
-// Per light: its list, from COUNT to FILL.
-layout(std430, set = 0, binding = 5) buffer LightGridListOfBuffer { uint list_of[]; };
-layout(std430, set = 0, binding = 6) writeonly buffer LightGridIndexBuffer { uint grid_lights[]; };
+layout(std430, set = 0, binding = 2) readonly buffer LightGridRestLightBuffer { PointLight rest_lights[]; };
+// Per place of the grid's order: the light's index in the scene.
+layout(std430, set = 0, binding = 9) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
+// Per list: COUNT its count; after the scan its start, after FILL its end.
+layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_list_ends[]; };
+// Per 32 cells: their marks and the list of the first marked one (light_grid.glsl).
+layout(std430, set = 0, binding = 4) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
+// Per work group of COUNT: its kept lights (place in the grid's order, list) and how many.
+layout(std430, set = 0, binding = 5) buffer LightGridKeptBuffer { uvec2 kept[]; };
+layout(std430, set = 0, binding = 10) buffer LightGridKeptCountBuffer { uint kept_count[]; };
+// The lists: each light moved, and its index in the scene.
+layout(std430, set = 0, binding = 6) writeonly buffer LightGridLightBuffer { PointLight grid_lights[]; };
+layout(std430, set = 0, binding = 11) writeonly buffer LightGridIndexBuffer { uint grid_scene_index[]; };
 
-const uint GRID_BLOCK = 1024u;
+shared uint group_kept;
 
 void main() {
     // Work groups come in rows (a device takes at most 65,535 along x).
-    uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
-    if (i >= frame.light_count) {
-        return;
-    }
+    uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    uint t = gl_LocalInvocationID.x;
+    uint first = group * gl_WorkGroupSize.x;
     if (FILL) {
-        uint list = list_of[i];
-        uint slot = grid_blocks[list / GRID_BLOCK].x + atomicAdd(grid_cell_ends[list], 1u);
-        grid_lights[slot] = i;
+        if (t >= kept_count[group]) {
+            return;
+        }
+        uvec2 k = kept[first + t];
+        uint slot = atomicAdd(grid_list_ends[k.y], 1u);
+        PointLight l = rest_lights[k.x];
+        l.position_radius.xyz += frame.light_animation.xyz;
+        grid_lights[slot] = l;
+        grid_scene_index[slot] = grid_order[k.x];
         return;
     }
-    vec4 light = rest_positions[i];
-    light.xyz += frame.light_animation.xyz;
-    uint list = frame.light_grid_dims.w;
-    if (light.w <= frame.light_grid_reach.x) {
-        vec3 g = (light.xyz - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
-        uvec3 c = uvec3(clamp(floor(g), vec3(0.0), vec3(frame.light_grid_dims.xyz - 1u)));
-        list = (c.z * frame.light_grid_dims.y + c.y) * frame.light_grid_dims.x + c.x;
+    if (t == 0u) {
+        group_kept = 0u;
     }
-    list_of[i] = list;
-    atomicAdd(grid_cell_ends[list], 1u);
+    barrier();
+    uint i = first + t;
+    if (i < frame.light_count) {
+        vec4 light = rest_positions[i];
+        light.xyz += frame.light_animation.xyz;
+        bool listed = true;
+        uint list = 0u;
+        if (light.w <= frame.light_grid_reach.x) {
+            vec3 g = (light.xyz - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
+            uvec3 c = uvec3(clamp(floor(g), vec3(0.0), vec3(frame.light_grid_dims.xyz - 1u)));
+            uint cell = (c.z * frame.light_grid_dims.y + c.y) * frame.light_grid_dims.x + c.x;
+            uvec2 o = grid_occupancy[cell >> 5u];
+            listed = (o.x & (1u << (cell & 31u))) != 0u;
+            list = o.y + bitCount(o.x & ((1u << (cell & 31u)) - 1u));
+        }
+        if (listed) {
+            atomicAdd(grid_list_ends[list], 1u);
+            kept[first + atomicAdd(group_kept, 1u)] = uvec2(i, list);
+        }
+    }
+    barrier();
+    if (t == 0u) {
+        kept_count[group] = group_kept;
+    }
 }

@@ -121,13 +121,30 @@ gpu_struct!(
 gpu_struct!(
     /// What the light grid's build reports back after a frame.
     LightGridFeedback {
-        /// Lights in the lists (every light).
+        /// Lights in the lists: those in a marked cell, and the wide ones.
         listed: u32,
         /// Lights every point tests.
         wide: u32,
         /// Most lights in one cell.
         max_count: u32,
+        /// Cells that may hold a light a surface point tests.
+        cells_marked: u32,
+    }
+);
+
+gpu_struct!(
+    /// The light grid's lists this frame and the work groups of the scan over them (the
+    /// scan's indirect dispatches; device-local).
+    LightGridDispatch {
+        /// The wide lights' list and one per marked cell.
+        lists: u32,
         _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
+        /// xyz: work groups over the lists' blocks.
+        block_groups: [u32; 4],
+        /// xyz: work groups over the blocks' super-blocks.
+        super_groups: [u32; 4],
     }
 );
 

@@ -7,6 +7,7 @@ use crate::clusters::cluster_assign_cpu;
 use crate::error::RenderError;
 use crate::exposure::{exposure_meter, tone_map};
 use crate::light_grid::light_grid_build::LightGridBuild;
+use crate::light_grid::light_grid_mark::LightGridMark;
 use crate::light_stats::light_count::LightCount;
 use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
@@ -85,7 +86,8 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
             Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.scene.meshlets()?, (views, 0, atlas.lists.large))?)
         }
         PassKind::ClusterAssignCpu => Box::<cluster_assign_cpu::CpuClusterAssign>::default(),
-        PassKind::LightGridBuild => Box::new(LightGridBuild::new(ctx, a.lights)?),
+        PassKind::LightGridBuild { marked } => Box::new(LightGridBuild::new(ctx, a.lights, marked)?),
+        PassKind::LightGridMark { depth_buffer } => Box::new(LightGridMark::new(ctx, depth_buffer)?),
         PassKind::Forward { lights, heat_legend } => {
             Box::new(forward::Forward::new(ctx, a.scene, raster, (lights, heat_legend), s.technique.name())?)
         }

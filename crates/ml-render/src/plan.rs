@@ -31,8 +31,12 @@ pub enum PassKind {
     ShadowAtlas,
     /// Light assignment on the CPU, before the frame is recorded (no GPU work).
     ClusterAssignCpu,
-    /// Light assignment on the GPU: the light grid's build.
-    LightGridBuild,
+    /// Light assignment on the GPU: the light grid's build (`marked`: after the marks, else
+    /// of every cell).
+    LightGridBuild { marked: bool },
+    /// The light grid's marks: the cells the opaque surfaces' points walk (`depth_buffer`:
+    /// from the compute raster's buffer, else the depth target).
+    LightGridMark { depth_buffer: bool },
     /// Forward shading, every light or through the technique's light lists (`lights`: who
     /// assigns them), with the heat map's legend.
     Forward { lights: LightAssignment, heat_legend: bool },
@@ -151,17 +155,25 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
         Some(_) => kinds.push(PassKind::OmniShadows),
         None => {}
     }
-    match technique.assignment() {
+    // The opaque depth after the raster: the compute raster's buffer, or the depth target.
+    let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
+    // The light grid is built once the opaque surfaces are known, for the cells their points
+    // walk, where a technique knows them before its lighting and nothing else is lit (the
+    // transparent layers' points are not in the depth); else first, for every cell.
+    let lights = technique.assignment();
+    let surfaces_first = technique.geometry() == Geometry::Meshlets || technique.lighting_stage() == LightingStage::Compute;
+    let marks = lights == LightAssignment::Gpu && surfaces_first && !key.layers;
+    let marked_build = [PassKind::LightGridMark { depth_buffer: opaque_depth_buffer }, PassKind::LightGridBuild { marked: true }];
+    let marked_build = if marks { &marked_build[..] } else { &[] };
+    match lights {
         LightAssignment::None => {}
         LightAssignment::Cpu => kinds.push(PassKind::ClusterAssignCpu),
-        LightAssignment::Gpu => kinds.push(PassKind::LightGridBuild),
+        LightAssignment::Gpu if !marks => kinds.push(PassKind::LightGridBuild { marked: false }),
+        LightAssignment::Gpu => {}
     }
-    let lights = technique.assignment();
     let clustered = lights == LightAssignment::Cpu;
     // Transparent layers: built once the opaque depth is known, resolved over the opaque
     // pass's linear HDR output.
-    // The opaque depth after the raster: the compute raster's buffer, or the depth target.
-    let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
     let build = PassKind::TransparentBuild { depth_buffer: opaque_depth_buffer };
     let after_compute = technique.lighting_stage() == LightingStage::Compute;
     let resolve = PassKind::TransparentResolve { lights, after_compute };
@@ -178,6 +190,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
                 }
             }
             kinds.extend(key.layers.then_some(build));
+            kinds.extend(marked_build);
             kinds.push(PassKind::VisibilityLighting);
             kinds.extend(key.layers.then_some(resolve));
         }
@@ -200,6 +213,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
         (Geometry::Meshes, LightingStage::Compute) => {
             kinds.push(PassKind::GBuffer);
             kinds.extend(key.layers.then_some(build));
+            kinds.extend(marked_build);
             kinds.push(PassKind::ComputeLighting);
             kinds.extend(key.layers.then_some(resolve));
         }
@@ -237,10 +251,13 @@ mod tests {
         let cases: [(Technique, &[PassKind]); 6] = [
             (Technique::Forward, &[Forward { lights: LightAssignment::None, heat_legend: false }]),
             (Technique::ClusteredCpu, &[ClusterAssignCpu, Forward { lights: LightAssignment::Cpu, heat_legend: false }]),
-            (Technique::ClusteredGpu, &[LightGridBuild, Forward { lights: LightAssignment::Gpu, heat_legend: false }]),
+            (Technique::ClusteredGpu, &[LightGridBuild { marked: false }, Forward { lights: LightAssignment::Gpu, heat_legend: false }]),
             (Technique::Deferred, &[DeferredSubpasses { clustered: false }, ToneMap { curve: true }]),
             (Technique::DeferredClustered, &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, ToneMap { curve: true }]),
-            (Technique::DeferredCompute, &[LightGridBuild, GBuffer, ComputeLighting]),
+            (
+                Technique::DeferredCompute,
+                &[GBuffer, LightGridMark { depth_buffer: false }, LightGridBuild { marked: true }, ComputeLighting],
+            ),
         ];
         for (technique, expected) in cases {
             let mut k = key(technique);
@@ -253,24 +270,26 @@ mod tests {
     fn visibility_culls_and_draws_in_two_phases_around_the_pyramid() {
         let mut k = key(Technique::Visibility);
         k.meters_exposure = false;
-        let phases = |raster: fn(Phase) -> PassKind| {
+        // The light grid after the raster, for the cells the surfaces' points walk.
+        let phases = |raster: fn(Phase) -> PassKind, depth_buffer| {
             vec![
-                LightGridBuild,
                 MeshletCull(Phase::Early),
                 raster(Phase::Early),
                 DepthPyramid,
                 MeshletCull(Phase::Late),
                 raster(Phase::Late),
+                LightGridMark { depth_buffer },
+                LightGridBuild { marked: true },
                 VisibilityLighting,
             ]
         };
         k.raster = Raster::Hardware;
-        assert_eq!(plan(&k), phases(VisibilityRaster));
+        assert_eq!(plan(&k), phases(VisibilityRaster, false));
         k.raster = Raster::hybrid(64);
-        assert_eq!(plan(&k), phases(VisibilityRaster), "hybrid: large triangles by the hardware");
+        assert_eq!(plan(&k), phases(VisibilityRaster, true), "hybrid: large triangles by the hardware");
         k.raster = Raster::compute(64);
         assert!(matches!(k.raster, Raster::Compute { large: LargeTriangles::Bins { .. }, .. }));
-        assert_eq!(plan(&k), phases(TriangleRasterLarge));
+        assert_eq!(plan(&k), phases(TriangleRasterLarge, true));
     }
 
     #[test]
@@ -292,7 +311,7 @@ mod tests {
         let mut k = key(Technique::ClusteredGpu);
         k.debug_view = DebugView::ClusterHeat;
         k.meters_exposure = false;
-        assert_eq!(plan(&k), [LightGridBuild, Forward { lights: LightAssignment::Gpu, heat_legend: true }]);
+        assert_eq!(plan(&k), [LightGridBuild { marked: false }, Forward { lights: LightAssignment::Gpu, heat_legend: true }]);
     }
 
     #[test]
@@ -307,7 +326,7 @@ mod tests {
             (
                 Technique::ClusteredGpu,
                 &[
-                    LightGridBuild,
+                    LightGridBuild { marked: false },
                     Forward { lights: LightAssignment::Gpu, heat_legend: false },
                     build,
                     resolve(LightAssignment::Gpu, false),
@@ -317,7 +336,10 @@ mod tests {
                 Technique::DeferredClustered,
                 &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, build, resolve(LightAssignment::Cpu, false)],
             ),
-            (Technique::DeferredCompute, &[LightGridBuild, GBuffer, build, ComputeLighting, resolve(LightAssignment::Gpu, true)]),
+            (
+                Technique::DeferredCompute,
+                &[LightGridBuild { marked: false }, GBuffer, build, ComputeLighting, resolve(LightAssignment::Gpu, true)],
+            ),
         ];
         for (technique, expected) in cases {
             let mut k = key(technique);
@@ -327,6 +349,7 @@ mod tests {
         }
         let mut k = key(Technique::Visibility);
         (k.layers, k.meters_exposure, k.raster) = (true, false, Raster::compute(64));
+        assert_eq!(plan(&k)[0], LightGridBuild { marked: false }, "the layers' points are not in the depth");
         assert_eq!(plan(&k)[6..], [TransparentBuild { depth_buffer: true }, VisibilityLighting, resolve(LightAssignment::Gpu, true)]);
         // A surface view shows the opaque surfaces only; the layers' own view keeps them.
         let mut s = RenderSettings { transparency: Some(Default::default()), ..RenderSettings::new(Technique::Forward, 64, 64) };
@@ -340,10 +363,20 @@ mod tests {
     fn the_light_counts_follow_the_lighting_and_precede_the_meter() {
         let mut k = key(Technique::DeferredCompute);
         k.light_stats = true;
-        assert_eq!(plan(&k), [LightGridBuild, GBuffer, ComputeLighting, LightCount { depth_buffer: false }, ExposureMeter { curve: true }]);
+        assert_eq!(
+            plan(&k),
+            [
+                GBuffer,
+                LightGridMark { depth_buffer: false },
+                LightGridBuild { marked: true },
+                ComputeLighting,
+                LightCount { depth_buffer: false },
+                ExposureMeter { curve: true }
+            ]
+        );
         let mut k = key(Technique::Visibility);
         (k.light_stats, k.meters_exposure, k.raster) = (true, false, Raster::compute(64));
-        assert_eq!(plan(&k)[6..], [VisibilityLighting, LightCount { depth_buffer: true }]);
+        assert_eq!(plan(&k)[7..], [VisibilityLighting, LightCount { depth_buffer: true }]);
         let s = RenderSettings { light_stats: true, ..RenderSettings::new(Technique::Visibility, 64, 64) };
         assert!(s.pipeline_key().light_stats);
     }

@@ -4,8 +4,8 @@
 
 use ml_cpu::gpu_types::{
     ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance, LargeTriangle, LayerObject, LightCone,
-    LightGridFeedback, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight, ShadowCubeTiles,
-    ShadowPush, StageProbePush,
+    LightGridDispatch, LightGridFeedback, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight,
+    ShadowCubeTiles, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -90,6 +90,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<LightCone>(&structs);
     check::<ClusterRange>(&structs);
     check::<LightGridFeedback>(&structs);
+    check::<LightGridDispatch>(&structs);
     check::<Meshlet>(&structs);
     check::<Instance>(&structs);
     check::<CullCounters>(&structs);

@@ -2,19 +2,22 @@
 //! lights at rest and the frame's motion, with no per-light CPU work and no read-back in the
 //! frame:
 //!
-//! clear the counts → COUNT (a thread per light: move it, count it into its list — its cell,
-//! or the wide lights') → SCAN (per block of 1024 lists, per 1024 blocks, over those, then
-//! back down; every step but one wide) → FILL (each light
-//! writes its index at its list's next place) → the shading passes walk the rows of cells
-//! near their points, reading the lights at rest and moving them as the build did.
+//! the marks (`light_grid_mark`: the cells the frame's surface points will walk; every cell
+//! where the technique has no surfaces before its lighting) → SCAN of the marks (each marked
+//! cell gets a list after the wide lights' list 0) → COUNT (a thread per light: move it, find
+//! its list — list 0 if wide, else its cell's if marked, else none: no pixel tests it — and
+//! count it there) → SCAN of the counts → FILL (each kept light writes itself, moved, at its
+//! list's next place) → the shading passes walk the rows of cells near their points and read
+//! the lists' lights in order.
 //!
 //! The lights are uploaded once in the order of their cells at rest (`grid_order`): the
-//! build's neighbouring threads then count into neighbouring cells, and a cell's lights lie
-//! side by side for the shading — memory traffic in order instead of scattered, which is what
-//! the build costs at millions of lights.
+//! build's neighbouring threads then count into neighbouring cells. Only the kept lights are
+//! written: the lights far from every visible surface cost the frame one read of their
+//! position.
 //!
-//! Every light is listed exactly once, so the index list has one entry per light and can
-//! never overflow; the feedback (lights listed, wide, the fullest cell) is only reported.
+//! Every kept light is listed exactly once, so the lists hold at most one entry per light
+//! and can never overflow; the feedback (lights listed, wide, the fullest cell, the marked
+//! cells) is only reported.
 
 use super::LightGridStats;
 use crate::descriptors::{FrameSets, Resource};
@@ -23,25 +26,25 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
 use crate::specialization::compute_pipeline;
-use crate::sync::{Use, LIGHT_GRID_LISTS};
-use ml_cpu::gpu_types::{FrameUniforms, LightGridFeedback, PointLight};
+use crate::sync::{Use, LIGHT_GRID_LISTS, LIGHT_GRID_OCCUPANCY};
+use bytemuck::Zeroable;
+use ml_cpu::gpu_types::{FrameUniforms, LightGridDispatch, LightGridFeedback, PointLight};
 use ml_cpu::light_grid::{cell_budget, grid_order, LightGridShape};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
-/// Lists per scan block (what light_grid_scan.comp's work group takes, light_grid.glsl
-/// GRID_BLOCK).
+/// Counts per scan block (what light_grid_scan.comp's work group takes).
 const SCAN_BLOCK: u32 = 1024;
 /// Work groups a dispatch puts along x before it adds rows along y (a device may take no more
-/// than 65,535 along one axis).
+/// than 65,535 along one axis; light_grid_scan.comp GROUPS_PER_ROW).
 const GROUPS_PER_ROW: u32 = 32_768;
+/// Cells per word of marks.
+const CELLS_PER_WORD: u64 = 32;
 
 /// The grid's names of its lists in the shaders (what the shading passes bind).
-const CELLS: &str = "LightGridCellBuffer";
-const BLOCKS: &str = "LightGridBlockBuffer";
+const LISTS: &str = "LightGridListBuffer";
 const INDICES: &str = "LightGridIndexBuffer";
 const LIGHTS: &str = "LightGridLightBuffer";
-const ORDER: &str = "LightGridOrderBuffer";
 
 pub struct LightGridBuild {
     /// The build's set per frame slot (one layout for every step: the union of the shaders').
@@ -50,53 +53,76 @@ pub struct LightGridBuild {
     slots: Vec<GridSlot>,
     pipeline_layout: vk::PipelineLayout,
     count_pipeline: vk::Pipeline,
-    /// The scan's four steps (blocks, super-blocks, their starts, the blocks' starts).
-    scan_pipelines: [vk::Pipeline; 4],
     fill_pipeline: vk::Pipeline,
-    /// The lights at rest in the grid's order (device-local, uploaded once; the shading
-    /// moves them), their positions and radii alone (what the build reads), and per place
-    /// the light's index in the scene (its spot cone's).
+    /// The scans' five steps (blocks, super-blocks, their starts, the blocks' starts, the
+    /// counts' starts), of the marks and of the lists' counts.
+    mark_scan: [vk::Pipeline; 5],
+    list_scan: [vk::Pipeline; 5],
+    /// The lights at rest in the grid's order (device-local, uploaded once), their positions
+    /// and radii alone (what COUNT reads of every light), and per place the light's index in
+    /// the scene (its spot cone's).
     lights: Buffer,
     positions: Buffer,
     order: Buffer,
     shape: LightGridShape,
     light_count: u32,
+    /// A marks pass (`LightGridMark`) runs before the build; else the build marks every cell.
+    marked: bool,
 }
 
 /// One frame slot's buffers.
 struct GridSlot {
-    /// Per list: its count, then its start, then its end (relative to its block).
-    cells: Buffer,
-    /// Per block of lists: its start in the index list (and its largest count).
+    /// Per list: its count, then its start, then its end.
+    lists: Buffer,
+    /// Per 32 cells: their marks and the list of the first marked one.
+    occupancy: Buffer,
+    /// Per block of counts: its total, then its start (and its largest count); per 1024
+    /// blocks the same.
     blocks: Buffer,
-    /// Per 1024 blocks: the same, for the scan.
     supers: Buffer,
-    /// The light indices, list after list.
+    /// Per work group of COUNT: its kept lights (place, list), and how many.
+    kept: Buffer,
+    kept_count: Buffer,
+    /// The lists: the lights, moved, list after list; their indices in the scene.
+    grid_lights: Buffer,
     indices: Buffer,
-    /// Per light: its list, from COUNT to FILL.
-    list_of: Buffer,
+    /// The lists this frame and the work groups of their scan (indirect dispatches).
+    dispatch: Buffer,
     feedback: Buffer,
 }
 
 impl GridSlot {
-    fn new(ctx: &Context, lights: u64, lists: u64) -> Result<GridSlot, VkError> {
+    fn new(ctx: &Context, lights: u64, cells: u64) -> Result<GridSlot, VkError> {
         let slot = GridSlot {
-            cells: Buffer::null(),
+            lists: Buffer::null(),
+            occupancy: Buffer::null(),
             blocks: Buffer::null(),
             supers: Buffer::null(),
+            kept: Buffer::null(),
+            kept_count: Buffer::null(),
+            grid_lights: Buffer::null(),
             indices: Buffer::null(),
-            list_of: Buffer::null(),
+            dispatch: Buffer::null(),
             feedback: Buffer::null(),
         };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let gpu = gpu_allocator::MemoryLocation::GpuOnly;
+        let lists = cells + 1;
+        let group = u64::from(ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0]);
+        let light_groups = lights.div_ceil(group);
         ml_vk::build(ctx, slot, |s| {
-            s.cells = Buffer::new(ctx, "light grid cells", lists * 4, storage | vk::BufferUsageFlags::TRANSFER_DST, gpu)?;
+            s.lists = Buffer::new(ctx, "light grid lists", lists * 4, storage, gpu)?;
+            let words = cells.div_ceil(CELLS_PER_WORD);
+            s.occupancy = Buffer::new(ctx, "light grid marks", words * 8, storage | vk::BufferUsageFlags::TRANSFER_DST, gpu)?;
             let blocks = lists.div_ceil(SCAN_BLOCK.into());
             s.blocks = Buffer::new(ctx, "light grid blocks", blocks * 8, storage, gpu)?;
             s.supers = Buffer::new(ctx, "light grid super-blocks", blocks.div_ceil(SCAN_BLOCK.into()) * 8, storage, gpu)?;
+            s.kept = Buffer::new(ctx, "light grid kept lights", light_groups * group * 8, storage, gpu)?;
+            s.kept_count = Buffer::new(ctx, "light grid kept counts", light_groups * 4, storage, gpu)?;
+            s.grid_lights = Buffer::new(ctx, "light grid lights", lights * size_of::<PointLight>() as u64, storage, gpu)?;
             s.indices = Buffer::new(ctx, "light grid indices", lights * 4, storage, gpu)?;
-            s.list_of = Buffer::new(ctx, "light grid list of", lights * 4, storage, gpu)?;
+            let dispatch = size_of::<LightGridDispatch>() as u64;
+            s.dispatch = Buffer::new(ctx, "light grid dispatch", dispatch, storage | vk::BufferUsageFlags::INDIRECT_BUFFER, gpu)?;
             let feedback = size_of::<LightGridFeedback>() as u64;
             s.feedback = Buffer::new(ctx, "light grid feedback", feedback, storage, gpu_allocator::MemoryLocation::GpuToCpu)?;
             Ok(())
@@ -106,11 +132,26 @@ impl GridSlot {
     fn feedback(&self) -> LightGridFeedback {
         bytemuck::pod_read_unaligned(&self.feedback.mapped()[..size_of::<LightGridFeedback>()])
     }
+
+    fn buffers(&mut self) -> [&mut Buffer; 10] {
+        [
+            &mut self.lists,
+            &mut self.occupancy,
+            &mut self.blocks,
+            &mut self.supers,
+            &mut self.kept,
+            &mut self.kept_count,
+            &mut self.grid_lights,
+            &mut self.indices,
+            &mut self.dispatch,
+            &mut self.feedback,
+        ]
+    }
 }
 
 impl ml_vk::Release for GridSlot {
     fn release(&mut self, ctx: &Context) {
-        for b in [&mut self.cells, &mut self.blocks, &mut self.supers, &mut self.indices, &mut self.list_of, &mut self.feedback] {
+        for b in self.buffers() {
             b.destroy(ctx);
         }
     }
@@ -126,10 +167,17 @@ fn dispatch_grid(groups: u32) -> (u32, u32) {
     }
 }
 
+/// One step of the build: a pipeline and its work groups.
+enum Groups {
+    Direct(u32, u32),
+    /// From the slot's dispatch buffer at this offset (written by the marks' scan).
+    Indirect(u64),
+}
+
 impl LightGridBuild {
     /// The build for `rest_lights`: a grid of at most `cell_budget` cells (what the device
-    /// binds as one storage buffer of lists).
-    pub fn new(ctx: &Context, rest_lights: &[PointLight]) -> Result<LightGridBuild, VkError> {
+    /// binds as one storage buffer of lists); `marked`: a marks pass runs before it.
+    pub fn new(ctx: &Context, rest_lights: &[PointLight], marked: bool) -> Result<LightGridBuild, VkError> {
         let bindable = u64::from(ctx.info.limits.max_storage_buffer_range) / 4;
         let shape = LightGridShape::fit(rest_lights, cell_budget(rest_lights.len(), bindable));
         let stages = [&ml_shaders::LIGHT_GRID_BUILD_COMP, &ml_shaders::LIGHT_GRID_SCAN_COMP].map(|s| (s, vk::ShaderStageFlags::COMPUTE));
@@ -138,13 +186,15 @@ impl LightGridBuild {
             slots: Vec::new(),
             pipeline_layout: vk::PipelineLayout::null(),
             count_pipeline: vk::Pipeline::null(),
-            scan_pipelines: [vk::Pipeline::null(); 4],
             fill_pipeline: vk::Pipeline::null(),
+            mark_scan: [vk::Pipeline::null(); 5],
+            list_scan: [vk::Pipeline::null(); 5],
             lights: Buffer::null(),
             positions: Buffer::null(),
             order: Buffer::null(),
             shape,
             light_count: rest_lights.len() as u32,
+            marked,
         };
         ml_vk::build(ctx, b, |b| b.create(ctx, rest_lights))
     }
@@ -154,26 +204,28 @@ impl LightGridBuild {
         let build = &ml_shaders::LIGHT_GRID_BUILD_COMP;
         self.count_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 0)])?;
         self.fill_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 1)])?;
-        for (step, pipeline) in self.scan_pipelines.iter_mut().enumerate() {
-            *pipeline = compute_pipeline(ctx, &ml_shaders::LIGHT_GRID_SCAN_COMP, self.pipeline_layout, &[("STEP", step as u32)])?;
+        for (source, pipelines) in [(1, &mut self.mark_scan), (0, &mut self.list_scan)] {
+            for (step, pipeline) in pipelines.iter_mut().enumerate() {
+                let constants = [("STEP", step as u32), ("SOURCE", source)];
+                *pipeline = compute_pipeline(ctx, &ml_shaders::LIGHT_GRID_SCAN_COMP, self.pipeline_layout, &constants)?;
+            }
         }
+        // A one-element stand-in where there are no lights (a buffer has a size).
+        let guard = |n: usize| n.max(1);
         let order = grid_order(&self.shape, rest_lights);
-        let sorted: Vec<PointLight> = order.iter().map(|&i| rest_lights[i as usize]).collect();
+        let mut sorted: Vec<PointLight> = order.iter().map(|&i| rest_lights[i as usize]).collect();
+        sorted.resize(guard(sorted.len()), PointLight::zeroed());
         let positions: Vec<[f32; 4]> = sorted.iter().map(|l| l.position_radius).collect();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let order = if order.is_empty() { vec![0] } else { order };
-        self.lights = Buffer::device_local_with(ctx, "light grid lights", bytemuck::cast_slice(&sorted), storage)?;
+        let mut order = order;
+        order.resize(guard(order.len()), 0);
+        self.lights = Buffer::device_local_with(ctx, "light grid lights at rest", bytemuck::cast_slice(&sorted), storage)?;
         self.positions = Buffer::device_local_with(ctx, "light grid positions", bytemuck::cast_slice(&positions), storage)?;
         self.order = Buffer::device_local_with(ctx, "light grid order", bytemuck::cast_slice(&order), storage)?;
         for _ in 0..FRAMES_IN_FLIGHT {
-            self.slots.push(GridSlot::new(ctx, u64::from(self.light_count.max(1)), self.lists())?);
+            self.slots.push(GridSlot::new(ctx, u64::from(self.light_count.max(1)), u64::from(self.shape.cells()))?);
         }
         Ok(())
-    }
-
-    /// Lists: every cell, then the wide lights'.
-    fn lists(&self) -> u64 {
-        u64::from(self.shape.cells()) + 1
     }
 
     /// Record the frame's build: the lists (ordered with their readers by the barriers its
@@ -182,36 +234,56 @@ impl LightGridBuild {
         let (own, set) = (&self.slots[slot], self.sets.sets[slot]);
         let d = &ctx.device;
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         // Its own buffers were last used by this slot's build two submissions ago.
         memory_barrier(
             ctx,
             cmd,
-            (compute | vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE),
-            (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE),
+            (compute | indirect, vk::AccessFlags::SHADER_WRITE),
+            (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ),
         );
         let light_groups = self.light_count.div_ceil(ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0]);
-        let blocks = self.lists().div_ceil(SCAN_BLOCK.into()) as u32;
-        let supers = blocks.div_ceil(SCAN_BLOCK);
+        let words = u64::from(self.shape.cells()).div_ceil(CELLS_PER_WORD);
+        let word_blocks = words.div_ceil(SCAN_BLOCK.into()) as u32;
+        let word_supers = word_blocks.div_ceil(SCAN_BLOCK);
+        let (bx, by) = dispatch_grid(word_blocks);
+        let (sx, sy) = dispatch_grid(word_supers);
+        let block_groups = std::mem::offset_of!(LightGridDispatch, block_groups) as u64;
+        let super_groups = std::mem::offset_of!(LightGridDispatch, super_groups) as u64;
+        let (lx, ly) = dispatch_grid(light_groups);
         let steps = [
-            (self.count_pipeline, dispatch_grid(light_groups)),
-            (self.scan_pipelines[0], dispatch_grid(blocks)),
-            (self.scan_pipelines[1], dispatch_grid(supers)),
-            (self.scan_pipelines[2], (1, 1)),
-            (self.scan_pipelines[3], dispatch_grid(supers)),
-            (self.fill_pipeline, dispatch_grid(light_groups)),
+            (self.mark_scan[0], Groups::Direct(bx, by)),
+            (self.mark_scan[1], Groups::Direct(sx, sy)),
+            (self.mark_scan[2], Groups::Direct(1, 1)),
+            (self.mark_scan[3], Groups::Direct(sx, sy)),
+            (self.mark_scan[4], Groups::Direct(bx, by)),
+            (self.count_pipeline, Groups::Direct(lx, ly)),
+            (self.list_scan[0], Groups::Indirect(block_groups)),
+            (self.list_scan[1], Groups::Indirect(super_groups)),
+            (self.list_scan[2], Groups::Direct(1, 1)),
+            (self.list_scan[3], Groups::Indirect(super_groups)),
+            (self.list_scan[4], Groups::Indirect(block_groups)),
+            (self.fill_pipeline, Groups::Direct(lx, ly)),
         ];
         // SAFETY: recording state outside a render pass; all bound objects are alive.
         unsafe {
-            d.cmd_fill_buffer(cmd, own.cells.raw, 0, vk::WHOLE_SIZE, 0);
-            memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
+            if !self.marked {
+                // No surfaces before the lighting: every cell is marked.
+                d.cmd_fill_buffer(cmd, own.occupancy.raw, 0, vk::WHOLE_SIZE, u32::MAX);
+                memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
+            }
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
-            for (i, (pipeline, (x, y))) in steps.into_iter().enumerate() {
+            for (i, (pipeline, groups)) in steps.into_iter().enumerate() {
                 if i > 0 {
-                    memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
+                    let to = (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ);
+                    memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), to);
                 }
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
-                d.cmd_dispatch(cmd, x, y, 1);
+                match groups {
+                    Groups::Direct(x, y) => d.cmd_dispatch(cmd, x, y, 1),
+                    Groups::Indirect(offset) => d.cmd_dispatch_indirect(cmd, own.dispatch.raw, offset),
+                }
             }
         }
         memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));
@@ -227,7 +299,7 @@ impl LightGridBuild {
         }
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
-            for p in [self.count_pipeline, self.fill_pipeline].into_iter().chain(self.scan_pipelines) {
+            for p in [self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan) {
                 ctx.device.destroy_pipeline(p, None);
             }
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
@@ -248,7 +320,7 @@ impl Pass for LightGridBuild {
 
     fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
         let s = &self.slots[slot];
-        vec![(CELLS, s.cells.raw), (BLOCKS, s.blocks.raw), (INDICES, s.indices.raw), (LIGHTS, self.lights.raw), (ORDER, self.order.raw)]
+        vec![(LISTS, s.lists.raw), (LIGHT_GRID_OCCUPANCY, s.occupancy.raw), (INDICES, s.indices.raw), (LIGHTS, s.grid_lights.raw)]
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
@@ -256,8 +328,13 @@ impl Pass for LightGridBuild {
         self.sets.write(ctx, frame.slot, &|name| {
             let buffer = match name {
                 "LightGridRestBuffer" => self.positions.raw,
-                "LightGridListOfBuffer" => own.list_of.raw,
+                "LightGridRestLightBuffer" => self.lights.raw,
+                "LightGridOrderBuffer" => self.order.raw,
+                "LightGridBlockBuffer" => own.blocks.raw,
                 "LightGridSuperBuffer" => own.supers.raw,
+                "LightGridKeptBuffer" => own.kept.raw,
+                "LightGridKeptCountBuffer" => own.kept_count.raw,
+                "LightGridDispatchBuffer" => own.dispatch.raw,
                 "LightGridFeedbackBuffer" => own.feedback.raw,
                 _ => return frame.buffer(name),
             };
@@ -267,7 +344,17 @@ impl Pass for LightGridBuild {
 
     fn uses(&self) -> Vec<Use> {
         let rw = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-        LIGHT_GRID_LISTS.iter().map(|&name| Use::at(name, rw, None)).collect()
+        let mut uses: Vec<Use> =
+            LIGHT_GRID_LISTS.iter().filter(|&&name| name != LIGHT_GRID_OCCUPANCY).map(|&name| Use::at(name, rw, None)).collect();
+        // The marks: read (and their words' lists written) after the marks pass, or all set here.
+        let marks = if self.marked {
+            rw
+        } else {
+            let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+            (stages, rw.1 | vk::AccessFlags::TRANSFER_WRITE)
+        };
+        uses.push(Use::at(LIGHT_GRID_OCCUPANCY, marks, None));
+        uses
     }
 
     fn frame_uniforms(&self, uniforms: &mut FrameUniforms, light_offset: glam::Vec3) {
@@ -286,6 +373,8 @@ impl Pass for LightGridBuild {
         let grid = LightGridStats {
             dims: self.shape.dims.to_array(),
             cell: self.shape.cell,
+            cells_marked: f.cells_marked,
+            lights: self.light_count,
             listed: f.listed,
             wide: f.wide,
             max_per_cell: f.max_count,
@@ -301,7 +390,7 @@ impl Pass for LightGridBuild {
 
 #[cfg(test)]
 mod tests {
-    /// The scan's work group takes a block (four counts an invocation), the walk's GRID_BLOCK.
+    /// The scan's work group takes a block (four counts an invocation).
     #[test]
     fn scan_block_is_what_the_scan_shaders_work_group_takes() {
         assert_eq!(ml_shaders::LIGHT_GRID_SCAN_COMP.workgroup_size, [super::SCAN_BLOCK / 4, 1, 1]);

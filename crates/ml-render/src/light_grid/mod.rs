@@ -6,6 +6,7 @@
 //! it, not the lights in the scene; the cells' shape is `ml_cpu::light_grid`'s.
 
 pub mod light_grid_build;
+pub mod light_grid_mark;
 
 use crate::report::FeatureStats;
 
@@ -15,7 +16,12 @@ pub struct LightGridStats {
     /// Cells per axis and their edge (m).
     pub dims: [u32; 3],
     pub cell: f32,
-    /// Lights listed (every light of the scene), of them wide (tested by every point).
+    /// Cells marked (within reach of a surface point of the frame; all where the technique
+    /// has no surfaces before its lighting).
+    pub cells_marked: u32,
+    /// Lights in the scene; of them listed (wide, or in a marked cell), of those wide
+    /// (tested by every point).
+    pub lights: u32,
     pub listed: u32,
     pub wide: u32,
     /// Most lights in one cell.
@@ -36,8 +42,8 @@ impl FeatureStats for LightGridStats {
         vec![(
             "light grid",
             format!(
-                "{x}x{y}x{z} cells of {:.3} m; {} lights listed, {} wide; at most {} in a cell",
-                self.cell, self.listed, self.wide, self.max_per_cell
+                "{x}x{y}x{z} cells of {:.3} m, {} marked; {} of {} lights listed, {} wide; at most {} in a cell",
+                self.cell, self.cells_marked, self.listed, self.lights, self.wide, self.max_per_cell
             ),
         )]
     }

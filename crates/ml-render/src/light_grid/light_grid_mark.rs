@@ -1,0 +1,70 @@
+//! The light grid's marks (docs/DESIGN.md#the-light-grid): once the opaque surfaces are
+//! known (the visibility raster, the G-buffer) and before the build, a thread per pixel marks
+//! the cells its surface point's walk will visit (light_grid_mark.glsl). The build then lists
+//! only lights of marked cells, which the frame's pixels may test: at millions of lights most
+//! lie far from every visible surface.
+
+use crate::compute_pass::ComputePass;
+use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
+use crate::pass::{Pass, Recording};
+use crate::sync::{Use, LIGHT_GRID_OCCUPANCY, VISIBILITY_DEPTH};
+use ml_vk::commands::memory_barrier;
+use ml_vk::{vk, Context, VkError};
+
+pub struct LightGridMark {
+    pass: ComputePass,
+    /// Per frame slot: the marks (the build's), cleared before each frame's.
+    occupancy: Vec<vk::Buffer>,
+    /// The opaque depth is the compute raster's 64-bit buffer (else the depth target).
+    depth_buffer: bool,
+}
+
+impl LightGridMark {
+    pub fn new(ctx: &Context, depth_buffer: bool) -> Result<LightGridMark, VkError> {
+        let shader = if depth_buffer { &ml_shaders::LIGHT_GRID_MARK_BUFFER_COMP } else { &ml_shaders::LIGHT_GRID_MARK_COMP };
+        let pass = ComputePass::new(ctx, &[], (shader, &[]))?;
+        Ok(LightGridMark { pass, occupancy: vec![vk::Buffer::null(); FRAMES_IN_FLIGHT], depth_buffer })
+    }
+}
+
+impl Pass for LightGridMark {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("light grid marks")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        self.occupancy[frame.slot] = frame.raw_buffer(LIGHT_GRID_OCCUPANCY).unwrap_or_default();
+        let depth = self.pass.sampled(&frame.targets.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        self.pass.bind_frame(ctx, frame, &|name| match name {
+            "opaque_depth" => depth,
+            _ => frame.buffer(name),
+        })
+    }
+
+    /// Clears and writes the marks; reads the opaque depth (the compute raster's buffer; the
+    /// depth target is ordered by the raster's render pass, whose outgoing dependency reaches
+    /// compute shaders).
+    fn uses(&self) -> Vec<Use> {
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        let marks = (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE);
+        let mut uses = vec![Use::at(LIGHT_GRID_OCCUPANCY, marks, None)];
+        if self.depth_buffer {
+            uses.push(Use::at(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ), None));
+        }
+        uses
+    }
+
+    fn record(&self, rec: &Recording) {
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        // SAFETY: recording state outside a render pass; the marks' buffer is alive.
+        unsafe { rec.ctx.device.cmd_fill_buffer(rec.cmd, self.occupancy[rec.slot], 0, vk::WHOLE_SIZE, 0) };
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        memory_barrier(rec.ctx, rec.cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
+        self.pass.dispatch(rec.ctx, rec.cmd, rec.slot, (&[], &[]), rec.extent);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pass.destroy(ctx);
+    }
+}
