@@ -36,7 +36,18 @@
     }
 #elif defined(LIGHT_GRID)
 #define SUM_LIGHTS(sum, LIGHT)                                                            \
-    GRID_FOR_LIGHTS(PointLight l_ = grid_lights[k_]; sum += LIGHT(l_) * spot_cone(SPOT_LIGHTS ? grid_scene_index[k_] : 0u, l_, world);)
+    GRID_FOR_LIGHTS(GRID_LIGHT(sum, LIGHT, k_))
+
+// Light k_ of the grid's lists, its colour read only where it may reach `world` (beyond the
+// radius every model gives exactly nothing: the same test they make first).
+#define GRID_LIGHT(sum, LIGHT, k)                                                            \
+    {                                                                                        \
+        vec4 p_ = grid_light_positions[k];                                                   \
+        if (!(length(p_.xyz - world) > p_.w)) {                                              \
+            PointLight l_ = PointLight(p_, grid_light_colors[k]);                            \
+            sum += LIGHT(l_) * spot_cone(SPOT_LIGHTS ? grid_scene_index[k] : 0u, l_, world); \
+        }                                                                                    \
+    }
 #else
 #define SUM_LIGHTS(sum, LIGHT)                                         \
     for (uint i_ = 0u; i_ < frame.light_count; ++i_) {               \

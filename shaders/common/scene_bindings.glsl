@@ -8,8 +8,10 @@
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 #ifdef LIGHT_GRID
 // The light grid's lists: each light as it is this frame, list after list
-// (light_grid/light_grid.glsl), and its index in the scene (its spot cone's).
-layout(std430, set = 0, binding = 34) readonly buffer LightGridLightBuffer { PointLight grid_lights[]; };
+// (light_grid/light_grid.glsl): position and radius, colour, index in the scene (its spot
+// cone's).
+layout(std430, set = 0, binding = 34) readonly buffer LightGridPositionBuffer { vec4 grid_light_positions[]; };
+layout(std430, set = 0, binding = 35) readonly buffer LightGridColorBuffer { vec4 grid_light_colors[]; };
 layout(std430, set = 0, binding = 32) readonly buffer LightGridIndexBuffer { uint grid_scene_index[]; };
 #else
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer { PointLight lights[]; };
@@ -21,8 +23,7 @@ layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { Cluste
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };
 #endif
 #ifdef LIGHT_GRID
-layout(std430, set = 0, binding = 30) readonly buffer LightGridListBuffer { uint grid_list_ends[]; };
-layout(std430, set = 0, binding = 31) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
+layout(std430, set = 0, binding = 30) readonly buffer LightGridCellRangeBuffer { uvec2 grid_cell_ranges[]; };
 #endif
 
 #endif

@@ -7,8 +7,7 @@
 //          (light_grid_mark.glsl; otherwise no pixel tests it and it is left out). Count it
 //          there and keep (light, list) in the work group's part of the kept lights;
 //   FILL:  after the scan, each kept light takes the next place of its list and writes itself
-//          there, moved, with its index in the scene. The lists' counters end as each list's
-//          end (light_grid.glsl reads them so).
+//          there, moved: position and radius, colour, index in the scene.
 // Keep the list choice in sync with crates/ml-cpu/src/light_grid.rs (list_of).
 #include "common/common.glsl"
 
@@ -22,15 +21,16 @@ layout(std430, set = 0, binding = 1) readonly buffer LightGridRestBuffer { vec4 
 layout(std430, set = 0, binding = 2) readonly buffer LightGridRestLightBuffer { PointLight rest_lights[]; };
 // Per place of the grid's order: the light's index in the scene.
 layout(std430, set = 0, binding = 9) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
-// Per list: COUNT its count; after the scan its start, after FILL its end.
+// Per list: COUNT its count; after the scan its start (FILL's cursor).
 layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_list_ends[]; };
 // Per 32 cells: their marks and the list of the first marked one (light_grid.glsl).
 layout(std430, set = 0, binding = 4) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 // Per work group of COUNT: its kept lights (place in the grid's order, list) and how many.
 layout(std430, set = 0, binding = 5) buffer LightGridKeptBuffer { uvec2 kept[]; };
 layout(std430, set = 0, binding = 10) buffer LightGridKeptCountBuffer { uint kept_count[]; };
-// The lists: each light moved, and its index in the scene.
-layout(std430, set = 0, binding = 6) writeonly buffer LightGridLightBuffer { PointLight grid_lights[]; };
+// The lists: each light moved (position and radius; colour), and its index in the scene.
+layout(std430, set = 0, binding = 6) writeonly buffer LightGridPositionBuffer { vec4 grid_light_positions[]; };
+layout(std430, set = 0, binding = 14) writeonly buffer LightGridColorBuffer { vec4 grid_light_colors[]; };
 layout(std430, set = 0, binding = 11) writeonly buffer LightGridIndexBuffer { uint grid_scene_index[]; };
 
 shared uint group_kept;
@@ -47,8 +47,8 @@ void main() {
         uvec2 k = kept[first + t];
         uint slot = atomicAdd(grid_list_ends[k.y], 1u);
         PointLight l = rest_lights[k.x];
-        l.position_radius.xyz += frame.light_animation.xyz;
-        grid_lights[slot] = l;
+        grid_light_positions[slot] = vec4(l.position_radius.xyz + frame.light_animation.xyz, l.position_radius.w);
+        grid_light_colors[slot] = l.color;
         grid_scene_index[slot] = grid_order[k.x];
         return;
     }

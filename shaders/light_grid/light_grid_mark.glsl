@@ -25,35 +25,108 @@ float mark_margin(vec3 world) {
     return 1e-3 + 1e-5 * length(world) * frame.light_grid_origin.w;
 }
 
-// Mark cells c0..c1 (one row along x).
+// Set `bits` of the grid's marks' word `word`.
+void mark_word(uint word, uint bits) {
+    // Neighbouring work groups mark the same cells: an atomic only where a bit is missing
+    // (bits are only ever set, so a stale read costs at most a needless atomic).
+    if ((grid_occupancy[word].x & bits) != bits) {
+        atomicOr(grid_occupancy[word].x, bits);
+    }
+}
+
+// The mask of bits first..last of a word (0 ≤ first ≤ last ≤ 31).
+uint bits_between(uint first, uint last) {
+    return (0xffffffffu >> (31u - last)) & (0xffffffffu << first);
+}
+
+// Mark cells c0..c1 (one row along x) in the grid's marks.
 void mark_run(uint c0, uint c1) {
     for (uint word = c0 >> 5u; word <= c1 >> 5u; ++word) {
-        uint first = max(c0, word << 5u) - (word << 5u);
-        uint last = min(c1, (word << 5u) + 31u) - (word << 5u);
-        uint bits = (0xffffffffu >> (31u - last)) & (0xffffffffu << first);
-        // Neighbouring pixels mark the same cells: an atomic only where a bit is missing
-        // (bits are only ever set, so a stale read costs at most a needless atomic).
-        if ((grid_occupancy[word].x & bits) != bits) {
-            atomicOr(grid_occupancy[word].x, bits);
-        }
+        mark_word(word, bits_between(max(c0, word << 5u) - (word << 5u), min(c1, (word << 5u) + 31u) - (word << 5u)));
+    }
+}
+
+// The work group's box of cells (the union of its points' walks) and, where it has at most
+// BOX_CELLS cells, their marks: the group's 64 points mostly walk the same cells, so they
+// mark them here first and the group writes each word of the grid's marks once.
+const uint BOX_CELLS = 512u;
+const uint GROUP_THREADS = 64u;
+shared uint box_lo[3];
+shared uint box_hi[3];
+shared uint box_marks[BOX_CELLS / 32u];
+
+// Mark cells u0..u1 of the box (one row along x).
+void mark_box_run(uint u0, uint u1) {
+    for (uint word = u0 >> 5u; word <= u1 >> 5u; ++word) {
+        atomicOr(box_marks[word], bits_between(max(u0, word << 5u) - (word << 5u), min(u1, (word << 5u) + 31u) - (word << 5u)));
     }
 }
 
 void main() {
+    uint t = gl_LocalInvocationIndex;
+    if (t < 3u) {
+        box_lo[t] = 0xffffffffu;
+        box_hi[t] = 0u;
+    }
+    if (t < BOX_CELLS / 32u) {
+        box_marks[t] = 0u;
+    }
+    barrier();
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
-        return;
+    bool inside = p.x < int(frame.viewport.x) && p.y < int(frame.viewport.y);
+    float z = inside ? opaque_depth_at(p) : 1.0;
+    bool surface = z < 1.0;
+    GridWalk w;
+    if (surface) {
+        vec3 world = world_from_depth(vec2(p) + 0.5, z);
+        w = grid_walk_wider(world, mark_margin(world));
+        for (uint i = 0u; i < 3u; ++i) {
+            atomicMin(box_lo[i], w.lo[i]);
+            atomicMax(box_hi[i], w.hi[i]);
+        }
     }
-    float z = opaque_depth_at(p);
-    if (z >= 1.0) {
-        return;
+    barrier();
+    uvec3 lo = uvec3(box_lo[0], box_lo[1], box_lo[2]);
+    uvec3 hi = uvec3(box_hi[0], box_hi[1], box_hi[2]);
+    uvec3 n = lo.x > hi.x ? uvec3(0u) : hi - lo + 1u;
+    bool in_box = n.x * n.y * n.z <= BOX_CELLS;
+    if (surface) {
+        for (uint cz = w.lo.z; cz <= w.hi.z; ++cz) {
+            for (uint cy = w.lo.y; cy <= w.hi.y; ++cy) {
+                if (in_box) {
+                    uint row = ((cz - lo.z) * n.y + (cy - lo.y)) * n.x - lo.x;
+                    mark_box_run(row + w.lo.x, row + w.hi.x);
+                } else {
+                    uint row = (cz * frame.light_grid_dims.y + cy) * frame.light_grid_dims.x;
+                    mark_run(row + w.lo.x, row + w.hi.x);
+                }
+            }
+        }
     }
-    vec3 world = world_from_depth(vec2(p) + 0.5, z);
-    GridWalk w = grid_walk_wider(world, mark_margin(world));
-    for (uint cz = w.lo.z; cz <= w.hi.z; ++cz) {
-        for (uint cy = w.lo.y; cy <= w.hi.y; ++cy) {
-            uint row = (cz * frame.light_grid_dims.y + cy) * frame.light_grid_dims.x;
-            mark_run(row + w.lo.x, row + w.hi.x);
+    barrier();
+    if (in_box) {
+        // A box row per invocation: its marked cells, a word of the grid's marks at a time.
+        for (uint r = t; r < n.y * n.z; r += GROUP_THREADS) {
+            uint cell0 = ((lo.z + r / n.y) * frame.light_grid_dims.y + lo.y + r % n.y) * frame.light_grid_dims.x + lo.x;
+            uint bits = 0u;
+            uint word = cell0 >> 5u;
+            for (uint x = 0u; x < n.x; ++x) {
+                uint c = cell0 + x;
+                if ((c >> 5u) != word) {
+                    if (bits != 0u) {
+                        mark_word(word, bits);
+                    }
+                    word = c >> 5u;
+                    bits = 0u;
+                }
+                uint u = r * n.x + x;
+                if ((box_marks[u >> 5u] & (1u << (u & 31u))) != 0u) {
+                    bits |= 1u << (c & 31u);
+                }
+            }
+            if (bits != 0u) {
+                mark_word(word, bits);
+            }
         }
     }
 }

@@ -6,7 +6,7 @@
 //             (list 0 is the wide lights'); their lists' counts are zeroed for COUNT, and the
 //             lists' scan gets its work groups (LightGridDispatch);
 //   SOURCE 0, the lists' counts (between COUNT and FILL, light_grid_build.comp): each becomes
-//             its list's start.
+//             its list's start (and one past the last list holds the total).
 // A work group scans 1024 counts, four per invocation, as sums of four over its invocations.
 //   STEP 0, a work group per block of 1024 counts: each becomes its start relative to the
 //           block; the block keeps its total and largest count;
@@ -15,7 +15,9 @@
 //   STEP 2, one work group: the super-blocks' totals become their starts (at most 1024
 //           super-blocks: 2^30 counts), and the totals go where the source says;
 //   STEP 3, a work group per super-block: each block's start becomes absolute;
-//   STEP 4, a work group per block: each start becomes absolute.
+//   STEP 4, a work group per block: each start becomes absolute;
+//   STEP 5 (marks only, after the lists' scan), a work group per block of words: each marked
+//           cell's range of the lists (light_grid.glsl grid_cell_ranges), and the wide lights'.
 #include "common/common.glsl"
 
 layout(local_size_x = 256) in;
@@ -31,6 +33,7 @@ layout(std430, set = 0, binding = 8) buffer LightGridBlockBuffer { uvec2 grid_bl
 layout(std430, set = 0, binding = 12) buffer LightGridSuperBuffer { uvec2 grid_supers[]; };
 layout(std430, set = 0, binding = 7) buffer LightGridFeedbackBuffer { LightGridFeedback feedback; };
 layout(std430, set = 0, binding = 13) buffer LightGridDispatchBuffer { LightGridDispatch grid_dispatch; };
+layout(std430, set = 0, binding = 15) writeonly buffer LightGridCellRangeBuffer { uvec2 grid_cell_ranges[]; };
 
 const uint BLOCK = 1024u;
 const uint THREADS = 256u;
@@ -63,12 +66,14 @@ uint source_size() {
     return SOURCE == 1u ? (frame.light_grid_dims.w + 31u) / 32u : grid_dispatch.lists;
 }
 
+// Word i's marks, its bits beyond the last cell left out.
+uint word_marks(uint i) {
+    uint beyond = (i + 1u) * 32u - min((i + 1u) * 32u, frame.light_grid_dims.w);
+    return grid_occupancy[i].x & (0xffffffffu >> beyond);
+}
+
 uint source_count(uint i) {
-    if (SOURCE == 1u) {
-        uint beyond = (i + 1u) * 32u - min((i + 1u) * 32u, frame.light_grid_dims.w);
-        return bitCount(grid_occupancy[i].x & (0xffffffffu >> beyond));
-    }
-    return grid_list_ends[i];
+    return SOURCE == 1u ? bitCount(word_marks(i)) : grid_list_ends[i];
 }
 
 // The count (and largest count) of item i of a scan over the source (level 0), blocks (1) or
@@ -138,6 +143,7 @@ void report(uint total, uint largest) {
         feedback.cells_marked = total;
     } else {
         // List 0 is the wide lights': list 1 starts where it ends (block 0 starts at 0).
+        grid_list_ends[grid_dispatch.lists] = total;
         feedback.listed = total;
         feedback.wide = grid_dispatch.lists > 1u ? grid_list_ends[1] : total;
         feedback.max_count = largest;
@@ -159,6 +165,22 @@ void finish_item(uint i, uint g) {
         }
     } else {
         grid_list_ends[i] += grid_blocks[g].x;
+    }
+}
+
+// STEP 5 for word i of marks: each marked cell's range of the lists (whose starts the
+// lists' scan left, one past the last list holding the total); word 0 also the wide lights'.
+void write_ranges(uint i) {
+    uint bits = word_marks(i);
+    uint list = grid_occupancy[i].y;
+    while (bits != 0u) {
+        uint c = i * 32u + uint(findLSB(bits));
+        grid_cell_ranges[c] = uvec2(grid_list_ends[list], grid_list_ends[list + 1u]);
+        list++;
+        bits &= bits - 1u;
+    }
+    if (i == 0u) {
+        grid_cell_ranges[frame.light_grid_dims.w] = uvec2(0u, grid_list_ends[1]);
     }
 }
 
@@ -197,11 +219,18 @@ void main() {
                 grid_blocks[b].x += grid_supers[b / BLOCK].x;
             }
         }
-    } else {
+    } else if (STEP == 4u) {
         for (uint k = 0u; k < PER; ++k) {
             uint i = g * BLOCK + t * PER + k;
             if (i < n) {
                 finish_item(i, g);
+            }
+        }
+    } else {
+        for (uint k = 0u; k < PER; ++k) {
+            uint i = g * BLOCK + t * PER + k;
+            if (i < n) {
+                write_ranges(i);
             }
         }
     }

@@ -1,6 +1,6 @@
 // The light counts (`render --light-stats`): for every pixel with a surface, how many lights
 // the light loop tests there — the light grid's lists near it, walked by the lighting's own
-// loop (SUM_LIGHTS) — and how many of them reach the point (it lies inside the light's sphere).
+// walk (GRID_FOR_LIGHTS) — and how many of them reach the point (it lies inside the light's sphere).
 // Their ratio is what light culling wastes; a thread per pixel, the sums per 8×4 work group
 // for the host (light_stats/light_count.rs adds them up): 32 pixels of at most 2^26 lights
 // each (the most `--lights` takes) fit one 32-bit word.
@@ -27,14 +27,13 @@ shared uint group_reached;
 uint tested_here;
 uint reached_here;
 
-// Counts light `l` at `world` (the loop's LIGHT: it adds nothing to the colour).
-vec3 count_light(PointLight l, vec3 world) {
+// Counts the light at `position_radius` at `world`.
+void count_light(vec4 position_radius, vec3 world) {
     tested_here++;
-    vec3 d = l.position_radius.xyz - world;
-    if (dot(d, d) < l.position_radius.w * l.position_radius.w) {
+    vec3 d = position_radius.xyz - world;
+    if (dot(d, d) < position_radius.w * position_radius.w) {
         reached_here++;
     }
-    return vec3(0.0);
 }
 
 void main() {
@@ -52,9 +51,7 @@ void main() {
         if (z < 1.0) {
             vec2 frag_xy = vec2(p) + 0.5;
             vec3 world = world_from_depth(frag_xy, z);
-            vec3 unused = vec3(0.0);
-#define COUNT_LIGHT(l) count_light(l, world)
-            SUM_LIGHTS(unused, COUNT_LIGHT)
+            GRID_FOR_LIGHTS(count_light(grid_light_positions[k_], world);)
             atomicAdd(group_pixels, 1u);
             atomicAdd(group_tested, tested_here);
             atomicAdd(group_reached, reached_here);

@@ -213,13 +213,15 @@ pub const HDR_TARGET: &str = "hdr target";
 /// the host (the CPU assignment), read by every shading pass.
 pub const LIGHT_LISTS: [&str; 3] = ["LightBuffer", "ClusterRangeBuffer", "LightIndexBuffer"];
 
-/// The frame slot's light-grid lists (their ends, the marks that number them, the lights in
-/// them and their scene indices): written by the light grid's build (the marks first by the
-/// marks pass), read by every shading pass.
-pub const LIGHT_GRID_LISTS: [&str; 4] = ["LightGridListBuffer", LIGHT_GRID_OCCUPANCY, "LightGridIndexBuffer", "LightGridLightBuffer"];
+/// The frame slot's light-grid lists (the cells' ranges of them, the lights in them —
+/// positions, colours — and their scene indices): written by the light grid's build, read by
+/// every shading pass.
+pub const LIGHT_GRID_LISTS: [&str; 4] =
+    ["LightGridCellRangeBuffer", "LightGridPositionBuffer", "LightGridColorBuffer", "LightGridIndexBuffer"];
 
 /// The frame slot's light-grid marks (a bit per cell a surface point walks, and per 32 cells
-/// the list of the first marked one).
+/// the list of the first marked one): written by the marks pass (or the build), read by the
+/// build.
 pub const LIGHT_GRID_OCCUPANCY: &str = "LightGridOccupancyBuffer";
 
 /// How a shading pass reads the lights and lists (whichever the technique has): in `stages`.

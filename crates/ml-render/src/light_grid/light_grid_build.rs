@@ -42,9 +42,10 @@ const GROUPS_PER_ROW: u32 = 32_768;
 const CELLS_PER_WORD: u64 = 32;
 
 /// The grid's names of its lists in the shaders (what the shading passes bind).
-const LISTS: &str = "LightGridListBuffer";
+const CELL_RANGES: &str = "LightGridCellRangeBuffer";
+const POSITIONS: &str = "LightGridPositionBuffer";
+const COLORS: &str = "LightGridColorBuffer";
 const INDICES: &str = "LightGridIndexBuffer";
-const LIGHTS: &str = "LightGridLightBuffer";
 
 pub struct LightGridBuild {
     /// The build's set per frame slot (one layout for every step: the union of the shaders').
@@ -54,9 +55,9 @@ pub struct LightGridBuild {
     pipeline_layout: vk::PipelineLayout,
     count_pipeline: vk::Pipeline,
     fill_pipeline: vk::Pipeline,
-    /// The scans' five steps (blocks, super-blocks, their starts, the blocks' starts, the
-    /// counts' starts), of the marks and of the lists' counts.
-    mark_scan: [vk::Pipeline; 5],
+    /// The scans' steps (blocks, super-blocks, their starts, the blocks' starts, the counts'
+    /// starts; for the marks also the cells' ranges), of the marks and of the lists' counts.
+    mark_scan: [vk::Pipeline; 6],
     list_scan: [vk::Pipeline; 5],
     /// The lights at rest in the grid's order (device-local, uploaded once), their positions
     /// and radii alone (what COUNT reads of every light), and per place the light's index in
@@ -72,8 +73,11 @@ pub struct LightGridBuild {
 
 /// One frame slot's buffers.
 struct GridSlot {
-    /// Per list: its count, then its start, then its end.
+    /// Per list: its count, then its start (FILL's cursor); one more for the total.
     lists: Buffer,
+    /// Per cell: where its lights start and end in the lists (marked cells'), then the wide
+    /// lights'.
+    cell_ranges: Buffer,
     /// Per 32 cells: their marks and the list of the first marked one.
     occupancy: Buffer,
     /// Per block of counts: its total, then its start (and its largest count); per 1024
@@ -83,8 +87,10 @@ struct GridSlot {
     /// Per work group of COUNT: its kept lights (place, list), and how many.
     kept: Buffer,
     kept_count: Buffer,
-    /// The lists: the lights, moved, list after list; their indices in the scene.
-    grid_lights: Buffer,
+    /// The lists: the lights, moved, list after list (position and radius; colour); their
+    /// indices in the scene.
+    positions: Buffer,
+    colors: Buffer,
     indices: Buffer,
     /// The lists this frame and the work groups of their scan (indirect dispatches).
     dispatch: Buffer,
@@ -95,23 +101,26 @@ impl GridSlot {
     fn new(ctx: &Context, lights: u64, cells: u64) -> Result<GridSlot, VkError> {
         let slot = GridSlot {
             lists: Buffer::null(),
+            cell_ranges: Buffer::null(),
             occupancy: Buffer::null(),
             blocks: Buffer::null(),
             supers: Buffer::null(),
             kept: Buffer::null(),
             kept_count: Buffer::null(),
-            grid_lights: Buffer::null(),
+            positions: Buffer::null(),
+            colors: Buffer::null(),
             indices: Buffer::null(),
             dispatch: Buffer::null(),
             feedback: Buffer::null(),
         };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let gpu = gpu_allocator::MemoryLocation::GpuOnly;
-        let lists = cells + 1;
+        let lists = cells + 2;
         let group = u64::from(ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0]);
         let light_groups = lights.div_ceil(group);
         ml_vk::build(ctx, slot, |s| {
             s.lists = Buffer::new(ctx, "light grid lists", lists * 4, storage, gpu)?;
+            s.cell_ranges = Buffer::new(ctx, "light grid cell ranges", (cells + 1) * 8, storage, gpu)?;
             let words = cells.div_ceil(CELLS_PER_WORD);
             s.occupancy = Buffer::new(ctx, "light grid marks", words * 8, storage | vk::BufferUsageFlags::TRANSFER_DST, gpu)?;
             let blocks = lists.div_ceil(SCAN_BLOCK.into());
@@ -119,7 +128,8 @@ impl GridSlot {
             s.supers = Buffer::new(ctx, "light grid super-blocks", blocks.div_ceil(SCAN_BLOCK.into()) * 8, storage, gpu)?;
             s.kept = Buffer::new(ctx, "light grid kept lights", light_groups * group * 8, storage, gpu)?;
             s.kept_count = Buffer::new(ctx, "light grid kept counts", light_groups * 4, storage, gpu)?;
-            s.grid_lights = Buffer::new(ctx, "light grid lights", lights * size_of::<PointLight>() as u64, storage, gpu)?;
+            s.positions = Buffer::new(ctx, "light grid positions", lights * 16, storage, gpu)?;
+            s.colors = Buffer::new(ctx, "light grid colours", lights * 16, storage, gpu)?;
             s.indices = Buffer::new(ctx, "light grid indices", lights * 4, storage, gpu)?;
             let dispatch = size_of::<LightGridDispatch>() as u64;
             s.dispatch = Buffer::new(ctx, "light grid dispatch", dispatch, storage | vk::BufferUsageFlags::INDIRECT_BUFFER, gpu)?;
@@ -133,15 +143,17 @@ impl GridSlot {
         bytemuck::pod_read_unaligned(&self.feedback.mapped()[..size_of::<LightGridFeedback>()])
     }
 
-    fn buffers(&mut self) -> [&mut Buffer; 10] {
+    fn buffers(&mut self) -> [&mut Buffer; 12] {
         [
             &mut self.lists,
+            &mut self.cell_ranges,
             &mut self.occupancy,
             &mut self.blocks,
             &mut self.supers,
             &mut self.kept,
             &mut self.kept_count,
-            &mut self.grid_lights,
+            &mut self.positions,
+            &mut self.colors,
             &mut self.indices,
             &mut self.dispatch,
             &mut self.feedback,
@@ -178,7 +190,8 @@ impl LightGridBuild {
     /// The build for `rest_lights`: a grid of at most `cell_budget` cells (what the device
     /// binds as one storage buffer of lists); `marked`: a marks pass runs before it.
     pub fn new(ctx: &Context, rest_lights: &[PointLight], marked: bool) -> Result<LightGridBuild, VkError> {
-        let bindable = u64::from(ctx.info.limits.max_storage_buffer_range) / 4;
+        // Cells' ranges are 8 bytes each.
+        let bindable = u64::from(ctx.info.limits.max_storage_buffer_range) / 8;
         let shape = LightGridShape::fit(rest_lights, cell_budget(rest_lights.len(), bindable));
         let stages = [&ml_shaders::LIGHT_GRID_BUILD_COMP, &ml_shaders::LIGHT_GRID_SCAN_COMP].map(|s| (s, vk::ShaderStageFlags::COMPUTE));
         let b = LightGridBuild {
@@ -187,7 +200,7 @@ impl LightGridBuild {
             pipeline_layout: vk::PipelineLayout::null(),
             count_pipeline: vk::Pipeline::null(),
             fill_pipeline: vk::Pipeline::null(),
-            mark_scan: [vk::Pipeline::null(); 5],
+            mark_scan: [vk::Pipeline::null(); 6],
             list_scan: [vk::Pipeline::null(); 5],
             lights: Buffer::null(),
             positions: Buffer::null(),
@@ -204,7 +217,7 @@ impl LightGridBuild {
         let build = &ml_shaders::LIGHT_GRID_BUILD_COMP;
         self.count_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 0)])?;
         self.fill_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 1)])?;
-        for (source, pipelines) in [(1, &mut self.mark_scan), (0, &mut self.list_scan)] {
+        for (source, pipelines) in [(1, &mut self.mark_scan[..]), (0, &mut self.list_scan[..])] {
             for (step, pipeline) in pipelines.iter_mut().enumerate() {
                 let constants = [("STEP", step as u32), ("SOURCE", source)];
                 *pipeline = compute_pipeline(ctx, &ml_shaders::LIGHT_GRID_SCAN_COMP, self.pipeline_layout, &constants)?;
@@ -264,6 +277,7 @@ impl LightGridBuild {
             (self.list_scan[2], Groups::Direct(1, 1)),
             (self.list_scan[3], Groups::Indirect(super_groups)),
             (self.list_scan[4], Groups::Indirect(block_groups)),
+            (self.mark_scan[5], Groups::Direct(bx, by)),
             (self.fill_pipeline, Groups::Direct(lx, ly)),
         ];
         // SAFETY: recording state outside a render pass; all bound objects are alive.
@@ -320,7 +334,13 @@ impl Pass for LightGridBuild {
 
     fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
         let s = &self.slots[slot];
-        vec![(LISTS, s.lists.raw), (LIGHT_GRID_OCCUPANCY, s.occupancy.raw), (INDICES, s.indices.raw), (LIGHTS, s.grid_lights.raw)]
+        vec![
+            (CELL_RANGES, s.cell_ranges.raw),
+            (POSITIONS, s.positions.raw),
+            (COLORS, s.colors.raw),
+            (INDICES, s.indices.raw),
+            (LIGHT_GRID_OCCUPANCY, s.occupancy.raw),
+        ]
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
@@ -330,6 +350,7 @@ impl Pass for LightGridBuild {
                 "LightGridRestBuffer" => self.positions.raw,
                 "LightGridRestLightBuffer" => self.lights.raw,
                 "LightGridOrderBuffer" => self.order.raw,
+                "LightGridListBuffer" => own.lists.raw,
                 "LightGridBlockBuffer" => own.blocks.raw,
                 "LightGridSuperBuffer" => own.supers.raw,
                 "LightGridKeptBuffer" => own.kept.raw,
@@ -344,8 +365,7 @@ impl Pass for LightGridBuild {
 
     fn uses(&self) -> Vec<Use> {
         let rw = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-        let mut uses: Vec<Use> =
-            LIGHT_GRID_LISTS.iter().filter(|&&name| name != LIGHT_GRID_OCCUPANCY).map(|&name| Use::at(name, rw, None)).collect();
+        let mut uses: Vec<Use> = LIGHT_GRID_LISTS.iter().map(|&name| Use::at(name, rw, None)).collect();
         // The marks: read (and their words' lists written) after the marks pass, or all set here.
         let marks = if self.marked {
             rw
