@@ -95,7 +95,6 @@ struct LightGridDispatch {
     uint _pad1;
     uint _pad2;
     uvec4 block_groups;  // xyz: work groups over the lists' blocks (rows of 32768 along x)
-    uvec4 super_groups;  // xyz: work groups over the blocks' super-blocks
 };
 
 // Per object (set 0, binding 4, std430 array, every shading path): where it is and what it

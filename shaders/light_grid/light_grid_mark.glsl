@@ -11,8 +11,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
-// Per 32 cells: x their marks (bit c % 32 for cell c); y is the build's.
-layout(std430, set = 0, binding = 31) buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
+// Per 32 cells: x their marks (bit c % 32 for cell c); y is the build's. Coherent: a read sees
+// the other work groups' marks so far (not a stale cached copy), and skips their atomics.
+layout(std430, set = 0, binding = 31) coherent buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 
 #include "common/opaque_depth.glsl"
 #include "common/world_from_depth.glsl"
@@ -28,7 +29,7 @@ float mark_margin(vec3 world) {
 // Set `bits` of the grid's marks' word `word`.
 void mark_word(uint word, uint bits) {
     // Neighbouring work groups mark the same cells: an atomic only where a bit is missing
-    // (bits are only ever set, so a stale read costs at most a needless atomic).
+    // (bits are only ever set, so an outdated read costs at most a needless atomic).
     if ((grid_occupancy[word].x & bits) != bits) {
         atomicOr(grid_occupancy[word].x, bits);
     }

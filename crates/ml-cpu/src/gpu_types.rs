@@ -143,8 +143,6 @@ gpu_struct!(
         _pad2: u32,
         /// xyz: work groups over the lists' blocks.
         block_groups: [u32; 4],
-        /// xyz: work groups over the blocks' super-blocks.
-        super_groups: [u32; 4],
     }
 );
 

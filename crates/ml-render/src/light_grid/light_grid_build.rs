@@ -55,10 +55,10 @@ pub struct LightGridBuild {
     pipeline_layout: vk::PipelineLayout,
     count_pipeline: vk::Pipeline,
     fill_pipeline: vk::Pipeline,
-    /// The scans' steps (blocks, super-blocks, their starts, the blocks' starts, the counts'
-    /// starts; for the marks also the cells' ranges), of the marks and of the lists' counts.
-    mark_scan: [vk::Pipeline; 6],
-    list_scan: [vk::Pipeline; 5],
+    /// The scans' three steps (blocks' totals, their starts, the counts' starts), of the marks
+    /// and of the lists' counts.
+    mark_scan: [vk::Pipeline; 3],
+    list_scan: [vk::Pipeline; 3],
     /// The lights at rest in the grid's order (device-local, uploaded once), their positions
     /// and radii alone (what COUNT reads of every light), and per place the light's index in
     /// the scene (its spot cone's).
@@ -73,17 +73,16 @@ pub struct LightGridBuild {
 
 /// One frame slot's buffers.
 struct GridSlot {
-    /// Per list: its count, then its start (FILL's cursor); one more for the total.
+    /// Per list: its count, then its start (FILL's cursor); and its cell.
     lists: Buffer,
+    list_cells: Buffer,
     /// Per cell: where its lights start and end in the lists (marked cells'), then the wide
     /// lights'.
     cell_ranges: Buffer,
     /// Per 32 cells: their marks and the list of the first marked one.
     occupancy: Buffer,
-    /// Per block of counts: its total, then its start (and its largest count); per 1024
-    /// blocks the same.
+    /// Per block of counts: its total, then its start (and its largest count).
     blocks: Buffer,
-    supers: Buffer,
     /// Per work group of COUNT: its kept lights (place, list), and how many.
     kept: Buffer,
     kept_count: Buffer,
@@ -101,10 +100,10 @@ impl GridSlot {
     fn new(ctx: &Context, lights: u64, cells: u64) -> Result<GridSlot, VkError> {
         let slot = GridSlot {
             lists: Buffer::null(),
+            list_cells: Buffer::null(),
             cell_ranges: Buffer::null(),
             occupancy: Buffer::null(),
             blocks: Buffer::null(),
-            supers: Buffer::null(),
             kept: Buffer::null(),
             kept_count: Buffer::null(),
             positions: Buffer::null(),
@@ -115,17 +114,17 @@ impl GridSlot {
         };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let gpu = gpu_allocator::MemoryLocation::GpuOnly;
-        let lists = cells + 2;
+        let lists = cells + 1;
         let group = u64::from(ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0]);
         let light_groups = lights.div_ceil(group);
         ml_vk::build(ctx, slot, |s| {
             s.lists = Buffer::new(ctx, "light grid lists", lists * 4, storage, gpu)?;
+            s.list_cells = Buffer::new(ctx, "light grid lists' cells", lists * 4, storage, gpu)?;
             s.cell_ranges = Buffer::new(ctx, "light grid cell ranges", (cells + 1) * 8, storage, gpu)?;
             let words = cells.div_ceil(CELLS_PER_WORD);
             s.occupancy = Buffer::new(ctx, "light grid marks", words * 8, storage | vk::BufferUsageFlags::TRANSFER_DST, gpu)?;
             let blocks = lists.div_ceil(SCAN_BLOCK.into());
             s.blocks = Buffer::new(ctx, "light grid blocks", blocks * 8, storage, gpu)?;
-            s.supers = Buffer::new(ctx, "light grid super-blocks", blocks.div_ceil(SCAN_BLOCK.into()) * 8, storage, gpu)?;
             s.kept = Buffer::new(ctx, "light grid kept lights", light_groups * group * 8, storage, gpu)?;
             s.kept_count = Buffer::new(ctx, "light grid kept counts", light_groups * 4, storage, gpu)?;
             s.positions = Buffer::new(ctx, "light grid positions", lights * 16, storage, gpu)?;
@@ -146,10 +145,10 @@ impl GridSlot {
     fn buffers(&mut self) -> [&mut Buffer; 12] {
         [
             &mut self.lists,
+            &mut self.list_cells,
             &mut self.cell_ranges,
             &mut self.occupancy,
             &mut self.blocks,
-            &mut self.supers,
             &mut self.kept,
             &mut self.kept_count,
             &mut self.positions,
@@ -180,6 +179,7 @@ fn dispatch_grid(groups: u32) -> (u32, u32) {
 }
 
 /// One step of the build: a pipeline and its work groups.
+#[derive(Clone, Copy)]
 enum Groups {
     Direct(u32, u32),
     /// From the slot's dispatch buffer at this offset (written by the marks' scan).
@@ -200,8 +200,8 @@ impl LightGridBuild {
             pipeline_layout: vk::PipelineLayout::null(),
             count_pipeline: vk::Pipeline::null(),
             fill_pipeline: vk::Pipeline::null(),
-            mark_scan: [vk::Pipeline::null(); 6],
-            list_scan: [vk::Pipeline::null(); 5],
+            mark_scan: [vk::Pipeline::null(); 3],
+            list_scan: [vk::Pipeline::null(); 3],
             lights: Buffer::null(),
             positions: Buffer::null(),
             order: Buffer::null(),
@@ -258,26 +258,17 @@ impl LightGridBuild {
         );
         let light_groups = self.light_count.div_ceil(ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0]);
         let words = u64::from(self.shape.cells()).div_ceil(CELLS_PER_WORD);
-        let word_blocks = words.div_ceil(SCAN_BLOCK.into()) as u32;
-        let word_supers = word_blocks.div_ceil(SCAN_BLOCK);
-        let (bx, by) = dispatch_grid(word_blocks);
-        let (sx, sy) = dispatch_grid(word_supers);
-        let block_groups = std::mem::offset_of!(LightGridDispatch, block_groups) as u64;
-        let super_groups = std::mem::offset_of!(LightGridDispatch, super_groups) as u64;
+        let word_blocks = dispatch_grid(words.div_ceil(SCAN_BLOCK.into()) as u32);
+        let list_blocks = Groups::Indirect(std::mem::offset_of!(LightGridDispatch, block_groups) as u64);
         let (lx, ly) = dispatch_grid(light_groups);
         let steps = [
-            (self.mark_scan[0], Groups::Direct(bx, by)),
-            (self.mark_scan[1], Groups::Direct(sx, sy)),
-            (self.mark_scan[2], Groups::Direct(1, 1)),
-            (self.mark_scan[3], Groups::Direct(sx, sy)),
-            (self.mark_scan[4], Groups::Direct(bx, by)),
+            (self.mark_scan[0], Groups::Direct(word_blocks.0, word_blocks.1)),
+            (self.mark_scan[1], Groups::Direct(1, 1)),
+            (self.mark_scan[2], Groups::Direct(word_blocks.0, word_blocks.1)),
             (self.count_pipeline, Groups::Direct(lx, ly)),
-            (self.list_scan[0], Groups::Indirect(block_groups)),
-            (self.list_scan[1], Groups::Indirect(super_groups)),
-            (self.list_scan[2], Groups::Direct(1, 1)),
-            (self.list_scan[3], Groups::Indirect(super_groups)),
-            (self.list_scan[4], Groups::Indirect(block_groups)),
-            (self.mark_scan[5], Groups::Direct(bx, by)),
+            (self.list_scan[0], list_blocks),
+            (self.list_scan[1], Groups::Direct(1, 1)),
+            (self.list_scan[2], list_blocks),
             (self.fill_pipeline, Groups::Direct(lx, ly)),
         ];
         // SAFETY: recording state outside a render pass; all bound objects are alive.
@@ -352,7 +343,7 @@ impl Pass for LightGridBuild {
                 "LightGridOrderBuffer" => self.order.raw,
                 "LightGridListBuffer" => own.lists.raw,
                 "LightGridBlockBuffer" => own.blocks.raw,
-                "LightGridSuperBuffer" => own.supers.raw,
+                "LightGridListCellBuffer" => own.list_cells.raw,
                 "LightGridKeptBuffer" => own.kept.raw,
                 "LightGridKeptCountBuffer" => own.kept_count.raw,
                 "LightGridDispatchBuffer" => own.dispatch.raw,
