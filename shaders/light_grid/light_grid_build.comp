@@ -1,7 +1,10 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// The light grid's build, one invocation per light, run twice around the scan of the lists
-// (light_grid_scan.comp):
+// The light grid's build, after the scan of the marks (light_grid_scan.comp):
+//   NUMBER, an invocation per cell: a marked cell's list (that of its word's first marked cell,
+//          plus the marked cells before it in the word) learns its cell, and its count is
+//          zeroed for COUNT;
+// then an invocation per light, twice around the scan of the lists:
 //   COUNT: move the light by the frame's offset and find its list: the wide lights' (list 0)
 //          when wider than the reach, else its cell's if the cell is marked
 //          (light_grid_mark.glsl; otherwise no pixel tests it and it is left out). Count it
@@ -12,7 +15,8 @@
 #include "common/common.glsl"
 
 layout(local_size_x = 256) in;
-layout(constant_id = 0) const bool FILL = false;
+// 0: COUNT, 1: FILL, 2: NUMBER.
+layout(constant_id = 0) const uint STEP = 0u;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 // The lights at rest in the grid's order (that of their cells at rest, so that neighbouring
@@ -23,8 +27,10 @@ layout(std430, set = 0, binding = 2) readonly buffer LightGridRestLightBuffer { 
 layout(std430, set = 0, binding = 9) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
 // Per list: COUNT its count; after the scan its start (FILL's cursor).
 layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_list_ends[]; };
-// Per 32 cells: their marks and the list of the first marked one (light_grid.glsl).
+// Per 32 cells: their marks and the list of the first marked one.
 layout(std430, set = 0, binding = 4) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
+// Per list: its cell.
+layout(std430, set = 0, binding = 16) writeonly buffer LightGridListCellBuffer { uint list_cells[]; };
 // Per work group of COUNT: its kept lights (place in the grid's order, list) and how many.
 layout(std430, set = 0, binding = 5) buffer LightGridKeptBuffer { uvec2 kept[]; };
 layout(std430, set = 0, binding = 10) buffer LightGridKeptCountBuffer { uint kept_count[]; };
@@ -40,7 +46,22 @@ void main() {
     uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
     uint t = gl_LocalInvocationID.x;
     uint first = group * gl_WorkGroupSize.x;
-    if (FILL) {
+    if (STEP == 2u) {
+        uint c = first + t;
+        if (c == 0u) {
+            grid_list_ends[0] = 0u;
+        }
+        if (c < frame.light_grid_dims.w) {
+            uvec2 o = grid_occupancy[c >> 5u];
+            if ((o.x & (1u << (c & 31u))) != 0u) {
+                uint list = o.y + bitCount(o.x & ((1u << (c & 31u)) - 1u));
+                list_cells[list] = c;
+                grid_list_ends[list] = 0u;
+            }
+        }
+        return;
+    }
+    if (STEP == 1u) {
         if (t >= kept_count[group]) {
             return;
         }

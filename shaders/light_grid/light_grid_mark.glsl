@@ -8,7 +8,7 @@
 // The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer.
 #include "common/common.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 16, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 // Per 32 cells: x their marks (bit c % 32 for cell c); y is the build's. Coherent: a read sees
@@ -48,10 +48,10 @@ void mark_run(uint c0, uint c1) {
 }
 
 // The work group's box of cells (the union of its points' walks) and, where it has at most
-// BOX_CELLS cells, their marks: the group's 64 points mostly walk the same cells, so they
+// BOX_CELLS cells, their marks: the group's 256 points mostly walk the same cells, so they
 // mark them here first and the group writes each word of the grid's marks once.
-const uint BOX_CELLS = 512u;
-const uint GROUP_THREADS = 64u;
+const uint BOX_CELLS = 4096u;
+const uint GROUP_THREADS = 256u;
 shared uint box_lo[3];
 shared uint box_hi[3];
 shared uint box_marks[BOX_CELLS / 32u];
@@ -69,8 +69,8 @@ void main() {
         box_lo[t] = 0xffffffffu;
         box_hi[t] = 0u;
     }
-    if (t < BOX_CELLS / 32u) {
-        box_marks[t] = 0u;
+    for (uint i = t; i < BOX_CELLS / 32u; i += GROUP_THREADS) {
+        box_marks[i] = 0u;
     }
     barrier();
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);

@@ -3,8 +3,8 @@
 // The light grid's scans (exclusive prefix sums) in three steps, of
 //   SOURCE 1, the marks (after light_grid_mark.glsl, before COUNT): per 32 cells the marked
 //             ones become the list of their first, so that every marked cell gets a list
-//             (list 0 is the wide lights'); each list learns its cell, their counts are zeroed
-//             for COUNT, and the lists' scan gets its work groups (LightGridDispatch);
+//             (list 0 is the wide lights'), and the lists' scan gets its work groups
+//             (LightGridDispatch);
 //   SOURCE 0, the lists' counts (between COUNT and FILL, light_grid_build.comp): each becomes
 //             its list's start (FILL's cursor), and its cell's range of the lists is written.
 // Blocks of 1024 counts, four per invocation:
@@ -26,8 +26,8 @@ layout(std430, set = 0, binding = 4) buffer LightGridOccupancyBuffer { uvec2 gri
 layout(std430, set = 0, binding = 8) buffer LightGridBlockBuffer { uvec2 grid_blocks[]; };
 layout(std430, set = 0, binding = 7) buffer LightGridFeedbackBuffer { LightGridFeedback feedback; };
 layout(std430, set = 0, binding = 13) buffer LightGridDispatchBuffer { LightGridDispatch grid_dispatch; };
-// Per list: its cell.
-layout(std430, set = 0, binding = 16) buffer LightGridListCellBuffer { uint list_cells[]; };
+// Per list: its cell (light_grid_build.comp NUMBER).
+layout(std430, set = 0, binding = 16) readonly buffer LightGridListCellBuffer { uint list_cells[]; };
 // Per cell: where its lights start and end in the lists (marked cells'); then the wide lights'.
 layout(std430, set = 0, binding = 15) writeonly buffer LightGridCellRangeBuffer { uvec2 grid_cell_ranges[]; };
 
@@ -97,23 +97,12 @@ void report(uint total, uint largest) {
     }
 }
 
-// STEP 2: count i starts at `start`. A word of marks gives its marked cells their lists (after
-// the wide lights' list 0), each list its cell, and zeroes their counts for COUNT; a list
-// keeps its start for FILL, and its cell (list 0: the wide lights) gets its range.
+// STEP 2: count i starts at `start`. A word of marks gives its first marked cell its list
+// (after the wide lights' list 0; the build's NUMBER step numbers the others); a list keeps
+// its start for FILL, and its cell (list 0: the wide lights) gets its range.
 void set_start(uint i, uint start, uint count) {
     if (SOURCE == 1u) {
-        uint list = start + 1u;
-        grid_occupancy[i].y = list;
-        uint bits = word_marks(i);
-        while (bits != 0u) {
-            list_cells[list] = i * 32u + uint(findLSB(bits));
-            grid_list_ends[list] = 0u;
-            list++;
-            bits &= bits - 1u;
-        }
-        if (i == 0u) {
-            grid_list_ends[0] = 0u;
-        }
+        grid_occupancy[i].y = start + 1u;
     } else {
         grid_list_ends[i] = start;
         grid_cell_ranges[i == 0u ? frame.light_grid_dims.w : list_cells[i]] = uvec2(start, start + count);

@@ -53,6 +53,7 @@ pub struct LightGridBuild {
     /// Per frame slot: its lists and the build's own buffers.
     slots: Vec<GridSlot>,
     pipeline_layout: vk::PipelineLayout,
+    number_pipeline: vk::Pipeline,
     count_pipeline: vk::Pipeline,
     fill_pipeline: vk::Pipeline,
     /// The scans' three steps (blocks' totals, their starts, the counts' starts), of the marks
@@ -198,6 +199,7 @@ impl LightGridBuild {
             sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
             slots: Vec::new(),
             pipeline_layout: vk::PipelineLayout::null(),
+            number_pipeline: vk::Pipeline::null(),
             count_pipeline: vk::Pipeline::null(),
             fill_pipeline: vk::Pipeline::null(),
             mark_scan: [vk::Pipeline::null(); 3],
@@ -215,8 +217,9 @@ impl LightGridBuild {
     fn create(&mut self, ctx: &Context, rest_lights: &[PointLight]) -> Result<(), VkError> {
         self.pipeline_layout = shader::pipeline_layout(ctx, &[self.sets.layout.raw], &[])?;
         let build = &ml_shaders::LIGHT_GRID_BUILD_COMP;
-        self.count_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 0)])?;
-        self.fill_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("FILL", 1)])?;
+        self.count_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("STEP", 0)])?;
+        self.fill_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("STEP", 1)])?;
+        self.number_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("STEP", 2)])?;
         for (source, pipelines) in [(1, &mut self.mark_scan[..]), (0, &mut self.list_scan[..])] {
             for (step, pipeline) in pipelines.iter_mut().enumerate() {
                 let constants = [("STEP", step as u32), ("SOURCE", source)];
@@ -261,10 +264,13 @@ impl LightGridBuild {
         let word_blocks = dispatch_grid(words.div_ceil(SCAN_BLOCK.into()) as u32);
         let list_blocks = Groups::Indirect(std::mem::offset_of!(LightGridDispatch, block_groups) as u64);
         let (lx, ly) = dispatch_grid(light_groups);
+        let group = ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0];
+        let (cx, cy) = dispatch_grid(self.shape.cells().div_ceil(group));
         let steps = [
             (self.mark_scan[0], Groups::Direct(word_blocks.0, word_blocks.1)),
             (self.mark_scan[1], Groups::Direct(1, 1)),
             (self.mark_scan[2], Groups::Direct(word_blocks.0, word_blocks.1)),
+            (self.number_pipeline, Groups::Direct(cx, cy)),
             (self.count_pipeline, Groups::Direct(lx, ly)),
             (self.list_scan[0], list_blocks),
             (self.list_scan[1], Groups::Direct(1, 1)),
@@ -304,7 +310,7 @@ impl LightGridBuild {
         }
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
-            for p in [self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan) {
+            for p in [self.number_pipeline, self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan) {
                 ctx.device.destroy_pipeline(p, None);
             }
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
