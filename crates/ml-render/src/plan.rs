@@ -35,8 +35,9 @@ pub enum PassKind {
     /// of every cell).
     LightGridBuild { marked: bool },
     /// The light grid's marks: the cells the opaque surfaces' points walk (`depth_buffer`:
-    /// from the compute raster's buffer, else the depth target).
-    LightGridMark { depth_buffer: bool },
+    /// from the compute raster's buffer, else the depth target), and with `layers` the
+    /// transparent layers' nodes'.
+    LightGridMark { depth_buffer: bool, layers: bool },
     /// Forward shading, every light or through the technique's light lists (`lights`: who
     /// assigns them), with the heat map's legend.
     Forward { lights: LightAssignment, heat_legend: bool },
@@ -157,13 +158,14 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     }
     // The opaque depth after the raster: the compute raster's buffer, or the depth target.
     let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
-    // The light grid is built once the opaque surfaces are known, for the cells their points
-    // walk, where a technique knows them before its lighting and nothing else is lit (the
-    // transparent layers' points are not in the depth); else first, for every cell.
+    // The light grid is built once the surfaces are known, for the cells their points walk,
+    // where a technique knows them before its lighting (the opaque depth, the transparent
+    // layers' nodes); else first, for every cell.
     let lights = technique.assignment();
     let surfaces_first = technique.geometry() == Geometry::Meshlets || technique.lighting_stage() == LightingStage::Compute;
-    let marks = lights == LightAssignment::Gpu && surfaces_first && !key.layers;
-    let marked_build = [PassKind::LightGridMark { depth_buffer: opaque_depth_buffer }, PassKind::LightGridBuild { marked: true }];
+    let marks = lights == LightAssignment::Gpu && surfaces_first;
+    let marked_build =
+        [PassKind::LightGridMark { depth_buffer: opaque_depth_buffer, layers: key.layers }, PassKind::LightGridBuild { marked: true }];
     let marked_build = if marks { &marked_build[..] } else { &[] };
     match lights {
         LightAssignment::None => {}
@@ -256,7 +258,7 @@ mod tests {
             (Technique::DeferredClustered, &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, ToneMap { curve: true }]),
             (
                 Technique::DeferredCompute,
-                &[GBuffer, LightGridMark { depth_buffer: false }, LightGridBuild { marked: true }, ComputeLighting],
+                &[GBuffer, LightGridMark { depth_buffer: false, layers: false }, LightGridBuild { marked: true }, ComputeLighting],
             ),
         ];
         for (technique, expected) in cases {
@@ -278,7 +280,7 @@ mod tests {
                 DepthPyramid,
                 MeshletCull(Phase::Late),
                 raster(Phase::Late),
-                LightGridMark { depth_buffer },
+                LightGridMark { depth_buffer, layers: false },
                 LightGridBuild { marked: true },
                 VisibilityLighting,
             ]
@@ -338,7 +340,14 @@ mod tests {
             ),
             (
                 Technique::DeferredCompute,
-                &[LightGridBuild { marked: false }, GBuffer, build, ComputeLighting, resolve(LightAssignment::Gpu, true)],
+                &[
+                    GBuffer,
+                    build,
+                    LightGridMark { depth_buffer: false, layers: true },
+                    LightGridBuild { marked: true },
+                    ComputeLighting,
+                    resolve(LightAssignment::Gpu, true),
+                ],
             ),
         ];
         for (technique, expected) in cases {
@@ -349,8 +358,17 @@ mod tests {
         }
         let mut k = key(Technique::Visibility);
         (k.layers, k.meters_exposure, k.raster) = (true, false, Raster::compute(64));
-        assert_eq!(plan(&k)[0], LightGridBuild { marked: false }, "the layers' points are not in the depth");
-        assert_eq!(plan(&k)[6..], [TransparentBuild { depth_buffer: true }, VisibilityLighting, resolve(LightAssignment::Gpu, true)]);
+        assert_eq!(
+            plan(&k)[5..],
+            [
+                TransparentBuild { depth_buffer: true },
+                LightGridMark { depth_buffer: true, layers: true },
+                LightGridBuild { marked: true },
+                VisibilityLighting,
+                resolve(LightAssignment::Gpu, true)
+            ],
+            "the grid marked from the opaque depth and the layers' nodes"
+        );
         // A surface view shows the opaque surfaces only; the layers' own view keeps them.
         let mut s = RenderSettings { transparency: Some(Default::default()), ..RenderSettings::new(Technique::Forward, 64, 64) };
         s.debug_view = DebugView::GBufferAlbedo;
@@ -367,7 +385,7 @@ mod tests {
             plan(&k),
             [
                 GBuffer,
-                LightGridMark { depth_buffer: false },
+                LightGridMark { depth_buffer: false, layers: false },
                 LightGridBuild { marked: true },
                 ComputeLighting,
                 LightCount { depth_buffer: false },

@@ -141,3 +141,44 @@ fn lists_larger_than_a_storage_buffer_fail_loudly_where_the_light_grid_renders()
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages");
 }
+
+#[test]
+fn lights_that_reach_only_a_transparent_layer_are_listed() {
+    // A wall at z = 0 and a glass pane at z = 1.5 in front of it, each lit by its own light:
+    // the pane's is 1.7 from the wall with a radius of 0.6, so the wall's points walk no cell of
+    // it; only the marks of the pane's nodes keep it in the lists.
+    let rotation = glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let pane = |z: f32, half: f32, albedo: f32| {
+        let material = Material { albedo: Vec3::splat(albedo), roughness: 0.7, metallic: 0.0 };
+        let mut o = Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, material);
+        o.transform = glam::Mat4::from_scale_rotation_translation(Vec3::new(half, 1.0, half), rotation, Vec3::new(0.0, 0.0, z));
+        o
+    };
+    let mut glass = pane(1.5, 1.0, 0.9);
+    glass.extras.alpha_mode = ml_cpu::scene::AlphaMode::Blend;
+    glass.extras.base_alpha = 0.5;
+    let light = |z: f32, c: f32| PointLight { position_radius: [0.1, 0.05, z, 0.6], color: [c, c, c, 0.0] };
+    let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 50.0, 0.1, 20.0);
+    let mut scene = Scene::new(vec![pane(0.0, 6.0, 0.8), glass], vec![light(0.4, 3.0), light(1.7, 20.0)], camera);
+    scene.light_motion = 0.0;
+    let settings = |technique| {
+        let mut s = RenderSettings { transparency: Some(Default::default()), ..RenderSettings::new(technique, W, H) };
+        if technique == Technique::Visibility {
+            s.raster = Raster::compute(Raster::DEFAULT_SPLIT);
+        }
+        s
+    };
+    let outs =
+        common::render_each(&scene, &[settings(Technique::Forward), settings(Technique::DeferredCompute), settings(Technique::Visibility)]);
+    let lit_by_the_pane_light = {
+        let unlit = Scene::new(scene.objects.clone(), vec![light(0.4, 3.0)], scene.camera);
+        common::max_difference(&outs[0], &common::render(unlit, settings(Technique::Forward)))
+    };
+    assert!(lit_by_the_pane_light.0 > 20 && lit_by_the_pane_light.1 > 100, "the pane's light shows on the pane: {lit_by_the_pane_light:?}");
+    for (out, name) in outs[1..].iter().zip(["deferred-compute", "visibility"]) {
+        let grid = out.stats.feature::<LightGridStats>().expect("the light grid's figures");
+        assert_eq!(grid.listed, 2, "{name}: both lights listed: {grid:?}");
+        let (worst, count) = common::max_difference(&outs[0], out);
+        assert!(worst <= 1, "{name}: {count} pixels differ from forward, by up to {worst}");
+    }
+}

@@ -310,7 +310,8 @@ impl LightGridBuild {
         }
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
-            for p in [self.number_pipeline, self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan) {
+            for p in [self.number_pipeline, self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan)
+            {
                 ctx.device.destroy_pipeline(p, None);
             }
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);

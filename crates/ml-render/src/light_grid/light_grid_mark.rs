@@ -1,18 +1,25 @@
 //! The light grid's marks (docs/DESIGN.md#the-light-grid): once the opaque surfaces are
 //! known (the visibility raster, the G-buffer) and before the build, a thread per pixel marks
-//! the cells its surface point's walk will visit (light_grid_mark.glsl). The build then lists
-//! only lights of marked cells, which the frame's pixels may test: at millions of lights most
-//! lie far from every visible surface.
+//! the cells its surface point's walk will visit (light_grid_mark.glsl), and with transparent
+//! layers a thread per node the cells of its point (light_grid_mark_layers.comp). The build
+//! then lists only lights of marked cells, which the frame's points may test: at millions of
+//! lights most lie far from every visible surface.
 
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
 use crate::pass::{Pass, Recording};
 use crate::sync::{Use, LIGHT_GRID_OCCUPANCY, VISIBILITY_DEPTH};
+use crate::transparency::LAYER_BUFFERS;
 use ml_vk::commands::memory_barrier;
 use ml_vk::{vk, Context, VkError};
 
+/// Threads of the layers' marks (each strides through the nodes).
+const LAYER_THREADS: u32 = 1 << 20;
+
 pub struct LightGridMark {
     pass: ComputePass,
+    /// The transparent layers' nodes' marks (frames with layers).
+    layers: Option<ComputePass>,
     /// Per frame slot: the marks (the build's), cleared before each frame's.
     occupancy: Vec<vk::Buffer>,
     /// The opaque depth is the compute raster's 64-bit buffer (else the depth target).
@@ -20,10 +27,22 @@ pub struct LightGridMark {
 }
 
 impl LightGridMark {
-    pub fn new(ctx: &Context, depth_buffer: bool) -> Result<LightGridMark, VkError> {
+    /// The marks from the opaque depth (`depth_buffer`: the compute raster's buffer, else the
+    /// depth target), and with `layers` from the transparent layers' nodes.
+    pub fn new(ctx: &Context, depth_buffer: bool, layers: bool) -> Result<LightGridMark, VkError> {
         let shader = if depth_buffer { &ml_shaders::LIGHT_GRID_MARK_BUFFER_COMP } else { &ml_shaders::LIGHT_GRID_MARK_COMP };
         let pass = ComputePass::new(ctx, &[], (shader, &[]))?;
-        Ok(LightGridMark { pass, occupancy: vec![vk::Buffer::null(); FRAMES_IN_FLIGHT], depth_buffer })
+        let mut mark = LightGridMark { pass, layers: None, occupancy: vec![vk::Buffer::null(); FRAMES_IN_FLIGHT], depth_buffer };
+        if layers {
+            match ComputePass::new(ctx, &[], (&ml_shaders::LIGHT_GRID_MARK_LAYERS_COMP, &[])) {
+                Ok(p) => mark.layers = Some(p),
+                Err(e) => {
+                    mark.pass.destroy(ctx);
+                    return Err(e);
+                }
+            }
+        }
+        Ok(mark)
     }
 }
 
@@ -38,7 +57,11 @@ impl Pass for LightGridMark {
         self.pass.bind_frame(ctx, frame, &|name| match name {
             "opaque_depth" => depth,
             _ => frame.buffer(name),
-        })
+        })?;
+        match &self.layers {
+            Some(layers) => layers.bind_frame(ctx, frame, &|name| frame.buffer(name)),
+            None => Ok(()),
+        }
     }
 
     /// Clears and writes the marks; reads the opaque depth (the compute raster's buffer; the
@@ -52,6 +75,10 @@ impl Pass for LightGridMark {
         if self.depth_buffer {
             uses.push(Use::at(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ), None));
         }
+        if self.layers.is_some() {
+            // The nodes and their count, as the transparent build left them.
+            uses.extend(LAYER_BUFFERS[1..].iter().map(|&name| Use::at(name, (compute, vk::AccessFlags::SHADER_READ), None)));
+        }
         uses
     }
 
@@ -62,9 +89,16 @@ impl Pass for LightGridMark {
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         memory_barrier(rec.ctx, rec.cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute, rw));
         self.pass.dispatch(rec.ctx, rec.cmd, rec.slot, (&[], &[]), rec.extent);
+        if let Some(layers) = &self.layers {
+            memory_barrier(rec.ctx, rec.cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
+            layers.dispatch(rec.ctx, rec.cmd, rec.slot, (&[], &[]), vk::Extent2D { width: LAYER_THREADS, height: 1 });
+        }
     }
 
     fn destroy(&mut self, ctx: &Context) {
         self.pass.destroy(ctx);
+        if let Some(layers) = &mut self.layers {
+            layers.destroy(ctx);
+        }
     }
 }
