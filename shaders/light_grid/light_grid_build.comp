@@ -20,8 +20,9 @@ layout(constant_id = 0) const uint STEP = 0u;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
 // The lights at rest in the grid's order (that of their cells at rest, so that neighbouring
-// invocations count into neighbouring cells): xyz position, w radius; and whole.
-layout(std430, set = 0, binding = 1) readonly buffer LightGridRestBuffer { vec4 rest_positions[]; };
+// invocations count into neighbouring cells; the wide lights last): positions alone, packed
+// (x, y, z of light i at 3i: twelve bytes a light, what COUNT reads of every light); and whole.
+layout(std430, set = 0, binding = 1) readonly buffer LightGridRestBuffer { float rest_positions[]; };
 layout(std430, set = 0, binding = 2) readonly buffer LightGridRestLightBuffer { PointLight rest_lights[]; };
 // Per place of the grid's order: the light's index in the scene.
 layout(std430, set = 0, binding = 9) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
@@ -79,12 +80,13 @@ void main() {
     barrier();
     uint i = first + t;
     if (i < frame.light_count) {
-        vec4 light = rest_positions[i];
-        light.xyz += frame.light_animation.xyz;
         bool listed = true;
         uint list = 0u;
-        if (light.w <= frame.light_grid_reach.x) {
-            vec3 g = (light.xyz - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
+        // The wide lights, last in the grid's order, go in list 0.
+        if (i < frame.light_count - uint(frame.light_grid_reach.y)) {
+            vec3 light = vec3(rest_positions[3u * i], rest_positions[3u * i + 1u], rest_positions[3u * i + 2u]);
+            light += frame.light_animation.xyz;
+            vec3 g = (light - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
             uvec3 c = uvec3(clamp(floor(g), vec3(0.0), vec3(frame.light_grid_dims.xyz - 1u)));
             uint cell = (c.z * frame.light_grid_dims.y + c.y) * frame.light_grid_dims.x + c.x;
             uvec2 o = grid_occupancy[cell >> 5u];

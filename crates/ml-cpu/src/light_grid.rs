@@ -298,6 +298,7 @@ mod tests {
         let lists: Vec<u32> = order.iter().map(|&i| shape.list_of(shape.origin, &lights[i as usize])).collect();
         assert!(lists.windows(2).all(|w| w[0] <= w[1]), "in list order");
         assert_eq!(*lists.last().unwrap(), shape.cells(), "the wide light last");
+        assert_eq!(lists.iter().filter(|&&l| l == shape.cells()).count(), shape.wide as usize, "the build counts the last `wide` as wide");
     }
 
     #[test]

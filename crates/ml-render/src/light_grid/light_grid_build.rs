@@ -60,9 +60,9 @@ pub struct LightGridBuild {
     /// and of the lists' counts.
     mark_scan: [vk::Pipeline; 3],
     list_scan: [vk::Pipeline; 3],
-    /// The lights at rest in the grid's order (device-local, uploaded once), their positions
-    /// and radii alone (what COUNT reads of every light), and per place the light's index in
-    /// the scene (its spot cone's).
+    /// The lights at rest in the grid's order (device-local, uploaded once; the wide lights
+    /// last), their positions alone, packed (what COUNT reads of every light: 12 bytes), and
+    /// per place the light's index in the scene (its spot cone's).
     lights: Buffer,
     positions: Buffer,
     order: Buffer,
@@ -231,7 +231,7 @@ impl LightGridBuild {
         let order = grid_order(&self.shape, rest_lights);
         let mut sorted: Vec<PointLight> = order.iter().map(|&i| rest_lights[i as usize]).collect();
         sorted.resize(guard(sorted.len()), PointLight::zeroed());
-        let positions: Vec<[f32; 4]> = sorted.iter().map(|l| l.position_radius).collect();
+        let positions: Vec<f32> = sorted.iter().flat_map(|l| l.position_radius[..3].to_vec()).collect();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let mut order = order;
         order.resize(guard(order.len()), 0);
