@@ -287,7 +287,11 @@ impl LightGridBuild {
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[set], &[]);
             for (i, (pipeline, groups)) in steps.into_iter().enumerate() {
                 if i > 0 {
-                    let to = (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ);
+                    // An indirect dispatch also waits for its work groups' count.
+                    let to = match groups {
+                        Groups::Direct(..) => (compute, rw),
+                        Groups::Indirect(_) => (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ),
+                    };
                     memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), to);
                 }
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
