@@ -24,13 +24,23 @@ pub const WIDE_SHARE: usize = 64;
 /// nothing, so a wider walk only tests a few more lights.
 pub const GRID_MARGIN: f32 = 1e-4;
 
-/// The most lists (cells and the wide lights') a grid has: 2^27 × 4 B of counts, within what
-/// a device binds as one storage buffer (the GPU scan takes up to 2^30).
+/// The most lists (cells and the wide lights') a grid has: 2^27 cells' ranges of 8 B, within
+/// what a device binds as one storage buffer.
 pub const MAX_LISTS: u64 = 1 << 27;
 
+/// Bytes per cell of the largest per-cell buffer the GPU binds (a cell's range of the lists:
+/// start and end).
+pub const CELL_RANGE_BYTES: u64 = 8;
+
+/// The cells a device binds as one storage buffer of cells' ranges, for its
+/// `maxStorageBufferRange`.
+pub fn bindable_cells(max_storage_buffer_range: u32) -> u64 {
+    u64::from(max_storage_buffer_range) / CELL_RANGE_BYTES
+}
+
 /// The most cells a grid of `lights` lights gets where the device binds `bindable_lists`
-/// lists (one u32 each) as one storage buffer: cells about the lights' radius in a box
-/// of uniform lights come to about one per light, so two per light keeps the scan and its
+/// cells (`bindable_cells`) as one storage buffer: cells about the lights' radius in a box
+/// of uniform lights come to about one per light, so two per light keeps the scans and their
 /// memory in proportion to the lights.
 pub fn cell_budget(lights: usize, bindable_lists: u64) -> u64 {
     (2 * lights as u64 + 64).min(bindable_lists.saturating_sub(1)).clamp(1, MAX_LISTS - 1)

@@ -10,7 +10,7 @@ mod common;
 use glam::{Mat4, Quat, Vec3};
 use ml_cpu::camera::Camera;
 use ml_cpu::gpu_types::PointLight;
-use ml_cpu::light_grid::{cell_budget, cpu_lists, tested_at, LightGridShape};
+use ml_cpu::light_grid::{bindable_cells, cell_budget, cpu_lists, tested_at, LightGridShape};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
@@ -81,7 +81,7 @@ fn the_counts_equal_the_lists_and_a_cpu_count_of_the_lights_reaching() {
             let out = renderer.render().expect("render");
             drop(renderer);
             let got = *out.stats.feature::<LightStats>().expect("the light counts");
-            let bindable = u64::from(ctx.info.limits.max_storage_buffer_range) / 4;
+            let bindable = bindable_cells(ctx.info.limits.max_storage_buffer_range);
             let grid = LightGridShape::fit(&scene.lights, cell_budget(scene.lights.len(), bindable));
             let want = cpu_counts(&scene, &grid);
             let name = format!("{} ({}), scene {seed}", technique.name(), raster.name());

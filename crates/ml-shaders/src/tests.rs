@@ -77,11 +77,11 @@ fn every_shader_reflects_what_its_glsl_declares() {
 
 #[test]
 fn known_shaders_have_their_glsl_numbers() {
-    // light_grid_build.comp: local_size_x = 256; constant_id 0 FILL.
+    // light_grid_build.comp: local_size_x = 256; constant_id 0 STEP.
     assert_eq!(LIGHT_GRID_BUILD_COMP.file, "light_grid/light_grid_build.comp");
     assert_eq!(LIGHT_GRID_BUILD_COMP.workgroup_size, [256, 1, 1]);
-    assert_eq!(LIGHT_GRID_BUILD_COMP.spec_constants, &[SpecConstant { name: "FILL", id: 0 }]);
-    assert_eq!(LIGHT_GRID_BUILD_COMP.spec_id("STEP"), None);
+    assert_eq!(LIGHT_GRID_BUILD_COMP.spec_constants, &[SpecConstant { name: "STEP", id: 0 }]);
+    assert_eq!(LIGHT_GRID_BUILD_COMP.spec_id("SOURCE"), None);
     // tonemap.comp: 8×8, and the shading model's constants from common/shading_model.glsl.
     assert_eq!(TONEMAP_COMP.workgroup_size, [8, 8, 1]);
     assert_eq!(TONEMAP_COMP.spec_id("MODEL_PBR"), Some(11));

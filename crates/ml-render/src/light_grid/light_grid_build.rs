@@ -29,7 +29,7 @@ use crate::specialization::compute_pipeline;
 use crate::sync::{Use, LIGHT_GRID_LISTS, LIGHT_GRID_OCCUPANCY};
 use bytemuck::Zeroable;
 use ml_cpu::gpu_types::{FrameUniforms, LightGridDispatch, LightGridFeedback, PointLight};
-use ml_cpu::light_grid::{cell_budget, grid_order, LightGridShape};
+use ml_cpu::light_grid::{bindable_cells, cell_budget, grid_order, LightGridShape, CELL_RANGE_BYTES};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
@@ -121,7 +121,7 @@ impl GridSlot {
         ml_vk::build(ctx, slot, |s| {
             s.lists = Buffer::new(ctx, "light grid lists", lists * 4, storage, gpu)?;
             s.list_cells = Buffer::new(ctx, "light grid lists' cells", lists * 4, storage, gpu)?;
-            s.cell_ranges = Buffer::new(ctx, "light grid cell ranges", (cells + 1) * 8, storage, gpu)?;
+            s.cell_ranges = Buffer::new(ctx, "light grid cell ranges", (cells + 1) * CELL_RANGE_BYTES, storage, gpu)?;
             let words = cells.div_ceil(CELLS_PER_WORD);
             s.occupancy = Buffer::new(ctx, "light grid marks", words * 8, storage | vk::BufferUsageFlags::TRANSFER_DST, gpu)?;
             let blocks = lists.div_ceil(SCAN_BLOCK.into());
@@ -191,8 +191,7 @@ impl LightGridBuild {
     /// The build for `rest_lights`: a grid of at most `cell_budget` cells (what the device
     /// binds as one storage buffer of lists); `marked`: a marks pass runs before it.
     pub fn new(ctx: &Context, rest_lights: &[PointLight], marked: bool) -> Result<LightGridBuild, VkError> {
-        // Cells' ranges are 8 bytes each.
-        let bindable = u64::from(ctx.info.limits.max_storage_buffer_range) / 8;
+        let bindable = bindable_cells(ctx.info.limits.max_storage_buffer_range);
         let shape = LightGridShape::fit(rest_lights, cell_budget(rest_lights.len(), bindable));
         let stages = [&ml_shaders::LIGHT_GRID_BUILD_COMP, &ml_shaders::LIGHT_GRID_SCAN_COMP].map(|s| (s, vk::ShaderStageFlags::COMPUTE));
         let b = LightGridBuild {
