@@ -5,8 +5,8 @@
 //          plus the marked cells before it in the word) learns its cell, and its count is
 //          zeroed for COUNT;
 // then an invocation per light, twice around the scan of the lists:
-//   COUNT: move the light by the frame's offset and find its list: the wide lights' (list 0)
-//          when wider than the reach, else its cell's if the cell is marked
+//   COUNT: find the light's list: the wide lights' (list 0) for the last `wide` of the grid's
+//          order, else, moved by the frame's offset, its cell's if the cell is marked
 //          (light_grid_mark.glsl; otherwise no pixel tests it and it is left out). Count it
 //          there and keep (light, list) in the work group's part of the kept lights;
 //   FILL:  after the scan, each kept light takes the next place of its list and writes itself
@@ -27,7 +27,7 @@ layout(std430, set = 0, binding = 2) readonly buffer LightGridRestLightBuffer { 
 // Per place of the grid's order: the light's index in the scene.
 layout(std430, set = 0, binding = 9) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
 // Per list: COUNT its count; after the scan its start (FILL's cursor).
-layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_list_ends[]; };
+layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint list_counts[]; };
 // Per 32 cells: their marks and the list of the first marked one.
 layout(std430, set = 0, binding = 4) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 // Per list: its cell.
@@ -50,14 +50,14 @@ void main() {
     if (STEP == 2u) {
         uint c = first + t;
         if (c == 0u) {
-            grid_list_ends[0] = 0u;
+            list_counts[0] = 0u;
         }
         if (c < frame.light_grid_dims.w) {
             uvec2 o = grid_occupancy[c >> 5u];
             if ((o.x & (1u << (c & 31u))) != 0u) {
                 uint list = o.y + bitCount(o.x & ((1u << (c & 31u)) - 1u));
                 list_cells[list] = c;
-                grid_list_ends[list] = 0u;
+                list_counts[list] = 0u;
             }
         }
         return;
@@ -67,7 +67,7 @@ void main() {
             return;
         }
         uvec2 k = kept[first + t];
-        uint slot = atomicAdd(grid_list_ends[k.y], 1u);
+        uint slot = atomicAdd(list_counts[k.y], 1u);
         PointLight l = rest_lights[k.x];
         grid_light_positions[slot] = vec4(l.position_radius.xyz + frame.light_animation.xyz, l.position_radius.w);
         grid_light_colors[slot] = l.color;
@@ -94,7 +94,7 @@ void main() {
             list = o.y + bitCount(o.x & ((1u << (cell & 31u)) - 1u));
         }
         if (listed) {
-            atomicAdd(grid_list_ends[list], 1u);
+            atomicAdd(list_counts[list], 1u);
             kept[first + atomicAdd(group_kept, 1u)] = uvec2(i, list);
         }
     }

@@ -20,7 +20,7 @@ layout(constant_id = 0) const uint STEP = 0u;
 layout(constant_id = 1) const uint SOURCE = 0u;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
-layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_list_ends[]; };
+layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint list_counts[]; };
 layout(std430, set = 0, binding = 4) buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 // Per block: x its total, then its start; y its largest count.
 layout(std430, set = 0, binding = 8) buffer LightGridBlockBuffer { uvec2 grid_blocks[]; };
@@ -74,7 +74,7 @@ uint source_count(uint i, uint size) {
     if (i >= size) {
         return 0u;
     }
-    return SOURCE == 1u ? bitCount(word_marks(i)) : grid_list_ends[i];
+    return SOURCE == 1u ? bitCount(word_marks(i)) : list_counts[i];
 }
 
 // A dispatch of `groups` work groups as rows of GROUPS_PER_ROW.
@@ -104,7 +104,7 @@ void set_start(uint i, uint start, uint count) {
     if (SOURCE == 1u) {
         grid_occupancy[i].y = start + 1u;
     } else {
-        grid_list_ends[i] = start;
+        list_counts[i] = start;
         grid_cell_ranges[i == 0u ? frame.light_grid_dims.w : list_cells[i]] = uvec2(start, start + count);
         if (i == 0u) {
             feedback.wide = count;
