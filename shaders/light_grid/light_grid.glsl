@@ -6,9 +6,9 @@
 // nothing marks), cell after cell in cell order (x fastest), each light moved to where it is
 // this frame, its position and radius apart from its colour (a point reads the colour only of
 // the lights that reach it). `grid_cell_ranges[c]` is where marked cell c's lights start and
-// end (other cells' entries are stale: no point walks them), `grid_cell_ranges[cells]` the
-// wide lights'. The cells a point walks are all marked, so a row of them along x is one
-// contiguous run of the lists.
+// end (other cells' entries are stale or never written: no point walks them),
+// `grid_cell_ranges[cells]` the wide lights'. The cells a point walks are all marked, so a
+// row of them along x is one contiguous run of the lists.
 
 #ifndef MANYLIGHTS_LIGHT_GRID_GLSL
 #define MANYLIGHTS_LIGHT_GRID_GLSL

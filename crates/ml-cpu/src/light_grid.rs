@@ -7,7 +7,9 @@
 //! it, not the total.
 //!
 //! This is the CPU model of what the GPU builds (light_grid_build.comp) and walks
-//! (light_grid.glsl): the same f32 arithmetic, used to fit the grid and by the tests.
+//! (light_grid.glsl): the same f32 arithmetic, used to fit the grid and by the tests. The GPU
+//! lists only the cells some point of the frame walks (its marks); the cells a point walks
+//! hold the same lights as here, so what a point tests is the same.
 
 use crate::gpu_types::PointLight;
 use glam::{UVec3, Vec3};
