@@ -42,6 +42,14 @@ layout(std430, set = 0, binding = 11) writeonly buffer LightGridIndexBuffer { ui
 
 shared uint group_kept;
 
+// Whether cell c is marked, and its list (its word's first marked cell's, plus the marked
+// cells before it in the word).
+bool marked_list(uint c, out uint list) {
+    uvec2 o = grid_occupancy[c >> 5u];
+    list = o.y + bitCount(o.x & ((1u << (c & 31u)) - 1u));
+    return (o.x & (1u << (c & 31u))) != 0u;
+}
+
 void main() {
     // Work groups come in rows (a device takes at most 65,535 along x).
     uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -52,13 +60,10 @@ void main() {
         if (c == 0u) {
             list_counts[0] = 0u;
         }
-        if (c < frame.light_grid_dims.w) {
-            uvec2 o = grid_occupancy[c >> 5u];
-            if ((o.x & (1u << (c & 31u))) != 0u) {
-                uint list = o.y + bitCount(o.x & ((1u << (c & 31u)) - 1u));
-                list_cells[list] = c;
-                list_counts[list] = 0u;
-            }
+        uint list;
+        if (c < frame.light_grid_dims.w && marked_list(c, list)) {
+            list_cells[list] = c;
+            list_counts[list] = 0u;
         }
         return;
     }
@@ -88,10 +93,7 @@ void main() {
             light += frame.light_animation.xyz;
             vec3 g = (light - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
             uvec3 c = uvec3(clamp(floor(g), vec3(0.0), vec3(frame.light_grid_dims.xyz - 1u)));
-            uint cell = (c.z * frame.light_grid_dims.y + c.y) * frame.light_grid_dims.x + c.x;
-            uvec2 o = grid_occupancy[cell >> 5u];
-            listed = (o.x & (1u << (cell & 31u))) != 0u;
-            list = o.y + bitCount(o.x & ((1u << (cell & 31u)) - 1u));
+            listed = marked_list((c.z * frame.light_grid_dims.y + c.y) * frame.light_grid_dims.x + c.x, list);
         }
         if (listed) {
             atomicAdd(list_counts[list], 1u);

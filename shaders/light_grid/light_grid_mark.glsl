@@ -52,7 +52,7 @@ void main() {
     GridWalk w;
     if (surface) {
         vec3 world = world_from_depth(vec2(p) + 0.5, z);
-        w = grid_walk_wider(world, mark_margin(world));
+        w = mark_walk_of(world);
         for (uint i = 0u; i < 3u; ++i) {
             atomicMin(box_lo[i], w.lo[i]);
             atomicMax(box_hi[i], w.hi[i]);
@@ -63,16 +63,13 @@ void main() {
     uvec3 hi = uvec3(box_hi[0], box_hi[1], box_hi[2]);
     uvec3 n = lo.x > hi.x ? uvec3(0u) : hi - lo + 1u;
     bool in_box = n.x * n.y * n.z <= BOX_CELLS;
-    if (surface) {
+    if (surface && !in_box) {
+        mark_rows(w);
+    } else if (surface) {
         for (uint cz = w.lo.z; cz <= w.hi.z; ++cz) {
             for (uint cy = w.lo.y; cy <= w.hi.y; ++cy) {
-                if (in_box) {
-                    uint row = ((cz - lo.z) * n.y + (cy - lo.y)) * n.x - lo.x;
-                    mark_box_run(row + w.lo.x, row + w.hi.x);
-                } else {
-                    uint row = (cz * frame.light_grid_dims.y + cy) * frame.light_grid_dims.x;
-                    mark_run(row + w.lo.x, row + w.hi.x);
-                }
+                uint row = ((cz - lo.z) * n.y + (cy - lo.y)) * n.x - lo.x;
+                mark_box_run(row + w.lo.x, row + w.hi.x);
             }
         }
     }

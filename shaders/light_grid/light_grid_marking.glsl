@@ -36,15 +36,24 @@ void mark_run(uint c0, uint c1) {
     }
 }
 
-// Mark every cell the walk of a point at `world` visits, row by row, in the grid's marks.
-void mark_walk(vec3 world) {
-    GridWalk w = grid_walk_wider(world, mark_margin(world));
+// Mark the cells of walk `w`'s box, row by row, in the grid's marks.
+void mark_rows(GridWalk w) {
     for (uint cz = w.lo.z; cz <= w.hi.z; ++cz) {
         for (uint cy = w.lo.y; cy <= w.hi.y; ++cy) {
             uint row = (cz * frame.light_grid_dims.y + cy) * frame.light_grid_dims.x;
             mark_run(row + w.lo.x, row + w.hi.x);
         }
     }
+}
+
+// The walk a mark covers for a point at `world`: its cells and the margin beyond.
+GridWalk mark_walk_of(vec3 world) {
+    return grid_walk_wider(world, mark_margin(world));
+}
+
+// Mark every cell the walk of a point at `world` visits.
+void mark_walk(vec3 world) {
+    mark_rows(mark_walk_of(world));
 }
 
 #endif
