@@ -23,7 +23,10 @@ layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { Cluste
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };
 #endif
 #ifdef LIGHT_GRID
-layout(std430, set = 0, binding = 30) readonly buffer LightGridCellRangeBuffer { uvec2 grid_cell_ranges[]; };
+// The light grid's lists' ends (list 0 the wide lights', then a list per marked cell) and per
+// 32 cells their marks and the list of the first marked one (light_grid/light_grid.glsl).
+layout(std430, set = 0, binding = 30) readonly buffer LightGridListBuffer { uint grid_lists[]; };
+layout(std430, set = 0, binding = 31) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 #endif
 
 #endif

@@ -1,21 +1,28 @@
 // The light grid's walk (docs/DESIGN.md#the-light-grid): the lights a surface point tests.
 // Keep in sync with crates/ml-cpu/src/light_grid.rs (LightGridShape::rows_near).
 //
-// The lists, as the build leaves them: the wide lights first, then the lights of each marked
-// cell (a cell some surface point of the frame walks, light_grid_mark.glsl; every cell where
+// The lists, as the build leaves them: the wide lights' (list 0), then a list per marked cell
+// (a cell some surface point of the frame walks, light_grid_mark.glsl; every cell where
 // nothing marks), cell after cell in cell order (x fastest), each light moved to where it is
 // this frame, its position and radius apart from its colour (a point reads the colour only of
-// the lights that reach it). `grid_cell_ranges[c]` is where marked cell c's lights start and
-// end (other cells' entries are stale or never written: no point walks them),
-// `grid_cell_ranges[cells]` the wide lights'. The cells a point walks are all marked, so a
-// row of them along x is one contiguous run of the lists.
+// the lights that reach it). `grid_lists[l]` is where list l ends and list l + 1 starts;
+// a marked cell's list is its rank among the marked cells, from the marks' words
+// (`grid_occupancy`: per 32 cells their bits and the list of the first marked one). The
+// cells a point walks are all marked, so a row of them along x is one contiguous run of the
+// lists, from the start of its first cell's list to the end of its last's. Only the small
+// per-word table and the lists are read, never a table of every cell.
 
 #ifndef MANYLIGHTS_LIGHT_GRID_GLSL
 #define MANYLIGHTS_LIGHT_GRID_GLSL
 
 #include "light_grid/light_grid_walk.glsl"
 
-// The run of the list that row (y, z) gives the walk (empty where the row is out of reach).
+// The list of marked cell c.
+uint grid_list(uint c) {
+    return grid_word_list(grid_occupancy[c >> 5u], c);
+}
+
+// The run of the lists that row (y, z) gives the walk (empty where the row is out of reach).
 uvec2 grid_row(GridWalk w, uint y, uint z) {
     float dy = grid_slab_distance(w.g.y, y, frame.light_grid_dims.y);
     float dz = grid_slab_distance(w.g.z, z, frame.light_grid_dims.z);
@@ -28,7 +35,8 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
     uint row = (z * frame.light_grid_dims.y + y) * frame.light_grid_dims.x;
     uint x0 = uint(clamp(floor(w.g.x - h), 0.0, top));
     uint x1 = uint(clamp(floor(w.g.x + h), 0.0, top));
-    return uvec2(grid_cell_ranges[row + x0].x, grid_cell_ranges[row + x1].y);
+    // Lists are numbered from 1 after the wide lights' list 0.
+    return uvec2(grid_lists[grid_list(row + x0) - 1u], grid_lists[grid_list(row + x1)]);
 }
 
 // Run BODY for each place `k_` of the lists (the light's position and radius
@@ -37,8 +45,8 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
 // cells within reach.
 #define GRID_FOR_LIGHTS(BODY)                                                   \
     {                                                                           \
-        uvec2 wide_ = grid_cell_ranges[frame.light_grid_dims.w];                \
-        for (uint k_ = wide_.x; k_ < wide_.y; ++k_) {                           \
+        uint wide_ = grid_lists[0];                                             \
+        for (uint k_ = 0u; k_ < wide_; ++k_) {                                  \
             BODY                                                                \
         }                                                                       \
         GridWalk w_ = grid_walk(world);                                         \

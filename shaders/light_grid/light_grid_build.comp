@@ -1,10 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// The light grid's build, after the scan of the marks (light_grid_scan.comp):
-//   NUMBER, an invocation per cell: a marked cell's list (that of its word's first marked cell,
-//          plus the marked cells before it in the word) learns its cell, and its count is
-//          zeroed for COUNT;
-// then an invocation per light, twice around the scan of the lists:
+// The light grid's build, after the scan of the marks (light_grid_scan.comp: the marked
+// cells' lists numbered, their counts zeroed), an invocation per light, twice around the
+// scan of the lists:
 //   COUNT: find the light's list: the wide lights' (list 0) for the last `wide` of the grid's
 //          order, else, moved by the frame's offset, its cell's if the cell is marked
 //          (light_grid_mark.glsl; otherwise no pixel tests it and it is left out). Count it
@@ -15,10 +13,11 @@
 #include "common/common.glsl"
 
 layout(local_size_x = 256) in;
-// 0: COUNT, 1: FILL, 2: NUMBER.
+// 0: COUNT, 1: FILL.
 layout(constant_id = 0) const uint STEP = 0u;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+#include "light_grid/light_grid_walk.glsl"
 // The lights at rest in the grid's order (that of their cells at rest, so that neighbouring
 // invocations count into neighbouring cells; the wide lights last): positions alone, packed
 // (x, y, z of light i at 3i: twelve bytes a light, what COUNT reads of every light); and whole.
@@ -26,12 +25,11 @@ layout(std430, set = 0, binding = 1) readonly buffer LightGridRestBuffer { float
 layout(std430, set = 0, binding = 2) readonly buffer LightGridRestLightBuffer { PointLight rest_lights[]; };
 // Per place of the grid's order: the light's index in the scene.
 layout(std430, set = 0, binding = 9) readonly buffer LightGridOrderBuffer { uint grid_order[]; };
-// Per list: COUNT its count; after the scan its start (FILL's cursor).
-layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint list_counts[]; };
+// Per list: COUNT its count; after the scan its start (FILL's cursor); after FILL its end
+// (what the walk reads, light_grid.glsl).
+layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_lists[]; };
 // Per 32 cells: their marks and the list of the first marked one.
 layout(std430, set = 0, binding = 4) readonly buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
-// Per list: its cell.
-layout(std430, set = 0, binding = 16) writeonly buffer LightGridListCellBuffer { uint list_cells[]; };
 // Per work group of COUNT: its kept lights (place in the grid's order, list) and how many.
 layout(std430, set = 0, binding = 5) buffer LightGridKeptBuffer { uvec2 kept[]; };
 layout(std430, set = 0, binding = 10) buffer LightGridKeptCountBuffer { uint kept_count[]; };
@@ -42,11 +40,10 @@ layout(std430, set = 0, binding = 11) writeonly buffer LightGridIndexBuffer { ui
 
 shared uint group_kept;
 
-// Whether cell c is marked, and its list (its word's first marked cell's, plus the marked
-// cells before it in the word).
+// Whether cell c is marked, and its list.
 bool marked_list(uint c, out uint list) {
     uvec2 o = grid_occupancy[c >> 5u];
-    list = o.y + bitCount(o.x & ((1u << (c & 31u)) - 1u));
+    list = grid_word_list(o, c);
     return (o.x & (1u << (c & 31u))) != 0u;
 }
 
@@ -55,24 +52,12 @@ void main() {
     uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
     uint t = gl_LocalInvocationID.x;
     uint first = group * gl_WorkGroupSize.x;
-    if (STEP == 2u) {
-        uint c = first + t;
-        if (c == 0u) {
-            list_counts[0] = 0u;
-        }
-        uint list;
-        if (c < frame.light_grid_dims.w && marked_list(c, list)) {
-            list_cells[list] = c;
-            list_counts[list] = 0u;
-        }
-        return;
-    }
     if (STEP == 1u) {
         if (t >= kept_count[group]) {
             return;
         }
         uvec2 k = kept[first + t];
-        uint slot = atomicAdd(list_counts[k.y], 1u);
+        uint slot = atomicAdd(grid_lists[k.y], 1u);
         PointLight l = rest_lights[k.x];
         grid_light_positions[slot] = vec4(l.position_radius.xyz + frame.light_animation.xyz, l.position_radius.w);
         grid_light_colors[slot] = l.color;
@@ -96,7 +81,7 @@ void main() {
             listed = marked_list((c.z * frame.light_grid_dims.y + c.y) * frame.light_grid_dims.x + c.x, list);
         }
         if (listed) {
-            atomicAdd(list_counts[list], 1u);
+            atomicAdd(grid_lists[list], 1u);
             kept[first + atomicAdd(group_kept, 1u)] = uvec2(i, list);
         }
     }

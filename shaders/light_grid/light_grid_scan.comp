@@ -3,10 +3,10 @@
 // The light grid's scans (exclusive prefix sums) in three steps, of
 //   SOURCE 1, the marks (after light_grid_mark.glsl, before COUNT): per 32 cells the marked
 //             ones become the list of their first, so that every marked cell gets a list
-//             (list 0 is the wide lights'), and the lists' scan gets its work groups
-//             (LightGridDispatch);
+//             (list 0 is the wide lights'), the lists' counts are zeroed for COUNT, and the
+//             lists' scan gets its work groups (LightGridDispatch);
 //   SOURCE 0, the lists' counts (between COUNT and FILL, light_grid_build.comp): each becomes
-//             its list's start (FILL's cursor), and its cell's range of the lists is written.
+//             its list's start (FILL's cursor; after FILL its end, what the walk reads).
 // Blocks of 1024 counts, four per invocation:
 //   STEP 0, a work group per block: the block's total and largest count;
 //   STEP 1, one work group: the blocks' totals become their starts, 4096 at a time; the
@@ -20,16 +20,12 @@ layout(constant_id = 0) const uint STEP = 0u;
 layout(constant_id = 1) const uint SOURCE = 0u;
 
 layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
-layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint list_counts[]; };
+layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_lists[]; };
 layout(std430, set = 0, binding = 4) buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 // Per block: x its total, then its start; y its largest count.
 layout(std430, set = 0, binding = 8) buffer LightGridBlockBuffer { uvec2 grid_blocks[]; };
 layout(std430, set = 0, binding = 7) buffer LightGridFeedbackBuffer { LightGridFeedback feedback; };
 layout(std430, set = 0, binding = 13) buffer LightGridDispatchBuffer { LightGridDispatch grid_dispatch; };
-// Per list: its cell (light_grid_build.comp NUMBER).
-layout(std430, set = 0, binding = 16) readonly buffer LightGridListCellBuffer { uint list_cells[]; };
-// Per cell: where its lights start and end in the lists (marked cells'); then the wide lights'.
-layout(std430, set = 0, binding = 15) writeonly buffer LightGridCellRangeBuffer { uvec2 grid_cell_ranges[]; };
 
 const uint BLOCK = 1024u;
 const uint THREADS = 256u;
@@ -74,7 +70,7 @@ uint source_count(uint i, uint size) {
     if (i >= size) {
         return 0u;
     }
-    return SOURCE == 1u ? bitCount(word_marks(i)) : list_counts[i];
+    return SOURCE == 1u ? bitCount(word_marks(i)) : grid_lists[i];
 }
 
 // A dispatch of `groups` work groups as rows of GROUPS_PER_ROW.
@@ -98,14 +94,13 @@ void report(uint total, uint largest) {
 }
 
 // STEP 2: count i starts at `start`. A word of marks gives its first marked cell its list
-// (after the wide lights' list 0; the build's NUMBER step numbers the others); a list keeps
-// its start for FILL, and its cell (list 0: the wide lights) gets its range.
+// (after the wide lights' list 0; the others follow it by rank); a list keeps its start for
+// FILL.
 void set_start(uint i, uint start, uint count) {
     if (SOURCE == 1u) {
         grid_occupancy[i].y = start + 1u;
     } else {
-        list_counts[i] = start;
-        grid_cell_ranges[i == 0u ? frame.light_grid_dims.w : list_cells[i]] = uvec2(start, start + count);
+        grid_lists[i] = start;
         if (i == 0u) {
             feedback.wide = count;
         }
@@ -176,6 +171,17 @@ void main() {
         return;
     }
     uint start = grid_blocks[g].x + scan[t] - sum;
+    if (SOURCE == 1u) {
+        // The block's marked cells have the lists from its start on (after list 0): zero
+        // their counts for COUNT, side by side.
+        uint lists = scan[THREADS - 1u];
+        for (uint j = t; j < lists; j += THREADS) {
+            grid_lists[grid_blocks[g].x + 1u + j] = 0u;
+        }
+        if (g == 0u && t == 0u) {
+            grid_lists[0] = 0u;
+        }
+    }
     for (uint k = 0u; k < PER; ++k) {
         if (first + k < n) {
             set_start(first + k, start, counts[k]);

@@ -40,4 +40,11 @@ float grid_slab_distance(float g, uint c, uint n) {
     return max(max(below, above), 0.0);
 }
 
+// The list of cell c, marked, from its word of marks `o` (per 32 cells their bits and the list
+// of the first marked one): its word's first marked cell's, plus the marked cells before it in
+// the word.
+uint grid_word_list(uvec2 o, uint c) {
+    return o.y + bitCount(o.x & ((1u << (c & 31u)) - 1u));
+}
+
 #endif

@@ -26,18 +26,17 @@ pub const WIDE_SHARE: usize = 64;
 /// nothing, so a wider walk only tests a few more lights.
 pub const GRID_MARGIN: f32 = 1e-4;
 
-/// The most lists (cells and the wide lights') a grid has: 2^27 cells' ranges of 8 B, within
+/// The most lists (cells and the wide lights') a grid has: 2^27 lists' ends of 4 B, within
 /// what a device binds as one storage buffer.
 pub const MAX_LISTS: u64 = 1 << 27;
 
-/// Bytes per cell of the largest per-cell buffer the GPU binds (a cell's range of the lists:
-/// start and end).
-pub const CELL_RANGE_BYTES: u64 = 8;
+/// Bytes per cell of the largest per-cell buffer the GPU binds (a list per cell: its count,
+/// start, then end).
+pub const LIST_BYTES: u64 = 4;
 
-/// The cells a device binds as one storage buffer of cells' ranges, for its
-/// `maxStorageBufferRange`.
+/// The cells a device binds as one storage buffer of lists, for its `maxStorageBufferRange`.
 pub fn bindable_cells(max_storage_buffer_range: u32) -> u64 {
-    u64::from(max_storage_buffer_range) / CELL_RANGE_BYTES
+    u64::from(max_storage_buffer_range) / LIST_BYTES
 }
 
 /// The most cells a grid of `lights` lights gets where the device binds `bindable_lists`

@@ -213,21 +213,21 @@ pub const HDR_TARGET: &str = "hdr target";
 /// the host (the CPU assignment), read by every shading pass.
 pub const LIGHT_LISTS: [&str; 3] = ["LightBuffer", "ClusterRangeBuffer", "LightIndexBuffer"];
 
-/// The frame slot's light-grid lists (the cells' ranges of them, the lights in them —
-/// positions, colours — and their scene indices): written by the light grid's build, read by
-/// every shading pass.
-pub const LIGHT_GRID_LISTS: [&str; 4] =
-    ["LightGridCellRangeBuffer", "LightGridPositionBuffer", "LightGridColorBuffer", "LightGridIndexBuffer"];
+/// The frame slot's light-grid lists (where each ends, the lights in them — positions,
+/// colours — and their scene indices): written by the light grid's build, read by every
+/// shading pass.
+pub const LIGHT_GRID_LISTS: [&str; 4] = ["LightGridListBuffer", "LightGridPositionBuffer", "LightGridColorBuffer", "LightGridIndexBuffer"];
 
 /// The frame slot's light-grid marks (a bit per cell a surface point walks, and per 32 cells
 /// the list of the first marked one): written by the marks pass (or the build), read by the
-/// build.
+/// build and by every shading pass (a marked cell's list is its rank among them).
 pub const LIGHT_GRID_OCCUPANCY: &str = "LightGridOccupancyBuffer";
 
 /// How a shading pass reads the lights and lists (whichever the technique has): in `stages`.
 pub fn light_list_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let mut names = LIGHT_LISTS.to_vec();
     names.extend(&LIGHT_GRID_LISTS);
+    names.push(LIGHT_GRID_OCCUPANCY);
     names.into_iter().map(|name| Use::at(name, (stages, vk::AccessFlags::SHADER_READ), None)).collect()
 }
 

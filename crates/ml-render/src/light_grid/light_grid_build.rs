@@ -29,7 +29,7 @@ use crate::specialization::compute_pipeline;
 use crate::sync::{Use, LIGHT_GRID_LISTS, LIGHT_GRID_OCCUPANCY};
 use bytemuck::Zeroable;
 use ml_cpu::gpu_types::{FrameUniforms, LightGridDispatch, LightGridFeedback, PointLight};
-use ml_cpu::light_grid::{bindable_cells, cell_budget, grid_order, LightGridShape, CELL_RANGE_BYTES};
+use ml_cpu::light_grid::{bindable_cells, cell_budget, grid_order, LightGridShape};
 use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Buffer, Context, VkError};
 
@@ -42,7 +42,7 @@ const GROUPS_PER_ROW: u32 = 32_768;
 const CELLS_PER_WORD: u64 = 32;
 
 /// The grid's names of its lists in the shaders (what the shading passes bind).
-const CELL_RANGES: &str = "LightGridCellRangeBuffer";
+const LIST_ENDS: &str = "LightGridListBuffer";
 const POSITIONS: &str = "LightGridPositionBuffer";
 const COLORS: &str = "LightGridColorBuffer";
 const INDICES: &str = "LightGridIndexBuffer";
@@ -53,7 +53,6 @@ pub struct LightGridBuild {
     /// Per frame slot: its lists and the build's own buffers.
     slots: Vec<GridSlot>,
     pipeline_layout: vk::PipelineLayout,
-    number_pipeline: vk::Pipeline,
     count_pipeline: vk::Pipeline,
     fill_pipeline: vk::Pipeline,
     /// The scans' three steps (blocks' totals, their starts, the counts' starts), of the marks
@@ -74,12 +73,9 @@ pub struct LightGridBuild {
 
 /// One frame slot's buffers.
 struct GridSlot {
-    /// Per list: its count, then its start (FILL's cursor); and its cell.
+    /// Per list: its count, then its start (FILL's cursor), then its end (what the walk
+    /// reads).
     lists: Buffer,
-    list_cells: Buffer,
-    /// Per cell: where its lights start and end in the lists (marked cells'), then the wide
-    /// lights'.
-    cell_ranges: Buffer,
     /// Per 32 cells: their marks and the list of the first marked one.
     occupancy: Buffer,
     /// Per block of counts: its total, then its start (and its largest count).
@@ -101,8 +97,6 @@ impl GridSlot {
     fn new(ctx: &Context, lights: u64, cells: u64) -> Result<GridSlot, VkError> {
         let slot = GridSlot {
             lists: Buffer::null(),
-            list_cells: Buffer::null(),
-            cell_ranges: Buffer::null(),
             occupancy: Buffer::null(),
             blocks: Buffer::null(),
             kept: Buffer::null(),
@@ -120,8 +114,6 @@ impl GridSlot {
         let light_groups = lights.div_ceil(group);
         ml_vk::build(ctx, slot, |s| {
             s.lists = Buffer::new(ctx, "light grid lists", lists * 4, storage, gpu)?;
-            s.list_cells = Buffer::new(ctx, "light grid lists' cells", lists * 4, storage, gpu)?;
-            s.cell_ranges = Buffer::new(ctx, "light grid cell ranges", (cells + 1) * CELL_RANGE_BYTES, storage, gpu)?;
             let words = cells.div_ceil(CELLS_PER_WORD);
             s.occupancy = Buffer::new(ctx, "light grid marks", words * 8, storage | vk::BufferUsageFlags::TRANSFER_DST, gpu)?;
             let blocks = lists.div_ceil(SCAN_BLOCK.into());
@@ -143,11 +135,9 @@ impl GridSlot {
         bytemuck::pod_read_unaligned(&self.feedback.mapped()[..size_of::<LightGridFeedback>()])
     }
 
-    fn buffers(&mut self) -> [&mut Buffer; 12] {
+    fn buffers(&mut self) -> [&mut Buffer; 10] {
         [
             &mut self.lists,
-            &mut self.list_cells,
-            &mut self.cell_ranges,
             &mut self.occupancy,
             &mut self.blocks,
             &mut self.kept,
@@ -198,7 +188,6 @@ impl LightGridBuild {
             sets: FrameSets::new(ctx, &stages, 0, FRAMES_IN_FLIGHT)?,
             slots: Vec::new(),
             pipeline_layout: vk::PipelineLayout::null(),
-            number_pipeline: vk::Pipeline::null(),
             count_pipeline: vk::Pipeline::null(),
             fill_pipeline: vk::Pipeline::null(),
             mark_scan: [vk::Pipeline::null(); 3],
@@ -218,7 +207,6 @@ impl LightGridBuild {
         let build = &ml_shaders::LIGHT_GRID_BUILD_COMP;
         self.count_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("STEP", 0)])?;
         self.fill_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("STEP", 1)])?;
-        self.number_pipeline = compute_pipeline(ctx, build, self.pipeline_layout, &[("STEP", 2)])?;
         for (source, pipelines) in [(1, &mut self.mark_scan[..]), (0, &mut self.list_scan[..])] {
             for (step, pipeline) in pipelines.iter_mut().enumerate() {
                 let constants = [("STEP", step as u32), ("SOURCE", source)];
@@ -263,13 +251,10 @@ impl LightGridBuild {
         let word_blocks = dispatch_grid(words.div_ceil(SCAN_BLOCK.into()) as u32);
         let list_blocks = Groups::Indirect(std::mem::offset_of!(LightGridDispatch, block_groups) as u64);
         let (lx, ly) = dispatch_grid(light_groups);
-        let group = ml_shaders::LIGHT_GRID_BUILD_COMP.workgroup_size[0];
-        let (cx, cy) = dispatch_grid(self.shape.cells().div_ceil(group));
         let steps = [
             (self.mark_scan[0], Groups::Direct(word_blocks.0, word_blocks.1)),
             (self.mark_scan[1], Groups::Direct(1, 1)),
             (self.mark_scan[2], Groups::Direct(word_blocks.0, word_blocks.1)),
-            (self.number_pipeline, Groups::Direct(cx, cy)),
             (self.count_pipeline, Groups::Direct(lx, ly)),
             (self.list_scan[0], list_blocks),
             (self.list_scan[1], Groups::Direct(1, 1)),
@@ -313,8 +298,7 @@ impl LightGridBuild {
         }
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
-            for p in [self.number_pipeline, self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan)
-            {
+            for p in [self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan) {
                 ctx.device.destroy_pipeline(p, None);
             }
             ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
@@ -336,7 +320,7 @@ impl Pass for LightGridBuild {
     fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
         let s = &self.slots[slot];
         vec![
-            (CELL_RANGES, s.cell_ranges.raw),
+            (LIST_ENDS, s.lists.raw),
             (POSITIONS, s.positions.raw),
             (COLORS, s.colors.raw),
             (INDICES, s.indices.raw),
@@ -351,9 +335,7 @@ impl Pass for LightGridBuild {
                 "LightGridRestBuffer" => self.positions.raw,
                 "LightGridRestLightBuffer" => self.lights.raw,
                 "LightGridOrderBuffer" => self.order.raw,
-                "LightGridListBuffer" => own.lists.raw,
                 "LightGridBlockBuffer" => own.blocks.raw,
-                "LightGridListCellBuffer" => own.list_cells.raw,
                 "LightGridKeptBuffer" => own.kept.raw,
                 "LightGridKeptCountBuffer" => own.kept_count.raw,
                 "LightGridDispatchBuffer" => own.dispatch.raw,
