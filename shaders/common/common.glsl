@@ -286,6 +286,41 @@ struct OmniRasterCounters {
                  // (the pair list was full)
 };
 
+// A node of a two-wide BVH for shadow rays (shadows/shadow_rays.glsl): both children's
+// boxes, so that one read tests both. A child with count 0 is a node (its index in the same
+// buffer), else a leaf of `count` primitives from index `child`: triangles in a mesh's bottom
+// level, instances in the top level.
+struct RayNode {
+    vec3 left_min;
+    uint left_child;
+    vec3 left_max;
+    uint left_count;
+    vec3 right_min;
+    uint right_child;
+    vec3 right_max;
+    uint right_count;
+};
+
+// A triangle of a mesh's bottom level, in object space: a corner and the edges from it.
+struct RayTriangle {
+    vec3 v0;
+    uint source; // its index in its mesh's index list
+    vec3 e1;
+    uint pad0;
+    vec3 e2;
+    uint pad1;
+};
+
+// An object in the shadow rays' top level: world -> object space (rows of an affine map) and
+// its mesh's bottom level.
+struct RayInstance {
+    vec4 to_object[3];
+    uint root;   // its mesh's root node in the bottom levels' nodes
+    uint object; // its index in the scene's objects
+    uint pad0;
+    uint pad1;
+};
+
 // One shadowed light's faces in the shadow atlas (omni_shadow.glsl, omni_raster.glsl): the
 // atlas holds depths in Z-order, a face's texel (x, y) at base[face] + morton(x, y).
 struct ShadowCubeTiles {

@@ -386,3 +386,48 @@ gpu_struct!(
         triangles: [u32; 4],
     }
 );
+
+gpu_struct!(
+    /// A node of a two-wide BVH for shadow rays (ray_bvh.rs): both children's boxes, so that
+    /// one read tests both. A child with count 0 is a node (its index in the same buffer), else
+    /// a leaf of `count` primitives from index `child`: triangles in a mesh's bottom level,
+    /// instances in the top level.
+    RayNode {
+        left_min: [f32; 3],
+        left_child: u32,
+        left_max: [f32; 3],
+        left_count: u32,
+        right_min: [f32; 3],
+        right_child: u32,
+        right_max: [f32; 3],
+        right_count: u32,
+    }
+);
+
+gpu_struct!(
+    /// A triangle of a mesh's bottom level, in object space: a corner and the two edges from it
+    /// (what the ray test reads).
+    RayTriangle {
+        v0: [f32; 3],
+        /// Its index in its mesh's index list (triangle i: indices 3i..3i+3).
+        source: u32,
+        e1: [f32; 3],
+        pad0: u32,
+        e2: [f32; 3],
+        pad1: u32,
+    }
+);
+
+gpu_struct!(
+    /// An object in the shadow rays' top level: world → object space (the rows of an affine
+    /// map) and its mesh's bottom level.
+    RayInstance {
+        to_object: [[f32; 4]; 3],
+        /// Its mesh's root node in the bottom levels' nodes.
+        root: u32,
+        /// Its index in the scene's objects.
+        object: u32,
+        pad0: u32,
+        pad1: u32,
+    }
+);

@@ -22,6 +22,7 @@ pub mod mesh;
 pub mod meshlets;
 pub mod omni_shadow;
 pub mod random_scene;
+pub mod ray_bvh;
 pub mod scene;
 pub mod scene_file;
 pub mod scene_load;

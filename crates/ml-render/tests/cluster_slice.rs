@@ -9,21 +9,15 @@ use gpu_allocator::MemoryLocation;
 use ml_cpu::camera::Camera;
 use ml_cpu::cluster::{ClusterDims, ClusterGrid};
 use ml_cpu::gpu_types::FrameUniforms;
-use ml_render::internals::{FrameSets, Resource};
-use ml_vk::{commands, shader, Buffer, Context, ContextDesc};
+use ml_vk::{Buffer, Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
+
+mod common;
 
 const COUNT: usize = 100_000;
 
 fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
-    // One set 0, laid out as the shader declares it.
-    let probe = &ml_shaders::CLUSTER_SLICE_PROBE_COMP;
-    let mut sets = FrameSets::new(ctx, &[(probe, vk::ShaderStageFlags::COMPUTE)], 0, 1).unwrap();
-    let pipeline_layout = shader::pipeline_layout(ctx, &[sets.layout.raw], &[]).unwrap();
-    let pipeline = shader::compute_pipeline(ctx, probe.spirv, pipeline_layout, &[]).unwrap();
-    let set = sets.sets[0];
-
     let frame = FrameUniforms {
         cluster_dims: [grid.dims.x, grid.dims.y, grid.dims.z, 0],
         viewport: [grid.width, grid.height, 0, 0],
@@ -39,39 +33,12 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
     input.write(0, depths);
     let mut output =
         Buffer::new(ctx, "slices", (depths.len() * 4) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
-    let buffer = |name: &str| match name {
-        "FrameBlock" => Some(Resource::Buffer(uniforms.raw)),
-        "DepthBuffer" => Some(Resource::Buffer(input.raw)),
-        "SliceBuffer" => Some(Resource::Buffer(output.raw)),
-        _ => None,
-    };
-    sets.write(ctx, 0, &buffer).unwrap();
-    commands::one_shot(ctx, |cmd| {
-        // SAFETY: recording state; all bound objects are alive.
-        unsafe {
-            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
-            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, pipeline_layout, 0, &[set], &[]);
-            let [groups, ..] = probe.groups([depths.len() as u32, 1, 1]);
-            ctx.device.cmd_dispatch(cmd, groups, 1, 1);
-        }
-        commands::memory_barrier(
-            ctx,
-            cmd,
-            (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE),
-            (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
-        );
-    })
-    .expect("probe dispatch");
+    let buffers = [("FrameBlock", uniforms.raw), ("DepthBuffer", input.raw), ("SliceBuffer", output.raw)];
+    common::dispatch_probe(ctx, &ml_shaders::CLUSTER_SLICE_PROBE_COMP, &buffers, depths.len() as u32);
     let slices: Vec<u32> = bytemuck::cast_slice(output.mapped()).to_vec();
     for b in [&mut uniforms, &mut input, &mut output] {
         b.destroy(ctx);
     }
-    // SAFETY: the GPU is idle (one_shot waited).
-    unsafe {
-        ctx.device.destroy_pipeline(pipeline, None);
-        ctx.device.destroy_pipeline_layout(pipeline_layout, None);
-    }
-    sets.destroy(ctx);
     slices
 }
 

@@ -5,7 +5,7 @@
 use ml_cpu::gpu_types::{
     ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance, LargeTriangle, LayerObject, LightCone,
     LightGridDispatch, LightGridFeedback, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight,
-    ShadowCubeTiles, ShadowPush, StageProbePush,
+    RayInstance, RayNode, RayTriangle, ShadowCubeTiles, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -100,6 +100,9 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<OmniRasterPush>(&structs);
     check::<OmniRasterCounters>(&structs);
     check::<ShadowCubeTiles>(&structs);
+    check::<RayNode>(&structs);
+    check::<RayTriangle>(&structs);
+    check::<RayInstance>(&structs);
 }
 
 /// Mistake 5 (docs/DESIGN.md#mistakes-we-avoid): the original demo's index list was a std140

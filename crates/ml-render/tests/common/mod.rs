@@ -85,3 +85,36 @@ pub fn coverage_difference(a: &[f32], b: &[f32]) -> (Vec<(usize, f32, f32)>, usi
     let one_only = a.iter().zip(b).enumerate().filter(|(_, (x, y))| reached(**x) != reached(**y)).map(|(i, (&x, &y))| (i, x, y)).collect();
     (one_only, a.iter().zip(b).filter(|(x, y)| x != y).count())
 }
+
+/// Run a probe compute shader once over `invocations` threads with its set 0 bound by block
+/// name from `buffers`, and wait for it (its host-visible outputs are then readable).
+pub fn dispatch_probe(ctx: &Context, probe: &ml_shaders::Shader, buffers: &[(&str, ash::vk::Buffer)], invocations: u32) {
+    use ash::vk;
+    use ml_render::internals::{FrameSets, Resource};
+    let mut sets = FrameSets::new(ctx, &[(probe, vk::ShaderStageFlags::COMPUTE)], 0, 1).unwrap();
+    let pipeline_layout = ml_vk::shader::pipeline_layout(ctx, &[sets.layout.raw], &[]).unwrap();
+    let pipeline = ml_vk::shader::compute_pipeline(ctx, probe.spirv, pipeline_layout, &[]).unwrap();
+    sets.write(ctx, 0, &|name| buffers.iter().find(|(n, _)| *n == name).map(|(_, b)| Resource::Buffer(*b))).unwrap();
+    ml_vk::commands::one_shot(ctx, |cmd| {
+        // SAFETY: recording state; all bound objects are alive.
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, pipeline_layout, 0, &[sets.sets[0]], &[]);
+            let [groups, ..] = probe.groups([invocations, 1, 1]);
+            ctx.device.cmd_dispatch(cmd, groups, 1, 1);
+        }
+        ml_vk::commands::memory_barrier(
+            ctx,
+            cmd,
+            (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE),
+            (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+        );
+    })
+    .expect("probe dispatch");
+    // SAFETY: the GPU is idle (one_shot waited).
+    unsafe {
+        ctx.device.destroy_pipeline(pipeline, None);
+        ctx.device.destroy_pipeline_layout(pipeline_layout, None);
+    }
+    sets.destroy(ctx);
+}

@@ -1,0 +1,501 @@
+//! The scene's triangles for shadow rays (docs/DESIGN.md#shadow-rays): a bounding volume
+//! hierarchy per mesh over its triangles in object space (the bottom levels, built once), and
+//! one over the objects' world boxes (the top level, whose leaves are instances: an object's
+//! world → object map and its mesh's bottom level). Both are two-wide BVHs built by `obvhs`
+//! (PLOC, then reinsertion and leaf collapsing) and flattened into the layout the shaders
+//! read (`RayNode`: a node holds both children's boxes, so one read tests both).
+//!
+//! A shadow ray is a segment from a surface point to a light: it is blocked if any triangle
+//! crosses it strictly between the two (any hit ends the search; both faces of a triangle
+//! block). `RayScene::occluded` is the CPU model of the shaders' traversal
+//! (shadows/shadow_rays.glsl) — the same tests in the same f32 arithmetic — and
+//! `WorldTriangles::occluded` the reference it is tested against: every triangle of every
+//! object, in world space, no hierarchy.
+
+use crate::geometry::Mesh;
+use crate::gpu_types::{RayInstance, RayNode, RayTriangle};
+use crate::scene::Scene;
+use glam::{Mat4, Vec3};
+use std::time::Instant;
+
+/// Most primitives a leaf holds (obvhs collapses leaves up to this many where its cost model
+/// says they trace faster).
+const MAX_LEAF: u32 = 4;
+
+/// Nodes the shaders' traversal keeps to visit (shadow_rays.glsl RAY_STACK): a hierarchy whose
+/// `stack_needed` exceeds it cannot be traced there.
+pub const RAY_STACK: usize = 64;
+
+/// The shadow rays' hierarchies for a scene, as the GPU reads them.
+#[derive(Clone, Debug, Default)]
+pub struct RayScene {
+    /// Every mesh's bottom level, one after another (children indices are global).
+    pub nodes: Vec<RayNode>,
+    /// Every mesh's triangles, in the order of their bottom level's leaves.
+    pub triangles: Vec<RayTriangle>,
+    /// The objects with triangles, in the order of the top level's leaves.
+    pub instances: Vec<RayInstance>,
+    /// The top level over the instances (node 0 its root).
+    pub top: Vec<RayNode>,
+    /// CPU milliseconds the build took (every bottom level and the top).
+    pub build_ms: f64,
+}
+
+/// A child of a flattened node: its box, and a node index (count 0) or a leaf's primitives.
+#[derive(Clone, Copy)]
+struct Child {
+    min: Vec3,
+    max: Vec3,
+    child: u32,
+    count: u32,
+}
+
+/// A child that no segment enters (a root that is itself a leaf gets one as its sibling): a
+/// point at the far corner of the f32 range, which every slab test puts beyond t = 1 or
+/// before t = 0 (a box with min > max would not do: the test swaps its slabs' ends).
+const EMPTY: Child = Child { min: Vec3::splat(f32::MAX), max: Vec3::splat(f32::MAX), child: 0, count: 0 };
+
+fn node(left: Child, right: Child) -> RayNode {
+    RayNode {
+        left_min: left.min.to_array(),
+        left_child: left.child,
+        left_max: left.max.to_array(),
+        left_count: left.count,
+        right_min: right.min.to_array(),
+        right_child: right.child,
+        right_max: right.max.to_array(),
+        right_count: right.count,
+    }
+}
+
+/// A box grown by a little more than f32 rounding, so that a segment the box tests would miss
+/// by a rounding step still reaches the triangles inside (which decide).
+fn padded(min: Vec3, max: Vec3) -> (Vec3, Vec3) {
+    let pad = (max - min).max_element() * 1e-5 + min.abs().max(max.abs()).max_element() * 1e-6;
+    (min - Vec3::splat(pad), max + Vec3::splat(pad))
+}
+
+/// Flatten obvhs's BVH2 into `out` (from `out.len()` on): node i of ours per inner node,
+/// leaves' primitives appended to `order` (the caller lays its primitives out in that order,
+/// from `first_primitive` on).
+fn flatten(bvh: &obvhs::bvh2::Bvh2, out: &mut Vec<RayNode>, order: &mut Vec<u32>, first_primitive: u32) -> u32 {
+    let root = out.len() as u32;
+    let nodes = &bvh.nodes;
+    if nodes.is_empty() {
+        out.push(node(EMPTY, EMPTY));
+        return root;
+    }
+    // (obvhs node, our node) pairs still to write; our nodes are made before their children.
+    let child_of = |i: usize, out_len: &mut u32, order: &mut Vec<u32>, pending: &mut Vec<(usize, u32)>| -> Child {
+        let n = &nodes[i];
+        let (min, max) = padded(Vec3::from(n.aabb.min), Vec3::from(n.aabb.max));
+        if n.prim_count > 0 {
+            let first = first_primitive + order.len() as u32;
+            let range = n.first_index as usize..(n.first_index + n.prim_count) as usize;
+            order.extend(range.map(|k| bvh.primitive_indices[k]));
+            Child { min, max, child: first, count: n.prim_count }
+        } else {
+            let ours = *out_len;
+            *out_len += 1;
+            pending.push((i, ours));
+            Child { min, max, child: ours, count: 0 }
+        }
+    };
+    let mut out_len = root + 1;
+    let mut pending = Vec::new();
+    let mut written: Vec<(u32, RayNode)> = Vec::new();
+    if nodes[0].prim_count > 0 {
+        let leaf = child_of(0, &mut out_len, order, &mut pending);
+        written.push((root, node(leaf, EMPTY)));
+    } else {
+        pending.push((0, root));
+    }
+    while let Some((i, ours)) = pending.pop() {
+        let first = nodes[i].first_index as usize;
+        let left = child_of(first, &mut out_len, order, &mut pending);
+        let right = child_of(first + 1, &mut out_len, order, &mut pending);
+        written.push((ours, node(left, right)));
+    }
+    out.resize(out_len as usize, node(EMPTY, EMPTY));
+    for (i, n) in written {
+        out[i as usize] = n;
+    }
+    root
+}
+
+/// A mesh's triangles in object space (obvhs's form).
+fn mesh_triangles(mesh: &Mesh) -> Vec<obvhs::triangle::Triangle> {
+    let p = |i: u32| glam::Vec3A::from_array(mesh.vertices[i as usize].position);
+    mesh.indices.chunks_exact(3).map(|t| obvhs::triangle::Triangle { v0: p(t[0]), v1: p(t[1]), v2: p(t[2]) }).collect()
+}
+
+/// A world box as obvhs bounds it.
+struct WorldBox(obvhs::aabb::Aabb);
+
+impl obvhs::Boundable for WorldBox {
+    fn aabb(&self) -> obvhs::aabb::Aabb {
+        self.0
+    }
+}
+
+/// The world box of a box in object space under `m`.
+fn transformed_box(m: &Mat4, min: Vec3, max: Vec3) -> (Vec3, Vec3) {
+    (0..8).fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), k| {
+        let corner = Vec3::new(
+            if k & 1 == 0 { min.x } else { max.x },
+            if k & 2 == 0 { min.y } else { max.y },
+            if k & 4 == 0 { min.z } else { max.z },
+        );
+        let w = m.transform_point3(corner);
+        (lo.min(w), hi.max(w))
+    })
+}
+
+/// The rows of the affine map world → object space of an object placed by `transform`.
+fn to_object_rows(transform: &Mat4) -> [[f32; 4]; 3] {
+    let inv = transform.inverse();
+    let row = |r: usize| [inv.col(0)[r], inv.col(1)[r], inv.col(2)[r], inv.col(3)[r]];
+    [row(0), row(1), row(2)]
+}
+
+fn build_params() -> obvhs::BvhBuildParams {
+    obvhs::BvhBuildParams { max_prims_per_leaf: MAX_LEAF, ..obvhs::BvhBuildParams::fast_build() }
+}
+
+impl RayScene {
+    /// The hierarchies of `scene`'s objects: a bottom level per mesh (each built once, however
+    /// many objects draw it), the top level over the objects with triangles.
+    pub fn build(scene: &Scene) -> RayScene {
+        let start = Instant::now();
+        let mut rays = RayScene::default();
+        let mut duration = std::time::Duration::ZERO;
+        // Per mesh kind: its root and object-space box (None: no triangles).
+        let mut roots = Vec::new();
+        for kind in scene.mesh_kinds() {
+            let Some(mesh) = scene.mesh(kind) else { continue };
+            let tris = mesh_triangles(&mesh);
+            if tris.is_empty() {
+                roots.push((kind, None));
+                continue;
+            }
+            let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, build_params(), &mut duration);
+            let mut order = Vec::new();
+            let first = rays.triangles.len() as u32;
+            let root = flatten(&bvh, &mut rays.nodes, &mut order, first);
+            rays.triangles.extend(order.iter().map(|&t| {
+                let tri = &tris[t as usize];
+                let v0 = Vec3::from(tri.v0);
+                RayTriangle {
+                    v0: v0.to_array(),
+                    source: t,
+                    e1: (Vec3::from(tri.v1) - v0).to_array(),
+                    e2: (Vec3::from(tri.v2) - v0).to_array(),
+                    ..RayTriangle::default()
+                }
+            }));
+            let b = &bvh.nodes[0].aabb;
+            roots.push((kind, Some((root, Vec3::from(b.min), Vec3::from(b.max)))));
+        }
+        let mut placed = Vec::new();
+        let mut boxes = Vec::new();
+        for (i, o) in scene.objects.iter().enumerate() {
+            let Some(&(_, Some((root, min, max)))) = roots.iter().find(|(k, _)| *k == o.mesh) else { continue };
+            let (lo, hi) = transformed_box(&o.transform, min, max);
+            boxes.push(WorldBox(obvhs::aabb::Aabb { min: lo.into(), max: hi.into() }));
+            placed.push(RayInstance { to_object: to_object_rows(&o.transform), root, object: i as u32, ..RayInstance::default() });
+        }
+        let mut order = Vec::new();
+        if boxes.is_empty() {
+            rays.top.push(node(EMPTY, EMPTY));
+        } else {
+            let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, build_params(), &mut duration);
+            flatten(&bvh, &mut rays.top, &mut order, 0);
+        }
+        rays.instances = order.iter().map(|&k| placed[k as usize]).collect();
+        rays.build_ms = start.elapsed().as_secs_f64() * 1e3;
+        rays
+    }
+
+    /// Bytes the GPU holds for it.
+    pub fn bytes(&self) -> u64 {
+        let size = |n: usize, each: usize| (n * each) as u64;
+        size(self.nodes.len() + self.top.len(), size_of::<RayNode>())
+            + size(self.triangles.len(), size_of::<RayTriangle>())
+            + size(self.instances.len(), size_of::<RayInstance>())
+    }
+
+    /// Most nodes a traversal keeps on its stack: one per inner node on the deepest path below
+    /// the root, in the top level and in any mesh's bottom level (each has its own stack).
+    pub fn stack_needed(&self) -> usize {
+        fn deepest(nodes: &[RayNode], root: u32) -> usize {
+            let mut most = 0;
+            let mut stack = vec![(root, 0usize)];
+            while let Some((n, depth)) = stack.pop() {
+                most = most.max(depth);
+                for c in children(&nodes[n as usize]) {
+                    if c.count == 0 && c.min != EMPTY.min {
+                        stack.push((c.child, depth + 1));
+                    }
+                }
+            }
+            most
+        }
+        let roots = self.instances.iter().map(|i| deepest(&self.nodes, i.root));
+        roots.chain([deepest(&self.top, 0)]).max().unwrap_or(0)
+    }
+
+    /// Whether a triangle crosses the segment from `origin` to `target` strictly between them
+    /// (the shaders' traversal: shadows/shadow_rays.glsl).
+    pub fn occluded(&self, origin: Vec3, target: Vec3) -> bool {
+        let d = target - origin;
+        traverse(&self.top, 0, &Segment::new(origin, d), |first, count| {
+            self.instances[first as usize..(first + count) as usize].iter().any(|inst| self.mesh_occludes(inst, origin, d))
+        })
+    }
+
+    /// Whether a triangle of `inst`'s mesh crosses the segment (world `origin`, `d`).
+    fn mesh_occludes(&self, inst: &RayInstance, origin: Vec3, d: Vec3) -> bool {
+        let rows = inst.to_object.map(glam::Vec4::from_array);
+        let o = Vec3::new(
+            rows[0].truncate().dot(origin) + rows[0].w,
+            rows[1].truncate().dot(origin) + rows[1].w,
+            rows[2].truncate().dot(origin) + rows[2].w,
+        );
+        let od = Vec3::new(rows[0].truncate().dot(d), rows[1].truncate().dot(d), rows[2].truncate().dot(d));
+        traverse(&self.nodes, inst.root, &Segment::new(o, od), |first, count| {
+            let tris = &self.triangles[first as usize..(first + count) as usize];
+            tris.iter().any(|t| segment_crosses(o, od, Vec3::from(t.v0), Vec3::from(t.e1), Vec3::from(t.e2)))
+        })
+    }
+}
+
+/// One level's traversal from `root`: `leaf(first, count)` tests the primitives of each leaf the
+/// segment enters, and the first that reports a hit ends it.
+fn traverse(nodes: &[RayNode], root: u32, seg: &Segment, mut leaf: impl FnMut(u32, u32) -> bool) -> bool {
+    let mut stack = vec![root];
+    while let Some(n) = stack.pop() {
+        for c in children(&nodes[n as usize]) {
+            if !seg.enters(c.min, c.max) {
+                continue;
+            }
+            if c.count == 0 {
+                stack.push(c.child);
+            } else if leaf(c.child, c.count) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+fn children(n: &RayNode) -> [Child; 2] {
+    [
+        Child { min: Vec3::from(n.left_min), max: Vec3::from(n.left_max), child: n.left_child, count: n.left_count },
+        Child { min: Vec3::from(n.right_min), max: Vec3::from(n.right_max), child: n.right_child, count: n.right_count },
+    ]
+}
+
+/// A segment `origin + t·d`, t in [0, 1], as the box test takes it.
+struct Segment {
+    origin: Vec3,
+    inv: Vec3,
+}
+
+/// Smallest |direction| the box test divides by (a zero component would give 0·∞).
+const MIN_DIRECTION: f32 = 1e-30;
+
+impl Segment {
+    fn new(origin: Vec3, d: Vec3) -> Segment {
+        let tiny = |x: f32| if x < 0.0 { -MIN_DIRECTION } else { MIN_DIRECTION };
+        let safe = |x: f32| if x.abs() < MIN_DIRECTION { tiny(x) } else { x };
+        Segment { origin, inv: Vec3::new(1.0 / safe(d.x), 1.0 / safe(d.y), 1.0 / safe(d.z)) }
+    }
+
+    /// Whether the segment meets the box.
+    fn enters(&self, min: Vec3, max: Vec3) -> bool {
+        let t0 = (min - self.origin) * self.inv;
+        let t1 = (max - self.origin) * self.inv;
+        let near = t0.min(t1).max_element().max(0.0);
+        let far = t0.max(t1).min_element().min(1.0);
+        near <= far
+    }
+}
+
+/// Whether the triangle (`v0`, edges `e1`, `e2`) crosses the segment `o + t·d` at some
+/// 0 < t < 1 (Möller–Trumbore; either face; a triangle edge-on to the segment never).
+pub fn segment_crosses(o: Vec3, d: Vec3, v0: Vec3, e1: Vec3, e2: Vec3) -> bool {
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return false;
+    }
+    let inv_det = 1.0 / det;
+    let s = o - v0;
+    let u = s.dot(p) * inv_det;
+    if !(0.0..=1.0).contains(&u) {
+        return false;
+    }
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv_det;
+    if v < 0.0 || u + v > 1.0 {
+        return false;
+    }
+    let t = e2.dot(q) * inv_det;
+    t > 0.0 && t < 1.0
+}
+
+/// Every triangle of every object of a scene in world space: the reference shadow rays are
+/// tested against (no hierarchy, nothing skipped).
+pub struct WorldTriangles {
+    /// (v0, e1, e2) per triangle.
+    triangles: Vec<[Vec3; 3]>,
+}
+
+impl WorldTriangles {
+    pub fn new(scene: &Scene) -> WorldTriangles {
+        let mut triangles = Vec::new();
+        for o in &scene.objects {
+            let Some(mesh) = scene.mesh(o.mesh) else { continue };
+            let p = |i: u32| o.transform.transform_point3(Vec3::from(mesh.vertices[i as usize].position));
+            for t in mesh.indices.chunks_exact(3) {
+                let v0 = p(t[0]);
+                triangles.push([v0, p(t[1]) - v0, p(t[2]) - v0]);
+            }
+        }
+        WorldTriangles { triangles }
+    }
+
+    /// Whether any triangle crosses the segment from `origin` to `target` strictly between
+    /// them.
+    pub fn occluded(&self, origin: Vec3, target: Vec3) -> bool {
+        let d = target - origin;
+        self.triangles.iter().any(|&[v0, e1, e2]| segment_crosses(origin, d, v0, e1, e2))
+    }
+
+    /// The smallest margin by which the segment meets or misses a triangle, in the triangle's
+    /// barycentric units and the segment's t (how near the answer is to changing under a
+    /// rounding step: the tests leave segments within a hair of an edge out).
+    pub fn margin(&self, origin: Vec3, target: Vec3) -> f32 {
+        let d = target - origin;
+        let mut least = f32::MAX;
+        for &[v0, e1, e2] in &self.triangles {
+            let p = d.cross(e2);
+            let det = e1.dot(p);
+            if det.abs() < 1e-20 {
+                continue;
+            }
+            let s = origin - v0;
+            let u = s.dot(p) / det;
+            let q = s.cross(e1);
+            let v = d.dot(q) / det;
+            let t = e2.dot(q) / det;
+            // How far inside (or outside) the triangle and the segment the crossing lies.
+            let inside = u.min(v).min(1.0 - u - v);
+            let within = t.min(1.0 - t);
+            least = least.min(if inside >= 0.0 && within >= 0.0 { inside.min(within) } else { inside.min(within).abs() });
+        }
+        least
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::Material;
+    use crate::mesh::MeshKind;
+    use crate::scene::Object;
+    use rand::{Rng, SeedableRng};
+
+    fn grey() -> Material {
+        Material { albedo: Vec3::splat(0.5), roughness: 0.5, metallic: 0.0 }
+    }
+
+    /// Objects of every built-in mesh, rotated, scaled unevenly and overlapping, in a room.
+    fn cluttered_scene(seed: u64) -> Scene {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut objects =
+            vec![Object { transform: Mat4::from_scale(Vec3::splat(8.0)), ..Object::placed(MeshKind::Room, Vec3::ZERO, 1.0, grey()) }];
+        for k in 0..24 {
+            let kind = MeshKind::ALL[k % MeshKind::ALL.len()];
+            if kind == MeshKind::Room {
+                continue;
+            }
+            let at = Vec3::new(rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0));
+            let rotation = glam::Quat::from_euler(glam::EulerRot::XYZ, rng.random_range(0.0..6.3), rng.random_range(0.0..6.3), 0.3);
+            let scale = Vec3::new(rng.random_range(0.3..2.0), rng.random_range(0.3..2.0), rng.random_range(0.3..2.0));
+            let transform = Mat4::from_scale_rotation_translation(scale, rotation, at);
+            objects.push(Object { transform, ..Object::placed(kind, Vec3::ZERO, 1.0, grey()) });
+        }
+        Scene::new(objects, Vec::new(), crate::camera::Camera::seed())
+    }
+
+    #[test]
+    fn the_hierarchy_blocks_exactly_the_segments_some_triangle_crosses() {
+        for seed in 0..3 {
+            let scene = cluttered_scene(seed);
+            let rays = RayScene::build(&scene);
+            let world = WorldTriangles::new(&scene);
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(100 + seed);
+            let (mut blocked, mut checked) = (0, 0);
+            for _ in 0..2000 {
+                let mut p = || Vec3::new(rng.random_range(-7.9..7.9), rng.random_range(-7.9..7.9), rng.random_range(-7.9..7.9));
+                let (origin, target) = (p(), p());
+                // A segment within a rounding step of an edge or an end may go either way.
+                if world.margin(origin, target) < 1e-4 {
+                    continue;
+                }
+                let expected = world.occluded(origin, target);
+                assert_eq!(rays.occluded(origin, target), expected, "seed {seed}: {origin} -> {target}");
+                blocked += usize::from(expected);
+                checked += 1;
+            }
+            // Both answers are common, so neither could pass by always being given.
+            assert!(checked > 1500 && blocked > checked / 10 && blocked < checked * 9 / 10, "{blocked} of {checked} blocked");
+        }
+    }
+
+    #[test]
+    fn a_segment_ends_before_the_triangles_at_its_ends() {
+        // A floor at y = 0: a segment from above it to a point on it is not blocked; one that
+        // goes through it is.
+        let floor =
+            Object { transform: Mat4::from_scale(Vec3::new(5.0, 1.0, 5.0)), ..Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, grey()) };
+        let scene = Scene::new(vec![floor], Vec::new(), crate::camera::Camera::seed());
+        let rays = RayScene::build(&scene);
+        assert!(!rays.occluded(Vec3::new(0.3, 2.0, 0.1), Vec3::new(0.5, 0.0, 0.2)));
+        assert!(rays.occluded(Vec3::new(0.3, 2.0, 0.1), Vec3::new(0.5, -1.0, 0.2)));
+        assert!(!rays.occluded(Vec3::new(0.3, 2.0, 0.1), Vec3::new(9.0, -1.0, 0.2)), "passes beside the floor");
+    }
+
+    #[test]
+    fn one_object_of_one_triangle_and_a_scene_without_triangles_trace() {
+        let empty = Scene::new(Vec::new(), Vec::new(), crate::camera::Camera::seed());
+        assert!(!RayScene::build(&empty).occluded(Vec3::ZERO, Vec3::ONE));
+        let mut one = Scene::new(Vec::new(), Vec::new(), crate::camera::Camera::seed());
+        one.meshes.push(Mesh {
+            vertices: [[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.0, 1.0]]
+                .map(|p| crate::geometry::Vertex { position: p, normal: [0.0, 1.0, 0.0], uv: [0.0; 2], tangent: [0.0; 4] })
+                .to_vec(),
+            indices: vec![0, 1, 2],
+        });
+        one.objects.push(Object::placed(MeshKind::Loaded(0), Vec3::ZERO, 1.0, grey()));
+        let rays = RayScene::build(&one);
+        assert_eq!(rays.triangles.len(), 1);
+        assert!(rays.occluded(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, -1.0, 0.0)));
+        assert!(!rays.occluded(Vec3::new(3.0, 1.0, 0.0), Vec3::new(3.0, -1.0, 0.0)));
+    }
+
+    #[test]
+    fn each_mesh_is_built_once_however_many_objects_draw_it() {
+        let scene = cluttered_scene(7);
+        let rays = RayScene::build(&scene);
+        let kinds = scene.mesh_kinds();
+        let expected: usize = kinds.iter().map(|&k| scene.mesh(k).unwrap().indices.len() / 3).sum();
+        assert_eq!(rays.triangles.len(), expected);
+        assert_eq!(rays.instances.len(), scene.objects.len());
+        assert!((1..=RAY_STACK).contains(&rays.stack_needed()), "{}", rays.stack_needed());
+        let mut objects: Vec<u32> = rays.instances.iter().map(|i| i.object).collect();
+        objects.sort_unstable();
+        assert_eq!(objects, (0..scene.objects.len() as u32).collect::<Vec<_>>());
+    }
+}
