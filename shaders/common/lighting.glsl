@@ -113,18 +113,18 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
     if (MODEL_BLINN_PHONG) {
         vec3 r0 = mix(vec3(0.04), albedo, metallic);
         float shininess = 1.0 - roughness;
-#define BP_LIGHT(l) (bp_point_light(l, world, n, v, albedo, r0, shininess) * omni_visibility(l, world, n))
+#define BP_LIGHT(l) shadowed(bp_point_light(l, world, n, v, albedo, r0, shininess), l, world, n)
         SUM_LIGHTS(lo, BP_LIGHT)
         SUM_DIRECTIONAL(lo, BP_LIGHT)
         return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo + emission;
     }
     if (MODEL_PBR) {
-#define PBR_LIGHT(l) (pbr_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
+#define PBR_LIGHT(l) shadowed(pbr_point_light(l, world, n, v, albedo, roughness, metallic), l, world, n)
         SUM_LIGHTS(lo, PBR_LIGHT)
         SUM_DIRECTIONAL(lo, PBR_LIGHT)
         return albedo * frame.ambient * occlusion + lo + emission;
     }
-#define SEED_LIGHT(l) (seed_point_light(l, world, n, v, albedo, roughness, metallic) * omni_visibility(l, world, n))
+#define SEED_LIGHT(l) shadowed(seed_point_light(l, world, n, v, albedo, roughness, metallic), l, world, n)
     SUM_LIGHTS(lo, SEED_LIGHT)
     SUM_DIRECTIONAL(lo, SEED_LIGHT)
     return albedo * frame.ambient * occlusion + lo + emission;

@@ -22,6 +22,13 @@ layout(std430, set = 0, binding = 10) readonly buffer LightConeBuffer { LightCon
 layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { ClusterRange cluster_ranges[]; };
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };
 #endif
+// The shadow rays' hierarchy (shadows/shadow_rays.glsl): the top level over the objects, every
+// mesh's bottom level, their triangles and the objects' instances. One-element stand-ins
+// where point lights cast no shadow rays.
+layout(std430, set = 0, binding = 40) readonly buffer RayTopBuffer { RayNode ray_top[]; };
+layout(std430, set = 0, binding = 41) readonly buffer RayNodeBuffer { RayNode ray_nodes[]; };
+layout(std430, set = 0, binding = 42) readonly buffer RayTriangleBuffer { RayTriangle ray_triangles[]; };
+layout(std430, set = 0, binding = 43) readonly buffer RayInstanceBuffer { RayInstance ray_instances[]; };
 #ifdef LIGHT_GRID
 // The light grid's lists' ends (list 0 the wide lights', then a list per marked cell) and per
 // 32 cells their marks and the list of the first marked one (light_grid/light_grid.glsl).

@@ -1,7 +1,9 @@
 // Point-light shadows (docs/DESIGN.md#point-light-shadows), read side: each shadowed light has
 // a cube in the cube-map array `omni_shadows` holding, per texel, the distance from the light
-// to the nearest surface over the light's radius. Compiled in only when OMNI_SHADOWS is set (a
-// specialization constant), so renders without them run the loop they always ran.
+// to the nearest surface over the light's radius — or, with SHADOW_RAYS, a shadow ray from the
+// point to the light through the scene's triangles (shadow_rays.glsl). Compiled in only when
+// OMNI_SHADOWS is set (a specialization constant), so renders without them run the loop they
+// always ran.
 
 #ifndef MANYLIGHTS_OMNI_SHADOW_GLSL
 #define MANYLIGHTS_OMNI_SHADOW_GLSL
@@ -10,6 +12,14 @@ layout(constant_id = 12) const bool OMNI_SHADOWS = false;
 // The lights' faces lie in the shadow atlas (docs/DESIGN.md#shadow-atlas), not in the cube
 // array.
 layout(constant_id = 15) const bool SHADOW_ATLAS = false;
+// Shadowed lights are tested by a shadow ray each (no cubes).
+layout(constant_id = 21) const bool SHADOW_RAYS = false;
+
+#include "shadows/shadow_rays.glsl"
+
+// A shadow ray's origin leaves the surface along its normal by this much per unit of the
+// point's largest coordinate (at least 1 m): clear of its own triangle's rounding.
+const float RAY_NORMAL_OFFSET = 1e-4;
 
 // The surface point moves this many texels along its normal before the lookup (normal-offset
 // bias: a lit surface at a grazing angle to the light stays clear of its own texels)…
@@ -78,6 +88,11 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
         if (dist >= radius) {
             return 1.0;
         }
+        if (SHADOW_RAYS) {
+            vec3 a = abs(world);
+            vec3 origin = world + n * (RAY_NORMAL_OFFSET * max(1.0, max(a.x, max(a.y, a.z))));
+            return ray_occluded(origin, l.position_radius.xyz) ? 0.0 : 1.0;
+        }
         // One texel of a face in face units: the cube array's, or in the atlas the light's own.
         uint slot = uint(l.color.w) - 1u;
         float texel = frame.omni_texel;
@@ -107,6 +122,17 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
         return 0.25 * lit;
     }
     return 1.0;
+}
+
+// A light's contribution `c` at `world` with its shadow: times omni_visibility where the
+// light casts one. Only where `c` is not zero — every model gives exactly zero beyond the
+// radius and where the light is behind the surface (N·L ≤ 0) — so that no shadow ray is
+// traced (nor cube read) for light that would be multiplied by zero anyway.
+vec3 shadowed(vec3 c, PointLight l, vec3 world, vec3 n) {
+    if (OMNI_SHADOWS && l.color.w != 0.0 && c != vec3(0.0)) {
+        return c * omni_visibility(l, world, n);
+    }
+    return c;
 }
 
 #endif

@@ -237,8 +237,11 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         Rule::setting(id, own_lights.map(|own| !own), format!("the lights of '{}'", args.scene), "--lights N, whose lights replace them")
     };
     let omni = args.omni_shadow.as_str();
-    let cube_modes = OmniShadowMode::ALL.into_iter().filter(|m| !matches!(m, OmniShadowMode::Atlas(_))).map(OmniShadowMode::name);
+    let cube_modes =
+        OmniShadowMode::ALL.into_iter().filter(|m| !matches!(m, OmniShadowMode::Atlas(_) | OmniShadowMode::Rays)).map(OmniShadowMode::name);
     let cubes = format!("point-light shadow cubes (--omni-shadow {})", or_list(cube_modes));
+    let map_modes = OmniShadowMode::ALL.into_iter().filter(|m| *m != OmniShadowMode::Rays).map(OmniShadowMode::name);
+    let shadow_maps = format!("point-light shadow maps (--omni-shadow {})", or_list(map_modes));
     let shadows = format!("point-light shadows (--omni-shadow {})", or_list(OmniShadowMode::ALL.into_iter().map(OmniShadowMode::name)));
     let atlas = "the shadow atlas (--omni-shadow atlas)";
     let model = built.map(|b| b.shading);
@@ -268,7 +271,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         own("light_radius"),
         own("light_seed"),
         Rule::setting("shadowed_lights", Some(omni != "off"), "--omni-shadow off", &shadows),
-        Rule::setting("cube_size", Some(omni != "off"), "--omni-shadow off", &shadows),
+        Rule::setting("cube_size", Some(omni != "off" && omni != "rays"), format!("--omni-shadow {omni}"), &shadow_maps),
         Rule::setting("shadow_budget", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas),
         Rule::setting("shadow_cache", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas),
         sun("sun_shadow"),
@@ -316,7 +319,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
             }
             DebugView::ShadowMap => Some(sun("debug_view")),
             DebugView::ShadowCube => {
-                Some(Rule::setting("debug_view", Some(omni != "off" && omni != "atlas"), format!("--omni-shadow {omni}"), cubes))
+                Some(Rule::setting("debug_view", Some(!matches!(omni, "off" | "atlas" | "rays")), format!("--omni-shadow {omni}"), cubes))
             }
             DebugView::ShadowAtlas => Some(Rule::setting("debug_view", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas)),
             DebugView::TransparencyLayers => Some(Rule::setting(

@@ -178,7 +178,9 @@ struct SceneArgs {
     /// layer) or compute (every face of every cube drawn by compute shaders, meshlets culled
     /// per face); or atlas (one shadow atlas of --shadow-budget MiB: only the faces a visible
     /// pixel may sample, each light's as large as the light is on screen, drawn in compute,
-    /// kept while their light stays).
+    /// kept while their light stays); or rays (no maps: a shadow ray from each point to each
+    /// shadowed light that lights it, through a hierarchy of the scene's triangles, exact and
+    /// hard).
     #[arg(long, default_value = "off")]
     omni_shadow: String,
     /// Who draws the sun's shadow map (blinn-phong), once at start: graphics (a depth-only
@@ -187,7 +189,8 @@ struct SceneArgs {
     #[arg(long, default_value = "graphics")]
     sun_shadow: String,
     /// How many point lights cast shadows (with --omni-shadow): K (the strongest as seen from
-    /// the camera) or all (every light that reaches the view, the strongest 4096 at most).
+    /// the camera) or all (every light that reaches the view, the strongest 4096 at most;
+    /// with --omni-shadow rays, every light).
     #[arg(long, default_value = "1", allow_negative_numbers = true)]
     shadowed_lights: String,
     /// Texels per side of each shadow-cube face (with --omni-shadow; 1 to 16384, and at most

@@ -107,6 +107,14 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                     if a.cache { "on" } else { "off" }
                 ),
             )),
+            None if o.rays() => rows.push((
+                "omni shadows",
+                format!(
+                    "rays: {} light(s) ({}), a shadow ray per point and light that reaches it",
+                    o.lights,
+                    if o.all { "every light" } else { "the strongest" }
+                ),
+            )),
             None => rows.push((
                 "omni shadows",
                 format!("{}: {} light(s) ({which}), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size),

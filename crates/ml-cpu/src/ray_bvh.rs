@@ -228,6 +228,9 @@ impl RayScene {
     /// the root, in the top level and in any mesh's bottom level (each has its own stack).
     pub fn stack_needed(&self) -> usize {
         fn deepest(nodes: &[RayNode], root: u32) -> usize {
+            if nodes.is_empty() {
+                return 0;
+            }
             let mut most = 0;
             let mut stack = vec![(root, 0usize)];
             while let Some((n, depth)) = stack.pop() {
@@ -372,29 +375,57 @@ impl WorldTriangles {
         self.triangles.iter().any(|&[v0, e1, e2]| segment_crosses(origin, d, v0, e1, e2))
     }
 
-    /// The smallest margin by which the segment meets or misses a triangle, in the triangle's
-    /// barycentric units and the segment's t (how near the answer is to changing under a
-    /// rounding step: the tests leave segments within a hair of an edge out).
-    pub fn margin(&self, origin: Vec3, target: Vec3) -> f32 {
-        let d = target - origin;
-        let mut least = f32::MAX;
+    /// The nearest triangle the ray `o + t·d` (t > 0) meets: t and the triangle's unit
+    /// normal (facing against `d`).
+    pub fn first_hit(&self, o: Vec3, d: Vec3) -> Option<(f32, Vec3)> {
+        let mut best: Option<(f32, Vec3)> = None;
         for &[v0, e1, e2] in &self.triangles {
             let p = d.cross(e2);
             let det = e1.dot(p);
-            if det.abs() < 1e-20 {
+            if det == 0.0 {
                 continue;
+            }
+            let s = o - v0;
+            let u = s.dot(p) / det;
+            let q = s.cross(e1);
+            let v = d.dot(q) / det;
+            let t = e2.dot(q) / det;
+            if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && best.is_none_or(|(b, _)| t < b) {
+                let n = e1.cross(e2).normalize();
+                best = Some((t, if n.dot(d) > 0.0 { -n } else { n }));
+            }
+        }
+        best
+    }
+
+    /// Whether every triangle's answer for the segment holds under rounding: a triangle it
+    /// misses, it misses by more than `bary` (barycentric units) beside an edge or by more than
+    /// `dist` (world units) before or after its ends; one it crosses, it crosses by both.
+    /// (The tests leave segments within a hair of an edge or an end out.)
+    pub fn sure(&self, origin: Vec3, target: Vec3, bary: f32, dist: f32) -> bool {
+        let d = target - origin;
+        let length = d.length();
+        self.triangles.iter().all(|&[v0, e1, e2]| {
+            let p = d.cross(e2);
+            let det = e1.dot(p);
+            if det.abs() < 1e-20 {
+                // Edge-on: the segment lies in the triangle's plane or parallel to it.
+                let n = e1.cross(e2).normalize_or_zero();
+                return (origin - v0).dot(n).abs() > dist;
             }
             let s = origin - v0;
             let u = s.dot(p) / det;
             let q = s.cross(e1);
             let v = d.dot(q) / det;
             let t = e2.dot(q) / det;
-            // How far inside (or outside) the triangle and the segment the crossing lies.
             let inside = u.min(v).min(1.0 - u - v);
-            let within = t.min(1.0 - t);
-            least = least.min(if inside >= 0.0 && within >= 0.0 { inside.min(within) } else { inside.min(within).abs() });
-        }
-        least
+            let within = t.min(1.0 - t) * length;
+            if inside >= 0.0 && within >= 0.0 {
+                inside > bary && within > dist
+            } else {
+                inside < -bary || within < -dist
+            }
+        })
     }
 }
 
@@ -441,7 +472,7 @@ mod tests {
                 let mut p = || Vec3::new(rng.random_range(-7.9..7.9), rng.random_range(-7.9..7.9), rng.random_range(-7.9..7.9));
                 let (origin, target) = (p(), p());
                 // A segment within a rounding step of an edge or an end may go either way.
-                if world.margin(origin, target) < 1e-4 {
+                if !world.sure(origin, target, 1e-4, 1e-4) {
                     continue;
                 }
                 let expected = world.occluded(origin, target);

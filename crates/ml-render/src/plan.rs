@@ -153,8 +153,9 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     match key.omni.map(|o| o.mode) {
         Some(OmniShadowMode::Compute { .. }) => kinds.push(PassKind::OmniShadowsCompute),
         Some(OmniShadowMode::Atlas(_)) => kinds.push(PassKind::ShadowAtlas),
+        // Shadow rays are traced by the lighting itself.
+        Some(OmniShadowMode::Rays) | None => {}
         Some(_) => kinds.push(PassKind::OmniShadows),
-        None => {}
     }
     // The opaque depth after the raster: the compute raster's buffer, or the depth target.
     let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
@@ -310,6 +311,10 @@ mod tests {
             k.meters_exposure = false;
             assert_eq!(plan(&k), [first, forward, ShadowMapView], "{}", mode.name());
         }
+        // Shadow rays are traced in the lighting: no pass of their own.
+        let mut k = shadowed(key(Technique::Forward), OmniShadowMode::Rays);
+        k.meters_exposure = false;
+        assert_eq!(plan(&k), [forward]);
         let mut k = key(Technique::ClusteredGpu);
         k.debug_view = DebugView::ClusterHeat;
         k.meters_exposure = false;

@@ -392,6 +392,9 @@ impl<'a> Renderer<'a> {
         }
         stats.frames = self.settings.frames;
         stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
+        if let Some(rays) = self.gpu.rays.stats {
+            stats.set_feature(rays);
+        }
         stats.memory = Some(self.ctx.memory_use());
         self.last_frame = last;
         let rgba = self.read_back(last)?;

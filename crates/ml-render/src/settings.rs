@@ -203,6 +203,7 @@ impl RenderSettings {
             model: self.shading,
             omni_shadows: self.omni.is_some(),
             shadow_atlas: self.omni.is_some_and(|o| o.atlas().is_some()),
+            shadow_rays: self.omni.is_some_and(|o| o.rays()),
             object_textures: !scene.textures.is_empty(),
             spot_lights: !scene.cones.is_empty(),
             transparency: self.blends_layers(),
@@ -352,10 +353,14 @@ impl SettingsRequest {
 }
 
 /// How many lights cast shadows: `--shadowed-lights all` counts those that reach the view
-/// (at least one slot, so that a view without any still renders).
+/// (at least one slot, so that a view without any still renders); with shadow rays, every
+/// light.
 fn shadowed_count(omni: &OmniShadowSettings, scene: &ml_cpu::scene::Scene, (width, height): (u32, u32)) -> u32 {
     if !omni.all {
         return omni.lights;
+    }
+    if omni.rays() {
+        return (scene.lights.len() as u32).max(1);
     }
     let aspect = width.max(1) as f32 / height.max(1) as f32;
     let seen = ml_cpu::omni_shadow::lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, MAX_SHADOWED_LIGHTS as usize);

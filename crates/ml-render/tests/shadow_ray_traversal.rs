@@ -82,7 +82,7 @@ fn the_gpu_traversal_blocks_exactly_the_segments_a_triangle_crosses() {
         let (mut blocked, mut checked) = (0, 0);
         for (s, g) in segs.iter().zip(&gpu) {
             let cpu = rays.occluded(s[0], s[1]);
-            if world.margin(s[0], s[1]) < 1e-4 {
+            if !world.sure(s[0], s[1], 1e-4, 1e-4) {
                 continue;
             }
             let expected = world.occluded(s[0], s[1]);

@@ -6,6 +6,7 @@ pub mod meshlets;
 pub mod object_data;
 pub mod object_textures;
 pub mod omni_shadow;
+pub mod ray_geometry;
 pub mod shadow_atlas;
 pub mod shadow_raster;
 pub mod shadow_settings;
@@ -18,6 +19,7 @@ use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeomet
 use crate::scene::object_data::{object_data, SurfaceVariant};
 use crate::scene::object_textures::ObjectTextureSets;
 use crate::scene::omni_shadow::OmniShadows;
+use crate::scene::ray_geometry::RayGeometry;
 use crate::scene::shadow_settings::{OmniShadowSettings, SunShadowMode};
 use crate::scene::textures::SceneTextures;
 use crate::targets::{depth_format, Output};
@@ -54,6 +56,9 @@ pub struct SceneGpu {
     /// the settings have no such pass.
     meshlets: Option<MeshletGeometry>,
     wants_meshlets: bool,
+    /// The shadow rays' hierarchy of the objects (stand-ins where no light casts rays).
+    pub rays: RayGeometry,
+    wants_rays: bool,
 }
 
 impl SceneGpu {
@@ -80,6 +85,8 @@ impl SceneGpu {
             sun_shadow_ms: None,
             meshlets: None,
             wants_meshlets: config.meshlets,
+            rays: RayGeometry::null(),
+            wants_rays: config.omni.is_some_and(|o| o.rays()),
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
@@ -111,6 +118,7 @@ impl SceneGpu {
         if self.wants_meshlets {
             self.meshlets = Some(MeshletGeometry::build(ctx, scene, &self.object_textures.set_index)?);
         }
+        self.rays = RayGeometry::new(ctx, scene, self.wants_rays)?;
         let (lo, hi) = scene.bounds();
         self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
         if let Some(mode) = self.sun {
@@ -155,12 +163,16 @@ impl SceneGpu {
         if let Some(mut meshlets) = self.meshlets.take() {
             meshlets.destroy(ctx);
         }
+        self.rays.destroy(ctx);
     }
 
     /// The scene's buffers that shaders bind, under their blocks' names (a frame's table of
     /// resources holds them).
-    pub fn named_buffers(&self) -> [(&'static str, vk::Buffer); 3] {
-        [("ObjectBuffer", self.objects.raw), ("LightConeBuffer", self.cones.raw), ("AlphaMaskBuffer", self.alpha_masks.raw)]
+    pub fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
+        let mut named =
+            vec![("ObjectBuffer", self.objects.raw), ("LightConeBuffer", self.cones.raw), ("AlphaMaskBuffer", self.alpha_masks.raw)];
+        named.extend(self.rays.named_buffers());
+        named
     }
 
     /// The scene's images that passes declare (`sync`), under their names: the shadow cubes.

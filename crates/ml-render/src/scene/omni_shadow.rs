@@ -114,6 +114,7 @@ impl OmniShadows {
     pub fn choose(&mut self, scene: &Scene, aspect: f32) {
         self.chosen = match self.settings {
             None => Vec::new(),
+            Some(o) if o.all && o.rays() => (0..scene.lights.len() as u32).collect(),
             Some(o) if o.all => lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, o.lights as usize),
             Some(o) => shadowed_lights(&scene.lights, o.lights as usize, scene.camera.position),
         };
@@ -131,6 +132,10 @@ impl OmniShadows {
     /// Place the chosen lights for a frame: `lights` at rest moved by the animation's
     /// `offset` (the same sum the light buffer holds, on the CPU or the GPU).
     pub fn place(&mut self, lights: &[PointLight], offset: Vec3) {
+        if self.settings.is_some_and(|o| o.rays()) {
+            // Shadow rays aim at the lights where the GPU has them; nothing reads these.
+            return;
+        }
         self.placed = self
             .chosen
             .iter()
@@ -229,7 +234,7 @@ impl OmniShadows {
                     self.add_framebuffer(ctx, view, (size, layers))?;
                 }
             }
-            OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_) => {}
+            OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_) | OmniShadowMode::Rays => {}
         }
         Ok(())
     }
@@ -246,7 +251,7 @@ impl OmniShadows {
 
     /// The settings where the shadows are in the cube array (not the atlas).
     fn cube_settings(&self) -> Option<OmniShadowSettings> {
-        self.settings.filter(|s| s.atlas().is_none())
+        self.settings.filter(|s| s.atlas().is_none() && !s.rays())
     }
 
     /// What a frame's cube drawing by the graphics modes does to the cube array (`sync`):
@@ -258,7 +263,7 @@ impl OmniShadows {
         let settings = self.cube_settings()?;
         let read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
         match settings.mode {
-            OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_) => None,
+            OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_) | OmniShadowMode::Rays => None,
             OmniShadowMode::Copy => Some(Use::overwriting(SHADOW_CUBES, (TRANSFER_DST.0, TRANSFER_DST.1), TRANSFER_DST.2)),
             OmniShadowMode::Direct | OmniShadowMode::Multiview | OmniShadowMode::Layered => Some(Use {
                 name: SHADOW_CUBES,

@@ -29,6 +29,9 @@ pub enum OmniShadowMode {
     /// light's faces as large as it is on screen, drawn by the compute raster; faces whose
     /// light did not move keep their texels (docs/DESIGN.md#shadow-atlas).
     Atlas(AtlasSettings),
+    /// No cubes: each point a shadowed light reaches traces a shadow ray to it through the
+    /// scene's triangles (docs/DESIGN.md#shadow-rays), so every light may cast shadows.
+    Rays,
 }
 
 /// The shadow atlas's settings.
@@ -57,13 +60,14 @@ impl OmniShadowMode {
     /// The compute raster with its default list of large triangles (2^20: 8 MiB).
     pub const COMPUTE: OmniShadowMode = OmniShadowMode::Compute { large_list: 1 << 20 };
 
-    pub const ALL: [OmniShadowMode; 6] = [
+    pub const ALL: [OmniShadowMode; 7] = [
         OmniShadowMode::Copy,
         OmniShadowMode::Direct,
         OmniShadowMode::Multiview,
         OmniShadowMode::Layered,
         OmniShadowMode::COMPUTE,
         OmniShadowMode::Atlas(AtlasSettings::DEFAULT),
+        OmniShadowMode::Rays,
     ];
 
     pub fn name(self) -> &'static str {
@@ -74,6 +78,7 @@ impl OmniShadowMode {
             OmniShadowMode::Layered => "layered",
             OmniShadowMode::Compute { .. } => "compute",
             OmniShadowMode::Atlas(_) => "atlas",
+            OmniShadowMode::Rays => "rays",
         }
     }
 
@@ -87,10 +92,11 @@ impl OmniShadowMode {
 pub struct OmniShadowSettings {
     pub mode: OmniShadowMode,
     /// Lights with a shadow cube (the strongest as seen from the camera), at most; with
-    /// `all`, the lights that reach the view (SettingsRequest::for_scene counts them).
+    /// `all`, the lights that reach the view (SettingsRequest::for_scene counts them); with
+    /// shadow rays, every light.
     pub lights: u32,
-    /// Shadow every light that reaches the view (at most MAX_SHADOWED_LIGHTS), not the
-    /// `lights` strongest.
+    /// Shadow every light that reaches the view (at most MAX_SHADOWED_LIGHTS; with shadow
+    /// rays every light, no cap), not the `lights` strongest.
     pub all: bool,
     /// Texels per side of each cube face (cube array modes).
     pub size: u32,
@@ -111,10 +117,17 @@ impl OmniShadowSettings {
         }
     }
 
-    /// Bytes of the cube array (32-bit depth; the shadow atlas's are its budget).
+    /// Whether shadowed lights are tested by shadow rays (no cubes).
+    pub fn rays(&self) -> bool {
+        self.mode == OmniShadowMode::Rays
+    }
+
+    /// Bytes of the cube array (32-bit depth; the shadow atlas's are its budget; shadow rays
+    /// have none: their hierarchy is the scene's).
     pub fn bytes(&self) -> u64 {
         match self.atlas() {
             Some(a) => a.budget_bytes(),
+            None if self.rays() => 0,
             None => self.lights as u64 * 6 * self.size as u64 * self.size as u64 * 4,
         }
     }
@@ -132,6 +145,9 @@ impl OmniShadowSettings {
         }
         if let Some(atlas) = self.atlas() {
             return check_atlas(ctx, self, atlas);
+        }
+        if self.rays() {
+            return Ok(());
         }
         let max_cubes = limits.max_image_array_layers / 6;
         if self.lights > max_cubes {

@@ -19,6 +19,8 @@ pub struct Shading {
     pub omni_shadows: bool,
     /// The point lights' shadows are in the shadow atlas (else in the cube array).
     pub shadow_atlas: bool,
+    /// The point lights' shadows are shadow rays (no cubes).
+    pub shadow_rays: bool,
     pub object_textures: bool,
     pub spot_lights: bool,
     /// Transparent objects are blended in per-pixel layers (the opaque passes skip them).
@@ -38,9 +40,9 @@ impl Shading {
     }
 
     /// The specialization constants (name, value) of a lighting pipeline: the surface's,
-    /// `OMNI_SHADOWS` and `SHADOW_ATLAS` (shadows/omni_shadow.glsl) and `SPOT_LIGHTS`
-    /// (common/lighting.glsl).
-    pub fn lighting_constants(self) -> [(&'static str, u32); 6] {
+    /// `OMNI_SHADOWS`, `SHADOW_ATLAS` and `SHADOW_RAYS` (shadows/omni_shadow.glsl) and
+    /// `SPOT_LIGHTS` (common/lighting.glsl).
+    pub fn lighting_constants(self) -> [(&'static str, u32); 7] {
         let [model_a, model_b, textures] = self.surface_constants();
         [
             model_a,
@@ -48,14 +50,15 @@ impl Shading {
             textures,
             ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
             ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
+            ("SHADOW_RAYS", u32::from(self.shadow_rays)),
             ("SPOT_LIGHTS", u32::from(self.spot_lights)),
         ]
     }
 
     /// `lighting_constants` and `TRANSPARENT_LAYERS` (shading/forward_frag.glsl): the forward
     /// pass of a scene with transparent layers writes linear HDR for their resolve.
-    pub fn layered_lighting_constants(self) -> [(&'static str, u32); 7] {
-        let [a, b, c, d, e, f] = self.lighting_constants();
-        [a, b, c, d, e, f, ("TRANSPARENT_LAYERS", u32::from(self.transparency))]
+    pub fn layered_lighting_constants(self) -> [(&'static str, u32); 8] {
+        let [a, b, c, d, e, f, g] = self.lighting_constants();
+        [a, b, c, d, e, f, g, ("TRANSPARENT_LAYERS", u32::from(self.transparency))]
     }
 }

@@ -1,0 +1,116 @@
+//! The shadow rays' hierarchy on the GPU (`ml_cpu::ray_bvh`, docs/DESIGN.md#shadow-rays):
+//! built on the CPU with the scene's objects (again whenever they are replaced) and uploaded
+//! once; one-element stand-ins where no light casts shadow rays (every lighting pipeline
+//! binds the four buffers; only SHADOW_RAYS pipelines read them).
+
+use crate::error::RenderError;
+use crate::report::FeatureStats;
+use ml_cpu::gpu_types::{RayInstance, RayNode, RayTriangle};
+use ml_cpu::ray_bvh::{RayScene, RAY_STACK};
+use ml_cpu::scene::Scene;
+use ml_vk::{vk, Buffer, Context};
+
+/// What the hierarchy took (the `render` table's row).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayStats {
+    pub build_ms: f64,
+    pub bytes: u64,
+    pub nodes: usize,
+    pub triangles: usize,
+    pub instances: usize,
+}
+
+impl FeatureStats for RayStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let mib = self.bytes as f64 / (1 << 20) as f64;
+        vec![(
+            "shadow rays",
+            format!(
+                "hierarchy of {} triangles (each mesh once), {} nodes, {} instances: {mib:.1} MiB, built in {:.1} ms on the CPU",
+                self.triangles, self.nodes, self.instances, self.build_ms
+            ),
+        )]
+    }
+}
+
+pub struct RayGeometry {
+    top: Buffer,
+    nodes: Buffer,
+    triangles: Buffer,
+    instances: Buffer,
+    /// None for the stand-ins.
+    pub stats: Option<RayStats>,
+}
+
+impl RayGeometry {
+    /// Nothing uploaded yet.
+    pub fn null() -> RayGeometry {
+        RayGeometry { top: Buffer::null(), nodes: Buffer::null(), triangles: Buffer::null(), instances: Buffer::null(), stats: None }
+    }
+
+    /// `scene`'s hierarchy if `rays`, else stand-ins.
+    pub fn new(ctx: &Context, scene: &Scene, rays: bool) -> Result<RayGeometry, RenderError> {
+        if rays && scene.objects.iter().any(|o| o.extras.masked()) {
+            return Err(RenderError::Invalid(
+                "shadow rays do not cut alpha-masked surfaces yet (they would cast solid shadows): use --omni-shadow atlas for this scene"
+                    .into(),
+            ));
+        }
+        let built = if rays { RayScene::build(scene) } else { RayScene::default() };
+        if built.stack_needed() > RAY_STACK {
+            return Err(RenderError::Invalid(format!(
+                "the scene's shadow-ray hierarchy is {} levels deep, more than the {RAY_STACK} its traversal keeps: use shadow cubes (--omni-shadow atlas)",
+                built.stack_needed()
+            )));
+        }
+        let mut geometry = RayGeometry::null();
+        let made = geometry.upload(ctx, &built);
+        if let Err(e) = made {
+            geometry.destroy(ctx);
+            return Err(e.into());
+        }
+        geometry.stats = rays.then(|| RayStats {
+            build_ms: built.build_ms,
+            bytes: built.bytes(),
+            nodes: built.nodes.len() + built.top.len(),
+            triangles: built.triangles.len(),
+            instances: built.instances.len(),
+        });
+        Ok(geometry)
+    }
+
+    fn upload(&mut self, ctx: &Context, built: &RayScene) -> Result<(), ml_vk::VkError> {
+        // A stand-in element where a part is empty (a buffer has a size).
+        fn or_one<T: bytemuck::Pod + Default>(items: &[T]) -> Vec<T> {
+            if items.is_empty() {
+                vec![T::default()]
+            } else {
+                items.to_vec()
+            }
+        }
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let upload = |name: &str, bytes: &[u8]| Buffer::device_local_with(ctx, name, bytes, storage);
+        self.top = upload("shadow-ray top level", bytemuck::cast_slice(&or_one::<RayNode>(&built.top)))?;
+        self.nodes = upload("shadow-ray nodes", bytemuck::cast_slice(&or_one::<RayNode>(&built.nodes)))?;
+        self.triangles = upload("shadow-ray triangles", bytemuck::cast_slice(&or_one::<RayTriangle>(&built.triangles)))?;
+        self.instances = upload("shadow-ray instances", bytemuck::cast_slice(&or_one::<RayInstance>(&built.instances)))?;
+        Ok(())
+    }
+
+    /// The buffers under the shaders' block names (common/scene_bindings.glsl).
+    pub fn named_buffers(&self) -> [(&'static str, vk::Buffer); 4] {
+        [
+            ("RayTopBuffer", self.top.raw),
+            ("RayNodeBuffer", self.nodes.raw),
+            ("RayTriangleBuffer", self.triangles.raw),
+            ("RayInstanceBuffer", self.instances.raw),
+        ]
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [&mut self.top, &mut self.nodes, &mut self.triangles, &mut self.instances] {
+            b.destroy(ctx);
+        }
+        self.stats = None;
+    }
+}
