@@ -18,6 +18,8 @@ pub struct RayStats {
     pub nodes: usize,
     pub triangles: usize,
     pub instances: usize,
+    /// Most nodes a traversal keeps (its deepest path).
+    pub depth: usize,
 }
 
 impl FeatureStats for RayStats {
@@ -26,8 +28,8 @@ impl FeatureStats for RayStats {
         vec![(
             "shadow rays",
             format!(
-                "hierarchy of {} triangles (each mesh once), {} nodes, {} instances: {mib:.1} MiB, built in {:.1} ms on the CPU",
-                self.triangles, self.nodes, self.instances, self.build_ms
+                "hierarchy of {} triangles (each mesh once), {} nodes, {} instances, {} levels at most: {mib:.1} MiB, built in {:.1} ms on the CPU",
+                self.triangles, self.nodes, self.instances, self.depth, self.build_ms
             ),
         )]
     }
@@ -75,6 +77,7 @@ impl RayGeometry {
             nodes: built.nodes.len() + built.top.len(),
             triangles: built.triangles.len(),
             instances: built.instances.len(),
+            depth: built.stack_needed(),
         });
         Ok(geometry)
     }
