@@ -29,6 +29,8 @@ layout(std430, set = 0, binding = 40) readonly buffer RayTopBuffer { RayNode ray
 layout(std430, set = 0, binding = 41) readonly buffer RayNodeBuffer { RayNode ray_nodes[]; };
 layout(std430, set = 0, binding = 42) readonly buffer RayTriangleBuffer { RayTriangle ray_triangles[]; };
 layout(std430, set = 0, binding = 43) readonly buffer RayInstanceBuffer { RayInstance ray_instances[]; };
+// Per triangle of the bottom levels, its corners' texture coordinates (alpha masks).
+layout(std430, set = 0, binding = 44) readonly buffer RayUvBuffer { vec2 ray_uvs[]; };
 #ifdef LIGHT_GRID
 // The light grid's lists' ends (list 0 the wide lights', then a list per marked cell) and per
 // 32 cells their marks and the list of the first marked one (light_grid/light_grid.glsl).

@@ -11,8 +11,9 @@
 
 #include "common/textures.glsl"
 #include "common/surface.glsl"
-#include "common/lighting.glsl"
+// Before the light loop: its shadow rays read the alpha masks at this shader's binding.
 #include "shading/mesh_coverage.glsl"
+#include "common/lighting.glsl"
 
 layout(location = 0) out vec4 out_color;
 

@@ -15,6 +15,13 @@ layout(constant_id = 15) const bool SHADOW_ATLAS = false;
 // Shadowed lights are tested by a shadow ray each (no cubes).
 layout(constant_id = 21) const bool SHADOW_RAYS = false;
 
+// Shadow rays read masked objects' alpha (the shading shaders that cut fragments themselves
+// have included it with their binding already).
+#ifndef ALPHA_MASK_BINDING
+#define ALPHA_MASK_BINDING 45
+#endif
+#include "common/alpha_mask.glsl"
+#define RAY_ALPHA_MASKS 1
 #include "shadows/shadow_rays.glsl"
 
 // A shadow ray's origin leaves the surface along its normal by this much per unit of the

@@ -6,7 +6,9 @@
 //
 // The includer declares (readonly): RayTopBuffer { RayNode ray_top[]; }, RayNodeBuffer
 // { RayNode ray_nodes[]; }, RayTriangleBuffer { RayTriangle ray_triangles[]; } and
-// RayInstanceBuffer { RayInstance ray_instances[]; }.
+// RayInstanceBuffer { RayInstance ray_instances[]; }. With RAY_ALPHA_MASKS defined, also
+// RayUvBuffer { vec2 ray_uvs[]; }, ObjectBuffer and alpha_mask.glsl: a masked object's
+// triangles block only where its mask keeps the point.
 
 #ifndef MANYLIGHTS_SHADOW_RAYS_GLSL
 #define MANYLIGHTS_SHADOW_RAYS_GLSL
@@ -35,8 +37,10 @@ bool ray_enters(vec3 o, vec3 inv, vec3 lo, vec3 hi) {
     return near <= far;
 }
 
-// Whether the triangle crosses the segment o + t d at some 0 < t < 1 (Moller-Trumbore).
-bool ray_crosses(vec3 o, vec3 d, RayTriangle tri) {
+// Whether the triangle crosses the segment o + t d at some 0 < t < 1 (Moller-Trumbore), and
+// where: `bary`, the weights of its second and third corners.
+bool ray_crosses(vec3 o, vec3 d, RayTriangle tri, out vec2 bary) {
+    bary = vec2(0.0);
     vec3 p = cross(d, tri.e2);
     float det = dot(tri.e1, p);
     if (det == 0.0) {
@@ -54,7 +58,21 @@ bool ray_crosses(vec3 o, vec3 d, RayTriangle tri) {
         return false;
     }
     float t = dot(tri.e2, q) * inv_det;
+    bary = vec2(u, v);
     return t > 0.0 && t < 1.0;
+}
+
+// Whether triangle k of object `object`'s mesh, crossed at `bary`, is there: a masked
+// object's mask keeps the point (ml_cpu::ray_bvh::WorldTriangles::kept).
+bool ray_kept(uint k, uint object, vec2 bary) {
+#ifdef RAY_ALPHA_MASKS
+    uvec4 alpha_texture = objects[object].alpha_texture;
+    if ((alpha_texture.x & OBJECT_MASKED) != 0u) {
+        vec2 uv = ray_uvs[3u * k] * (1.0 - bary.x - bary.y) + ray_uvs[3u * k + 1u] * bary.x + ray_uvs[3u * k + 2u] * bary.y;
+        return alpha_kept(objects[object].alpha, alpha_texture, transform_uv(objects[object].uv_transform, uv));
+    }
+#endif
+    return true;
 }
 
 // The traversal of one level: NODES the node array, LEAF(first, count) tests a leaf's
@@ -94,10 +112,12 @@ bool ray_crosses(vec3 o, vec3 d, RayTriangle tri) {
         }                                                                                            \
     }
 
-// Whether a triangle of a leaf's `count` triangles from `first` crosses the segment.
-bool ray_leaf_triangles(uint first, uint count, vec3 o, vec3 d) {
+// Whether a triangle of a leaf's `count` triangles from `first` (of object `object`) crosses
+// the segment where it is there.
+bool ray_leaf_triangles(uint first, uint count, uint object, vec3 o, vec3 d) {
     for (uint k = first; k < first + count; ++k) {
-        if (ray_crosses(o, d, ray_triangles[k])) {
+        vec2 bary;
+        if (ray_crosses(o, d, ray_triangles[k], bary) && ray_kept(k, object, bary)) {
             return true;
         }
     }
@@ -110,7 +130,7 @@ bool ray_instance_occludes(RayInstance inst, vec3 origin, vec3 d) {
                   dot(inst.to_object[2].xyz, origin) + inst.to_object[2].w);
     vec3 od = vec3(dot(inst.to_object[0].xyz, d), dot(inst.to_object[1].xyz, d), dot(inst.to_object[2].xyz, d));
     vec3 inv = ray_inverse(od);
-#define RAY_MESH_LEAF(first, count) ray_leaf_triangles(first, count, o, od)
+#define RAY_MESH_LEAF(first, count) ray_leaf_triangles(first, count, inst.object, o, od)
     RAY_TRAVERSE(ray_nodes, inst.root, o, inv, RAY_MESH_LEAF)
 #undef RAY_MESH_LEAF
     return false;

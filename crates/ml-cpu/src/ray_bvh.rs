@@ -15,7 +15,7 @@
 use crate::geometry::Mesh;
 use crate::gpu_types::{RayInstance, RayNode, RayTriangle};
 use crate::scene::Scene;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use std::time::Instant;
 
 /// Most primitives a leaf holds (obvhs collapses leaves up to this many where its cost model
@@ -33,6 +33,9 @@ pub struct RayScene {
     pub nodes: Vec<RayNode>,
     /// Every mesh's triangles, in the order of their bottom level's leaves.
     pub triangles: Vec<RayTriangle>,
+    /// Per triangle, its corners' texture coordinates (v0, v1, v2; what an alpha-masked
+    /// object's mask is read at).
+    pub uvs: Vec<[f32; 2]>,
     /// The objects with triangles, in the order of the top level's leaves.
     pub instances: Vec<RayInstance>,
     /// The top level over the instances (node 0 its root).
@@ -182,6 +185,8 @@ impl RayScene {
             let mut order = Vec::new();
             let first = rays.triangles.len() as u32;
             let root = flatten(&bvh, &mut rays.nodes, &mut order, first);
+            let uv = |i: u32| mesh.vertices[i as usize].uv;
+            rays.uvs.extend(order.iter().flat_map(|&t| mesh.indices[3 * t as usize..3 * t as usize + 3].iter().map(|&i| uv(i))));
             rays.triangles.extend(order.iter().map(|&t| {
                 let tri = &tris[t as usize];
                 let v0 = Vec3::from(tri.v0);
@@ -221,6 +226,7 @@ impl RayScene {
         let size = |n: usize, each: usize| (n * each) as u64;
         size(self.nodes.len() + self.top.len(), size_of::<RayNode>())
             + size(self.triangles.len(), size_of::<RayTriangle>())
+            + size(self.uvs.len(), 8)
             + size(self.instances.len(), size_of::<RayInstance>())
     }
 
@@ -348,51 +354,72 @@ pub fn segment_crosses(o: Vec3, d: Vec3, v0: Vec3, e1: Vec3, e2: Vec3) -> bool {
 }
 
 /// Every triangle of every object of a scene in world space: the reference shadow rays are
-/// tested against (no hierarchy, nothing skipped).
-pub struct WorldTriangles {
+/// tested against (no hierarchy, nothing skipped; an alpha-masked object's triangles block
+/// only where its mask keeps the point, by `alpha_mask::kept`, the shaders' twin).
+pub struct WorldTriangles<'a> {
+    scene: &'a Scene,
     /// (v0, e1, e2) per triangle.
     triangles: Vec<[Vec3; 3]>,
+    /// Per triangle: its object and its corners' texture coordinates.
+    sources: Vec<(u32, [Vec2; 3])>,
 }
 
-impl WorldTriangles {
-    pub fn new(scene: &Scene) -> WorldTriangles {
-        let mut triangles = Vec::new();
-        for o in &scene.objects {
+/// Where a segment `o + t·d` meets a triangle's plane: the barycentric weights of v1 and v2,
+/// and t (None where the segment lies parallel to the plane).
+fn crossing(o: Vec3, d: Vec3, [v0, e1, e2]: [Vec3; 3]) -> Option<(f32, f32, f32)> {
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return None;
+    }
+    let s = o - v0;
+    let q = s.cross(e1);
+    Some((s.dot(p) / det, d.dot(q) / det, e2.dot(q) / det))
+}
+
+impl<'a> WorldTriangles<'a> {
+    pub fn new(scene: &'a Scene) -> WorldTriangles<'a> {
+        let (mut triangles, mut sources) = (Vec::new(), Vec::new());
+        for (k, o) in scene.objects.iter().enumerate() {
             let Some(mesh) = scene.mesh(o.mesh) else { continue };
             let p = |i: u32| o.transform.transform_point3(Vec3::from(mesh.vertices[i as usize].position));
+            let uv = |i: u32| Vec2::from(mesh.vertices[i as usize].uv);
             for t in mesh.indices.chunks_exact(3) {
                 let v0 = p(t[0]);
                 triangles.push([v0, p(t[1]) - v0, p(t[2]) - v0]);
+                sources.push((k as u32, [uv(t[0]), uv(t[1]), uv(t[2])]));
             }
         }
-        WorldTriangles { triangles }
+        WorldTriangles { scene, triangles, sources }
+    }
+
+    /// Whether triangle `i`'s point at barycentric weights (u, v) of its second and third
+    /// corners is there (its object's alpha mask keeps it).
+    fn kept(&self, i: usize, u: f32, v: f32) -> bool {
+        let (object, [uv0, uv1, uv2]) = self.sources[i];
+        let o = &self.scene.objects[object as usize];
+        !o.extras.masked() || crate::alpha_mask::kept(o, &self.scene.textures, uv0 * (1.0 - u - v) + uv1 * u + uv2 * v)
     }
 
     /// Whether any triangle crosses the segment from `origin` to `target` strictly between
-    /// them.
+    /// them where it is there.
     pub fn occluded(&self, origin: Vec3, target: Vec3) -> bool {
         let d = target - origin;
-        self.triangles.iter().any(|&[v0, e1, e2]| segment_crosses(origin, d, v0, e1, e2))
+        self.triangles.iter().enumerate().any(|(i, &[v0, e1, e2])| {
+            segment_crosses(origin, d, v0, e1, e2) && crossing(origin, d, [v0, e1, e2]).is_some_and(|(u, v, _)| self.kept(i, u, v))
+        })
     }
 
-    /// The nearest triangle the ray `o + t·d` (t > 0) meets: t and the triangle's unit
-    /// normal (facing against `d`).
-    pub fn first_hit(&self, o: Vec3, d: Vec3) -> Option<(f32, Vec3)> {
-        let mut best: Option<(f32, Vec3)> = None;
-        for &[v0, e1, e2] in &self.triangles {
-            let p = d.cross(e2);
-            let det = e1.dot(p);
-            if det == 0.0 {
-                continue;
-            }
-            let s = o - v0;
-            let u = s.dot(p) / det;
-            let q = s.cross(e1);
-            let v = d.dot(q) / det;
-            let t = e2.dot(q) / det;
-            if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && best.is_none_or(|(b, _)| t < b) {
-                let n = e1.cross(e2).normalize();
-                best = Some((t, if n.dot(d) > 0.0 { -n } else { n }));
+    /// The nearest point the ray `o + t·d` (t > 0) meets: t, the triangle's unit normal (facing
+    /// against `d`) and its object.
+    pub fn first_hit(&self, o: Vec3, d: Vec3) -> Option<(f32, Vec3, u32)> {
+        let mut best: Option<(f32, Vec3, u32)> = None;
+        for (i, &tri) in self.triangles.iter().enumerate() {
+            let Some((u, v, t)) = crossing(o, d, tri) else { continue };
+            let inside = u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
+            if inside && best.is_none_or(|(b, _, _)| t < b) && self.kept(i, u, v) {
+                let n = tri[1].cross(tri[2]).normalize();
+                best = Some((t, if n.dot(d) > 0.0 { -n } else { n }, self.sources[i].0));
             }
         }
         best
@@ -400,32 +427,41 @@ impl WorldTriangles {
 
     /// Whether every triangle's answer for the segment holds under rounding: a triangle it
     /// misses, it misses by more than `bary` (barycentric units) beside an edge or by more than
-    /// `dist` (world units) before or after its ends; one it crosses, it crosses by both.
-    /// (The tests leave segments within a hair of an edge or an end out.)
+    /// `dist` (world units) before or after its ends; one it crosses, it crosses by both, and
+    /// where its object is masked, the alpha there is more than 1/64 from the cutoff. (The
+    /// tests leave segments within a hair of an edge, an end or a mask's edge out.)
     pub fn sure(&self, origin: Vec3, target: Vec3, bary: f32, dist: f32) -> bool {
         let d = target - origin;
         let length = d.length();
-        self.triangles.iter().all(|&[v0, e1, e2]| {
-            let p = d.cross(e2);
-            let det = e1.dot(p);
-            if det.abs() < 1e-20 {
+        self.triangles.iter().enumerate().all(|(i, &tri)| {
+            let Some((u, v, t)) = crossing(origin, d, tri).filter(|_| tri[1].dot(d.cross(tri[2])).abs() >= 1e-20) else {
                 // Edge-on: the segment lies in the triangle's plane or parallel to it.
-                let n = e1.cross(e2).normalize_or_zero();
-                return (origin - v0).dot(n).abs() > dist;
-            }
-            let s = origin - v0;
-            let u = s.dot(p) / det;
-            let q = s.cross(e1);
-            let v = d.dot(q) / det;
-            let t = e2.dot(q) / det;
+                let n = tri[1].cross(tri[2]).normalize_or_zero();
+                return (origin - tri[0]).dot(n).abs() > dist;
+            };
             let inside = u.min(v).min(1.0 - u - v);
             let within = t.min(1.0 - t) * length;
             if inside >= 0.0 && within >= 0.0 {
-                inside > bary && within > dist
+                inside > bary && within > dist && self.alpha_clear(i, u, v)
             } else {
                 inside < -bary || within < -dist
             }
         })
+    }
+
+    /// Whether triangle `i`'s alpha at (u, v), if its object is masked, is clear of the cutoff.
+    fn alpha_clear(&self, i: usize, u: f32, v: f32) -> bool {
+        let (object, [uv0, uv1, uv2]) = self.sources[i];
+        let o = &self.scene.objects[object as usize];
+        let Some(cutoff) = o.extras.alpha_mode.cutoff() else { return true };
+        let alpha = match o.textures.base_color.and_then(|t| self.scene.textures.get(t as usize)) {
+            Some(t) => {
+                let uv = o.extras.uv_transform.transform_point2(uv0 * (1.0 - u - v) + uv1 * u + uv2 * v);
+                o.extras.base_alpha * crate::alpha_mask::texture_alpha(t, uv)
+            }
+            None => o.extras.base_alpha,
+        };
+        (alpha - cutoff).abs() > 1.0 / 64.0
     }
 }
 

@@ -50,11 +50,13 @@ fn sure_pixels(scene: &Scene, world: &WorldTriangles) -> Vec<((u32, u32), Vec<bo
         for x in 0..SIZE {
             let hit = |dx: f32, dy: f32| {
                 let (o, d) = common::shadow_rays::ray(&scene.camera, x as f32 + 0.5 + dx, y as f32 + 0.5 + dy, SIZE);
-                world.first_hit(o, d).map(|(t, n)| (o + d * t, n))
+                world.first_hit(o, d).map(|(t, n, object)| (o + d * t, n, object))
             };
-            let Some((point, normal)) = hit(0.0, 0.0) else { continue };
+            let Some((point, normal, object)) = hit(0.0, 0.0) else { continue };
+            // Its corners on the same flat surface of the same object (off silhouettes and
+            // the edges of cut-outs).
             let corners = [(-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)];
-            if !corners.iter().all(|&(dx, dy)| hit(dx, dy).is_some_and(|(_, n)| n.dot(normal) > 0.9999)) {
+            if !corners.iter().all(|&(dx, dy)| hit(dx, dy).is_some_and(|(_, n, o)| o == object && n.dot(normal) > 0.9999)) {
                 continue;
             }
             // The shaders' origin (omni_shadow.glsl RAY_NORMAL_OFFSET); its own surface lies
@@ -156,13 +158,27 @@ fn every_technique_gives_the_forward_image() {
     }
 }
 
-/// Alpha-masked surfaces are not cut by the rays yet: such a scene is refused in one line
-/// (it would get solid shadows), not rendered wrong.
+/// A grate between the light and the floor: a plane whose alpha texture cuts it into
+/// stripes (bilinear, repeated four times) casts striped shadows — the rays read its mask at
+/// each crossing as the raster reads it at each fragment.
 #[test]
-fn a_scene_with_alpha_masked_surfaces_is_refused() {
-    let mut scene = cluttered_room(2, 7);
-    scene.objects[1].extras.alpha_mode = ml_cpu::scene::AlphaMode::Mask { cutoff: 0.5 };
-    let ctx = ml_vk::Context::new(&ml_vk::ContextDesc { validation: true, ..Default::default() }).expect("Vulkan with validation");
-    let err = ml_render::Renderer::new(&ctx, scene, settings(Technique::Forward, true, 2)).err().expect("refused").to_string();
-    assert!(err.contains("alpha-masked") && err.contains("--omni-shadow atlas"), "{err}");
+fn alpha_masked_surfaces_cast_the_shadows_their_masks_cut() {
+    let mut scene = Scene::shadow_room();
+    // Stripes across u: alpha 255 for four texels, 0 for four.
+    let rgba = (0..8 * 8).flat_map(|i| [200, 200, 200, if (i % 8) < 4 { 255 } else { 0 }]).collect();
+    scene.textures.push(ml_cpu::textures::TextureImage { width: 8, height: 8, rgba, srgb: true, sampler: Default::default() });
+    let grey = Material { albedo: Vec3::splat(0.7), roughness: 0.7, metallic: 0.0 };
+    let transform = glam::Mat4::from_scale_rotation_translation(
+        Vec3::new(1.6, 1.0, 1.6),
+        glam::Quat::from_rotation_y(0.4),
+        Vec3::new(-1.0, -3.6, -0.5),
+    );
+    let mut grate = Object { transform, ..Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, grey) };
+    grate.textures.base_color = Some(0);
+    grate.extras.alpha_mode = ml_cpu::scene::AlphaMode::Mask { cutoff: 0.5 };
+    grate.extras.double_sided = true;
+    grate.extras.uv_transform = glam::Affine2::from_scale(glam::Vec2::splat(4.0));
+    scene.objects.push(grate);
+    let (checked, in_shadow) = ray_test("room with a grate", &scene);
+    assert!(checked > 3000 && in_shadow > 300, "{checked} checked, {in_shadow} in shadow");
 }

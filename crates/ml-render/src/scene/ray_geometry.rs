@@ -1,7 +1,7 @@
 //! The shadow rays' hierarchy on the GPU (`ml_cpu::ray_bvh`, docs/DESIGN.md#shadow-rays):
 //! built on the CPU with the scene's objects (again whenever they are replaced) and uploaded
 //! once; one-element stand-ins where no light casts shadow rays (every lighting pipeline
-//! binds the four buffers; only SHADOW_RAYS pipelines read them).
+//! binds the five buffers; only SHADOW_RAYS pipelines read them).
 
 use crate::error::RenderError;
 use crate::report::FeatureStats;
@@ -40,6 +40,7 @@ pub struct RayGeometry {
     nodes: Buffer,
     triangles: Buffer,
     instances: Buffer,
+    uvs: Buffer,
     /// None for the stand-ins.
     pub stats: Option<RayStats>,
 }
@@ -47,17 +48,18 @@ pub struct RayGeometry {
 impl RayGeometry {
     /// Nothing uploaded yet.
     pub fn null() -> RayGeometry {
-        RayGeometry { top: Buffer::null(), nodes: Buffer::null(), triangles: Buffer::null(), instances: Buffer::null(), stats: None }
+        RayGeometry {
+            top: Buffer::null(),
+            nodes: Buffer::null(),
+            triangles: Buffer::null(),
+            instances: Buffer::null(),
+            uvs: Buffer::null(),
+            stats: None,
+        }
     }
 
     /// `scene`'s hierarchy if `rays`, else stand-ins.
     pub fn new(ctx: &Context, scene: &Scene, rays: bool) -> Result<RayGeometry, RenderError> {
-        if rays && scene.objects.iter().any(|o| o.extras.masked()) {
-            return Err(RenderError::Invalid(
-                "shadow rays do not cut alpha-masked surfaces yet (they would cast solid shadows): use --omni-shadow atlas for this scene"
-                    .into(),
-            ));
-        }
         let built = if rays { RayScene::build(scene) } else { RayScene::default() };
         if built.stack_needed() > RAY_STACK {
             return Err(RenderError::Invalid(format!(
@@ -97,21 +99,23 @@ impl RayGeometry {
         self.nodes = upload("shadow-ray nodes", bytemuck::cast_slice(&or_one::<RayNode>(&built.nodes)))?;
         self.triangles = upload("shadow-ray triangles", bytemuck::cast_slice(&or_one::<RayTriangle>(&built.triangles)))?;
         self.instances = upload("shadow-ray instances", bytemuck::cast_slice(&or_one::<RayInstance>(&built.instances)))?;
+        self.uvs = upload("shadow-ray texture coordinates", bytemuck::cast_slice(&or_one::<[f32; 2]>(&built.uvs)))?;
         Ok(())
     }
 
     /// The buffers under the shaders' block names (common/scene_bindings.glsl).
-    pub fn named_buffers(&self) -> [(&'static str, vk::Buffer); 4] {
+    pub fn named_buffers(&self) -> [(&'static str, vk::Buffer); 5] {
         [
             ("RayTopBuffer", self.top.raw),
             ("RayNodeBuffer", self.nodes.raw),
             ("RayTriangleBuffer", self.triangles.raw),
             ("RayInstanceBuffer", self.instances.raw),
+            ("RayUvBuffer", self.uvs.raw),
         ]
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for b in [&mut self.top, &mut self.nodes, &mut self.triangles, &mut self.instances] {
+        for b in [&mut self.top, &mut self.nodes, &mut self.triangles, &mut self.instances, &mut self.uvs] {
             b.destroy(ctx);
         }
         self.stats = None;
