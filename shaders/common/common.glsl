@@ -22,6 +22,7 @@
 #define DEBUG_VIEW_SHADOW_ATLAS 10u
 #define DEBUG_VIEW_ALPHA 11u
 #define DEBUG_VIEW_TRANSPARENCY_LAYERS 12u
+#define DEBUG_VIEW_RAY_COST 13u
 
 // Per frame, one uniform buffer per frame in flight (set 0, binding 0).
 struct FrameUniforms {

@@ -130,11 +130,24 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
     return albedo * frame.ambient * occlusion + lo + emission;
 }
 
+// Steps the ray-cost view's heat scale ends at (tables.rs says so in its legend).
+const float RAY_COST_TOP = 1024.0;
+
+// Traces the shadow ray of light `l` at `world` where the light loop would (it reaches the
+// point from in front, and casts a shadow), for its steps alone.
+vec3 ray_cost_light(PointLight l, vec3 world, vec3 n) {
+    vec3 to_light = l.position_radius.xyz - world;
+    if (OMNI_SHADOWS && l.color.w != 0.0 && dot(n, to_light) > 0.0 && length(to_light) <= l.position_radius.w) {
+        omni_visibility(l, world, n);
+    }
+    return vec3(0.0);
+}
+
 // The surface debug views (G-buffer channels, depth): what the view shows at a surface point
 // as linear colour, which encode_gamma turns into the promised display values — albedo as
 // it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
 // False for any other view. Every shading path calls it with the values it would shade with.
-bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, uint object_flags, out vec3 color) {
+bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, uint object_flags, vec2 frag_xy, out vec3 color) {
     uint view = frame.cluster_dims.w;
     vec3 display;
     if (view == DEBUG_VIEW_ALPHA) {
@@ -150,6 +163,13 @@ bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metal
         display = n * 0.5 + 0.5;
     } else if (view == DEBUG_VIEW_GBUFFER_MATERIAL) {
         display = vec3(roughness, metallic, 0.0);
+    } else if (view == DEBUG_VIEW_RAY_COST) {
+        // The point's shadow rays' traversal steps on a log scale up to RAY_COST_TOP.
+        ray_steps = 0u;
+        vec3 none = vec3(0.0);
+#define RAY_COST_LIGHT(l) ray_cost_light(l, world, n)
+        SUM_LIGHTS(none, RAY_COST_LIGHT)
+        display = heat(log2(1.0 + float(ray_steps)) / log2(1.0 + RAY_COST_TOP));
     } else if (view == DEBUG_VIEW_DEPTH) {
         float depth = -(frame.view * vec4(world, 1.0)).z;
         display = vec3(log(depth / frame.cluster_frustum.x) / log(frame.cluster_frustum.y / frame.cluster_frustum.x));

@@ -17,7 +17,7 @@ layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 // `object_flags`: the object's OBJECT_* bits (the alpha debug view).
 void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags) {
     vec3 color;
-    if (debug_surface(world, n, m.albedo, m.roughness, m.metallic, object_flags, color)) {
+    if (debug_surface(world, n, m.albedo, m.roughness, m.metallic, object_flags, frag_xy, color)) {
         imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
         return;
     }

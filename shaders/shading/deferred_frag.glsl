@@ -43,7 +43,7 @@ void main() {
     PointMaterial m =
         point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, subpassLoad(albedo_input), roughness_metallic, emissive_factor);
     vec3 color;
-    if (!debug_surface(world, n, m.albedo, m.roughness, m.metallic, objects[id].alpha_texture.x, color)) {
+    if (!debug_surface(world, n, m.albedo, m.roughness, m.metallic, objects[id].alpha_texture.x, gl_FragCoord.xy, color)) {
         color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
     }
     out_hdr = vec4(color, 1.0);

@@ -37,7 +37,7 @@ void main() {
     PointMaterial m = point_material(object.albedo_roughness, object.material, object.emissive, vec4(s.albedo_factor, s.occlusion),
                                      s.roughness_metallic, s.emissive_factor);
     vec3 color;
-    if (debug_surface(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, color)) {
+    if (debug_surface(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, gl_FragCoord.xy, color)) {
         out_color = vec4(encode_gamma(color), 1.0);
         return;
     }

@@ -18,6 +18,9 @@
 const uint RAY_STACK = 64u;
 // Smallest |direction| the box test divides by (a zero component would give 0 * inf).
 const float RAY_MIN_DIRECTION = 1e-30;
+// Traversal steps (nodes visited, triangles tested) of this invocation's rays so far: the
+// ray-cost debug view.
+uint ray_steps = 0u;
 
 // 1 / d per axis, each |d| at least RAY_MIN_DIRECTION.
 vec3 ray_inverse(vec3 d) {
@@ -85,6 +88,7 @@ bool ray_kept(uint k, uint object, vec2 bary) {
         uint node_ = ROOT;                                                                           \
         while (true) {                                                                               \
             RayNode n_ = NODES[node_];                                                               \
+            ray_steps++;                                                                             \
             bool left_ = ray_enters(O, INV, n_.left_min, n_.left_max);                               \
             bool right_ = ray_enters(O, INV, n_.right_min, n_.right_max);                            \
             if (left_ && n_.left_count != 0u) {                                                      \
@@ -116,6 +120,7 @@ bool ray_kept(uint k, uint object, vec2 bary) {
 // the segment where it is there.
 bool ray_leaf_triangles(uint first, uint count, uint object, vec3 o, vec3 d) {
     for (uint k = first; k < first + count; ++k) {
+        ray_steps++;
         vec2 bary;
         if (ray_crosses(o, d, ray_triangles[k], bary) && ray_kept(k, object, bary)) {
             return true;

@@ -322,6 +322,9 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
                 Some(Rule::setting("debug_view", Some(!matches!(omni, "off" | "atlas" | "rays")), format!("--omni-shadow {omni}"), cubes))
             }
             DebugView::ShadowAtlas => Some(Rule::setting("debug_view", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas)),
+            DebugView::RayCost => {
+                Some(Rule::setting("debug_view", Some(omni == "rays"), format!("--omni-shadow {omni}"), "shadow rays (--omni-shadow rays)"))
+            }
             DebugView::TransparencyLayers => Some(Rule::setting(
                 "debug_view",
                 transparent,

@@ -139,7 +139,8 @@ struct SceneArgs {
     /// of --omni-shadow), shadow-atlas (--omni-shadow atlas), meshlets, triangles (a colour per
     /// meshlet or triangle; visibility), alpha (opaque grey, alpha-masked green, blended
     /// orange), transparency-layers (transparent layers per pixel, white where some were
-    /// merged; scenes with transparent objects).
+    /// merged; scenes with transparent objects), ray-cost (the traversal steps of each point's
+    /// shadow rays, log scale; --omni-shadow rays).
     #[arg(long, default_value = "none")]
     debug_view: String,
     /// Object of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.

@@ -89,6 +89,13 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
         rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
     }
+    if settings.debug_view == DebugView::RayCost {
+        rows.push((
+            "heat legend",
+            "log scale: black 0, blue 1, cyan, green, yellow, red 1024 traversal steps (nodes and triangles) of a point's shadow rays"
+                .into(),
+        ));
+    }
     if settings.debug_view == DebugView::ClusterHeat {
         let grid = stats.feature::<ml_render::LightGridStats>().map(|g| g.heat_top());
         let top = stats.clusters.map(|c| c.max_lights).or(grid).unwrap_or(1).max(1);

@@ -45,10 +45,13 @@ pub enum DebugView {
     /// Transparent layers per pixel as a heat map up to the 32 a pixel blends exactly; white
     /// where more were merged (scenes with transparent objects).
     TransparencyLayers,
+    /// The traversal steps (nodes visited, triangles tested) of each point's shadow rays as a
+    /// heat map on a log scale (--omni-shadow rays).
+    RayCost,
 }
 
 impl DebugView {
-    pub const ALL: [DebugView; 13] = [
+    pub const ALL: [DebugView; 14] = [
         DebugView::None,
         DebugView::ClusterHeat,
         DebugView::GBufferAlbedo,
@@ -62,6 +65,7 @@ impl DebugView {
         DebugView::Triangles,
         DebugView::Alpha,
         DebugView::TransparencyLayers,
+        DebugView::RayCost,
     ];
 
     pub fn name(self) -> &'static str {
@@ -79,6 +83,7 @@ impl DebugView {
             DebugView::Triangles => "triangles",
             DebugView::Alpha => "alpha",
             DebugView::TransparencyLayers => "transparency-layers",
+            DebugView::RayCost => "ray-cost",
         }
     }
 
@@ -103,6 +108,7 @@ impl DebugView {
             DebugView::Triangles => v::TRIANGLES,
             DebugView::Alpha => v::ALPHA,
             DebugView::TransparencyLayers => v::TRANSPARENCY_LAYERS,
+            DebugView::RayCost => v::RAY_COST,
         }
     }
 }

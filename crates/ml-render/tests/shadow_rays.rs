@@ -182,3 +182,25 @@ fn alpha_masked_surfaces_cast_the_shadows_their_masks_cut() {
     let (checked, in_shadow) = ray_test("room with a grate", &scene);
     assert!(checked > 3000 && in_shadow > 300, "{checked} checked, {in_shadow} in shadow");
 }
+
+/// The ray-cost view shows heat wherever a point traces a shadow ray (in every technique at
+/// the same pixels), and none where no light reaches: the room's light shrunk to reach no
+/// surface.
+#[test]
+fn the_ray_cost_view_shows_where_rays_are_traced() {
+    let scene = Scene::shadow_room();
+    let view = |technique| RenderSettings { debug_view: ml_render::DebugView::RayCost, ..settings(technique, true, 1) };
+    let outputs = common::render_each(&scene, &[view(Technique::Forward), view(Technique::Visibility), view(Technique::DeferredCompute)]);
+    let lit = |out: &RenderOutput| out.rgba.chunks_exact(4).filter(|p| p[..3] != [0, 0, 0]).count();
+    let traced = lit(&outputs[0]);
+    assert!(traced > (SIZE * SIZE / 2) as usize, "{traced} pixels with heat");
+    // The same pixels trace rays in every technique (their counts may differ by a step where a
+    // point rebuilt from depth falls on the other side of a box's face).
+    for out in &outputs[1..] {
+        assert_eq!(lit(out), traced);
+    }
+    let mut dark = scene.clone();
+    dark.lights[0].position_radius[3] = 0.01;
+    let none = common::render(dark, view(Technique::Forward));
+    assert_eq!(lit(&none), 0, "no ray, no heat");
+}
