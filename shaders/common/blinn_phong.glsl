@@ -38,7 +38,15 @@ vec3 bp_point_light(PointLight light, vec3 world, vec3 n, vec3 v, vec3 diffuse, 
 // Fraction of the sun that reaches `world`: 3×3 PCF, one shadow-map texel apart, through the
 // comparison sampler. The lookup point moves 1.5 texels along the normal first (normal-offset
 // bias: no acne on lit surfaces, no visible gap at contact).
+// With SUN_RAYS there is no map: a shadow ray from the point toward the sun, beyond the
+// scene's box (shadows/shadow_rays.glsl).
+layout(constant_id = 22) const bool SUN_RAYS = false;
+
 float bp_sun_visibility(vec3 world, vec3 n) {
+    if (SUN_RAYS) {
+        vec3 origin = ray_origin(world, n);
+        return ray_occluded(origin, origin - frame.sun_direction.xyz * frame.shadow_rays.x) ? 0.0 : 1.0;
+    }
     vec4 c = frame.shadow_view_proj * vec4(world + n * (1.5 * frame.sun_strength.w), 1.0);
     vec3 p = c.xyz / c.w;
     vec2 uv = p.xy * 0.5 + 0.5;
@@ -57,7 +65,11 @@ vec3 bp_scene_lights(vec3 world, vec3 n, vec3 v, vec3 diffuse, vec3 r0, float sh
     vec3 color = frame.ambient_light.rgb * diffuse;
     vec3 sun_l = -frame.sun_direction.xyz;
     vec3 sun = bp_brdf(frame.sun_strength.rgb * max(dot(sun_l, n), 0.0), sun_l, n, v, diffuse, r0, shininess);
-    color += sun * bp_sun_visibility(world, n);
+    // (Its shadow only where the sun lights the point: no ray where it would be multiplied by
+    // zero anyway.)
+    if (sun != vec3(0.0)) {
+        color += sun * bp_sun_visibility(world, n);
+    }
     // The spot light is a point light (same range and falloff) dimmed by its cone.
     vec3 spot_l = normalize(frame.spot_position_range.xyz - world);
     float cone = pow(max(dot(-spot_l, frame.spot_direction_power.xyz), 0.0), frame.spot_direction_power.w);

@@ -58,6 +58,7 @@ struct FrameUniforms {
     vec4 directional_direction[4];
     vec4 directional_color[4]; // rgb
     vec4 exposure;             // x: the factor lit colour is multiplied by before tone map and gamma (2^EV)
+    vec4 shadow_rays;          // x: length of the sun's shadow rays (beyond the scene's box from any point in it)
 };
 
 // A radius-limited point light (set 0, binding 1, std430 array).

@@ -12,9 +12,9 @@
 
 #include "common/shading_model.glsl"
 #include "common/seed_brdf.glsl"
+#include "shadows/omni_shadow.glsl"
 #include "common/blinn_phong.glsl"
 #include "clusters/cluster.glsl"
-#include "shadows/omni_shadow.glsl"
 #include "common/world_from_depth.glsl"
 #ifdef LIGHT_GRID
 #include "light_grid/light_grid.glsl"

@@ -28,6 +28,12 @@ layout(constant_id = 21) const bool SHADOW_RAYS = false;
 // point's largest coordinate (at least 1 m): clear of its own triangle's rounding.
 const float RAY_NORMAL_OFFSET = 1e-4;
 
+// Where the shadow rays of the point `world` (normal `n`) start.
+vec3 ray_origin(vec3 world, vec3 n) {
+    vec3 a = abs(world);
+    return world + n * (RAY_NORMAL_OFFSET * max(1.0, max(a.x, max(a.y, a.z))));
+}
+
 // The surface point moves this many texels along its normal before the lookup (normal-offset
 // bias: a lit surface at a grazing angle to the light stays clear of its own texels)…
 const float OMNI_NORMAL_OFFSET_TEXELS = 1.5;
@@ -96,9 +102,7 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
             return 1.0;
         }
         if (SHADOW_RAYS) {
-            vec3 a = abs(world);
-            vec3 origin = world + n * (RAY_NORMAL_OFFSET * max(1.0, max(a.x, max(a.y, a.z))));
-            return ray_occluded(origin, l.position_radius.xyz) ? 0.0 : 1.0;
+            return ray_occluded(ray_origin(world, n), l.position_radius.xyz) ? 0.0 : 1.0;
         }
         // One texel of a face in face units: the cube array's, or in the atlas the light's own.
         uint slot = uint(l.color.w) - 1u;

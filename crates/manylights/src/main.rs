@@ -186,7 +186,7 @@ struct SceneArgs {
     omni_shadow: String,
     /// Who draws the sun's shadow map (blinn-phong), once at start: graphics (a depth-only
     /// render pass) or compute (the compute shadow raster of --omni-shadow compute, in one
-    /// orthographic view).
+    /// orthographic view); or rays (no map: a shadow ray from each point toward the sun).
     #[arg(long, default_value = "graphics")]
     sun_shadow: String,
     /// How many point lights cast shadows (with --omni-shadow): K (the strongest as seen from

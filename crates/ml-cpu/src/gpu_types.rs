@@ -74,6 +74,8 @@ gpu_struct!(
         directional_color: [[f32; 4]; 4],
         /// x: the factor lit colour is multiplied by before tone map and gamma, 2^EV.
         exposure: [f32; 4],
+        /// x: length of the sun's shadow rays (beyond the scene's box from any point in it).
+        shadow_rays: [f32; 4],
     }
 );
 

@@ -642,6 +642,7 @@ impl<'a> Renderer<'a> {
             }),
             directional_color: std::array::from_fn(|i| self.scene.directional.get(i).map_or([0.0; 4], |d| d.color.extend(0.0).to_array())),
             exposure: [exposure, 0.0, 0.0, 0.0],
+            shadow_rays: [self.gpu.sun_ray_length, 0.0, 0.0, 0.0],
             ..FrameUniforms::default()
         };
         for p in &self.passes {

@@ -210,6 +210,7 @@ impl RenderSettings {
             omni_shadows: self.omni.is_some(),
             shadow_atlas: self.omni.is_some_and(|o| o.atlas().is_some()),
             shadow_rays: self.omni.is_some_and(|o| o.rays()),
+            sun_rays: self.shading == ShadingModel::BlinnPhong && self.sun_shadow == SunShadowMode::Rays,
             object_textures: !scene.textures.is_empty(),
             spot_lights: !scene.cones.is_empty(),
             transparency: self.blends_layers(),

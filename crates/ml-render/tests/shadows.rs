@@ -40,8 +40,13 @@ fn scene(ball: bool, sun_on: bool, camera: Camera) -> Scene {
 }
 
 fn render_abc(camera: Camera, size: u32) -> [RenderOutput; 3] {
+    render_abc_with(camera, size, ml_render::SunShadowMode::Graphics)
+}
+
+fn render_abc_with(camera: Camera, size: u32, sun_shadow: ml_render::SunShadowMode) -> [RenderOutput; 3] {
     let mut settings = RenderSettings::new(Technique::Forward, size, size);
     settings.shading = ShadingModel::BlinnPhong;
+    settings.sun_shadow = sun_shadow;
     [(true, true), (false, true), (true, false)].map(|(ball, sun_on)| common::render(scene(ball, sun_on, camera), settings))
 }
 
@@ -94,6 +99,48 @@ fn umbra_is_the_sunless_image_and_the_rest_is_unchanged() {
         }
     }
     assert!(compared > 2000, "only {compared} pixels compared");
+}
+
+/// With `--sun-shadow rays` the shadow is hard and exact: at every floor pixel where a CPU ray
+/// caster over every triangle is sure whether the sun's ray from the point is blocked, the
+/// sun's visibility (A − C)/(B − C) is 0 where it is and 1 where not, within 1/255.
+#[test]
+fn sun_rays_cast_the_shadow_a_triangle_caster_says() {
+    const SIZE: u32 = 96;
+    let camera = Camera::looking_at(Vec3::new(1.0, 7.0, 1.5), Vec3::new(1.0, 0.0, 0.0), 50.0, 0.1, 100.0);
+    let [a, b, c] = render_abc_with(camera, SIZE, ml_render::SunShadowMode::Rays);
+    let with_ball = scene(true, true, camera);
+    let world = ml_cpu::ray_bvh::WorldTriangles::new(&with_ball);
+    let (mut shadowed, mut lit) = (0, 0);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let p = floor_point(&camera, x, y, SIZE);
+            // The floor in view there (not the ball in front of it).
+            let (o, d) = camera.pixel_ray(x, y, SIZE, SIZE);
+            if p.x.abs() > 3.9 || p.z.abs() > 3.9 || world.first_hit(o, d).is_none_or(|(_, _, object)| object != 0) {
+                continue;
+            }
+            let origin = p + Vec3::Y * 1e-4;
+            let target = origin - sun() * 100.0;
+            if !world.sure(origin, target, 2e-3, 1e-5) {
+                continue;
+            }
+            let blocked = world.occluded(origin, target);
+            let (pa, pb, pc) = (common::pixel(&a, x, y), common::pixel(&b, x, y), common::pixel(&c, x, y));
+            let want = if blocked { pc } else { pb };
+            assert!(
+                pa.iter().zip(want).all(|(g, w)| g.abs_diff(w) <= 1),
+                "pixel ({x}, {y}) at {p}: {pa:?}, want {want:?} (blocked: {blocked})"
+            );
+            if blocked {
+                shadowed += 1;
+            } else {
+                lit += 1;
+            }
+        }
+    }
+    println!("sun rays: {shadowed} shadowed and {lit} lit floor pixels as the caster says");
+    assert!(shadowed > 40 && lit > 2000, "{shadowed} shadowed, {lit} lit");
 }
 
 #[test]

@@ -47,6 +47,8 @@ pub struct SceneGpu {
     pub omni: OmniShadows,
     /// The sun's shadow-map view-projection (blinn-phong).
     pub shadow_view_proj: glam::Mat4,
+    /// How long the sun's shadow rays are: from any point of the scene's box beyond it.
+    pub sun_ray_length: f32,
     /// Whether the sun's shadow map is drawn (blinn-phong), and by whom.
     sun: Option<SunShadowMode>,
     /// GPU milliseconds the sun's shadow map took to draw (None: not drawn, or no timestamps).
@@ -81,12 +83,13 @@ impl SceneGpu {
             object_textures,
             omni,
             shadow_view_proj: glam::Mat4::IDENTITY,
+            sun_ray_length: 1.0,
             sun,
             sun_shadow_ms: None,
             meshlets: None,
             wants_meshlets: config.meshlets,
             rays: RayGeometry::null(),
-            wants_rays: config.omni.is_some_and(|o| o.rays()),
+            wants_rays: config.omni.is_some_and(|o| o.rays()) || config.sun == Some(SunShadowMode::Rays),
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
@@ -121,6 +124,7 @@ impl SceneGpu {
         self.rays = RayGeometry::new(ctx, scene, self.wants_rays)?;
         let (lo, hi) = scene.bounds();
         self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
+        self.sun_ray_length = (hi - lo).length() + 1.0;
         if let Some(mode) = self.sun {
             let view_proj = self.shadow_view_proj;
             let inputs = sun_shadow::ShadowInputs {

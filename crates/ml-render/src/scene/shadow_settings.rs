@@ -200,15 +200,18 @@ pub enum SunShadowMode {
     Graphics,
     /// The compute shadow raster, in one orthographic view (docs/DESIGN.md#compute-shadow-raster).
     Compute,
+    /// No map: each point traces a shadow ray toward the sun (docs/DESIGN.md#shadow-rays).
+    Rays,
 }
 
 impl SunShadowMode {
-    pub const ALL: [SunShadowMode; 2] = [SunShadowMode::Graphics, SunShadowMode::Compute];
+    pub const ALL: [SunShadowMode; 3] = [SunShadowMode::Graphics, SunShadowMode::Compute, SunShadowMode::Rays];
 
     pub fn name(self) -> &'static str {
         match self {
             SunShadowMode::Graphics => "graphics",
             SunShadowMode::Compute => "compute",
+            SunShadowMode::Rays => "rays",
         }
     }
 

@@ -43,9 +43,15 @@ const LARGE_LIST: u32 = 1 << 16;
 /// holds the far plane until then); leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL. Returns the
 /// drawing's GPU milliseconds (None without timestamps).
 pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInputs) -> Result<Option<f64>, RenderError> {
+    if inputs.mode == SunShadowMode::Rays {
+        // No map is read: the shading traces rays. It is only cleared, for its layout.
+        render_shadow_map(ctx, target, None)?;
+        return Ok(None);
+    }
     let mut timer = GpuTimer::new(ctx, 1)?;
     let drawn = match inputs.mode {
         SunShadowMode::Graphics => render_shadow_map(ctx, target, Some((inputs, &mut timer))).map_err(RenderError::from),
+        SunShadowMode::Rays => Ok(()),
         SunShadowMode::Compute => {
             // One orthographic view; its "light" at the origin with radius 1 leaves world
             // positions as they are (omni_raster.glsl).

@@ -21,6 +21,8 @@ pub struct Shading {
     pub shadow_atlas: bool,
     /// The point lights' shadows are shadow rays (no cubes).
     pub shadow_rays: bool,
+    /// The sun's shadow is a shadow ray (no map; blinn-phong).
+    pub sun_rays: bool,
     pub object_textures: bool,
     pub spot_lights: bool,
     /// Transparent objects are blended in per-pixel layers (the opaque passes skip them).
@@ -40,9 +42,9 @@ impl Shading {
     }
 
     /// The specialization constants (name, value) of a lighting pipeline: the surface's,
-    /// `OMNI_SHADOWS`, `SHADOW_ATLAS` and `SHADOW_RAYS` (shadows/omni_shadow.glsl) and
-    /// `SPOT_LIGHTS` (common/lighting.glsl).
-    pub fn lighting_constants(self) -> [(&'static str, u32); 7] {
+    /// `OMNI_SHADOWS`, `SHADOW_ATLAS` and `SHADOW_RAYS` (shadows/omni_shadow.glsl),
+    /// `SUN_RAYS` (common/blinn_phong.glsl) and `SPOT_LIGHTS` (common/lighting.glsl).
+    pub fn lighting_constants(self) -> [(&'static str, u32); 8] {
         let [model_a, model_b, textures] = self.surface_constants();
         [
             model_a,
@@ -51,14 +53,15 @@ impl Shading {
             ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
             ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
             ("SHADOW_RAYS", u32::from(self.shadow_rays)),
+            ("SUN_RAYS", u32::from(self.sun_rays)),
             ("SPOT_LIGHTS", u32::from(self.spot_lights)),
         ]
     }
 
     /// `lighting_constants` and `TRANSPARENT_LAYERS` (shading/forward_frag.glsl): the forward
     /// pass of a scene with transparent layers writes linear HDR for their resolve.
-    pub fn layered_lighting_constants(self) -> [(&'static str, u32); 8] {
-        let [a, b, c, d, e, f, g] = self.lighting_constants();
-        [a, b, c, d, e, f, g, ("TRANSPARENT_LAYERS", u32::from(self.transparency))]
+    pub fn layered_lighting_constants(self) -> [(&'static str, u32); 9] {
+        let [a, b, c, d, e, f, g, h] = self.lighting_constants();
+        [a, b, c, d, e, f, g, h, ("TRANSPARENT_LAYERS", u32::from(self.transparency))]
     }
 }
