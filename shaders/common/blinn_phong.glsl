@@ -35,13 +35,13 @@ vec3 bp_point_light(PointLight light, vec3 world, vec3 n, vec3 v, vec3 diffuse, 
     return bp_brdf(light.color.rgb * max(dot(l, n), 0.0) * falloff, l, n, v, diffuse, r0, shininess);
 }
 
-// Fraction of the sun that reaches `world`: 3×3 PCF, one shadow-map texel apart, through the
-// comparison sampler. The lookup point moves 1.5 texels along the normal first (normal-offset
-// bias: no acne on lit surfaces, no visible gap at contact).
-// With SUN_RAYS there is no map: a shadow ray from the point toward the sun, beyond the
-// scene's box (shadows/shadow_rays.glsl).
+// The sun's shadow is a shadow ray (--sun-shadow rays): no map.
 layout(constant_id = 22) const bool SUN_RAYS = false;
 
+// Fraction of the sun that reaches `world`: 3×3 PCF, one shadow-map texel apart, through the
+// comparison sampler. The lookup point moves 1.5 texels along the normal first (normal-offset
+// bias: no acne on lit surfaces, no visible gap at contact). With SUN_RAYS: a shadow ray from
+// the point toward the sun, longer than the scene's box is wide (shadows/shadow_rays.glsl).
 float bp_sun_visibility(vec3 world, vec3 n) {
     if (SUN_RAYS) {
         vec3 origin = ray_origin(world, n);

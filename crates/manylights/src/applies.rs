@@ -10,7 +10,7 @@ use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::ArgMatches;
 use ml_cpu::scene_request::{BuiltScene, SceneSource, SceneWarning};
-use ml_render::{DebugView, OmniShadowMode, RenderSettings, ShadingModel, Technique};
+use ml_render::{DebugView, OmniShadowMode, RenderSettings, ShadingModel, SunShadowMode, Technique};
 
 /// The options of a command given on the command line, by clap's id (the field's name): the
 /// others keep their defaults, which never make an option refused as not applying.
@@ -335,6 +335,11 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         }
         .map(|rule| rule.of_value(view)),
     );
+    if view == DebugView::ShadowMap.name() {
+        let drawn = Some(args.sun_shadow != SunShadowMode::Rays.name());
+        let map = "a sun's shadow map (--sun-shadow graphics or compute)";
+        rules.push(Rule::setting("debug_view", drawn, format!("--sun-shadow {}", args.sun_shadow), map).of_value(view));
+    }
     rules
 }
 
