@@ -4,6 +4,6 @@
 # and synchronization validation on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+bash scripts/setup.sh tests
 bash scripts/lint.sh
 cargo test --workspace --locked "$@"

@@ -8,6 +8,17 @@
 #ifndef MANYLIGHTS_COMMON_GLSL
 #define MANYLIGHTS_COMMON_GLSL
 
+#extension GL_KHR_shader_subgroup_ballot : require
+
+// A branch or a loop count that depends on nothing but push constants and the frame's uniform
+// block reads them through `opaque_uniform`. Mesa's lavapipe (the CPU driver CI renders with)
+// inlines such values as constants and compiles the shader anew at every pipeline bind — a
+// quarter of a second for a lighting shader, every frame (docs/DESIGN.md#shaders-on-lavapipe).
+// A dynamically uniform value read through the subgroup's first invocation is the same value,
+// hidden from that analysis. The test `no_branch_rests_on_uniforms_alone` checks every shader.
+// Compute and fragment shaders only (the stages lavapipe runs subgroup operations in).
+#define opaque_uniform(x) subgroupBroadcastFirst(x)
+
 
 #define DEBUG_VIEW_NONE 0u
 #define DEBUG_VIEW_CLUSTER_HEAT 1u

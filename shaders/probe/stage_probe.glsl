@@ -26,7 +26,7 @@ vec4 probe_pixel(ivec2 p) {
     vec3 n = vec3(0.0, 1.0, 0.0);
     vec3 v = normalize(vec3(0.0, 15.0, 25.0) - world);
     vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < probe.size_lights.z; ++i) {
+    for (uint i = 0u; i < opaque_uniform(probe.size_lights.z); ++i) {
         sum += seed_point_light(probe_lights[i], world, n, v, vec3(1.0, 0.765557, 0.336057), 0.3, 1.0);
     }
     return vec4(sum / (1.0 + sum), 1.0);

@@ -24,7 +24,7 @@ layout(location = 4) out vec4 out_emissive;
 #endif
 
 void main() {
-    Surface s = surface_at(covered_normal(), in_tangent, in_uv, object.ids.y, object.material);
+    Surface s = surface_at(covered_normal(), in_tangent, in_uv, opaque_uniform(object.ids.y), object.material);
     out_normal = oct_encode(s.normal);
     out_object = object.ids.x;
     out_albedo_occlusion = vec4(s.albedo_factor, s.occlusion);

@@ -45,7 +45,7 @@ bool sphere_in_box(mat4 p, vec3 c, float r) {
 void main() {
     uint light = ATLAS ? redrawn_lights[gl_WorkGroupID.y] : gl_WorkGroupID.y;
     vec4 l = shadow_lights[light];
-    for (uint id = gl_GlobalInvocationID.x; id < omni.sizes.w; id += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
+    for (uint id = gl_GlobalInvocationID.x; id < opaque_uniform(omni.sizes.w); id += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
         uvec2 object_meshlet = meshlet_instances[id];
         Meshlet m = meshlets[object_meshlet.y];
         vec3 c = (objects[object_meshlet.x].model * vec4(m.center_radius.xyz, 1.0)).xyz - l.xyz;
@@ -76,7 +76,7 @@ void main() {
         atomicMax(counters.pairs.x, min(min(at + n, omni.capacity.x), MAX_GROUPS));
         for (; faces != 0u; faces &= faces - 1u) {
             uint layer = light * 6u + uint(findLSB(faces));
-            if (at < omni.capacity.x) {
+            if (at < opaque_uniform(omni.capacity.x)) {
                 pairs[at] = uvec2(id, layer);
             } else {
                 atomicAdd(counters.drawn.z, raster_meshlet_alone(id, layer));

@@ -15,7 +15,7 @@ shared vec3 corner_rel[64];
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
-    uint pair_count = min(counters.pairs.w, omni.capacity.x);
+    uint pair_count = min(counters.pairs.w, opaque_uniform(omni.capacity.x));
     uint small = 0u, in_place = 0u, covered = 0u;
     for (uint e = gl_WorkGroupID.x; e < pair_count; e += gl_NumWorkGroups.x) {
         uvec2 pair = pairs[e];
@@ -41,7 +41,7 @@ void main() {
             if (a.z >= 0.0 && b.z >= 0.0 && c.z >= 0.0) {
                 vec2 pa = face_xy(a, layer), pb = face_xy(b, layer), pc = face_xy(c, layer);
                 vec2 box = max(pa, max(pb, pc)) - min(pa, min(pb, pc));
-                if (all(lessThanEqual(box, vec2(float(omni.sizes.z))))) {
+                if (all(lessThanEqual(box, vec2(float(opaque_uniform(omni.sizes.z)))))) {
                     covered += raster_small(pa, pb, pc, vec4(ra, 1.0 / a.w), vec4(rb, 1.0 / b.w), vec4(rc, 1.0 / c.w), layer, s);
                     small++;
                     continue;

@@ -88,7 +88,7 @@ vec3 view_vertex(uint vertex, mat4 model, uint layer, out vec4 clip) {
 
 // Texels a side of the view `layer`.
 uint view_side(uint layer) {
-    return ATLAS ? cube_tiles[layer / 6u].size : omni.sizes.x;
+    return ATLAS ? cube_tiles[layer / 6u].size : opaque_uniform(omni.sizes.x);
 }
 
 // The viewport transform of view `layer`, in texels.

@@ -24,7 +24,7 @@ shared vec2 corner_uv[3];
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
-    uint count = min(counters.large.w, omni.capacity.y);
+    uint count = min(counters.large.w, opaque_uniform(omni.capacity.y));
     uint covered = 0u;
     for (uint e = gl_WorkGroupID.x; e < count; e += gl_NumWorkGroups.x) {
         // The last triangle's threads are done with the polygon.

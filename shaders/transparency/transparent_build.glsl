@@ -22,7 +22,7 @@ void main() {
     // The textures first, sampled with their implicit derivatives while the whole quad still
     // runs (after a fragment of it returns they are undefined); and every read this fragment
     // needs issued together, before the test that waits on the opaque depth.
-    Surface s = surface_at(covered_normal(), in_tangent, in_uv, object.ids.y, object.material);
+    Surface s = surface_at(covered_normal(), in_tangent, in_uv, opaque_uniform(object.ids.y), object.material);
     float alpha = objects[o].alpha.y;
     uvec4 alpha_texture = objects[o].alpha_texture;
     float opaque = opaque_depth_at(p);

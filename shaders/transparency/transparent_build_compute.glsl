@@ -201,7 +201,7 @@ void main() {
     vec2 to_ndc = 2.0 / vec2(frame.viewport.xy);
     vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0);
     uint capacity = layer_capacity();
-    for (uint listed = 0u; listed < dispatch_objects.y; listed += CHUNK) {
+    for (uint listed = 0u; listed < opaque_uniform(dispatch_objects.y); listed += CHUNK) {
         if (lid == 0u) {
             tile_object_count = 0u;
         }

@@ -8,6 +8,7 @@
 #ifndef MANYLIGHTS_DEPTH_PYRAMID_PASS_GLSL
 #define MANYLIGHTS_DEPTH_PYRAMID_PASS_GLSL
 
+#include "common/common.glsl"
 #include "visibility/depth_pyramid.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -17,7 +18,7 @@ layout(push_constant) uniform PyramidPushBlock { uvec4 level; }; // x: the level
 
 void main() {
     uvec2 image = level.yz;
-    int l = int(level.x);
+    int l = int(opaque_uniform(level.x));
     uvec2 size = pyramid_level_size(image, l);
     uvec2 p = gl_GlobalInvocationID.xy;
     if (any(greaterThanEqual(p, size))) {

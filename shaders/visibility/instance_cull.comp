@@ -31,7 +31,7 @@ void main() {
         return;
     }
     vec4 b = instances[i].bounds;
-    if (cull.mode.y == 0u || sphere_in_frustum(b.xyz, b.w)) {
+    if (opaque_uniform(cull.mode.y) == 0u || sphere_in_frustum(b.xyz, b.w)) {
         visible_instances[atomicAdd(counters.dispatch.x, 1u)] = i;
     }
 }

@@ -20,8 +20,8 @@ void main() {
     uint instance = visible_instances[gl_WorkGroupID.x];
     Instance inst = instances[instance];
     mat4 model = objects[instance].model;
-    bool late = cull.mode.x == 1u;
-    bool culling = cull.mode.y != 0u;
+    bool late = opaque_uniform(cull.mode.x) == 1u;
+    bool culling = opaque_uniform(cull.mode.y) != 0u;
     if (late && gl_GlobalInvocationID.x == 0u) {
         // The early triangles are all compacted by now: the late ones follow them.
         counters.draws[1].first_index = counters.draws[0].index_count;

@@ -20,7 +20,7 @@ void main() {
     uvec4 d = draw_slots[group_slot()];
     Meshlet m = meshlets[d.w];
     transform_meshlet(m, d);
-    bool culling = cull.mode.y != 0u;
+    bool culling = opaque_uniform(cull.mode.y) != 0u;
     bool both_faces = (instances[d.y].meshlets.w & INSTANCE_DOUBLE_SIDED) != 0u;
     for (uint t = gl_LocalInvocationID.x; t < m.triangles.y; t += gl_WorkGroupSize.x) {
         uvec3 v = meshlet_corners(m, t);

@@ -31,7 +31,7 @@ bool triangle_visible(vec4 a, vec4 b, vec4 c, bool both_faces) {
     if (a.w <= 0.0 || b.w <= 0.0 || c.w <= 0.0) {
         return true;
     }
-    vec2 size = vec2(frame.viewport.xy);
+    vec2 size = vec2(opaque_uniform(frame.viewport.xy));
     vec2 pa = (a.xy / a.w * 0.5 + 0.5) * size;
     vec2 pb = (b.xy / b.w * 0.5 + 0.5) * size;
     vec2 pc = (c.xy / c.w * 0.5 + 0.5) * size;
@@ -96,7 +96,7 @@ void keep_triangle(uint t) {
 
 // After every triangle's verdict: the kept ones appended to the phase's draw.
 void append_kept(Meshlet m, uvec4 d) {
-    uint phase = cull.mode.x;
+    uint phase = opaque_uniform(cull.mode.x);
     uint slot = group_slot();
     uint lid = gl_LocalInvocationID.x;
     barrier();

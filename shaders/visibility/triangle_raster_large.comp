@@ -28,9 +28,9 @@ shared uint group_pixels;
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
-    uint phase = cull.mode.x;
-    uint count = min(counters.binned[phase], cull.triangles.z);
-    ivec2 size = ivec2(frame.viewport.xy);
+    uint phase = opaque_uniform(cull.mode.x);
+    uint count = min(counters.binned[phase], opaque_uniform(cull.triangles.z));
+    ivec2 size = ivec2(opaque_uniform(frame.viewport.xy));
     if (lid == 0u) {
         group_pixels = 0u;
     }

@@ -75,7 +75,7 @@ void main() {
     float z = raster_depth(p);
     if (z >= 1.0) {
         // The background, once: by the first set's dispatch.
-        if (texture_set.x == 0u) {
+        if (opaque_uniform(texture_set.x) == 0u) {
             store_background(p);
         }
         return;
@@ -88,7 +88,7 @@ void main() {
     if (inst.surface.y != texture_set.x) {
         return;
     }
-    uint view = frame.cluster_dims.w;
+    uint view = opaque_uniform(frame.cluster_dims.w);
     if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
         imageStore(out_image, p, vec4(id_color(view == DEBUG_VIEW_MESHLETS ? meshlet_instance : id), 1.0));
         return;

@@ -108,3 +108,5 @@ include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod uniform_branches;
