@@ -13,8 +13,8 @@
 #ifndef MANYLIGHTS_SHADOW_RAYS_GLSL
 #define MANYLIGHTS_SHADOW_RAYS_GLSL
 
-// Nodes a traversal keeps to visit (ml_cpu::ray_bvh::RAY_STACK: the renderer refuses a
-// hierarchy deeper than this).
+// Entries the traversal keeps on its stack (ml_cpu::ray_bvh::RAY_STACK: the renderer refuses
+// a hierarchy whose RayScene::stack_needed exceeds it).
 const uint RAY_STACK = 64u;
 // Smallest |direction| the box test divides by (a zero component would give 0 * inf).
 const float RAY_MIN_DIRECTION = 1e-30;
@@ -78,44 +78,6 @@ bool ray_kept(uint k, uint object, vec2 bary) {
     return true;
 }
 
-// The traversal of one level: NODES the node array, LEAF(first, count) tests a leaf's
-// primitives and returns true on a hit. Both children of a node are tested from its one read;
-// where both are entered, one is kept on the stack and the other visited next.
-#define RAY_TRAVERSE(NODES, ROOT, O, INV, LEAF)                                                      \
-    {                                                                                                \
-        uint stack_[RAY_STACK];                                                                      \
-        uint depth_ = 0u;                                                                            \
-        uint node_ = ROOT;                                                                           \
-        while (true) {                                                                               \
-            RayNode n_ = NODES[node_];                                                               \
-            ray_steps++;                                                                             \
-            bool left_ = ray_enters(O, INV, n_.left_min, n_.left_max);                               \
-            bool right_ = ray_enters(O, INV, n_.right_min, n_.right_max);                            \
-            if (left_ && n_.left_count != 0u) {                                                      \
-                if (LEAF(n_.left_child, n_.left_count)) {                                            \
-                    return true;                                                                     \
-                }                                                                                    \
-                left_ = false;                                                                       \
-            }                                                                                        \
-            if (right_ && n_.right_count != 0u) {                                                    \
-                if (LEAF(n_.right_child, n_.right_count)) {                                          \
-                    return true;                                                                     \
-                }                                                                                    \
-                right_ = false;                                                                      \
-            }                                                                                        \
-            if (left_ && right_) {                                                                   \
-                stack_[depth_++] = n_.right_child;                                                   \
-                node_ = n_.left_child;                                                               \
-            } else if (left_ || right_) {                                                            \
-                node_ = left_ ? n_.left_child : n_.right_child;                                      \
-            } else if (depth_ == 0u) {                                                               \
-                break;                                                                               \
-            } else {                                                                                 \
-                node_ = stack_[--depth_];                                                            \
-            }                                                                                        \
-        }                                                                                            \
-    }
-
 // Whether a triangle of a leaf's `count` triangles from `first` (of object `object`) crosses
 // the segment where it is there.
 bool ray_leaf_triangles(uint first, uint count, uint object, vec3 o, vec3 d) {
@@ -129,35 +91,99 @@ bool ray_leaf_triangles(uint first, uint count, uint object, vec3 o, vec3 d) {
     return false;
 }
 
-// Whether a triangle of instance `inst`'s mesh crosses the world segment origin + t d.
-bool ray_instance_occludes(RayInstance inst, vec3 origin, vec3 d) {
-    vec3 o = vec3(dot(inst.to_object[0].xyz, origin) + inst.to_object[0].w, dot(inst.to_object[1].xyz, origin) + inst.to_object[1].w,
-                  dot(inst.to_object[2].xyz, origin) + inst.to_object[2].w);
-    vec3 od = vec3(dot(inst.to_object[0].xyz, d), dot(inst.to_object[1].xyz, d), dot(inst.to_object[2].xyz, d));
-    vec3 inv = ray_inverse(od);
-#define RAY_MESH_LEAF(first, count) ray_leaf_triangles(first, count, inst.object, o, od)
-    RAY_TRAVERSE(ray_nodes, inst.root, o, inv, RAY_MESH_LEAF)
-#undef RAY_MESH_LEAF
-    return false;
-}
-
-// Whether an instance of a leaf's `count` from `first` blocks the world segment.
-bool ray_leaf_instances(uint first, uint count, vec3 origin, vec3 d) {
-    for (uint k = first; k < first + count; ++k) {
-        if (ray_instance_occludes(ray_instances[k], origin, d)) {
-            return true;
-        }
-    }
-    return false;
-}
+// What a traversal stack entry is (its top two bits): a node of the top level, a node of a
+// mesh's hierarchy, an instance to enter, or the end of an instance (back to the world
+// segment). The low 30 bits: the node's or the instance's index.
+const uint RAY_TOP_NODE = 0u;
+const uint RAY_MESH_NODE = 1u << 30;
+const uint RAY_ENTER = 2u << 30;
+const uint RAY_LEAVE = 3u << 30;
+const uint RAY_INDEX = (1u << 30) - 1u;
 
 // Whether a triangle crosses the segment from `origin` to `target` strictly between them.
+// Both levels in one loop with one stack, so that the invocations of a subgroup step through
+// the top level and their meshes together rather than waiting for each other's meshes.
 bool ray_occluded(vec3 origin, vec3 target) {
-    vec3 d = target - origin;
-    vec3 inv = ray_inverse(d);
-#define RAY_TOP_LEAF(first, count) ray_leaf_instances(first, count, origin, d)
-    RAY_TRAVERSE(ray_top, 0u, origin, inv, RAY_TOP_LEAF)
-#undef RAY_TOP_LEAF
+    vec3 world_d = target - origin;
+    vec3 world_inv = ray_inverse(world_d);
+    vec3 o = origin, d = world_d, inv = world_inv;
+    uint object = 0u;
+    uint stack[RAY_STACK];
+    uint depth = 0u;
+    uint entry = RAY_TOP_NODE;
+    while (true) {
+        uint kind = entry & ~RAY_INDEX, index = entry & RAY_INDEX;
+        if (kind == RAY_ENTER) {
+            // Into the instance's object space, the way back on the stack.
+            RayInstance inst = ray_instances[index];
+            o = vec3(dot(inst.to_object[0].xyz, origin) + inst.to_object[0].w, dot(inst.to_object[1].xyz, origin) + inst.to_object[1].w,
+                     dot(inst.to_object[2].xyz, origin) + inst.to_object[2].w);
+            d = vec3(dot(inst.to_object[0].xyz, world_d), dot(inst.to_object[1].xyz, world_d), dot(inst.to_object[2].xyz, world_d));
+            inv = ray_inverse(d);
+            object = inst.object;
+            stack[depth++] = RAY_LEAVE;
+            entry = RAY_MESH_NODE | inst.root;
+            continue;
+        }
+        if (kind == RAY_LEAVE) {
+            o = origin;
+            d = world_d;
+            inv = world_inv;
+            if (depth == 0u) {
+                break;
+            }
+            entry = stack[--depth];
+            continue;
+        }
+        bool mesh = kind == RAY_MESH_NODE;
+        RayNode n = mesh ? ray_nodes[index] : ray_top[index];
+        ray_steps++;
+        bool left = ray_enters(o, inv, n.left_min, n.left_max);
+        bool right = ray_enters(o, inv, n.right_min, n.right_max);
+        if (!mesh) {
+            // The top level: the children to visit on the stack, and above them the instances
+            // of the leaves entered, which are thus entered first (the stack stays within the
+            // top level's depth + 1, the instances of two leaves, and one mesh's traversal).
+            if (left && n.left_count == 0u) {
+                stack[depth++] = RAY_TOP_NODE | n.left_child;
+            }
+            if (right && n.right_count == 0u) {
+                stack[depth++] = RAY_TOP_NODE | n.right_child;
+            }
+            for (uint k = 0u; left && k < n.left_count; ++k) {
+                stack[depth++] = RAY_ENTER | (n.left_child + k);
+            }
+            for (uint k = 0u; right && k < n.right_count; ++k) {
+                stack[depth++] = RAY_ENTER | (n.right_child + k);
+            }
+            if (depth == 0u) {
+                break;
+            }
+            entry = stack[--depth];
+            continue;
+        }
+        if (left && n.left_count != 0u) {
+            if (ray_leaf_triangles(n.left_child, n.left_count, object, o, d)) {
+                return true;
+            }
+            left = false;
+        }
+        if (right && n.right_count != 0u) {
+            if (ray_leaf_triangles(n.right_child, n.right_count, object, o, d)) {
+                return true;
+            }
+            right = false;
+        }
+        if (left && right) {
+            stack[depth++] = RAY_MESH_NODE | n.right_child;
+            entry = RAY_MESH_NODE | n.left_child;
+        } else if (left || right) {
+            entry = RAY_MESH_NODE | (left ? n.left_child : n.right_child);
+        } else {
+            // A mesh's stack always holds its way back (RAY_LEAVE) below its nodes.
+            entry = stack[--depth];
+        }
+    }
     return false;
 }
 

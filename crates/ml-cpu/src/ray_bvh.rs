@@ -14,8 +14,10 @@
 
 use crate::geometry::Mesh;
 use crate::gpu_types::{RayInstance, RayNode, RayTriangle};
+use crate::mesh::MeshKind;
 use crate::scene::Scene;
 use glam::{Mat4, Vec2, Vec3};
+use std::collections::HashMap;
 use std::time::Instant;
 
 /// Most primitives a leaf holds (obvhs collapses leaves up to this many where its cost model
@@ -230,8 +232,10 @@ impl RayScene {
             + size(self.instances.len(), size_of::<RayInstance>())
     }
 
-    /// Most nodes a traversal keeps on its stack: one per inner node on the deepest path below
-    /// the root, in the top level and in any mesh's bottom level (each has its own stack).
+    /// Most entries the traversal keeps on its one stack: the top level's pending nodes (one
+    /// per inner node on its deepest path, and one more), the instances of the two leaves of
+    /// one top node, the way back from a mesh, and that mesh's pending nodes (one per inner
+    /// node on its deepest path).
     pub fn stack_needed(&self) -> usize {
         fn deepest(nodes: &[RayNode], root: u32) -> usize {
             if nodes.is_empty() {
@@ -249,52 +253,113 @@ impl RayScene {
             }
             most
         }
-        let roots = self.instances.iter().map(|i| deepest(&self.nodes, i.root));
-        roots.chain([deepest(&self.top, 0)]).max().unwrap_or(0)
+        if self.top.is_empty() {
+            return 0;
+        }
+        let top_leaves = self.top.iter().map(|n| (n.left_count + n.right_count) as usize).max().unwrap_or(0);
+        let mesh = self.instances.iter().map(|i| deepest(&self.nodes, i.root)).max().unwrap_or(0);
+        deepest(&self.top, 0) + 1 + top_leaves + 1 + mesh
     }
 
-    /// Whether a triangle crosses the segment from `origin` to `target` strictly between them
-    /// (the shaders' traversal: shadows/shadow_rays.glsl).
+    /// Whether a triangle crosses the segment from `origin` to `target` strictly between them:
+    /// the shaders' traversal (shadows/shadow_rays.glsl), step for step — both levels in one
+    /// loop over one stack, whose deepest use is returned too (`stack_needed` bounds it).
     pub fn occluded(&self, origin: Vec3, target: Vec3) -> bool {
-        let d = target - origin;
-        traverse(&self.top, 0, &Segment::new(origin, d), |first, count| {
-            self.instances[first as usize..(first + count) as usize].iter().any(|inst| self.mesh_occludes(inst, origin, d))
-        })
+        self.traverse(origin, target).0
     }
 
-    /// Whether a triangle of `inst`'s mesh crosses the segment (world `origin`, `d`).
-    fn mesh_occludes(&self, inst: &RayInstance, origin: Vec3, d: Vec3) -> bool {
-        let rows = inst.to_object.map(glam::Vec4::from_array);
-        let o = Vec3::new(
-            rows[0].truncate().dot(origin) + rows[0].w,
-            rows[1].truncate().dot(origin) + rows[1].w,
-            rows[2].truncate().dot(origin) + rows[2].w,
-        );
-        let od = Vec3::new(rows[0].truncate().dot(d), rows[1].truncate().dot(d), rows[2].truncate().dot(d));
-        traverse(&self.nodes, inst.root, &Segment::new(o, od), |first, count| {
-            let tris = &self.triangles[first as usize..(first + count) as usize];
-            tris.iter().any(|t| segment_crosses(o, od, Vec3::from(t.v0), Vec3::from(t.e1), Vec3::from(t.e2)))
-        })
-    }
-}
-
-/// One level's traversal from `root`: `leaf(first, count)` tests the primitives of each leaf the
-/// segment enters, and the first that reports a hit ends it.
-fn traverse(nodes: &[RayNode], root: u32, seg: &Segment, mut leaf: impl FnMut(u32, u32) -> bool) -> bool {
-    let mut stack = vec![root];
-    while let Some(n) = stack.pop() {
-        for c in children(&nodes[n as usize]) {
-            if !seg.enters(c.min, c.max) {
-                continue;
-            }
-            if c.count == 0 {
-                stack.push(c.child);
-            } else if leaf(c.child, c.count) {
-                return true;
+    /// `occluded`, and the most entries its stack held.
+    pub fn traverse(&self, origin: Vec3, target: Vec3) -> (bool, usize) {
+        if self.top.is_empty() {
+            return (false, 0);
+        }
+        let world_d = target - origin;
+        let (mut seg, mut d) = (Segment::new(origin, world_d), world_d);
+        let mut stack: Vec<Entry> = Vec::new();
+        let mut most = 0;
+        let mut entry = Entry::Top(0);
+        loop {
+            most = most.max(stack.len());
+            match entry {
+                Entry::Enter(i) => {
+                    // Into the instance's object space, the way back on the stack.
+                    let inst = &self.instances[i as usize];
+                    let rows = inst.to_object.map(glam::Vec4::from_array);
+                    let o = Vec3::new(
+                        rows[0].truncate().dot(origin) + rows[0].w,
+                        rows[1].truncate().dot(origin) + rows[1].w,
+                        rows[2].truncate().dot(origin) + rows[2].w,
+                    );
+                    d = Vec3::new(rows[0].truncate().dot(world_d), rows[1].truncate().dot(world_d), rows[2].truncate().dot(world_d));
+                    seg = Segment::new(o, d);
+                    stack.push(Entry::Leave);
+                    entry = Entry::Mesh(inst.root);
+                }
+                Entry::Leave => {
+                    (seg, d) = (Segment::new(origin, world_d), world_d);
+                    match stack.pop() {
+                        Some(next) => entry = next,
+                        None => return (false, most),
+                    }
+                }
+                Entry::Top(n) => {
+                    // The children to visit on the stack, above them the instances of the
+                    // leaves entered (so these are entered first).
+                    let cs = children(&self.top[n as usize]).map(|c| (seg.enters(c.min, c.max), c));
+                    stack.extend(cs.iter().filter(|(e, c)| *e && c.count == 0).map(|(_, c)| Entry::Top(c.child)));
+                    for (_, c) in cs.iter().filter(|(e, c)| *e && c.count != 0) {
+                        stack.extend((c.child..c.child + c.count).map(Entry::Enter));
+                    }
+                    most = most.max(stack.len());
+                    match stack.pop() {
+                        Some(next) => entry = next,
+                        None => return (false, most),
+                    }
+                }
+                Entry::Mesh(n) => {
+                    let mut next = Vec::new();
+                    for c in children(&self.nodes[n as usize]) {
+                        if !seg.enters(c.min, c.max) {
+                            continue;
+                        }
+                        if c.count == 0 {
+                            next.push(c.child);
+                        } else {
+                            let tris = &self.triangles[c.child as usize..(c.child + c.count) as usize];
+                            let o = seg.origin;
+                            if tris.iter().any(|t| segment_crosses(o, d, Vec3::from(t.v0), Vec3::from(t.e1), Vec3::from(t.e2))) {
+                                return (true, most);
+                            }
+                        }
+                    }
+                    // Both entered: the right kept, the left visited next.
+                    if let [left, right] = next[..] {
+                        stack.push(Entry::Mesh(right));
+                        most = most.max(stack.len());
+                        entry = Entry::Mesh(left);
+                    } else if let [only] = next[..] {
+                        entry = Entry::Mesh(only);
+                    } else {
+                        // A mesh's stack always holds its way back below its nodes.
+                        entry = stack.pop().expect("the way back from a mesh");
+                    }
+                }
             }
         }
     }
-    false
+}
+
+/// A traversal stack entry (shadow_rays.glsl: the entry's top two bits).
+#[derive(Clone, Copy, Debug)]
+enum Entry {
+    /// A node of the top level.
+    Top(u32),
+    /// A node of a mesh's hierarchy.
+    Mesh(u32),
+    /// An instance to enter.
+    Enter(u32),
+    /// The end of an instance: back to the world segment.
+    Leave,
 }
 
 fn children(n: &RayNode) -> [Child; 2] {
@@ -365,11 +430,12 @@ pub struct WorldTriangles<'a> {
 }
 
 /// Where a segment `o + t·d` meets a triangle's plane: the barycentric weights of v1 and v2,
-/// and t (None where the segment lies parallel to the plane).
-fn crossing(o: Vec3, d: Vec3, [v0, e1, e2]: [Vec3; 3]) -> Option<(f32, f32, f32)> {
+/// and t (None where the segment lies parallel to the plane, or so nearly that the
+/// determinant is at most `min_det` in magnitude).
+fn crossing(o: Vec3, d: Vec3, [v0, e1, e2]: [Vec3; 3], min_det: f32) -> Option<(f32, f32, f32)> {
     let p = d.cross(e2);
     let det = e1.dot(p);
-    if det == 0.0 {
+    if det.abs() <= min_det || det.is_nan() {
         return None;
     }
     let s = o - v0;
@@ -379,9 +445,11 @@ fn crossing(o: Vec3, d: Vec3, [v0, e1, e2]: [Vec3; 3]) -> Option<(f32, f32, f32)
 
 impl<'a> WorldTriangles<'a> {
     pub fn new(scene: &'a Scene) -> WorldTriangles<'a> {
+        // Each mesh built (or cloned) once, however many objects draw it.
+        let meshes: HashMap<MeshKind, Option<Mesh>> = scene.mesh_kinds().into_iter().map(|kind| (kind, scene.mesh(kind))).collect();
         let (mut triangles, mut sources) = (Vec::new(), Vec::new());
         for (k, o) in scene.objects.iter().enumerate() {
-            let Some(mesh) = scene.mesh(o.mesh) else { continue };
+            let Some(mesh) = &meshes[&o.mesh] else { continue };
             let p = |i: u32| o.transform.transform_point3(Vec3::from(mesh.vertices[i as usize].position));
             let uv = |i: u32| Vec2::from(mesh.vertices[i as usize].uv);
             for t in mesh.indices.chunks_exact(3) {
@@ -406,7 +474,7 @@ impl<'a> WorldTriangles<'a> {
     pub fn occluded(&self, origin: Vec3, target: Vec3) -> bool {
         let d = target - origin;
         self.triangles.iter().enumerate().any(|(i, &[v0, e1, e2])| {
-            segment_crosses(origin, d, v0, e1, e2) && crossing(origin, d, [v0, e1, e2]).is_some_and(|(u, v, _)| self.kept(i, u, v))
+            segment_crosses(origin, d, v0, e1, e2) && crossing(origin, d, [v0, e1, e2], 0.0).is_some_and(|(u, v, _)| self.kept(i, u, v))
         })
     }
 
@@ -415,7 +483,7 @@ impl<'a> WorldTriangles<'a> {
     pub fn first_hit(&self, o: Vec3, d: Vec3) -> Option<(f32, Vec3, u32)> {
         let mut best: Option<(f32, Vec3, u32)> = None;
         for (i, &tri) in self.triangles.iter().enumerate() {
-            let Some((u, v, t)) = crossing(o, d, tri) else { continue };
+            let Some((u, v, t)) = crossing(o, d, tri, 0.0) else { continue };
             let inside = u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
             if inside && best.is_none_or(|(b, _, _)| t < b) && self.kept(i, u, v) {
                 let n = tri[1].cross(tri[2]).normalize();
@@ -434,7 +502,7 @@ impl<'a> WorldTriangles<'a> {
         let d = target - origin;
         let length = d.length();
         self.triangles.iter().enumerate().all(|(i, &tri)| {
-            let Some((u, v, t)) = crossing(origin, d, tri).filter(|_| tri[1].dot(d.cross(tri[2])).abs() >= 1e-20) else {
+            let Some((u, v, t)) = crossing(origin, d, tri, 1e-20) else {
                 // Edge-on: the segment lies in the triangle's plane or parallel to it.
                 let n = tri[1].cross(tri[2]).normalize_or_zero();
                 return (origin - tri[0]).dot(n).abs() > dist;
@@ -503,7 +571,7 @@ mod tests {
             let rays = RayScene::build(&scene);
             let world = WorldTriangles::new(&scene);
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(100 + seed);
-            let (mut blocked, mut checked) = (0, 0);
+            let (mut blocked, mut checked, mut deepest) = (0, 0, 0);
             for _ in 0..2000 {
                 let mut p = || Vec3::new(rng.random_range(-7.9..7.9), rng.random_range(-7.9..7.9), rng.random_range(-7.9..7.9));
                 let (origin, target) = (p(), p());
@@ -512,12 +580,17 @@ mod tests {
                     continue;
                 }
                 let expected = world.occluded(origin, target);
-                assert_eq!(rays.occluded(origin, target), expected, "seed {seed}: {origin} -> {target}");
+                let (occluded, stack) = rays.traverse(origin, target);
+                assert_eq!(occluded, expected, "seed {seed}: {origin} -> {target}");
+                assert!(stack <= rays.stack_needed(), "seed {seed}: {stack} entries, bound {}", rays.stack_needed());
+                deepest = deepest.max(stack);
                 blocked += usize::from(expected);
                 checked += 1;
             }
-            // Both answers are common, so neither could pass by always being given.
+            // Both answers are common, so neither could pass by always being given; the stack
+            // holds a mesh's nodes above the top level's.
             assert!(checked > 1500 && blocked > checked / 10 && blocked < checked * 9 / 10, "{blocked} of {checked} blocked");
+            assert!(deepest > 4, "{deepest}");
         }
     }
 

@@ -18,7 +18,7 @@ pub struct RayStats {
     pub nodes: usize,
     pub triangles: usize,
     pub instances: usize,
-    /// Most nodes a traversal keeps (its deepest path).
+    /// Most entries a traversal keeps on its stack (RayScene::stack_needed).
     pub depth: usize,
 }
 
@@ -28,7 +28,7 @@ impl FeatureStats for RayStats {
         vec![(
             "shadow rays",
             format!(
-                "hierarchy of {} triangles (each mesh once), {} nodes, {} instances, {} levels at most: {mib:.1} MiB, built in {:.1} ms on the CPU",
+                "hierarchy of {} triangles (each mesh once), {} nodes, {} instances, a traversal stack of {} at most: {mib:.1} MiB, built in {:.1} ms on the CPU",
                 self.triangles, self.nodes, self.instances, self.depth, self.build_ms
             ),
         )]
@@ -63,7 +63,7 @@ impl RayGeometry {
         let built = if rays { RayScene::build(scene) } else { RayScene::default() };
         if built.stack_needed() > RAY_STACK {
             return Err(RenderError::Invalid(format!(
-                "the scene's shadow-ray hierarchy is {} levels deep, more than the {RAY_STACK} its traversal keeps: use shadow cubes (--omni-shadow atlas)",
+                "the scene's shadow-ray hierarchy needs a traversal stack of {} entries, more than the {RAY_STACK} the shaders keep: use shadow cubes (--omni-shadow atlas)",
                 built.stack_needed()
             )));
         }
