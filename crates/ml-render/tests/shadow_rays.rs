@@ -6,7 +6,9 @@
 //! misses or crosses every triangle by a margin (the GPU's point and normal differ from the
 //! CPU's by rounding). And every technique gives the image the brute-force forward pass gives,
 //! but for a counted few pixels on shadow edges, where the techniques' points (interpolated
-//! or rebuilt from depth) fall on either side.
+//! or rebuilt from depth) fall on either side. Against the shadow cubes and the atlas, rays
+//! shadow the same pixels wherever an analytic ray test is sure of each light by a margin of
+//! the cubes' texels.
 
 mod common;
 
@@ -256,4 +258,40 @@ fn the_ray_cost_view_shows_where_rays_are_traced() {
     dark.lights[0].position_radius[3] = 0.01;
     let none = common::render(dark, view(Technique::Forward));
     assert_eq!(lit(&none), 0, "no ray, no heat");
+}
+
+/// Against the shadow maps: in the shadow room with two more, coloured lights near the pillar
+/// (whose shadows cross the floor and the walls in view), rays give the
+/// image of the cube array (compute raster, 128² faces) and of the atlas at that size wherever
+/// the analytic ray test is sure of each light — lit or shadowed by a margin of the cubes'
+/// texels, so that their filtered edges lie elsewhere; the pixels that differ (the maps' edges)
+/// are counted and few.
+#[test]
+fn rays_classify_as_the_cube_array_and_the_atlas_where_the_ray_test_is_sure() {
+    const CUBE: u32 = 128;
+    let mut scene = Scene::shadow_room();
+    scene.lights.push(PointLight { position_radius: [3.0, -3.5, 1.5, 20.0], color: [1.0, 2.0, 3.0, 0.0] });
+    scene.lights.push(PointLight { position_radius: [-0.5, -4.0, 0.5, 20.0], color: [3.0, 1.5, 0.5, 0.0] });
+    let sure = common::shadow_rays::sure_pixels(&scene, SIZE, CUBE);
+    let shadowed = sure.iter().filter(|(_, lit)| lit.iter().any(|&l| !l)).count();
+    assert!(sure.len() > 3000 && shadowed > 300, "{} sure pixels, {shadowed} shadowed from some light", sure.len());
+    let maps = |mode: OmniShadowMode| {
+        let mut s = settings(Technique::Forward, false, 3);
+        s.omni = Some(OmniShadowSettings { mode, lights: 3, all: false, size: CUBE });
+        s
+    };
+    let atlas = OmniShadowMode::Atlas(ml_render::settings::AtlasSettings { budget_mib: 256, cache: true, fixed_size: Some(CUBE) });
+    let outputs = common::render_each(&scene, &[settings(Technique::Forward, true, 3), maps(OmniShadowMode::COMPUTE), maps(atlas)]);
+    let rays = &outputs[0];
+    for (name, other) in [("cube array", &outputs[1]), ("atlas", &outputs[2])] {
+        let wrong: Vec<(u32, u32)> = sure
+            .iter()
+            .map(|&(p, _)| p)
+            .filter(|&(x, y)| common::pixel(rays, x, y).iter().zip(common::pixel(other, x, y)).any(|(a, b)| a.abs_diff(b) > 1))
+            .collect();
+        let beyond = common::pixels_beyond(rays, other, 1);
+        println!("rays against the {name}: {beyond} of {} pixels > 1/255 apart, none of the {} sure", SIZE * SIZE, sure.len());
+        assert!(wrong.is_empty(), "{name}: sure pixels differ: {:?}", &wrong[..wrong.len().min(12)]);
+        assert!(beyond * 16 <= (SIZE * SIZE) as usize, "{name}: {beyond} pixels differ");
+    }
 }
