@@ -21,6 +21,8 @@ const float RAY_MIN_DIRECTION = 1e-30;
 // Traversal steps (nodes visited, triangles tested) of this invocation's rays so far: the
 // ray-cost debug view.
 uint ray_steps = 0u;
+// Rays this invocation has traced (the compute lightings add them up for the host).
+uint rays_traced = 0u;
 
 // 1 / d per axis, each |d| at least RAY_MIN_DIRECTION.
 vec3 ray_inverse(vec3 d) {
@@ -104,6 +106,7 @@ const uint RAY_INDEX = (1u << 30) - 1u;
 // Both levels in one loop with one stack, so that the invocations of a subgroup step through
 // the top level and their meshes together rather than waiting for each other's meshes.
 bool ray_occluded(vec3 origin, vec3 target) {
+    rays_traced++;
     vec3 world_d = target - origin;
     vec3 world_inv = ray_inverse(world_d);
     vec3 o = origin, d = world_d, inv = world_inv;

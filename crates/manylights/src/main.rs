@@ -64,8 +64,9 @@ struct RenderArgs {
     #[arg(long)]
     out: PathBuf,
     /// Count, after the lighting, the lights the light loop tests per pixel and those that
-    /// reach the pixel's surface (a table row; an untimed extra pass each frame). For the
-    /// compute-lit techniques: deferred-compute, visibility.
+    /// reach the pixel's surface (a table row; an untimed extra pass each frame), and with
+    /// shadow rays the rays the lighting traces (the shadow-ray row; the lighting then counts
+    /// them, at a small cost). For the compute-lit techniques: deferred-compute, visibility.
     #[arg(long)]
     light_stats: bool,
 }

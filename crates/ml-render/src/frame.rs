@@ -7,7 +7,7 @@
 use crate::error::{ListsTooLong, RenderError};
 use crate::frame_resources::FrameResources;
 use crate::pass::ListUpload;
-use crate::sync::SyncStates;
+use crate::sync::{SyncStates, RAY_COUNT};
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::cluster::ClusterLists;
@@ -21,6 +21,8 @@ pub struct FrameInFlight {
     pub lights: Buffer,
     pub cluster_ranges: Buffer,
     pub light_indices: Buffer,
+    /// The shadow rays the compute lightings traced (host-visible; zeroed before each frame).
+    pub ray_count: Buffer,
     pub timer: GpuTimer,
     pub targets: Option<Targets>,
     /// Its named resources' states between passes, from frame to frame (`sync`).
@@ -52,6 +54,7 @@ impl FrameInFlight {
             lights: Buffer::null(),
             cluster_ranges: Buffer::null(),
             light_indices: Buffer::null(),
+            ray_count: Buffer::null(),
             timer: GpuTimer::null(),
             targets: None,
             sync: SyncStates::default(),
@@ -73,6 +76,8 @@ impl FrameInFlight {
         self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>())?;
         self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>())?;
         self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.clamp(1, max_index_entries(ctx)) * 4)?;
+        self.ray_count = Buffer::new(ctx, "ray count", 16, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu)?;
+        self.ray_count.write(0, &[0u32; 4]);
         self.timer = GpuTimer::new(ctx, setup.passes)?;
         self.targets = Some((setup.make_targets)()?);
         Ok(())
@@ -88,8 +93,17 @@ impl FrameInFlight {
                 ("LightBuffer", self.lights.raw),
                 ("ClusterRangeBuffer", self.cluster_ranges.raw),
                 ("LightIndexBuffer", self.light_indices.raw),
+                (RAY_COUNT, self.ray_count.raw),
             ])
             .with(scene)
+    }
+
+    /// The shadow rays the slot's last frame traced from its opaque surfaces (compute lightings
+    /// with rays; 0 elsewhere), and zero for the next: call only after its fence has signalled.
+    pub fn take_ray_count(&mut self) -> u64 {
+        let traced = bytemuck::pod_read_unaligned::<u32>(&self.ray_count.mapped()[..4]);
+        self.ray_count.write(0, &[0u32; 4]);
+        u64::from(traced)
     }
 
     /// Entries the light-index list holds.
@@ -122,7 +136,7 @@ impl FrameInFlight {
             t.destroy(ctx);
         }
         self.timer.destroy(ctx);
-        for b in [&mut self.uniforms, &mut self.lights, &mut self.cluster_ranges, &mut self.light_indices] {
+        for b in [&mut self.uniforms, &mut self.lights, &mut self.cluster_ranges, &mut self.light_indices, &mut self.ray_count] {
             b.destroy(ctx);
         }
         // SAFETY: the caller waited for the device to be idle; a null fence is ignored.

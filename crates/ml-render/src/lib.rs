@@ -63,6 +63,7 @@ pub use frame_resources::FRAMES_IN_FLIGHT;
 pub use light_grid::LightGridStats;
 pub use light_stats::LightStats;
 pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
+pub use scene::ray_geometry::RayStats;
 pub use scene::textures::SHADOW_MAP_SIZE;
 pub use settings::{
     DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,

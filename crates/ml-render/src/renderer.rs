@@ -77,6 +77,8 @@ pub struct Renderer<'a> {
     reports: Vec<SlotReport>,
     /// Per frame slot: whether it has been submitted since its results were last collected.
     pending: Vec<bool>,
+    /// Per frame slot: the shadow rays its last frame's compute lighting traced.
+    rays_traced: Vec<u64>,
     /// Top of the heat-map scale (lights per cluster), from the newest known frame.
     heat_top: f32,
     /// Slot of the frame that was read back last.
@@ -163,6 +165,7 @@ impl<'a> Renderer<'a> {
             lights_on_gpu,
             reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
+            rays_traced: vec![0; FRAMES_IN_FLIGHT],
             heat_top: DEFAULT_HEAT_TOP,
             last_frame: 0,
             depth_format: depth,
@@ -392,7 +395,9 @@ impl<'a> Renderer<'a> {
         }
         stats.frames = self.settings.frames;
         stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
-        if let Some(rays) = self.gpu.rays.stats {
+        if let Some(mut rays) = self.gpu.rays.stats {
+            // Counted with the light statistics (compute lightings only).
+            rays.traced = self.settings.light_stats.then_some(self.rays_traced[last]);
             stats.set_feature(rays);
         }
         stats.memory = Some(self.ctx.memory_use());
@@ -546,6 +551,7 @@ impl<'a> Renderer<'a> {
         for p in &self.passes {
             p.collect(f, &mut report, stats);
         }
+        self.rays_traced[f] = self.frames[f].take_ray_count();
         self.reports[f] = report;
         if let Some(max_lights) = report.max_lights {
             self.heat_top = max_lights.max(1) as f32;

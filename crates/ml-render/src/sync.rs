@@ -260,6 +260,16 @@ pub fn shadow_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     std::iter::once(cubes).chain(SHADOW_ATLAS.iter().map(|&name| Use::at(name, read, None))).collect()
 }
 
+/// The frame slot's count of the shadow rays its compute lighting traced (its shader block's
+/// name): added to by the lighting's subgroups, read by the host after the frame.
+pub const RAY_COUNT: &str = "RayCountBuffer";
+
+/// How a compute lighting adds to the ray count, and how the host then reads it.
+pub fn ray_count_uses() -> (Use, Use) {
+    let add = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+    (Use::at(RAY_COUNT, add, None), Use::at(RAY_COUNT, (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ), None))
+}
+
 /// How a pass that shades reads what the frame lit it with: the lights and their lists, and
 /// the point-light shadows.
 pub fn shading_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {

@@ -295,3 +295,41 @@ fn rays_classify_as_the_cube_array_and_the_atlas_where_the_ray_test_is_sure() {
         assert!(beyond * 16 <= (SIZE * SIZE) as usize, "{name}: {beyond} pixels differ");
     }
 }
+
+/// The rays a compute lighting traces are counted (`--light-stats`), exactly: one for each
+/// pixel and light whose contribution is not zero — as many as a CPU ray caster finds pixels
+/// whose surface faces the light within its radius (but for a few pixels on silhouettes and
+/// where N·L is within rounding of 0), twice as many with the light doubled, the same in
+/// `visibility` and `deferred-compute`; without the statistics none are reported.
+#[test]
+fn the_rays_traced_are_counted() {
+    let room = Scene::shadow_room();
+    let mut doubled = room.clone();
+    doubled.lights.push(doubled.lights[0]);
+    let traced = |scene: &Scene, technique: Technique, light_stats: bool| {
+        let s = RenderSettings { light_stats, ..settings(technique, true, scene.lights.len() as u32) };
+        let out = common::render_each(scene, &[s]);
+        out[0].stats.feature::<ml_render::RayStats>().expect("the hierarchy's row").traced
+    };
+    let once = traced(&room, Technique::Visibility, true).expect("visibility counts");
+    assert_eq!(traced(&doubled, Technique::Visibility, true), Some(2 * once), "two lights at one place: twice the rays");
+    let deferred = traced(&room, Technique::DeferredCompute, true).expect("deferred-compute counts");
+    assert!(deferred.abs_diff(once) * 200 <= once, "visibility {once}, deferred-compute {deferred}");
+    assert_eq!(traced(&room, Technique::Visibility, false), None);
+    // The CPU's count: pixels whose nearest surface faces the light, within its radius.
+    let world = WorldTriangles::new(&room);
+    let l = room.lights[0].position_radius;
+    let light = Vec3::new(l[0], l[1], l[2]);
+    let expected = (0..SIZE * SIZE)
+        .into_par_iter()
+        .filter(|i| {
+            let (o, d) = common::shadow_rays::ray(&room.camera, (i % SIZE) as f32 + 0.5, (i / SIZE) as f32 + 0.5, SIZE);
+            world.first_hit(o, d).is_some_and(|(t, n, _)| {
+                let to_light = light - (o + d * t);
+                to_light.length() < l[3] && n.dot(to_light) > 0.0
+            })
+        })
+        .count() as u64;
+    println!("rays traced: {once} (CPU: {expected} pixels facing the light); deferred-compute {deferred}");
+    assert!(expected > 5000 && once.abs_diff(expected) * 100 <= expected, "GPU {once}, CPU {expected}");
+}

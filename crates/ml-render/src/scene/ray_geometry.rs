@@ -20,15 +20,19 @@ pub struct RayStats {
     pub instances: usize,
     /// Most entries a traversal keeps on its stack (RayScene::stack_needed).
     pub depth: usize,
+    /// The rays the last frame traced from its opaque surfaces, counted with `--light-stats`
+    /// (which the compute lightings alone take).
+    pub traced: Option<u64>,
 }
 
 impl FeatureStats for RayStats {
     fn rows(&self) -> Vec<(&'static str, String)> {
         let mib = self.bytes as f64 / (1 << 20) as f64;
+        let traced = self.traced.map_or_else(String::new, |n| format!("; {n} rays traced in the last frame"));
         vec![(
             "shadow rays",
             format!(
-                "hierarchy of {} triangles (each mesh once), {} nodes, {} instances, a traversal stack of {} at most: {mib:.1} MiB, built in {:.1} ms on the CPU",
+                "hierarchy of {} triangles (each mesh once), {} nodes, {} instances, a traversal stack of {} at most: {mib:.1} MiB, built in {:.1} ms on the CPU{traced}",
                 self.triangles, self.nodes, self.instances, self.depth, self.build_ms
             ),
         )]
@@ -80,6 +84,7 @@ impl RayGeometry {
             triangles: built.triangles.len(),
             instances: built.instances.len(),
             depth: built.stack_needed(),
+            traced: None,
         });
         Ok(geometry)
     }

@@ -9,7 +9,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{shading_reads, Use};
+use crate::sync::{ray_count_uses, shading_reads, Use};
 use crate::targets::GBUFFER;
 use ml_vk::{vk, Context, VkError};
 
@@ -22,7 +22,7 @@ pub struct ComputeLighting {
 impl ComputeLighting {
     pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading) -> Result<ComputeLighting, VkError> {
         // Set 1: the scene's textures (blinn-phong's shadow map and sky, the shadow cubes).
-        let model = shading.lighting_constants();
+        let model = shading.compute_lighting_constants();
         // With transparent layers, linear HDR for their resolve.
         let shader = if shading.transparency { &ml_shaders::DEFERRED_LIGHTING_LINEAR_COMP } else { &ml_shaders::DEFERRED_LIGHTING_COMP };
         let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &model))?;
@@ -59,7 +59,12 @@ impl Pass for ComputeLighting {
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::output_use(self.layers));
+        uses.push(ray_count_uses().0);
         uses
+    }
+
+    fn host_reads(&self) -> Vec<Use> {
+        vec![ray_count_uses().1]
     }
 
     fn record(&self, rec: &Recording) {

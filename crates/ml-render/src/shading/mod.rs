@@ -27,6 +27,8 @@ pub struct Shading {
     pub spot_lights: bool,
     /// Transparent objects are blended in per-pixel layers (the opaque passes skip them).
     pub transparency: bool,
+    /// The compute lightings count the shadow rays they trace (`--light-stats` with rays).
+    pub count_rays: bool,
 }
 
 impl Shading {
@@ -56,6 +58,13 @@ impl Shading {
             ("SUN_RAYS", u32::from(self.sun_rays)),
             ("SPOT_LIGHTS", u32::from(self.spot_lights)),
         ]
+    }
+
+    /// `lighting_constants` and `COUNT_RAYS` (shading/compute_shading.glsl): the compute
+    /// lightings'.
+    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 9] {
+        let [a, b, c, d, e, f, g, h] = self.lighting_constants();
+        [a, b, c, d, e, f, g, h, ("COUNT_RAYS", u32::from(self.count_rays))]
     }
 
     /// `lighting_constants` and `TRANSPARENT_LAYERS` (shading/forward_frag.glsl): the forward

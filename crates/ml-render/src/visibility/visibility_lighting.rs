@@ -9,7 +9,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{shading_reads, Use, VISIBILITY_DEPTH};
+use crate::sync::{ray_count_uses, shading_reads, Use, VISIBILITY_DEPTH};
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};
 
@@ -31,7 +31,7 @@ impl VisibilityLighting {
         (scene, from_buffer): (SharedMeshletScene, bool),
         shading: Shading,
     ) -> Result<VisibilityLighting, VkError> {
-        let model = shading.lighting_constants();
+        let model = shading.compute_lighting_constants();
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
         // With transparent layers, linear HDR for their resolve.
         let shader = match (from_buffer, shading.transparency) {
@@ -68,7 +68,12 @@ impl Pass for VisibilityLighting {
         if self.from_buffer {
             uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
         }
+        uses.push(ray_count_uses().0);
         uses
+    }
+
+    fn host_reads(&self) -> Vec<Use> {
+        vec![ray_count_uses().1]
     }
 
     fn record(&self, rec: &Recording) {
