@@ -2,19 +2,20 @@
 // Keep in sync: the test `gpu_layout` compares each Rust field offset and struct size with
 // what SPIR-V reflection of the compiled shaders reports, so a moved field fails CI.
 // Storage buffers are std430 (no 16-byte padding of scalars in arrays, no 64 KiB uniform cap:
-// mistake 5 of docs/DESIGN.md#mistakes-we-avoid); the one uniform block is std140, so it holds
-// only vec4-aligned members.
+// mistake 5 of docs/DESIGN.md#mistakes-we-avoid). There is no uniform block: the frame's
+// values too are a read-only storage buffer (FrameBlock; why: opaque_uniform below).
 
 #ifndef MANYLIGHTS_COMMON_GLSL
 #define MANYLIGHTS_COMMON_GLSL
 
 #extension GL_KHR_shader_subgroup_ballot : require
 
-// A branch or a loop count that depends on nothing but push constants and the frame's uniform
-// block reads them through `opaque_uniform`. Mesa's lavapipe (the CPU driver CI renders with)
-// inlines such values as constants and compiles the shader anew at every pipeline bind — a
-// quarter of a second for a lighting shader, every frame (docs/DESIGN.md#shaders-on-lavapipe).
-// A dynamically uniform value read through the subgroup's first invocation is the same value,
+// Mesa's lavapipe (the CPU driver CI renders with) inlines, as constants, the push-constant and
+// uniform-buffer values a branch or a loop count depends on alone, and compiles the shader anew
+// at every pipeline bind and push of constants — a quarter of a second for a lighting shader,
+// every frame (docs/DESIGN.md#shaders-on-lavapipe). So the frame's values live in a storage
+// buffer, which it never inlines, and such push constants are read through `opaque_uniform`:
+// a dynamically uniform value read through the subgroup's first invocation is the same value,
 // hidden from that analysis. The test `no_branch_rests_on_uniforms_alone` checks every shader.
 // Compute and fragment shaders only (the stages lavapipe runs subgroup operations in).
 #define opaque_uniform(x) subgroupBroadcastFirst(x)
@@ -35,7 +36,7 @@
 #define DEBUG_VIEW_TRANSPARENCY_LAYERS 12u
 #define DEBUG_VIEW_RAY_COST 13u
 
-// Per frame, one uniform buffer per frame in flight (set 0, binding 0).
+// Per frame, one buffer per frame in flight (set 0, binding 0; read-only storage).
 struct FrameUniforms {
     mat4 view;
     mat4 proj;           // Vulkan clip space: Y flipped, depth 0..1

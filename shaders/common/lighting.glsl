@@ -50,7 +50,7 @@
     }
 #else
 #define SUM_LIGHTS(sum, LIGHT)                                         \
-    for (uint i_ = 0u; i_ < opaque_uniform(frame.light_count); ++i_) { \
+    for (uint i_ = 0u; i_ < frame.light_count; ++i_) {               \
         sum += LIGHT(lights[i_]) * spot_cone(i_, lights[i_], world);   \
     }
 #endif
@@ -73,7 +73,7 @@ float spot_cone(uint i, PointLight l, vec3 world) {
 // radius of 10³⁰ m, so every model's own point-light code applies with a falloff of exactly 1
 // (1 − 10⁴/10³⁰ rounds to 1) and a direction off by under 10⁻⁷ rad.
 #define SUM_DIRECTIONAL(sum, LIGHT)                                                                   \
-    for (uint d_ = 0u; d_ < opaque_uniform(frame.directional_count); ++d_) {                           \
+    for (uint d_ = 0u; d_ < frame.directional_count; ++d_) {                                           \
         PointLight far_ = PointLight(vec4(world - frame.directional_direction[d_].xyz * 1e4, 1e30),   \
                                      vec4(frame.directional_color[d_].rgb, 0.0));                      \
         sum += LIGHT(far_);                                                                            \
@@ -108,7 +108,7 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
     // Towards the eye; an orthographic camera looks along its axis everywhere (the view
     // matrix's third row is the eye's +Z, its back, in world space).
     vec3 back = vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
-    vec3 v = opaque_uniform(frame.camera_pos.w) != 0.0 ? normalize(frame.camera_pos.xyz - world) : back;
+    vec3 v = frame.camera_pos.w != 0.0 ? normalize(frame.camera_pos.xyz - world) : back;
     vec3 lo = vec3(0.0);
     if (MODEL_BLINN_PHONG) {
         vec3 r0 = mix(vec3(0.04), albedo, metallic);
@@ -148,7 +148,7 @@ vec3 ray_cost_light(PointLight l, vec3 world, vec3 n) {
 // it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
 // False for any other view. Every shading path calls it with the values it would shade with.
 bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, uint object_flags, vec2 frag_xy, out vec3 color) {
-    uint view = opaque_uniform(frame.cluster_dims.w);
+    uint view = frame.cluster_dims.w;
     vec3 display;
     if (view == DEBUG_VIEW_ALPHA) {
         // Which surfaces an alpha mask cuts: opaque grey, masked green, blended (drawn as a

@@ -21,8 +21,8 @@ struct GridWalk {
 GridWalk grid_walk_wider(vec3 world, float extra) {
     GridWalk w;
     w.g = (world - frame.light_grid_origin.xyz) * frame.light_grid_origin.w;
-    w.r = opaque_uniform(frame.light_grid_reach.x) * frame.light_grid_origin.w * (1.0 + GRID_MARGIN);
-    vec3 top = vec3(opaque_uniform(frame.light_grid_dims.xyz) - 1u);
+    w.r = frame.light_grid_reach.x * frame.light_grid_origin.w * (1.0 + GRID_MARGIN);
+    vec3 top = vec3(frame.light_grid_dims.xyz - 1u);
     w.lo = uvec3(clamp(floor(w.g - (w.r + extra)), vec3(0.0), top));
     w.hi = uvec3(clamp(floor(w.g + (w.r + extra)), vec3(0.0), top));
     return w;

@@ -9,7 +9,7 @@
 
 layout(local_size_x = 64) in;
 
-layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
 layout(std430, set = 0, binding = 1) buffer ProbeValues { float probe_values[]; };
 layout(push_constant) uniform UniformBranchPushBlock { uvec4 mode; };
 

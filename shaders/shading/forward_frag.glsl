@@ -25,7 +25,7 @@ layout(constant_id = 40) const bool TRANSPARENT_LAYERS = false;
 void main() {
     vec3 normal = covered_normal();
 #if defined(CLUSTERED) || defined(LIGHT_GRID)
-    if (opaque_uniform(frame.cluster_dims.w) == DEBUG_VIEW_CLUSTER_HEAT) {
+    if (frame.cluster_dims.w == DEBUG_VIEW_CLUSTER_HEAT) {
         // Lights tested on a log scale up to cluster_slices.z.
         uint count = cluster_light_count(in_world_pos, gl_FragCoord.xy);
         float t = log2(1.0 + float(count)) / log2(1.0 + frame.cluster_slices.z);

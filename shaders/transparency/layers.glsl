@@ -204,7 +204,7 @@ vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
     float transmittance;
     uint count;
     vec3 color = blend_layers(p, background ? vec3(0.0) : under, transmittance, count);
-    if (opaque_uniform(frame.cluster_dims.w) == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
+    if (frame.cluster_dims.w == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
         return layer_count_color(count);
     }
     if (!background) {

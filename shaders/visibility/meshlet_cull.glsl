@@ -8,7 +8,7 @@
 
 #include "visibility/depth_pyramid.glsl"
 
-layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
 layout(std430, set = 0, binding = 1) readonly buffer InstanceBuffer { Instance instances[]; };
 layout(std430, set = 0, binding = 2) readonly buffer ObjectBuffer { ObjectData objects[]; };
 layout(std430, set = 0, binding = 3) readonly buffer MeshletBuffer { Meshlet meshlets[]; };
@@ -63,7 +63,7 @@ bool meshlet_backfacing(Meshlet m, mat4 model, uint flags) {
     vec3 apex = (model * vec4(m.cone_apex.xyz, 1.0)).xyz;
     // Perspective: from the eye to the apex; orthographic: the view direction.
     vec3 forward = -vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
-    vec3 to_apex = opaque_uniform(frame.camera_pos.w) > 0.5 ? normalize(apex - frame.camera_pos.xyz) : forward;
+    vec3 to_apex = frame.camera_pos.w > 0.5 ? normalize(apex - frame.camera_pos.xyz) : forward;
     return dot(to_apex, axis) >= cutoff + 1e-3;
 }
 
@@ -89,14 +89,14 @@ bool sphere_occluded(vec3 c, float r) {
     if (depth <= 0.0) {
         return false;
     }
-    vec2 size = vec2(opaque_uniform(frame.viewport.xy));
+    vec2 size = vec2(frame.viewport.xy);
     ivec2 p0 = clamp(ivec2(floor((lo * 0.5 + 0.5) * size)), ivec2(0), ivec2(size) - 1);
     ivec2 p1 = clamp(ivec2(floor((hi * 0.5 + 0.5) * size)), ivec2(0), ivec2(size) - 1);
     // Level L's texels cover 2^(L+1) pixels a side: at the level where the rectangle spans
     // at most 2 texels each way.
     ivec2 span = p1 - p0;
     int level = clamp(findMSB(max(span.x, span.y)), 0, int(opaque_uniform(cull.mode.z)) - 1);
-    uvec2 image = opaque_uniform(frame.viewport.xy);
+    uvec2 image = frame.viewport.xy;
     uvec2 texels = pyramid_level_size(image, level);
     uint base = pyramid_level_offset(image, level);
     uvec2 t0 = uvec2(p0) >> uint(level + 1), t1 = min(uvec2(p1) >> uint(level + 1), texels - 1u);

@@ -31,7 +31,7 @@ bool triangle_visible(vec4 a, vec4 b, vec4 c, bool both_faces) {
     if (a.w <= 0.0 || b.w <= 0.0 || c.w <= 0.0) {
         return true;
     }
-    vec2 size = vec2(opaque_uniform(frame.viewport.xy));
+    vec2 size = vec2(frame.viewport.xy);
     vec2 pa = (a.xy / a.w * 0.5 + 0.5) * size;
     vec2 pb = (b.xy / b.w * 0.5 + 0.5) * size;
     vec2 pc = (c.xy / c.w * 0.5 + 0.5) * size;

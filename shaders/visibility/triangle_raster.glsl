@@ -43,7 +43,7 @@ shared uint group_pixels;
 
 // The viewport transform, in pixels.
 vec2 framebuffer_xy(vec4 c) {
-    return viewport_xy(c, vec2(opaque_uniform(frame.viewport.xy)));
+    return viewport_xy(c, vec2(frame.viewport.xy));
 }
 
 // In front of the near plane (or behind the eye) somewhere: the hardware clips it.
@@ -58,7 +58,7 @@ uint route(vec2 pa, vec2 pb, vec2 pc) {
         return ROUTE_LARGE;
     }
     // Off screen, with a pixel of margin for the snapping.
-    if (any(lessThan(hi, vec2(-1.0))) || any(greaterThan(lo, vec2(opaque_uniform(frame.viewport.xy)) + 1.0))) {
+    if (any(lessThan(hi, vec2(-1.0))) || any(greaterThan(lo, vec2(frame.viewport.xy) + 1.0))) {
         return ROUTE_NONE;
     }
     return ROUTE_COMPUTE;
@@ -82,7 +82,7 @@ uint route_triangle(vec4 a, vec4 b, vec4 c, out vec2 pa, out vec2 pb, out vec2 p
 // draw_masked_meshlet.
 uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces) {
     SmallTriangle t;
-    if (!small_triangle(pa, pb, pc, ivec2(opaque_uniform(frame.viewport.xy)), both_faces, t)) {
+    if (!small_triangle(pa, pb, pc, ivec2(frame.viewport.xy), both_faces, t)) {
         return 0u;
     }
     if (t.swapped) {
@@ -117,7 +117,7 @@ uint list_large(vec4 a, vec4 b, vec4 c, uint id, uint flags, uint object, Surfac
         hi = max(hi, p.s[i]);
     }
     ivec2 first, last;
-    centres_in_box(ivec2(lo), ivec2(hi), ivec2(opaque_uniform(frame.viewport.xy)), first, last);
+    centres_in_box(ivec2(lo), ivec2(hi), ivec2(frame.viewport.xy), first, last);
     if (any(greaterThan(first, last))) {
         return 0u;
     }
@@ -178,7 +178,7 @@ shared vec4 mask_uv_w_rest[64]; // u/w of c, v/w of a, b, c
 // hardware interpolates); returns the pixels of its box (0: none to test).
 uint set_up_masked(uint lid, vec2 pa, vec2 pb, vec2 pc, vec3 z, bool both_faces, SurfaceTest s) {
     SmallTriangle t;
-    if (!small_triangle(pa, pb, pc, ivec2(opaque_uniform(frame.viewport.xy)), both_faces, t) || any(greaterThan(t.first, t.last))) {
+    if (!small_triangle(pa, pb, pc, ivec2(frame.viewport.xy), both_faces, t) || any(greaterThan(t.first, t.last))) {
         return 0u;
     }
     vec3 inv_w = 1.0 / vec3(s.clip[0].w, s.clip[1].w, s.clip[2].w);

@@ -10,7 +10,7 @@
 
 layout(local_size_x = 64) in;
 
-layout(set = 0, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
 layout(std430, set = 0, binding = 1) buffer CullCounterBuffer { CullCounters counters; };
 layout(std430, set = 0, binding = 2) readonly buffer LargeBinBuffer { uvec2 large_bins[]; };
 layout(std430, set = 0, binding = 3) buffer LargeTriangleBuffer { LargeTriangle large_triangles[]; };
@@ -30,7 +30,7 @@ void main() {
     uint lid = gl_LocalInvocationID.x;
     uint phase = opaque_uniform(cull.mode.x);
     uint count = min(counters.binned[phase], opaque_uniform(cull.triangles.z));
-    ivec2 size = ivec2(opaque_uniform(frame.viewport.xy));
+    ivec2 size = ivec2(frame.viewport.xy);
     if (lid == 0u) {
         group_pixels = 0u;
     }

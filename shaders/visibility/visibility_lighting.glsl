@@ -88,7 +88,7 @@ void main() {
     if (inst.surface.y != texture_set.x) {
         return;
     }
-    uint view = opaque_uniform(frame.cluster_dims.w);
+    uint view = frame.cluster_dims.w;
     if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
         imageStore(out_image, p, vec4(id_color(view == DEBUG_VIEW_MESHLETS ? meshlet_instance : id), 1.0));
         return;

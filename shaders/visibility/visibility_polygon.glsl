@@ -36,7 +36,7 @@ void keep_nearest_id(ivec2 pixel, float depth, uint id) {
 
 // The triangle's polygon in the image, each corner's depth z/w in q.x.
 Polygon visibility_polygon(vec4 a, vec4 b, vec4 c) {
-    Polygon p = clipped_polygon(a, b, c, vec3(a.z, 0.0, 0.0), vec3(b.z, 0.0, 0.0), vec3(c.z, 0.0, 0.0), vec2(opaque_uniform(frame.viewport.xy)));
+    Polygon p = clipped_polygon(a, b, c, vec3(a.z, 0.0, 0.0), vec3(b.z, 0.0, 0.0), vec3(c.z, 0.0, 0.0), vec2(frame.viewport.xy));
     for (int i = 0; i < p.count; i++) {
         p.q[i].x *= p.q[i].w;
     }
@@ -91,7 +91,7 @@ uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id, SurfaceTest s) {
             }
             vec3 weights = vec3(w);
             float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
-            if (!surface_kept(s, ivec2(x, y), vec2(opaque_uniform(frame.viewport.xy)))) {
+            if (!surface_kept(s, ivec2(x, y), vec2(frame.viewport.xy))) {
                 continue;
             }
             covered++;
@@ -107,7 +107,7 @@ uint raster_polygon_alone(Polygon p, uint id, bool both_faces, SurfaceTest s) {
     uint covered = 0u;
     for (int k = 1; k + 1 < p.count; k++) {
         FanTriangle t;
-        if (fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(opaque_uniform(frame.viewport.xy)), both_faces, t)) {
+        if (fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(frame.viewport.xy), both_faces, t)) {
             covered += fan_block(t, t.first, t.last, id, s);
         }
     }

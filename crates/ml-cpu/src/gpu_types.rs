@@ -27,7 +27,8 @@ macro_rules! gpu_struct {
 }
 
 gpu_struct!(
-    /// Per-frame uniforms (std140; every member 16-byte friendly).
+    /// Per-frame values (a read-only storage buffer; every member 16-byte friendly, so std140
+    /// and std430 would place them alike).
     FrameUniforms {
         view: [[f32; 4]; 4],
         proj: [[f32; 4]; 4],

@@ -1,7 +1,7 @@
 //! One frame in flight (two of them: docs/DESIGN.md#frames-in-flight): its command buffer and
-//! fence, its own persistently mapped uniform buffer, the light and cluster-list buffers the
-//! CPU writes (a placeholder each where the light grid keeps the lights), its timer and its
-//! render targets. The passes point their own per-frame sets at these. Cluster buffers grow
+//! fence, its own persistently mapped buffer of per-frame values (FrameUniforms), the light
+//! and cluster-list buffers the CPU writes (a placeholder each where the light grid keeps the
+//! lights), its timer and its render targets. The passes point their own per-frame sets at these. Cluster buffers grow
 //! when a frame needs more; nothing is ever dropped.
 
 use crate::error::{ListsTooLong, RenderError};
@@ -72,7 +72,7 @@ impl FrameInFlight {
         self.fence =
             unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }.ctx("vkCreateFence")?;
         let uniform_bytes = size_of::<FrameUniforms>() as u64;
-        self.uniforms = Buffer::new(ctx, "frame uniforms", uniform_bytes, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;
+        self.uniforms = Buffer::new(ctx, "frame uniforms", uniform_bytes, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu)?;
         self.lights = list_buffer(ctx, "lights", setup.light_count * size_of::<PointLight>())?;
         self.cluster_ranges = list_buffer(ctx, "cluster ranges", setup.cluster_count * size_of::<ClusterRange>())?;
         self.light_indices = list_buffer(ctx, "light indices", setup.initial_indices.clamp(1, max_index_entries(ctx)) * 4)?;

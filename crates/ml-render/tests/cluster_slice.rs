@@ -25,7 +25,7 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
         ..Default::default()
     };
     let mut uniforms =
-        Buffer::new(ctx, "uniforms", size_of::<FrameUniforms>() as u64, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)
+        Buffer::new(ctx, "uniforms", size_of::<FrameUniforms>() as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu)
             .unwrap();
     uniforms.write(0, &[frame]);
     let mut input =
