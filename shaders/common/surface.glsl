@@ -81,7 +81,10 @@ Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, 
         }
     }
     if (MODEL_BLINN_PHONG) {
-        mat2 st_transform = mat2(frame.texture_transform.xy, frame.texture_transform.zw);
+        // Through opaque_uniform: lavapipe's fragment shaders read a storage buffer as 0 in the
+        // lanes of a quad outside the triangle, which would spoil the derivatives of `st`.
+        vec4 t = opaque_uniform(frame.texture_transform);
+        mat2 st_transform = mat2(t.xy, t.zw);
         vec2 st = st_transform * uv;
         s.albedo_factor *= SURFACE_SAMPLE(albedo_map, st, st_transform).rgb;
         s.normal = perturb_normal(s.normal, tangent, SURFACE_SAMPLE(normal_map, st, st_transform).xyz, 1.0);
