@@ -274,7 +274,8 @@ impl RayScene {
             return (false, 0);
         }
         let world_d = target - origin;
-        let (mut seg, mut d) = (Segment::new(origin, world_d), world_d);
+        let world = Segment::new(origin, world_d);
+        let (mut seg, mut d) = (world.clone(), world_d);
         let mut stack: Vec<Entry> = Vec::new();
         let mut most = 0;
         let mut entry = Entry::Top(0);
@@ -296,7 +297,7 @@ impl RayScene {
                     entry = Entry::Mesh(inst.root);
                 }
                 Entry::Leave => {
-                    (seg, d) = (Segment::new(origin, world_d), world_d);
+                    (seg, d) = (world.clone(), world_d);
                     match stack.pop() {
                         Some(next) => entry = next,
                         None => return (false, most),
@@ -370,6 +371,7 @@ fn children(n: &RayNode) -> [Child; 2] {
 }
 
 /// A segment `origin + t·d`, t in [0, 1], as the box test takes it.
+#[derive(Clone)]
 struct Segment {
     origin: Vec3,
     inv: Vec3,
