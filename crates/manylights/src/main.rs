@@ -58,6 +58,11 @@ struct RenderArgs {
     /// one's — or, with a # in --out, every frame's.
     #[arg(long, default_value_t = 1, value_parser = Whole::<u32>::new(1, MAX_FRAMES as u64), allow_negative_numbers = true)]
     frames: u32,
+    /// Frames rendered first and thrown away (untimed, unsaved; 0 to 100000), so that the
+    /// timing table shows the GPU's steady state: a GPU lowers its clocks while the scene
+    /// loads and takes a moment under load to raise them again.
+    #[arg(long, default_value_t = 0, value_parser = Whole::<u32>::new(0, MAX_FRAMES as u64), allow_negative_numbers = true)]
+    warmup: u32,
     /// Output PNG file; a name with a run of # (frames/####.png) is an image sequence: every
     /// frame, the #s replaced by its number from 0, zero-padded to their count, in a folder
     /// made if it does not exist.
@@ -617,7 +622,10 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
     let mut sink =
         RenderSink { progress: Progress::new(settings.frames as u64, "frames"), sequence, size: (settings.width, settings.height) };
-    let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render_into(&mut sink));
+    let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| {
+        r.warm_up(cmd.warmup)?;
+        r.render_into(&mut sink)
+    });
     sink.progress.finish();
     let device = tables::device_line(&ctx.info);
     drop(ctx);

@@ -36,6 +36,24 @@ fn renders_a_png_and_prints_the_table() {
     assert_eq!(img.dimensions(), (64, 36));
 }
 
+/// Warm-up frames are rendered and thrown away: the image is the one without them, and the
+/// table's frames are the measured ones.
+#[test]
+fn a_warm_up_changes_no_pixel() {
+    let (cold, warm) = (temp_png("cold.png"), temp_png("warm.png"));
+    for (png, warmup) in [(&cold, "0"), (&warm, "3")] {
+        let args = ["render", "--validation", "--scene", "bench", "--lights", "2000", "--technique", "deferred-compute", "--width", "64"];
+        let out = manylights(
+            &[&args[..], &["--height", "36", "--frames", "2", "--warmup", warmup, "--out", png.to_str().unwrap()]].concat(),
+            &[],
+        );
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(stdout.lines().any(|l| l.split_whitespace().collect::<Vec<_>>() == ["frames", "2"]), "{stdout}");
+    }
+    assert_eq!(std::fs::read(&cold).unwrap(), std::fs::read(&warm).unwrap(), "the warm-up changed the image");
+}
+
 #[test]
 fn clustered_render_reports_its_clusters() {
     let png = temp_png("clustered.png");
