@@ -321,13 +321,19 @@ impl FeatureStats for CullStats {
                     c.triangles - c.compute_triangles
                 ),
             )),
-            Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => rows.push((
-                "compute raster",
-                format!(
-                    "{} small triangles a thread each, {} large ones in {} bins ({} drawn in place, the lists full); {} pixels covered",
-                    c.compute_triangles, c.large_triangles, c.bins, c.in_place, c.compute_pixels
-                ),
-            )),
+            Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => {
+                // Said only where it happened: a triangle is drawn in place when the bins'
+                // lists are full.
+                let in_place =
+                    if c.in_place > 0 { format!(" ({} drawn in place: the bins' lists were full)", c.in_place) } else { String::new() };
+                rows.push((
+                    "compute raster",
+                    format!(
+                        "{} small triangles a thread each, {} large ones in {} bins{in_place}; {} pixels covered",
+                        c.compute_triangles, c.large_triangles, c.bins, c.compute_pixels
+                    ),
+                ))
+            }
         }
         rows
     }
