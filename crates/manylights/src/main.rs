@@ -620,10 +620,13 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
-    let mut sink =
-        RenderSink { progress: Progress::new(settings.frames as u64, "frames"), sequence, size: (settings.width, settings.height) };
+    let mut sink = RenderSink {
+        progress: Progress::new(u64::from(settings.frames) + u64::from(cmd.warmup), "frames"),
+        sequence,
+        size: (settings.width, settings.height),
+    };
     let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| {
-        r.warm_up(cmd.warmup)?;
+        r.warm_up(cmd.warmup, &mut sink)?;
         r.render_into(&mut sink)
     });
     sink.progress.finish();

@@ -352,13 +352,21 @@ impl<'a> Renderer<'a> {
     /// Renders `frames` frames and throws their images and times away, so that what `render`
     /// measures next is the device's steady state: a GPU lowers its clocks while the CPU
     /// loads the scene (an H100 falls from 1,980 to 345 MHz) and raises them only under load.
-    /// The frames `render` then returns are the ones it returns without a warm-up.
-    pub fn warm_up(&mut self, frames: u32) -> Result<(), RenderError> {
+    /// The frames `render` then returns are the ones it returns without a warm-up. `sink` is
+    /// told of each frame submitted (a progress bar), and given no image.
+    pub fn warm_up(&mut self, frames: u32, sink: &mut dyn FrameSink) -> Result<(), RenderError> {
+        /// Passes on the submissions alone.
+        struct Submissions<'s>(&'s mut dyn FrameSink);
+        impl FrameSink for Submissions<'_> {
+            fn submitted(&mut self, i: u32) {
+                self.0.submitted(i);
+            }
+        }
         if frames == 0 {
             return Ok(());
         }
         let measured = std::mem::replace(&mut self.settings.frames, frames);
-        let result = self.render_into(&mut ());
+        let result = self.render_into(&mut Submissions(sink));
         self.settings.frames = measured;
         result.map(|_| ())
     }
