@@ -6,7 +6,7 @@
 #include "clusters/cluster.glsl"
 
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(std430, set = 0, binding = 1) readonly buffer DepthBuffer { float depths[]; };
 layout(std430, set = 0, binding = 2) writeonly buffer SliceBuffer { uint slices[]; };
 

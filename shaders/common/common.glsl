@@ -73,6 +73,10 @@ struct FrameUniforms {
     vec4 shadow_rays;          // x: length of the sun's shadow rays (beyond the scene's box from any point in it)
 };
 
+// Declares the frame's values as `frame`, at binding `b` of set 0: every shader reads them
+// from a read-only storage buffer, never a uniform block (why: opaque_uniform above).
+#define FRAME_BLOCK(b) layout(std430, set = 0, binding = b) readonly buffer FrameBlock { FrameUniforms frame; }
+
 // A radius-limited point light (set 0, binding 1, std430 array).
 struct PointLight {
     vec4 position_radius; // xyz: world position, w: radius (no light at all beyond it)

@@ -5,7 +5,7 @@
 #ifndef MANYLIGHTS_SCENE_BINDINGS_GLSL
 #define MANYLIGHTS_SCENE_BINDINGS_GLSL
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 #ifdef LIGHT_GRID
 // The light grid's lists: each light as it is this frame, list after list
 // (light_grid/light_grid.glsl): position and radius, colour, index in the scene (its spot

@@ -14,7 +14,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0, rgba8) uniform readonly image2D out_image;
-layout(std430, set = 0, binding = 1) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(1);
 // Per work group (row by row): x, the sum of log2 luminance; y, the pixels metered.
 layout(std430, set = 0, binding = 2) writeonly buffer ExposureMeterBuffer { vec2 group_sums[]; };
 

@@ -11,7 +11,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0) uniform sampler2D hdr_image;
 layout(set = 0, binding = 1, rgba8) uniform writeonly image2D out_image;
-layout(std430, set = 0, binding = 2) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(2);
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);

@@ -16,7 +16,7 @@ layout(local_size_x = 256) in;
 // 0: COUNT, 1: FILL.
 layout(constant_id = 0) const uint STEP = 0u;
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 #include "light_grid/light_grid_walk.glsl"
 // The lights at rest in the grid's order (that of their cells at rest, so that neighbouring
 // invocations count into neighbouring cells; the wide lights last): positions alone, packed

@@ -10,7 +10,7 @@
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 // Per 32 cells: x their marks (bit c % 32 for cell c); y is the build's. Coherent: a read sees
 // the other work groups' marks so far (not a stale cached copy), and skips their atomics.
 layout(std430, set = 0, binding = 31) coherent buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };

@@ -7,7 +7,7 @@
 
 layout(local_size_x = 256) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(std430, set = 0, binding = 31) coherent buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 #define LAYER_BINDING 20
 #include "transparency/layers.glsl"

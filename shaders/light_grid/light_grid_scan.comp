@@ -19,7 +19,7 @@ layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint STEP = 0u;
 layout(constant_id = 1) const uint SOURCE = 0u;
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(std430, set = 0, binding = 3) buffer LightGridListBuffer { uint grid_lists[]; };
 layout(std430, set = 0, binding = 4) buffer LightGridOccupancyBuffer { uvec2 grid_occupancy[]; };
 // Per block: x its total, then its start; y its largest count.

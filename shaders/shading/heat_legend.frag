@@ -7,7 +7,7 @@
 #include "clusters/cluster.glsl"
 
 layout(location = 0) in vec2 in_uv;
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(location = 0) out vec4 out_color;
 
 // 3×5 glyphs of 0-9, rows top to bottom, bit 14 = top left.

@@ -8,7 +8,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(set = 0, binding = 5) uniform sampler2D hdr_image;
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 #include "common/shading_model.glsl"

@@ -8,7 +8,7 @@
 
 #include "visibility/depth_pyramid.glsl"
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(std430, set = 0, binding = 1) readonly buffer InstanceBuffer { Instance instances[]; };
 layout(std430, set = 0, binding = 2) readonly buffer ObjectBuffer { ObjectData objects[]; };
 layout(std430, set = 0, binding = 3) readonly buffer MeshletBuffer { Meshlet meshlets[]; };

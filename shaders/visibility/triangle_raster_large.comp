@@ -10,7 +10,7 @@
 
 layout(local_size_x = 64) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(std430, set = 0, binding = 1) buffer CullCounterBuffer { CullCounters counters; };
 layout(std430, set = 0, binding = 2) readonly buffer LargeBinBuffer { uvec2 large_bins[]; };
 layout(std430, set = 0, binding = 3) buffer LargeTriangleBuffer { LargeTriangle large_triangles[]; };

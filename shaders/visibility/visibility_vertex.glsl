@@ -9,7 +9,7 @@
 
 #include "common/common.glsl"
 
-layout(std430, set = 0, binding = 0) readonly buffer FrameBlock { FrameUniforms frame; };
+FRAME_BLOCK(0);
 layout(std430, set = 0, binding = 1) readonly buffer ObjectBuffer { ObjectData objects[]; };
 // Per draw slot: x: meshlet instance; y: object; z: its meshlet's first vertex; w: meshlet.
 layout(std430, set = 0, binding = 2) readonly buffer DrawSlotBuffer { uvec4 draw_slots[]; };
