@@ -44,7 +44,7 @@ pub fn compute_pipeline(
     constants: &[(&str, u32)],
 ) -> Result<vk::Pipeline, VkError> {
     let [ids] = resolve([shader], constants)?;
-    shader::compute_pipeline(ctx, shader.spirv, layout, &ids)
+    shader::compute_pipeline(ctx, shader.file, shader.spirv, layout, &ids)
 }
 
 #[cfg(test)]

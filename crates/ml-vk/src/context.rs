@@ -327,8 +327,22 @@ pub struct Context {
     pub queue_family: u32,
     /// Bits of a timestamp that are valid on our queue (0: no GPU timing).
     pub timestamp_valid_bits: u32,
+    /// Whether compute pipelines print the driver's statistics of their shaders (registers,
+    /// shared memory) as they are made: asked for with `MANYLIGHTS_PIPELINE_STATS`, on a device
+    /// with VK_KHR_pipeline_executable_properties.
+    pub pipeline_stats: bool,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) transient_pool: vk::CommandPool,
+}
+
+/// The environment variable that asks for compute pipelines' statistics (`Context::pipeline_stats`).
+pub const PIPELINE_STATS_VAR: &str = "MANYLIGHTS_PIPELINE_STATS";
+
+/// Whether `pd` offers the device extension `name`.
+fn has_device_extension(instance: &ash::Instance, pd: vk::PhysicalDevice, name: &std::ffi::CStr) -> bool {
+    // SAFETY: a physical device of this instance.
+    let extensions = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(name))
 }
 
 /// Describe every Vulkan device (for `manylights info`).
@@ -343,7 +357,7 @@ impl Context {
     pub fn new(desc: &ContextDesc) -> Result<Context> {
         let mut parts = InstanceParts::new(desc.validation, desc.window)?;
         match Self::with_instance(&parts, desc) {
-            Ok((physical_device, info, device, queue_family, timestamp_valid_bits)) => {
+            Ok((physical_device, info, device, queue_family, timestamp_valid_bits, pipeline_stats)) => {
                 // SAFETY: the device was created with one queue in this family.
                 let queue = unsafe { device.get_device_queue(queue_family, 0) };
                 let allocator = Allocator::new(&AllocatorCreateDesc {
@@ -368,6 +382,7 @@ impl Context {
                     queue,
                     queue_family,
                     timestamp_valid_bits,
+                    pipeline_stats,
                     allocator: ManuallyDrop::new(Mutex::new(allocator)),
                     transient_pool,
                 })
@@ -380,7 +395,7 @@ impl Context {
     }
 
     #[allow(clippy::type_complexity)]
-    fn with_instance(parts: &InstanceParts, desc: &ContextDesc) -> Result<(vk::PhysicalDevice, DeviceInfo, ash::Device, u32, u32)> {
+    fn with_instance(parts: &InstanceParts, desc: &ContextDesc) -> Result<(vk::PhysicalDevice, DeviceInfo, ash::Device, u32, u32, bool)> {
         let devices = parts.devices()?;
         let (pd, info) = match desc.device_index {
             Some(index) => {
@@ -414,16 +429,26 @@ impl Context {
         let mut v12 = vk::PhysicalDeviceVulkan12Features::default()
             .shader_output_layer(features.shader_output_layer)
             .shader_buffer_int64_atomics(features.buffer_int64_atomics);
-        let extensions = if parts.surface.is_some() { vec![ash::khr::swapchain::NAME.as_ptr()] } else { Vec::new() };
-        let info_create = vk::DeviceCreateInfo::default()
-            .queue_create_infos(&queues)
-            .enabled_extension_names(&extensions)
-            .enabled_features(&core)
-            .push_next(&mut v11)
-            .push_next(&mut v12);
+        let mut extensions = if parts.surface.is_some() { vec![ash::khr::swapchain::NAME.as_ptr()] } else { Vec::new() };
+        let mut executable_info = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default().pipeline_executable_info(true);
+        let mut info_create =
+            vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut v11).push_next(&mut v12);
+        let pipeline_stats = std::env::var_os(PIPELINE_STATS_VAR).is_some() && {
+            let name = ash::khr::pipeline_executable_properties::NAME;
+            let has = has_device_extension(&parts.instance, pd, name);
+            if !has {
+                eprintln!("{PIPELINE_STATS_VAR}: {} does not report pipeline statistics (no {})", info.name, name.to_string_lossy());
+            }
+            has
+        };
+        if pipeline_stats {
+            extensions.push(ash::khr::pipeline_executable_properties::NAME.as_ptr());
+            info_create = info_create.push_next(&mut executable_info);
+        }
+        let info_create = info_create.enabled_extension_names(&extensions);
         // SAFETY: valid physical device and create info; only supported features are enabled.
         let device = unsafe { parts.instance.create_device(pd, &info_create, None) }.ctx("vkCreateDevice")?;
-        Ok((pd, info, device, family, family_props.timestamp_valid_bits))
+        Ok((pd, info, device, family, family_props.timestamp_valid_bits, pipeline_stats))
     }
 
     pub fn instance(&self) -> &ash::Instance {

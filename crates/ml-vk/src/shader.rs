@@ -24,8 +24,15 @@ fn specialization(constants: &[(u32, u32)]) -> (Vec<vk::SpecializationMapEntry>,
 }
 
 /// A compute pipeline running `main` of the given SPIR-V with `layout`; `constants` sets
-/// 32-bit specialization constants (id, value; a GLSL bool is 0 or 1).
-pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout, constants: &[(u32, u32)]) -> Result<vk::Pipeline> {
+/// 32-bit specialization constants (id, value; a GLSL bool is 0 or 1). `name` (the shader's
+/// file) labels its statistics where the context prints them.
+pub fn compute_pipeline(
+    ctx: &Context,
+    name: &str,
+    spirv: &[u8],
+    layout: vk::PipelineLayout,
+    constants: &[(u32, u32)],
+) -> Result<vk::Pipeline> {
     let module = module(ctx, spirv)?;
     let (entries, data) = specialization(constants);
     let spec = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
@@ -34,12 +41,50 @@ pub fn compute_pipeline(ctx: &Context, spirv: &[u8], layout: vk::PipelineLayout,
         .module(module)
         .name(c"main")
         .specialization_info(&spec);
-    let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
+    let stats = ctx.pipeline_stats;
+    let flags = if stats { vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR } else { vk::PipelineCreateFlags::empty() };
+    let info = [vk::ComputePipelineCreateInfo::default().flags(flags).stage(stage).layout(layout)];
     // SAFETY: valid module and layout.
     let result = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
     // SAFETY: the module is not needed once the pipeline exists (or failed).
     unsafe { ctx.device.destroy_shader_module(module, None) };
-    result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateComputePipelines")
+    let pipeline = result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateComputePipelines")?;
+    if stats {
+        print_pipeline_stats(ctx, name, constants, pipeline);
+    }
+    Ok(pipeline)
+}
+
+/// One line on stderr per executable of `pipeline` (`Context::pipeline_stats`): its statistics
+/// as the driver names and counts them — on NVIDIA the registers a thread takes, which bound
+/// how many warps a multiprocessor keeps (the latency a memory-bound pass can hide).
+fn print_pipeline_stats(ctx: &Context, name: &str, constants: &[(u32, u32)], pipeline: vk::Pipeline) {
+    let ext = ash::khr::pipeline_executable_properties::Device::new(ctx.instance(), &ctx.device);
+    let info = vk::PipelineInfoKHR::default().pipeline(pipeline);
+    // SAFETY: a pipeline made with CAPTURE_STATISTICS on a device with the extension enabled.
+    let Ok(executables) = (unsafe { ext.get_pipeline_executable_properties(&info) }) else { return };
+    for index in 0..executables.len() as u32 {
+        let exe = vk::PipelineExecutableInfoKHR::default().pipeline(pipeline).executable_index(index);
+        // SAFETY: as above, index within the executables.
+        let Ok(stats) = (unsafe { ext.get_pipeline_executable_statistics(&exe) }) else { continue };
+        let values: Vec<String> = stats
+            .iter()
+            .map(|s| {
+                let label = s.name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
+                // SAFETY: the union member the statistic's format names.
+                let value = unsafe {
+                    match s.format {
+                        vk::PipelineExecutableStatisticFormatKHR::BOOL32 => (s.value.b32 != 0).to_string(),
+                        vk::PipelineExecutableStatisticFormatKHR::INT64 => s.value.i64.to_string(),
+                        vk::PipelineExecutableStatisticFormatKHR::UINT64 => s.value.u64.to_string(),
+                        _ => format!("{:.3}", s.value.f64),
+                    }
+                };
+                format!("{label}={value}")
+            })
+            .collect();
+        eprintln!("pipeline stats: {name} {constants:?}: {}", values.join(", "));
+    }
 }
 
 /// What differs between the graphics pipelines we make. Fixed for all: `main` entry points,

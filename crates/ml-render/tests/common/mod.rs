@@ -93,7 +93,7 @@ pub fn dispatch_probe(ctx: &Context, probe: &ml_shaders::Shader, buffers: &[(&st
     use ml_render::internals::{FrameSets, Resource};
     let mut sets = FrameSets::new(ctx, &[(probe, vk::ShaderStageFlags::COMPUTE)], 0, 1).unwrap();
     let pipeline_layout = ml_vk::shader::pipeline_layout(ctx, &[sets.layout.raw], &[]).unwrap();
-    let pipeline = ml_vk::shader::compute_pipeline(ctx, probe.spirv, pipeline_layout, &[]).unwrap();
+    let pipeline = ml_vk::shader::compute_pipeline(ctx, probe.file, probe.spirv, pipeline_layout, &[]).unwrap();
     sets.write(ctx, 0, &|name| buffers.iter().find(|(n, _)| *n == name).map(|(_, b)| Resource::Buffer(*b))).unwrap();
     ml_vk::commands::one_shot(ctx, |cmd| {
         // SAFETY: recording state; all bound objects are alive.
