@@ -54,6 +54,27 @@ fn a_warm_up_changes_no_pixel() {
     assert_eq!(std::fs::read(&cold).unwrap(), std::fs::read(&warm).unwrap(), "the warm-up changed the image");
 }
 
+/// `MANYLIGHTS_PIPELINE_STATS` never changes what a run does: on a device that reports
+/// pipeline statistics, one line per compute pipeline (the lighting's among them); on one that
+/// does not (lavapipe), one line that says so. The image is rendered either way.
+#[test]
+fn pipeline_stats_are_printed_or_declined_in_one_line() {
+    let png = temp_png("stats.png");
+    let args = ["render", "--validation", "--scene", "bench", "--technique", "deferred-compute", "--width", "32", "--height", "18"];
+    let out = manylights(&[&args[..], &["--frames", "1", "--out", png.to_str().unwrap()]].concat(), &[("MANYLIGHTS_PIPELINE_STATS", "1")]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{}{stderr}", String::from_utf8_lossy(&out.stdout));
+    let declined: Vec<&str> = stderr.lines().filter(|l| l.contains("does not report pipeline statistics")).collect();
+    let printed: Vec<&str> = stderr.lines().filter(|l| l.starts_with("pipeline stats: ")).collect();
+    if declined.is_empty() {
+        assert!(printed.iter().any(|l| l.contains("shading/deferred_lighting.comp")), "{stderr}");
+    } else {
+        assert_eq!((declined.len(), printed.len()), (1, 0), "{stderr}");
+        assert!(declined[0].starts_with("MANYLIGHTS_PIPELINE_STATS: "), "{stderr}");
+    }
+    assert!(std::fs::metadata(&png).unwrap().len() > 0);
+}
+
 #[test]
 fn clustered_render_reports_its_clusters() {
     let png = temp_png("clustered.png");
