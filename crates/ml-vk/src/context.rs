@@ -433,16 +433,20 @@ impl Context {
         let mut executable_info = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default().pipeline_executable_info(true);
         let mut info_create =
             vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut v11).push_next(&mut v12);
+        let stats_extension = ash::khr::pipeline_executable_properties::NAME;
         let pipeline_stats = std::env::var_os(PIPELINE_STATS_VAR).is_some() && {
-            let name = ash::khr::pipeline_executable_properties::NAME;
-            let has = has_device_extension(&parts.instance, pd, name);
+            let has = has_device_extension(&parts.instance, pd, stats_extension);
             if !has {
-                eprintln!("{PIPELINE_STATS_VAR}: {} does not report pipeline statistics (no {})", info.name, name.to_string_lossy());
+                eprintln!(
+                    "{PIPELINE_STATS_VAR}: {} does not report pipeline statistics (no {})",
+                    info.name,
+                    stats_extension.to_string_lossy()
+                );
             }
             has
         };
         if pipeline_stats {
-            extensions.push(ash::khr::pipeline_executable_properties::NAME.as_ptr());
+            extensions.push(stats_extension.as_ptr());
             info_create = info_create.push_next(&mut executable_info);
         }
         let info_create = info_create.enabled_extension_names(&extensions);

@@ -62,11 +62,20 @@ fn print_pipeline_stats(ctx: &Context, name: &str, constants: &[(u32, u32)], pip
     let ext = ash::khr::pipeline_executable_properties::Device::new(ctx.instance(), &ctx.device);
     let info = vk::PipelineInfoKHR::default().pipeline(pipeline);
     // SAFETY: a pipeline made with CAPTURE_STATISTICS on a device with the extension enabled.
-    let Ok(executables) = (unsafe { ext.get_pipeline_executable_properties(&info) }) else { return };
+    let executables = match unsafe { ext.get_pipeline_executable_properties(&info) } {
+        Ok(executables) => executables,
+        Err(e) => return eprintln!("pipeline stats: {name} {constants:?}: not read ({e})"),
+    };
     for index in 0..executables.len() as u32 {
         let exe = vk::PipelineExecutableInfoKHR::default().pipeline(pipeline).executable_index(index);
         // SAFETY: as above, index within the executables.
-        let Ok(stats) = (unsafe { ext.get_pipeline_executable_statistics(&exe) }) else { continue };
+        let stats = match unsafe { ext.get_pipeline_executable_statistics(&exe) } {
+            Ok(stats) => stats,
+            Err(e) => {
+                eprintln!("pipeline stats: {name} {constants:?}: executable {index} not read ({e})");
+                continue;
+            }
+        };
         let values: Vec<String> = stats
             .iter()
             .map(|s| {
