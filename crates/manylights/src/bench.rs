@@ -16,7 +16,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, Exposure, Geometry, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
+use ml_render::{DebugView, Exposure, Geometry, LightGridMarks, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -230,6 +230,7 @@ impl Plan {
             exposure: Exposure::Ev(0.0),
             transparency: ml_render::TransparencySettings { budget: a.transparency_budget },
             light_stats: false,
+            light_grid_marks: LightGridMarks::Auto,
         };
         Ok(Plan { scene, settings, warned: false })
     }

@@ -15,7 +15,9 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
-use ml_render::{DebugView, Exposure, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique};
+use ml_render::{
+    DebugView, Exposure, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique,
+};
 use ml_vk::{Context, ContextDesc};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -250,6 +252,12 @@ struct SceneArgs {
     /// must not change).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     culling: String,
+    /// Whether the light grid lists only the lights near the frame's surfaces, after a pass
+    /// that marks the cells their points walk (deferred-compute, visibility): auto (where the
+    /// lights are more than a third of the pixels, where the pass costs less than listing every
+    /// light), on, or off. The same lights light every pixel either way.
+    #[arg(long, default_value = "auto", value_parser = LightGridMarks::NAMES)]
+    light_grid_marks: String,
     /// Who draws the visibility technique's visibility buffer: hardware (the graphics
     /// pipeline), compute (compute shaders only: triangles up to --raster-split pixels a
     /// thread each, larger ones clipped and drawn by a work group per 64x64-pixel bin),
@@ -487,6 +495,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         frames,
         time: args.time,
         culling: args.culling == "on",
+        light_grid_marks: LightGridMarks::from_name(&args.light_grid_marks)?,
         exposure: exposure_choice(args)?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
@@ -698,7 +707,7 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     first.raster =
         auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args)?, args.raster_split), (args.validation, args.device))?;
     let options = ml_viewer::ViewerOptions {
-        choices: ml_viewer::Choices::new(&request, &built, &first),
+        choices: ml_viewer::Choices { light_grid_marks: wanted.light_grid_marks, ..ml_viewer::Choices::new(&request, &built, &first) },
         scene: request,
         width: args.width,
         height: args.height,

@@ -66,6 +66,7 @@ pub enum Named {
     OmniShadowMode,
     SunShadowMode,
     Raster,
+    LightGridMarks,
 }
 
 impl std::fmt::Display for Named {
@@ -76,6 +77,7 @@ impl std::fmt::Display for Named {
             Named::OmniShadowMode => "point-light shadow mode",
             Named::SunShadowMode => "sun shadow mode",
             Named::Raster => "rasteriser",
+            Named::LightGridMarks => "light grid marks choice",
         })
     }
 }

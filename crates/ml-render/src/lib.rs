@@ -66,8 +66,8 @@ pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use scene::ray_geometry::RayStats;
 pub use scene::textures::SHADOW_MAP_SIZE;
 pub use settings::{
-    DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,
-    RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
+    DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightGridMarks, LightingStage, OmniShadowMode, OmniShadowSettings,
+    Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
 };
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage};

@@ -93,6 +93,9 @@ pub struct PipelineKey {
     pub layers: bool,
     /// The lights tested and reaching per pixel are counted (`RenderSettings::light_stats`).
     pub light_stats: bool,
+    /// The light grid marks the cells near the surfaces first, where the technique knows them
+    /// (`RenderSettings::light_grid_marks`).
+    pub light_grid_marks: bool,
 }
 
 impl PipelineKey {
@@ -132,6 +135,7 @@ impl RenderSettings {
             meters_exposure: self.meters_exposure(),
             layers: self.blends_layers(),
             light_stats: self.light_stats,
+            light_grid_marks: self.light_grid_marks,
         }
     }
 
@@ -161,10 +165,9 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
     // The light grid is built once the surfaces are known, for the cells their points walk,
     // where a technique knows them before its lighting (the opaque depth, the transparent
-    // layers' nodes); else first, for every cell.
+    // layers' nodes) and the settings want the marks; else first, for every cell.
     let lights = technique.assignment();
-    let surfaces_first = technique.geometry() == Geometry::Meshlets || technique.lighting_stage() == LightingStage::Compute;
-    let marks = lights == LightAssignment::Gpu && surfaces_first;
+    let marks = technique.marks_light_grid() && key.light_grid_marks;
     let marked_build =
         [PassKind::LightGridMark { depth_buffer: opaque_depth_buffer, layers: key.layers }, PassKind::LightGridBuild { marked: true }];
     let marked_build = if marks { &marked_build[..] } else { &[] };
@@ -293,6 +296,19 @@ mod tests {
         k.raster = Raster::compute(64);
         assert!(matches!(k.raster, Raster::Compute { large: LargeTriangles::Bins { .. }, .. }));
         assert_eq!(plan(&k), phases(TriangleRasterLarge, true));
+    }
+
+    #[test]
+    fn without_marks_the_light_grid_is_built_first_for_every_cell() {
+        for technique in [Technique::DeferredCompute, Technique::Visibility] {
+            let mut k = key(technique);
+            k.light_grid_marks = false;
+            let kinds = plan(&k);
+            assert!(kinds.contains(&LightGridBuild { marked: false }), "{}: {kinds:?}", technique.name());
+            assert!(!kinds.iter().any(|p| matches!(p, LightGridMark { .. } | LightGridBuild { marked: true })), "{kinds:?}");
+        }
+        // Techniques without surfaces before their lighting never mark.
+        assert!(!Technique::ClusteredGpu.marks_light_grid());
     }
 
     #[test]

@@ -113,6 +113,41 @@ impl DebugView {
     }
 }
 
+/// Whether the light grid's build lists only the lights near the frame's surfaces, after a
+/// pass over the pixels that marks the cells their points walk (docs/DESIGN.md#the-light-grid),
+/// or every light. The pass costs per pixel and listing a light costs per light: the marks
+/// pay where the lights are more than about a third of the pixels (measured on the H100).
+/// The same lights light every pixel either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightGridMarks {
+    /// Marks where the lights are more than a third of the pixels.
+    Auto,
+    On,
+    Off,
+}
+
+impl LightGridMarks {
+    pub const ALL: [LightGridMarks; 3] = [LightGridMarks::Auto, LightGridMarks::On, LightGridMarks::Off];
+    pub const NAMES: [&'static str; 3] = ["auto", "on", "off"];
+
+    pub fn name(self) -> &'static str {
+        LightGridMarks::NAMES[self as usize]
+    }
+
+    pub fn from_name(name: &str) -> Result<LightGridMarks, RenderError> {
+        by_name(&LightGridMarks::ALL, LightGridMarks::name, Named::LightGridMarks, name)
+    }
+
+    /// Whether a frame of `width`×`height` pixels with `lights` lights marks.
+    pub fn resolve(self, lights: u64, width: u32, height: u32) -> bool {
+        match self {
+            LightGridMarks::On => true,
+            LightGridMarks::Off => false,
+            LightGridMarks::Auto => lights.saturating_mul(3) > u64::from(width) * u64::from(height),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     pub technique: Technique,
@@ -142,6 +177,9 @@ pub struct RenderSettings {
     /// Count the lights tested and reaching per pixel after the lighting (`LightStats`; the
     /// compute-lit techniques, deferred-compute and visibility).
     pub light_stats: bool,
+    /// The light grid marks the cells near the surfaces before its build (the techniques
+    /// that know their surfaces before their lighting: deferred-compute, visibility).
+    pub light_grid_marks: bool,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -178,6 +216,7 @@ impl RenderSettings {
             exposure: Exposure::Ev(0.0),
             transparency: None,
             light_stats: false,
+            light_grid_marks: true,
         }
     }
 
@@ -337,6 +376,8 @@ pub struct SettingsRequest {
     pub transparency: TransparencySettings,
     /// Count the lights tested and reaching per pixel.
     pub light_stats: bool,
+    /// Whether the light grid marks the cells near the surfaces first.
+    pub light_grid_marks: LightGridMarks,
 }
 
 impl SettingsRequest {
@@ -358,6 +399,7 @@ impl SettingsRequest {
             exposure: self.exposure,
             transparency: scene.has_blended_objects().then_some(self.transparency),
             light_stats: self.light_stats,
+            light_grid_marks: self.light_grid_marks.resolve(scene.lights.len() as u64, self.width, self.height),
         }
     }
 }
@@ -375,4 +417,24 @@ fn shadowed_count(omni: &OmniShadowSettings, scene: &ml_cpu::scene::Scene, (widt
     let aspect = width.max(1) as f32 / height.max(1) as f32;
     let seen = ml_cpu::omni_shadow::lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, MAX_SHADOWED_LIGHTS as usize);
     (seen.len() as u32).max(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LightGridMarks;
+
+    #[test]
+    fn auto_marks_where_the_lights_are_more_than_a_third_of_the_pixels() {
+        // 1920×1080 = 2,073,600 pixels: a third is 691,200.
+        assert!(!LightGridMarks::Auto.resolve(691_200, 1920, 1080));
+        assert!(LightGridMarks::Auto.resolve(691_201, 1920, 1080));
+        assert!(!LightGridMarks::Auto.resolve(1 << 20, 3840, 2160));
+        assert!(LightGridMarks::Auto.resolve(1 << 22, 3840, 2160));
+        assert!(LightGridMarks::On.resolve(0, 1920, 1080));
+        assert!(!LightGridMarks::Off.resolve(u64::MAX, 1, 1));
+        for marks in LightGridMarks::ALL {
+            assert_eq!(LightGridMarks::from_name(marks.name()).ok(), Some(marks));
+        }
+        assert!(LightGridMarks::from_name("sometimes").is_err());
+    }
 }

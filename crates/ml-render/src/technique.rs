@@ -81,6 +81,14 @@ impl Technique {
         self.assignment() != LightAssignment::None
     }
 
+    /// Whether its light grid may mark the cells near the surfaces before its build: the GPU
+    /// assignment of a technique that knows its surfaces before its lighting (its visibility
+    /// buffer or G-buffer; deferred-compute, visibility).
+    pub fn marks_light_grid(self) -> bool {
+        self.assignment() == LightAssignment::Gpu
+            && (self.geometry() == Geometry::Meshlets || self.lighting_stage() == LightingStage::Compute)
+    }
+
     /// Whether it has the cluster grid (`--clusters`): the techniques that assign on the CPU.
     pub fn has_cluster_grid(self) -> bool {
         self.assignment() == LightAssignment::Cpu

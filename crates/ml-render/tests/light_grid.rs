@@ -1,5 +1,5 @@
 //! The light grid (the GPU techniques' light assignment): a million lights at 160×90 against
-//! brute force on the CPU over every light, on a crop; a hundred thousand lights without a
+//! brute force on the CPU over every light, on a crop, with the marks and without; a hundred thousand lights without a
 //! validation message; and lights whose cluster lists outgrow a storage buffer, which the
 //! light grid (one entry per light) still renders.
 
@@ -71,17 +71,22 @@ fn a_million_lights_equal_brute_force_on_a_crop() {
         .collect();
     let lit = reference.iter().filter(|c| c.iter().any(|&v| v > 50)).count();
     assert!(lit > crop.len() / 5, "a crop the lights light: {lit} of {} pixels", crop.len());
+    // (technique, raster, whether the surfaces mark the cells they walk first)
+    let compute = Raster::compute(Raster::DEFAULT_SPLIT);
     let variants = [
-        (Technique::ClusteredGpu, Raster::Hardware),
-        (Technique::DeferredCompute, Raster::Hardware),
-        (Technique::Visibility, Raster::compute(Raster::DEFAULT_SPLIT)),
+        (Technique::ClusteredGpu, Raster::Hardware, false),
+        (Technique::DeferredCompute, Raster::Hardware, true),
+        (Technique::Visibility, compute, true),
+        (Technique::DeferredCompute, Raster::Hardware, false),
+        (Technique::Visibility, compute, false),
     ];
-    for (technique, raster) in variants {
-        let settings = RenderSettings { raster, ..RenderSettings::new(technique, W, H) };
+    for (technique, raster, marks) in variants {
+        let settings = RenderSettings { raster, light_grid_marks: marks, ..RenderSettings::new(technique, W, H) };
         let out = Renderer::new(&ctx, scene.clone(), settings).and_then(|mut r| r.render()).expect("render");
         let grid = out.stats.feature::<LightGridStats>().expect("the light grid's figures");
-        if technique == Technique::ClusteredGpu {
-            // No surfaces before its lighting: every cell marked, every light listed once.
+        if !marks {
+            // No marks (no surfaces before its lighting, or not asked for): every cell
+            // marked, every light listed once.
             assert_eq!((grid.listed, grid.cells_marked), (1 << 20, grid.dims.iter().product()), "every light listed once");
         } else {
             // The marks: only the cells the wall's points walk, a few layers of the box.
@@ -92,9 +97,9 @@ fn a_million_lights_equal_brute_force_on_a_crop() {
             let got = common::pixel(&out, x, y);
             let diff = (0..3).map(|c| got[c].abs_diff(want[c])).max().unwrap_or(0);
             worst = worst.max(diff);
-            assert!(diff <= MAX_DIFF, "{}: pixel ({x}, {y}) is {got:?}, brute force {want:?}", technique.name());
+            assert!(diff <= MAX_DIFF, "{} (marks {marks}): pixel ({x}, {y}) is {got:?}, brute force {want:?}", technique.name());
         }
-        println!("{}: {grid:?}; crop within {worst}/255 of brute force", technique.name());
+        println!("{} (marks {marks}): {grid:?}; crop within {worst}/255 of brute force", technique.name());
     }
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");

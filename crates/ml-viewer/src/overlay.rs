@@ -9,7 +9,8 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
 use ml_render::settings::MAX_SHADOWED_LIGHTS;
 use ml_render::{
-    DebugView, Exposure, Geometry, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode, Technique,
+    DebugView, Exposure, Geometry, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode,
+    Technique,
 };
 use std::collections::VecDeque;
 
@@ -35,6 +36,9 @@ pub struct Choices {
     pub exposure: Exposure,
     /// The scene's transparent layers (None: it has no transparent objects).
     pub transparency: Option<ml_render::TransparencySettings>,
+    /// Whether the light grid marks the cells near the surfaces (the command line's choice;
+    /// auto decides again as lights and size change).
+    pub light_grid_marks: LightGridMarks,
 }
 
 impl Choices {
@@ -60,6 +64,7 @@ impl Choices {
             raster: settings.raster,
             exposure: settings.exposure,
             transparency: settings.transparency,
+            light_grid_marks: LightGridMarks::Auto,
         }
     }
 
@@ -100,6 +105,7 @@ impl Choices {
             transparency: self.transparency,
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
+            light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
         }
     }
 }
@@ -284,6 +290,7 @@ mod tests {
             raster: Raster::Hardware,
             exposure: Exposure::Ev(0.0),
             transparency: None,
+            light_grid_marks: LightGridMarks::Auto,
         }
     }
 
