@@ -283,11 +283,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         ),
         Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
         Rule::technique("culling", "the technique that culls meshlets on the GPU", draws_meshlets),
-        Rule::technique(
-            "light_grid_marks",
-            "the techniques that know their surfaces before their lighting (deferred-compute, visibility)",
-            Technique::marks_light_grid,
-        ),
+        Rule::technique("light_grid_marks", "the techniques that know their surfaces before their lighting", Technique::marks_light_grid),
         Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
         Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
         Rule::setting(
