@@ -707,7 +707,7 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     first.raster =
         auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args)?, args.raster_split), (args.validation, args.device))?;
     let options = ml_viewer::ViewerOptions {
-        choices: ml_viewer::Choices { light_grid_marks: wanted.light_grid_marks, ..ml_viewer::Choices::new(&request, &built, &first) },
+        choices: ml_viewer::Choices::new(&request, &built, &first, wanted.light_grid_marks),
         scene: request,
         width: args.width,
         height: args.height,

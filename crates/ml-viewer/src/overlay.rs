@@ -43,8 +43,10 @@ pub struct Choices {
 
 impl Choices {
     /// What a viewer of `request`'s scene starts with: the scene as built, rendered with
-    /// `settings` (the seed scene's object and material where the scene is another).
-    pub fn new(request: &SceneRequest, built: &BuiltScene, settings: &RenderSettings) -> Choices {
+    /// `settings` (the seed scene's object and material where the scene is another), the
+    /// light grid's marks as asked (`settings` holds only what that choice resolved to at
+    /// its first size).
+    pub fn new(request: &SceneRequest, built: &BuiltScene, settings: &RenderSettings, light_grid_marks: LightGridMarks) -> Choices {
         let (object, material) = match request.source {
             SceneSource::Seed { object, material } => (object, material),
             _ => (MeshKind::Sphere, Material::built_in()[0]),
@@ -64,7 +66,7 @@ impl Choices {
             raster: settings.raster,
             exposure: settings.exposure,
             transparency: settings.transparency,
-            light_grid_marks: LightGridMarks::Auto,
+            light_grid_marks,
         }
     }
 
