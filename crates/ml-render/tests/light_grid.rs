@@ -1,7 +1,7 @@
 //! The light grid (the GPU techniques' light assignment): a million lights at 160×90 against
-//! brute force on the CPU over every light, on a crop, with the marks and without; a hundred thousand lights without a
-//! validation message; and lights whose cluster lists outgrow a storage buffer, which the
-//! light grid (one entry per light) still renders.
+//! brute force on the CPU over every light, on a crop, with the marks and without; a hundred
+//! thousand lights without a validation message; and lights whose cluster lists outgrow a
+//! storage buffer, which the light grid (one entry per light) still renders.
 
 mod common;
 
