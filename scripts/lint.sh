@@ -11,7 +11,9 @@ if ! cargo fmt --version >/dev/null 2>&1 || ! cargo clippy --version >/dev/null 
 fi
 echo "lint: cargo fmt --check" >&2
 cargo fmt --all -- --check
+# Both with the test profile, the one `cargo test` builds with: the dependencies' build scripts
+# (glslang's C++ above all) then run once for the gates and the tests, not once per profile.
 echo "lint: cargo clippy -D warnings" >&2
-cargo clippy --workspace --all-targets --locked -q -- -D warnings
+cargo clippy --profile test --workspace --all-targets --locked -q -- -D warnings
 echo "lint: cargo doc -D warnings" >&2
-RUSTDOCFLAGS=-Dwarnings cargo doc --no-deps --workspace --locked -q
+RUSTDOCFLAGS=-Dwarnings cargo doc --profile test --no-deps --workspace --locked -q

@@ -351,6 +351,8 @@ impl<T: TryFrom<u64> + Clone + Send + Sync + 'static> clap::builder::TypedValueP
 }
 
 fn main() -> ExitCode {
+    // Before any thread: it may set a variable the Vulkan driver reads.
+    ml_vk::driver_env::prepare();
     let cli = match parse_arguments() {
         Ok(cli) => cli,
         Err(code) => return code,

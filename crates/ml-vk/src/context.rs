@@ -120,6 +120,7 @@ struct InstanceParts {
 
 impl InstanceParts {
     fn new(validation: bool, window: Option<WindowHandles>) -> Result<InstanceParts> {
+        crate::driver_env::prepare();
         // SAFETY: loading the system Vulkan loader; its symbols are used through ash only.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))?;
         let mut layers = Vec::new();

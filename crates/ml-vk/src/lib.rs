@@ -7,6 +7,7 @@ pub mod buffer;
 pub mod commands;
 pub mod context;
 pub mod descriptors;
+pub mod driver_env;
 pub mod error;
 pub mod image;
 pub mod shader;

@@ -99,7 +99,7 @@ fn the_seed_scene_survives_a_round_trip() {
 }
 
 // The broken texts (each with its expected error, through the binary and its exit code):
-// crates/manylights/tests/cli.rs.
+// crates/manylights/tests/command_line/cli.rs.
 
 #[test]
 fn files_that_are_no_scene_files_are_refused() {

@@ -1,0 +1,179 @@
+//! What a new user meets with their own scene (docs/usage.md): `--camera` frames a scene as
+//! a scene file's camera does, a file without lights gets the default rig and says so, an
+//! image sequence writes every frame (its last the `--frames N` image), and bad values of the
+//! new options get one error line.
+
+use crate::common;
+
+use common::{assert_one_line_error, manylights};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn temp_dir(name: &str) -> PathBuf {
+    common::temp_dir("first-hour", name)
+}
+
+fn ok(out: &Output) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{}{stderr}", String::from_utf8_lossy(&out.stdout));
+    stderr
+}
+
+fn pixels(path: &Path) -> image::RgbaImage {
+    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
+}
+
+const SIZE: [&str; 4] = ["--width", "96", "--height", "64"];
+
+/// A scene file of a torus knot and a floor, its lights the default rig; `camera` its
+/// [camera] section.
+fn scene_file(dir: &Path, name: &str, camera: &str) -> PathBuf {
+    let path = dir.join(name);
+    let text = format!(
+        "{camera}\n[shading]\nmodel = \"pbr\"\n\n[[objects]]\nmesh = \"torusknot\"\nposition = [0.0, 1.0, 0.0]\n\n\
+         [[objects]]\nmesh = \"plane\"\nscale = 4.0\nmaterial = {{ name = \"white\" }}\n"
+    );
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn camera_option_gives_the_scene_files_camera_image() {
+    let dir = temp_dir("camera");
+    let with_camera = scene_file(&dir, "with.toml", "[camera]\nposition = [3.0, 4.0, 5.0]\ntarget = [0.0, 0.5, 0.0]\nfov_y_deg = 45.0\n");
+    let without = scene_file(&dir, "without.toml", "");
+    let (a, b, framed) = (dir.join("file.png"), dir.join("option.png"), dir.join("framed.png"));
+    // One technique for all three (auto's pick may differ from run to run, by 1/255 at most).
+    let render = |scene: &Path, out: &Path, extra: &[&str]| {
+        let mut args =
+            vec!["render", "--validation", "--technique", "forward", "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        args.extend(SIZE);
+        args.extend(extra);
+        ok(&manylights(&args))
+    };
+    render(&with_camera, &a, &[]);
+    let stderr = render(&without, &b, &["--camera", "3,4,5:0,0.5,0:45"]);
+    // Neither file has lights: both get the rig, and say so.
+    assert!(stderr.contains("the scene has no lights: added 64 point lights (grid layout"), "{stderr}");
+    render(&without, &framed, &[]);
+    let (a, b, framed) = (pixels(&a), pixels(&b), pixels(&framed));
+    assert!(a == b, "--camera and the scene file's camera differ");
+    assert!(a != framed, "the framing camera gave the same image: the camera was not used");
+}
+
+#[test]
+fn an_image_sequence_has_every_frame_and_ends_with_the_frames_image() {
+    // Also under auto exposure, whose render settles its last frame before returning it.
+    for exposure in ["0", "auto"] {
+        let dir = temp_dir(&format!("sequence-{exposure}"));
+        let pattern = dir.join("frames").join("##.png");
+        std::fs::create_dir_all(dir.join("frames")).unwrap();
+        let last = dir.join("last.png");
+        // Technique clustered-gpu: its frames are the ones that can be rendered again.
+        let render = |out: &Path| {
+            let mut args = vec!["render", "--validation", "--technique", "clustered-gpu", "--frames", "5", "--out", out.to_str().unwrap()];
+            args.extend(SIZE);
+            args.extend(["--exposure", exposure]);
+            ok(&manylights(&args))
+        };
+        render(&pattern);
+        render(&last);
+        let mut files: Vec<String> =
+            std::fs::read_dir(dir.join("frames")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        files.sort();
+        assert_eq!(files, ["00.png", "01.png", "02.png", "03.png", "04.png"]);
+        let frames: Vec<_> = files.iter().map(|f| pixels(&dir.join("frames").join(f))).collect();
+        assert!(frames[4] == pixels(&last), "exposure {exposure}: the sequence's last frame differs from the --frames 5 image");
+        // The lights move: the frames are not one image written five times.
+        assert!(frames[0] != frames[4]);
+    }
+}
+
+/// Mean luma (Rec. 709 weights on the 8-bit values, 0…1) over the whole image.
+fn mean_luma(image: &image::RgbaImage) -> f64 {
+    let sum: f64 = image.pixels().map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64).sum();
+    sum / 255.0 / (image.width() * image.height()) as f64
+}
+
+/// An image sequence into folders that do not exist yet: they are made, and under auto
+/// exposure (a scene file's default) the first frame is exposed like the last, not dark.
+#[test]
+fn a_sequence_makes_its_folder_and_starts_exposed() {
+    let dir = temp_dir("new-folder");
+    let file = scene_file(&dir, "knot.toml", "");
+    let folder = dir.join("renders").join("knot");
+    assert!(!folder.exists());
+    let pattern = folder.join("###.png");
+    let mut args = vec!["render", "--validation", "--scene", file.to_str().unwrap(), "--frames", "6", "--out", pattern.to_str().unwrap()];
+    args.extend(SIZE);
+    ok(&manylights(&args));
+    let first = pixels(&folder.join("000.png"));
+    let last = pixels(&folder.join("005.png"));
+    let (a, b) = (mean_luma(&first), mean_luma(&last));
+    println!("mean luma: first frame {a:.4}, last {b:.4}");
+    assert!((a / b - 1.0).abs() <= 0.02, "the first frame's mean luma {a:.4} is not within 2 % of the last's {b:.4}");
+}
+
+#[test]
+fn bad_cameras_exposures_frames_and_patterns_are_refused() {
+    let dir = temp_dir("bad");
+    let out = dir.join("never.png");
+    let p = out.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["render", "--out", p];
+        args.extend(extra);
+        manylights(&args)
+    };
+    assert_one_line_error(&run(&["--camera", "1,2:3,4,5"]), &["--camera", "EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z"]);
+    assert_one_line_error(&run(&["--camera", "1,2,3:1,2,3"]), &["--camera", "looks nowhere"]);
+    assert_one_line_error(&run(&["--camera", "1,2,3:4,5,6:200"]), &["--camera", "field of view"]);
+    assert_one_line_error(&run(&["--camera", "-1,2,3:-1,-5,3"]), &["--camera", "straight up or down"]);
+    assert_one_line_error(&run(&["--exposure", "100"]), &["--exposure", "-20 to 20"]);
+    assert_one_line_error(&run(&["--exposure", "bright"]), &["--exposure", "'bright'"]);
+    assert_one_line_error(&run(&["--frames", "1000000"]), &["--frames 1000000", "100000"]);
+    assert_one_line_error(&run(&["--light-layout", "spiral"]), &["spiral", "grid, random, surface"]);
+    let bench = manylights(&["bench", "--camera", "1,2,3", "--out", dir.join("bench").to_str().unwrap()]);
+    assert_one_line_error(&bench, &["--camera", "EYE_X,EYE_Y,EYE_Z"]);
+    assert_one_line_error(&run(&["--show-lights", "--omni-shadow", "layered"]), &["--show-lights", "--omni-shadow"]);
+    assert_one_line_error(&run(&["--show-lights", "--lights", "70000"]), &["--show-lights", "70000 lights", "65536"]);
+    let bad_pattern = dir.join("a#b#.png");
+    assert_one_line_error(&manylights(&["render", "--frames", "2", "--out", bad_pattern.to_str().unwrap()]), &["one run of #"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn exposure_scales_the_lit_image() {
+    let dir = temp_dir("exposure");
+    let (plain, darker) = (dir.join("plain.png"), dir.join("darker.png"));
+    for (out, ev) in [(&plain, "0"), (&darker, "-2")] {
+        let mut args = vec!["render", "--validation", "--exposure", ev, "--out", out.to_str().unwrap()];
+        args.extend(SIZE);
+        ok(&manylights(&args));
+    }
+    let mean = |p: &Path| pixels(p).pixels().map(|px| px[0] as f64 + px[1] as f64 + px[2] as f64).sum::<f64>();
+    let (a, b) = (mean(&plain), mean(&darker));
+    assert!(b < a * 0.75, "EV -2 should darken the image: {b} against {a}");
+}
+
+/// A scene file is exposed automatically unless `--exposure` says otherwise; the built-in
+/// scenes are not (their images stay), and `--exposure auto` meters them too. The table says
+/// which EV auto exposure settled on.
+#[test]
+fn files_are_exposed_automatically_and_built_in_scenes_on_request() {
+    let dir = temp_dir("auto-exposure");
+    let scene = scene_file(&dir, "scene.toml", "");
+    let out = dir.join("out.png");
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "--validation", "--out", out.to_str().unwrap()];
+        args.extend(SIZE);
+        args.extend(extra);
+        let run = manylights(&args);
+        ok(&run);
+        String::from_utf8_lossy(&run.stdout).into_owned()
+    };
+    let metered = |table: &str| table.lines().any(|l| l.starts_with("exposure") && l.contains("auto:") && l.contains("EV"));
+    assert!(metered(&render(&["--scene", scene.to_str().unwrap()])), "a scene file is metered by default");
+    assert!(!metered(&render(&["--scene", scene.to_str().unwrap(), "--exposure", "0"])), "--exposure 0 fixes it");
+    assert!(!metered(&render(&[])), "the seed scene keeps EV 0");
+    assert!(metered(&render(&["--exposure", "auto", "--shading", "blinn-phong"])), "--exposure auto meters the seed scene");
+}

@@ -1,0 +1,150 @@
+//! Outputs on a full disk: a render, an image sequence and a bench that cannot finish writing
+//! fail with one error line and leave the previous files byte-identical, with no partial file
+//! beside them. The full disk is a file-size limit (RLIMIT_FSIZE, with SIGXFSZ ignored so that
+//! a write past it fails with an error instead of killing the process): what a test may set
+//! without privileges, and a write fails the same way as on a full file system.
+
+use crate::common;
+
+use common::assert_one_line_error;
+use std::collections::BTreeMap;
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Bytes a file may grow to in the "full" runs: less than any PNG, CSV or JSON they write.
+const FULL_DISK_BYTES: u64 = 48;
+
+fn manylights(args: &[&str], file_size_limit: Option<u64>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_manylights"));
+    cmd.args(args);
+    if let Some(limit) = file_size_limit {
+        // SAFETY: between fork and exec only async-signal-safe calls are made (signal and
+        // setrlimit), on plain values.
+        unsafe {
+            cmd.pre_exec(move || {
+                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                let rlimit = libc::rlimit { rlim_cur: limit, rlim_max: limit };
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &rlimit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+    }
+    cmd.output().expect("run manylights")
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("manylights-outputs-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Every file under `d` (relative name → bytes).
+fn files(d: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut all = BTreeMap::new();
+    for entry in std::fs::read_dir(d).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            all.extend(files(&path));
+        } else {
+            all.insert(path.clone(), std::fs::read(&path).unwrap());
+        }
+    }
+    all
+}
+
+fn ok(out: &Output) {
+    assert!(out.status.success(), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+}
+
+const SMALL: [&str; 6] = ["--technique", "forward", "--width", "48", "--height", "32"];
+
+#[test]
+fn a_render_into_a_full_disk_keeps_the_previous_image() {
+    let d = dir("render");
+    let (png, new) = (d.join("image.png"), d.join("new.png"));
+    let render = |out: &Path, lights: &str, limit| {
+        let mut args = vec!["render", "--validation", "--time", "0", "--lights", lights, "--out", out.to_str().unwrap()];
+        args.extend(SMALL);
+        manylights(&args, limit)
+    };
+    ok(&render(&png, "16", None));
+    let before = files(&d);
+    assert!(image::open(&png).is_ok());
+    // A different image that cannot be written: the previous one stays, byte for byte.
+    let failed = render(&png, "32", Some(FULL_DISK_BYTES));
+    assert_one_line_error(&failed, &["cannot write", "image.png"]);
+    // A new path that cannot be written is not made at all.
+    assert_one_line_error(&render(&new, "32", Some(FULL_DISK_BYTES)), &["cannot write", "new.png"]);
+    assert!(files(&d) == before, "the folder changed: {:?}", files(&d).keys().collect::<Vec<_>>());
+}
+
+#[test]
+fn a_sequence_into_a_full_disk_keeps_the_previous_frames() {
+    let d = dir("sequence");
+    let pattern = d.join("frames/##.png");
+    let sequence = |limit| {
+        let mut args = vec!["render", "--validation", "--frames", "3", "--lights", "16", "--out", pattern.to_str().unwrap()];
+        args.extend(SMALL);
+        manylights(&args, limit)
+    };
+    ok(&sequence(None));
+    let before = files(&d);
+    assert_eq!(before.len(), 3, "{:?}", before.keys());
+    assert_one_line_error(&sequence(Some(FULL_DISK_BYTES)), &["cannot write", "00.png"]);
+    assert!(files(&d) == before, "the frames changed: {:?}", files(&d).keys().collect::<Vec<_>>());
+}
+
+#[test]
+fn a_bench_into_a_full_disk_keeps_the_previous_results() {
+    let d = dir("bench");
+    let bench = |limit| {
+        let args = [
+            "bench",
+            "--validation",
+            "--techniques",
+            "forward",
+            "--lights",
+            "64",
+            "--resolution",
+            "32x32",
+            "--frames",
+            "2",
+            "--warmup",
+            "1",
+        ];
+        manylights(&[&args[..], &["--out", d.to_str().unwrap()]].concat(), limit)
+    };
+    ok(&bench(None));
+    let before = files(&d);
+    let names: Vec<_> = before.keys().filter_map(|p| p.file_name()).map(|n| n.to_string_lossy().into_owned()).collect();
+    assert!(["results.csv", "results.json", "results.png"].iter().all(|n| names.contains(&n.to_string())), "{names:?}");
+    assert_one_line_error(&bench(Some(FULL_DISK_BYTES)), &["cannot write", "results.csv"]);
+    assert!(files(&d) == before, "the results changed: {:?}", files(&d).keys().collect::<Vec<_>>());
+}
+
+/// Outputs that are not regular files (a pipe would block the writer forever, a device never
+/// fills) are refused before any work.
+#[test]
+fn outputs_that_are_not_regular_files_are_refused_at_once() {
+    let d = dir("special");
+    let fifo = d.join("pipe.png");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    let device = d.join("null.png");
+    std::os::unix::fs::symlink("/dev/null", &device).unwrap();
+    for out in [&fifo, &device] {
+        let start = std::time::Instant::now();
+        let mut args = vec!["render", "--out", out.to_str().unwrap()];
+        args.extend(SMALL);
+        assert_one_line_error(&manylights(&args, None), &["cannot write", "not a regular file"]);
+        assert!(start.elapsed().as_secs() < 5, "{} took {:?}", out.display(), start.elapsed());
+    }
+    let mut args = vec!["render", "--out", "image.jpg"];
+    args.extend(SMALL);
+    assert_one_line_error(&manylights(&args, None), &["--out", ".png"]);
+}

@@ -1,0 +1,114 @@
+//! Shared harness for image tests: a validated context, render → read back, compare.
+//! Validation (with synchronization validation) is always on; any message fails the test,
+//! including those the layer reports while the device and instance are destroyed.
+
+#![allow(dead_code)] // each test binary uses part of the harness
+
+pub mod shadow_rays;
+
+use ml_cpu::scene::Scene;
+use ml_render::{RenderOutput, RenderSettings, Renderer, Technique};
+use ml_vk::{Context, ContextDesc};
+use std::sync::atomic::Ordering;
+
+pub fn settings(width: u32, height: u32) -> RenderSettings {
+    RenderSettings::new(Technique::Forward, width, height)
+}
+
+/// Render on a fresh validated context and check the layer said nothing.
+pub fn render(scene: Scene, settings: RenderSettings) -> RenderOutput {
+    render_each(&scene, &[settings]).pop().expect("one output")
+}
+
+/// Render the scene once per settings on one validated context; no validation message allowed.
+pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutput> {
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() })
+        .expect("a Vulkan device with the validation layer (CI installs lavapipe and vulkan-validationlayers)");
+    let counter = ctx.validation_counter();
+    let outputs = settings
+        .iter()
+        .map(|s| {
+            let mut renderer = Renderer::new(&ctx, scene.clone(), *s).expect("renderer");
+            renderer.render().expect("render")
+        })
+        .collect();
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
+    outputs
+}
+
+/// Largest per-channel difference between two images of the same size, and how many
+/// pixels differ at all.
+pub fn max_difference(a: &RenderOutput, b: &RenderOutput) -> (u8, usize) {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut worst = 0;
+    let mut pixels = 0;
+    for (pa, pb) in a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)) {
+        let d = pa.iter().zip(pb).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+        worst = worst.max(d);
+        pixels += (d > 0) as usize;
+    }
+    (worst, pixels)
+}
+
+/// Pixels whose largest channel difference exceeds `limit`.
+pub fn pixels_beyond(a: &RenderOutput, b: &RenderOutput, limit: u8) -> usize {
+    a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)).filter(|(pa, pb)| pa.iter().zip(*pb).any(|(x, y)| x.abs_diff(*y) > limit)).count()
+}
+
+pub fn pixel(out: &RenderOutput, x: u32, y: u32) -> [u8; 3] {
+    let i = ((y * out.width + x) * 4) as usize;
+    [out.rgba[i], out.rgba[i + 1], out.rgba[i + 2]]
+}
+
+/// `pixel` at (x, y), None outside the image (for looking at a pixel's neighbours).
+pub fn pixel_at(out: &RenderOutput, x: i64, y: i64) -> Option<[u8; 3]> {
+    let inside = x >= 0 && y >= 0 && x < out.width as i64 && y < out.height as i64;
+    inside.then(|| pixel(out, x as u32, y as u32))
+}
+
+/// Whether a depth-map texel holds a surface (1.0: cleared, nothing in reach).
+pub fn reached(depth: f32) -> bool {
+    depth < 1.0
+}
+
+/// The texels (index, a's depth, b's depth) that one of two depth maps covers and the other
+/// does not, with how many texels differ at all.
+pub fn coverage_difference(a: &[f32], b: &[f32]) -> (Vec<(usize, f32, f32)>, usize) {
+    assert_eq!(a.len(), b.len());
+    let one_only = a.iter().zip(b).enumerate().filter(|(_, (x, y))| reached(**x) != reached(**y)).map(|(i, (&x, &y))| (i, x, y)).collect();
+    (one_only, a.iter().zip(b).filter(|(x, y)| x != y).count())
+}
+
+/// Run a probe compute shader once over `invocations` threads with its set 0 bound by block
+/// name from `buffers`, and wait for it (its host-visible outputs are then readable).
+pub fn dispatch_probe(ctx: &Context, probe: &ml_shaders::Shader, buffers: &[(&str, ash::vk::Buffer)], invocations: u32) {
+    use ash::vk;
+    use ml_render::internals::{FrameSets, Resource};
+    let mut sets = FrameSets::new(ctx, &[(probe, vk::ShaderStageFlags::COMPUTE)], 0, 1).unwrap();
+    let pipeline_layout = ml_vk::shader::pipeline_layout(ctx, &[sets.layout.raw], &[]).unwrap();
+    let pipeline = ml_vk::shader::compute_pipeline(ctx, probe.file, probe.spirv, pipeline_layout, &[]).unwrap();
+    sets.write(ctx, 0, &|name| buffers.iter().find(|(n, _)| *n == name).map(|(_, b)| Resource::Buffer(*b))).unwrap();
+    ml_vk::commands::one_shot(ctx, |cmd| {
+        // SAFETY: recording state; all bound objects are alive.
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, pipeline_layout, 0, &[sets.sets[0]], &[]);
+            let [groups, ..] = probe.groups([invocations, 1, 1]);
+            ctx.device.cmd_dispatch(cmd, groups, 1, 1);
+        }
+        ml_vk::commands::memory_barrier(
+            ctx,
+            cmd,
+            (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE),
+            (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+        );
+    })
+    .expect("probe dispatch");
+    // SAFETY: the GPU is idle (one_shot waited).
+    unsafe {
+        ctx.device.destroy_pipeline(pipeline, None);
+        ctx.device.destroy_pipeline_layout(pipeline_layout, None);
+    }
+    sets.destroy(ctx);
+}

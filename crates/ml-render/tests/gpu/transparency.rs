@@ -1,0 +1,448 @@
+//! Transparency (glTF `alphaMode: BLEND`): transparent surfaces lit by the same lights as the
+//! opaque ones and blended back to front per pixel, in every technique.
+//!
+//! - three overlapping coloured glass quads in front of a lit wall, under point lights: every
+//!   technique's image equals a CPU reference — each surface the pixel's ray meets shaded by
+//!   the seed model's CPU reference (`shade_seed`), the glass layers blended over the wall by
+//!   `ml_cpu::transparency::composite` — within 2/255, but at counted edge pixels (where the
+//!   ray of a neighbouring pixel meets another set of surfaces);
+//! - the order in which the quads are listed does not change a byte (all six orders);
+//! - a budget smaller than the depth complexity drops fragments and says how many; more
+//!   layers than a pixel blends exactly are merged and counted;
+//! - foliage: leaves (quads of a glTF file written here, BLEND, double-sided, a texture whose
+//!   alpha is 0 in a round hole, 1 in a ring round it and fades to 0 over soft bands on both
+//!   sides) over a lit floor: every technique gives forward's image within 1/255 but at
+//!   counted edge pixels; the hole shows exactly what the scene without the leaves shows, and
+//!   the soft bands blend: their pixels lie between the leafless image and the one with the
+//!   leaves opaque;
+//! - the transparency-layers debug view counts each pixel's layers.
+
+use crate::common;
+
+use glam::{Mat4, Quat, Vec3, Vec4};
+use ml_cpu::camera::Camera;
+use ml_cpu::gltf_writer::{png, quad as gltf_quad, GltfWriter, PrimitiveData};
+use ml_cpu::gpu_types::PointLight;
+use ml_cpu::material::Material;
+use ml_cpu::mesh::MeshKind;
+use ml_cpu::scene::{AlphaMode, Object, Scene};
+use ml_cpu::shading::{encode_gamma_unorm8, shade_seed};
+use ml_cpu::transparency::{composite, Layer};
+use ml_render::{
+    DebugView, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings, TransparencyStats, LAYER_KEEP,
+};
+use ml_vk::{Context, ContextDesc};
+use serde_json::json;
+use std::sync::atomic::Ordering;
+
+const W: u32 = 160;
+const H: u32 = 120;
+/// Allowed difference from the reference, in 8-bit steps.
+const MAX_DIFF: u8 = 2;
+/// Most edge pixels an image may have beyond the tolerance (quad borders: a pixel whose
+/// neighbour's ray meets another set of surfaces).
+const MAX_EDGE_PIXELS: usize = 400;
+
+/// A quad facing +Z (the camera): the plane mesh (±1 in x and z, normal +Y) stood up, centred
+/// at `at`, `half` to each side.
+fn quad(at: Vec3, half: (f32, f32), albedo: [f32; 3], alpha: Option<f32>) -> Object {
+    let rotation = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let mut o = Object::placed(MeshKind::Plane, Vec3::ZERO, 1.0, Material { albedo: Vec3::from(albedo), roughness: 0.6, metallic: 0.0 });
+    o.transform = Mat4::from_scale_rotation_translation(Vec3::new(half.0, 1.0, half.1), rotation, at);
+    if let Some(a) = alpha {
+        o.extras.alpha_mode = AlphaMode::Blend;
+        o.extras.base_alpha = a;
+    }
+    o
+}
+
+fn light(p: [f32; 3], radius: f32, c: [f32; 3]) -> PointLight {
+    PointLight { position_radius: [p[0], p[1], p[2], radius], color: [c[0], c[1], c[2], 0.0] }
+}
+
+/// The three glass quads (red, green, blue; alpha 0.5, 0.4, 0.6), overlapping in the middle.
+fn glass() -> [Object; 3] {
+    [
+        quad(Vec3::new(-0.5, 0.3, 0.9), (1.0, 0.8), [0.9, 0.15, 0.1], Some(0.5)),
+        quad(Vec3::new(0.45, 0.2, 0.6), (0.9, 1.0), [0.1, 0.85, 0.2], Some(0.4)),
+        quad(Vec3::new(0.0, -0.45, 0.3), (1.2, 0.7), [0.15, 0.2, 0.95], Some(0.6)),
+    ]
+}
+
+/// The wall at z = 0 behind them, filling the view, then the glass in `order`, lit by
+/// four lights in front (one of them crossing the glass).
+fn scene(order: [usize; 3]) -> Scene {
+    let panes = glass();
+    let mut objects = vec![quad(Vec3::ZERO, (6.0, 6.0), [0.8, 0.75, 0.7], None)];
+    objects.extend(order.iter().map(|&i| panes[i]));
+    let lights = vec![
+        light([1.5, 1.2, 2.0], 5.0, [1.0, 0.9, 0.8]),
+        light([-1.8, -0.6, 1.6], 4.0, [0.6, 0.7, 1.0]),
+        light([0.2, 0.1, 0.7], 1.5, [1.0, 0.6, 0.3]),
+        light([0.0, -1.5, 3.0], 5.0, [0.5, 0.5, 0.5]),
+    ];
+    let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 50.0, 0.1, 20.0);
+    let mut s = Scene::new(objects, lights, camera);
+    s.light_motion = 0.0;
+    s
+}
+
+/// Where the ray (o, d) meets the quad `q` (facing +Z): the distance along it.
+fn hit(q: &Object, (o, d): (Vec3, Vec3)) -> Option<f32> {
+    let at = q.position();
+    let half = (q.transform.x_axis.length(), q.transform.z_axis.length());
+    let t = (at.z - o.z) / d.z;
+    let p = o + d * t;
+    (t > 0.0 && (p.x - at.x).abs() <= half.0 && (p.y - at.y).abs() <= half.1).then_some(t)
+}
+
+/// The surfaces a pixel's ray meets: the objects' indices.
+fn met(scene: &Scene, x: u32, y: u32) -> Vec<usize> {
+    let ray = scene.camera.pixel_ray(x, y, W, H);
+    (0..scene.objects.len()).filter(|&i| hit(&scene.objects[i], ray).is_some()).collect()
+}
+
+/// The CPU reference image: each surface the ray meets shaded, the glass blended over the wall.
+fn reference(scene: &Scene) -> Vec<[u8; 3]> {
+    let eye = scene.camera.position;
+    let mut out = Vec::new();
+    for y in 0..H {
+        for x in 0..W {
+            let ray = scene.camera.pixel_ray(x, y, W, H);
+            let shade = |o: &Object, t: f32| shade_seed(ray.0 + ray.1 * t, Vec3::Z, eye, &o.material, &scene.lights, scene.ambient);
+            let wall = &scene.objects[0];
+            let under = hit(wall, ray).map(|t| shade(wall, t)).expect("the wall fills the view");
+            let layers: Vec<Layer> = (1..scene.objects.len())
+                .filter_map(|i| {
+                    let o = &scene.objects[i];
+                    hit(o, ray).map(|t| Layer { depth: t, id: i as u32, color: shade(o, t), alpha: o.extras.base_alpha })
+                })
+                .collect();
+            out.push(encode_gamma_unorm8(composite(under, &layers, LAYER_KEEP as usize).color));
+        }
+    }
+    out
+}
+
+/// Whether pixel (x, y)'s neighbours' rays meet other surfaces than its own.
+fn edge(scene: &Scene, x: u32, y: u32) -> bool {
+    let own = met(scene, x, y);
+    (-1i32..=1).any(|dy| {
+        (-1i32..=1).any(|dx| {
+            let (nx, ny) = (x as i32 + dx, y as i32 + dy);
+            (0..W as i32).contains(&nx) && (0..H as i32).contains(&ny) && met(scene, nx as u32, ny as u32) != own
+        })
+    })
+}
+
+fn settings(technique: Technique) -> RenderSettings {
+    let mut s = RenderSettings::new(technique, W, H);
+    s.transparency = Some(TransparencySettings::default());
+    if technique == Technique::Visibility {
+        s.raster = Raster::compute(Raster::DEFAULT_SPLIT);
+    }
+    s
+}
+
+fn stats(out: &RenderOutput) -> TransparencyStats {
+    *out.stats.feature::<TransparencyStats>().expect("the layers' figures")
+}
+
+#[test]
+fn glass_over_a_wall_equals_the_cpu_blend_in_every_technique() {
+    let scene = scene([0, 1, 2]);
+    let want = reference(&scene);
+    let mut all: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| settings(t)).collect();
+    all.push(RenderSettings { raster: Raster::Hardware, ..settings(Technique::Visibility) });
+    let outs = common::render_each(&scene, &all);
+    for (s, out) in all.iter().zip(&outs) {
+        let (mut edges, mut worst) = (0, 0u8);
+        for y in 0..H {
+            for x in 0..W {
+                let got = common::pixel(out, x, y);
+                let w = want[(y * W + x) as usize];
+                let d = (0..3).map(|c| got[c].abs_diff(w[c])).max().unwrap();
+                if d > MAX_DIFF {
+                    assert!(
+                        edge(&scene, x, y),
+                        "{} ({}): pixel ({x}, {y}) is {got:?}, the CPU blend {w:?}",
+                        s.technique.name(),
+                        s.raster.name()
+                    );
+                    edges += 1;
+                } else {
+                    worst = worst.max(d);
+                }
+            }
+        }
+        assert!(edges <= MAX_EDGE_PIXELS, "{}: {edges} edge pixels differ", s.technique.name());
+        let st = stats(out);
+        assert!(!st.overflowed(), "{}: {st:?}", s.technique.name());
+        assert!(st.fragments > (W * H / 2) as u64, "{}: only {} transparent fragments", s.technique.name(), st.fragments);
+        println!(
+            "{} ({}): {edges} edge pixels beyond {MAX_DIFF}/255, others within {worst}/255; {st:?}",
+            s.technique.name(),
+            s.raster.name()
+        );
+    }
+}
+
+#[test]
+fn the_order_the_quads_are_listed_in_changes_nothing() {
+    let orders = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+    for technique in [Technique::Forward, Technique::DeferredCompute, Technique::Visibility] {
+        let outs: Vec<RenderOutput> = orders.iter().map(|&o| common::render(scene(o), settings(technique))).collect();
+        for (o, out) in orders.iter().zip(&outs).skip(1) {
+            assert!(out.rgba == outs[0].rgba, "{}: the order {o:?} gives another image", technique.name());
+        }
+    }
+}
+
+#[test]
+fn a_resized_renderer_draws_the_layers_as_a_fresh_one_does() {
+    // The lists are the build pass's own buffers of each frame slot, made again for the new
+    // size when the viewer resizes.
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a Vulkan device with validation");
+    let counter = ctx.validation_counter();
+    for technique in [Technique::Forward, Technique::Visibility] {
+        let small = RenderSettings { frames: 2, ..settings(technique) };
+        let large = RenderSettings { width: W + 24, height: H + 16, ..small };
+        let mut live = Renderer::new(&ctx, scene([0, 1, 2]), small).expect("renderer");
+        live.render().expect("render");
+        assert!(live.reconfigure(large).expect("resize"), "a new size keeps the passes");
+        let resized = live.render().expect("render after the resize");
+        drop(live);
+        let fresh = Renderer::new(&ctx, scene([0, 1, 2]), large).and_then(|mut r| r.render()).expect("fresh render");
+        assert_eq!((resized.width, resized.height), (W + 24, H + 16));
+        assert!(resized.rgba == fresh.rgba, "{}: the resized renderer's layers differ from a fresh one's", technique.name());
+        assert_eq!(stats(&resized), stats(&fresh), "{}", technique.name());
+    }
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
+}
+
+#[test]
+fn a_budget_below_the_depth_complexity_is_reported() {
+    // 40 faint panes one behind another over a third of the image, listed out of depth order
+    // (each in its own colour and coverage): more layers than a pixel blends exactly —
+    // merged beyond the nearest 32 as the CPU rule merges them — and more fragments than a
+    // budget of one node per pixel holds (dropped).
+    let mut deep = scene([0, 1, 2]);
+    deep.objects.truncate(1);
+    for k in 0..40 {
+        let i = (k * 17) % 40;
+        let c = [0.2 + 0.02 * i as f32, 0.9 - 0.02 * i as f32, 0.3 + 0.3 * (i % 3) as f32];
+        deep.objects.push(quad(Vec3::new(0.0, 0.0, 0.05 + 0.05 * i as f32), (0.8, 0.8), c, Some(0.05 + 0.004 * i as f32)));
+    }
+    let mut s = settings(Technique::DeferredCompute);
+    s.transparency = Some(TransparencySettings { budget: 1 });
+    let st = stats(&common::render(deep.clone(), s));
+    assert!(st.dropped() > 0 && st.overflowed(), "{st:?}");
+    assert_eq!(st.capacity, (W * H) as u64);
+    let mut s = settings(Technique::Visibility);
+    s.transparency = Some(TransparencySettings { budget: 16 });
+    let out = common::render(deep.clone(), s);
+    let st = stats(&out);
+    assert_eq!(st.dropped(), 0, "{st:?}");
+    assert!(st.merged_pixels > 100, "{st:?}");
+    let want = reference(&deep);
+    let mut edges = 0;
+    for y in 0..H {
+        for x in 0..W {
+            let (got, w) = (common::pixel(&out, x, y), want[(y * W + x) as usize]);
+            if diff(got, w) > MAX_DIFF {
+                assert!(edge(&deep, x, y), "pixel ({x}, {y}) is {got:?}, the CPU blend {w:?}");
+                edges += 1;
+            }
+        }
+    }
+    assert!(edges <= MAX_EDGE_PIXELS, "{edges} edge pixels differ");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Foliage
+// ---------------------------------------------------------------------------------------------
+
+const LEAF_TEXELS: u32 = 64;
+
+/// The leaf's alpha at texture coordinate distance `r` from its centre (in texels of a
+/// 64-texel side): a hole to 9, rising to 1 by 13, 1 to 24, fading to 0 by 31.
+fn leaf_alpha(r: f32) -> f32 {
+    ((r - 9.0) / 4.0).clamp(0.0, 1.0) * ((31.0 - r) / 7.0).clamp(0.0, 1.0)
+}
+
+fn leaf_png() -> Vec<u8> {
+    let n = LEAF_TEXELS;
+    let rgba: Vec<u8> = (0..n * n)
+        .flat_map(|i| {
+            let (x, y) = ((i % n) as f32 + 0.5 - n as f32 / 2.0, (i / n) as f32 + 0.5 - n as f32 / 2.0);
+            [255, 255, 255, (leaf_alpha((x * x + y * y).sqrt()) * 255.0).round() as u8]
+        })
+        .collect();
+    png(n, n, &rgba)
+}
+
+/// Leaf i's place: standing, facing the camera (on +Z), turned a little, one behind another.
+fn leaf_at(i: usize) -> (Vec3, Quat) {
+    let at = Vec3::new(-1.6 + 1.1 * i as f32, 1.2 + 0.25 * (i % 2) as f32, 0.6 - 0.5 * i as f32);
+    (at, Quat::from_rotation_y((10.0 * i as f32 - 15.0).to_radians()) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2))
+}
+
+const LEAVES: usize = 4;
+
+/// A lit floor and LEAVES leaves of `mode` ("BLEND", or "OPAQUE" for their colour without
+/// alpha; None: no leaves), loaded from a GLB written here.
+fn foliage(mode: Option<&str>) -> Scene {
+    foliage_of(mode, gltf_quad())
+}
+
+/// The quad as a grid of 12×12 cells (288 triangles, more than the compute build takes: the
+/// hardware raster builds its layers).
+fn fine_quad() -> PrimitiveData {
+    let n = 12u32;
+    let at = |i: u32| i as f32 / n as f32;
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            positions.push([at(i) * 2.0 - 1.0, 0.0, at(j) * 2.0 - 1.0]);
+            uvs.push([at(i), at(j)]);
+        }
+    }
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    let indices = (0..n)
+        .flat_map(|j| (0..n).flat_map(move |i| [v(i, j), v(i, j + 1), v(i + 1, j), v(i + 1, j), v(i, j + 1), v(i + 1, j + 1)]))
+        .collect();
+    PrimitiveData {
+        normals: Some(vec![[0.0, 1.0, 0.0]; positions.len()]),
+        positions,
+        uvs: Some(uvs),
+        indices: Some((indices, ml_cpu::gltf_writer::IndexType::U32)),
+        material: None,
+    }
+}
+
+fn foliage_of(mode: Option<&str>, leaf: PrimitiveData) -> Scene {
+    let mut w = GltfWriter::new();
+    let floor = w.material([0.6, 0.55, 0.5, 1.0], 0.0, 0.8);
+    let floor_mesh = w.mesh(&[PrimitiveData { material: Some(floor), ..gltf_quad() }]);
+    w.node(json!({ "mesh": floor_mesh, "scale": [6.0, 6.0, 6.0] }), true);
+    // A back wall, so that every pixel has an opaque surface or the leaves' colour behind.
+    let upright = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2).to_array();
+    w.node(json!({ "mesh": floor_mesh, "translation": [0.0, 3.0, -3.0], "rotation": upright, "scale": [6.0, 6.0, 6.0] }), true);
+    if let Some(mode) = mode {
+        // The same leaf as two textures: leaves of two texture sets (the compute build
+        // dispatches once per set).
+        let textures = [w.texture(leaf_png(), "image/png"), w.texture(leaf_png(), "image/png")];
+        let colours = [[0.3, 0.8, 0.2, 1.0], [0.5, 0.9, 0.1, 0.9], [0.2, 0.6, 0.3, 1.0], [0.7, 0.8, 0.2, 0.8]];
+        for (i, c) in colours.iter().enumerate().take(LEAVES) {
+            let m = w.alpha_material(Some(textures[i % 2]), *c, mode, None, true);
+            let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..leaf.clone() }]);
+            let (at, rotation) = leaf_at(i);
+            w.node(json!({ "mesh": mesh, "translation": at.to_array(), "rotation": rotation.to_array(), "scale": [0.8, 0.8, 0.8] }), true);
+        }
+    }
+    let (mut scene, _) = ml_cpu::gltf_scene::from_bytes(&w.to_glb(), None).expect("a good file");
+    scene.camera = Camera::looking_at(Vec3::new(0.3, 2.2, 5.0), Vec3::new(0.0, 1.1, 0.0), 45.0, 0.1, 30.0);
+    scene.lights = vec![
+        light([1.0, 2.0, 2.5], 6.0, [4.0, 3.6, 3.2]),
+        light([-2.0, 1.5, 2.0], 5.0, [2.0, 2.4, 4.0]),
+        light([0.5, 0.6, -0.8], 3.0, [4.0, 2.8, 1.6]),
+        light([0.0, 3.0, -2.0], 5.0, [2.4, 2.4, 2.4]),
+    ];
+    scene.cones.clear();
+    scene.light_motion = 0.0;
+    scene
+}
+
+/// Where a world point lands in the image (pixel coordinates).
+fn project(scene: &Scene, p: Vec3) -> (u32, u32) {
+    let clip = scene.camera.projection(W as f32 / H as f32) * scene.camera.view() * Vec4::from((p, 1.0));
+    let ndc = clip.truncate() / clip.w;
+    (((ndc.x + 1.0) * 0.5 * W as f32) as u32, ((ndc.y + 1.0) * 0.5 * H as f32) as u32)
+}
+
+fn diff(a: [u8; 3], b: [u8; 3]) -> u8 {
+    (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap()
+}
+
+#[test]
+fn foliage_shows_the_background_through_its_holes_and_blends_its_soft_edges_alike_in_every_technique() {
+    let scene = foliage(Some("BLEND"));
+    assert!(scene.has_blended_objects());
+    let pbr = |t| RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
+    let mut all: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| pbr(t)).collect();
+    all.push(RenderSettings { raster: Raster::Hardware, ..pbr(Technique::Visibility) });
+    let outs = common::render_each(&scene, &all);
+    let forward = &outs[0];
+    for (s, out) in all.iter().zip(&outs).skip(1) {
+        let edges = common::pixels_beyond(forward, out, 1);
+        assert!(
+            edges <= (W * H / 100) as usize,
+            "{} ({}): {edges} pixels differ from forward by more than 1/255",
+            s.technique.name(),
+            s.raster.name()
+        );
+        println!("{} ({}): {edges} edge pixels beyond 1/255 of forward", s.technique.name(), s.raster.name());
+    }
+    let bare = common::render(foliage(None), pbr(Technique::Forward));
+    let mut opaque = pbr(Technique::Forward);
+    opaque.transparency = None;
+    let opaque = common::render(foliage(Some("OPAQUE")), opaque);
+    // Through each leaf's hole: the scene without leaves.
+    for i in 0..LEAVES {
+        let (x, y) = project(&scene, leaf_at(i).0);
+        for out in &outs {
+            let (got, want) = (common::pixel(out, x, y), common::pixel(&bare, x, y));
+            assert!(diff(got, want) <= 1, "leaf {i}'s hole at ({x}, {y}): {got:?}, without leaves {want:?}");
+        }
+        assert!(diff(common::pixel(&opaque, x, y), common::pixel(&bare, x, y)) > 8, "leaf {i}: the opaque leaf covers its hole");
+    }
+    // The soft bands: between the leafless and the opaque-leaf images, apart from both.
+    let between = (0..H)
+        .flat_map(|y| (0..W).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let (g, b, o) = (common::pixel(forward, x, y), common::pixel(&bare, x, y), common::pixel(&opaque, x, y));
+            diff(g, b) >= 4 && diff(g, o) >= 4 && (0..3).all(|c| g[c].clamp(b[c].min(o[c]), b[c].max(o[c])) == g[c])
+        })
+        .count();
+    assert!(between > 300, "only {between} pixels blend the leaves' soft edges");
+    println!("{between} pixels blend a soft edge");
+}
+
+#[test]
+fn the_layer_view_counts_each_pixels_layers() {
+    let mut s = settings(Technique::Visibility);
+    s.debug_view = DebugView::TransparencyLayers;
+    let scene = scene([0, 1, 2]);
+    let out = common::render(scene.clone(), s);
+    // No layer: black; more layers: hotter colours, never black.
+    for y in (0..H).step_by(7) {
+        for x in (0..W).step_by(7) {
+            let layers = met(&scene, x, y).len() - 1;
+            let got = common::pixel(&out, x, y);
+            if edge(&scene, x, y) {
+                continue;
+            }
+            assert_eq!(got == [0, 0, 0], layers == 0, "({x}, {y}) with {layers} layers shows {got:?}");
+        }
+    }
+}
+
+#[test]
+fn the_compute_build_and_the_hardware_raster_build_agree() {
+    // The leaves as two triangles each (built in compute) and as 288 (built by the hardware
+    // raster): the same image but at edge pixels and where the two pick texture levels apart.
+    let pbr = |t| RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
+    for technique in [Technique::Forward, Technique::Visibility] {
+        let leaves = foliage(Some("BLEND"));
+        assert_eq!(leaves.textures.len(), 2, "leaves of two texture sets");
+        let coarse = common::render(leaves, pbr(technique));
+        let fine = common::render(foliage_of(Some("BLEND"), fine_quad()), pbr(technique));
+        let (a, b) = (stats(&coarse), stats(&fine));
+        assert!(a.fragments.abs_diff(b.fragments) <= a.fragments / 100, "{a:?} against {b:?}");
+        let beyond = common::pixels_beyond(&coarse, &fine, 2);
+        assert!(beyond <= (W * H / 100) as usize, "{}: {beyond} pixels differ by more than 2/255", technique.name());
+        println!("{}: {beyond} pixels beyond 2/255; fragments {} and {}", technique.name(), a.fragments, b.fragments);
+    }
+}
