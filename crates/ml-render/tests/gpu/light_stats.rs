@@ -5,7 +5,6 @@
 //! equal a CPU count over every light at each pixel's point on the wall — in both compute-lit techniques (and the visibility technique's two rasters),
 //! with validation on.
 
-
 use glam::{Mat4, Quat, Vec3};
 use ml_cpu::camera::Camera;
 use ml_cpu::gpu_types::PointLight;
