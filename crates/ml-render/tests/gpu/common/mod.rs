@@ -22,6 +22,11 @@ pub fn render(scene: Scene, settings: RenderSettings) -> RenderOutput {
 
 /// Render the scene once per settings on one validated context; no validation message allowed.
 pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutput> {
+    render_each_on_driver(scene, settings).0
+}
+
+/// `render_each`, and the name of the driver that rendered (Vulkan's `driverName`).
+pub fn render_each_on_driver(scene: &Scene, settings: &[RenderSettings]) -> (Vec<RenderOutput>, String) {
     let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() })
         .expect("a Vulkan device with the validation layer (CI installs lavapipe and vulkan-validationlayers)");
     let counter = ctx.validation_counter();
@@ -32,9 +37,10 @@ pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutp
             renderer.render().expect("render")
         })
         .collect();
+    let driver = ctx.info.driver_name.clone();
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
-    outputs
+    (outputs, driver)
 }
 
 /// Largest per-channel difference between two images of the same size, and how many
