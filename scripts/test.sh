@@ -12,5 +12,5 @@ bash scripts/lint.sh
 cargo test --workspace --locked "$@"
 if [ $# -eq 0 ]; then
   echo "test: again with LP_NATIVE_VECTOR_WIDTH=128 (golden images, CPU reference)" >&2
-  LP_NATIVE_VECTOR_WIDTH=128 cargo test --locked -p ml-render --test gpu -- golden:: reference::
+  LP_NATIVE_VECTOR_WIDTH=128 cargo test --workspace --locked --test gpu -- golden:: reference::
 fi

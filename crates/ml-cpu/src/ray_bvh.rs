@@ -429,6 +429,8 @@ pub struct WorldTriangles<'a> {
     triangles: Vec<[Vec3; 3]>,
     /// Per triangle: its object and its corners' texture coordinates.
     sources: Vec<(u32, [Vec2; 3])>,
+    /// Per triangle: its box (min, max) and the length of its two edges from v0, added.
+    boxes: Vec<(Vec3, Vec3, f32)>,
 }
 
 /// Where a segment `o + t·d` meets a triangle's plane: the barycentric weights of v1 and v2,
@@ -460,7 +462,26 @@ impl<'a> WorldTriangles<'a> {
                 sources.push((k as u32, [uv(t[0]), uv(t[1]), uv(t[2])]));
             }
         }
-        WorldTriangles { scene, triangles, sources }
+        let boxes = triangles
+            .iter()
+            .map(|&[v0, e1, e2]| {
+                let (a, b) = (v0 + e1, v0 + e2);
+                (v0.min(a).min(b), v0.max(a).max(b), e1.length() + e2.length())
+            })
+            .collect();
+        WorldTriangles { scene, triangles, sources, boxes }
+    }
+
+    /// Whether triangle `i` lies clear of the segment's box: no point of the segment (or of
+    /// its line within `dist` beyond its ends) comes within `bary` (barycentric units) of the
+    /// triangle, nor within `dist` of its plane's part near it — the cheap test that lets every
+    /// test below skip most triangles. Conservative: the margins are widened by the triangle's
+    /// size and a relative hair for rounding.
+    fn clear_of(&self, i: usize, (lo, hi): (Vec3, Vec3), bary: f32, dist: f32) -> bool {
+        let (min, max, span) = self.boxes[i];
+        let hair = 1e-5 * max.abs().max(min.abs()).max(hi.abs()).max(lo.abs()).max_element();
+        let margin = dist + 2.0 * bary * span + hair;
+        (lo - margin).cmpgt(max).any() || (hi + margin).cmplt(min).any()
     }
 
     /// Whether triangle `i`'s point at barycentric weights (u, v) of its second and third
@@ -475,8 +496,11 @@ impl<'a> WorldTriangles<'a> {
     /// them where it is there.
     pub fn occluded(&self, origin: Vec3, target: Vec3) -> bool {
         let d = target - origin;
+        let segment = (origin.min(target), origin.max(target));
         self.triangles.iter().enumerate().any(|(i, &[v0, e1, e2])| {
-            segment_crosses(origin, d, v0, e1, e2) && crossing(origin, d, [v0, e1, e2], 0.0).is_some_and(|(u, v, _)| self.kept(i, u, v))
+            !self.clear_of(i, segment, 0.0, 0.0)
+                && segment_crosses(origin, d, v0, e1, e2)
+                && crossing(origin, d, [v0, e1, e2], 0.0).is_some_and(|(u, v, _)| self.kept(i, u, v))
         })
     }
 
@@ -500,10 +524,15 @@ impl<'a> WorldTriangles<'a> {
     /// `dist` (world units) before or after its ends; one it crosses, it crosses by both, and
     /// where its object is masked, the alpha there is more than 1/64 from the cutoff. (The
     /// tests leave segments within a hair of an edge, an end or a mask's edge out.)
+    /// A triangle clear of the segment's box by those margins is missed, surely.
     pub fn sure(&self, origin: Vec3, target: Vec3, bary: f32, dist: f32) -> bool {
         let d = target - origin;
         let length = d.length();
+        let segment = (origin.min(target), origin.max(target));
         self.triangles.iter().enumerate().all(|(i, &tri)| {
+            if self.clear_of(i, segment, bary, dist) {
+                return true;
+            }
             let Some((u, v, t)) = crossing(origin, d, tri, 1e-20) else {
                 // Edge-on: the segment lies in the triangle's plane or parallel to it.
                 let n = tri[1].cross(tri[2]).normalize_or_zero();

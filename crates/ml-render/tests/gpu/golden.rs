@@ -207,7 +207,9 @@ fn every_technique_renders_the_golden_images() {
         let (outputs, driver) = common::render_each_on_driver(&case.scene, &settings);
         if !bless && !golden_dir(&driver).is_dir() {
             assert_ne!(golden_dir(&driver), golden_dir(CI_DRIVER), "the CI driver's golden images are missing");
-            println!("no golden images for driver '{driver}' (sets: tests/golden/*): nothing compared; bless a set with MANYLIGHTS_BLESS=1");
+            println!(
+                "no golden images for driver '{driver}' (sets: tests/golden/*): nothing compared; bless a set with MANYLIGHTS_BLESS=1"
+            );
             return;
         }
         for (t, out) in case.techniques.iter().zip(&outputs) {
