@@ -429,7 +429,8 @@ pub struct WorldTriangles<'a> {
     triangles: Vec<[Vec3; 3]>,
     /// Per triangle: its object and its corners' texture coordinates.
     sources: Vec<(u32, [Vec2; 3])>,
-    /// Per triangle: its box (min, max) and the length of its two edges from v0, added.
+    /// Per triangle: its box (min, max), widened by a relative hair for rounding, and the
+    /// length of its two edges from v0, added.
     boxes: Vec<(Vec3, Vec3, f32)>,
 }
 
@@ -466,7 +467,9 @@ impl<'a> WorldTriangles<'a> {
             .iter()
             .map(|&[v0, e1, e2]| {
                 let (a, b) = (v0 + e1, v0 + e2);
-                (v0.min(a).min(b), v0.max(a).max(b), e1.length() + e2.length())
+                let (min, max) = (v0.min(a).min(b), v0.max(a).max(b));
+                let hair = 1e-5 * min.abs().max(max.abs()).max_element();
+                (min - hair, max + hair, e1.length() + e2.length())
             })
             .collect();
         WorldTriangles { scene, triangles, sources, boxes }
@@ -475,13 +478,20 @@ impl<'a> WorldTriangles<'a> {
     /// Whether triangle `i` lies clear of the segment's box: no point of the segment (or of
     /// its line within `dist` beyond its ends) comes within `bary` (barycentric units) of the
     /// triangle, nor within `dist` of its plane's part near it — the cheap test that lets every
-    /// test below skip most triangles. Conservative: the margins are widened by the triangle's
-    /// size and a relative hair for rounding.
+    /// test below skip most triangles. Conservative: the margins grow with the triangle's size,
+    /// and both boxes are widened by a relative hair for rounding.
+    #[inline]
     fn clear_of(&self, i: usize, (lo, hi): (Vec3, Vec3), bary: f32, dist: f32) -> bool {
         let (min, max, span) = self.boxes[i];
-        let hair = 1e-5 * max.abs().max(min.abs()).max(hi.abs()).max(lo.abs()).max_element();
-        let margin = dist + 2.0 * bary * span + hair;
+        let margin = dist + 2.0 * bary * span;
         (lo - margin).cmpgt(max).any() || (hi + margin).cmplt(min).any()
+    }
+
+    /// A segment's box, widened by a relative hair for rounding.
+    fn segment_box(origin: Vec3, target: Vec3) -> (Vec3, Vec3) {
+        let (lo, hi) = (origin.min(target), origin.max(target));
+        let hair = 1e-5 * lo.abs().max(hi.abs()).max_element();
+        (lo - hair, hi + hair)
     }
 
     /// Whether triangle `i`'s point at barycentric weights (u, v) of its second and third
@@ -496,7 +506,7 @@ impl<'a> WorldTriangles<'a> {
     /// them where it is there.
     pub fn occluded(&self, origin: Vec3, target: Vec3) -> bool {
         let d = target - origin;
-        let segment = (origin.min(target), origin.max(target));
+        let segment = Self::segment_box(origin, target);
         self.triangles.iter().enumerate().any(|(i, &[v0, e1, e2])| {
             !self.clear_of(i, segment, 0.0, 0.0)
                 && segment_crosses(origin, d, v0, e1, e2)
@@ -528,7 +538,7 @@ impl<'a> WorldTriangles<'a> {
     pub fn sure(&self, origin: Vec3, target: Vec3, bary: f32, dist: f32) -> bool {
         let d = target - origin;
         let length = d.length();
-        let segment = (origin.min(target), origin.max(target));
+        let segment = Self::segment_box(origin, target);
         self.triangles.iter().enumerate().all(|(i, &tri)| {
             if self.clear_of(i, segment, bary, dist) {
                 return true;
