@@ -10,13 +10,13 @@
 //!
 //! A committed image was made on one machine, and the same driver rounds differently on
 //! another: lavapipe's shaders follow the CPU's vector width and instruction set, so a few
-//! pixels land a step apart (measured: up to 8 pixels by 1/255 between two CPUs, 256 and
-//! 128 bits). The comparison therefore allows a few pixels a step or two apart
-//! ([`GOLDEN_TOLERANCE`]) and prints what it found; a real change moves pixels further or
-//! moves many. Drivers differ by more than that, hence a set each ([`golden_dir`]); on a
-//! driver without a set the test says so and compares nothing. Comparisons of two images from one run on one machine
-//! (technique against technique, culling on against off) stay exact where they were: they
-//! live in the other tests.
+//! pixels land a step apart (measured: 8 pixels of one image by 1/255 between two AVX-512
+//! machines; none between 256 and 128 bits on one). The comparison therefore allows a few
+//! pixels a step or two apart ([`GOLDEN_TOLERANCE`]) and prints what it found; a real change
+//! moves pixels further or moves many. Drivers differ by more than that, hence a set each
+//! ([`golden_dir`]); on a driver without a set the test says so and compares nothing.
+//! Comparisons of two images from one run on one machine (technique against technique,
+//! culling on against off) stay exact where they were: they live in the other tests.
 
 use crate::common;
 
