@@ -9,8 +9,8 @@
 //! vertices past the end of that allocation, and the process dies in JIT-compiled code
 //! (a mesh of a few hundred vertices through the classic vertex pipeline is enough: the seed
 //! scene's teapot, every fragment technique). With its own cache folder per width the driver
-//! never sees code compiled for another width. On a CPU without AVX, where 128 bits is the only
-//! width, nothing changes.
+//! never sees code compiled for another width. On a CPU without AVX every run is at 128 bits
+//! anyway, and the split costs at most one more cold cache.
 
 use std::path::PathBuf;
 use std::sync::Once;
@@ -29,7 +29,7 @@ pub fn shader_cache_folder(var: impl Fn(&str) -> Option<String>) -> Option<PathB
     if off {
         return None;
     }
-    // The width as a name: digits only (the driver reads it as a number).
+    // The width as part of a folder name: letters and digits only, no path separators.
     let width: String = width.chars().filter(char::is_ascii_alphanumeric).collect();
     let nonempty = |v: Option<String>| v.filter(|v| !v.is_empty()).map(PathBuf::from);
     let name = format!("lp-vector-width-{width}");
