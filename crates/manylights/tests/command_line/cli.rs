@@ -695,11 +695,7 @@ fn the_teapot_renders_at_either_vector_width_from_one_shader_cache() {
             assert!(out.status.success(), "{technique} at {width} bits: {:?}\n{}", out.status, say(&out));
             image::open(&png).expect("a PNG").to_rgba8().into_raw()
         });
-        let pixels = images[0].chunks_exact(4).zip(images[1].chunks_exact(4));
-        let (worst, moved) = pixels.fold((0, 0), |(worst, moved), (a, b)| {
-            let d = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
-            (d.max(worst), moved + usize::from(d > 0))
-        });
+        let (worst, moved) = common::rgba_difference(&images[0], &images[1]);
         println!("{technique}: 256 against 128 bits: {moved} pixels differ, by up to {worst}/255");
         assert!(worst <= 2 && moved <= 96 * 64 / 100, "{technique}: {moved} pixels differ, by up to {worst}/255");
     }

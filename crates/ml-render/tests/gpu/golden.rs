@@ -53,17 +53,6 @@ struct Difference {
     pixels: usize,
 }
 
-fn difference(a: &[u8], b: &[u8]) -> Difference {
-    assert_eq!(a.len(), b.len(), "images of one size");
-    let (mut worst, mut pixels) = (0u8, 0usize);
-    for (pa, pb) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
-        let d = pa.iter().zip(pb).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
-        worst = worst.max(d);
-        pixels += usize::from(d > 0);
-    }
-    Difference { worst, pixels }
-}
-
 /// The images of one driver (Vulkan's driver name, lower case: `llvmpipe` is Mesa's lavapipe,
 /// what CI runs; `nvidia`), each set blessed on its driver. Drivers differ by more than
 /// rounding — on the H200, sharp pbr highlights by up to 47/255 and minified textures (another
@@ -166,7 +155,8 @@ fn compare_with_file(name: &str, path: &std::path::Path, (width, height, rgba): 
     if (golden.width(), golden.height()) != (width, height) {
         return Err(format!("{name}: golden image is {}x{}, render {width}x{height}", golden.width(), golden.height()));
     }
-    let d = difference(golden.as_raw(), rgba);
+    let (worst, pixels) = common::rgba_difference(golden.as_raw(), rgba);
+    let d = Difference { worst, pixels };
     let Tolerance { max_step, max_pixels } = GOLDEN_TOLERANCE;
     if d.worst > max_step || d.pixels > max_pixels {
         return Err(format!(

@@ -30,3 +30,13 @@ pub fn assert_one_line_error(out: &Output, needles: &[&str]) {
         assert!(lines[0].contains(n), "'{n}' missing from: {stderr}");
     }
 }
+
+/// Largest per-channel difference between two RGBA byte arrays of one size, and how many
+/// pixels differ at all.
+pub fn rgba_difference(a: &[u8], b: &[u8]) -> (u8, usize) {
+    assert_eq!(a.len(), b.len(), "images of one size");
+    a.chunks_exact(4).zip(b.chunks_exact(4)).fold((0, 0), |(worst, pixels), (pa, pb)| {
+        let d = pa.iter().zip(pb).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
+        (d.max(worst), pixels + usize::from(d > 0))
+    })
+}

@@ -47,9 +47,15 @@ pub fn render_each_on_driver(scene: &Scene, settings: &[RenderSettings]) -> (Vec
 /// pixels differ at all.
 pub fn max_difference(a: &RenderOutput, b: &RenderOutput) -> (u8, usize) {
     assert_eq!((a.width, a.height), (b.width, b.height));
+    rgba_difference(&a.rgba, &b.rgba)
+}
+
+/// `max_difference` of two RGBA byte arrays of one size.
+pub fn rgba_difference(a: &[u8], b: &[u8]) -> (u8, usize) {
+    assert_eq!(a.len(), b.len(), "images of one size");
     let mut worst = 0;
     let mut pixels = 0;
-    for (pa, pb) in a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)) {
+    for (pa, pb) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
         let d = pa.iter().zip(pb).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
         worst = worst.max(d);
         pixels += (d > 0) as usize;
