@@ -35,6 +35,7 @@
 #define DEBUG_VIEW_ALPHA 11u
 #define DEBUG_VIEW_TRANSPARENCY_LAYERS 12u
 #define DEBUG_VIEW_RAY_COST 13u
+#define DEBUG_VIEW_AA 14u
 
 // Per frame, one buffer per frame in flight (set 0, binding 0; read-only storage).
 struct FrameUniforms {

@@ -8,9 +8,15 @@
 // The opaque depth: the raster's depth image, or (OPAQUE_DEPTH_BUFFER) the compute raster's
 // 64-bit buffer (depth in the high word). 1 where nothing was drawn.
 #ifdef OPAQUE_DEPTH_BUFFER
+#include "visibility/visibility_samples.glsl"
 layout(std430, set = 0, binding = 13) readonly buffer VisibilityDepthBuffer { uvec2 visibility_depth[]; };
+// Sample k of pixel p as the compute raster left it (visibility_samples.glsl).
+uvec2 opaque_sample(ivec2 p, uint k) {
+    return visibility_depth[sample_slot(p, k, frame.viewport.x)];
+}
+// With anti-aliasing, the first sample's.
 float opaque_depth_at(ivec2 p) {
-    return visibility_buffer_depth(visibility_depth[uint(p.y) * frame.viewport.x + uint(p.x)]);
+    return visibility_buffer_depth(opaque_sample(p, 0u));
 }
 #else
 layout(set = 0, binding = 12) uniform sampler2D opaque_depth;

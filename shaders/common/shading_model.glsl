@@ -32,4 +32,15 @@ vec3 encode_output(vec3 linear, float exposure) {
     return encode_gamma(linear);
 }
 
+// What encode_output shows before its gamma curve, clipped to what the target holds: the
+// display's linear light, in which anti-aliasing averages a pixel's surfaces (so that an edge
+// against a light far brighter than white stays smooth once clipped or tone-mapped).
+vec3 display_linear(vec3 linear, float exposure) {
+    linear *= exposure;
+    if (MODEL_PBR) {
+        linear = aces_tone_map(linear);
+    }
+    return clamp(linear, 0.0, 1.0);
+}
+
 #endif

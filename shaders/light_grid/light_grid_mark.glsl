@@ -35,7 +35,54 @@ void mark_box_run(uint u0, uint u1) {
     }
 }
 
+#ifdef OPAQUE_DEPTH_BUFFER
+// Anti-aliased: every surface of the pixel marks the walks of the box around its samples'
+// points. The lighting shades it at a point between them (visibility_samples.glsl
+// shading_xy): on the surface, inside their hull, so inside the box, and every cell its walk
+// visits is marked. Edge pixels have several surfaces, so the points do not share the work
+// group's box: each marks the grid itself.
+void mark_samples(ivec2 p) {
+    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
+        return;
+    }
+    uvec2 v[VISIBILITY_SAMPLES];
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        v[k] = opaque_sample(p, k);
+    }
+    uint grouped = 0u;
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        if ((grouped & (1u << k)) != 0u || visibility_buffer_depth(v[k]) >= 1.0) {
+            continue;
+        }
+        uint id = visibility_buffer_id(v[k]), members = 0u;
+        for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
+            if (visibility_buffer_depth(v[j]) < 1.0 && visibility_buffer_id(v[j]) == id) {
+                members |= 1u << j;
+            }
+        }
+        grouped |= members;
+        vec3 lo = vec3(1e30), hi = vec3(-1e30);
+        for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
+            if ((members & (1u << j)) != 0u) {
+                vec3 world = world_from_depth(sample_xy(p, j), visibility_buffer_depth(v[j]));
+                lo = min(lo, world);
+                hi = max(hi, world);
+            }
+        }
+        mark_rows(mark_walk_of_box(lo, hi));
+    }
+}
+#endif
+
 void main() {
+#ifdef OPAQUE_DEPTH_BUFFER
+    // The same for the whole dispatch (a constant): no barrier below is skipped by part of a
+    // work group.
+    if (VISIBILITY_SAMPLES != 1u) {
+        mark_samples(ivec2(gl_GlobalInvocationID.xy));
+        return;
+    }
+#endif
     uint t = gl_LocalInvocationIndex;
     if (t < 3u) {
         box_lo[t] = 0xffffffffu;

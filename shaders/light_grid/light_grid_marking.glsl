@@ -51,6 +51,15 @@ GridWalk mark_walk_of(vec3 world) {
     return grid_walk_wider(world, mark_margin(world));
 }
 
+// The walks a mark covers for every point in the box [lo, hi]: the walk's cells grow with
+// the point, so the box's corners bound them.
+GridWalk mark_walk_of_box(vec3 lo, vec3 hi) {
+    float margin = mark_margin(max(abs(lo), abs(hi)));
+    GridWalk w = grid_walk_wider(lo, margin);
+    w.hi = grid_walk_wider(hi, margin).hi;
+    return w;
+}
+
 // Mark every cell the walk of a point at `world` visits.
 void mark_walk(vec3 world) {
     mark_rows(mark_walk_of(world));

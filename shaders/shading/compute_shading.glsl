@@ -12,7 +12,7 @@
 
 // With COUNT_RAYS (`--light-stats` with rays): the shadow rays the frame traced from its opaque
 // surfaces (x; the frame slot's, zeroed by the host before the frame), each subgroup adding
-// its own. Counting costs the 1k bench scene's lighting 3 % on the H100, so it is off unless
+// its own. With anti-aliasing, y: the surfaces the visibility lighting shaded. Counting costs the 1k bench scene's lighting 3 % on the H100, so it is off unless
 // asked for.
 layout(constant_id = 23) const bool COUNT_RAYS = false;
 layout(std430, set = 0, binding = 46) buffer RayCountBuffer { uvec4 ray_count; };
@@ -20,7 +20,9 @@ layout(std430, set = 0, binding = 46) buffer RayCountBuffer { uvec4 ray_count; }
 #ifdef LINEAR_OUTPUT
 layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D out_image;
 #else
-layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
+// Read too by the anti-aliased visibility lighting: a pixel whose surfaces' textures are bound
+// by several dispatches gets each one's share added to what the one before stored.
+layout(set = 0, binding = 8, rgba8) uniform image2D out_image;
 #endif
 
 // `object_flags`: the object's OBJECT_* bits (the alpha debug view).
@@ -42,6 +44,23 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m,
 #else
     imageStore(out_image, p, vec4(encode_output(color, frame.exposure.x), 1.0));
 #endif
+}
+
+// A surface point shaded — or shown by a surface debug view — as display-linear colour
+// (display_linear), for the anti-aliased resolve to weigh by the samples the surface covers.
+vec3 shade_display(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags) {
+    vec3 color;
+    if (debug_surface(world, n, m.albedo, m.roughness, m.metallic, object_flags, frag_xy, color)) {
+        return clamp(color, 0.0, 1.0);
+    }
+    color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+    if (COUNT_RAYS) {
+        uint traced = subgroupAdd(rays_traced);
+        if (subgroupElect() && traced != 0u) {
+            atomicAdd(ray_count.x, traced);
+        }
+    }
+    return display_linear(color, frame.exposure.x);
 }
 
 // A pixel no opaque surface covers.

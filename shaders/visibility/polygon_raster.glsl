@@ -141,15 +141,17 @@ bool fan_covers(FanTriangle t, ivec2 pixel, out i64vec3 w) {
     return all(greaterThanEqual(w - i64vec3(t.bias), i64vec3(0)));
 }
 
-// Whether edge s → e (bias: the fill rule's) may cover a pixel centre of the rectangle
-// [lo, hi]: its edge function is not negative at the corner where it is largest.
+// Whether edge s → e (bias: the fill rule's) may cover a sample point (raster_rules.glsl
+// RASTER_SAMPLE_LO/HI) of the rectangle [lo, hi]: its edge function is not negative at the
+// point where it is largest.
 bool edge_reaches(i64vec2 s, i64vec2 e, int bias, ivec2 lo, ivec2 hi) {
     i64vec2 d = e - s;
     ivec2 corner = ivec2(d.y < 0l ? hi.x : lo.x, d.x > 0l ? hi.y : lo.y);
-    return edge_function64(s, e, i64vec2(corner * 256 + 128)) - int64_t(bias) >= 0l;
+    ivec2 inside = ivec2(d.y < 0l ? RASTER_SAMPLE_HI.x : RASTER_SAMPLE_LO.x, d.x > 0l ? RASTER_SAMPLE_HI.y : RASTER_SAMPLE_LO.y);
+    return edge_function64(s, e, i64vec2(corner * 256 + inside)) - int64_t(bias) >= 0l;
 }
 
-// Whether any pixel centre of the rectangle [lo, hi] may be covered (no edge rules it out).
+// Whether any sample point of the rectangle [lo, hi] may be covered (no edge rules it out).
 bool fan_reaches(FanTriangle t, ivec2 lo, ivec2 hi) {
     return edge_reaches(t.b, t.c, t.bias.x, lo, hi) && edge_reaches(t.c, t.a, t.bias.y, lo, hi) && edge_reaches(t.a, t.b, t.bias.z, lo, hi);
 }

@@ -30,11 +30,19 @@ int fill_bias(ivec2 s, ivec2 e) {
     return d.y < 0 || (d.y == 0 && d.x > 0) ? 0 : 1;
 }
 
-// The pixel centres (256 i + 128 in sub-pixel units) inside the box [lo, hi] of sub-pixel
-// corners, within an image of `size` pixels (>> rounds towards −∞): first > last where none.
+// Where a pixel's sample points lie, in sub-pixel units from its corner: the pixel centre
+// (128) unless the includer samples more points a pixel (visibility_samples.glsl).
+#ifndef RASTER_SAMPLE_LO
+#define RASTER_SAMPLE_LO ivec2(128)
+#define RASTER_SAMPLE_HI ivec2(128)
+#endif
+
+// The pixels with a sample point (the centre: 256 i + 128 in sub-pixel units) inside the box
+// [lo, hi] of sub-pixel corners, within an image of `size` pixels (>> rounds towards −∞):
+// first > last where none.
 void centres_in_box(ivec2 lo, ivec2 hi, ivec2 size, out ivec2 first, out ivec2 last) {
-    first = max((lo - 128 + 255) >> 8, ivec2(0));
-    last = min((hi - 128) >> 8, size - 1);
+    first = max((lo - RASTER_SAMPLE_HI + 255) >> 8, ivec2(0));
+    last = min((hi - RASTER_SAMPLE_LO) >> 8, size - 1);
 }
 
 // A small triangle (box at most 64 pixels a side) set up for its pixels: corners snapped and
@@ -77,12 +85,17 @@ bool small_triangle(vec2 pa, vec2 pb, vec2 pc, ivec2 size, bool both_faces, out 
     return true;
 }
 
-// Whether the triangle covers `pixel`'s centre; `w`: the edge functions there, the weights
-// of corners a, b, c (summing to t.area).
-bool small_covers(SmallTriangle t, ivec2 pixel, out ivec3 w) {
-    ivec2 p = pixel * 256 + 128 - t.lo;
+// Whether the triangle covers the point `offset` sub-pixels from `pixel`'s corner; `w`: the
+// edge functions there, the weights of corners a, b, c (summing to t.area).
+bool small_covers_at(SmallTriangle t, ivec2 pixel, ivec2 offset, out ivec3 w) {
+    ivec2 p = pixel * 256 + offset - t.lo;
     w = ivec3(edge_function(t.b, t.c, p), edge_function(t.c, t.a, p), edge_function(t.a, t.b, p));
     return all(greaterThanEqual(w - t.bias, ivec3(0)));
+}
+
+// Whether the triangle covers `pixel`'s centre (small_covers_at).
+bool small_covers(SmallTriangle t, ivec2 pixel, out ivec3 w) {
+    return small_covers_at(t, pixel, ivec2(128), w);
 }
 
 #endif

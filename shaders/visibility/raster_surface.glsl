@@ -1,7 +1,7 @@
 // The surface tests of the compute rasters (triangle_raster.comp, triangle_raster_large.comp,
 // omni_raster.glsl): a double-sided object's triangles are drawn whichever way they face, and
-// a masked object's pixel is drawn only where its alpha mask keeps the point the pixel centre
-// sees (alpha_mask.glsl). That point comes from the triangle's clip-space corners, not from the
+// a masked object's pixel (or sample) is drawn only where its alpha mask keeps the point the
+// pixel centre (or sample) sees (alpha_mask.glsl). That point comes from the triangle's clip-space corners, not from the
 // snapped edge functions, so a triangle clipped into a polygon, or crossing the eye's plane,
 // finds the same point. Opaque triangles skip all of it.
 // Needs common.glsl and alpha_mask.glsl.
@@ -37,15 +37,20 @@ vec3 clip_barycentrics(vec4 a, vec4 b, vec4 c, vec2 ndc) {
     return l / (l.x + l.y + l.z);
 }
 
-// Whether the centre of `pixel` (in an image of `size` pixels) is drawn.
-bool surface_kept(SurfaceTest s, ivec2 pixel, vec2 size) {
+// Whether the point `xy` (in pixels, of an image of `size` pixels) is drawn.
+bool surface_kept_at(SurfaceTest s, vec2 xy, vec2 size) {
     // (Not `!MASK_TESTS || …`: the reflection cannot evaluate a negated constant.)
     if (MASK_TESTS && s.masked) {
-        vec2 ndc = (vec2(pixel) + 0.5) / size * 2.0 - 1.0;
+        vec2 ndc = xy / size * 2.0 - 1.0;
         vec3 l = clip_barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
         return alpha_kept(s.alpha, s.alpha_texture, l.x * s.uv[0] + l.y * s.uv[1] + l.z * s.uv[2]);
     }
     return true;
+}
+
+// Whether the centre of `pixel` (in an image of `size` pixels) is drawn.
+bool surface_kept(SurfaceTest s, ivec2 pixel, vec2 size) {
+    return surface_kept_at(s, vec2(pixel) + 0.5, size);
 }
 
 // The test of a masked object's triangle: the object's ObjectData `alpha` and

@@ -19,7 +19,15 @@ shared vec4 clip[64];
 shared uint kept[4]; // a bit per triangle
 shared uint group_first;
 
-// Whether the triangle may cover a pixel centre; back faces count where `both_faces` (a
+// The points a pixel samples: its centre, or (the includer included visibility_samples.glsl
+// first) the compute raster's samples.
+#ifdef MANYLIGHTS_VISIBILITY_SAMPLES_GLSL
+#define CULL_SAMPLES VISIBILITY_SAMPLES
+#else
+#define CULL_SAMPLES 1u
+#endif
+
+// Whether the triangle may cover a pixel centre (or sample); back faces count where `both_faces` (a
 // double-sided object's).
 bool triangle_visible(vec4 a, vec4 b, vec4 c, bool both_faces) {
     if (a.z < 0.0 && b.z < 0.0 && c.z < 0.0) {
@@ -48,15 +56,20 @@ bool triangle_visible(vec4 a, vec4 b, vec4 c, bool both_faces) {
     if (area > (edges.x + edges.y + edges.z) * EDGE_ON) {
         return false;
     }
-    // The pixel centres (i + 0.5) inside the bounding box, within the image.
-    vec2 first = max(ceil(min(pa, min(pb, pc)) - SNAP - 0.5), vec2(0.0));
-    vec2 last = min(floor(max(pa, max(pb, pc)) + SNAP - 0.5), size - 1.0);
+    // The pixel centres (i + 0.5) inside the bounding box, within the image — with several
+    // samples a pixel (the compute raster's anti-aliasing), the pixels the box reaches.
+    float centre = 0.5;
+    if (CULL_SAMPLES != 1u) {
+        centre = 0.0;
+    }
+    vec2 first = max(ceil(min(pa, min(pb, pc)) - SNAP - centre) - (1.0 - 2.0 * centre), vec2(0.0));
+    vec2 last = min(floor(max(pa, max(pb, pc)) + SNAP - centre), size - 1.0);
     if (any(greaterThan(first, last))) {
         return false;
     }
     // A small front face (at most 2×2 centres in its box): does it hold one of them? A
     // centre is outside where it lies beyond an edge by more than the margin.
-    if (area >= 0.0 || any(greaterThan(last - first, vec2(1.0)))) {
+    if (area >= 0.0 || any(greaterThan(last - first, vec2(1.0))) || centre == 0.0) {
         return true;
     }
     for (float y = first.y; y <= last.y; y += 1.0) {

@@ -21,6 +21,7 @@ layout(local_size_x = 64) in;
 
 #include "visibility/meshlet_cull.glsl"
 #include "visibility/meshlet_geometry.glsl"
+#include "visibility/visibility_samples.glsl"
 #include "visibility/triangle_cull.glsl"
 
 // Per pixel, row by row: floatBitsToUint(depth) << 32 | visibility id, the nearest kept; all
@@ -77,8 +78,8 @@ uint route_triangle(vec4 a, vec4 b, vec4 c, out vec2 pa, out vec2 pb, out vec2 p
 }
 
 // Draws the triangle — its corners in pixels, their depths z/w — with visibility id `id`,
-// both faces where `both_faces` (else the front alone, as the pipeline culls back faces);
-// returns the pixels covered. Every pixel it covers is kept: masked triangles are drawn by
+// both faces where `both_faces` (else the front alone, as the pipeline culls back faces),
+// into every sample it covers; returns the samples covered. Every pixel it covers is kept: masked triangles are drawn by
 // draw_masked_meshlet.
 uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces) {
     SmallTriangle t;
@@ -92,12 +93,14 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces) {
     uint covered = 0u;
     for (int y = t.first.y; y <= t.last.y; y++) {
         for (int x = t.first.x; x <= t.last.x; x++) {
-            ivec3 w;
-            if (!small_covers(t, ivec2(x, y), w)) {
-                continue;
+            for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+                ivec3 w;
+                if (!small_covers_at(t, ivec2(x, y), sample_offset(k), w)) {
+                    continue;
+                }
+                covered++;
+                keep_nearest_id(ivec2(x, y), k, dot(vec3(w), z) / float(t.area), id);
             }
-            covered++;
-            keep_nearest_id(ivec2(x, y), dot(vec3(w), z) / float(t.area), id);
         }
     }
     return covered;
@@ -105,7 +108,7 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces) {
 
 // A large triangle (or one crossing the near plane), clipped, into the list of large
 // triangles and listed by the bins of its polygon's box; where the lists cannot hold it,
-// drawn by this thread. Returns the pixels it covered here.
+// drawn by this thread. Returns the samples it covered here.
 uint list_large(vec4 a, vec4 b, vec4 c, uint id, uint flags, uint object, SurfaceTest s) {
     Polygon p = visibility_polygon(a, b, c);
     if (p.count == 0) {
@@ -193,8 +196,9 @@ uint set_up_masked(uint lid, vec2 pa, vec2 pb, vec2 pc, vec3 z, bool both_faces,
     }
     ivec2 size = t.last - t.first + 1;
     // Corners relative to the first pixel's centre (edge functions do not change when the
-    // origin moves): a box is at most 65 pixels a side, so 16 signed bits hold each
-    // coordinate, and a pixel's coverage needs one read of shared memory.
+    // origin moves): a box is at most 66 pixels a side (65, and a pixel more for samples off
+    // the centre), so 16 signed bits hold each coordinate, and a pixel's coverage needs one
+    // read of shared memory.
     ivec2 origin = t.first * 256 + 128 - t.lo;
     ivec2 a = t.a - origin, b = t.b - origin, c = t.c - origin;
     int bias = t.bias.x | (t.bias.y << 1) | (t.bias.z << 2);
@@ -212,51 +216,76 @@ uint set_up_masked(uint lid, vec2 pa, vec2 pb, vec2 pc, vec3 z, bool both_faces,
 const uint MASK_FILTER_CAPACITY = 256u;
 shared uint mask_filter[MASK_FILTER_CAPACITY];
 shared uint mask_filtered;
-const uint MASK_PIXEL_FILTER = 2u;
+const uint MASK_PIXEL_FILTER = 0xffffffffu;
 
 // A corner as set_up_masked packs it: x in the low 16 bits, y in the high, both signed.
 ivec2 unpack_corner(int packed) {
     return ivec2((packed << 16) >> 16, packed >> 16);
 }
 
-// Pixel `n` of triangle i's box (n from 0): whether the triangle covers it, `cell` its place
-// from the box's first pixel and `w` the edge functions there.
-bool masked_covers(uint i, uint n, out ivec2 cell, out ivec3 w) {
-    ivec4 edges = mask_edges[i];
-    int width = edges.w & 0xffff, bias = edges.w >> 16;
-    // n / width without an integer division: n and width are small (a box is at most 65
+// Pixel `n` of triangle i's box (n from 0): `cell`, its place from the box's first pixel.
+ivec2 masked_cell(uint i, uint n) {
+    int width = mask_edges[i].w & 0xffff;
+    // n / width without an integer division: n and width are small (a box is at most 66
     // pixels a side), so n + 0.5 lies at least 0.5 / width from a multiple of width, far more
     // than the float's rounding.
     int row = int((float(n) + 0.5) / float(width));
-    cell = ivec2(int(n) - row * width, row);
-    ivec2 a = unpack_corner(edges.x), b = unpack_corner(edges.y), c = unpack_corner(edges.z), p = cell * 256;
+    return ivec2(int(n) - row * width, row);
+}
+
+// Whether triangle i covers sample k of the pixel at `cell` of its box; `w` the edge
+// functions there.
+bool masked_covers(uint i, ivec2 cell, uint k, out ivec3 w) {
+    ivec4 edges = mask_edges[i];
+    int bias = edges.w >> 16;
+    ivec2 a = unpack_corner(edges.x), b = unpack_corner(edges.y), c = unpack_corner(edges.z);
+    ivec2 p = cell * 256 + sample_offset(k) - 128;
     w = ivec3(edge_function(b, c, p), edge_function(c, a, p), edge_function(a, b, p));
     return all(greaterThanEqual(w - ivec3(bias & 1, (bias >> 1) & 1, bias >> 2), ivec3(0)));
 }
 
-// Pixel `n` of triangle i's box, which the triangle covers, drawn where its alpha keeps it;
-// returns 1 if drawn, 0 if not, MASK_PIXEL_FILTER where the texture must be filtered to tell
-// and `filter_now` is false.
+// Whether triangle i covers any sample of pixel `n` of its box.
+bool masked_covers_any(uint i, uint n) {
+    ivec2 cell = masked_cell(i, n);
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        ivec3 w;
+        if (masked_covers(i, cell, k, w)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Pixel `n` of triangle i's box, which the triangle covers, drawn into each sample it covers
+// where its alpha keeps the sample's point; returns the samples drawn, or MASK_PIXEL_FILTER
+// where the texture must be filtered to tell and `filter_now` is false (samples drawn before
+// are drawn again then: the atomic min makes that harmless).
 uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) {
-    ivec2 cell;
-    ivec3 w;
-    masked_covers(i, n, cell, w);
+    ivec2 cell = masked_cell(i, n);
     ivec2 box = mask_box[i];
     ivec2 pixel = ivec2(box.x & 0xffff, box.x >> 16) + cell;
-    vec3 weights = vec3(w);
     vec4 z_inv_w = mask_z_inv_w[i], uv_w = mask_uv_w[i], uv_w_rest = mask_uv_w_rest[i];
-    float depth = dot(weights, z_inv_w.xyz) / float(box.y);
     vec3 inv_w = vec3(z_inv_w.w, uv_w.xy), u_w = vec3(uv_w.zw, uv_w_rest.x), v_w = uv_w_rest.yzw;
-    vec2 uv = vec2(dot(weights, u_w), dot(weights, v_w)) / dot(weights, inv_w);
-    uint verdict = alpha_verdict(s.alpha, s.alpha_texture, uv);
-    if (verdict == ALPHA_FILTER && !filter_now) {
-        return MASK_PIXEL_FILTER;
+    uint drawn = 0u;
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        ivec3 w;
+        if (!masked_covers(i, cell, k, w)) {
+            continue;
+        }
+        vec3 weights = vec3(w);
+        float depth = dot(weights, z_inv_w.xyz) / float(box.y);
+        vec2 uv = vec2(dot(weights, u_w), dot(weights, v_w)) / dot(weights, inv_w);
+        uint verdict = alpha_verdict(s.alpha, s.alpha_texture, uv);
+        if (verdict == ALPHA_FILTER && !filter_now) {
+            return MASK_PIXEL_FILTER;
+        }
+        if (verdict == ALPHA_DROPPED || (verdict == ALPHA_FILTER && !alpha_filtered_kept(s.alpha, s.alpha_texture, uv))) {
+            continue;
+        }
+        keep_nearest_id(pixel, k, depth, id);
+        drawn++;
     }
-    if (verdict == ALPHA_DROPPED || (verdict == ALPHA_FILTER && !alpha_filtered_kept(s.alpha, s.alpha_texture, uv))) {
-        return 0u;
-    }
-    keep_nearest_id(pixel, depth, id);
-    return 1u;
+    return drawn;
 }
 
 // Covered pixels (triangle << 16 | pixel number in its box) queued per subgroup, two
@@ -267,7 +296,7 @@ uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) 
 shared uint mask_queue[2u * gl_WorkGroupSize.x];
 
 // Queue entry `e` of the meshlet's batch from triangle `first` drawn (draw_masked_pixel), or
-// listed to be filtered later; returns the pixels drawn.
+// listed to be filtered later; returns the samples drawn.
 uint draw_queued(uint e, uint first, uvec4 d, SurfaceTest s) {
     uint i = e >> 16u, n = e & 0xffffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
     uint drawn = draw_masked_pixel(i, n, id, s, false);
@@ -283,7 +312,7 @@ uint draw_queued(uint e, uint first, uvec4 d, SurfaceTest s) {
 }
 
 // The meshlet's triangles, its object masked (`flags`: its instance's), by the whole work
-// group; the counts of small triangles and of pixels drawn are added to `triangles` and
+// group; the counts of small triangles and of samples drawn are added to `triangles` and
 // `pixels`.
 void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTest s, inout uint triangles, inout uint pixels) {
     uint lid = gl_LocalInvocationID.x;
@@ -349,9 +378,7 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
                 bvec3 past = lessThanEqual(ends.xyz, uvec3(n));
                 uint i = 4u * j + uint(past.x) + uint(past.y) + uint(past.z);
                 uint start = past.z ? ends.z : past.y ? ends.y : past.x ? ends.x : before;
-                ivec2 cell;
-                ivec3 w;
-                covered = masked_covers(i, n - start, cell, w);
+                covered = masked_covers_any(i, n - start);
                 entry = (i << 16u) | (n - start);
             }
             uvec4 ballot = subgroupBallot(covered);

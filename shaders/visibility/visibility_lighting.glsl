@@ -67,32 +67,13 @@ vec3 id_color(uint x) {
     return vec3(uvec3(x, x >> 8u, x >> 16u) & 255u) / 255.0;
 }
 
-void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
-        return;
-    }
-    float z = raster_depth(p);
-    if (z >= 1.0) {
-        // The background, once: by the first set's dispatch.
-        if (opaque_uniform(texture_set.x) == 0u) {
-            store_background(p);
-        }
-        return;
-    }
-    uint id = raster_id(p);
-    uint meshlet_instance = id >> VISIBILITY_TRIANGLE_BITS;
-    uvec2 object_meshlet = meshlet_instances[meshlet_instance];
+// The surface of visibility id `id` at the point `frag_xy` of pixel p, ready to shade: its
+// point (`world`, rebuilt from `z`, its depth there, as every compute lighting and the light
+// grid's marks rebuild it; z < 0: the depth the triangle has there), normal and material.
+void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, out vec3 world, out vec3 n, out PointMaterial m, out uint flags) {
+    uvec2 object_meshlet = meshlet_instances[id >> VISIBILITY_TRIANGLE_BITS];
     uint object = object_meshlet.x;
     Instance inst = instances[object];
-    if (inst.surface.y != texture_set.x) {
-        return;
-    }
-    uint view = frame.cluster_dims.w;
-    if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
-        imageStore(out_image, p, vec4(id_color(view == DEBUG_VIEW_MESHLETS ? meshlet_instance : id), 1.0));
-        return;
-    }
     uvec3 corners = meshlet_triangle(meshlets[object_meshlet.y], id & ((1u << VISIBILITY_TRIANGLE_BITS) - 1u));
     ObjectData o = objects[object];
     Attributes v[3];
@@ -100,10 +81,9 @@ void main() {
     for (int k = 0; k < 3; k++) {
         v[k] = vertex_at(corners[k]);
         v[k].uv = transform_uv(o.uv_transform, v[k].uv);
-        vec3 world = (o.model * vec4(v[k].position, 1.0)).xyz;
-        c[k] = frame.proj * frame.view * vec4(world, 1.0);
+        vec3 corner = (o.model * vec4(v[k].position, 1.0)).xyz;
+        c[k] = frame.proj * frame.view * vec4(corner, 1.0);
     }
-    vec2 frag_xy = vec2(p) + 0.5;
     vec3 b = barycentrics(c, frag_xy);
     // Texture derivatives as a fragment shader's: differences across its 2×2 quad, the
     // triangle's attributes taken at the quad's pixels (extrapolated where the triangle does
@@ -125,9 +105,141 @@ void main() {
     vec4 tangent = mat4(v[0].tangent, v[1].tangent, v[2].tangent, vec4(0.0)) * vec4(b, 0.0);
     tangent.xyz = mat3(o.model) * tangent.xyz;
     Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material);
-    PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic,
-                                     s.emissive_factor);
-    shade_and_store(p, frag_xy, world_from_depth(frag_xy, z), s.normal, m, o.alpha_texture.x);
+    m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, s.emissive_factor);
+    if (z < 0.0) {
+        // Clip space interpolates linearly in the perspective-correct barycentrics.
+        vec4 point = mat4(c[0], c[1], c[2], vec4(0.0)) * vec4(b, 0.0);
+        z = point.z / point.w;
+    }
+    world = world_from_depth(frag_xy, z);
+    n = s.normal;
+    flags = o.alpha_texture.x;
+}
+
+// The texture set whose dispatch shades the surface of visibility id `id`.
+uint texture_set_of(uint id) {
+    return instances[meshlet_instances[id >> VISIBILITY_TRIANGLE_BITS].x].surface.y;
+}
+
+#if defined(RASTER_SAMPLES) && !defined(LINEAR_OUTPUT)
+// Anti-aliased (docs/DESIGN.md#anti-aliasing): the pixel's samples grouped by the surface
+// (visibility id) they hold, each surface shaded once (at shading_xy), and the pixel the mean of its samples' display-linear colours:
+// each surface weighed by the samples it covers, the background likewise. Surfaces whose
+// textures another dispatch binds are that dispatch's: the first dispatch with a surface in
+// the pixel (the first set's where none has) stores its share, the later ones add theirs.
+void shade_samples(ivec2 p) {
+    uvec2 v[VISIBILITY_SAMPLES];
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        v[k] = raster_sample(p, k);
+    }
+    uint view = frame.cluster_dims.w;
+    uint set = opaque_uniform(texture_set.x);
+    vec3 sum = vec3(0.0);
+    uint grouped = 0u, surfaces = 0u, background = 0u, first_set = 0xffffffffu, shaded = 0u;
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        if ((grouped & (1u << k)) != 0u) {
+            continue;
+        }
+        bool drawn = visibility_buffer_depth(v[k]) < 1.0;
+        uint id = visibility_buffer_id(v[k]);
+        uint members = 0u;
+        for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
+            bool drawn_j = visibility_buffer_depth(v[j]) < 1.0;
+            if (drawn_j == drawn && (!drawn || visibility_buffer_id(v[j]) == id)) {
+                members |= 1u << j;
+            }
+        }
+        grouped |= members;
+        float count = float(bitCount(members));
+        if (!drawn) {
+            background += uint(count);
+            continue;
+        }
+        surfaces++;
+        uint surface_set = texture_set_of(id);
+        first_set = min(first_set, surface_set);
+        if (surface_set != set) {
+            continue;
+        }
+        shaded++;
+        vec3 display;
+        if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
+            display = pow(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), vec3(2.2));
+        } else {
+            vec2 xy = shading_xy(p, members);
+            vec3 world, n;
+            PointMaterial m;
+            uint flags;
+            surface_of(p, id, xy, -1.0, world, n, m, flags);
+            display = shade_display(xy, world, n, m, flags);
+        }
+        sum += count * display;
+    }
+    // The surfaces shaded, for the report (ray_count.y; the host zeroes it before the frame).
+    uint counted = subgroupAdd(shaded);
+    if (subgroupElect() && counted != 0u) {
+        atomicAdd(ray_count.y, counted);
+    }
+    bool first = surfaces == 0u ? set == 0u : first_set == set;
+    if (view == DEBUG_VIEW_AA) {
+        // Surfaces shaded in the pixel: none the background, one to four and more as heat.
+        if (first) {
+            vec4 c = surfaces == 0u ? CLEAR_COLOR : vec4(heat(min(float(surfaces - 1u) / 3.0, 1.0)), 1.0);
+            imageStore(out_image, p, c);
+        }
+        return;
+    }
+    sum /= float(VISIBILITY_SAMPLES);
+    if (first) {
+        sum += float(background) / float(VISIBILITY_SAMPLES) * pow(CLEAR_COLOR.rgb, vec3(2.2));
+    } else if (shaded != 0u) {
+        sum += pow(imageLoad(out_image, p).rgb, vec3(2.2));
+    } else {
+        return;
+    }
+    imageStore(out_image, p, vec4(encode_gamma(sum), 1.0));
+}
+#endif
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
+        return;
+    }
+#if defined(RASTER_SAMPLES) && !defined(LINEAR_OUTPUT)
+    if (VISIBILITY_SAMPLES != 1u) {
+        shade_samples(p);
+        return;
+    }
+#endif
+    float z = raster_depth(p);
+    if (z >= 1.0) {
+        // The background, once: by the first set's dispatch.
+        if (opaque_uniform(texture_set.x) == 0u) {
+            store_background(p);
+        }
+        return;
+    }
+    uint id = raster_id(p);
+    if (texture_set_of(id) != texture_set.x) {
+        return;
+    }
+    uint view = frame.cluster_dims.w;
+    if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
+        imageStore(out_image, p, vec4(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), 1.0));
+        return;
+    }
+    if (view == DEBUG_VIEW_AA) {
+        // One surface per pixel without anti-aliasing.
+        imageStore(out_image, p, vec4(heat(0.0), 1.0));
+        return;
+    }
+    vec2 frag_xy = vec2(p) + 0.5;
+    vec3 world, n;
+    PointMaterial m;
+    uint flags;
+    surface_of(p, id, frag_xy, z, world, n, m, flags);
+    shade_and_store(p, frag_xy, world, n, m, flags);
 }
 
 #endif

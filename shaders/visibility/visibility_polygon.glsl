@@ -16,6 +16,7 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
 
+#include "visibility/visibility_samples.glsl"
 #include "visibility/polygon_raster.glsl"
 #include "visibility/raster_surface.glsl"
 
@@ -25,12 +26,12 @@ const int BIN = 64;
 // triangle drew it itself (the lists were full) and left the entry unused.
 const uint NO_BIN = 0xffffffffu;
 
-// LESS against what is there (the depth << 32 | id of the nearest triangle so far; all ones,
-// above every value, where nothing is) and against the far plane.
-void keep_nearest_id(ivec2 pixel, float depth, uint id) {
+// LESS against what sample s of `pixel` holds (the depth << 32 | id of the nearest triangle
+// so far; all ones, above every value, where nothing is) and against the far plane.
+void keep_nearest_id(ivec2 pixel, uint s, float depth, uint id) {
     if (depth < 1.0) {
         uint64_t value = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(id);
-        atomicMin(visibility_depth[uint(pixel.y) * frame.viewport.x + uint(pixel.x)], value);
+        atomicMin(visibility_depth[sample_slot(pixel, s, frame.viewport.x)], value);
     }
 }
 
@@ -73,29 +74,36 @@ vec4 large_depth(uint at, int k) {
 }
 
 // The pixels of [from, to] the fan triangle covers (and `s` keeps) drawn with visibility id
-// `id`, the edge functions stepped from pixel to pixel (exact: integers); returns the pixels
-// covered.
+// `id`, sample by sample, the edge functions stepped from pixel to pixel (exact: integers);
+// returns the samples covered.
 uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id, SurfaceTest s) {
-    // Per pixel to the right and down, each edge function changes by −d.y and d.x sub-pixels.
-    i64vec3 step_x = -256l * i64vec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
-    i64vec3 step_y = 256l * i64vec3(t.c.x - t.b.x, t.a.x - t.c.x, t.b.x - t.a.x);
+    // Per sub-pixel to the right and down, each edge function changes by −d.y and d.x.
+    i64vec3 unit_x = -i64vec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
+    i64vec3 unit_y = i64vec3(t.c.x - t.b.x, t.a.x - t.c.x, t.b.x - t.a.x);
+    i64vec3 step_x = 256l * unit_x, step_y = 256l * unit_y;
     i64vec3 row;
     fan_covers(t, from, row);
     vec3 z = vec3(t.qa.x, t.qb.x, t.qc.x);
+    vec2 size = vec2(frame.viewport.xy);
     uint covered = 0u;
     for (int y = from.y; y <= to.y; y++, row += step_y) {
-        i64vec3 w = row;
-        for (int x = from.x; x <= to.x; x++, w += step_x) {
-            if (any(lessThan(w - i64vec3(t.bias), i64vec3(0)))) {
-                continue;
+        i64vec3 centre = row;
+        for (int x = from.x; x <= to.x; x++, centre += step_x) {
+            for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+                // From the pixel centre (where `centre` is) to the sample.
+                ivec2 offset = sample_offset(k) - 128;
+                i64vec3 w = centre + int64_t(offset.x) * unit_x + int64_t(offset.y) * unit_y;
+                if (any(lessThan(w - i64vec3(t.bias), i64vec3(0)))) {
+                    continue;
+                }
+                vec3 weights = vec3(w);
+                float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
+                if (!surface_kept_at(s, vec2(x, y) + vec2(sample_offset(k)) / SUBPIXEL, size)) {
+                    continue;
+                }
+                covered++;
+                keep_nearest_id(ivec2(x, y), k, depth, id);
             }
-            vec3 weights = vec3(w);
-            float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
-            if (!surface_kept(s, ivec2(x, y), vec2(frame.viewport.xy))) {
-                continue;
-            }
-            covered++;
-            keep_nearest_id(ivec2(x, y), depth, id);
         }
     }
     return covered;

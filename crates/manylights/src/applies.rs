@@ -286,6 +286,13 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         Rule::technique("light_grid_marks", "the techniques that know their surfaces before their lighting", Technique::marks_light_grid),
         Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
         Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
+        Rule::technique("aa", VISIBILITY_BUFFER, draws_meshlets),
+        Rule::setting(
+            "aa",
+            Some(matches!(args.raster.as_str(), "compute" | "auto")),
+            format!("--raster {}", args.raster),
+            "the compute raster (--raster compute or auto), whose buffer keeps the samples",
+        ),
         Rule::setting(
             "raster_split",
             Some(args.raster != "hardware"),
@@ -315,7 +322,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
             DebugView::ClusterHeat => {
                 Some(Rule::technique("debug_view", "the clustered forward techniques", Technique::draws_cluster_heat))
             }
-            DebugView::Meshlets | DebugView::Triangles => {
+            DebugView::Meshlets | DebugView::Triangles | DebugView::Aa => {
                 Some(Rule::technique("debug_view", "the technique drawn in meshlets", draws_meshlets))
             }
             DebugView::ShadowMap => Some(sun("debug_view")),

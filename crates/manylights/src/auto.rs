@@ -5,7 +5,7 @@ use anyhow::{bail, Result};
 use ml_cpu::scene::Scene;
 use ml_render::settings::{missing_meshlet_feature, missing_raster_feature};
 use ml_render::stage_probe::{pick_lighting_path, quick_probe, StageTimes};
-use ml_render::{Geometry, Raster, RenderSettings, Renderer, Technique};
+use ml_render::{Antialiasing, Geometry, Raster, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -74,6 +74,17 @@ pub fn resolve_raster(
     }
     let device = &ctx.info.name;
     let features = &ctx.info.features;
+    if choice.is_none() && settings.antialiasing != Antialiasing::Off {
+        // Anti-aliasing's samples are the compute raster's alone.
+        let raster = Raster::compute(split);
+        if let Some(feature) = missing_raster_feature(raster, features) {
+            bail!(
+                "--aa {} needs the compute raster, which needs {feature}, which '{device}' lacks: use --aa off",
+                settings.antialiasing.name()
+            );
+        }
+        return Ok((raster, Some(format!("--aa {} samples in the compute raster alone", settings.antialiasing.name()))));
+    }
     if let Some(raster) = choice {
         return Ok(match missing_raster_feature(raster, features) {
             Some(feature) => {

@@ -16,7 +16,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
-use ml_render::{DebugView, Exposure, Geometry, LightGridMarks, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
+use ml_render::{Antialiasing, DebugView, Exposure, Geometry, LightGridMarks, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -101,6 +101,10 @@ pub struct BenchArgs {
     /// (each a row of its own; the other techniques have one).
     #[arg(long, default_value = "hardware,compute")]
     raster: String,
+    /// Anti-aliasing sample counts, comma-separated: off, 4, 8, 16 (render's --aa); the
+    /// counts other than off make rows of the visibility technique's compute raster only.
+    #[arg(long, default_value = "off")]
+    aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread, pixels a side (1
     /// to 64; render's --raster-split).
     #[arg(long, default_value_t = Raster::DEFAULT_SPLIT, value_parser = crate::RASTER_SPLIT, allow_negative_numbers = true)]
@@ -140,6 +144,7 @@ impl BenchArgs {
             "clusters",
             "raster",
             "raster_split",
+            "aa",
             "transparent_objects",
             "glass_layers",
             "transparency_budget",
@@ -160,6 +165,13 @@ impl BenchArgs {
             Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
             Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
             Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
+            Rule::technique("aa", VISIBILITY_BUFFER, draws_meshlets),
+            Rule::setting(
+                "aa",
+                Some(rasters.iter().any(|r| matches!(r, Raster::Compute { large: ml_render::LargeTriangles::Bins { .. }, .. }))),
+                format!("--raster {}", self.raster),
+                "the compute raster (--raster compute), whose buffer keeps the samples",
+            ),
             Rule::setting(
                 "raster_split",
                 Some(rasters.iter().any(|r| *r != Raster::Hardware)),
@@ -231,6 +243,7 @@ impl Plan {
             transparency: ml_render::TransparencySettings { budget: a.transparency_budget },
             light_stats: false,
             light_grid_marks: LightGridMarks::Auto,
+            antialiasing: Antialiasing::Off,
         };
         Ok(Plan { scene, settings, warned: false })
     }
@@ -242,21 +255,40 @@ enum Work {
     Techniques(Plan),
 }
 
-/// What a row measures: a technique, and for the visibility technique its rasteriser.
+/// What a row measures: a technique, for the visibility technique its rasteriser, and the
+/// anti-aliasing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Variant {
     technique: Technique,
     raster: Raster,
+    antialiasing: Antialiasing,
 }
 
 impl Variant {
-    /// `visibility`, `visibility (compute raster)`, `forward`, …
+    /// `visibility`, `visibility (compute raster)`, `visibility (compute raster, 8x AA)`,
+    /// `forward`, …
     fn label(self) -> String {
+        let aa = match self.antialiasing {
+            Antialiasing::Off => String::new(),
+            aa => format!(", {}x AA", aa.samples()),
+        };
         match self.raster {
             Raster::Hardware => self.technique.name().to_owned(),
-            Raster::Compute { .. } => format!("{} ({} raster)", self.technique.name(), self.raster.name()),
+            Raster::Compute { .. } => format!("{} ({} raster{aa})", self.technique.name(), self.raster.name()),
         }
     }
+}
+
+/// --aa: the sample counts of the rows.
+fn antialiasing_list(a: &BenchArgs) -> Result<Vec<Antialiasing>> {
+    let mut list = Vec::new();
+    for name in a.aa.split(',').map(str::trim) {
+        let aa = Antialiasing::from_name(name).context("--aa")?;
+        if !list.contains(&aa) {
+            list.push(aa);
+        }
+    }
+    Ok(list)
 }
 
 /// --raster: the rasterisers the visibility rows use.
@@ -296,6 +328,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         bail!("--budget-s {} must be greater than 0", a.budget_s);
     }
     let rasters = raster_list(a)?;
+    let sample_counts = antialiasing_list(a)?;
     let rules = a.rules(&rasters);
     let named: Vec<Technique> = choices.iter().flatten().copied().collect();
     let auto = if choices.contains(&None) { Auto::Pending } else { Auto::No };
@@ -330,9 +363,16 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 eprintln!("warning: the {} raster needs {feature}, which '{}' lacks: not measured", raster.name(), ctx.info.name);
                 continue;
             }
-            let v = Variant { technique, raster };
-            if !variants.contains(&v) {
-                variants.push(v);
+            for &antialiasing in &sample_counts {
+                // Samples are the compute raster's (the others draw one a pixel).
+                let samples = matches!(raster, Raster::Compute { large: ml_render::LargeTriangles::Bins { .. }, .. });
+                if antialiasing != Antialiasing::Off && !samples {
+                    continue;
+                }
+                let v = Variant { technique, raster, antialiasing };
+                if !variants.contains(&v) {
+                    variants.push(v);
+                }
             }
         }
     }
@@ -427,7 +467,8 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Va
         print_warnings(&built.warnings);
     }
     let scene = built.scene;
-    let mut settings = SettingsRequest { technique, raster: variant.raster, ..plan.settings }.for_scene(&scene, built.shading);
+    let request = SettingsRequest { technique, raster: variant.raster, antialiasing: variant.antialiasing, ..plan.settings };
+    let mut settings = request.for_scene(&scene, built.shading);
     let probe = Renderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
         return Ok(Measured { variant, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: probe.stats.wall_ms });
@@ -446,16 +487,17 @@ fn spread_json(s: &Spread) -> Value {
 fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Value), results: &[Measured]) -> Result<()> {
     let skip = a.warmup as usize;
     let mut csv = String::from(
-        "technique,raster,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,cpu_assign_median_ms,cpu_upload_median_ms,cpu_record_median_ms,cpu_submit_median_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
+        "technique,raster,aa,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,cpu_assign_median_ms,cpu_upload_median_ms,cpu_record_median_ms,cpu_submit_median_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
     );
     let mut rows = Vec::new();
     for m in results {
         let (technique, raster) = (m.variant.technique.name(), raster_name(m.variant));
-        let head = format!("{technique},{raster},{},{w},{h},{}", m.lights, a.frames);
+        let aa = m.variant.antialiasing.name();
+        let head = format!("{technique},{raster},{aa},{},{w},{h},{}", m.lights, a.frames);
         let Some(out) = &m.output else {
             let why = m.skipped.clone().unwrap_or_default();
             csv += &format!("{head},\"{why}\",,,,,,,,,,,,,\n");
-            rows.push(json!({ "technique": technique, "raster": raster, "lights": m.lights, "status": why }));
+            rows.push(json!({ "technique": technique, "raster": raster, "aa": aa, "lights": m.lights, "status": why }));
             continue;
         };
         let stats = &out.stats;
@@ -481,6 +523,7 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
         rows.push(json!({
             "technique": technique,
             "raster": raster,
+            "aa": aa,
             "lights": m.lights,
             "status": "measured",
             "passes": passes.iter().map(|(n, s)| json!({ "pass": n, "gpu": spread_json(s) })).collect::<Vec<_>>(),
@@ -501,7 +544,7 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
         "settings": {
             "scene": a.scene, "objects": a.objects, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
             "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
-            "raster": a.raster, "raster_split": a.raster_split,
+            "raster": a.raster, "raster_split": a.raster_split, "aa": a.aa,
             "clusters": a.clusters,
         },
         "auto": auto,

@@ -16,7 +16,8 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{
-    DebugView, Exposure, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode, Technique,
+    Antialiasing, DebugView, Exposure, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode,
+    Technique,
 };
 use ml_vk::{Context, ContextDesc};
 use std::path::PathBuf;
@@ -76,7 +77,15 @@ struct RenderArgs {
     /// them, at a small cost). For the compute-lit techniques: deferred-compute, visibility.
     #[arg(long)]
     light_stats: bool,
+    /// Render K times wider and taller and filter each KxK block down to a pixel in the
+    /// display's linear light (1 to 16; 1: off): the reference anti-aliasing is measured
+    /// against, and offline stills. The table's times are the large image's.
+    #[arg(long, default_value_t = 1, value_parser = Whole::<u32>::new(1, MAX_SUPERSAMPLE as u64), allow_negative_numbers = true)]
+    supersample: u32,
 }
+
+/// `--supersample`'s largest factor (8 gives 64 samples a pixel, as many as a reference needs).
+const MAX_SUPERSAMPLE: u32 = 16;
 
 /// The most frames `render` takes: at 60 frames a second, half an hour of animation.
 const MAX_FRAMES: u32 = 100_000;
@@ -266,6 +275,11 @@ struct SceneArgs {
     /// why).
     #[arg(long, default_value = "auto", value_parser = ["hardware", "hybrid", "compute", "auto"])]
     raster: String,
+    /// Anti-aliasing: coverage samples per pixel, off, 4, 8 or 16 (Vulkan's standard positions),
+    /// each distinct surface of a pixel shaded once and the pixel the mean of its samples;
+    /// the visibility technique's compute raster (which --raster auto then picks).
+    #[arg(long, default_value = "off", value_parser = Antialiasing::ALL.map(Antialiasing::name))]
+    aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread: bounding box up to
     /// PX pixels a side (1 to 64).
     #[arg(long, default_value_t = Raster::DEFAULT_SPLIT, value_parser = RASTER_SPLIT, allow_negative_numbers = true)]
@@ -498,6 +512,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         time: args.time,
         culling: args.culling == "on",
         light_grid_marks: LightGridMarks::from_name(&args.light_grid_marks)?,
+        antialiasing: Antialiasing::from_name(&args.aa)?,
         exposure: exposure_choice(args)?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
@@ -581,7 +596,17 @@ impl Progress {
 struct RenderSink {
     progress: Progress,
     sequence: Option<output::SequencePattern>,
+    /// The size rendered, and the supersampling factor it is filtered down by.
     size: (u32, u32),
+    supersample: u32,
+}
+
+impl RenderSink {
+    /// A frame as it is written: filtered down where supersampled.
+    fn written(&self, rgba: &[u8]) -> (Vec<u8>, (u32, u32)) {
+        let k = self.supersample;
+        (ml_cpu::supersample::downsample(rgba, self.size, k), (self.size.0 / k, self.size.1 / k))
+    }
 }
 
 impl ml_render::FrameSink for RenderSink {
@@ -595,7 +620,8 @@ impl ml_render::FrameSink for RenderSink {
 
     fn image(&mut self, i: u32, rgba: &[u8]) -> Result<(), ml_render::RenderError> {
         let Some(pattern) = &self.sequence else { return Ok(()) };
-        ml_cpu::files::write_png(&output::sequence_path(pattern, i), rgba, self.size)
+        let (image, size) = self.written(rgba);
+        ml_cpu::files::write_png(&output::sequence_path(pattern, i), &image, size)
             .map_err(|e| ml_render::RenderError::Invalid(e.to_string()))
     }
 }
@@ -606,7 +632,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let request = scene_request(args)?;
     // Every setting is checked before the GPU work; auto's technique is set once it is known.
     let wanted = settings_request(args, choice.unwrap_or(Technique::DeferredClustered), cmd.frames)?;
-    let wanted = SettingsRequest { light_stats: cmd.light_stats, ..wanted };
+    let wanted = SettingsRequest { light_stats: cmd.light_stats, ..supersampled(wanted, cmd.supersample)? };
     let mut techniques = Techniques::chosen(choice);
     check_options_apply(args, &request.source, None, &techniques)?;
     let sequence = output::sequence_pattern(&cmd.out)?;
@@ -635,6 +661,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         progress: Progress::new(u64::from(settings.frames) + u64::from(cmd.warmup), "frames"),
         sequence,
         size: (settings.width, settings.height),
+        supersample: cmd.supersample,
     };
     let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| {
         r.warm_up(cmd.warmup, &mut sink)?;
@@ -645,7 +672,8 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     drop(ctx);
     let output = result?;
     if sink.sequence.is_none() {
-        ml_cpu::files::write_png(&cmd.out, &output.rgba, (output.width, output.height))?;
+        let (image, size) = sink.written(&output.rgba);
+        ml_cpu::files::write_png(&cmd.out, &image, size)?;
     }
     let facts = tables::RenderFacts {
         device: &device,
@@ -655,6 +683,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         auto: auto_why.as_deref(),
         raster_auto: raster_why.as_deref(),
         output: &cmd.out,
+        supersample: cmd.supersample,
     };
     print!("{}", tables::table(&tables::render_rows(&facts, &output.stats)));
     if let Some(t) = output.stats.feature::<ml_render::TransparencyStats>().filter(|t| t.overflowed()) {
@@ -671,6 +700,17 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         bail!("the validation layer reported {count} message(s) (printed above)");
     }
     Ok(())
+}
+
+/// `wanted` rendered `k` times wider and taller (`--supersample`), refused where that passes
+/// the largest image we make.
+fn supersampled(wanted: SettingsRequest, k: u32) -> Result<SettingsRequest> {
+    let max = ml_render::settings::MAX_DIMENSION;
+    let (width, height) = (wanted.width.saturating_mul(k), wanted.height.saturating_mul(k));
+    if width > max || height > max {
+        bail!("--supersample {k} renders {width}x{height}, more than {max} pixels a side: use a smaller --supersample or size");
+    }
+    Ok(SettingsRequest { width, height, ..wanted })
 }
 
 /// The largest viewer script read (a script of a million lines is far past any session).

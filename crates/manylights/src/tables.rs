@@ -35,6 +35,8 @@ pub struct RenderFacts<'a> {
     pub raster_auto: Option<&'a str>,
     /// Where the image was written.
     pub output: &'a Path,
+    /// `--supersample`: the image rendered this many times wider and taller, filtered down.
+    pub supersample: u32,
 }
 
 /// Who drew the visibility buffer, in words.
@@ -56,7 +58,7 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     let technique = settings.technique;
     let mut rows = vec![
         ("device", facts.device.to_owned()),
-        ("resolution", format!("{}x{}", settings.width, settings.height)),
+        ("resolution", format!("{}x{}", settings.width / facts.supersample, settings.height / facts.supersample)),
         ("technique", technique.name().to_owned() + if facts.auto.is_some() { " (auto)" } else { "" }),
         ("shading", settings.shading.name().to_owned()),
         ("lights", facts.lights.to_string()),
@@ -64,6 +66,16 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     ];
     if let Some(why) = facts.auto {
         rows.push(("auto", why.to_owned()));
+    }
+    if facts.supersample > 1 {
+        let k = facts.supersample;
+        rows.push((
+            "supersample",
+            format!(
+                "{k}x{k}: rendered at {}x{}, each {k}x{k} block filtered to a pixel in linear light (times are the large image's)",
+                settings.width, settings.height
+            ),
+        ));
     }
     match stats.gpu_ms() {
         Some(passes) => rows.extend(passes.into_iter().map(|(name, ms)| ("gpu ms", format!("{ms:.3}  ({name} pass, mean)")))),
@@ -74,6 +86,9 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         rows.push(("raster", raster_line(settings.raster) + if facts.raster_auto.is_some() { " (auto)" } else { "" }));
         if let Some(why) = facts.raster_auto {
             rows.push(("auto raster", why.to_owned()));
+        }
+        if settings.antialiasing == ml_render::Antialiasing::Off {
+            rows.push(("anti-aliasing", "off (one sample a pixel, at its centre)".to_owned()));
         }
     } else if technique.lights_in_subpass() || technique.lights_in_compute() {
         rows.push(("g-buffer", gbuffer_line(facts.object_textures, stats.gbuffer_lazily_allocated)));
@@ -216,6 +231,7 @@ mod tests {
             auto: None,
             raster_auto: None,
             output: Path::new("a.png"),
+            supersample: 1,
         };
         let mut stats = FrameStats::new(&["g-buffer + lighting"]);
         stats.frames = 1;

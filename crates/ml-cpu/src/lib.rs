@@ -30,6 +30,7 @@ pub mod scene_request;
 pub mod shading;
 pub mod shading_model;
 pub mod shadow_atlas;
+pub mod supersample;
 pub mod surface_sampler;
 mod teapot;
 pub mod textures;

@@ -63,6 +63,8 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
     let raster = (a.depth_format, a.shading);
     // With the compute or hybrid raster, the pyramid and the lighting read the 64-bit buffer.
     let compute = s.raster != Raster::Hardware;
+    // Samples per pixel of that buffer.
+    let aa = s.antialiasing;
     let mut shared = || -> Result<SharedMeshletScene, RenderError> {
         if meshlets.is_none() {
             *meshlets = Some(MeshletScene::new(ctx, a.scene.meshlets()?, s.raster.bin_list().unwrap_or(0))?);
@@ -87,7 +89,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         }
         PassKind::ClusterAssignCpu => Box::<cluster_assign_cpu::CpuClusterAssign>::default(),
         PassKind::LightGridBuild { marked } => Box::new(LightGridBuild::new(ctx, a.lights, marked)?),
-        PassKind::LightGridMark { depth_buffer, layers } => Box::new(LightGridMark::new(ctx, depth_buffer, layers)?),
+        PassKind::LightGridMark { depth_buffer, layers } => Box::new(LightGridMark::new(ctx, (depth_buffer, aa), layers)?),
         PassKind::Forward { lights, heat_legend } => {
             Box::new(forward::Forward::new(ctx, a.scene, raster, (lights, heat_legend), s.technique.name())?)
         }
@@ -96,15 +98,17 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::GBuffer => Box::new(gbuffer::GBuffer::new(ctx, a.scene, raster)?),
         PassKind::ComputeLighting => Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?),
         PassKind::MeshletCull(phase) => {
-            Box::new(meshlet_cull::MeshletCull::new(ctx, shared()?, phase, (s.culling, s.raster, a.shading.transparency))?)
+            Box::new(meshlet_cull::MeshletCull::new(ctx, shared()?, phase, (s.culling, s.raster, a.shading.transparency, aa))?)
         }
-        PassKind::TriangleRasterLarge(phase) => Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, s.raster)?),
+        PassKind::TriangleRasterLarge(phase) => {
+            Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, (s.raster, aa))?)
+        }
         PassKind::VisibilityRaster(phase) => {
             Box::new(visibility_raster::VisibilityRaster::new(ctx, shared()?, (phase, compute), a.depth_format)?)
         }
-        PassKind::DepthPyramid => Box::new(depth_pyramid::DepthPyramid::new(ctx, compute)?),
+        PassKind::DepthPyramid => Box::new(depth_pyramid::DepthPyramid::new(ctx, compute, aa)?),
         PassKind::VisibilityLighting => {
-            Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, (shared()?, compute), a.shading)?)
+            Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, (shared()?, compute), (a.shading, aa))?)
         }
         PassKind::ShadowMapView => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
@@ -114,6 +118,6 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::TransparentResolve { lights, after_compute } => {
             Box::new(TransparentResolve::new(ctx, a.scene, (a.shading, transparency()), (lights, after_compute))?)
         }
-        PassKind::LightCount { depth_buffer } => Box::new(LightCount::new(ctx, a.scene, a.shading, depth_buffer)?),
+        PassKind::LightCount { depth_buffer } => Box::new(LightCount::new(ctx, a.scene, a.shading, (depth_buffer, aa))?),
     })
 }

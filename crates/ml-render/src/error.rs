@@ -67,6 +67,7 @@ pub enum Named {
     SunShadowMode,
     Raster,
     LightGridMarks,
+    Antialiasing,
 }
 
 impl std::fmt::Display for Named {
@@ -78,6 +79,7 @@ impl std::fmt::Display for Named {
             Named::SunShadowMode => "sun shadow mode",
             Named::Raster => "rasteriser",
             Named::LightGridMarks => "light grid marks choice",
+            Named::Antialiasing => "anti-aliasing sample count",
         })
     }
 }
@@ -136,8 +138,15 @@ pub enum SettingsError {
     RasterNeedsVisibility { technique: &'static str },
     #[error("the {raster} raster needs {feature}, which '{device}' lacks: use --raster hardware")]
     RasterFeature { raster: &'static str, feature: &'static str, device: String },
-    #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size or --raster hardware")]
+    #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size, fewer --aa samples or --raster hardware")]
     RasterBuffer { width: u32, height: u32, bytes: u64, device: String, max: u32 },
+    /// Anti-aliasing's samples live in the compute raster's buffer.
+    #[error("--aa {samples} needs the visibility technique with --raster compute (the hybrid and hardware rasters and {technique} keep one sample a pixel so far): use --technique visibility --raster compute or --aa off")]
+    AntialiasingNeedsComputeRaster { samples: &'static str, technique: &'static str },
+    #[error("--aa {samples} does not blend transparent layers yet, and the scene has transparent (BLEND) materials: use --aa off")]
+    AntialiasingWithLayers { samples: &'static str },
+    #[error("the aa debug view shows the anti-aliasing samples of the visibility technique's compute raster, not {technique}'s")]
+    AaViewNeedsComputeRaster { technique: &'static str },
     #[error(
         "a transparency budget of {budget} nodes per pixel at {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: lower --transparency-budget"
     )]

@@ -99,11 +99,12 @@ impl FrameInFlight {
     }
 
     /// The shadow rays the slot's last frame traced from its opaque surfaces (compute lightings
-    /// with rays; 0 elsewhere), and zero for the next: call only after its fence has signalled.
-    pub fn take_ray_count(&mut self) -> u64 {
-        let traced = bytemuck::pod_read_unaligned::<u32>(&self.ray_count.mapped()[..4]);
+    /// with rays; 0 elsewhere) and the surfaces it shaded (anti-aliased visibility lighting; 0
+    /// elsewhere), and zero for the next: call only after its fence has signalled.
+    pub fn take_ray_count(&mut self) -> (u64, u64) {
+        let [traced, surfaces] = bytemuck::pod_read_unaligned::<[u32; 2]>(&self.ray_count.mapped()[..8]);
         self.ray_count.write(0, &[0u32; 4]);
-        u64::from(traced)
+        (u64::from(traced), u64::from(surfaces))
     }
 
     /// Entries the light-index list holds.

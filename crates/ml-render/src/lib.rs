@@ -34,6 +34,7 @@ pub mod report;
 pub mod settings;
 pub mod stage_probe;
 
+mod antialiasing;
 mod assembly;
 mod clusters;
 mod compute_pass;
@@ -58,6 +59,7 @@ mod technique;
 mod transparency;
 mod visibility;
 
+pub use antialiasing::AntialiasingStats;
 pub use error::RenderError;
 pub use frame_resources::FRAMES_IN_FLIGHT;
 pub use light_grid::LightGridStats;
@@ -66,8 +68,8 @@ pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use scene::ray_geometry::RayStats;
 pub use scene::textures::SHADOW_MAP_SIZE;
 pub use settings::{
-    DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightGridMarks, LightingStage, OmniShadowMode, OmniShadowSettings,
-    Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
+    Antialiasing, DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightGridMarks, LightingStage, OmniShadowMode,
+    OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
 };
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage};

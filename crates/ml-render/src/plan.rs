@@ -8,8 +8,8 @@
 //! frame slots: size, exposure value) and the run (nothing: frame count, clock).
 
 use crate::settings::{
-    DebugView, Exposure, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings,
-    ShadingModel, SunShadowMode, Technique,
+    Antialiasing, DebugView, Exposure, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,
+    RenderSettings, ShadingModel, SunShadowMode, Technique,
 };
 use ml_cpu::cluster::ClusterDims;
 
@@ -96,6 +96,8 @@ pub struct PipelineKey {
     /// The light grid marks the cells near the surfaces first, where the technique knows them
     /// (`RenderSettings::light_grid_marks`).
     pub light_grid_marks: bool,
+    /// Coverage samples per pixel (`RenderSettings::antialiasing`).
+    pub antialiasing: Antialiasing,
 }
 
 impl PipelineKey {
@@ -136,6 +138,7 @@ impl RenderSettings {
             layers: self.blends_layers(),
             light_stats: self.light_stats,
             light_grid_marks: self.light_grid_marks,
+            antialiasing: self.antialiasing,
         }
     }
 

@@ -5,6 +5,7 @@
 //! `assembly::assemble`) that it binds, prepares, records with the barriers their declared
 //! uses need (`sync`), times and collects from.
 
+use crate::antialiasing::{Antialiasing, AntialiasingStats};
 use crate::assembly::{assemble, Assembly};
 use crate::error::RenderError;
 use crate::exposure::auto_exposure::{self, AutoExposure};
@@ -77,8 +78,9 @@ pub struct Renderer<'a> {
     reports: Vec<SlotReport>,
     /// Per frame slot: whether it has been submitted since its results were last collected.
     pending: Vec<bool>,
-    /// Per frame slot: the shadow rays its last frame's compute lighting traced.
-    rays_traced: Vec<u64>,
+    /// Per frame slot: the shadow rays its last frame's compute lighting traced, and the
+    /// surfaces the anti-aliased visibility lighting shaded.
+    rays_traced: Vec<(u64, u64)>,
     /// Top of the heat-map scale (lights per cluster), from the newest known frame.
     heat_top: f32,
     /// Slot of the frame that was read back last.
@@ -165,7 +167,7 @@ impl<'a> Renderer<'a> {
             lights_on_gpu,
             reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
-            rays_traced: vec![0; FRAMES_IN_FLIGHT],
+            rays_traced: vec![(0, 0); FRAMES_IN_FLIGHT],
             heat_top: DEFAULT_HEAT_TOP,
             last_frame: 0,
             depth_format: depth,
@@ -296,7 +298,8 @@ impl<'a> Renderer<'a> {
         let raster = self.settings.raster;
         let layers = self.settings.blends_layers();
         let cpu_lists = technique.has_cluster_grid();
-        let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers));
+        let antialiasing = self.settings.antialiasing;
+        let make_targets = || Targets::new(ctx, extent, depth, (Output::of(technique), gbuffer), (raster, layers, antialiasing));
         let setup = FrameSetup {
             pool: self.command_pool,
             // The light grid keeps its own copy of the lights (GPU techniques).
@@ -419,8 +422,13 @@ impl<'a> Renderer<'a> {
         stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
         if let Some(mut rays) = self.gpu.rays.stats {
             // Counted with the light statistics (compute lightings only).
-            rays.traced = self.settings.light_stats.then_some(self.rays_traced[last]);
+            rays.traced = self.settings.light_stats.then_some(self.rays_traced[last].0);
             stats.set_feature(rays);
+        }
+        let antialiasing = self.settings.antialiasing;
+        if antialiasing != Antialiasing::Off {
+            let (width, height) = (self.extent.width, self.extent.height);
+            stats.set_feature(AntialiasingStats { antialiasing, width, height, surfaces: self.rays_traced[last].1 });
         }
         stats.memory = Some(self.ctx.memory_use());
         self.last_frame = last;

@@ -1,5 +1,6 @@
 //! What a render is asked to do, checked against the device before anything is allocated.
 
+pub use crate::antialiasing::Antialiasing;
 use crate::error::{by_name, Named, RenderError, Setting, SettingsError};
 pub use crate::exposure::{parse_exposure, Exposure, MAX_EXPOSURE_EV};
 pub use crate::scene::shadow_settings::{
@@ -48,10 +49,13 @@ pub enum DebugView {
     /// The traversal steps (nodes visited, triangles tested) of each point's shadow rays as a
     /// heat map on a log scale (--omni-shadow rays).
     RayCost,
+    /// Surfaces shaded per pixel with anti-aliasing (visibility, compute raster): one blue,
+    /// up to four and more red; the background as it is.
+    Aa,
 }
 
 impl DebugView {
-    pub const ALL: [DebugView; 14] = [
+    pub const ALL: [DebugView; 15] = [
         DebugView::None,
         DebugView::ClusterHeat,
         DebugView::GBufferAlbedo,
@@ -66,6 +70,7 @@ impl DebugView {
         DebugView::Alpha,
         DebugView::TransparencyLayers,
         DebugView::RayCost,
+        DebugView::Aa,
     ];
 
     pub fn name(self) -> &'static str {
@@ -84,6 +89,7 @@ impl DebugView {
             DebugView::Alpha => "alpha",
             DebugView::TransparencyLayers => "transparency-layers",
             DebugView::RayCost => "ray-cost",
+            DebugView::Aa => "aa",
         }
     }
 
@@ -109,6 +115,7 @@ impl DebugView {
             DebugView::Alpha => v::ALPHA,
             DebugView::TransparencyLayers => v::TRANSPARENCY_LAYERS,
             DebugView::RayCost => v::RAY_COST,
+            DebugView::Aa => v::AA,
         }
     }
 }
@@ -180,6 +187,8 @@ pub struct RenderSettings {
     /// The light grid marks the cells near the surfaces before its build (the techniques
     /// that know their surfaces before their lighting: deferred-compute, visibility).
     pub light_grid_marks: bool,
+    /// Coverage samples per pixel (the visibility technique's compute raster).
+    pub antialiasing: Antialiasing,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -217,6 +226,7 @@ impl RenderSettings {
             transparency: None,
             light_stats: false,
             light_grid_marks: true,
+            antialiasing: Antialiasing::Off,
         }
     }
 
@@ -282,6 +292,19 @@ impl RenderSettings {
         if matches!(self.debug_view, DebugView::Meshlets | DebugView::Triangles) && self.technique.geometry() != Geometry::Meshlets {
             return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view.name(), technique: self.technique.name() }.into());
         }
+        if self.antialiasing != Antialiasing::Off {
+            if !matches!(self.raster, Raster::Compute { large: LargeTriangles::Bins { .. }, .. }) || self.technique != Technique::Visibility
+            {
+                let technique = if self.technique == Technique::Visibility { self.raster.name() } else { self.technique.name() };
+                return Err(SettingsError::AntialiasingNeedsComputeRaster { samples: self.antialiasing.name(), technique }.into());
+            }
+            if self.blends_layers() {
+                return Err(SettingsError::AntialiasingWithLayers { samples: self.antialiasing.name() }.into());
+            }
+        }
+        if self.debug_view == DebugView::Aa && (self.technique != Technique::Visibility || self.raster == Raster::Hardware) {
+            return Err(SettingsError::AaViewNeedsComputeRaster { technique: self.technique.name() }.into());
+        }
         if self.technique.geometry() == Geometry::Meshlets {
             if let Some(feature) = missing_meshlet_feature(&ctx.info.features) {
                 return Err(SettingsError::TechniqueFeature { technique: self.technique.name(), feature, device: device() }.into());
@@ -297,8 +320,8 @@ impl RenderSettings {
             if split == 0 || split > Raster::MAX_SPLIT {
                 return Err(SettingsError::OutOfRange { what: Setting::RasterSplit, value: split, max: Raster::MAX_SPLIT }.into());
             }
-            // Its depth-and-id buffer, 8 bytes a pixel, is one storage buffer.
-            let bytes = self.width as u64 * self.height as u64 * 8;
+            // Its depth-and-id buffer, 8 bytes a sample, is one storage buffer.
+            let bytes = self.antialiasing.buffer_bytes(self.width, self.height);
             if bytes > limits.max_storage_buffer_range as u64 {
                 let (width, height, max) = (self.width, self.height, limits.max_storage_buffer_range);
                 return Err(SettingsError::RasterBuffer { width, height, bytes, device: device(), max }.into());
@@ -378,6 +401,7 @@ pub struct SettingsRequest {
     pub light_stats: bool,
     /// Whether the light grid marks the cells near the surfaces first.
     pub light_grid_marks: LightGridMarks,
+    pub antialiasing: Antialiasing,
 }
 
 impl SettingsRequest {
@@ -400,6 +424,7 @@ impl SettingsRequest {
             transparency: scene.has_blended_objects().then_some(self.transparency),
             light_stats: self.light_stats,
             light_grid_marks: self.light_grid_marks.resolve(scene.lights.len() as u64, self.width, self.height),
+            antialiasing: self.antialiasing,
         }
     }
 }

@@ -2,6 +2,7 @@
 //! buffer, the G-buffer and the HDR image of the deferred techniques. The raster passes make
 //! their framebuffers over them.
 
+use crate::antialiasing::Antialiasing;
 use crate::technique::{Geometry, LightingStage, Raster, Technique};
 use ml_vk::{vk, Buffer, Context, Image, VkError};
 
@@ -132,7 +133,7 @@ pub struct Targets {
     /// visibility: the depth pyramid of the late culling phase, level after level (null
     /// otherwise).
     pub depth_pyramid: Buffer,
-    /// visibility with the compute raster: 64 bits per pixel, depth and id, which its passes
+    /// visibility with the compute raster: 64 bits per sample (`Antialiasing`), depth and id, which its passes
     /// write by atomic min and the depth pyramid and the lighting read (null otherwise; `depth`
     /// and `visibility` are null then).
     pub visibility_depth: Buffer,
@@ -180,7 +181,7 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        (raster, layers): (Raster, bool),
+        (raster, layers, antialiasing): (Raster, bool, Antialiasing),
     ) -> Result<Targets, VkError> {
         let t = Targets {
             color: Image::null(),
@@ -191,7 +192,7 @@ impl Targets {
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layers)))
+        ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layers, antialiasing)))
     }
 
     fn create(
@@ -200,7 +201,7 @@ impl Targets {
         extent: vk::Extent2D,
         depth_format: vk::Format,
         (output, gbuffer): (Output, &[GBufferImage]),
-        (raster, layers): (Raster, bool),
+        (raster, layers, antialiasing): (Raster, bool, Antialiasing),
     ) -> Result<(), VkError> {
         use vk::ImageUsageFlags as U;
         let colour = vk::ImageAspectFlags::COLOR;
@@ -247,7 +248,7 @@ impl Targets {
             self.depth_pyramid = Buffer::new(ctx, "depth pyramid", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
         }
         if compute_raster {
-            let bytes = extent.width as u64 * extent.height as u64 * 8;
+            let bytes = antialiasing.buffer_bytes(extent.width, extent.height);
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
             self.visibility_depth = Buffer::new(ctx, "visibility-depth buffer", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
         }

@@ -9,8 +9,8 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
 use ml_render::settings::MAX_SHADOWED_LIGHTS;
 use ml_render::{
-    DebugView, Exposure, Geometry, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel, SunShadowMode,
-    Technique,
+    Antialiasing, DebugView, Exposure, Geometry, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel,
+    SunShadowMode, Technique,
 };
 use std::collections::VecDeque;
 
@@ -39,6 +39,8 @@ pub struct Choices {
     /// Whether the light grid marks the cells near the surfaces (the command line's choice;
     /// auto decides again as lights and size change).
     pub light_grid_marks: LightGridMarks,
+    /// Coverage samples per pixel (used with the visibility technique's compute raster).
+    pub antialiasing: Antialiasing,
 }
 
 impl Choices {
@@ -67,6 +69,7 @@ impl Choices {
             exposure: settings.exposure,
             transparency: settings.transparency,
             light_grid_marks,
+            antialiasing: settings.antialiasing,
         }
     }
 
@@ -89,6 +92,10 @@ impl Choices {
 
     /// The settings of these choices at a size, the clock fixed at `time` if given.
     pub fn settings(&self, (width, height): (u32, u32), time: Option<f32>) -> RenderSettings {
+        // Other techniques have no visibility buffer to draw.
+        let raster = if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware };
+        // Only the compute raster keeps samples, and they are not blended with layers yet.
+        let samples = matches!(raster, Raster::Compute { large: ml_render::LargeTriangles::Bins { .. }, .. });
         RenderSettings {
             technique: self.technique,
             shading: self.shading,
@@ -101,13 +108,13 @@ impl Choices {
             frames: 1,
             time,
             culling: true,
-            // Other techniques have no visibility buffer to draw.
-            raster: if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware },
+            raster,
             exposure: self.exposure,
             transparency: self.transparency,
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
             light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
+            antialiasing: if samples && self.transparency.is_none() { self.antialiasing } else { Antialiasing::Off },
         }
     }
 }
@@ -168,6 +175,9 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
             combo(ui, "Raster", &mut choices.raster, &options, |r| r.name());
             if let Raster::Compute { split, .. } = &mut choices.raster {
                 ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
+            }
+            if choices.raster.name() == "compute" && choices.transparency.is_none() {
+                combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
             }
         }
         combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());
@@ -293,6 +303,7 @@ mod tests {
             exposure: Exposure::Ev(0.0),
             transparency: None,
             light_grid_marks: LightGridMarks::Auto,
+            antialiasing: Antialiasing::Off,
         }
     }
 

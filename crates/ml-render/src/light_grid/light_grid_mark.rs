@@ -5,6 +5,7 @@
 //! then lists only lights of marked cells, which the frame's points may test: at millions of
 //! lights most lie far from every visible surface.
 
+use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
 use crate::pass::{Pass, Recording};
@@ -28,10 +29,15 @@ pub struct LightGridMark {
 
 impl LightGridMark {
     /// The marks from the opaque depth (`depth_buffer`: the compute raster's buffer, else the
-    /// depth target), and with `layers` from the transparent layers' nodes.
-    pub fn new(ctx: &Context, depth_buffer: bool, layers: bool) -> Result<LightGridMark, VkError> {
-        let shader = if depth_buffer { &ml_shaders::LIGHT_GRID_MARK_BUFFER_COMP } else { &ml_shaders::LIGHT_GRID_MARK_COMP };
-        let pass = ComputePass::new(ctx, &[], (shader, &[]))?;
+    /// depth target; its samples: `antialiasing`), and with `layers` from the transparent
+    /// layers' nodes.
+    pub fn new(ctx: &Context, (depth_buffer, antialiasing): (bool, Antialiasing), layers: bool) -> Result<LightGridMark, VkError> {
+        let (shader, constants) = if depth_buffer {
+            (&ml_shaders::LIGHT_GRID_MARK_BUFFER_COMP, vec![antialiasing.constant()])
+        } else {
+            (&ml_shaders::LIGHT_GRID_MARK_COMP, Vec::new())
+        };
+        let pass = ComputePass::new(ctx, &[], (shader, &constants))?;
         let mut mark = LightGridMark { pass, layers: None, occupancy: vec![vk::Buffer::null(); FRAMES_IN_FLIGHT], depth_buffer };
         if layers {
             match ComputePass::new(ctx, &[], (&ml_shaders::LIGHT_GRID_MARK_LAYERS_COMP, &[])) {

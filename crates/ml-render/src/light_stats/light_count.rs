@@ -5,6 +5,7 @@
 //! frame, it is not part of it.
 
 use super::LightStats;
+use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::descriptors::Resource;
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
@@ -28,9 +29,22 @@ pub struct LightCount {
 }
 
 impl LightCount {
-    pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading, depth_buffer: bool) -> Result<LightCount, VkError> {
-        let shader = if depth_buffer { &ml_shaders::LIGHT_COUNT_BUFFER_COMP } else { &ml_shaders::LIGHT_COUNT_COMP };
-        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &shading.lighting_constants()))?;
+    /// The counts at the opaque surfaces: with `depth_buffer` those of the compute raster's
+    /// buffer (with anti-aliasing, each pixel's first sample's), else of the depth target.
+    pub fn new(
+        ctx: &Context,
+        scene: &SceneGpu,
+        shading: Shading,
+        (depth_buffer, antialiasing): (bool, Antialiasing),
+    ) -> Result<LightCount, VkError> {
+        let mut constants = shading.lighting_constants().to_vec();
+        let shader = if depth_buffer {
+            constants.push(antialiasing.constant());
+            &ml_shaders::LIGHT_COUNT_BUFFER_COMP
+        } else {
+            &ml_shaders::LIGHT_COUNT_COMP
+        };
+        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &constants))?;
         Ok(LightCount { pass, counts: (0..FRAMES_IN_FLIGHT).map(|_| Buffer::null()).collect(), depth_buffer })
     }
 }

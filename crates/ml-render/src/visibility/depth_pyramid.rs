@@ -5,6 +5,7 @@
 //! others). A buffer rather than a mipmapped image: plain loads, no per-level views, and the
 //! same answers on every driver.
 
+use crate::antialiasing::Antialiasing;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
@@ -29,8 +30,9 @@ pub struct DepthPyramid {
 }
 
 impl DepthPyramid {
-    /// The pyramid of the depth image, or with `from_buffer` of the compute raster's buffer.
-    pub fn new(ctx: &Context, from_buffer: bool) -> Result<DepthPyramid, VkError> {
+    /// The pyramid of the depth image, or with `from_buffer` of the compute raster's buffer
+    /// (its samples: `antialiasing`).
+    pub fn new(ctx: &Context, from_buffer: bool, antialiasing: Antialiasing) -> Result<DepthPyramid, VkError> {
         let shader = if from_buffer { &ml_shaders::DEPTH_PYRAMID_BUFFER_COMP } else { &ml_shaders::DEPTH_PYRAMID_COMP };
         let p = DepthPyramid {
             sets: FrameSets::new(ctx, &[(shader, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
@@ -43,7 +45,8 @@ impl DepthPyramid {
         ml_vk::build(ctx, p, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(16)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &[])?;
+            let constants = if from_buffer { vec![antialiasing.constant()] } else { Vec::new() };
+            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &constants)?;
             p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })

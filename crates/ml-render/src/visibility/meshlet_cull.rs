@@ -12,6 +12,7 @@
 //! the large-triangle pass (which then reads the counters back instead) or, with the hybrid
 //! raster, appended to the draw; the early phase clears its 64-bit buffer first.
 
+use crate::antialiasing::Antialiasing;
 use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
@@ -49,7 +50,7 @@ impl MeshletCull {
         ctx: &Context,
         scene: SharedMeshletScene,
         phase: Phase,
-        (culling, raster, layers): (bool, Raster, bool),
+        (culling, raster, layers, antialiasing): (bool, Raster, bool, Antialiasing),
     ) -> Result<MeshletCull, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
         // Scenes with masked objects get the compute raster that draws their pixels from
@@ -81,11 +82,14 @@ impl MeshletCull {
             p.meshlet_pipeline = compute_pipeline(ctx, &ml_shaders::MESHLET_CULL_COMP, p.pipeline_layout, &[])?;
             // Only the compute raster's triangle pass draws, so only it tests surfaces: the
             // hardware raster's culling (triangle_cull.comp) declares no SURFACE_TESTS.
-            let surface = match raster {
-                Raster::Hardware => None,
-                Raster::Compute { .. } => Some(p.scene.borrow().geometry.surface_constants()),
+            let constants = match raster {
+                Raster::Hardware => Vec::new(),
+                Raster::Compute { .. } => {
+                    let [tests, masks] = p.scene.borrow().geometry.surface_constants();
+                    vec![tests, masks, antialiasing.constant()]
+                }
             };
-            p.triangle_pipeline = compute_pipeline(ctx, triangles, p.pipeline_layout, surface.as_ref().map_or(&[], |s| s.as_slice()))?;
+            p.triangle_pipeline = compute_pipeline(ctx, triangles, p.pipeline_layout, &constants)?;
             Ok(())
         })
     }

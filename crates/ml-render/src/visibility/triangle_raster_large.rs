@@ -4,6 +4,7 @@
 //! hardware clips them, into the same 64-bit buffer as the small ones. One indirect dispatch
 //! whose size the culling wrote; in place of the hybrid raster's hardware draw.
 
+use crate::antialiasing::Antialiasing;
 use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
@@ -28,7 +29,12 @@ pub struct TriangleRasterLarge {
 }
 
 impl TriangleRasterLarge {
-    pub fn new(ctx: &Context, scene: SharedMeshletScene, phase: Phase, raster: Raster) -> Result<TriangleRasterLarge, VkError> {
+    pub fn new(
+        ctx: &Context,
+        scene: SharedMeshletScene,
+        phase: Phase,
+        (raster, antialiasing): (Raster, Antialiasing),
+    ) -> Result<TriangleRasterLarge, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
         let shader = &ml_shaders::TRIANGLE_RASTER_LARGE_COMP;
         let pass = TriangleRasterLarge {
@@ -42,8 +48,8 @@ impl TriangleRasterLarge {
         ml_vk::build(ctx, pass, |p| {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
-            let surface = p.scene.borrow().geometry.surface_constants();
-            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &surface)?;
+            let [tests, masks] = p.scene.borrow().geometry.surface_constants();
+            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &[tests, masks, antialiasing.constant()])?;
             Ok(())
         })
     }

@@ -4,6 +4,7 @@
 //! texture set: a dispatch per set, each shading its objects' pixels. Its output is the colour
 //! target, left in TRANSFER_SRC_OPTIMAL like the other lighting passes'.
 
+use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
@@ -29,9 +30,12 @@ impl VisibilityLighting {
         ctx: &Context,
         gpu: &SceneGpu,
         (scene, from_buffer): (SharedMeshletScene, bool),
-        shading: Shading,
+        (shading, antialiasing): (Shading, Antialiasing),
     ) -> Result<VisibilityLighting, VkError> {
-        let model = shading.compute_lighting_constants();
+        let mut constants = shading.compute_lighting_constants().to_vec();
+        if from_buffer {
+            constants.push(antialiasing.constant());
+        }
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
         // With transparent layers, linear HDR for their resolve.
         let shader = match (from_buffer, shading.transparency) {
@@ -40,7 +44,7 @@ impl VisibilityLighting {
             (false, false) => &ml_shaders::VISIBILITY_LIGHTING_COMP,
             (false, true) => &ml_shaders::VISIBILITY_LIGHTING_LINEAR_COMP,
         };
-        let pass = ComputePass::with_push(ctx, &more_sets, (shader, &model), 16)?;
+        let pass = ComputePass::with_push(ctx, &more_sets, (shader, &constants), 16)?;
         Ok(VisibilityLighting { pass, scene, from_buffer, layers: shading.transparency })
     }
 }

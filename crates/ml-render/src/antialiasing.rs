@@ -1,0 +1,102 @@
+//! Anti-aliasing (docs/DESIGN.md#anti-aliasing): coverage samples per pixel in the compute
+//! raster's 64-bit buffer (`VISIBILITY_SAMPLES` in visibility/visibility_samples.glsl), each
+//! distinct surface of a pixel shaded once, the pixel the mean of its samples in the
+//! display's linear light.
+
+use crate::error::{by_name, Named, RenderError};
+use crate::report::FeatureStats;
+
+/// Coverage samples per pixel (`--aa`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Antialiasing {
+    /// One sample, at the pixel centre.
+    Off,
+    X4,
+    X8,
+    X16,
+}
+
+impl Antialiasing {
+    pub const ALL: [Antialiasing; 4] = [Antialiasing::Off, Antialiasing::X4, Antialiasing::X8, Antialiasing::X16];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Antialiasing::Off => "off",
+            Antialiasing::X4 => "4",
+            Antialiasing::X8 => "8",
+            Antialiasing::X16 => "16",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<Antialiasing, RenderError> {
+        by_name(&Antialiasing::ALL, Antialiasing::name, Named::Antialiasing, name)
+    }
+
+    /// Samples per pixel (1 when off).
+    pub fn samples(self) -> u32 {
+        match self {
+            Antialiasing::Off => 1,
+            Antialiasing::X4 => 4,
+            Antialiasing::X8 => 8,
+            Antialiasing::X16 => 16,
+        }
+    }
+
+    /// The specialization constant of the shaders that read or write the samples.
+    pub fn constant(self) -> (&'static str, u32) {
+        ("VISIBILITY_SAMPLES", self.samples())
+    }
+
+    /// Bytes the compute raster's buffer takes at `width`×`height`: depth and id, 8 bytes a
+    /// sample.
+    pub fn buffer_bytes(self, width: u32, height: u32) -> u64 {
+        u64::from(width) * u64::from(height) * 8 * u64::from(self.samples())
+    }
+}
+
+/// What anti-aliasing took in the last frame: its samples' memory, and the surfaces the
+/// lighting shaded (a pixel shades each surface its samples hold).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AntialiasingStats {
+    pub antialiasing: Antialiasing,
+    pub width: u32,
+    pub height: u32,
+    /// Surfaces shaded in the last frame, summed over the pixels.
+    pub surfaces: u64,
+}
+
+impl AntialiasingStats {
+    /// Surfaces shaded per pixel (the background counts none).
+    pub fn surfaces_per_pixel(&self) -> f64 {
+        self.surfaces as f64 / (f64::from(self.width) * f64::from(self.height)).max(1.0)
+    }
+}
+
+impl FeatureStats for AntialiasingStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let mib = self.antialiasing.buffer_bytes(self.width, self.height) as f64 / f64::from(1 << 20);
+        vec![(
+            "anti-aliasing",
+            format!(
+                "{} samples a pixel ({mib:.1} MiB of depth and id); {:.3} surfaces shaded a pixel in the last frame",
+                self.antialiasing.samples(),
+                self.surfaces_per_pixel()
+            ),
+        )]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Antialiasing;
+
+    #[test]
+    fn names_and_samples() {
+        for aa in Antialiasing::ALL {
+            assert_eq!(Antialiasing::from_name(aa.name()).ok(), Some(aa));
+        }
+        assert_eq!(Antialiasing::ALL.map(Antialiasing::samples), [1, 4, 8, 16]);
+        assert!(Antialiasing::from_name("2").is_err());
+        assert_eq!(Antialiasing::X8.buffer_bytes(1920, 1080), 1920 * 1080 * 64);
+    }
+}

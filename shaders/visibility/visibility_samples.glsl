@@ -1,0 +1,90 @@
+// The coverage samples of the compute raster's 64-bit buffer (docs/DESIGN.md#anti-aliasing):
+// VISIBILITY_SAMPLES per pixel (1: the pixel centre alone, anti-aliasing off), at Vulkan's
+// standard sample positions, each keeping its own nearest depth << 32 | visibility id. A
+// pixel's samples lie side by side in the buffer: the lighting reads them in one go.
+// Included before raster_rules.glsl, it widens the rasters' pixel boxes to the samples.
+
+#ifndef MANYLIGHTS_VISIBILITY_SAMPLES_GLSL
+#define MANYLIGHTS_VISIBILITY_SAMPLES_GLSL
+
+// Samples per pixel: 1, 4, 8 or 16 (settings.rs Antialiasing).
+layout(constant_id = 24) const uint VISIBILITY_SAMPLES = 1u;
+
+// Vulkan's standard sample positions (standardSampleLocations), in 1/16 pixel from the
+// pixel's corner, sample by sample.
+const ivec2 SAMPLES_4[4] = ivec2[4](ivec2(6, 2), ivec2(14, 6), ivec2(2, 10), ivec2(10, 14));
+const ivec2 SAMPLES_8[8] = ivec2[8](ivec2(9, 5), ivec2(7, 11), ivec2(13, 9), ivec2(5, 3), ivec2(3, 13), ivec2(1, 7), ivec2(11, 15), ivec2(15, 1));
+const ivec2 SAMPLES_16[16] = ivec2[16](ivec2(9, 9), ivec2(7, 5), ivec2(5, 10), ivec2(12, 7), ivec2(3, 6), ivec2(10, 13), ivec2(13, 11), ivec2(11, 3),
+                                       ivec2(6, 14), ivec2(8, 1), ivec2(4, 2), ivec2(2, 12), ivec2(0, 8), ivec2(15, 4), ivec2(14, 15), ivec2(1, 0));
+
+// Sample s's position in sub-pixel units (1/256 pixel, raster_rules.glsl SUBPIXEL) from the
+// pixel's corner.
+ivec2 sample_offset(uint s) {
+    if (VISIBILITY_SAMPLES == 4u) {
+        return SAMPLES_4[s] * 16;
+    }
+    if (VISIBILITY_SAMPLES == 8u) {
+        return SAMPLES_8[s] * 16;
+    }
+    if (VISIBILITY_SAMPLES == 16u) {
+        return SAMPLES_16[s] * 16;
+    }
+    return ivec2(128);
+}
+
+// The samples' extent in a pixel (sub-pixel units from its corner): a pixel may be covered
+// only where a triangle's box reaches between them (raster_rules.glsl centres_in_box).
+// Branches, not `?:` on the constant: the build's reflection evaluates no constant select.
+ivec2 samples_lo() {
+    if (VISIBILITY_SAMPLES == 16u) {
+        return ivec2(0);
+    }
+    if (VISIBILITY_SAMPLES == 8u) {
+        return ivec2(16);
+    }
+    if (VISIBILITY_SAMPLES == 4u) {
+        return ivec2(32);
+    }
+    return ivec2(128);
+}
+
+ivec2 samples_hi() {
+    if (VISIBILITY_SAMPLES == 4u) {
+        return ivec2(224);
+    }
+    if (VISIBILITY_SAMPLES == 1u) {
+        return ivec2(128);
+    }
+    return ivec2(240);
+}
+#define RASTER_SAMPLE_LO samples_lo()
+#define RASTER_SAMPLE_HI samples_hi()
+
+// Where sample s of `pixel` lies in the buffer, for an image `width` pixels wide.
+uint sample_slot(ivec2 pixel, uint s, uint width) {
+    return (uint(pixel.y) * width + uint(pixel.x)) * VISIBILITY_SAMPLES + s;
+}
+
+// Where a surface covering the samples `members` (a bit each) of `pixel` is shaded: the pixel
+// centre where it covers every sample, else the mean of the samples it covers. Inside their
+// hull either way (the standard positions surround the centre), so the point lies on the
+// surface between its samples' points — which the light grid's marks rely on.
+vec2 shading_xy(ivec2 pixel, uint members) {
+    if (members == (1u << VISIBILITY_SAMPLES) - 1u) {
+        return vec2(pixel) + 0.5;
+    }
+    ivec2 sum = ivec2(0);
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        if ((members & (1u << k)) != 0u) {
+            sum += sample_offset(k);
+        }
+    }
+    return vec2(pixel) + vec2(sum) / (256.0 * float(bitCount(members)));
+}
+
+// Sample k's position in pixels in the image.
+vec2 sample_xy(ivec2 pixel, uint k) {
+    return vec2(pixel) + vec2(sample_offset(k)) / 256.0;
+}
+
+#endif
