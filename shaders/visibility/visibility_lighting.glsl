@@ -67,10 +67,22 @@ vec3 id_color(uint x) {
     return vec3(uvec3(x, x >> 8u, x >> 16u) & 255u) / 255.0;
 }
 
+// Specular anti-aliasing (Tokuyoshi & Kaplanyan's, as Filament does it): a highlight
+// narrower than the pixel's spread of normals flickers between pixels, so the roughness is
+// widened by the normal's variance over the pixel (`dndx`, `dndy`: its change to the next
+// pixel). `roughness` is perceptual (its square the GGX alpha).
+float filtered_roughness(float roughness, vec3 dndx, vec3 dndy) {
+    float variance = 0.01 * (dot(dndx, dndx) + dot(dndy, dndy));
+    float alpha = roughness * roughness;
+    return sqrt(sqrt(clamp(alpha * alpha + min(2.0 * variance, 0.2), 0.0, 1.0)));
+}
+
 // The surface of visibility id `id` at the point `frag_xy` of pixel p, ready to shade: its
 // point (`world`, rebuilt from `z`, its depth there, as every compute lighting and the light
-// grid's marks rebuild it; z < 0: the depth the triangle has there), normal and material.
-void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, out vec3 world, out vec3 n, out PointMaterial m, out uint flags) {
+// grid's marks rebuild it; z < 0: the depth the triangle has there), normal and material —
+// its roughness widened by the normal's variance over the pixel where `filter_specular`
+// (anti-aliasing on).
+void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, bool filter_specular, out vec3 world, out vec3 n, out PointMaterial m, out uint flags) {
     uvec2 object_meshlet = meshlet_instances[id >> VISIBILITY_TRIANGLE_BITS];
     uint object = object_meshlet.x;
     Instance inst = instances[object];
@@ -106,6 +118,14 @@ void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, out vec3 world, out vec
     tangent.xyz = mat3(o.model) * tangent.xyz;
     Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material);
     m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, s.emissive_factor);
+    if (filter_specular) {
+        // The interpolated normal at the quad's pixels, as the texture derivatives above.
+        mat3 normals = mat3(o.normal_matrix) * mat3(v[0].normal, v[1].normal, v[2].normal);
+        vec3 n00 = normalize(normals * barycentrics(c, q));
+        vec3 dndx = normalize(normals * barycentrics(c, q + vec2(1.0, 0.0))) - n00;
+        vec3 dndy = normalize(normals * barycentrics(c, q + vec2(0.0, 1.0))) - n00;
+        m.roughness = filtered_roughness(m.roughness, dndx, dndy);
+    }
     if (z < 0.0) {
         // Clip space interpolates linearly in the perspective-correct barycentrics.
         vec4 point = mat4(c[0], c[1], c[2], vec4(0.0)) * vec4(b, 0.0);
@@ -170,7 +190,7 @@ void shade_samples(ivec2 p) {
             vec3 world, n;
             PointMaterial m;
             uint flags;
-            surface_of(p, id, xy, -1.0, world, n, m, flags);
+            surface_of(p, id, xy, -1.0, true, world, n, m, flags);
             display = shade_display(xy, world, n, m, flags);
         }
         sum += count * display;
@@ -182,9 +202,10 @@ void shade_samples(ivec2 p) {
     }
     bool first = surfaces == 0u ? set == 0u : first_set == set;
     if (view == DEBUG_VIEW_AA) {
-        // Surfaces shaded in the pixel: none the background, one to four and more as heat.
+        // Surfaces shaded in the pixel: none the background; one blue, two cyan, three green,
+        // four yellow, five and more red.
         if (first) {
-            vec4 c = surfaces == 0u ? CLEAR_COLOR : vec4(heat(min(float(surfaces - 1u) / 3.0, 1.0)), 1.0);
+            vec4 c = surfaces == 0u ? CLEAR_COLOR : vec4(heat(min(float(surfaces), 5.0) / 5.0), 1.0);
             imageStore(out_image, p, c);
         }
         return;
@@ -231,14 +252,14 @@ void main() {
     }
     if (view == DEBUG_VIEW_AA) {
         // One surface per pixel without anti-aliasing.
-        imageStore(out_image, p, vec4(heat(0.0), 1.0));
+        imageStore(out_image, p, vec4(heat(0.2), 1.0));
         return;
     }
     vec2 frag_xy = vec2(p) + 0.5;
     vec3 world, n;
     PointMaterial m;
     uint flags;
-    surface_of(p, id, frag_xy, z, world, n, m, flags);
+    surface_of(p, id, frag_xy, z, false, world, n, m, flags);
     shade_and_store(p, frag_xy, world, n, m, flags);
 }
 

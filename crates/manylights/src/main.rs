@@ -157,7 +157,8 @@ struct SceneArgs {
     /// meshlet or triangle; visibility), alpha (opaque grey, alpha-masked green, blended
     /// orange), transparency-layers (transparent layers per pixel, white where some were
     /// merged; scenes with transparent objects), ray-cost (the traversal steps of each point's
-    /// shadow rays, log scale; --omni-shadow rays).
+    /// shadow rays, log scale; --omni-shadow rays), aa (surfaces shaded per pixel: blue one,
+    /// cyan two, green three, yellow four, red more; visibility).
     #[arg(long, default_value = "none")]
     debug_view: String,
     /// Object of the seed scene: sphere, teapot, torusknot, plane, disc, cube, room.

@@ -111,6 +111,9 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                 .into(),
         ));
     }
+    if settings.debug_view == DebugView::Aa {
+        rows.push(("heat legend", "surfaces shaded per pixel: blue 1, cyan 2, green 3, yellow 4, red 5 or more".into()));
+    }
     if settings.debug_view == DebugView::ClusterHeat {
         let grid = stats.feature::<ml_render::LightGridStats>().map(|g| g.heat_top());
         let top = stats.clusters.map(|c| c.max_lights).or(grid).unwrap_or(1).max(1);

@@ -50,7 +50,7 @@ pub enum DebugView {
     /// heat map on a log scale (--omni-shadow rays).
     RayCost,
     /// Surfaces shaded per pixel with anti-aliasing (visibility, compute raster): one blue,
-    /// up to four and more red; the background as it is.
+    /// two cyan, three green, four yellow, five and more red; the background as it is.
     Aa,
 }
 

@@ -50,6 +50,10 @@ fn negative_and_huge_counts_get_their_range() {
     assert_argument_error(&render("--device", "-1"), &["--device -1 is out of range"]);
     assert_argument_error(&render("--shadow-budget", "-5"), &["--shadow-budget -5 is out of range", "device's memory"]);
     assert_argument_error(&render("--width", "wide"), &["--width 'wide' is not a whole number"]);
+    assert_argument_error(&render("--supersample", "17"), &["--supersample 17 is out of range: use 1 to 16"]);
+    assert_argument_error(&render("--aa", "2"), &["'2'", "--aa", "off, 4, 8, 16"]);
+    let big = manylights(&["render", "--supersample", "9", "--width", "2000", "--out", "a.png"]);
+    assert_one_line_error(&big, &["--supersample 9 renders 18000x", "more than 16384 pixels a side"]);
     let out = temp_dir("bench-counts");
     let bench = |args: &[&str]| manylights(&[&["bench", "--out", out.to_str().unwrap()], args].concat());
     // Once warm-up and measured frames were added in 32 bits: 2³² − 1 + 2 wrapped to 1.
@@ -90,6 +94,9 @@ fn options_that_do_not_apply_are_refused() {
         (&["--technique", "forward", "--raster", "hardware"], &["--raster does not apply to forward", "--technique visibility"]),
         (&["--technique", "clustered-gpu", "--raster-split", "8"], &["--raster-split does not apply to clustered-gpu"]),
         (&["--technique", "visibility", "--raster", "hardware", "--raster-split", "8"], &["--raster-split", "--raster hardware"]),
+        (&["--technique", "forward", "--aa", "8"], &["--aa does not apply to forward", "--technique visibility"]),
+        (&["--technique", "visibility", "--raster", "hybrid", "--aa", "4"], &["--aa does not apply to --raster hybrid", "--raster compute"]),
+        (&["--technique", "deferred", "--debug-view", "aa"], &["--debug-view aa", "--technique visibility"]),
         (&["--technique", "forward", "--debug-view", "cluster-heat"], &["--debug-view cluster-heat", "clustered-cpu or clustered-gpu"]),
         (&["--technique", "deferred-compute", "--debug-view", "meshlets"], &["--debug-view meshlets", "--technique visibility"]),
         (&["--technique", "forward", "--debug-view", "shadow-atlas"], &["--debug-view shadow-atlas", "--omni-shadow atlas"]),
@@ -136,6 +143,7 @@ fn options_that_do_not_apply_are_refused() {
         ),
         (&["--techniques", "forward", "--raster", "compute"], &["--raster does not apply to forward", "--techniques visibility"]),
         (&["--raster", "hardware", "--raster-split", "8"], &["--raster-split does not apply to --raster hardware"]),
+        (&["--techniques", "visibility", "--raster", "hardware", "--aa", "8"], &["--aa does not apply to --raster hardware", "--raster compute"]),
         (&["--probe", "--techniques", "forward"], &["--techniques does not apply to bench --probe"]),
         (&["--probe", "--lights", "1k"], &["--lights does not apply to bench --probe"]),
         (&["--probe-lights", "16"], &["--probe-lights does not apply to bench without --probe", "--probe"]),

@@ -4,6 +4,7 @@
 //! Run one subject with `cargo test -p ml-render --test gpu golden::`.
 
 mod alpha_masks;
+mod antialiasing;
 mod cluster_slice;
 mod common;
 mod compute_raster;
