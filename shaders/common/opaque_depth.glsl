@@ -14,9 +14,13 @@ layout(std430, set = 0, binding = 13) readonly buffer VisibilityDepthBuffer { uv
 uvec2 opaque_sample(ivec2 p, uint k) {
     return visibility_depth[sample_slot(p, k, frame.viewport.x)];
 }
+// Sample k's depth.
+float opaque_depth_of_sample(ivec2 p, uint k) {
+    return visibility_buffer_depth(opaque_sample(p, k));
+}
 // With anti-aliasing, the first sample's.
 float opaque_depth_at(ivec2 p) {
-    return visibility_buffer_depth(opaque_sample(p, 0u));
+    return opaque_depth_of_sample(p, 0u);
 }
 #else
 layout(set = 0, binding = 12) uniform sampler2D opaque_depth;

@@ -7,6 +7,7 @@
 //
 // The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer.
 #include "common/common.glsl"
+#extension GL_EXT_control_flow_attributes : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
@@ -36,53 +37,60 @@ void mark_box_run(uint u0, uint u1) {
 }
 
 #ifdef OPAQUE_DEPTH_BUFFER
-// Anti-aliased: every surface of the pixel marks the walks of the box around its samples'
+// Anti-aliased: each surface of a pixel marks the walks from the box around its samples'
 // points. The lighting shades it at a point between them (visibility_samples.glsl
 // shading_xy): on the surface, inside their hull, so inside the box, and every cell its walk
-// visits is marked. Edge pixels have several surfaces, so the points do not share the work
-// group's box: each marks the grid itself.
-void mark_samples(ivec2 p) {
-    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
-        return;
-    }
+// visits is marked. Edge pixels have several surfaces: each is a walk of its own through the
+// work group's box (one box around them all would mark the cells between a near surface and
+// a far one).
+#define MARK_SAMPLES VISIBILITY_SAMPLES
+
+// The surfaces of pixel p as the lighting groups its samples: per surface the samples it
+// covers (a bit each), the count returned.
+uint pixel_surfaces(ivec2 p, out uint members[MARK_SAMPLES]) {
     uvec2 v[VISIBILITY_SAMPLES];
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         v[k] = opaque_sample(p, k);
+        members[k] = 0u;
     }
-    uint grouped = 0u;
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    uint grouped = 0u, count = 0u;
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         if ((grouped & (1u << k)) != 0u || visibility_buffer_depth(v[k]) >= 1.0) {
             continue;
         }
-        uint id = visibility_buffer_id(v[k]), members = 0u;
-        for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
+        uint id = visibility_buffer_id(v[k]), group = 0u;
+        [[unroll]] for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
             if (visibility_buffer_depth(v[j]) < 1.0 && visibility_buffer_id(v[j]) == id) {
-                members |= 1u << j;
+                group |= 1u << j;
             }
         }
-        grouped |= members;
-        vec3 lo = vec3(1e30), hi = vec3(-1e30);
-        for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
-            if ((members & (1u << j)) != 0u) {
-                vec3 world = world_from_depth(sample_xy(p, j), visibility_buffer_depth(v[j]));
-                lo = min(lo, world);
-                hi = max(hi, world);
-            }
-        }
-        mark_rows(mark_walk_of_box(lo, hi));
+        grouped |= group;
+        members[count++] = group;
     }
+    return count;
 }
+
+// The walk of pixel p's surface `i` (its samples `members[i]`; without anti-aliasing `centre`,
+// the walk of the pixel centre's point).
+GridWalk surface_walk(ivec2 p, uint members[MARK_SAMPLES], uint i, GridWalk centre) {
+    if (VISIBILITY_SAMPLES == 1u) {
+        return centre;
+    }
+    vec3 lo = vec3(1e30), hi = vec3(-1e30);
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        if ((members[i] & (1u << k)) != 0u) {
+            vec3 world = world_from_depth(sample_xy(p, k), opaque_depth_of_sample(p, k));
+            lo = min(lo, world);
+            hi = max(hi, world);
+        }
+    }
+    return mark_walk_of_box(lo, hi);
+}
+#else
+#define MARK_SAMPLES 1u
 #endif
 
 void main() {
-#ifdef OPAQUE_DEPTH_BUFFER
-    // The same for the whole dispatch (a constant): no barrier below is skipped by part of a
-    // work group.
-    if (VISIBILITY_SAMPLES != 1u) {
-        mark_samples(ivec2(gl_GlobalInvocationID.xy));
-        return;
-    }
-#endif
     uint t = gl_LocalInvocationIndex;
     if (t < 3u) {
         box_lo[t] = 0xffffffffu;
@@ -94,15 +102,33 @@ void main() {
     barrier();
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     bool inside = p.x < int(frame.viewport.x) && p.y < int(frame.viewport.y);
-    float z = inside ? opaque_depth_at(p) : 1.0;
-    bool surface = z < 1.0;
-    GridWalk w;
-    if (surface) {
-        vec3 world = world_from_depth(vec2(p) + 0.5, z);
-        w = mark_walk_of(world);
-        for (uint i = 0u; i < 3u; ++i) {
-            atomicMin(box_lo[i], w.lo[i]);
-            atomicMax(box_hi[i], w.hi[i]);
+    // The pixel's walks: the centre point's (`centre`), or with anti-aliasing one per surface.
+    GridWalk centre;
+    uint surfaces = 0u;
+    uint members[MARK_SAMPLES];
+    members[0] = 0u;
+    if (MARK_SAMPLES == 1u) {
+        float z = inside ? opaque_depth_at(p) : 1.0;
+        surfaces = z < 1.0 ? 1u : 0u;
+        if (z < 1.0) {
+            centre = mark_walk_of(world_from_depth(vec2(p) + 0.5, z));
+        }
+    }
+#ifdef OPAQUE_DEPTH_BUFFER
+    else if (inside) {
+        surfaces = pixel_surfaces(p, members);
+    }
+#define WALK(i) surface_walk(p, members, i, centre)
+#else
+#define WALK(i) centre
+#endif
+    // Not unrolled: each walk's code is large, and lavapipe builds a frame of every value live
+    // across the barriers below (LLVM coroutines): 16 copies took it minutes.
+    for (uint i = 0u; i < surfaces; i++) {
+        GridWalk w = WALK(i);
+        for (uint a = 0u; a < 3u; ++a) {
+            atomicMin(box_lo[a], w.lo[a]);
+            atomicMax(box_hi[a], w.hi[a]);
         }
     }
     barrier();
@@ -110,9 +136,12 @@ void main() {
     uvec3 hi = uvec3(box_hi[0], box_hi[1], box_hi[2]);
     uvec3 n = lo.x > hi.x ? uvec3(0u) : hi - lo + 1u;
     bool in_box = n.x * n.y * n.z <= BOX_CELLS;
-    if (surface && !in_box) {
-        mark_rows(w);
-    } else if (surface) {
+    for (uint i = 0u; i < surfaces; i++) {
+        GridWalk w = WALK(i);
+        if (!in_box) {
+            mark_rows(w);
+            continue;
+        }
         for (uint cz = w.lo.z; cz <= w.hi.z; ++cz) {
             for (uint cy = w.lo.y; cy <= w.hi.y; ++cy) {
                 uint row = ((cz - lo.z) * n.y + (cy - lo.y)) * n.x - lo.x;

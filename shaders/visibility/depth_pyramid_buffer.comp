@@ -10,7 +10,7 @@ layout(std430, set = 0, binding = 0) readonly buffer VisibilityDepthBuffer { uve
 
 float raster_depth(uvec2 pixel, uint width) {
     float farthest = 0.0;
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         farthest = max(farthest, visibility_buffer_depth(visibility_depth[sample_slot(ivec2(pixel), k, width)]));
     }
     return farthest;

@@ -93,7 +93,7 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces) {
     uint covered = 0u;
     for (int y = t.first.y; y <= t.last.y; y++) {
         for (int x = t.first.x; x <= t.last.x; x++) {
-            for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+            [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
                 ivec3 w;
                 if (!small_covers_at(t, ivec2(x, y), sample_offset(k), w)) {
                     continue;
@@ -247,7 +247,7 @@ bool masked_covers(uint i, ivec2 cell, uint k, out ivec3 w) {
 // Whether triangle i covers any sample of pixel `n` of its box.
 bool masked_covers_any(uint i, uint n) {
     ivec2 cell = masked_cell(i, n);
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         ivec3 w;
         if (masked_covers(i, cell, k, w)) {
             return true;
@@ -267,7 +267,7 @@ uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) 
     vec4 z_inv_w = mask_z_inv_w[i], uv_w = mask_uv_w[i], uv_w_rest = mask_uv_w_rest[i];
     vec3 inv_w = vec3(z_inv_w.w, uv_w.xy), u_w = vec3(uv_w.zw, uv_w_rest.x), v_w = uv_w_rest.yzw;
     uint drawn = 0u;
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         ivec3 w;
         if (!masked_covers(i, cell, k, w)) {
             continue;

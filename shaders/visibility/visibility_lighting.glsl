@@ -104,9 +104,10 @@ void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, bool filter_specular, o
     mat3x2 uvs = mat3x2(v[0].uv, v[1].uv, v[2].uv);
     vec2 uv = uvs * b;
     vec2 q = vec2(p & ~1) + 0.5;
-    vec2 uv00 = uvs * barycentrics(c, q);
-    surface_uv_dx = uvs * barycentrics(c, q + vec2(1.0, 0.0)) - uv00;
-    surface_uv_dy = uvs * barycentrics(c, q + vec2(0.0, 1.0)) - uv00;
+    vec3 b00 = barycentrics(c, q), b10 = barycentrics(c, q + vec2(1.0, 0.0)), b01 = barycentrics(c, q + vec2(0.0, 1.0));
+    vec2 uv00 = uvs * b00;
+    surface_uv_dx = uvs * b10 - uv00;
+    surface_uv_dy = uvs * b01 - uv00;
     vec3 normal = mat3(o.normal_matrix) * (mat3(v[0].normal, v[1].normal, v[2].normal) * b);
     // A double-sided object's back face (its corners clockwise on screen: the homogeneous
     // determinant is the projected area's sign, also for corners behind the eye) is lit on
@@ -121,9 +122,9 @@ void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, bool filter_specular, o
     if (filter_specular) {
         // The interpolated normal at the quad's pixels, as the texture derivatives above.
         mat3 normals = mat3(o.normal_matrix) * mat3(v[0].normal, v[1].normal, v[2].normal);
-        vec3 n00 = normalize(normals * barycentrics(c, q));
-        vec3 dndx = normalize(normals * barycentrics(c, q + vec2(1.0, 0.0))) - n00;
-        vec3 dndy = normalize(normals * barycentrics(c, q + vec2(0.0, 1.0))) - n00;
+        vec3 n00 = normalize(normals * b00);
+        vec3 dndx = normalize(normals * b10) - n00;
+        vec3 dndy = normalize(normals * b01) - n00;
         m.roughness = filtered_roughness(m.roughness, dndx, dndy);
     }
     if (z < 0.0) {
@@ -143,65 +144,115 @@ uint texture_set_of(uint id) {
 
 #if defined(RASTER_SAMPLES) && !defined(LINEAR_OUTPUT)
 // Anti-aliased (docs/DESIGN.md#anti-aliasing): the pixel's samples grouped by the surface
-// (visibility id) they hold, each surface shaded once (at shading_xy), and the pixel the mean of its samples' display-linear colours:
-// each surface weighed by the samples it covers, the background likewise. Surfaces whose
+// (visibility id) they hold, each surface shaded once (at shading_xy), and the pixel the mean
+// of its samples' display-linear colours: each surface weighed by the samples it covers, the
+// background likewise. Edge pixels hold several surfaces and interior ones one, so a thread
+// shading its own pixel's would keep its subgroup waiting on the pixel with the most: each
+// subgroup lists its pixels' surfaces and shades the list a surface a lane, adding each colour
+// into its pixel's sum in fixed point (integers: the same sum in any order). Subgroups, not
+// the work group: no barrier holds one subgroup's lanes for another's. Surfaces whose
 // textures another dispatch binds are that dispatch's: the first dispatch with a surface in
 // the pixel (the first set's where none has) stores its share, the later ones add theirs.
-void shade_samples(ivec2 p) {
-    uvec2 v[VISIBILITY_SAMPLES];
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-        v[k] = raster_sample(p, k);
-    }
+
+const uint GROUP_PIXELS = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+// Per subgroup, the surfaces to shade: each one's pixel in the work group << 16 | the samples
+// it covers (a bit each).
+shared uint surface_list[GROUP_PIXELS * VISIBILITY_SAMPLES];
+// Per pixel of the work group, its surfaces' colours summed (display-linear × samples covered,
+// in units of 1 / FIXED_ONE): only its own subgroup touches them.
+shared uint colour_sums[GROUP_PIXELS * 3u];
+const float FIXED_ONE = 1048576.0; // 2^20: 16 samples of colour 1 still fit 32 bits
+
+// The colour of the surface that covers the samples `members` of pixel p: shaded, or a
+// debug view's.
+vec3 surface_display(ivec2 p, uint members) {
+    uint id = visibility_buffer_id(raster_sample(p, findLSB(members)));
     uint view = frame.cluster_dims.w;
+    if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
+        return pow(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), vec3(2.2));
+    }
+    vec2 xy = shading_xy(p, members);
+    vec3 world, n;
+    PointMaterial m;
+    uint flags;
+    surface_of(p, id, xy, -1.0, true, world, n, m, flags);
+    return shade_display(xy, world, n, m, flags);
+}
+
+// Every lane of the subgroup calls it (subgroup operations); pixels outside the image list
+// nothing.
+void shade_samples(ivec2 p, bool inside) {
+    uint lid = gl_LocalInvocationIndex;
     uint set = opaque_uniform(texture_set.x);
-    vec3 sum = vec3(0.0);
+    colour_sums[3u * lid] = 0u;
+    colour_sums[3u * lid + 1u] = 0u;
+    colour_sums[3u * lid + 2u] = 0u;
+    uvec2 v[VISIBILITY_SAMPLES];
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        v[k] = inside ? raster_sample(p, k) : uvec2(0u, 0xffffffffu);
+    }
+    // The pixel's surfaces: those of this dispatch's set (`mine`, as the list will hold them).
     uint grouped = 0u, surfaces = 0u, background = 0u, first_set = 0xffffffffu, shaded = 0u;
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    uint mine[VISIBILITY_SAMPLES];
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        mine[k] = 0u;
         if ((grouped & (1u << k)) != 0u) {
             continue;
         }
         bool drawn = visibility_buffer_depth(v[k]) < 1.0;
         uint id = visibility_buffer_id(v[k]);
         uint members = 0u;
-        for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
+        [[unroll]] for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
             bool drawn_j = visibility_buffer_depth(v[j]) < 1.0;
             if (drawn_j == drawn && (!drawn || visibility_buffer_id(v[j]) == id)) {
                 members |= 1u << j;
             }
         }
         grouped |= members;
-        float count = float(bitCount(members));
         if (!drawn) {
-            background += uint(count);
+            background += uint(bitCount(members));
             continue;
         }
         surfaces++;
         uint surface_set = texture_set_of(id);
         first_set = min(first_set, surface_set);
-        if (surface_set != set) {
-            continue;
+        if (surface_set == set) {
+            mine[k] = (lid << 16u) | members;
+            shaded++;
         }
-        shaded++;
-        vec3 display;
-        if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
-            display = pow(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), vec3(2.2));
-        } else {
-            vec2 xy = shading_xy(p, members);
-            vec3 world, n;
-            PointMaterial m;
-            uint flags;
-            surface_of(p, id, xy, -1.0, true, world, n, m, flags);
-            display = shade_display(xy, world, n, m, flags);
+    }
+    // The subgroup's list: each lane's surfaces after those of the lanes before it.
+    uint list = gl_SubgroupID * gl_SubgroupSize * VISIBILITY_SAMPLES;
+    uint at = list + subgroupExclusiveAdd(shaded), listed = subgroupAdd(shaded);
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        if (mine[k] != 0u) {
+            surface_list[at++] = mine[k];
         }
-        sum += count * display;
+    }
+    subgroupMemoryBarrierShared();
+    subgroupBarrier();
+    uvec2 origin = gl_WorkGroupID.xy * gl_WorkGroupSize.xy;
+    for (uint first = 0u; first < listed; first += gl_SubgroupSize) {
+        if (first + gl_SubgroupInvocationID < listed) {
+            uint entry = surface_list[list + first + gl_SubgroupInvocationID], pixel = entry >> 16u, members = entry & 0xffffu;
+            ivec2 q = ivec2(origin + uvec2(pixel % gl_WorkGroupSize.x, pixel / gl_WorkGroupSize.x));
+            uvec3 fixed_colour = uvec3(round(surface_display(q, members) * FIXED_ONE)) * uint(bitCount(members));
+            atomicAdd(colour_sums[3u * pixel], fixed_colour.r);
+            atomicAdd(colour_sums[3u * pixel + 1u], fixed_colour.g);
+            atomicAdd(colour_sums[3u * pixel + 2u], fixed_colour.b);
+        }
     }
     // The surfaces shaded, for the report (ray_count.y; the host zeroes it before the frame).
-    uint counted = subgroupAdd(shaded);
-    if (subgroupElect() && counted != 0u) {
-        atomicAdd(ray_count.y, counted);
+    if (subgroupElect() && listed != 0u) {
+        atomicAdd(ray_count.y, listed);
+    }
+    subgroupMemoryBarrierShared();
+    subgroupBarrier();
+    if (!inside) {
+        return;
     }
     bool first = surfaces == 0u ? set == 0u : first_set == set;
-    if (view == DEBUG_VIEW_AA) {
+    if (frame.cluster_dims.w == DEBUG_VIEW_AA) {
         // Surfaces shaded in the pixel: none the background; one blue, two cyan, three green,
         // four yellow, five and more red.
         if (first) {
@@ -210,7 +261,7 @@ void shade_samples(ivec2 p) {
         }
         return;
     }
-    sum /= float(VISIBILITY_SAMPLES);
+    vec3 sum = vec3(colour_sums[3u * lid], colour_sums[3u * lid + 1u], colour_sums[3u * lid + 2u]) / (FIXED_ONE * float(VISIBILITY_SAMPLES));
     if (first) {
         sum += float(background) / float(VISIBILITY_SAMPLES) * pow(CLEAR_COLOR.rgb, vec3(2.2));
     } else if (shaded != 0u) {
@@ -224,15 +275,17 @@ void shade_samples(ivec2 p) {
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
-        return;
-    }
+    bool inside = p.x < int(frame.viewport.x) && p.y < int(frame.viewport.y);
 #if defined(RASTER_SAMPLES) && !defined(LINEAR_OUTPUT)
+    // The same for the whole dispatch (a constant): every thread of a work group takes it.
     if (VISIBILITY_SAMPLES != 1u) {
-        shade_samples(p);
+        shade_samples(p, inside);
         return;
     }
 #endif
+    if (!inside) {
+        return;
+    }
     float z = raster_depth(p);
     if (z >= 1.0) {
         // The background, once: by the first set's dispatch.

@@ -7,6 +7,11 @@
 #ifndef MANYLIGHTS_VISIBILITY_SAMPLES_GLSL
 #define MANYLIGHTS_VISIBILITY_SAMPLES_GLSL
 
+// Loops over a pixel's samples are unrolled ([[unroll]]): their count is a constant once
+// specialized, and an unrolled loop keeps its per-sample values (the samples read, the
+// positions) in registers, where a loop indexes them from memory.
+#extension GL_EXT_control_flow_attributes : require
+
 // Samples per pixel: 1, 4, 8 or 16 (settings.rs Antialiasing).
 layout(constant_id = 24) const uint VISIBILITY_SAMPLES = 1u;
 
@@ -74,7 +79,7 @@ vec2 shading_xy(ivec2 pixel, uint members) {
         return vec2(pixel) + 0.5;
     }
     ivec2 sum = ivec2(0);
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         if ((members & (1u << k)) != 0u) {
             sum += sample_offset(k);
         }

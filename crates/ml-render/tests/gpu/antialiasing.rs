@@ -27,7 +27,11 @@ const REFERENCE: u32 = 8;
 
 /// The visibility technique with the compute raster at `width`×`height`, samples `aa`.
 fn visibility(width: u32, height: u32, aa: Antialiasing) -> RenderSettings {
-    RenderSettings { raster: Raster::compute(Raster::DEFAULT_SPLIT), antialiasing: aa, ..RenderSettings::new(Technique::Visibility, width, height) }
+    RenderSettings {
+        raster: Raster::compute(Raster::DEFAULT_SPLIT),
+        antialiasing: aa,
+        ..RenderSettings::new(Technique::Visibility, width, height)
+    }
 }
 
 /// RMS error (8-bit units) of anti-aliasing off and at `samples` against the supersampled
@@ -56,9 +60,13 @@ fn foliage() -> Scene {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(52);
     for _ in 0..300 {
         let at = Vec3::new(rng.random_range(-1.5..1.5), rng.random_range(0.3..2.8), rng.random_range(-1.5..1.5));
-        let turn = Quat::from_euler(glam::EulerRot::XYZ, rng.random_range(0.0..6.3), rng.random_range(0.0..6.3), rng.random_range(0.0..6.3));
+        let turn =
+            Quat::from_euler(glam::EulerRot::XYZ, rng.random_range(0.0..6.3), rng.random_range(0.0..6.3), rng.random_range(0.0..6.3));
         let scale = rng.random_range(0.12..0.3);
-        w.node(json!({ "mesh": leaf_mesh, "translation": at.to_array(), "rotation": turn.to_array(), "scale": [scale, scale, scale] }), true);
+        w.node(
+            json!({ "mesh": leaf_mesh, "translation": at.to_array(), "rotation": turn.to_array(), "scale": [scale, scale, scale] }),
+            true,
+        );
     }
     let (mut scene, _) = ml_cpu::gltf_scene::from_bytes(&w.to_glb(), None).expect("a good file");
     scene.camera = Camera::looking_at(Vec3::new(0.5, 2.2, 5.5), Vec3::new(0.0, 1.5, 0.0), 45.0, 0.1, 50.0);
@@ -97,7 +105,9 @@ fn samples_change_no_pixel_they_must_not() {
         RenderSettings { light_grid_marks: true, ..base },
     ];
     let outputs = common::render_each(&scene, &settings);
-    for (what, out) in ["a second render", "culling off", "the light grid's marks off", "the light grid's marks on"].iter().zip(&outputs[1..]) {
+    for (what, out) in
+        ["a second render", "culling off", "the light grid's marks off", "the light grid's marks on"].iter().zip(&outputs[1..])
+    {
         let (worst, pixels) = common::max_difference(&outputs[0], out);
         assert_eq!((worst, pixels), (0, 0), "{what}: {pixels} pixels differ, by up to {worst}/255");
     }
@@ -113,7 +123,10 @@ fn a_pixel_shades_each_surface_its_samples_hold_once() {
     let mut w = GltfWriter::new();
     let m = w.material([0.7, 0.7, 0.7, 1.0], 0.0, 0.5);
     let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
-    w.node(json!({ "mesh": mesh, "rotation": Quat::from_rotation_x(std::f32::consts::FRAC_PI_2).to_array(), "scale": [8.0, 8.0, 8.0] }), true);
+    w.node(
+        json!({ "mesh": mesh, "rotation": Quat::from_rotation_x(std::f32::consts::FRAC_PI_2).to_array(), "scale": [8.0, 8.0, 8.0] }),
+        true,
+    );
     let (mut scene, _) = ml_cpu::gltf_scene::from_bytes(&w.to_glb(), None).expect("a good file");
     scene.camera = Camera::looking_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 60.0, 0.1, 20.0);
     scene.lights = vec![PointLight { position_radius: [0.0, 0.0, 2.0, 10.0], color: [1.0, 1.0, 1.0, 0.0] }];
