@@ -146,56 +146,66 @@ uint texture_set_of(uint id) {
 // Anti-aliased (docs/DESIGN.md#anti-aliasing): the pixel's samples grouped by the surface
 // (visibility id) they hold, each surface shaded once (at shading_xy), and the pixel the mean
 // of its samples' display-linear colours: each surface weighed by the samples it covers, the
-// background likewise. Edge pixels hold several surfaces and interior ones one, so a thread
-// shading its own pixel's would keep its subgroup waiting on the pixel with the most: each
-// subgroup lists its pixels' surfaces and shades the list a surface a lane, adding each colour
-// into its pixel's sum in fixed point (integers: the same sum in any order). Subgroups, not
-// the work group: no barrier holds one subgroup's lanes for another's. Surfaces whose
-// textures another dispatch binds are that dispatch's: the first dispatch with a surface in
-// the pixel (the first set's where none has) stores its share, the later ones add theirs.
+// background likewise. Every lane shades its pixel's first surface; edge pixels hold more,
+// and a lane shading its own would keep its subgroup waiting on the pixel with the most, so
+// the others are dealt out: each round the subgroup's lanes list their pending surfaces, a
+// lane each (as many as it has lanes), shade them and hand the colours back through shared
+// memory. A surface is named by its first sample (its "leader"); the lane that shades it
+// finds its samples again from the buffer. Shared memory is a slot per lane (the lighting
+// is fast only with most of L1 left as cache). Surfaces whose textures another dispatch
+// binds are that dispatch's: the first dispatch with a surface in the pixel (the first set's
+// where none has) stores its share, the later ones add theirs.
 
-const uint GROUP_PIXELS = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
-// Per subgroup, the surfaces to shade: each one's pixel in the work group << 16 | the samples
-// it covers (a bit each).
-shared uint surface_list[GROUP_PIXELS * VISIBILITY_SAMPLES];
-// Per pixel of the work group, its surfaces' colours summed (display-linear × samples covered,
-// in units of 1 / FIXED_ONE): only its own subgroup touches them.
-shared uint colour_sums[GROUP_PIXELS * 3u];
-const float FIXED_ONE = 1048576.0; // 2^20: 16 samples of colour 1 still fit 32 bits
+// Per lane, the surface it shades this round (its pixel in the work group << 16 | leader
+// sample), and then its colour × samples covered.
+shared uint dealt[gl_WorkGroupSize.x * gl_WorkGroupSize.y];
+shared vec3 dealt_colour[gl_WorkGroupSize.x * gl_WorkGroupSize.y];
 
-// The colour of the surface that covers the samples `members` of pixel p: shaded, or a
-// debug view's.
-vec3 surface_display(ivec2 p, uint members) {
-    uint id = visibility_buffer_id(raster_sample(p, findLSB(members)));
-    uint view = frame.cluster_dims.w;
-    if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
-        return pow(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), vec3(2.2));
+// The samples of pixel p holding the same surface as sample `leader` (a bit each).
+uint samples_of(ivec2 p, uint leader) {
+    uvec2 l = raster_sample(p, leader);
+    uint members = 0u;
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        uvec2 v = raster_sample(p, k);
+        if (visibility_buffer_depth(v) < 1.0 && visibility_buffer_id(v) == l.x) {
+            members |= 1u << k;
+        }
     }
-    vec2 xy = shading_xy(p, members);
-    vec3 world, n;
-    PointMaterial m;
-    uint flags;
-    surface_of(p, id, xy, -1.0, true, world, n, m, flags);
-    return shade_display(xy, world, n, m, flags);
+    return members;
 }
 
-// Every lane of the subgroup calls it (subgroup operations); pixels outside the image list
-// nothing.
+// The colour of the surface whose first sample is `leader` in pixel p, shaded (or a debug
+// view's), times the samples it covers.
+vec3 surface_display(ivec2 p, uint leader) {
+    uint members = samples_of(p, leader);
+    uint id = visibility_buffer_id(raster_sample(p, leader));
+    uint view = frame.cluster_dims.w;
+    vec3 display;
+    if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
+        display = pow(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), vec3(2.2));
+    } else {
+        vec2 xy = shading_xy(p, members);
+        vec3 world, n;
+        PointMaterial m;
+        uint flags;
+        surface_of(p, id, xy, -1.0, true, world, n, m, flags);
+        display = shade_display(xy, world, n, m, flags);
+    }
+    return display * float(bitCount(members));
+}
+
+// Every lane of the subgroup calls it (subgroup operations); pixels outside the image have
+// no surfaces.
 void shade_samples(ivec2 p, bool inside) {
-    uint lid = gl_LocalInvocationIndex;
+    uint lid = gl_LocalInvocationIndex, lane = gl_SubgroupInvocationID;
     uint set = opaque_uniform(texture_set.x);
-    colour_sums[3u * lid] = 0u;
-    colour_sums[3u * lid + 1u] = 0u;
-    colour_sums[3u * lid + 2u] = 0u;
     uvec2 v[VISIBILITY_SAMPLES];
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         v[k] = inside ? raster_sample(p, k) : uvec2(0u, 0xffffffffu);
     }
-    // The pixel's surfaces: those of this dispatch's set (`mine`, as the list will hold them).
-    uint grouped = 0u, surfaces = 0u, background = 0u, first_set = 0xffffffffu, shaded = 0u;
-    uint mine[VISIBILITY_SAMPLES];
+    // The pixel's surfaces by their leaders: those of this dispatch's set to shade.
+    uint grouped = 0u, surfaces = 0u, background = 0u, first_set = 0xffffffffu, leaders = 0u;
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-        mine[k] = 0u;
         if ((grouped & (1u << k)) != 0u) {
             continue;
         }
@@ -217,37 +227,58 @@ void shade_samples(ivec2 p, bool inside) {
         uint surface_set = texture_set_of(id);
         first_set = min(first_set, surface_set);
         if (surface_set == set) {
-            mine[k] = (lid << 16u) | members;
-            shaded++;
+            leaders |= 1u << k;
         }
     }
-    // The subgroup's list: each lane's surfaces after those of the lanes before it.
-    uint list = gl_SubgroupID * gl_SubgroupSize * VISIBILITY_SAMPLES;
-    uint at = list + subgroupExclusiveAdd(shaded), listed = subgroupAdd(shaded);
-    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-        if (mine[k] != 0u) {
-            surface_list[at++] = mine[k];
+    uint shaded = uint(bitCount(leaders));
+    // Round 0: each lane its own first surface. Then the others, dealt out.
+    int own = findLSB(leaders);
+    leaders &= leaders - 1u;
+    ivec2 item = p;
+    int item_leader = own;
+    vec3 sum = vec3(0.0);
+    uint first_slot = 0u, slots = 0u;
+    for (uint round = 0u;; round++) {
+        vec3 colour = item_leader >= 0 ? surface_display(item, uint(item_leader)) : vec3(0.0);
+        if (round == 0u) {
+            sum = colour;
+        } else {
+            dealt_colour[gl_SubgroupID * gl_SubgroupSize + lane] = colour;
         }
-    }
-    subgroupMemoryBarrierShared();
-    subgroupBarrier();
-    uvec2 origin = gl_WorkGroupID.xy * gl_WorkGroupSize.xy;
-    for (uint first = 0u; first < listed; first += gl_SubgroupSize) {
-        if (first + gl_SubgroupInvocationID < listed) {
-            uint entry = surface_list[list + first + gl_SubgroupInvocationID], pixel = entry >> 16u, members = entry & 0xffffu;
-            ivec2 q = ivec2(origin + uvec2(pixel % gl_WorkGroupSize.x, pixel / gl_WorkGroupSize.x));
-            uvec3 fixed_colour = uvec3(round(surface_display(q, members) * FIXED_ONE)) * uint(bitCount(members));
-            atomicAdd(colour_sums[3u * pixel], fixed_colour.r);
-            atomicAdd(colour_sums[3u * pixel + 1u], fixed_colour.g);
-            atomicAdd(colour_sums[3u * pixel + 2u], fixed_colour.b);
+        subgroupMemoryBarrierShared();
+        subgroupBarrier();
+        // Collect what was shaded for this pixel last round.
+        for (uint i = 0u; i < slots; i++) {
+            sum += dealt_colour[gl_SubgroupID * gl_SubgroupSize + first_slot + i];
+        }
+        // Deal the next round: each lane's pending surfaces after those of the lanes before it.
+        uint pending = uint(bitCount(leaders));
+        uint total = subgroupAdd(pending);
+        if (total == 0u) {
+            break;
+        }
+        first_slot = subgroupExclusiveAdd(pending);
+        slots = first_slot < gl_SubgroupSize ? min(pending, gl_SubgroupSize - first_slot) : 0u;
+        subgroupBarrier();
+        for (uint i = 0u; i < slots; i++) {
+            dealt[gl_SubgroupID * gl_SubgroupSize + first_slot + i] = (lid << 16u) | uint(findLSB(leaders));
+            leaders &= leaders - 1u;
+        }
+        subgroupMemoryBarrierShared();
+        subgroupBarrier();
+        item_leader = -1;
+        if (lane < total) {
+            uint entry = dealt[gl_SubgroupID * gl_SubgroupSize + lane], pixel = entry >> 16u;
+            uvec2 origin = gl_WorkGroupID.xy * gl_WorkGroupSize.xy;
+            item = ivec2(origin + uvec2(pixel % gl_WorkGroupSize.x, pixel / gl_WorkGroupSize.x));
+            item_leader = int(entry & 0xffffu);
         }
     }
     // The surfaces shaded, for the report (ray_count.y; the host zeroes it before the frame).
-    if (subgroupElect() && listed != 0u) {
-        atomicAdd(ray_count.y, listed);
+    uint counted = subgroupAdd(shaded);
+    if (subgroupElect() && counted != 0u) {
+        atomicAdd(ray_count.y, counted);
     }
-    subgroupMemoryBarrierShared();
-    subgroupBarrier();
     if (!inside) {
         return;
     }
@@ -261,7 +292,7 @@ void shade_samples(ivec2 p, bool inside) {
         }
         return;
     }
-    vec3 sum = vec3(colour_sums[3u * lid], colour_sums[3u * lid + 1u], colour_sums[3u * lid + 2u]) / (FIXED_ONE * float(VISIBILITY_SAMPLES));
+    sum /= float(VISIBILITY_SAMPLES);
     if (first) {
         sum += float(background) / float(VISIBILITY_SAMPLES) * pow(CLEAR_COLOR.rgb, vec3(2.2));
     } else if (shaded != 0u) {
