@@ -45,41 +45,37 @@ void mark_box_run(uint u0, uint u1) {
 // a far one).
 #define MARK_SAMPLES VISIBILITY_SAMPLES
 
-// The surfaces of pixel p as the lighting groups its samples: per surface the samples it
-// covers (a bit each), the count returned.
-uint pixel_surfaces(ivec2 p, out uint members[MARK_SAMPLES]) {
+// The surfaces of pixel p as the lighting groups its samples, each named by its first sample
+// (a bit each: no array, which a loop would index in memory).
+uint pixel_leaders(ivec2 p) {
     uvec2 v[VISIBILITY_SAMPLES];
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         v[k] = opaque_sample(p, k);
-        members[k] = 0u;
     }
-    uint grouped = 0u, count = 0u;
+    uint grouped = 0u, leaders = 0u;
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         if ((grouped & (1u << k)) != 0u || visibility_buffer_depth(v[k]) >= 1.0) {
             continue;
         }
-        uint id = visibility_buffer_id(v[k]), group = 0u;
+        leaders |= 1u << k;
         [[unroll]] for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
-            if (visibility_buffer_depth(v[j]) < 1.0 && visibility_buffer_id(v[j]) == id) {
-                group |= 1u << j;
+            if (visibility_buffer_depth(v[j]) < 1.0 && visibility_buffer_id(v[j]) == visibility_buffer_id(v[k])) {
+                grouped |= 1u << j;
             }
         }
-        grouped |= group;
-        members[count++] = group;
     }
-    return count;
+    return leaders;
 }
 
-// The walk of pixel p's surface `i` (its samples `members[i]`; without anti-aliasing `centre`,
-// the walk of the pixel centre's point).
-GridWalk surface_walk(ivec2 p, uint members[MARK_SAMPLES], uint i, GridWalk centre) {
-    if (VISIBILITY_SAMPLES == 1u) {
-        return centre;
-    }
+// The walk of pixel p's surface whose first sample is `leader`: the box around its samples'
+// points.
+GridWalk leader_walk(ivec2 p, uint leader) {
+    uint id = visibility_buffer_id(opaque_sample(p, leader));
     vec3 lo = vec3(1e30), hi = vec3(-1e30);
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-        if ((members[i] & (1u << k)) != 0u) {
-            vec3 world = world_from_depth(sample_xy(p, k), opaque_depth_of_sample(p, k));
+        uvec2 v = opaque_sample(p, k);
+        if (visibility_buffer_depth(v) < 1.0 && visibility_buffer_id(v) == id) {
+            vec3 world = world_from_depth(sample_xy(p, k), visibility_buffer_depth(v));
             lo = min(lo, world);
             hi = max(hi, world);
         }
@@ -102,30 +98,29 @@ void main() {
     barrier();
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     bool inside = p.x < int(frame.viewport.x) && p.y < int(frame.viewport.y);
-    // The pixel's walks: the centre point's (`centre`), or with anti-aliasing one per surface.
+    // The pixel's walks: the centre point's (`centre`), or with anti-aliasing one per surface
+    // (`leaders`, a bit each).
     GridWalk centre;
-    uint surfaces = 0u;
-    uint members[MARK_SAMPLES];
-    members[0] = 0u;
+    uint leaders = 0u;
     if (MARK_SAMPLES == 1u) {
         float z = inside ? opaque_depth_at(p) : 1.0;
-        surfaces = z < 1.0 ? 1u : 0u;
+        leaders = z < 1.0 ? 1u : 0u;
         if (z < 1.0) {
             centre = mark_walk_of(world_from_depth(vec2(p) + 0.5, z));
         }
     }
 #ifdef OPAQUE_DEPTH_BUFFER
     else if (inside) {
-        surfaces = pixel_surfaces(p, members);
+        leaders = pixel_leaders(p);
     }
-#define WALK(i) surface_walk(p, members, i, centre)
+#define WALK(l) (MARK_SAMPLES == 1u ? centre : leader_walk(p, uint(findLSB(l))))
 #else
-#define WALK(i) centre
+#define WALK(l) centre
 #endif
     // Not unrolled: each walk's code is large, and lavapipe builds a frame of every value live
     // across the barriers below (LLVM coroutines): 16 copies took it minutes.
-    for (uint i = 0u; i < surfaces; i++) {
-        GridWalk w = WALK(i);
+    for (uint l = leaders; l != 0u; l &= l - 1u) {
+        GridWalk w = WALK(l);
         for (uint a = 0u; a < 3u; ++a) {
             atomicMin(box_lo[a], w.lo[a]);
             atomicMax(box_hi[a], w.hi[a]);
@@ -136,8 +131,8 @@ void main() {
     uvec3 hi = uvec3(box_hi[0], box_hi[1], box_hi[2]);
     uvec3 n = lo.x > hi.x ? uvec3(0u) : hi - lo + 1u;
     bool in_box = n.x * n.y * n.z <= BOX_CELLS;
-    for (uint i = 0u; i < surfaces; i++) {
-        GridWalk w = WALK(i);
+    for (uint l = leaders; l != 0u; l &= l - 1u) {
+        GridWalk w = WALK(l);
         if (!in_box) {
             mark_rows(w);
             continue;
