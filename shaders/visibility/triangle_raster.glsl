@@ -267,7 +267,7 @@ uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) 
     vec4 z_inv_w = mask_z_inv_w[i], uv_w = mask_uv_w[i], uv_w_rest = mask_uv_w_rest[i];
     vec3 inv_w = vec3(z_inv_w.w, uv_w.xy), u_w = vec3(uv_w.zw, uv_w_rest.x), v_w = uv_w_rest.yzw;
     uint drawn = 0u;
-    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         ivec3 w;
         if (!masked_covers(i, cell, k, w)) {
             continue;

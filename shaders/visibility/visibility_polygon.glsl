@@ -92,7 +92,7 @@ uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id, SurfaceTest s) {
     for (int y = from.y; y <= to.y; y++, row += step_y) {
         i64vec3 centre = row;
         for (int x = from.x; x <= to.x; x++, centre += step_x) {
-            [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+            for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
                 // From the pixel centre (where `centre` is) to the sample.
                 ivec2 offset = sample_offset(k) - 128;
                 i64vec3 w = centre + int64_t(offset.x) * unit_x + int64_t(offset.y) * unit_y;

@@ -16,26 +16,31 @@
 layout(constant_id = 24) const uint VISIBILITY_SAMPLES = 1u;
 
 // Vulkan's standard sample positions (standardSampleLocations), in 1/16 pixel from the
-// pixel's corner, sample by sample.
-const ivec2 SAMPLES_4[4] = ivec2[4](ivec2(6, 2), ivec2(14, 6), ivec2(2, 10), ivec2(10, 14));
-const ivec2 SAMPLES_8[8] = ivec2[8](ivec2(9, 5), ivec2(7, 11), ivec2(13, 9), ivec2(5, 3), ivec2(3, 13), ivec2(1, 7), ivec2(11, 15), ivec2(15, 1));
-const ivec2 SAMPLES_16[16] = ivec2[16](ivec2(9, 9), ivec2(7, 5), ivec2(5, 10), ivec2(12, 7), ivec2(3, 6), ivec2(10, 13), ivec2(13, 11), ivec2(11, 3),
-                                       ivec2(6, 14), ivec2(8, 1), ivec2(4, 2), ivec2(2, 12), ivec2(0, 8), ivec2(15, 4), ivec2(14, 15), ivec2(1, 0));
+// pixel's corner: a byte a sample (x in its low 4 bits, y in its high 4), four to a word, so
+// that finding one is arithmetic — a constant array indexed in a loop that is not unrolled
+// lives in memory.
+const uvec4 SAMPLES_4 = uvec4(0xeaa26e26u, 0x00000000u, 0x00000000u, 0x00000000u);
+const uvec4 SAMPLES_8 = uvec4(0x359db759u, 0x1ffb71d3u, 0x00000000u, 0x00000000u);
+const uvec4 SAMPLES_16 = uvec4(0x7ca55799u, 0x3bbdda63u, 0xc22418e6u, 0x01fe4f80u);
 
 // Sample s's position in sub-pixel units (1/256 pixel, raster_rules.glsl SUBPIXEL) from the
 // pixel's corner.
 ivec2 sample_offset(uint s) {
+    if (VISIBILITY_SAMPLES == 1u) {
+        return ivec2(128);
+    }
+    uvec4 table = SAMPLES_16;
     if (VISIBILITY_SAMPLES == 4u) {
-        return SAMPLES_4[s] * 16;
+        table = SAMPLES_4;
     }
     if (VISIBILITY_SAMPLES == 8u) {
-        return SAMPLES_8[s] * 16;
+        table = SAMPLES_8;
     }
-    if (VISIBILITY_SAMPLES == 16u) {
-        return SAMPLES_16[s] * 16;
-    }
-    return ivec2(128);
+    uint word = s < 4u ? table.x : s < 8u ? table.y : s < 12u ? table.z : table.w;
+    uint position = (word >> (8u * (s & 3u))) & 0xffu;
+    return ivec2(position & 15u, position >> 4u) * 16;
 }
+
 
 // The samples' extent in a pixel (sub-pixel units from its corner): a pixel may be covered
 // only where a triangle's box reaches between them (raster_rules.glsl centres_in_box).

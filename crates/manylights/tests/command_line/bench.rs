@@ -24,6 +24,7 @@ fn a_tiny_bench_writes_its_tables() {
     for column in [
         "technique",
         "raster",
+        "aa",
         "lights",
         "status",
         "pass",
@@ -53,6 +54,7 @@ fn a_tiny_bench_writes_its_tables() {
     for r in &rows {
         assert_eq!(r.len(), header.len(), "{r:?}");
         assert_eq!(r[col("status")], "measured");
+        assert_eq!(r[col("aa")], "off", "{r:?}");
         let (median, p95): (f64, f64) = (r[col("gpu_median_ms")].parse().unwrap(), r[col("gpu_p95_ms")].parse().unwrap());
         assert!(median > 0.0 && p95 >= median, "{r:?}");
         // CPU phases: recording takes time in every technique; only CPU-built clusters assign.
@@ -88,9 +90,9 @@ fn a_tiny_bench_writes_its_tables() {
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), 4, "{csv}");
-    assert!(rows[0].starts_with("forward,,64,") && rows[0].contains("skipped: 3 frames would take"), "{csv}");
+    assert!(rows[0].starts_with("forward,,off,64,") && rows[0].contains("skipped: 3 frames would take"), "{csv}");
     assert!(rows[0].contains("one frame measured") && rows[1].contains("one frame measured"), "{csv}");
-    assert!(rows[2].starts_with("forward,,1000000,") && rows[2].contains("scaled from 64 lights"), "{csv}");
+    assert!(rows[2].starts_with("forward,,off,1000000,") && rows[2].contains("scaled from 64 lights"), "{csv}");
     assert!(rows[3].contains("skipped: one frame would take about") && rows[3].contains("scaled from 64 lights"), "{csv}");
 }
 
