@@ -7,8 +7,10 @@
 
 // The opaque depth: the raster's depth image, or (OPAQUE_DEPTH_BUFFER) the compute raster's
 // 64-bit buffer (depth in the high word). 1 where nothing was drawn.
-#ifdef OPAQUE_DEPTH_BUFFER
+// (The samples' header for every includer: declared, its constant is left at one where no
+// buffer is read.)
 #include "visibility/visibility_samples.glsl"
+#ifdef OPAQUE_DEPTH_BUFFER
 layout(std430, set = 0, binding = 13) readonly buffer VisibilityDepthBuffer { uvec2 visibility_depth[]; };
 // Sample k of pixel p as the compute raster left it (visibility_samples.glsl).
 uvec2 opaque_sample(ivec2 p, uint k) {
