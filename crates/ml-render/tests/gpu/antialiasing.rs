@@ -95,24 +95,18 @@ fn eight_samples_cut_the_error_against_the_supersampled_reference_to_a_third() {
 
 #[test]
 fn samples_change_no_pixel_they_must_not() {
-    let scene = ml_cpu::bench_scene::bench_scene(4096, 3, 30).expect("the bench scene");
+    // The marks' pass runs where the settings leave it on (their default).
+    let scene = ml_cpu::bench_scene::bench_scene(4096, 3, 12).expect("the bench scene");
     let base = visibility(160, 96, Antialiasing::X8);
-    let settings = [
-        base,
-        base,
-        RenderSettings { culling: false, ..base },
-        RenderSettings { light_grid_marks: false, ..base },
-        RenderSettings { light_grid_marks: true, ..base },
-    ];
+    assert!(base.light_grid_marks);
+    let settings = [base, base, RenderSettings { culling: false, ..base }, RenderSettings { light_grid_marks: false, ..base }];
     let outputs = common::render_each(&scene, &settings);
-    for (what, out) in
-        ["a second render", "culling off", "the light grid's marks off", "the light grid's marks on"].iter().zip(&outputs[1..])
-    {
+    for (what, out) in ["a second render", "culling off", "the light grid's marks off"].iter().zip(&outputs[1..]) {
         let (worst, pixels) = common::max_difference(&outputs[0], out);
         assert_eq!((worst, pixels), (0, 0), "{what}: {pixels} pixels differ, by up to {worst}/255");
     }
     let leaves = foliage();
-    let base = visibility(128, 96, Antialiasing::X4);
+    let base = visibility(128, 96, Antialiasing::X8);
     let outputs = common::render_each(&leaves, &[base, RenderSettings { culling: false, ..base }]);
     assert_eq!(common::max_difference(&outputs[0], &outputs[1]), (0, 0), "foliage: culling off changed the image");
 }
