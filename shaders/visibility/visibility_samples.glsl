@@ -7,12 +7,13 @@
 #ifndef MANYLIGHTS_VISIBILITY_SAMPLES_GLSL
 #define MANYLIGHTS_VISIBILITY_SAMPLES_GLSL
 
-// Loops over a pixel's samples are unrolled ([[unroll]]): their count is a constant once
-// specialized, and an unrolled loop keeps its per-sample values (the samples read, the
-// positions) in registers, where a loop indexes them from memory.
+// Loops over a pixel's samples with small bodies are unrolled ([[unroll]]): their count is a
+// constant once specialized, and an unrolled loop keeps its per-sample values (the samples
+// read) in registers, where a loop indexes them from memory. Large bodies (the masked
+// raster's alpha test) stay loops: unrolled, their registers cost more than the loop.
 #extension GL_EXT_control_flow_attributes : require
 
-// Samples per pixel: 1, 4, 8 or 16 (settings.rs Antialiasing).
+// Samples per pixel: 1, 4, 8 or 16 (antialiasing.rs Antialiasing).
 layout(constant_id = 24) const uint VISIBILITY_SAMPLES = 1u;
 
 // Vulkan's standard sample positions (standardSampleLocations), in 1/16 pixel from the
