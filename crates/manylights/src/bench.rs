@@ -168,7 +168,7 @@ impl BenchArgs {
             Rule::technique("aa", VISIBILITY_BUFFER, draws_meshlets),
             Rule::setting(
                 "aa",
-                Some(rasters.iter().any(|r| matches!(r, Raster::Compute { large: ml_render::LargeTriangles::Bins { .. }, .. }))),
+                Some(rasters.iter().any(|r| r.keeps_samples())),
                 format!("--raster {}", self.raster),
                 "the compute raster (--raster compute), whose buffer keeps the samples",
             ),
@@ -281,23 +281,21 @@ impl Variant {
 
 /// --aa: the sample counts of the rows.
 fn antialiasing_list(a: &BenchArgs) -> Result<Vec<Antialiasing>> {
-    let mut list = Vec::new();
-    for name in a.aa.split(',').map(str::trim) {
-        let aa = Antialiasing::from_name(name).context("--aa")?;
-        if !list.contains(&aa) {
-            list.push(aa);
-        }
-    }
-    Ok(list)
+    unique_list(&a.aa, |name| Antialiasing::from_name(name).context("--aa"))
 }
 
 /// --raster: the rasterisers the visibility rows use.
 fn raster_list(a: &BenchArgs) -> Result<Vec<Raster>> {
+    unique_list(&a.raster, |name| Ok(Raster::from_name(name, a.raster_split)?))
+}
+
+/// A comma-separated list of names, each parsed, in order, repeats dropped.
+fn unique_list<T: PartialEq>(text: &str, parse: impl Fn(&str) -> Result<T>) -> Result<Vec<T>> {
     let mut list = Vec::new();
-    for name in a.raster.split(',').map(str::trim) {
-        let raster = Raster::from_name(name, a.raster_split)?;
-        if !list.contains(&raster) {
-            list.push(raster);
+    for name in text.split(',').map(str::trim) {
+        let value = parse(name)?;
+        if !list.contains(&value) {
+            list.push(value);
         }
     }
     Ok(list)
@@ -365,8 +363,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             }
             for &antialiasing in &sample_counts {
                 // Samples are the compute raster's (the others draw one a pixel).
-                let samples = matches!(raster, Raster::Compute { large: ml_render::LargeTriangles::Bins { .. }, .. });
-                if antialiasing != Antialiasing::Off && !samples {
+                if antialiasing != Antialiasing::Off && !raster.keeps_samples() {
                     continue;
                 }
                 let v = Variant { technique, raster, antialiasing };

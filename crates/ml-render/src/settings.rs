@@ -293,8 +293,7 @@ impl RenderSettings {
             return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view.name(), technique: self.technique.name() }.into());
         }
         if self.antialiasing != Antialiasing::Off {
-            if !matches!(self.raster, Raster::Compute { large: LargeTriangles::Bins { .. }, .. }) || self.technique != Technique::Visibility
-            {
+            if !self.raster.keeps_samples() || self.technique != Technique::Visibility {
                 let technique = if self.technique == Technique::Visibility { self.raster.name() } else { self.technique.name() };
                 return Err(SettingsError::AntialiasingNeedsComputeRaster { samples: self.antialiasing.name(), technique }.into());
             }

@@ -217,6 +217,12 @@ impl Raster {
             _ => None,
         }
     }
+
+    /// Whether it keeps anti-aliasing's coverage samples (`--aa`): the compute raster, whose
+    /// every pass draws into its buffer (the hybrid's hardware draw keeps one a pixel).
+    pub fn keeps_samples(self) -> bool {
+        self.bin_list().is_some()
+    }
 }
 
 /// The first device feature `raster` needs that `features` lacks, if any.

@@ -95,7 +95,6 @@ impl Choices {
         // Other techniques have no visibility buffer to draw.
         let raster = if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware };
         // Only the compute raster keeps samples, and they are not blended with layers yet.
-        let samples = matches!(raster, Raster::Compute { large: ml_render::LargeTriangles::Bins { .. }, .. });
         RenderSettings {
             technique: self.technique,
             shading: self.shading,
@@ -114,7 +113,7 @@ impl Choices {
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
             light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
-            antialiasing: if samples && self.transparency.is_none() { self.antialiasing } else { Antialiasing::Off },
+            antialiasing: if raster.keeps_samples() && self.transparency.is_none() { self.antialiasing } else { Antialiasing::Off },
         }
     }
 }
@@ -176,7 +175,7 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
             if let Raster::Compute { split, .. } = &mut choices.raster {
                 ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
             }
-            if choices.raster.name() == "compute" && choices.transparency.is_none() {
+            if choices.raster.keeps_samples() && choices.transparency.is_none() {
                 combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
             }
         }
