@@ -13,11 +13,21 @@ layout(set = 0, binding = 0) uniform sampler2D hdr_image;
 layout(set = 0, binding = 1, rgba8) uniform writeonly image2D out_image;
 FRAME_BLOCK(2);
 
+// Anti-aliasing (shading/display_output.glsl): the image holds the mean of each pixel's
+// samples in the display's linear light, premultiplied by the share of them that a surface
+// covers (alpha); the rest shows the background. Only the gamma curve is left to apply.
+layout(constant_id = 42) const bool DISPLAY_LINEAR_INPUT = false;
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, textureSize(hdr_image, 0)))) {
         return;
     }
     vec4 hdr = texelFetch(hdr_image, p, 0);
+    if (DISPLAY_LINEAR_INPUT) {
+        vec3 shown = hdr.rgb + (1.0 - hdr.a) * pow(CLEAR_COLOR.rgb, vec3(2.2));
+        imageStore(out_image, p, vec4(encode_gamma(shown), 1.0));
+        return;
+    }
     imageStore(out_image, p, hdr.a == 0.0 ? CLEAR_COLOR : vec4(encode_output(hdr.rgb, frame.exposure.x), 1.0));
 }

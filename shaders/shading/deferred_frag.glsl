@@ -9,42 +9,127 @@
 
 #include "common/scene_bindings.glsl"
 #include "common/textures.glsl"
-layout(input_attachment_index = 0, set = 2, binding = 1) uniform subpassInput depth_input;
-layout(input_attachment_index = 1, set = 2, binding = 2) uniform subpassInput normal_input;
-layout(input_attachment_index = 2, set = 2, binding = 3) uniform usubpassInput object_input;
-layout(input_attachment_index = 3, set = 2, binding = 4) uniform subpassInput albedo_input;
+// MULTISAMPLED (the *_samples.frag variants): anti-aliasing. Subpass 0 drew into multisampled
+// attachments; this pixel's samples are grouped by surface (equal G-buffer values: one
+// fragment of subpass 0 wrote them), each surface shaded once at the mean of its samples'
+// points, and the pixel written as the mean of its samples in the display's linear light
+// (display_output.glsl), with the covered share in alpha for the tone map's background.
+#ifdef MULTISAMPLED
+#define INPUT subpassInputMS
+#define UINPUT usubpassInputMS
+#define LOAD(input, s) subpassLoad(input, s)
+#else
+#define INPUT subpassInput
+#define UINPUT usubpassInput
+#define LOAD(input, s) subpassLoad(input)
+#endif
+layout(input_attachment_index = 0, set = 2, binding = 1) uniform INPUT depth_input;
+layout(input_attachment_index = 1, set = 2, binding = 2) uniform INPUT normal_input;
+layout(input_attachment_index = 2, set = 2, binding = 3) uniform UINPUT object_input;
+layout(input_attachment_index = 3, set = 2, binding = 4) uniform INPUT albedo_input;
 // GBUFFER_MATERIAL (the *_textured.frag variants): scenes whose objects have textures of their
 // own, whose G-buffer has two more images (targets.rs gbuffer_images). A variant, not a
 // specialization constant: a subpass may not even declare inputs it lacks.
 #ifdef GBUFFER_MATERIAL
-layout(input_attachment_index = 4, set = 2, binding = 5) uniform subpassInput roughness_metallic_input;
-layout(input_attachment_index = 5, set = 2, binding = 6) uniform subpassInput emissive_input;
+layout(input_attachment_index = 4, set = 2, binding = 5) uniform INPUT roughness_metallic_input;
+layout(input_attachment_index = 5, set = 2, binding = 6) uniform INPUT emissive_input;
 #endif
 
 #include "common/lighting.glsl"
+// For every variant (the reflection test reads includes whole): the samples' count and
+// positions, which the multisampled one reads.
+#include "visibility/visibility_samples.glsl"
 
 layout(location = 0) out vec4 out_hdr;
 
+// What subpass 0 wrote at sample `s` (0 without samples), depth aside.
+struct GSample {
+    vec2 normal;
+    uint id;
+    vec4 albedo;
+    vec2 roughness_metallic;
+    vec3 emissive_factor;
+};
+
+GSample gbuffer_sample(int s) {
+    GSample g;
+    g.normal = LOAD(normal_input, s).xy;
+    g.id = LOAD(object_input, s).r;
+    g.albedo = LOAD(albedo_input, s);
+#ifdef GBUFFER_MATERIAL
+    g.roughness_metallic = LOAD(roughness_metallic_input, s).xy;
+    g.emissive_factor = LOAD(emissive_input, s).rgb;
+#else
+    g.roughness_metallic = vec2(1.0);
+    g.emissive_factor = vec3(1.0);
+#endif
+    return g;
+}
+
+// The surface `g` at `frag_xy` (pixels) and depth `z`, lit; `debug`: a surface debug view's
+// colour, shown as it is.
+vec3 shade_gbuffer(vec2 frag_xy, float z, GSample g, out bool debug) {
+    vec3 world = world_from_depth(frag_xy, z);
+    vec3 n = oct_decode(g.normal);
+    PointMaterial m = point_material(objects[g.id].albedo_roughness, objects[g.id].material, objects[g.id].emissive, g.albedo,
+                                     g.roughness_metallic, g.emissive_factor);
+    vec3 color;
+    debug = debug_surface(world, n, m.albedo, m.roughness, m.metallic, objects[g.id].alpha_texture.x, frag_xy, color);
+    if (!debug) {
+        color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+    }
+    return color;
+}
+
+#ifdef MULTISAMPLED
+bool same_surface(GSample a, GSample b) {
+    return a.normal == b.normal && a.id == b.id && a.albedo == b.albedo && a.roughness_metallic == b.roughness_metallic
+        && a.emissive_factor == b.emissive_factor;
+}
+
 void main() {
-    float z = subpassLoad(depth_input).r;
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    uint left = (1u << VISIBILITY_SAMPLES) - 1u;
+    vec3 sum = vec3(0.0);
+    uint covered = 0u;
+    while (left != 0u) {
+        int s = findLSB(left);
+        left &= ~(1u << uint(s));
+        float z = LOAD(depth_input, s).r;
+        if (z >= 1.0) {
+            continue;
+        }
+        GSample g = gbuffer_sample(s);
+        uint members = 1u << uint(s);
+        float depth_sum = z;
+        for (int t = s + 1; t < int(VISIBILITY_SAMPLES); t++) {
+            float zt = LOAD(depth_input, t).r;
+            if ((left & (1u << uint(t))) != 0u && zt < 1.0 && same_surface(g, gbuffer_sample(t))) {
+                members |= 1u << uint(t);
+                depth_sum += zt;
+            }
+        }
+        left &= ~members;
+        // One plane's depth is affine in the image: the mean of its samples' depths lies at
+        // the mean of their points.
+        uint count = uint(bitCount(members));
+        bool debug;
+        vec3 color = shade_gbuffer(shading_xy(pixel, members), depth_sum / float(count), g, debug);
+        sum += float(count) * (debug ? clamp(color, 0.0, 1.0) : display_linear(color, frame.exposure.x));
+        covered += count;
+    }
+    if (covered == 0u) {
+        discard;
+    }
+    out_hdr = vec4(sum, float(covered)) / float(VISIBILITY_SAMPLES);
+}
+#else
+void main() {
+    float z = LOAD(depth_input, 0).r;
     if (z >= 1.0) {
         discard;
     }
-    vec3 world = world_from_depth(gl_FragCoord.xy, z);
-    vec3 n = oct_decode(subpassLoad(normal_input).xy);
-    uint id = subpassLoad(object_input).r;
-#ifdef GBUFFER_MATERIAL
-    vec2 roughness_metallic = subpassLoad(roughness_metallic_input).xy;
-    vec3 emissive_factor = subpassLoad(emissive_input).rgb;
-#else
-    vec2 roughness_metallic = vec2(1.0);
-    vec3 emissive_factor = vec3(1.0);
-#endif
-    PointMaterial m =
-        point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, subpassLoad(albedo_input), roughness_metallic, emissive_factor);
-    vec3 color;
-    if (!debug_surface(world, n, m.albedo, m.roughness, m.metallic, objects[id].alpha_texture.x, gl_FragCoord.xy, color)) {
-        color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
-    }
-    out_hdr = vec4(color, 1.0);
+    bool debug;
+    out_hdr = vec4(shade_gbuffer(gl_FragCoord.xy, z, gbuffer_sample(0), debug), 1.0);
 }
+#endif

@@ -14,6 +14,7 @@
 // Before the light loop: its shadow rays read the alpha masks at this shader's binding.
 #include "shading/mesh_coverage.glsl"
 #include "common/lighting.glsl"
+#include "shading/display_output.glsl"
 
 layout(location = 0) out vec4 out_color;
 
@@ -23,25 +24,26 @@ layout(location = 0) out vec4 out_color;
 layout(constant_id = 40) const bool TRANSPARENT_LAYERS = false;
 
 void main() {
-    vec3 normal = covered_normal();
+    MeshPoint at = covered_point();
 #if defined(CLUSTERED) || defined(LIGHT_GRID)
     if (frame.cluster_dims.w == DEBUG_VIEW_CLUSTER_HEAT) {
         // Lights tested on a log scale up to cluster_slices.z.
-        uint count = cluster_light_count(in_world_pos, gl_FragCoord.xy);
+        uint count = cluster_light_count(at.world, gl_FragCoord.xy);
         float t = log2(1.0 + float(count)) / log2(1.0 + frame.cluster_slices.z);
-        out_color = vec4(heat(t), 1.0);
+        out_color = target_stored(heat(t));
         return;
     }
 #endif
-    Surface s = surface_at(normal, in_tangent, in_uv, opaque_uniform(object.ids.y), object.material);
+    Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material);
     PointMaterial m = point_material(object.albedo_roughness, object.material, object.emissive, vec4(s.albedo_factor, s.occlusion),
                                      s.roughness_metallic, s.emissive_factor);
     vec3 color;
-    if (debug_surface(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, gl_FragCoord.xy, color)) {
-        out_color = vec4(encode_gamma(color), 1.0);
+    if (debug_surface(at.world, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, gl_FragCoord.xy, color)) {
+        out_color = target_shown(color);
         return;
     }
-    color = shade_point(in_world_pos, s.normal, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
-    // The target is UNORM: the seed writes gamma-encoded values itself.
-    out_color = vec4(TRANSPARENT_LAYERS ? color : encode_output(color, frame.exposure.x), 1.0);
+    color = shade_point(at.world, s.normal, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
+    // The target is UNORM: the seed writes gamma-encoded values itself (or, anti-aliased, the
+    // display's linear light, display_output.glsl).
+    out_color = TRANSPARENT_LAYERS ? vec4(color, 1.0) : target_lit(color, frame.exposure.x);
 }

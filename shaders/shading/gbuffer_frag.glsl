@@ -24,7 +24,8 @@ layout(location = 4) out vec4 out_emissive;
 #endif
 
 void main() {
-    Surface s = surface_at(covered_normal(), in_tangent, in_uv, opaque_uniform(object.ids.y), object.material);
+    MeshPoint at = covered_point();
+    Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material);
     out_normal = oct_encode(s.normal);
     out_object = object.ids.x;
     out_albedo_occlusion = vec4(s.albedo_factor, s.occlusion);

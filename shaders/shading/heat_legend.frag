@@ -5,6 +5,8 @@
 // (bottom part, a 3×5 pixel font scaled to fit).
 #include "common/common.glsl"
 #include "clusters/cluster.glsl"
+#include "common/shading_model.glsl"
+#include "shading/display_output.glsl"
 
 layout(location = 0) in vec2 in_uv;
 FRAME_BLOCK(0);
@@ -52,7 +54,7 @@ void main() {
     uint top = uint(frame.cluster_slices.z + 0.5);
     if (in_uv.y < RAMP_HEIGHT) {
         // The view's log scale: position t stands for 2^(t·log2(1 + top)) − 1 lights.
-        out_color = vec4(heat(in_uv.x), 1.0);
+        out_color = target_stored(heat(in_uv.x));
         return;
     }
     // Pixel coordinates inside the text strip (the legend spans 0.33 × 0.08 of the image).
@@ -61,5 +63,5 @@ void main() {
     int scale = max(1, int(size.y) / 7);
     int top_width = (int(digit_count(top)) * 4 - 1) * scale;
     bool ink = number(0u, px - ivec2(scale), scale) || number(top, px - ivec2(int(size.x) - scale - top_width, scale), scale);
-    out_color = vec4(ink ? vec3(1.0) : vec3(0.0), 1.0);
+    out_color = target_stored(ink ? vec3(1.0) : vec3(0.0));
 }

@@ -22,12 +22,13 @@ void main() {
     // The textures first, sampled with their implicit derivatives while the whole quad still
     // runs (after a fragment of it returns they are undefined); and every read this fragment
     // needs issued together, before the test that waits on the opaque depth.
-    Surface s = surface_at(covered_normal(), in_tangent, in_uv, opaque_uniform(object.ids.y), object.material);
+    MeshPoint at = covered_point();
+    Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material);
     float alpha = objects[o].alpha.y;
     uvec4 alpha_texture = objects[o].alpha_texture;
     float opaque = opaque_depth_at(p);
     if ((alpha_texture.x & OBJECT_ALPHA_TEXTURE) != 0u) {
-        alpha *= texture_alpha(alpha_texture, in_uv);
+        alpha *= texture_alpha(alpha_texture, at.uv);
     }
     if (gl_FragCoord.z >= opaque || alpha <= 0.0) {
         return;

@@ -13,7 +13,9 @@ layout(local_size_x = 64) in;
 
 #include "visibility/meshlet_cull.glsl"
 #include "visibility/meshlet_geometry.glsl"
-
+// With anti-aliasing's samples (the hardware raster multisampled) a triangle that misses
+// every centre may still cover a sample.
+#include "visibility/visibility_samples.glsl"
 #include "visibility/triangle_cull.glsl"
 
 void main() {

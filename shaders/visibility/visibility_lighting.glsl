@@ -67,23 +67,10 @@ vec3 id_color(uint x) {
     return vec3(uvec3(x, x >> 8u, x >> 16u) & 255u) / 255.0;
 }
 
-// Specular anti-aliasing (Tokuyoshi & Kaplanyan's, as Filament does it): a highlight
-// narrower than the pixel's spread of normals flickers between pixels, so the roughness is
-// widened by the normal's variance over the pixel, `variance`: the squared change of the
-// normal to the next pixel across and down, scaled. The scale is ours: Filament's 0.15 made
-// the bench scene's error against its supersampled reference larger than none; 0.01 made it
-// smallest. `roughness` is perceptual (its square the GGX alpha).
-float filtered_roughness(float roughness, float variance) {
-    float alpha = roughness * roughness;
-    return sqrt(sqrt(clamp(alpha * alpha + min(2.0 * variance, 0.2), 0.0, 1.0)));
-}
-
 // The surface of visibility id `id` at the point `frag_xy` of pixel p, ready to shade: its
 // point (`world`, rebuilt from `z`, its depth there, as every compute lighting and the light
-// grid's marks rebuild it; z < 0: the depth the triangle has there), normal and material —
-// its roughness widened by the normal's variance over the pixel where `filter_specular`
-// (anti-aliasing on).
-void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, bool filter_specular, out vec3 world, out vec3 n, out PointMaterial m, out uint flags) {
+// grid's marks rebuild it; z < 0: the depth the triangle has there), normal and material.
+void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, out vec3 world, out vec3 n, out PointMaterial m, out uint flags) {
     uvec2 object_meshlet = meshlet_instances[id >> VISIBILITY_TRIANGLE_BITS];
     uint object = object_meshlet.x;
     Instance inst = instances[object];
@@ -109,17 +96,6 @@ void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, bool filter_specular, o
     vec2 uv00 = uvs * b00;
     surface_uv_dx = uvs * b10 - uv00;
     surface_uv_dy = uvs * b01 - uv00;
-    float variance = 0.0;
-    if (filter_specular) {
-        // The interpolated normal at the quad's pixels, as the texture derivatives above,
-        // found before the material so that only the variance stays live through it (on the
-        // H200: 72 registers instead of 96, the lighting 0.341 ms instead of 0.381 at 1080p).
-        mat3 normals = mat3(o.normal_matrix) * mat3(v[0].normal, v[1].normal, v[2].normal);
-        vec3 n00 = normalize(normals * b00);
-        vec3 dndx = normalize(normals * b10) - n00, dndy = normalize(normals * b01) - n00;
-        variance = 0.01 * (dot(dndx, dndx) + dot(dndy, dndy));
-    }
-
     vec3 normal = mat3(o.normal_matrix) * (mat3(v[0].normal, v[1].normal, v[2].normal) * b);
     // A double-sided object's back face (its corners clockwise on screen: the homogeneous
     // determinant is the projected area's sign, also for corners behind the eye) is lit on
@@ -131,9 +107,6 @@ void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, bool filter_specular, o
     tangent.xyz = mat3(o.model) * tangent.xyz;
     Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material);
     m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, s.emissive_factor);
-    if (filter_specular) {
-        m.roughness = filtered_roughness(m.roughness, variance);
-    }
     if (z < 0.0) {
         // Clip space interpolates linearly in the perspective-correct barycentrics.
         vec4 point = mat4(c[0], c[1], c[2], vec4(0.0)) * vec4(b, 0.0);
@@ -195,7 +168,7 @@ vec3 surface_display(ivec2 p, uint leader) {
         vec3 world, n;
         PointMaterial m;
         uint flags;
-        surface_of(p, id, xy, -1.0, true, world, n, m, flags);
+        surface_of(p, id, xy, -1.0, world, n, m, flags);
         display = shade_display(xy, world, n, m, flags);
     }
     return display * float(bitCount(members));
@@ -360,7 +333,7 @@ void main() {
     vec3 world, n;
     PointMaterial m;
     uint flags;
-    surface_of(p, id, frag_xy, z, false, world, n, m, flags);
+    surface_of(p, id, frag_xy, z, world, n, m, flags);
     shade_and_store(p, frag_xy, world, n, m, flags);
 }
 

@@ -16,14 +16,25 @@ layout(std430, set = 0, binding = 1) readonly buffer ObjectBuffer { ObjectData o
 layout(location = 0) flat in uint in_object;
 layout(location = 1) in vec2 in_uv;
 
+// Whether the side of the surface the viewer sees is drawn (a single-sided object's back face
+// is not).
+bool side_drawn() {
+    return gl_FrontFacing || (objects[in_object].alpha_texture.x & OBJECT_DOUBLE_SIDED) != 0u;
+}
+
+// Whether the point at texture coordinates `uv` is there (its alpha mask keeps it).
+bool point_there(vec2 uv) {
+    return alpha_kept(objects[in_object].alpha, objects[in_object].alpha_texture, uv);
+}
+
 bool surface_there() {
-    uvec4 alpha_texture = objects[in_object].alpha_texture;
-    if (!gl_FrontFacing && (alpha_texture.x & OBJECT_DOUBLE_SIDED) == 0u) {
-        return false;
-    }
-    return alpha_kept(objects[in_object].alpha, alpha_texture, in_uv);
+    return side_drawn() && point_there(in_uv);
 }
 #else
+bool side_drawn() {
+    return true;
+}
+
 bool surface_there() {
     return true;
 }

@@ -4,7 +4,9 @@
 //! would take longer than the budget is skipped and says so: brute force estimated from a smaller
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
-use crate::applies::{check_rules, draws_meshlets, objects_rule, Auto, Given, Rule, Techniques, CLUSTER_GRID, VISIBILITY_BUFFER};
+use crate::applies::{
+    check_rules, draws_meshlets, objects_rule, Auto, Given, Rule, Techniques, ANTIALIASING, CLUSTER_GRID, VISIBILITY_BUFFER,
+};
 use crate::auto::{self, technique_choice};
 use crate::{cluster_choice, print_warnings, scene_source, shading_choice, Progress, Whole};
 use anyhow::{bail, Context as _, Result};
@@ -102,7 +104,8 @@ pub struct BenchArgs {
     #[arg(long, default_value = "hardware,compute")]
     raster: String,
     /// Anti-aliasing sample counts, comma-separated: off, 4, 8, 16 (render's --aa); the
-    /// counts other than off make rows of the visibility technique's compute raster only.
+    /// counts other than off make rows of the techniques that anti-alias (every rasteriser's
+    /// for visibility).
     #[arg(long, default_value = "off")]
     aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread, pixels a side (1
@@ -165,13 +168,7 @@ impl BenchArgs {
             Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
             Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
             Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
-            Rule::technique("aa", VISIBILITY_BUFFER, draws_meshlets),
-            Rule::setting(
-                "aa",
-                Some(rasters.iter().any(|r| r.keeps_samples())),
-                format!("--raster {}", self.raster),
-                "the compute raster (--raster compute), whose buffer keeps the samples",
-            ),
+            Rule::technique("aa", ANTIALIASING, Technique::has_antialiasing),
             Rule::setting(
                 "raster_split",
                 Some(rasters.iter().any(|r| *r != Raster::Hardware)),
@@ -273,7 +270,8 @@ impl Variant {
             aa => format!(", {}x AA", aa.samples()),
         };
         match self.raster {
-            Raster::Hardware => self.technique.name().to_owned(),
+            Raster::Hardware if self.antialiasing == Antialiasing::Off => self.technique.name().to_owned(),
+            Raster::Hardware => format!("{} ({}x AA)", self.technique.name(), self.antialiasing.samples()),
             Raster::Compute { .. } => format!("{} ({} raster{aa})", self.technique.name(), self.raster.name()),
         }
     }
@@ -362,8 +360,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 continue;
             }
             for &antialiasing in &sample_counts {
-                // Samples are the compute raster's (the others draw one a pixel).
-                if antialiasing != Antialiasing::Off && !raster.keeps_samples() {
+                if antialiasing != Antialiasing::Off && !technique.has_antialiasing() {
                     continue;
                 }
                 let v = Variant { technique, raster, antialiasing };

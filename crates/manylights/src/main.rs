@@ -276,9 +276,11 @@ struct SceneArgs {
     /// why).
     #[arg(long, default_value = "auto", value_parser = ["hardware", "hybrid", "compute", "auto"])]
     raster: String,
-    /// Anti-aliasing: coverage samples per pixel, off, 4, 8 or 16 (Vulkan's standard positions),
-    /// each distinct surface of a pixel shaded once and the pixel the mean of its samples;
-    /// the visibility technique's compute raster (which --raster auto then picks).
+    /// Anti-aliasing: coverage samples per pixel, off, 4, 8 or 16 (Vulkan's standard positions;
+    /// the counts the device offers), each distinct surface of a pixel shaded once and the
+    /// pixel the mean of its samples in the display's linear light: forward, clustered and
+    /// deferred by Vulkan multisampling, visibility in its 64-bit buffer (any raster; --raster
+    /// auto then picks compute); not deferred-compute.
     #[arg(long, default_value = "off", value_parser = Antialiasing::ALL.map(Antialiasing::name))]
     aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread: bounding box up to

@@ -1,10 +1,11 @@
-//! Anti-aliasing (docs/DESIGN.md#anti-aliasing): coverage samples per pixel in the compute
-//! raster's 64-bit buffer (`VISIBILITY_SAMPLES` in visibility/visibility_samples.glsl), each
-//! distinct surface of a pixel shaded once, the pixel the mean of its samples in the
-//! display's linear light.
+//! Anti-aliasing (docs/DESIGN.md#anti-aliasing): coverage samples per pixel — in the compute
+//! and hybrid rasters' 64-bit buffer (`VISIBILITY_SAMPLES` in visibility/visibility_samples.glsl),
+//! or in the mesh techniques' multisampled attachments — each distinct surface of a pixel
+//! shaded once, the pixel the mean of its samples in the display's linear light.
 
 use crate::error::{by_name, Named, RenderError};
 use crate::report::FeatureStats;
+use ml_vk::vk;
 
 /// Coverage samples per pixel (`--aa`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -42,6 +43,11 @@ impl Antialiasing {
         }
     }
 
+    /// Samples per pixel as Vulkan counts them (the mesh techniques' multisampled attachments).
+    pub fn sample_count(self) -> vk::SampleCountFlags {
+        vk::SampleCountFlags::from_raw(self.samples())
+    }
+
     /// The specialization constant of the shaders that read or write the samples.
     pub fn constant(self) -> (&'static str, u32) {
         ("VISIBILITY_SAMPLES", self.samples())
@@ -61,28 +67,30 @@ pub struct AntialiasingStats {
     pub antialiasing: Antialiasing,
     pub width: u32,
     pub height: u32,
-    /// Surfaces shaded in the last frame, summed over the pixels.
-    pub surfaces: u64,
+    /// Bytes its samples take: the compute raster's buffer, or the mesh techniques'
+    /// multisampled attachments.
+    pub sample_bytes: u64,
+    /// Surfaces shaded in the last frame, summed over the pixels, where the lighting counts
+    /// them (the visibility technique; the hardware's multisampling shades each triangle a
+    /// pixel's samples hold once, uncounted).
+    pub surfaces: Option<u64>,
 }
 
 impl AntialiasingStats {
-    /// Surfaces shaded per pixel (the background counts none).
-    pub fn surfaces_per_pixel(&self) -> f64 {
-        self.surfaces as f64 / (f64::from(self.width) * f64::from(self.height)).max(1.0)
+    /// Surfaces shaded per pixel (the background counts none), where counted.
+    pub fn surfaces_per_pixel(&self) -> Option<f64> {
+        Some(self.surfaces? as f64 / (f64::from(self.width) * f64::from(self.height)).max(1.0))
     }
 }
 
 impl FeatureStats for AntialiasingStats {
     fn rows(&self) -> Vec<(&'static str, String)> {
-        let mib = self.antialiasing.buffer_bytes(self.width, self.height) as f64 / f64::from(1 << 20);
-        vec![(
-            "anti-aliasing",
-            format!(
-                "{} samples a pixel ({mib:.1} MiB of depth and id); {:.3} surfaces shaded a pixel in the last frame",
-                self.antialiasing.samples(),
-                self.surfaces_per_pixel()
-            ),
-        )]
+        let mib = self.sample_bytes as f64 / f64::from(1 << 20);
+        let shaded = match self.surfaces_per_pixel() {
+            Some(s) => format!("{s:.3} surfaces shaded a pixel in the last frame"),
+            None => "each triangle a pixel's samples hold shaded once (the hardware's multisampling)".to_owned(),
+        };
+        vec![("anti-aliasing", format!("{} samples a pixel ({mib:.1} MiB of samples); {shaded}", self.antialiasing.samples()))]
     }
 }
 

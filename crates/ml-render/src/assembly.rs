@@ -13,12 +13,12 @@ use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
 use crate::scene::shadow_raster::ShadowViews;
 use crate::scene::SceneGpu;
-use crate::settings::{OmniShadowMode, Raster, RenderSettings, Shading};
+use crate::settings::{Antialiasing, OmniShadowMode, Raster, RenderSettings, Shading};
 use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
 use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
 use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
-use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_lighting, visibility_raster};
+use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_gather, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context};
 
@@ -61,8 +61,10 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
 fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<SharedMeshletScene>) -> Result<Box<dyn Pass>, RenderError> {
     let s = a.settings;
     let raster = (a.depth_format, a.shading);
-    // With the compute or hybrid raster, the pyramid and the lighting read the 64-bit buffer.
-    let compute = s.raster != Raster::Hardware;
+    // With the compute or hybrid raster, or anti-aliased (the hardware raster's samples
+    // gathered into it), the pyramid and the lighting read the 64-bit buffer.
+    let compute = s.raster != Raster::Hardware || s.antialiasing != Antialiasing::Off;
+    let atomic = s.raster != Raster::Hardware;
     // Samples per pixel of that buffer.
     let aa = s.antialiasing;
     let mut shared = || -> Result<SharedMeshletScene, RenderError> {
@@ -94,7 +96,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
             Box::new(forward::Forward::new(ctx, a.scene, raster, (lights, heat_legend), s.technique.name())?)
         }
         PassKind::DeferredSubpasses { clustered } => Box::new(deferred_subpass::DeferredSubpasses::new(ctx, a.scene, raster, clustered)?),
-        PassKind::ToneMap { curve } => Box::new(tone_map::ToneMap::new(ctx, curve)?),
+        PassKind::ToneMap { curve, display_linear } => Box::new(tone_map::ToneMap::new(ctx, (curve, display_linear))?),
         PassKind::GBuffer => Box::new(gbuffer::GBuffer::new(ctx, a.scene, raster)?),
         PassKind::ComputeLighting => Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?),
         PassKind::MeshletCull(phase) => {
@@ -104,8 +106,9 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
             Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, (s.raster, aa))?)
         }
         PassKind::VisibilityRaster(phase) => {
-            Box::new(visibility_raster::VisibilityRaster::new(ctx, shared()?, (phase, compute), a.depth_format)?)
+            Box::new(visibility_raster::VisibilityRaster::new(ctx, shared()?, (phase, atomic, aa), a.depth_format)?)
         }
+        PassKind::VisibilityGather(phase) => Box::new(visibility_gather::VisibilityGather::new(ctx, phase, aa)?),
         PassKind::DepthPyramid => Box::new(depth_pyramid::DepthPyramid::new(ctx, compute, aa)?),
         PassKind::VisibilityLighting => {
             Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, (shared()?, compute), (a.shading, aa))?)

@@ -107,6 +107,7 @@ fn depth_pipeline(
                 .depth_write_enable(true)
                 .depth_compare_op(vk::CompareOp::LESS),
             colour_attachments: 0,
+            samples: vk::SampleCountFlags::TYPE_1,
             layout,
             render_pass,
             subpass: 0,

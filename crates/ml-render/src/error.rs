@@ -140,12 +140,19 @@ pub enum SettingsError {
     RasterFeature { raster: &'static str, feature: &'static str, device: String },
     #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size, fewer --aa samples or --raster hardware")]
     RasterBuffer { width: u32, height: u32, bytes: u64, device: String, max: u32 },
-    /// Anti-aliasing's samples live in the compute raster's buffer.
-    #[error("--aa {samples} needs the visibility technique with --raster compute (the hybrid and hardware rasters and {technique} keep one sample a pixel so far): use --technique visibility --raster compute or --aa off")]
-    AntialiasingNeedsComputeRaster { samples: &'static str, technique: &'static str },
+    /// Anti-aliasing's samples: the compute raster's buffer, the mesh techniques' multisampled
+    /// attachments.
+    #[error("--aa {samples}: {technique} keeps one sample a pixel so far (every other technique anti-aliases): use another or --aa off")]
+    AntialiasingUnsupported { samples: &'static str, technique: &'static str },
+    #[error("--aa {samples} needs {feature}, which '{device}' lacks: use --aa off")]
+    AntialiasingFeature { samples: &'static str, feature: &'static str, device: String },
+    #[error(
+        "--aa {samples}: '{device}' draws {what} with {offered} samples a pixel, not {samples}: use --aa with one of those or --aa off"
+    )]
+    AntialiasingSamples { samples: &'static str, what: String, device: String, offered: String },
     #[error("--aa {samples} does not blend transparent layers yet, and the scene has transparent (BLEND) materials: use --aa off")]
     AntialiasingWithLayers { samples: &'static str },
-    #[error("the aa debug view shows the anti-aliasing samples of the visibility technique's compute raster, not {technique}'s")]
+    #[error("the aa debug view shows the surfaces the visibility technique shades in its 64-bit buffer (with --aa, or the compute and hybrid rasters), not {technique}'s")]
     AaViewNeedsComputeRaster { technique: &'static str },
     #[error(
         "a transparency budget of {budget} nodes per pixel at {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: lower --transparency-budget"

@@ -43,8 +43,10 @@ pub enum PassKind {
     Forward { lights: LightAssignment, heat_legend: bool },
     /// The deferred render pass: G-buffer subpass, lighting subpass.
     DeferredSubpasses { clustered: bool },
-    /// HDR → colour target after the deferred subpasses, with pbr's curve or as it is.
-    ToneMap { curve: bool },
+    /// HDR → colour target after the deferred subpasses (or the anti-aliased forward pass),
+    /// with pbr's curve or as it is; `display_linear`: the samples' mean in the display's
+    /// linear light, gamma only.
+    ToneMap { curve: bool, display_linear: bool },
     /// deferred-compute's G-buffer.
     GBuffer,
     /// deferred-compute's lighting of the G-buffer.
@@ -55,6 +57,9 @@ pub enum PassKind {
     TriangleRasterLarge(Phase),
     /// A phase's kept triangles drawn by the hardware (all, or the large ones of the hybrid).
     VisibilityRaster(Phase),
+    /// The hardware raster's samples (anti-aliasing) gathered into the 64-bit buffer after a
+    /// phase's draw.
+    VisibilityGather(Phase),
     /// The depth pyramid the late culling tests against.
     DepthPyramid,
     /// Lighting from the visibility buffer.
@@ -164,8 +169,10 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
         Some(OmniShadowMode::Rays) | None => {}
         Some(_) => kinds.push(PassKind::OmniShadows),
     }
-    // The opaque depth after the raster: the compute raster's buffer, or the depth target.
-    let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster != Raster::Hardware;
+    // The opaque depth after the raster: the 64-bit buffer (the compute rasters', or the
+    // hardware raster's samples gathered into it), or the depth target.
+    let antialiased = key.antialiasing != Antialiasing::Off;
+    let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && (key.raster != Raster::Hardware || antialiased);
     // The light grid is built once the surfaces are known, for the cells their points walk,
     // where a technique knows them before its lighting (the opaque depth, the transparent
     // layers' nodes) and the settings want the marks; else first, for every cell.
@@ -194,6 +201,9 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
                     Raster::Compute { .. } if key.raster.bin_list().is_some() => PassKind::TriangleRasterLarge(phase),
                     _ => PassKind::VisibilityRaster(phase),
                 });
+                if key.raster == Raster::Hardware && antialiased {
+                    kinds.push(PassKind::VisibilityGather(phase));
+                }
                 if phase == Phase::Early {
                     kinds.push(PassKind::DepthPyramid);
                 }
@@ -207,6 +217,8 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
             kinds.push(PassKind::Forward { lights, heat_legend: key.debug_view == DebugView::ClusterHeat });
             if key.layers {
                 kinds.extend([build, resolve]);
+            } else if antialiased {
+                kinds.push(PassKind::ToneMap { curve: false, display_linear: true });
             }
         }
         (Geometry::Meshes, LightingStage::Subpass) => {
@@ -216,7 +228,8 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
             } else {
                 // pbr's curve, not for surface views (their values are shown as they are).
                 let surface_view = !matches!(key.debug_view, DebugView::None | DebugView::ClusterHeat);
-                kinds.push(PassKind::ToneMap { curve: key.shading == ShadingModel::Pbr && !surface_view });
+                let curve = key.shading == ShadingModel::Pbr && !surface_view && !antialiased;
+                kinds.push(PassKind::ToneMap { curve, display_linear: antialiased });
             }
         }
         (Geometry::Meshes, LightingStage::Compute) => {
@@ -261,8 +274,11 @@ mod tests {
             (Technique::Forward, &[Forward { lights: LightAssignment::None, heat_legend: false }]),
             (Technique::ClusteredCpu, &[ClusterAssignCpu, Forward { lights: LightAssignment::Cpu, heat_legend: false }]),
             (Technique::ClusteredGpu, &[LightGridBuild { marked: false }, Forward { lights: LightAssignment::Gpu, heat_legend: false }]),
-            (Technique::Deferred, &[DeferredSubpasses { clustered: false }, ToneMap { curve: true }]),
-            (Technique::DeferredClustered, &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, ToneMap { curve: true }]),
+            (Technique::Deferred, &[DeferredSubpasses { clustered: false }, ToneMap { curve: true, display_linear: false }]),
+            (
+                Technique::DeferredClustered,
+                &[ClusterAssignCpu, DeferredSubpasses { clustered: true }, ToneMap { curve: true, display_linear: false }],
+            ),
             (
                 Technique::DeferredCompute,
                 &[GBuffer, LightGridMark { depth_buffer: false, layers: false }, LightGridBuild { marked: true }, ComputeLighting],
@@ -428,10 +444,20 @@ mod tests {
         let mut k = key(Technique::Deferred);
         k.meters_exposure = false;
         k.debug_view = DebugView::GBufferNormal;
-        assert_eq!(plan(&k)[1], ToneMap { curve: false });
+        assert_eq!(plan(&k)[1], ToneMap { curve: false, display_linear: false });
         k.debug_view = DebugView::None;
         k.shading = ShadingModel::BlinnPhong;
-        assert_eq!(plan(&k)[1], ToneMap { curve: false });
+        assert_eq!(plan(&k)[1], ToneMap { curve: false, display_linear: false });
+    }
+
+    #[test]
+    fn multisampled_meshes_are_resolved_in_the_display_light_and_gamma_encoded() {
+        let gamma_only = ToneMap { curve: false, display_linear: true };
+        for technique in [Technique::Forward, Technique::ClusteredGpu, Technique::Deferred, Technique::DeferredClustered] {
+            let mut k = key(technique);
+            (k.meters_exposure, k.antialiasing) = (false, Antialiasing::X4);
+            assert_eq!(plan(&k).last(), Some(&gamma_only), "{}", technique.name());
+        }
     }
 
     #[test]

@@ -16,6 +16,9 @@ pub struct Subpass {
     pub depth: Option<vk::AttachmentReference>,
     /// Read with subpassLoad, in input_attachment_index order.
     pub inputs: Vec<vk::AttachmentReference>,
+    /// Where each multisampled colour attachment is resolved at the subpass's end (none, or
+    /// one per colour attachment).
+    pub resolve: Vec<vk::AttachmentReference>,
 }
 
 #[derive(Clone, Debug)]
@@ -66,14 +69,64 @@ fn dependency(
 /// The render pass the raster pass uses for `output`, with `gbuffer`'s images (targets.rs
 /// gbuffer_images) where it writes a G-buffer. With transparent `layers`, whose build
 /// samples the opaque depth after the pass, depth is stored and the forward pass writes
-/// linear HDR for their resolve.
-pub fn describe(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage], layers: bool) -> RenderPassDesc {
-    match output {
+/// linear HDR for their resolve. With `samples` above one (anti-aliasing), the meshes are
+/// drawn into multisampled attachments: the forward pass's colour, the display's linear light
+/// in HDR_FORMAT, is resolved into the HDR target (the mean of the samples: a box filter in
+/// the display's linear light), which the tone map encodes; the deferred lighting subpass reads
+/// the multisampled G-buffer and depth and writes the HDR target once per pixel.
+pub fn describe(
+    depth_format: vk::Format,
+    output: Output,
+    gbuffer: &[GBufferImage],
+    (layers, samples): (bool, vk::SampleCountFlags),
+) -> RenderPassDesc {
+    let mut desc = match output {
+        Output::Color if samples != vk::SampleCountFlags::TYPE_1 => return multisampled_forward(depth_format, samples),
         Output::Color | Output::GBuffer => one_subpass(depth_format, output, gbuffer, layers),
         Output::Subpasses => two_subpasses(depth_format, gbuffer, layers),
-        Output::Visibility => visibility(depth_format, true),
+        Output::Visibility => visibility(depth_format, true, samples),
         Output::Layers { .. } => transparent_layers(),
+    };
+    // Subpass 0's attachments (the G-buffer and depth) take the samples; the lighting
+    // subpass's HDR output (the last attachment) keeps one.
+    if output == Output::Subpasses {
+        let last = desc.attachments.len() - 1;
+        for a in &mut desc.attachments[..last] {
+            a.samples = samples;
+        }
     }
+    desc
+}
+
+/// The forward pass with anti-aliasing: the multisampled colour (the display's linear light)
+/// and depth never leave the pass; the colour is resolved into the single-sampled HDR target,
+/// which the tone map reads.
+fn multisampled_forward(depth_format: vk::Format, samples: vk::SampleCountFlags) -> RenderPassDesc {
+    let colour = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+    let depth = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    let attachments = vec![
+        attachment(HDR_FORMAT, false, colour).samples(samples),
+        attachment(depth_format, false, depth).samples(samples),
+        // Every pixel is written by the resolve: nothing to clear.
+        attachment(HDR_FORMAT, true, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL).load_op(vk::AttachmentLoadOp::DONT_CARE),
+    ];
+    let subpass = Subpass {
+        colour: vec![reference(0, colour)],
+        depth: Some(reference(1, depth)),
+        inputs: Vec::new(),
+        resolve: vec![reference(2, colour)],
+    };
+    let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+    let dependencies = vec![
+        // The earlier frame's tone map read the HDR target this pass resolves into again.
+        dependency(
+            (vk::SUBPASS_EXTERNAL, COLOUR_OUT | FRAGMENT_TESTS | compute, ATTACHMENT_WRITES),
+            (0, COLOUR_OUT | FRAGMENT_TESTS, ATTACHMENT_WRITES | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
+        ),
+        // The resolve (a colour attachment write) before the tone map reads it.
+        dependency((0, COLOUR_OUT, vk::AccessFlags::COLOR_ATTACHMENT_WRITE), (vk::SUBPASS_EXTERNAL, compute, vk::AccessFlags::SHADER_READ)),
+    ];
+    RenderPassDesc { attachments, subpasses: vec![subpass], dependencies }
 }
 
 /// The transparent layers' build: no attachments — its fragments test the opaque depth and
@@ -86,8 +139,10 @@ fn transparent_layers() -> RenderPassDesc {
 
 /// The visibility raster's pass: the visibility buffer and depth, cleared by the early phase
 /// (`first`), kept by the late one. Between them the depth pyramid samples depth; after the
-/// late phase the lighting pass samples both.
-pub fn visibility(depth_format: vk::Format, first: bool) -> RenderPassDesc {
+/// late phase the lighting pass samples both. With `samples` above one (anti-aliasing) a
+/// compute pass gathers both into the 64-bit buffer after each phase: the ids leave each
+/// phase ready to be read.
+pub fn visibility(depth_format: vk::Format, first: bool, samples: vk::SampleCountFlags) -> RenderPassDesc {
     let colour = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
     let depth_read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
     let kept = |a: vk::AttachmentDescription, before: vk::ImageLayout| {
@@ -97,15 +152,19 @@ pub fn visibility(depth_format: vk::Format, first: bool) -> RenderPassDesc {
             a.load_op(vk::AttachmentLoadOp::LOAD).initial_layout(before)
         }
     };
-    let ids_after = if first { colour } else { vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL };
+    let gathered = samples != vk::SampleCountFlags::TYPE_1;
+    let read = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+    let ids_after = if first && !gathered { colour } else { read };
+    let ids_before = if gathered { read } else { colour };
     let attachments = vec![
-        kept(attachment(VISIBILITY_FORMAT, true, ids_after), colour),
-        kept(attachment(depth_format, true, depth_read_only), depth_read_only),
+        kept(attachment(VISIBILITY_FORMAT, true, ids_after).samples(samples), ids_before),
+        kept(attachment(depth_format, true, depth_read_only).samples(samples), depth_read_only),
     ];
     let subpass = Subpass {
         colour: vec![reference(0, colour)],
         depth: Some(reference(1, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
         inputs: Vec::new(),
+        resolve: Vec::new(),
     };
     let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
     // The draws and their count come from the culling pass (compute writes); the vertex
@@ -176,6 +235,7 @@ fn one_subpass(depth_format: vk::Format, output: Output, gbuffer: &[GBufferImage
         colour: (0..colour_count).map(|a| reference(a, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)).collect(),
         depth: Some(reference(colour_count, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
         inputs: Vec::new(),
+        resolve: Vec::new(),
     };
     // Who uses the attachments after the pass: the read-back copy, or the lighting compute pass
     // (and the transparent layers' build, in fragment shaders).
@@ -214,12 +274,14 @@ fn two_subpasses(depth_format: vk::Format, gbuffer: &[GBufferImage], layers: boo
             colour: (0..g).map(|a| reference(a, colour)).collect(),
             depth: Some(reference(depth, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)),
             inputs: Vec::new(),
+            resolve: Vec::new(),
         },
         // input_attachment_index 0 (depth), then 1… (the G-buffer) in deferred_frag.glsl.
         Subpass {
             colour: vec![reference(hdr, colour)],
             depth: None,
             inputs: [reference(depth, depth_read_only)].into_iter().chain((0..g).map(|a| reference(a, read_only))).collect(),
+            resolve: Vec::new(),
         },
     ];
     let fragment = vk::PipelineStageFlags::FRAGMENT_SHADER;
@@ -292,6 +354,7 @@ impl RenderPassDesc {
                     .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
                     .color_attachments(&s.colour)
                     .input_attachments(&s.inputs);
+                let d = if s.resolve.is_empty() { d } else { d.resolve_attachments(&s.resolve) };
                 match &s.depth {
                     Some(depth) => d.depth_stencil_attachment(depth),
                     None => d,

@@ -14,7 +14,7 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
-use crate::settings::{LightAssignment, RenderSettings};
+use crate::settings::{Geometry, LightAssignment, RenderSettings};
 use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::Camera;
@@ -428,7 +428,15 @@ impl<'a> Renderer<'a> {
         let antialiasing = self.settings.antialiasing;
         if antialiasing != Antialiasing::Off {
             let (width, height) = (self.extent.width, self.extent.height);
-            stats.set_feature(AntialiasingStats { antialiasing, width, height, surfaces: self.rays_traced[last].1 });
+            // The visibility technique's buffer (and the hardware raster's images), whose
+            // lighting counts the surfaces it shades; or the mesh techniques' multisampled
+            // attachments.
+            let attachments = self.frames[0].targets.as_ref().expect("made with the frame").multisampled_bytes();
+            let (sample_bytes, surfaces) = match self.settings.technique.geometry() {
+                Geometry::Meshlets => (antialiasing.buffer_bytes(width, height) + attachments, Some(self.rays_traced[last].1)),
+                Geometry::Meshes => (attachments, None),
+            };
+            stats.set_feature(AntialiasingStats { antialiasing, width, height, sample_bytes, surfaces });
         }
         stats.memory = Some(self.ctx.memory_use());
         self.last_frame = last;

@@ -9,6 +9,7 @@ pub use crate::scene::shadow_settings::{
 use crate::scene::SceneConfig;
 pub use crate::shading::Shading;
 pub use crate::targets::MAX_DIMENSION;
+use crate::targets::{multisampled_images, Output};
 pub use crate::technique::{
     missing_meshlet_feature, missing_raster_feature, Geometry, LargeTriangles, LightAssignment, LightingStage, Raster, Technique,
 };
@@ -266,6 +267,7 @@ impl RenderSettings {
             spot_lights: !scene.cones.is_empty(),
             transparency: self.blends_layers(),
             count_rays: self.light_stats && (shadow_rays || sun_rays),
+            antialiasing: self.antialiasing,
         }
     }
 
@@ -292,16 +294,10 @@ impl RenderSettings {
         if matches!(self.debug_view, DebugView::Meshlets | DebugView::Triangles) && self.technique.geometry() != Geometry::Meshlets {
             return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view.name(), technique: self.technique.name() }.into());
         }
-        if self.antialiasing != Antialiasing::Off {
-            if !self.raster.keeps_samples() || self.technique != Technique::Visibility {
-                let technique = if self.technique == Technique::Visibility { self.raster.name() } else { self.technique.name() };
-                return Err(SettingsError::AntialiasingNeedsComputeRaster { samples: self.antialiasing.name(), technique }.into());
-            }
-            if self.blends_layers() {
-                return Err(SettingsError::AntialiasingWithLayers { samples: self.antialiasing.name() }.into());
-            }
-        }
-        if self.debug_view == DebugView::Aa && (self.technique != Technique::Visibility || self.raster == Raster::Hardware) {
+        check_antialiasing(self, ctx)?;
+        // The lighting that reads the 64-bit buffer counts the surfaces.
+        let buffer = self.raster != Raster::Hardware || self.antialiasing != Antialiasing::Off;
+        if self.debug_view == DebugView::Aa && (self.technique != Technique::Visibility || !buffer) {
             return Err(SettingsError::AaViewNeedsComputeRaster { technique: self.technique.name() }.into());
         }
         if self.technique.geometry() == Geometry::Meshlets {
@@ -441,6 +437,62 @@ fn shadowed_count(omni: &OmniShadowSettings, scene: &ml_cpu::scene::Scene, (widt
     let aspect = width.max(1) as f32 / height.max(1) as f32;
     let seen = ml_cpu::omni_shadow::lights_in_view(&scene.lights, &scene.camera, aspect, scene.light_motion, MAX_SHADOWED_LIGHTS as usize);
     (seen.len() as u32).max(1)
+}
+
+/// Refuse `--aa` where `s` cannot keep samples (in one line: the technique, the raster, the
+/// transparent layers, the sample counts the device offers for what the samples are drawn
+/// into).
+fn check_antialiasing(s: &RenderSettings, ctx: &Context) -> Result<(), RenderError> {
+    if s.antialiasing == Antialiasing::Off {
+        return Ok(());
+    }
+    let samples = s.antialiasing.name();
+    if !s.technique.has_antialiasing() {
+        return Err(SettingsError::AntialiasingUnsupported { samples, technique: s.technique.name() }.into());
+    }
+    if s.blends_layers() {
+        return Err(SettingsError::AntialiasingWithLayers { samples }.into());
+    }
+    // The visibility technique keeps its samples in the 64-bit buffer.
+    let int64 = ctx.info.features.buffer_int64_atomics;
+    if s.technique == Technique::Visibility && !int64 {
+        let feature = "shaderInt64 (the samples' 64-bit buffer)";
+        return Err(SettingsError::AntialiasingFeature { samples, feature, device: ctx.info.name.clone() }.into());
+    }
+    // The hardware raster's samples gathered into that buffer: one storage buffer (the
+    // compute rasters' is checked with them).
+    let max = ctx.info.limits.max_storage_buffer_range;
+    let bytes = s.antialiasing.buffer_bytes(s.width, s.height);
+    if s.technique == Technique::Visibility && s.raster == Raster::Hardware && bytes > u64::from(max) {
+        let (width, height, device) = (s.width, s.height, ctx.info.name.clone());
+        return Err(SettingsError::RasterBuffer { width, height, bytes, device, max }.into());
+    }
+    // What the samples are drawn into (the hybrid raster's large triangles: a draw without
+    // attachments), and the sample counts the device offers for each.
+    let mut drawn: Vec<(String, vk::SampleCountFlags)> = Vec::new();
+    let output = Output::of(s.technique);
+    let depth_format = crate::targets::depth_format(ctx, output)?;
+    let hybrid = s.raster != Raster::Hardware && s.raster.bin_list().is_none();
+    for (image, format, usage) in multisampled_images(output, s.raster, depth_format) {
+        drawn.push((format!("{}'s {image} ({format:?})", s.technique.name()), ctx.image_sample_counts(format, usage)));
+    }
+    if s.technique == Technique::Visibility && hybrid {
+        let offered = ctx.info.limits.framebuffer_no_attachments_sample_counts;
+        drawn.push(("the hybrid raster's large triangles (a draw without attachments)".to_owned(), offered));
+    }
+    for (what, offered) in drawn {
+        if !offered.contains(s.antialiasing.sample_count()) {
+            let offered: Vec<String> =
+                Antialiasing::ALL.iter().filter(|a| offered.contains(a.sample_count())).map(|a| a.samples().to_string()).collect();
+            let offered = match offered.split_last() {
+                Some((last, [])) => last.clone(),
+                Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+                None => "no".to_owned(),
+            };
+            return Err(SettingsError::AntialiasingSamples { samples, what, device: ctx.info.name.clone(), offered }.into());
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -186,6 +186,7 @@ impl StageProbe {
                     .line_width(1.0),
                 depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default(),
                 colour_attachments: 1,
+                samples: vk::SampleCountFlags::TYPE_1,
                 layout: self.fragment_layout,
                 render_pass: self.render_pass,
                 subpass: 0,

@@ -118,6 +118,35 @@ pub fn depth_format(ctx: &Context, output: Output) -> Result<vk::Format, VkError
         .ok_or_else(|| VkError::Unsupported { device: ctx.info.name.clone(), what: format!("a depth format with {needs:?}") })
 }
 
+/// The multisampled attachments a raster pass draws into with anti-aliasing (name, format,
+/// usage): the forward pass's colour and depth, the G-buffer's images (all five: a scene's may
+/// have them) and depth, or the hardware visibility raster's ids and depth. What `Targets`
+/// makes of them, and what the settings check against the device's sample counts before.
+pub fn multisampled_images(
+    output: Output,
+    raster: Raster,
+    depth_format: vk::Format,
+) -> Vec<(&'static str, vk::Format, vk::ImageUsageFlags)> {
+    use vk::ImageUsageFlags as U;
+    let inside = U::TRANSIENT_ATTACHMENT;
+    let depth = ("depth", depth_format, U::DEPTH_STENCIL_ATTACHMENT | inside);
+    match output {
+        // The hardware visibility raster's images, which a compute pass gathers into the
+        // 64-bit buffer (the compute rasters draw into that buffer alone).
+        Output::Visibility if raster == Raster::Hardware => vec![
+            ("visibility buffer", VISIBILITY_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED),
+            ("depth", depth_format, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED),
+        ],
+        Output::Color => vec![("colour", HDR_FORMAT, U::COLOR_ATTACHMENT | inside), depth],
+        Output::Subpasses => GBUFFER
+            .iter()
+            .map(|g| (g.name, g.format, U::COLOR_ATTACHMENT | U::INPUT_ATTACHMENT | inside))
+            .chain([(depth.0, depth.1, depth.2 | U::INPUT_ATTACHMENT)])
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
 pub struct Targets {
     /// The image that is read back (a colour attachment, or a storage image the lighting
     /// compute pass or the tone map writes).
@@ -133,6 +162,9 @@ pub struct Targets {
     /// visibility: the depth pyramid of the late culling phase, level after level (null
     /// otherwise).
     pub depth_pyramid: Buffer,
+    /// Forward techniques with anti-aliasing: the multisampled colour the meshes are drawn
+    /// into (the display's linear light), resolved into `hdr` (null otherwise).
+    pub colour_samples: Image,
     /// visibility with the compute raster: 64 bits per sample (`Antialiasing`), depth and id, which its passes
     /// write by atomic min and the depth pyramid and the lighting read (null otherwise; `depth`
     /// and `visibility` are null then).
@@ -191,6 +223,7 @@ impl Targets {
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
+            colour_samples: Image::null(),
         };
         ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layers, antialiasing)))
     }
@@ -221,18 +254,39 @@ impl Targets {
             Output::Visibility => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::empty()),
             Output::Layers { .. } => unreachable!("no technique's raster writes only layers"),
         };
-        // The compute raster keeps depth and ids in one buffer: no images of them.
+        // The compute raster keeps depth and ids in one buffer: no images of them. The
+        // hardware raster's samples are gathered into that buffer too.
         let compute_raster = output == Output::Visibility && raster != Raster::Hardware;
+        let aa = antialiasing != Antialiasing::Off;
+        let keeps_buffer = output == Output::Visibility && (compute_raster || aa);
+        // The mesh techniques' anti-aliasing: multisampled attachments that never leave the
+        // render pass (render_pass.rs describe); the visibility raster's, which a compute
+        // pass reads.
+        let multisampled = aa && matches!(output, Output::Color | Output::Subpasses);
+        let (samples, inside_only) = match (multisampled, aa && output == Output::Visibility) {
+            (true, _) => (antialiasing.sample_count(), U::TRANSIENT_ATTACHMENT),
+            (false, true) => (antialiasing.sample_count(), U::empty()),
+            (false, false) => (vk::SampleCountFlags::TYPE_1, U::empty()),
+        };
+        let (depth_usage, gbuffer_usage) = match multisampled {
+            true => (depth_usage | inside_only, gbuffer_usage | inside_only),
+            false => (depth_usage, gbuffer_usage),
+        };
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
         if !compute_raster {
-            self.depth = Image::new_2d(ctx, "depth target", extent, depth_format, depth_usage, vk::ImageAspectFlags::DEPTH)?;
+            let depth = vk::ImageAspectFlags::DEPTH;
+            self.depth = Image::new_2d_samples(ctx, "depth target", (extent, samples), depth_format, depth_usage, depth)?;
         }
         if matches!(output, Output::GBuffer | Output::Subpasses) {
             for g in gbuffer {
-                self.gbuffer.push(Image::new_2d(ctx, g.name, extent, g.format, gbuffer_usage, colour)?);
+                self.gbuffer.push(Image::new_2d_samples(ctx, g.name, (extent, samples), g.format, gbuffer_usage, colour)?);
             }
         }
-        if output == Output::Subpasses || (output == Output::Color && layers) {
+        if multisampled && output == Output::Color {
+            let usage = U::COLOR_ATTACHMENT | inside_only;
+            self.colour_samples = Image::new_2d_samples(ctx, "colour samples", (extent, samples), HDR_FORMAT, usage, colour)?;
+        }
+        if output == Output::Subpasses || (output == Output::Color && (layers || multisampled)) {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
         } else if layers {
             // The compute lighting's linear output, which the transparent resolve reads.
@@ -241,18 +295,25 @@ impl Targets {
         if output == Output::Visibility {
             if !compute_raster {
                 let usage = U::COLOR_ATTACHMENT | U::SAMPLED;
-                self.visibility = Image::new_2d(ctx, "visibility buffer", extent, VISIBILITY_FORMAT, usage, colour)?;
+                self.visibility = Image::new_2d_samples(ctx, "visibility buffer", (extent, samples), VISIBILITY_FORMAT, usage, colour)?;
             }
             let bytes = depth_pyramid_len(extent) * 4;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
             self.depth_pyramid = Buffer::new(ctx, "depth pyramid", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
         }
-        if compute_raster {
+        if keeps_buffer {
             let bytes = antialiasing.buffer_bytes(extent.width, extent.height);
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
             self.visibility_depth = Buffer::new(ctx, "visibility-depth buffer", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
         }
         Ok(())
+    }
+
+    /// Bytes of the multisampled attachments (anti-aliasing's samples: depth, and the forward
+    /// pass's colour, the G-buffer or the hardware visibility raster's ids).
+    pub fn multisampled_bytes(&self) -> u64 {
+        let ids = self.colour_samples.bytes + self.visibility.bytes;
+        self.depth.bytes + ids + self.gbuffer.iter().map(|g| g.bytes).sum::<u64>()
     }
 
     /// The G-buffer image the shaders call `key` (`normal`, `object`, `albedo`, …), where the
@@ -271,6 +332,7 @@ impl Targets {
         self.visibility.destroy(ctx);
         self.depth_pyramid.destroy(ctx);
         self.visibility_depth.destroy(ctx);
+        self.colour_samples.destroy(ctx);
     }
 }
 

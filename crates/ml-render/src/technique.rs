@@ -89,6 +89,13 @@ impl Technique {
             && (self.geometry() == Geometry::Meshlets || self.lighting_stage() == LightingStage::Compute)
     }
 
+    /// Whether it anti-aliases (`--aa`): the mesh techniques in multisampled attachments —
+    /// deferred-compute, whose compute lighting reads single-sampled images, not yet — and
+    /// visibility in its 64-bit buffer, whichever raster draws it.
+    pub fn has_antialiasing(self) -> bool {
+        self != Technique::DeferredCompute
+    }
+
     /// Whether it has the cluster grid (`--clusters`): the techniques that assign on the CPU.
     pub fn has_cluster_grid(self) -> bool {
         self.assignment() == LightAssignment::Cpu
@@ -216,12 +223,6 @@ impl Raster {
             Raster::Compute { large: LargeTriangles::Bins { bin_list }, .. } => Some(bin_list),
             _ => None,
         }
-    }
-
-    /// Whether it keeps anti-aliasing's coverage samples (`--aa`): the compute raster, whose
-    /// every pass draws into its buffer (the hybrid's hardware draw keeps one a pixel).
-    pub fn keeps_samples(self) -> bool {
-        self.bin_list().is_some()
     }
 }
 

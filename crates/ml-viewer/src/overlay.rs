@@ -90,11 +90,21 @@ impl Choices {
         r
     }
 
+    /// The raster the technique draws with: the chosen one for visibility; the others have no
+    /// visibility buffer to draw.
+    fn drawn_raster(&self) -> Raster {
+        if self.technique.geometry() == Geometry::Meshlets {
+            self.raster
+        } else {
+            Raster::Hardware
+        }
+    }
+
     /// The settings of these choices at a size, the clock fixed at `time` if given.
     pub fn settings(&self, (width, height): (u32, u32), time: Option<f32>) -> RenderSettings {
-        // Other techniques have no visibility buffer to draw.
-        let raster = if self.technique.geometry() == Geometry::Meshlets { self.raster } else { Raster::Hardware };
-        // Only the compute raster keeps samples, and they are not blended with layers yet.
+        let raster = self.drawn_raster();
+        // Anti-aliasing where the technique (and raster) keeps samples; they are not blended
+        // with layers yet.
         RenderSettings {
             technique: self.technique,
             shading: self.shading,
@@ -113,7 +123,11 @@ impl Choices {
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
             light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
-            antialiasing: if raster.keeps_samples() && self.transparency.is_none() { self.antialiasing } else { Antialiasing::Off },
+            antialiasing: if self.technique.has_antialiasing() && self.transparency.is_none() {
+                self.antialiasing
+            } else {
+                Antialiasing::Off
+            },
         }
     }
 }
@@ -175,9 +189,9 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
             if let Raster::Compute { split, .. } = &mut choices.raster {
                 ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
             }
-            if choices.raster.keeps_samples() && choices.transparency.is_none() {
-                combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
-            }
+        }
+        if choices.technique.has_antialiasing() && choices.transparency.is_none() {
+            combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
         }
         combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());
         ui.add_enabled_ui(state.seed_scene, |ui| {

@@ -495,6 +495,23 @@ impl Context {
         props.optimal_tiling_features.contains(features)
     }
 
+    /// The sample counts the device offers for 2D optimal-tiling images of `format` made for
+    /// `usage` (empty where it cannot make such an image at all).
+    pub fn image_sample_counts(&self, format: vk::Format, usage: vk::ImageUsageFlags) -> vk::SampleCountFlags {
+        // SAFETY: query on our physical device.
+        let props = unsafe {
+            self.parts.instance.get_physical_device_image_format_properties(
+                self.physical_device,
+                format,
+                vk::ImageType::TYPE_2D,
+                vk::ImageTiling::OPTIMAL,
+                usage,
+                vk::ImageCreateFlags::empty(),
+            )
+        };
+        props.map(|p| p.sample_counts).unwrap_or(vk::SampleCountFlags::empty())
+    }
+
     /// Bytes of the device's largest device-local memory heap.
     pub fn device_local_bytes(&self) -> u64 {
         // SAFETY: a physical device of this instance.

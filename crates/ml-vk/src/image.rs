@@ -17,6 +17,8 @@ pub struct Image {
     /// Memory of a transient attachment where the device has a lazily allocated kind (tilers:
     /// it may never be backed); null otherwise.
     lazy_memory: vk::DeviceMemory,
+    /// Bytes of memory it takes (its requirements; 0 for a null image).
+    pub bytes: u64,
 }
 
 impl Image {
@@ -30,6 +32,7 @@ impl Image {
             extent: vk::Extent2D::default(),
             allocation: None,
             lazy_memory: vk::DeviceMemory::null(),
+            bytes: 0,
         }
     }
 
@@ -44,12 +47,37 @@ impl Image {
         Image::new(ctx, name, ImageShape { extent, levels: 1, layers: 1, view: vk::ImageViewType::TYPE_2D }, format, usage, aspect)
     }
 
+    /// A 2D image of `samples` samples per pixel (a multisampled attachment; `TYPE_1` makes
+    /// what `new_2d` makes).
+    pub fn new_2d_samples(
+        ctx: &Context,
+        name: &str,
+        (extent, samples): (vk::Extent2D, vk::SampleCountFlags),
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+    ) -> Result<Image> {
+        let shape = ImageShape { extent, levels: 1, layers: 1, view: vk::ImageViewType::TYPE_2D };
+        Image::create(ctx, name, (shape, samples), format, usage, aspect)
+    }
+
     /// A 2D image, 2D array, cubemap or cube-map array (`shape`) with `shape.levels` mip
     /// levels, and one view of all of it.
     pub fn new(
         ctx: &Context,
         name: &str,
         shape: ImageShape,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+    ) -> Result<Image> {
+        Image::create(ctx, name, (shape, vk::SampleCountFlags::TYPE_1), format, usage, aspect)
+    }
+
+    fn create(
+        ctx: &Context,
+        name: &str,
+        (shape, samples): (ImageShape, vk::SampleCountFlags),
         format: vk::Format,
         usage: vk::ImageUsageFlags,
         aspect: vk::ImageAspectFlags,
@@ -63,7 +91,7 @@ impl Image {
             .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
             .mip_levels(shape.levels)
             .array_layers(layers)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(samples)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
@@ -72,7 +100,15 @@ impl Image {
         let raw = unsafe { ctx.device.create_image(&info, None) }.ctx("vkCreateImage")?;
         // SAFETY: `raw` was just created.
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
-        let mut image = Image { raw, view: vk::ImageView::null(), format, extent, allocation: None, lazy_memory: vk::DeviceMemory::null() };
+        let mut image = Image {
+            raw,
+            view: vk::ImageView::null(),
+            format,
+            extent,
+            allocation: None,
+            lazy_memory: vk::DeviceMemory::null(),
+            bytes: requirements.size,
+        };
         let lazy_type = usage
             .contains(vk::ImageUsageFlags::TRANSIENT_ATTACHMENT)
             .then(|| ctx.lazily_allocated_memory_type(requirements.memory_type_bits))

@@ -110,6 +110,8 @@ pub struct GraphicsPipelineDesc<'a> {
     pub rasterization: vk::PipelineRasterizationStateCreateInfo<'a>,
     pub depth_stencil: vk::PipelineDepthStencilStateCreateInfo<'a>,
     pub colour_attachments: usize,
+    /// Samples per pixel of the subpass's attachments (`TYPE_1` unless multisampled).
+    pub samples: vk::SampleCountFlags,
     pub layout: vk::PipelineLayout,
     pub render_pass: vk::RenderPass,
     pub subpass: u32,
@@ -146,7 +148,7 @@ pub fn graphics_pipeline(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<v
     }
     let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
     let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
-    let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(desc.samples);
     let blend_attachments =
         vec![vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA); desc.colour_attachments];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);

@@ -94,11 +94,7 @@ fn options_that_do_not_apply_are_refused() {
         (&["--technique", "forward", "--raster", "hardware"], &["--raster does not apply to forward", "--technique visibility"]),
         (&["--technique", "clustered-gpu", "--raster-split", "8"], &["--raster-split does not apply to clustered-gpu"]),
         (&["--technique", "visibility", "--raster", "hardware", "--raster-split", "8"], &["--raster-split", "--raster hardware"]),
-        (&["--technique", "forward", "--aa", "8"], &["--aa does not apply to forward", "--technique visibility"]),
-        (
-            &["--technique", "visibility", "--raster", "hybrid", "--aa", "4"],
-            &["--aa does not apply to --raster hybrid", "--raster compute"],
-        ),
+        (&["--technique", "deferred-compute", "--aa", "8"], &["--aa does not apply to deferred-compute", "all but deferred-compute"]),
         (&["--technique", "deferred", "--debug-view", "aa"], &["--debug-view aa", "--technique visibility"]),
         (&["--technique", "forward", "--debug-view", "cluster-heat"], &["--debug-view cluster-heat", "clustered-cpu or clustered-gpu"]),
         (&["--technique", "deferred-compute", "--debug-view", "meshlets"], &["--debug-view meshlets", "--technique visibility"]),
@@ -146,10 +142,6 @@ fn options_that_do_not_apply_are_refused() {
         ),
         (&["--techniques", "forward", "--raster", "compute"], &["--raster does not apply to forward", "--techniques visibility"]),
         (&["--raster", "hardware", "--raster-split", "8"], &["--raster-split does not apply to --raster hardware"]),
-        (
-            &["--techniques", "visibility", "--raster", "hardware", "--aa", "8"],
-            &["--aa does not apply to --raster hardware", "--raster compute"],
-        ),
         (&["--probe", "--techniques", "forward"], &["--techniques does not apply to bench --probe"]),
         (&["--probe", "--lights", "1k"], &["--lights does not apply to bench --probe"]),
         (&["--probe-lights", "16"], &["--probe-lights does not apply to bench without --probe", "--probe"]),

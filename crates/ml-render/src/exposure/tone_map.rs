@@ -14,10 +14,11 @@ pub struct ToneMap {
 
 impl ToneMap {
     /// `aces`: apply pbr's tone-mapping curve before gamma (not for debug views, whose
-    /// values are shown as they are).
-    pub fn new(ctx: &Context, aces: bool) -> Result<ToneMap, VkError> {
-        let curve = [("MODEL_PBR", u32::from(aces))];
-        Ok(ToneMap { pass: ComputePass::new(ctx, &[], (&ml_shaders::TONEMAP_COMP, &curve))? })
+    /// values are shown as they are); `display_linear`: the image holds the display's linear
+    /// light already (anti-aliasing's resolved samples), which only needs the gamma curve.
+    pub fn new(ctx: &Context, (aces, display_linear): (bool, bool)) -> Result<ToneMap, VkError> {
+        let constants = [("MODEL_PBR", u32::from(aces)), ("DISPLAY_LINEAR_INPUT", u32::from(display_linear))];
+        Ok(ToneMap { pass: ComputePass::new(ctx, &[], (&ml_shaders::TONEMAP_COMP, &constants))? })
     }
 }
 

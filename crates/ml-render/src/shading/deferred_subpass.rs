@@ -4,6 +4,7 @@
 //! pixel only) and lights a full-screen triangle into the HDR target — over every light, or
 //! over the pixel's cluster — which the tone-map pass turns into the colour target.
 
+use crate::antialiasing::Antialiasing;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
@@ -33,11 +34,18 @@ impl DeferredSubpasses {
         clustered: bool,
     ) -> Result<DeferredSubpasses, VkError> {
         let gbuffer = if shading.object_textures { &ml_shaders::GBUFFER_TEXTURED_FRAG } else { &ml_shaders::GBUFFER_FRAG };
-        let lighting = match (clustered, shading.object_textures) {
-            (false, false) => &ml_shaders::DEFERRED_FRAG,
-            (true, false) => &ml_shaders::DEFERRED_CLUSTERED_FRAG,
-            (false, true) => &ml_shaders::DEFERRED_TEXTURED_FRAG,
-            (true, true) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_FRAG,
+        // With anti-aliasing, the variant that reads the G-buffer's samples (a subpass input's
+        // type says whether it is multisampled).
+        let samples = shading.antialiasing != Antialiasing::Off;
+        let lighting = match (clustered, shading.object_textures, samples) {
+            (false, false, false) => &ml_shaders::DEFERRED_FRAG,
+            (true, false, false) => &ml_shaders::DEFERRED_CLUSTERED_FRAG,
+            (false, true, false) => &ml_shaders::DEFERRED_TEXTURED_FRAG,
+            (true, true, false) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_FRAG,
+            (false, false, true) => &ml_shaders::DEFERRED_SAMPLES_FRAG,
+            (true, false, true) => &ml_shaders::DEFERRED_CLUSTERED_SAMPLES_FRAG,
+            (false, true, true) => &ml_shaders::DEFERRED_TEXTURED_SAMPLES_FRAG,
+            (true, true, true) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_SAMPLES_FRAG,
         };
         let textures = scene.textures.set_layout.raw;
         let attachments = (depth_format, Output::Subpasses, gbuffer_images(shading.object_textures));
@@ -57,7 +65,10 @@ impl DeferredSubpasses {
             let layouts = [pass.lighting_sets.layout.raw, textures, pass.input_sets.layout.raw];
             pass.lighting_layout = shader::pipeline_layout(ctx, &layouts, &[])?;
             let shaders = (&ml_shaders::FULLSCREEN_VERT, lighting);
-            let constants = shading.lighting_constants();
+            let mut constants = shading.lighting_constants().to_vec();
+            if samples {
+                constants.push(shading.antialiasing.constant());
+            }
             pass.lighting = pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.lighting_layout, 1), &constants)?;
             Ok(())
         })

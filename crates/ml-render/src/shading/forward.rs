@@ -18,8 +18,9 @@ pub struct Forward {
     /// Draws the cluster-heat legend over the image (debug view cluster-heat; else null).
     legend: vk::Pipeline,
     name: &'static str,
-    /// It writes linear HDR for the transparent layers' resolve instead of the colour target.
-    layers: bool,
+    /// It writes the HDR image instead of the colour target: linear light for the transparent
+    /// layers' resolve, or with anti-aliasing the samples' mean for the tone map.
+    writes_hdr: bool,
 }
 
 impl Forward {
@@ -39,10 +40,11 @@ impl Forward {
         };
         let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
         let raster = MeshRaster::new(ctx, (depth_format, Output::Color, &[]), (fragment, shading, &scene.surface_variants), layouts)?;
-        let mut pass = Forward { raster, legend: vk::Pipeline::null(), name, layers: shading.transparency };
+        let mut pass = Forward { raster, legend: vk::Pipeline::null(), name, writes_hdr: false };
+        pass.writes_hdr = shading.transparency || pass.raster.multisampled();
         if legend {
             let shaders = (&ml_shaders::HEAT_LEGEND_VERT, &ml_shaders::HEAT_LEGEND_FRAG);
-            match pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.raster.pipeline_layout, 0), &[]) {
+            match pass.raster.pipeline(ctx, shaders, Draw::Screen, (pass.raster.pipeline_layout, 0), &[shading.display_constant()]) {
                 Ok(p) => pass.legend = p,
                 Err(e) => {
                     pass.destroy(ctx);
@@ -66,15 +68,16 @@ impl Pass for Forward {
     /// The colour target is its render pass's attachment: the pass's external dependencies
     /// order it after the transfers that read it last (the read-back, a window's blit) and
     /// before the transfers after it, and its final layout is TRANSFER_SRC_OPTIMAL
-    /// (render_pass.rs). With transparent layers it writes the HDR image instead, which only
-    /// the resolve after it reads (ordered by the render pass's dependencies likewise).
+    /// (render_pass.rs). With transparent layers or anti-aliasing it writes the HDR image
+    /// instead, which only the pass after it (the layers' resolve, the tone map) reads, ordered
+    /// by the render pass's dependencies likewise.
     fn uses(&self) -> Vec<Use> {
         let attachments = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
             | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
             | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let mut uses = shading_reads(vk::PipelineStageFlags::FRAGMENT_SHADER);
-        if self.layers {
+        if self.writes_hdr {
             return uses;
         }
         uses.push(Use {

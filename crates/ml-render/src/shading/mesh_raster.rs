@@ -42,6 +42,9 @@ pub struct MeshRaster {
     /// The scene's transparent objects are blended in layers: the opaque passes skip them and
     /// the forward pass writes linear HDR (else they are drawn as masks with the rest).
     layers: bool,
+    /// Samples per pixel of subpass 0's attachments (anti-aliasing; the transparent layers'
+    /// build has none).
+    samples: vk::SampleCountFlags,
 }
 
 impl MeshRaster {
@@ -63,18 +66,24 @@ impl MeshRaster {
             output,
             gbuffer,
             layers: shading.transparency,
+            samples: match output {
+                Output::Color | Output::GBuffer | Output::Subpasses => shading.antialiasing.sample_count(),
+                Output::Visibility | Output::Layers { .. } => vk::SampleCountFlags::TYPE_1,
+            },
         };
         ml_vk::build(ctx, r, |r| {
-            r.render_pass = render_pass::describe(depth_format, output, gbuffer, shading.transparency).create(ctx)?;
+            r.render_pass = render_pass::describe(depth_format, output, gbuffer, (shading.transparency, r.samples)).create(ctx)?;
             let push = [vk::PushConstantRange::default()
                 .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
                 .size(std::mem::size_of::<ObjectPush>() as u32)];
             r.pipeline_layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw, textures_layout, object_textures_layout], &push)?;
             // Drawn into the colour target, meshes are lit where they are drawn; into a
-            // G-buffer or the transparent layers, only their surfaces are read (unlit).
+            // G-buffer or the transparent layers, only their surfaces are read (unlit). The
+            // opaque passes test masks at each of their samples.
             let constants = match output {
-                Output::Color => shading.layered_lighting_constants().to_vec(),
-                _ => shading.surface_constants().to_vec(),
+                Output::Color => shading.forward_lighting_constants().to_vec(),
+                Output::Layers { .. } => shading.surface_constants().to_vec(),
+                _ => [&shading.surface_constants()[..], &[shading.antialiasing.constant()]].concat(),
             };
             let drawn: Vec<SurfaceVariant> = variants.iter().chain([&SurfaceVariant::OPAQUE]).map(|&v| r.drawn_as(v)).collect();
             for v in drawn {
@@ -85,6 +94,11 @@ impl MeshRaster {
             }
             Ok(())
         })
+    }
+
+    /// Whether subpass 0's attachments hold several samples a pixel (anti-aliasing).
+    pub fn multisampled(&self) -> bool {
+        self.samples != vk::SampleCountFlags::TYPE_1
     }
 
     /// How this pass draws an object of variant `v`: transparent layers are not cut by their
@@ -118,6 +132,8 @@ impl MeshRaster {
         constants: &[(&str, u32)],
     ) -> Result<vk::Pipeline, VkError> {
         let colour_attachments = if subpass == 0 { self.output.colour_attachments(self.gbuffer) } else { 1 };
+        // The deferred lighting subpass writes one HDR value a pixel.
+        let samples = if subpass == 0 { self.samples } else { vk::SampleCountFlags::TYPE_1 };
         let bindings = [vertex_binding()];
         let attributes = vertex_attributes();
         let mesh = matches!(draw, Draw::Mesh(_));
@@ -159,6 +175,7 @@ impl MeshRaster {
                 rasterization,
                 depth_stencil,
                 colour_attachments,
+                samples,
                 layout,
                 render_pass: self.render_pass,
                 subpass,
@@ -183,6 +200,7 @@ impl MeshRaster {
         let t = frame.targets;
         let mut views: Vec<vk::ImageView> = match self.output {
             Output::Color if self.layers => vec![t.hdr.view],
+            Output::Color if self.multisampled() => vec![t.colour_samples.view],
             Output::Color => vec![t.color.view],
             Output::Layers { .. } => Vec::new(),
             _ => t.gbuffer.iter().map(|g| g.view).collect(),
@@ -190,7 +208,8 @@ impl MeshRaster {
         if !matches!(self.output, Output::Layers { .. }) {
             views.push(t.depth.view);
         }
-        if self.output == Output::Subpasses {
+        // The lighting subpass's output, or the forward samples' resolve.
+        if self.output == Output::Subpasses || (self.output == Output::Color && self.multisampled()) {
             views.push(t.hdr.view);
         }
         render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.color.extent)
@@ -206,7 +225,8 @@ impl MeshRaster {
         let zero = vk::ClearValue { color: vk::ClearColorValue { uint32: [0; 4] } };
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
         let mut clear: Vec<vk::ClearValue> = match self.output {
-            Output::Color if self.layers => vec![zero],
+            // Alpha 0: no surface at the sample (the tone map shows the background there).
+            Output::Color if self.layers || self.multisampled() => vec![zero],
             Output::Color | Output::Visibility => vec![colour],
             Output::GBuffer | Output::Subpasses => vec![zero; self.gbuffer.len()],
             Output::Layers { .. } => Vec::new(),
@@ -214,7 +234,8 @@ impl MeshRaster {
         if !matches!(self.output, Output::Layers { .. }) {
             clear.push(depth);
         }
-        if self.output == Output::Subpasses {
+        // The lighting subpass's output, or the forward samples' resolve (not cleared).
+        if self.output == Output::Subpasses || (self.output == Output::Color && self.multisampled()) {
             clear.push(zero);
         }
         let extent = rec.extent;

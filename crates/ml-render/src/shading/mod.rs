@@ -8,6 +8,7 @@ pub mod forward;
 pub mod gbuffer;
 pub mod mesh_raster;
 
+use crate::antialiasing::Antialiasing;
 use ml_cpu::shading_model::ShadingModel;
 
 /// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
@@ -29,6 +30,9 @@ pub struct Shading {
     pub transparency: bool,
     /// The compute lightings count the shadow rays they trace (`--light-stats` with rays).
     pub count_rays: bool,
+    /// Coverage samples per pixel: the mesh techniques draw into multisampled attachments and
+    /// light in the display's linear light (`display_constants`).
+    pub antialiasing: Antialiasing,
 }
 
 impl Shading {
@@ -67,10 +71,19 @@ impl Shading {
         [a, b, c, d, e, f, g, h, ("COUNT_RAYS", u32::from(self.count_rays))]
     }
 
-    /// `lighting_constants` and `TRANSPARENT_LAYERS` (shading/forward_frag.glsl): the forward
-    /// pass of a scene with transparent layers writes linear HDR for their resolve.
-    pub fn layered_lighting_constants(self) -> [(&'static str, u32); 9] {
+    /// `lighting_constants`, `TRANSPARENT_LAYERS` (shading/forward_frag.glsl: the forward
+    /// pass of a scene with transparent layers writes linear HDR for their resolve), the
+    /// samples per pixel its masks are tested at and `display_constant`: the forward pass's.
+    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 11] {
         let [a, b, c, d, e, f, g, h] = self.lighting_constants();
-        [a, b, c, d, e, f, g, h, ("TRANSPARENT_LAYERS", u32::from(self.transparency))]
+        let layers = ("TRANSPARENT_LAYERS", u32::from(self.transparency));
+        [a, b, c, d, e, f, g, h, layers, self.antialiasing.constant(), self.display_constant()]
+    }
+
+    /// `DISPLAY_LINEAR_OUTPUT` (shading/display_output.glsl): with anti-aliasing, the forward
+    /// pass writes the display's linear light, in which its samples are averaged and which the
+    /// tone map only gamma-encodes.
+    pub fn display_constant(self) -> (&'static str, u32) {
+        ("DISPLAY_LINEAR_OUTPUT", u32::from(self.antialiasing != Antialiasing::Off))
     }
 }

@@ -81,9 +81,10 @@ impl MeshletCull {
             }
             p.meshlet_pipeline = compute_pipeline(ctx, &ml_shaders::MESHLET_CULL_COMP, p.pipeline_layout, &[])?;
             // Only the compute raster's triangle pass draws, so only it tests surfaces: the
-            // hardware raster's culling (triangle_cull.comp) declares no SURFACE_TESTS.
+            // hardware raster's culling (triangle_cull.comp) declares no SURFACE_TESTS, only the
+            // samples a triangle may cover.
             let constants = match raster {
-                Raster::Hardware => Vec::new(),
+                Raster::Hardware => vec![antialiasing.constant()],
                 Raster::Compute { .. } => {
                     let [tests, masks] = p.scene.borrow().geometry.surface_constants();
                     vec![tests, masks, antialiasing.constant()]

@@ -6,5 +6,6 @@ pub mod depth_pyramid;
 pub mod meshlet_cull;
 pub mod meshlet_scene;
 pub mod triangle_raster_large;
+pub mod visibility_gather;
 pub mod visibility_lighting;
 pub mod visibility_raster;

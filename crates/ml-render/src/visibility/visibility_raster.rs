@@ -5,14 +5,16 @@
 //! newly visible triangles over them. With the hybrid raster the same draw holds only the
 //! triangles it leaves to the hardware (large ones, those crossing the near plane), and
 //! their fragments write its 64-bit buffer by atomic min (visibility_atomic.frag) in a pass
-//! without attachments.
+//! without attachments — at each of anti-aliasing's samples, the pipeline multisampled.
 
+use crate::antialiasing::Antialiasing;
 use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::plan::Phase;
 use crate::render_pass;
+use crate::specialization;
 use crate::sync::{Use, VISIBILITY_DEPTH};
 use crate::visibility::meshlet_scene::{SharedMeshletScene, COMPACTED_INDICES, CULL_COUNTERS, DRAW_SLOTS, TRIANGLE_IDS};
 use ml_cpu::gpu_types::{CullCounters, DrawIndexedCommand};
@@ -31,11 +33,12 @@ pub struct VisibilityRaster {
 }
 
 impl VisibilityRaster {
-    /// The pass of `phase`; `atomic`: the compute raster's hardware half.
+    /// The pass of `phase`; `atomic`: the compute raster's hardware half; either draws
+    /// `antialiasing`'s samples.
     pub fn new(
         ctx: &Context,
         scene: SharedMeshletScene,
-        (phase, atomic): (Phase, bool),
+        (phase, atomic, antialiasing): (Phase, bool, Antialiasing),
         depth_format: vk::Format,
     ) -> Result<VisibilityRaster, VkError> {
         // Masked or double-sided objects: both sides drawn, the fragment tests its surface.
@@ -58,11 +61,16 @@ impl VisibilityRaster {
             framebuffers: vec![vk::Framebuffer::null(); FRAMES_IN_FLIGHT],
         };
         ml_vk::build(ctx, pass, |p| {
-            p.render_pass =
-                if atomic { render_pass::visibility_atomic() } else { render_pass::visibility(depth_format, phase == Phase::Early) }
-                    .create(ctx)?;
+            p.render_pass = if atomic {
+                render_pass::visibility_atomic()
+            } else {
+                render_pass::visibility(depth_format, phase == Phase::Early, antialiasing.sample_count())
+            }
+            .create(ctx)?;
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::FRAGMENT).size(16)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
+            let samples = antialiasing.sample_count();
+            let [vertex_constants, fragment_constants] = specialization::resolve([vert, frag], &[antialiasing.constant()])?;
             // The G-buffer pass's state: back faces culled (counter-clockwise fronts) — or, with
             // surface tests, by the fragment shader —, depth LESS (the atomic min is the test
             // of the compute raster's half).
@@ -70,9 +78,9 @@ impl VisibilityRaster {
                 ctx,
                 &shader::GraphicsPipelineDesc {
                     vertex: vert.spirv,
-                    vertex_constants: &[],
+                    vertex_constants: &vertex_constants,
                     fragment: Some(frag.spirv),
-                    fragment_constants: &[],
+                    fragment_constants: &fragment_constants,
                     // Vertices are pulled from storage buffers by index.
                     vertex_input: vk::PipelineVertexInputStateCreateInfo::default(),
                     rasterization: vk::PipelineRasterizationStateCreateInfo::default()
@@ -85,6 +93,9 @@ impl VisibilityRaster {
                         .depth_write_enable(!atomic)
                         .depth_compare_op(vk::CompareOp::LESS),
                     colour_attachments: usize::from(!atomic),
+                    // The attachments' samples; without attachments (the hybrid's half), the
+                    // coverage the fragments see (gl_SampleMaskIn).
+                    samples,
                     layout: p.pipeline_layout,
                     render_pass: p.render_pass,
                     subpass: 0,

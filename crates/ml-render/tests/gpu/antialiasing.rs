@@ -1,8 +1,9 @@
-//! Anti-aliasing (docs/DESIGN.md#anti-aliasing), the visibility technique's compute raster with
-//! several coverage samples a pixel:
+//! Anti-aliasing (docs/DESIGN.md#anti-aliasing), several coverage samples a pixel — the
+//! visibility technique's compute raster, the mesh techniques' multisampled attachments:
 //! - against the same view supersampled 8×8 and filtered in linear light
-//!   (`ml_cpu::supersample`), 8 samples cut the RMS error of the image without anti-aliasing
-//!   to at most a third, on the bench scene and on foliage of alpha-masked leaves;
+//!   (`ml_cpu::supersample`), 8 samples of the compute raster cut the RMS error of the image
+//!   without anti-aliasing to at most a third, on the bench scene and on foliage of
+//!   alpha-masked leaves; 4 samples (lavapipe's most) of forward and deferred to at most half;
 //! - it changes nothing it must not: culling off, and the light grid's marks on or off, give
 //!   the same image byte for byte; two renders are byte-identical;
 //! - a pixel shades each surface its samples hold once: a view filled by one quad shades a
@@ -18,7 +19,7 @@ use ml_cpu::gltf_writer::{cutout, png, quad, GltfWriter, PrimitiveData, CUTOUT_S
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::scene::Scene;
 use ml_cpu::supersample::{downsample, rms_difference};
-use ml_render::{Antialiasing, AntialiasingStats, Raster, RenderOutput, RenderSettings, ShadingModel, Technique};
+use ml_render::{Antialiasing, AntialiasingStats, Raster, RenderSettings, ShadingModel, Technique};
 use rand::{Rng, SeedableRng};
 use serde_json::json;
 
@@ -34,17 +35,28 @@ fn visibility(width: u32, height: u32, aa: Antialiasing) -> RenderSettings {
     }
 }
 
-/// RMS error (8-bit units) of anti-aliasing off and at `samples` against the supersampled
-/// reference of the same view.
-fn errors(what: &str, scene: &Scene, base: RenderSettings, samples: Antialiasing) -> (f64, f64) {
+/// RMS errors (8-bit units) against the supersampled reference of `base`'s view: of `base`
+/// (anti-aliasing off), then of each of `variants`, named (technique and samples) in `what`'s
+/// line.
+fn errors(what: &str, scene: &Scene, base: RenderSettings, variants: &[RenderSettings]) -> (f64, Vec<f64>) {
     let (w, h) = (base.width, base.height);
     let big = RenderSettings { width: w * REFERENCE, height: h * REFERENCE, ..base };
-    let settings = [big, base, RenderSettings { antialiasing: samples, ..base }];
-    let Ok::<[RenderOutput; 3], _>([reference, off, aa]) = common::render_each(scene, &settings).try_into() else { panic!("three images") };
-    let reference = downsample(&reference.rgba, (w * REFERENCE, h * REFERENCE), REFERENCE);
-    let (e_off, e_aa) = (rms_difference(&off.rgba, &reference), rms_difference(&aa.rgba, &reference));
-    println!("{what} {w}x{h}: RMS error against the {REFERENCE}x{REFERENCE} reference {e_off:.3} without anti-aliasing, {e_aa:.3} with {} samples ({:.2} of it)", samples.samples(), e_aa / e_off);
-    (e_off, e_aa)
+    let settings: Vec<RenderSettings> = [big, base].into_iter().chain(variants.iter().copied()).collect();
+    let outputs = common::render_each(scene, &settings);
+    let reference = downsample(&outputs[0].rgba, (w * REFERENCE, h * REFERENCE), REFERENCE);
+    let e_off = rms_difference(&outputs[1].rgba, &reference);
+    let errors: Vec<f64> = outputs[2..].iter().map(|o| rms_difference(&o.rgba, &reference)).collect();
+    for (v, e) in variants.iter().zip(&errors) {
+        let (technique, samples) = (v.technique.name(), v.antialiasing.samples());
+        let raster = if v.technique == Technique::Visibility { format!(" ({} raster)", v.raster.name()) } else { String::new() };
+        println!("{what} {w}x{h}: RMS error against the {REFERENCE}x{REFERENCE} reference {e_off:.3} without anti-aliasing, {e:.3} by {technique}{raster} with {samples} samples ({:.2} of it)", e / e_off);
+    }
+    (e_off, errors)
+}
+
+/// The mesh techniques at `aa` (lavapipe's rasterizer offers 4 samples a pixel, not 8).
+fn meshes(technique: Technique, base: RenderSettings, aa: Antialiasing) -> RenderSettings {
+    RenderSettings { antialiasing: aa, raster: Raster::Hardware, ..RenderSettings { technique, ..base } }
 }
 
 /// Foliage: 300 alpha-masked, double-sided leaves (the cut-out plate, small, turned every way)
@@ -82,15 +94,50 @@ fn foliage() -> Scene {
     scene
 }
 
+/// Four samples a pixel: what lavapipe's rasterizer offers the mesh techniques and the hardware
+/// and hybrid visibility rasters; measured, they leave 0.40 of the bench scene's error (the
+/// compute raster 0.40 at 4 samples, 0.30 at 8).
+const FOUR_SAMPLES_AT_MOST: f64 = 0.5;
+
 #[test]
-fn eight_samples_cut_the_error_against_the_supersampled_reference_to_a_third() {
+fn samples_cut_the_error_against_the_supersampled_reference() {
     let bench = ml_cpu::bench_scene::bench_scene(1024, 1, 20).expect("the bench scene");
-    let (off, aa) = errors("bench scene", &bench, visibility(320, 180, Antialiasing::Off), Antialiasing::X8);
-    assert!(aa * 3.0 <= off, "bench scene: {aa:.3} with 8 samples against {off:.3} without");
+    let base = visibility(320, 180, Antialiasing::Off);
+    // The hybrid raster's hardware half draws without attachments, the hardware raster into
+    // multisampled ones, at what lavapipe offers there: 4 samples.
+    let hybrid = RenderSettings { antialiasing: Antialiasing::X4, raster: Raster::hybrid(Raster::DEFAULT_SPLIT), ..base };
+    let hardware = RenderSettings { antialiasing: Antialiasing::X4, raster: Raster::Hardware, ..base };
+    let variants = [
+        RenderSettings { antialiasing: Antialiasing::X8, ..base },
+        meshes(Technique::Forward, base, Antialiasing::X4),
+        meshes(Technique::Deferred, base, Antialiasing::X4),
+        hybrid,
+        hardware,
+    ];
+    let (off, aa) = errors("bench scene", &bench, base, &variants);
+    assert!(aa[0] * 3.0 <= off, "bench scene: {:.3} with 8 samples against {off:.3} without", aa[0]);
+    for (v, e) in variants[1..].iter().zip(&aa[1..]) {
+        assert!(
+            *e <= FOUR_SAMPLES_AT_MOST * off,
+            "bench scene: {:.3} by {} ({} raster) with 4 samples against {off:.3} without",
+            e,
+            v.technique.name(),
+            v.raster.name()
+        );
+    }
     let leaves = foliage();
     let base = RenderSettings { shading: ShadingModel::Pbr, ..visibility(160, 120, Antialiasing::Off) };
-    let (off, aa) = errors("foliage", &leaves, base, Antialiasing::X8);
-    assert!(aa * 3.0 <= off, "foliage: {aa:.3} with 8 samples against {off:.3} without");
+    let variants = [
+        RenderSettings { antialiasing: Antialiasing::X8, ..base },
+        meshes(Technique::Forward, base, Antialiasing::X4),
+        RenderSettings { antialiasing: Antialiasing::X4, raster: Raster::Hardware, ..base },
+    ];
+    let (off, aa) = errors("foliage", &leaves, base, &variants);
+    assert!(aa[0] * 3.0 <= off, "foliage: {:.3} with 8 samples against {off:.3} without", aa[0]);
+    for (v, e) in variants[1..].iter().zip(&aa[1..]) {
+        let what = format!("{} ({} raster)", v.technique.name(), v.raster.name());
+        assert!(*e <= FOUR_SAMPLES_AT_MOST * off, "foliage: {e:.3} by {what} with 4 samples against {off:.3} without");
+    }
 }
 
 #[test]
@@ -131,7 +178,8 @@ fn a_pixel_shades_each_surface_its_samples_hold_once() {
         let pixels = u64::from(width * height);
         // The diagonal crosses at most width + height pixels, each shading both triangles.
         let diagonal = u64::from(width + height);
-        println!("{} samples: {} surfaces shaded over {pixels} pixels", aa.samples(), stats.surfaces);
-        assert!(stats.surfaces > pixels && stats.surfaces <= pixels + diagonal, "{} samples: {} surfaces", aa.samples(), stats.surfaces);
+        let surfaces = stats.surfaces.expect("the visibility lighting counts them");
+        println!("{} samples: {surfaces} surfaces shaded over {pixels} pixels", aa.samples());
+        assert!(surfaces > pixels && surfaces <= pixels + diagonal, "{} samples: {surfaces} surfaces", aa.samples());
     }
 }

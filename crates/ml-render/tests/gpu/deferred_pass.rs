@@ -33,7 +33,7 @@ fn deferred_pass_has_two_subpasses_joined_by_input_attachments() {
 fn check_two_subpasses(object_textures: bool) {
     let images = gbuffer_images(object_textures);
     assert_eq!(images.len(), if object_textures { 5 } else { 3 });
-    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, images, false);
+    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, images, (false, vk::SampleCountFlags::TYPE_1));
     assert_eq!(d.subpasses.len(), 2);
     let (gbuffer, lighting) = (&d.subpasses[0], &d.subpasses[1]);
     // Subpass 1 reads exactly what subpass 0 wrote: its colour attachments and its depth.
@@ -68,14 +68,18 @@ fn check_two_subpasses(object_textures: bool) {
 
 #[test]
 fn lighting_shaders_load_the_gbuffer_as_input_attachments() {
-    use ml_shaders::{DEFERRED_CLUSTERED_FRAG, DEFERRED_CLUSTERED_TEXTURED_FRAG, DEFERRED_FRAG, DEFERRED_TEXTURED_FRAG};
+    use ml_shaders::*;
     for (name, spirv, object_textures) in [
         ("deferred.frag", DEFERRED_FRAG, false),
         ("deferred_clustered.frag", DEFERRED_CLUSTERED_FRAG, false),
         ("deferred_textured.frag", DEFERRED_TEXTURED_FRAG, true),
         ("deferred_clustered_textured.frag", DEFERRED_CLUSTERED_TEXTURED_FRAG, true),
+        ("deferred_samples.frag", DEFERRED_SAMPLES_FRAG, false),
+        ("deferred_clustered_samples.frag", DEFERRED_CLUSTERED_SAMPLES_FRAG, false),
+        ("deferred_textured_samples.frag", DEFERRED_TEXTURED_SAMPLES_FRAG, true),
+        ("deferred_clustered_textured_samples.frag", DEFERRED_CLUSTERED_TEXTURED_SAMPLES_FRAG, true),
     ] {
-        let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(object_textures), false);
+        let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(object_textures), (false, vk::SampleCountFlags::TYPE_1));
         let inputs = d.subpasses[1].inputs.len() as u32;
         let words: Vec<u32> = spirv.spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         let entries = ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().expect("reflect");
@@ -90,6 +94,28 @@ fn lighting_shaders_load_the_gbuffer_as_input_attachments() {
         indices.sort_unstable();
         assert_eq!(indices, (0..inputs).collect::<Vec<_>>(), "{name}: input_attachment_index of its subpassInputs");
     }
+}
+
+/// Anti-aliasing: subpass 0 draws into multisampled attachments, which the lighting subpass
+/// reads sample by sample into the single-sampled HDR target; the forward pass's multisampled
+/// colour is resolved into the HDR target at its end.
+#[test]
+fn multisampled_passes_keep_samples_inside_and_one_value_a_pixel_out() {
+    let four = vk::SampleCountFlags::TYPE_4;
+    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(true), (false, four));
+    let hdr = d.subpasses[1].colour[0].attachment as usize;
+    for (i, a) in d.attachments.iter().enumerate() {
+        assert_eq!(a.samples, if i == hdr { vk::SampleCountFlags::TYPE_1 } else { four }, "attachment {i}");
+    }
+    let f = describe(vk::Format::D32_SFLOAT, Output::Color, &[], (false, four));
+    let s = &f.subpasses[0];
+    let (colour, resolve) = (&f.attachments[s.colour[0].attachment as usize], &f.attachments[s.resolve[0].attachment as usize]);
+    assert_eq!((colour.samples, colour.store_op), (four, vk::AttachmentStoreOp::DONT_CARE));
+    assert_eq!(
+        (resolve.samples, resolve.store_op, resolve.format),
+        (vk::SampleCountFlags::TYPE_1, vk::AttachmentStoreOp::STORE, HDR_FORMAT)
+    );
+    assert_eq!(f.attachments[s.depth.expect("depth").attachment as usize].samples, four);
 }
 
 #[test]

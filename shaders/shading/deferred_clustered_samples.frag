@@ -1,0 +1,6 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Technique `deferred-clustered` with anti-aliasing: the lighting subpass reads the samples.
+#define CLUSTERED 1
+#define MULTISAMPLED 1
+#include "shading/deferred_frag.glsl"
