@@ -42,29 +42,8 @@ layout(input_attachment_index = 5, set = 2, binding = 6) uniform INPUT emissive_
 
 layout(location = 0) out vec4 out_hdr;
 
-// What subpass 0 wrote at sample `s` (0 without samples), depth aside.
-struct GSample {
-    vec2 normal;
-    uint id;
-    vec4 albedo;
-    vec2 roughness_metallic;
-    vec3 emissive_factor;
-};
-
-GSample gbuffer_sample(int s) {
-    GSample g;
-    g.normal = LOAD(normal_input, s).xy;
-    g.id = LOAD(object_input, s).r;
-    g.albedo = LOAD(albedo_input, s);
-#ifdef GBUFFER_MATERIAL
-    g.roughness_metallic = LOAD(roughness_metallic_input, s).xy;
-    g.emissive_factor = LOAD(emissive_input, s).rgb;
-#else
-    g.roughness_metallic = vec2(1.0);
-    g.emissive_factor = vec3(1.0);
-#endif
-    return g;
-}
+#define GBUFFER_LOAD(name, s) LOAD(name##_input, s)
+#include "shading/gbuffer_samples.glsl"
 
 // The surface `g` at `frag_xy` (pixels) and depth `z`, lit; `debug`: a surface debug view's
 // colour, shown as it is.
@@ -81,47 +60,19 @@ vec3 shade_gbuffer(vec2 frag_xy, float z, GSample g, out bool debug) {
     return color;
 }
 
-#ifdef MULTISAMPLED
-bool same_surface(GSample a, GSample b) {
-    return a.normal == b.normal && a.id == b.id && a.albedo == b.albedo && a.roughness_metallic == b.roughness_metallic
-        && a.emissive_factor == b.emissive_factor;
+vec3 surface_display(vec2 xy, float z, GSample g) {
+    bool debug;
+    vec3 color = shade_gbuffer(xy, z, g, debug);
+    return debug ? clamp(color, 0.0, 1.0) : display_linear(color, frame.exposure.x);
 }
 
+#ifdef MULTISAMPLED
 void main() {
-    ivec2 pixel = ivec2(gl_FragCoord.xy);
-    uint left = (1u << VISIBILITY_SAMPLES) - 1u;
-    vec3 sum = vec3(0.0);
-    uint covered = 0u;
-    while (left != 0u) {
-        int s = findLSB(left);
-        left &= ~(1u << uint(s));
-        float z = LOAD(depth_input, s).r;
-        if (z >= 1.0) {
-            continue;
-        }
-        GSample g = gbuffer_sample(s);
-        uint members = 1u << uint(s);
-        float depth_sum = z;
-        for (int t = s + 1; t < int(VISIBILITY_SAMPLES); t++) {
-            float zt = LOAD(depth_input, t).r;
-            if ((left & (1u << uint(t))) != 0u && zt < 1.0 && same_surface(g, gbuffer_sample(t))) {
-                members |= 1u << uint(t);
-                depth_sum += zt;
-            }
-        }
-        left &= ~members;
-        // One plane's depth is affine in the image: the mean of its samples' depths lies at
-        // the mean of their points.
-        uint count = uint(bitCount(members));
-        bool debug;
-        vec3 color = shade_gbuffer(shading_xy(pixel, members), depth_sum / float(count), g, debug);
-        sum += float(count) * (debug ? clamp(color, 0.0, 1.0) : display_linear(color, frame.exposure.x));
-        covered += count;
-    }
-    if (covered == 0u) {
+    vec4 resolved = resolve_samples(ivec2(gl_FragCoord.xy));
+    if (resolved.a == 0.0) {
         discard;
     }
-    out_hdr = vec4(sum, float(covered)) / float(VISIBILITY_SAMPLES);
+    out_hdr = resolved;
 }
 #else
 void main() {

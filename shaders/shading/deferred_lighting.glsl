@@ -8,17 +8,57 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "common/scene_bindings.glsl"
-layout(set = 0, binding = 5) uniform sampler2D depth_image;
-layout(set = 0, binding = 6) uniform sampler2D normal_image;
-layout(set = 0, binding = 7) uniform usampler2D object_image;
-layout(set = 0, binding = 9) uniform sampler2D albedo_image;
-layout(set = 0, binding = 11) uniform sampler2D roughness_metallic_image;
-layout(set = 0, binding = 12) uniform sampler2D emissive_image;
+// MULTISAMPLED (deferred_lighting_samples.comp): anti-aliasing, the G-buffer multisampled and
+// each pixel resolved from its samples (gbuffer_samples.glsl).
+#ifdef MULTISAMPLED
+#define IMAGE sampler2DMS
+#define UIMAGE usampler2DMS
+#else
+#define IMAGE sampler2D
+#define UIMAGE usampler2D
+#endif
+layout(set = 0, binding = 5) uniform IMAGE depth_image;
+layout(set = 0, binding = 6) uniform IMAGE normal_image;
+layout(set = 0, binding = 7) uniform UIMAGE object_image;
+layout(set = 0, binding = 9) uniform IMAGE albedo_image;
+layout(set = 0, binding = 11) uniform IMAGE roughness_metallic_image;
+layout(set = 0, binding = 12) uniform IMAGE emissive_image;
 #include "common/textures.glsl"
 
 #include "common/lighting.glsl"
 #include "shading/compute_shading.glsl"
 
+// For every variant (the reflection test reads includes whole): the samples' count and
+// positions, which the multisampled one reads.
+#include "visibility/visibility_samples.glsl"
+
+#ifdef MULTISAMPLED
+// This invocation's pixel, whose samples GBUFFER_LOAD reads.
+ivec2 gbuffer_pixel;
+#define GBUFFER_LOAD(name, s) texelFetch(name##_image, gbuffer_pixel, s)
+// Without OBJECT_TEXTURES the material and emissive images are stand-ins, never read.
+#define GBUFFER_MATERIAL 1
+#include "shading/gbuffer_samples.glsl"
+
+vec3 surface_display(vec2 xy, float z, GSample g) {
+    vec2 roughness_metallic = OBJECT_TEXTURES ? g.roughness_metallic : vec2(1.0);
+    vec3 emissive_factor = OBJECT_TEXTURES ? g.emissive_factor : vec3(1.0);
+    PointMaterial m = point_material(objects[g.id].albedo_roughness, objects[g.id].material, objects[g.id].emissive, g.albedo,
+                                     roughness_metallic, emissive_factor);
+    return shade_display(xy, world_from_depth(xy, z), oct_decode(g.normal), m, objects[g.id].alpha_texture.x);
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
+        return;
+    }
+    gbuffer_pixel = p;
+    vec4 resolved = resolve_samples(p);
+    vec3 shown = resolved.rgb + (1.0 - resolved.a) * pow(CLEAR_COLOR.rgb, vec3(2.2));
+    imageStore(out_image, p, vec4(encode_gamma(shown), 1.0));
+}
+#else
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) {
@@ -41,3 +81,4 @@ void main() {
         point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, texelFetch(albedo_image, p, 0), roughness_metallic, emissive_factor);
     shade_and_store(p, frag_xy, world, n, m, objects[id].alpha_texture.x);
 }
+#endif

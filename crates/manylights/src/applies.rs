@@ -94,9 +94,6 @@ pub(crate) const CLUSTER_GRID: &str = "the techniques with a cluster grid";
 /// … and the technique whose visibility buffer the rasterisers draw.
 pub(crate) const VISIBILITY_BUFFER: &str = "the technique with a visibility buffer";
 
-/// … and the techniques that anti-alias.
-pub(crate) const ANTIALIASING: &str = "the techniques that anti-alias (all but deferred-compute)";
-
 pub(crate) fn draws_meshlets(t: Technique) -> bool {
     t.geometry() == ml_render::Geometry::Meshlets
 }
@@ -289,7 +286,6 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         Rule::technique("light_grid_marks", "the techniques that know their surfaces before their lighting", Technique::marks_light_grid),
         Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
         Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
-        Rule::technique("aa", ANTIALIASING, Technique::has_antialiasing),
         Rule::setting(
             "raster_split",
             Some(args.raster != "hardware"),

@@ -4,9 +4,7 @@
 //! would take longer than the budget is skipped and says so: brute force estimated from a smaller
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
-use crate::applies::{
-    check_rules, draws_meshlets, objects_rule, Auto, Given, Rule, Techniques, ANTIALIASING, CLUSTER_GRID, VISIBILITY_BUFFER,
-};
+use crate::applies::{check_rules, draws_meshlets, objects_rule, Auto, Given, Rule, Techniques, CLUSTER_GRID, VISIBILITY_BUFFER};
 use crate::auto::{self, technique_choice};
 use crate::{cluster_choice, print_warnings, scene_source, shading_choice, Progress, Whole};
 use anyhow::{bail, Context as _, Result};
@@ -104,8 +102,8 @@ pub struct BenchArgs {
     #[arg(long, default_value = "hardware,compute")]
     raster: String,
     /// Anti-aliasing sample counts, comma-separated: off, 4, 8, 16 (render's --aa); the
-    /// counts other than off make rows of the techniques that anti-alias (every rasteriser's
-    /// for visibility).
+    /// counts other than off make rows of every technique (and every rasteriser's for
+    /// visibility); a count the device does not offer one makes a row that says so.
     #[arg(long, default_value = "off")]
     aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread, pixels a side (1
@@ -168,7 +166,6 @@ impl BenchArgs {
             Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
             Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
             Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
-            Rule::technique("aa", ANTIALIASING, Technique::has_antialiasing),
             Rule::setting(
                 "raster_split",
                 Some(rasters.iter().any(|r| *r != Raster::Hardware)),
@@ -360,9 +357,6 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 continue;
             }
             for &antialiasing in &sample_counts {
-                if antialiasing != Antialiasing::Off && !technique.has_antialiasing() {
-                    continue;
-                }
                 let v = Variant { technique, raster, antialiasing };
                 if !variants.contains(&v) {
                     variants.push(v);
@@ -463,6 +457,20 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Va
     let scene = built.scene;
     let request = SettingsRequest { technique, raster: variant.raster, antialiasing: variant.antialiasing, ..plan.settings };
     let mut settings = request.for_scene(&scene, built.shading);
+    // A sample count the device does not offer this technique is a row that says so, not the
+    // end of the sweep.
+    if variant.antialiasing != Antialiasing::Off {
+        if let Err(e) = settings.check(ctx, scene.lights.len()) {
+            return Ok(Measured {
+                variant,
+                lights,
+                skipped: Some(format!("not measured: {e}")),
+                output: None,
+                grid: None,
+                ms_per_frame: 0.0,
+            });
+        }
+    }
     let probe = Renderer::new(ctx, scene.clone(), settings).and_then(|mut r| r.render())?;
     if let Some(why) = skip(probe.stats.wall_ms, "one frame measured") {
         return Ok(Measured { variant, lights, skipped: Some(why), output: None, grid: None, ms_per_frame: probe.stats.wall_ms });

@@ -280,7 +280,7 @@ struct SceneArgs {
     /// the counts the device offers), each distinct surface of a pixel shaded once and the
     /// pixel the mean of its samples in the display's linear light: forward, clustered and
     /// deferred by Vulkan multisampling, visibility in its 64-bit buffer (any raster; --raster
-    /// auto then picks compute); not deferred-compute.
+    /// auto then picks compute).
     #[arg(long, default_value = "off", value_parser = Antialiasing::ALL.map(Antialiasing::name))]
     aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread: bounding box up to

@@ -142,8 +142,10 @@ pub enum SettingsError {
     RasterBuffer { width: u32, height: u32, bytes: u64, device: String, max: u32 },
     /// Anti-aliasing's samples: the compute raster's buffer, the mesh techniques' multisampled
     /// attachments.
-    #[error("--aa {samples}: {technique} keeps one sample a pixel so far (every other technique anti-aliases): use another or --aa off")]
-    AntialiasingUnsupported { samples: &'static str, technique: &'static str },
+    #[error(
+        "--light-stats with --aa {samples}: {technique}'s light counts read a single-sampled depth target: use --aa off, or visibility"
+    )]
+    LightStatsWithSamples { samples: &'static str, technique: &'static str },
     #[error("--aa {samples} needs {feature}, which '{device}' lacks: use --aa off")]
     AntialiasingFeature { samples: &'static str, feature: &'static str, device: String },
     #[error(

@@ -169,15 +169,17 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
         Some(OmniShadowMode::Rays) | None => {}
         Some(_) => kinds.push(PassKind::OmniShadows),
     }
+    let antialiased = key.antialiasing != Antialiasing::Off;
     // The opaque depth after the raster: the 64-bit buffer (the compute rasters', or the
     // hardware raster's samples gathered into it), or the depth target.
-    let antialiased = key.antialiasing != Antialiasing::Off;
     let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && (key.raster != Raster::Hardware || antialiased);
     // The light grid is built once the surfaces are known, for the cells their points walk,
     // where a technique knows them before its lighting (the opaque depth, the transparent
     // layers' nodes) and the settings want the marks; else first, for every cell.
     let lights = technique.assignment();
-    let marks = technique.marks_light_grid() && key.light_grid_marks;
+    // The marks read a single-sampled depth target or the 64-bit buffer: with anti-aliasing's
+    // multisampled G-buffer, deferred-compute builds the grid for every cell.
+    let marks = technique.marks_light_grid() && key.light_grid_marks && !(antialiased && technique.geometry() == Geometry::Meshes);
     let marked_build =
         [PassKind::LightGridMark { depth_buffer: opaque_depth_buffer, layers: key.layers }, PassKind::LightGridBuild { marked: true }];
     let marked_build = if marks { &marked_build[..] } else { &[] };
@@ -448,6 +450,13 @@ mod tests {
         k.debug_view = DebugView::None;
         k.shading = ShadingModel::BlinnPhong;
         assert_eq!(plan(&k)[1], ToneMap { curve: false, display_linear: false });
+    }
+
+    #[test]
+    fn a_multisampled_gbuffer_builds_the_light_grid_for_every_cell() {
+        let mut k = key(Technique::DeferredCompute);
+        (k.meters_exposure, k.antialiasing) = (false, Antialiasing::X4);
+        assert_eq!(plan(&k), [LightGridBuild { marked: false }, GBuffer, ComputeLighting]);
     }
 
     #[test]

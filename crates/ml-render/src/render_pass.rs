@@ -88,12 +88,15 @@ pub fn describe(
         Output::Layers { .. } => transparent_layers(),
     };
     // Subpass 0's attachments (the G-buffer and depth) take the samples; the lighting
-    // subpass's HDR output (the last attachment) keeps one.
-    if output == Output::Subpasses {
-        let last = desc.attachments.len() - 1;
-        for a in &mut desc.attachments[..last] {
-            a.samples = samples;
-        }
+    // subpass's HDR output (the last attachment) keeps one. deferred-compute's G-buffer and
+    // depth are read sample by sample by its compute lighting.
+    let multisampled = match output {
+        Output::Subpasses => desc.attachments.len() - 1,
+        Output::GBuffer => desc.attachments.len(),
+        _ => 0,
+    };
+    for a in &mut desc.attachments[..multisampled] {
+        a.samples = samples;
     }
     desc
 }

@@ -447,8 +447,10 @@ fn check_antialiasing(s: &RenderSettings, ctx: &Context) -> Result<(), RenderErr
         return Ok(());
     }
     let samples = s.antialiasing.name();
-    if !s.technique.has_antialiasing() {
-        return Err(SettingsError::AntialiasingUnsupported { samples, technique: s.technique.name() }.into());
+    // The light counts read the opaque depth: the 64-bit buffer (visibility) or a
+    // single-sampled depth target.
+    if s.light_stats && s.technique.geometry() == Geometry::Meshes {
+        return Err(SettingsError::LightStatsWithSamples { samples, technique: s.technique.name() }.into());
     }
     if s.blends_layers() {
         return Err(SettingsError::AntialiasingWithLayers { samples }.into());

@@ -120,7 +120,8 @@ pub fn depth_format(ctx: &Context, output: Output) -> Result<vk::Format, VkError
 
 /// The multisampled attachments a raster pass draws into with anti-aliasing (name, format,
 /// usage): the forward pass's colour and depth, the G-buffer's images (all five: a scene's may
-/// have them) and depth, or the hardware visibility raster's ids and depth. What `Targets`
+/// have them) and depth (deferred and deferred-compute), or the hardware visibility raster's
+/// ids and depth. What `Targets`
 /// makes of them, and what the settings check against the device's sample counts before.
 pub fn multisampled_images(
     output: Output,
@@ -142,6 +143,12 @@ pub fn multisampled_images(
             .iter()
             .map(|g| (g.name, g.format, U::COLOR_ATTACHMENT | U::INPUT_ATTACHMENT | inside))
             .chain([(depth.0, depth.1, depth.2 | U::INPUT_ATTACHMENT)])
+            .collect(),
+        // deferred-compute's, which its compute lighting reads.
+        Output::GBuffer => GBUFFER
+            .iter()
+            .map(|g| (g.name, g.format, U::COLOR_ATTACHMENT | U::SAMPLED))
+            .chain([(depth.0, depth.1, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED)])
             .collect(),
         _ => Vec::new(),
     }
@@ -165,9 +172,10 @@ pub struct Targets {
     /// Forward techniques with anti-aliasing: the multisampled colour the meshes are drawn
     /// into (the display's linear light), resolved into `hdr` (null otherwise).
     pub colour_samples: Image,
-    /// visibility with the compute raster: 64 bits per sample (`Antialiasing`), depth and id, which its passes
-    /// write by atomic min and the depth pyramid and the lighting read (null otherwise; `depth`
-    /// and `visibility` are null then).
+    /// visibility with the compute or hybrid raster: 64 bits per sample (`Antialiasing`), depth
+    /// and id, which its passes write by atomic min and the depth pyramid and the lighting read
+    /// (`depth` and `visibility` are null then); with the hardware raster and anti-aliasing,
+    /// its multisampled images gathered (null otherwise).
     pub visibility_depth: Buffer,
 }
 
@@ -263,8 +271,10 @@ impl Targets {
         // render pass (render_pass.rs describe); the visibility raster's, which a compute
         // pass reads.
         let multisampled = aa && matches!(output, Output::Color | Output::Subpasses);
-        let (samples, inside_only) = match (multisampled, aa && output == Output::Visibility) {
+        let (samples, inside_only) = match (multisampled, aa) {
             (true, _) => (antialiasing.sample_count(), U::TRANSIENT_ATTACHMENT),
+            // deferred-compute's G-buffer, the hardware visibility raster's images: read in
+            // compute.
             (false, true) => (antialiasing.sample_count(), U::empty()),
             (false, false) => (vk::SampleCountFlags::TYPE_1, U::empty()),
         };

@@ -89,13 +89,6 @@ impl Technique {
             && (self.geometry() == Geometry::Meshlets || self.lighting_stage() == LightingStage::Compute)
     }
 
-    /// Whether it anti-aliases (`--aa`): the mesh techniques in multisampled attachments —
-    /// deferred-compute, whose compute lighting reads single-sampled images, not yet — and
-    /// visibility in its 64-bit buffer, whichever raster draws it.
-    pub fn has_antialiasing(self) -> bool {
-        self != Technique::DeferredCompute
-    }
-
     /// Whether it has the cluster grid (`--clusters`): the techniques that assign on the CPU.
     pub fn has_cluster_grid(self) -> bool {
         self.assignment() == LightAssignment::Cpu

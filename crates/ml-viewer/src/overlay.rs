@@ -103,8 +103,7 @@ impl Choices {
     /// The settings of these choices at a size, the clock fixed at `time` if given.
     pub fn settings(&self, (width, height): (u32, u32), time: Option<f32>) -> RenderSettings {
         let raster = self.drawn_raster();
-        // Anti-aliasing where the technique (and raster) keeps samples; they are not blended
-        // with layers yet.
+        // Anti-aliasing's samples are not blended with transparent layers yet.
         RenderSettings {
             technique: self.technique,
             shading: self.shading,
@@ -123,11 +122,7 @@ impl Choices {
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
             light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
-            antialiasing: if self.technique.has_antialiasing() && self.transparency.is_none() {
-                self.antialiasing
-            } else {
-                Antialiasing::Off
-            },
+            antialiasing: if self.transparency.is_none() { self.antialiasing } else { Antialiasing::Off },
         }
     }
 }
@@ -190,7 +185,7 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
                 ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
             }
         }
-        if choices.technique.has_antialiasing() && choices.transparency.is_none() {
+        if choices.transparency.is_none() {
             combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
         }
         combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());

@@ -94,7 +94,6 @@ fn options_that_do_not_apply_are_refused() {
         (&["--technique", "forward", "--raster", "hardware"], &["--raster does not apply to forward", "--technique visibility"]),
         (&["--technique", "clustered-gpu", "--raster-split", "8"], &["--raster-split does not apply to clustered-gpu"]),
         (&["--technique", "visibility", "--raster", "hardware", "--raster-split", "8"], &["--raster-split", "--raster hardware"]),
-        (&["--technique", "deferred-compute", "--aa", "8"], &["--aa does not apply to deferred-compute", "all but deferred-compute"]),
         (&["--technique", "deferred", "--debug-view", "aa"], &["--debug-view aa", "--technique visibility"]),
         (&["--technique", "forward", "--debug-view", "cluster-heat"], &["--debug-view cluster-heat", "clustered-cpu or clustered-gpu"]),
         (&["--technique", "deferred-compute", "--debug-view", "meshlets"], &["--debug-view meshlets", "--technique visibility"]),

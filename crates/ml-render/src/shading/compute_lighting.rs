@@ -4,6 +4,7 @@
 //! graphics work 4 of 132). Its output is the colour target, left in TRANSFER_SRC_OPTIMAL
 //! like the forward pass's.
 
+use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
@@ -23,9 +24,16 @@ impl ComputeLighting {
     pub fn new(ctx: &Context, scene: &SceneGpu, shading: Shading) -> Result<ComputeLighting, VkError> {
         // Set 1: the scene's textures (blinn-phong's shadow map and sky, the shadow cubes).
         let model = shading.compute_lighting_constants();
-        // With transparent layers, linear HDR for their resolve.
-        let shader = if shading.transparency { &ml_shaders::DEFERRED_LIGHTING_LINEAR_COMP } else { &ml_shaders::DEFERRED_LIGHTING_COMP };
-        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &model))?;
+        // With transparent layers, linear HDR for their resolve; with anti-aliasing, each pixel
+        // resolved from the multisampled G-buffer.
+        let (shader, constants) = if shading.antialiasing != Antialiasing::Off {
+            (&ml_shaders::DEFERRED_LIGHTING_SAMPLES_COMP, [&model[..], &[shading.antialiasing.constant()]].concat())
+        } else if shading.transparency {
+            (&ml_shaders::DEFERRED_LIGHTING_LINEAR_COMP, model.to_vec())
+        } else {
+            (&ml_shaders::DEFERRED_LIGHTING_COMP, model.to_vec())
+        };
+        let pass = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &constants))?;
         Ok(ComputeLighting { pass, layers: shading.transparency })
     }
 }

@@ -3,7 +3,8 @@
 //! - against the same view supersampled 8×8 and filtered in linear light
 //!   (`ml_cpu::supersample`), 8 samples of the compute raster cut the RMS error of the image
 //!   without anti-aliasing to at most a third, on the bench scene and on foliage of
-//!   alpha-masked leaves; 4 samples (lavapipe's most) of forward and deferred to at most half;
+//!   alpha-masked leaves; 4 samples (lavapipe's most) of forward, deferred, deferred-compute and
+//!   the hybrid and hardware rasters to at most half;
 //! - it changes nothing it must not: culling off, and the light grid's marks on or off, give
 //!   the same image byte for byte; two renders are byte-identical;
 //! - a pixel shades each surface its samples hold once: a view filled by one quad shades a
@@ -111,6 +112,7 @@ fn samples_cut_the_error_against_the_supersampled_reference() {
         RenderSettings { antialiasing: Antialiasing::X8, ..base },
         meshes(Technique::Forward, base, Antialiasing::X4),
         meshes(Technique::Deferred, base, Antialiasing::X4),
+        meshes(Technique::DeferredCompute, base, Antialiasing::X4),
         hybrid,
         hardware,
     ];
