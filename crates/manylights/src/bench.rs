@@ -369,6 +369,15 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     for &lights in &counts {
         for &variant in &variants {
             bar.set_message(format!("{} at {lights} lights", variant.label()));
+            // A variant the device cannot run at one count it cannot run at any (no scene of
+            // the next count built for it).
+            let refused = results.iter().find_map(|m| m.skipped.as_deref().filter(|s| m.variant == variant && s.starts_with(NOT_MEASURED)));
+            if let Some(why) = refused {
+                let skipped = Some(why.to_owned());
+                results.push(Measured { variant, lights, skipped, output: None, grid: None, ms_per_frame: 0.0 });
+                bar.inc();
+                continue;
+            }
             // The same variant at the largest smaller count, measured or estimated.
             let previous = results
                 .iter()
@@ -428,6 +437,9 @@ fn probe_lengths(text: &str) -> Result<Vec<u32>> {
 /// which then estimates the rest.
 type Previous = Option<(u64, f64)>;
 
+/// How the status of a combination the device cannot run begins (the reason follows).
+const NOT_MEASURED: &str = "not measured: ";
+
 fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Variant, u64), previous: Previous) -> Result<Measured> {
     let technique = variant.technique;
     let frames = a.rounds()?;
@@ -464,7 +476,7 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Va
             return Ok(Measured {
                 variant,
                 lights,
-                skipped: Some(format!("not measured: {e}")),
+                skipped: Some(format!("{NOT_MEASURED}{e}")),
                 output: None,
                 grid: None,
                 ms_per_frame: 0.0,
