@@ -138,7 +138,7 @@ pub enum SettingsError {
     RasterNeedsVisibility { technique: &'static str },
     #[error("the {raster} raster needs {feature}, which '{device}' lacks: use --raster hardware")]
     RasterFeature { raster: &'static str, feature: &'static str, device: String },
-    #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size, fewer --aa samples or --raster hardware")]
+    #[error("the compute raster's buffer for {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: use a smaller size, fewer --aa samples or --raster hardware (without --aa)")]
     RasterBuffer { width: u32, height: u32, bytes: u64, device: String, max: u32 },
     /// Anti-aliasing's samples: the compute raster's buffer, the mesh techniques' multisampled
     /// attachments.
