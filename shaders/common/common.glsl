@@ -370,6 +370,14 @@ vec3 encode_gamma(vec3 linear) {
     return pow(linear, vec3(1.0 / 2.2));
 }
 
+// A pixel's samples resolved in the display's linear light — `surfaces`: their colours' sum
+// over every sample divided by the sample count; `background`: the share of samples no
+// surface holds — as the 8-bit target stores it (anti-aliasing; the background's
+// display-linear value is CLEAR_COLOR decoded).
+vec3 encode_over_background(vec3 surfaces, float background) {
+    return encode_gamma(surfaces + background * pow(CLEAR_COLOR.rgb, vec3(2.2)));
+}
+
 // Octahedral encoding of a unit normal into [-1, 1]² (the G-buffer keeps it in 2 floats).
 vec2 oct_encode(vec3 n) {
     n /= abs(n.x) + abs(n.y) + abs(n.z);

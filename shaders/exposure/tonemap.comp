@@ -25,8 +25,7 @@ void main() {
     }
     vec4 hdr = texelFetch(hdr_image, p, 0);
     if (DISPLAY_LINEAR_INPUT) {
-        vec3 shown = hdr.rgb + (1.0 - hdr.a) * pow(CLEAR_COLOR.rgb, vec3(2.2));
-        imageStore(out_image, p, vec4(encode_gamma(shown), 1.0));
+        imageStore(out_image, p, vec4(encode_over_background(hdr.rgb, 1.0 - hdr.a), 1.0));
         return;
     }
     imageStore(out_image, p, hdr.a == 0.0 ? CLEAR_COLOR : vec4(encode_output(hdr.rgb, frame.exposure.x), 1.0));

@@ -55,8 +55,7 @@ void main() {
     }
     gbuffer_pixel = p;
     vec4 resolved = resolve_samples(p);
-    vec3 shown = resolved.rgb + (1.0 - resolved.a) * pow(CLEAR_COLOR.rgb, vec3(2.2));
-    imageStore(out_image, p, vec4(encode_gamma(shown), 1.0));
+    imageStore(out_image, p, vec4(encode_over_background(resolved.rgb, 1.0 - resolved.a), 1.0));
 }
 #else
 void main() {

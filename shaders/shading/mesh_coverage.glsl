@@ -50,7 +50,7 @@ MeshPoint covered_point() {
         } else {
             kept = 0;
             for (uint s = 0u; s < VISIBILITY_SAMPLES; s++) {
-                vec2 uv = in_uv + uv_d * (vec2(sample_offset(s)) / 256.0 - 0.5);
+                vec2 uv = in_uv + uv_d * sample_step(s);
                 if ((gl_SampleMaskIn[0] & (1 << s)) != 0 && alpha_kept(objects[o].alpha, objects[o].alpha_texture, uv)) {
                     kept |= 1 << s;
                 }

@@ -39,7 +39,7 @@ void main() {
         return;
     }
     for (uint s = 0u; s < VISIBILITY_SAMPLES; s++) {
-        vec2 step = vec2(sample_offset(s)) / 256.0 - 0.5;
+        vec2 step = sample_step(s);
         // The plane's depth at the sample (never below the near plane's 0: the sign bit would
         // make it the farthest).
         float z = max(depth + dot(depth_d, step), 0.0);

@@ -93,6 +93,12 @@ vec2 shading_xy(ivec2 pixel, uint members) {
     return vec2(pixel) + vec2(sum) / (256.0 * float(bitCount(members)));
 }
 
+// Sample k's offset from the pixel centre, in pixels: how far a fragment shader, which sees
+// its inputs at the centre, steps them (by their screen derivatives) to the sample.
+vec2 sample_step(uint k) {
+    return vec2(sample_offset(k)) / 256.0 - 0.5;
+}
+
 // Sample k's position in pixels in the image.
 vec2 sample_xy(ivec2 pixel, uint k) {
     return vec2(pixel) + vec2(sample_offset(k)) / 256.0;

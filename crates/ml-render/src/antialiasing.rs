@@ -71,8 +71,8 @@ pub struct AntialiasingStats {
     /// multisampled attachments.
     pub sample_bytes: u64,
     /// Surfaces shaded in the last frame, summed over the pixels, where the lighting counts
-    /// them (the visibility technique; the hardware's multisampling shades each triangle a
-    /// pixel's samples hold once, uncounted).
+    /// them (the visibility technique; the mesh techniques shade each surface a pixel's
+    /// samples hold once too, uncounted).
     pub surfaces: Option<u64>,
 }
 
@@ -88,7 +88,7 @@ impl FeatureStats for AntialiasingStats {
         let mib = self.sample_bytes as f64 / f64::from(1 << 20);
         let shaded = match self.surfaces_per_pixel() {
             Some(s) => format!("{s:.3} surfaces shaded a pixel in the last frame"),
-            None => "each triangle a pixel's samples hold shaded once (the hardware's multisampling)".to_owned(),
+            None => "each surface a pixel's samples hold shaded once (not counted)".to_owned(),
         };
         vec![("anti-aliasing", format!("{} samples a pixel ({mib:.1} MiB of samples); {shaded}", self.antialiasing.samples()))]
     }

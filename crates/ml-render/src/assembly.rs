@@ -13,7 +13,7 @@ use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
 use crate::scene::shadow_raster::ShadowViews;
 use crate::scene::SceneGpu;
-use crate::settings::{Antialiasing, OmniShadowMode, Raster, RenderSettings, Shading};
+use crate::settings::{OmniShadowMode, Raster, RenderSettings, Shading};
 use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
 use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
 use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
@@ -61,9 +61,9 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
 fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<SharedMeshletScene>) -> Result<Box<dyn Pass>, RenderError> {
     let s = a.settings;
     let raster = (a.depth_format, a.shading);
-    // With the compute or hybrid raster, or anti-aliased (the hardware raster's samples
-    // gathered into it), the pyramid and the lighting read the 64-bit buffer.
-    let compute = s.raster != Raster::Hardware || s.antialiasing != Antialiasing::Off;
+    // The pyramid and the lighting read the 64-bit buffer, or the hardware raster's images.
+    let compute = s.raster.fills_buffer(s.antialiasing);
+    // The hybrid's hardware half writes that buffer by atomics.
     let atomic = s.raster != Raster::Hardware;
     // Samples per pixel of that buffer.
     let aa = s.antialiasing;

@@ -172,7 +172,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     let antialiased = key.antialiasing != Antialiasing::Off;
     // The opaque depth after the raster: the 64-bit buffer (the compute rasters', or the
     // hardware raster's samples gathered into it), or the depth target.
-    let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && (key.raster != Raster::Hardware || antialiased);
+    let opaque_depth_buffer = technique.geometry() == Geometry::Meshlets && key.raster.fills_buffer(key.antialiasing);
     // The light grid is built once the surfaces are known, for the cells their points walk,
     // where a technique knows them before its lighting (the opaque depth, the transparent
     // layers' nodes) and the settings want the marks; else first, for every cell.

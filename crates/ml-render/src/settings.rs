@@ -296,7 +296,7 @@ impl RenderSettings {
         }
         check_antialiasing(self, ctx)?;
         // The lighting that reads the 64-bit buffer counts the surfaces.
-        let buffer = self.raster != Raster::Hardware || self.antialiasing != Antialiasing::Off;
+        let buffer = self.raster.fills_buffer(self.antialiasing);
         if self.debug_view == DebugView::Aa && (self.technique != Technique::Visibility || !buffer) {
             return Err(SettingsError::AaViewNeedsComputeRaster { technique: self.technique.name() }.into());
         }

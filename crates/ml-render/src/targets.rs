@@ -265,23 +265,15 @@ impl Targets {
         // The compute raster keeps depth and ids in one buffer: no images of them. The
         // hardware raster's samples are gathered into that buffer too.
         let compute_raster = output == Output::Visibility && raster != Raster::Hardware;
-        let aa = antialiasing != Antialiasing::Off;
-        let keeps_buffer = output == Output::Visibility && (compute_raster || aa);
-        // The mesh techniques' anti-aliasing: multisampled attachments that never leave the
-        // render pass (render_pass.rs describe); the visibility raster's, which a compute
-        // pass reads.
-        let multisampled = aa && matches!(output, Output::Color | Output::Subpasses);
-        let (samples, inside_only) = match (multisampled, aa) {
-            (true, _) => (antialiasing.sample_count(), U::TRANSIENT_ATTACHMENT),
-            // deferred-compute's G-buffer, the hardware visibility raster's images: read in
-            // compute.
-            (false, true) => (antialiasing.sample_count(), U::empty()),
-            (false, false) => (vk::SampleCountFlags::TYPE_1, U::empty()),
-        };
-        let (depth_usage, gbuffer_usage) = match multisampled {
-            true => (depth_usage | inside_only, gbuffer_usage | inside_only),
-            false => (depth_usage, gbuffer_usage),
-        };
+        let keeps_buffer = output == Output::Visibility && raster.fills_buffer(antialiasing);
+        // Anti-aliasing's multisampled attachments (Antialiasing::Off: one sample). The forward
+        // pass's and the deferred subpasses' never leave the render pass (render_pass.rs
+        // describe); deferred-compute's G-buffer and the hardware visibility raster's images
+        // are read in compute.
+        let samples = antialiasing.sample_count();
+        let multisampled = antialiasing != Antialiasing::Off && matches!(output, Output::Color | Output::Subpasses);
+        let inside_only = if multisampled { U::TRANSIENT_ATTACHMENT } else { U::empty() };
+        let (depth_usage, gbuffer_usage) = (depth_usage | inside_only, gbuffer_usage | inside_only);
         self.color = Image::new_2d(ctx, "colour target", extent, COLOR_FORMAT, color_usage, colour)?;
         if !compute_raster {
             let depth = vk::ImageAspectFlags::DEPTH;

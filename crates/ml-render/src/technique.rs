@@ -2,6 +2,7 @@
 //! assigned, where the lighting runs, how geometry reaches the pixels) and who draws the
 //! visibility buffer. A leaf module: the settings, the targets and the passes all read it.
 
+use crate::antialiasing::Antialiasing;
 use crate::error::{by_name, Named, RenderError};
 
 /// Lighting techniques (docs/DESIGN.md#techniques-are-two-choices). Each must give the same image as `Forward`.
@@ -208,6 +209,14 @@ impl Raster {
             Raster::Hardware => 0,
             Raster::Compute { split, .. } => split,
         }
+    }
+
+    /// Whether the visibility technique's passes after this raster (the depth pyramid, the
+    /// light grid's marks, the lighting) read the 64-bit depth-and-id buffer rather than the
+    /// hardware raster's images: the rasters in compute draw into it, and with anti-aliasing
+    /// the hardware raster's samples are gathered into it.
+    pub fn fills_buffer(self, antialiasing: Antialiasing) -> bool {
+        self != Raster::Hardware || antialiasing != Antialiasing::Off
     }
 
     /// The large triangles' bin list's size, where they are drawn in compute.

@@ -101,6 +101,12 @@ impl MeshRaster {
         self.samples != vk::SampleCountFlags::TYPE_1
     }
 
+    /// Whether the render pass's last attachment is the HDR image: the lighting subpass's
+    /// output, or the forward samples' resolve.
+    fn ends_in_hdr(&self) -> bool {
+        self.output == Output::Subpasses || (self.output == Output::Color && self.multisampled())
+    }
+
     /// How this pass draws an object of variant `v`: transparent layers are not cut by their
     /// alpha but weighted by it.
     fn drawn_as(&self, v: SurfaceVariant) -> SurfaceVariant {
@@ -208,8 +214,7 @@ impl MeshRaster {
         if !matches!(self.output, Output::Layers { .. }) {
             views.push(t.depth.view);
         }
-        // The lighting subpass's output, or the forward samples' resolve.
-        if self.output == Output::Subpasses || (self.output == Output::Color && self.multisampled()) {
+        if self.ends_in_hdr() {
             views.push(t.hdr.view);
         }
         render_pass::replace_framebuffer(ctx, &mut self.framebuffers[frame.slot], self.render_pass, &views, t.color.extent)
@@ -234,8 +239,8 @@ impl MeshRaster {
         if !matches!(self.output, Output::Layers { .. }) {
             clear.push(depth);
         }
-        // The lighting subpass's output, or the forward samples' resolve (not cleared).
-        if self.output == Output::Subpasses || (self.output == Output::Color && self.multisampled()) {
+        // (The forward samples' resolve is not cleared.)
+        if self.ends_in_hdr() {
             clear.push(zero);
         }
         let extent = rec.extent;

@@ -31,7 +31,7 @@ pub struct Shading {
     /// The compute lightings count the shadow rays they trace (`--light-stats` with rays).
     pub count_rays: bool,
     /// Coverage samples per pixel: the mesh techniques draw into multisampled attachments and
-    /// light in the display's linear light (`display_constants`).
+    /// light in the display's linear light (`display_constant`).
     pub antialiasing: Antialiasing,
 }
 
