@@ -23,6 +23,7 @@ use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
 use crate::scene::{AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
 use crate::scene_load::{check_extent, read_reference, ExtentError, ReferenceError, SceneFile};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
+use crate::twin_faces;
 use base64::Engine as _;
 use glam::{Affine2, Mat3, Mat4, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
@@ -621,6 +622,30 @@ fn percent_decoded(uri: &str) -> Option<String> {
     String::from_utf8(out).ok()
 }
 
+/// One of a primitive's meshes: its index in `Builder::meshes`, the centre and half-size of
+/// the box it was fitted from, and whether it holds twin faces.
+#[derive(Clone, Copy, Debug)]
+struct LoadedMesh {
+    mesh: u32,
+    centre: Vec3,
+    half: f32,
+    twin_faces: bool,
+}
+
+/// Fit `mesh` into [−1, 1]³ (what every mesh of a scene does; the object's transform undoes
+/// it): returns its box's centre and half-size.
+fn fit_unit_box(mesh: &mut Mesh) -> (Vec3, f32) {
+    let (lo, hi) = mesh.vertices.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), v| {
+        (lo.min(Vec3::from(v.position)), hi.max(Vec3::from(v.position)))
+    });
+    let centre = (lo + hi) * 0.5;
+    let half = ((hi - lo).max_element() * 0.5).max(f32::MIN_POSITIVE);
+    for v in &mut mesh.vertices {
+        v.position = ((Vec3::from(v.position) - centre) / half).to_array();
+    }
+    (centre, half)
+}
+
 struct Builder<'a> {
     doc: &'a gltf::Document,
     /// Where external files are (None: refused).
@@ -634,9 +659,8 @@ struct Builder<'a> {
     by_texture: HashMap<(usize, bool, TextureSampler), u32>,
     buffers: Vec<Vec<u8>>,
     meshes: Vec<Mesh>,
-    /// (mesh, primitive) → (index in `meshes`, its box's centre and half-size), so that
-    /// instanced meshes are loaded once.
-    by_primitive: HashMap<(usize, usize), (u32, Vec3, f32)>,
+    /// (mesh, primitive) → its meshes, so that instanced meshes are loaded once.
+    by_primitive: HashMap<(usize, usize), Vec<LoadedMesh>>,
     objects: Vec<Object>,
     lights: Vec<PointLight>,
     camera: Option<Camera>,
@@ -652,12 +676,9 @@ impl Builder<'_> {
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
                 let what = Part::Primitive { mesh: mesh.index(), primitive: primitive.index() };
-                let Some((index, centre, half)) = self.primitive(&mesh, &primitive).map_err(|e| e.within(what))? else {
+                let Some(parts) = self.primitive(&mesh, &primitive).map_err(|e| e.within(what))? else {
                     continue;
                 };
-                if self.objects.len() == MAX_OBJECTS {
-                    return Err(GltfError::TooManyPrimitives);
-                }
                 let (material, extras, mixed) = material(&primitive.material()).map_err(|e| e.within(what))?;
                 let m = primitive.material();
                 let named = || match m.name() {
@@ -668,9 +689,16 @@ impl Builder<'_> {
                     self.mixed_transforms.insert(named());
                 }
                 let textures = self.object_textures(&primitive.material()).map_err(|e| e.within(what))?;
-                // The mesh was stored fitted to [−1, 1]³: undo that inside the object's transform.
-                let transform = world * Mat4::from_translation(centre) * Mat4::from_scale(Vec3::splat(half));
-                self.objects.push(Object { mesh: MeshKind::Loaded(index), transform, material, textures, extras });
+                for part in parts {
+                    if self.objects.len() == MAX_OBJECTS {
+                        return Err(GltfError::TooManyPrimitives);
+                    }
+                    // The mesh was stored fitted to [−1, 1]³: undo that inside the object's transform.
+                    let transform = world * Mat4::from_translation(part.centre) * Mat4::from_scale(Vec3::splat(part.half));
+                    // Twin faces are drawn single-sided: each face from its own side (twin_faces).
+                    let extras = MaterialExtras { double_sided: extras.double_sided && !part.twin_faces, ..extras };
+                    self.objects.push(Object { mesh: MeshKind::Loaded(part.mesh), transform, material, textures, extras });
+                }
             }
         }
         if let Some(light) = node.light() {
@@ -682,12 +710,13 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// Load a primitive's triangles (once per primitive); None for points and lines.
-    fn primitive(&mut self, mesh: &gltf::Mesh, primitive: &gltf::Primitive) -> Result<Option<(u32, Vec3, f32)>, GltfError> {
+    /// Load a primitive's triangles (once per primitive): one mesh, or with a double-sided
+    /// material and twin faces two (the twins apart); None for points and lines.
+    fn primitive(&mut self, mesh: &gltf::Mesh, primitive: &gltf::Primitive) -> Result<Option<Vec<LoadedMesh>>, GltfError> {
         use gltf::mesh::Mode;
         let key = (mesh.index(), primitive.index());
-        if let Some(&known) = self.by_primitive.get(&key) {
-            return Ok(Some(known));
+        if let Some(known) = self.by_primitive.get(&key) {
+            return Ok(Some(known.clone()));
         }
         let mode = primitive.mode();
         if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
@@ -754,19 +783,18 @@ impl Builder<'_> {
             }
         }
         compute_tangents(&mut out);
-        // Fit [−1, 1]³ (what every mesh of a scene does; the object's transform undoes it).
-        let (lo, hi) = out.vertices.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), v| {
-            (lo.min(Vec3::from(v.position)), hi.max(Vec3::from(v.position)))
-        });
-        let centre = (lo + hi) * 0.5;
-        let half = ((hi - lo).max_element() * 0.5).max(f32::MIN_POSITIVE);
-        for v in &mut out.vertices {
-            v.position = ((Vec3::from(v.position) - centre) / half).to_array();
+        let pieces = match primitive.material().double_sided().then(|| twin_faces::split_twin_faces(&out)).flatten() {
+            Some((rest, twins)) => vec![(rest, false), (twins, true)],
+            None => vec![(out, false)],
+        };
+        let mut parts = Vec::new();
+        for (mut piece, twin_faces) in pieces.into_iter().filter(|(m, _)| !m.indices.is_empty()) {
+            let (centre, half) = fit_unit_box(&mut piece);
+            parts.push(LoadedMesh { mesh: self.meshes.len() as u32, centre, half, twin_faces });
+            self.meshes.push(piece);
         }
-        let index = self.meshes.len() as u32;
-        self.meshes.push(out);
-        self.by_primitive.insert(key, (index, centre, half));
-        Ok(Some((index, centre, half)))
+        self.by_primitive.insert(key, parts.clone());
+        Ok(Some(parts))
     }
 
     /// The material's textures (first texture coordinates) with their samplers.

@@ -35,5 +35,6 @@ pub mod surface_sampler;
 mod teapot;
 pub mod textures;
 pub mod transparency;
+pub mod twin_faces;
 
 pub use error::SceneError;

@@ -9,7 +9,8 @@
 //! decide a boundary differently.
 //!
 //! - every technique × shading model equals forward on a grid of masked quads (some seen from
-//!   behind) over a floor under 256 lights, but at counted edge pixels; so do the visibility
+//!   behind, two modelled with both faces on shared vertices, as foliage exporters write
+//!   leaves) over a floor under 256 lights, but at counted edge pixels; so do the visibility
 //!   technique's compute and hybrid rasters and its culling off;
 //! - the albedo view shows, at every sure pixel, the object the CPU sees there: holes show
 //!   what is behind them (the floor, another quad, a cube hidden behind a plate but for a
@@ -65,8 +66,23 @@ fn standing(yaw_deg: f32) -> Quat {
 
 /// A quad of `material` placed by a node.
 fn add_quad(w: &mut GltfWriter, material: usize, at: Vec3, rotation: Quat, scale: Vec3) {
-    let mesh = w.mesh(&[PrimitiveData { material: Some(material), ..quad() }]);
+    add_primitive(w, PrimitiveData { material: Some(material), ..quad() }, at, rotation, scale);
+}
+
+fn add_primitive(w: &mut GltfWriter, primitive: PrimitiveData, at: Vec3, rotation: Quat, scale: Vec3) {
+    let mesh = w.mesh(&[primitive]);
     w.node(json!({ "mesh": mesh, "translation": at.to_array(), "rotation": rotation.to_array(), "scale": scale.to_array() }), true);
+}
+
+/// The quad modelled with both faces, as foliage exporters write double-sided leaves: each
+/// triangle also present reversed on the same vertices (sharing their normal, so one face's
+/// normal points against its winding), the reversed ones first.
+fn twin_faced_quad(material: usize) -> PrimitiveData {
+    let q = quad();
+    let Some((indices, ty)) = q.indices else { unreachable!("the quad is indexed") };
+    let mut twins: Vec<u32> = indices.chunks_exact(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
+    twins.extend(indices);
+    PrimitiveData { indices: Some((twins, ty)), material: Some(material), ..q }
 }
 
 /// An opaque, single-sided floor: the quad at y = 0 facing up, `half` to each side.
@@ -116,7 +132,8 @@ const GRID_H: u32 = 120;
 /// colour and material — MASK at the default cutoff, MASK at 0.3 with factor alpha 0.45 (still
 /// kept), BLEND (a mask at 0.5), MASK through a nearest-filtered sampler (of the cut-out
 /// mirrored) — all double-sided,
-/// turned every way (four of them seen from behind); a small cube hidden behind the middle
+/// turned every way (four of them seen from behind), two modelled with both faces
+/// (`twin_faced_quad`: one seen from the front, one from behind); a small cube hidden behind the middle
 /// plate but for one of its holes; 256 random lights.
 fn grid_scene() -> (Scene, Vec<String>) {
     let mut w = GltfWriter::new();
@@ -155,7 +172,12 @@ fn grid_scene() -> (Scene, Vec<String>) {
             transform_texture(&mut w, m);
         }
         let (col, row) = ((i % 3) as f32 - 1.0, (i / 3) as f32 - 1.0);
-        add_quad(&mut w, m, Vec3::new(col * 3.0, 1.3, row * 3.0), standing(yaw), Vec3::ONE);
+        let at = Vec3::new(col * 3.0, 1.3, row * 3.0);
+        if i == 0 || i == 3 {
+            add_primitive(&mut w, twin_faced_quad(m), at, standing(yaw), Vec3::ONE);
+        } else {
+            add_quad(&mut w, m, at, standing(yaw), Vec3::ONE);
+        }
     }
     // Behind the middle plate (i = 4, facing +Z), where its large hole at uv (0.28, 0.28) is
     // (object (−0.44, −0.44): world (−0.44, 1.74, 0)), on the camera's line through it.
@@ -401,8 +423,13 @@ fn a_masked_grid_is_the_same_in_every_technique_and_shading_model() {
         println!("{}: {lit} pixels lit above 40/255, {saturated} saturated", model.name());
         assert!(lit > 2000, "{}: the lights light too little ({lit} pixels)", model.name());
         for (o, t) in out.iter().zip(Technique::ALL).skip(1) {
-            let outliers = if model == ShadingModel::BlinnPhong && tolerance(t) == 2 { SHADOW_OUTLIERS } else { 0 };
-            assert_same_but_edges(&format!("grid {} {}", model.name(), t.name()), &out[0], o, tolerance(t), &cpu, outliers);
+            // Without the sun's shadow map every technique, twin-faced plates included, is
+            // within 1/255 of forward (measured: 1 at most where the position is rebuilt).
+            let (allowed, outliers) = match model {
+                ShadingModel::BlinnPhong => (tolerance(t), if tolerance(t) == 2 { SHADOW_OUTLIERS } else { 0 }),
+                _ => (1, 0),
+            };
+            assert_same_but_edges(&format!("grid {} {}", model.name(), t.name()), &out[0], o, allowed, &cpu, outliers);
         }
     }
 }
