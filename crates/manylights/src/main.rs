@@ -689,14 +689,8 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         supersample: cmd.supersample,
     };
     print!("{}", tables::table(&tables::render_rows(&facts, &output.stats)));
-    if let Some(t) = output.stats.feature::<ml_render::TransparencyStats>().filter(|t| t.overflowed()) {
-        eprintln!(
-            "warning: the transparent layers did not fit: {} fragments dropped (pool of {} nodes full; raise --transparency-budget), {} pixels merged layers beyond the nearest {}",
-            t.dropped(),
-            t.capacity,
-            t.merged_pixels,
-            ml_render::LAYER_KEEP
-        );
+    if let Some(warning) = output.stats.feature::<ml_render::TransparencyStats>().and_then(|t| t.overflow_warning()) {
+        eprintln!("warning: {warning}");
     }
     let count = messages.load(Ordering::SeqCst);
     if count > 0 {

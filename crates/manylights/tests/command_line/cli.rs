@@ -626,25 +626,42 @@ fn scenes_on_devices_and_pipes_are_refused_at_once() {
 fn transparent_layers_report_their_memory_and_what_did_not_fit() {
     let png = temp_png("glass.png");
     let render = |extra: &[&str]| {
-        let mut args =
-            vec!["render", "--validation", "--width", "64", "--height", "36", "--glass-layers", "6", "--out", png.to_str().unwrap()];
+        let mut args = vec!["render", "--validation", "--width", "64", "--height", "36", "--out", png.to_str().unwrap()];
         args.extend_from_slice(extra);
         manylights(&args, &[])
     };
     // Six panes on every pixel, room for eight: all kept, the table says so, no warning.
-    let out = render(&["--transparency-budget", "8"]);
+    let out = render(&["--glass-layers", "6", "--transparency-budget", "8"]);
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "{stdout}{stderr}");
     for row in ["transparent layers pass", "transparent resolve pass", "13824 fragments (6.00 a pixel)", "0 fragments dropped"] {
         assert!(stdout.contains(row), "'{row}' missing from:\n{stdout}");
     }
-    assert!(!stderr.contains("did not fit"), "{stderr}");
+    assert!(!stderr.contains("transparent layers"), "{stderr}");
     // Room for two: the rest dropped, counted in the table and said in a warning.
-    let out = render(&["--transparency-budget", "2"]);
+    let out = render(&["--glass-layers", "6", "--transparency-budget", "2"]);
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "{stdout}{stderr}");
     assert!(stdout.contains("9216 fragments dropped"), "{stdout}");
-    assert!(stderr.contains("warning: the transparent layers did not fit: 9216 fragments dropped"), "{stderr}");
+    let warning = |stderr: &str| -> Vec<String> {
+        stderr.lines().filter(|l| l.starts_with("warning: the transparent layers")).map(str::to_owned).collect()
+    };
+    assert_eq!(
+        warning(&stderr),
+        ["warning: the transparent layers are not exact: 9216 fragments dropped, the pool of 4608 nodes full (raise --transparency-budget)"],
+        "{stderr}"
+    );
+    // Forty panes with room for all: nothing dropped, the farthest 8 of each pixel merged —
+    // and the warning says that, and only that.
+    let out = render(&["--glass-layers", "40", "--transparency-budget", "48"]);
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{stdout}{stderr}");
+    assert!(stdout.contains("0 fragments dropped (pool full), 2304 pixels over 32 layers"), "{stdout}");
+    assert_eq!(
+        warning(&stderr),
+        ["warning: the transparent layers are not exact: 2304 pixels had more than 32 layers, the farthest merged into one layer behind the nearest 32 (their order lost)"],
+        "{stderr}"
+    );
     // Without transparent objects the budget and the layer view do not apply.
     for option in [&["--transparency-budget", "8"][..], &["--debug-view", "transparency-layers"]] {
         let mut args = vec!["render", "--width", "64", "--height", "36", "--out", png.to_str().unwrap()];

@@ -102,6 +102,26 @@ impl TransparencyStats {
     pub fn overflowed(&self) -> bool {
         self.dropped() > 0 || self.merged_pixels > 0
     }
+
+    /// What a user is told when the frame is not exact: what was dropped and what merged,
+    /// each only where it happened (None when neither did).
+    pub fn overflow_warning(&self) -> Option<String> {
+        let mut parts = Vec::new();
+        if self.dropped() > 0 {
+            parts.push(format!(
+                "{} fragments dropped, the pool of {} nodes full (raise --transparency-budget)",
+                self.dropped(),
+                self.capacity
+            ));
+        }
+        if self.merged_pixels > 0 {
+            parts.push(format!(
+                "{} pixels had more than {LAYER_KEEP} layers, the farthest merged into one layer behind the nearest {LAYER_KEEP} (their order lost)",
+                self.merged_pixels
+            ));
+        }
+        (!parts.is_empty()).then(|| format!("the transparent layers are not exact: {}", parts.join("; ")))
+    }
 }
 
 impl FeatureStats for TransparencyStats {
@@ -121,7 +141,7 @@ impl FeatureStats for TransparencyStats {
             (
                 "transparent overflow",
                 format!(
-                    "{} fragments dropped (pool full), {} pixels merged layers beyond the nearest {LAYER_KEEP}",
+                    "{} fragments dropped (pool full), {} pixels over {LAYER_KEEP} layers (the farthest merged)",
                     s.dropped(),
                     s.merged_pixels
                 ),
