@@ -29,7 +29,8 @@ layout(std430, set = 0, binding = LAYER_BINDING) buffer TransparentHeadBuffer { 
 // replaces by (lit colour rgb, alpha) as floats.
 layout(std430, set = 0, binding = LAYER_BINDING + 1) buffer TransparentNodeBuffer { uvec4 layer_nodes[]; };
 // x: nodes asked for this frame (beyond the pool's size: dropped); y: pixels that merged
-// layers; z, w: unused.
+// layers; z, w: triangles the per-triangle build listed for a work group each, and for the
+// tiles (transparent_build_triangles.glsl).
 layout(std430, set = 0, binding = LAYER_BINDING + 2) buffer TransparentCountBuffer { uvec4 layer_counts; };
 
 uint layer_pixel(ivec2 p) {
@@ -52,17 +53,6 @@ uvec4 pack_layer_surface(vec3 normal, vec4 albedo_occlusion, vec2 roughness_meta
 void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uvec4 surface) {
     layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, object, uint(p.y) << 16 | uint(p.x));
     layer_nodes[2u * node + 1u] = surface;
-}
-
-// Keep a transparent fragment of pixel `p`: false where the pool is full (it is counted).
-bool store_layer(ivec2 p, float depth, uint object, uvec4 surface) {
-    uint node = atomicAdd(layer_counts.x, 1u);
-    if (node >= layer_capacity()) {
-        return false;
-    }
-    uint next = atomicExchange(layer_heads[layer_pixel(p)], node);
-    write_layer(node, p, depth, next, object, surface);
-    return true;
 }
 
 #ifdef MANYLIGHTS_LIGHTING_GLSL

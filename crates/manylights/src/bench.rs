@@ -234,7 +234,7 @@ impl Plan {
             culling: true,
             raster: Raster::Hardware,
             exposure: Exposure::Ev(0.0),
-            transparency: ml_render::TransparencySettings { budget: a.transparency_budget },
+            transparency: ml_render::TransparencySettings { budget: a.transparency_budget, ..Default::default() },
             light_stats: false,
             light_grid_marks: LightGridMarks::Auto,
             antialiasing: Antialiasing::Off,

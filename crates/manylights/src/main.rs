@@ -519,7 +519,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         exposure: exposure_choice(args)?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
-        transparency: ml_render::TransparencySettings { budget: args.transparency_budget },
+        transparency: ml_render::TransparencySettings { budget: args.transparency_budget, ..Default::default() },
         light_stats: false,
     })
 }

@@ -1,9 +1,10 @@
 //! Writes a forest of cut-out leaves, made by our own code: trees of leaf cards (quads whose
 //! base-colour texture's alpha cuts out the leaf shape, `alphaMode: MASK`, double-sided) on a
 //! ground plane — the content alpha masks exist for, and the benchmark of their cost: the
-//! same file with `--opaque` draws the same triangles as opaque squares.
+//! same file with `--opaque` draws the same triangles as opaque squares, with `--blend` as
+//! transparent leaves (`alphaMode: BLEND`: soft-edged foliage, the transparent layers' cost).
 //!
-//! Usage: forest OUT.glb [--trees N] [--leaves-per-tree M] [--opaque]
+//! Usage: forest OUT.glb [--trees N] [--leaves-per-tree M] [--opaque | --blend]
 //! (default 16 × 16 trees of 2,048 leaves: 1,048,576 leaf triangles). Each tree's mesh is
 //! stored once and placed by nodes, so the file stays small whatever the count.
 use ml_cpu::gltf_writer::{mesh_primitive, png, GltfWriter, IndexType, PrimitiveData};
@@ -75,7 +76,7 @@ fn crown(leaves: u32, seed: u64) -> PrimitiveData {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let usage = || -> ! {
-        eprintln!("usage: forest OUT.glb [--trees N] [--leaves-per-tree M] [--opaque]");
+        eprintln!("usage: forest OUT.glb [--trees N] [--leaves-per-tree M] [--opaque | --blend]");
         std::process::exit(2);
     };
     let Some(out) = args.first().filter(|a| !a.starts_with("--")) else { usage() };
@@ -86,10 +87,15 @@ fn main() {
         }
     };
     let (trees, leaves) = (number("--trees", 256), number("--leaves-per-tree", 2048));
-    let opaque = args.iter().any(|a| a == "--opaque");
+    let mode = match (args.iter().any(|a| a == "--opaque"), args.iter().any(|a| a == "--blend")) {
+        (false, false) => "MASK",
+        (true, false) => "OPAQUE",
+        (false, true) => "BLEND",
+        (true, true) => usage(),
+    };
     let mut w = GltfWriter::new();
     let texture = w.texture(png(LEAF_TEXELS, LEAF_TEXELS, &leaf_texture()), "image/png");
-    let leaf = w.alpha_material(Some(texture), [1.0; 4], if opaque { "OPAQUE" } else { "MASK" }, None, true);
+    let leaf = w.alpha_material(Some(texture), [1.0; 4], mode, None, true);
     w.material_name(leaf, "leaf");
     let bark = w.material([0.35, 0.25, 0.18, 1.0], 0.0, 0.9);
     let ground = w.material([0.3, 0.36, 0.22, 1.0], 0.0, 0.95);
@@ -113,9 +119,5 @@ fn main() {
         eprintln!("error: cannot write '{out}': {e}");
         std::process::exit(1);
     });
-    println!(
-        "{out}: {trees} trees of {leaves} leaves ({} leaf triangles), {}",
-        trees as u64 * leaves as u64 * 2,
-        if opaque { "opaque" } else { "masked" }
-    );
+    println!("{out}: {trees} trees of {leaves} leaves ({} leaf triangles), alphaMode {mode}", trees as u64 * leaves as u64 * 2);
 }

@@ -29,6 +29,8 @@ pub struct Assembly<'a> {
     /// The scene's lights at rest (the GPU build animates them).
     pub lights: &'a [PointLight],
     pub scene: &'a SceneGpu,
+    /// The scene's objects (what the transparent layers' build makes room for).
+    pub objects: &'a [ml_cpu::scene::Object],
     /// Depth format of the technique's raster pass.
     pub depth_format: vk::Format,
 }
@@ -116,7 +118,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::ShadowMapView => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
         PassKind::TransparentBuild { depth_buffer } => {
-            Box::new(TransparentBuild::new(ctx, a.scene, (a.shading, transparency()), depth_buffer)?)
+            Box::new(TransparentBuild::new(ctx, (a.scene, a.objects), (a.shading, transparency()), depth_buffer)?)
         }
         PassKind::TransparentResolve { lights, after_compute } => {
             Box::new(TransparentResolve::new(ctx, a.scene, (a.shading, transparency()), (lights, after_compute))?)

@@ -23,6 +23,17 @@ pub struct ComputePass {
 }
 
 impl ComputePass {
+    /// None yet (a pass under construction; destroying it does nothing).
+    pub fn empty() -> ComputePass {
+        ComputePass {
+            sets: FrameSets::empty(),
+            sampler: vk::Sampler::null(),
+            pipeline_layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            workgroup_size: [1; 3],
+        }
+    }
+
     /// The pass of `shader` (with specialization `constants`: name, value); set 0 as the
     /// shader declares it, further sets of `more_sets`.
     pub fn new(
@@ -147,6 +158,28 @@ impl ComputePass {
         (more_sets, push): (&[vk::DescriptorSet], &[u8]),
         extent: vk::Extent2D,
     ) {
+        self.bind(ctx, cmd, slot, (more_sets, push));
+        let (x, y) = self.groups(extent);
+        // SAFETY: recording state outside a render pass; bound above.
+        unsafe { ctx.device.cmd_dispatch(cmd, x, y, 1) };
+    }
+
+    /// As `dispatch`, the work groups read from `buffer` at `offset` (a
+    /// VkDispatchIndirectCommand the GPU wrote; the caller orders that write before).
+    pub fn dispatch_indirect(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        (more_sets, push): (&[vk::DescriptorSet], &[u8]),
+        (buffer, offset): (vk::Buffer, u64),
+    ) {
+        self.bind(ctx, cmd, slot, (more_sets, push));
+        // SAFETY: recording state outside a render pass; bound above; the buffer is alive.
+        unsafe { ctx.device.cmd_dispatch_indirect(cmd, buffer, offset) };
+    }
+
+    fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize, (more_sets, push): (&[vk::DescriptorSet], &[u8])) {
         let d = &ctx.device;
         let sets: Vec<vk::DescriptorSet> = std::iter::once(self.sets.sets[slot]).chain(more_sets.iter().copied()).collect();
         // SAFETY: recording state outside a render pass; everything bound is alive.
@@ -156,8 +189,6 @@ impl ComputePass {
             if !push.is_empty() {
                 d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
-            let (x, y) = self.groups(extent);
-            d.cmd_dispatch(cmd, x, y, 1);
         }
     }
 

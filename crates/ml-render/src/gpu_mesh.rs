@@ -32,17 +32,18 @@ impl GpuMesh {
     }
 }
 
-/// Transparent objects of at most this many triangles have their layers built in compute
-/// (transparent_build_compute.glsl), the others by the hardware raster.
+/// Transparent objects of at most this many triangles have their layers built over tiles
+/// (transparent_build_compute.glsl), the others a thread per triangle
+/// (transparent_build_triangles.glsl), unless the settings say otherwise
+/// (`TransparencySettings::tiled_up_to`).
 pub const COMPUTE_LAYER_TRIANGLES: u32 = 64;
 
-/// Where `o` is a transparent object whose layers are built in compute (its mesh has few
-/// triangles: a pane, a card), the index of its mesh among `meshes`.
-pub fn compute_layer_mesh(o: &Object, meshes: &[GpuMesh]) -> Option<usize> {
+/// Where `o` is a transparent object, the index of its mesh among `meshes`.
+pub fn layer_mesh(o: &Object, meshes: &[GpuMesh]) -> Option<usize> {
     if o.extras.alpha_mode != ml_cpu::scene::AlphaMode::Blend {
         return None;
     }
-    meshes.iter().position(|m| m.kind == o.mesh).filter(|&m| meshes[m].index_count / 3 <= COMPUTE_LAYER_TRIANGLES)
+    meshes.iter().position(|m| m.kind == o.mesh)
 }
 
 /// The vertex buffer's binding (one, per vertex) as pipelines read it.

@@ -85,7 +85,6 @@ pub fn describe(
         Output::Color | Output::GBuffer => one_subpass(depth_format, output, gbuffer, layers),
         Output::Subpasses => two_subpasses(depth_format, gbuffer, layers),
         Output::Visibility => visibility(depth_format, true, samples),
-        Output::Layers { .. } => transparent_layers(),
     };
     // Subpass 0's attachments (the G-buffer and depth) take the samples; the lighting
     // subpass's HDR output (the last attachment) keeps one. deferred-compute's G-buffer and
@@ -136,10 +135,6 @@ fn multisampled_forward(depth_format: vk::Format, samples: vk::SampleCountFlags)
 /// append to the lists themselves — between the opaque raster (its depth, by the raster's
 /// own outgoing dependency; the lists' clearing, by the build's barrier) and the passes that
 /// blend the lists, ordered by their declared uses.
-fn transparent_layers() -> RenderPassDesc {
-    RenderPassDesc { attachments: Vec::new(), subpasses: vec![Subpass::default()], dependencies: Vec::new() }
-}
-
 /// The visibility raster's pass: the visibility buffer and depth, cleared by the early phase
 /// (`first`), kept by the late one. Between them the depth pyramid samples depth; after the
 /// late phase the lighting pass samples both. With `samples` above one (anti-aliasing) a

@@ -195,6 +195,7 @@ impl<'a> Renderer<'a> {
             shading: self.settings.lighting(&self.scene),
             lights: &self.lights,
             scene: &self.gpu,
+            objects: &self.scene.objects,
             depth_format: self.depth_format,
         };
         self.passes = assemble(self.ctx, &assembly)?;

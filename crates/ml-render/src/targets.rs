@@ -74,10 +74,6 @@ pub enum Output {
     /// A visibility buffer (an id per pixel) and depth, which a compute pass lights
     /// (visibility).
     Visibility,
-    /// Nothing: the transparent objects' fragments go to per-pixel lists (transparency/);
-    /// `depth_buffer`: the opaque depth they are tested against is the compute raster's
-    /// buffer (else the depth target).
-    Layers { depth_buffer: bool },
 }
 
 impl Output {
@@ -95,7 +91,6 @@ impl Output {
         match self {
             Output::Color | Output::Visibility => 1,
             Output::GBuffer | Output::Subpasses => gbuffer.len(),
-            Output::Layers { .. } => 0,
         }
     }
 }
@@ -260,7 +255,6 @@ impl Targets {
                 (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | depth, U::COLOR_ATTACHMENT | inside_pass)
             }
             Output::Visibility => (U::STORAGE | U::TRANSFER_SRC, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED, U::empty()),
-            Output::Layers { .. } => unreachable!("no technique's raster writes only layers"),
         };
         // The compute raster keeps depth and ids in one buffer: no images of them. The
         // hardware raster's samples are gathered into that buffer too.

@@ -68,7 +68,7 @@ impl MeshRaster {
             layers: shading.transparency,
             samples: match output {
                 Output::Color | Output::GBuffer | Output::Subpasses => shading.antialiasing.sample_count(),
-                Output::Visibility | Output::Layers { .. } => vk::SampleCountFlags::TYPE_1,
+                Output::Visibility => vk::SampleCountFlags::TYPE_1,
             },
         };
         ml_vk::build(ctx, r, |r| {
@@ -78,15 +78,13 @@ impl MeshRaster {
                 .size(std::mem::size_of::<ObjectPush>() as u32)];
             r.pipeline_layout = shader::pipeline_layout(ctx, &[r.sets.layout.raw, textures_layout, object_textures_layout], &push)?;
             // Drawn into the colour target, meshes are lit where they are drawn; into a
-            // G-buffer or the transparent layers, only their surfaces are read (unlit). The
-            // opaque passes test masks at each of their samples.
+            // G-buffer, only their surfaces are read (unlit). The passes test masks at each of
+            // their samples.
             let constants = match output {
                 Output::Color => shading.forward_lighting_constants().to_vec(),
-                Output::Layers { .. } => shading.surface_constants().to_vec(),
                 _ => [&shading.surface_constants()[..], &[shading.antialiasing.constant()]].concat(),
             };
-            let drawn: Vec<SurfaceVariant> = variants.iter().chain([&SurfaceVariant::OPAQUE]).map(|&v| r.drawn_as(v)).collect();
-            for v in drawn {
+            for &v in variants.iter().chain([&SurfaceVariant::OPAQUE]) {
                 if r.pipelines[v.index()] == vk::Pipeline::null() {
                     r.pipelines[v.index()] =
                         r.pipeline(ctx, (&ml_shaders::FORWARD_VERT, fragment), Draw::Mesh(v), (r.pipeline_layout, 0), &constants)?;
@@ -107,24 +105,10 @@ impl MeshRaster {
         self.output == Output::Subpasses || (self.output == Output::Color && self.multisampled())
     }
 
-    /// How this pass draws an object of variant `v`: transparent layers are not cut by their
-    /// alpha but weighted by it.
-    fn drawn_as(&self, v: SurfaceVariant) -> SurfaceVariant {
-        match self.output {
-            Output::Layers { .. } => SurfaceVariant { masked: false, ..v },
-            _ => v,
-        }
-    }
-
-    /// Whether this pass draws `o`: the transparent layers' build only the transparent
-    /// objects it does not build in compute; with layers, the opaque passes all others;
-    /// without, every object.
-    fn draws(&self, o: &ml_cpu::scene::Object, meshes: &[crate::gpu_mesh::GpuMesh]) -> bool {
-        let blended = o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend;
-        match self.output {
-            Output::Layers { .. } => blended && crate::gpu_mesh::compute_layer_mesh(o, meshes).is_none(),
-            _ => !(self.layers && blended),
-        }
+    /// Whether this pass draws `o`: with transparent layers every opaque object (the layers'
+    /// build draws the others in compute); without, every object.
+    fn draws(&self, o: &ml_cpu::scene::Object) -> bool {
+        !(self.layers && o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend)
     }
 
     /// A pipeline of this pass: `draw` kind, in `subpass` with `layout`, specialised by
@@ -159,8 +143,7 @@ impl MeshRaster {
             })
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
-        // The layers' build has no depth attachment (it compares the opaque depth itself).
-        let depth = mesh && !matches!(self.output, Output::Layers { .. });
+        let depth = mesh;
         let depth_stencil = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(depth)
             .depth_write_enable(depth)
@@ -208,12 +191,9 @@ impl MeshRaster {
             Output::Color if self.layers => vec![t.hdr.view],
             Output::Color if self.multisampled() => vec![t.colour_samples.view],
             Output::Color => vec![t.color.view],
-            Output::Layers { .. } => Vec::new(),
             _ => t.gbuffer.iter().map(|g| g.view).collect(),
         };
-        if !matches!(self.output, Output::Layers { .. }) {
-            views.push(t.depth.view);
-        }
+        views.push(t.depth.view);
         if self.ends_in_hdr() {
             views.push(t.hdr.view);
         }
@@ -234,11 +214,8 @@ impl MeshRaster {
             Output::Color if self.layers || self.multisampled() => vec![zero],
             Output::Color | Output::Visibility => vec![colour],
             Output::GBuffer | Output::Subpasses => vec![zero; self.gbuffer.len()],
-            Output::Layers { .. } => Vec::new(),
         };
-        if !matches!(self.output, Output::Layers { .. }) {
-            clear.push(depth);
-        }
+        clear.push(depth);
         // (The forward samples' resolve is not cleared.)
         if self.ends_in_hdr() {
             clear.push(zero);
@@ -269,9 +246,9 @@ impl MeshRaster {
                 ctx,
                 cmd,
                 (&scene.meshes, rec.objects),
-                |index| u32::from(self.draws(&rec.objects[index as usize], &scene.meshes)),
+                |index| u32::from(self.draws(&rec.objects[index as usize])),
                 |index, o| {
-                    let variant = self.drawn_as(SurfaceVariant::of(o));
+                    let variant = SurfaceVariant::of(o);
                     if variant != bound_variant {
                         // Made for every variant the scene's objects have (SceneGpu refuses
                         // replaced objects of another).

@@ -48,10 +48,10 @@ impl LayerBuffers {
         self.nodes.size / NODE_BYTES
     }
 
-    /// The counters as the slot's last frame left them: nodes asked for, pixels that merged.
-    pub fn counts(&self) -> [u32; 2] {
-        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counts.mapped()[..16]);
-        [c[0], c[1]]
+    /// The counters as the slot's last frame left them: nodes asked for, pixels that merged,
+    /// triangles listed for a work group each and for the tiles.
+    pub fn counts(&self) -> [u32; 4] {
+        bytemuck::pod_read_unaligned(&self.counts.mapped()[..16])
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -28,15 +28,20 @@ pub const DEFAULT_BUDGET: u32 = 4;
 /// The most nodes per pixel the option takes.
 pub const MAX_BUDGET: u32 = 256;
 
-/// How transparent objects are drawn: the node pool's size, in nodes per pixel on average.
+/// How transparent objects are drawn: the node pool's size, in nodes per pixel on average,
+/// and which objects the build draws over tiles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct TransparencySettings {
     pub budget: u32,
+    /// Objects of at most this many triangles are built over tiles, the others a thread per
+    /// triangle (`transparent_build`; the same fragments either way, which tests check by
+    /// moving this bound).
+    pub tiled_up_to: u32,
 }
 
 impl Default for TransparencySettings {
     fn default() -> Self {
-        TransparencySettings { budget: DEFAULT_BUDGET }
+        TransparencySettings { budget: DEFAULT_BUDGET, tiled_up_to: crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES }
     }
 }
 
@@ -85,6 +90,10 @@ pub struct TransparencyStats {
     pub pixels: u64,
     /// Pixels with more than `LAYER_KEEP` layers, whose farthest ones were merged.
     pub merged_pixels: u64,
+    /// Triangles of the objects built a thread per triangle that were too large for a
+    /// thread: built by a work group each, and (larger still) over the tiles.
+    pub group_triangles: u64,
+    pub tiled_triangles: u64,
 }
 
 impl TransparencyStats {
@@ -144,6 +153,15 @@ impl FeatureStats for TransparencyStats {
                     "{} fragments dropped (pool full), {} pixels over {LAYER_KEEP} layers (the farthest merged)",
                     s.dropped(),
                     s.merged_pixels
+                ),
+            ),
+            (
+                "transparent build",
+                format!(
+                    "{} triangles too large for a thread: {} by a work group each, {} over tiles",
+                    s.group_triangles + s.tiled_triangles,
+                    s.group_triangles,
+                    s.tiled_triangles
                 ),
             ),
         ]

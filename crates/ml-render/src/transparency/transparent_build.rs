@@ -1,39 +1,63 @@
 //! The transparent layers' build: each fragment of a transparent object in front of the opaque
-//! depth appended to its pixel's list (layers.glsl). Objects of few triangles (panes, cards)
-//! are rasterised in compute, one dispatch over the tiles their screen rectangles meet
-//! (transparent_build_compute.glsl: the H100 runs fragment shaders on 4 of its 132 SMs); the
-//! others are drawn by the hardware raster with no attachments (transparent_build.frag). Runs
-//! after the opaque raster, before the resolve; clears the slot's lists first.
+//! depth appended to its pixel's list (layers.glsl), in compute (the H100 runs fragment
+//! shaders on 4 of its 132 SMs). Objects of few triangles (panes, cards) are rasterised over
+//! the tiles their screen rectangles meet (transparent_build_compute.glsl); the others a
+//! thread per triangle (transparent_build_triangles.glsl), which lists its triangles too
+//! large for a thread for a work group each (transparent_build_large.glsl) and the huge ones
+//! for the tiles' build. Runs after the opaque raster, before the resolve; clears the slot's
+//! lists first.
 
 use super::{counts_to_host, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
-use crate::gpu_mesh::{compute_layer_mesh, GpuMesh};
+use crate::gpu_mesh::{layer_mesh, GpuMesh};
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
-use crate::shading::mesh_raster::MeshRaster;
 use crate::shading::Shading;
 use crate::sync::{Use, VISIBILITY_DEPTH};
-use crate::targets::Output;
 use ml_cpu::gpu_types::LayerObject;
+use ml_cpu::scene::Object;
 use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
 use ml_vk::image::fetch_sampler;
 use ml_vk::{vk, Buffer, Context, MemoryLocation, VkError};
 
+/// Work groups of one dispatch along x (Vulkan's least maxComputeWorkGroupCount): the
+/// per-triangle build dispatches a texture set's triangles in pieces of this many groups.
+const MAX_GROUPS_X: u32 = 65_535;
+
+/// Words per texture set in the listed triangles' counts (layer_triangles.glsl
+/// LIST_WORDS): the two lists' lengths, then the large triangles' and the tiles' work groups
+/// (VkDispatchIndirectCommand at words 4 and 8), which the per-triangle build raises.
+const LIST_WORDS: usize = 12;
+
+/// The listed triangles' counts of `sets` texture sets as a frame starts, for an image
+/// `tile_rows` tiles high: nothing listed, no work groups.
+fn empty_lists(sets: usize, tile_rows: u32) -> Vec<u32> {
+    let one = [0, 0, 0, 0, 0, 1, 1, 0, 0, tile_rows, 1, 0];
+    one.repeat(sets)
+}
+
 pub struct TransparentBuild {
-    raster: MeshRaster,
-    /// The compute build of small transparent objects.
-    compute: ComputePass,
-    /// Set 3 of the compute build, per frame slot: the small meshes and the slot's object list.
+    /// The tiles' build: objects of few triangles, and the huge triangles of the others.
+    tiles: ComputePass,
+    /// The per-triangle build of the other objects.
+    triangles: ComputePass,
+    /// Their triangles too large for a thread, a work group each.
+    large: ComputePass,
+    /// Set 3 of the builds, per frame slot: the meshes, the slot's entries and the listed
+    /// triangles' counts.
     mesh_sets: FrameSets,
-    /// The small meshes (at most `COMPUTE_LAYER_TRIANGLES` triangles) one after another, and
-    /// where each mesh of the scene's starts in them.
-    small_meshes: SmallMeshes,
-    /// Per frame slot, the frame's compute-built objects (`LayerObject`), written as its
-    /// commands are recorded: room for every object of the scene.
+    /// The transparent objects' meshes one after another.
+    meshes: LayerMeshes,
+    /// Per frame slot, the frame's entries (`LayerObject`), written as its commands are
+    /// recorded: room for every transparent object, then for every triangle of the objects
+    /// built a thread per triangle (each may be listed for the tiles' build).
     object_lists: Vec<Buffer>,
+    /// Per frame slot, per texture set, the triangles the per-triangle build listed: for a
+    /// work group each, and huge ones for the tiles' build.
+    large_counts: Vec<Buffer>,
     /// The lists' pool size, per pixel.
     settings: TransparencySettings,
     /// Per frame slot, the lists (made with the slot, for its image size), which the frame's
@@ -45,64 +69,82 @@ pub struct TransparentBuild {
     depth_buffer: bool,
 }
 
+/// The push constants of both builds (layer_triangles.glsl LayerDispatchBlock).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct DispatchPush {
+    objects: [u32; 4],
+    large_list: [u32; 4],
+}
+
 impl TransparentBuild {
     pub fn new(
         ctx: &Context,
-        scene: &SceneGpu,
+        (scene, objects): (&SceneGpu, &[Object]),
         (shading, settings): (Shading, TransparencySettings),
         depth_buffer: bool,
     ) -> Result<TransparentBuild, VkError> {
-        let (fragment, kernel) = if depth_buffer {
-            (&ml_shaders::TRANSPARENT_BUILD_BUFFER_FRAG, &ml_shaders::TRANSPARENT_BUILD_COMPUTE_BUFFER_COMP)
+        use ml_shaders as s;
+        let (tiles, triangles, large) = if depth_buffer {
+            (
+                &s::TRANSPARENT_BUILD_COMPUTE_BUFFER_COMP,
+                &s::TRANSPARENT_BUILD_TRIANGLES_BUFFER_COMP,
+                &s::TRANSPARENT_BUILD_LARGE_BUFFER_COMP,
+            )
         } else {
-            (&ml_shaders::TRANSPARENT_BUILD_FRAG, &ml_shaders::TRANSPARENT_BUILD_COMPUTE_COMP)
+            (&s::TRANSPARENT_BUILD_COMPUTE_COMP, &s::TRANSPARENT_BUILD_TRIANGLES_COMP, &s::TRANSPARENT_BUILD_LARGE_COMP)
         };
-        let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
-        // No depth attachment: the format is not used.
-        let output = (vk::Format::UNDEFINED, Output::Layers { depth_buffer }, &[][..]);
-        let mut raster = MeshRaster::new(ctx, output, (fragment, shading, &scene.surface_variants), layouts)?;
-        let mut mesh_sets = match FrameSets::new(ctx, &[(kernel, vk::ShaderStageFlags::COMPUTE)], 3, FRAMES_IN_FLIGHT) {
-            Ok(sets) => sets,
-            Err(e) => {
-                raster.destroy(ctx);
-                return Err(e);
-            }
-        };
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let mesh_sets = FrameSets::new(ctx, &[(tiles, compute), (triangles, compute), (large, compute)], 3, FRAMES_IN_FLIGHT)?;
+        let layouts = [scene.textures.set_layout.raw, scene.object_textures.set_layout, mesh_sets.layout.raw];
         let constants = shading.surface_constants();
-        let more = [layouts.0, layouts.1, mesh_sets.layout.raw];
-        let push = std::mem::size_of::<[u32; 4]>() as u32;
-        let compute = match ComputePass::with_push(ctx, &more, (kernel, &constants), push) {
-            Ok(c) => c,
-            Err(e) => {
-                raster.destroy(ctx);
-                mesh_sets.destroy(ctx);
-                return Err(e);
-            }
-        };
+        let push = std::mem::size_of::<DispatchPush>() as u32;
         let pass = TransparentBuild {
-            raster,
-            compute,
+            tiles: ComputePass::empty(),
+            triangles: ComputePass::empty(),
+            large: ComputePass::empty(),
             mesh_sets,
-            small_meshes: SmallMeshes { vertices: Buffer::null(), indices: Buffer::null(), places: Vec::new() },
+            meshes: LayerMeshes { vertices: Buffer::null(), indices: Buffer::null(), places: Vec::new() },
             object_lists: Vec::new(),
+            large_counts: Vec::new(),
             settings,
             layers: (0..FRAMES_IN_FLIGHT).map(|_| None).collect(),
             sampler: vk::Sampler::null(),
             depth_buffer,
         };
         ml_vk::build(ctx, pass, |pass| {
-            pass.small_meshes = SmallMeshes::new(ctx, &scene.meshes)?;
-            let objects = scene.object_textures.per_object.len().max(1);
-            let bytes = (objects * std::mem::size_of::<LayerObject>()) as u64;
+            pass.tiles = ComputePass::with_push(ctx, &layouts, (tiles, &constants), push)?;
+            pass.triangles = ComputePass::with_push(ctx, &layouts, (triangles, &constants), push)?;
+            pass.large = ComputePass::with_push(ctx, &layouts, (large, &constants), push)?;
+            pass.meshes = LayerMeshes::new(ctx, &scene.meshes, objects)?;
+            // Room for every transparent object and every triangle the per-triangle build may
+            // list: a list never overflows.
+            let transparent = objects.iter().filter_map(|o| layer_mesh(o, &scene.meshes)).map(|m| scene.meshes[m].index_count / 3);
+            let (count, listed) = transparent.fold((0u64, 0u64), |(n, t), triangles| {
+                (n + 1, t + if triangles > settings.tiled_up_to { u64::from(triangles) } else { 0 })
+            });
+            let bytes = (count + listed).max(1) * std::mem::size_of::<LayerObject>() as u64;
+            let max = u64::from(ctx.info.limits.max_storage_buffer_range);
+            if bytes > max {
+                return Err(VkError::DeviceLimit(format!(
+                    "the transparent objects' {listed} triangles built a thread each need a list of {bytes} bytes, more than device '{}' binds as one storage buffer ({max})",
+                    ctx.info.name
+                )));
+            }
+            let sets = scene.object_textures.sets.len().max(1) as u64;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
             for slot in 0..FRAMES_IN_FLIGHT {
                 pass.object_lists.push(Buffer::new(ctx, "transparent objects", bytes, usage, MemoryLocation::GpuOnly)?);
-                let (vertices, indices, objects) =
-                    (pass.small_meshes.vertices.raw, pass.small_meshes.indices.raw, pass.object_lists[slot].raw);
+                let bytes = sets * (LIST_WORDS * 4) as u64;
+                let usage = usage | vk::BufferUsageFlags::INDIRECT_BUFFER;
+                pass.large_counts.push(Buffer::new(ctx, "listed transparent triangles", bytes, usage, MemoryLocation::GpuOnly)?);
+                let (vertices, indices) = (pass.meshes.vertices.raw, pass.meshes.indices.raw);
+                let (entries, large) = (pass.object_lists[slot].raw, pass.large_counts[slot].raw);
                 pass.mesh_sets.write(ctx, slot, &|name| match name {
                     "MeshVertexBuffer" => Some(Resource::Buffer(vertices)),
                     "MeshIndexBuffer" => Some(Resource::Buffer(indices)),
-                    "LayerObjectBuffer" => Some(Resource::Buffer(objects)),
+                    "LayerObjectBuffer" => Some(Resource::Buffer(entries)),
+                    "LargeTriangleCountBuffer" => Some(Resource::Buffer(large)),
                     _ => None,
                 })?;
             }
@@ -111,30 +153,34 @@ impl TransparentBuild {
         })
     }
 
-    /// The frame's compute-built objects, those of one texture set side by side, and per
-    /// texture set its objects' range in the list and the rectangle they may cover.
+    /// The frame's transparent objects as entries: per texture set those built over tiles,
+    /// then those built a thread per triangle (their first triangle counted over the set's
+    /// in `place.w`), then room for the large triangles of the latter; and per texture set
+    /// where its entries lie.
     fn object_list(&self, rec: &Recording) -> (Vec<LayerObject>, Vec<ObjectGroup>) {
         let scene = rec.scene;
-        let mut listed: Vec<(u32, LayerObject)> = Vec::new();
+        let mut listed: Vec<(u32, bool, LayerObject)> = Vec::new();
         for (index, o) in rec.objects.iter().enumerate() {
-            let Some(m) = compute_layer_mesh(o, &scene.meshes) else { continue };
+            let Some(m) = layer_mesh(o, &scene.meshes) else { continue };
             let Some(((x, y), size)) = screen_rect(o.bounds(), rec.view_proj, rec.extent) else { continue };
-            let (first_vertex, first_index) = self.small_meshes.places[m].expect("a compute-built object's mesh is small");
+            let (first_vertex, first_index) = self.meshes.places[m].expect("a transparent object's mesh is among the build's");
             let end = (y + size.height) << 16 | (x + size.width);
-            let ids = [index as u32, o.textures.bits(), first_index, scene.meshes[m].index_count / 3];
-            listed.push((scene.object_textures.set_index[index], LayerObject { ids, place: [first_vertex, y << 16 | x, end, 0] }));
+            let triangles = scene.meshes[m].index_count / 3;
+            let ids = [index as u32, o.textures.bits(), first_index, triangles];
+            let entry = LayerObject { ids, place: [first_vertex, y << 16 | x, end, 0] };
+            listed.push((scene.object_textures.set_index[index], triangles > self.settings.tiled_up_to, entry));
         }
-        listed.sort_by_key(|(set, _)| *set);
-        let groups = object_groups(&listed);
-        (listed.into_iter().map(|(_, entry)| entry).collect(), groups)
+        listed.sort_by_key(|(set, per_triangle, _)| (*set, *per_triangle));
+        object_groups(listed)
     }
 
-    /// Record the compute build: the slot's object list written, a dispatch per texture set
-    /// over the tiles its objects' rectangles span.
+    /// Record the build: the slot's entries written; per texture set, its tiles' dispatch
+    /// over the rectangle its small objects span, the per-triangle dispatch, the large
+    /// triangles' dispatch, then the tiles' dispatch of the huge ones over the whole image.
     fn record_compute(&self, rec: &Recording) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let (entries, groups) = self.object_list(rec);
-        if entries.is_empty() {
+        if groups.is_empty() {
             return;
         }
         update_buffer(ctx, cmd, self.object_lists[rec.slot].raw, bytemuck::cast_slice(&entries));
@@ -143,82 +189,139 @@ impl TransparentBuild {
             ctx,
             cmd,
             (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
-            (compute, vk::AccessFlags::SHADER_READ),
+            (compute, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE),
         );
-        let [tile_x, tile_y, _] = self.compute.workgroup_size();
-        for (i, g) in groups.iter().enumerate() {
-            if i > 0 {
-                // Each dispatch stores its tiles' list heads without atomics.
-                let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        let [tile_x, tile_y, _] = self.tiles.workgroup_size();
+        let per_group = self.triangles.workgroup_size()[0];
+        let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
+        let mut first_dispatch = true;
+        // The tiles' build stores its pixels' heads without atomics: every dispatch after the
+        // earlier ones.
+        let mut after_earlier = || {
+            if !std::mem::take(&mut first_dispatch) {
                 memory_barrier(ctx, cmd, (compute, rw), (compute, rw));
             }
-            // Tiles aligned with the resolve's (a pixel's nodes then lie together).
-            let origin = (g.lo.0 / tile_x * tile_x, g.lo.1 / tile_y * tile_y);
-            let size = vk::Extent2D { width: g.end.0 - origin.0, height: g.end.1 - origin.1 };
-            let push = [g.first, g.count, origin.1 << 16 | origin.0, 0];
+        };
+        for g in &groups {
             let sets = [rec.scene.textures.set, rec.scene.object_textures.sets[g.set as usize], self.mesh_sets.sets[rec.slot]];
-            self.compute.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), size);
+            if let Some((lo, end)) = g.tiled_rect {
+                after_earlier();
+                // Tiles aligned with the resolve's (a pixel's nodes then lie together).
+                let origin = (lo.0 / tile_x * tile_x, lo.1 / tile_y * tile_y);
+                let size = vk::Extent2D { width: end.0 - origin.0, height: end.1 - origin.1 };
+                let push = DispatchPush { objects: [g.first, g.tiled, origin.1 << 16 | origin.0, 0], large_list: [0; 4] };
+                self.tiles.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), size);
+            }
+            if g.triangles == 0 {
+                continue;
+            }
+            let large = g.set + 1;
+            let large_list = [g.large_first, g.triangles, 0, 0];
+            let piece = MAX_GROUPS_X * per_group;
+            for base in (0..g.triangles).step_by(piece as usize) {
+                after_earlier();
+                let count = (g.triangles - base).min(piece);
+                let push = DispatchPush {
+                    objects: [g.first + g.tiled, g.per_triangle, g.triangles, large],
+                    large_list: [large_list[0], large_list[1], base, 0],
+                };
+                self.triangles.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), vk::Extent2D { width: count, height: 1 });
+            }
+            // The lists and their work groups, as the per-triangle build left them.
+            let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
+            memory_barrier(ctx, cmd, (compute, rw), (compute | indirect, rw | vk::AccessFlags::INDIRECT_COMMAND_READ));
+            let push = DispatchPush { objects: [0, 0, 0, large], large_list };
+            let counts = (self.large_counts[rec.slot].raw, (g.set as usize * LIST_WORDS * 4) as u64);
+            let push = (&sets[..], bytemuck::bytes_of(&push));
+            self.large.dispatch_indirect(ctx, cmd, rec.slot, push, (counts.0, counts.1 + 16));
+            memory_barrier(ctx, cmd, (compute, rw), (compute, rw));
+            self.tiles.dispatch_indirect(ctx, cmd, rec.slot, push, (counts.0, counts.1 + 32));
         }
     }
 }
 
-/// The compute-built objects of one texture set: their range in the frame's list and the
-/// rectangle they may cover (first pixel, end).
+/// One texture set's transparent objects in the frame's entries: `tiled` built over tiles
+/// from `first` on (the rectangle they span, if any), then `per_triangle` built a thread per
+/// triangle (`triangles` in all), and the room for their large triangles from `large_first`.
 #[derive(Debug, PartialEq)]
 struct ObjectGroup {
     set: u32,
     first: u32,
-    count: u32,
-    lo: (u32, u32),
-    end: (u32, u32),
+    tiled: u32,
+    tiled_rect: Option<((u32, u32), (u32, u32))>,
+    per_triangle: u32,
+    triangles: u32,
+    large_first: u32,
 }
 
-/// The groups of `listed` (texture set, object), sorted by texture set.
-fn object_groups(listed: &[(u32, LayerObject)]) -> Vec<ObjectGroup> {
+/// `listed` (texture set, built per triangle, entry), sorted by set then per-triangle, as
+/// the frame's entries (the per-triangle ones numbering their first triangle in `place.w`,
+/// room for their large triangles after all of them) and its groups.
+fn object_groups(listed: Vec<(u32, bool, LayerObject)>) -> (Vec<LayerObject>, Vec<ObjectGroup>) {
     let corner = |packed: u32| (packed & 0xffff, packed >> 16);
     let mut groups: Vec<ObjectGroup> = Vec::new();
-    for (i, (set, entry)) in listed.iter().enumerate() {
-        let (lo, end) = (corner(entry.place[1]), corner(entry.place[2]));
-        match groups.last_mut() {
-            Some(g) if g.set == *set => {
-                g.count += 1;
-                g.lo = (g.lo.0.min(lo.0), g.lo.1.min(lo.1));
-                g.end = (g.end.0.max(end.0), g.end.1.max(end.1));
-            }
-            _ => groups.push(ObjectGroup { set: *set, first: i as u32, count: 1, lo, end }),
+    let mut entries = Vec::with_capacity(listed.len());
+    for (set, per_triangle, mut entry) in listed {
+        if groups.last().is_none_or(|g| g.set != set) {
+            let first = entries.len() as u32;
+            groups.push(ObjectGroup { set, first, tiled: 0, tiled_rect: None, per_triangle: 0, triangles: 0, large_first: 0 });
         }
+        let g = groups.last_mut().expect("just pushed");
+        if per_triangle {
+            entry.place[3] = g.triangles;
+            g.per_triangle += 1;
+            g.triangles += entry.ids[3];
+        } else {
+            let (lo, end) = (corner(entry.place[1]), corner(entry.place[2]));
+            g.tiled += 1;
+            g.tiled_rect = Some(match g.tiled_rect {
+                Some((l, e)) => ((l.0.min(lo.0), l.1.min(lo.1)), (e.0.max(end.0), e.1.max(end.1))),
+                None => (lo, end),
+            });
+        }
+        entries.push(entry);
     }
-    groups
+    let mut room = entries.len() as u32;
+    for g in &mut groups {
+        g.large_first = room;
+        room += g.triangles;
+    }
+    (entries, groups)
 }
 
-/// The scene's small meshes (compute-built layers) in one vertex and one index buffer.
-struct SmallMeshes {
+/// The transparent objects' meshes in one vertex and one index buffer.
+struct LayerMeshes {
     vertices: Buffer,
     indices: Buffer,
-    /// Per mesh of the scene: where it starts in them (first vertex, first index), if small.
+    /// Per mesh of the scene: where it starts in them (first vertex, first index), if a
+    /// transparent object draws it.
     places: Vec<Option<(u32, u32)>>,
 }
 
-impl SmallMeshes {
+impl LayerMeshes {
     /// Copied on the GPU from the scene's meshes.
-    fn new(ctx: &Context, meshes: &[GpuMesh]) -> Result<SmallMeshes, VkError> {
+    fn new(ctx: &Context, meshes: &[GpuMesh], objects: &[Object]) -> Result<LayerMeshes, VkError> {
         let vertex_bytes = std::mem::size_of::<ml_cpu::mesh::Vertex>() as u64;
-        let small = |m: &GpuMesh| m.index_count / 3 <= crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES;
+        let mut drawn = vec![false; meshes.len()];
+        for m in objects.iter().filter_map(|o| layer_mesh(o, meshes)) {
+            drawn[m] = true;
+        }
         let (mut vertex_count, mut index_count) = (0u64, 0u64);
         let mut places = Vec::new();
-        for m in meshes {
-            places.push(small(m).then_some((vertex_count as u32, index_count as u32)));
-            if small(m) {
+        for (m, &drawn) in meshes.iter().zip(&drawn) {
+            places.push(drawn.then_some((vertex_count as u32, index_count as u32)));
+            if drawn {
                 vertex_count += m.vertices.size / vertex_bytes;
                 index_count += u64::from(m.index_count);
             }
         }
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-        let made = SmallMeshes { vertices: Buffer::null(), indices: Buffer::null(), places };
-        // Vulkan has no empty buffers: one vertex and index where no mesh is small.
+        let made = LayerMeshes { vertices: Buffer::null(), indices: Buffer::null(), places };
+        // Vulkan has no empty buffers: one vertex and index where no object is transparent.
         ml_vk::build(ctx, made, |made| {
-            made.vertices = Buffer::new(ctx, "small mesh vertices", vertex_count.max(1) * vertex_bytes, usage, MemoryLocation::GpuOnly)?;
-            made.indices = Buffer::new(ctx, "small mesh indices", index_count.max(1) * 4, usage, MemoryLocation::GpuOnly)?;
+            made.vertices =
+                Buffer::new(ctx, "transparent mesh vertices", vertex_count.max(1) * vertex_bytes, usage, MemoryLocation::GpuOnly)?;
+            made.indices = Buffer::new(ctx, "transparent mesh indices", index_count.max(1) * 4, usage, MemoryLocation::GpuOnly)?;
             if vertex_count == 0 {
                 return Ok(());
             }
@@ -241,7 +344,7 @@ impl SmallMeshes {
     }
 }
 
-impl ml_vk::Release for SmallMeshes {
+impl ml_vk::Release for LayerMeshes {
     fn release(&mut self, ctx: &Context) {
         self.vertices.destroy(ctx);
         self.indices.destroy(ctx);
@@ -304,16 +407,17 @@ impl Pass for TransparentBuild {
             .sampler(self.sampler)
             .image_view(frame.targets.depth.view)
             .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-        let extra = |name: &str| (name == "opaque_depth").then_some(Resource::Image(depth));
-        self.raster.bind_frame_with(ctx, frame, &extra)?;
-        self.compute.bind_frame(ctx, frame, &|name| extra(name).or_else(|| frame.buffer(name)))
+        let lookup = |name: &str| (name == "opaque_depth").then_some(Resource::Image(depth)).or_else(|| frame.buffer(name));
+        self.tiles.bind_frame(ctx, frame, &lookup)?;
+        self.triangles.bind_frame(ctx, frame, &lookup)?;
+        self.large.bind_frame(ctx, frame, &lookup)
     }
 
     /// Clears and appends to the lists (after the earlier frame's readers of this slot's); reads
     /// the compute raster's depth. The depth target is ordered by the opaque raster's render
-    /// pass, whose outgoing dependency reaches compute and fragment shaders.
+    /// pass, whose outgoing dependency reaches compute shaders.
     fn uses(&self) -> Vec<Use> {
-        let shaders = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
+        let shaders = vk::PipelineStageFlags::COMPUTE_SHADER;
         let stages = vk::PipelineStageFlags::TRANSFER | shaders;
         let access = vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         let mut uses: Vec<Use> = LAYER_BUFFERS.iter().map(|&name| Use::at(name, (stages, access), None)).collect();
@@ -331,25 +435,25 @@ impl Pass for TransparentBuild {
             ctx.device.cmd_fill_buffer(cmd, layers.heads.raw, 0, vk::WHOLE_SIZE, super::LAYER_END);
             ctx.device.cmd_fill_buffer(cmd, layers.counts.raw, 0, vk::WHOLE_SIZE, 0);
         }
-        let (compute, fragment) = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::PipelineStageFlags::FRAGMENT_SHADER);
+        let sets = rec.scene.object_textures.sets.len().max(1);
+        let tile_rows = rec.extent.height.div_ceil(self.tiles.workgroup_size()[1]);
+        update_buffer(ctx, cmd, self.large_counts[rec.slot].raw, bytemuck::cast_slice(&empty_lists(sets, tile_rows)));
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
-        memory_barrier(ctx, cmd, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE), (compute | fragment, rw));
+        let transfer = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE);
+        memory_barrier(ctx, cmd, transfer, (vk::PipelineStageFlags::COMPUTE_SHADER, rw));
         self.record_compute(rec);
-        // The compute build's nodes and heads before the raster's appends (which swap heads).
-        memory_barrier(ctx, cmd, (compute, rw), (fragment, rw));
-        self.raster.begin_and_draw_meshes(rec);
-        // SAFETY: recording inside the render pass begun above.
-        unsafe { ctx.device.cmd_end_render_pass(cmd) };
     }
 
     fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
         let Some(layers) = self.layers[slot].as_ref() else { return };
-        let [fragments, merged] = layers.counts();
+        let [fragments, merged, group_triangles, tiled_triangles] = layers.counts();
         stats.set_feature(TransparencyStats {
             fragments: fragments as u64,
             capacity: layers.capacity(),
             pixels: layers.pixels(),
             merged_pixels: merged as u64,
+            group_triangles: group_triangles as u64,
+            tiled_triangles: tiled_triangles as u64,
         });
     }
 
@@ -357,17 +461,19 @@ impl Pass for TransparentBuild {
         // SAFETY: no pending work uses it; a null handle is ignored.
         unsafe { ctx.device.destroy_sampler(self.sampler, None) };
         self.sampler = vk::Sampler::null();
-        self.compute.destroy(ctx);
+        self.tiles.destroy(ctx);
+        self.triangles.destroy(ctx);
+        self.large.destroy(ctx);
         self.mesh_sets.destroy(ctx);
-        ml_vk::Release::release(&mut self.small_meshes, ctx);
-        for list in &mut self.object_lists {
+        ml_vk::Release::release(&mut self.meshes, ctx);
+        for list in self.object_lists.iter_mut().chain(&mut self.large_counts) {
             list.destroy(ctx);
         }
         self.object_lists.clear();
+        self.large_counts.clear();
         for mut layers in self.layers.iter_mut().filter_map(Option::take) {
             layers.destroy(ctx);
         }
-        self.raster.destroy(ctx);
     }
 }
 
@@ -383,17 +489,37 @@ mod tests {
     use glam::{Mat4, Vec3};
 
     #[test]
-    fn objects_of_one_texture_set_make_one_dispatch_over_their_rectangles() {
-        let entry = |lo: (u32, u32), end: (u32, u32)| LayerObject { ids: [0; 4], place: [0, lo.1 << 16 | lo.0, end.1 << 16 | end.0, 0] };
-        let listed = [(0, entry((10, 20), (30, 40))), (0, entry((5, 30), (20, 50))), (2, entry((100, 0), (120, 16)))];
+    fn each_texture_sets_objects_make_its_dispatches_and_room_for_listed_triangles() {
+        let entry = |lo: (u32, u32), end: (u32, u32), triangles: u32| LayerObject {
+            ids: [0, 0, 0, triangles],
+            place: [0, lo.1 << 16 | lo.0, end.1 << 16 | end.0, 0],
+        };
+        let listed = vec![
+            (0, false, entry((10, 20), (30, 40), 2)),
+            (0, false, entry((5, 30), (20, 50), 2)),
+            (0, true, entry((0, 0), (90, 90), 100)),
+            (0, true, entry((0, 0), (90, 90), 300)),
+            (2, true, entry((100, 0), (120, 16), 70)),
+        ];
+        let (entries, groups) = object_groups(listed);
         assert_eq!(
-            object_groups(&listed),
+            groups,
             [
-                ObjectGroup { set: 0, first: 0, count: 2, lo: (5, 20), end: (30, 50) },
-                ObjectGroup { set: 2, first: 2, count: 1, lo: (100, 0), end: (120, 16) }
+                ObjectGroup {
+                    set: 0,
+                    first: 0,
+                    tiled: 2,
+                    tiled_rect: Some(((5, 20), (30, 50))),
+                    per_triangle: 2,
+                    triangles: 400,
+                    large_first: 5
+                },
+                ObjectGroup { set: 2, first: 4, tiled: 0, tiled_rect: None, per_triangle: 1, triangles: 70, large_first: 405 }
             ]
         );
-        assert!(object_groups(&[]).is_empty());
+        // The per-triangle entries number their first triangle within their set's.
+        assert_eq!(entries.iter().map(|e| e.place[3]).collect::<Vec<_>>(), [0, 0, 0, 100, 0]);
+        assert_eq!(object_groups(Vec::new()), (Vec::new(), Vec::new()));
     }
 
     #[test]

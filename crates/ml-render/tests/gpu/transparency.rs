@@ -15,7 +15,9 @@
 //!   counted edge pixels; the hole shows exactly what the scene without the leaves shows, and
 //!   the soft bands blend: their pixels lie between the leafless image and the one with the
 //!   leaves opaque;
-//! - the transparency-layers debug view counts each pixel's layers.
+//! - the transparency-layers debug view counts each pixel's layers;
+//! - the build over tiles and the build a thread per triangle leave the same fragments: an
+//!   object moved from one to the other changes no byte.
 
 use crate::common;
 
@@ -235,12 +237,12 @@ fn a_budget_below_the_depth_complexity_is_reported() {
         deep.objects.push(quad(Vec3::new(0.0, 0.0, 0.05 + 0.05 * i as f32), (0.8, 0.8), c, Some(0.05 + 0.004 * i as f32)));
     }
     let mut s = settings(Technique::DeferredCompute);
-    s.transparency = Some(TransparencySettings { budget: 1 });
+    s.transparency = Some(TransparencySettings { budget: 1, ..Default::default() });
     let st = stats(&common::render(deep.clone(), s));
     assert!(st.dropped() > 0 && st.overflowed(), "{st:?}");
     assert_eq!(st.capacity, (W * H) as u64);
     let mut s = settings(Technique::Visibility);
-    s.transparency = Some(TransparencySettings { budget: 16 });
+    s.transparency = Some(TransparencySettings { budget: 16, ..Default::default() });
     let out = common::render(deep.clone(), s);
     let st = stats(&out);
     assert_eq!(st.dropped(), 0, "{st:?}");
@@ -296,8 +298,8 @@ fn foliage(mode: Option<&str>) -> Scene {
     foliage_of(mode, gltf_quad())
 }
 
-/// The quad as a grid of 12×12 cells (288 triangles, more than the compute build takes: the
-/// hardware raster builds its layers).
+/// The quad as a grid of 12×12 cells (288 triangles, more than the tiles' build takes: built
+/// a thread per triangle).
 fn fine_quad() -> PrimitiveData {
     let n = 12u32;
     let at = |i: u32| i as f32 / n as f32;
@@ -429,19 +431,47 @@ fn the_layer_view_counts_each_pixels_layers() {
     }
 }
 
+/// Both builds (over tiles; a thread per triangle, with its work group and tile lists of
+/// larger triangles) give the same fragments bit for bit: each object moved to the other
+/// build leaves every byte of the image and the fragment count unchanged — the coarse leaves'
+/// large triangles through the per-triangle build's lists, the fine leaves' small triangles
+/// over tiles. And the leaves as two triangles each or as 288 give the same image but at
+/// edge pixels and where the two pick texture levels apart.
 #[test]
-fn the_compute_build_and_the_hardware_raster_build_agree() {
-    // The leaves as two triangles each (built in compute) and as 288 (built by the hardware
-    // raster): the same image but at edge pixels and where the two pick texture levels apart.
-    let pbr = |t| RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
+fn the_tiles_build_and_the_per_triangle_build_agree() {
+    let pbr = |t, tiled_up_to| {
+        let mut s = RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
+        s.transparency = Some(TransparencySettings { tiled_up_to, ..TransparencySettings::default() });
+        s
+    };
+    let default = TransparencySettings::default().tiled_up_to;
     for technique in [Technique::Forward, Technique::Visibility] {
         let leaves = foliage(Some("BLEND"));
         assert_eq!(leaves.textures.len(), 2, "leaves of two texture sets");
-        let coarse = common::render(leaves, pbr(technique));
-        let fine = common::render(foliage_of(Some("BLEND"), fine_quad()), pbr(technique));
-        let (a, b) = (stats(&coarse), stats(&fine));
+        let coarse = common::render_each(&leaves, &[pbr(technique, default), pbr(technique, 0)]);
+        let fine_leaves = foliage_of(Some("BLEND"), fine_quad());
+        let fine = common::render_each(&fine_leaves, &[pbr(technique, default), pbr(technique, u32::MAX)]);
+        // Panes of glass close up: triangles larger than a work group walks, and reaching
+        // behind the eye, listed for the tiles.
+        let mut glass = scene([0, 1, 2]);
+        glass.camera = Camera::looking_at(Vec3::new(0.3, 0.2, 0.9), Vec3::new(0.0, 0.0, 0.5), 70.0, 0.1, 20.0);
+        let panes = common::render_each(&glass, &[pbr(technique, u32::MAX), pbr(technique, 0)]);
+        for (what, [a, b]) in
+            [("coarse leaves", &coarse[..]), ("fine leaves", &fine[..]), ("panes", &panes[..])].map(|(w, o)| (w, [&o[0], &o[1]]))
+        {
+            println!("{} {what}: {} fragments, {} pixels differ", technique.name(), stats(a).fragments, common::pixels_beyond(a, b, 0));
+            assert_eq!(stats(a).fragments, stats(b).fragments, "{} {what}", technique.name());
+            assert!(a.rgba == b.rgba, "{} {what}: the builds' images differ", technique.name());
+        }
+        // Each kind of triangle went where the test means it to: the coarse leaves' to work
+        // groups, the close panes' to the tiles, the fine leaves' to threads.
+        let (coarse_listed, panes_listed, fine_listed) = (stats(&coarse[1]), stats(&panes[1]), stats(&fine[0]));
+        assert!(coarse_listed.group_triangles > 0, "{coarse_listed:?}");
+        assert!(panes_listed.tiled_triangles > 0, "{panes_listed:?}");
+        assert_eq!(fine_listed.group_triangles + fine_listed.tiled_triangles, 0, "{fine_listed:?}");
+        let (a, b) = (stats(&coarse[0]), stats(&fine[0]));
         assert!(a.fragments.abs_diff(b.fragments) <= a.fragments / 100, "{a:?} against {b:?}");
-        let beyond = common::pixels_beyond(&coarse, &fine, 2);
+        let beyond = common::pixels_beyond(&coarse[0], &fine[0], 2);
         assert!(beyond <= (W * H / 100) as usize, "{}: {beyond} pixels differ by more than 2/255", technique.name());
         println!("{}: {beyond} pixels beyond 2/255; fragments {} and {}", technique.name(), a.fragments, b.fragments);
     }

@@ -1,0 +1,273 @@
+// What the transparent layers' compute builds share (transparent_build_compute.glsl over
+// tiles, transparent_build_triangles.glsl a thread per triangle): the bindings, a triangle's
+// set-up in shared memory (one of CHUNK places), its coverage test and its surface. Both
+// builds run these same functions, so a triangle leaves the same fragments, bit for bit,
+// whichever builds it.
+//
+// Triangles are rasterised in homogeneous coordinates (no clipping: a triangle crossing the
+// eye plane still covers exactly its visible part): with M = (x, y, w) of the three vertices as
+// columns, the rows of adj(M) are edge functions whose values at the pixel's (x, y, 1),
+// normalised, are its perspective-correct barycentrics; the pixel is inside where all three
+// have the sign of det(M). A pixel on an edge shared by two triangles belongs to one of them
+// (the two edge functions are exact negatives of each other; the sign of their x, then y,
+// coefficient decides). Depth and attributes are interpolated with those barycentrics; the
+// texture gradients are their differences one pixel to the right and one down.
+//
+// The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer, and sets
+// its work group size.
+
+#ifndef MANYLIGHTS_LAYER_TRIANGLES_GLSL
+#define MANYLIGHTS_LAYER_TRIANGLES_GLSL
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
+#define SURFACE_GRADIENTS 1
+#include "common/common.glsl"
+
+#include "common/scene_bindings.glsl"
+#include "common/textures.glsl"
+#include "common/surface.glsl"
+#define ALPHA_MASK_BINDING 11
+#include "common/alpha_mask.glsl"
+#define LAYER_BINDING 14
+#include "transparency/layers.glsl"
+#include "common/opaque_depth.glsl"
+
+// The transparent objects' meshes one after another (gpu_mesh.rs: 12 floats a vertex, position, normal, uv,
+// tangent; three indices a triangle, each from its mesh's first vertex), and this frame's
+// objects, those of one texture set side by side.
+layout(std430, set = 3, binding = 0) readonly buffer MeshVertexBuffer { float mesh_vertices[]; };
+layout(std430, set = 3, binding = 1) readonly buffer MeshIndexBuffer { uint mesh_indices[]; };
+layout(std430, set = 3, binding = 2) buffer LayerObjectBuffer { LayerObject layer_objects[]; };
+// Per texture set (by its slot), LIST_WORDS words on the triangles the per-triangle build
+// leaves to others: how many it listed for a work group each (transparent_build_large.glsl)
+// as single-triangle entries from large_list.x on, and how many huge ones for the tiles'
+// build from the end of that room (large_list.x + large_list.y) down — the room holds all of
+// them, one entry at most a triangle — and the two builds' work groups, which they are
+// dispatched with (VkDispatchIndirectCommand: 1, 1 and 0, tile rows, 1 before the build).
+layout(std430, set = 3, binding = 3) buffer LargeTriangleCountBuffer { uint large_triangles[]; };
+const uint LIST_WORDS = 12u;
+const uint LIST_LARGE = 0u;           // triangles listed for a work group each
+const uint LIST_HUGE = 1u;            // triangles listed for the tiles
+const uint LIST_LARGE_GROUPS = 4u;    // x, y, z: the large triangles' work groups
+const uint LIST_HUGE_GROUPS = 8u;     // x, y, z: the tiles' (x: the image's tile columns once one is listed)
+// dispatch_objects: x: the dispatch's first entry in layer_objects, y: its entries; z: tiles:
+// the first pixel of the rectangle it covers (y << 16 | x, each a multiple of the tile's
+// size), per triangle: its entries' triangles; w: 0 for the CPU's entries, else 1 + the
+// texture set's slot in large_triangles (per triangle: where it lists; the others: whose
+// list they draw, its count and place replacing x and y). large_list: x: the first entry of
+// the texture set's room for listed triangles, y: its size; z: per triangle: the first
+// triangle of this dispatch's piece.
+layout(push_constant) uniform LayerDispatchBlock {
+    uvec4 dispatch_objects;
+    uvec4 large_list;
+};
+
+// Triangles set up at once (the tiles' build: 64; a work group's own triangle: 1).
+#ifndef LAYER_SLOTS
+#define LAYER_SLOTS 64u
+#endif
+const uint CHUNK = LAYER_SLOTS;
+// CHUNK triangles, set up: edge functions (rows of adj(M), times the sign of det(M)),
+// clip z and w per vertex, world-space normals and tangents (w: handedness), texture
+// coordinates; (object, TRIANGLE_* bits, its textures), its alpha factor, alpha texture
+// (ObjectData.alpha_texture) and material.
+shared vec3 tri_edges[CHUNK][3];
+shared vec3 tri_z[CHUNK];
+shared vec3 tri_w[CHUNK];
+shared vec3 tri_normal[CHUNK][3];
+shared vec4 tri_tangent[CHUNK][3];
+shared vec2 tri_uv[CHUNK][3];
+shared uvec3 tri_object[CHUNK];
+shared float tri_alpha[CHUNK];
+shared uvec4 tri_alpha_texture[CHUNK];
+shared vec4 tri_material[CHUNK];
+
+const uint TRIANGLE_DRAWN = 1u; // faces a way its object is drawn from (and is not degenerate)
+const uint TRIANGLE_FRONT = 2u; // faces the viewer
+
+struct Vtx {
+    vec3 position;
+    vec3 normal;
+    vec2 uv;
+    vec4 tangent;
+};
+
+Vtx mesh_vertex(uint i) {
+    uint b = 12u * i;
+    Vtx v;
+    v.position = vec3(mesh_vertices[b], mesh_vertices[b + 1u], mesh_vertices[b + 2u]);
+    v.normal = vec3(mesh_vertices[b + 3u], mesh_vertices[b + 4u], mesh_vertices[b + 5u]);
+    v.uv = vec2(mesh_vertices[b + 6u], mesh_vertices[b + 7u]);
+    v.tangent = vec4(mesh_vertices[b + 8u], mesh_vertices[b + 9u], mesh_vertices[b + 10u], mesh_vertices[b + 11u]);
+    return v;
+}
+
+// Set up triangle `k` of entry `entry` (of layer_objects) in place `slot`; `box` gets the
+// pixels whose centres it may cover (first, last; inclusive, within the image: empty where
+// none).
+void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
+    uint o = entry.ids.x;
+    mat4 model = objects[o].model;
+    mat3 normal_matrix = mat3(objects[o].normal_matrix);
+    vec4 uv_transform[2] = objects[o].uv_transform;
+    mat4 view_proj = frame.proj * frame.view;
+    uint first = entry.ids.z + 3u * k;
+    vec4 clip[3];
+    for (uint v = 0u; v < 3u; v++) {
+        Vtx x = mesh_vertex(entry.place.x + mesh_indices[first + v]);
+        vec3 world = (model * vec4(x.position, 1.0)).xyz;
+        clip[v] = view_proj * vec4(world, 1.0);
+        tri_normal[slot][v] = normal_matrix * x.normal;
+        tri_uv[slot][v] = transform_uv(uv_transform, x.uv);
+        tri_tangent[slot][v] = vec4(mat3(model) * x.tangent.xyz, x.tangent.w);
+    }
+    vec3 a = clip[0].xyw, b = clip[1].xyw, c = clip[2].xyw;
+    vec3 r0 = cross(b, c), r1 = cross(c, a), r2 = cross(a, b);
+    float det = dot(a, r0);
+    // Front faces wind counter-clockwise as the pipelines see them (Y-flipped projection):
+    // det < 0 here.
+    bool front = det < 0.0;
+    uvec4 alpha_texture = objects[o].alpha_texture;
+    bool drawn = det != 0.0 && (front || (alpha_texture.x & OBJECT_DOUBLE_SIDED) != 0u);
+    float s = sign(det);
+    tri_edges[slot][0] = r0 * s;
+    tri_edges[slot][1] = r1 * s;
+    tri_edges[slot][2] = r2 * s;
+    tri_z[slot] = vec3(clip[0].z, clip[1].z, clip[2].z);
+    tri_w[slot] = vec3(clip[0].w, clip[1].w, clip[2].w);
+    tri_object[slot] = uvec3(o, (drawn ? TRIANGLE_DRAWN : 0u) | (front ? TRIANGLE_FRONT : 0u), entry.ids.y);
+    tri_alpha[slot] = objects[o].alpha.y;
+    tri_alpha_texture[slot] = alpha_texture;
+    tri_material[slot] = objects[o].material;
+    // The corners on the near plane's far side (clip z ≥ 0, where depth is; w is positive
+    // there) and where the edges cross it, projected: a triangle reaching behind the eye
+    // gets the box of the part that may be seen.
+    vec2 size = vec2(frame.viewport.xy);
+    vec2 lo = vec2(1e30), hi = vec2(-1e30);
+    for (uint v = 0u; v < 3u; v++) {
+        vec4 x = clip[v], y = clip[(v + 1u) % 3u];
+        if (x.z >= 0.0 && x.w > 0.0) {
+            vec2 p = (x.xy / x.w + 1.0) * 0.5 * size;
+            lo = min(lo, p);
+            hi = max(hi, p);
+        }
+        if ((x.z >= 0.0) != (y.z >= 0.0)) {
+            vec4 c = mix(x, y, x.z / (x.z - y.z));
+            if (c.w > 0.0) {
+                vec2 p = (c.xy / c.w + 1.0) * 0.5 * size;
+                lo = min(lo, p);
+                hi = max(hi, p);
+            }
+        }
+    }
+    // Centres p + 0.5 within [lo, hi], a pixel of margin for the projection's rounding;
+    // clamped before the conversion (a crossing's projection may be far outside).
+    lo = clamp(floor(lo - 0.5) - 1.0, vec2(0.0), size);
+    hi = clamp(ceil(hi - 0.5) + 1.0, vec2(-1.0), size - 1.0);
+    box = ivec4(ivec2(lo), ivec2(hi));
+}
+
+// Whether a pixel where edge function `e` (coefficients `c`) is 0 belongs to this triangle.
+bool edge_owns(float e, vec2 c) {
+    return e > 0.0 || (e == 0.0 && (c.x > 0.0 || (c.x == 0.0 && c.y > 0.0)));
+}
+
+// The barycentrics of point `q` (x, y in NDC, 1) on triangle `i`'s plane.
+vec3 barycentrics(uint i, vec3 q) {
+    vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
+    return e / (e.x + e.y + e.z);
+}
+
+// Whether triangle `i` leaves a fragment at `q` in front of `opaque`: its barycentrics,
+// depth and coverage.
+bool layer_fragment(uint i, vec3 q, float opaque, out vec3 w, out float depth, out float alpha) {
+    w = vec3(0.0);
+    depth = 0.0;
+    alpha = 0.0;
+    if ((tri_object[i].y & TRIANGLE_DRAWN) == 0u) {
+        return false;
+    }
+    vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
+    if (!(edge_owns(e.x, tri_edges[i][0].xy) && edge_owns(e.y, tri_edges[i][1].xy) && edge_owns(e.z, tri_edges[i][2].xy))) {
+        return false;
+    }
+    float sum = e.x + e.y + e.z;
+    if (sum <= 0.0) {
+        return false;
+    }
+    w = e / sum;
+    depth = dot(w, tri_z[i]) / dot(w, tri_w[i]);
+    if (!(depth >= 0.0 && depth <= 1.0) || depth >= opaque) {
+        return false;
+    }
+    alpha = tri_alpha[i];
+    if ((tri_alpha_texture[i].x & OBJECT_ALPHA_TEXTURE) != 0u) {
+        alpha *= texture_alpha(tri_alpha_texture[i], w.x * tri_uv[i][0] + w.y * tri_uv[i][1] + w.z * tri_uv[i][2]);
+    }
+    return alpha > 0.0;
+}
+
+// The surface of triangle `i` at barycentrics `w` (pixel `q`), packed for its node.
+uvec4 layer_surface(uint i, vec3 q, vec3 w, float alpha, vec2 to_ndc) {
+    vec2 uv = w.x * tri_uv[i][0] + w.y * tri_uv[i][1] + w.z * tri_uv[i][2];
+    // The texture coordinates one pixel to the right and one down.
+    vec3 wx = barycentrics(i, q + vec3(to_ndc.x, 0.0, 0.0)), wy = barycentrics(i, q + vec3(0.0, to_ndc.y, 0.0));
+    surface_uv_dx = wx.x * tri_uv[i][0] + wx.y * tri_uv[i][1] + wx.z * tri_uv[i][2] - uv;
+    surface_uv_dy = wy.x * tri_uv[i][0] + wy.y * tri_uv[i][1] + wy.z * tri_uv[i][2] - uv;
+    vec3 n = w.x * tri_normal[i][0] + w.y * tri_normal[i][1] + w.z * tri_normal[i][2];
+    vec4 tangent = w.x * tri_tangent[i][0] + w.y * tri_tangent[i][1] + w.z * tri_tangent[i][2];
+    bool front = (tri_object[i].y & TRIANGLE_FRONT) != 0u;
+    Surface sf = surface_at(front ? n : -n, tangent, uv, tri_object[i].z, tri_material[i]);
+    return pack_layer_surface(sf.normal, vec4(sf.albedo_factor, sf.occlusion), sf.roughness_metallic, min(alpha, 1.0), sf.emissive_factor);
+}
+
+// Whether triangle `slot` leaves a fragment at pixel `p` in front of the opaque depth (the
+// opaque depth read only where it may cover the pixel: most of a box lies outside it;
+// layer_fragment decides exactly).
+bool pixel_fragment(uint slot, ivec2 p, vec2 to_ndc) {
+    vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0), w;
+    float depth, alpha;
+    vec3 e = vec3(dot(tri_edges[slot][0], q), dot(tri_edges[slot][1], q), dot(tri_edges[slot][2], q));
+    return all(greaterThanEqual(e, vec3(0.0))) && layer_fragment(slot, q, opaque_depth_at(p), w, depth, alpha);
+}
+
+// Keep pixel `p`'s fragment of triangle `slot`, which pixel_fragment found, in node `node`
+// (dropped where the pool is full), linked in front of its pixel's list by an atomic
+// exchange of the head. Its barycentrics, depth and coverage found again (not kept from the
+// test: registers), its existence not: the writes follow the test's bits, so they take
+// exactly the room counted.
+void keep_fragment(uint slot, ivec2 p, uint node, uint capacity, vec2 to_ndc) {
+    vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0), w;
+    float depth, alpha;
+    layer_fragment(slot, q, opaque_depth_at(p), w, depth, alpha);
+    if (node < capacity) {
+        uint next = atomicExchange(layer_heads[layer_pixel(p)], node);
+        write_layer(node, p, depth, next, tri_object[slot].x, layer_surface(slot, q, w, alpha, to_ndc));
+    }
+}
+
+// The work group's room in the pool: `mine` nodes for this thread, the first returned. One
+// atomic on the pool's counter a work group (its fragments one atomic each would wait on
+// each other on that one counter). Every thread of the work group calls it.
+shared uint group_nodes;
+shared uint group_first_node;
+uint take_nodes(uint mine) {
+    if (gl_LocalInvocationIndex == 0u) {
+        group_nodes = 0u;
+    }
+    barrier();
+    uint before = subgroupExclusiveAdd(mine), total = subgroupAdd(mine);
+    uint base = 0u;
+    if (subgroupElect() && total > 0u) {
+        base = atomicAdd(group_nodes, total);
+    }
+    base = subgroupBroadcastFirst(base);
+    barrier();
+    if (gl_LocalInvocationIndex == 0u && group_nodes > 0u) {
+        group_first_node = atomicAdd(layer_counts.x, group_nodes);
+    }
+    barrier();
+    return group_first_node + base + before;
+}
+
+#endif
