@@ -10,7 +10,7 @@ use clap::error::ErrorKind;
 use clap::{Args, CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
-use ml_cpu::lights::{LightLayout, RadiusRange};
+use ml_cpu::lights::{LightColors, LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
@@ -186,6 +186,11 @@ struct SceneArgs {
     /// of the bench scene's lights.
     #[arg(long, default_value_t = 1, value_parser = Whole::<u64>::new(0, u64::MAX), allow_negative_numbers = true)]
     light_seed: u64,
+    /// Colours of the lights placed by layout: palette (the seed's red, green, blue and yellow)
+    /// or white (near-white: warm, neutral and cool, which show a model's materials). Default:
+    /// palette in the seed scene, white in a scene or glTF file.
+    #[arg(long)]
+    light_colors: Option<String>,
     /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene; in
     /// a scene or glTF file the radius at which about 4 lights reach a point of the scene, from
     /// its box and the light count.
@@ -469,6 +474,7 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         aspect: args.width.max(1) as f32 / args.height.max(1) as f32,
         transparent_percent: args.transparent_objects,
         glass_layers: args.glass_layers,
+        light_colors: args.light_colors.as_deref().map(LightColors::from_name).transpose()?,
     })
 }
 
@@ -629,6 +635,14 @@ impl ml_render::FrameSink for RenderSink {
     }
 }
 
+/// The scene's camera as `--camera` reads it (a user starts from it), its target the point
+/// ahead nearest the middle of the scene's box.
+fn camera_line(scene: &ml_cpu::scene::Scene) -> String {
+    let (lo, hi) = scene.bounds();
+    let ahead = ((lo + hi) * 0.5 - scene.camera.position).dot(scene.camera.forward());
+    ml_cpu::camera::CameraSpec::describe(&scene.camera, if ahead > 0.0 { ahead } else { 1.0 })
+}
+
 fn render(cmd: &RenderArgs) -> Result<()> {
     let args = &cmd.scene;
     let choice = auto::technique_choice(&args.technique)?;
@@ -660,6 +674,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
+    let camera = camera_line(&built.scene);
     let mut sink = RenderSink {
         progress: Progress::new(u64::from(settings.frames) + u64::from(cmd.warmup), "frames"),
         sequence,
@@ -687,6 +702,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         raster_auto: raster_why.as_deref(),
         output: &cmd.out,
         supersample: cmd.supersample,
+        camera: &camera,
     };
     print!("{}", tables::table(&tables::render_rows(&facts, &output.stats)));
     if let Some(warning) = output.stats.feature::<ml_render::TransparencyStats>().and_then(|t| t.overflow_warning()) {

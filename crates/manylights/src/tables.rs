@@ -37,6 +37,8 @@ pub struct RenderFacts<'a> {
     pub output: &'a Path,
     /// `--supersample`: the image rendered this many times wider and taller, filtered down.
     pub supersample: u32,
+    /// The camera it was seen from, as `--camera` reads it.
+    pub camera: &'a str,
 }
 
 /// Who drew the visibility buffer, in words.
@@ -63,6 +65,7 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         ("shading", settings.shading.name().to_owned()),
         ("lights", facts.lights.to_string()),
         ("frames", stats.frames.to_string()),
+        ("camera", format!("--camera {}", facts.camera)),
     ];
     if let Some(why) = facts.auto {
         rows.push(("auto", why.to_owned()));
@@ -235,6 +238,7 @@ mod tests {
             raster_auto: None,
             output: Path::new("a.png"),
             supersample: 1,
+            camera: "0,1,2:0,0,0:60",
         };
         let mut stats = FrameStats::new(&["g-buffer + lighting"]);
         stats.frames = 1;
@@ -250,6 +254,7 @@ mod tests {
                 "shading",
                 "lights",
                 "frames",
+                "camera",
                 "gpu ms",
                 "g-buffer",
                 "cpu ms/frame",

@@ -1,5 +1,6 @@
 //! The framing camera (docs/scenes.md#the-framing-camera): the camera that shows a whole model
-//! in an image of a given aspect, from above and in front, as close as the image allows. Scene
+//! in an image of a given aspect, in a three-quarter view from above its front, as close as
+//! the image allows but never inside, or just in front of, the model's box. Scene
 //! files and glTF files without a camera of their own are seen from it, and the viewer's F key
 //! frames the scene again with it. Apart from camera.rs because it reads a scene's vertices:
 //! a scene holds a camera, so camera.rs takes no scene.
@@ -25,17 +26,27 @@ pub const FRAME_FILL: f32 = 0.8;
 /// perspective's lopsided projection never cuts a model at the border.
 pub const FRAME_REACH: f32 = 0.95;
 
-/// Where a framing camera stands as seen from its target: above and in front (+Y, +Z).
+/// Where a framing camera stands as seen from its target: a three-quarter view from above the
+/// model's front (glTF's front is +Z): 30° round towards +X, 25° up. Off every axis, so that a
+/// model built along one (a barrel, a boom, a deer's length) is not seen end on.
 pub fn framing_direction() -> Vec3 {
-    Vec3::new(0.0, 0.5, 1.0).normalize()
+    let (yaw, pitch) = (30f32.to_radians(), 25f32.to_radians());
+    Vec3::new(yaw.sin() * pitch.cos(), pitch.sin(), yaw.cos() * pitch.cos())
 }
 
-/// A camera of `fov_y_deg` looking at the middle of `points`' box from above and in front
-/// (`framing_direction`), as close as it may stand for an image of `aspect` (width / height):
-/// the points' projections span FRAME_FILL of the image's width or height, whichever binds
-/// first, and none lies beyond FRAME_REACH of its centre. The distance is found by bisection
-/// (both measures shrink as the camera backs away); the near plane is half the camera's
-/// distance to the points' box, the far plane past its far corner (`clip_planes_to_box`).
+/// How far in front of the model's box (along the framing direction, from the box's farthest
+/// reach that way) a framing camera stands at least, in radii of the box's bounding sphere: a
+/// part of the model reaching toward the camera (a boom, a barrel) then stays that far away,
+/// and the camera never stands inside the model's bounds.
+pub const MIN_CLEARANCE_RADII: f32 = 0.1;
+
+/// A camera of `fov_y_deg` looking at the middle of `points`' box along `framing_direction`, as
+/// close as it may stand for an image of `aspect` (width / height): the points' projections
+/// span FRAME_FILL of the image's width or height, whichever binds first, and none lies beyond
+/// FRAME_REACH of its centre — but MIN_CLEARANCE_RADII of its bounding sphere in front of the
+/// box at least. The distance is found by bisection (both measures shrink as the camera
+/// backs away); the near plane is half the camera's distance to the points' box, the far plane
+/// past its far corner (`clip_planes_to_box`).
 pub fn frame_points(points: &[Vec3], aspect: f32, fov_y_deg: f32) -> Camera {
     let (lo, hi) = points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     let (lo, hi) = if points.is_empty() { (Vec3::splat(-1.0), Vec3::ONE) } else { (lo, hi) };
@@ -120,6 +131,10 @@ pub fn frame_points(points: &[Vec3], aspect: f32, fov_y_deg: f32) -> Camera {
             break;
         }
     }
+    // Never closer than MIN_CLEARANCE_RADII in front of the box: backing away keeps the fit
+    // (both measures shrink).
+    let reach = ((hi - lo) * 0.5).dot(back.abs());
+    let d = d.max(reach + radius * MIN_CLEARANCE_RADII);
     let position = centre + right * shift.x + up * shift.y + back * d;
     let (near, far) = clip_planes_to_box(lo, hi, position);
     Camera::looking_at(position, position - back * d, fov_y_deg, near, far)
@@ -205,7 +220,12 @@ mod tests {
                         let (x0, x1, y0, y1) = projected(&camera, &corners, aspect);
                         let fill = (x1 - x0).max(y1 - y0) * 0.5;
                         let what = format!("{lo}..{hi} at {aspect:.2}, {fov}°: x {x0:.3}..{x1:.3}, y {y0:.3}..{y1:.3}");
-                        assert!((0.7..=FRAME_FILL + 1e-3).contains(&fill), "{what}: fills {fill}");
+                        // Filled as the image allows, or as close as the camera may stand.
+                        let radius = (hi - lo).length() * 0.5;
+                        let along = (camera.position - (lo + hi) * 0.5).dot(framing_direction());
+                        let reach = ((hi - lo) * 0.5).dot(framing_direction().abs());
+                        let closest = along <= (reach + radius * MIN_CLEARANCE_RADII) * 1.01;
+                        assert!(fill <= FRAME_FILL + 1e-3 && (fill >= 0.7 || closest), "{what}: fills {fill}");
                         assert!([x0, x1, y0, y1].iter().all(|v| v.abs() <= FRAME_REACH + 1e-3), "{what}");
                         let vp = camera.projection(aspect) * camera.view();
                         for c in &corners {
@@ -232,5 +252,34 @@ mod tests {
         assert!(y1 - y0 > x1 - x0, "a cube in a wide image: the height binds");
         let tall = frame_box(lo, hi, 9.0 / 16.0, 60.0);
         assert!(tall.position.distance(Vec3::ZERO) > wide.position.distance(Vec3::ZERO), "a tall image stands further back");
+    }
+
+    /// A model with a long thin part (a space probe's boom) pointing straight at where the
+    /// camera stands: framed whole, the camera outside the model's box and MIN_CLEARANCE_RADII
+    /// from every point of it, the body a fair part of the image.
+    #[test]
+    fn a_boom_pointing_at_the_camera_does_not_pull_it_in() {
+        let radius_of = |points: &[Vec3]| {
+            let (lo, hi) = points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+            ((lo, hi), (hi - lo).length() * 0.5)
+        };
+        let body: Vec<Vec3> = (0..8).map(|i| Vec3::new([-1.0, 1.0][i & 1], [-0.6, 0.6][(i >> 1) & 1], [-0.8, 0.8][(i >> 2) & 1])).collect();
+        for fov in [40.0, 60.0, 90.0] {
+            // The boom: a thin line of points from the body toward the camera, 6 long.
+            let mut points = body.clone();
+            points.extend((1..=60).map(|k| framing_direction() * (0.1 * k as f32)));
+            let ((lo, hi), radius) = radius_of(&points);
+            let camera = frame_points(&points, 16.0 / 9.0, fov);
+            let inside = camera.position.cmpge(lo).all() && camera.position.cmple(hi).all();
+            assert!(!inside, "fov {fov}: the camera {} stands inside the model's box", camera.position);
+            let nearest = points.iter().map(|p| p.distance(camera.position)).fold(f32::MAX, f32::min);
+            assert!(nearest >= MIN_CLEARANCE_RADII * radius * 0.99, "fov {fov}: the camera is {nearest} from the model (radius {radius})");
+            let (x0, x1, y0, y1) = projected(&camera, &points, 16.0 / 9.0);
+            assert!([x0, x1, y0, y1].iter().all(|v| v.abs() <= FRAME_REACH + 1e-3), "fov {fov}: cut at the border");
+            let (bx0, bx1, by0, by1) = projected(&camera, &body, 16.0 / 9.0);
+            let body_fill = (bx1 - bx0).max(by1 - by0) * 0.5;
+            println!("fov {fov}: nearest point {nearest:.2} (radius {radius:.2}), body fills {body_fill:.2}");
+            assert!(body_fill > 0.1, "fov {fov}: the body is a speck ({body_fill})");
+        }
     }
 }

@@ -15,6 +15,52 @@ use std::f32::consts::TAU;
 /// The seed's light colours, cycled by index.
 pub const SEED_COLORS: [[f32; 3]; 4] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.0]];
 
+/// The near-white colours of a file's default lights, cycled by index: warm, neutral and
+/// cool whites (a little variety, no tint: their mean is grey), so that a model shows its
+/// materials' own colours.
+pub const WHITE_COLORS: [[f32; 3]; 3] = [[1.0, 0.93, 0.85], [0.96, 0.96, 0.96], [0.88, 0.94, 1.0]];
+
+/// What colours placed lights get.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightColors {
+    /// The seed's saturated red, green, blue and yellow (`SEED_COLORS`): the seed scene's.
+    Palette,
+    /// Near-white (`WHITE_COLORS`): scene and glTF files' default, which shows materials.
+    White,
+}
+
+impl LightColors {
+    pub const ALL: [LightColors; 2] = [LightColors::Palette, LightColors::White];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            LightColors::Palette => "palette",
+            LightColors::White => "white",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<LightColors, SceneError> {
+        crate::error::find_named("light colours", &LightColors::ALL, LightColors::name, name)
+    }
+
+    /// Light `i`'s colour.
+    pub fn color(self, i: usize) -> [f32; 3] {
+        match self {
+            LightColors::Palette => SEED_COLORS[i % SEED_COLORS.len()],
+            LightColors::White => WHITE_COLORS[i % WHITE_COLORS.len()],
+        }
+    }
+
+    /// `lights` coloured so, by index (their own strength kept: each colour's largest
+    /// channel is 1, as the palette's are).
+    pub fn paint(self, lights: &mut [PointLight]) {
+        for (i, l) in lights.iter_mut().enumerate() {
+            let c = self.color(i);
+            l.color = [c[0], c[1], c[2], l.color[3]];
+        }
+    }
+}
+
 /// Half-size of the seed grid in x and z, and its height above the objects.
 pub const GRID_HALF_SIZE: f32 = 15.0;
 pub const GRID_HEIGHT: f32 = 7.5;
@@ -106,6 +152,10 @@ pub struct LightFrame {
     pub grid_floor: f32,
     pub box_min: Vec3,
     pub box_max: Vec3,
+    /// Whether grid lights are moved off their places at random within their cells (a fitted
+    /// frame's: a regular lattice of many lights prints a pattern of dots or stripes on every
+    /// surface; the built-in frame keeps the seed's exact grid).
+    pub jittered: bool,
 }
 
 /// How a grid of some count is laid out: `layers` layers (the first at the grid's height, the
@@ -153,6 +203,7 @@ impl LightFrame {
         grid_floor: GRID_HEIGHT,
         box_min: RANDOM_BOX_MIN,
         box_max: RANDOM_BOX_MAX,
+        jittered: false,
     };
 
     /// The frame fitted to a scene's box [lo, hi]: the grid a little wider than the scene's
@@ -170,6 +221,7 @@ impl LightFrame {
             grid_floor: (centre - half).y,
             box_min: centre - half,
             box_max: centre + half,
+            jittered: true,
         }
     }
 
@@ -299,6 +351,8 @@ impl LightParams {
             (_, surfaces) => surfaces,
         };
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(self.seed);
+        // The grid's jitter draws from its own sequence: the radii stay those of the exact grid.
+        let mut jitter = rand_chacha::ChaCha8Rng::seed_from_u64(self.seed ^ 0x6a17);
         let mut lights = Vec::with_capacity(n);
         let grid = frame.grid_shape(self.count);
         let (lo, hi, half) = (frame.box_min, frame.box_max, frame.grid_half_size);
@@ -312,7 +366,23 @@ impl LightParams {
                     let (layer, place) = (i / (side * side), i % (side * side));
                     let offset =
                         Vec3::new(origin + (place % side) as f32 * step, -(layer as f32) * rise, origin + (place / side) as f32 * step);
-                    (frame.grid_centre + offset, Vec3::ZERO)
+                    // Anywhere in the light's cell (half a step each way; layers half a rise,
+                    // not above the grid nor below its floor).
+                    let moved = if frame.jittered {
+                        let mut within = |extent: f32| if extent > 0.0 { jitter.random_range(-0.5..0.5) * extent } else { 0.0 };
+                        let (x, z, y) = (within(step), within(step), within(rise));
+                        let y = if layer == 0 {
+                            -y.abs()
+                        } else if layer + 1 == grid.layers {
+                            y.abs()
+                        } else {
+                            y
+                        };
+                        Vec3::new(x, y, z)
+                    } else {
+                        Vec3::ZERO
+                    };
+                    (frame.grid_centre + offset + moved, Vec3::ZERO)
                 }
                 (LightLayout::Surface, Some(surfaces)) => surfaces.sample(&mut rng),
                 _ => (Vec3::new(rng.random_range(lo.x..=hi.x), rng.random_range(lo.y..=hi.y), rng.random_range(lo.z..=hi.z)), Vec3::ZERO),

@@ -6,7 +6,7 @@ use crate::bench_scene::bench_scene;
 use crate::camera::CameraSpec;
 use crate::framing::{frame_scene, DEFAULT_ASPECT};
 use crate::gltf_scene::{self, GltfFileError};
-use crate::lights::{LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_RADIUS};
+use crate::lights::{LightColors, LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::Scene;
@@ -65,6 +65,9 @@ pub struct SceneRequest {
     pub transparent_percent: u32,
     /// Panes of glass added across the whole view (`transparency::add_glass_layers`).
     pub glass_layers: u32,
+    /// Colours of the lights placed by layout; None: the seed scene's palette, near-white in
+    /// a file (`LightColors`).
+    pub light_colors: Option<LightColors>,
 }
 
 /// A built scene and the shading model to render it with.
@@ -121,6 +124,7 @@ impl SceneRequest {
             aspect: DEFAULT_ASPECT,
             transparent_percent: 0,
             glass_layers: 0,
+            light_colors: None,
         }
     }
 
@@ -163,7 +167,8 @@ impl SceneRequest {
                 Ok(built(bench_scene(count, self.seed, *objects)?))
             }
             SceneSource::Seed { object, material } => {
-                let scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS), |_| Ok(SEED_RADIUS))?)?;
+                let mut scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS), |_| Ok(SEED_RADIUS))?)?;
+                self.light_colors.unwrap_or(LightColors::Palette).paint(&mut scene.lights);
                 Ok(built(if model == ShadingModel::BlinnPhong { scene.with_floor() } else { scene }))
             }
             SceneSource::File(path) => self.build_file(path),
@@ -201,6 +206,7 @@ impl SceneRequest {
                 other => other.into(),
             })?;
             scene.lights = params.build_in(&frame, surfaces.as_ref())?;
+            self.light_colors.unwrap_or(LightColors::White).paint(&mut scene.lights);
             scene.light_motion = frame.motion();
             // The file's spot cones belonged to its own lights.
             scene.cones.clear();
@@ -269,9 +275,12 @@ mod tests {
         let rig = SceneWarning::DefaultRig { path: dir.join("dark.toml"), lights: 64, layout: LightLayout::Grid, radius };
         assert_eq!(built.warnings, [rig]);
         assert_eq!(built.scene.lights.len(), 64);
-        // The grid's first layer hangs over the sphere, the others reach down through its box.
-        assert_eq!(built.scene.lights[0].position_radius[1], 1.5);
+        // The grid's first layer hangs over the sphere, the others reach down through its box,
+        // each light moved about within its cell (never above the grid), near-white.
+        let top = built.scene.lights.iter().map(|l| l.position_radius[1]).fold(f32::MIN, f32::max);
+        assert!(top > 1.2 && top <= 1.5, "{top}");
         assert!(built.scene.lights.iter().all(|l| l.position_radius[1] <= 1.5 && l.position_radius[3] == radius));
+        assert!(built.scene.lights.iter().all(|l| l.color[..3].iter().all(|&c| c > 0.8)), "near-white lights");
         // Framed for a default-sized image; asked for another aspect, framed for that one.
         let framed = crate::framing::frame_scene(&built.scene, DEFAULT_ASPECT, 60.0);
         assert_eq!(built.scene.camera, framed);

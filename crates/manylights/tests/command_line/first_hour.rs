@@ -177,3 +177,53 @@ fn files_are_exposed_automatically_and_built_in_scenes_on_request() {
     assert!(!metered(&render(&[])), "the seed scene keeps EV 0");
     assert!(metered(&render(&["--exposure", "auto", "--shading", "blinn-phong"])), "--exposure auto meters the seed scene");
 }
+
+/// A white matte model without lights: the default rig's near-white lights show it white
+/// (mean saturation of its pixels at most 0.15; the seed's palette, asked for, tints it), and
+/// the table's `camera` row, given back as `--camera`, shows the same image.
+#[test]
+fn a_white_model_without_lights_renders_white_and_its_camera_row_is_ready_to_use() {
+    use ml_cpu::gltf_writer::{quad, GltfWriter, PrimitiveData};
+    let dir = temp_dir("white");
+    let model = dir.join("white.glb");
+    let mut w = GltfWriter::new();
+    let white = w.material([1.0, 1.0, 1.0, 1.0], 0.0, 1.0);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(white), ..quad() }]);
+    w.node(serde_json::json!({ "mesh": mesh }), true);
+    std::fs::write(&model, w.to_glb()).unwrap();
+    let render = |out: &Path, extra: &[&str]| {
+        let mut args =
+            vec!["render", "--validation", "--technique", "forward", "--scene", model.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        args.extend(SIZE);
+        args.extend(extra);
+        let out = manylights(&args);
+        ok(&out);
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    // Mean saturation of the pixels the model covers (brighter than the background).
+    let saturation = |path: &Path| {
+        let (mut sum, mut n) = (0.0, 0);
+        for p in pixels(path).pixels() {
+            let (max, min) = (p[0].max(p[1]).max(p[2]) as f32, p[0].min(p[1]).min(p[2]) as f32);
+            if max > 40.0 {
+                sum += (max - min) / max;
+                n += 1;
+            }
+        }
+        assert!(n > 500, "{}: the model covers only {n} pixels", path.display());
+        sum / n as f32
+    };
+    let (plain, palette, again) = (dir.join("plain.png"), dir.join("palette.png"), dir.join("again.png"));
+    let table = render(&plain, &[]);
+    render(&palette, &["--light-colors", "palette"]);
+    let (white, tinted) = (saturation(&plain), saturation(&palette));
+    println!("mean saturation: {white:.3} with the default rig, {tinted:.3} with the palette");
+    assert!(white <= 0.15, "the default rig tints a white model: mean saturation {white}");
+    assert!(tinted > 0.15, "the palette does not tint: {tinted}");
+    let camera = table.lines().find_map(|l| l.strip_prefix("camera")).map(str::trim).expect("a camera row");
+    let spec = camera.strip_prefix("--camera ").unwrap_or_else(|| panic!("not an option: {camera}"));
+    render(&again, &["--camera", spec]);
+    let (a, b) = (pixels(&plain), pixels(&again));
+    let worst = a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap()).max().unwrap();
+    assert!(worst <= 1, "--camera {spec} shows another image (by {worst}/255)");
+}
