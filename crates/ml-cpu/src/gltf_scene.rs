@@ -262,6 +262,9 @@ pub enum GltfError {
     /// An image whose format cannot be told.
     #[error("{0}")]
     ImageFormat(std::io::Error),
+    /// An image in a container manylights does not read (KTX, KTX2, DDS), named.
+    #[error("it is a {0} image, which manylights does not read (PNG and JPEG only)")]
+    ImageContainer(&'static str),
     #[error("cannot decode it: {0}")]
     Decode(image::ImageError),
     #[error("a directional light needs a usable node direction and a colour × intensity in [0, {}]", Number(MAX_INTENSITY))]
@@ -291,6 +294,54 @@ impl GltfError {
     fn within(self, part: Part) -> GltfError {
         GltfError::In { part, problem: Box::new(self) }
     }
+
+    /// Where a texture's image is missing or of a format manylights does not read (what a
+    /// viewer shows with a stand-in and a warning), why, in words; None for anything else —
+    /// a file not let read, bytes of no image format, malformed data —, which refuses the
+    /// model.
+    fn left_out_because(&self) -> Option<String> {
+        match self {
+            GltfError::In { problem, .. } => problem.left_out_because(),
+            GltfError::External { reference, problem: ReferenceError::Read(ReadError::Io(e)) }
+                if e.kind() == std::io::ErrorKind::NotFound =>
+            {
+                Some(format!("its file '{reference}' does not exist"))
+            }
+            GltfError::ImageContainer(_) => Some(self.to_string()),
+            // A format the decoder knows but was not built to read (bytes of no format are
+            // malformed, and refused).
+            GltfError::Decode(image::ImageError::Unsupported(e)) if e.format_hint() != image::error::ImageFormatHint::Unknown => {
+                Some(format!("its format is not one manylights reads ({self})"))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// What the file animates or deforms, which manylights draws still: skins (the meshes in
+/// their bind pose), animations, morph targets (the base shape), one warning each.
+fn motion_left_out(doc: &gltf::Document) -> Vec<String> {
+    let mut left = Vec::new();
+    let skins = doc.skins().count();
+    if skins > 0 {
+        left.push(format!("{skins} skin(s) are not applied: skinned meshes are drawn in their bind pose"));
+    }
+    let animations = doc.animations().count();
+    if animations > 0 {
+        left.push(format!("{animations} animation(s) are not played: the scene is drawn as the file places it"));
+    }
+    let morphed = doc.meshes().filter(|m| m.primitives().any(|p| p.morph_targets().next().is_some())).count();
+    if morphed > 0 {
+        left.push(format!("the morph targets of {morphed} mesh(es) are not applied: they are drawn in their base shape"));
+    }
+    left
+}
+
+/// The containers of GPU texture formats, by their first bytes: read by no decoder here.
+fn image_container(bytes: &[u8]) -> Option<&'static str> {
+    const KINDS: [(&[u8], &str); 4] =
+        [(b"\xABKTX 20\xBB", "KTX2"), (b"\xABKTX 11\xBB", "KTX"), (b"DDS ", "DDS"), (b"sB", "Basis Universal")];
+    KINDS.iter().find(|(magic, _)| bytes.starts_with(magic)).map(|&(_, name)| name)
 }
 
 /// The first three validation errors, and how many more there are.
@@ -340,6 +391,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         warnings: unread.into_iter().map(|e| format!("extension {e} is not supported; the file is read without it")).collect(),
         mixed_transforms: Default::default(),
     };
+    builder.warnings.extend(motion_left_out(&gltf.document));
     let parents = node_parents(&gltf.document)?;
     let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(scene) => {
@@ -811,7 +863,18 @@ impl Builder<'_> {
             if set != 0 {
                 self.warnings.push(format!("material {name}: the {what} texture names TEXCOORD_{set}; TEXCOORD_0 is used"));
             }
-            self.texture(&texture, srgb).map(Some).map_err(|e| e.within(Part::Texture { material: name.0, slot: what }))
+            match self.texture(&texture, srgb) {
+                Ok(slot) => Ok(Some(slot)),
+                // Missing or unreadable: drawn without it (its factor alone), as a viewer does.
+                Err(e) => match e.left_out_because() {
+                    Some(why) => {
+                        let image = texture.source().index();
+                        self.warnings.push(format!("material {name}: the {what} texture (image {image}) is left out: {why}"));
+                        Ok(None)
+                    }
+                    None => Err(e.within(Part::Texture { material: name.0, slot: what })),
+                },
+            }
         };
         Ok(ObjectTextures {
             base_color: slot("base colour", base_color, true)?,
@@ -857,6 +920,9 @@ impl Builder<'_> {
         // (A file is capped as it is read; a data URI or a buffer view only here.)
         if bytes.len() as u64 > MAX_IMAGE_BYTES {
             return Err(GltfError::ImageTooLarge(bytes.len()));
+        }
+        if let Some(container) = image_container(&bytes) {
+            return Err(GltfError::ImageContainer(container));
         }
         decode_image(&bytes, srgb)
     }

@@ -85,7 +85,9 @@ impl GltfWriter {
         self.push("accessors", a)
     }
 
-    fn floats<const N: usize>(&mut self, values: &[[f32; N]], kind: &str, min_max: bool) -> usize {
+    /// An accessor of float `values` ("SCALAR", "VEC2", …), with min and max where asked
+    /// (POSITION and animation inputs need them); returns its index.
+    pub fn floats<const N: usize>(&mut self, values: &[[f32; N]], kind: &str, min_max: bool) -> usize {
         let bytes = values.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
         let extra = if min_max {
             let lo: Vec<f32> = (0..N).map(|k| values.iter().map(|v| v[k]).fold(f32::MAX, f32::min)).collect();

@@ -227,3 +227,34 @@ fn a_white_model_without_lights_renders_white_and_its_camera_row_is_ready_to_use
     let worst = a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap()).max().unwrap();
     assert!(worst <= 1, "--camera {spec} shows another image (by {worst}/255)");
 }
+
+/// A model with a texture file missing, a KTX2 texture and a skin renders, each named in a
+/// warning (a viewer shows such a model with stand-ins).
+#[test]
+fn a_model_with_missing_and_ktx_textures_and_a_skin_renders_and_says_what_is_left_out() {
+    use ml_cpu::gltf_writer::{quad, GltfWriter, PrimitiveData};
+    let dir = temp_dir("left-out");
+    let mut w = GltfWriter::new();
+    let ktx = w.texture(b"\xABKTX 20\xBB\r\n\x1A\n0000".to_vec(), "image/ktx2");
+    let missing = w.texture(vec![0; 4], "image/png");
+    w.json["images"][missing] = serde_json::json!({ "uri": "textures/gone.png" });
+    let m = w.textured_material(Some(ktx), Some(missing));
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(serde_json::json!({ "mesh": mesh, "skin": 0 }), true);
+    w.json["skins"] = serde_json::json!([{ "joints": [0] }]);
+    let model = dir.join("left-out.gltf");
+    std::fs::write(&model, w.to_gltf()).unwrap();
+    let out = dir.join("left-out.png");
+    let mut args =
+        vec!["render", "--validation", "--technique", "forward", "--scene", model.to_str().unwrap(), "--out", out.to_str().unwrap()];
+    args.extend(SIZE);
+    let stderr = ok(&manylights(&args));
+    for said in [
+        "the base colour texture (image 0) is left out: it is a KTX2 image",
+        "the normal texture (image 1) is left out: its file 'textures/gone.png' does not exist",
+        "1 skin(s) are not applied",
+    ] {
+        assert!(stderr.contains(said), "'{said}' not in:\n{stderr}");
+    }
+    assert!(pixels(&out).pixels().any(|p| p[0].max(p[1]).max(p[2]) > 40), "nothing drawn");
+}

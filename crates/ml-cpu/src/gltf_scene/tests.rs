@@ -528,3 +528,61 @@ fn shared_children_are_refused_at_once_and_later_minor_versions_read() {
     w.json["asset"] = json!({ "version": "2.1", "minVersion": "2.0" });
     from_bytes(&w.to_gltf(), None).unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// What a viewer draws with a stand-in is drawn without it, and said: a texture whose file is
+/// missing, KTX2, KTX and DDS images (named); skins,
+/// animations and morph targets are not applied and each warns. An image of no format, a
+/// broken PNG and a texture not let read (outside the folder) still refuse the model.
+#[test]
+fn missing_and_unreadable_textures_are_left_out_with_a_warning_and_motion_warns() {
+    let d = std::env::temp_dir().join(format!("ml-gltf-left-out-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let loaded = |bytes: Vec<u8>| from_bytes(&bytes, Some(&d)).unwrap_or_else(|e| panic!("{e}"));
+    let (scene, warnings) = loaded(textured_by_uri("gone.png"));
+    assert_eq!(scene.objects.len(), 1);
+    assert_eq!(scene.objects[0].textures.base_color, None, "drawn with its factor alone");
+    assert!(
+        warnings.iter().any(|w| w.contains("base colour texture (image 0) is left out: its file 'gone.png' does not exist")),
+        "{warnings:?}"
+    );
+    for (bytes, name) in [
+        (b"\xABKTX 20\xBB\r\n\x1A\n....".to_vec(), "KTX2"),
+        (b"\xABKTX 11\xBB\r\n\x1A\n....".to_vec(), "KTX"),
+        (b"DDS |....".to_vec(), "DDS"),
+    ] {
+        let mut w = GltfWriter::new();
+        let t = w.texture(bytes, "image/ktx2");
+        let m = w.textured_material(Some(t), None);
+        let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+        w.node(json!({ "mesh": mesh }), true);
+        let (scene, warnings) = loaded(w.to_glb());
+        assert!(scene.textures.is_empty(), "{name}");
+        let said = format!("is left out: it is a {name} image, which manylights does not read");
+        assert!(warnings.iter().any(|w| w.contains(&said)), "{name}: {warnings:?}");
+    }
+    // Bytes of no image format, broken data of a known one, and a file outside the folder
+    // refuse the model.
+    std::fs::write(d.join("noise.png"), b"not an image at all").unwrap();
+    assert!(from_bytes(&textured_by_uri("noise.png"), Some(&d)).unwrap_err().to_string().contains("could not be determined"));
+    let mut broken = png(2, 2, &[255; 16]);
+    broken.truncate(broken.len() - 20);
+    std::fs::write(d.join("broken.png"), broken).unwrap();
+    assert!(from_bytes(&textured_by_uri("broken.png"), Some(&d)).is_err());
+    assert!(from_bytes(&textured_by_uri("../outside.png"), Some(&d)).unwrap_err().to_string().contains("leads out of the folder"));
+    // A skin on the node, an animation of it, a morph target on the mesh.
+    let mut w = quad_writer();
+    let times = w.floats(&[[0.0f32], [1.0]], "SCALAR", true);
+    let moves = w.floats(&[[0.0f32, 0.0, 0.0], [0.0, 1.0, 0.0]], "VEC3", false);
+    w.json["skins"] = json!([{ "joints": [0] }]);
+    w.json["nodes"][0]["skin"] = json!(0);
+    w.json["animations"] = json!([{
+        "samplers": [{ "input": times, "output": moves }],
+        "channels": [{ "sampler": 0, "target": { "node": 0, "path": "translation" } }]
+    }]);
+    let offsets = w.floats(&[[0.0f32, 0.1, 0.0]; 4], "VEC3", false);
+    w.json["meshes"][0]["primitives"][0]["targets"] = json!([{ "POSITION": offsets }]);
+    let (_, warnings) = loaded(w.to_glb());
+    for said in ["1 skin(s) are not applied", "1 animation(s) are not played", "morph targets of 1 mesh(es) are not applied"] {
+        assert!(warnings.iter().any(|w| w.contains(said)), "{said}: {warnings:?}");
+    }
+}
