@@ -191,7 +191,7 @@ fn parse_count(text: &str) -> Result<u64> {
 
 /// `--resolution WxH`, each side 1 to MAX_DIMENSION (the device may allow less: checked once
 /// it is known).
-fn parse_resolution(text: &str) -> Result<(u32, u32)> {
+pub(crate) fn parse_resolution(text: &str) -> Result<(u32, u32)> {
     let (w, h) = text.split_once('x').with_context(|| format!("--resolution '{text}': expected WxH, e.g. 1920x1080"))?;
     let max = ml_render::settings::MAX_DIMENSION;
     let side = |s: &str| s.trim().parse::<u32>().ok().filter(|n| (1..=max).contains(n));

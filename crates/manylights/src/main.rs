@@ -191,9 +191,9 @@ struct SceneArgs {
     /// palette in the seed scene, white in a scene or glTF file.
     #[arg(long)]
     light_colors: Option<String>,
-    /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene; in
-    /// a scene or glTF file the radius at which about 4 lights reach a point of the scene, from
-    /// its box and the light count.
+    /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene up to
+    /// its 64 lights (beyond, one that follows the count); in a scene or glTF file the radius at
+    /// which about 4 lights reach a point of the scene, from its box and the light count.
     #[arg(long)]
     light_radius: Option<String>,
     /// Point-light shadows: off; through cube maps, rendered by copy (each face offscreen,
@@ -242,6 +242,9 @@ struct SceneArgs {
     /// Image height in pixels (1 to 16384, and at most the device's largest image).
     #[arg(long, default_value_t = 720, value_parser = SIDE, allow_negative_numbers = true)]
     height: u32,
+    /// Image size WxH (e.g. 1920x1080), as bench spells it: the same as --width W --height H.
+    #[arg(long, conflicts_with_all = ["width", "height"])]
+    resolution: Option<String>,
     /// The camera: eye position, the point it looks at and its vertical field of view in
     /// degrees (60 where left out), as EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV]; its
     /// near and far planes fit the scene. The viewer's C key prints its camera in this form.
@@ -360,7 +363,14 @@ impl<T: TryFrom<u64> + Clone + Send + Sync + 'static> clap::builder::TypedValueP
             let range = self.range.map_or_else(|| format!("{} to {}", self.min, self.max), str::to_owned);
             refuse(format!("{text} is out of range: use {range}"))
         };
-        match text.trim().parse::<i128>() {
+        // `16k` and `1M` as bench's light counts are spelt (thousands, millions).
+        let trimmed = text.trim();
+        let (digits, factor) = match trimmed.char_indices().last() {
+            Some((i, 'k' | 'K')) => (&trimmed[..i], 1_000),
+            Some((i, 'M')) => (&trimmed[..i], 1_000_000),
+            _ => (trimmed, 1),
+        };
+        match digits.parse::<i128>().map(|n| n.saturating_mul(factor)) {
             Ok(n) => u64::try_from(n)
                 .ok()
                 .filter(|n| (self.min..=self.max).contains(n))
@@ -399,6 +409,21 @@ fn main() -> ExitCode {
 fn parse_arguments() -> Result<Cli, ExitCode> {
     let matches = Cli::command().try_get_matches().map_err(argument_error)?;
     let mut cli = Cli::from_arg_matches(&matches).map_err(argument_error)?;
+    // --resolution WxH is --width W --height H.
+    let scene = match &mut cli.command {
+        Command::Render(args) => Some(&mut args.scene),
+        Command::View(args) => Some(&mut args.scene),
+        _ => None,
+    };
+    if let Some(scene) = scene.filter(|s| s.resolution.is_some()) {
+        match bench::parse_resolution(scene.resolution.as_deref().unwrap_or_default()) {
+            Ok((width, height)) => (scene.width, scene.height) = (width, height),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return Err(ExitCode::from(2));
+            }
+        }
+    }
     if let Some((_, options)) = matches.subcommand() {
         let given = Given::of(options);
         match &mut cli.command {
@@ -577,8 +602,19 @@ const PROGRESS_AFTER: std::time::Duration = std::time::Duration::from_secs(2);
 impl Progress {
     pub(crate) fn new(len: u64, what: &str) -> Progress {
         let bar = indicatif::ProgressBar::with_draw_target(Some(len), indicatif::ProgressDrawTarget::hidden());
-        bar.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} ({eta} left)").expect("a valid template"));
+        let style = "{bar:30} {pos}/{len} {msg} ({elapsed} so far, {eta} left)";
+        bar.set_style(indicatif::ProgressStyle::with_template(style).expect("a valid template"));
         bar.set_message(what.to_owned());
+        // A single long frame (many lights on a CPU driver) shows its bar too, ticking: a
+        // thread shows it once PROGRESS_AFTER has passed unless the work is done by then.
+        let ticking = bar.clone();
+        std::thread::spawn(move || {
+            std::thread::sleep(PROGRESS_AFTER);
+            if !ticking.is_finished() {
+                ticking.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+                ticking.enable_steady_tick(std::time::Duration::from_millis(500));
+            }
+        });
         Progress { bar, start: std::time::Instant::now(), shown: false }
     }
 

@@ -78,6 +78,9 @@ pub const LIGHTS_PER_POINT: f32 = 4.0;
 /// scene's 64, on a grid fitted to the scene's box.
 pub const DEFAULT_RIG_LIGHTS: u32 = 64;
 
+/// The seed scene's own light count: up to it, its lights keep the seed's radius.
+pub const SEED_LIGHT_COUNT: u32 = 64;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightLayout {
     /// ceil(√N)² grid over the frame's square (the seed's: x,z ∈ [−15, 15] at y = 7.5); in a
@@ -205,6 +208,19 @@ impl LightFrame {
         box_max: RANDOM_BOX_MAX,
         jittered: false,
     };
+
+    /// The seed scene's frame for `count` lights: the built-in one up to the seed's 64 (its
+    /// grid one plane, its radius the seed's 15); beyond, its grid stacks layers down to the
+    /// objects' middle plane (y = 0), so that the default radius can shrink as the count grows
+    /// and every point keeps a few lights (one plane of many lights would need a radius that
+    /// reaches the objects 7.5 below from every light: thousands of lights a point).
+    pub fn seed(count: u32) -> LightFrame {
+        if count <= SEED_LIGHT_COUNT {
+            LightFrame::BUILT_IN
+        } else {
+            LightFrame { grid_floor: 0.0, ..LightFrame::BUILT_IN }
+        }
+    }
 
     /// The frame fitted to a scene's box [lo, hi]: the grid a little wider than the scene's
     /// footprint, GRID_RISE of the largest side above its top, its floor the bottom of the

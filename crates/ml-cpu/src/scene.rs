@@ -223,6 +223,13 @@ impl Scene {
     /// The built-in `seed` scene (docs/DESIGN.md#the-seed-scene): a 7×7 grid of one object kind at
     /// x,z = (i − 3.5)·2.5, y = 0, in one material.
     pub fn seed(mesh: MeshKind, material: Material, lights: &LightParams) -> Result<Scene, SceneError> {
+        let mut scene = Scene::seed_objects(mesh, material);
+        scene.lights = scene.build_lights(lights, &LightFrame::BUILT_IN)?;
+        Ok(scene)
+    }
+
+    /// The seed scene's 7×7 objects and camera, without lights.
+    pub fn seed_objects(mesh: MeshKind, material: Material) -> Scene {
         let mut objects = Vec::with_capacity(49);
         for i in 0..7 {
             for j in 0..7 {
@@ -230,9 +237,7 @@ impl Scene {
                 objects.push(Object::placed(mesh, Vec3::new(at(i), 0.0, at(j)), 1.0, material));
             }
         }
-        let mut scene = Scene::new(objects, Vec::new(), Camera::seed());
-        scene.lights = scene.build_lights(lights, &LightFrame::BUILT_IN)?;
-        Ok(scene)
+        Scene::new(objects, Vec::new(), Camera::seed())
     }
 
     /// `objects` lit by point `lights` and the seed's ambient, seen by `camera`; the

@@ -6,7 +6,7 @@ use crate::bench_scene::bench_scene;
 use crate::camera::CameraSpec;
 use crate::framing::{frame_scene, DEFAULT_ASPECT};
 use crate::gltf_scene::{self, GltfFileError};
-use crate::lights::{LightColors, LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_RADIUS};
+use crate::lights::{LightColors, LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_LIGHT_COUNT, SEED_RADIUS};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::Scene;
@@ -167,7 +167,20 @@ impl SceneRequest {
                 Ok(built(bench_scene(count, self.seed, *objects)?))
             }
             SceneSource::Seed { object, material } => {
-                let mut scene = Scene::seed(*object, *material, &self.lights_of(self.lights.unwrap_or(SEED_LIGHTS), |_| Ok(SEED_RADIUS))?)?;
+                // The seed's 15 up to its 64 lights; beyond, a radius that follows the count in
+                // a frame of layers (LightFrame::seed), so that any count renders in bounded time.
+                let mut scene = Scene::seed_objects(*object, *material);
+                let count = self.lights.unwrap_or(SEED_LIGHTS);
+                let frame = LightFrame::seed(u32::try_from(count).unwrap_or(u32::MAX));
+                let area = || scene.surfaces().as_ref().map_or(0.0, SurfaceSampler::area);
+                let params = self.lights_of(count, |n| {
+                    if n <= SEED_LIGHT_COUNT {
+                        Ok(SEED_RADIUS)
+                    } else {
+                        frame.fitted_radius(self.layout, n, if self.layout == LightLayout::Surface { area() } else { 0.0 })
+                    }
+                })?;
+                scene.lights = scene.build_lights(&params, &frame)?;
                 self.light_colors.unwrap_or(LightColors::Palette).paint(&mut scene.lights);
                 Ok(built(if model == ShadingModel::BlinnPhong { scene.with_floor() } else { scene }))
             }

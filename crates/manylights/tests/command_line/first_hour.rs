@@ -258,3 +258,25 @@ fn a_model_with_missing_and_ktx_textures_and_a_skin_renders_and_says_what_is_lef
     }
     assert!(pixels(&out).pixels().any(|p| p[0].max(p[1]).max(p[2]) > 40), "nothing drawn");
 }
+
+/// The seed scene at 100,000 lights: its radius follows the count beyond its own 64, so the
+/// lights per cluster stay few (at the seed's radius 15 every cluster held thousands and the
+/// light lists outgrew the device) and the render finishes like any other.
+#[test]
+fn the_seed_scene_takes_a_hundred_thousand_lights() {
+    let out = temp_dir("seed-100k").join("seed.png");
+    let args = ["render", "--validation", "--technique", "deferred-clustered", "--lights", "100k", "--width", "160", "--height", "90"];
+    let run = manylights(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+    ok(&run);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let mean: f32 = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("lights/cluster"))
+        .and_then(|l| l.trim().strip_prefix("mean "))
+        .and_then(|l| l.split(',').next())
+        .and_then(|m| m.parse().ok())
+        .unwrap_or_else(|| panic!("no lights/cluster row:\n{stdout}"));
+    let lights = stdout.lines().find_map(|l| l.strip_prefix("lights ")).map(str::trim);
+    assert_eq!(lights, Some("100000"), "{stdout}");
+    assert!(mean < 64.0, "{mean} lights a cluster on average");
+}
