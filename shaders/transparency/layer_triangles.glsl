@@ -62,6 +62,9 @@ layout(push_constant) uniform LayerDispatchBlock {
     uvec4 large_list;
 };
 
+// The side of the tiles' build's square tiles, in pixels.
+const uint LAYER_TILE = 16u;
+
 // Triangles set up at once (the tiles' build: 64; a work group's own triangle: 1).
 #ifndef LAYER_SLOTS
 #define LAYER_SLOTS 64u

@@ -17,11 +17,11 @@
 // The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer.
 #include "common/common.glsl"
 
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = 16, local_size_y = 16) in; // LAYER_TILE²
 
 #include "transparency/layer_triangles.glsl"
 
-const uvec2 TILE = uvec2(16u);
+const uvec2 TILE = uvec2(LAYER_TILE);
 // The tile's objects among the CHUNK being listed, and their triangles numbered in a row.
 shared uint tile_objects[CHUNK];
 shared uint tile_object_count;

@@ -66,7 +66,7 @@ void main() {
             if (any(greaterThan(size, ivec2(GROUP_BOX)))) {
                 at = room - 1u - atomicAdd(large_triangles[counts + LIST_HUGE], 1u);
                 atomicAdd(layer_counts.w, 1u);
-                atomicMax(large_triangles[counts + LIST_HUGE_GROUPS], (frame.viewport.x + 15u) / 16u);
+                atomicMax(large_triangles[counts + LIST_HUGE_GROUPS], (frame.viewport.x + LAYER_TILE - 1u) / LAYER_TILE);
             } else {
                 uint listed = atomicAdd(large_triangles[counts + LIST_LARGE], 1u);
                 atomicAdd(layer_counts.z, 1u);

@@ -20,7 +20,7 @@ use ml_render::{
     Technique,
 };
 use ml_vk::{Context, ContextDesc};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
@@ -467,6 +467,9 @@ fn scene_source(name: &str, object: MeshKind, material: Material, objects: usize
         "room" => SceneSource::Room,
         "bench" => SceneSource::Bench { objects },
         path if is_scene_file(path) => SceneSource::File(PathBuf::from(path)),
+        folder if Path::new(folder).is_dir() => {
+            bail!("--scene '{folder}' is a folder: name the scene file in it (FILE.toml, FILE.gltf or FILE.glb)")
+        }
         other => bail!("unknown scene '{other}': expected seed, room, bench, a scene file FILE.toml or a glTF file FILE.gltf|FILE.glb"),
     })
 }

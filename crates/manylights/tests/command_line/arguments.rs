@@ -52,6 +52,16 @@ fn negative_and_huge_counts_get_their_range() {
     assert_argument_error(&render("--width", "wide"), &["--width 'wide' is not a whole number"]);
     assert_argument_error(&render("--supersample", "17"), &["--supersample 17 is out of range: use 1 to 16"]);
     assert_argument_error(&render("--aa", "2"), &["'2'", "--aa", "off, 4, 8, 16"]);
+    // Counts spelt as bench spells them, and sizes as WxH.
+    assert_argument_error(&render("--lights", "100M"), &["--lights 100M is out of range: use 1 to 67108864"]);
+    assert_argument_error(&render("--lights", "1.5k"), &["--lights '1.5k' is not a whole number"]);
+    assert_argument_error(&render("--resolution", "0x5"), &["--resolution 0x5: each side must be 1 to 16384"]);
+    let both = manylights(&["render", "--resolution", "64x36", "--width", "64", "--out", "a.png"]);
+    assert_argument_error(&both, &["'--resolution <RESOLUTION>' cannot be used with '--width <WIDTH>'"]);
+    // A folder named as the scene is said to be one.
+    let folder = temp_dir("scene-folder");
+    let scene = manylights(&["render", "--scene", folder.to_str().unwrap(), "--out", "a.png"]);
+    assert_one_line_error(&scene, &["is a folder: name the scene file in it"]);
     let big = manylights(&["render", "--supersample", "9", "--width", "2000", "--out", "a.png"]);
     assert_one_line_error(&big, &["--supersample 9 renders 18000x", "more than 16384 pixels a side"]);
     let out = temp_dir("bench-counts");
