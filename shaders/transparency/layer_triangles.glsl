@@ -64,6 +64,11 @@ layout(push_constant) uniform LayerDispatchBlock {
 
 // The side of the tiles' build's square tiles, in pixels.
 const uint LAYER_TILE = 16u;
+// The largest box, in pixels a side, a work group of the large triangles' build walks
+// (transparent_build_large.glsl, 16×16 threads a block), and the words of a thread's bits,
+// one a block.
+const int GROUP_BOX = 256;
+const uint GROUP_BLOCK_WORDS = uint((GROUP_BOX / 16) * (GROUP_BOX / 16)) / 32u;
 
 // Triangles set up at once (the tiles' build: 64; a work group's own triangle: 1).
 #ifndef LAYER_SLOTS

@@ -1,6 +1,6 @@
 // The transparent layers' build of the triangles too large for a thread of the per-triangle
 // build (transparent_build_triangles.glsl), which lists them: a work group each, its threads
-// a 16×16 block stepped over the triangle's box (at most GROUP_BOX, 128 pixels, a side: 64
+// a 16×16 block stepped over the triangle's box (at most GROUP_BOX, 256 pixels, a side: 256
 // steps), marking where they find fragments, then taking room for all of them at once. The work groups (as many as that build
 // counted, at most 65,535) stride through the list.
 //
@@ -29,7 +29,10 @@ void main() {
         // The blocks where this thread's pixel has a fragment, a bit each ((GROUP_BOX / 16)²
         // at most), then room for all of the work group's, then their nodes.
         int columns = (box.z - box.x + 16) / 16, blocks = columns * ((box.w - box.y + 16) / 16);
-        uvec2 hits = uvec2(0u);
+        uint hits[GROUP_BLOCK_WORDS];
+        for (uint k = 0u; k < GROUP_BLOCK_WORDS; k++) {
+            hits[k] = 0u;
+        }
         uint mine = 0u;
         for (int b = 0; b < blocks; b++) {
             ivec2 p = box.xy + 16 * ivec2(b % columns, b / columns) + ivec2(gl_LocalInvocationID.xy);
@@ -39,7 +42,7 @@ void main() {
             }
         }
         uint node = take_nodes(mine);
-        for (uint k = 0u; k < 2u && mine > 0u; k++) {
+        for (uint k = 0u; k < GROUP_BLOCK_WORDS && mine > 0u; k++) {
             for (uint bits = hits[k]; bits != 0u; bits &= bits - 1u) {
                 int b = int(32u * k) + findLSB(bits);
                 keep_fragment(0u, box.xy + 16 * ivec2(b % columns, b / columns) + ivec2(gl_LocalInvocationID.xy), node++, capacity, to_ndc);

@@ -20,10 +20,9 @@ layout(local_size_x = 64) in;
 
 #include "transparency/layer_triangles.glsl"
 
-// The largest boxes, in pixels a side, a thread and a work group walk; the words of a
-// thread's box's bits.
+// The largest box, in pixels a side, a thread walks (a work group: GROUP_BOX); the words of
+// a thread's box's bits.
 const int THREAD_BOX = 16;
-const int GROUP_BOX = 128;
 const uint BOX_WORDS = uint(THREAD_BOX * THREAD_BOX) / 32u;
 
 // The entry among the dispatch's `entries` from `first` whose triangles hold triangle `t`

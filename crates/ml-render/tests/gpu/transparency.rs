@@ -455,7 +455,9 @@ fn the_tiles_build_and_the_per_triangle_build_agree() {
         // behind the eye, listed for the tiles.
         let mut glass = scene([0, 1, 2]);
         glass.camera = Camera::looking_at(Vec3::new(0.3, 0.2, 0.9), Vec3::new(0.0, 0.0, 0.5), 70.0, 0.1, 20.0);
-        let panes = common::render_each(&glass, &[pbr(technique, u32::MAX), pbr(technique, 0)]);
+        // (Wider than a work group walks: GROUP_BOX, 256 pixels.)
+        let wide = |tiled_up_to| RenderSettings { width: 272, height: 160, ..pbr(technique, tiled_up_to) };
+        let panes = common::render_each(&glass, &[wide(u32::MAX), wide(0)]);
         for (what, [a, b]) in
             [("coarse leaves", &coarse[..]), ("fine leaves", &fine[..]), ("panes", &panes[..])].map(|(w, o)| (w, [&o[0], &o[1]]))
         {
