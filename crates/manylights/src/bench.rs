@@ -309,7 +309,48 @@ struct Measured {
     ms_per_frame: f64,
 }
 
-pub fn bench(a: &BenchArgs) -> Result<()> {
+/// What a CPU driver measures unless told otherwise: the defaults (1080p, 300 frames, up to a
+/// million lights) would take it hours, every combination skipped for the time budget and
+/// nothing plotted.
+const CPU_DEFAULTS: [(&str, &str); 4] = [("resolution", "320x180"), ("frames", "5"), ("warmup", "1"), ("lights", "1k,16k")];
+
+/// On a CPU driver, CPU_DEFAULTS for each of those options not given, and a note saying so.
+fn fit_to_a_cpu(a: &mut BenchArgs, device: &ml_vk::DeviceInfo) {
+    if device.device_type != ml_vk::vk::PhysicalDeviceType::CPU || a.probe {
+        return;
+    }
+    let mut taken = Vec::new();
+    for (id, value) in CPU_DEFAULTS {
+        if a.given.has(id) {
+            continue;
+        }
+        match id {
+            "resolution" => a.resolution = value.to_owned(),
+            "frames" => a.frames = value.parse().expect("a count"),
+            "warmup" => a.warmup = value.parse().expect("a count"),
+            _ => a.lights = value.to_owned(),
+        }
+        taken.push(format!("--{id} {value}"));
+    }
+    if !taken.is_empty() {
+        eprintln!("note: '{}' is a CPU driver: measuring {} (give them to choose others)", device.name, taken.join(" "));
+    }
+}
+
+/// The arguments read and checked: the techniques asked for, the light counts (ascending),
+/// the image size, the rasters and sample counts, and whether auto is among the techniques.
+struct Asked {
+    choices: Vec<Option<Technique>>,
+    counts: Vec<u64>,
+    resolution: (u32, u32),
+    rasters: Vec<Raster>,
+    sample_counts: Vec<ml_render::Antialiasing>,
+    rules: Vec<Rule>,
+    named: Vec<Technique>,
+    auto: Auto,
+}
+
+fn asked(a: &BenchArgs) -> Result<Asked> {
     let choices: Vec<Option<Technique>> = a.techniques.split(',').map(|t| technique_choice(t.trim())).collect::<Result<_>>()?;
     let mut counts: Vec<u64> = a.lights.split(',').map(parse_count).collect::<Result<_>>()?;
     // Ascending: each count's estimate can lean on the smaller ones measured before it.
@@ -326,9 +367,18 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     let named: Vec<Technique> = choices.iter().flatten().copied().collect();
     let auto = if choices.contains(&None) { Auto::Pending } else { Auto::No };
     check_rules(&rules, &a.given, &Techniques { flag: "--techniques", named: named.clone(), auto })?;
+    Ok(Asked { choices, counts, resolution, rasters, sample_counts, rules, named, auto })
+}
+
+pub fn bench(a: &mut BenchArgs) -> Result<()> {
+    // Every argument checked before the device is; a CPU driver then gets sizes it can finish.
+    asked(a)?;
+    let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
+    fit_to_a_cpu(a, &ctx.info);
+    let a = &*a;
+    let Asked { choices, counts, resolution, rasters, sample_counts, rules, named, auto } = asked(a)?;
     let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Plan::new(a, resolution)?) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
-    let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
     let messages = ctx.validation_counter();
     let mut plan = match work {
         Work::Techniques(plan) => plan,
@@ -566,12 +616,11 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
     });
     write_file(a, "results.csv", &csv)?;
     write_file(a, "results.json", &serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
+    // Always a plot, empty (and saying why) where nothing was measured.
     let series = frame_times(results, skip);
-    if series.iter().any(|(_, points)| !points.is_empty()) {
-        let (size, rgb) = plot(&series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
-        let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
-        ml_cpu::files::write_png(&a.out.join("results.png"), &rgba, size)?;
-    }
+    let (size, rgb) = plot(&series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
+    let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
+    ml_cpu::files::write_png(&a.out.join("results.png"), &rgba, size)?;
     print!("{csv}");
     Ok(())
 }
@@ -618,8 +667,10 @@ fn plot(series: &[(Variant, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<Plo
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
     });
     let points = series.iter().flat_map(|(_, p)| p.iter());
-    let (x0, x1) = points.clone().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
-    let (y0, y1) = points.fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
+    let measured = points.clone().count() > 0;
+    // Nothing measured: the axes of 1k–1M lights and 0.1–100 ms, empty.
+    let (x0, x1) = if measured { points.clone().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.0), hi.max(p.0))) } else { (1e3, 1e6) };
+    let (y0, y1) = if measured { points.fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1))) } else { (0.1, 100.0) };
     // Whole decades, so that the log axes have labels.
     let decades =
         |lo: f64, hi: f64| (10f64.powf(lo.log10().floor()), 10f64.powf(hi.log10().ceil()).max(10f64.powf(lo.log10().floor() + 1.0)));
@@ -629,7 +680,14 @@ fn plot(series: &[(Variant, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<Plo
     let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(format!("GPU ms per frame at {w}x{h} (median)"), ("sans-serif", 24))
+        .caption(
+            if measured {
+                format!("GPU ms per frame at {w}x{h} (median)")
+            } else {
+                format!("GPU ms per frame at {w}x{h}: nothing measured (results.csv says why)")
+            },
+            ("sans-serif", 24),
+        )
         .margin(16)
         // Room for the last decade's label, which is centred on the right edge.
         .margin_right(48)

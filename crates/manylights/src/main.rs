@@ -392,7 +392,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render(&args),
         Command::View(args) => view(&args),
-        Command::Bench(args) => bench::bench(&args),
+        Command::Bench(mut args) => bench::bench(&mut args),
         Command::Info => info(),
     };
     match result {

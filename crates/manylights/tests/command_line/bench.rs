@@ -160,3 +160,35 @@ fn the_probe_writes_its_ratios() {
     assert!(csv.lines().nth(1).unwrap().contains("skipped: 2 rounds would take"), "{csv}");
     assert!(String::from_utf8_lossy(&skipped.stdout).contains("auto: nothing measured"));
 }
+
+/// On a CPU driver (as CI's lavapipe is) a bench without --resolution, --frames, --warmup
+/// and --lights measures what the driver can finish, says so, and writes its plot; a bench
+/// whose every combination is skipped writes a plot too, an empty one.
+#[test]
+fn a_bench_on_a_cpu_picks_what_it_can_finish_and_always_plots() {
+    let out_dir = std::env::temp_dir().join(format!("manylights-bench-cpu-{}", std::process::id()));
+    let run = |extra: &[&str]| {
+        let run = Command::new(env!("CARGO_BIN_EXE_manylights"))
+            .args(["bench", "--techniques", "clustered-gpu", "--out", out_dir.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+        assert!(run.status.success(), "{stderr}");
+        stderr
+    };
+    let stderr = run(&["--lights", "1k"]);
+    let info = Command::new(env!("CARGO_BIN_EXE_manylights")).arg("info").output().unwrap();
+    if String::from_utf8_lossy(&info.stdout).contains("CPU") {
+        assert!(stderr.contains("is a CPU driver: measuring --resolution 320x180 --frames 5 --warmup 1"), "{stderr}");
+        assert!(!stderr.contains("--lights 1k,16k"), "--lights was given: {stderr}");
+        let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+        assert!(csv.contains(",1000,320,180,5,measured,"), "{csv}");
+    }
+    assert!(out_dir.join("results.png").is_file());
+    std::fs::remove_file(out_dir.join("results.png")).unwrap();
+    run(&["--lights", "1k", "--resolution", "64x36", "--frames", "2", "--budget-s", "0.000001"]);
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    assert!(!csv.contains(",measured,"), "{csv}");
+    assert!(out_dir.join("results.png").is_file(), "no plot where nothing was measured");
+}
