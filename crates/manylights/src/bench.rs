@@ -314,10 +314,11 @@ struct Measured {
 /// nothing plotted.
 const CPU_DEFAULTS: [(&str, &str); 4] = [("resolution", "320x180"), ("frames", "5"), ("warmup", "1"), ("lights", "1k,16k")];
 
-/// On a CPU driver, CPU_DEFAULTS for each of those options not given, and a note saying so.
-fn fit_to_a_cpu(a: &mut BenchArgs, device: &ml_vk::DeviceInfo) {
+/// On a CPU driver, CPU_DEFAULTS for each of those options not given; the note that says so
+/// (printed once every argument has been checked: an error stays the only line).
+fn fit_to_a_cpu(a: &mut BenchArgs, device: &ml_vk::DeviceInfo) -> Option<String> {
     if device.device_type != ml_vk::vk::PhysicalDeviceType::CPU || a.probe {
-        return;
+        return None;
     }
     let mut taken = Vec::new();
     for (id, value) in CPU_DEFAULTS {
@@ -332,9 +333,8 @@ fn fit_to_a_cpu(a: &mut BenchArgs, device: &ml_vk::DeviceInfo) {
         }
         taken.push(format!("--{id} {value}"));
     }
-    if !taken.is_empty() {
-        eprintln!("note: '{}' is a CPU driver: measuring {} (give them to choose others)", device.name, taken.join(" "));
-    }
+    (!taken.is_empty())
+        .then(|| format!("note: '{}' is a CPU driver: measuring {} (give them to choose others)", device.name, taken.join(" ")))
 }
 
 /// The arguments read and checked: the techniques asked for, the light counts (ascending),
@@ -374,11 +374,14 @@ pub fn bench(a: &mut BenchArgs) -> Result<()> {
     // Every argument checked before the device is; a CPU driver then gets sizes it can finish.
     asked(a)?;
     let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
-    fit_to_a_cpu(a, &ctx.info);
+    let note = fit_to_a_cpu(a, &ctx.info);
     let a = &*a;
     let Asked { choices, counts, resolution, rasters, sample_counts, rules, named, auto } = asked(a)?;
     let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Plan::new(a, resolution)?) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
+    if let Some(note) = note {
+        eprintln!("{note}");
+    }
     let messages = ctx.validation_counter();
     let mut plan = match work {
         Work::Techniques(plan) => plan,

@@ -341,7 +341,7 @@ pub struct LightParams {
 
 impl LightParams {
     pub fn seed_default() -> LightParams {
-        LightParams { count: 64, layout: LightLayout::Grid, seed: 1, radius: RadiusRange::fixed(SEED_RADIUS) }
+        LightParams { count: SEED_LIGHT_COUNT, layout: LightLayout::Grid, seed: 1, radius: RadiusRange::fixed(SEED_RADIUS) }
     }
 
     pub fn check_count(count: u64) -> Result<u32, SceneError> {

@@ -17,8 +17,8 @@ use crate::SceneError;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-/// Point lights of the seed and bench scenes when the request does not say.
-pub const SEED_LIGHTS: u64 = 64;
+/// Point lights of the bench scene when the request does not say (the seed scene's:
+/// `SEED_LIGHT_COUNT`).
 pub const BENCH_LIGHTS: u64 = 1024;
 
 /// Which scene.
@@ -170,7 +170,7 @@ impl SceneRequest {
                 // The seed's 15 up to its 64 lights; beyond, a radius that follows the count in
                 // a frame of layers (LightFrame::seed), so that any count renders in bounded time.
                 let mut scene = Scene::seed_objects(*object, *material);
-                let count = self.lights.unwrap_or(SEED_LIGHTS);
+                let count = self.lights.unwrap_or(u64::from(SEED_LIGHT_COUNT));
                 let frame = LightFrame::seed(u32::try_from(count).unwrap_or(u32::MAX));
                 let area = || scene.surfaces().as_ref().map_or(0.0, SurfaceSampler::area);
                 let params = self.lights_of(count, |n| {
