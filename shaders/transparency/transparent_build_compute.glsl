@@ -17,7 +17,8 @@
 // The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer.
 #include "common/common.glsl"
 
-layout(local_size_x = 16, local_size_y = 16) in; // LAYER_TILE²
+// A thread per pixel of a LAYER_TILE² tile.
+layout(local_size_x = 16, local_size_y = 16) in;
 
 #include "transparency/layer_triangles.glsl"
 
