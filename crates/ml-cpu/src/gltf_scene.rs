@@ -687,9 +687,7 @@ struct LoadedMesh {
 /// Fit `mesh` into [−1, 1]³ (what every mesh of a scene does; the object's transform undoes
 /// it): returns its box's centre and half-size.
 fn fit_unit_box(mesh: &mut Mesh) -> (Vec3, f32) {
-    let (lo, hi) = mesh.vertices.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), v| {
-        (lo.min(Vec3::from(v.position)), hi.max(Vec3::from(v.position)))
-    });
+    let (lo, hi) = crate::mesh::bounds(mesh);
     let centre = (lo + hi) * 0.5;
     let half = ((hi - lo).max_element() * 0.5).max(f32::MIN_POSITIVE);
     for v in &mut mesh.vertices {
