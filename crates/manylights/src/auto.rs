@@ -4,8 +4,8 @@
 use anyhow::{bail, Result};
 use ml_cpu::scene::Scene;
 use ml_render::settings::{missing_meshlet_feature, missing_raster_feature};
-use ml_render::stage_probe::{pick_lighting_path, quick_probe, StageTimes};
-use ml_render::{Antialiasing, Geometry, Raster, RenderSettings, Renderer, Technique};
+use ml_render::stage_probe::{pick_lighting_path, quick_probe, too_close_to_call, StageTimes};
+use ml_render::{Antialiasing, Geometry, LargeTriangles, Raster, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -23,12 +23,71 @@ pub fn technique_choice(name: &str) -> Result<Option<Technique>> {
     Technique::from_name(name).map(Some).map_err(|e| anyhow::anyhow!("{e}, or auto"))
 }
 
+/// What `auto`'s technique pick may render to decide: the scene, its settings and the
+/// rasteriser asked for (`--raster`, None for auto).
+pub type SceneProbe<'s> = (&'s Scene, &'s RenderSettings, Option<Raster>);
+
 /// Probe `ctx`'s device and say which technique `auto` is there, why, and what the probe
-/// measured.
-pub fn pick(ctx: &Context) -> Result<(Technique, String, StageTimes)> {
+/// measured. Where the light loop's probe cannot tell the kinds of pass apart
+/// (`too_close_to_call`, or a CPU driver) and the device runs the meshlet techniques, `scene`
+/// decides: rendered with visibility and with deferred-clustered, the first of them within
+/// PICK_MARGIN of the faster is kept.
+pub fn pick(ctx: &Context, scene: Option<SceneProbe>) -> Result<(Technique, String, StageTimes)> {
     let times = quick_probe(ctx)?;
-    let (technique, why) = pick_lighting_path(&times, missing_meshlet_feature(&ctx.info.features).is_none());
-    Ok((technique, why, times))
+    let meshlets = missing_meshlet_feature(&ctx.info.features).is_none();
+    let (technique, why) = pick_lighting_path(&times, meshlets);
+    // A CPU driver runs both kinds of pass on the same cores: what its probe measures is
+    // noise (lavapipe: 0.74-1.17x on repeats).
+    let undecided = if ctx.info.device_type == ml_vk::vk::PhysicalDeviceType::CPU {
+        Some("a CPU driver runs both on the same cores")
+    } else {
+        too_close_to_call(&times).then_some("too close to call")
+    };
+    match (scene, undecided) {
+        (Some(scene), Some(reason)) if meshlets => match pick_by_scene(ctx, scene)? {
+            Some((technique, decided)) => Ok((technique, format!("{why}; {reason}, so {decided}"), times)),
+            None => Ok((technique, why, times)),
+        },
+        _ => Ok((technique, why, times)),
+    }
+}
+
+/// visibility and deferred-clustered timed on `scene` (visibility with the rasteriser asked
+/// for, else the compute raster with samples and the hardware without: the raster probe comes
+/// after), the first within the margin of the faster, and how; None where neither renders.
+fn pick_by_scene(ctx: &Context, (scene, settings, raster): SceneProbe) -> Result<Option<(Technique, String)>> {
+    let features = &ctx.info.features;
+    let supported = |r: Raster| missing_raster_feature(r, features).is_none();
+    let raster = match raster {
+        Some(r) if supported(r) => r,
+        _ if settings.antialiasing != Antialiasing::Off && supported(Raster::compute(Raster::DEFAULT_SPLIT)) => {
+            Raster::compute(Raster::DEFAULT_SPLIT)
+        }
+        _ => Raster::Hardware,
+    };
+    let order = [Technique::Visibility, Technique::DeferredClustered];
+    let mut timed: Vec<Timed<Technique>> = Vec::new();
+    let mut refused = Vec::new();
+    for technique in order {
+        let s =
+            RenderSettings { technique, raster: if technique == Technique::Visibility { raster } else { Raster::Hardware }, ..*settings };
+        let best = timed.iter().map(|t| t.ms).fold(f64::INFINITY, f64::min);
+        match time_renders(ctx, scene, s, best) {
+            Ok(frames) => timed.push(frames.of(technique)),
+            Err(e) => refused.push(format!("{} cannot render it: {e}", technique.name())),
+        }
+    }
+    if timed.is_empty() {
+        return Ok(None);
+    }
+    let picked = pick_within_margin(&timed, &order);
+    let names: Vec<&str> = order.iter().map(|t| t.name()).collect();
+    let mut how = format!("{}; {}", describe(&timed, |t| t.name()), margin_rule(&names));
+    for r in refused {
+        how.push_str("; ");
+        how.push_str(&r);
+    }
+    Ok(Some((picked, how)))
 }
 
 /// The line that tells what `auto` picked and why.
@@ -38,13 +97,13 @@ pub fn announce(technique: Technique, why: &str) {
 
 /// `name`'s technique; for `auto`, probed on a context of its own (the viewer makes its own
 /// for the window), which must leave the validation layer silent.
-pub fn resolve_alone(name: &str, validation: bool, device_index: Option<usize>) -> Result<Technique> {
+pub fn resolve_alone(name: &str, scene: SceneProbe, (validation, device_index): (bool, Option<usize>)) -> Result<Technique> {
     if let Some(t) = technique_choice(name)? {
         return Ok(t);
     }
     let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
     let messages = ctx.validation_counter();
-    let picked = pick(&ctx);
+    let picked = pick(&ctx, Some(scene));
     drop(ctx);
     let count = messages.load(Ordering::SeqCst);
     if count > 0 {
@@ -54,9 +113,6 @@ pub fn resolve_alone(name: &str, validation: bool, device_index: Option<usize>) 
     announce(technique, &why);
     Ok(technique)
 }
-
-/// Frames each rasteriser renders in `--raster auto`'s probe.
-pub const RASTER_PROBE_FRAMES: u32 = 4;
 
 /// The rasteriser for `settings` on `ctx`'s device and, where `auto` (`choice` None) chose it,
 /// why. Techniques without a visibility buffer keep the hardware (an explicit compute raster
@@ -134,28 +190,122 @@ pub fn resolve_raster_alone(
     Ok(raster)
 }
 
-/// Render `scene` with `settings` and each of `candidates` for RASTER_PROBE_FRAMES frames; the
-/// one whose frames took least GPU time (wall time where the device has no timestamps), and
-/// the line that says so.
+/// `--raster auto`'s order of preference (the compute raster was the fastest wherever a GPU
+/// measured it): the first within PICK_MARGIN of the fastest is kept.
+fn raster_rank(raster: &Raster) -> u8 {
+    match raster {
+        Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => 0,
+        Raster::Compute { large: LargeTriangles::Hardware, .. } => 1,
+        Raster::Hardware => 2,
+    }
+}
+
+/// Render `scene` with `settings` and each of `candidates`, timed in this order (the
+/// hardware's, cheap on every device, first: the slow ones then leave after a frame), and keep
+/// the first of the order of preference within the margin of the fastest; the line that says
+/// so.
 pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, candidates: &[Raster]) -> Result<(Raster, String)> {
-    let time = |raster| -> Result<f64> {
-        let s = RenderSettings { raster, frames: RASTER_PROBE_FRAMES, ..*settings };
-        let out = Renderer::new(ctx, scene.clone(), s)?.render()?;
-        Ok(match out.stats.gpu_ms() {
-            Some(passes) => passes.iter().map(|(_, ms)| ms).sum(),
-            None => out.stats.wall_ms_per_frame(),
-        })
+    let mut timed: Vec<Timed<Raster>> = Vec::new();
+    for &raster in candidates {
+        let best = timed.iter().map(|t| t.ms).fold(f64::INFINITY, f64::min);
+        timed.push(time_renders(ctx, scene, RenderSettings { raster, ..*settings }, best)?.of(raster));
+    }
+    let mut preference = candidates.to_vec();
+    preference.sort_by_key(raster_rank);
+    let picked = pick_within_margin(&timed, &preference);
+    let order: Vec<&str> = preference.iter().map(|r| r.name()).collect();
+    Ok((picked, format!("{}; {}", describe(&timed, |r| r.name()), margin_rule(&order))))
+}
+
+/// Frames each candidate renders in auto's scene probes, after its warm-up.
+pub const PROBE_FRAMES: usize = 3;
+/// A candidate's warm-up on a GPU: frames until this much wall time has passed (a GPU raises
+/// its clocks only under load, and lowers them while the CPU loads the scene), one at least;
+/// on a CPU driver one frame (no clocks to raise).
+const WARM_UP_MS: f64 = 200.0;
+/// The most warm-up frames, whatever the time.
+const WARM_UP_FRAMES: u32 = 256;
+/// A candidate whose first timed frame takes this many times the best median so far is out
+/// after that frame (on a CPU driver the slow rasters take seconds a frame).
+const CLEARLY_SLOWER: f64 = 2.0;
+/// auto keeps its first preference unless another candidate is faster by more than this
+/// share: repeated probes on a busy machine, or a GPU whose clock moves, then pick the same.
+pub const PICK_MARGIN: f64 = 0.10;
+
+/// One candidate's frames in a scene probe: their median GPU time (wall time on a device
+/// without timestamps) and how many were timed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timed<T> {
+    pub candidate: T,
+    pub ms: f64,
+    pub frames: usize,
+}
+
+/// A median and a frame count not yet tied to a candidate.
+struct Frames(f64, usize);
+
+impl Frames {
+    fn of<T>(self, candidate: T) -> Timed<T> {
+        Timed { candidate, ms: self.0, frames: self.1 }
+    }
+}
+
+/// `scene` rendered with `settings` one frame at a time: warmed up, then PROBE_FRAMES frames
+/// timed, and their median. A candidate is out after one frame where that frame takes
+/// CLEARLY_SLOWER times `best` (the best median so far): the first timed one, or the warm-up's
+/// only one where that alone lasted the warm-up's time (seconds a frame, a CPU driver).
+fn time_renders(ctx: &Context, scene: &Scene, settings: RenderSettings, best: f64) -> Result<Frames> {
+    let mut renderer = Renderer::new(ctx, scene.clone(), RenderSettings { frames: 1, ..settings })?;
+    let mut frame = || -> Result<f64> {
+        let stats = renderer.render()?.stats;
+        Ok(stats.gpu_ms().map_or(stats.wall_ms_per_frame(), |passes| passes.iter().map(|(_, ms)| ms).sum()))
     };
-    let timed = candidates.iter().map(|&r| Ok((r, time(r)?))).collect::<Result<Vec<(Raster, f64)>>>()?;
-    let &(picked, best) = timed.iter().min_by(|a, b| a.1.total_cmp(&b.1)).expect("at least one rasteriser");
-    let each: Vec<String> = timed.iter().map(|(r, ms)| format!("{ms:.3} ms {}", r.name())).collect();
-    let runner_up = timed.iter().filter(|(r, _)| *r != picked).map(|t| t.1).fold(f64::INFINITY, f64::min);
-    let why = format!(
-        "a frame of this scene took {} ({:.2}× faster than the next; mean of {RASTER_PROBE_FRAMES} frames each)",
-        each.join(", "),
-        runner_up / best
-    );
-    Ok((picked, why))
+    let start = std::time::Instant::now();
+    let first = frame()?;
+    let warm_up_ms = if ctx.info.device_type == ml_vk::vk::PhysicalDeviceType::CPU { 0.0 } else { WARM_UP_MS };
+    let warmed = |ms: f64| ms >= warm_up_ms;
+    if warmed(start.elapsed().as_secs_f64() * 1e3) && first > CLEARLY_SLOWER * best {
+        return Ok(Frames(first, 1));
+    }
+    for _ in 1..WARM_UP_FRAMES {
+        if warmed(start.elapsed().as_secs_f64() * 1e3) {
+            break;
+        }
+        frame()?;
+    }
+    let mut times = Vec::new();
+    while times.len() < PROBE_FRAMES {
+        times.push(frame()?);
+        if times[0] > CLEARLY_SLOWER * best {
+            break;
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(Frames(times[times.len() / 2], times.len()))
+}
+
+/// The first of `preference` among `timed` whose time is within PICK_MARGIN of the fastest.
+pub fn pick_within_margin<T: Copy + PartialEq>(timed: &[Timed<T>], preference: &[T]) -> T {
+    let fastest = timed.iter().map(|t| t.ms).fold(f64::INFINITY, f64::min);
+    preference
+        .iter()
+        .filter_map(|p| timed.iter().find(|t| t.candidate == *p))
+        .find(|t| t.ms <= fastest * (1.0 + PICK_MARGIN))
+        .map_or_else(|| timed.iter().min_by(|a, b| a.ms.total_cmp(&b.ms)).expect("a candidate").candidate, |t| t.candidate)
+}
+
+/// What the probe measured, e.g. "a frame of this scene took 0.958 ms compute, 1.467 ms
+/// hardware (medians of 5 after a warm-up; hybrid out after one frame)".
+fn describe<T>(timed: &[Timed<T>], name: impl Fn(&T) -> &'static str) -> String {
+    let each: Vec<String> = timed.iter().map(|t| format!("{:.3} ms {}", t.ms, name(&t.candidate))).collect();
+    let out: Vec<&str> = timed.iter().filter(|t| t.frames < PROBE_FRAMES).map(|t| name(&t.candidate)).collect();
+    let out = if out.is_empty() { String::new() } else { format!("; {} out after one frame", out.join(", ")) };
+    format!("a frame of this scene took {} (medians of {PROBE_FRAMES} frames after a warm-up{out})", each.join(", "))
+}
+
+/// How auto chose among `order`.
+fn margin_rule(order: &[&str]) -> String {
+    format!("kept: the first of {} within {:.0} % of the fastest", order.join(", "), PICK_MARGIN * 100.0)
 }
 
 #[cfg(test)]
@@ -174,6 +324,22 @@ mod tests {
                 assert!(CANDIDATES.contains(&t), "{t:?}");
             }
         }
+    }
+
+    /// The first preference within the margin of the fastest, however the candidates were
+    /// timed; beyond it, the fastest.
+    #[test]
+    fn the_first_preference_within_the_margin_is_kept() {
+        let t = |candidate, ms| Timed { candidate, ms, frames: PROBE_FRAMES };
+        let order = ["compute", "hybrid", "hardware"];
+        assert_eq!(pick_within_margin(&[t("hardware", 1.0), t("hybrid", 2.0), t("compute", 1.09)], &order), "compute");
+        assert_eq!(pick_within_margin(&[t("hardware", 1.0), t("hybrid", 1.05), t("compute", 1.2)], &order), "hybrid");
+        assert_eq!(pick_within_margin(&[t("hardware", 1.0), t("hybrid", 1.2), t("compute", 1.2)], &order), "hardware");
+        assert_eq!(pick_within_margin(&[t("hardware", 0.3), t("compute", 3.0)], &order), "hardware");
+        // Timed but not in the order: still a candidate.
+        assert_eq!(pick_within_margin(&[t("other", 0.5), t("compute", 3.0)], &order), "other");
+        let line = describe(&[t("hardware", 1.0), Timed { candidate: "compute", ms: 9.0, frames: 1 }], |n| n);
+        assert!(line.contains("1.000 ms hardware, 9.000 ms compute") && line.ends_with("compute out after one frame)"), "{line}");
     }
 
     #[test]

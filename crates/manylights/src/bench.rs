@@ -396,7 +396,7 @@ pub fn bench(a: &mut BenchArgs) -> Result<()> {
         }
     };
     // Every run records the quick probe and what auto makes of it.
-    let (auto_technique, auto_why, quick) = auto::pick(&ctx)?;
+    let (auto_technique, auto_why, quick) = auto::pick(&ctx, None)?;
     if auto == Auto::Pending {
         check_rules(&rules, &a.given, &Techniques { flag: "--techniques", named, auto: Auto::Picked(auto_technique) })?.warn();
     }

@@ -701,7 +701,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let auto_why = match choice {
         Some(_) => None,
         None => {
-            let (t, why, _) = auto::pick(&ctx)?;
+            let (t, why, _) = auto::pick(&ctx, Some((&built.scene, &settings, raster_choice(args)?)))?;
             settings.technique = t;
             techniques.auto = Auto::Picked(t);
             check_options_apply(args, &request.source, Some(&built), &techniques)?.take_effect(&mut settings);
@@ -789,7 +789,9 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     check_options_apply(args, &request.source, Some(&built), &techniques)?;
     // Before auto's probes: without a display, that is the one line, at once.
     let windows = ml_viewer::connect()?;
-    let technique = auto::resolve_alone(&args.technique, args.validation, args.device)?;
+    let probe_settings = wanted.for_scene(&built.scene, built.shading);
+    let technique =
+        auto::resolve_alone(&args.technique, (&built.scene, &probe_settings, raster_choice(args)?), (args.validation, args.device))?;
     let mut unused = Default::default();
     if choice.is_none() {
         techniques.auto = Auto::Picked(technique);

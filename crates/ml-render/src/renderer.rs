@@ -396,13 +396,13 @@ impl<'a> Renderer<'a> {
                 // start dark, and later frames meter a settled image (two back). A sequence
                 // and a plain render do the same, so their last images stay equal.
                 self.collect_all(&mut stats)?;
-                last = self.settle_exposure(last, i, &mut stats)?;
+                last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
             }
             if sink.wants_images() {
                 self.collect_all(&mut stats)?;
                 // The last image is the one `render` returns: with its exposure settled.
                 if i + 1 == frames {
-                    last = self.settle_exposure(last, i, &mut stats)?;
+                    last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
                 }
                 let rgba = self.read_back(last)?;
                 sink.image(i, &rgba)?;
@@ -412,7 +412,7 @@ impl<'a> Renderer<'a> {
         self.collect_all(&mut stats)?;
         if !sink.wants_images() {
             // (An image sequence settled its last frame before handing it over.)
-            last = self.settle_exposure(last, frames - 1, &mut stats)?;
+            last = self.settle_exposure(last, self.settings.clock(frames - 1), &mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         if Output::of(self.settings.technique) == Output::Subpasses {
@@ -445,10 +445,10 @@ impl<'a> Renderer<'a> {
         Ok(RenderOutput { width: self.extent.width, height: self.extent.height, rgba, stats })
     }
 
-    /// Auto exposure: render frame `i` (in slot `last`) again, into the other slot, while the
-    /// EV its image asks for is not the one it used (at most `auto_exposure::REPEATS` times); the slot
-    /// that holds the final image.
-    fn settle_exposure(&mut self, mut last: usize, i: u32, stats: &mut FrameStats) -> Result<usize, RenderError> {
+    /// Auto exposure: render the frame at clock `t` (in slot `last`) again, into the other
+    /// slot, while the EV its image asks for is not the one it used (at most
+    /// `auto_exposure::REPEATS` times); the slot that holds the final image.
+    fn settle_exposure(&mut self, mut last: usize, t: f32, stats: &mut FrameStats) -> Result<usize, RenderError> {
         if !self.settings.meters_exposure() {
             return Ok(last);
         }
@@ -459,11 +459,28 @@ impl<'a> Renderer<'a> {
             }
             stats.exposure_repeats += 1;
             last = (last + 1) % FRAMES_IN_FLIGHT;
-            self.run_frame(last, self.settings.clock(i), stats, None)?;
+            self.run_frame(last, t, stats, None)?;
             self.collect_all(stats)?;
         }
         stats.exposure_ev = Some(self.exposure.slot_ev(last));
         Ok(last)
+    }
+
+    /// Auto exposure: a frame at clock `t` rendered off screen and exposed again until it
+    /// settles, as `render` settles its frames, so that a viewer's first frames start at the
+    /// scene's exposure instead of easing in from 0 EV (a glTF model lit by fitted lights
+    /// wants several EV). Nothing where the exposure is fixed.
+    pub fn settle_first_exposure(&mut self, t: f32) -> Result<(), RenderError> {
+        if !self.settings.meters_exposure() {
+            return Ok(());
+        }
+        let mut stats = FrameStats::new(&self.pass_names());
+        self.collect_all(&mut stats)?;
+        let slot = (self.last_frame + 1) % FRAMES_IN_FLIGHT;
+        self.run_frame(slot, t, &mut stats, None)?;
+        self.collect_all(&mut stats)?;
+        self.last_frame = self.settle_exposure(slot, t, &mut stats)?;
+        Ok(())
     }
 
     /// Auto exposure: move the next frame's EV `share` of the way to the one that brings the

@@ -41,8 +41,9 @@ impl StageTimes {
 }
 
 /// Above this ratio the compute lighting path wins by more than what the measurement can
-/// blur (repeats of one run on lavapipe spread by under 10 %); at or below it, deferred
-/// shading stays in the render pass as a subpass.
+/// blur (repeats of one run on lavapipe spread by under 10 %); below its inverse the fragment
+/// shader does, and deferred shading stays in the render pass as a subpass; in between the
+/// probe cannot choose (`too_close_to_call`).
 pub const COMPUTE_WINS_ABOVE: f64 = 1.25;
 
 /// The lighting path `--technique auto` takes on a device whose probe measured `times` (and
@@ -50,7 +51,9 @@ pub const COMPUTE_WINS_ABOVE: f64 = 1.25;
 /// lights by the same clusters; they differ in the kind of pass that runs the light loop
 /// (compute: `visibility`, whose GPU-culled geometry also beat the G-buffer pass wherever it
 /// was measured, else `deferred-compute`; the render pass's second subpass:
-/// `deferred-clustered`, whose G-buffer reads stay on chip on tiled GPUs).
+/// `deferred-clustered`, whose G-buffer reads stay on chip on tiled GPUs). Where the probe is
+/// `too_close_to_call`, this says deferred-clustered, and `--technique auto` lets the scene
+/// decide.
 pub fn pick_lighting_path(times: &StageTimes, meshlets: bool) -> (Technique, String) {
     let ratio = times.ratio();
     let technique = match (ratio > COMPUTE_WINS_ABOVE, meshlets) {
@@ -64,6 +67,14 @@ pub fn pick_lighting_path(times: &StageTimes, meshlets: bool) -> (Technique, Str
         times.pixels, times.lights, times.fragment.median, times.compute.median
     );
     (technique, why)
+}
+
+/// Whether neither kind of pass wins by more than COMPUTE_WINS_ABOVE (a CPU driver, where
+/// both run on the same cores; any device whose fragment and compute units are the same): the
+/// probe alone cannot choose there (`--technique auto` then renders the scene with each).
+pub fn too_close_to_call(times: &StageTimes) -> bool {
+    let ratio = times.ratio();
+    ratio <= COMPUTE_WINS_ABOVE && ratio * COMPUTE_WINS_ABOVE >= 1.0
 }
 
 /// Deterministic lights over the probe's floor, every one reaching every pixel (radius 1 km
@@ -394,18 +405,33 @@ pub fn quick_probe(ctx: &Context) -> Result<StageTimes, VkError> {
     const MAX_LIGHTS: u32 = 4096;
     let mut probe = StageProbe::new(ctx, 512, 512, MAX_LIGHTS)?;
     let result = (|| {
+        // The loop length first: one pass of each kind per length.
         let mut lights = 16;
         loop {
-            let t = probe.measure(ctx, lights, 1, 3)?;
+            let t = probe.measure(ctx, lights, 0, 1)?;
             if t.fragment.median.min(t.compute.median) >= 1.0 || t.fragment.median.max(t.compute.median) >= 100.0 || lights >= MAX_LIGHTS {
-                return Ok(t);
+                break;
             }
             lights *= 4;
         }
+        // Then both kinds in turn until the GPU's clocks have risen, and the median of repeats.
+        let start = Instant::now();
+        let warm_up_s = if ctx.info.device_type == vk::PhysicalDeviceType::CPU { 0.0 } else { QUICK_WARM_UP_S };
+        while start.elapsed().as_secs_f64() < warm_up_s {
+            probe.measure(ctx, lights, 0, 1)?;
+        }
+        probe.measure(ctx, lights, 0, QUICK_REPEATS)
     })();
     probe.destroy(ctx);
     result
 }
+
+/// The quick probe's warm-up on a GPU: a GPU raises its clocks only under load (and lowers
+/// them while the CPU loads a scene), so the measured repeats come after this much of it (on a
+/// CPU driver none: the loop-length search's passes warmed it).
+const QUICK_WARM_UP_S: f64 = 0.2;
+/// The quick probe's repeats of each kind of pass; their medians are compared.
+const QUICK_REPEATS: u32 = 5;
 
 #[cfg(test)]
 mod tests {
@@ -425,6 +451,10 @@ mod tests {
         assert_eq!(pick_lighting_path(&times(1.0, 1.0), false).0, Technique::DeferredClustered);
         assert_eq!(pick_lighting_path(&times(0.5, 1.0), true).0, Technique::DeferredClustered);
         assert!(pick_lighting_path(&times(33.0, 1.0), true).1.contains("33.00×"));
+        // Within the margin either way the probe cannot choose (auto renders the scene).
+        for (fragment, close) in [(1.0, true), (1.25, true), (0.8, true), (1.3, false), (0.75, false), (33.0, false)] {
+            assert_eq!(too_close_to_call(&times(fragment, 1.0)), close, "{fragment}");
+        }
     }
 
     #[test]

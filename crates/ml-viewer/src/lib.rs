@@ -357,6 +357,8 @@ impl<'c> Session<'c> {
             if let Some(c) = camera {
                 r.set_camera(c)?;
             }
+            // Auto exposure starts where it settles, not dark.
+            r.settle_first_exposure(self.clock)?;
             Ok(r)
         });
         match (made, self.built.clone()) {

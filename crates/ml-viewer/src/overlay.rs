@@ -130,6 +130,9 @@ impl Choices {
 /// Frames the graph shows.
 const GRAPH_FRAMES: usize = 240;
 
+/// The smallest window (points) the overlay opens in by itself.
+const ROOMY: egui::Vec2 = egui::vec2(960.0, 540.0);
+
 /// What the overlay shows besides the choices.
 pub struct OverlayState {
     pub visible: bool,
@@ -146,6 +149,8 @@ pub struct OverlayState {
     pub error: Option<String>,
     /// The EV the newest frame was exposed with (auto exposure moves it).
     pub exposure_ev: f32,
+    /// Whether the window had room for the open panel when last drawn (None: not yet drawn).
+    pub roomy: Option<bool>,
 }
 
 impl OverlayState {
@@ -159,6 +164,7 @@ impl OverlayState {
             seed_scene,
             error: None,
             exposure_ev: 0.0,
+            roomy: None,
         }
     }
 
@@ -175,7 +181,21 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
     if !state.visible {
         return;
     }
-    egui::Window::new("manylights").default_pos([8.0, 8.0]).resizable(false).show(ctx, |ui| {
+    // The open panel is about 300×600 points: in a smaller window it starts folded to its
+    // title bar (a click opens it), and it opens or folds again whenever the window crosses
+    // ROOMY; in between it stays as the user left it, and scrolls where it is taller than
+    // the window.
+    let screen = ctx.content_rect().size();
+    let roomy = screen.x >= ROOMY.x && screen.y >= ROOMY.y;
+    let id = egui::Id::new("manylights overlay");
+    if state.roomy != Some(roomy) {
+        state.roomy = Some(roomy);
+        let mut folding = egui::collapsing_header::CollapsingState::load_with_default_open(ctx, id.with("collapsing"), roomy);
+        folding.set_open(roomy);
+        folding.store(ctx);
+    }
+    let window = egui::Window::new("manylights").id(id).default_pos([8.0, 8.0]).resizable(false);
+    window.vscroll(true).max_height((screen.y - 48.0).max(60.0)).show(ctx, |ui| {
         combo(ui, "Technique", &mut choices.technique, &Technique::ALL, |t| t.name());
         if choices.technique.geometry() == Geometry::Meshlets {
             let split = if choices.raster.split() > 0 { choices.raster.split() } else { Raster::DEFAULT_SPLIT };

@@ -564,8 +564,8 @@ fn auto_renders_what_it_picked() {
 }
 
 /// `--raster auto` renders the scene with each rasteriser (hardware, hybrid, compute), keeps
-/// the one whose frames took least time, and says so with every time; a rasteriser the
-/// settings cannot take is one error line.
+/// the first of compute, hybrid, hardware whose frames took within 10 % of the least time, and
+/// says so with every time; a rasteriser the settings cannot take is one error line.
 #[test]
 fn raster_auto_keeps_the_faster_and_says_why() {
     let png = temp_png("raster-auto.png");
@@ -578,10 +578,13 @@ fn raster_auto_keeps_the_faster_and_says_why() {
         let head = &why[..why.find(&format!(" ms {name}")).unwrap_or_else(|| panic!("{why}"))];
         head.split_whitespace().next_back().unwrap().parse().unwrap_or_else(|_| panic!("{why}"))
     };
-    let times = ["hardware", "hybrid", "compute"].map(|name| (ms(name), name));
+    // In the order of preference: the first within 10 % of the fastest is kept.
+    let times = ["compute", "hybrid", "hardware"].map(|name| (ms(name), name));
     let raster = stdout.lines().find(|l| l.starts_with("raster ")).expect("a raster row");
-    let fastest = times.iter().min_by(|a, b| a.0.total_cmp(&b.0)).unwrap().1;
-    assert!(raster.split_whitespace().nth(1) == Some(fastest) && raster.ends_with("(auto)"), "{raster} ({why})");
+    let fastest = times.iter().map(|t| t.0).fold(f64::INFINITY, f64::min);
+    let kept = times.iter().find(|t| t.0 <= fastest * 1.1).unwrap().1;
+    assert!(raster.split_whitespace().nth(1) == Some(kept) && raster.ends_with("(auto)"), "{raster} ({why})");
+    assert!(why.contains("medians of 3 frames after a warm-up") && why.contains("within 10 % of the fastest"), "{why}");
     for (extra, needles) in [
         (&["--technique", "forward", "--raster", "compute"][..], &["--raster does not apply to forward", "--technique visibility"][..]),
         (&["--technique", "visibility", "--raster", "compute", "--raster-split", "0"][..], &["--raster-split 0", "1 to 64"][..]),
@@ -627,6 +630,7 @@ fn transparent_layers_report_their_memory_and_what_did_not_fit() {
     let png = temp_png("glass.png");
     let render = |extra: &[&str]| {
         let mut args = vec!["render", "--validation", "--width", "64", "--height", "36", "--out", png.to_str().unwrap()];
+        args.extend_from_slice(&["--technique", "deferred-clustered"]);
         args.extend_from_slice(extra);
         manylights(&args, &[])
     };
