@@ -219,12 +219,16 @@ pub fn pick_raster(ctx: &Context, scene: &Scene, settings: &RenderSettings, cand
 
 /// Frames each candidate renders in auto's scene probes, after its warm-up.
 pub const PROBE_FRAMES: usize = 3;
-/// A candidate's warm-up on a GPU: frames until this much wall time has passed (a GPU raises
-/// its clocks only under load, and lowers them while the CPU loads the scene), one at least;
-/// on a CPU driver one frame (no clocks to raise).
+/// A candidate's warm-up on a GPU: frames for at least this much wall time (a GPU raises its
+/// clocks only under load, and lowers them while the CPU makes the next candidate's
+/// pipelines), and then until its frames stop getting faster (STEADY), at most
+/// WARM_UP_MAX_MS; on a CPU driver one frame (no clocks to raise).
 const WARM_UP_MS: f64 = 200.0;
-/// The most warm-up frames, whatever the time.
-const WARM_UP_FRAMES: u32 = 256;
+const WARM_UP_MAX_MS: f64 = 1500.0;
+/// Frames whose median is within this share of the median of the frames before them are
+/// the steady state (each group WARM_UP_GROUP frames).
+const STEADY: f64 = 0.03;
+const WARM_UP_GROUP: usize = 5;
 /// A candidate whose first timed frame takes this many times the best median so far is out
 /// after that frame (on a CPU driver the slow rasters take seconds a frame).
 const CLEARLY_SLOWER: f64 = 2.0;
@@ -261,17 +265,19 @@ fn time_renders(ctx: &Context, scene: &Scene, settings: RenderSettings, best: f6
         Ok(stats.gpu_ms().map_or(stats.wall_ms_per_frame(), |passes| passes.iter().map(|(_, ms)| ms).sum()))
     };
     let start = std::time::Instant::now();
+    let elapsed_ms = || start.elapsed().as_secs_f64() * 1e3;
     let first = frame()?;
-    let warm_up_ms = if ctx.info.device_type == ml_vk::vk::PhysicalDeviceType::CPU { 0.0 } else { WARM_UP_MS };
-    let warmed = |ms: f64| ms >= warm_up_ms;
-    if warmed(start.elapsed().as_secs_f64() * 1e3) && first > CLEARLY_SLOWER * best {
-        return Ok(Frames(first, 1));
-    }
-    for _ in 1..WARM_UP_FRAMES {
-        if warmed(start.elapsed().as_secs_f64() * 1e3) {
-            break;
+    if ctx.info.device_type == ml_vk::vk::PhysicalDeviceType::CPU || elapsed_ms() >= WARM_UP_MS {
+        // One frame took the warm-up's time (a CPU driver warms up in one): a candidate
+        // clearly slower than the best is out after it.
+        if first > CLEARLY_SLOWER * best {
+            return Ok(Frames(first, 1));
         }
-        frame()?;
+    } else {
+        let mut warm = vec![first];
+        while elapsed_ms() < WARM_UP_MAX_MS && !(elapsed_ms() >= WARM_UP_MS && steady(&warm)) {
+            warm.push(frame()?);
+        }
     }
     let mut times = Vec::new();
     while times.len() < PROBE_FRAMES {
@@ -282,6 +288,22 @@ fn time_renders(ctx: &Context, scene: &Scene, settings: RenderSettings, best: f6
     }
     times.sort_by(f64::total_cmp);
     Ok(Frames(times[times.len() / 2], times.len()))
+}
+
+/// Whether the last WARM_UP_GROUP frames of `times` are as fast as the group before them
+/// (within STEADY): the clocks have stopped rising.
+fn steady(times: &[f64]) -> bool {
+    let n = times.len();
+    if n < 2 * WARM_UP_GROUP {
+        return false;
+    }
+    let median = |group: &[f64]| {
+        let mut g = group.to_vec();
+        g.sort_by(f64::total_cmp);
+        g[g.len() / 2]
+    };
+    let (before, last) = (median(&times[n - 2 * WARM_UP_GROUP..n - WARM_UP_GROUP]), median(&times[n - WARM_UP_GROUP..]));
+    last >= before * (1.0 - STEADY)
 }
 
 /// The first of `preference` among `timed` whose time is within PICK_MARGIN of the fastest.
@@ -340,6 +362,18 @@ mod tests {
         assert_eq!(pick_within_margin(&[t("other", 0.5), t("compute", 3.0)], &order), "other");
         let line = describe(&[t("hardware", 1.0), Timed { candidate: "compute", ms: 9.0, frames: 1 }], |n| n);
         assert!(line.contains("1.000 ms hardware, 9.000 ms compute") && line.ends_with("compute out after one frame)"), "{line}");
+    }
+
+    /// The warm-up ends once a group of frames is no faster than the group before it.
+    #[test]
+    fn frames_are_steady_once_they_stop_getting_faster() {
+        let rising: Vec<f64> = (0..10).map(|i| 2.0 - 0.1 * i as f64).collect();
+        assert!(!steady(&rising), "still getting faster");
+        assert!(steady(&[1.0; 10]) && steady(&[1.0, 1.0, 1.0, 1.0, 1.0, 1.02, 0.99, 1.0, 0.98, 1.01]));
+        assert!(!steady(&[1.0; 9]), "too few frames to tell");
+        let mut settled = rising.clone();
+        settled.extend([1.0; 10]);
+        assert!(steady(&settled));
     }
 
     #[test]
