@@ -1,8 +1,9 @@
 // G-buffer of the deferred techniques: 16 bytes per pixel besides depth — the normal
 // (octahedral, two floats: exact enough that the seed's sharp highlights do not move), the
 // object's index (its material comes from the object buffer at full precision) and the
-// surface's albedo factor (the base-colour or blinn-phong texture; 1 for the seed model) with
-// the ambient occlusion in alpha — and, in scenes whose objects have textures of their own
+// surface's albedo factor (the base-colour or blinn-phong texture; 1 for the seed model;
+// sRGB-encoded by its image's format, so a texture's darks keep their steps) with the ambient
+// occlusion in alpha — and, in scenes whose objects have textures of their own
 // (GBUFFER_MATERIAL), 6 more: the roughness and metallic factors and the emissive factor
 // (targets.rs). Position comes from depth.
 #include "common/common.glsl"

@@ -267,12 +267,12 @@ mod tests {
         assert_eq!(value(&rows, "gpu ms"), "n/a (device has no timestamp queries)");
         assert_eq!(
             value(&rows, "g-buffer"),
-            "16 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8); transient, lazily allocated"
+            "16 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo (sRGB)-occlusion RGBA8); transient, lazily allocated"
         );
         facts.object_textures = true;
         facts.auto = Some("it was faster");
         let rows = render_rows(&facts, &stats);
-        assert!(value(&rows, "g-buffer").starts_with("22 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo-occlusion RGBA8, roughness-metallic RG8, emissive RGBA8)"));
+        assert!(value(&rows, "g-buffer").starts_with("22 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo (sRGB)-occlusion RGBA8, roughness-metallic RG8, emissive RGBA8)"));
         assert_eq!((value(&rows, "technique").as_str(), value(&rows, "auto").as_str()), ("deferred-clustered (auto)", "it was faster"));
         let forward = RenderSettings::new(Technique::Forward, 64, 36);
         let rows = render_rows(&RenderFacts { settings: &forward, ..facts }, &stats);

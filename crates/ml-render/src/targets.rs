@@ -18,7 +18,9 @@ pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// subpass's inputs after depth, deferred-compute's bindings): the octahedral normal in two
 /// floats (8 B; half floats would move the seed's sharp highlights by several 8-bit steps),
 /// the object's index (4 B; its material is read from the object buffer at full precision),
-/// the albedo factor with the ambient occlusion in alpha (4 B) — 16 B/pixel besides depth —
+/// the albedo factor sRGB-encoded with the ambient occlusion in alpha (4 B: a texture's dark
+/// base colours keep the 8-bit steps they have in the texture; stored linear, a dark texel of
+/// a model exposed several EV up moved the image by up to 6/255) — 16 B/pixel besides depth —
 /// then, only in scenes whose objects have textures of their own (`gbuffer_images`), the
 /// roughness and metallic factors (2 B) and the emissive factor (4 B, sRGB like its texture).
 pub const GBUFFER: [GBufferImage; 5] = [
@@ -29,9 +31,9 @@ pub const GBUFFER: [GBufferImage; 5] = [
     GBufferImage {
         key: "albedo",
         name: "g-buffer albedo-occlusion",
-        format: vk::Format::R8G8B8A8_UNORM,
+        format: vk::Format::R8G8B8A8_SRGB,
         bytes: 4,
-        layout: "albedo-occlusion RGBA8",
+        layout: "albedo (sRGB)-occlusion RGBA8",
     },
     GBufferImage {
         key: "roughness_metallic",

@@ -251,3 +251,35 @@ fn a_minified_texture_is_read_from_its_mipmaps() {
         }
     }
 }
+
+/// A dark base-colour texture (sRGB 0–63, the darks of real models) seen at +5 EV, as auto
+/// exposure shows a model lit by fitted lights: every technique gives forward's image within
+/// the deferred tolerance (2/255). The G-buffer keeps the albedo sRGB-encoded, with the steps
+/// the texture itself has; stored linear in 8 bits, these texels moved the image by up to
+/// 7/255 (a public helmet model: 4,395 of 102,400 pixels beyond 1/255).
+#[test]
+fn dark_textures_keep_their_steps_through_the_gbuffer() {
+    let mut w = GltfWriter::new();
+    let texels: Vec<u8> = (0..32 * 32u32)
+        .flat_map(|i| {
+            let v = ((i * 7) % 64) as u8;
+            [v, (v / 2) + 8, 63 - v, 255]
+        })
+        .collect();
+    let texture = w.texture(png(32, 32, &texels), "image/png");
+    let material = w.textured_material(Some(texture), None);
+    let mut scene = row_of_quads(&mut w, &[(material, 0.0)], 1.2, 1.0);
+    scene.lights = vec![ml_cpu::gpu_types::PointLight { position_radius: [0.3, -0.2, 1.5, 6.0], color: [1.0, 1.0, 1.0, 0.0] }];
+    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, DebugView::None, (SIZE, SIZE))
+        .into_iter()
+        .map(|s| RenderSettings { exposure: ml_render::Exposure::Ev(5.0), ..s })
+        .collect();
+    let out = common::render_each(&scene, &settings);
+    let lit = out[0].rgba.chunks_exact(4).filter(|p| p[0].max(p[1]).max(p[2]) > 40).count();
+    assert!(lit > SIZE as usize * SIZE as usize / 4, "the quad is hardly lit: {lit} pixels");
+    for (s, o) in settings.iter().zip(&out).skip(1) {
+        let (worst, pixels) = common::max_difference(&out[0], o);
+        println!("{}: {pixels} pixels differ from forward, by up to {worst}/255", s.technique.name());
+        assert!(worst <= 2, "{}: differs from forward by {worst}/255 on dark texels", s.technique.name());
+    }
+}
