@@ -379,6 +379,11 @@ pub fn bench(a: &mut BenchArgs) -> Result<()> {
     let Asked { choices, counts, resolution, rasters, sample_counts, rules, named, auto } = asked(a)?;
     let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Plan::new(a, resolution)?) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
+    // What the run writes, checked before it runs (a bad path must not cost a sweep).
+    let outputs: &[&str] = if a.probe { &PROBE_RESULTS } else { &RESULTS };
+    for name in outputs {
+        ml_cpu::files::check_writable(&a.out.join(name))?;
+    }
     if let Some(note) = note {
         eprintln!("{note}");
     }
@@ -617,21 +622,22 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
         "auto": auto,
         "results": rows,
     });
-    write_file(a, "results.csv", &csv)?;
-    write_file(a, "results.json", &serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
     // Always a plot, empty (and saying why) where nothing was measured.
     let series = frame_times(results, skip);
     let (size, rgb) = plot(&series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
     let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
-    ml_cpu::files::write_png(&a.out.join("results.png"), &rgba, size)?;
+    let [csv_path, json_path, png_path] = RESULTS.map(|name| a.out.join(name));
+    let png = ml_cpu::files::png_bytes(&png_path, &rgba, size)?;
+    let json = serde_json::to_string_pretty(&report).expect("plain JSON values");
+    // The three replace an earlier run's together, or none does.
+    ml_cpu::files::write_all_replacing(&[(csv_path, csv.clone().into_bytes()), (json_path, json.into_bytes()), (png_path, png)])?;
     print!("{csv}");
     Ok(())
 }
 
-/// Write `name` in the output folder, replacing an earlier run's only once complete.
-fn write_file(a: &BenchArgs, name: &str, text: &str) -> Result<()> {
-    Ok(ml_cpu::files::write_bytes_replacing(&a.out.join(name), text.as_bytes())?)
-}
+/// What a bench run writes in its folder, and a probe run.
+const RESULTS: [&str; 3] = ["results.csv", "results.json", "results.png"];
+pub const PROBE_RESULTS: [&str; 2] = ["probe.csv", "probe.json"];
 
 /// The raster column: the visibility technique's rasteriser, empty for the others.
 fn raster_name(v: Variant) -> &'static str {

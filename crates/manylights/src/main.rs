@@ -389,6 +389,15 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(code) => return code,
     };
+    // Interrupted (Ctrl+C, SIGTERM, SIGHUP), a render or bench leaves no temporary file beside
+    // its outputs: every finished output was renamed into place whole, the one being written
+    // is removed. (The handler runs on a thread of its own, so it may take locks.)
+    if let Err(e) = ctrlc::set_handler(|| {
+        ml_cpu::files::remove_temporaries();
+        std::process::exit(130);
+    }) {
+        eprintln!("warning: no signal handler ({e}): an interrupted write may leave a .partial file beside its output");
+    }
     let result = match cli.command {
         Command::Render(args) => render(&args),
         Command::View(args) => view(&args),
@@ -694,7 +703,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let sequence = output::sequence_pattern(&cmd.out)?;
     let built = request.build()?;
     check_options_apply(args, &request.source, Some(&built), &techniques)?;
-    output::prepare(&cmd.out, sequence.as_ref())?;
+    output::prepare(&cmd.out, sequence.as_ref(), cmd.frames)?;
     let mut settings = wanted.for_scene(&built.scene, built.shading);
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();

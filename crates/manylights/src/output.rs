@@ -30,16 +30,20 @@ pub fn sequence_path((before, after, digits): &SequencePattern, i: u32) -> PathB
     PathBuf::from(format!("{before}{i:0digits$}{after}"))
 }
 
-/// Fail before rendering if the image (or a sequence's first frame) could not be written:
-/// nothing is computed for nothing. A sequence's folder is made for it (a single image's
-/// must exist).
-pub fn prepare(out: &Path, sequence: Option<&SequencePattern>) -> Result<()> {
+/// Fail before rendering if the image (or any of a sequence's `frames` frames) could not be
+/// written: nothing is computed for nothing, and a sequence never stops after replacing some
+/// of an earlier run's frames. A sequence's folder is made for it (a single image's must
+/// exist).
+pub fn prepare(out: &Path, sequence: Option<&SequencePattern>, frames: u32) -> Result<()> {
     let Some(pattern) = sequence else { return Ok(files::check_writable(out)?) };
     let first = sequence_path(pattern, 0);
     if let Some(folder) = first.parent().filter(|p| !p.as_os_str().is_empty() && !p.is_dir()) {
         std::fs::create_dir_all(folder).with_context(|| format!("cannot make folder '{}'", folder.display()))?;
     }
-    Ok(files::check_writable(&first)?)
+    for i in 0..frames.max(1) {
+        files::check_writable(&sequence_path(pattern, i))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

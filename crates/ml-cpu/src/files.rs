@@ -1,6 +1,8 @@
 //! Files written so that nothing is lost: an output is made beside its target under a
-//! temporary name and renamed over it only once it is complete, so a full disk, a killed
-//! process or an encoder error leaves the previous file byte-identical and no partial file.
+//! temporary name and renamed over it only once it is complete, so a full disk, an
+//! interrupted process (the binary removes the temporary files on a signal:
+//! `remove_temporaries`) or an encoder error leaves the previous file byte-identical and no
+//! partial file; the replacement keeps the replaced file's mode.
 //! And files read so that a hostile one cannot hang or exhaust us: regular files only, never
 //! more bytes than a cap (`read_regular`).
 
@@ -8,6 +10,25 @@ use std::fs::{File, OpenOptions};
 use std::io::{self, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
+
+/// The temporary files this process is writing: removed by `remove_temporaries` when a signal
+/// ends the process (the binary's SIGINT/SIGTERM handler), so an interrupted write leaves
+/// nothing beside its output.
+static TEMPORARIES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Remove every temporary file this process has open for writing (none is renamed after it:
+/// call it only on the way out).
+pub fn remove_temporaries() {
+    let temps = TEMPORARIES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    for t in temps.iter() {
+        let _ = std::fs::remove_file(t);
+    }
+}
+
+fn forget_temporary(temp: &Path) {
+    let mut temps = TEMPORARIES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    temps.retain(|t| t != temp);
+}
 
 /// Why an output could not be written (the path is named in the message).
 #[derive(Debug, Error)]
@@ -57,6 +78,7 @@ pub fn check_writable(path: &Path) -> Result<(), WriteError> {
     let (file, temp) = create_temporary(path, &target)?;
     drop(file);
     let _ = std::fs::remove_file(&temp);
+    forget_temporary(&temp);
     Ok(())
 }
 
@@ -68,15 +90,30 @@ where
     F: FnOnce(&mut BufWriter<File>) -> io::Result<()>,
 {
     let target = output_target(path)?;
+    let previous = std::fs::metadata(&target).ok();
+    #[cfg(unix)]
+    if let Some(links) = previous.as_ref().map(std::os::unix::fs::MetadataExt::nlink).filter(|&n| n > 1) {
+        // A rename gives the path a new file: the other names keep the old bytes.
+        eprintln!(
+            "warning: '{}' has {} other hard link(s): it is replaced by a new file, which they do not share",
+            path.display(),
+            links - 1
+        );
+    }
     let (file, temp) = create_temporary(path, &target)?;
     let written = (|| {
         let mut out = BufWriter::new(file);
         write(&mut out)?;
         let file = out.into_inner().map_err(|e| e.into_error())?;
+        // The replacement keeps the replaced file's mode (a 0600 output stays private).
+        if let Some(meta) = &previous {
+            file.set_permissions(meta.permissions())?;
+        }
         // Renaming before the bytes are on disk could leave an empty file after a crash.
         file.sync_all()?;
         std::fs::rename(&temp, &target)
     })();
+    forget_temporary(&temp);
     written.map_err(|source| {
         let _ = std::fs::remove_file(&temp);
         WriteError::Io { path: path.to_owned(), source }
@@ -89,15 +126,67 @@ pub fn write_bytes_replacing(path: &Path, bytes: &[u8]) -> Result<(), WriteError
 }
 
 /// An RGBA8 image of `width` × `height` as a PNG at `path`, replacing it only once complete.
-pub fn write_png(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<(), WriteError> {
-    // (The encoder asserts this; a mistake must be an error, not a panic.)
+pub fn write_png(path: &Path, rgba: &[u8], size: (u32, u32)) -> Result<(), WriteError> {
+    check_image(path, rgba, size)?;
+    write_replacing(path, |out| encode_png(out, rgba, size))
+}
+
+/// The same image as PNG bytes (for `write_all_replacing`); errors name `path`.
+pub fn png_bytes(path: &Path, rgba: &[u8], size: (u32, u32)) -> Result<Vec<u8>, WriteError> {
+    check_image(path, rgba, size)?;
+    let mut bytes = io::Cursor::new(Vec::new());
+    encode_png(&mut bytes, rgba, size).map_err(|source| WriteError::Io { path: path.to_owned(), source })?;
+    Ok(bytes.into_inner())
+}
+
+/// Whether `rgba` holds a `width` × `height` image: the encoder asserts it, and a mistake must
+/// be an error, not a panic.
+fn check_image(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<(), WriteError> {
     if (width as usize).checked_mul(height as usize).and_then(|n| n.checked_mul(4)) != Some(rgba.len()) {
         return Err(WriteError::refused(path, format!("{} bytes are not a {width}×{height} RGBA image", rgba.len())));
     }
-    write_replacing(path, |out| {
-        image::write_buffer_with_format(out, rgba, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
-            .map_err(io::Error::other)
-    })
+    Ok(())
+}
+
+fn encode_png(out: &mut (impl Write + io::Seek), rgba: &[u8], (width, height): (u32, u32)) -> io::Result<()> {
+    image::write_buffer_with_format(out, rgba, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
+        .map_err(io::Error::other)
+}
+
+/// Several outputs replaced together: every one written beside its target and on disk before
+/// any is renamed into place, so a failure (a full disk, a bad path) leaves all of them as
+/// they were — results that belong together (a table, its JSON and its plot) never mix two
+/// runs. (The renames themselves follow one another.)
+pub fn write_all_replacing(outputs: &[(PathBuf, Vec<u8>)]) -> Result<(), WriteError> {
+    let mut ready: Vec<(PathBuf, PathBuf)> = Vec::new();
+    let mut written = || -> Result<(), WriteError> {
+        for (path, bytes) in outputs {
+            let target = output_target(path)?;
+            let (file, temp) = create_temporary(path, &target)?;
+            ready.push((temp.clone(), target.clone()));
+            let previous = std::fs::metadata(&target).ok();
+            let io = |source| WriteError::Io { path: path.clone(), source };
+            let mut out = BufWriter::new(file);
+            out.write_all(bytes).map_err(io)?;
+            let file = out.into_inner().map_err(|e| io(e.into_error()))?;
+            if let Some(meta) = previous {
+                file.set_permissions(meta.permissions()).map_err(io)?;
+            }
+            file.sync_all().map_err(io)?;
+        }
+        for ((temp, target), (path, _)) in ready.iter().zip(outputs) {
+            std::fs::rename(temp, target).map_err(|source| WriteError::Io { path: path.clone(), source })?;
+        }
+        Ok(())
+    };
+    let result = written();
+    for (temp, _) in &ready {
+        forget_temporary(temp);
+        if result.is_err() {
+            let _ = std::fs::remove_file(temp);
+        }
+    }
+    result
 }
 
 /// The folder `path` is in ("." for a bare name).
@@ -105,21 +194,56 @@ fn parent_folder(path: &Path) -> &Path {
     path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."))
 }
 
+/// The longest file name the temporary name takes from its target: with the dot, the process
+/// id and the suffix it stays within the 255 bytes file systems allow, whatever the target's
+/// own name.
+const TEMPORARY_NAME_BYTES: usize = 200;
+
 /// A new file beside `target` (hidden, named after it and this process, never an existing
-/// file); errors name `shown`, the path the user gave.
+/// file), registered for removal on a signal; errors name `shown`, the path the user gave.
+/// An existing target this process may not write is refused rather than replaced around it
+/// (a rename needs only the folder's permission).
 fn create_temporary(shown: &Path, target: &Path) -> Result<(File, PathBuf), WriteError> {
+    if target.exists() && !may_write(target) {
+        return Err(WriteError::refused(shown, "it is read-only to this user (its permissions say so; it is not replaced)"));
+    }
     let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let mut cut = name.len().min(TEMPORARY_NAME_BYTES);
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
     let folder = parent_folder(target);
     let mut last = None;
     for attempt in 0..16u32 {
-        let temp = folder.join(format!(".{name}.{}-{attempt}.partial", std::process::id()));
+        let temp = folder.join(format!(".{}.{}-{attempt}.partial", &name[..cut], std::process::id()));
+        let mut temps = TEMPORARIES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         match OpenOptions::new().write(true).create_new(true).open(&temp) {
-            Ok(file) => return Ok((file, temp)),
+            Ok(file) => {
+                temps.push(temp.clone());
+                return Ok((file, temp));
+            }
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last = Some(e),
             Err(source) => return Err(WriteError::Io { path: shown.to_owned(), source }),
         }
     }
     Err(WriteError::Io { path: shown.to_owned(), source: last.expect("sixteen attempts made") })
+}
+
+/// Whether this process may write `path` (the permission bits and who owns it, as the kernel
+/// decides them).
+#[cfg(unix)]
+fn may_write(path: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    match std::ffi::CString::new(path.as_os_str().as_bytes()) {
+        // SAFETY: a valid, NUL-terminated path; access() only reads it.
+        Ok(c) => unsafe { libc::access(c.as_ptr(), libc::W_OK) == 0 },
+        Err(_) => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn may_write(path: &Path) -> bool {
+    std::fs::metadata(path).map(|m| !m.permissions().readonly()).unwrap_or(false)
 }
 
 /// Why a file could not be read (the path is named by whoever asked for it).
@@ -249,6 +373,35 @@ mod tests {
         write_bytes_replacing(&path, b"new bytes").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new bytes");
         assert_eq!(entries(&d), ["out.png"]);
+    }
+
+    /// A replaced output keeps its mode; a name of 255 bytes (the most a file system takes)
+    /// is written, its temporary name shortened; a temporary file is registered for removal.
+    #[cfg(unix)]
+    #[test]
+    fn a_replacement_keeps_the_mode_and_any_name_fits() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = dir("mode-and-names");
+        let private = d.join("private.bin");
+        std::fs::write(&private, b"old").unwrap();
+        std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_bytes_replacing(&private, b"new").unwrap();
+        assert_eq!(std::fs::metadata(&private).unwrap().permissions().mode() & 0o777, 0o600);
+        assert_eq!(std::fs::read(&private).unwrap(), b"new");
+        for name in ["a".repeat(255), "é".repeat(127)] {
+            let long = d.join(&name);
+            write_bytes_replacing(&long, b"long").unwrap_or_else(|e| panic!("{} bytes: {e}", name.len()));
+            write_bytes_replacing(&long, b"again").unwrap();
+            assert_eq!(std::fs::read(&long).unwrap(), b"again");
+        }
+        // (remove_temporaries itself would take other tests' files: the command-line test
+        // interrupts a sequence.)
+        let (_, temp) = create_temporary(&private, &private).unwrap();
+        assert!(TEMPORARIES.lock().unwrap().contains(&temp), "a temporary file not registered for removal");
+        forget_temporary(&temp);
+        std::fs::remove_file(&temp).unwrap();
+        let left: Vec<String> = entries(&d).into_iter().filter(|e| e.ends_with(".partial")).collect();
+        assert!(left.is_empty(), "{left:?}");
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! their ratio — written to probe.csv and probe.json, with what `--technique auto` makes of
 //! the longest loop measured.
 
-use super::{spread_json, write_file, BenchArgs};
+use super::{spread_json, BenchArgs};
 use anyhow::{bail, Result};
 use ml_render::stage_probe::{pick_lighting_path, StageProbe, StageTimes};
 use ml_vk::Context;
@@ -121,8 +121,10 @@ pub fn write(a: &BenchArgs, (w, h): (u32, u32), device: &Value, meshlets: bool, 
         "auto": pick.as_ref().map(|(technique, why)| json!({ "technique": technique.name(), "why": why })),
         "results": json_rows,
     });
-    write_file(a, "probe.csv", &csv)?;
-    write_file(a, "probe.json", &serde_json::to_string_pretty(&report).expect("plain JSON values"))?;
+    // The two replace an earlier run's together, or neither does.
+    let json = serde_json::to_string_pretty(&report).expect("plain JSON values");
+    let [csv_path, json_path] = super::PROBE_RESULTS.map(|name| a.out.join(name));
+    ml_cpu::files::write_all_replacing(&[(csv_path, csv.clone().into_bytes()), (json_path, json.into_bytes())])?;
     print!("{csv}");
     match pick {
         Some((technique, why)) => crate::auto::announce(technique, &why),

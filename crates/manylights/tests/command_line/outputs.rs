@@ -98,6 +98,66 @@ fn a_sequence_into_a_full_disk_keeps_the_previous_frames() {
     assert!(files(&d) == before, "the frames changed: {:?}", files(&d).keys().collect::<Vec<_>>());
 }
 
+/// A sequence whose later frame cannot be written (here a folder where frame 2 goes) is
+/// refused before the first frame: an earlier run's frames stay as they were, not a mix of
+/// two runs.
+#[test]
+fn a_sequence_with_a_bad_later_frame_changes_nothing() {
+    let d = dir("bad-later-frame");
+    let pattern = d.join("##.png");
+    let sequence = |lights: &str| {
+        let mut args = vec!["render", "--frames", "3", "--lights", lights, "--out", pattern.to_str().unwrap()];
+        args.extend(SMALL);
+        manylights(&args, None)
+    };
+    ok(&sequence("16"));
+    std::fs::remove_file(d.join("02.png")).unwrap();
+    std::fs::create_dir(d.join("02.png")).unwrap();
+    let before = files(&d);
+    assert_one_line_error(&sequence("32"), &["cannot write", "02.png", "it is a directory"]);
+    assert!(files(&d) == before, "the frames changed: {:?}", files(&d).keys().collect::<Vec<_>>());
+}
+
+/// Ctrl+C (SIGINT) while a frame of an image sequence is being written (its temporary file
+/// seen beside the finished ones, frames of 1024×1024 so that writing takes a while): the
+/// process ends, every frame it finished is a whole PNG, and no temporary file is left.
+#[test]
+fn an_interrupted_sequence_leaves_whole_frames_and_no_partial_file() {
+    let d = dir("interrupted");
+    let pattern = d.join("####.png");
+    let args = ["render", "--technique", "forward", "--resolution", "1024x1024", "--frames", "200", "--lights", "16"];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args(args)
+        .args(["--out", pattern.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let names = || -> Vec<String> {
+        std::fs::read_dir(&d).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect()
+    };
+    let start = std::time::Instant::now();
+    loop {
+        let now = names();
+        if now.iter().any(|n| n.ends_with(".partial")) && now.len() >= 4 {
+            break;
+        }
+        assert!(start.elapsed().as_secs() < 180, "no frame being written after three frames: {now:?}");
+        assert!(child.try_wait().unwrap().is_none(), "the sequence ended before it was interrupted");
+    }
+    // SAFETY: a signal to the child we started, which has not been waited for.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGINT) }, 0);
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "interrupted, it still says it succeeded");
+    let left = names();
+    let partial: Vec<_> = left.iter().filter(|n| n.ends_with(".partial")).collect();
+    assert!(partial.is_empty(), "left behind: {partial:?}");
+    assert!(left.len() >= 3 && left.len() < 200, "{} frames", left.len());
+    for name in &left {
+        let frame = image::open(d.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!((frame.width(), frame.height()), (1024, 1024), "{name}");
+    }
+}
+
 #[test]
 fn a_bench_into_a_full_disk_keeps_the_previous_results() {
     let d = dir("bench");
@@ -123,6 +183,15 @@ fn a_bench_into_a_full_disk_keeps_the_previous_results() {
     let names: Vec<_> = before.keys().filter_map(|p| p.file_name()).map(|n| n.to_string_lossy().into_owned()).collect();
     assert!(["results.csv", "results.json", "results.png"].iter().all(|n| names.contains(&n.to_string())), "{names:?}");
     assert_one_line_error(&bench(Some(FULL_DISK_BYTES)), &["cannot write", "results.csv"]);
+    assert!(files(&d) == before, "the results changed: {:?}", files(&d).keys().collect::<Vec<_>>());
+    // The plot's path taken by a folder: refused before the run, and the table and its JSON
+    // stay the earlier run's (the three are replaced together or not at all).
+    std::fs::remove_file(d.join("results.png")).unwrap();
+    std::fs::create_dir(d.join("results.png")).unwrap();
+    let before = files(&d);
+    let start = std::time::Instant::now();
+    assert_one_line_error(&bench(None), &["cannot write", "results.png", "it is a directory"]);
+    assert!(start.elapsed().as_secs() < 10, "refused only after {:?}", start.elapsed());
     assert!(files(&d) == before, "the results changed: {:?}", files(&d).keys().collect::<Vec<_>>());
 }
 
