@@ -117,6 +117,24 @@ pub enum GlbHeader {
     Version(u32),
     #[error("the GLB header says {claimed} bytes, the file has {actual}")]
     Length { claimed: u32, actual: usize },
+    #[error("GLB chunk {chunk} ({}) says {claimed} bytes, but {left} follow its 8-byte header", chunk_kind(*kind))]
+    ChunkLength { chunk: usize, kind: u32, claimed: u32, left: usize },
+    #[error("the first GLB chunk is {}, not JSON", chunk_kind(*.0))]
+    FirstNotJson(u32),
+    #[error("{0} bytes after the last GLB chunk are not a chunk (a chunk is an 8-byte header and its bytes)")]
+    Trailing(usize),
+}
+
+/// A GLB chunk's type as its four bytes read ("JSON", "BIN" and others as text where they
+/// are, else in hex).
+fn chunk_kind(kind: u32) -> String {
+    let b = kind.to_le_bytes();
+    let text: String = b.iter().filter(|&&c| c != 0).map(|&c| c as char).collect();
+    if !text.is_empty() && text.chars().all(|c| c.is_ascii_alphanumeric()) {
+        text
+    } else {
+        format!("type 0x{kind:08x}")
+    }
 }
 
 /// What is wrong with a glTF file.
@@ -493,6 +511,24 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), GltfError> {
     if (length as usize) < 12 + 8 || length as usize != bytes.len() {
         return Err(GltfError::Glb(GlbHeader::Length { claimed: length, actual: bytes.len() }));
     }
+    // The chunks: JSON first, then (glTF) the binary chunk and any others, each whole, and
+    // nothing after the last.
+    let mut at = 12;
+    let mut chunk = 0;
+    while at < bytes.len() {
+        let (Some(claimed), Some(kind)) = (word(at), word(at + 4)) else {
+            return Err(GltfError::Glb(GlbHeader::Trailing(bytes.len() - at)));
+        };
+        let left = bytes.len() - at - 8;
+        if claimed as usize > left {
+            return Err(GltfError::Glb(GlbHeader::ChunkLength { chunk, kind, claimed, left }));
+        }
+        if chunk == 0 && kind != u32::from_le_bytes(*b"JSON") {
+            return Err(GltfError::Glb(GlbHeader::FirstNotJson(kind)));
+        }
+        at += 8 + claimed as usize;
+        chunk += 1;
+    }
     Ok(())
 }
 
@@ -635,7 +671,8 @@ fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, 
 /// (percent-encoded) URI names relative to the glTF's folder, inside it (`read_reference`).
 /// URIs with a scheme name files elsewhere, or on the network.
 fn read_uri(uri: &str, base: Option<&Path>, max: u64) -> Result<Vec<u8>, GltfError> {
-    if let Some(rest) = uri.strip_prefix("data:") {
+    // A scheme is case-insensitive (RFC 3986): DATA: is a data URI too.
+    if let Some(rest) = uri.get(..5).filter(|scheme| scheme.eq_ignore_ascii_case("data:")).map(|_| &uri[5..]) {
         let (_, data) = rest.split_once(";base64,").ok_or(GltfError::NotBase64)?;
         return base64::engine::general_purpose::STANDARD.decode(data).map_err(GltfError::Base64);
     }

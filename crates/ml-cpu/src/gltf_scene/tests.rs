@@ -19,7 +19,10 @@ fn a_quad_keeps_its_place_material_and_normals() {
     let m = w.material([0.2, 0.4, 0.6, 1.0], 0.25, 0.75);
     let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
     w.node(json!({ "mesh": mesh, "translation": [1.0, 2.0, 3.0], "scale": [2.0, 1.0, 1.0] }), true);
-    for bytes in [w.to_gltf(), w.to_glb()] {
+    // A URI's scheme is case-insensitive: "DATA:" is a data URI like "data:".
+    let upper = String::from_utf8(w.to_gltf()).unwrap().replace("\"data:", "\"DATA:").into_bytes();
+    assert!(String::from_utf8_lossy(&upper).contains("\"DATA:application"));
+    for bytes in [w.to_gltf(), w.to_glb(), upper] {
         let s = load_bytes(&bytes);
         assert_eq!(s.objects.len(), 1);
         assert_eq!(s.objects[0].material, Material { albedo: Vec3::new(0.2, 0.4, 0.6), roughness: 0.75, metallic: 0.25 });
@@ -397,6 +400,28 @@ fn files_that_break_gltf_rules_or_ranges_are_refused() {
     };
     let mut longer_glb = quad_writer().to_glb();
     longer_glb.extend([0; 8]);
+    // The header's length matching the file, and the chunks not: a JSON chunk claiming more
+    // than the file holds, 5 bytes after the binary chunk (not a chunk: its header alone is
+    // 8), and chunks in the wrong order.
+    let with_length = |mut glb: Vec<u8>| {
+        let length = glb.len() as u32;
+        glb[8..12].copy_from_slice(&length.to_le_bytes());
+        glb
+    };
+    let mut long_json = quad_writer().to_glb();
+    long_json[12..16].copy_from_slice(&100_000u32.to_le_bytes());
+    let mut trailing = quad_writer().to_glb();
+    trailing.extend([1, 2, 3, 4, 5]);
+    let trailing = with_length(trailing);
+    let good = quad_writer().to_glb();
+    let json_length = u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize;
+    let (json, bin) = good[12..].split_at(8 + json_length);
+    let swapped = with_length([&good[..12], bin, json].concat());
+    // An extra chunk of an unknown type after the binary one is glTF's way to extend: read.
+    let mut extended = quad_writer().to_glb();
+    extended.extend([4, 0, 0, 0, b'X', b'T', b'R', b'A', 9, 9, 9, 9]);
+    let extended = with_length(extended);
+    assert!(from_bytes(&extended, None).is_ok(), "a GLB with an extra chunk after its binary chunk is refused");
     let mut same_point = quad_writer();
     for corner in 1..4 {
         let at = corner * 12;
@@ -419,6 +444,9 @@ fn files_that_break_gltf_rules_or_ranges_are_refused() {
         (gltf(&|w| w.json["bufferViews"][0]["byteOffset"] = json!(2)), "in a buffer view at 2"),
         (gltf(&|w| w.json["bufferViews"][0]["byteStride"] = json!(14)), "stride 14) is not a multiple"),
         (longer_glb, "the GLB header says"),
+        (long_json, "GLB chunk 0 (JSON) says 100000 bytes, but"),
+        (trailing, "5 bytes after the last GLB chunk are not a chunk"),
+        (swapped, "the first GLB chunk is BIN, not JSON"),
         (gltf(&|w| w.json["asset"]["version"] = json!("3.0")), "asset.version '3.0' is not glTF 2.x"),
         (gltf(&|w| w.json["asset"]["version"] = json!("2")), "asset.version '2' is not glTF 2.x"),
         (gltf(&|w| w.json["asset"]["version"] = json!("+2.0")), "is not glTF 2.x"),
