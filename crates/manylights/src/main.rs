@@ -363,12 +363,12 @@ impl<T: TryFrom<u64> + Clone + Send + Sync + 'static> clap::builder::TypedValueP
             let range = self.range.map_or_else(|| format!("{} to {}", self.min, self.max), str::to_owned);
             refuse(format!("{text} is out of range: use {range}"))
         };
-        // `16k` and `1M` as bench's light counts are spelt (thousands, millions).
-        let trimmed = text.trim();
-        let (digits, factor) = match trimmed.char_indices().last() {
-            Some((i, 'k' | 'K')) => (&trimmed[..i], 1_000),
-            Some((i, 'M')) => (&trimmed[..i], 1_000_000),
-            _ => (trimmed, 1),
+        // `16k` and `1M` as bench's light counts are spelt (thousands, millions). Nothing
+        // else around the number: ' 5' is a mistake (a quoting slip), not 5.
+        let (digits, factor) = match text.char_indices().last() {
+            Some((i, 'k' | 'K')) => (&text[..i], 1_000),
+            Some((i, 'M')) => (&text[..i], 1_000_000),
+            _ => (&text[..], 1),
         };
         match digits.parse::<i128>().map(|n| n.saturating_mul(factor)) {
             Ok(n) => u64::try_from(n)

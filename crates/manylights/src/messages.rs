@@ -29,7 +29,20 @@ pub fn argument_error(text: &str) -> String {
 /// The error and its causes in one line, as anyhow's `{:#}` writes it, each cause that is
 /// about a flag's value said with that flag.
 pub fn describe(e: &anyhow::Error) -> String {
-    e.chain().map(|cause| with_flags(cause).unwrap_or_else(|| cause.to_string())).collect::<Vec<_>>().join(": ")
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = with_flags(cause).unwrap_or_else(|| cause.to_string());
+        // An error whose message already ends with its source's ("cannot write 'x':
+        // Permission denied (os error 13)") says it once.
+        if line.ends_with(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line += ": ";
+        }
+        line += &text;
+    }
+    line
 }
 
 /// `cause` in the command line's words, where they differ from the library's.
@@ -137,6 +150,17 @@ fn settings(e: &SettingsError) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A write refused by the system names its reason once, though the error both says it and
+    /// keeps it as its source.
+    #[test]
+    fn a_cause_already_said_is_not_said_again() {
+        let denied = std::io::Error::from(std::io::ErrorKind::PermissionDenied);
+        let e = anyhow::Error::new(ml_cpu::files::WriteError::Io { path: "out.png".into(), source: denied });
+        let line = describe(&e.context("render"));
+        assert_eq!(line.matches("ermission denied").count(), 1, "{line}");
+        assert!(line.starts_with("render: cannot write 'out.png': "), "{line}");
+    }
 
     #[test]
     fn argument_errors_keep_every_line() {

@@ -121,8 +121,10 @@ pub struct CameraSpec {
 pub enum CameraSpecError {
     #[error("camera '{0}' is not EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z[:FOV_DEGREES] (finite numbers)")]
     Syntax(String),
-    #[error("camera '{0}': the field of view must lie strictly between 0 and 180 degrees")]
+    #[error("camera '{0}': the field of view must be at least {min} and below 180 degrees", min = crate::limits::MIN_FOV_Y_DEG)]
     FieldOfView(String),
+    #[error("camera '{0}': a coordinate lies beyond ±{max}", max = crate::limits::MAX_COORDINATE)]
+    TooFar(String),
     #[error("camera '{0}': eye and target are the same point, so it looks nowhere")]
     Nowhere(String),
     #[error("camera '{0}' looks straight up or down, where its yaw is undefined: move the target sideways")]
@@ -144,8 +146,11 @@ impl CameraSpec {
             [eye, target, fov] => (point(eye)?, point(target)?, number(fov)?),
             _ => return Err(syntax()),
         };
-        if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) {
+        if !(crate::limits::MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {
             return Err(CameraSpecError::FieldOfView(text.to_owned()));
+        }
+        if position.abs().max(target.abs()).max_element() > crate::limits::MAX_COORDINATE {
+            return Err(CameraSpecError::TooFar(text.to_owned()));
         }
         if position.distance(target) < 1e-6 {
             return Err(CameraSpecError::Nowhere(text.to_owned()));
@@ -192,6 +197,9 @@ mod tests {
         }
         assert!(matches!(CameraSpec::parse("1,2,3:0,0,0:180"), Err(CameraSpecError::FieldOfView(_))));
         assert!(matches!(CameraSpec::parse("1,2,3:0,0,0:0"), Err(CameraSpecError::FieldOfView(_))));
+        assert!(matches!(CameraSpec::parse("1,2,3:0,0,0:1e-30"), Err(CameraSpecError::FieldOfView(_))));
+        assert!(matches!(CameraSpec::parse("1e30,2,3:0,0,0"), Err(CameraSpecError::TooFar(_))));
+        assert!(matches!(CameraSpec::parse("1,2,3:0,-2e6,0"), Err(CameraSpecError::TooFar(_))));
         assert!(matches!(CameraSpec::parse("1,2,3:1,2,3"), Err(CameraSpecError::Nowhere(_))));
         assert!(matches!(CameraSpec::parse("0,5,0:0,0,0"), Err(CameraSpecError::Vertical(_))));
     }

@@ -174,6 +174,10 @@ pub enum GltfError {
     NodeTransform(usize),
     #[error("node {0}: its matrix's last row is not (0, 0, 0, 1) (glTF: a matrix is a translation, rotation and scale)")]
     NodeProjective(usize),
+    #[error("node {0}: it has a matrix and a translation, rotation or scale too (glTF: one or the other)")]
+    NodeMatrixAndTrs(usize),
+    #[error("node {node}: its rotation's length is {}, not 1 (glTF: a unit quaternion, within {ROTATION_LENGTH_TOLERANCE})", Number(*length))]
+    NodeRotation { node: usize, length: f32 },
     #[error("node {0}: its transform is singular (it flattens the node to a plane, a line or a point)")]
     NodeSingular(usize),
     #[error("node {node}: its transform scales an axis by {}, outside {} to {}", Number(*scale), Number(*SCALES.start()), Number(*SCALES.end()))]
@@ -425,6 +429,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         if depth > MAX_NODE_DEPTH {
             return Err(GltfError::TooDeep(node.index()));
         }
+        check_node_fields(node.index(), &gltf.document.as_json().nodes[node.index()])?;
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         if !local.is_finite() {
             return Err(GltfError::NodeTransform(node.index()));
@@ -491,6 +496,25 @@ fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
     }
     let document = gltf::Document::from_json(root).map_err(describe_gltf_error)?;
     Ok(gltf::Gltf { document, blob })
+}
+
+/// How far from 1 a node's rotation quaternion may be: exporters' rounding (a few 1e-7),
+/// never a zero or scaled quaternion, which would scale or flatten the node.
+const ROTATION_LENGTH_TOLERANCE: f32 = 1e-3;
+
+/// glTF's rules for a node's transform fields: a matrix or translation-rotation-scale, not
+/// both; a rotation of unit length.
+fn check_node_fields(index: usize, node: &gltf::json::Node) -> Result<(), GltfError> {
+    if node.matrix.is_some() && (node.translation.is_some() || node.rotation.is_some() || node.scale.is_some()) {
+        return Err(GltfError::NodeMatrixAndTrs(index));
+    }
+    if let Some(q) = &node.rotation {
+        let length = q.0.iter().map(|c| c * c).sum::<f32>().sqrt();
+        if !length.is_finite() || (length - 1.0).abs() > ROTATION_LENGTH_TOLERANCE {
+            return Err(GltfError::NodeRotation { node: index, length });
+        }
+    }
+    Ok(())
 }
 
 /// A GLB's 12-byte header, checked before the gltf crate reads it: its length field less the

@@ -29,6 +29,9 @@ pub const MAX_OBJECTS: usize = 1 << 20;
 /// thousand kilometres in metres, a kilometre in millimetres. Beyond, f32 keeps too few digits
 /// for the model, and its depth range for the camera.
 pub const MAX_COORDINATE: f32 = 1e6;
+/// A perspective camera's vertical field of view in degrees: at least this (a narrower one
+/// magnifies past what f32 depth and positions resolve), and below 180.
+pub const MIN_FOV_Y_DEG: f32 = 0.01;
 /// Lengths a file gives: light radii, near and far planes, an orthographic camera's half-height.
 pub const LENGTHS: RangeInclusive<f32> = 1e-6..=1e7;
 /// Scales: a scene file's objects, each axis of a glTF node's transform.

@@ -119,10 +119,12 @@ pub enum SceneFileProblem {
     TooManyDirectional,
     #[error("unknown kind '{0}': expected point, spot or directional")]
     UnknownLightKind(String),
-    #[error("[camera] fov_y_deg {0} must lie strictly between 0 and 180")]
+    #[error("[camera] fov_y_deg {0} must be at least {min} and below 180", min = crate::limits::MIN_FOV_Y_DEG)]
     FieldOfView(f32),
     #[error("[camera] position and target are the same point: the camera looks nowhere")]
     CameraNowhere,
+    #[error("[camera] fov_y_deg and ortho_half_height together: an orthographic camera has no field of view (give one)")]
+    OrthographicWithFov,
     #[error("[camera] near {near} must be less than far {far}")]
     NearFar { near: f32, far: f32 },
     #[error("[camera] looks straight up or down, where its yaw is undefined: move target or position sideways")]
@@ -524,8 +526,11 @@ fn camera(c: Option<&FileCamera>, scene: &Scene) -> Result<(Camera, bool), Probl
     let (lo, hi) = scene.bounds();
     let centre = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    if c.is_some_and(|c| c.fov_y_deg.is_some() && c.ortho_half_height.is_some()) {
+        return Err(Problem::OrthographicWithFov);
+    }
     let fov = match c.and_then(|c| c.fov_y_deg) {
-        Some(f) if finite("[camera] fov_y_deg", f)? > 0.0 && f < 180.0 => f,
+        Some(f) if finite("[camera] fov_y_deg", f)? >= crate::limits::MIN_FOV_Y_DEG && f < 180.0 => f,
         Some(f) => return Err(Problem::FieldOfView(f)),
         None => DEFAULT_FOV_Y_DEG,
     };
@@ -574,12 +579,15 @@ fn orthographic(c: Option<&FileCamera>) -> Result<Option<f32>, Problem> {
 pub fn to_toml(scene: &Scene, shading: &str, target: Vec3) -> String {
     let v = |v: Vec3| format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z);
     let c = &scene.camera;
-    let ortho = c.orthographic.map_or(String::new(), |h| format!("ortho_half_height = {h:?}\n"));
+    // An orthographic camera's half-height, a perspective one's field of view.
+    let lens = match c.orthographic {
+        Some(h) => format!("ortho_half_height = {h:?}\n"),
+        None => format!("fov_y_deg = {:?}\n", c.fov_y_deg),
+    };
     let mut out = format!(
-        "[camera]\nposition = {}\ntarget = {}\nfov_y_deg = {:?}\n{ortho}near = {:?}\nfar = {:?}\n\n[shading]\nmodel = \"{shading}\"\nambient = {:?}\n",
+        "[camera]\nposition = {}\ntarget = {}\n{lens}near = {:?}\nfar = {:?}\n\n[shading]\nmodel = \"{shading}\"\nambient = {:?}\n",
         v(c.position),
         v(target),
-        c.fov_y_deg,
         c.near,
         c.far,
         scene.ambient

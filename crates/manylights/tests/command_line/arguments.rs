@@ -55,6 +55,9 @@ fn negative_and_huge_counts_get_their_range() {
     // Counts spelt as bench spells them, and sizes as WxH.
     assert_argument_error(&render("--lights", "100M"), &["--lights 100M is out of range: use 1 to 67108864"]);
     assert_argument_error(&render("--lights", "1.5k"), &["--lights '1.5k' is not a whole number"]);
+    // A quoting slip is not a number: nothing around it.
+    assert_argument_error(&render("--lights", " 5"), &["--lights ' 5' is not a whole number"]);
+    assert_argument_error(&render("--width", "64 "), &["--width '64 ' is not a whole number"]);
     assert_argument_error(&render("--resolution", "0x5"), &["--resolution 0x5: each side must be 1 to 16384"]);
     let both = manylights(&["render", "--resolution", "64x36", "--width", "64", "--out", "a.png"]);
     assert_argument_error(&both, &["'--resolution <RESOLUTION>' cannot be used with '--width <WIDTH>'"]);

@@ -444,6 +444,15 @@ fn files_that_break_gltf_rules_or_ranges_are_refused() {
         (gltf(&|w| w.json["bufferViews"][0]["byteOffset"] = json!(2)), "in a buffer view at 2"),
         (gltf(&|w| w.json["bufferViews"][0]["byteStride"] = json!(14)), "stride 14) is not a multiple"),
         (longer_glb, "the GLB header says"),
+        (
+            gltf(&|w| {
+                w.json["nodes"][0]["matrix"] = json!([1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+                w.json["nodes"][0]["translation"] = json!([1.0, 0.0, 0.0]);
+            }),
+            "node 0: it has a matrix and a translation, rotation or scale too",
+        ),
+        (gltf(&|w| w.json["nodes"][0]["rotation"] = json!([0.0, 0.0, 0.0, 0.0])), "node 0: its rotation's length is 0, not 1"),
+        (gltf(&|w| w.json["nodes"][0]["rotation"] = json!([0.0, 0.0, 0.0, 2.0])), "node 0: its rotation's length is 2, not 1"),
         (long_json, "GLB chunk 0 (JSON) says 100000 bytes, but"),
         (trailing, "5 bytes after the last GLB chunk are not a chunk"),
         (swapped, "the first GLB chunk is BIN, not JSON"),

@@ -269,6 +269,8 @@ fn values_out_of_range_are_refused_naming_the_field() {
         (format!("{sphere}[[lights]]\nkind = \"directional\"\ndirection = [1e38, -1e38, 0.0]\n"), "direction 1e38 is out of range"),
         (format!("{sphere}[shading]\nambient = 1e38\n"), "[shading] ambient 1e38 is out of range"),
         (format!("{sphere}[camera]\nnear = 1e-38\n"), "[camera] near 1e-38 is out of range"),
+        (format!("{sphere}[camera]\nfov_y_deg = 1e-30\n"), "must be at least 0.01 and below 180"),
+        (format!("{sphere}[camera]\nfov_y_deg = 40.0\northo_half_height = 3.0\n"), "fov_y_deg and ortho_half_height together"),
         (format!("{sphere}[camera]\nfar = 1e38\n"), "[camera] far 1e38 is out of range"),
         (format!("{sphere}[camera]\northo_half_height = 1e38\n"), "[camera] ortho_half_height 1e38 is out of range"),
         (format!("{sphere}[camera]\nposition = [1e38, 1.0, 1.0]\n"), "[camera] position 1e38 is out of range"),
