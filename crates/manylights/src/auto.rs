@@ -317,7 +317,7 @@ pub fn pick_within_margin<T: Copy + PartialEq>(timed: &[Timed<T>], preference: &
 }
 
 /// What the probe measured, e.g. "a frame of this scene took 0.958 ms compute, 1.467 ms
-/// hardware (medians of 5 after a warm-up; hybrid out after one frame)".
+/// hardware (medians of 3 frames after a warm-up; hybrid out after one frame)".
 fn describe<T>(timed: &[Timed<T>], name: impl Fn(&T) -> &'static str) -> String {
     let each: Vec<String> = timed.iter().map(|t| format!("{:.3} ms {}", t.ms, name(&t.candidate))).collect();
     let out: Vec<&str> = timed.iter().filter(|t| t.frames < PROBE_FRAMES).map(|t| name(&t.candidate)).collect();

@@ -89,35 +89,61 @@ pub fn write_replacing<F>(path: &Path, write: F) -> Result<(), WriteError>
 where
     F: FnOnce(&mut BufWriter<File>) -> io::Result<()>,
 {
-    let target = output_target(path)?;
-    let previous = std::fs::metadata(&target).ok();
-    #[cfg(unix)]
-    if let Some(links) = previous.as_ref().map(std::os::unix::fs::MetadataExt::nlink).filter(|&n| n > 1) {
-        // A rename gives the path a new file: the other names keep the old bytes.
-        eprintln!(
-            "warning: '{}' has {} other hard link(s): it is replaced by a new file, which they do not share",
-            path.display(),
-            links - 1
-        );
+    let mut pending = Pending::begin(path)?;
+    let written = pending.fill(write).and_then(|()| std::fs::rename(&pending.temp, &pending.target));
+    pending.end(written.is_ok());
+    written.map_err(|source| WriteError::Io { path: path.to_owned(), source })
+}
+
+/// An output being written: where it goes, its temporary file beside it, and the mode of the
+/// file it replaces.
+struct Pending {
+    target: PathBuf,
+    temp: PathBuf,
+    file: Option<File>,
+    previous: Option<std::fs::Metadata>,
+}
+
+impl Pending {
+    /// `path`'s target checked and its temporary file made (registered for removal on a
+    /// signal).
+    fn begin(path: &Path) -> Result<Pending, WriteError> {
+        let target = output_target(path)?;
+        let previous = std::fs::metadata(&target).ok();
+        #[cfg(unix)]
+        if let Some(links) = previous.as_ref().map(std::os::unix::fs::MetadataExt::nlink).filter(|&n| n > 1) {
+            // A rename gives the path a new file: the other names keep the old bytes.
+            eprintln!(
+                "warning: '{}' has {} other hard link(s): it is replaced by a new file, which they do not share",
+                path.display(),
+                links - 1
+            );
+        }
+        let (file, temp) = create_temporary(path, &target)?;
+        Ok(Pending { target, temp, file: Some(file), previous })
     }
-    let (file, temp) = create_temporary(path, &target)?;
-    let written = (|| {
+
+    /// The temporary file written through `write`, given the replaced file's mode (a 0600
+    /// output stays private) and flushed to the disk: renaming before the bytes are there
+    /// could leave an empty file after a crash.
+    fn fill(&mut self, write: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>) -> io::Result<()> {
+        let file = self.file.take().expect("filled once");
         let mut out = BufWriter::new(file);
         write(&mut out)?;
         let file = out.into_inner().map_err(|e| e.into_error())?;
-        // The replacement keeps the replaced file's mode (a 0600 output stays private).
-        if let Some(meta) = &previous {
+        if let Some(meta) = &self.previous {
             file.set_permissions(meta.permissions())?;
         }
-        // Renaming before the bytes are on disk could leave an empty file after a crash.
-        file.sync_all()?;
-        std::fs::rename(&temp, &target)
-    })();
-    forget_temporary(&temp);
-    written.map_err(|source| {
-        let _ = std::fs::remove_file(&temp);
-        WriteError::Io { path: path.to_owned(), source }
-    })
+        file.sync_all()
+    }
+
+    /// Done: renamed into place (`kept`) or not, in which case the temporary file goes.
+    fn end(&self, kept: bool) {
+        forget_temporary(&self.temp);
+        if !kept {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+    }
 }
 
 /// `write_replacing` with bytes already made.
@@ -158,35 +184,22 @@ fn encode_png(out: &mut (impl Write + io::Seek), rgba: &[u8], (width, height): (
 /// they were — results that belong together (a table, its JSON and its plot) never mix two
 /// runs. (The renames themselves follow one another.)
 pub fn write_all_replacing(outputs: &[(PathBuf, Vec<u8>)]) -> Result<(), WriteError> {
-    let mut ready: Vec<(PathBuf, PathBuf)> = Vec::new();
-    let mut written = || -> Result<(), WriteError> {
+    let mut pending: Vec<Pending> = Vec::new();
+    let written = (|| {
         for (path, bytes) in outputs {
-            let target = output_target(path)?;
-            let (file, temp) = create_temporary(path, &target)?;
-            ready.push((temp.clone(), target.clone()));
-            let previous = std::fs::metadata(&target).ok();
-            let io = |source| WriteError::Io { path: path.clone(), source };
-            let mut out = BufWriter::new(file);
-            out.write_all(bytes).map_err(io)?;
-            let file = out.into_inner().map_err(|e| io(e.into_error()))?;
-            if let Some(meta) = previous {
-                file.set_permissions(meta.permissions()).map_err(io)?;
-            }
-            file.sync_all().map_err(io)?;
+            pending.push(Pending::begin(path)?);
+            let p = pending.last_mut().expect("just pushed");
+            p.fill(|out| out.write_all(bytes)).map_err(|source| WriteError::Io { path: path.clone(), source })?;
         }
-        for ((temp, target), (path, _)) in ready.iter().zip(outputs) {
-            std::fs::rename(temp, target).map_err(|source| WriteError::Io { path: path.clone(), source })?;
+        for (p, (path, _)) in pending.iter().zip(outputs) {
+            std::fs::rename(&p.temp, &p.target).map_err(|source| WriteError::Io { path: path.clone(), source })?;
         }
         Ok(())
-    };
-    let result = written();
-    for (temp, _) in &ready {
-        forget_temporary(temp);
-        if result.is_err() {
-            let _ = std::fs::remove_file(temp);
-        }
+    })();
+    for p in &pending {
+        p.end(written.is_ok());
     }
-    result
+    written
 }
 
 /// The folder `path` is in ("." for a bare name).
