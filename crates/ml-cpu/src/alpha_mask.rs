@@ -251,8 +251,8 @@ mod tests {
 
     /// A 4×2 texture whose alpha is 0, 85, 170, 255 along each row.
     fn ramp(sampler: TextureSampler) -> TextureImage {
-        let rgba = (0..8).flat_map(|i| [9, 9, 9, (i % 4) as u8 * 85]).collect();
-        TextureImage { width: 4, height: 2, rgba, srgb: true, sampler }
+        let rgba: Vec<u8> = (0..8).flat_map(|i| [9, 9, 9, (i % 4) as u8 * 85]).collect();
+        TextureImage { width: 4, height: 2, rgba: rgba.into(), srgb: true, sampler }
     }
 
     fn masked(texture: Option<u32>, alpha_mode: AlphaMode) -> Object {
@@ -293,7 +293,7 @@ mod tests {
         // A disc of alpha 255 in a 32×32 texture of 0: inside and outside blocks are decided
         // by their bounds; every point, decided or filtered, gets the filter's answer.
         let n = 32u32;
-        let rgba = (0..n * n)
+        let rgba: Vec<u8> = (0..n * n)
             .flat_map(|i| {
                 let (x, y) = ((i % n) as f32 - 15.5, (i / n) as f32 - 15.5);
                 [0, 0, 0, if x * x + y * y < 50.0 { 255 } else { 0 }]
@@ -302,7 +302,7 @@ mod tests {
         for wrap in [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge] {
             for mag in [Filter::Linear, Filter::Nearest] {
                 let sampler = TextureSampler { wrap_u: wrap, wrap_v: wrap, mag, ..TextureSampler::default() };
-                let t = TextureImage { width: n, height: n, rgba: Vec::clone(&rgba), srgb: false, sampler };
+                let t = TextureImage { width: n, height: n, rgba: rgba.clone().into(), srgb: false, sampler };
                 assert_eq!(block_side(&t), 2);
                 assert_eq!(block_bounds(&t, 7, 7), (255, 255));
                 assert_eq!(block_bounds(&t, 4, 7), (0, 255));
@@ -325,7 +325,7 @@ mod tests {
 
     #[test]
     fn large_textures_get_larger_blocks() {
-        let t = |width, height| TextureImage { width, height, rgba: Vec::new(), srgb: false, sampler: TextureSampler::default() };
+        let t = |width, height| TextureImage { width, height, rgba: Vec::new().into(), srgb: false, sampler: TextureSampler::default() };
         assert_eq!(block_side(&t(512, 512)), 2); // 256² = 65,536 blocks
         assert_eq!(block_side(&t(514, 514)), 4);
         assert_eq!(block_side(&t(2048, 2048)), 8);

@@ -952,7 +952,7 @@ impl Builder<'_> {
             return Ok(known);
         }
         let decoded = match self.by_texture.iter().find(|((i, s, _), _)| (*i, *s) == (index, srgb)) {
-            // The same image with another sampler: decoded already.
+            // The same image with another sampler: decoded already, its texels shared.
             Some((_, &other)) => TextureImage { sampler, ..self.textures[other as usize].clone() },
             None => TextureImage { sampler, ..self.image(index, srgb).map_err(|e| e.within(Part::Image(index)))? },
         };
@@ -1062,7 +1062,7 @@ fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, GltfError> {
     reader.limits(limits);
     let decoded = reader.decode().map_err(GltfError::Decode)?.to_rgba8();
     let (width, height) = decoded.dimensions();
-    Ok(TextureImage { width, height, rgba: decoded.into_raw(), srgb, sampler: TextureSampler::default() })
+    Ok(TextureImage { width, height, rgba: decoded.into_raw().into(), srgb, sampler: TextureSampler::default() })
 }
 
 /// glTF's metallic-roughness factors, and its emissive factor (times

@@ -12,12 +12,14 @@ pub struct MipChain {
 }
 
 /// A material texture of a scene (glTF): RGBA8 texels, row 0 at the top; `srgb` for colour
-/// (the GPU decodes it), not for data such as normal maps; and how it is sampled.
+/// (the GPU decodes it), not for data such as normal maps; and how it is sampled. Textures of
+/// one image share its texels (`rgba`, shared: an image under eight samplers is decoded,
+/// held and uploaded once).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureImage {
     pub width: u32,
     pub height: u32,
-    pub rgba: Vec<u8>,
+    pub rgba: std::sync::Arc<[u8]>,
     pub srgb: bool,
     pub sampler: TextureSampler,
 }
@@ -71,7 +73,7 @@ impl TextureImage {
         let (mut w, mut h) = (self.width, self.height);
         let mut level: Vec<[f32; 4]> =
             self.rgba.chunks_exact(4).map(|t| [to_linear(t[0]), to_linear(t[1]), to_linear(t[2]), t[3] as f32 / 255.0]).collect();
-        let mut out = vec![self.rgba.clone()];
+        let mut out = vec![self.rgba.to_vec()];
         while w > 1 || h > 1 {
             let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
             let at = |x: u32, y: u32| level[(y.min(h - 1) * w + x.min(w - 1)) as usize];
@@ -290,7 +292,7 @@ mod tests {
         // 3×2: black and white columns; sRGB.
         let (b, w) = ([0u8, 0, 0, 255], [255u8, 255, 255, 255]);
         let rgba: Vec<u8> = [b, w, b, b, w, b].concat();
-        let t = TextureImage { width: 3, height: 2, rgba, srgb: true, sampler: TextureSampler::default() };
+        let t = TextureImage { width: 3, height: 2, rgba: rgba.into(), srgb: true, sampler: TextureSampler::default() };
         let mips = t.mips();
         assert_eq!(mips.iter().map(Vec::len).collect::<Vec<_>>(), vec![24, 4]);
         // Level 1 (1×1) averages the top-left 2×2: half white in linear light is sRGB 188.

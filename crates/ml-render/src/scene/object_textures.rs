@@ -46,12 +46,23 @@ impl ObjectTextureSets {
         let bindings: Vec<(u32, vk::DescriptorType)> = (0..TEXTURE_SLOTS as u32).map(|b| (b, sampled)).collect();
         // Fragment shaders (per draw) and the visibility lighting (per texture set) read them.
         self.set_layout = shader::set_layout(ctx, &bindings, vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE)?;
+        // One image per distinct texels and colour space: textures that share an image's
+        // texels (one glTF image under several samplers) share its upload and mip chain.
+        let mut by_texels: HashMap<(*const u8, bool), usize> = HashMap::new();
+        let mut image_of = Vec::with_capacity(textures.len());
         for (i, t) in textures.iter().enumerate() {
+            let key = (t.rgba.as_ptr(), t.srgb);
+            if let Some(&image) = by_texels.get(&key) {
+                image_of.push(image);
+                continue;
+            }
             let mips = t.mips();
             let levels: Vec<Vec<&[u8]>> = mips.iter().map(|l| vec![l.as_slice()]).collect();
             let extent = vk::Extent2D { width: t.width, height: t.height };
             let shape = ImageShape { extent, levels: mips.len() as u32, layers: 1, view: vk::ImageViewType::TYPE_2D };
             let format = if t.srgb { vk::Format::R8G8B8A8_SRGB } else { vk::Format::R8G8B8A8_UNORM };
+            by_texels.insert(key, self.images.len());
+            image_of.push(self.images.len());
             self.images.push(texture_with(ctx, &format!("object texture {i}"), shape, format, &levels)?);
         }
         let white = [255u8; 4];
@@ -87,11 +98,13 @@ impl ObjectTextureSets {
         for combination in combinations {
             let set = allocate_set(ctx, self.pool, self.set_layout)?;
             for (binding, texture) in (0u32..).zip(combination.slots()) {
-                let index = texture.map_or(stand_in, |i| i as usize);
-                let desc = textures.get(index).map_or(TextureSampler::default(), |t| t.sampler);
+                let (image, desc) = match texture {
+                    Some(i) => (image_of[i as usize], textures[i as usize].sampler),
+                    None => (stand_in, TextureSampler::default()),
+                };
                 let info = vk::DescriptorImageInfo::default()
                     .sampler(by_sampler[&desc])
-                    .image_view(self.images[index].view)
+                    .image_view(self.images[image].view)
                     .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
                 write_image(ctx, set, binding, sampled, info);
             }

@@ -283,3 +283,42 @@ fn dark_textures_keep_their_steps_through_the_gbuffer() {
         assert!(worst <= 2, "{}: differs from forward by {worst}/255 on dark texels", s.technique.name());
     }
 }
+
+/// One image under eight samplers (eight textures of one image, as real files share an image
+/// between textures): decoded and held once on the CPU (the textures share its texels) and
+/// uploaded once — the renderer's memory as with one texture, within 1.2× (each copy of this
+/// 1024² image and its mips would add 5.3 MiB).
+#[test]
+fn an_image_under_eight_samplers_is_held_and_uploaded_once() {
+    let texels: Vec<u8> = (0..1024 * 1024u32).flat_map(|i| [(i % 251) as u8, (i % 241) as u8, (i % 239) as u8, 255]).collect();
+    let image = png(1024, 1024, &texels);
+    let scene = |samplers: bool| {
+        let mut w = GltfWriter::new();
+        let first = w.texture(image.clone(), "image/png");
+        let wraps = [33071, 33648, 10497];
+        let quads: Vec<(usize, f32)> = (0..8)
+            .map(|k| {
+                let texture = if samplers && k > 0 {
+                    let t = w.json["textures"].as_array().unwrap().len();
+                    w.json["textures"].as_array_mut().unwrap().push(json!({ "source": 0 }));
+                    t
+                } else {
+                    first
+                };
+                if samplers {
+                    w.sampler(texture, json!({ "wrapS": wraps[k % 3], "wrapT": wraps[k / 3] }));
+                }
+                (w.textured_material(Some(texture), None), k as f32 * 2.2 - 7.7)
+            })
+            .collect();
+        row_of_quads(&mut w, &quads, 1.2, 8.0)
+    };
+    let (shared, single) = (scene(true), scene(false));
+    assert_eq!((shared.textures.len(), single.textures.len()), (8, 1));
+    assert!(shared.textures.iter().all(|t| std::sync::Arc::ptr_eq(&t.rgba, &shared.textures[0].rgba)), "the textures hold copies");
+    let settings = [RenderSettings { shading: ShadingModel::Pbr, ..RenderSettings::new(Technique::Forward, 128, 16) }];
+    let bytes = |s: &Scene| common::render_each(s, &settings)[0].stats.memory.expect("memory use").allocated;
+    let (eight, one) = (bytes(&shared), bytes(&single));
+    println!("8 samplers: {:.1} MiB; 1: {:.1} MiB", eight as f64 / 1048576.0, one as f64 / 1048576.0);
+    assert!(eight as f64 <= one as f64 * 1.2, "8 samplers take {eight} bytes, one {one}");
+}

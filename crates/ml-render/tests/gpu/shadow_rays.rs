@@ -220,8 +220,8 @@ fn every_technique_gives_the_forward_image() {
 fn alpha_masked_surfaces_cast_the_shadows_their_masks_cut() {
     let mut scene = Scene::shadow_room();
     // Stripes across u: alpha 255 for four texels, 0 for four.
-    let rgba = (0..8 * 8).flat_map(|i| [200, 200, 200, if (i % 8) < 4 { 255 } else { 0 }]).collect();
-    scene.textures.push(ml_cpu::textures::TextureImage { width: 8, height: 8, rgba, srgb: true, sampler: Default::default() });
+    let rgba: Vec<u8> = (0..8 * 8).flat_map(|i| [200, 200, 200, if (i % 8) < 4 { 255 } else { 0 }]).collect();
+    scene.textures.push(ml_cpu::textures::TextureImage { width: 8, height: 8, rgba: rgba.into(), srgb: true, sampler: Default::default() });
     let grey = Material { albedo: Vec3::splat(0.7), roughness: 0.7, metallic: 0.0 };
     let transform = glam::Mat4::from_scale_rotation_translation(
         Vec3::new(1.6, 1.0, 1.6),
