@@ -21,6 +21,7 @@ use crate::scene_load::{check_extent, read_reference, ExtentError, ReferenceErro
 use crate::SceneError;
 use glam::Vec3;
 use serde::{de, Deserialize, Deserializer};
+use std::collections::HashMap;
 use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -285,10 +286,12 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
         return Err(Problem::TooManyLights(file.lights.len()));
     }
     let (mut objects, mut meshes, mut textures, mut warnings) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut loaded_files = HashMap::new();
     for (i, o) in file.objects.iter().enumerate() {
         match &o.gltf {
             Some(gltf) => {
-                let loaded = gltf_object(o, gltf, base, (&mut meshes, &mut textures)).map_err(|e| e.at(Entry::Object(i)))?;
+                let loaded =
+                    gltf_object(o, gltf, base, (&mut meshes, &mut textures, &mut loaded_files)).map_err(|e| e.at(Entry::Object(i)))?;
                 objects.extend(loaded.0);
                 warnings.extend(loaded.1.into_iter().map(|w| format!("objects[{i}] ({gltf}): {w}")));
             }
@@ -433,13 +436,16 @@ fn placement(o: &FileObject) -> Result<(Vec3, f32), Problem> {
 }
 
 /// A `gltf = "path"` object: every drawn primitive of that file, its materials, placed by the
-/// object's position and scale; its meshes appended to `meshes`. Its lights and camera are
-/// not used (the scene file says where lights and camera are).
+/// object's position and scale; its meshes and textures appended to `meshes` and `textures`
+/// the first time the file is placed, and shared by every later placement (`loaded`: per
+/// file, its objects before placement): a file placed 800 times is read, decoded and held
+/// once. Its warnings come with its first placement. Its lights and camera are not used (the
+/// scene file says where lights and camera are).
 fn gltf_object(
     o: &FileObject,
     gltf: &str,
     base: Option<&Path>,
-    (meshes, textures): (&mut Vec<crate::mesh::Mesh>, &mut Vec<crate::textures::TextureImage>),
+    (meshes, textures, loaded): (&mut Vec<crate::mesh::Mesh>, &mut Vec<crate::textures::TextureImage>, &mut LoadedFiles),
 ) -> Result<(Vec<Object>, Vec<String>), Problem> {
     if o.mesh.is_some() {
         return Err(Problem::MeshAndGltf);
@@ -448,19 +454,23 @@ fn gltf_object(
         return Err(Problem::GltfMaterial);
     }
     let base = base.ok_or(Problem::NoFolder)?;
+    let (position, scale) = placement(o)?;
+    let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);
+    let placed = |unplaced: &[Object]| unplaced.iter().map(|obj| Object { transform: place * obj.transform, ..*obj }).collect();
+    if let Some(unplaced) = loaded.get(gltf) {
+        return Ok((placed(unplaced), Vec::new()));
+    }
     let bytes = read_reference(base, Path::new(gltf), crate::gltf_scene::MAX_FILE_BYTES)
         .map_err(|problem| Problem::Reference { file: gltf.to_owned(), problem })?;
     // Its buffers and images are named relative to its own folder.
     let folder = base.join(gltf).parent().map(Path::to_path_buf).unwrap_or_default();
     let (scene, warnings) =
         crate::gltf_scene::from_bytes(&bytes, Some(&folder)).map_err(|problem| Problem::Gltf { file: gltf.to_owned(), problem })?;
-    let (position, scale) = placement(o)?;
-    let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);
     let offset = meshes.len() as u32;
     meshes.extend(scene.meshes);
     let texture_offset = textures.len() as u32;
     textures.extend(scene.textures);
-    let objects = scene
+    let unplaced: Vec<Object> = scene
         .objects
         .into_iter()
         .map(|obj| {
@@ -468,12 +478,17 @@ fn gltf_object(
                 MeshKind::Loaded(i) => MeshKind::Loaded(i + offset),
                 builtin => builtin,
             };
-            let textures = obj.textures.map(|i| i + texture_offset);
-            Object { mesh, transform: place * obj.transform, textures, ..obj }
+            Object { mesh, textures: obj.textures.map(|i| i + texture_offset), ..obj }
         })
         .collect();
+    let objects = placed(&unplaced);
+    loaded.insert(gltf.to_owned(), unplaced);
     Ok((objects, warnings))
 }
+
+/// The glTF files a scene file has placed, by the path it names them with: their objects
+/// (meshes and textures already in the scene's lists), before placement.
+type LoadedFiles = HashMap<String, Vec<Object>>;
 
 fn light(l: &FileLight) -> Result<Light, Problem> {
     let color = l.color.map(|c| vec3("color", c)).transpose()?.unwrap_or(Vec3::ONE);

@@ -151,13 +151,20 @@ fn gltf_objects_bring_their_meshes_placed_by_the_scene_file() {
     let f = load(&dir.join("scene.toml")).unwrap();
     let s = &f.scene;
     assert_eq!(s.objects.len(), 3);
-    assert_eq!(s.meshes.len(), 2, "each glTF object brings its own copy");
+    // A file placed twice is loaded once: both placements are instances of its one mesh.
+    assert_eq!(s.meshes.len(), 1, "each placement brought its own copy");
     assert_eq!(s.objects[1].mesh, MeshKind::Loaded(0));
-    assert_eq!(s.objects[2].mesh, MeshKind::Loaded(1));
+    assert_eq!(s.objects[2].mesh, MeshKind::Loaded(0));
     assert_eq!(s.objects[1].material.albedo, Vec3::new(0.5, 0.25, 1.0));
     // The glTF node's (0, 1, 0), scaled by 2 and moved by 10 in x.
     assert!((s.objects[1].position() - Vec3::new(10.0, 2.0, 0.0)).length() < 1e-5, "{}", s.objects[1].position());
     assert!((s.objects[2].position() - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-5);
+    // 800 placements (a 12 MB model placed so used to hold 800 copies): one mesh, 800 objects.
+    let many: String = (0..800).map(|i| format!("[[objects]]\ngltf = \"models/quad.glb\"\nposition = [{i}.0, 0.0, 0.0]\n")).collect();
+    std::fs::write(dir.join("many.toml"), many).unwrap();
+    let f = load(&dir.join("many.toml")).unwrap();
+    assert_eq!((f.scene.meshes.len(), f.scene.objects.len()), (1, 800));
+    assert!((f.scene.objects[799].position() - Vec3::new(799.0, 1.0, 0.0)).length() < 1e-3);
     // Refused: a material on it, a missing file, no folder to look in.
     std::fs::write(dir.join("bad.toml"), "[[objects]]\ngltf = \"models/quad.glb\"\nmaterial = { roughness = 0.5 }\n").unwrap();
     let in_first_object = |e: SceneFileProblem| match e {
