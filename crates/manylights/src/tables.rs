@@ -173,10 +173,21 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             ),
         ));
     }
+    if let Some(kib) = peak_resident_kib() {
+        rows.push(("host memory", format!("{} MiB at the peak (resident; the scene, its decoded textures, the driver)", kib >> 10)));
+    }
     rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
     rows.push(("output", facts.output.display().to_string()));
     rows
+}
+
+/// This process's peak resident memory in KiB (Linux: VmHWM in /proc/self/status; None
+/// elsewhere).
+fn peak_resident_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
 }
 
 /// The G-buffer of a scene (with object textures or not): its size, its images, and whether
@@ -257,6 +268,7 @@ mod tests {
                 "camera",
                 "gpu ms",
                 "g-buffer",
+                "host memory",
                 "cpu ms/frame",
                 "wall ms/frame",
                 "output"

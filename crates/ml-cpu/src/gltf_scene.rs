@@ -43,6 +43,10 @@ const BUFFER_PADDING: u64 = 3;
 pub const MAX_VERTICES: usize = 1 << 26;
 /// Widest and tallest texture we decode.
 pub const MAX_TEXTURE_SIZE: u32 = 16384;
+/// Most bytes a file's textures may take decoded, their mip chains included (RGBA8, 4/3 of
+/// the largest level): checked from each image's header before it is decoded, so a small file
+/// of huge images is refused in one line instead of taking the machine's memory.
+pub const MAX_TEXTURE_BYTES: u64 = 4 << 30;
 /// Most elements of an accessor without a buffer view (zeros but for its sparse
 /// substitutions): its count is all a few bytes of JSON would need to claim gigabytes.
 pub const MAX_VIEWLESS_ELEMENTS: usize = 1 << 20;
@@ -287,6 +291,8 @@ pub enum GltfError {
     /// An image in a container manylights does not read (KTX, KTX2, DDS), named.
     #[error("it is a {0} image, which manylights does not read (PNG and JPEG only)")]
     ImageContainer(&'static str),
+    #[error("its {width}×{height} texels would take {} MiB decoded, past the {} MiB a file's textures may take together ({} MiB taken before it)", need >> 20, MAX_TEXTURE_BYTES >> 20, taken >> 20)]
+    TextureBudget { width: u32, height: u32, need: u64, taken: u64 },
     #[error("cannot decode it: {0}")]
     Decode(image::ImageError),
     #[error("a directional light needs a usable node direction and a colour × intensity in [0, {}]", Number(MAX_INTENSITY))]
@@ -400,6 +406,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         doc: &gltf.document,
         base,
         textures: Vec::new(),
+        texture_bytes: 0,
         directional: Vec::new(),
         cones: Vec::new(),
         by_texture: HashMap::new(),
@@ -765,6 +772,8 @@ struct Builder<'a> {
     directional: Vec<DirectionalLight>,
     /// One per light in `lights` (kept only if one of them is a spot).
     cones: Vec<LightCone>,
+    /// Bytes the decoded textures take (with their mip chains): at most MAX_TEXTURE_BYTES.
+    texture_bytes: u64,
     /// (image, as sRGB, sampler) → index in `textures`: each image decoded once per colour
     /// space.
     by_texture: HashMap<(usize, bool, TextureSampler), u32>,
@@ -965,7 +974,7 @@ impl Builder<'_> {
     /// Image `index` decoded to RGBA8, checked before it is read: the gltf crate's own accessor
     /// for an image's source panics on an image with neither a URI nor a buffer view, and on a
     /// buffer view without a MIME type.
-    fn image(&self, index: usize, srgb: bool) -> Result<TextureImage, GltfError> {
+    fn image(&mut self, index: usize, srgb: bool) -> Result<TextureImage, GltfError> {
         let json = &self.doc.as_json().images[index];
         let bytes: Vec<u8> = match (&json.uri, &json.buffer_view, &json.mime_type) {
             (Some(uri), None, _) => read_uri(uri, self.base, MAX_IMAGE_BYTES)?,
@@ -983,6 +992,7 @@ impl Builder<'_> {
         if let Some(container) = image_container(&bytes) {
             return Err(GltfError::ImageContainer(container));
         }
+        self.texture_bytes = within_texture_budget(&bytes, self.texture_bytes)?;
         decode_image(&bytes, srgb)
     }
 
@@ -1050,6 +1060,18 @@ fn light_color(color: Vec3) -> bool {
 /// A place within ±MAX_COORDINATE.
 fn within_reach(p: Vec3) -> bool {
     p.is_finite() && p.abs().max_element() <= MAX_COORDINATE
+}
+
+/// The bytes the textures take once the image `bytes` encode is decoded (RGBA8 and its mip
+/// chain, from the image's header) on top of `taken`; refused past MAX_TEXTURE_BYTES.
+fn within_texture_budget(bytes: &[u8], taken: u64) -> Result<u64, GltfError> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(GltfError::ImageFormat)?;
+    let (width, height) = reader.into_dimensions().map_err(GltfError::Decode)?;
+    let need = u64::from(width) * u64::from(height) * 4 * 4 / 3;
+    match taken.checked_add(need).filter(|&total| total <= MAX_TEXTURE_BYTES) {
+        Some(total) => Ok(total),
+        None => Err(GltfError::TextureBudget { width, height, need, taken }),
+    }
 }
 
 /// PNG or JPEG bytes as an RGBA8 texture, its size and memory capped before decoding.

@@ -623,3 +623,42 @@ fn missing_and_unreadable_textures_are_left_out_with_a_warning_and_motion_warns(
         assert!(warnings.iter().any(|w| w.contains(said)), "{said}: {warnings:?}");
     }
 }
+
+/// A PNG of `width` × `height` whose header says so and whose pixels are not there: enough
+/// for the budget, which reads headers alone.
+fn png_header(width: u32, height: u32) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut crc = !0u32;
+        for &b in bytes {
+            crc ^= u32::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 { (crc >> 1) ^ 0xedb8_8320 } else { crc >> 1 };
+            }
+        }
+        !crc
+    }
+    let mut chunk = b"IHDR".to_vec();
+    chunk.extend(width.to_be_bytes());
+    chunk.extend(height.to_be_bytes());
+    chunk.extend([8, 6, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    for chunk in [chunk, b"IDAT".to_vec(), b"IEND".to_vec()] {
+        png.extend((chunk.len() as u32 - 4).to_be_bytes());
+        png.extend(&chunk);
+        png.extend(crc32(&chunk).to_be_bytes());
+    }
+    png
+}
+
+/// A file's textures together take at most MAX_TEXTURE_BYTES decoded (mips included), known
+/// from each image's header before it is decoded: a 16384² image (1.3 GiB) fits alone and is
+/// refused on top of 3 GiB, naming its size; small images pass.
+#[test]
+fn textures_are_held_to_a_budget_read_from_their_headers() {
+    let big = png_header(16384, 16384);
+    let need = 16384u64 * 16384 * 4 * 4 / 3;
+    assert_eq!(within_texture_budget(&big, 0).unwrap(), need);
+    let e = within_texture_budget(&big, 3 << 30).unwrap_err().to_string();
+    assert!(e.contains("16384×16384") && e.contains("4096 MiB") && e.contains("3072 MiB taken"), "{e}");
+    assert_eq!(within_texture_budget(&png(2, 2, &[0; 16]), 5).unwrap(), 5 + 2 * 2 * 4 * 4 / 3);
+}
