@@ -630,7 +630,7 @@ fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Va
     let png = ml_cpu::files::png_bytes(&png_path, &rgba, size)?;
     let json = serde_json::to_string_pretty(&report).expect("plain JSON values");
     // The three replace an earlier run's together, or none does.
-    ml_cpu::files::write_all_replacing(&[(csv_path, csv.clone().into_bytes()), (json_path, json.into_bytes()), (png_path, png)])?;
+    ml_cpu::files::write_all_replacing(&[(csv_path, csv.as_bytes()), (json_path, json.as_bytes()), (png_path, &png)])?;
     print!("{csv}");
     Ok(())
 }

@@ -183,7 +183,7 @@ fn encode_png(out: &mut (impl Write + io::Seek), rgba: &[u8], (width, height): (
 /// any is renamed into place, so a failure (a full disk, a bad path) leaves all of them as
 /// they were — results that belong together (a table, its JSON and its plot) never mix two
 /// runs. (The renames themselves follow one another.)
-pub fn write_all_replacing(outputs: &[(PathBuf, Vec<u8>)]) -> Result<(), WriteError> {
+pub fn write_all_replacing(outputs: &[(PathBuf, &[u8])]) -> Result<(), WriteError> {
     let mut pending: Vec<Pending> = Vec::new();
     let written = (|| {
         for (path, bytes) in outputs {

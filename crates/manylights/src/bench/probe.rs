@@ -124,7 +124,7 @@ pub fn write(a: &BenchArgs, (w, h): (u32, u32), device: &Value, meshlets: bool, 
     // The two replace an earlier run's together, or neither does.
     let json = serde_json::to_string_pretty(&report).expect("plain JSON values");
     let [csv_path, json_path] = super::PROBE_RESULTS.map(|name| a.out.join(name));
-    ml_cpu::files::write_all_replacing(&[(csv_path, csv.clone().into_bytes()), (json_path, json.into_bytes())])?;
+    ml_cpu::files::write_all_replacing(&[(csv_path, csv.as_bytes()), (json_path, json.as_bytes())])?;
     print!("{csv}");
     match pick {
         Some((technique, why)) => crate::auto::announce(technique, &why),
