@@ -29,6 +29,10 @@ layout(set = 0, binding = 12) uniform sampler2D opaque_depth;
 float opaque_depth_at(ivec2 p) {
     return texelFetch(opaque_depth, p, 0).r;
 }
+// One sample (no anti-aliasing here): the centre's.
+float opaque_depth_of_sample(ivec2 p, uint k) {
+    return opaque_depth_at(p);
+}
 #endif
 
 #endif

@@ -17,7 +17,6 @@ void main() {
     uint kept = min(layer_counts.x, layer_capacity());
     for (uint node = gl_GlobalInvocationID.x; node < kept; node += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
         uvec4 a = layer_nodes[2u * node];
-        vec2 frag_xy = vec2(a.w & 0xffffu, a.w >> 16) + 0.5;
-        mark_walk(world_from_depth(frag_xy, uintBitsToFloat(a.x)));
+        mark_walk(world_from_depth(layer_xy(a), uintBitsToFloat(a.x)));
     }
 }

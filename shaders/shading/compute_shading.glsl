@@ -46,11 +46,12 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m,
 #endif
 }
 
-// A surface point shaded — or shown by a surface debug view — as display-linear colour
-// (display_linear), for the anti-aliased resolve to weigh by the samples the surface covers.
-vec3 shade_display(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags) {
+// A surface point shaded, in linear light — or shown by a surface debug view (`debug`: its
+// colour then, display-linear).
+vec3 shade_linear(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags, out bool debug) {
     vec3 color;
-    if (debug_surface(world, n, m.albedo, m.roughness, m.metallic, object_flags, frag_xy, color)) {
+    debug = debug_surface(world, n, m.albedo, m.roughness, m.metallic, object_flags, frag_xy, color);
+    if (debug) {
         return clamp(color, 0.0, 1.0);
     }
     color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
@@ -60,7 +61,20 @@ vec3 shade_display(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint objec
             atomicAdd(ray_count.x, traced);
         }
     }
-    return display_linear(color, frame.exposure.x);
+    return color;
+}
+
+// shade_linear's colour as the display's linear light (display_linear), for the anti-aliased
+// resolve to weigh by the samples the surface covers.
+vec3 display_of(vec3 shaded, bool debug) {
+    return debug ? shaded : display_linear(shaded, frame.exposure.x);
+}
+
+// A surface point shaded (or a debug view's) as the display's linear light.
+vec3 shade_display(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags) {
+    bool debug;
+    vec3 shaded = shade_linear(frag_xy, world, n, m, object_flags, debug);
+    return display_of(shaded, debug);
 }
 
 // A pixel no opaque surface covers.

@@ -186,15 +186,11 @@ vec3 barycentrics(uint i, vec3 q) {
     return e / (e.x + e.y + e.z);
 }
 
-// Whether triangle `i` leaves a fragment at `q` in front of `opaque`: its barycentrics,
-// depth and coverage.
-bool layer_fragment(uint i, vec3 q, float opaque, out vec3 w, out float depth, out float alpha) {
+// Whether triangle `i` covers the point `q` (x, y in NDC, 1) at a depth in [0, 1] in front of
+// `opaque`: its barycentrics and depth there.
+bool layer_point(uint i, vec3 q, float opaque, out vec3 w, out float depth) {
     w = vec3(0.0);
     depth = 0.0;
-    alpha = 0.0;
-    if ((tri_object[i].y & TRIANGLE_DRAWN) == 0u) {
-        return false;
-    }
     vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
     if (!(edge_owns(e.x, tri_edges[i][0].xy) && edge_owns(e.y, tri_edges[i][1].xy) && edge_owns(e.z, tri_edges[i][2].xy))) {
         return false;
@@ -205,8 +201,43 @@ bool layer_fragment(uint i, vec3 q, float opaque, out vec3 w, out float depth, o
     }
     w = e / sum;
     depth = dot(w, tri_z[i]) / dot(w, tri_w[i]);
-    if (!(depth >= 0.0 && depth <= 1.0) || depth >= opaque) {
+    return depth >= 0.0 && depth <= 1.0 && depth < opaque;
+}
+
+// Whether triangle `i` leaves a fragment at pixel `p`: the samples it covers in front of the
+// opaque surface there (`covered`, a bit each; without anti-aliasing, bit 0: the centre, in
+// front of `opaque`), and at the point the pixel shades it (`q`: the centre, or with
+// anti-aliasing visibility_samples.glsl shading_xy of its samples — inside the triangle, as
+// they are) its barycentrics, depth and coverage.
+bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out uint covered, out vec3 w, out float depth, out float alpha) {
+    q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0);
+    covered = 0u;
+    w = vec3(0.0);
+    depth = 0.0;
+    alpha = 0.0;
+    if ((tri_object[i].y & TRIANGLE_DRAWN) == 0u) {
         return false;
+    }
+    if (VISIBILITY_SAMPLES == 1u) {
+        if (!layer_point(i, q, opaque, w, depth)) {
+            return false;
+        }
+        covered = 1u;
+    } else {
+        for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+            vec3 wk;
+            float dk;
+            if (layer_point(i, vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0), opaque_depth_of_sample(p, k), wk, dk)) {
+                covered |= 1u << k;
+            }
+        }
+        if (covered == 0u) {
+            return false;
+        }
+        q = vec3(shading_xy(p, covered) * to_ndc - 1.0, 1.0);
+        vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
+        w = e / (e.x + e.y + e.z);
+        depth = dot(w, tri_z[i]) / dot(w, tri_w[i]);
     }
     alpha = tri_alpha[i];
     if ((tri_alpha_texture[i].x & OBJECT_ALPHA_TEXTURE) != 0u) {
@@ -235,8 +266,11 @@ uvec4 layer_surface(uint i, vec3 q, vec3 w, float alpha, vec2 to_ndc) {
 bool pixel_fragment(uint slot, ivec2 p, vec2 to_ndc) {
     vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0), w;
     float depth, alpha;
+    uint covered;
     vec3 e = vec3(dot(tri_edges[slot][0], q), dot(tri_edges[slot][1], q), dot(tri_edges[slot][2], q));
-    return all(greaterThanEqual(e, vec3(0.0))) && layer_fragment(slot, q, opaque_depth_at(p), w, depth, alpha);
+    // With anti-aliasing a triangle may cover samples and not the centre.
+    bool may = VISIBILITY_SAMPLES != 1u || all(greaterThanEqual(e, vec3(0.0)));
+    return may && layer_fragment(slot, p, to_ndc, opaque_depth_at(p), q, covered, w, depth, alpha);
 }
 
 // Keep pixel `p`'s fragment of triangle `slot`, which pixel_fragment found, in node `node`
@@ -245,12 +279,13 @@ bool pixel_fragment(uint slot, ivec2 p, vec2 to_ndc) {
 // test: registers), its existence not: the writes follow the test's bits, so they take
 // exactly the room counted.
 void keep_fragment(uint slot, ivec2 p, uint node, uint capacity, vec2 to_ndc) {
-    vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0), w;
+    vec3 q, w;
     float depth, alpha;
-    layer_fragment(slot, q, opaque_depth_at(p), w, depth, alpha);
+    uint covered;
+    layer_fragment(slot, p, to_ndc, opaque_depth_at(p), q, covered, w, depth, alpha);
     if (node < capacity) {
         uint next = atomicExchange(layer_heads[layer_pixel(p)], node);
-        write_layer(node, p, depth, next, tri_object[slot].x, layer_surface(slot, q, w, alpha, to_ndc));
+        write_layer(node, p, depth, next, tri_object[slot].x, covered, layer_surface(slot, q, w, alpha, to_ndc));
     }
 }
 

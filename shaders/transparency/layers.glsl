@@ -11,15 +11,47 @@
 // ones are merged into one layer behind them (coverage 1 − Π(1 − α), α-weighted colour) and
 // the pixel is counted. ml-cpu transparency.rs is the same rule on the CPU.
 //
+// With anti-aliasing (VISIBILITY_SAMPLES > 1) a node also keeps the samples of its pixel its
+// fragment covers in front of the opaque surface there; it is shaded where the opaque
+// surfaces are (visibility_samples.glsl shading_xy), and the resolve blends each sample's
+// layers over that sample's opaque surface (LAYER_SAMPLES).
+//
 // Needs common.glsl; the includer defines LAYER_BINDING, the first of its three set-0
 // bindings. Lighting (light_layer) also needs lighting.glsl; blending, LAYER_BLENDING.
 
 #ifndef MANYLIGHTS_LAYERS_GLSL
 #define MANYLIGHTS_LAYERS_GLSL
 
+#include "visibility/visibility_samples.glsl"
+
 const uint LAYER_END = 0xffffffffu;
 // Layers a pixel blends exactly (an array per thread); beyond, merged.
 const uint LAYER_KEEP = 32u;
+
+// A node's object word: the object (ml-cpu limits.rs MAX_OBJECTS: 20 bits) and, with
+// anti-aliasing, the samples its fragment covers above it (a bit each; at most
+// LAYER_MAX_SAMPLES). Without, the fragment covers its pixel's centre.
+const uint LAYER_OBJECT_BITS = 20u;
+const uint LAYER_MAX_SAMPLES = 8u;
+
+uint layer_object_word(uint object, uint covered) {
+    return VISIBILITY_SAMPLES == 1u ? object : object | (covered << LAYER_OBJECT_BITS);
+}
+
+uint layer_object(uint word) {
+    return word & ((1u << LAYER_OBJECT_BITS) - 1u);
+}
+
+uint layer_covered(uint word) {
+    return VISIBILITY_SAMPLES == 1u ? 1u : word >> LAYER_OBJECT_BITS;
+}
+
+// Where node `a` (its first four words) is shaded: its pixel's centre, or the point
+// visibility_samples.glsl shading_xy gives its samples.
+vec2 layer_xy(uvec4 a) {
+    ivec2 p = ivec2(a.w & 0xffffu, a.w >> 16);
+    return VISIBILITY_SAMPLES == 1u ? vec2(p) + 0.5 : shading_xy(p, layer_covered(a.z));
+}
 
 // Per pixel (row-major): its nearest-drawn node, LAYER_END for none.
 layout(std430, set = 0, binding = LAYER_BINDING) buffer TransparentHeadBuffer { uint layer_heads[]; };
@@ -49,9 +81,10 @@ uvec4 pack_layer_surface(vec3 normal, vec4 albedo_occlusion, vec2 roughness_meta
                  packUnorm4x8(vec4(emissive_factor, 0.0)));
 }
 
-// Node `node` (of the pool) made pixel `p`'s fragment at `depth` of `object`, before `next`.
-void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uvec4 surface) {
-    layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, object, uint(p.y) << 16 | uint(p.x));
+// Node `node` (of the pool) made pixel `p`'s fragment at `depth` of `object` covering the
+// samples `covered`, before `next`.
+void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uint covered, uvec4 surface) {
+    layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, layer_object_word(object, covered), uint(p.y) << 16 | uint(p.x));
     layer_nodes[2u * node + 1u] = surface;
 }
 
@@ -61,10 +94,10 @@ void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uvec4 
 void light_layer(uint node) {
     uvec4 a = layer_nodes[2u * node];
     uvec4 b = layer_nodes[2u * node + 1u];
-    vec2 frag_xy = vec2(a.w & 0xffffu, a.w >> 16) + 0.5;
+    vec2 frag_xy = layer_xy(a);
     vec3 world = world_from_depth(frag_xy, uintBitsToFloat(a.x));
     vec3 n = oct_decode(unpackSnorm2x16(b.x));
-    ObjectData o = objects[a.z];
+    ObjectData o = objects[layer_object(a.z)];
     vec2 roughness_metallic = OBJECT_TEXTURES ? unpackUnorm4x8(b.z).xy : vec2(1.0);
     vec3 emissive_factor = OBJECT_TEXTURES ? unpackUnorm4x8(b.w).rgb : vec3(1.0);
     PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, unpackUnorm4x8(b.y), roughness_metallic, emissive_factor);
@@ -82,7 +115,7 @@ void light_layer(uint node) {
 // Whether node x lies in front of node y (nearer, or as near and of a lower object).
 bool layer_before(uvec2 x, uvec2 y) {
     float dx = uintBitsToFloat(x.x), dy = uintBitsToFloat(y.x);
-    return dx < dy || (dx == dy && x.y < y.y);
+    return dx < dy || (dx == dy && layer_object(x.y) < layer_object(y.y));
 }
 
 // A lit node's colour and alpha.
@@ -90,35 +123,41 @@ vec4 layer_color(uint node) {
     return uintBitsToFloat(layer_nodes[2u * node + 1u]);
 }
 
-// Pixel `p`'s lit layers blended over `under` (linear; black for the background) back to
-// front; `transmittance`: how much of `under` still shows, `count`: its layers.
-vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) {
-    transmittance = 1.0;
-    count = 0u;
-    uint head = layer_heads[layer_pixel(p)];
-    if (head == LAYER_END) {
-        return under;
-    }
-    // The nearest LAYER_KEEP, sorted, in [lo, hi) of a double-ended array that starts in its
-    // middle: (depth bits, object) keys and node indices. A list holds its pixel's layers in
-    // the reverse of the order they were drawn, so they often come nearest-first or
-    // farthest-first; either way each one goes to an end, without moving the others (an array
-    // filled from one end would move them all for one of the two).
-    uvec2 keys[2u * LAYER_KEEP];
-    uint nodes[2u * LAYER_KEEP];
-    uint lo = LAYER_KEEP, hi = LAYER_KEEP;
+// A pixel's nearest LAYER_KEEP layers, sorted (sort_layers), in [lo, hi) of a double-ended
+// array that starts in its middle: (depth bits, object word) keys and node indices.
+uvec2 sorted_keys[2u * LAYER_KEEP];
+uint sorted_nodes[2u * LAYER_KEEP];
+
+// What a pixel keeps of its layers: the nearest sorted into sorted_keys/sorted_nodes
+// [lo, hi); the farther ones merged (`merged`: their α-weighted mean colour, and Π(1 − α)
+// over them all: what they leave uncovered); `count`: its layers.
+struct SortedLayers {
+    uint lo;
+    uint hi;
+    uint count;
+    vec4 merged;
+};
+
+// Pixel `p`'s layers sorted (the nearest LAYER_KEEP) and merged (the rest).
+SortedLayers sort_layers(ivec2 p) {
+    SortedLayers s = SortedLayers(LAYER_KEEP, LAYER_KEEP, 0u, vec4(0.0, 0.0, 0.0, 1.0));
+    // A list holds its pixel's layers in the reverse of the order they were drawn, so they
+    // often come nearest-first or farthest-first; either way each one goes to an end of the
+    // array, without moving the others (an array filled from one end would move them all for
+    // one of the two).
+    uint lo = LAYER_KEEP, hi = LAYER_KEEP, count = 0u;
     // What is merged behind them: Π(1 − α), Σα, Σα·colour.
     float uncovered = 1.0, weight = 0.0;
     vec3 weighted = vec3(0.0);
     uint capacity = layer_capacity();
-    for (uint node = head; node != LAYER_END && count < capacity; count++) {
+    for (uint node = layer_heads[layer_pixel(p)]; node != LAYER_END && count < capacity; count++) {
         uvec4 a = layer_nodes[2u * node];
         uvec2 key = a.xz;
         uint merged_node = LAYER_END;
         if (hi - lo == LAYER_KEEP) {
-            if (layer_before(key, keys[hi - 1u])) {
+            if (layer_before(key, sorted_keys[hi - 1u])) {
                 hi--;
-                merged_node = nodes[hi];
+                merged_node = sorted_nodes[hi];
             } else {
                 merged_node = node;
             }
@@ -126,12 +165,12 @@ vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) 
         if (merged_node != node) {
             // Its place i: keys[lo, i) before it, keys[i, hi) not. The ends first.
             uint i = hi;
-            if (lo != hi && layer_before(key, keys[hi - 1u])) {
-                if (layer_before(key, keys[lo])) {
+            if (lo != hi && layer_before(key, sorted_keys[hi - 1u])) {
+                if (layer_before(key, sorted_keys[lo])) {
                     i = lo;
                 } else {
                     i = hi - 1u;
-                    while (layer_before(key, keys[i - 1u])) {
+                    while (layer_before(key, sorted_keys[i - 1u])) {
                         i--;
                     }
                 }
@@ -140,20 +179,20 @@ vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) 
             // LAYER_KEEP - 1 layers are kept here, and lo never passes the middle).
             if (hi < 2u * LAYER_KEEP && (lo == 0u || hi - i <= i - lo)) {
                 for (uint k = hi; k > i; k--) {
-                    keys[k] = keys[k - 1u];
-                    nodes[k] = nodes[k - 1u];
+                    sorted_keys[k] = sorted_keys[k - 1u];
+                    sorted_nodes[k] = sorted_nodes[k - 1u];
                 }
                 hi++;
             } else {
                 for (uint k = lo; k < i; k++) {
-                    keys[k - 1u] = keys[k];
-                    nodes[k - 1u] = nodes[k];
+                    sorted_keys[k - 1u] = sorted_keys[k];
+                    sorted_nodes[k - 1u] = sorted_nodes[k];
                 }
                 lo--;
                 i--;
             }
-            keys[i] = key;
-            nodes[i] = node;
+            sorted_keys[i] = key;
+            sorted_nodes[i] = node;
         }
         if (merged_node != LAYER_END) {
             vec4 c = layer_color(merged_node);
@@ -163,19 +202,39 @@ vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) 
         }
         node = a.y;
     }
-    vec3 color = under;
+    s.lo = lo;
+    s.hi = hi;
+    s.count = count;
     if (count > LAYER_KEEP) {
         atomicAdd(layer_counts.y, 1u);
-        vec3 mean = weight > 0.0 ? weighted / weight : vec3(0.0);
-        color = mix(color, mean, 1.0 - uncovered);
-        transmittance = uncovered;
+        s.merged = vec4(weight > 0.0 ? weighted / weight : vec3(0.0), uncovered);
     }
-    for (uint i = hi; i > lo; i--) {
-        vec4 c = layer_color(nodes[i - 1u]);
+    return s;
+}
+
+// The sorted layers `s` whose bit `layers` has (bit i: sorted_nodes[s.lo + i]; all ones: every
+// one), and the merged ones, blended over `under` (linear) back to front; `transmittance`:
+// how much of `under` still shows.
+vec3 blend_sorted(SortedLayers s, uint layers, vec3 under, out float transmittance) {
+    vec3 color = mix(under, s.merged.rgb, 1.0 - s.merged.a);
+    transmittance = s.merged.a;
+    for (uint i = s.hi; i > s.lo; i--) {
+        if ((layers & (1u << (i - 1u - s.lo))) == 0u) {
+            continue;
+        }
+        vec4 c = layer_color(sorted_nodes[i - 1u]);
         color = c.rgb * c.a + color * (1.0 - c.a);
         transmittance *= 1.0 - c.a;
     }
     return color;
+}
+
+// Pixel `p`'s lit layers blended over `under` (linear; black for the background) back to
+// front; `transmittance`: how much of `under` still shows, `count`: its layers.
+vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) {
+    SortedLayers s = sort_layers(p);
+    count = s.count;
+    return blend_sorted(s, 0xffffffffu, under, transmittance);
 }
 
 // The transparency-layers debug view: layers per pixel on a log scale up to LAYER_KEEP; white
@@ -202,6 +261,70 @@ vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
     }
     return vec4(encode_output(color, exposure) + transmittance * CLEAR_COLOR.rgb, 1.0);
 }
+
+#ifdef LAYER_SAMPLES
+// Anti-aliased (docs/DESIGN.md#anti-aliasing): the includer binds the opaque samples
+// (`uvec2 opaque_sample(ivec2 p, uint k)`, opaque_depth.glsl) and `vec3 surface_colour(ivec2
+// p, uint leader)`, the linear colour the lighting gave the opaque surface whose first sample
+// is `leader`. Each sample gets its own layers — those whose fragment covers it — over its
+// own opaque surface (or the background), tone-mapped; the pixel is the mean of its samples
+// in the display's linear light, as without layers. Samples with the same surface and the
+// same layers are blended once.
+
+// Which sorted layers of `s` cover sample k (bit i: sorted_nodes[s.lo + i]).
+uint layers_over_sample(SortedLayers s, uint k) {
+    uint bits = 0u;
+    for (uint i = s.lo; i < s.hi; i++) {
+        bits |= ((layer_covered(sorted_keys[i].y) >> k) & 1u) << (i - s.lo);
+    }
+    return bits;
+}
+
+vec4 layered_samples_output(ivec2 p, float exposure) {
+    SortedLayers s = sort_layers(p);
+    if (frame.cluster_dims.w == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
+        return layer_count_color(s.count);
+    }
+    vec3 background = pow(CLEAR_COLOR.rgb, vec3(2.2));
+    vec3 sum = vec3(0.0);
+    uint done = 0u;
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        if ((done & (1u << k)) != 0u) {
+            continue;
+        }
+        uvec2 v = opaque_sample(p, k);
+        bool drawn = visibility_buffer_depth(v) < 1.0;
+        uint id = visibility_buffer_id(v);
+        uint layers = layers_over_sample(s, k);
+        // The samples like k: the same surface (or the background) and the same layers; the
+        // surface's first sample (its leader, where the lighting left its colour).
+        uint members = 0u, leader = k;
+        for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
+            uvec2 u = opaque_sample(p, j);
+            bool same_surface = drawn ? visibility_buffer_depth(u) < 1.0 && visibility_buffer_id(u) == id : visibility_buffer_depth(u) >= 1.0;
+            if (same_surface && layers_over_sample(s, j) == layers) {
+                members |= 1u << j;
+            }
+        }
+        for (uint j = 0u; j < k && drawn; j++) {
+            uvec2 u = opaque_sample(p, j);
+            if (visibility_buffer_depth(u) < 1.0 && visibility_buffer_id(u) == id) {
+                leader = j;
+                break;
+            }
+        }
+        done |= members;
+        float transmittance;
+        vec3 color = blend_sorted(s, layers, drawn ? surface_colour(p, leader) : vec3(0.0), transmittance);
+        vec3 display = display_linear(color, exposure);
+        if (!drawn) {
+            display += transmittance * background;
+        }
+        sum += display * float(bitCount(members));
+    }
+    return vec4(encode_gamma(sum / float(VISIBILITY_SAMPLES)), 1.0);
+}
+#endif
 
 #endif
 

@@ -53,7 +53,6 @@ void main() {
     uint head = first_head;
     float opaque = in_image ? opaque_depth_at(p) : 0.0;
     vec2 to_ndc = 2.0 / vec2(frame.viewport.xy);
-    vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0);
     uint capacity = layer_capacity();
     // The CPU's objects, or the huge triangles the per-triangle build listed at the end of
     // its room.
@@ -98,10 +97,11 @@ void main() {
             // follow these bits, not a second test, so they take exactly the room counted
             // (a compiler may evaluate two copies of a test with different rounding).
             uvec2 hits = uvec2(0u);
-            vec3 w;
+            vec3 q, w;
             float depth, alpha;
+            uint covered;
             for (uint i = 0u; i < count && in_image; i++) {
-                if (layer_fragment(i, q, opaque, w, depth, alpha)) {
+                if (layer_fragment(i, p, to_ndc, opaque, q, covered, w, depth, alpha)) {
                     hits[i >> 5] |= 1u << (i & 31u);
                 }
             }
@@ -118,10 +118,10 @@ void main() {
                 if ((hits[i >> 5] & (1u << (i & 31u))) != 0u) {
                     // Its barycentrics, depth and coverage again (not kept from the count: 64
                     // triangles' worth of registers).
-                    layer_fragment(i, q, opaque, w, depth, alpha);
+                    layer_fragment(i, p, to_ndc, opaque, q, covered, w, depth, alpha);
                     uint node = tile_first_node + atomicAdd(tile_taken, 1u);
                     if (node < capacity) {
-                        write_layer(node, p, depth, head, tri_object[i].x, layer_surface(i, q, w, alpha, to_ndc));
+                        write_layer(node, p, depth, head, tri_object[i].x, covered, layer_surface(i, q, w, alpha, to_ndc));
                         head = node;
                     }
                 }

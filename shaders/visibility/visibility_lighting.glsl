@@ -136,6 +136,11 @@ uint texture_set_of(uint id) {
 // binds are that dispatch's: the first dispatch with a surface in the pixel (the first set's
 // where none has) stores its share, the later ones add theirs.
 
+#ifdef LAYERED_SAMPLES
+// With transparent layers, each surface's linear colour is kept for their blend too.
+#include "visibility/surface_colours.glsl"
+#endif
+
 // Per lane, the surface it shades this round (its pixel in the work group << 16 | leader
 // sample), and then its colour × samples covered.
 shared uint dealt[gl_WorkGroupSize.x * gl_WorkGroupSize.y];
@@ -169,7 +174,12 @@ vec3 surface_display(ivec2 p, uint leader) {
         PointMaterial m;
         uint flags;
         surface_of(p, id, xy, -1.0, world, n, m, flags);
-        display = shade_display(xy, world, n, m, flags);
+        bool debug;
+        vec3 shaded = shade_linear(xy, world, n, m, flags, debug);
+#ifdef LAYERED_SAMPLES
+        store_surface_colour(p, leader, shaded);
+#endif
+        display = display_of(shaded, debug);
     }
     return display * float(bitCount(members));
 }

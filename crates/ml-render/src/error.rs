@@ -152,8 +152,8 @@ pub enum SettingsError {
         "--aa {samples}: '{device}' draws {what} with {offered} samples a pixel, not {samples}: use --aa with one of those or --aa off"
     )]
     AntialiasingSamples { samples: &'static str, what: String, device: String, offered: String },
-    #[error("--aa {samples} does not blend transparent layers yet, and the scene has transparent (BLEND) materials: use --aa off")]
-    AntialiasingWithLayers { samples: &'static str },
+    #[error("the scene has transparent (BLEND) materials, whose layers are anti-aliased by the visibility technique at up to {max} samples a pixel, not by {technique} at {samples}: use --technique visibility with --aa 4 or 8, or --aa off")]
+    AntialiasingWithLayers { samples: &'static str, technique: &'static str, max: u32 },
     #[error("the aa debug view shows the surfaces the visibility technique shades in its 64-bit buffer (with --aa, or the compute and hybrid rasters), not {technique}'s")]
     AaViewNeedsComputeRaster { technique: &'static str },
     #[error(

@@ -4,7 +4,7 @@
 //! a pass looks up the names its shaders declare and knows nothing of who made them.
 
 use crate::descriptors::Resource;
-use crate::sync::{DEPTH_PYRAMID, VISIBILITY_DEPTH};
+use crate::sync::{DEPTH_PYRAMID, SURFACE_COLOURS, VISIBILITY_DEPTH};
 use crate::targets::Targets;
 use ml_vk::vk;
 
@@ -20,10 +20,14 @@ pub struct FrameResources<'a> {
 
 impl<'a> FrameResources<'a> {
     /// Slot `slot`'s table: its targets' buffers (the depth pyramid, the compute raster's
-    /// depth-and-id buffer) and, added by `with`, everyone else's (the slot's, the scene's,
+    /// depth-and-id buffer, the surface colours) and, added by `with`, everyone else's (the slot's, the scene's,
     /// the passes' own).
     pub fn new(slot: usize, targets: &'a Targets) -> FrameResources<'a> {
-        let buffers = vec![(DEPTH_PYRAMID, targets.depth_pyramid.raw), (VISIBILITY_DEPTH, targets.visibility_depth.raw)];
+        let buffers = vec![
+            (DEPTH_PYRAMID, targets.depth_pyramid.raw),
+            (VISIBILITY_DEPTH, targets.visibility_depth.raw),
+            (SURFACE_COLOURS, targets.surface_colours.raw),
+        ];
         FrameResources { slot, buffers, targets }
     }
 

@@ -452,8 +452,11 @@ fn check_antialiasing(s: &RenderSettings, ctx: &Context) -> Result<(), RenderErr
     if s.light_stats && s.technique.geometry() == Geometry::Meshes {
         return Err(SettingsError::LightStatsWithSamples { samples, technique: s.technique.name() }.into());
     }
-    if s.blends_layers() {
-        return Err(SettingsError::AntialiasingWithLayers { samples }.into());
+    // The layers' nodes keep at most LAYER_MAX_SAMPLES samples' coverage, and only the
+    // visibility technique keeps its surfaces' colours per sample for their blend.
+    let max = crate::transparency::LAYER_MAX_SAMPLES;
+    if s.blends_layers() && (s.technique != Technique::Visibility || s.antialiasing.samples() > max) {
+        return Err(SettingsError::AntialiasingWithLayers { samples, technique: s.technique.name(), max }.into());
     }
     // The visibility technique keeps its samples in the 64-bit buffer.
     let int64 = ctx.info.features.buffer_int64_atomics;

@@ -240,6 +240,11 @@ pub const DEPTH_PYRAMID: &str = "DepthPyramidBuffer";
 /// the hybrid's fragments, read by the depth pyramid and the lighting.
 pub const VISIBILITY_DEPTH: &str = "VisibilityDepthBuffer";
 
+/// The frame slot's opaque surface colours at their first samples (visibility with
+/// anti-aliasing and transparent layers; its shader block's name): written by the lighting,
+/// read by the transparent layers' blend.
+pub const SURFACE_COLOURS: &str = "SurfaceColourBuffer";
+
 /// Each meshlet instance's visibility at the end of the last frame (its shader block's name):
 /// read by the early culling, written by the late one. The frame slots share it.
 pub const MESHLET_VISIBILITY: &str = "MeshletVisibilityBuffer";

@@ -174,6 +174,10 @@ pub struct Targets {
     /// (`depth` and `visibility` are null then); with the hardware raster and anti-aliasing,
     /// its multisampled images gathered (null otherwise).
     pub visibility_depth: Buffer,
+    /// visibility with anti-aliasing and transparent layers: each opaque surface's linear
+    /// colour at its first sample, in `visibility_depth`'s layout (8 bytes a sample), for the
+    /// layers' blend (null otherwise).
+    pub surface_colours: Buffer,
 }
 
 /// Format of the visibility buffer: the 32-bit id (meshlets.rs).
@@ -228,6 +232,7 @@ impl Targets {
             visibility: Image::null(),
             depth_pyramid: Buffer::null(),
             visibility_depth: Buffer::null(),
+            surface_colours: Buffer::null(),
             colour_samples: Image::null(),
         };
         ml_vk::build(ctx, t, |t| t.create(ctx, extent, depth_format, (output, gbuffer), (raster, layers, antialiasing)))
@@ -286,8 +291,9 @@ impl Targets {
         }
         if output == Output::Subpasses || (output == Output::Color && (layers || multisampled)) {
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED, colour)?;
-        } else if layers {
-            // The compute lighting's linear output, which the transparent resolve reads.
+        } else if layers && !(output == Output::Visibility && antialiasing != Antialiasing::Off) {
+            // The compute lighting's linear output, which the transparent resolve reads
+            // (anti-aliased, the visibility lighting keeps its surfaces' colours instead).
             self.hdr = Image::new_2d(ctx, "hdr target", extent, HDR_FORMAT, U::STORAGE | U::SAMPLED, colour)?;
         }
         if output == Output::Visibility {
@@ -303,15 +309,20 @@ impl Targets {
             let bytes = antialiasing.buffer_bytes(extent.width, extent.height);
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
             self.visibility_depth = Buffer::new(ctx, "visibility-depth buffer", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
+            if layers && antialiasing != Antialiasing::Off {
+                let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+                self.surface_colours = Buffer::new(ctx, "surface colours", bytes, usage, gpu_allocator::MemoryLocation::GpuOnly)?;
+            }
         }
         Ok(())
     }
 
     /// Bytes of the multisampled attachments (anti-aliasing's samples: depth, and the forward
-    /// pass's colour, the G-buffer or the hardware visibility raster's ids).
+    /// pass's colour, the G-buffer or the hardware visibility raster's ids) and of the surface
+    /// colours kept per sample for the transparent layers.
     pub fn multisampled_bytes(&self) -> u64 {
         let ids = self.colour_samples.bytes + self.visibility.bytes;
-        self.depth.bytes + ids + self.gbuffer.iter().map(|g| g.bytes).sum::<u64>()
+        self.depth.bytes + ids + self.gbuffer.iter().map(|g| g.bytes).sum::<u64>() + self.surface_colours.size
     }
 
     /// The G-buffer image the shaders call `key` (`normal`, `object`, `albedo`, …), where the
@@ -330,6 +341,7 @@ impl Targets {
         self.visibility.destroy(ctx);
         self.depth_pyramid.destroy(ctx);
         self.visibility_depth.destroy(ctx);
+        self.surface_colours.destroy(ctx);
         self.colour_samples.destroy(ctx);
     }
 }

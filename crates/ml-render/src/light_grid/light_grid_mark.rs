@@ -40,7 +40,7 @@ impl LightGridMark {
         let pass = ComputePass::new(ctx, &[], (shader, &constants))?;
         let mut mark = LightGridMark { pass, layers: None, occupancy: vec![vk::Buffer::null(); FRAMES_IN_FLIGHT], depth_buffer };
         if layers {
-            match ComputePass::new(ctx, &[], (&ml_shaders::LIGHT_GRID_MARK_LAYERS_COMP, &[])) {
+            match ComputePass::new(ctx, &[], (&ml_shaders::LIGHT_GRID_MARK_LAYERS_COMP, &[antialiasing.constant()])) {
                 Ok(p) => mark.layers = Some(p),
                 Err(e) => {
                     mark.pass.destroy(ctx);

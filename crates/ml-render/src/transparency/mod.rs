@@ -23,6 +23,9 @@ use ml_vk::{vk, Context};
 pub const LAYER_END: u32 = 0xffff_ffff;
 /// Layers a pixel blends exactly (layers.glsl LAYER_KEEP); farther ones are merged.
 pub const LAYER_KEEP: u32 = 32;
+/// The most samples a pixel's layers keep their coverage of with anti-aliasing (layers.glsl
+/// LAYER_MAX_SAMPLES: a bit each in a node's object word).
+pub const LAYER_MAX_SAMPLES: u32 = 8;
 /// Nodes per pixel on average, unless the option says otherwise.
 pub const DEFAULT_BUDGET: u32 = 4;
 /// The most nodes per pixel the option takes.

@@ -97,7 +97,11 @@ impl TransparentBuild {
         let compute = vk::ShaderStageFlags::COMPUTE;
         let mesh_sets = FrameSets::new(ctx, &[(tiles, compute), (triangles, compute), (large, compute)], 3, FRAMES_IN_FLIGHT)?;
         let layouts = [scene.textures.set_layout.raw, scene.object_textures.set_layout, mesh_sets.layout.raw];
-        let constants = shading.surface_constants();
+        // From the compute raster's buffer, the fragments keep the samples they cover.
+        let mut constants = shading.surface_constants().to_vec();
+        if depth_buffer {
+            constants.push(shading.antialiasing.constant());
+        }
         let push = std::mem::size_of::<DispatchPush>() as u32;
         let pass = TransparentBuild {
             tiles: ComputePass::empty(),

@@ -3,15 +3,19 @@
 //! and shadows as the opaque surfaces), then per pixel sorted and blended back to front over
 //! the opaque pass's linear HDR output (the forward pass's, the lighting subpass's, the compute
 //! lighting's) and encoded into the colour target (transparent_blend.comp; in place of the
-//! deferred techniques' tone map). One pair of shaders for every technique.
+//! deferred techniques' tone map). One pair of shaders for every technique. With
+//! anti-aliasing (the visibility technique), the lighting resolved the colour target and kept
+//! its surfaces' colours: the blend redoes the pixels with layers, sample by sample
+//! (transparent_blend_samples.comp).
 
 use super::{layer_uses, TransparencySettings};
+use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{shading_reads, Use, HDR_TARGET};
+use crate::sync::{shading_reads, Use, COLOUR_TARGET, HDR_TARGET, SURFACE_COLOURS, VISIBILITY_DEPTH};
 use crate::technique::LightAssignment;
 use ml_vk::commands::memory_barrier;
 use ml_vk::{vk, Context, VkError};
@@ -28,6 +32,9 @@ pub struct TransparentResolve {
     after_compute: bool,
     /// The pool's size per pixel (the lighting dispatch covers the pool).
     settings: TransparencySettings,
+    /// Anti-aliased: the blend reads the samples and the surfaces' colours, and rewrites the
+    /// colour target's pixels that have layers.
+    samples: bool,
 }
 
 impl TransparentResolve {
@@ -45,11 +52,19 @@ impl TransparentResolve {
             LightAssignment::Cpu => &ml_shaders::TRANSPARENT_LIGHTING_CLUSTERED_COMP,
             LightAssignment::Gpu => &ml_shaders::TRANSPARENT_LIGHTING_GRID_COMP,
         };
-        let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &shading.lighting_constants()))?;
+        // The nodes keep their samples (layers.glsl): every pass of theirs knows the count.
+        let samples = shading.antialiasing.constant();
+        let lighting_constants = [&shading.lighting_constants()[..], &[samples]].concat();
+        let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &lighting_constants))?;
         let [blinn_phong, pbr, _] = shading.surface_constants();
-        let blend_constants = [blinn_phong, pbr];
-        match ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_COMP, &blend_constants)) {
-            Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute, settings }),
+        let antialiased = shading.antialiasing != Antialiasing::Off;
+        let blend = if antialiased {
+            ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_SAMPLES_COMP, &[blinn_phong, pbr, samples]))
+        } else {
+            ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_COMP, &[blinn_phong, pbr]))
+        };
+        match blend {
+            Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute, settings, samples: antialiased }),
             Err(e) => {
                 let mut lighting = lighting;
                 lighting.destroy(ctx);
@@ -66,6 +81,7 @@ impl Pass for TransparentResolve {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         self.lighting.bind_frame(ctx, frame, &|name| frame.buffer(name))?;
+        // (Anti-aliased, the blend reads no HDR image: none is asked for.)
         let hdr = self.blend.sampled(&frame.targets.hdr, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
         self.blend.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { frame.buffer(name) })
     }
@@ -75,6 +91,15 @@ impl Pass for TransparentResolve {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let mut uses = shading_reads(compute);
         uses.extend(layer_uses(compute));
+        if self.samples {
+            let read = (compute, vk::AccessFlags::SHADER_READ);
+            uses.push(Use::at(VISIBILITY_DEPTH, read, None));
+            uses.push(Use::at(SURFACE_COLOURS, read, None));
+            // The pixels without layers keep the lighting's colour.
+            let write = (compute, vk::AccessFlags::SHADER_WRITE);
+            uses.push(Use::at(COLOUR_TARGET, write, Some(vk::ImageLayout::GENERAL)));
+            return uses;
+        }
         if self.after_compute {
             let layout = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
             uses.push(Use::at(HDR_TARGET, (compute, vk::AccessFlags::SHADER_READ), Some(layout)));

@@ -10,7 +10,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{ray_count_uses, shading_reads, Use, VISIBILITY_DEPTH};
+use crate::sync::{ray_count_uses, shading_reads, Use, SURFACE_COLOURS, VISIBILITY_DEPTH};
 use crate::visibility::meshlet_scene::SharedMeshletScene;
 use ml_vk::{vk, Context, VkError};
 
@@ -21,6 +21,9 @@ pub struct VisibilityLighting {
     from_buffer: bool,
     /// It writes linear HDR for the transparent layers' resolve (else the colour target).
     layers: bool,
+    /// Anti-aliased with transparent layers: it writes the colour target and keeps each
+    /// surface's linear colour for the layers' blend.
+    surface_colours: bool,
 }
 
 impl VisibilityLighting {
@@ -37,15 +40,19 @@ impl VisibilityLighting {
             constants.push(antialiasing.constant());
         }
         let more_sets = [gpu.textures.set_layout.raw, gpu.object_textures.set_layout];
-        // With transparent layers, linear HDR for their resolve.
+        // With transparent layers, linear HDR for their resolve; anti-aliased, the colour
+        // target and the surfaces' colours.
+        let surface_colours = shading.transparency && antialiasing != Antialiasing::Off;
         let shader = match (from_buffer, shading.transparency) {
+            (true, _) if surface_colours => &ml_shaders::VISIBILITY_LIGHTING_BUFFER_LAYERS_COMP,
             (true, false) => &ml_shaders::VISIBILITY_LIGHTING_BUFFER_COMP,
             (true, true) => &ml_shaders::VISIBILITY_LIGHTING_BUFFER_LINEAR_COMP,
             (false, false) => &ml_shaders::VISIBILITY_LIGHTING_COMP,
             (false, true) => &ml_shaders::VISIBILITY_LIGHTING_LINEAR_COMP,
         };
         let pass = ComputePass::with_push(ctx, &more_sets, (shader, &constants), 16)?;
-        Ok(VisibilityLighting { pass, scene, from_buffer, layers: shading.transparency })
+        let layers = shading.transparency && !surface_colours;
+        Ok(VisibilityLighting { pass, scene, from_buffer, layers, surface_colours })
     }
 }
 
@@ -71,6 +78,9 @@ impl Pass for VisibilityLighting {
         uses.push(ComputePass::output_use(self.layers));
         if self.from_buffer {
             uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
+        }
+        if self.surface_colours {
+            uses.push(Use::at(SURFACE_COLOURS, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), None));
         }
         uses.push(ray_count_uses().0);
         uses
