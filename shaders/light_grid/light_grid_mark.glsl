@@ -37,17 +37,25 @@ void mark_box_run(uint u0, uint u1) {
 }
 
 #ifdef OPAQUE_DEPTH_BUFFER
-// Anti-aliased: each surface of a pixel marks the walks from the box around its samples'
-// points. The lighting shades it at a point between them (visibility_samples.glsl
-// shading_xy): on the surface, inside their hull, so inside the box, and every cell its walk
-// visits is marked. Edge pixels have several surfaces: each is a walk of its own through the
-// work group's box (one box around them all would mark the cells between a near surface and
-// a far one).
+// Anti-aliased: each surface of a pixel marks the walk from the point where the lighting
+// shades it — the mean of its samples' positions (visibility_samples.glsl shading_xy) at the
+// mean of their depths, found from the same samples the same way (visibility_lighting.glsl
+// samples_of). Edge pixels have several surfaces: each is a walk of its own through the work
+// group's box (one box around them all would mark the cells between a near surface and a far
+// one).
 #define MARK_SAMPLES VISIBILITY_SAMPLES
 
+// The walk of the point where the lighting shades a surface of pixel p covering the samples
+// `members` (`depths`: the sum of their depths). Depth is affine in the image over a
+// triangle, so that is the surface's point at the mean position, up to rounding.
+GridWalk surface_walk(ivec2 p, uint members, float depths) {
+    return mark_walk_of(world_from_depth(shading_xy(p, members), depths / float(bitCount(members))));
+}
+
 // The surfaces of pixel p as the lighting groups its samples, each named by its first sample
-// (a bit each: no array, which a loop would index in memory).
-uint pixel_leaders(ivec2 p) {
+// (a bit each: no array, which a loop would index in memory), and the walk of the first (most
+// pixels hold one surface): the samples read once, held in registers for both.
+uint pixel_leaders(ivec2 p, out GridWalk first) {
     uvec2 v[VISIBILITY_SAMPLES];
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         v[k] = opaque_sample(p, k);
@@ -64,23 +72,34 @@ uint pixel_leaders(ivec2 p) {
             }
         }
     }
+    if (leaders != 0u) {
+        uint id = visibility_buffer_id(v[findLSB(leaders)]);
+        uint members = 0u;
+        float depths = 0.0;
+        [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+            if (visibility_buffer_depth(v[k]) < 1.0 && visibility_buffer_id(v[k]) == id) {
+                members |= 1u << k;
+                depths += visibility_buffer_depth(v[k]);
+            }
+        }
+        first = surface_walk(p, members, depths);
+    }
     return leaders;
 }
 
-// The walk of pixel p's surface whose first sample is `leader`: the box around its samples'
-// points.
+// The walk of pixel p's surface whose first sample is `leader`.
 GridWalk leader_walk(ivec2 p, uint leader) {
     uint id = visibility_buffer_id(opaque_sample(p, leader));
-    vec3 lo = vec3(1e30), hi = vec3(-1e30);
+    uint members = 0u;
+    float depths = 0.0;
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         uvec2 v = opaque_sample(p, k);
         if (visibility_buffer_depth(v) < 1.0 && visibility_buffer_id(v) == id) {
-            vec3 world = world_from_depth(sample_xy(p, k), visibility_buffer_depth(v));
-            lo = min(lo, world);
-            hi = max(hi, world);
+            members |= 1u << k;
+            depths += visibility_buffer_depth(v);
         }
     }
-    return mark_walk_of_box(lo, hi);
+    return surface_walk(p, members, depths);
 }
 #else
 #define MARK_SAMPLES 1u
@@ -99,7 +118,7 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     bool inside = p.x < int(frame.viewport.x) && p.y < int(frame.viewport.y);
     // The pixel's walks: the centre point's (`centre`), or with anti-aliasing one per surface
-    // (`leaders`, a bit each).
+    // (`leaders`, a bit each; `centre` the first's).
     GridWalk centre;
     uint leaders = 0u;
     if (MARK_SAMPLES == 1u) {
@@ -111,9 +130,10 @@ void main() {
     }
 #ifdef OPAQUE_DEPTH_BUFFER
     else if (inside) {
-        leaders = pixel_leaders(p);
+        leaders = pixel_leaders(p, centre);
     }
-#define WALK(l) (MARK_SAMPLES == 1u ? centre : leader_walk(p, uint(findLSB(l))))
+    uint all_leaders = leaders;
+#define WALK(l) (MARK_SAMPLES == 1u || l == all_leaders ? centre : leader_walk(p, uint(findLSB(l))))
 #else
 #define WALK(l) centre
 #endif

@@ -69,7 +69,7 @@ vec3 id_color(uint x) {
 
 // The surface of visibility id `id` at the point `frag_xy` of pixel p, ready to shade: its
 // point (`world`, rebuilt from `z`, its depth there, as every compute lighting and the light
-// grid's marks rebuild it; z < 0: the depth the triangle has there), normal and material.
+// grid's marks rebuild it), normal and material.
 void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, out vec3 world, out vec3 n, out PointMaterial m, out uint flags) {
     uvec2 object_meshlet = meshlet_instances[id >> VISIBILITY_TRIANGLE_BITS];
     uint object = object_meshlet.x;
@@ -107,11 +107,6 @@ void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, out vec3 world, out vec
     tangent.xyz = mat3(o.model) * tangent.xyz;
     Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material);
     m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, s.emissive_factor);
-    if (z < 0.0) {
-        // Clip space interpolates linearly in the perspective-correct barycentrics.
-        vec4 point = mat4(c[0], c[1], c[2], vec4(0.0)) * vec4(b, 0.0);
-        z = point.z / point.w;
-    }
     world = world_from_depth(frag_xy, z);
     n = s.normal;
     flags = o.alpha_texture.x;
@@ -146,23 +141,30 @@ uint texture_set_of(uint id) {
 shared uint dealt[gl_WorkGroupSize.x * gl_WorkGroupSize.y];
 shared vec3 dealt_colour[gl_WorkGroupSize.x * gl_WorkGroupSize.y];
 
-// The samples of pixel p holding the same surface as sample `leader` (a bit each).
-uint samples_of(ivec2 p, uint leader) {
+// The samples of pixel p holding the same surface as sample `leader` (a bit each), and the
+// mean of their depths.
+uint samples_of(ivec2 p, uint leader, out float depth) {
     uvec2 l = raster_sample(p, leader);
     uint members = 0u;
+    float depths = 0.0;
     [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         uvec2 v = raster_sample(p, k);
         if (visibility_buffer_depth(v) < 1.0 && visibility_buffer_id(v) == l.x) {
             members |= 1u << k;
+            depths += visibility_buffer_depth(v);
         }
     }
+    depth = depths / float(bitCount(members));
     return members;
 }
 
 // The colour of the surface whose first sample is `leader` in pixel p, shaded (or a debug
-// view's), times the samples it covers.
+// view's), times the samples it covers. Its point is the mean of its samples' positions at
+// the mean of their depths (depth is affine in the image over a triangle: the triangle's
+// point there), as the light grid's marks find it (light_grid_mark.glsl surface_walk).
 vec3 surface_display(ivec2 p, uint leader) {
-    uint members = samples_of(p, leader);
+    float depth;
+    uint members = samples_of(p, leader, depth);
     uint id = visibility_buffer_id(raster_sample(p, leader));
     uint view = frame.cluster_dims.w;
     vec3 display;
@@ -173,7 +175,7 @@ vec3 surface_display(ivec2 p, uint leader) {
         vec3 world, n;
         PointMaterial m;
         uint flags;
-        surface_of(p, id, xy, -1.0, world, n, m, flags);
+        surface_of(p, id, xy, depth, world, n, m, flags);
         bool debug;
         vec3 shaded = shade_linear(xy, world, n, m, flags, debug);
 #ifdef LAYERED_SAMPLES
