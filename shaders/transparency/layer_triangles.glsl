@@ -186,9 +186,9 @@ vec3 barycentrics(uint i, vec3 q) {
     return e / (e.x + e.y + e.z);
 }
 
-// Whether triangle `i` covers the point `q` (x, y in NDC, 1) at a depth in [0, 1] in front of
-// `opaque`: its barycentrics and depth there.
-bool layer_point(uint i, vec3 q, float opaque, out vec3 w, out float depth) {
+// Whether triangle `i` covers the point `q` (x, y in NDC, 1) at a depth in [0, 1]: its
+// barycentrics and depth there.
+bool layer_point(uint i, vec3 q, out vec3 w, out float depth) {
     w = vec3(0.0);
     depth = 0.0;
     vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
@@ -201,7 +201,21 @@ bool layer_point(uint i, vec3 q, float opaque, out vec3 w, out float depth) {
     }
     w = e / sum;
     depth = dot(w, tri_z[i]) / dot(w, tri_w[i]);
-    return depth >= 0.0 && depth <= 1.0 && depth < opaque;
+    return depth >= 0.0 && depth <= 1.0;
+}
+
+// Whether no sample of the pixel centred at `q` can lie inside triangle `i`: an edge function
+// below zero by more than it changes over half a pixel each way (with a margin for rounding:
+// this only skips work, layer_point decides).
+bool samples_outside(uint i, vec3 q, vec2 to_ndc) {
+    for (uint j = 0u; j < 3u; j++) {
+        vec3 r = tri_edges[i][j];
+        float reach = 0.5 * (abs(r.x) * to_ndc.x + abs(r.y) * to_ndc.y);
+        if (dot(r, q) + 1.01 * reach < 0.0) {
+            return true;
+        }
+    }
+    return false;
 }
 
 // Whether triangle `i` leaves a fragment at pixel `p`: the samples it covers in front of the
@@ -219,15 +233,19 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
         return false;
     }
     if (VISIBILITY_SAMPLES == 1u) {
-        if (!layer_point(i, q, opaque, w, depth)) {
+        if (!layer_point(i, q, w, depth) || depth >= opaque) {
             return false;
         }
         covered = 1u;
     } else {
+        if (samples_outside(i, q, to_ndc)) {
+            return false;
+        }
         for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
             vec3 wk;
             float dk;
-            if (layer_point(i, vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0), opaque_depth_of_sample(p, k), wk, dk)) {
+            // The opaque sample read only where the triangle covers it.
+            if (layer_point(i, vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0), wk, dk) && dk < opaque_depth_of_sample(p, k)) {
                 covered |= 1u << k;
             }
         }

@@ -164,6 +164,66 @@ pub fn resolve_raster(
     Ok((raster, Some(why)))
 }
 
+/// `--aa` as given: a sample count, or None for auto.
+pub fn antialiasing_choice(name: &str) -> Result<Option<Antialiasing>> {
+    if name == AUTO {
+        return Ok(None);
+    }
+    Antialiasing::from_name(name).map(Some).map_err(|e| anyhow::anyhow!("{e}, or auto"))
+}
+
+/// The samples for `settings` (its technique known, its raster not yet where `raster` is None:
+/// with samples, the compute raster where the device runs it) on `ctx`'s device: `choice`, or
+/// for auto (None) `ml_render::auto_antialiasing` — the first count these settings
+/// pass their check with — and why; none for a supersampled render (`supersample` > 1), whose
+/// K×K pixels a pixel are its samples.
+pub fn resolve_antialiasing(
+    ctx: &Context,
+    settings: &RenderSettings,
+    (choice, raster): (Option<Antialiasing>, (Option<Raster>, u32)),
+    (lights, supersample): (usize, u32),
+) -> (Antialiasing, Option<String>) {
+    if let Some(aa) = choice {
+        return (aa, None);
+    }
+    if supersample > 1 {
+        return (
+            Antialiasing::Off,
+            Some(format!("--supersample {supersample} filters {supersample}x{supersample} samples a pixel already")),
+        );
+    }
+    let cpu = ctx.info.device_type == ml_vk::vk::PhysicalDeviceType::CPU;
+    let takes = |aa: Antialiasing| {
+        let mut s = RenderSettings { antialiasing: aa, ..*settings };
+        if settings.technique.geometry() == Geometry::Meshlets && raster.0.is_none() {
+            let compute = Raster::compute(raster.1);
+            s.raster = if missing_raster_feature(compute, &ctx.info.features).is_none() { compute } else { Raster::Hardware };
+        }
+        s.check(ctx, lights)
+    };
+    let (aa, why) = ml_render::auto_antialiasing(cpu, takes);
+    (aa, Some(why))
+}
+
+/// `resolve_antialiasing` on a context of its own (the viewer's), announced.
+pub fn resolve_antialiasing_alone(
+    settings: &RenderSettings,
+    choice: (Option<Antialiasing>, (Option<Raster>, u32)),
+    lights: usize,
+    (validation, device_index): (bool, Option<usize>),
+) -> Result<Antialiasing> {
+    if let Some(aa) = choice.0 {
+        return Ok(aa);
+    }
+    let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
+    let (aa, why) = resolve_antialiasing(&ctx, settings, choice, (lights, 1));
+    drop(ctx);
+    if let Some(why) = why {
+        println!("auto aa: {}: {why}", aa.name());
+    }
+    Ok(aa)
+}
+
 /// `resolve_raster` on a context of its own (the viewer makes its own for the window), which
 /// must leave the validation layer silent; auto's pick is announced.
 pub fn resolve_raster_alone(

@@ -101,10 +101,11 @@ pub struct BenchArgs {
     /// (each a row of its own; the other techniques have one).
     #[arg(long, default_value = "hardware,compute")]
     raster: String,
-    /// Anti-aliasing sample counts, comma-separated: off, 4, 8, 16 (render's --aa); the
-    /// counts other than off make rows of every technique (and every rasteriser's for
-    /// visibility); a count the device does not offer one makes a row that says so.
-    #[arg(long, default_value = "off")]
+    /// Anti-aliasing sample counts, comma-separated: off, 4, 8, 16 or auto (render's --aa:
+    /// 8 on a GPU, off on a CPU driver); the counts other than off make rows of every technique
+    /// (and every rasteriser's for visibility); a count the device does not offer one makes a
+    /// row that says so.
+    #[arg(long, default_value = "auto")]
     aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread, pixels a side (1
     /// to 64; render's --raster-split).
@@ -274,9 +275,9 @@ impl Variant {
     }
 }
 
-/// --aa: the sample counts of the rows.
-fn antialiasing_list(a: &BenchArgs) -> Result<Vec<Antialiasing>> {
-    unique_list(&a.aa, |name| Antialiasing::from_name(name).context("--aa"))
+/// --aa: the sample counts of the rows (None: auto, the device's).
+fn antialiasing_list(a: &BenchArgs) -> Result<Vec<Option<Antialiasing>>> {
+    unique_list(&a.aa, |name| auto::antialiasing_choice(name).context("--aa"))
 }
 
 /// --raster: the rasterisers the visibility rows use.
@@ -344,7 +345,7 @@ struct Asked {
     counts: Vec<u64>,
     resolution: (u32, u32),
     rasters: Vec<Raster>,
-    sample_counts: Vec<ml_render::Antialiasing>,
+    sample_counts: Vec<Option<ml_render::Antialiasing>>,
     rules: Vec<Rule>,
     named: Vec<Technique>,
     auto: Auto,
@@ -406,6 +407,18 @@ pub fn bench(a: &mut BenchArgs) -> Result<()> {
         check_rules(&rules, &a.given, &Techniques { flag: "--techniques", named, auto: Auto::Picked(auto_technique) })?.warn();
     }
     auto::announce(auto_technique, &auto_why);
+    // --aa auto: the device's count (a row that cannot take it says so, as for any count).
+    let cpu = ctx.info.device_type == ml_vk::vk::PhysicalDeviceType::CPU;
+    let (device_aa, aa_why) = ml_render::auto_antialiasing(cpu, |_| Ok(()));
+    if sample_counts.contains(&None) {
+        println!("auto aa: {}: {aa_why}", device_aa.name());
+    }
+    let sample_counts: Vec<Antialiasing> = sample_counts.iter().map(|c| c.unwrap_or(device_aa)).fold(Vec::new(), |mut list, aa| {
+        if !list.contains(&aa) {
+            list.push(aa);
+        }
+        list
+    });
     let mut variants: Vec<Variant> = Vec::new();
     for technique in choices.into_iter().map(|c| c.unwrap_or(auto_technique)) {
         let rasters = if technique.geometry() == Geometry::Meshlets { rasters.clone() } else { vec![Raster::Hardware] };

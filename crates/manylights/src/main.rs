@@ -288,8 +288,9 @@ struct SceneArgs {
     /// the counts the device offers), each distinct surface of a pixel shaded once and the
     /// pixel the mean of its samples in the display's linear light: forward, clustered and
     /// deferred by Vulkan multisampling, visibility in its 64-bit buffer (any raster; --raster
-    /// auto then picks compute).
-    #[arg(long, default_value = "off", value_parser = Antialiasing::ALL.map(Antialiasing::name))]
+    /// auto then picks compute). auto: 8 on a GPU (4 where the settings take no 8, off where
+    /// they take none), off on a CPU driver, said why.
+    #[arg(long, default_value = "auto", value_parser = ["off", "4", "8", "16", "auto"])]
     aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread: bounding box up to
     /// PX pixels a side (1 to 64).
@@ -558,7 +559,8 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         time: args.time,
         culling: args.culling == "on",
         light_grid_marks: LightGridMarks::from_name(&args.light_grid_marks)?,
-        antialiasing: Antialiasing::from_name(&args.aa)?,
+        // Set once the technique and device are known where auto: `auto::resolve_antialiasing`.
+        antialiasing: auto::antialiasing_choice(&args.aa)?.unwrap_or(Antialiasing::Off),
         exposure: exposure_choice(args)?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,
@@ -719,6 +721,9 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     };
     // Once every option is known to apply, so that a refusal stays the only line.
     print_warnings(&built.warnings);
+    let aa_choice = (auto::antialiasing_choice(&args.aa)?, (raster_choice(args)?, args.raster_split));
+    let aa_why;
+    (settings.antialiasing, aa_why) = auto::resolve_antialiasing(&ctx, &settings, aa_choice, (built.scene.lights.len(), cmd.supersample));
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
@@ -748,6 +753,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         object_textures,
         auto: auto_why.as_deref(),
         raster_auto: raster_why.as_deref(),
+        aa_auto: aa_why.as_deref(),
         output: &cmd.out,
         supersample: cmd.supersample,
         camera: &camera,
@@ -809,6 +815,8 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     print_warnings(&built.warnings);
     let mut first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
     unused.take_effect(&mut first);
+    let aa_choice = (auto::antialiasing_choice(&args.aa)?, (raster_choice(args)?, args.raster_split));
+    first.antialiasing = auto::resolve_antialiasing_alone(&first, aa_choice, built.scene.lights.len(), (args.validation, args.device))?;
     first.raster =
         auto::resolve_raster_alone(&built.scene, &first, (raster_choice(args)?, args.raster_split), (args.validation, args.device))?;
     let options = ml_viewer::ViewerOptions {

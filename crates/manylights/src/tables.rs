@@ -33,6 +33,8 @@ pub struct RenderFacts<'a> {
     pub auto: Option<&'a str>,
     /// Why `--raster auto` picked the rasteriser; None where it was asked for by name.
     pub raster_auto: Option<&'a str>,
+    /// Why `--aa auto` took its samples (None: given).
+    pub aa_auto: Option<&'a str>,
     /// Where the image was written.
     pub output: &'a Path,
     /// `--supersample`: the image rendered this many times wider and taller, filtered down.
@@ -98,6 +100,9 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     }
     // What the features' passes counted (the culling, the shadow raster, the atlas).
     rows.extend(stats.feature_rows());
+    if let Some(why) = facts.aa_auto {
+        rows.push(("auto aa", format!("{}: {why}", settings.antialiasing.name())));
+    }
     if let Some(ms) = stats.assign_ms() {
         rows.push(("cpu assign ms", format!("{ms:.3}  (light assignment, mean)")));
     }
@@ -247,6 +252,7 @@ mod tests {
             object_textures: false,
             auto: None,
             raster_auto: None,
+            aa_auto: None,
             output: Path::new("a.png"),
             supersample: 1,
             camera: "0,1,2:0,0,0:60",

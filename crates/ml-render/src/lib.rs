@@ -59,7 +59,7 @@ mod technique;
 mod transparency;
 mod visibility;
 
-pub use antialiasing::AntialiasingStats;
+pub use antialiasing::{auto_antialiasing, AntialiasingStats};
 pub use error::RenderError;
 pub use frame_resources::FRAMES_IN_FLIGHT;
 pub use light_grid::LightGridStats;
@@ -74,7 +74,7 @@ pub use settings::{
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage};
 pub use transparency::{
-    TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,
+    layers_take, TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,
     MAX_BUDGET as MAX_TRANSPARENCY_BUDGET,
 };
 pub use visibility::meshlet_cull::CullStats;

@@ -455,7 +455,7 @@ fn check_antialiasing(s: &RenderSettings, ctx: &Context) -> Result<(), RenderErr
     // The layers' nodes keep at most LAYER_MAX_SAMPLES samples' coverage, and only the
     // visibility technique keeps its surfaces' colours per sample for their blend.
     let max = crate::transparency::LAYER_MAX_SAMPLES;
-    if s.blends_layers() && (s.technique != Technique::Visibility || s.antialiasing.samples() > max) {
+    if s.blends_layers() && !crate::transparency::layers_take(s.technique, s.antialiasing) {
         return Err(SettingsError::AntialiasingWithLayers { samples, technique: s.technique.name(), max }.into());
     }
     // The visibility technique keeps its samples in the 64-bit buffer.

@@ -122,7 +122,13 @@ impl Choices {
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
             light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
-            antialiasing: if self.transparency.is_none() { self.antialiasing } else { Antialiasing::Off },
+            // Transparent layers take samples in the visibility technique (the overlay offers
+            // what the settings take).
+            antialiasing: if self.transparency.is_none() || ml_render::layers_take(self.technique, self.antialiasing) {
+                self.antialiasing
+            } else {
+                Antialiasing::Off
+            },
         }
     }
 }
@@ -205,7 +211,7 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
                 ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
             }
         }
-        if choices.transparency.is_none() {
+        if choices.transparency.is_none() || choices.technique == Technique::Visibility {
             combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
         }
         combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());

@@ -556,6 +556,10 @@ fn auto_renders_what_it_picked() {
     );
     let why = stdout.lines().find(|l| l.starts_with("auto")).expect("an auto row");
     assert!(why.contains("as a fragment shader") && why.contains("as a compute shader"), "{why}");
+    // --aa auto is the default: off on a CPU driver, samples on a GPU, said why.
+    let aa = stdout.lines().find(|l| l.starts_with("auto aa")).expect("an auto aa row");
+    let cpu = stdout.lines().any(|l| l.starts_with("device") && l.contains("(CPU"));
+    assert!(if cpu { aa.contains("off: a CPU driver") } else { aa.contains(": a GPU") }, "{aa}");
     let raster: &[&str] = if picked == "visibility" { &raster } else { &[] };
     let out = manylights(&[&common[..], raster, &["--technique", &picked, "--out", picked_png.to_str().unwrap()]].concat(), &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
