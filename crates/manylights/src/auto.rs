@@ -130,10 +130,12 @@ pub fn resolve_raster(
     }
     let device = &ctx.info.name;
     let features = &ctx.info.features;
-    if choice.is_none() && settings.antialiasing != Antialiasing::Off {
-        // With samples, the compute raster: every raster keeps them, but the hybrid's and the
-        // hardware's multisampled draws run on the fragment units (on the H200 at 8 samples:
-        // 1.26 ms a frame against 3.08 and 6.79).
+    let cpu = ctx.info.device_type == ml_vk::vk::PhysicalDeviceType::CPU;
+    if choice.is_none() && settings.antialiasing != Antialiasing::Off && !cpu {
+        // With samples on a GPU, the compute raster: every raster keeps them, but the hybrid's
+        // and the hardware's multisampled draws run on the fragment units (on the H200 at 8
+        // samples: 1.26 ms a frame against 3.08 and 6.79). A CPU driver times them as without
+        // (lavapipe draws the bench scene's samples with its rasteriser many times faster).
         let raster = Raster::compute(split);
         let samples = settings.antialiasing.name();
         return Ok(match missing_raster_feature(raster, features) {
