@@ -115,8 +115,8 @@ pub fn resolve_alone(name: &str, scene: SceneProbe, (validation, device_index): 
 }
 
 /// The rasteriser for `settings` on `ctx`'s device and, where `auto` (`choice` None) chose it,
-/// why. Techniques without a visibility buffer keep the hardware (an explicit compute raster
-/// is refused by the settings check); a device without what the asked-for raster needs draws
+/// why. Techniques without a visibility buffer draw with the hardware (`--raster` given with
+/// one is refused before, or where auto picked it, said to be unused); a device without what the asked-for raster needs draws
 /// with the hardware, and says so; auto renders `scene` with each rasteriser the device can
 /// run (hardware, hybrid and compute, those with `split`) and keeps the fastest.
 pub fn resolve_raster(
@@ -126,7 +126,7 @@ pub fn resolve_raster(
     (choice, split): (Option<Raster>, u32),
 ) -> Result<(Raster, Option<String>)> {
     if settings.technique.geometry() != Geometry::Meshlets {
-        return Ok((choice.unwrap_or(Raster::Hardware), None));
+        return Ok((Raster::Hardware, None));
     }
     let device = &ctx.info.name;
     let features = &ctx.info.features;
@@ -235,7 +235,7 @@ pub fn resolve_raster_alone(
     (validation, device_index): (bool, Option<usize>),
 ) -> Result<Raster> {
     if settings.technique.geometry() != Geometry::Meshlets {
-        return Ok(choice.0.unwrap_or(Raster::Hardware));
+        return Ok(Raster::Hardware);
     }
     let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
     let messages = ctx.validation_counter();

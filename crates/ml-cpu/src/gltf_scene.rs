@@ -21,7 +21,7 @@ use crate::limits::{LENGTHS, MAX_COORDINATE, MAX_INTENSITY, MAX_OBJECTS, SCALES}
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
 use crate::scene::{AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
-use crate::scene_load::{check_extent, read_reference, ExtentError, ReferenceError, SceneFile};
+use crate::scene_load::{check_draw_work, check_extent, read_reference, DrawWorkError, ExtentError, ReferenceError, SceneFile};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use crate::twin_faces;
 use base64::Engine as _;
@@ -188,6 +188,8 @@ pub enum GltfError {
     NodeScale { node: usize, scale: f32 },
     #[error(transparent)]
     Extent(#[from] ExtentError),
+    #[error(transparent)]
+    DrawWork(#[from] DrawWorkError),
     #[error("the scene has no triangles to draw")]
     NoTriangles,
     /// A primitive's attribute naming an accessor that does not exist.
@@ -468,6 +470,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     let mut scene = Scene { meshes, textures, directional, cones, ..Scene::new(objects, lights, Camera::seed()) };
     // The framing camera and the lights fitted to the scene are made from its box.
     check_extent(&scene)?;
+    check_draw_work(&scene)?;
     scene.camera = match camera {
         Some(c) => c,
         None => {

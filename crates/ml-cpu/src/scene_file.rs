@@ -17,7 +17,7 @@ use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::{DirectionalLight, Object, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
 pub use crate::scene_load::SceneFile;
-use crate::scene_load::{check_extent, read_reference, ExtentError, ReferenceError};
+use crate::scene_load::{check_draw_work, check_extent, read_reference, DrawWorkError, ExtentError, ReferenceError};
 use crate::SceneError;
 use glam::Vec3;
 use serde::{de, Deserialize, Deserializer};
@@ -88,6 +88,8 @@ pub enum SceneFileProblem {
     OutOfRange { what: &'static str, value: f32, range: RangeInclusive<f32> },
     #[error(transparent)]
     Extent(#[from] ExtentError),
+    #[error(transparent)]
+    DrawWork(#[from] DrawWorkError),
     /// An unknown mesh or material name.
     #[error(transparent)]
     Name(#[from] SceneError),
@@ -327,6 +329,7 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
     };
     // The camera and the lights fitted to the scene are made from its box.
     check_extent(&scene)?;
+    check_draw_work(&scene)?;
     (scene.camera, scene.camera_framed) = camera(file.camera.as_ref(), &scene)?;
     Ok(SceneFile { scene, shading, warnings })
 }

@@ -3,7 +3,8 @@
 
 use crate::error::Number;
 use crate::files::{read_regular, ReadError};
-use crate::limits::{LENGTHS, MAX_COORDINATE};
+use crate::limits::{LENGTHS, MAX_COORDINATE, MAX_DRAWN_TRIANGLES};
+use crate::mesh::MeshKind;
 use crate::scene::Scene;
 use std::path::{Component, Path};
 use thiserror::Error;
@@ -38,6 +39,52 @@ pub fn check_extent(scene: &Scene) -> Result<(), ExtentError> {
     Ok(())
 }
 
+/// A scene whose placements draw more than MAX_DRAWN_TRIANGLES a frame, and the mesh that
+/// draws the most of them.
+#[derive(Debug, Error, PartialEq)]
+#[error("the scene draws {triangles} triangles a frame, more than {max}: most of them {mesh} of {each} triangles placed {placed} times", max = MAX_DRAWN_TRIANGLES)]
+pub struct DrawWorkError {
+    pub triangles: u64,
+    pub mesh: String,
+    pub each: u64,
+    pub placed: u64,
+}
+
+/// Whether `scene` draws at most MAX_DRAWN_TRIANGLES a frame: its objects' meshes' triangles,
+/// each placement counted (from the meshes' index counts: nothing is uploaded before).
+pub fn check_draw_work(scene: &Scene) -> Result<(), DrawWorkError> {
+    // Placements per mesh: the scene's own by index, the built-in kinds after them.
+    let kinds = MeshKind::ALL;
+    let mut placed = vec![0u64; scene.meshes.len() + kinds.len()];
+    for o in &scene.objects {
+        let slot = match o.mesh {
+            MeshKind::Loaded(i) => i as usize,
+            kind => scene.meshes.len() + kinds.iter().position(|&k| k == kind).unwrap_or(0),
+        };
+        if let Some(count) = placed.get_mut(slot) {
+            *count += 1;
+        }
+    }
+    let triangles_of = |slot: usize| -> u64 {
+        match scene.meshes.get(slot) {
+            Some(mesh) => mesh.indices.len() as u64 / 3,
+            None => kinds[slot - scene.meshes.len()].build().indices.len() as u64 / 3,
+        }
+    };
+    let drawn: Vec<(usize, u64)> =
+        placed.iter().enumerate().filter(|(_, &n)| n > 0).map(|(slot, &n)| (slot, n * triangles_of(slot))).collect();
+    let triangles: u64 = drawn.iter().map(|d| d.1).sum();
+    if triangles <= MAX_DRAWN_TRIANGLES {
+        return Ok(());
+    }
+    let &(slot, _) = drawn.iter().max_by_key(|d| d.1).expect("triangles drawn");
+    let mesh = match scene.meshes.get(slot) {
+        Some(_) => "a mesh".to_owned(),
+        None => format!("the built-in {}", kinds[slot - scene.meshes.len()].name()),
+    };
+    Err(DrawWorkError { triangles, mesh, each: triangles_of(slot), placed: placed[slot] })
+}
+
 /// A loaded scene file or glTF file: the scene, the name of the shading model it asks for
 /// (resolved by whoever builds the scene, who may be asked for another), and what it holds
 /// that is left out.
@@ -57,6 +104,10 @@ pub enum ReferenceError {
     Absolute,
     #[error("it leads out of the folder of the file that names it")]
     OutsideFolder,
+    /// Through a symbolic link, out of the folder or to nothing: one answer for both, so that
+    /// an error never tells whether a file exists outside the folder.
+    #[error("it leads out of the folder of the file that names it, or to no file, through a link")]
+    ThroughLink,
     #[error(transparent)]
     Read(#[from] ReadError),
 }
@@ -79,9 +130,65 @@ pub fn read_reference(folder: &Path, reference: &Path, max: u64) -> Result<Vec<u
     // A file named without a folder is in the current one.
     let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
     let io = |e| ReferenceError::Read(ReadError::Io(e));
-    let (inside, resolved) = (folder.canonicalize().map_err(io)?, folder.join(reference).canonicalize().map_err(io)?);
+    let inside = folder.canonicalize().map_err(io)?;
+    let through_link = passes_a_link(folder, reference);
+    let resolved = match folder.join(reference).canonicalize() {
+        Ok(resolved) => resolved,
+        Err(_) if through_link => return Err(ReferenceError::ThroughLink),
+        Err(e) => return Err(io(e)),
+    };
     if !resolved.starts_with(&inside) {
-        return Err(ReferenceError::OutsideFolder);
+        return Err(if through_link { ReferenceError::ThroughLink } else { ReferenceError::OutsideFolder });
     }
     Ok(read_regular(&resolved, max)?)
+}
+
+/// Whether `reference`, followed from `folder` one name at a time, meets a symbolic link.
+fn passes_a_link(folder: &Path, reference: &Path) -> bool {
+    let mut path = folder.to_path_buf();
+    for part in reference.components() {
+        match part {
+            Component::ParentDir => {
+                path.pop();
+            }
+            Component::Normal(name) => {
+                path.push(name);
+                if std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink()) {
+                    return true;
+                }
+            }
+            _ => {}
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::material::Material;
+    use crate::mesh::Mesh;
+    use crate::scene::Object;
+    use glam::Vec3;
+
+    /// A mesh of 2^20 triangles placed 1,024 times draws MAX_DRAWN_TRIANGLES: it renders; once
+    /// more is refused, naming it; the built-in kinds count their own triangles.
+    #[test]
+    fn placements_count_every_triangle_they_draw() {
+        let mesh = Mesh { vertices: Vec::new(), indices: vec![0; 3 << 20] };
+        let placed = |n: usize, extra: MeshKind| {
+            let mut objects: Vec<Object> =
+                (0..n).map(|_| Object::placed(MeshKind::Loaded(0), Vec3::ZERO, 1.0, Material::built_in()[0])).collect();
+            objects.push(Object::placed(extra, Vec3::ZERO, 1.0, Material::built_in()[0]));
+            let mut scene = Scene::new(objects, Vec::new(), Camera::seed());
+            scene.meshes = vec![mesh.clone()];
+            check_draw_work(&scene)
+        };
+        let plane = MeshKind::Plane.build().indices.len() as u64 / 3;
+        assert_eq!(placed(1023, MeshKind::Plane), Ok(()));
+        let e = placed(1024, MeshKind::Plane).unwrap_err();
+        assert_eq!(e, DrawWorkError { triangles: (1 << 30) + plane, mesh: "a mesh".into(), each: 1 << 20, placed: 1024 });
+        assert!(e.to_string().contains("more than 1073741824: most of them a mesh of 1048576 triangles placed 1024 times"), "{e}");
+    }
 }

@@ -68,13 +68,14 @@ pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use scene::ray_geometry::RayStats;
 pub use scene::textures::SHADOW_MAP_SIZE;
 pub use settings::{
-    Antialiasing, DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightGridMarks, LightingStage, OmniShadowMode,
-    OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS, TIMER_SPEED,
+    layers_take, Antialiasing, DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightGridMarks, LightingStage,
+    OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS,
+    TIMER_SPEED,
 };
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage};
 pub use transparency::{
-    layers_take, TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,
+    TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,
     MAX_BUDGET as MAX_TRANSPARENCY_BUDGET,
 };
 pub use visibility::meshlet_cull::CullStats;

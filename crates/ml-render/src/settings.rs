@@ -439,6 +439,14 @@ fn shadowed_count(omni: &OmniShadowSettings, scene: &ml_cpu::scene::Scene, (widt
     (seen.len() as u32).max(1)
 }
 
+/// Whether transparent layers are blended with `antialiasing` in `technique`: without samples
+/// in every technique; with them in the visibility technique, which keeps each opaque
+/// surface's colour per sample (up to LAYER_MAX_SAMPLES).
+pub fn layers_take(technique: Technique, antialiasing: Antialiasing) -> bool {
+    let max = crate::transparency::LAYER_MAX_SAMPLES;
+    antialiasing == Antialiasing::Off || (technique == Technique::Visibility && antialiasing.samples() <= max)
+}
+
 /// Refuse `--aa` where `s` cannot keep samples (in one line: the technique, the raster, the
 /// transparent layers, the sample counts the device offers for what the samples are drawn
 /// into).
@@ -455,7 +463,7 @@ fn check_antialiasing(s: &RenderSettings, ctx: &Context) -> Result<(), RenderErr
     // The layers' nodes keep at most LAYER_MAX_SAMPLES samples' coverage, and only the
     // visibility technique keeps its surfaces' colours per sample for their blend.
     let max = crate::transparency::LAYER_MAX_SAMPLES;
-    if s.blends_layers() && !crate::transparency::layers_take(s.technique, s.antialiasing) {
+    if s.blends_layers() && !layers_take(s.technique, s.antialiasing) {
         return Err(SettingsError::AntialiasingWithLayers { samples, technique: s.technique.name(), max }.into());
     }
     // The visibility technique keeps its samples in the 64-bit buffer.

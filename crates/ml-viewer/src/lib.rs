@@ -461,6 +461,7 @@ impl<'c> Session<'c> {
                     return Ok(());
                 }
                 Command::Technique(name) => self.choices.technique = ml_render::Technique::from_name(&name)?,
+                Command::Antialiasing(samples) => self.choices.antialiasing = ml_render::Antialiasing::from_name(&samples)?,
                 Command::Lights(n) => {
                     self.choices.lights = n;
                     self.overlay.lights_edit = n;

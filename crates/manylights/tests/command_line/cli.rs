@@ -560,6 +560,14 @@ fn auto_renders_what_it_picked() {
     let aa = stdout.lines().find(|l| l.starts_with("auto aa")).expect("an auto aa row");
     let cpu = stdout.lines().any(|l| l.starts_with("device") && l.contains("(CPU"));
     assert!(if cpu { aa.contains("off: a CPU driver") } else { aa.contains(": a GPU") }, "{aa}");
+    // --raster compute given and auto's pick without a visibility buffer: said to be unused,
+    // and only that (the render draws with the hardware).
+    let compute = ["--raster", "compute", "--technique", "auto", "--out", picked_png.to_str().unwrap()];
+    let out = manylights(&[&common[..], &compute].concat(), &[]);
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{stderr}");
+    let technique = stdout.lines().find(|l| l.starts_with("technique")).expect("a technique row");
+    assert!(technique.contains("visibility") || stderr.contains("--raster is not used"), "{technique}: {stderr}");
     let raster: &[&str] = if picked == "visibility" { &raster } else { &[] };
     let out = manylights(&[&common[..], raster, &["--technique", &picked, "--out", picked_png.to_str().unwrap()]].concat(), &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -329,13 +329,20 @@ fn references_stay_inside_the_model_folder() {
     // Outside: 12,345 bytes an error must not tell of.
     std::fs::write(d.join("secret.bin"), vec![7u8; 12_345]).unwrap();
     link(&model, "out.bin", d.join("secret.bin"));
+    // A link to a file outside that does not exist, and one to a folder outside: answered as
+    // the link to the file that does.
+    link(&model, "gone.bin", d.join("missing.bin"));
+    link(&model, "up", d.clone());
     let good = quad_writer();
     let buffer = |uri: &str| from_bytes(&with_external_buffer(&good, &model, "data/quad bin.bin", uri), Some(&model)).map(drop);
     for (uri, expected) in [
         ("../secret.bin", "'../secret.bin': it leads out of the folder of the file that names it"),
         ("data/../../secret.bin", "it leads out of the folder"),
         ("%2E%2E/secret.bin", "'%2E%2E/secret.bin': it leads out of the folder"),
-        ("out.bin", "'out.bin': it leads out of the folder"),
+        ("out.bin", "'out.bin': it leads out of the folder of the file that names it, or to no file, through a link"),
+        ("gone.bin", "'gone.bin': it leads out of the folder of the file that names it, or to no file, through a link"),
+        ("up/secret.bin", "'up/secret.bin': it leads out of the folder of the file that names it, or to no file, through a link"),
+        ("up/missing.bin", "'up/missing.bin': it leads out of the folder of the file that names it, or to no file, through a link"),
         ("/etc/passwd", "'/etc/passwd': an absolute path"),
         ("%2Fetc%2Fpasswd", "an absolute path"),
         ("file:///etc/passwd", "never downloads"),

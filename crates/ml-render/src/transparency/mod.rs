@@ -26,13 +26,6 @@ pub const LAYER_KEEP: u32 = 32;
 /// The most samples a pixel's layers keep their coverage of with anti-aliasing (layers.glsl
 /// LAYER_MAX_SAMPLES: a bit each in a node's object word).
 pub const LAYER_MAX_SAMPLES: u32 = 8;
-/// Whether transparent layers are blended with `antialiasing` in `technique`: without samples
-/// in every technique; with them in the visibility technique, which keeps each opaque
-/// surface's colour per sample (up to LAYER_MAX_SAMPLES).
-pub fn layers_take(technique: crate::Technique, antialiasing: crate::Antialiasing) -> bool {
-    antialiasing == crate::Antialiasing::Off || (technique == crate::Technique::Visibility && antialiasing.samples() <= LAYER_MAX_SAMPLES)
-}
-
 /// Nodes per pixel on average, unless the option says otherwise.
 pub const DEFAULT_BUDGET: u32 = 4;
 /// The most nodes per pixel the option takes.
