@@ -127,9 +127,9 @@ impl SceneMeshlets {
             per_mesh.push((first_meshlet, built.meshlets.len() as u32, bounding_sphere(&mesh), (mesh.indices.len() / 3) as u64));
             s.vertices.extend_from_slice(&mesh.vertices);
         }
-        // Each object's mesh (kinds holds every object's).
-        let mesh_of: Vec<usize> =
-            scene.objects.iter().map(|o| kinds.iter().position(|&k| k == o.mesh).expect("kinds of the objects")).collect();
+        // Each object's mesh (kinds holds every object's; a map: as many meshes as objects).
+        let index: std::collections::HashMap<crate::mesh::MeshKind, usize> = kinds.iter().enumerate().map(|(i, &k)| (k, i)).collect();
+        let mesh_of: Vec<usize> = scene.objects.iter().map(|o| index[&o.mesh]).collect();
         let count: usize = mesh_of.iter().map(|&m| per_mesh[m].1 as usize).sum();
         if count > MAX_MESHLET_INSTANCES {
             return Err(MeshletError::TooManyInstances { count });

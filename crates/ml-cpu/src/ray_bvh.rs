@@ -205,8 +205,10 @@ impl RayScene {
         }
         let mut placed = Vec::new();
         let mut boxes = Vec::new();
+        // Each kind's root by a map: a scene may hold as many meshes as objects.
+        let roots: HashMap<MeshKind, Option<(u32, Vec3, Vec3)>> = roots.into_iter().collect();
         for (i, o) in scene.objects.iter().enumerate() {
-            let Some(&(_, Some((root, min, max)))) = roots.iter().find(|(k, _)| *k == o.mesh) else { continue };
+            let Some(&Some((root, min, max))) = roots.get(&o.mesh) else { continue };
             let (lo, hi) = transformed_box(&o.transform, min, max);
             boxes.push(WorldBox(obvhs::aabb::Aabb { min: lo.into(), max: hi.into() }));
             placed.push(RayInstance { to_object: to_object_rows(&o.transform), root, object: i as u32, ..RayInstance::default() });

@@ -342,13 +342,9 @@ impl Scene {
 
     /// The distinct meshes this scene draws, in first-use order.
     pub fn mesh_kinds(&self) -> Vec<MeshKind> {
-        let mut kinds: Vec<MeshKind> = Vec::new();
-        for o in &self.objects {
-            if !kinds.contains(&o.mesh) {
-                kinds.push(o.mesh);
-            }
-        }
-        kinds
+        // A set beside the list: a scene may hold as many meshes as objects.
+        let mut seen = std::collections::HashSet::new();
+        self.objects.iter().map(|o| o.mesh).filter(|&kind| seen.insert(kind)).collect()
     }
 }
 

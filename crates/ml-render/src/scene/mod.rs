@@ -14,7 +14,7 @@ pub mod sun_shadow;
 pub mod textures;
 
 use crate::error::RenderError;
-use crate::gpu_mesh::GpuMesh;
+use crate::gpu_mesh::SceneMeshes;
 use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
 use crate::scene::object_data::{object_data, SurfaceVariant};
 use crate::scene::object_textures::ObjectTextureSets;
@@ -30,7 +30,7 @@ use ml_cpu::scene::Scene;
 use ml_vk::{release_on_error, vk, Buffer, Context};
 
 pub struct SceneGpu {
-    pub meshes: Vec<GpuMesh>,
+    pub meshes: SceneMeshes,
     /// Every object's transform and material (draws push their index; the G-buffer stores it).
     pub objects: Buffer,
     /// Spot cones, parallel to the lights (static: only positions animate).
@@ -74,7 +74,7 @@ impl SceneGpu {
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
         let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
         let mut gpu = SceneGpu {
-            meshes: Vec::new(),
+            meshes: SceneMeshes::empty(),
             objects: Buffer::null(),
             cones: Buffer::null(),
             alpha_masks: Buffer::null(),
@@ -109,10 +109,7 @@ impl SceneGpu {
     /// The scene's objects on the GPU: its meshes, the object buffer, and (blinn-phong) the
     /// sun's shadow map of them.
     fn upload_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), RenderError> {
-        for kind in scene.mesh_kinds() {
-            let mesh = scene.mesh(kind).ok_or_else(|| RenderError::Internal(format!("the scene has no mesh {kind:?}")))?;
-            self.meshes.push(GpuMesh::upload(ctx, kind, &mesh)?);
-        }
+        self.meshes = SceneMeshes::upload(ctx, scene)?;
         let masks = AlphaMasks::pack(scene).map_err(|e| RenderError::Invalid(e.to_string()))?;
         self.alpha_masks = storage_buffer_with(ctx, "alpha masks", bytemuck::cast_slice(&masks.words))?;
         let objects: Vec<ObjectData> = scene.objects.iter().map(|o| object_data(o, &masks, &scene.textures)).collect();
@@ -158,10 +155,7 @@ impl SceneGpu {
     }
 
     fn release_objects(&mut self, ctx: &Context) {
-        for mesh in &mut self.meshes {
-            mesh.destroy(ctx);
-        }
-        self.meshes.clear();
+        self.meshes.destroy(ctx);
         self.objects.destroy(ctx);
         self.alpha_masks.destroy(ctx);
         if let Some(mut meshlets) = self.meshlets.take() {

@@ -20,7 +20,7 @@
 
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::error::RenderError;
-use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::gpu_mesh::{record_draws, SceneMeshes};
 use crate::scene::shadow_atlas::ShadowAtlasGpu;
 use crate::scene::shadow_settings::{OmniShadowMode, OmniShadowSettings};
 use crate::sync::{Entry, Exit, Use, SHADOW_CUBES};
@@ -299,7 +299,7 @@ impl OmniShadows {
     /// Render every cube: `lights[i]` into cube i, the objects that reach into its sphere.
     /// The cube array as `cube_use` declares it: copy takes it in TRANSFER_DST_OPTIMAL and
     /// leaves it so; the other modes' render passes order it themselves.
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&[GpuMesh], &[Object])) {
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: &[ShadowedLight], (meshes, objects): (&SceneMeshes, &[Object])) {
         let Some(settings) = self.cube_settings().filter(|s| !matches!(s.mode, OmniShadowMode::Compute { .. })) else { return };
         let masked_pipeline = self.masked.as_ref();
         // Which objects the masked pipeline draws (none without it).

@@ -9,7 +9,7 @@
 
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::error::RenderError;
-use crate::gpu_mesh::{record_draws, GpuMesh};
+use crate::gpu_mesh::{record_draws, SceneMeshes};
 use crate::scene::meshlets::MeshletGeometryView;
 use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use crate::scene::shadow_settings::SunShadowMode;
@@ -20,7 +20,7 @@ use ml_vk::{shader, vk, Context, GpuTimer, Image, VkError, VkResultExt};
 /// What the sun's shadow pass draws.
 pub struct ShadowInputs<'a> {
     pub scene: &'a Scene,
-    pub meshes: &'a [GpuMesh],
+    pub meshes: &'a SceneMeshes,
     /// The scene's object buffer (the compute raster reads the transforms there).
     pub objects: vk::Buffer,
     /// The scene's alpha masks (masked objects' shadows have their shape).

@@ -11,7 +11,7 @@ use super::{counts_to_host, LayerBuffers, TransparencySettings, TransparencyStat
 use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
-use crate::gpu_mesh::{layer_mesh, GpuMesh};
+use crate::gpu_mesh::{layer_mesh, SceneMeshes};
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
@@ -123,7 +123,7 @@ impl TransparentBuild {
             pass.meshes = LayerMeshes::new(ctx, &scene.meshes, objects)?;
             // Room for every transparent object and every triangle the per-triangle build may
             // list: a list never overflows.
-            let transparent = objects.iter().filter_map(|o| layer_mesh(o, &scene.meshes)).map(|m| scene.meshes[m].index_count / 3);
+            let transparent = objects.iter().filter_map(|o| layer_mesh(o, &scene.meshes)).map(|m| scene.meshes.meshes[m].index_count / 3);
             let (count, listed) = transparent.fold((0u64, 0u64), |(n, t), triangles| {
                 (n + 1, t + if triangles > settings.tiled_up_to { u64::from(triangles) } else { 0 })
             });
@@ -169,7 +169,7 @@ impl TransparentBuild {
             let Some(((x, y), size)) = screen_rect(o.bounds(), rec.view_proj, rec.extent) else { continue };
             let (first_vertex, first_index) = self.meshes.places[m].expect("a transparent object's mesh is among the build's");
             let end = (y + size.height) << 16 | (x + size.width);
-            let triangles = scene.meshes[m].index_count / 3;
+            let triangles = scene.meshes.meshes[m].index_count / 3;
             let ids = [index as u32, o.textures.bits(), first_index, triangles];
             let entry = LayerObject { ids, place: [first_vertex, y << 16 | x, end, 0] };
             listed.push((scene.object_textures.set_index[index], triangles > self.settings.tiled_up_to, entry));
@@ -304,10 +304,11 @@ struct LayerMeshes {
 
 impl LayerMeshes {
     /// Copied on the GPU from the scene's meshes.
-    fn new(ctx: &Context, meshes: &[GpuMesh], objects: &[Object]) -> Result<LayerMeshes, VkError> {
+    fn new(ctx: &Context, scene_meshes: &SceneMeshes, objects: &[Object]) -> Result<LayerMeshes, VkError> {
+        let meshes = &scene_meshes.meshes;
         let vertex_bytes = std::mem::size_of::<ml_cpu::mesh::Vertex>() as u64;
         let mut drawn = vec![false; meshes.len()];
-        for m in objects.iter().filter_map(|o| layer_mesh(o, meshes)) {
+        for m in objects.iter().filter_map(|o| layer_mesh(o, scene_meshes)) {
             drawn[m] = true;
         }
         let (mut vertex_count, mut index_count) = (0u64, 0u64);
@@ -315,7 +316,7 @@ impl LayerMeshes {
         for (m, &drawn) in meshes.iter().zip(&drawn) {
             places.push(drawn.then_some((vertex_count as u32, index_count as u32)));
             if drawn {
-                vertex_count += m.vertices.size / vertex_bytes;
+                vertex_count += u64::from(m.vertex_count);
                 index_count += u64::from(m.index_count);
             }
         }
@@ -332,13 +333,19 @@ impl LayerMeshes {
             one_shot(ctx, |cmd| {
                 for (m, place) in meshes.iter().zip(&made.places) {
                     // Vulkan copies nothing empty (a mesh without triangles draws nothing anyway).
-                    let Some((first_vertex, first_index)) = place.filter(|_| m.vertices.size > 0 && m.index_count > 0) else { continue };
-                    let vertices = [vk::BufferCopy::default().dst_offset(u64::from(first_vertex) * vertex_bytes).size(m.vertices.size)];
-                    let indices = [vk::BufferCopy::default().dst_offset(u64::from(first_index) * 4).size(u64::from(m.index_count) * 4)];
+                    let Some((first_vertex, first_index)) = place.filter(|_| m.vertex_count > 0 && m.index_count > 0) else { continue };
+                    let vertices = [vk::BufferCopy::default()
+                        .src_offset(u64::from(m.first_vertex) * vertex_bytes)
+                        .dst_offset(u64::from(first_vertex) * vertex_bytes)
+                        .size(u64::from(m.vertex_count) * vertex_bytes)];
+                    let indices = [vk::BufferCopy::default()
+                        .src_offset(u64::from(m.first_index) * 4)
+                        .dst_offset(u64::from(first_index) * 4)
+                        .size(u64::from(m.index_count) * 4)];
                     // SAFETY: recording; the buffers are alive and hold these ranges.
                     unsafe {
-                        ctx.device.cmd_copy_buffer(cmd, m.vertices.raw, made.vertices.raw, &vertices);
-                        ctx.device.cmd_copy_buffer(cmd, m.indices.raw, made.indices.raw, &indices);
+                        ctx.device.cmd_copy_buffer(cmd, scene_meshes.vertices.raw, made.vertices.raw, &vertices);
+                        ctx.device.cmd_copy_buffer(cmd, scene_meshes.indices.raw, made.indices.raw, &indices);
                     }
                 }
                 let shaders = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
