@@ -3,7 +3,8 @@
 # SECONDS, and prints how many inputs it ran and how many crashes it found (a crash's input
 # is kept under ARTIFACTS; exit status 1 if there was one).
 # Usage: bash fuzz/run.sh TARGET SECONDS [CORPUS_DIR] [JOBS]
-#   TARGET      gltf (glTF JSON), glb or scene_file (TOML)
+#   TARGET      gltf (glTF JSON), glb, scene_file (TOML), image (a texture's bytes) or
+#               scene_gltf (a scene file and the glTF it places)
 #   CORPUS_DIR  where the corpus grows (default fuzz/corpus/TARGET); fuzz/seed-corpus/TARGET
 #               is read as well
 #   JOBS        processes (default 1; more runs libFuzzer's fork mode, which goes on past a

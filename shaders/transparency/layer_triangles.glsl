@@ -204,6 +204,30 @@ bool layer_point(uint i, vec3 q, out vec3 w, out float depth) {
     return depth >= 0.0 && depth <= 1.0;
 }
 
+// Which samples of pixel `p` (centre `q`, x and y in NDC) triangle `i` covers in front of the
+// opaque samples there (a bit each): layer_point's test, the triangle read from shared memory
+// once for all of them, each edge's tie rule decided once, and the depth a/b of the edge
+// functions' weights compared as a against b (b > 0: in front of the eye) — the anti-aliased
+// build runs it for every pixel its triangles' boxes hold.
+uint samples_in_front(uint i, ivec2 p, vec2 to_ndc) {
+    vec3 r0 = tri_edges[i][0], r1 = tri_edges[i][1], r2 = tri_edges[i][2];
+    vec3 z = tri_z[i], w = tri_w[i];
+    // edge_owns' rule where an edge function is 0, per edge.
+    bvec3 ties = bvec3(r0.x > 0.0 || (r0.x == 0.0 && r0.y > 0.0), r1.x > 0.0 || (r1.x == 0.0 && r1.y > 0.0), r2.x > 0.0 || (r2.x == 0.0 && r2.y > 0.0));
+    uint covered = 0u;
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        vec3 q = vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0);
+        vec3 e = vec3(dot(r0, q), dot(r1, q), dot(r2, q));
+        bvec3 pos = greaterThan(e, vec3(0.0)), zero = equal(e, vec3(0.0));
+        bool inside = (pos.x || (zero.x && ties.x)) && (pos.y || (zero.y && ties.y)) && (pos.z || (zero.z && ties.z));
+        float a = dot(e, z), b = dot(e, w);
+        if (inside && b > 0.0 && a >= 0.0 && a <= b && a < opaque_depth_of_sample(p, k) * b) {
+            covered |= 1u << k;
+        }
+    }
+    return covered;
+}
+
 // Whether no sample of the pixel centred at `q` can lie inside triangle `i`: an edge function
 // below zero by more than it changes over half a pixel each way (with a margin for rounding:
 // this only skips work, layer_point decides).
@@ -241,14 +265,7 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
         if (samples_outside(i, q, to_ndc)) {
             return false;
         }
-        for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-            vec3 wk;
-            float dk;
-            // The opaque sample read only where the triangle covers it.
-            if (layer_point(i, vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0), wk, dk) && dk < opaque_depth_of_sample(p, k)) {
-                covered |= 1u << k;
-            }
-        }
+        covered = samples_in_front(i, p, to_ndc);
         if (covered == 0u) {
             return false;
         }
