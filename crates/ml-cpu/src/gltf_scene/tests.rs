@@ -669,3 +669,27 @@ fn textures_are_held_to_a_budget_read_from_their_headers() {
     assert!(e.contains("16384×16384") && e.contains("4096 MiB") && e.contains("3072 MiB taken"), "{e}");
     assert_eq!(within_texture_budget(&png(2, 2, &[0; 16]), 5).unwrap(), 5 + 2 * 2 * 4 * 4 / 3);
 }
+
+/// A JPEG the fuzzer found, on which the decoder multiplies past u32 (with overflow checks, as
+/// in this test's build, a panic in the decoder): the model loads or is refused in one line,
+/// never a panic.
+#[test]
+fn a_decoder_that_stops_is_an_error_not_a_crash() {
+    let mut w = GltfWriter::new();
+    let t = w.texture(include_bytes!("fixtures/decoder_overflow.jpg").to_vec(), "image/jpeg");
+    let m = w.textured_material(Some(t), None);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(json!({ "mesh": mesh }), true);
+    match from_bytes(&w.to_glb(), None) {
+        // Built with overflow checks (the tests' profile), the decoder panics: answered.
+        Err(e) => assert!(e.to_string().contains("image 0: cannot decode it: its decoder stopped on malformed data"), "{e}"),
+        // Without (release), its arithmetic wraps and it decodes something.
+        Ok(_) => {
+            let checked = cfg!(debug_assertions);
+            assert!(!checked, "the decoder did not stop where overflow checks are on");
+        }
+    }
+    // Any panic inside is answered None; a panic outside still unwinds.
+    assert_eq!(guarded_decode(|| -> u32 { panic!("inside") }), None);
+    assert!(std::panic::catch_unwind(|| panic!("outside")).is_err());
+}
