@@ -2,7 +2,9 @@
 //! fail with one error line and leave the previous files byte-identical, with no partial file
 //! beside them. The full disk is a file-size limit (RLIMIT_FSIZE, with SIGXFSZ ignored so that
 //! a write past it fails with an error instead of killing the process): what a test may set
-//! without privileges, and a write fails the same way as on a full file system.
+//! without privileges, and a write fails the same way as on a full file system. Beside them:
+//! outputs that are not regular files, interrupted sequences, bad later frames, and an output
+//! this user may not write.
 
 use crate::common;
 
@@ -216,4 +218,32 @@ fn outputs_that_are_not_regular_files_are_refused_at_once() {
     let mut args = vec!["render", "--out", "image.jpg"];
     args.extend(SMALL);
     assert_one_line_error(&manylights(&args, None), &["--out", ".png"]);
+}
+
+/// An output this user may not write — a read-only (0444) file in a folder anyone may write to
+/// — is refused in one line, not replaced around (a rename needs only the folder's
+/// permission): its bytes and mode stay. As root (who may write anything), the run is made as
+/// the user `nobody`, the file staying root's.
+#[test]
+fn an_output_this_user_may_not_write_is_refused_not_replaced() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = dir("read-only");
+    // Anyone may write the folder (no sticky bit: the kernel would let a rename replace the file).
+    std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o777)).unwrap();
+    let png = d.join("theirs.png");
+    std::fs::write(&png, b"someone else's image").unwrap();
+    std::fs::set_permissions(&png, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let args = ["render", "--width", "16", "--height", "16", "--out", png.to_str().unwrap()];
+    // SAFETY: geteuid has no preconditions.
+    let root = unsafe { libc::geteuid() } == 0;
+    let out = if root {
+        Command::new("runuser").args(["-u", "nobody", "--", env!("CARGO_BIN_EXE_manylights")]).args(args).output().expect("run runuser")
+    } else {
+        manylights(&args, None)
+    };
+    assert_one_line_error(&out, &["theirs.png", "read-only to this user", "not replaced"]);
+    assert_eq!(std::fs::read(&png).unwrap(), b"someone else's image");
+    assert_eq!(std::fs::metadata(&png).unwrap().permissions().mode() & 0o777, 0o444);
+    let left: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(left.len(), 1, "{left:?}");
 }
