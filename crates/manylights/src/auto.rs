@@ -116,9 +116,10 @@ pub fn resolve_alone(name: &str, scene: SceneProbe, (validation, device_index): 
 
 /// The rasteriser for `settings` on `ctx`'s device and, where `auto` (`choice` None) chose it,
 /// why. Techniques without a visibility buffer draw with the hardware (`--raster` given with
-/// one is refused before, or where auto picked it, said to be unused); a device without what the asked-for raster needs draws
-/// with the hardware, and says so; auto renders `scene` with each rasteriser the device can
-/// run (hardware, hybrid and compute, those with `split`) and keeps the fastest.
+/// one is refused before, or where auto picked it, said to be unused); a device without what
+/// the asked-for raster needs draws with the hardware, and says so; auto renders `scene` with
+/// each rasteriser the device can run (hardware, hybrid and compute, those with `split`) and
+/// keeps the fastest.
 pub fn resolve_raster(
     ctx: &Context,
     scene: &Scene,
@@ -207,7 +208,8 @@ pub fn resolve_antialiasing(
     (aa, Some(why))
 }
 
-/// `resolve_antialiasing` on a context of its own (the viewer's), announced.
+/// `resolve_antialiasing` on a context of its own (the viewer makes its own for the window),
+/// which must leave the validation layer silent; auto's choice is announced.
 pub fn resolve_antialiasing_alone(
     settings: &RenderSettings,
     choice: (Option<Antialiasing>, (Option<Raster>, u32)),
@@ -218,8 +220,13 @@ pub fn resolve_antialiasing_alone(
         return Ok(aa);
     }
     let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
+    let messages = ctx.validation_counter();
     let (aa, why) = resolve_antialiasing(&ctx, settings, choice, (lights, 1));
     drop(ctx);
+    let count = messages.load(Ordering::SeqCst);
+    if count > 0 {
+        bail!("the validation layer reported {count} message(s) while choosing --aa auto's samples (printed above)");
+    }
     if let Some(why) = why {
         println!("auto aa: {}: {why}", aa.name());
     }
