@@ -299,3 +299,15 @@ fn the_help_points_to_documents_that_exist() {
         assert!(usage.contains(&format!("`{command}`")), "docs/usage.md does not describe the script command `{command}`");
     }
 }
+
+/// The front door and the documents a newcomer reads first stay within what a reader reads:
+/// README 10 KiB, docs/BENCHMARKS.md (current figures with their commands) 30 KiB,
+/// docs/DESIGN.md (the reasoning) 40 KiB. A run's narrative belongs in its commit message.
+#[test]
+fn the_front_documents_stay_within_their_sizes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    for (doc, limit) in [("README.md", 10 << 10), ("docs/BENCHMARKS.md", 30 << 10), ("docs/DESIGN.md", 40 << 10)] {
+        let bytes = std::fs::metadata(root.join(doc)).unwrap_or_else(|e| panic!("{doc}: {e}")).len();
+        assert!(bytes <= limit, "{doc} is {bytes} bytes, more than its {limit}: cut it to what a reader needs now");
+    }
+}
