@@ -175,9 +175,15 @@ void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
     box = ivec4(ivec2(lo), ivec2(hi));
 }
 
+// Whether the points where an edge function (coefficients `c`) is 0 belong to this triangle:
+// the sign of its x, then y, coefficient decides.
+bool edge_owns_ties(vec2 c) {
+    return c.x > 0.0 || (c.x == 0.0 && c.y > 0.0);
+}
+
 // Whether a pixel where edge function `e` (coefficients `c`) is 0 belongs to this triangle.
 bool edge_owns(float e, vec2 c) {
-    return e > 0.0 || (e == 0.0 && (c.x > 0.0 || (c.x == 0.0 && c.y > 0.0)));
+    return e > 0.0 || (e == 0.0 && edge_owns_ties(c));
 }
 
 // The barycentrics of point `q` (x, y in NDC, 1) on triangle `i`'s plane.
@@ -213,7 +219,7 @@ uint samples_in_front(uint i, ivec2 p, vec2 to_ndc) {
     vec3 r0 = tri_edges[i][0], r1 = tri_edges[i][1], r2 = tri_edges[i][2];
     vec3 z = tri_z[i], w = tri_w[i];
     // edge_owns' rule where an edge function is 0, per edge.
-    bvec3 ties = bvec3(r0.x > 0.0 || (r0.x == 0.0 && r0.y > 0.0), r1.x > 0.0 || (r1.x == 0.0 && r1.y > 0.0), r2.x > 0.0 || (r2.x == 0.0 && r2.y > 0.0));
+    bvec3 ties = bvec3(edge_owns_ties(r0.xy), edge_owns_ties(r1.xy), edge_owns_ties(r2.xy));
     uint covered = 0u;
     for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         vec3 q = vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0);
@@ -270,8 +276,7 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
             return false;
         }
         q = vec3(shading_xy(p, covered) * to_ndc - 1.0, 1.0);
-        vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
-        w = e / (e.x + e.y + e.z);
+        w = barycentrics(i, q);
         depth = dot(w, tri_z[i]) / dot(w, tri_w[i]);
     }
     alpha = tri_alpha[i];

@@ -286,28 +286,34 @@ vec4 layered_samples_output(ivec2 p, float exposure) {
         return layer_count_color(s.count);
     }
     vec3 background = pow(CLEAR_COLOR.rgb, vec3(2.2));
+    // Each sample's opaque surface and layers, found once.
+    uvec2 v[VISIBILITY_SAMPLES];
+    uint over[VISIBILITY_SAMPLES];
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        v[k] = opaque_sample(p, k);
+        over[k] = layers_over_sample(s, k);
+    }
     vec3 sum = vec3(0.0);
     uint done = 0u;
     for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         if ((done & (1u << k)) != 0u) {
             continue;
         }
-        uvec2 v = opaque_sample(p, k);
-        bool drawn = visibility_buffer_depth(v) < 1.0;
-        uint id = visibility_buffer_id(v);
-        uint layers = layers_over_sample(s, k);
+        bool drawn = visibility_buffer_depth(v[k]) < 1.0;
+        uint id = visibility_buffer_id(v[k]);
+        uint layers = over[k];
         // The samples like k: the same surface (or the background) and the same layers; the
         // surface's first sample (its leader, where the lighting left its colour).
         uint members = 0u, leader = k;
         for (uint j = k; j < VISIBILITY_SAMPLES; j++) {
-            uvec2 u = opaque_sample(p, j);
+            uvec2 u = v[j];
             bool same_surface = drawn ? visibility_buffer_depth(u) < 1.0 && visibility_buffer_id(u) == id : visibility_buffer_depth(u) >= 1.0;
-            if (same_surface && layers_over_sample(s, j) == layers) {
+            if (same_surface && over[j] == layers) {
                 members |= 1u << j;
             }
         }
         for (uint j = 0u; j < k && drawn; j++) {
-            uvec2 u = opaque_sample(p, j);
+            uvec2 u = v[j];
             if (visibility_buffer_depth(u) < 1.0 && visibility_buffer_id(u) == id) {
                 leader = j;
                 break;

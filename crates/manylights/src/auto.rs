@@ -95,21 +95,31 @@ pub fn announce(technique: Technique, why: &str) {
     println!("auto: {}: {why}", technique.name());
 }
 
+/// `decide` on a context of its own (the viewer makes its own for the window), which must
+/// leave the validation layer silent (`what` it was doing names it in the error).
+fn on_own_context<T>(
+    (validation, device_index): (bool, Option<usize>),
+    what: &str,
+    decide: impl FnOnce(&Context) -> Result<T>,
+) -> Result<T> {
+    let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
+    let messages = ctx.validation_counter();
+    let decided = decide(&ctx);
+    drop(ctx);
+    let count = messages.load(Ordering::SeqCst);
+    if count > 0 {
+        bail!("the validation layer reported {count} message(s) while {what} (printed above)");
+    }
+    decided
+}
+
 /// `name`'s technique; for `auto`, probed on a context of its own (the viewer makes its own
 /// for the window), which must leave the validation layer silent.
 pub fn resolve_alone(name: &str, scene: SceneProbe, (validation, device_index): (bool, Option<usize>)) -> Result<Technique> {
     if let Some(t) = technique_choice(name)? {
         return Ok(t);
     }
-    let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
-    let messages = ctx.validation_counter();
-    let picked = pick(&ctx, Some(scene));
-    drop(ctx);
-    let count = messages.load(Ordering::SeqCst);
-    if count > 0 {
-        bail!("the validation layer reported {count} message(s) while probing for --technique auto (printed above)");
-    }
-    let (technique, why, _) = picked?;
+    let (technique, why, _) = on_own_context((validation, device_index), "probing for --technique auto", |ctx| pick(ctx, Some(scene)))?;
     announce(technique, &why);
     Ok(technique)
 }
@@ -219,14 +229,9 @@ pub fn resolve_antialiasing_alone(
     if let Some(aa) = choice.0 {
         return Ok(aa);
     }
-    let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
-    let messages = ctx.validation_counter();
-    let (aa, why) = resolve_antialiasing(&ctx, settings, choice, (lights, 1));
-    drop(ctx);
-    let count = messages.load(Ordering::SeqCst);
-    if count > 0 {
-        bail!("the validation layer reported {count} message(s) while choosing --aa auto's samples (printed above)");
-    }
+    let (aa, why) = on_own_context((validation, device_index), "choosing --aa auto's samples", |ctx| {
+        Ok(resolve_antialiasing(ctx, settings, choice, (lights, 1)))
+    })?;
     if let Some(why) = why {
         println!("auto aa: {}: {why}", aa.name());
     }
@@ -244,15 +249,9 @@ pub fn resolve_raster_alone(
     if settings.technique.geometry() != Geometry::Meshlets {
         return Ok(Raster::Hardware);
     }
-    let ctx = Context::new(&ContextDesc { validation, device_index, window: None })?;
-    let messages = ctx.validation_counter();
-    let resolved = resolve_raster(&ctx, scene, settings, choice);
-    drop(ctx);
-    let count = messages.load(Ordering::SeqCst);
-    if count > 0 {
-        bail!("the validation layer reported {count} message(s) while timing the rasterisers for --raster auto (printed above)");
-    }
-    let (raster, why) = resolved?;
+    let (raster, why) = on_own_context((validation, device_index), "timing the rasterisers for --raster auto", |ctx| {
+        resolve_raster(ctx, scene, settings, choice)
+    })?;
     if let Some(why) = why {
         println!("auto raster: {}: {why}", raster.name());
     }

@@ -71,18 +71,19 @@ pub fn check_draw_work(scene: &Scene) -> Result<(), DrawWorkError> {
             None => kinds[slot - scene.meshes.len()].build().indices.len() as u64 / 3,
         }
     };
-    let drawn: Vec<(usize, u64)> =
-        placed.iter().enumerate().filter(|(_, &n)| n > 0).map(|(slot, &n)| (slot, n * triangles_of(slot))).collect();
-    let triangles: u64 = drawn.iter().map(|d| d.1).sum();
+    // Per mesh placed: (its slot, its triangles, its placements), each mesh counted once.
+    let drawn: Vec<(usize, u64, u64)> =
+        placed.iter().enumerate().filter(|(_, &n)| n > 0).map(|(slot, &n)| (slot, triangles_of(slot), n)).collect();
+    let triangles: u64 = drawn.iter().map(|&(_, each, n)| each * n).sum();
     if triangles <= MAX_DRAWN_TRIANGLES {
         return Ok(());
     }
-    let &(slot, _) = drawn.iter().max_by_key(|d| d.1).expect("triangles drawn");
+    let &(slot, each, placed) = drawn.iter().max_by_key(|&&(_, each, n)| each * n).expect("triangles drawn");
     let mesh = match scene.meshes.get(slot) {
         Some(_) => "a mesh".to_owned(),
         None => format!("the built-in {}", kinds[slot - scene.meshes.len()].name()),
     };
-    Err(DrawWorkError { triangles, mesh, each: triangles_of(slot), placed: placed[slot] })
+    Err(DrawWorkError { triangles, mesh, each, placed })
 }
 
 /// A loaded scene file or glTF file: the scene, the name of the shading model it asks for
