@@ -89,11 +89,22 @@ struct PointMaterial {
     vec3 emission;
 };
 
+// The roughness of a surface whose normals spread by `spread` (surface.glsl normal_spread)
+// within the pixel: the microfacets' slope variance (GGX α² = roughness⁴) plus theirs, twice
+// over (Toksvig's widened Blinn-Phong exponent, 1/s' = 1/s + σ², with s ≈ 2/α²).
+float widened_roughness(float roughness, float spread) {
+    if (spread == 0.0) {
+        return roughness;
+    }
+    float alpha = roughness * roughness;
+    return sqrt(sqrt(min(alpha * alpha + 2.0 * spread * spread, 1.0)));
+}
+
 PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive, vec4 albedo_occlusion, vec2 roughness_metallic,
-                             vec3 emissive_factor) {
+                             vec3 emissive_factor, float normal_spread) {
     PointMaterial m;
     m.albedo = albedo_roughness.rgb * albedo_occlusion.rgb;
-    m.roughness = albedo_roughness.a * roughness_metallic.x;
+    m.roughness = widened_roughness(albedo_roughness.a * roughness_metallic.x, normal_spread);
     m.metallic = material.x * roughness_metallic.y;
     m.occlusion = albedo_occlusion.a;
     m.emission = emissive.rgb * emissive_factor;

@@ -15,6 +15,9 @@ layout(constant_id = 11) const bool MODEL_PBR = false;
 // forward pass at 64 lights 11.1 ms instead of 10.2 on the H100 (measured). Without them the
 // G-buffer's material and emissive attachments are neither written nor read.
 layout(constant_id = 13) const bool OBJECT_TEXTURES = false;
+// Highlights widened by the spread of the normals a filtered normal map averages
+// (surface.glsl normal_spread; --specular-aa).
+layout(constant_id = 43) const bool SPECULAR_AA = true;
 
 // ACES filmic curve (Narkowicz 2015's fit): HDR → [0, 1].
 vec3 aces_tone_map(vec3 x) {

@@ -12,6 +12,9 @@
 
 #include "common/shading_model.glsl"
 
+// What an 8-bit unit normal's rounding alone can take off its length (√3/255).
+const float NORMAL_ROUNDING = 0.0068;
+
 // Sample `t` at `uv`, whose texture coordinates are `m` times the surface's.
 #ifdef SURFACE_GRADIENTS
 vec2 surface_uv_dx;
@@ -43,6 +46,9 @@ struct Surface {
     vec2 roughness_metallic;    // multiply its roughness and metallic
     float occlusion;            // of ambient light (1: none)
     vec3 emissive_factor;       // multiplies its emissive factor
+    // How far the normals a filtered normal-map texel averages spread (normal_spread),
+    // in 1/255 steps as the G-buffer and the transparent layers keep it; 0 without a map.
+    float normal_spread;
 };
 
 // `n` perturbed by a tangent-space normal-map texel (n·0.5 + 0.5 encoded), its x and y
@@ -54,6 +60,20 @@ vec3 perturb_normal(vec3 n, vec4 tangent, vec3 texel, float scale) {
     return normalize(m.x * t + m.y * b + m.z * n);
 }
 
+// How far the normals under a filtered normal-map texel spread: the mean of unit vectors is
+// the shorter the more they differ, and its length |m| gives the variance of their slopes,
+// (1 − |m|) / |m| (Toksvig 2005). Far away or at a grazing angle a texel's mip level averages
+// bumps a pixel cannot show, and where the unfiltered map would sparkle, the lighting widens
+// the highlight by this much instead (point_material) — as a supersampled image averages the
+// sparkles. Less than 8-bit texels' own rounding (a unit vector's length is off by up to
+// √3/255) counts as none. The standard deviation, in the 1/255 steps the G-buffer keeps it,
+// so that every technique lights the same value; the normal map's scale scales the slopes.
+float normal_spread(vec3 texel, float scale) {
+    float len = length(texel * 2.0 - 1.0);
+    float variance = max((1.0 - len) / max(len, 1e-4) - NORMAL_ROUNDING, 0.0) * scale * scale;
+    return round(min(sqrt(variance), 1.0) * 255.0) / 255.0;
+}
+
 // `textures`: which textures the object has of its own (TEXTURE_* bits); `material`: its
 // ObjectData.material (y: occlusion strength, z: normal scale).
 Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, vec4 material) {
@@ -63,12 +83,17 @@ Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, 
     s.roughness_metallic = vec2(1.0);
     s.occlusion = 1.0;
     s.emissive_factor = vec3(1.0);
+    s.normal_spread = 0.0;
     if (OBJECT_TEXTURES) {
         if ((textures & TEXTURE_BASE_COLOR) != 0u) {
             s.albedo_factor = SURFACE_SAMPLE(object_base_color, uv, mat2(1.0)).rgb;
         }
         if ((textures & TEXTURE_NORMAL) != 0u) {
-            s.normal = perturb_normal(s.normal, tangent, SURFACE_SAMPLE(object_normal_map, uv, mat2(1.0)).xyz, material.z);
+            vec3 texel = SURFACE_SAMPLE(object_normal_map, uv, mat2(1.0)).xyz;
+            s.normal = perturb_normal(s.normal, tangent, texel, material.z);
+            if (SPECULAR_AA) {
+                s.normal_spread = normal_spread(texel, material.z);
+            }
         }
         if ((textures & TEXTURE_METALLIC_ROUGHNESS) != 0u) {
             s.roughness_metallic = SURFACE_SAMPLE(object_metallic_roughness, uv, mat2(1.0)).gb;

@@ -32,6 +32,6 @@ void main() {
     out_albedo_occlusion = vec4(s.albedo_factor, s.occlusion);
 #ifdef GBUFFER_MATERIAL
     out_roughness_metallic = s.roughness_metallic;
-    out_emissive = vec4(s.emissive_factor, 1.0);
+    out_emissive = vec4(s.emissive_factor, s.normal_spread);
 #endif
 }

@@ -19,6 +19,7 @@ struct GSample {
     vec4 albedo;
     vec2 roughness_metallic;
     vec3 emissive_factor;
+    float normal_spread; // in the emissive image's alpha
 };
 
 GSample gbuffer_sample(int s) {
@@ -28,17 +29,20 @@ GSample gbuffer_sample(int s) {
     g.albedo = GBUFFER_LOAD(albedo, s);
 #ifdef GBUFFER_MATERIAL
     g.roughness_metallic = GBUFFER_LOAD(roughness_metallic, s).xy;
-    g.emissive_factor = GBUFFER_LOAD(emissive, s).rgb;
+    vec4 emissive = GBUFFER_LOAD(emissive, s);
+    g.emissive_factor = emissive.rgb;
+    g.normal_spread = emissive.a;
 #else
     g.roughness_metallic = vec2(1.0);
     g.emissive_factor = vec3(1.0);
+    g.normal_spread = 0.0;
 #endif
     return g;
 }
 
 bool same_surface(GSample a, GSample b) {
     return a.normal == b.normal && a.id == b.id && a.albedo == b.albedo && a.roughness_metallic == b.roughness_metallic
-        && a.emissive_factor == b.emissive_factor;
+        && a.emissive_factor == b.emissive_factor && a.normal_spread == b.normal_spread;
 }
 
 // The display-linear colour of a surface point (the includer's; see above).

@@ -297,7 +297,8 @@ uvec4 layer_surface(uint i, vec3 q, vec3 w, float alpha, vec2 to_ndc) {
     vec4 tangent = w.x * tri_tangent[i][0] + w.y * tri_tangent[i][1] + w.z * tri_tangent[i][2];
     bool front = (tri_object[i].y & TRIANGLE_FRONT) != 0u;
     Surface sf = surface_at(front ? n : -n, tangent, uv, tri_object[i].z, tri_material[i]);
-    return pack_layer_surface(sf.normal, vec4(sf.albedo_factor, sf.occlusion), sf.roughness_metallic, min(alpha, 1.0), sf.emissive_factor);
+    return pack_layer_surface(sf.normal, vec4(sf.albedo_factor, sf.occlusion), sf.roughness_metallic, min(alpha, 1.0),
+                              vec4(sf.emissive_factor, sf.normal_spread));
 }
 
 // Whether triangle `slot` leaves a fragment at pixel `p` in front of the opaque depth (the

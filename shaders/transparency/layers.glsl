@@ -57,7 +57,7 @@ vec2 layer_xy(uvec4 a) {
 layout(std430, set = 0, binding = LAYER_BINDING) buffer TransparentHeadBuffer { uint layer_heads[]; };
 // Two uvec4 a node: (depth, next, object, pixel y << 16 | x), then the surface (octahedral
 // normal snorm 2×16, albedo factor and occlusion unorm 4×8, roughness and metallic factors
-// unorm 2×8 with alpha unorm 16 above them, emissive factor unorm 4×8), which lighting
+// unorm 2×8 with alpha unorm 16 above them, emissive factor and normal spread unorm 4×8), which lighting
 // replaces by (lit colour rgb, alpha) as floats.
 layout(std430, set = 0, binding = LAYER_BINDING + 1) buffer TransparentNodeBuffer { uvec4 layer_nodes[]; };
 // x: nodes asked for this frame (beyond the pool's size: dropped); y: pixels that merged
@@ -75,10 +75,10 @@ uint layer_capacity() {
 }
 
 // The surface of a node as the build packs it (`alpha` in [0, 1]).
-uvec4 pack_layer_surface(vec3 normal, vec4 albedo_occlusion, vec2 roughness_metallic, float alpha, vec3 emissive_factor) {
+uvec4 pack_layer_surface(vec3 normal, vec4 albedo_occlusion, vec2 roughness_metallic, float alpha, vec4 emissive_spread) {
     uint material = packUnorm4x8(vec4(roughness_metallic, 0.0, 0.0)) & 0xffffu;
     return uvec4(packSnorm2x16(oct_encode(normal)), packUnorm4x8(albedo_occlusion), material | (packUnorm2x16(vec2(alpha, 0.0)) << 16),
-                 packUnorm4x8(vec4(emissive_factor, 0.0)));
+                 packUnorm4x8(emissive_spread));
 }
 
 // Node `node` (of the pool) made pixel `p`'s fragment at `depth` of `object` covering the
@@ -99,8 +99,9 @@ void light_layer(uint node) {
     vec3 n = oct_decode(unpackSnorm2x16(b.x));
     ObjectData o = objects[layer_object(a.z)];
     vec2 roughness_metallic = OBJECT_TEXTURES ? unpackUnorm4x8(b.z).xy : vec2(1.0);
-    vec3 emissive_factor = OBJECT_TEXTURES ? unpackUnorm4x8(b.w).rgb : vec3(1.0);
-    PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, unpackUnorm4x8(b.y), roughness_metallic, emissive_factor);
+    vec4 emissive_spread = OBJECT_TEXTURES ? unpackUnorm4x8(b.w) : vec4(1.0, 1.0, 1.0, 0.0);
+    PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, unpackUnorm4x8(b.y), roughness_metallic, emissive_spread.rgb,
+                                     emissive_spread.a);
     vec3 color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
     float alpha = unpackUnorm2x16(b.z).y;
     layer_nodes[2u * node + 1u] = uvec4(floatBitsToUint(color), floatBitsToUint(alpha));

@@ -239,6 +239,7 @@ impl Plan {
             light_stats: false,
             light_grid_marks: LightGridMarks::Auto,
             antialiasing: Antialiasing::Off,
+            specular_aa: true,
         };
         Ok(Plan { scene, settings, warned: false })
     }

@@ -292,6 +292,11 @@ struct SceneArgs {
     /// they take none), off on a CPU driver, said why.
     #[arg(long, default_value = "auto", value_parser = ["off", "4", "8", "16", "auto"])]
     aa: String,
+    /// Specular anti-aliasing: on, highlights under a normal map widened by the spread of the
+    /// normals each filtered texel averages (Toksvig), so that they do not sparkle far away;
+    /// off lights the filtered normal alone.
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    specular_aa: String,
     /// The compute and hybrid rasters' largest triangle drawn by one thread: bounding box up to
     /// PX pixels a side (1 to 64).
     #[arg(long, default_value_t = Raster::DEFAULT_SPLIT, value_parser = RASTER_SPLIT, allow_negative_numbers = true)]
@@ -561,6 +566,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
         light_grid_marks: LightGridMarks::from_name(&args.light_grid_marks)?,
         // Set once the technique and device are known where auto: `auto::resolve_antialiasing`.
         antialiasing: auto::antialiasing_choice(&args.aa)?.unwrap_or(Antialiasing::Off),
+        specular_aa: args.specular_aa == "on",
         exposure: exposure_choice(args)?,
         // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
         raster: Raster::Hardware,

@@ -190,6 +190,8 @@ pub struct RenderSettings {
     pub light_grid_marks: bool,
     /// Coverage samples per pixel (the visibility technique's compute raster).
     pub antialiasing: Antialiasing,
+    /// Highlights under normal maps widened by the normals' spread (surface.glsl).
+    pub specular_aa: bool,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -228,6 +230,7 @@ impl RenderSettings {
             light_stats: false,
             light_grid_marks: true,
             antialiasing: Antialiasing::Off,
+            specular_aa: true,
         }
     }
 
@@ -268,6 +271,7 @@ impl RenderSettings {
             transparency: self.blends_layers(),
             count_rays: self.light_stats && (shadow_rays || sun_rays),
             antialiasing: self.antialiasing,
+            specular_aa: self.specular_aa,
         }
     }
 
@@ -397,6 +401,7 @@ pub struct SettingsRequest {
     /// Whether the light grid marks the cells near the surfaces first.
     pub light_grid_marks: LightGridMarks,
     pub antialiasing: Antialiasing,
+    pub specular_aa: bool,
 }
 
 impl SettingsRequest {
@@ -420,6 +425,7 @@ impl SettingsRequest {
             light_stats: self.light_stats,
             light_grid_marks: self.light_grid_marks.resolve(scene.lights.len() as u64, self.width, self.height),
             antialiasing: self.antialiasing,
+            specular_aa: self.specular_aa,
         }
     }
 }

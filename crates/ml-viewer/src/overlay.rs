@@ -41,6 +41,8 @@ pub struct Choices {
     pub light_grid_marks: LightGridMarks,
     /// Coverage samples per pixel (used with the visibility technique's compute raster).
     pub antialiasing: Antialiasing,
+    /// Highlights under normal maps widened by the normals' spread.
+    pub specular_aa: bool,
 }
 
 impl Choices {
@@ -70,6 +72,7 @@ impl Choices {
             transparency: settings.transparency,
             light_grid_marks,
             antialiasing: settings.antialiasing,
+            specular_aa: settings.specular_aa,
         }
     }
 
@@ -124,6 +127,7 @@ impl Choices {
             light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
             // Transparent layers take samples in the visibility technique (the overlay offers
             // what the settings take).
+            specular_aa: self.specular_aa,
             antialiasing: if self.transparency.is_none() || ml_render::layers_take(self.technique, self.antialiasing) {
                 self.antialiasing
             } else {
@@ -214,6 +218,7 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         if choices.transparency.is_none() || choices.technique == Technique::Visibility {
             combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
         }
+        ui.checkbox(&mut choices.specular_aa, "Specular anti-aliasing");
         combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());
         ui.add_enabled_ui(state.seed_scene, |ui| {
             combo(ui, "Type", &mut choices.object, &MeshKind::ALL, |k| k.name());
@@ -338,6 +343,7 @@ mod tests {
             transparency: None,
             light_grid_marks: LightGridMarks::Auto,
             antialiasing: Antialiasing::Off,
+            specular_aa: true,
         }
     }
 

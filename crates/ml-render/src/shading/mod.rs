@@ -33,29 +33,33 @@ pub struct Shading {
     /// Coverage samples per pixel: the mesh techniques draw into multisampled attachments and
     /// light in the display's linear light (`display_constant`).
     pub antialiasing: Antialiasing,
+    /// Highlights under normal maps widened by the normals' spread (`SPECULAR_AA`).
+    pub specular_aa: bool,
 }
 
 impl Shading {
     /// The specialization constants (name, value) of a pipeline that reads surfaces without
-    /// lighting them (the G-buffer's): `MODEL_BLINN_PHONG`, `MODEL_PBR` and `OBJECT_TEXTURES`
-    /// (common/shading_model.glsl).
-    pub fn surface_constants(self) -> [(&'static str, u32); 3] {
+    /// lighting them (the G-buffer's): `MODEL_BLINN_PHONG`, `MODEL_PBR`, `OBJECT_TEXTURES` and
+    /// `SPECULAR_AA` (common/shading_model.glsl).
+    pub fn surface_constants(self) -> [(&'static str, u32); 4] {
         [
             ("MODEL_BLINN_PHONG", u32::from(self.model == ShadingModel::BlinnPhong)),
             ("MODEL_PBR", u32::from(self.model == ShadingModel::Pbr)),
             ("OBJECT_TEXTURES", u32::from(self.object_textures)),
+            ("SPECULAR_AA", u32::from(self.specular_aa)),
         ]
     }
 
     /// The specialization constants (name, value) of a lighting pipeline: the surface's,
     /// `OMNI_SHADOWS`, `SHADOW_ATLAS` and `SHADOW_RAYS` (shadows/omni_shadow.glsl),
     /// `SUN_RAYS` (common/blinn_phong.glsl) and `SPOT_LIGHTS` (common/lighting.glsl).
-    pub fn lighting_constants(self) -> [(&'static str, u32); 8] {
-        let [model_a, model_b, textures] = self.surface_constants();
+    pub fn lighting_constants(self) -> [(&'static str, u32); 9] {
+        let [model_a, model_b, textures, specular] = self.surface_constants();
         [
             model_a,
             model_b,
             textures,
+            specular,
             ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
             ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
             ("SHADOW_RAYS", u32::from(self.shadow_rays)),
@@ -66,18 +70,18 @@ impl Shading {
 
     /// `lighting_constants` and `COUNT_RAYS` (shading/compute_shading.glsl): the compute
     /// lightings'.
-    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 9] {
-        let [a, b, c, d, e, f, g, h] = self.lighting_constants();
-        [a, b, c, d, e, f, g, h, ("COUNT_RAYS", u32::from(self.count_rays))]
+    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 10] {
+        let [a, b, c, d, e, f, g, h, i] = self.lighting_constants();
+        [a, b, c, d, e, f, g, h, i, ("COUNT_RAYS", u32::from(self.count_rays))]
     }
 
     /// `lighting_constants`, `TRANSPARENT_LAYERS` (shading/forward_frag.glsl: the forward
     /// pass of a scene with transparent layers writes linear HDR for their resolve), the
     /// samples per pixel its masks are tested at and `display_constant`: the forward pass's.
-    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 11] {
-        let [a, b, c, d, e, f, g, h] = self.lighting_constants();
+    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 12] {
+        let [a, b, c, d, e, f, g, h, i] = self.lighting_constants();
         let layers = ("TRANSPARENT_LAYERS", u32::from(self.transparency));
-        [a, b, c, d, e, f, g, h, layers, self.antialiasing.constant(), self.display_constant()]
+        [a, b, c, d, e, f, g, h, i, layers, self.antialiasing.constant(), self.display_constant()]
     }
 
     /// `DISPLAY_LINEAR_OUTPUT` (shading/display_output.glsl): with anti-aliasing, the forward

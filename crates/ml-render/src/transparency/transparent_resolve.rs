@@ -56,7 +56,7 @@ impl TransparentResolve {
         let samples = shading.antialiasing.constant();
         let lighting_constants = [&shading.lighting_constants()[..], &[samples]].concat();
         let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &lighting_constants))?;
-        let [blinn_phong, pbr, _] = shading.surface_constants();
+        let [blinn_phong, pbr, _, _] = shading.surface_constants();
         let antialiased = shading.antialiasing != Antialiasing::Off;
         let blend = if antialiased {
             ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_SAMPLES_COMP, &[blinn_phong, pbr, samples]))
