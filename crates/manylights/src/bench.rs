@@ -16,7 +16,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
-use ml_render::{Antialiasing, DebugView, Exposure, Geometry, LightGridMarks, Raster, RenderOutput, Renderer, SunShadowMode, Technique};
+use ml_render::{Antialiasing, Geometry, Raster, RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -222,24 +222,12 @@ impl Plan {
             glass_layers: a.glass_layers,
             ..SceneRequest::new(source)
         };
+        // The clock runs (the lights move from frame to frame); technique, raster and samples
+        // are each combination's.
         let settings = SettingsRequest {
-            technique: Technique::Forward,
             clusters: cluster_choice(&a.clusters)?,
-            debug_view: DebugView::None,
-            omni: None,
-            sun_shadow: SunShadowMode::Graphics,
-            width,
-            height,
-            frames: 1,
-            time: None,
-            culling: true,
-            raster: Raster::Hardware,
-            exposure: Exposure::Ev(0.0),
             transparency: ml_render::TransparencySettings { budget: a.transparency_budget, ..Default::default() },
-            light_stats: false,
-            light_grid_marks: LightGridMarks::Auto,
-            antialiasing: Antialiasing::Off,
-            specular_aa: true,
+            ..SettingsRequest::new(RenderSettings { time: None, ..RenderSettings::new(Technique::Forward, width, height) })
         };
         Ok(Plan { scene, settings, warned: false })
     }
@@ -539,7 +527,9 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Va
         print_warnings(&built.warnings);
     }
     let scene = built.scene;
-    let request = SettingsRequest { technique, raster: variant.raster, antialiasing: variant.antialiasing, ..plan.settings };
+    let base = plan.settings.settings;
+    let chosen = RenderSettings { technique, raster: variant.raster, antialiasing: variant.antialiasing, ..base };
+    let request = SettingsRequest { settings: chosen, ..plan.settings };
     let mut settings = request.for_scene(&scene, built.shading);
     // A sample count the device does not offer this technique is a row that says so, not the
     // end of the sweep.

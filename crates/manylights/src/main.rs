@@ -16,8 +16,8 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{
-    Antialiasing, DebugView, Exposure, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, Renderer, ShadingModel, SunShadowMode,
-    Technique,
+    Antialiasing, DebugView, Exposure, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Renderer, ShadingModel,
+    SunShadowMode, Technique,
 };
 use ml_vk::{Context, ContextDesc};
 use std::path::{Path, PathBuf};
@@ -552,26 +552,25 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
             Some(OmniShadowSettings { mode, lights, all, size: args.cube_size.unwrap_or(OmniShadowSettings::DEFAULT_SIZE) })
         }
     };
-    Ok(SettingsRequest {
-        technique,
-        clusters: cluster_choice(&args.clusters)?,
+    // The raster is set once the technique (and for auto, the probe) is known
+    // (`auto::resolve_raster`), and so are auto's samples (`auto::resolve_antialiasing`).
+    let settings = RenderSettings {
         debug_view: DebugView::from_name(&args.debug_view)?,
         omni,
         sun_shadow: SunShadowMode::from_name(&args.sun_shadow)?,
-        width: args.width,
-        height: args.height,
         frames,
         time: args.time,
         culling: args.culling == "on",
-        light_grid_marks: LightGridMarks::from_name(&args.light_grid_marks)?,
-        // Set once the technique and device are known where auto: `auto::resolve_antialiasing`.
         antialiasing: auto::antialiasing_choice(&args.aa)?.unwrap_or(Antialiasing::Off),
         specular_aa: args.specular_aa == "on",
         exposure: exposure_choice(args)?,
-        // Set once the technique (and for auto, the probe) is known: `auto::resolve_raster`.
-        raster: Raster::Hardware,
+        ..RenderSettings::new(technique, args.width, args.height)
+    };
+    Ok(SettingsRequest {
+        clusters: cluster_choice(&args.clusters)?,
+        light_grid_marks: LightGridMarks::from_name(&args.light_grid_marks)?,
         transparency: ml_render::TransparencySettings { budget: args.transparency_budget, ..Default::default() },
-        light_stats: false,
+        ..SettingsRequest::new(settings)
     })
 }
 
@@ -705,7 +704,8 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let request = scene_request(args)?;
     // Every setting is checked before the GPU work; auto's technique is set once it is known.
     let wanted = settings_request(args, choice.unwrap_or(Technique::DeferredClustered), cmd.frames)?;
-    let wanted = SettingsRequest { light_stats: cmd.light_stats, ..supersampled(wanted, cmd.supersample)? };
+    let mut wanted = supersampled(wanted, cmd.supersample)?;
+    wanted.settings.light_stats = cmd.light_stats;
     let mut techniques = Techniques::chosen(choice);
     check_options_apply(args, &request.source, None, &techniques)?;
     let sequence = output::sequence_pattern(&cmd.out)?;
@@ -779,11 +779,12 @@ fn render(cmd: &RenderArgs) -> Result<()> {
 /// the largest image we make.
 fn supersampled(wanted: SettingsRequest, k: u32) -> Result<SettingsRequest> {
     let max = ml_render::settings::MAX_DIMENSION;
-    let (width, height) = (wanted.width.saturating_mul(k), wanted.height.saturating_mul(k));
+    let s = wanted.settings;
+    let (width, height) = (s.width.saturating_mul(k), s.height.saturating_mul(k));
     if width > max || height > max {
         bail!("--supersample {k} renders {width}x{height}, more than {max} pixels a side: use a smaller --supersample or size");
     }
-    Ok(SettingsRequest { width, height, ..wanted })
+    Ok(SettingsRequest { settings: RenderSettings { width, height, ..s }, ..wanted })
 }
 
 /// The largest viewer script read (a script of a million lines is far past any session).
@@ -819,7 +820,8 @@ fn view(cmd: &ViewArgs) -> Result<()> {
         unused = check_options_apply(args, &request.source, Some(&built), &techniques)?;
     }
     print_warnings(&built.warnings);
-    let mut first = SettingsRequest { technique, ..wanted }.for_scene(&built.scene, built.shading);
+    let mut first =
+        SettingsRequest { settings: RenderSettings { technique, ..wanted.settings }, ..wanted }.for_scene(&built.scene, built.shading);
     unused.take_effect(&mut first);
     let aa_choice = (auto::antialiasing_choice(&args.aa)?, (raster_choice(args)?, args.raster_split));
     first.antialiasing = auto::resolve_antialiasing_alone(&first, aa_choice, built.scene.lights.len(), (args.validation, args.device))?;

@@ -377,55 +377,41 @@ impl RenderSettings {
     }
 }
 
-/// The settings a command asks for, before the scene is known: its cluster grid may be left
-/// to the scene's light count, and its shading model comes with the scene.
+/// The settings a command asks for, before the scene is known: the render's own, but for what
+/// the scene settles — its shading model (`settings.shading` is replaced), the cluster grid
+/// its light count may choose, whether it has transparent objects to blend, whether the light
+/// grid marks its cells (auto: by its lights per pixel) and how many lights cast shadows
+/// (`--shadowed-lights all`: those in view).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SettingsRequest {
-    pub technique: Technique,
+    /// Everything else, as it will render; its `clusters`, `transparency` and
+    /// `light_grid_marks` are replaced by `for_scene` from the fields below.
+    pub settings: RenderSettings,
     /// Cluster grid; None: `ClusterDims::for_lights` for the scene's lights at this size.
     pub clusters: Option<ClusterDims>,
-    pub debug_view: DebugView,
-    pub omni: Option<OmniShadowSettings>,
-    pub sun_shadow: SunShadowMode,
-    pub width: u32,
-    pub height: u32,
-    pub frames: u32,
-    pub time: Option<f32>,
-    pub culling: bool,
-    pub raster: Raster,
-    pub exposure: Exposure,
     /// How transparent objects are blended, where the scene has any.
     pub transparency: TransparencySettings,
-    /// Count the lights tested and reaching per pixel.
-    pub light_stats: bool,
     /// Whether the light grid marks the cells near the surfaces first.
     pub light_grid_marks: LightGridMarks,
-    pub antialiasing: Antialiasing,
-    pub specular_aa: bool,
 }
 
 impl SettingsRequest {
+    /// `settings` asked for as they are, the rest at its defaults: the scene's grid, its
+    /// transparent objects blended within the default budget, the marks decided by its lights.
+    pub fn new(settings: RenderSettings) -> SettingsRequest {
+        SettingsRequest { settings, clusters: None, transparency: TransparencySettings::default(), light_grid_marks: LightGridMarks::Auto }
+    }
+
     /// The settings that render `scene` with `shading` (the model its request resolved to).
     pub fn for_scene(&self, scene: &ml_cpu::scene::Scene, shading: ShadingModel) -> RenderSettings {
+        let s = &self.settings;
         RenderSettings {
-            technique: self.technique,
             shading,
-            clusters: self.clusters.unwrap_or_else(|| ClusterDims::for_lights(scene.lights.len(), self.width, self.height)),
-            debug_view: self.debug_view,
-            omni: self.omni.map(|o| OmniShadowSettings { lights: shadowed_count(&o, scene, (self.width, self.height)), ..o }),
-            sun_shadow: self.sun_shadow,
-            width: self.width,
-            height: self.height,
-            frames: self.frames,
-            time: self.time,
-            culling: self.culling,
-            raster: self.raster,
-            exposure: self.exposure,
+            clusters: self.clusters.unwrap_or_else(|| ClusterDims::for_lights(scene.lights.len(), s.width, s.height)),
+            omni: s.omni.map(|o| OmniShadowSettings { lights: shadowed_count(&o, scene, (s.width, s.height)), ..o }),
             transparency: scene.has_blended_objects().then_some(self.transparency),
-            light_stats: self.light_stats,
-            light_grid_marks: self.light_grid_marks.resolve(scene.lights.len() as u64, self.width, self.height),
-            antialiasing: self.antialiasing,
-            specular_aa: self.specular_aa,
+            light_grid_marks: self.light_grid_marks.resolve(scene.lights.len() as u64, s.width, s.height),
+            ..*s
         }
     }
 }
