@@ -236,7 +236,7 @@ impl Plan {
 /// What a run measures: the probe at these loop lengths, or the techniques.
 enum Work {
     Probe(Vec<u32>),
-    Techniques(Plan),
+    Techniques(Box<Plan>),
 }
 
 /// What a row measures: a technique, for the visibility technique its rasteriser, and the
@@ -367,7 +367,7 @@ pub fn bench(a: &mut BenchArgs) -> Result<()> {
     let note = fit_to_a_cpu(a, &ctx.info);
     let a = &*a;
     let Asked { choices, counts, resolution, rasters, sample_counts, rules, named, auto } = asked(a)?;
-    let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Plan::new(a, resolution)?) };
+    let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Box::new(Plan::new(a, resolution)?)) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
     // What the run writes, checked before it runs (a bad path must not cost a sweep).
     let outputs: &[&str] = if a.probe { &PROBE_RESULTS } else { &RESULTS };
