@@ -47,8 +47,8 @@ struct FrameUniforms {
     float ambient;       // seed: colour = albedo * ambient + Lo
     float omni_texel;    // one texel of a point-light shadow cube face, in face units (2 / size)
     uint directional_count; // lights in directional_direction/colour
-    uvec4 cluster_dims;  // xyz: cluster grid size; w: debug view (DEBUG_VIEW_*)
-    uvec4 viewport;      // xy: image size in pixels
+    uvec4 cluster_dims;  // xyz: cluster grid size
+    uvec4 viewport;      // xy: image size in pixels; z: the debug view shown (DEBUG_VIEW_*)
     vec4 cluster_slices; // x, y: slice = floor(log(depth) * x + y); z: heat-map top (lights)
     vec4 cluster_frustum; // x: near, y: far, z: proj[0][0], w: proj[1][1] (symmetric perspective)
     vec4 light_animation; // xyz: offset every light moves by this frame (the seed's animation)

@@ -159,7 +159,7 @@ vec3 ray_cost_light(PointLight l, vec3 world, vec3 n) {
 // it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
 // False for any other view. Every shading path calls it with the values it would shade with.
 bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, uint object_flags, vec2 frag_xy, out vec3 color) {
-    uint view = frame.cluster_dims.w;
+    uint view = frame.viewport.z;
     vec3 display;
     if (view == DEBUG_VIEW_ALPHA) {
         // Which surfaces an alpha mask cuts: opaque grey, masked green, blended (drawn as a

@@ -26,7 +26,7 @@ layout(constant_id = 40) const bool TRANSPARENT_LAYERS = false;
 void main() {
     MeshPoint at = covered_point();
 #if defined(CLUSTERED) || defined(LIGHT_GRID)
-    if (frame.cluster_dims.w == DEBUG_VIEW_CLUSTER_HEAT) {
+    if (frame.viewport.z == DEBUG_VIEW_CLUSTER_HEAT) {
         // Lights tested on a log scale up to cluster_slices.z.
         uint count = cluster_light_count(at.world, gl_FragCoord.xy);
         float t = log2(1.0 + float(count)) / log2(1.0 + frame.cluster_slices.z);

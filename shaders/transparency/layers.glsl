@@ -254,7 +254,7 @@ vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
     float transmittance;
     uint count;
     vec3 color = blend_layers(p, background ? vec3(0.0) : under, transmittance, count);
-    if (frame.cluster_dims.w == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
+    if (frame.viewport.z == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
         return layer_count_color(count);
     }
     if (!background) {
@@ -283,7 +283,7 @@ uint layers_over_sample(SortedLayers s, uint k) {
 
 vec4 layered_samples_output(ivec2 p, float exposure) {
     SortedLayers s = sort_layers(p);
-    if (frame.cluster_dims.w == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
+    if (frame.viewport.z == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
         return layer_count_color(s.count);
     }
     vec3 background = pow(CLEAR_COLOR.rgb, vec3(2.2));

@@ -166,7 +166,7 @@ vec3 surface_display(ivec2 p, uint leader) {
     float depth;
     uint members = samples_of(p, leader, depth);
     uint id = visibility_buffer_id(raster_sample(p, leader));
-    uint view = frame.cluster_dims.w;
+    uint view = frame.viewport.z;
     vec3 display;
     if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
         display = pow(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), vec3(2.2));
@@ -285,7 +285,7 @@ void shade_samples(ivec2 p, bool inside) {
         return;
     }
     bool first = surfaces == 0u ? set == 0u : first_set == set;
-    if (frame.cluster_dims.w == DEBUG_VIEW_AA) {
+    if (frame.viewport.z == DEBUG_VIEW_AA) {
         // Surfaces shaded in the pixel: none the background; one blue, two cyan, three green,
         // four yellow, five and more red.
         if (first) {
@@ -328,7 +328,7 @@ void main() {
     if (texture_set_of(id) != texture_set.x) {
         return;
     }
-    uint view = frame.cluster_dims.w;
+    uint view = frame.viewport.z;
     if (view == DEBUG_VIEW_MESHLETS || view == DEBUG_VIEW_TRIANGLES) {
         imageStore(out_image, p, vec4(id_color(view == DEBUG_VIEW_MESHLETS ? id >> VISIBILITY_TRIANGLE_BITS : id), 1.0));
         return;

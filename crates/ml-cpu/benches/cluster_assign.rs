@@ -3,12 +3,12 @@
 //! Run: `cargo bench -p ml-cpu --bench cluster_assign`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use ml_cpu::camera::Camera;
+use ml_cpu::camera::{Camera, View};
 use ml_cpu::cluster::{ClusterAssigner, ClusterDims, ClusterGrid, ClusterLists};
 use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 
 fn assign(c: &mut Criterion) {
-    let grid = ClusterGrid::new(ClusterDims::DEFAULT, 1920, 1080, &Camera::seed());
+    let grid = ClusterGrid::new(ClusterDims::DEFAULT, &View::new(Camera::seed(), 1920, 1080));
     let mut group = c.benchmark_group("cluster_assign_16x9x24_1080p");
     for count in [1_000u32, 10_000, 100_000] {
         let lights =

@@ -93,6 +93,31 @@ impl Camera {
     }
 }
 
+/// What a frame is seen through: a camera on an image of `width`×`height` pixels, with the
+/// view and projection every pass of the frame takes (the frame's uniforms), the cluster grid
+/// is cut along, and the transparent build bins by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+    /// World → view space (the eye at the origin, looking down −Z).
+    pub view: Mat4,
+    /// View → Vulkan clip space (`Camera::projection` at the image's aspect).
+    pub projection: Mat4,
+}
+
+impl View {
+    pub fn new(camera: Camera, width: u32, height: u32) -> View {
+        View { camera, width, height, view: camera.view(), projection: camera.projection(width as f32 / height as f32) }
+    }
+
+    /// World → clip space.
+    pub fn view_proj(&self) -> Mat4 {
+        self.projection * self.view
+    }
+}
+
 /// A camera's field of view when nothing says otherwise (the seed's).
 pub const DEFAULT_FOV_Y_DEG: f32 = 60.0;
 

@@ -40,10 +40,10 @@ gpu_struct!(
         omni_texel: f32,
         /// Lights in `directional_*`.
         directional_count: u32,
-        /// xyz: cluster grid size; w: debug view (DEBUG_VIEW_* in common.glsl, generated as
-        /// ml_shaders::debug_view).
+        /// xyz: cluster grid size.
         cluster_dims: [u32; 4],
-        /// xy: image size in pixels.
+        /// xy: image size in pixels; z: the debug view shown (DEBUG_VIEW_* in common.glsl,
+        /// generated as ml_shaders::debug_view).
         viewport: [u32; 4],
         /// x, y: slice = ⌊ln(depth)·x + y⌋; z: lights per cluster at the top of the heat map.
         cluster_slices: [f32; 4],

@@ -9,7 +9,7 @@ use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::sync::Use;
 use crate::targets::Targets;
-use ml_cpu::camera::Camera;
+use ml_cpu::camera::View;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
 use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context, VkError};
@@ -40,13 +40,13 @@ pub struct SlotReport {
 }
 
 /// The CPU side of a frame, before it is recorded (`Pass::prepare`): what a pass's CPU step
-/// reads (the frame's camera, lights and grid) and may change (the slot's light lists, the
+/// reads (the frame's view, lights and grid) and may change (the slot's light lists, the
 /// scene's GPU state such as the shadow atlas's cache, the frame's statistics).
 pub struct Prepare<'a> {
     pub ctx: &'a Context,
     pub grid: &'a ClusterGrid,
-    pub camera: &'a Camera,
-    pub extent: vk::Extent2D,
+    /// The camera and image size the frame is seen through.
+    pub view: &'a View,
     /// The scene's lights at rest, and how far the animation moves them this frame (every
     /// light by the same offset).
     pub rest_lights: &'a [PointLight],

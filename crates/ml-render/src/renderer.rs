@@ -17,7 +17,7 @@ use crate::scene::SceneGpu;
 use crate::settings::{Geometry, LightAssignment, RenderSettings};
 use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
-use ml_cpu::camera::Camera;
+use ml_cpu::camera::{Camera, View};
 use ml_cpu::cluster::{count_entries, ClusterGrid};
 use ml_cpu::gpu_types::{FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
@@ -72,7 +72,10 @@ pub struct Renderer<'a> {
     /// `animated`, which every frame uploads.
     lights_on_gpu: bool,
     animated: Vec<PointLight>,
-    /// The cluster grid (its shader parameters are also set for techniques without one).
+    /// What the frames are seen through: the camera's view and projection at the image's size.
+    view: View,
+    /// The cluster grid cut along `view` (its shader parameters are also set for techniques
+    /// without one).
     grid: ClusterGrid,
     /// Per frame slot: what its last frame reported (the heat map's top, the exposure meter).
     reports: Vec<SlotReport>,
@@ -136,7 +139,8 @@ impl<'a> Renderer<'a> {
             settings.transparency = None;
         }
         settings.check(ctx, scene.lights.len())?;
-        let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &scene.camera);
+        let view = View::new(scene.camera, settings.width, settings.height);
+        let grid = ClusterGrid::new(settings.clusters, &view);
         check_lists_fit(ctx, &settings, &grid, &scene.lights, scene.light_motion)?;
         if !scene.cones.is_empty() && scene.cones.len() != scene.lights.len() {
             return Err(RenderError::Invalid(format!("the scene has {} spot cones for {} lights", scene.cones.len(), scene.lights.len())));
@@ -153,6 +157,7 @@ impl<'a> Renderer<'a> {
         let mut r = Renderer {
             ctx,
             extent: vk::Extent2D { width: settings.width, height: settings.height },
+            view,
             grid,
             animated: if lights_on_gpu { Vec::new() } else { lights.clone() },
             lights,
@@ -214,13 +219,14 @@ impl<'a> Renderer<'a> {
             return Ok(false);
         }
         settings.check(self.ctx, self.scene.lights.len())?;
-        let grid = ClusterGrid::new(settings.clusters, settings.width, settings.height, &self.scene.camera);
+        let view = View::new(self.scene.camera, settings.width, settings.height);
+        let grid = ClusterGrid::new(settings.clusters, &view);
         check_lists_fit(self.ctx, &settings, &grid, &self.scene.lights, self.scene.light_motion)?;
         self.release_frames()?;
         self.exposure.set_mode(settings.exposure);
         self.settings = settings;
         self.extent = vk::Extent2D { width: settings.width, height: settings.height };
-        self.grid = grid;
+        (self.view, self.grid) = (view, grid);
         // The passes depend on the grid (the GPU build's sizes), the debug view (legend,
         // tone-map curve, view passes) and the exposure meter; the view only needs new frame
         // slots.
@@ -509,9 +515,10 @@ impl<'a> Renderer<'a> {
     /// again when it changed (field of view, near, far).
     pub fn set_camera(&mut self, camera: Camera) -> Result<(), RenderError> {
         self.scene.camera = camera;
-        let projection = self.grid.projection;
-        self.grid = ClusterGrid::new(self.settings.clusters, self.extent.width, self.extent.height, &camera);
-        if self.grid.projection != projection {
+        let projection = self.view.projection;
+        self.view = View::new(camera, self.extent.width, self.extent.height);
+        self.grid = ClusterGrid::new(self.settings.clusters, &self.view);
+        if self.view.projection != projection {
             // Frame 0's uniforms carry the projection to the passes: wait for its frame.
             self.ctx.wait_idle()?;
             self.projection_changed()?;
@@ -637,8 +644,7 @@ impl<'a> Renderer<'a> {
         let mut prepare = Prepare {
             ctx,
             grid: &self.grid,
-            camera: &self.scene.camera,
-            extent: self.extent,
+            view: &self.view,
             rest_lights: &self.lights,
             light_offset: motion_offset(t, self.scene.light_motion),
             lights: &self.animated,
@@ -665,9 +671,9 @@ impl<'a> Renderer<'a> {
     }
 
     fn write_uniforms(&mut self, f: usize, t: f32) {
-        let g = &self.grid;
+        let (g, v) = (&self.grid, &self.view);
         let debug_view = self.settings.debug_view.code();
-        let cam = &self.scene.camera;
+        let cam = &v.camera;
         let bp = &self.scene.blinn_phong;
         // World size of a shadow-map texel: the orthographic projection's first row is the
         // sun's x axis over the half-width it covers.
@@ -676,19 +682,19 @@ impl<'a> Renderer<'a> {
         let frame = &mut self.frames[f];
         let light_offset = motion_offset(t, self.scene.light_motion);
         let mut uniforms = FrameUniforms {
-            view: g.view.to_cols_array_2d(),
-            proj: g.projection.to_cols_array_2d(),
-            inv_view_proj: (g.projection * g.view).inverse().to_cols_array_2d(),
+            view: v.view.to_cols_array_2d(),
+            proj: v.projection.to_cols_array_2d(),
+            inv_view_proj: v.view_proj().inverse().to_cols_array_2d(),
             // w: clip w = w·depth + (1 − w) (Camera::w_of_depth).
             camera_pos: cam.position.extend(cam.w_of_depth().0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
             omni_texel: self.gpu.omni.texel(),
             directional_count: self.scene.directional.len() as u32,
-            cluster_dims: [g.dims.x, g.dims.y, g.dims.z, debug_view],
-            viewport: [self.extent.width, self.extent.height, 0, 0],
+            cluster_dims: [g.dims.x, g.dims.y, g.dims.z, 0],
+            viewport: [v.width, v.height, debug_view, 0],
             cluster_slices: [g.log_scale, g.log_bias, self.heat_top, 0.0],
-            cluster_frustum: [g.near, g.far, g.projection.x_axis.x, g.projection.y_axis.y],
+            cluster_frustum: [g.near, g.far, v.projection.x_axis.x, v.projection.y_axis.y],
             light_animation: light_offset.extend(0.0).to_array(),
             cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
             shadow_view_proj: self.gpu.shadow_view_proj.to_cols_array_2d(),
@@ -725,7 +731,7 @@ impl<'a> Renderer<'a> {
         }
         frame.timer.reset(ctx, cmd);
         let targets = frame.targets.as_ref().expect("made with the frame");
-        let view_proj = self.grid.projection * self.grid.view;
+        let view_proj = self.view.view_proj();
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
         let image = |name: &str| targets.named_image(name).or_else(|| self.gpu.named_image(name));

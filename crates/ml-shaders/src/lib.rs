@@ -92,7 +92,7 @@ impl Shader {
     }
 }
 
-/// The codes of the debug views as the shaders compare `FrameUniforms::cluster_dims.w`
+/// The codes of the debug views as the shaders compare `FrameUniforms::viewport.z`
 /// against them: `#define DEBUG_VIEW_NAME Nu` in `shaders/common/common.glsl` becomes `NAME`.
 pub mod debug_view {
     include!(concat!(env!("OUT_DIR"), "/debug_view.rs"));

@@ -10,7 +10,7 @@
 //! (mistake 2): NDC z of a perspective projection crowds almost every depth into the last few
 //! slices.
 
-use crate::camera::Camera;
+use crate::camera::View;
 use crate::limits::MAX_CLUSTERS;
 use glam::{Mat4, Vec3, Vec3A};
 
@@ -124,7 +124,8 @@ fn tile_of(p: u32, tiles: u32, size: u32) -> u32 {
     ((p as u64 * tiles as u64) / size as u64) as u32
 }
 
-/// The grid for one camera and image size.
+/// The clusters of one view (`View`: a camera and image size), and what assigning lights to
+/// them needs of it.
 #[derive(Clone, Debug)]
 pub struct ClusterGrid {
     pub dims: ClusterDims,
@@ -135,6 +136,7 @@ pub struct ClusterGrid {
     /// Slice = ⌊ln(depth)·log_scale + log_bias⌋.
     pub log_scale: f32,
     pub log_bias: f32,
+    /// The view's matrices, as the grid was cut (`View`; lights are assigned in view space).
     pub view: Mat4,
     pub projection: Mat4,
     /// Clip w at view depth d = a·d + b: (1, 0) perspective, (0, 1) orthographic.
@@ -161,12 +163,13 @@ pub struct ClusterGrid {
 const SLACK: f32 = 1e-4;
 
 impl ClusterGrid {
-    pub fn new(dims: ClusterDims, width: u32, height: u32, camera: &Camera) -> ClusterGrid {
+    /// The grid of `dims` clusters cut along `v`'s frustum.
+    pub fn new(dims: ClusterDims, v: &View) -> ClusterGrid {
+        let (width, height, camera) = (v.width, v.height, &v.camera);
         let (near, far) = (camera.near, camera.far);
         let ln_ratio = (far / near).ln();
         let log_scale = dims.z as f32 / ln_ratio;
         let log_bias = -(dims.z as f32) * near.ln() / ln_ratio;
-        let projection = camera.projection(width as f32 / height as f32);
         let mut grid = ClusterGrid {
             dims,
             width,
@@ -175,8 +178,8 @@ impl ClusterGrid {
             far,
             log_scale,
             log_bias,
-            view: camera.view(),
-            projection,
+            view: v.view,
+            projection: v.projection,
             w_of_depth: camera.w_of_depth(),
             bounds: Vec::with_capacity(dims.count()),
             slice_starts: Vec::new(),

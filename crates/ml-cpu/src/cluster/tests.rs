@@ -1,5 +1,5 @@
 use super::*;
-use crate::camera::Camera;
+use crate::camera::{Camera, View};
 use crate::gpu_types::PointLight;
 use crate::lights::LightParams;
 use crate::random_scene::{hostile_lights, random_camera};
@@ -35,7 +35,7 @@ fn world_point(grid: &ClusterGrid, px: u32, py: u32, depth: f32) -> Vec3 {
 }
 
 fn seed_camera_grid(dims: ClusterDims) -> ClusterGrid {
-    ClusterGrid::new(dims, W, H, &Camera::seed())
+    ClusterGrid::new(dims, &View::new(Camera::seed(), W, H))
 }
 
 #[test]
@@ -84,7 +84,7 @@ fn no_light_that_reaches_a_point_is_missing_from_its_cluster() {
     for scene in 0..24 {
         let camera = random_camera(&mut rng);
         let dims = if scene % 3 == 0 { ClusterDims { x: 4, y: 4, z: 2 } } else { ClusterDims::DEFAULT };
-        let grid = ClusterGrid::new(dims, W, H, &camera);
+        let grid = ClusterGrid::new(dims, &View::new(camera, W, H));
         let count = rng.random_range(1..3000);
         let lights = hostile_lights(&mut rng, &camera, count);
         let lists = assign(&grid, &lights);
@@ -131,7 +131,7 @@ fn no_light_that_reaches_a_point_is_missing_from_its_cluster() {
 fn lists_are_sorted_and_match_the_per_light_test() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     let camera = random_camera(&mut rng);
-    let grid = ClusterGrid::new(ClusterDims::DEFAULT, W, H, &camera);
+    let grid = ClusterGrid::new(ClusterDims::DEFAULT, &View::new(camera, W, H));
     let lights = hostile_lights(&mut rng, &camera, 5000);
     let lists = assign(&grid, &lights);
     let mut expected = vec![Vec::new(); grid.dims.count()];
@@ -164,7 +164,7 @@ fn seed_tile_range(grid: &ClusterGrid, l: &PointLight) -> Option<(u32, u32, u32,
 #[test]
 fn mistake_1_ndc_radius_approximation_misses_tiles_that_a_near_light_lights() {
     let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, 60.0, 0.1, 256.0);
-    let grid = ClusterGrid::new(ClusterDims::DEFAULT, W, H, &camera);
+    let grid = ClusterGrid::new(ClusterDims::DEFAULT, &View::new(camera, W, H));
     // A light 3 in front of the eye with radius 6 lights the whole screen at depth 3.
     let l = light(Vec3::new(0.0, 0.0, 2.0), 6.0);
     let p = world_point(&grid, 0, 0, 3.0); // top-left corner pixel
@@ -194,7 +194,7 @@ fn mistake_2_ndc_depth_is_not_linear_depth() {
 #[test]
 fn mistake_3_lights_behind_the_camera_still_light_what_is_in_front() {
     let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, 60.0, 0.1, 256.0);
-    let grid = ClusterGrid::new(ClusterDims::DEFAULT, W, H, &camera);
+    let grid = ClusterGrid::new(ClusterDims::DEFAULT, &View::new(camera, W, H));
     let l = light(Vec3::new(0.0, 0.0, 6.0), 3.0); // 1 behind the eye, reaches 2 in front
     assert!(seed_tile_range(&grid, &l).is_none(), "the seed skips it");
     let p = world_point(&grid, W / 2, H / 2, 1.5);
@@ -208,7 +208,7 @@ fn mistake_4_no_fixed_capacity_drops_lights() {
     // The seed's per-cluster arrays stopped adding at a fixed size; 10,000 overlapping
     // lights must all be listed.
     let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, 60.0, 0.1, 256.0);
-    let grid = ClusterGrid::new(ClusterDims::DEFAULT, W, H, &camera);
+    let grid = ClusterGrid::new(ClusterDims::DEFAULT, &View::new(camera, W, H));
     let lights: Vec<PointLight> = (0..10_000).map(|i| light(Vec3::new(0.0, (i as f32) * 1e-5, 0.0), 2.0)).collect();
     let lists = assign(&grid, &lights);
     let centre = lists.lights_of(grid.cluster_of(W / 2, H / 2, 5.0));
@@ -245,7 +245,7 @@ fn counted_entries_bound_every_frames_lists() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
     for seed in 0..6u64 {
         let camera = random_camera(&mut rng);
-        let grid = ClusterGrid::new(ClusterDims::DEFAULT, W, H, &camera);
+        let grid = ClusterGrid::new(ClusterDims::DEFAULT, &View::new(camera, W, H));
         let lights = hostile_lights(&mut rng, &camera, 400);
         let exact = assign(&grid, &lights).indices.len();
         let still = count_entries(&grid, &lights, 0.0, usize::MAX);

@@ -139,8 +139,8 @@ fn plan_atlas(p: &mut Prepare) -> Result<Option<AtlasPlan>, RenderError> {
     let Some(atlas) = omni.settings.and_then(|o| o.atlas()) else { return Ok(None) };
     let lights: Vec<(u32, PlannedLight)> =
         omni.chosen().iter().zip(omni.placed()).map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius })).collect();
-    let size = (p.extent.width, p.extent.height);
-    let Some(plan) = omni.atlas.plan(&lights, p.camera, size, atlas) else { return Ok(None) };
+    let size = (p.view.width, p.view.height);
+    let Some(plan) = omni.atlas.plan(&lights, &p.view.camera, size, atlas) else { return Ok(None) };
     let plan = plan.map_err(|e| {
         RenderError::Invalid(format!(
             "shadow atlas: {e} (a budget of {} MiB; more would hold them, or fewer shadowed lights)",

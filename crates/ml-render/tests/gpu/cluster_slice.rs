@@ -6,7 +6,7 @@
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use ml_cpu::camera::Camera;
+use ml_cpu::camera::{Camera, View};
 use ml_cpu::cluster::{ClusterDims, ClusterGrid};
 use ml_cpu::gpu_types::FrameUniforms;
 use ml_vk::{Buffer, Context, ContextDesc};
@@ -46,7 +46,7 @@ fn gpu_slices(ctx: &Context, grid: &ClusterGrid, depths: &[f32]) -> Vec<u32> {
 fn glsl_and_rust_slices_agree_on_random_depths() {
     let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("Vulkan with validation");
     let counter = ctx.validation_counter();
-    let grid = ClusterGrid::new(ClusterDims::DEFAULT, 1920, 1080, &Camera::seed());
+    let grid = ClusterGrid::new(ClusterDims::DEFAULT, &View::new(Camera::seed(), 1920, 1080));
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
     // Uniform in log depth (like the slices), plus some out of [near, far].
     let depths: Vec<f32> = (0..COUNT).map(|_| grid.near * (grid.far / grid.near).powf(rng.random_range(-0.05..1.05))).collect();
