@@ -317,10 +317,12 @@ impl<'c> Session<'c> {
     /// they do not (or it failed): a new renderer then.
     fn change_in_place(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
         let (Some(renderer), Some(built)) = (&mut self.renderer, &self.built) else { return false };
-        let c = &self.choices;
+        let (c, b) = (&self.choices, &built.settings);
         let lights_only = Choices { lights: built.lights, layout: built.layout, radius: built.radius, ..c.clone() } == *built;
-        let settings_only =
-            Choices { clusters: built.clusters, debug_view: built.debug_view, exposure: built.exposure, ..c.clone() } == *built;
+        let settings_only = Choices {
+            settings: RenderSettings { clusters: b.clusters, debug_view: b.debug_view, exposure: b.exposure, ..c.settings },
+            ..c.clone()
+        } == *built;
         let objects_only = Choices { object: built.object, material: built.material, ..c.clone() } == *built;
         let done = if lights_only {
             // With markers shown the objects change with the lights: their markers too.
@@ -333,7 +335,12 @@ impl<'c> Session<'c> {
         } else if objects_only {
             matches!(build(c, (extent.width, extent.height)).and_then(|(scene, _)| Ok(renderer.set_objects(&scene)?)), Ok(true))
         } else if settings_only {
-            let settings = RenderSettings { clusters: c.clusters, debug_view: c.debug_view, exposure: c.exposure, ..*renderer.settings() };
+            let settings = RenderSettings {
+                clusters: c.settings.clusters,
+                debug_view: c.settings.debug_view,
+                exposure: c.settings.exposure,
+                ..*renderer.settings()
+            };
             matches!(renderer.reconfigure(settings), Ok(true))
         } else {
             false
@@ -460,8 +467,8 @@ impl<'c> Session<'c> {
                     self.wait_turns = n;
                     return Ok(());
                 }
-                Command::Technique(name) => self.choices.technique = ml_render::Technique::from_name(&name)?,
-                Command::Antialiasing(samples) => self.choices.antialiasing = ml_render::Antialiasing::from_name(&samples)?,
+                Command::Technique(name) => self.choices.settings.technique = ml_render::Technique::from_name(&name)?,
+                Command::Antialiasing(samples) => self.choices.settings.antialiasing = ml_render::Antialiasing::from_name(&samples)?,
                 Command::Lights(n) => {
                     self.choices.lights = n;
                     self.overlay.lights_edit = n;

@@ -2,7 +2,6 @@
 //! settings (`Choices`), pause, and a panel of per-pass GPU times with a frame-time graph.
 
 use egui::{ComboBox, DragValue, Slider};
-use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::{LightLayout, RadiusRange, SEED_RADIUS};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
@@ -10,39 +9,26 @@ use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
 use ml_render::settings::MAX_SHADOWED_LIGHTS;
 use ml_render::{
     Antialiasing, DebugView, Exposure, Geometry, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel,
-    SunShadowMode, Technique,
+    Technique,
 };
 use std::collections::VecDeque;
 
 /// Everything the overlay can change that needs a new scene or renderer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Choices {
-    pub technique: Technique,
-    pub shading: ShadingModel,
+    /// The render settings chosen: technique, model, raster, samples, cluster grid, debug
+    /// view, shadows, exposure, transparency (None: the scene has no transparent objects).
+    /// Size, clock and the light grid's marks are the window's and the scene's (`settings`).
+    pub settings: RenderSettings,
     /// Seed scene only: its object kind and material.
     pub object: MeshKind,
     pub material: Material,
     pub lights: u64,
     pub layout: LightLayout,
     pub radius: f32,
-    pub clusters: ClusterDims,
-    pub debug_view: DebugView,
-    pub omni: Option<OmniShadowSettings>,
-    /// Who draws the sun's shadow map (the command line's choice; blinn-phong).
-    pub sun_shadow: SunShadowMode,
-    /// Who draws the visibility buffer (used where the technique is visibility).
-    pub raster: Raster,
-    /// Exposure: an EV, or auto (metered each frame, smoothed over frames).
-    pub exposure: Exposure,
-    /// The scene's transparent layers (None: it has no transparent objects).
-    pub transparency: Option<ml_render::TransparencySettings>,
     /// Whether the light grid marks the cells near the surfaces (the command line's choice;
     /// auto decides again as lights and size change).
     pub light_grid_marks: LightGridMarks,
-    /// Coverage samples per pixel (used with the visibility technique's compute raster).
-    pub antialiasing: Antialiasing,
-    /// Highlights under normal maps widened by the normals' spread.
-    pub specular_aa: bool,
 }
 
 impl Choices {
@@ -56,23 +42,13 @@ impl Choices {
             _ => (MeshKind::Sphere, Material::built_in()[0]),
         };
         Choices {
-            technique: settings.technique,
-            shading: built.shading,
+            settings: RenderSettings { shading: built.shading, ..*settings },
             object,
             material,
             lights: built.scene.lights.len() as u64,
             layout: request.layout,
             radius: request.radius.map_or_else(|| built.scene.lights.first().map_or(SEED_RADIUS, |l| l.position_radius[3]), |r| r.max),
-            clusters: settings.clusters,
-            debug_view: settings.debug_view,
-            omni: settings.omni,
-            sun_shadow: settings.sun_shadow,
-            raster: settings.raster,
-            exposure: settings.exposure,
-            transparency: settings.transparency,
             light_grid_marks,
-            antialiasing: settings.antialiasing,
-            specular_aa: settings.specular_aa,
         }
     }
 
@@ -80,7 +56,7 @@ impl Choices {
     /// the model, the seed scene's object and material, and the lights — a scene file keeps its
     /// own until their count, layout or radius changes.
     pub fn request(&self, base: &SceneRequest, initial: &Choices) -> SceneRequest {
-        let mut r = SceneRequest { shading: Some(self.shading), ..base.clone() };
+        let mut r = SceneRequest { shading: Some(self.settings.shading), ..base.clone() };
         if let SceneSource::Seed { object, material } = &mut r.source {
             (*object, *material) = (self.object, self.material);
         }
@@ -96,8 +72,8 @@ impl Choices {
     /// The raster the technique draws with: the chosen one for visibility; the others have no
     /// visibility buffer to draw.
     fn drawn_raster(&self) -> Raster {
-        if self.technique.geometry() == Geometry::Meshlets {
-            self.raster
+        if self.settings.technique.geometry() == Geometry::Meshlets {
+            self.settings.raster
         } else {
             Raster::Hardware
         }
@@ -105,34 +81,25 @@ impl Choices {
 
     /// The settings of these choices at a size, the clock fixed at `time` if given.
     pub fn settings(&self, (width, height): (u32, u32), time: Option<f32>) -> RenderSettings {
-        let raster = self.drawn_raster();
-        // Anti-aliasing's samples are not blended with transparent layers yet.
+        let s = &self.settings;
         RenderSettings {
-            technique: self.technique,
-            shading: self.shading,
-            clusters: self.clusters,
-            debug_view: self.debug_view,
-            omni: self.omni,
-            sun_shadow: self.sun_shadow,
             width,
             height,
             frames: 1,
             time,
             culling: true,
-            raster,
-            exposure: self.exposure,
-            transparency: self.transparency,
+            raster: self.drawn_raster(),
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
             light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
             // Transparent layers take samples in the visibility technique (the overlay offers
             // what the settings take).
-            specular_aa: self.specular_aa,
-            antialiasing: if self.transparency.is_none() || ml_render::layers_take(self.technique, self.antialiasing) {
-                self.antialiasing
+            antialiasing: if s.transparency.is_none() || ml_render::layers_take(s.technique, s.antialiasing) {
+                s.antialiasing
             } else {
                 Antialiasing::Off
             },
+            ..*s
         }
     }
 }
@@ -206,20 +173,20 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
     }
     let window = egui::Window::new("manylights").id(id).default_pos([8.0, 8.0]).resizable(false);
     window.vscroll(true).max_height((screen.y - 48.0).max(60.0)).show(ctx, |ui| {
-        combo(ui, "Technique", &mut choices.technique, &Technique::ALL, |t| t.name());
-        if choices.technique.geometry() == Geometry::Meshlets {
-            let split = if choices.raster.split() > 0 { choices.raster.split() } else { Raster::DEFAULT_SPLIT };
+        combo(ui, "Technique", &mut choices.settings.technique, &Technique::ALL, |t| t.name());
+        if choices.settings.technique.geometry() == Geometry::Meshlets {
+            let split = if choices.settings.raster.split() > 0 { choices.settings.raster.split() } else { Raster::DEFAULT_SPLIT };
             let options = [Raster::Hardware, Raster::hybrid(split), Raster::compute(split)];
-            combo(ui, "Raster", &mut choices.raster, &options, |r| r.name());
-            if let Raster::Compute { split, .. } = &mut choices.raster {
+            combo(ui, "Raster", &mut choices.settings.raster, &options, |r| r.name());
+            if let Raster::Compute { split, .. } = &mut choices.settings.raster {
                 ui.add(DragValue::new(split).range(1..=Raster::MAX_SPLIT).prefix("compute up to ").suffix(" px"));
             }
         }
-        if choices.transparency.is_none() || choices.technique == Technique::Visibility {
-            combo(ui, "Anti-aliasing", &mut choices.antialiasing, &Antialiasing::ALL, |a| a.name());
+        if choices.settings.transparency.is_none() || choices.settings.technique == Technique::Visibility {
+            combo(ui, "Anti-aliasing", &mut choices.settings.antialiasing, &Antialiasing::ALL, |a| a.name());
         }
-        ui.checkbox(&mut choices.specular_aa, "Specular anti-aliasing");
-        combo(ui, "Shading", &mut choices.shading, &ShadingModel::ALL, |m| m.name());
+        ui.checkbox(&mut choices.settings.specular_aa, "Specular anti-aliasing");
+        combo(ui, "Shading", &mut choices.settings.shading, &ShadingModel::ALL, |m| m.name());
         ui.add_enabled_ui(state.seed_scene, |ui| {
             combo(ui, "Type", &mut choices.object, &MeshKind::ALL, |k| k.name());
             combo(ui, "Material", &mut choices.material, &Material::built_in(), |m| m.name().unwrap_or("custom"));
@@ -231,24 +198,24 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         combo(ui, "Layout", &mut choices.layout, &LightLayout::ALL, |l| l.name());
         ui.add(Slider::new(&mut choices.radius, 0.1..=100.0).logarithmic(true).text("light radius"));
         ui.horizontal(|ui| {
-            let mut auto = choices.exposure == Exposure::Auto;
+            let mut auto = choices.settings.exposure == Exposure::Auto;
             ui.checkbox(&mut auto, "auto");
             // Under auto the slider shows the EV the meter settled on; unticked, it starts there.
-            let mut ev = match choices.exposure {
+            let mut ev = match choices.settings.exposure {
                 Exposure::Ev(ev) => ev,
                 Exposure::Auto => state.exposure_ev,
             };
             ui.add_enabled(!auto, Slider::new(&mut ev, -8.0..=8.0).text("exposure (EV)"));
-            choices.exposure = if auto { Exposure::Auto } else { Exposure::Ev(ev) };
+            choices.settings.exposure = if auto { Exposure::Auto } else { Exposure::Ev(ev) };
         });
         ui.horizontal(|ui| {
             ui.label("clusters");
-            ui.add(DragValue::new(&mut choices.clusters.x).range(1..=128));
-            ui.add(DragValue::new(&mut choices.clusters.y).range(1..=128));
-            ui.add(DragValue::new(&mut choices.clusters.z).range(1..=64));
+            ui.add(DragValue::new(&mut choices.settings.clusters.x).range(1..=128));
+            ui.add(DragValue::new(&mut choices.settings.clusters.y).range(1..=128));
+            ui.add(DragValue::new(&mut choices.settings.clusters.z).range(1..=64));
         });
-        combo(ui, "Debug view", &mut choices.debug_view, &DebugView::ALL, |v| v.name());
-        let mut mode = choices.omni.map(|o| o.mode);
+        combo(ui, "Debug view", &mut choices.settings.debug_view, &DebugView::ALL, |v| v.name());
+        let mut mode = choices.settings.omni.map(|o| o.mode);
         ComboBox::from_label("Point-light shadows").selected_text(mode.map_or("off", |m| m.name())).show_ui(ui, |ui| {
             ui.selectable_value(&mut mode, None, "off");
             for m in OmniShadowMode::ALL {
@@ -258,13 +225,13 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         let fresh = |mode| OmniShadowSettings { mode, lights: 1, all: false, size: OmniShadowSettings::DEFAULT_SIZE };
         // A mode keeps its own settings (the atlas its budget) when picked again.
         let same = |a: OmniShadowMode, b: OmniShadowMode| a.name() == b.name();
-        choices.omni = mode.map(|m| match choices.omni {
+        choices.settings.omni = mode.map(|m| match choices.settings.omni {
             Some(o) if same(o.mode, m) => o,
             Some(o) => OmniShadowSettings { mode: m, ..o },
             None => fresh(m),
         });
         let scene_lights = u32::try_from(choices.lights).unwrap_or(u32::MAX).max(1);
-        if let Some(o) = &mut choices.omni {
+        if let Some(o) = &mut choices.settings.omni {
             // The atlas takes thousands of lights; the cube array's memory grows by 6 faces a light.
             let max = if o.atlas().is_some() { MAX_SHADOWED_LIGHTS } else { 64 };
             ui.horizontal(|ui| {
@@ -327,31 +294,22 @@ mod tests {
 
     fn initial() -> Choices {
         Choices {
-            technique: Technique::Forward,
-            shading: ShadingModel::Seed,
+            settings: RenderSettings::new(Technique::Forward, 64, 64),
             object: MeshKind::Sphere,
             material: Material::built_in()[0],
             lights: 7,
             layout: LightLayout::Grid,
             radius: 3.0,
-            clusters: ClusterDims::DEFAULT,
-            debug_view: DebugView::None,
-            omni: None,
-            sun_shadow: SunShadowMode::Graphics,
-            raster: Raster::Hardware,
-            exposure: Exposure::Ev(0.0),
-            transparency: None,
             light_grid_marks: LightGridMarks::Auto,
-            antialiasing: Antialiasing::Off,
-            specular_aa: true,
         }
     }
 
     #[test]
     fn only_the_visibility_technique_takes_the_compute_raster() {
-        let compute = Choices { raster: Raster::compute(16), ..initial() };
+        let start = initial();
+        let compute = Choices { settings: RenderSettings { raster: Raster::compute(16), ..start.settings }, ..start };
         assert_eq!(compute.settings((64, 64), None).raster, Raster::Hardware);
-        let visibility = Choices { technique: Technique::Visibility, ..compute };
+        let visibility = Choices { settings: RenderSettings { technique: Technique::Visibility, ..compute.settings }, ..compute };
         assert_eq!(visibility.settings((64, 64), None).raster, Raster::compute(16));
     }
 
@@ -360,7 +318,7 @@ mod tests {
         let base =
             SceneRequest { radius: Some(RadiusRange { min: 1.0, max: 3.0 }), ..SceneRequest::new(SceneSource::File("a.toml".into())) };
         let start = initial();
-        let pbr = Choices { shading: ShadingModel::Pbr, ..start.clone() };
+        let pbr = Choices { settings: RenderSettings { shading: ShadingModel::Pbr, ..start.settings }, ..start.clone() };
         assert_eq!(pbr.request(&base, &start), SceneRequest { shading: Some(ShadingModel::Pbr), ..base.clone() });
         let more = Choices { lights: 9, layout: LightLayout::Random, ..start.clone() }.request(&base, &start);
         assert_eq!((more.lights, more.layout, more.radius), (Some(9), LightLayout::Random, base.radius));
