@@ -659,7 +659,8 @@ impl Progress {
 /// sequence, writes its PNG.
 struct RenderSink {
     progress: Progress,
-    sequence: Option<output::SequencePattern>,
+    /// An image sequence's pattern and the writer its frames go to.
+    sequence: Option<(output::SequencePattern, output::FrameWriter)>,
     /// The size rendered, and the supersampling factor it is filtered down by.
     size: (u32, u32),
     supersample: u32,
@@ -682,10 +683,10 @@ impl ml_render::FrameSink for RenderSink {
         self.sequence.is_some()
     }
 
-    fn image(&mut self, i: u32, rgba: &[u8]) -> Result<(), ml_render::RenderError> {
-        let Some(pattern) = &self.sequence else { return Ok(()) };
-        let (image, size) = self.written(rgba);
-        ml_cpu::files::write_png(&output::sequence_path(pattern, i), &image, size)
+    fn image(&mut self, i: u32, rgba: Vec<u8>) -> Result<(), ml_render::RenderError> {
+        let Some((pattern, writer)) = &mut self.sequence else { return Ok(()) };
+        writer
+            .write(output::sequence_path(pattern, i), rgba, self.size, self.supersample)
             .map_err(|e| ml_render::RenderError::Invalid(e.to_string()))
     }
 }
@@ -736,7 +737,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let camera = camera_line(&built.scene);
     let mut sink = RenderSink {
         progress: Progress::new(u64::from(settings.frames) + u64::from(cmd.warmup), "frames"),
-        sequence,
+        sequence: sequence.map(|pattern| (pattern, output::FrameWriter::new())),
         size: (settings.width, settings.height),
         supersample: cmd.supersample,
     };
@@ -748,10 +749,14 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let device = tables::device_line(&ctx.info);
     drop(ctx);
     let output = result?;
-    if sink.sequence.is_none() {
-        let (image, size) = sink.written(&output.rgba);
-        ml_cpu::files::write_png(&cmd.out, &image, size)?;
-    }
+    let writing = match &mut sink.sequence {
+        Some((_, writer)) => Some(writer.finish()?),
+        None => {
+            let (image, size) = sink.written(&output.rgba);
+            ml_cpu::files::write_png(&cmd.out, &image, size)?;
+            None
+        }
+    };
     let facts = tables::RenderFacts {
         device: &device,
         settings: &settings,
@@ -763,6 +768,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         output: &cmd.out,
         supersample: cmd.supersample,
         camera: &camera,
+        sequence: writing.as_ref(),
     };
     print!("{}", tables::table(&tables::render_rows(&facts, &output.stats)));
     if let Some(warning) = output.stats.feature::<ml_render::TransparencyStats>().and_then(|t| t.overflow_warning()) {

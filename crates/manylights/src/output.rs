@@ -4,6 +4,8 @@
 use anyhow::{bail, Context as _, Result};
 use ml_cpu::files;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::{Duration, Instant};
 
 /// An image sequence's pattern: the name before and after its run of #, and the run's length.
 pub type SequencePattern = (String, String, usize);
@@ -46,6 +48,108 @@ pub fn prepare(out: &Path, sequence: Option<&SequencePattern>, frames: u32) -> R
     Ok(())
 }
 
+/// An image sequence's frames encoded and written on rayon's threads while the GPU renders the
+/// next ones: the renderer hands a frame over and goes on, waiting only while `limit` frames
+/// are already being written (their images' memory is bounded by it). Each file is replaced
+/// only once complete (files::write_png); the first failure is returned by the next `write` or
+/// by `finish`, and no frame is handed over after it.
+pub struct FrameWriter {
+    state: Arc<(Mutex<Writing>, Condvar)>,
+    limit: usize,
+    started: Instant,
+    /// Time the renderer spent waiting for a free place.
+    waited: Duration,
+}
+
+#[derive(Default)]
+struct Writing {
+    pending: usize,
+    written: u32,
+    /// Encoding and writing, summed over the threads.
+    busy: Duration,
+    failure: Option<String>,
+}
+
+/// What a sequence's writing took (`FrameWriter::finish`).
+#[derive(Clone, Copy, Debug)]
+pub struct WritingStats {
+    pub frames: u32,
+    pub threads: usize,
+    /// Encoding and writing a frame, mean over the frames (on one thread).
+    pub ms_per_frame: f64,
+    /// From the first frame handed over to the last written.
+    pub wall_ms: f64,
+    /// What the renderer waited for a free place in all.
+    pub waited_ms: f64,
+}
+
+impl FrameWriter {
+    pub fn new() -> FrameWriter {
+        let threads = rayon::current_num_threads();
+        FrameWriter { state: Arc::default(), limit: 2 * threads, started: Instant::now(), waited: Duration::ZERO }
+    }
+
+    /// Encode and write `rgba` (`size`, filtered down by `supersample` each axis first) to
+    /// `path` on another thread; waits while `limit` frames are being written. The first
+    /// failure of an earlier frame, if any.
+    pub fn write(&mut self, path: PathBuf, rgba: Vec<u8>, size: (u32, u32), supersample: u32) -> Result<()> {
+        let (lock, freed) = &*self.state;
+        let wait = Instant::now();
+        let mut w = freed.wait_while(lock.lock().expect("a writer thread panicked"), |w| w.pending >= self.limit).expect("not poisoned");
+        self.waited += wait.elapsed();
+        if let Some(failure) = &w.failure {
+            bail!("{failure}");
+        }
+        if w.written == 0 && w.pending == 0 {
+            self.started = Instant::now();
+        }
+        w.pending += 1;
+        drop(w);
+        let state = Arc::clone(&self.state);
+        rayon::spawn(move || {
+            let begun = Instant::now();
+            let k = supersample;
+            let image = if k == 1 { rgba } else { ml_cpu::supersample::downsample(&rgba, size, k) };
+            let result = files::write_png(&path, &image, (size.0 / k, size.1 / k));
+            let (lock, freed) = &*state;
+            let mut w = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            w.busy += begun.elapsed();
+            w.pending -= 1;
+            w.written += 1;
+            if let Err(e) = result {
+                w.failure.get_or_insert(e.to_string());
+            }
+            freed.notify_all();
+        });
+        Ok(())
+    }
+
+    /// Wait until every frame handed over is written; the first failure, else what it took.
+    pub fn finish(&mut self) -> Result<WritingStats> {
+        let (lock, freed) = &*self.state;
+        let w = freed.wait_while(lock.lock().expect("a writer thread panicked"), |w| w.pending > 0).expect("not poisoned");
+        if let Some(failure) = &w.failure {
+            bail!("{failure}");
+        }
+        Ok(WritingStats {
+            frames: w.written,
+            threads: rayon::current_num_threads(),
+            ms_per_frame: w.busy.as_secs_f64() * 1e3 / f64::from(w.written.max(1)),
+            wall_ms: self.started.elapsed().as_secs_f64() * 1e3,
+            waited_ms: self.waited.as_secs_f64() * 1e3,
+        })
+    }
+}
+
+impl Drop for FrameWriter {
+    /// Frames still being written finish (a failed render returns after its last frame is on
+    /// disk or refused, never while a thread writes).
+    fn drop(&mut self) {
+        let (lock, freed) = &*self.state;
+        drop(freed.wait_while(lock.lock().unwrap_or_else(|p| p.into_inner()), |w| w.pending > 0));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -61,5 +165,32 @@ mod tests {
         for bad in ["a#b#.png", "frames#/#.png", "##x##.png", "##.jpg", "out"] {
             assert!(sequence_pattern(Path::new(bad)).is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn a_sequence_writer_writes_every_frame_and_stops_at_the_first_failure() {
+        let folder = std::env::temp_dir().join(format!("manylights-writer-{}", std::process::id()));
+        std::fs::create_dir_all(&folder).unwrap();
+        // Frame i: a 4x2 image (each 2x2 block one value) filtered down to 2x1 by 2x2 blocks.
+        let frame = |i: u8| (0..8u32).flat_map(|p| [i, (p % 4 / 2) as u8 * 100, 0, 255]).collect::<Vec<u8>>();
+        let mut writer = FrameWriter::new();
+        for i in 0..20u8 {
+            writer.write(folder.join(format!("{i:02}.png")), frame(i), (4, 2), 2).unwrap();
+        }
+        let stats = writer.finish().unwrap();
+        assert_eq!(stats.frames, 20);
+        for i in 0..20u8 {
+            let image = image::open(folder.join(format!("{i:02}.png"))).unwrap().to_rgba8();
+            assert_eq!((image.width(), image.height()), (2, 1), "frame {i}");
+            assert_eq!(image.as_raw(), &[i, 0, 0, 255, i, 100, 0, 255], "frame {i}");
+        }
+        // A frame that cannot be written: its error comes back, from `finish` or the next frame
+        // handed over, and nothing is handed over after it.
+        let mut writer = FrameWriter::new();
+        writer.write(folder.join("missing/00.png"), frame(0), (4, 2), 2).unwrap();
+        let failure = writer.finish().unwrap_err().to_string();
+        assert!(failure.contains("missing/00.png"), "{failure}");
+        assert!(writer.write(folder.join("01.png"), frame(1), (4, 2), 2).is_err());
+        std::fs::remove_dir_all(&folder).unwrap();
     }
 }

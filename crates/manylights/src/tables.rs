@@ -41,6 +41,8 @@ pub struct RenderFacts<'a> {
     pub supersample: u32,
     /// The camera it was seen from, as `--camera` reads it.
     pub camera: &'a str,
+    /// An image sequence's writing (None: one image).
+    pub sequence: Option<&'a crate::output::WritingStats>,
 }
 
 /// Who drew the visibility buffer, in words.
@@ -183,6 +185,16 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     }
     rows.push(("cpu ms/frame", format!("{:.3}  (assign + upload + record + submit)", stats.cpu_ms())));
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
+    if let Some(w) = facts.sequence {
+        let per_second = f64::from(w.frames) / (w.wall_ms / 1e3).max(1e-9);
+        rows.push((
+            "sequence",
+            format!(
+                "{} frames written, {per_second:.1} a second; encoding and writing {:.1} ms a frame on {} threads, the renderer waited {:.0} ms for them in all",
+                w.frames, w.ms_per_frame, w.threads, w.waited_ms
+            ),
+        ));
+    }
     rows.push(("output", facts.output.display().to_string()));
     rows
 }
@@ -256,6 +268,7 @@ mod tests {
             output: Path::new("a.png"),
             supersample: 1,
             camera: "0,1,2:0,0,0:60",
+            sequence: None,
         };
         let mut stats = FrameStats::new(&["g-buffer + lighting"]);
         stats.frames = 1;

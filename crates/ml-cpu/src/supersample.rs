@@ -14,6 +14,10 @@ const GAMMA: f32 = 2.2;
 pub fn downsample(rgba: &[u8], (width, height): (u32, u32), k: u32) -> Vec<u8> {
     assert!(k >= 1 && width % k == 0 && height % k == 0, "{width}x{height} is not a multiple of {k}");
     assert_eq!(rgba.len(), width as usize * height as usize * 4, "RGBA8 of {width}x{height}");
+    if k == 1 {
+        // Decoding and encoding one sample gives every 8-bit value back (the test below).
+        return rgba.to_vec();
+    }
     let decode: Vec<f32> = (0..=255u8).map(|v| (f32::from(v) / 255.0).powf(GAMMA)).collect();
     let (w, h, k) = (width as usize / k as usize, height as usize / k as usize, k as usize);
     let samples = (k * k) as f32;
@@ -64,6 +68,16 @@ mod tests {
         let rgba: Vec<u8> = [17u8, 128, 255, 255].repeat(6 * 4);
         assert_eq!(downsample(&rgba, (6, 4), 2), [17u8, 128, 255, 255].repeat(3 * 2));
         assert_eq!(downsample(&rgba, (6, 4), 1), rgba);
+    }
+
+    #[test]
+    fn one_sample_decoded_and_encoded_is_the_value_it_was() {
+        // What the filter makes of a block of one sample, which downsample(_, _, 1) skips.
+        for v in 0..=255u8 {
+            let linear = (f32::from(v) / 255.0).powf(GAMMA);
+            assert_eq!((linear.powf(1.0 / GAMMA) * 255.0).round().clamp(0.0, 255.0) as u8, v);
+            assert_eq!((f32::from(v) / 255.0 * 255.0).round() as u8, v);
+        }
     }
 
     #[test]

@@ -42,8 +42,9 @@ pub trait FrameSink {
     fn wants_images(&self) -> bool {
         false
     }
-    /// Frame `i`'s image, RGBA8, rows from the top.
-    fn image(&mut self, _i: u32, _rgba: &[u8]) -> Result<(), RenderError> {
+    /// Frame `i`'s image, RGBA8, rows from the top (the sink's to keep: a sequence's writer
+    /// encodes it on another thread while the next frame renders).
+    fn image(&mut self, _i: u32, _rgba: Vec<u8>) -> Result<(), RenderError> {
         Ok(())
     }
 }
@@ -411,7 +412,7 @@ impl<'a> Renderer<'a> {
                     last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
                 }
                 let rgba = self.read_back(last)?;
-                sink.image(i, &rgba)?;
+                sink.image(i, rgba)?;
             }
             sink.submitted(i);
         }

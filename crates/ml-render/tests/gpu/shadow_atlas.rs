@@ -152,8 +152,8 @@ impl FrameSink for Frames {
     fn wants_images(&self) -> bool {
         true
     }
-    fn image(&mut self, _i: u32, rgba: &[u8]) -> Result<(), RenderError> {
-        self.0.push(rgba.to_vec());
+    fn image(&mut self, _i: u32, rgba: Vec<u8>) -> Result<(), RenderError> {
+        self.0.push(rgba);
         Ok(())
     }
 }
