@@ -9,6 +9,7 @@ pub mod camera;
 pub mod cluster;
 pub mod error;
 pub mod files;
+pub mod forest;
 pub mod framing;
 mod geometry;
 pub mod gltf_scene;

@@ -17,7 +17,8 @@
 //!   leaves opaque;
 //! - the transparency-layers debug view counts each pixel's layers;
 //! - the build over tiles and the build a thread per triangle leave the same fragments: an
-//!   object moved from one to the other changes no byte.
+//!   object moved from one to the other changes no byte — test foliage, panes, and the forest
+//!   the benchmarks render (`ml_cpu::forest`, BLEND leaves), small.
 
 use crate::common;
 
@@ -476,5 +477,43 @@ fn the_tiles_build_and_the_per_triangle_build_agree() {
         let beyond = common::pixels_beyond(&coarse[0], &fine[0], 2);
         assert!(beyond <= (W * H / 100) as usize, "{}: {beyond} pixels differ by more than 2/255", technique.name());
         println!("{}: {beyond} pixels beyond 2/255; fragments {} and {}", technique.name(), a.fragments, b.fragments);
+    }
+}
+
+/// The BLEND forest the benchmarks render (`ml_cpu::forest`), small: 4 trees of 512 leaf cards
+/// (4,096 leaf triangles, each tree one object), framed by the loader's camera, 64 lights.
+/// Built over tiles or a thread per triangle, every byte and fragment the same, in the
+/// visibility technique and the forward pass.
+#[test]
+fn the_forest_is_the_same_from_either_build() {
+    let (mut forest, _) = ml_cpu::gltf_scene::from_bytes(&ml_cpu::forest::forest_glb(4, 512, "BLEND"), None).expect("a good file");
+    // 4×4×4 lights through the forest's box, each reaching a quarter of its diagonal.
+    let (lo, hi) = forest.bounds();
+    let radius = (hi - lo).length() / 4.0;
+    forest.lights = (0..64u32)
+        .map(|i| {
+            let at = lo + (hi - lo) * (Vec3::new((i % 4) as f32, (i / 4 % 4) as f32, (i / 16) as f32) + 0.5) / 4.0;
+            light(at.to_array(), radius, [0.6 + 0.1 * (i % 3) as f32, 0.7, 0.5 + 0.1 * (i % 5) as f32])
+        })
+        .collect();
+    forest.cones.clear();
+    forest.light_motion = 0.0;
+    let with = |technique, tiled_up_to| RenderSettings {
+        shading: ShadingModel::Pbr,
+        transparency: Some(TransparencySettings { tiled_up_to, ..TransparencySettings::default() }),
+        ..settings(technique)
+    };
+    for technique in [Technique::Visibility, Technique::Forward] {
+        let out = common::render_each(&forest, &[with(technique, 0), with(technique, u32::MAX)]);
+        let (threads, tiles) = (stats(&out[0]), stats(&out[1]));
+        println!(
+            "{} forest: {} fragments, {} pixels differ",
+            technique.name(),
+            threads.fragments,
+            common::pixels_beyond(&out[0], &out[1], 0)
+        );
+        assert!(threads.fragments > u64::from(W * H) / 4, "{}: {threads:?}", technique.name());
+        assert_eq!(threads.fragments, tiles.fragments, "{}", technique.name());
+        assert!(out[0].rgba == out[1].rgba, "{}: the builds' images differ", technique.name());
     }
 }
