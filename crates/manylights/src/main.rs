@@ -71,6 +71,17 @@ struct RenderArgs {
     /// made if it does not exist.
     #[arg(long)]
     out: PathBuf,
+    /// Of an image sequence, shard I of N (I from 0): the frames from ⌊F·I/N⌋ up to
+    /// ⌊F·(I+1)/N⌋ of the F --frames, each the image the whole sequence gives it; or env: a
+    /// Slurm array task's (SLURM_ARRAY_TASK_ID less SLURM_ARRAY_TASK_MIN, of
+    /// SLURM_ARRAY_TASK_COUNT).
+    #[arg(long)]
+    shard: Option<String>,
+    /// Of an image sequence, write only the frames whose files do not exist yet (a file
+    /// that exists is whole: outputs are replaced only once complete): a rerun of a sequence or
+    /// a shard that was stopped.
+    #[arg(long)]
+    resume: bool,
     /// Count, after the lighting, the lights the light loop tests per pixel and those that
     /// reach the pixel's surface (a table row; an untimed extra pass each frame), and with
     /// shadow rays the rays the lighting traces (the shadow-ray row; the lighting then counts
@@ -661,6 +672,8 @@ struct RenderSink {
     progress: Progress,
     /// An image sequence's pattern and the writer its frames go to.
     sequence: Option<(output::SequencePattern, output::FrameWriter)>,
+    /// The frames it writes, ascending (every frame of a single image's run).
+    to_write: Vec<u32>,
     /// The size rendered, and the supersampling factor it is filtered down by.
     size: (u32, u32),
     supersample: u32,
@@ -681,6 +694,10 @@ impl ml_render::FrameSink for RenderSink {
 
     fn wants_images(&self) -> bool {
         self.sequence.is_some()
+    }
+
+    fn wants_image(&self, i: u32) -> bool {
+        self.sequence.is_some() && self.to_write.binary_search(&i).is_ok()
     }
 
     fn image(&mut self, i: u32, rgba: Vec<u8>) -> Result<(), ml_render::RenderError> {
@@ -710,9 +727,15 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let mut techniques = Techniques::chosen(choice);
     check_options_apply(args, &request.source, None, &techniques)?;
     let sequence = output::sequence_pattern(&cmd.out)?;
+    let shard = output::shard_choice(cmd.shard.as_deref(), cmd.resume, sequence.is_some(), |name| std::env::var(name).ok())?;
+    let to_write = output::frames_to_write(cmd.frames, shard, cmd.resume.then_some(sequence.as_ref()).flatten());
+    if sequence.is_some() && to_write.is_empty() {
+        println!("nothing to render: every frame this run would write exists already");
+        return Ok(());
+    }
     let built = request.build()?;
     check_options_apply(args, &request.source, Some(&built), &techniques)?;
-    output::prepare(&cmd.out, sequence.as_ref(), cmd.frames)?;
+    output::prepare(&cmd.out, sequence.as_ref(), &to_write)?;
     let mut settings = wanted.for_scene(&built.scene, built.shading);
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
     let messages = ctx.validation_counter();
@@ -738,12 +761,17 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let mut sink = RenderSink {
         progress: Progress::new(u64::from(settings.frames) + u64::from(cmd.warmup), "frames"),
         sequence: sequence.map(|pattern| (pattern, output::FrameWriter::new())),
+        to_write: to_write.clone(),
         size: (settings.width, settings.height),
         supersample: cmd.supersample,
     };
+    // A sequence renders from its first frame to write, each frame at its own clock — from
+    // frame 0 under auto exposure, which carries from frame to frame.
+    let first = if settings.meters_exposure() { 0 } else { to_write[0] };
+    let frames = first..to_write[to_write.len() - 1] + 1;
     let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| {
         r.warm_up(cmd.warmup, &mut sink)?;
-        r.render_into(&mut sink)
+        r.render_frames(frames, &mut sink)
     });
     sink.progress.finish();
     let device = tables::device_line(&ctx.info);

@@ -32,20 +32,61 @@ pub fn sequence_path((before, after, digits): &SequencePattern, i: u32) -> PathB
     PathBuf::from(format!("{before}{i:0digits$}{after}"))
 }
 
-/// Fail before rendering if the image (or any of a sequence's `frames` frames) could not be
+/// Fail before rendering if the image (or any of a sequence's frames `to_write`) could not be
 /// written: nothing is computed for nothing, and a sequence never stops after replacing some
 /// of an earlier run's frames. A sequence's folder is made for it (a single image's must
 /// exist).
-pub fn prepare(out: &Path, sequence: Option<&SequencePattern>, frames: u32) -> Result<()> {
+pub fn prepare(out: &Path, sequence: Option<&SequencePattern>, to_write: &[u32]) -> Result<()> {
     let Some(pattern) = sequence else { return Ok(files::check_writable(out)?) };
     let first = sequence_path(pattern, 0);
     if let Some(folder) = first.parent().filter(|p| !p.as_os_str().is_empty() && !p.is_dir()) {
         std::fs::create_dir_all(folder).with_context(|| format!("cannot make folder '{}'", folder.display()))?;
     }
-    for i in 0..frames.max(1) {
+    for &i in to_write {
         files::check_writable(&sequence_path(pattern, i))?;
     }
     Ok(())
+}
+
+/// `--shard` (I/N, or env: a Slurm array task's, its variables read through `env`) as
+/// (I, N), checked: only for an image sequence, as `--resume` is.
+pub fn shard_choice(shard: Option<&str>, resume: bool, sequence: bool, env: impl Fn(&str) -> Option<String>) -> Result<Option<(u32, u32)>> {
+    if !sequence && (shard.is_some() || resume) {
+        bail!("--shard and --resume are for an image sequence: give --out a run of # (e.g. frames/####.png)");
+    }
+    let Some(text) = shard else { return Ok(None) };
+    let (index, count) = if text == "env" {
+        let var = |name: &str| {
+            env(name).map(|v| v.trim().parse::<u64>().map_err(|_| anyhow::anyhow!("--shard env: {name}='{v}' is not a whole number")))
+        };
+        let (Some(id), Some(count)) = (var("SLURM_ARRAY_TASK_ID"), var("SLURM_ARRAY_TASK_COUNT")) else {
+            bail!("--shard env: SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT are not set (not a Slurm array task): give --shard I/N");
+        };
+        let (id, count, min) = (id?, count?, var("SLURM_ARRAY_TASK_MIN").transpose()?.unwrap_or(0));
+        match id.checked_sub(min) {
+            Some(index) => (index, count),
+            None => bail!("--shard env: SLURM_ARRAY_TASK_ID {id} is below SLURM_ARRAY_TASK_MIN {min}"),
+        }
+    } else {
+        let parse = |v: &str| v.trim().parse::<u64>().ok();
+        match text.split_once('/').and_then(|(i, n)| Some((parse(i)?, parse(n)?))) {
+            Some(pair) => pair,
+            None => bail!("--shard '{text}': give I/N (shard I of N, I from 0) or env"),
+        }
+    };
+    if count == 0 || count > 100_000 || index >= count {
+        bail!("--shard {index}/{count}: the shard is one of 1 to 100000, numbered from 0");
+    }
+    Ok(Some((index as u32, count as u32)))
+}
+
+/// The frames a run writes, ascending: of `frames`, shard (I, N)'s ⌊F·I/N⌋ up to
+/// ⌊F·(I+1)/N⌋ (every frame without one), less, where `existing` gives the sequence, those
+/// whose files exist (`--resume`).
+pub fn frames_to_write(frames: u32, shard: Option<(u32, u32)>, existing: Option<&SequencePattern>) -> Vec<u32> {
+    let (index, count) = shard.unwrap_or((0, 1));
+    let bound = |k: u32| (u64::from(frames) * u64::from(k) / u64::from(count)) as u32;
+    (bound(index)..bound(index + 1)).filter(|&i| existing.is_none_or(|p| !sequence_path(p, i).exists())).collect()
 }
 
 /// An image sequence's frames encoded and written on rayon's threads while the GPU renders the
@@ -192,5 +233,39 @@ mod tests {
         assert!(failure.contains("missing/00.png"), "{failure}");
         assert!(writer.write(folder.join("01.png"), frame(1), (4, 2), 2).is_err());
         std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    #[test]
+    fn shards_split_a_sequence_into_blocks_that_cover_it_once() {
+        for frames in 0..20u32 {
+            for count in 1..8u32 {
+                let all: Vec<u32> = (0..count).flat_map(|i| frames_to_write(frames, Some((i, count)), None)).collect();
+                assert_eq!(all, (0..frames).collect::<Vec<_>>(), "{frames} frames in {count} shards");
+            }
+        }
+        assert_eq!(frames_to_write(10, Some((1, 3)), None), vec![3, 4, 5]);
+    }
+
+    #[test]
+    fn shards_are_given_as_index_and_count_or_by_slurm() {
+        let none = |_: &str| None;
+        assert_eq!(shard_choice(Some("1/4"), false, true, none).unwrap(), Some((1, 4)));
+        assert_eq!(shard_choice(None, true, true, none).unwrap(), None);
+        for bad in ["4/4", "0/0", "1", "a/b", "-1/4", "env"] {
+            assert!(shard_choice(Some(bad), false, true, none).is_err(), "{bad}");
+        }
+        assert!(shard_choice(Some("0/2"), false, false, none).is_err(), "a single image");
+        assert!(shard_choice(None, true, false, none).is_err(), "--resume of a single image");
+        let slurm = |id: &'static str| {
+            move |name: &str| match name {
+                "SLURM_ARRAY_TASK_ID" => Some(id.to_owned()),
+                "SLURM_ARRAY_TASK_MIN" => Some("4".to_owned()),
+                "SLURM_ARRAY_TASK_COUNT" => Some("3".to_owned()),
+                _ => None,
+            }
+        };
+        assert_eq!(shard_choice(Some("env"), false, true, slurm("5")).unwrap(), Some((1, 3)));
+        assert!(shard_choice(Some("env"), false, true, slurm("3")).is_err(), "below the array's first task");
+        assert!(shard_choice(Some("env"), false, true, slurm("7")).is_err(), "past the array's last task");
     }
 }

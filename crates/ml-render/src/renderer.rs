@@ -38,9 +38,14 @@ pub struct RenderOutput {
 pub trait FrameSink {
     /// Frame `i` (from 0) was submitted.
     fn submitted(&mut self, _i: u32) {}
-    /// Whether every frame's image is read back and handed to `image`.
+    /// Whether frames' images are read back and handed to `image` (an image sequence).
     fn wants_images(&self) -> bool {
         false
+    }
+    /// Of an image sequence, whether frame `i`'s image is wanted (a shard of it, or the frames
+    /// not yet written): the others are rendered without being waited for or read back.
+    fn wants_image(&self, _i: u32) -> bool {
+        self.wants_images()
     }
     /// Frame `i`'s image, RGBA8, rows from the top (the sink's to keep: a sequence's writer
     /// encodes it on another thread while the next frame renders).
@@ -386,11 +391,24 @@ impl<'a> Renderer<'a> {
     /// every frame's image (each then waited for): an image sequence whose last image is
     /// `render`'s.
     pub fn render_into(&mut self, sink: &mut dyn FrameSink) -> Result<RenderOutput, RenderError> {
+        self.render_frames(0..self.settings.frames, sink)
+    }
+
+    /// `render_into` for frames `range` of the settings' frames alone (a shard of an image
+    /// sequence, or what a rerun has left to write): each frame at its own clock, so a frame's
+    /// image is the one the whole sequence gives it — where nothing carries from frame to
+    /// frame. Auto exposure does (a frame is exposed from the one two back): with it, start the
+    /// range at 0, and only the frames the sink wants are waited for and read back.
+    pub fn render_frames(&mut self, range: std::ops::Range<u32>, sink: &mut dyn FrameSink) -> Result<RenderOutput, RenderError> {
         let mut stats = FrameStats::new(&self.pass_names());
         let start = Instant::now();
         let mut last = 0;
         let frames = self.settings.frames;
-        for i in 0..frames {
+        let range = range.start.min(frames)..range.end.min(frames);
+        if range.is_empty() {
+            return Err(RenderError::Invalid(format!("no frames to render in {range:?}")));
+        }
+        for i in range.clone() {
             last = i as usize % FRAMES_IN_FLIGHT;
             // Exposed from the image of the slot's previous frame (two back), whether or not
             // the frame before was waited for (an image sequence waits for each): the same
@@ -405,7 +423,7 @@ impl<'a> Renderer<'a> {
                 self.collect_all(&mut stats)?;
                 last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
             }
-            if sink.wants_images() {
+            if sink.wants_images() && sink.wants_image(i) {
                 self.collect_all(&mut stats)?;
                 // The last image is the one `render` returns: with its exposure settled.
                 if i + 1 == frames {
@@ -419,14 +437,14 @@ impl<'a> Renderer<'a> {
         self.collect_all(&mut stats)?;
         if !sink.wants_images() {
             // (An image sequence settled its last frame before handing it over.)
-            last = self.settle_exposure(last, self.settings.clock(frames - 1), &mut stats)?;
+            last = self.settle_exposure(last, self.settings.clock(range.end - 1), &mut stats)?;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         if Output::of(self.settings.technique) == Output::Subpasses {
             let targets = self.frames[0].targets.as_ref().expect("made with the frame");
             stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
         }
-        stats.frames = self.settings.frames;
+        stats.frames = range.len() as u32;
         stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
         if let Some(mut rays) = self.gpu.rays.stats {
             // Counted with the light statistics (compute lightings only).

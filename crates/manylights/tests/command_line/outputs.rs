@@ -3,13 +3,14 @@
 //! beside them. The full disk is a file-size limit (RLIMIT_FSIZE, with SIGXFSZ ignored so that
 //! a write past it fails with an error instead of killing the process): what a test may set
 //! without privileges, and a write fails the same way as on a full file system. Beside them:
-//! outputs that are not regular files, interrupted sequences, bad later frames, and an output
-//! this user may not write.
+//! outputs that are not regular files, interrupted sequences (and their rerun with `--resume`),
+//! shards of a sequence, bad later frames, and an output this user may not write.
 
 use crate::common;
 
 use common::assert_one_line_error;
 use std::collections::BTreeMap;
+use std::os::unix::fs::MetadataExt;
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -158,6 +159,71 @@ fn an_interrupted_sequence_leaves_whole_frames_and_no_partial_file() {
         let frame = image::open(d.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!((frame.width(), frame.height()), (1024, 1024), "{name}");
     }
+    // Rerun with --resume (a shard of the first frames, to keep it short): the frames written
+    // before the interruption stay as they are (the same file, not written again), the rest
+    // of the shard are written, and nothing is left beside them.
+    // (Frames are written by several threads: those left need not be the first ones.)
+    let written = |n: u32| std::fs::metadata(d.join(format!("{n:04}.png"))).ok().map(|m| (m.ino(), m.modified().unwrap()));
+    let last = left.iter().filter_map(|n| n.trim_end_matches(".png").parse::<u32>().ok()).max().unwrap();
+    // Shard 0 of 200 / (last + 3): the frames up to at least last + 2.
+    let count = 200 / (last + 3);
+    let end = 200 / count;
+    let before: Vec<_> = (0..end).map(written).collect();
+    ok(&manylights(&[&args[..], &["--shard", &format!("0/{count}"), "--resume", "--out", pattern.to_str().unwrap()]].concat(), None));
+    for (n, was) in before.iter().enumerate() {
+        let now = written(n as u32).unwrap_or_else(|| panic!("frame {n} missing after the rerun"));
+        if let Some(was) = was {
+            assert_eq!(*was, now, "frame {n} was written again");
+        }
+    }
+    assert!(before.iter().filter(|w| w.is_none()).count() >= 2, "{before:?}");
+    assert!(names().iter().all(|n| !n.ends_with(".partial")), "{:?}", names());
+}
+
+/// A sequence rendered in shards, and rerun with --resume where frames are missing, gives the
+/// frames the whole sequence gives, byte for byte — with the exposure fixed (each frame is its
+/// clock's) and automatic (metered from frame to frame: a shard renders the frames before its
+/// own without writing them); a rerun with nothing left to write renders nothing.
+#[test]
+fn shards_and_reruns_write_the_frames_the_whole_sequence_writes() {
+    let d = dir("shards");
+    let render = |exposure: &str, out: &Path, more: &[&str]| {
+        let args = ["render", "--technique", "forward", "--resolution", "96x54", "--frames", "6", "--exposure", exposure];
+        let out = manylights(&[&args[..], more, &["--out", out.join("#.png").to_str().unwrap()]].concat(), None);
+        ok(&out);
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let frames =
+        |folder: &Path| -> Vec<Vec<u8>> { (0..6).map(|i| std::fs::read(folder.join(format!("{i}.png"))).unwrap_or_default()).collect() };
+    for exposure in ["0", "auto"] {
+        let (whole, parts) = (d.join(format!("whole-{exposure}")), d.join(format!("parts-{exposure}")));
+        render(exposure, &whole, &[]);
+        let shards: &[u32] = if exposure == "auto" { &[2] } else { &[0, 1, 2] };
+        for i in shards {
+            let table = render(exposure, &parts, &["--shard", &format!("{i}/3")]);
+            assert!(table.contains("2 frames written"), "shard {i}/3: {table}");
+        }
+        let (a, b) = (frames(&whole), frames(&parts));
+        for i in 0..6 {
+            if exposure == "0" || i >= 4 {
+                assert!(!a[i].is_empty() && a[i] == b[i], "exposure {exposure}: frame {i} of the shards differs");
+            }
+        }
+    }
+    let parts = d.join("parts-0");
+    for i in [1, 4] {
+        std::fs::remove_file(parts.join(format!("{i}.png"))).unwrap();
+    }
+    let kept = std::fs::metadata(parts.join("2.png")).unwrap().modified().unwrap();
+    assert!(render("0", &parts, &["--resume"]).contains("2 frames written"));
+    assert_eq!(frames(&d.join("whole-0")), frames(&parts), "the rerun's frames differ");
+    assert_eq!(std::fs::metadata(parts.join("2.png")).unwrap().modified().unwrap(), kept, "a written frame was written again");
+    assert!(render("0", &parts, &["--resume"]).contains("nothing to render"));
+    assert_one_line_error(&manylights(&["render", "--shard", "0/2", "--out", d.join("one.png").to_str().unwrap()], None), &["--shard"]);
+    assert_one_line_error(
+        &manylights(&["render", "--frames", "4", "--shard", "2/2", "--out", d.join("#.png").to_str().unwrap()], None),
+        &["--shard 2/2"],
+    );
 }
 
 #[test]
