@@ -57,8 +57,8 @@ vec2 layer_xy(uvec4 a) {
 layout(std430, set = 0, binding = LAYER_BINDING) buffer TransparentHeadBuffer { uint layer_heads[]; };
 // Two uvec4 a node: (depth, next, object, pixel y << 16 | x), then the surface (octahedral
 // normal snorm 2×16, albedo factor and occlusion unorm 4×8, roughness and metallic factors
-// unorm 2×8 with alpha unorm 16 above them, emissive factor and normal spread unorm 4×8), which lighting
-// replaces by (lit colour rgb, alpha) as floats.
+// unorm 2×8 with alpha unorm 16 above them, emissive factor and normal spread unorm 4×8),
+// which lighting replaces by (lit colour rgb, alpha) as floats.
 layout(std430, set = 0, binding = LAYER_BINDING + 1) buffer TransparentNodeBuffer { uvec4 layer_nodes[]; };
 // x: nodes asked for this frame (beyond the pool's size: dropped); y: pixels that merged
 // layers; z, w: triangles the per-triangle build listed for a work group each, and for the

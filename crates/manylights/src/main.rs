@@ -758,17 +758,17 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
     let camera = camera_line(&built.scene);
-    let mut sink = RenderSink {
-        progress: Progress::new(u64::from(settings.frames) + u64::from(cmd.warmup), "frames"),
-        sequence: sequence.map(|pattern| (pattern, output::FrameWriter::new())),
-        to_write: to_write.clone(),
-        size: (settings.width, settings.height),
-        supersample: cmd.supersample,
-    };
     // A sequence renders from its first frame to write, each frame at its own clock — from
     // frame 0 under auto exposure, which carries from frame to frame.
     let first = if settings.meters_exposure() { 0 } else { to_write[0] };
     let frames = first..to_write[to_write.len() - 1] + 1;
+    let mut sink = RenderSink {
+        progress: Progress::new(u64::from(frames.end - frames.start) + u64::from(cmd.warmup), "frames"),
+        sequence: sequence.map(|pattern| (pattern, output::FrameWriter::new())),
+        to_write,
+        size: (settings.width, settings.height),
+        supersample: cmd.supersample,
+    };
     let result = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| {
         r.warm_up(cmd.warmup, &mut sink)?;
         r.render_frames(frames, &mut sink)

@@ -82,11 +82,13 @@ pub fn shard_choice(shard: Option<&str>, resume: bool, sequence: bool, env: impl
 
 /// The frames a run writes, ascending: of `frames`, shard (I, N)'s ⌊F·I/N⌋ up to
 /// ⌊F·(I+1)/N⌋ (every frame without one), less, where `existing` gives the sequence, those
-/// whose files exist (`--resume`).
+/// whose files exist (`--resume`) — regular files: anything else at a frame's path stays to
+/// be written, and `prepare` refuses it.
 pub fn frames_to_write(frames: u32, shard: Option<(u32, u32)>, existing: Option<&SequencePattern>) -> Vec<u32> {
     let (index, count) = shard.unwrap_or((0, 1));
     let bound = |k: u32| (u64::from(frames) * u64::from(k) / u64::from(count)) as u32;
-    (bound(index)..bound(index + 1)).filter(|&i| existing.is_none_or(|p| !sequence_path(p, i).exists())).collect()
+    let written = |p: &SequencePattern, i: u32| std::fs::symlink_metadata(sequence_path(p, i)).is_ok_and(|m| m.is_file());
+    (bound(index)..bound(index + 1)).filter(|&i| existing.is_none_or(|p| !written(p, i))).collect()
 }
 
 /// An image sequence's frames encoded and written on rayon's threads while the GPU renders the
