@@ -679,14 +679,6 @@ struct RenderSink {
     supersample: u32,
 }
 
-impl RenderSink {
-    /// A frame as it is written: filtered down where supersampled.
-    fn written(&self, rgba: &[u8]) -> (Vec<u8>, (u32, u32)) {
-        let k = self.supersample;
-        (ml_cpu::supersample::downsample(rgba, self.size, k), (self.size.0 / k, self.size.1 / k))
-    }
-}
-
 impl ml_render::FrameSink for RenderSink {
     fn submitted(&mut self, _i: u32) {
         self.progress.inc();
@@ -776,11 +768,11 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     sink.progress.finish();
     let device = tables::device_line(&ctx.info);
     drop(ctx);
-    let output = result?;
+    let mut output = result?;
     let writing = match &mut sink.sequence {
         Some((_, writer)) => Some(writer.finish()?),
         None => {
-            let (image, size) = sink.written(&output.rgba);
+            let (image, size) = output::filtered_down(std::mem::take(&mut output.rgba), sink.size, sink.supersample);
             ml_cpu::files::write_png(&cmd.out, &image, size)?;
             None
         }

@@ -91,6 +91,13 @@ pub fn frames_to_write(frames: u32, shard: Option<(u32, u32)>, existing: Option<
     (bound(index)..bound(index + 1)).filter(|&i| existing.is_none_or(|p| !written(p, i))).collect()
 }
 
+/// An image as it is written: `rgba` (`size`) filtered down by `k` each axis where
+/// supersampled (`--supersample`), and its size then; as it is where k is 1.
+pub fn filtered_down(rgba: Vec<u8>, size: (u32, u32), k: u32) -> (Vec<u8>, (u32, u32)) {
+    let image = if k == 1 { rgba } else { ml_cpu::supersample::downsample(&rgba, size, k) };
+    (image, (size.0 / k, size.1 / k))
+}
+
 /// An image sequence's frames encoded and written on rayon's threads while the GPU renders the
 /// next ones: the renderer hands a frame over and goes on, waiting only while `limit` frames
 /// are already being written (their images' memory is bounded by it). Each file is replaced
@@ -151,9 +158,8 @@ impl FrameWriter {
         let state = Arc::clone(&self.state);
         rayon::spawn(move || {
             let begun = Instant::now();
-            let k = supersample;
-            let image = if k == 1 { rgba } else { ml_cpu::supersample::downsample(&rgba, size, k) };
-            let result = files::write_png(&path, &image, (size.0 / k, size.1 / k));
+            let (image, size) = filtered_down(rgba, size, supersample);
+            let result = files::write_png(&path, &image, size);
             let (lock, freed) = &*state;
             let mut w = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
             w.busy += begun.elapsed();

@@ -30,7 +30,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{AlphaMode, Object, Scene};
 use ml_cpu::supersample::{downsample, rms_difference};
-use ml_render::{Antialiasing, AntialiasingStats, Raster, RenderSettings, ShadingModel, Technique, TransparencySettings};
+use ml_render::{Antialiasing, AntialiasingStats, Raster, RenderOutput, RenderSettings, ShadingModel, Technique, TransparencySettings};
 use rand::{Rng, SeedableRng};
 use serde_json::json;
 
@@ -48,12 +48,12 @@ fn visibility(width: u32, height: u32, aa: Antialiasing) -> RenderSettings {
 
 /// RMS errors (8-bit units) against the supersampled reference of `base`'s view: of `base`
 /// (anti-aliasing off), then of each of `variants`, named (technique and samples) in `what`'s
-/// line.
-fn errors(what: &str, scene: &Scene, base: RenderSettings, variants: &[RenderSettings]) -> (f64, Vec<f64>) {
+/// line; and the variants' renders.
+fn errors(what: &str, scene: &Scene, base: RenderSettings, variants: &[RenderSettings]) -> (f64, Vec<f64>, Vec<RenderOutput>) {
     let (w, h) = (base.width, base.height);
     let big = RenderSettings { width: w * REFERENCE, height: h * REFERENCE, ..base };
     let settings: Vec<RenderSettings> = [big, base].into_iter().chain(variants.iter().copied()).collect();
-    let outputs = common::render_each(scene, &settings);
+    let mut outputs = common::render_each(scene, &settings);
     let reference = downsample(&outputs[0].rgba, (w * REFERENCE, h * REFERENCE), REFERENCE);
     let e_off = rms_difference(&outputs[1].rgba, &reference);
     let errors: Vec<f64> = outputs[2..].iter().map(|o| rms_difference(&o.rgba, &reference)).collect();
@@ -62,7 +62,7 @@ fn errors(what: &str, scene: &Scene, base: RenderSettings, variants: &[RenderSet
         let raster = if v.technique == Technique::Visibility { format!(" ({} raster)", v.raster.name()) } else { String::new() };
         println!("{what} {w}x{h}: RMS error against the {REFERENCE}x{REFERENCE} reference {e_off:.3} without anti-aliasing, {e:.3} by {technique}{raster} with {samples} samples ({:.2} of it)", e / e_off);
     }
-    (e_off, errors)
+    (e_off, errors, outputs.split_off(2))
 }
 
 /// The mesh techniques at `aa` (lavapipe's rasterizer offers 4 samples a pixel, not 8).
@@ -141,7 +141,7 @@ fn samples_cut_the_error_against_the_supersampled_reference() {
         hybrid,
         hardware,
     ];
-    let (off, aa) = errors("bench scene", &bench, base, &variants);
+    let (off, aa, _) = errors("bench scene", &bench, base, &variants);
     assert!(aa[0] * 3.0 <= off, "bench scene: {:.3} with 8 samples against {off:.3} without", aa[0]);
     for (v, e) in variants[1..].iter().zip(&aa[1..]) {
         assert!(
@@ -159,7 +159,7 @@ fn samples_cut_the_error_against_the_supersampled_reference() {
         meshes(Technique::Forward, base, Antialiasing::X4),
         RenderSettings { antialiasing: Antialiasing::X4, raster: Raster::Hardware, ..base },
     ];
-    let (off, aa) = errors("foliage", &leaves, base, &variants);
+    let (off, aa, _) = errors("foliage", &leaves, base, &variants);
     assert!(aa[0] * 3.0 <= off, "foliage: {:.3} with 8 samples against {off:.3} without", aa[0]);
     for (v, e) in variants[1..].iter().zip(&aa[1..]) {
         let what = format!("{} ({} raster)", v.technique.name(), v.raster.name());
@@ -274,7 +274,7 @@ fn transparent_layers_are_anti_aliased_over_and_under_opaque_edges() {
         RenderSettings { antialiasing: Antialiasing::X4, raster: Raster::hybrid(Raster::DEFAULT_SPLIT), ..base },
         RenderSettings { antialiasing: Antialiasing::X4, raster: Raster::Hardware, ..base },
     ];
-    let (off, aa) = errors("glass over edges", &scene, base, &variants);
+    let (off, aa, _) = errors("glass over edges", &scene, base, &variants);
     assert!(aa[0] * 3.0 <= off, "glass over edges: {:.3} with 8 samples against {off:.3} without", aa[0]);
     for (v, e) in variants[1..].iter().zip(&aa[1..]) {
         assert!(
@@ -342,13 +342,12 @@ fn highlights_under_a_grainy_normal_map_do_not_sparkle() {
     let off = RenderSettings { shading: ShadingModel::Pbr, specular_aa: false, ..visibility(160, 120, Antialiasing::Off) };
     let on = RenderSettings { specular_aa: true, ..off };
     let variants = [on, meshes(Technique::Forward, on, Antialiasing::Off), meshes(Technique::DeferredClustered, on, Antialiasing::Off)];
-    let (e_off, e) = errors("grainy metal", &scene, off, &variants);
+    let (e_off, e, outputs) = errors("grainy metal", &scene, off, &variants);
     println!("specular anti-aliasing: RMS error {e_off:.3} without, {:.3} with ({:.2} of it)", e[0], e[0] / e_off);
     assert!(e[0] <= 0.6 * e_off, "{:.3} with specular anti-aliasing against {e_off:.3} without", e[0]);
     // Every technique lights the same spread: the forward pass and the G-buffer's deferred
     // lighting as the visibility technique does (the G-buffer rounds its textures' factors to
     // 8 bits: without specular anti-aliasing its sharp glints differ by up to 7/255).
-    let outputs = common::render_each(&scene, &variants);
     for (v, out) in variants[1..].iter().zip(&outputs[1..]) {
         let (worst, pixels) = common::max_difference(&outputs[0], out);
         println!("{}: {pixels} pixels differ from the visibility technique's, by up to {worst}/255", v.technique.name());
