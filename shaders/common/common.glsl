@@ -74,6 +74,14 @@ struct FrameUniforms {
     vec4 shadow_rays;          // x: length of the sun's shadow rays (beyond the scene's box from any point in it)
 };
 
+// The environment light (set 1 of every shading path; environment/environment.glsl): written
+// once per environment — the coefficients by its prefilter on the GPU, the rest by the CPU.
+struct EnvironmentData {
+    vec4 sh[9];        // rgb: what a white Lambert surface reflects, Σ sh[k]·Y_k(n) (image frame)
+    vec4 to_image[3];  // columns of the rotation from world directions to the image's
+    vec4 params;       // x: intensity (0: no environment), y: the specular cube's last level
+};
+
 // Declares the frame's values as `frame`, at binding `b` of set 0: every shader reads them
 // from a read-only storage buffer, never a uniform block (why: opaque_uniform above).
 #define FRAME_BLOCK(b) layout(std430, set = 0, binding = b) readonly buffer FrameBlock { FrameUniforms frame; }

@@ -16,6 +16,7 @@
 #include "common/blinn_phong.glsl"
 #include "clusters/cluster.glsl"
 #include "common/world_from_depth.glsl"
+#include "environment/environment.glsl"
 #ifdef LIGHT_GRID
 #include "light_grid/light_grid.glsl"
 #endif
@@ -112,7 +113,8 @@ PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive
 }
 
 // Linear colour of a surface point: every light that reaches it plus what the model adds
-// (seed, pbr: ambient, times `occlusion`; blinn-phong: ambient, sun, spot, reflection) plus
+// (seed, pbr: ambient, times `occlusion`, or pbr's environment light; blinn-phong: ambient, sun,
+// spot, reflection) plus
 // the light it gives off (`emission`). `frag_xy` is the pixel centre (gl_FragCoord.xy),
 // which picks the cluster.
 vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, float occlusion, vec3 emission, vec2 frag_xy) {
@@ -133,6 +135,9 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
 #define PBR_LIGHT(l) shadowed(pbr_point_light(l, world, n, v, albedo, roughness, metallic), l, world, n)
         SUM_LIGHTS(lo, PBR_LIGHT)
         SUM_DIRECTIONAL(lo, PBR_LIGHT)
+        if (ENVIRONMENT) {
+            return environment_light(n, v, albedo, roughness, metallic, occlusion) + lo + emission;
+        }
         return albedo * frame.ambient * occlusion + lo + emission;
     }
 #define SEED_LIGHT(l) shadowed(seed_point_light(l, world, n, v, albedo, roughness, metallic), l, world, n)

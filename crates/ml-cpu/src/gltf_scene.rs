@@ -1102,7 +1102,7 @@ thread_local! {
 /// decoder multiplies past u32 — a panic where overflow checks are on, as in debug builds).
 /// Its panic message is not printed: the panic hook stays quiet on a thread inside this call
 /// and hands every other panic to the hook before it.
-fn guarded_decode<T>(decode: impl FnOnce() -> T) -> Option<T> {
+pub(crate) fn guarded_decode<T>(decode: impl FnOnce() -> T) -> Option<T> {
     static QUIET_HOOK: std::sync::Once = std::sync::Once::new();
     QUIET_HOOK.call_once(|| {
         let before = std::panic::take_hook();

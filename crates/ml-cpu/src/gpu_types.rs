@@ -91,6 +91,19 @@ gpu_struct!(
 );
 
 gpu_struct!(
+    /// The environment light (std430; see common.glsl): the prefilter writes `sh`, the CPU the
+    /// rest.
+    EnvironmentData {
+        /// rgb: what a white Lambert surface reflects is the sum of `sh[k]·Y_k(n)` (the image's frame).
+        sh: [[f32; 4]; 9],
+        /// Columns of the rotation from world directions to the image's.
+        to_image: [[f32; 4]; 3],
+        /// x: intensity (0: no environment); y: the specular cube's last mip level.
+        params: [f32; 4],
+    }
+);
+
+gpu_struct!(
     /// A spot light's cone (std430), parallel to the light buffer; see common.glsl.
     LightCone {
         /// xyz: unit axis; w: 1 / (cos inner − cos outer).

@@ -7,6 +7,7 @@ pub mod bench_scene;
 pub mod blinn_phong;
 pub mod camera;
 pub mod cluster;
+pub mod environment;
 pub mod error;
 pub mod files;
 pub mod forest;

@@ -196,6 +196,8 @@ pub struct Scene {
     /// Spot cones, one per light (LightCone::NONE for point lights) — or none at all in a
     /// scene without spot lights.
     pub cones: Vec<LightCone>,
+    /// Light from every direction at infinity (the pbr model; None: the constant ambient).
+    pub environment: Option<crate::environment::Environment>,
 }
 
 /// A light marker's half-width as a fraction of its light's radius (the seed's radius-15
@@ -256,6 +258,7 @@ impl Scene {
             textures: Vec::new(),
             directional: Vec::new(),
             cones: Vec::new(),
+            environment: None,
         }
     }
 

@@ -57,6 +57,11 @@ pub fn shade_seed(p: Vec3, n: Vec3, eye: Vec3, m: &Material, lights: &[PointLigh
     m.albedo * ambient + lo
 }
 
+/// The pbr model's tone map before its gamma (ACES, Narkowicz 2015's fit; shading_model.glsl).
+pub fn aces_tone_map(x: Vec3) -> Vec3 {
+    (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
 /// The seed's output encoding: gamma 1/2.2, then 8-bit UNORM (round to nearest, clamped).
 pub fn encode_gamma_unorm8(c: Vec3) -> [u8; 3] {
     c.to_array().map(|x| (x.max(0.0).powf(1.0 / 2.2).min(1.0) * 255.0).round() as u8)

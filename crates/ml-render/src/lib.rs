@@ -40,6 +40,7 @@ mod clusters;
 mod compute_pass;
 mod depth_pass;
 mod descriptors;
+mod environment;
 mod exposure;
 mod frame;
 mod frame_resources;

@@ -272,6 +272,7 @@ impl RenderSettings {
             count_rays: self.light_stats && (shadow_rays || sun_rays),
             antialiasing: self.antialiasing,
             specular_aa: self.specular_aa,
+            environment: self.shading == ShadingModel::Pbr && scene.environment.is_some(),
         }
     }
 

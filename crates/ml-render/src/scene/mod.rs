@@ -13,6 +13,7 @@ pub mod shadow_settings;
 pub mod sun_shadow;
 pub mod textures;
 
+use crate::environment::EnvironmentMaps;
 use crate::error::RenderError;
 use crate::gpu_mesh::SceneMeshes;
 use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
@@ -41,6 +42,8 @@ pub struct SceneGpu {
     /// pipeline for each.
     pub surface_variants: Vec<SurfaceVariant>,
     pub textures: SceneTextures,
+    /// The environment light, prefiltered (stand-ins without one): part of the texture set.
+    pub environment: EnvironmentMaps,
     pub object_textures: ObjectTextureSets,
     /// Point-light shadow cubes (a stand-in without shadowed lights): part of the scene's
     /// texture set, rendered each frame by the omni-shadow pass.
@@ -70,9 +73,11 @@ impl SceneGpu {
         let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
         let has_masked = scene.objects.iter().any(|o| o.extras.masked());
         let mut omni = OmniShadows::new(ctx, config.omni, has_masked)?;
-        let mut textures = release_on_error(ctx, SceneTextures::new(ctx, sun.is_some(), gbuffer_depth, &omni), &mut [&mut omni])?;
+        let mut environment = release_on_error(ctx, EnvironmentMaps::new(ctx, scene.environment.as_ref()), &mut [&mut omni])?;
+        let made = SceneTextures::new(ctx, sun.is_some(), gbuffer_depth, (&omni, &environment));
+        let mut textures = release_on_error(ctx, made.map_err(RenderError::from), &mut [&mut omni, &mut environment])?;
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
-        let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut textures])?;
+        let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut environment, &mut textures])?;
         let mut gpu = SceneGpu {
             meshes: SceneMeshes::empty(),
             objects: Buffer::null(),
@@ -80,6 +85,7 @@ impl SceneGpu {
             alpha_masks: Buffer::null(),
             surface_variants: SurfaceVariant::needed(&scene.objects),
             textures,
+            environment,
             object_textures,
             omni,
             shadow_view_proj: glam::Mat4::IDENTITY,
@@ -190,6 +196,7 @@ impl SceneGpu {
         self.release_objects(ctx);
         self.cones.destroy(ctx);
         self.textures.destroy(ctx);
+        self.environment.destroy(ctx);
         self.object_textures.destroy(ctx);
         self.omni.destroy(ctx);
     }

@@ -1,9 +1,11 @@
 //! Set 1 of every shading pipeline: the scene's textures. For the blinn-phong model the sun's
 //! shadow map (drawn by sun_shadow.rs), a sky cubemap for reflections, the albedo and normal
 //! maps (all made by our code: ml_cpu::textures); the seed model binds 1×1 stand-ins it never
-//! samples. The layout is textures.glsl's set 1, as reflected from the shaders.
+//! samples. The environment light's maps (crate::environment) join the set. The layout is
+//! textures.glsl's and environment.glsl's set 1, as reflected from the shaders.
 
 use crate::descriptors::{self, Resource, SetLayout};
+use crate::environment::EnvironmentMaps;
 use crate::error::RenderError;
 use crate::scene::omni_shadow::{self, OmniShadows};
 use crate::scene::sun_shadow::{draw_shadow_map, render_shadow_map, ShadowInputs};
@@ -37,7 +39,12 @@ impl SceneTextures {
     /// The textures: with `blinn_phong` the real maps and a shadow map (cleared: fill it with
     /// `render_shadow_map` once the meshes are on the GPU), else 1×1 stand-ins. The shadow map
     /// uses `depth_format`, which must be sampleable. `omni` holds the point-light shadow cubes.
-    pub fn new(ctx: &Context, blinn_phong: bool, depth_format: vk::Format, omni: &OmniShadows) -> Result<SceneTextures, VkError> {
+    pub fn new(
+        ctx: &Context,
+        blinn_phong: bool,
+        depth_format: vk::Format,
+        (omni, environment): (&OmniShadows, &EnvironmentMaps),
+    ) -> Result<SceneTextures, VkError> {
         let t = SceneTextures {
             set_layout: SetLayout::null(),
             set: vk::DescriptorSet::null(),
@@ -46,7 +53,7 @@ impl SceneTextures {
             samplers: Vec::new(),
             shadow_size: 1,
         };
-        ml_vk::build(ctx, t, |t| t.create(ctx, blinn_phong, depth_format, omni))
+        ml_vk::build(ctx, t, |t| t.create(ctx, blinn_phong, depth_format, (omni, environment)))
     }
 
     /// Draw every object of `inputs` into the shadow map, from the sun; its GPU milliseconds
@@ -60,7 +67,13 @@ impl SceneTextures {
         omni_shadow::read_depth_layers(ctx, &self.images[SHADOW_IMAGE], 1)
     }
 
-    fn create(&mut self, ctx: &Context, real: bool, depth_format: vk::Format, omni: &OmniShadows) -> Result<(), VkError> {
+    fn create(
+        &mut self,
+        ctx: &Context,
+        real: bool,
+        depth_format: vk::Format,
+        (omni, environment): (&OmniShadows, &EnvironmentMaps),
+    ) -> Result<(), VkError> {
         // Read by the fragment shaders and the compute lighting pass: textures.glsl's set 1.
         let stages = [
             (&ml_shaders::FORWARD_FRAG, vk::ShaderStageFlags::FRAGMENT),
@@ -148,7 +161,7 @@ impl SceneTextures {
         let resource = |name: &str| match name {
             "ShadowAtlasBuffer" => Some(Resource::Buffer(omni.atlas.depths.raw)),
             "ShadowAtlasTileBuffer" => Some(Resource::Buffer(omni.atlas.tiles.raw)),
-            _ => image(name),
+            _ => image(name).or_else(|| environment.resource(name)),
         };
         self.set_layout.write(ctx, self.set, &resource)?;
         Ok(())

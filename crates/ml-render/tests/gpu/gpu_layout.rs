@@ -3,9 +3,9 @@
 //! docs/DESIGN.md#mistakes-we-avoid). A field moved on either side fails here.
 
 use ml_cpu::gpu_types::{
-    ClusterRange, CullCounters, CullPush, DrawIndexedCommand, FrameUniforms, GpuLayout, Instance, LargeTriangle, LayerObject, LightCone,
-    LightGridDispatch, LightGridFeedback, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush, OmniShadowPush, PointLight,
-    RayInstance, RayNode, RayTriangle, ShadowCubeTiles, ShadowPush, StageProbePush,
+    ClusterRange, CullCounters, CullPush, DrawIndexedCommand, EnvironmentData, FrameUniforms, GpuLayout, Instance, LargeTriangle,
+    LayerObject, LightCone, LightGridDispatch, LightGridFeedback, Meshlet, ObjectData, ObjectPush, OmniRasterCounters, OmniRasterPush,
+    OmniShadowPush, PointLight, RayInstance, RayNode, RayTriangle, ShadowCubeTiles, ShadowPush, StageProbePush,
 };
 use spirq::ty::{StructType, Type};
 use spirq::ReflectConfig;
@@ -88,6 +88,7 @@ fn rust_mirrors_match_spirv_reflection() {
     check::<StageProbePush>(&structs);
     check::<ObjectData>(&structs);
     check::<LightCone>(&structs);
+    check::<EnvironmentData>(&structs);
     check::<ClusterRange>(&structs);
     check::<LightGridFeedback>(&structs);
     check::<LightGridDispatch>(&structs);

@@ -11,6 +11,7 @@ mod compute_raster;
 mod culling;
 mod debug_views;
 mod deferred_pass;
+mod environment;
 mod exposure;
 mod fitted_lights;
 mod frames;

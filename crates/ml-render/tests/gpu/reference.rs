@@ -82,17 +82,13 @@ fn compare(material: Material, directional: &[DirectionalLight], orthographic: O
             // An orthographic camera looks along its axis at every point: an eye far back on the ray.
             let eye = if orthographic.is_some() { p - dir * 1e5 } else { cam.position };
             let shade = |n: Vec3| encode_gamma_unorm8(shade_seed(p, n, eye, &material, &all, scene.ambient));
-            let expected = shade(n);
-            let (t1, t2) = n.any_orthonormal_pair();
-            let tilted = [t1, -t1, t2, -t2].map(|t| shade((n + t * NORMAL_TOLERANCE).normalize()));
             let got = common::pixel(&out, x, y);
+            let (expected, off) = common::outside_reference(shade, n, NORMAL_TOLERANCE, (got, MAX_DIFF));
+            for (c, range) in off {
+                outside += 1;
+                println!("pixel ({x}, {y}) channel {c}: gpu {} outside the reference range {range:?}", got[c]);
+            }
             for c in 0..3 {
-                let lo = tilted.iter().map(|s| s[c]).min().unwrap().min(expected[c]).saturating_sub(MAX_DIFF);
-                let hi = tilted.iter().map(|s| s[c]).max().unwrap().max(expected[c]).saturating_add(MAX_DIFF);
-                if !(lo..=hi).contains(&got[c]) {
-                    outside += 1;
-                    println!("pixel ({x}, {y}) channel {c}: gpu {} outside the reference range {lo}..={hi}", got[c]);
-                }
                 let d = got[c].abs_diff(expected[c]);
                 worst = worst.max(d);
                 sum += d as u64;

@@ -68,6 +68,29 @@ pub fn pixels_beyond(a: &RenderOutput, b: &RenderOutput, limit: u8) -> usize {
     a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)).filter(|(pa, pb)| pa.iter().zip(*pb).any(|(x, y)| x.abs_diff(*y) > limit)).count()
 }
 
+/// Where a pixel `got` of a tessellated surface leaves its CPU reference: `shade` (the
+/// reference's 8-bit colour for a normal) at the exact normal `n` is `expected`; each channel
+/// may take any value the reference takes with `n` tilted by `tilt` rad (the facets' error),
+/// widened by `margin` steps. Returns `expected` and the channels outside, with their range.
+pub fn outside_reference(
+    shade: impl Fn(glam::Vec3) -> [u8; 3],
+    n: glam::Vec3,
+    tilt: f32,
+    (got, margin): ([u8; 3], u8),
+) -> ([u8; 3], Vec<(usize, std::ops::RangeInclusive<u8>)>) {
+    let expected = shade(n);
+    let (t1, t2) = n.any_orthonormal_pair();
+    let tilted = [t1, -t1, t2, -t2].map(|t| shade((n + t * tilt).normalize()));
+    let outside = (0..3)
+        .filter_map(|c| {
+            let lo = tilted.iter().map(|s| s[c]).fold(expected[c], u8::min).saturating_sub(margin);
+            let hi = tilted.iter().map(|s| s[c]).fold(expected[c], u8::max).saturating_add(margin);
+            (!(lo..=hi).contains(&got[c])).then_some((c, lo..=hi))
+        })
+        .collect();
+    (expected, outside)
+}
+
 pub fn pixel(out: &RenderOutput, x: u32, y: u32) -> [u8; 3] {
     let i = ((y * out.width + x) * 4) as usize;
     [out.rgba[i], out.rgba[i + 1], out.rgba[i + 2]]

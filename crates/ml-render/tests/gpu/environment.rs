@@ -1,0 +1,104 @@
+//! Environment light against its CPU reference: a unit sphere lit by the built-in sky alone
+//! (no point light reaches it), pbr model. For every pixel whose ray hits the analytic sphere,
+//! the GPU pixel must lie within 2/255 of the split sum the CPU computes at that point
+//! (ml_cpu::environment::environment_light: the coefficients and the GGX-weighted radiance
+//! summed over every texel of the image, the BRDF integral with 1,024 samples) — over the
+//! range the reference takes with the normal tilted by the tessellation's error, as in the
+//! point-light reference test. The GPU resamples the image into a cube, prefilters six
+//! roughness levels by importance sampling and interpolates between them; the sky is smooth,
+//! so each of those steps stays below a step of 8 bits. Every technique draws the same image.
+
+use crate::common;
+
+use glam::Vec3;
+use ml_cpu::camera::Camera;
+use ml_cpu::environment::{diffuse_sh9, environment_light, Environment, EnvironmentImage};
+use ml_cpu::gpu_types::PointLight;
+use ml_cpu::material::Material;
+use ml_cpu::mesh::MeshKind;
+use ml_cpu::scene::{Object, Scene};
+use ml_cpu::shading::{aces_tone_map, encode_gamma_unorm8};
+use ml_cpu::shading_model::ShadingModel;
+use ml_render::{RenderSettings, Technique};
+use std::sync::Arc;
+
+const SIZE: u32 = 96;
+const MAX_DIFF: u8 = 2;
+const NORMAL_TOLERANCE: f32 = 2e-3;
+
+fn sky_sphere(material: Material, rotation: f32) -> Scene {
+    // One light far from the sphere, its radius ending before it: the environment alone lights it.
+    let far = PointLight { position_radius: [50.0, 0.0, 0.0, 1.0], color: [1.0, 1.0, 1.0, 0.0] };
+    let camera = Camera::looking_at(Vec3::new(0.3, 0.6, 3.2), Vec3::ZERO, 45.0, 0.1, 100.0);
+    let mut scene = Scene::new(vec![Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, material)], vec![far], camera);
+    scene.environment = Some(Environment { image: Arc::new(EnvironmentImage::sky(128)), intensity: 1.3, rotation });
+    scene
+}
+
+fn pbr(technique: Technique) -> RenderSettings {
+    RenderSettings { shading: ShadingModel::Pbr, ..RenderSettings::new(technique, SIZE, SIZE) }
+}
+
+fn hit_unit_sphere(origin: Vec3, dir: Vec3) -> Option<Vec3> {
+    let b = origin.dot(dir);
+    let disc = b * b - (origin.length_squared() - 1.0);
+    (disc >= 0.0).then(|| origin + dir * (-b - disc.sqrt()))
+}
+
+fn compare(material: Material, rotation: f32) {
+    let scene = sky_sphere(material, rotation);
+    let out = common::render(scene.clone(), pbr(Technique::Forward));
+    let env = scene.environment.as_ref().expect("set above");
+    let sh = diffuse_sh9(&env.image);
+    let cam = &scene.camera;
+    let (mut compared, mut outside, mut worst) = (0u32, 0u32, 0u8);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let (origin, dir) = cam.pixel_ray(x, y, SIZE, SIZE);
+            let Some(p) = hit_unit_sphere(origin, dir) else { continue };
+            let n = p.normalize();
+            let v = -dir;
+            if n.dot(v) < 0.2 {
+                continue;
+            }
+            let m = &material;
+            let shade =
+                |n: Vec3| encode_gamma_unorm8(aces_tone_map(environment_light(env, &sh, (n, v), m.albedo, (m.roughness, m.metallic, 1.0))));
+            let got = common::pixel(&out, x, y);
+            let (expected, off) = common::outside_reference(shade, n, NORMAL_TOLERANCE, (got, MAX_DIFF));
+            worst = (0..3).map(|c| got[c].abs_diff(expected[c])).fold(worst, u8::max);
+            for (c, range) in off {
+                outside += 1;
+                if outside < 20 {
+                    println!("pixel ({x}, {y}) channel {c}: gpu {} outside {range:?}", got[c]);
+                }
+            }
+            compared += 1;
+        }
+    }
+    println!("{compared} pixels compared: max |gpu − cpu| {worst}/255, {outside} channels outside the tolerance");
+    assert!(compared > 2_000, "the sphere should cover much of the image, got {compared} pixels");
+    assert_eq!(outside, 0, "channels outside the reference range ± {MAX_DIFF}/255");
+}
+
+#[test]
+fn environment_light_matches_the_cpu_split_sum_on_a_rough_metal() {
+    compare(Material { albedo: Vec3::new(0.95, 0.75, 0.4), roughness: 0.45, metallic: 1.0 }, 0.0);
+}
+
+#[test]
+fn environment_light_matches_the_cpu_split_sum_on_a_turned_sky() {
+    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.7, metallic: 0.0 }, 2.0);
+}
+
+#[test]
+fn every_technique_draws_the_same_environment_light() {
+    let scene = sky_sphere(Material { albedo: Vec3::new(0.9, 0.9, 0.9), roughness: 0.3, metallic: 0.5 }, 1.0);
+    let settings: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| RenderSettings { width: 64, height: 64, ..pbr(t) }).collect();
+    let outs = common::render_each(&scene, &settings);
+    for (s, out) in settings.iter().zip(&outs).skip(1) {
+        let (worst, differing) = common::max_difference(&outs[0], out);
+        println!("{:?}: {differing} pixels differ, by up to {worst}/255", s.technique);
+        assert!(worst <= 1, "{:?} differs from forward by {worst}/255", s.technique);
+    }
+}

@@ -1,0 +1,51 @@
+// Environment light at a surface point (lighting.glsl's pbr model, with ENVIRONMENT): the
+// split sum (Karis 2013). Diffuse: albedo·(1 − metallic) times the nine coefficients' sum at
+// the normal, times the ambient occlusion. Specular: the cube prefiltered for the roughness at
+// the reflected direction times F₀·A + B from the BRDF table, times the specular occlusion
+// the ambient occlusion implies (Lagarde and de Rousiers 2014), so interiors do not shine.
+// ml_cpu::environment::environment_light is the CPU reference.
+
+#ifndef MANYLIGHTS_ENVIRONMENT_GLSL
+#define MANYLIGHTS_ENVIRONMENT_GLSL
+
+#include "environment/environment_maps.glsl"
+
+layout(set = 1, binding = 9) uniform samplerCube environment_specular;
+layout(set = 1, binding = 10) uniform sampler2D environment_brdf;
+layout(std430, set = 1, binding = 11) readonly buffer EnvironmentBuffer { EnvironmentData environment; };
+
+// Pipelines of scenes lit by an environment (the others keep their constant ambient term).
+layout(constant_id = 44) const bool ENVIRONMENT = false;
+
+vec3 environment_diffuse(vec3 n) {
+    float y[9];
+    sh9_basis(n, y);
+    vec3 sum = vec3(0.0);
+    for (int k = 0; k < 9; ++k) {
+        sum += environment.sh[k].rgb * y[k];
+    }
+    return max(sum, vec3(0.0));
+}
+
+float specular_occlusion(float n_dot_v, float occlusion, float roughness) {
+    if (occlusion >= 1.0) {
+        return 1.0;
+    }
+    return clamp(pow(n_dot_v + occlusion, exp2(-16.0 * roughness - 1.0)) - 1.0 + occlusion, 0.0, 1.0);
+}
+
+// `n`, `v`: unit normal and direction towards the eye, in the world.
+vec3 environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion) {
+    mat3 to_image = mat3(environment.to_image[0].xyz, environment.to_image[1].xyz, environment.to_image[2].xyz);
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    vec3 r = normalize(2.0 * dot(n, v) * n - v);
+    vec3 diffuse = albedo * (1.0 - metallic) * environment_diffuse(to_image * n) * occlusion;
+    vec3 f0 = mix(vec3(0.04), albedo, metallic);
+    vec2 table = vec2(textureSize(environment_brdf, 0));
+    vec2 ab = textureLod(environment_brdf, (vec2(n_dot_v, roughness) * (table - 1.0) + 0.5) / table, 0.0).xy;
+    vec3 prefiltered = textureLod(environment_specular, to_image * r, roughness * environment.params.y).rgb;
+    vec3 specular = prefiltered * (f0 * ab.x + ab.y) * specular_occlusion(n_dot_v, occlusion, roughness);
+    return (diffuse + specular) * environment.params.x;
+}
+
+#endif
