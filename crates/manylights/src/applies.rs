@@ -245,16 +245,27 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
     let shadows = format!("point-light shadows (--omni-shadow {})", or_list(OmniShadowMode::ALL.into_iter().map(OmniShadowMode::name)));
     let atlas = "the shadow atlas (--omni-shadow atlas)";
     let model = built.map(|b| b.shading);
-    let sun = |id| {
+    // Options of one shading model's feature.
+    let of_model = |id, wanted: ShadingModel, feature: &'static str| {
+        Rule::setting(id, model.map(|m| m == wanted), format!("the {} shading model", model.map_or("", ShadingModel::name)), feature)
+    };
+    let sun = |id| of_model(id, ShadingModel::BlinnPhong, "the blinn-phong model's sun (--shading blinn-phong)");
+    let pbr = |id| of_model(id, ShadingModel::Pbr, "the pbr model's environment light (--shading pbr)");
+    let lit = |id| {
         Rule::setting(
             id,
-            model.map(|m| m == ShadingModel::BlinnPhong),
-            format!("the {} shading model", model.map_or("", ShadingModel::name)),
-            "the blinn-phong model's sun (--shading blinn-phong)",
+            built.map(|b| b.scene.environment.is_some()),
+            "a scene without an environment",
+            "an environment (--environment FILE or sky)",
         )
     };
     let mut rules = vec![
         objects_rule(&args.scene),
+        pbr("environment"),
+        pbr("environment_intensity"),
+        pbr("environment_rotation"),
+        lit("environment_intensity"),
+        lit("environment_rotation"),
         Rule::setting("object", Some(seed), &scene, "the seed scene (--scene seed)"),
         Rule::setting("material", Some(seed), &scene, "the seed scene (--scene seed)"),
         Rule::setting(

@@ -10,10 +10,11 @@ use clap::error::ErrorKind;
 use clap::{Args, CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
+use ml_cpu::environment::{parse_intensity, parse_rotation_deg, EnvironmentSource};
 use ml_cpu::lights::{LightColors, LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
-use ml_cpu::scene_request::{SceneRequest, SceneSource, SceneWarning};
+use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource, SceneWarning};
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{
     Antialiasing, DebugView, Exposure, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Renderer, ShadingModel,
@@ -202,6 +203,18 @@ struct SceneArgs {
     /// palette in the seed scene, white in a scene or glTF file.
     #[arg(long)]
     light_colors: Option<String>,
+    /// Environment light (the pbr model): an equirectangular Radiance .hdr or OpenEXR file,
+    /// sky (the built-in sky) or none (the constant ambient term). Default: a scene file's
+    /// own; the sky for a scene or glTF file without lights of its own; else none.
+    #[arg(long)]
+    environment: Option<String>,
+    /// Multiplier of the environment's radiance. Default: 1, or a scene file's own.
+    #[arg(long, allow_negative_numbers = true)]
+    environment_intensity: Option<String>,
+    /// Turn of the environment about the up axis, in degrees. Default: 0, or a scene file's
+    /// own.
+    #[arg(long, allow_negative_numbers = true)]
+    environment_rotation: Option<String>,
     /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene up to
     /// its 64 lights (beyond, one that follows the count); in a scene or glTF file the radius at
     /// which about 4 lights reach a point of the scene, from its box and the light count.
@@ -529,6 +542,9 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         transparent_percent: args.transparent_objects,
         glass_layers: args.glass_layers,
         light_colors: args.light_colors.as_deref().map(LightColors::from_name).transpose()?,
+        environment: args.environment.as_deref().map(EnvironmentSource::parse),
+        environment_intensity: args.environment_intensity.as_deref().map(parse_intensity).transpose().map_err(anyhow::Error::msg)?,
+        environment_rotation_deg: args.environment_rotation.as_deref().map(parse_rotation_deg).transpose().map_err(anyhow::Error::msg)?,
     })
 }
 
@@ -592,6 +608,18 @@ fn exposure_choice(args: &SceneArgs) -> Result<Exposure> {
         Some(text) => Ok(ml_render::settings::parse_exposure(text).context("--exposure")?),
         None if is_scene_file(&args.scene) => Ok(Exposure::Auto),
         None => Ok(Exposure::Ev(0.0)),
+    }
+}
+
+/// A file without lights of its own, lit by the default rig under the built-in sky, is exposed
+/// as a glTF viewer shows it, at EV 0 (the sky's radiance is in display units: auto exposure
+/// brightened such models by 2–3 EV, past what a viewer shows), unless `--exposure` says.
+fn viewer_exposure(args: &SceneArgs, built: &BuiltScene, settings: &mut RenderSettings) {
+    let default_rig = built.warnings.iter().any(|w| matches!(w, SceneWarning::DefaultRig { .. }));
+    let sky = args.environment.as_deref().is_none_or(|e| e == "sky");
+    let lit = built.shading == ShadingModel::Pbr && built.scene.environment.is_some();
+    if args.exposure.is_none() && default_rig && lit && sky {
+        settings.exposure = Exposure::Ev(0.0);
     }
 }
 
@@ -727,6 +755,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     }
     let built = request.build()?;
     check_options_apply(args, &request.source, Some(&built), &techniques)?;
+    viewer_exposure(args, &built, &mut wanted.settings);
     output::prepare(&cmd.out, sequence.as_ref(), &to_write)?;
     let mut settings = wanted.for_scene(&built.scene, built.shading);
     let ctx = Context::new(&ContextDesc { validation: args.validation, device_index: args.device, window: None })?;
@@ -830,11 +859,12 @@ fn view(cmd: &ViewArgs) -> Result<()> {
     // Checked up front, so that a bad argument fails before a window opens.
     let choice = auto::technique_choice(&args.technique)?;
     let request = scene_request(args)?;
-    let wanted = settings_request(args, Technique::Forward, 1)?;
+    let mut wanted = settings_request(args, Technique::Forward, 1)?;
     let mut techniques = Techniques::chosen(choice);
     check_options_apply(args, &request.source, None, &techniques)?;
     let built = request.build()?;
     check_options_apply(args, &request.source, Some(&built), &techniques)?;
+    viewer_exposure(args, &built, &mut wanted.settings);
     // Before auto's probes: without a display, that is the one line, at once.
     let windows = ml_viewer::connect()?;
     let probe_settings = wanted.for_scene(&built.scene, built.shading);

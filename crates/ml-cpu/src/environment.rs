@@ -14,7 +14,7 @@ use std::sync::Arc;
 /// Largest environment file read (a 16k × 8k RGBA float EXR is 2 GiB; real ones are 50 MiB).
 pub const MAX_ENVIRONMENT_FILE_BYTES: u64 = 1 << 30;
 /// Largest environment image side (texels).
-pub const MAX_ENVIRONMENT_SIZE: u32 = 16384;
+pub const MAX_ENVIRONMENT_SIZE: u32 = 8192;
 /// The built-in sky's width (its height is half).
 pub const SKY_WIDTH: u32 = 512;
 
@@ -47,6 +47,62 @@ impl Environment {
     /// World direction → the image's own (the environment turned by `rotation` about +Y).
     pub fn to_image(&self) -> Mat3 {
         Mat3::from_rotation_y(-self.rotation)
+    }
+}
+
+/// Which environment lights a scene (the pbr model).
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvironmentSource {
+    /// None: the constant ambient term.
+    Off,
+    /// The built-in sky (`EnvironmentImage::sky`).
+    Sky,
+    /// An equirectangular Radiance .hdr or OpenEXR file.
+    File(std::path::PathBuf),
+}
+
+impl EnvironmentSource {
+    /// `none`, `sky`, or a file's path.
+    pub fn parse(text: &str) -> EnvironmentSource {
+        match text {
+            "none" => EnvironmentSource::Off,
+            "sky" => EnvironmentSource::Sky,
+            path => EnvironmentSource::File(path.into()),
+        }
+    }
+
+    /// The environment at unit intensity, unrotated (None: off).
+    pub fn load(&self) -> Result<Option<Environment>, EnvironmentError> {
+        Ok(match self {
+            EnvironmentSource::Off => None,
+            EnvironmentSource::Sky => Some(Environment::sky()),
+            EnvironmentSource::File(path) => {
+                Some(Environment { image: Arc::new(EnvironmentImage::load(path)?), intensity: 1.0, rotation: 0.0 })
+            }
+        })
+    }
+}
+
+/// Largest environment intensity (the lights' own cap).
+pub const MAX_ENVIRONMENT_INTENSITY: f32 = crate::limits::MAX_INTENSITY;
+/// Largest turn of an environment, in degrees either way.
+pub const MAX_ENVIRONMENT_ROTATION_DEG: f32 = 36_000.0;
+
+/// An intensity as given (text): finite, 0 to MAX_ENVIRONMENT_INTENSITY.
+pub fn parse_intensity(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && (0.0..=MAX_ENVIRONMENT_INTENSITY).contains(&v) => Ok(v),
+        _ => Err(format!("environment intensity '{text}': expected a number from 0 to {MAX_ENVIRONMENT_INTENSITY}")),
+    }
+}
+
+/// A turn as given (text, degrees): finite, within ±MAX_ENVIRONMENT_ROTATION_DEG.
+pub fn parse_rotation_deg(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v.abs() <= MAX_ENVIRONMENT_ROTATION_DEG => Ok(v),
+        _ => Err(format!(
+            "environment rotation '{text}': expected degrees from -{MAX_ENVIRONMENT_ROTATION_DEG} to {MAX_ENVIRONMENT_ROTATION_DEG}"
+        )),
     }
 }
 
@@ -114,7 +170,7 @@ impl EnvironmentImage {
         limits.max_image_height = Some(MAX_ENVIRONMENT_SIZE);
         limits.max_alloc = Some(4 << 30);
         reader.limits(limits);
-        let decoded = crate::gltf_scene::guarded_decode(|| reader.decode())
+        let decoded = crate::image_decode::guarded_decode(|| reader.decode())
             .ok_or_else(|| decode_error("its decoder stopped on malformed data".into()))?
             .map_err(|e| decode_error(e.to_string()))?
             .into_rgb32f();

@@ -1071,7 +1071,8 @@ fn within_reach(p: Vec3) -> bool {
 /// chain, from the image's header) on top of `taken`; refused past MAX_TEXTURE_BYTES.
 fn within_texture_budget(bytes: &[u8], taken: u64) -> Result<u64, GltfError> {
     let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(GltfError::ImageFormat)?;
-    let (width, height) = guarded_decode(|| reader.into_dimensions()).ok_or(GltfError::DecoderFailed)?.map_err(GltfError::Decode)?;
+    let (width, height) =
+        crate::image_decode::guarded_decode(|| reader.into_dimensions()).ok_or(GltfError::DecoderFailed)?.map_err(GltfError::Decode)?;
     let need = u64::from(width) * u64::from(height) * 4 * 4 / 3;
     match taken.checked_add(need).filter(|&total| total <= MAX_TEXTURE_BYTES) {
         Some(total) => Ok(total),
@@ -1087,35 +1088,10 @@ fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, GltfError> {
     limits.max_image_height = Some(MAX_TEXTURE_SIZE);
     limits.max_alloc = Some(1 << 30);
     reader.limits(limits);
-    let decoded = guarded_decode(|| reader.decode()).ok_or(GltfError::DecoderFailed)?.map_err(GltfError::Decode)?.to_rgba8();
+    let decoded =
+        crate::image_decode::guarded_decode(|| reader.decode()).ok_or(GltfError::DecoderFailed)?.map_err(GltfError::Decode)?.to_rgba8();
     let (width, height) = decoded.dimensions();
     Ok(TextureImage { width, height, rgba: decoded.into_raw().into(), srgb, sampler: TextureSampler::default() })
-}
-
-thread_local! {
-    /// Whether this thread is inside `guarded_decode` (its panics are answered there).
-    static DECODING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// `decode`'s result, or None where it panicked: the image decoders are others' code, and a
-/// file they cannot read must be one error line, not a crash (fuzzing found a JPEG whose
-/// decoder multiplies past u32 — a panic where overflow checks are on, as in debug builds).
-/// Its panic message is not printed: the panic hook stays quiet on a thread inside this call
-/// and hands every other panic to the hook before it.
-pub(crate) fn guarded_decode<T>(decode: impl FnOnce() -> T) -> Option<T> {
-    static QUIET_HOOK: std::sync::Once = std::sync::Once::new();
-    QUIET_HOOK.call_once(|| {
-        let before = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !DECODING.with(std::cell::Cell::get) {
-                before(info);
-            }
-        }));
-    });
-    DECODING.with(|d| d.set(true));
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode)).ok();
-    DECODING.with(|d| d.set(false));
-    result
 }
 
 /// glTF's metallic-roughness factors, and its emissive factor (times

@@ -16,6 +16,7 @@ mod geometry;
 pub mod gltf_scene;
 pub mod gltf_writer;
 pub mod gpu_types;
+pub mod image_decode;
 pub mod light_grid;
 pub mod lights;
 pub mod limits;

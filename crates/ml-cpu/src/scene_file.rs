@@ -5,6 +5,7 @@
 //! one error naming the file and, where the parser knows it, the line.
 
 use crate::camera::{clip_planes_for, Camera, DEFAULT_FOV_Y_DEG};
+use crate::environment::{Environment, EnvironmentSource, MAX_ENVIRONMENT_INTENSITY, MAX_ENVIRONMENT_ROTATION_DEG};
 use crate::error::Number;
 use crate::files::{read_regular, ReadError};
 use crate::framing::{frame_scene, framing_distance, DEFAULT_ASPECT};
@@ -132,6 +133,8 @@ pub enum SceneFileProblem {
     NearFar { near: f32, far: f32 },
     #[error("[camera] looks straight up or down, where its yaw is undefined: move target or position sideways")]
     CameraVertical,
+    #[error("[environment] {0}")]
+    Environment(String),
 }
 
 impl SceneFileProblem {
@@ -178,6 +181,7 @@ impl<'de> Deserialize<'de> for Triple {
 struct FileScene {
     camera: Option<FileCamera>,
     shading: Option<FileShading>,
+    environment: Option<FileEnvironment>,
     #[serde(default)]
     lights: Vec<FileLight>,
     objects: Vec<FileObject>,
@@ -200,6 +204,16 @@ struct FileCamera {
 struct FileShading {
     model: Option<String>,
     ambient: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileEnvironment {
+    /// An equirectangular .hdr or .exr file (relative to the scene file's folder), "sky" or
+    /// "none".
+    file: String,
+    intensity: Option<f32>,
+    rotation_deg: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -331,7 +345,26 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
     check_extent(&scene)?;
     check_draw_work(&scene)?;
     (scene.camera, scene.camera_framed) = camera(file.camera.as_ref(), &scene)?;
+    scene.environment = file.environment.as_ref().map(|e| environment(e, base)).transpose()?.flatten();
     Ok(SceneFile { scene, shading, warnings })
+}
+
+/// The file's [environment]: its image (a path relative to the scene file's folder), intensity
+/// and turn.
+fn environment(e: &FileEnvironment, base: Option<&Path>) -> Result<Option<Environment>, Problem> {
+    let source = match EnvironmentSource::parse(&e.file) {
+        EnvironmentSource::File(path) => EnvironmentSource::File(base.ok_or(Problem::NoFolder)?.join(path)),
+        other => other,
+    };
+    let Some(mut env) = source.load().map_err(|err| Problem::Environment(err.to_string()))? else { return Ok(None) };
+    if let Some(i) = e.intensity {
+        env.intensity = within("[environment] intensity", non_negative("[environment] intensity", i)?, 0.0..=MAX_ENVIRONMENT_INTENSITY)?;
+    }
+    if let Some(r) = e.rotation_deg {
+        let range = -MAX_ENVIRONMENT_ROTATION_DEG..=MAX_ENVIRONMENT_ROTATION_DEG;
+        env.rotation = within("[environment] rotation_deg", finite("[environment] rotation_deg", r)?, range)?.to_radians();
+    }
+    Ok(Some(env))
 }
 
 fn finite(what: &'static str, value: f32) -> Result<f32, Problem> {

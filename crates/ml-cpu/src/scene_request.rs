@@ -4,6 +4,7 @@
 
 use crate::bench_scene::bench_scene;
 use crate::camera::CameraSpec;
+use crate::environment::{EnvironmentError, EnvironmentSource};
 use crate::framing::{frame_scene, DEFAULT_ASPECT};
 use crate::gltf_scene::{self, GltfFileError};
 use crate::lights::{LightColors, LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_LIGHT_COUNT, SEED_RADIUS};
@@ -68,6 +69,13 @@ pub struct SceneRequest {
     /// Colours of the lights placed by layout; None: the seed scene's palette, near-white in
     /// a file (`LightColors`).
     pub light_colors: Option<LightColors>,
+    /// The environment light: None: a file's own, else the built-in sky for a file without
+    /// lights of its own (the default rig lights it too), else none.
+    pub environment: Option<EnvironmentSource>,
+    /// The environment's intensity and turn about +Y in degrees, where given (else its own:
+    /// 1 and 0 unless a scene file says).
+    pub environment_intensity: Option<f32>,
+    pub environment_rotation_deg: Option<f32>,
 }
 
 /// A built scene and the shading model to render it with.
@@ -106,6 +114,8 @@ pub enum SceneRequestError {
     /// A file whose box fits its lights no radius.
     #[error("'{}': {problem}", path.display())]
     FileLights { path: PathBuf, problem: SceneError },
+    #[error(transparent)]
+    Environment(#[from] EnvironmentError),
 }
 
 impl SceneRequest {
@@ -125,6 +135,9 @@ impl SceneRequest {
             transparent_percent: 0,
             glass_layers: 0,
             light_colors: None,
+            environment: None,
+            environment_intensity: None,
+            environment_rotation_deg: None,
         }
     }
 
@@ -154,6 +167,13 @@ impl SceneRequest {
         }
         crate::transparency::make_transparent(&mut built.scene, self.transparent_percent);
         crate::transparency::add_glass_layers(&mut built.scene, self.glass_layers, self.aspect);
+        if let Some(source) = &self.environment {
+            built.scene.environment = source.load()?;
+        }
+        if let Some(env) = &mut built.scene.environment {
+            env.intensity = self.environment_intensity.unwrap_or(env.intensity);
+            env.rotation = self.environment_rotation_deg.map_or(env.rotation, f32::to_radians);
+        }
         Ok(built)
     }
 
@@ -208,6 +228,10 @@ impl SceneRequest {
             scene.camera = frame_scene(&scene, self.aspect, scene.camera.fov_y_deg);
         }
         let unlit = scene.lights.is_empty() && scene.directional.is_empty();
+        // A pbr model without lights of its own looks as it does in a glTF viewer: under a sky.
+        if unlit && shading == ShadingModel::Pbr && self.environment.is_none() && scene.environment.is_none() {
+            scene.environment = Some(crate::environment::Environment::sky());
+        }
         if self.lights.is_some() || unlit {
             let count = self.lights.unwrap_or(DEFAULT_RIG_LIGHTS as u64);
             let (lo, hi) = scene.bounds();

@@ -266,6 +266,18 @@ impl<'a> Renderer<'a> {
     }
 
     /// Destroy the frame slots and what points at them (for `resize` and `set_lights`).
+    /// Light the scene with its environment at `intensity`, turned by `rotation` radians about
+    /// +Y, from the next frame on (no new prefiltering: the turn and scale apply as it is
+    /// read). False where the scene has no environment.
+    pub fn set_environment_view(&mut self, intensity: f32, rotation: f32) -> Result<bool, RenderError> {
+        let Some(env) = &mut self.scene.environment else { return Ok(false) };
+        (env.intensity, env.rotation) = (intensity, rotation);
+        let env = env.clone();
+        self.ctx.wait_idle()?;
+        self.gpu.environment.set_view(self.ctx, &env)?;
+        Ok(true)
+    }
+
     fn release_frames(&mut self) -> Result<(), VkError> {
         let ctx = self.ctx;
         ctx.wait_idle()?;
@@ -450,6 +462,9 @@ impl<'a> Renderer<'a> {
             // Counted with the light statistics (compute lightings only).
             rays.traced = self.settings.light_stats.then_some(self.rays_traced[last].0);
             stats.set_feature(rays);
+        }
+        if let Some(environment) = self.gpu.environment.stats {
+            stats.set_feature(environment);
         }
         let antialiasing = self.settings.antialiasing;
         if antialiasing != Antialiasing::Off {

@@ -313,7 +313,8 @@ impl<'c> Session<'c> {
     }
 
     /// Apply the changed choices to the current renderer where they allow it: new lights
-    /// (count, layout, radius), objects (kind, material), cluster grid, debug view or exposure. False if
+    /// (count, layout, radius), objects (kind, material), the environment's intensity and turn,
+    /// cluster grid, debug view or exposure. False if
     /// they do not (or it failed): a new renderer then.
     fn change_in_place(&mut self, build: &Build, extent: vk::Extent2D) -> bool {
         let (Some(renderer), Some(built)) = (&mut self.renderer, &self.built) else { return false };
@@ -324,7 +325,11 @@ impl<'c> Session<'c> {
             ..c.clone()
         } == *built;
         let objects_only = Choices { object: built.object, material: built.material, ..c.clone() } == *built;
-        let done = if lights_only {
+        let environment_only = Choices { environment: built.environment, ..c.clone() } == *built;
+        let done = if environment_only {
+            let (intensity, degrees) = c.environment.unwrap_or((1.0, 0.0));
+            matches!(renderer.set_environment_view(intensity, degrees.to_radians()), Ok(true))
+        } else if lights_only {
             // With markers shown the objects change with the lights: their markers too.
             let markers = self.show_lights;
             let changed = build(c, (extent.width, extent.height)).and_then(|(scene, _)| {

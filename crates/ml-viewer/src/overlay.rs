@@ -29,6 +29,8 @@ pub struct Choices {
     /// Whether the light grid marks the cells near the surfaces (the command line's choice;
     /// auto decides again as lights and size change).
     pub light_grid_marks: LightGridMarks,
+    /// The environment's intensity and turn in degrees (None: the scene has none).
+    pub environment: Option<(f32, f32)>,
 }
 
 impl Choices {
@@ -48,6 +50,7 @@ impl Choices {
             lights: built.scene.lights.len() as u64,
             layout: request.layout,
             radius: request.radius.map_or_else(|| built.scene.lights.first().map_or(SEED_RADIUS, |l| l.position_radius[3]), |r| r.max),
+            environment: built.scene.environment.as_ref().map(|e| (e.intensity, e.rotation.to_degrees())),
             light_grid_marks,
         }
     }
@@ -59,6 +62,9 @@ impl Choices {
         let mut r = SceneRequest { shading: Some(self.settings.shading), ..base.clone() };
         if let SceneSource::Seed { object, material } = &mut r.source {
             (*object, *material) = (self.object, self.material);
+        }
+        if let Some((intensity, degrees)) = self.environment {
+            (r.environment_intensity, r.environment_rotation_deg) = (Some(intensity), Some(degrees));
         }
         if (self.lights, self.layout, self.radius) != (initial.lights, initial.layout, initial.radius) {
             (r.lights, r.layout) = (Some(self.lights), self.layout);
@@ -197,6 +203,10 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         }
         combo(ui, "Layout", &mut choices.layout, &LightLayout::ALL, |l| l.name());
         ui.add(Slider::new(&mut choices.radius, 0.1..=100.0).logarithmic(true).text("light radius"));
+        if let Some((intensity, degrees)) = &mut choices.environment {
+            ui.add(Slider::new(intensity, 0.0..=16.0).text("environment"));
+            ui.add(Slider::new(degrees, -180.0..=180.0).suffix("°").text("turned"));
+        }
         ui.horizontal(|ui| {
             let mut auto = choices.settings.exposure == Exposure::Auto;
             ui.checkbox(&mut auto, "auto");
@@ -301,6 +311,7 @@ mod tests {
             layout: LightLayout::Grid,
             radius: 3.0,
             light_grid_marks: LightGridMarks::Auto,
+            environment: None,
         }
     }
 
@@ -334,5 +345,15 @@ mod tests {
         let teapot = Choices { object: MeshKind::Teapot, material: copper, ..start.clone() }.request(&base, &start);
         assert_eq!(teapot.source, SceneSource::Seed { object: MeshKind::Teapot, material: copper });
         assert_eq!(teapot.lights, None);
+    }
+
+    #[test]
+    fn an_environments_intensity_and_turn_go_into_the_request() {
+        let base = SceneRequest::new(SceneSource::File("a.glb".into()));
+        let start = Choices { environment: Some((1.0, 0.0)), ..initial() };
+        let turned = Choices { environment: Some((2.0, 90.0)), ..start.clone() }.request(&base, &start);
+        assert_eq!((turned.environment_intensity, turned.environment_rotation_deg), (Some(2.0), Some(90.0)));
+        let none = initial().request(&base, &initial());
+        assert_eq!((none.environment_intensity, none.environment_rotation_deg), (None, None));
     }
 }

@@ -342,3 +342,20 @@ pub fn fetch_sampler(ctx: &Context) -> Result<vk::Sampler> {
     // SAFETY: valid device and create info.
     unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")
 }
+
+/// A sampler (clamp-to-border samples read opaque white); `compare`: a depth comparison.
+pub fn sampler(ctx: &Context, address: vk::SamplerAddressMode, filter: vk::Filter, compare: Option<vk::CompareOp>) -> Result<vk::Sampler> {
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(filter)
+        .min_filter(filter)
+        .mipmap_mode(if filter == vk::Filter::LINEAR { vk::SamplerMipmapMode::LINEAR } else { vk::SamplerMipmapMode::NEAREST })
+        .address_mode_u(address)
+        .address_mode_v(address)
+        .address_mode_w(address)
+        .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE)
+        .compare_enable(compare.is_some())
+        .compare_op(compare.unwrap_or(vk::CompareOp::ALWAYS))
+        .max_lod(vk::LOD_CLAMP_NONE);
+    // SAFETY: valid device and create info.
+    unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")
+}

@@ -157,7 +157,8 @@ fn exposure_scales_the_lit_image() {
     assert!(b < a * 0.75, "EV -2 should darken the image: {b} against {a}");
 }
 
-/// A scene file is exposed automatically unless `--exposure` says otherwise; the built-in
+/// A scene file is exposed automatically unless `--exposure` says otherwise (or it is a pbr
+/// scene without lights, which the default rig and sky light at EV 0); the built-in
 /// scenes are not (their images stay), and `--exposure auto` meters them too. The table says
 /// which EV auto exposure settled on.
 #[test]
@@ -174,7 +175,11 @@ fn files_are_exposed_automatically_and_built_in_scenes_on_request() {
         String::from_utf8_lossy(&run.stdout).into_owned()
     };
     let metered = |table: &str| table.lines().any(|l| l.starts_with("exposure") && l.contains("auto:") && l.contains("EV"));
-    assert!(metered(&render(&["--scene", scene.to_str().unwrap()])), "a scene file is metered by default");
+    assert!(metered(&render(&["--scene", scene.to_str().unwrap(), "--environment", "none"])), "a scene file is metered by default");
+    // Unless it has no lights of its own and the default rig and sky light it (the pbr model):
+    // then it is shown at EV 0, as a glTF viewer shows it.
+    let pbr = ["--scene", scene.to_str().unwrap(), "--shading", "pbr"];
+    assert!(!metered(&render(&pbr)), "the default sky and rig are shown at EV 0");
     assert!(!metered(&render(&["--scene", scene.to_str().unwrap(), "--exposure", "0"])), "--exposure 0 fixes it");
     assert!(!metered(&render(&[])), "the seed scene keeps EV 0");
     assert!(metered(&render(&["--exposure", "auto", "--shading", "blinn-phong"])), "--exposure auto meters the seed scene");
@@ -217,7 +222,8 @@ fn a_white_model_without_lights_renders_white_and_its_camera_row_is_ready_to_use
     };
     let (plain, palette, again) = (dir.join("plain.png"), dir.join("palette.png"), dir.join("again.png"));
     let table = render(&plain, &[]);
-    render(&palette, &["--light-colors", "palette"]);
+    // The palette's lights alone (the default sky would light it too).
+    render(&palette, &["--light-colors", "palette", "--environment", "none"]);
     let (white, tinted) = (saturation(&plain), saturation(&palette));
     println!("mean saturation: {white:.3} with the default rig, {tinted:.3} with the palette");
     assert!(white <= 0.15, "the default rig tints a white model: mean saturation {white}");

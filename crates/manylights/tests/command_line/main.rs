@@ -6,6 +6,7 @@ mod arguments;
 mod bench;
 mod cli;
 mod common;
+mod environment;
 mod first_hour;
 mod import_circles;
 mod outputs;

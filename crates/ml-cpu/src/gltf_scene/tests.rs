@@ -690,6 +690,6 @@ fn a_decoder_that_stops_is_an_error_not_a_crash() {
         }
     }
     // Any panic inside is answered None; a panic outside still unwinds.
-    assert_eq!(guarded_decode(|| -> u32 { panic!("inside") }), None);
+    assert_eq!(crate::image_decode::guarded_decode(|| -> u32 { panic!("inside") }), None);
     assert!(std::panic::catch_unwind(|| panic!("outside")).is_err());
 }

@@ -10,11 +10,11 @@
 
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::error::RenderError;
-use crate::scene::textures::sampler;
+use crate::report::FeatureStats;
 use ml_cpu::environment::Environment;
 use ml_cpu::gpu_types::EnvironmentData;
 use ml_shaders::Shader;
-use ml_vk::image::{image_transition, texture_with, ImageShape};
+use ml_vk::image::{image_transition, sampler, texture_with, ImageShape};
 use ml_vk::{shader, vk, Buffer, Context, GpuTimer, Image, VkError, VkResultExt};
 
 /// Mip levels of the specular cube: roughness level / (levels − 1), 0 (a mirror) to 1.
@@ -44,10 +44,32 @@ pub struct EnvironmentMaps {
     /// EnvironmentData: the coefficients (written by the prefilter), rotation and intensity.
     pub buffer: Buffer,
     sampler: vk::Sampler,
-    /// Texels per side of the specular cube's level 0 (0: no environment).
+    /// What the prefiltering made and took (None: no environment).
+    pub stats: Option<EnvironmentStats>,
+}
+
+/// The environment's row of the timing table.
+#[derive(Clone, Copy, Debug)]
+pub struct EnvironmentStats {
+    /// The image's size and its cube's face.
+    pub image: (u32, u32),
     pub face_size: u32,
-    /// GPU milliseconds of the prefiltering (None: no environment, or no timestamps).
+    /// GPU milliseconds of the prefiltering (None: no timestamps).
     pub prefilter_ms: Option<f64>,
+}
+
+impl FeatureStats for EnvironmentStats {
+    fn rows(&self) -> Vec<(&'static str, String)> {
+        let ms = self.prefilter_ms.map_or_else(|| "not timed".into(), |ms| format!("{ms:.3} ms"));
+        let (w, h) = self.image;
+        vec![(
+            "environment",
+            format!(
+                "{w}x{h} image, prefiltered once at load in {ms} (a {f}² cube; a {SPECULAR_SIZE}² specular cube of {SPECULAR_LEVELS} roughness levels; a {BRDF_TABLE_SIZE}² BRDF table; 9 diffuse coefficients)",
+                f = self.face_size
+            ),
+        )]
+    }
 }
 
 /// The face size of the cube an equirectangular image of `width` texels becomes: about as
@@ -64,8 +86,7 @@ impl EnvironmentMaps {
             brdf: Image::null(),
             buffer: Buffer::null(),
             sampler: vk::Sampler::null(),
-            face_size: 0,
-            prefilter_ms: None,
+            stats: None,
         };
         ml_vk::build(ctx, maps, |m| {
             m.sampler = sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE, vk::Filter::LINEAR, None)?;
@@ -102,15 +123,7 @@ impl EnvironmentMaps {
         self.specular = Image::new(ctx, "environment specular", specular, FORMAT, usage, vk::ImageAspectFlags::COLOR)?;
         let table = vk::Extent2D { width: BRDF_TABLE_SIZE, height: BRDF_TABLE_SIZE };
         self.brdf = Image::new_2d(ctx, "environment brdf table", table, FORMAT, usage, vk::ImageAspectFlags::COLOR)?;
-        let rotation = env.to_image();
-        let column = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
-        let data = EnvironmentData {
-            sh: [[0.0; 4]; 9],
-            to_image: [column(rotation.x_axis), column(rotation.y_axis), column(rotation.z_axis)],
-            params: [env.intensity, (SPECULAR_LEVELS - 1) as f32, 0.0, 0.0],
-        };
-        self.buffer = data_buffer(ctx, &data)?;
-        self.face_size = size;
+        self.buffer = data_buffer(ctx, &view_data(env))?;
         let texels: Vec<[f32; 4]> = image.texels.iter().map(|t| [t[0], t[1], t[2], 1.0]).collect();
         let flat = ImageShape {
             extent: vk::Extent2D { width: image.width, height: image.height },
@@ -132,8 +145,27 @@ impl EnvironmentMaps {
         work.destroy(ctx);
         source.destroy(ctx);
         equirect.destroy(ctx);
-        self.prefilter_ms = done?;
+        self.stats = Some(EnvironmentStats { image: (image.width, image.height), face_size: size, prefilter_ms: done? });
         Ok(())
+    }
+
+    /// Turn and scale the environment as `env` says (its image unchanged), with no frame in
+    /// flight: only the CPU's part of EnvironmentData is written, the coefficients stay.
+    pub fn set_view(&self, ctx: &Context, env: &Environment) -> Result<(), VkError> {
+        let data = view_data(env);
+        let from = std::mem::offset_of!(EnvironmentData, to_image);
+        let bytes = &bytemuck::bytes_of(&data)[from..];
+        ml_vk::commands::one_shot(ctx, |cmd| {
+            let compute = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
+            // SAFETY: recording; the range lies within the buffer and is a multiple of 4 bytes.
+            unsafe { ctx.device.cmd_update_buffer(cmd, self.buffer.raw, from as u64, bytes) };
+            ml_vk::commands::memory_barrier(
+                ctx,
+                cmd,
+                (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE),
+                (compute, vk::AccessFlags::SHADER_READ),
+            );
+        })
     }
 
     /// What set 1's environment bindings point at, by the names environment.glsl gives them.
@@ -163,6 +195,17 @@ impl EnvironmentMaps {
 impl ml_vk::Release for EnvironmentMaps {
     fn release(&mut self, ctx: &Context) {
         self.destroy(ctx);
+    }
+}
+
+/// EnvironmentData without its coefficients (the prefilter's part): `env`'s turn and intensity.
+fn view_data(env: &Environment) -> EnvironmentData {
+    let rotation = env.to_image();
+    let column = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
+    EnvironmentData {
+        sh: [[0.0; 4]; 9],
+        to_image: [column(rotation.x_axis), column(rotation.y_axis), column(rotation.z_axis)],
+        params: [env.intensity, (SPECULAR_LEVELS - 1) as f32, 0.0, 0.0],
     }
 }
 

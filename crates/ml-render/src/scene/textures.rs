@@ -11,8 +11,8 @@ use crate::scene::omni_shadow::{self, OmniShadows};
 use crate::scene::sun_shadow::{draw_shadow_map, render_shadow_map, ShadowInputs};
 use ml_cpu::textures;
 use ml_vk::descriptors::allocate_set;
-use ml_vk::image::{texture_with, ImageShape};
-use ml_vk::{vk, Context, Image, VkError, VkResultExt};
+use ml_vk::image::{sampler, texture_with, ImageShape};
+use ml_vk::{vk, Context, Image, VkError};
 
 /// Texels per side of the sun's shadow map (blinn-phong).
 pub const SHADOW_MAP_SIZE: u32 = 2048;
@@ -196,26 +196,4 @@ fn depth_filter(ctx: &Context, format: vk::Format) -> vk::Filter {
     } else {
         vk::Filter::NEAREST
     }
-}
-
-/// A sampler (clamp-to-border samples read opaque white); `compare`: a depth comparison.
-pub(crate) fn sampler(
-    ctx: &Context,
-    address: vk::SamplerAddressMode,
-    filter: vk::Filter,
-    compare: Option<vk::CompareOp>,
-) -> Result<vk::Sampler, VkError> {
-    let info = vk::SamplerCreateInfo::default()
-        .mag_filter(filter)
-        .min_filter(filter)
-        .mipmap_mode(if filter == vk::Filter::LINEAR { vk::SamplerMipmapMode::LINEAR } else { vk::SamplerMipmapMode::NEAREST })
-        .address_mode_u(address)
-        .address_mode_v(address)
-        .address_mode_w(address)
-        .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE)
-        .compare_enable(compare.is_some())
-        .compare_op(compare.unwrap_or(vk::CompareOp::ALWAYS))
-        .max_lod(vk::LOD_CLAMP_NONE);
-    // SAFETY: valid device and create info.
-    unsafe { ctx.device.create_sampler(&info, None) }.ctx("vkCreateSampler")
 }

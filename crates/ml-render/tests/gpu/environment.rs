@@ -102,3 +102,28 @@ fn every_technique_draws_the_same_environment_light() {
         assert!(worst <= 1, "{:?} differs from forward by {worst}/255", s.technique);
     }
 }
+
+/// The viewer turns and scales the environment in place (no new prefiltering): the image is
+/// the one a renderer made for the turned, brighter environment draws.
+#[test]
+fn turning_the_environment_in_place_equals_a_renderer_made_turned() {
+    use ml_vk::{Context, ContextDesc};
+    use std::sync::atomic::Ordering;
+    let scene = sky_sphere(Material { albedo: Vec3::new(0.9, 0.9, 0.9), roughness: 0.3, metallic: 0.5 }, 0.0);
+    let mut turned = scene.clone();
+    let env = turned.environment.as_mut().expect("set");
+    (env.intensity, env.rotation) = (2.0, 1.0);
+    let settings = RenderSettings { width: 64, height: 64, ..pbr(Technique::Visibility) };
+    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a validated device");
+    let counter = ctx.validation_counter();
+    let made = ml_render::Renderer::new(&ctx, turned, settings).expect("renderer").render().expect("render");
+    let mut renderer = ml_render::Renderer::new(&ctx, scene, settings).expect("renderer");
+    let before = renderer.render().expect("render");
+    assert!(renderer.set_environment_view(2.0, 1.0).expect("changed"));
+    let after = renderer.render().expect("render");
+    drop(renderer);
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
+    assert!(common::max_difference(&before, &after).1 > 500, "the turn changed the image");
+    assert_eq!(common::max_difference(&made, &after), (0, 0), "in place = made turned");
+}

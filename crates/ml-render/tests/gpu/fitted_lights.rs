@@ -7,6 +7,7 @@
 
 use crate::common;
 
+use ml_cpu::environment::EnvironmentSource;
 use ml_cpu::gltf_writer::{mesh_primitive, GltfWriter};
 use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::mesh::MeshKind;
@@ -60,8 +61,9 @@ fn every_kind_at_every_size_is_lit_inside_one_band() {
     // None: the default rig of a file without lights.
     let layouts = [None, Some(LightLayout::Grid), Some(LightLayout::Random), Some(LightLayout::Surface)];
     let mut outside = Vec::new();
+    // The point lights alone: without the built-in sky a pbr file without lights gets.
     let render = |request: SceneRequest| {
-        let built = request.build().expect("the file builds");
+        let built = SceneRequest { environment: Some(EnvironmentSource::Off), ..request }.build().expect("the file builds");
         let settings = RenderSettings { shading: built.shading, ..RenderSettings::new(Technique::Forward, 96, 64) };
         let lights = built.scene.lights.len();
         (Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render()).expect("render"), lights)
