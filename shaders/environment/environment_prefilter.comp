@@ -5,6 +5,7 @@
 // linearly with the level. GGX importance sampling with Hammersley points, each sample read
 // from the source cube's mip whose texel covers the sample's share of the lobe (Karis 2013,
 // "filtered importance sampling"), so a few hundred samples give a smooth lobe.
+#include "common/common.glsl"
 #include "environment/environment_maps.glsl"
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
@@ -29,7 +30,8 @@ void main() {
         return;
     }
     vec3 n = normalize(cube_direction(p.z, (vec2(p.xy) + 0.5) / vec2(face_size)));
-    float roughness = prefilter.roughness;
+    // Through opaque_uniform: lavapipe would compile the shader anew for every level's push.
+    float roughness = opaque_uniform(prefilter.roughness);
     if (roughness == 0.0) {
         imageStore(specular_level, p, vec4(textureLod(source, n, 0.0).rgb, 1.0));
         return;
@@ -37,7 +39,7 @@ void main() {
     float a2 = roughness * roughness * roughness * roughness;
     float source_size = float(textureSize(source, 0).x);
     float texel_solid_angle = 4.0 * ENV_PI / (6.0 * source_size * source_size);
-    uint samples = prefilter.samples;
+    uint samples = opaque_uniform(prefilter.samples);
     vec3 sum = vec3(0.0);
     float weight = 0.0;
     for (uint i = 0u; i < samples; ++i) {

@@ -365,7 +365,7 @@ pub fn environment_light(
     let r = (2.0 * n.dot(v) * n - v).normalize();
     let diffuse = albedo * (1.0 - metallic) * sh9_diffuse_at(sh, to_image * n) * occlusion;
     let f0 = Vec3::splat(0.04).lerp(albedo, metallic);
-    let ab = brdf_integral(n_dot_v, roughness, 1024);
+    let ab = brdf_integral(n_dot_v, roughness, 512);
     let specular = prefiltered_radiance(&env.image, to_image * r, roughness) * (f0 * ab.x + Vec3::splat(ab.y));
     (diffuse + specular * specular_occlusion(n_dot_v, occlusion, roughness)) * env.intensity
 }

@@ -158,8 +158,19 @@ fn no_shader_declares_two_resources_at_one_binding() {
 
 #[test]
 fn files_lie_in_feature_folders_and_names_are_unique() {
-    let folders =
-        ["common", "shading", "visibility", "shadows", "clusters", "exposure", "probe", "transparency", "light_stats", "light_grid"];
+    let folders = [
+        "common",
+        "shading",
+        "visibility",
+        "shadows",
+        "clusters",
+        "exposure",
+        "probe",
+        "transparency",
+        "light_stats",
+        "light_grid",
+        "environment",
+    ];
     let mut names: Vec<&str> = Vec::new();
     for shader in ALL {
         let (folder, name) = shader.file.split_once('/').unwrap_or_else(|| panic!("{} is in no folder", shader.file));

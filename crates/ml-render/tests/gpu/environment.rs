@@ -2,7 +2,7 @@
 //! (no point light reaches it), pbr model. For every pixel whose ray hits the analytic sphere,
 //! the GPU pixel must lie within 2/255 of the split sum the CPU computes at that point
 //! (ml_cpu::environment::environment_light: the coefficients and the GGX-weighted radiance
-//! summed over every texel of the image, the BRDF integral with 1,024 samples) — over the
+//! summed over every texel of the image, the BRDF integral with the table's 512 samples) — over the
 //! range the reference takes with the normal tilted by the tessellation's error, as in the
 //! point-light reference test. The GPU resamples the image into a cube, prefilters six
 //! roughness levels by importance sampling and interpolates between them; the sky is smooth,
