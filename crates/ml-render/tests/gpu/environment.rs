@@ -52,8 +52,9 @@ fn compare(material: Material, rotation: f32) {
     let sh = diffuse_sh9(&env.image);
     let cam = &scene.camera;
     let (mut compared, mut outside, mut worst) = (0u32, 0u32, 0u8);
+    // Every other pixel, a checkerboard: the reference sums the whole image per point.
     for y in 0..SIZE {
-        for x in 0..SIZE {
+        for x in (y % 2..SIZE).step_by(2) {
             let (origin, dir) = cam.pixel_ray(x, y, SIZE, SIZE);
             let Some(p) = hit_unit_sphere(origin, dir) else { continue };
             let n = p.normalize();
@@ -77,7 +78,7 @@ fn compare(material: Material, rotation: f32) {
         }
     }
     println!("{compared} pixels compared: max |gpu − cpu| {worst}/255, {outside} channels outside the tolerance");
-    assert!(compared > 2_000, "the sphere should cover much of the image, got {compared} pixels");
+    assert!(compared > 1_800, "the sphere should cover much of the image, got {compared} pixels");
     assert_eq!(outside, 0, "channels outside the reference range ± {MAX_DIFF}/255");
 }
 
