@@ -6,6 +6,7 @@
 // from the source cube's mip whose texel covers the sample's share of the lobe (Karis 2013,
 // "filtered importance sampling"), so a few hundred samples give a smooth lobe.
 #include "common/common.glsl"
+#include "common/seed_brdf.glsl"
 #include "environment/environment_maps.glsl"
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
@@ -17,11 +18,6 @@ layout(push_constant) uniform Prefilter {
     float roughness;
     uint samples;
 } prefilter;
-
-float d_ggx(float n_dot_h, float a2) {
-    float denom = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
-    return a2 / (ENV_PI * denom * denom);
-}
 
 void main() {
     ivec3 p = ivec3(gl_GlobalInvocationID);
@@ -36,7 +32,6 @@ void main() {
         imageStore(specular_level, p, vec4(textureLod(source, n, 0.0).rgb, 1.0));
         return;
     }
-    float a2 = roughness * roughness * roughness * roughness;
     float source_size = float(textureSize(source, 0).x);
     float texel_solid_angle = 4.0 * ENV_PI / (6.0 * source_size * source_size);
     uint samples = opaque_uniform(prefilter.samples);
@@ -48,7 +43,7 @@ void main() {
         float n_dot_l = dot(n, l);
         if (n_dot_l > 0.0) {
             // pdf(l) = D(h)·(n·h) / (4·(v·h)) = D(h) / 4 with v = n.
-            float pdf = d_ggx(max(dot(n, h), 0.0), a2) / 4.0;
+            float pdf = d_ggx(max(dot(n, h), 0.0), roughness) / 4.0;
             float sample_solid_angle = 1.0 / (float(samples) * pdf + 1e-6);
             float lod = max(0.5 * log2(sample_solid_angle / texel_solid_angle), 0.0);
             sum += textureLod(source, l, lod).rgb * n_dot_l;

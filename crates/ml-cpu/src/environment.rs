@@ -6,6 +6,7 @@
 //! module is the CPU reference the image tests compare it with, and makes the built-in sky.
 
 use crate::files::read_regular;
+use crate::shading::d_ggx;
 use glam::{Mat3, Vec2, Vec3};
 use std::f32::consts::PI;
 use std::path::Path;
@@ -278,13 +279,6 @@ pub fn diffuse_sh9(image: &EnvironmentImage) -> [Vec3; 9] {
 /// What a white Lambert surface facing `n` reflects under coefficients `sh` (`diffuse_sh9`).
 pub fn sh9_diffuse_at(sh: &[Vec3; 9], n: Vec3) -> Vec3 {
     sh.iter().zip(sh9_basis(n)).map(|(c, y)| *c * y).sum::<Vec3>().max(Vec3::ZERO)
-}
-
-/// GGX's normal distribution D(n·h) for roughness r (α = r²): the point lights' own.
-fn d_ggx(n_dot_h: f32, roughness: f32) -> f32 {
-    let a2 = roughness.powi(4);
-    let denom = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
-    a2 / (PI * denom * denom)
 }
 
 /// The radiance reflected towards R by a GGX lobe of `roughness` about R (the split sum's first

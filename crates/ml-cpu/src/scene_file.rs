@@ -5,7 +5,7 @@
 //! one error naming the file and, where the parser knows it, the line.
 
 use crate::camera::{clip_planes_for, Camera, DEFAULT_FOV_Y_DEG};
-use crate::environment::{Environment, EnvironmentSource, MAX_ENVIRONMENT_INTENSITY, MAX_ENVIRONMENT_ROTATION_DEG};
+use crate::environment::{Environment, EnvironmentSource, MAX_ENVIRONMENT_ROTATION_DEG};
 use crate::error::Number;
 use crate::files::{read_regular, ReadError};
 use crate::framing::{frame_scene, framing_distance, DEFAULT_ASPECT};
@@ -358,7 +358,7 @@ fn environment(e: &FileEnvironment, base: Option<&Path>) -> Result<Option<Enviro
     };
     let Some(mut env) = source.load().map_err(|err| Problem::Environment(err.to_string()))? else { return Ok(None) };
     if let Some(i) = e.intensity {
-        env.intensity = within("[environment] intensity", non_negative("[environment] intensity", i)?, 0.0..=MAX_ENVIRONMENT_INTENSITY)?;
+        env.intensity = intensity("[environment] intensity", i)?;
     }
     if let Some(r) = e.rotation_deg {
         let range = -MAX_ENVIRONMENT_ROTATION_DEG..=MAX_ENVIRONMENT_ROTATION_DEG;

@@ -7,7 +7,7 @@ use crate::material::Material;
 use glam::Vec3;
 use std::f32::consts::PI;
 
-fn d_ggx(n_dot_h: f32, roughness: f32) -> f32 {
+pub(crate) fn d_ggx(n_dot_h: f32, roughness: f32) -> f32 {
     let alpha = roughness * roughness;
     let alpha2 = alpha * alpha;
     let denom = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;

@@ -272,9 +272,8 @@ impl<'a> Renderer<'a> {
     pub fn set_environment_view(&mut self, intensity: f32, rotation: f32) -> Result<bool, RenderError> {
         let Some(env) = &mut self.scene.environment else { return Ok(false) };
         (env.intensity, env.rotation) = (intensity, rotation);
-        let env = env.clone();
         self.ctx.wait_idle()?;
-        self.gpu.environment.set_view(self.ctx, &env)?;
+        self.gpu.environment.set_view(self.ctx, env)?;
         Ok(true)
     }
 

@@ -146,7 +146,7 @@ impl EnvironmentMaps {
                 return Err(e.into());
             }
         };
-        let mut work = Prefilter::new(ctx);
+        let mut work = Prefilter::new();
         let done = work.record(ctx, (&equirect, &source), (&self.specular, &self.brdf, self.buffer.raw), self.sampler);
         work.destroy(ctx);
         source.destroy(ctx);
@@ -251,7 +251,7 @@ const BRDF: usize = 3;
 const SPECULAR: usize = 4;
 
 impl Prefilter {
-    fn new(_ctx: &Context) -> Prefilter {
+    fn new() -> Prefilter {
         Prefilter {
             layouts: Vec::new(),
             pipeline_layouts: Vec::new(),

@@ -39,12 +39,6 @@ fn pbr(technique: Technique) -> RenderSettings {
     RenderSettings { shading: ShadingModel::Pbr, ..RenderSettings::new(technique, SIZE, SIZE) }
 }
 
-fn hit_unit_sphere(origin: Vec3, dir: Vec3) -> Option<Vec3> {
-    let b = origin.dot(dir);
-    let disc = b * b - (origin.length_squared() - 1.0);
-    (disc >= 0.0).then(|| origin + dir * (-b - disc.sqrt()))
-}
-
 fn compare(material: Material, rotation: f32) {
     let scene = sky_sphere(material, rotation);
     let out = common::render(scene.clone(), pbr(Technique::Forward));
@@ -56,7 +50,7 @@ fn compare(material: Material, rotation: f32) {
     for y in 0..SIZE {
         for x in (y % 2..SIZE).step_by(2) {
             let (origin, dir) = cam.pixel_ray(x, y, SIZE, SIZE);
-            let Some(p) = hit_unit_sphere(origin, dir) else { continue };
+            let Some(p) = common::hit_unit_sphere(origin, dir) else { continue };
             let n = p.normalize();
             let v = -dir;
             if n.dot(v) < 0.2 {

@@ -46,14 +46,6 @@ fn sphere_scene(material: Material) -> Scene {
     Scene::new(vec![Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, material)], lights, camera)
 }
 
-/// First intersection of a ray with the unit sphere at the origin.
-fn hit_unit_sphere(origin: Vec3, dir: Vec3) -> Option<Vec3> {
-    let b = origin.dot(dir);
-    let c = origin.length_squared() - 1.0;
-    let disc = b * b - c;
-    (disc >= 0.0).then(|| origin + dir * (-b - disc.sqrt()))
-}
-
 fn compare(material: Material, directional: &[DirectionalLight], orthographic: Option<f32>) {
     let mut scene = sphere_scene(material);
     scene.directional = directional.to_vec();
@@ -67,7 +59,7 @@ fn compare(material: Material, directional: &[DirectionalLight], orthographic: O
     for y in 0..SIZE {
         for x in 0..SIZE {
             let (origin, dir) = cam.pixel_ray(x, y, SIZE, SIZE);
-            let Some(p) = hit_unit_sphere(origin, dir) else { continue };
+            let Some(p) = common::hit_unit_sphere(origin, dir) else { continue };
             let n = p.normalize();
             if n.dot(-dir) < 0.2 {
                 continue;

@@ -68,6 +68,14 @@ pub fn pixels_beyond(a: &RenderOutput, b: &RenderOutput, limit: u8) -> usize {
     a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)).filter(|(pa, pb)| pa.iter().zip(*pb).any(|(x, y)| x.abs_diff(*y) > limit)).count()
 }
 
+/// First intersection of a ray with the unit sphere at the origin (the reference tests' sphere).
+pub fn hit_unit_sphere(origin: glam::Vec3, dir: glam::Vec3) -> Option<glam::Vec3> {
+    let b = origin.dot(dir);
+    let c = origin.length_squared() - 1.0;
+    let disc = b * b - c;
+    (disc >= 0.0).then(|| origin + dir * (-b - disc.sqrt()))
+}
+
 /// Where a pixel `got` of a tessellated surface leaves its CPU reference: `shade` (the
 /// reference's 8-bit colour for a normal) at the exact normal `n` is `expected`; each channel
 /// may take any value the reference takes with `n` tilted by `tilt` rad (the facets' error),
