@@ -78,6 +78,8 @@ struct FrameUniforms {
 // once per environment — the coefficients by its prefilter on the GPU, the rest by the CPU.
 struct EnvironmentData {
     vec4 sh[9];        // rgb: what a white Lambert surface reflects, Σ sh[k]·Y_k(n) (image frame)
+    float sheen_albedo[256]; // the sheen's directional albedo E(n·v, roughness), 16×16 entries
+                             // (material_lobes.glsl; there with or without an image)
     vec4 to_image[3];  // columns of the rotation from world directions to the image's
     vec4 params;       // x: intensity (0: no environment), y: the specular cube's last level
 };
@@ -138,6 +140,9 @@ struct ObjectData {
                            // alpha-mask buffer; z, w: that texture's width, height
     vec4 uv_transform[2];  // texture coordinates as the textures see them: uv' = M·uv + t,
                            // M's columns in [0].xy and [0].zw, t in [1].xy (transform_uv)
+    vec4 lobes[3];         // glTF's PBR extensions (material_lobes.glsl): (dielectric F₀,
+                           // specular factor), (clear coat, its roughness, unlit, 0), (sheen
+                           // colour, sheen roughness)
 };
 
 // The texture coordinates an object's textures see at mesh coordinates `uv`: its

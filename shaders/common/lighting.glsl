@@ -17,6 +17,7 @@
 #include "clusters/cluster.glsl"
 #include "common/world_from_depth.glsl"
 #include "environment/environment.glsl"
+#include "common/material_lobes.glsl"
 #ifdef LIGHT_GRID
 #include "light_grid/light_grid.glsl"
 #endif
@@ -81,13 +82,17 @@ float spot_cone(uint i, PointLight l, vec3 world) {
     }
 
 // What a surface point is shaded with: the object's material (ObjectData's or ObjectPush's
-// vectors) times the factors its textures give (Surface, or their copy in the G-buffer).
+// vectors) times the factors its textures give (Surface, or their copy in the G-buffer), and
+// under MATERIAL_LOBES its lobes (material_lobes.glsl).
 struct PointMaterial {
     vec3 albedo;
     float roughness;
     float metallic;
     float occlusion;
     vec3 emission;
+    vec4 specular;
+    vec4 coat;
+    vec4 sheen;
 };
 
 // The roughness of a surface whose normals spread by `spread` (surface.glsl normal_spread)
@@ -101,9 +106,15 @@ float widened_roughness(float roughness, float spread) {
     return sqrt(sqrt(min(alpha * alpha + 2.0 * spread * spread, 1.0)));
 }
 
+// `object`: its index in the object buffer (whose lobes it reads).
 PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive, vec4 albedo_occlusion, vec2 roughness_metallic,
-                             vec3 emissive_factor, float normal_spread) {
+                             vec3 emissive_factor, float normal_spread, uint object) {
     PointMaterial m;
+    if (MATERIAL_LOBES) {
+        m.specular = objects[object].lobes[0];
+        m.coat = objects[object].lobes[1];
+        m.sheen = objects[object].lobes[2];
+    }
     m.albedo = albedo_roughness.rgb * albedo_occlusion.rgb;
     m.roughness = widened_roughness(albedo_roughness.a * roughness_metallic.x, normal_spread);
     m.metallic = material.x * roughness_metallic.y;
@@ -113,11 +124,13 @@ PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive
 }
 
 // Linear colour of a surface point: every light that reaches it plus what the model adds
-// (seed, pbr: ambient, times `occlusion`, or pbr's environment light; blinn-phong: ambient, sun,
-// spot, reflection) plus
-// the light it gives off (`emission`). `frag_xy` is the pixel centre (gl_FragCoord.xy),
-// which picks the cluster.
-vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metallic, float occlusion, vec3 emission, vec2 frag_xy) {
+// (seed, pbr: ambient, times the occlusion, or pbr's environment light; blinn-phong: ambient,
+// sun, spot, reflection) plus the light it gives off (`emission`); pbr with lobes as
+// material_lobes.glsl has it (an unlit surface: its albedo). `frag_xy` is the pixel centre
+// (gl_FragCoord.xy), which picks the cluster.
+vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
+    vec3 albedo = m.albedo, emission = m.emission;
+    float roughness = m.roughness, metallic = m.metallic, occlusion = m.occlusion;
     // Towards the eye; an orthographic camera looks along its axis everywhere (the view
     // matrix's third row is the eye's +Z, its back, in world space).
     vec3 back = vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
@@ -132,6 +145,21 @@ vec3 shade_point(vec3 world, vec3 n, vec3 albedo, float roughness, float metalli
         return bp_scene_lights(world, n, v, albedo, r0, shininess) + lo + emission;
     }
     if (MODEL_PBR) {
+        // Nested, not `&&`: a constant expression of two specialization constants is an
+        // OpSpecConstantOp the SPIR-V reflection cannot evaluate.
+        if (MATERIAL_LOBES) {
+            if (m.coat.z != 0.0) {
+                return albedo;
+            }
+#define LOBED_LIGHT(l) shadowed(lobed_point_light(l, world, n, v, albedo, roughness, metallic, m.specular, m.coat, m.sheen), l, world, n)
+            SUM_LIGHTS(lo, LOBED_LIGHT)
+            SUM_DIRECTIONAL(lo, LOBED_LIGHT)
+            vec3 emitted = emission * coat_transmittance(n, v, m.coat);
+            if (ENVIRONMENT) {
+                return lobed_environment_light(n, v, albedo, roughness, metallic, occlusion, m.specular, m.coat, m.sheen) + lo + emitted;
+            }
+            return albedo * frame.ambient * occlusion * coat_transmittance(n, v, m.coat) + lo + emitted;
+        }
 #define PBR_LIGHT(l) shadowed(pbr_point_light(l, world, n, v, albedo, roughness, metallic), l, world, n)
         SUM_LIGHTS(lo, PBR_LIGHT)
         SUM_DIRECTIONAL(lo, PBR_LIGHT)

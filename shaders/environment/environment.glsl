@@ -34,6 +34,17 @@ float specular_occlusion(float n_dot_v, float occlusion, float roughness) {
     return clamp(pow(n_dot_v + occlusion, exp2(-16.0 * roughness - 1.0)) - 1.0 + occlusion, 0.0, 1.0);
 }
 
+// The BRDF table's (A, B) at n·v and roughness.
+vec2 environment_brdf_at(float n_dot_v, float roughness) {
+    vec2 table = vec2(textureSize(environment_brdf, 0));
+    return textureLod(environment_brdf, (vec2(n_dot_v, roughness) * (table - 1.0) + 0.5) / table, 0.0).xy;
+}
+
+// The radiance prefiltered for `roughness` towards image direction `d`.
+vec3 environment_prefiltered(vec3 d, float roughness) {
+    return textureLod(environment_specular, d, roughness * environment.params.y).rgb;
+}
+
 // `n`, `v`: unit normal and direction towards the eye, in the world.
 vec3 environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion) {
     mat3 to_image = mat3(environment.to_image[0].xyz, environment.to_image[1].xyz, environment.to_image[2].xyz);
@@ -41,9 +52,8 @@ vec3 environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metal
     vec3 r = normalize(2.0 * dot(n, v) * n - v);
     vec3 diffuse = albedo * (1.0 - metallic) * environment_diffuse(to_image * n) * occlusion;
     vec3 f0 = mix(vec3(0.04), albedo, metallic);
-    vec2 table = vec2(textureSize(environment_brdf, 0));
-    vec2 ab = textureLod(environment_brdf, (vec2(n_dot_v, roughness) * (table - 1.0) + 0.5) / table, 0.0).xy;
-    vec3 prefiltered = textureLod(environment_specular, to_image * r, roughness * environment.params.y).rgb;
+    vec2 ab = environment_brdf_at(n_dot_v, roughness);
+    vec3 prefiltered = environment_prefiltered(to_image * r, roughness);
     vec3 specular = prefiltered * (f0 * ab.x + ab.y) * specular_occlusion(n_dot_v, occlusion, roughness);
     return (diffuse + specular) * environment.params.x;
 }

@@ -32,7 +32,7 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m,
         imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
         return;
     }
-    color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+    color = shade_point(world, n, m, frag_xy);
     if (COUNT_RAYS) {
         uint traced = subgroupAdd(rays_traced);
         if (subgroupElect() && traced != 0u) {
@@ -54,7 +54,7 @@ vec3 shade_linear(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object
     if (debug) {
         return clamp(color, 0.0, 1.0);
     }
-    color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+    color = shade_point(world, n, m, frag_xy);
     if (COUNT_RAYS) {
         uint traced = subgroupAdd(rays_traced);
         if (subgroupElect() && traced != 0u) {

@@ -51,11 +51,11 @@ vec3 shade_gbuffer(vec2 frag_xy, float z, GSample g, out bool debug) {
     vec3 world = world_from_depth(frag_xy, z);
     vec3 n = oct_decode(g.normal);
     PointMaterial m = point_material(objects[g.id].albedo_roughness, objects[g.id].material, objects[g.id].emissive, g.albedo,
-                                     g.roughness_metallic, g.emissive_factor, g.normal_spread);
+                                     g.roughness_metallic, g.emissive_factor, g.normal_spread, g.id);
     vec3 color;
     debug = debug_surface(world, n, m.albedo, m.roughness, m.metallic, objects[g.id].alpha_texture.x, frag_xy, color);
     if (!debug) {
-        color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+        color = shade_point(world, n, m, frag_xy);
     }
     return color;
 }

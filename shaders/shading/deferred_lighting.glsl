@@ -45,7 +45,7 @@ vec3 surface_display(vec2 xy, float z, GSample g) {
     vec3 emissive_factor = OBJECT_TEXTURES ? g.emissive_factor : vec3(1.0);
     float normal_spread = OBJECT_TEXTURES ? g.normal_spread : 0.0;
     PointMaterial m = point_material(objects[g.id].albedo_roughness, objects[g.id].material, objects[g.id].emissive, g.albedo,
-                                     roughness_metallic, emissive_factor, normal_spread);
+                                     roughness_metallic, emissive_factor, normal_spread, g.id);
     return shade_display(xy, world_from_depth(xy, z), oct_decode(g.normal), m, objects[g.id].alpha_texture.x);
 }
 
@@ -78,7 +78,7 @@ void main() {
     vec2 roughness_metallic = OBJECT_TEXTURES ? texelFetch(roughness_metallic_image, p, 0).xy : vec2(1.0);
     vec4 emissive = OBJECT_TEXTURES ? texelFetch(emissive_image, p, 0) : vec4(1.0, 1.0, 1.0, 0.0);
     PointMaterial m = point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, texelFetch(albedo_image, p, 0),
-                                     roughness_metallic, emissive.rgb, emissive.a);
+                                     roughness_metallic, emissive.rgb, emissive.a, id);
     shade_and_store(p, frag_xy, world, n, m, objects[id].alpha_texture.x);
 }
 #endif

@@ -36,13 +36,13 @@ void main() {
 #endif
     Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material);
     PointMaterial m = point_material(object.albedo_roughness, object.material, object.emissive, vec4(s.albedo_factor, s.occlusion),
-                                     s.roughness_metallic, s.emissive_factor, s.normal_spread);
+                                     s.roughness_metallic, s.emissive_factor, s.normal_spread, object.ids.x);
     vec3 color;
     if (debug_surface(at.world, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, gl_FragCoord.xy, color)) {
         out_color = target_shown(color);
         return;
     }
-    color = shade_point(at.world, s.normal, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, gl_FragCoord.xy);
+    color = shade_point(at.world, s.normal, m, gl_FragCoord.xy);
     // The target is UNORM: the seed writes gamma-encoded values itself (or, anti-aliased, the
     // display's linear light, display_output.glsl).
     out_color = TRANSPARENT_LAYERS ? vec4(color, 1.0) : target_lit(color, frame.exposure.x);

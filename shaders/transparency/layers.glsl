@@ -97,12 +97,13 @@ void light_layer(uint node) {
     vec2 frag_xy = layer_xy(a);
     vec3 world = world_from_depth(frag_xy, uintBitsToFloat(a.x));
     vec3 n = oct_decode(unpackSnorm2x16(b.x));
-    ObjectData o = objects[layer_object(a.z)];
+    uint object = layer_object(a.z);
+    ObjectData o = objects[object];
     vec2 roughness_metallic = OBJECT_TEXTURES ? unpackUnorm4x8(b.z).xy : vec2(1.0);
     vec4 emissive_spread = OBJECT_TEXTURES ? unpackUnorm4x8(b.w) : vec4(1.0, 1.0, 1.0, 0.0);
     PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, unpackUnorm4x8(b.y), roughness_metallic, emissive_spread.rgb,
-                                     emissive_spread.a);
-    vec3 color = shade_point(world, n, m.albedo, m.roughness, m.metallic, m.occlusion, m.emission, frag_xy);
+                                     emissive_spread.a, object);
+    vec3 color = shade_point(world, n, m, frag_xy);
     float alpha = unpackUnorm2x16(b.z).y;
     layer_nodes[2u * node + 1u] = uvec4(floatBitsToUint(color), floatBitsToUint(alpha));
 }

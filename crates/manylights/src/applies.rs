@@ -226,6 +226,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         matches!(source, SceneSource::Bench { .. }),
         matches!(source, SceneSource::File(_)),
     );
+    let gltf = matches!(source, SceneSource::File(path) if !path.to_string_lossy().to_lowercase().ends_with(".toml"));
     let placed =
         "lights placed by layout (--scene seed or a scene or glTF file; the bench scene's are random, the room keeps its one light)";
     let random = args.light_layout != "grid" || args.light_radius.as_deref().is_some_and(|r| r.contains(".."));
@@ -266,6 +267,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         pbr("environment_rotation"),
         lit("environment_intensity"),
         lit("environment_rotation"),
+        Rule::setting("variant", Some(gltf), &scene, "a glTF file (--scene FILE.gltf or FILE.glb)"),
         Rule::setting("object", Some(seed), &scene, "the seed scene (--scene seed)"),
         Rule::setting("material", Some(seed), &scene, "the seed scene (--scene seed)"),
         Rule::setting(

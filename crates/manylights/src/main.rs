@@ -215,6 +215,10 @@ struct SceneArgs {
     /// own.
     #[arg(long, allow_negative_numbers = true)]
     environment_rotation: Option<String>,
+    /// A glTF file's material variant (KHR_materials_variants) to draw, by name. Default: the
+    /// materials its primitives name.
+    #[arg(long)]
+    variant: Option<String>,
     /// Light radius R, or MIN..MAX for radii drawn per light. Default: 15 in the seed scene up to
     /// its 64 lights (beyond, one that follows the count); in a scene or glTF file the radius at
     /// which about 4 lights reach a point of the scene, from its box and the light count.
@@ -545,6 +549,7 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         environment: args.environment.as_deref().map(EnvironmentSource::parse),
         environment_intensity: args.environment_intensity.as_deref().map(parse_intensity).transpose().map_err(anyhow::Error::msg)?,
         environment_rotation_deg: args.environment_rotation.as_deref().map(parse_rotation_deg).transpose().map_err(anyhow::Error::msg)?,
+        variant: args.variant.clone(),
     })
 }
 

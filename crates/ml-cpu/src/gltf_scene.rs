@@ -1,8 +1,9 @@
 //! glTF 2.0 scenes (`--scene FILE.gltf|FILE.glb`): the node hierarchy with its
 //! transforms, every triangle primitive (indexed or not; u8/u16/u32 indices; missing normals
 //! computed flat, tangents computed from the texture coordinates), metallic-roughness
-//! materials with their textures, KHR_lights_punctual point, spot and directional lights and
-//! the first camera (else a camera framing the scene).
+//! materials with their textures, the PBR extensions' factors (ior, specular, clearcoat, sheen,
+//! unlit: material_extensions), KHR_lights_punctual point, spot and directional lights and the
+//! first camera (else a camera framing the scene).
 //!
 //! The `gltf` crate parses and validates the JSON; everything it hands over unchecked is
 //! checked here before it is used or allocated: buffer sources and lengths, accessor bounds
@@ -52,8 +53,14 @@ pub const MAX_TEXTURE_BYTES: u64 = 4 << 30;
 pub const MAX_VIEWLESS_ELEMENTS: usize = 1 << 20;
 /// Deepest node hierarchy we follow.
 pub const MAX_NODE_DEPTH: usize = 256;
-/// Extensions we read (a file may require these; others it may only use, with a warning).
-const SUPPORTED_EXTENSIONS: [&str; 3] = ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_texture_transform"];
+/// Extensions we read (a file may require these; others it may only use, with a warning), with
+/// the material extensions of material_extensions::EXTENSIONS.
+const SUPPORTED_EXTENSIONS: [&str; 5] =
+    ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_variants", "KHR_mesh_quantization", "KHR_texture_transform"];
+
+fn supported(extension: &str) -> bool {
+    SUPPORTED_EXTENSIONS.contains(&extension) || material_extensions::EXTENSIONS.contains(&extension)
+}
 
 /// A glTF file that could not be loaded: where, and what is wrong (one line).
 #[derive(Debug, Error)]
@@ -109,6 +116,14 @@ impl std::fmt::Display for MaterialName {
             Some(i) => write!(f, "{i}"),
             None => f.write_str("default"),
         }
+    }
+}
+
+/// "a number in [a, b]", or "a number not below a" where the range has no upper end.
+fn describe_range(range: &std::ops::RangeInclusive<f32>) -> String {
+    match *range.end() {
+        f32::MAX => format!("a number not below {}", Number(*range.start())),
+        end => format!("a number in [{}, {}]", Number(*range.start()), Number(end)),
     }
 }
 
@@ -277,6 +292,12 @@ pub enum GltfError {
     AlphaCutoff { material: MaterialName, value: f32 },
     #[error("material {material}: its texture transform is not finite")]
     TextureTransform { material: MaterialName },
+    #[error("there is no material variant '{name}' (the file has {})", if known.is_empty() { "none".to_owned() } else { known.join(", ") })]
+    UnknownVariant { name: String, known: Vec<String> },
+    #[error("a material variant maps it to material {index}, but there are {materials} materials")]
+    VariantMaterial { index: u64, materials: usize },
+    #[error("material {material}: {field} is {value}; it must be {}", describe_range(range))]
+    ExtensionFactor { material: MaterialName, field: &'static str, value: String, range: std::ops::RangeInclusive<f32> },
     #[error("material {material}: emissive strength {} must be finite, not negative and at most {}", Number(*value), Number(MAX_INTENSITY))]
     EmissiveStrength { material: MaterialName, value: f32 },
     #[error("its buffer view does not exist")]
@@ -383,30 +404,33 @@ fn describe_invalid(errors: &[(gltf::json::Path, gltf::json::validation::Error)]
     first.join("; ") + &more
 }
 
-/// Load the glTF or GLB file at `path` (external buffers relative to its folder).
-pub fn load(path: &Path) -> Result<SceneFile, GltfFileError> {
+/// Load the glTF or GLB file at `path` (external buffers relative to its folder), its
+/// materials as material variant `variant` has them where it names one.
+pub fn load(path: &Path, variant: Option<&str>) -> Result<SceneFile, GltfFileError> {
     let fail = |problem: GltfError| GltfFileError { path: path.to_path_buf(), problem };
     let bytes = read_regular(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
-    let (scene, warnings) = from_bytes(&bytes, path.parent()).map_err(fail)?;
+    let (scene, warnings) = from_bytes_as(&bytes, path.parent(), variant).map_err(fail)?;
     Ok(SceneFile { scene, shading: Some("pbr".into()), warnings })
 }
 
 /// Read a glTF scene from the file's bytes, and what it holds that is left out; `base` is the
 /// folder external buffers are in (None: external buffers are refused).
 pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<String>), GltfError> {
+    from_bytes_as(bytes, base, None)
+}
+
+/// `from_bytes` with the materials of material variant `variant` where it names one.
+pub fn from_bytes_as(bytes: &[u8], base: Option<&Path>, variant: Option<&str>) -> Result<(Scene, Vec<String>), GltfError> {
     if bytes.is_empty() {
         return Err(GltfError::Empty);
     }
     let gltf = parse_and_validate(bytes)?;
-    for ext in gltf.extensions_required() {
-        if !SUPPORTED_EXTENSIONS.contains(&ext) {
-            return Err(GltfError::RequiredExtension(ext.to_owned()));
-        }
-    }
     // Optional extensions we do not read are left out, and said so.
-    let unread: Vec<String> = gltf.extensions_used().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).map(str::to_owned).collect();
+    let unread: Vec<String> = gltf.extensions_used().filter(|e| !supported(e)).map(str::to_owned).collect();
+    let variant = variant.map(|name| material_variants::variant_index(&gltf.document, name)).transpose()?;
     let buffers = load_buffers(&gltf, base)?;
     let mut builder = Builder {
+        variant,
         doc: &gltf.document,
         base,
         textures: Vec::new(),
@@ -423,6 +447,7 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
         vertices: 0,
         warnings: unread.into_iter().map(|e| format!("extension {e} is not supported; the file is read without it")).collect(),
         mixed_transforms: Default::default(),
+        unread_textures: Default::default(),
     };
     builder.warnings.extend(motion_left_out(&gltf.document));
     let parents = node_parents(&gltf.document)?;
@@ -457,7 +482,13 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
     if builder.objects.is_empty() {
         return Err(GltfError::NoTriangles);
     }
-    let Builder { objects, lights, camera, meshes, mut warnings, textures, directional, mut cones, mixed_transforms, .. } = builder;
+    let Builder {
+        objects, lights, camera, meshes, mut warnings, textures, directional, mut cones, mixed_transforms, unread_textures, ..
+    } = builder;
+    for (name, unread) in unread_textures {
+        let textures = if unread.len() == 1 { "texture is" } else { "textures are" };
+        warnings.push(format!("material {name}: its {} {textures} not read; the factors apply alone", unread.join(", ")));
+    }
     if !mixed_transforms.is_empty() {
         let names: Vec<String> = mixed_transforms.into_iter().collect();
         warnings.push(format!(
@@ -485,13 +516,19 @@ pub fn from_bytes(bytes: &[u8], base: Option<&Path>) -> Result<(Scene, Vec<Strin
 
 /// The gltf crate's parse and validation, minus its one known panic: its validation indexes
 /// the accessor a primitive's POSITION names without checking it exists (gltf-json 1.4.1,
-/// mesh.rs), so that index is checked first.
+/// mesh.rs), so that index is checked first; and the required extensions, checked here.
 fn parse_and_validate(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
     check_glb_header(bytes)?;
     let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
     let blob = raw.blob;
-    let root = raw.document.into_json();
+    let mut root = raw.document.into_json();
     check_version(&root.asset)?;
+    // Required extensions are checked here, against what we read: the crate's validation knows
+    // only the extensions it parses itself (not clearcoat or sheen, which we read raw).
+    if let Some(ext) = root.extensions_required.iter().find(|e| !supported(e)) {
+        return Err(GltfError::RequiredExtension(ext.clone()));
+    }
+    root.extensions_required.clear();
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             for (semantic, index) in &primitive.attributes {
@@ -794,6 +831,10 @@ struct Builder<'a> {
     warnings: Vec<String>,
     /// The materials whose textures carry different texture transforms, by name.
     mixed_transforms: std::collections::BTreeSet<String>,
+    /// Extension textures left out, by material name.
+    unread_textures: std::collections::BTreeMap<String, Vec<&'static str>>,
+    /// The material variant drawn (KHR_materials_variants), if one was asked for.
+    variant: Option<usize>,
 }
 
 impl Builder<'_> {
@@ -804,8 +845,8 @@ impl Builder<'_> {
                 let Some(parts) = self.primitive(&mesh, &primitive).map_err(|e| e.within(what))? else {
                     continue;
                 };
-                let (material, extras, mixed) = material(&primitive.material()).map_err(|e| e.within(what))?;
-                let m = primitive.material();
+                let m = material_variants::material_of(self.doc, &primitive, self.variant).map_err(|e| e.within(what))?;
+                let (material, extras, mixed, unread) = material(&m).map_err(|e| e.within(what))?;
                 let named = || match m.name() {
                     Some(name) => format!("{} '{name}'", MaterialName(m.index())),
                     None => MaterialName(m.index()).to_string(),
@@ -813,7 +854,10 @@ impl Builder<'_> {
                 if mixed {
                     self.mixed_transforms.insert(named());
                 }
-                let textures = self.object_textures(&primitive.material()).map_err(|e| e.within(what))?;
+                if !unread.is_empty() {
+                    self.unread_textures.insert(named(), unread);
+                }
+                let textures = self.object_textures(&m).map_err(|e| e.within(what))?;
                 for part in parts {
                     if self.objects.len() == MAX_OBJECTS {
                         return Err(GltfError::TooManyPrimitives);
@@ -849,7 +893,9 @@ impl Builder<'_> {
             return Ok(None);
         }
         let position = primitive.get(&gltf::Semantic::Positions).ok_or(GltfError::NoPositions)?;
-        let positions = read_floats::<3>(&self.buffers, &position, "POSITION")?;
+        // KHR_mesh_quantization: integer attributes, normalised or not.
+        let quantized = self.doc.extensions_used().any(|e| e == "KHR_mesh_quantization");
+        let positions = read_floats::<3>(&self.buffers, &position, "POSITION", quantized)?;
         let far =
             positions.iter().enumerate().find_map(|(index, p)| p.iter().find(|x| x.abs() > MAX_COORDINATE).map(|&value| (index, value)));
         if let Some((index, value)) = far {
@@ -861,11 +907,11 @@ impl Builder<'_> {
             return Err(GltfError::TooManyVertices);
         }
         let normals = match primitive.get(&gltf::Semantic::Normals) {
-            Some(a) => Some(read_floats::<3>(&self.buffers, &a, "NORMAL")?),
+            Some(a) => Some(read_floats::<3>(&self.buffers, &a, "NORMAL", quantized)?),
             None => None,
         };
         let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
-            Some(a) => Some(read_floats::<2>(&self.buffers, &a, "TEXCOORD_0")?),
+            Some(a) => Some(read_floats::<2>(&self.buffers, &a, "TEXCOORD_0", quantized)?),
             None => None,
         };
         for (attribute, n) in [("NORMAL", normals.as_ref().map(Vec::len)), ("TEXCOORD_0", uvs.as_ref().map(Vec::len))] {
@@ -908,7 +954,8 @@ impl Builder<'_> {
             }
         }
         compute_tangents(&mut out);
-        let pieces = match primitive.material().double_sided().then(|| twin_faces::split_twin_faces(&out)).flatten() {
+        let double_sided = material_variants::material_of(self.doc, primitive, self.variant)?.double_sided();
+        let pieces = match double_sided.then(|| twin_faces::split_twin_faces(&out)).flatten() {
             Some((rest, twins)) => vec![(rest, false), (twins, true)],
             None => vec![(out, false)],
         };
@@ -1098,7 +1145,7 @@ fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, GltfError> {
 /// KHR_materials_emissive_strength), normal scale, occlusion strength, alpha mode, sides and
 /// texture transform; and whether its textures carry different transforms (one is used: the
 /// base colour's, else the first textured slot's).
-fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool), GltfError> {
+fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool, Vec<&'static str>), GltfError> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, a] = pbr.base_color_factor();
     let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
@@ -1152,6 +1199,7 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool), Gltf
         return Err(GltfError::TextureTransform { material });
     }
     let mixed = transforms.iter().any(|t| *t != uv_transform);
+    let (lobes, unread) = material_extensions::material_lobes(m)?;
     let extras = MaterialExtras {
         uv_transform,
         emissive: Vec3::new(er, eg, eb) * emissive_strength,
@@ -1160,8 +1208,9 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool), Gltf
         alpha_mode,
         base_alpha: a,
         double_sided: m.double_sided(),
+        lobes,
     };
-    Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras, mixed))
+    Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras, mixed, unread))
 }
 
 /// A texture's KHR_texture_transform as the affine map of texture coordinates it is:
@@ -1361,9 +1410,15 @@ fn view_bytes<'b>(buffers: &'b [Vec<u8>], view: &gltf::buffer::View, what: &'sta
         .ok_or_else(|| GltfError::ViewOutside { view: view.index(), length, offset, buffer: data.len() }.within(Part::Data(what)))
 }
 
-/// A float accessor of N components (f32, or normalised u8/u16 for texture coordinates),
-/// every value finite.
-fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, what: &'static str) -> Result<Vec<[f32; N]>, GltfError> {
+/// A float accessor of N components (f32, or normalised u8/u16 for texture coordinates; with
+/// `quantized`, KHR_mesh_quantization's 8- and 16-bit integers too, signed or not, normalised
+/// or not), every value finite.
+fn read_floats<const N: usize>(
+    buffers: &[Vec<u8>],
+    accessor: &gltf::Accessor,
+    what: &'static str,
+    quantized: bool,
+) -> Result<Vec<[f32; N]>, GltfError> {
     let dims = match N {
         2 => Dimensions::Vec2,
         _ => Dimensions::Vec3,
@@ -1378,6 +1433,14 @@ fn read_floats<const N: usize>(buffers: &[Vec<u8>], accessor: &gltf::Accessor, w
             (DataType::F32, _) => Some(f32::from_le_bytes(bytes[k * 4..k * 4 + 4].try_into().ok()?)),
             (DataType::U8, true) => Some(bytes[k] as f32 / 255.0),
             (DataType::U16, true) => Some(u16::from_le_bytes(bytes[k * 2..k * 2 + 2].try_into().ok()?) as f32 / 65535.0),
+            _ if !quantized => None,
+            // Signed normalised: c / max, never below −1 (glTF's rule).
+            (DataType::I8, true) => Some((bytes[k] as i8 as f32 / 127.0).max(-1.0)),
+            (DataType::I16, true) => Some((i16::from_le_bytes(bytes[k * 2..k * 2 + 2].try_into().ok()?) as f32 / 32767.0).max(-1.0)),
+            (DataType::U8, false) => Some(bytes[k] as f32),
+            (DataType::I8, false) => Some(bytes[k] as i8 as f32),
+            (DataType::U16, false) => Some(u16::from_le_bytes(bytes[k * 2..k * 2 + 2].try_into().ok()?) as f32),
+            (DataType::I16, false) => Some(i16::from_le_bytes(bytes[k * 2..k * 2 + 2].try_into().ok()?) as f32),
             _ => None,
         }
     };
@@ -1417,6 +1480,9 @@ fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor, vertices: usize)
     }
     Ok(out)
 }
+
+mod material_extensions;
+mod material_variants;
 
 #[cfg(test)]
 mod tests;

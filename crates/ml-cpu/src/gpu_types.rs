@@ -96,6 +96,9 @@ gpu_struct!(
     EnvironmentData {
         /// rgb: what a white Lambert surface reflects is the sum of `sh[k]·Y_k(n)` (the image's frame).
         sh: [[f32; 4]; 9],
+        /// The sheen's directional albedo (`material_lobes::SHEEN_ALBEDO`), with or without an
+        /// environment.
+        sheen_albedo: [[f32; 16]; 16],
         /// Columns of the rotation from world directions to the image's.
         to_image: [[f32; 4]; 3],
         /// x: intensity (0: no environment); y: the specular cube's last mip level.
@@ -183,6 +186,8 @@ gpu_struct!(
         /// The texture transform, uv' = M·uv + t: M's columns in xy and zw of the first, t in
         /// xy of the second.
         uv_transform: [[f32; 4]; 2],
+        /// glTF's PBR extensions (`MaterialLobes::vectors`).
+        lobes: [[f32; 4]; 3],
     }
 );
 

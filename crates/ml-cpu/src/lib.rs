@@ -21,6 +21,7 @@ pub mod light_grid;
 pub mod lights;
 pub mod limits;
 pub mod material;
+pub mod material_lobes;
 pub mod mesh;
 pub mod meshlets;
 pub mod omni_shadow;

@@ -82,6 +82,8 @@ pub struct MaterialExtras {
     /// Maps the mesh's texture coordinates to the textures' (glTF's KHR_texture_transform):
     /// one for all of the object's textures and its alpha mask.
     pub uv_transform: glam::Affine2,
+    /// What glTF's PBR extensions add (pbr model).
+    pub lobes: crate::material_lobes::MaterialLobes,
 }
 
 impl Default for MaterialExtras {
@@ -94,6 +96,7 @@ impl Default for MaterialExtras {
             base_alpha: 1.0,
             double_sided: false,
             uv_transform: glam::Affine2::IDENTITY,
+            lobes: Default::default(),
         }
     }
 }

@@ -76,6 +76,8 @@ pub struct SceneRequest {
     /// 1 and 0 unless a scene file says).
     pub environment_intensity: Option<f32>,
     pub environment_rotation_deg: Option<f32>,
+    /// A glTF file's material variant to draw (KHR_materials_variants), by name.
+    pub variant: Option<String>,
 }
 
 /// A built scene and the shading model to render it with.
@@ -138,6 +140,7 @@ impl SceneRequest {
             environment: None,
             environment_intensity: None,
             environment_rotation_deg: None,
+            variant: None,
         }
     }
 
@@ -210,7 +213,7 @@ impl SceneRequest {
 
     fn build_file(&self, path: &Path) -> Result<BuiltScene, SceneRequestError> {
         let is_toml = path.to_string_lossy().to_lowercase().ends_with(".toml");
-        let file = if is_toml { scene_file::load(path)? } else { gltf_scene::load(path)? };
+        let file = if is_toml { scene_file::load(path)? } else { gltf_scene::load(path, self.variant.as_deref())? };
         let path = path.to_path_buf();
         let shading = match (self.shading, &file.shading) {
             (Some(model), _) => model,

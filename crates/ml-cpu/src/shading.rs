@@ -15,7 +15,7 @@ pub(crate) fn d_ggx(n_dot_h: f32, roughness: f32) -> f32 {
 }
 
 /// Schlick–Smith G / (4 NdotL NdotV), written so grazing views give no 0/0 (see the GLSL).
-fn g_schlick_smith_over_4nlnv(n_dot_l: f32, n_dot_v: f32, roughness: f32) -> f32 {
+pub(crate) fn g_schlick_smith_over_4nlnv(n_dot_l: f32, n_dot_v: f32, roughness: f32) -> f32 {
     let r = roughness + 1.0;
     let k = r * r / 8.0;
     0.25 / ((n_dot_l * (1.0 - k) + k) * (n_dot_v * (1.0 - k) + k))
@@ -26,28 +26,57 @@ fn f_schlick(cos_theta: f32, albedo: Vec3, metallic: f32) -> Vec3 {
     f0 + (Vec3::ONE - f0) * (1.0 - cos_theta).powf(5.0)
 }
 
-/// One light's contribution in the `seed` model; exactly zero beyond its radius.
-pub fn seed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material) -> Vec3 {
+/// Where one point light meets a surface point: the cosines and the radiance it brings,
+/// falloff (1 − d/r)² · N·L.
+pub(crate) struct LightAt {
+    pub n_dot_v: f32,
+    pub n_dot_l: f32,
+    pub n_dot_h: f32,
+    pub radiance: f32,
+}
+
+/// Light `light` at point `p` (unit normal `n`, towards the eye `v`); None beyond its radius or
+/// behind the surface, where every model's light is exactly zero.
+pub(crate) fn light_at(light: &PointLight, p: Vec3, n: Vec3, v: Vec3) -> Option<LightAt> {
     let to_light = Vec3::from_slice(&light.position_radius[..3]) - p;
     let dist = to_light.length();
     let radius = light.position_radius[3];
     if dist > radius {
-        return Vec3::ZERO;
+        return None;
     }
     let l = to_light / dist;
     let h = (v + l).normalize();
-    let n_dot_v = n.dot(v).clamp(0.0, 1.0);
     let n_dot_l = n.dot(l).clamp(0.0, 1.0);
-    let n_dot_h = n.dot(h).clamp(0.0, 1.0);
     if n_dot_l <= 0.0 {
-        return Vec3::ZERO;
+        return None;
     }
     let atten = (1.0 - dist / radius).clamp(0.0, 1.0);
-    let radiance = atten * atten * n_dot_l;
-    let spec = d_ggx(n_dot_h, m.roughness)
-        * f_schlick(n_dot_v, m.albedo, m.metallic)
-        * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, m.roughness.max(0.05));
-    spec * n_dot_l * Vec3::from_slice(&light.color[..3]) * radiance
+    Some(LightAt { n_dot_v: n.dot(v).clamp(0.0, 1.0), n_dot_l, n_dot_h: n.dot(h).clamp(0.0, 1.0), radiance: atten * atten * n_dot_l })
+}
+
+/// One light's contribution under the seed's Cook–Torrance terms (exactly zero beyond its
+/// radius): the `seed` model (specular only, N·L twice) or, with `pbr`, the `pbr` model
+/// (Lambert diffuse weighted by (1 − F)(1 − metallic), N·L once) — cook_torrance_point_light.
+fn cook_torrance_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material, pbr: bool) -> Vec3 {
+    let Some(LightAt { n_dot_v, n_dot_l, n_dot_h, radiance }) = light_at(light, p, n, v) else { return Vec3::ZERO };
+    let f = f_schlick(n_dot_v, m.albedo, m.metallic);
+    let spec = d_ggx(n_dot_h, m.roughness) * f * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, m.roughness.max(0.05));
+    let color = Vec3::from_slice(&light.color[..3]);
+    if pbr {
+        let diffuse = (Vec3::ONE - f) * (1.0 - m.metallic) * m.albedo / PI;
+        return (diffuse + spec) * color * radiance;
+    }
+    spec * n_dot_l * color * radiance
+}
+
+/// One light's contribution in the `seed` model; exactly zero beyond its radius.
+pub fn seed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material) -> Vec3 {
+    cook_torrance_point_light(light, p, n, v, m, false)
+}
+
+/// One light's contribution in the `pbr` model; exactly zero beyond its radius.
+pub fn pbr_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material) -> Vec3 {
+    cook_torrance_point_light(light, p, n, v, m, true)
 }
 
 /// Linear colour of surface point `p` with unit normal `n` seen from `eye` (`seed` model).

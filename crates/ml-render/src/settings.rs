@@ -273,6 +273,7 @@ impl RenderSettings {
             antialiasing: self.antialiasing,
             specular_aa: self.specular_aa,
             environment: self.shading == ShadingModel::Pbr && scene.environment.is_some(),
+            material_lobes: self.shading == ShadingModel::Pbr && scene.objects.iter().any(|o| o.extras.lobes.any()),
         }
     }
 

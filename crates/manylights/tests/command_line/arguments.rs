@@ -311,3 +311,22 @@ fn the_front_documents_stay_within_their_sizes() {
         assert!(bytes <= limit, "{doc} is {bytes} bytes, more than its {limit}: cut it to what a reader needs now");
     }
 }
+
+/// `--variant` names a glTF file's material variant: refused for other scenes, and a name the
+/// file lacks is refused with the names it has — each in one line, before any GPU work.
+#[test]
+fn a_material_variant_is_refused_where_there_is_none() {
+    let dir = temp_dir("variant");
+    let mut w = ml_cpu::gltf_writer::GltfWriter::new();
+    let mesh = w.mesh(&[ml_cpu::gltf_writer::quad()]);
+    w.node(serde_json::json!({ "mesh": mesh }), true);
+    w.json["extensions"] = serde_json::json!({ "KHR_materials_variants": { "variants": [{ "name": "red" }] } });
+    let file = dir.join("variants.glb");
+    std::fs::write(&file, w.to_glb()).unwrap();
+    let out = dir.join("out.png");
+    let render =
+        |scene: &str, variant: &str| manylights(&["render", "--scene", scene, "--variant", variant, "--out", out.to_str().unwrap()]);
+    assert_one_line_error(&render("seed", "red"), &["--variant", "glTF file"]);
+    assert_one_line_error(&render(file.to_str().unwrap(), "blue"), &["variants.glb", "no material variant 'blue'", "the file has red"]);
+    assert!(!out.exists(), "nothing written");
+}

@@ -222,12 +222,12 @@ fn optional_extensions_we_do_not_read_are_named_in_a_warning() {
     let mut w = GltfWriter::new();
     let mesh = w.mesh(&[quad()]);
     w.node(json!({ "mesh": mesh }), true);
-    w.json["extensionsUsed"] = json!(["KHR_materials_clearcoat", "KHR_texture_transform"]);
+    w.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_texture_transform"]);
     let (_, warnings) = from_bytes(&w.to_glb(), None).unwrap();
-    assert_eq!(warnings, ["extension KHR_materials_clearcoat is not supported; the file is read without it"]);
-    w.json["extensionsRequired"] = json!(["KHR_materials_clearcoat"]);
+    assert_eq!(warnings, ["extension KHR_materials_transmission is not supported; the file is read without it"]);
+    w.json["extensionsRequired"] = json!(["KHR_materials_transmission"]);
     let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
-    assert!(err.contains("KHR_materials_clearcoat") && err.contains("nsupported extension"), "{err}");
+    assert!(err.contains("KHR_materials_transmission") && err.contains("does not support"), "{err}");
 }
 
 /// KHR_texture_transform (translation · rotation · scale, one per material: the base
@@ -261,6 +261,130 @@ fn texture_transforms_and_emissive_strength_are_read() {
     w.json["materials"][m]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = json!(-1.0);
     let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
     assert!(err.contains("emissive strength -1"), "{err}");
+}
+
+/// The PBR extensions' factors (ior, specular, clearcoat, sheen, unlit) become the object's
+/// lobes; their textures are named in one warning per material; a factor outside its range
+/// is refused in one line.
+#[test]
+fn material_extensions_are_read_into_lobes() {
+    let mut w = GltfWriter::new();
+    let m = w.material([0.8, 0.2, 0.1, 1.0], 0.0, 0.6);
+    w.json["materials"][m]["extensions"] = json!({
+        "KHR_materials_ior": { "ior": 2.0 },
+        "KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [2.0, 1.0, 0.5], "specularTexture": { "index": 0 } },
+        "KHR_materials_clearcoat": { "clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.1, "clearcoatNormalTexture": { "index": 0 } },
+        "KHR_materials_sheen": { "sheenColorFactor": [0.5, 0.4, 0.3], "sheenRoughnessFactor": 0.25 },
+    });
+    let names = ["KHR_materials_ior", "KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit"];
+    w.json["extensionsUsed"] = json!(names);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(json!({ "mesh": mesh }), true);
+    let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert_eq!(warnings, ["material 0: its specular, clearcoat normal textures are not read; the factors apply alone"]);
+    let lobes = scene.objects[0].extras.lobes;
+    let f0 = 1.0f32 / 9.0;
+    assert!(lobes.dielectric_f0().abs_diff_eq(Vec3::new(2.0 * f0, f0, 0.5 * f0), 1e-6), "{lobes:?}");
+    assert_eq!((lobes.specular, lobes.clearcoat, lobes.clearcoat_roughness, lobes.sheen_roughness), (0.5, 0.8, 0.1, 0.25));
+    assert_eq!(lobes.sheen_color, Vec3::new(0.5, 0.4, 0.3));
+    assert!(!lobes.unlit && lobes.any());
+    // Unlit, required: read.
+    w.json["materials"][m]["extensions"] = json!({ "KHR_materials_unlit": {} });
+    w.json["extensionsRequired"] = json!(["KHR_materials_unlit"]);
+    let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert!(warnings.is_empty() && scene.objects[0].extras.lobes.unlit, "{warnings:?}");
+    for (ext, body, says) in [
+        ("KHR_materials_ior", json!({ "ior": 0.5 }), "ior (0, or at least 1) factor 0.5"),
+        ("KHR_materials_ior", json!({ "ior": "glass" }), "ior is \"glass\"; it must be a number in [0, 100]"),
+        (
+            "KHR_materials_specular",
+            json!({ "specularColorFactor": [1.0, -1.0, 0.0] }),
+            "specularColorFactor is [1.0,-1.0,0.0]; it must be a number not below 0",
+        ),
+        ("KHR_materials_clearcoat", json!({ "clearcoatFactor": 1.5 }), "clearcoatFactor is 1.5; it must be a number in [0, 1]"),
+        ("KHR_materials_sheen", json!({ "sheenColorFactor": [1.0, 1.0] }), "sheenColorFactor is [1.0,1.0]"),
+    ] {
+        w.json["materials"][m]["extensions"] = json!({ ext: body });
+        let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
+        assert!(err.contains("material 0") && err.contains(says) && !err.contains('\n'), "{err}");
+    }
+}
+
+/// KHR_mesh_quantization: the quad's positions as normalised i16, its normals as normalised
+/// i8 and its texture coordinates as u8 integers load as the float quad does (positions and
+/// normals; texture coordinates are the integers); without the extension such accessors are
+/// refused.
+#[test]
+fn quantized_attributes_load_as_floats() {
+    let mut w = GltfWriter::new();
+    let mesh = w.mesh(&[quad()]);
+    w.node(json!({ "mesh": mesh }), true);
+    let float_quad = load_bytes(&w.to_glb());
+    let accessor = |w: &mut GltfWriter, bytes: Vec<u8>, component: u32, kind: &str, normalized: bool| {
+        while !w.bin.len().is_multiple_of(4) {
+            w.bin.push(0);
+        }
+        let views = w.json["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({ "buffer": 0, "byteOffset": w.bin.len(), "byteLength": bytes.len(), "byteStride": 8 }));
+        let view = views.len() - 1;
+        w.bin.extend(bytes);
+        let accessors = w.json["accessors"].as_array_mut().unwrap();
+        accessors.push(json!({ "bufferView": view, "componentType": component, "count": 4, "type": kind, "normalized": normalized }));
+        accessors.len() - 1
+    };
+    // Each element padded to 8 bytes (attributes are 4-byte aligned).
+    let pad = |e: Vec<u8>| -> Vec<u8> { e.into_iter().chain(std::iter::repeat(0)).take(8).collect() };
+    let q = quad();
+    let positions: Vec<u8> =
+        q.positions.iter().flat_map(|p| pad(p.iter().flat_map(|&x| ((x * 32767.0) as i16).to_le_bytes()).collect())).collect();
+    let normals: Vec<u8> = q.normals.unwrap().iter().flat_map(|n| pad(n.iter().map(|&x| (x * 127.0) as i8 as u8).collect())).collect();
+    let uvs: Vec<u8> = q.uvs.unwrap().iter().flat_map(|t| pad(t.iter().map(|&x| (x * 3.0) as u8).collect())).collect();
+    let p = accessor(&mut w, positions, 5122, "VEC3", true);
+    w.json["accessors"][p]["min"] = json!([-1.0, 0.0, -1.0]);
+    w.json["accessors"][p]["max"] = json!([1.0, 0.0, 1.0]);
+    let n = accessor(&mut w, normals, 5120, "VEC3", true);
+    let t = accessor(&mut w, uvs, 5121, "VEC2", false);
+    w.json["meshes"][0]["primitives"][0]["attributes"] = json!({ "POSITION": p, "NORMAL": n, "TEXCOORD_0": t });
+    let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
+    assert!(err.contains("POSITION") && err.contains("I16"), "{err}");
+    w.json["extensionsUsed"] = json!(["KHR_mesh_quantization"]);
+    w.json["extensionsRequired"] = json!(["KHR_mesh_quantization"]);
+    let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let (a, b) = (scene.mesh(scene.objects[0].mesh).unwrap(), float_quad.mesh(float_quad.objects[0].mesh).unwrap());
+    for i in 0..4 {
+        assert_eq!(world_vertex(&scene, 0, i), world_vertex(&float_quad, 0, i));
+        assert_eq!(a.vertices[i].normal, b.vertices[i].normal);
+        assert_eq!(a.vertices[i].uv, b.vertices[i].uv.map(|x| x * 3.0));
+    }
+}
+
+/// KHR_materials_variants: a variant draws the material its mapping names, primitives it does
+/// not map keep theirs; an unknown name is refused with the file's names.
+#[test]
+fn material_variants_pick_their_materials() {
+    let mut w = GltfWriter::new();
+    let own = w.material([1.0, 1.0, 1.0, 1.0], 0.0, 0.5);
+    let red = w.material([1.0, 0.0, 0.0, 1.0], 0.0, 0.5);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(own), ..quad() }, PrimitiveData { material: Some(own), ..quad() }]);
+    w.node(json!({ "mesh": mesh }), true);
+    w.json["extensionsUsed"] = json!(["KHR_materials_variants"]);
+    w.json["extensions"] = json!({ "KHR_materials_variants": { "variants": [{ "name": "plain" }, { "name": "red" }] } });
+    w.json["meshes"][mesh]["primitives"][0]["extensions"] =
+        json!({ "KHR_materials_variants": { "mappings": [{ "material": red, "variants": [1] }] } });
+    let albedos = |variant: Option<&str>| -> Vec<Vec3> {
+        let (scene, warnings) = from_bytes_as(&w.to_glb(), None, variant).unwrap();
+        assert!(warnings.is_empty(), "{warnings:?}");
+        scene.objects.iter().map(|o| o.material.albedo).collect()
+    };
+    assert_eq!(albedos(None), [Vec3::ONE, Vec3::ONE]);
+    assert_eq!(albedos(Some("plain")), [Vec3::ONE, Vec3::ONE]);
+    assert_eq!(albedos(Some("red")), [Vec3::X, Vec3::ONE]);
+    let err = from_bytes_as(&w.to_glb(), None, Some("blue")).unwrap_err().to_string();
+    assert_eq!(err, "there is no material variant 'blue' (the file has plain, red)");
+    w.json["meshes"][mesh]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][0]["material"] = json!(7);
+    let err = from_bytes_as(&w.to_glb(), None, Some("red")).unwrap_err().to_string();
+    assert!(err.contains("mesh 0 primitive 0") && err.contains("material 7, but there are 2 materials"), "{err}");
 }
 
 /// `good` with its buffer in the file `name` of `folder` (and the JSON naming it as `uri`).
@@ -299,7 +423,7 @@ fn devices_and_pipes_are_refused_at_once_as_file_buffer_or_image() {
     let d = folder("gltf-devices");
     let not_regular = "not a regular file (a device, pipe or socket)";
     for file in [fifo(&d, "pipe.glb"), link(&d, "zero.glb", "/dev/zero"), PathBuf::from("/dev/zero"), PathBuf::from("/dev/urandom")] {
-        refused_at_once(&file.display().to_string(), not_regular, || load(&file).map(drop));
+        refused_at_once(&file.display().to_string(), not_regular, || load(&file, None).map(drop));
     }
     fifo(&d, "pipe.bin");
     fifo(&d, "pipe.png");

@@ -210,13 +210,18 @@ fn view_data(env: &Environment) -> EnvironmentData {
     let column = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
     EnvironmentData {
         sh: [[0.0; 4]; 9],
+        sheen_albedo: [[0.0; 16]; 16],
         to_image: [column(rotation.x_axis), column(rotation.y_axis), column(rotation.z_axis)],
         params: [env.intensity, (SPECULAR_LEVELS - 1) as f32, 0.0, 0.0],
     }
 }
 
+/// The buffer of `data` with the sheen's table (every scene's: material lobes need it with or
+/// without an environment).
 fn data_buffer(ctx: &Context, data: &EnvironmentData) -> Result<Buffer, VkError> {
-    Buffer::device_local_with(ctx, "environment", bytemuck::bytes_of(data), vk::BufferUsageFlags::STORAGE_BUFFER)
+    let mut data = *data;
+    data.sheen_albedo = bytemuck::cast(ml_cpu::material_lobes::SHEEN_ALBEDO);
+    Buffer::device_local_with(ctx, "environment", bytemuck::bytes_of(&data), vk::BufferUsageFlags::STORAGE_BUFFER)
 }
 
 /// The prefiltering's pipelines, sets and per-level views, made for one submission and

@@ -62,6 +62,7 @@ pub fn object_data(o: &Object, masks: &AlphaMasks, textures: &[TextureImage]) ->
         alpha,
         alpha_texture,
         uv_transform: uv_transform_vectors(o.extras.uv_transform),
+        lobes: o.extras.lobes.vectors(),
     }
 }
 

@@ -38,6 +38,9 @@ pub struct Shading {
     /// The pbr model lit by the scene's environment instead of its constant ambient
     /// (`ENVIRONMENT`, environment/environment.glsl).
     pub environment: bool,
+    /// Some object's material has glTF's PBR extensions (`MATERIAL_LOBES`,
+    /// common/material_lobes.glsl; pbr).
+    pub material_lobes: bool,
 }
 
 impl Shading {
@@ -56,8 +59,8 @@ impl Shading {
     /// The specialization constants (name, value) of a lighting pipeline: the surface's,
     /// `OMNI_SHADOWS`, `SHADOW_ATLAS` and `SHADOW_RAYS` (shadows/omni_shadow.glsl),
     /// `SUN_RAYS` (common/blinn_phong.glsl), `SPOT_LIGHTS` (common/lighting.glsl) and
-    /// `ENVIRONMENT`.
-    pub fn lighting_constants(self) -> [(&'static str, u32); 10] {
+    /// `ENVIRONMENT` (environment/environment.glsl) and `MATERIAL_LOBES`.
+    pub fn lighting_constants(self) -> [(&'static str, u32); 11] {
         let [model_a, model_b, textures, specular] = self.surface_constants();
         [
             model_a,
@@ -70,23 +73,24 @@ impl Shading {
             ("SUN_RAYS", u32::from(self.sun_rays)),
             ("SPOT_LIGHTS", u32::from(self.spot_lights)),
             ("ENVIRONMENT", u32::from(self.environment)),
+            ("MATERIAL_LOBES", u32::from(self.material_lobes)),
         ]
     }
 
     /// `lighting_constants` and `COUNT_RAYS` (shading/compute_shading.glsl): the compute
     /// lightings'.
-    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 11] {
-        let [a, b, c, d, e, f, g, h, i, j] = self.lighting_constants();
-        [a, b, c, d, e, f, g, h, i, j, ("COUNT_RAYS", u32::from(self.count_rays))]
+    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 12] {
+        let [a, b, c, d, e, f, g, h, i, j, k] = self.lighting_constants();
+        [a, b, c, d, e, f, g, h, i, j, k, ("COUNT_RAYS", u32::from(self.count_rays))]
     }
 
     /// `lighting_constants`, `TRANSPARENT_LAYERS` (shading/forward_frag.glsl: the forward
     /// pass of a scene with transparent layers writes linear HDR for their resolve), the
     /// samples per pixel its masks are tested at and `display_constant`: the forward pass's.
-    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 13] {
-        let [a, b, c, d, e, f, g, h, i, j] = self.lighting_constants();
+    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 14] {
+        let [a, b, c, d, e, f, g, h, i, j, k] = self.lighting_constants();
         let layers = ("TRANSPARENT_LAYERS", u32::from(self.transparency));
-        [a, b, c, d, e, f, g, h, i, j, layers, self.antialiasing.constant(), self.display_constant()]
+        [a, b, c, d, e, f, g, h, i, j, k, layers, self.antialiasing.constant(), self.display_constant()]
     }
 
     /// `DISPLAY_LINEAR_OUTPUT` (shading/display_output.glsl): with anti-aliasing, the forward

@@ -44,34 +44,13 @@ fn compare(material: Material, rotation: f32) {
     let out = common::render(scene.clone(), pbr(Technique::Forward));
     let env = scene.environment.as_ref().expect("set above");
     let sh = diffuse_sh9(&env.image);
-    let cam = &scene.camera;
-    let (mut compared, mut outside, mut worst) = (0u32, 0u32, 0u8);
+    let m = material;
     // Every other pixel, a checkerboard: the reference sums the whole image per point.
-    for y in 0..SIZE {
-        for x in (y % 2..SIZE).step_by(2) {
-            let (origin, dir) = cam.pixel_ray(x, y, SIZE, SIZE);
-            let Some(p) = common::hit_unit_sphere(origin, dir) else { continue };
-            let n = p.normalize();
-            let v = -dir;
-            if n.dot(v) < 0.2 {
-                continue;
-            }
-            let m = &material;
-            let shade =
-                |n: Vec3| encode_gamma_unorm8(aces_tone_map(environment_light(env, &sh, (n, v), m.albedo, (m.roughness, m.metallic, 1.0))));
-            let got = common::pixel(&out, x, y);
-            let (expected, off) = common::outside_reference(shade, n, NORMAL_TOLERANCE, (got, MAX_DIFF));
-            worst = (0..3).map(|c| got[c].abs_diff(expected[c])).fold(worst, u8::max);
-            for (c, range) in off {
-                outside += 1;
-                if outside < 20 {
-                    println!("pixel ({x}, {y}) channel {c}: gpu {} outside {range:?}", got[c]);
-                }
-            }
-            compared += 1;
-        }
-    }
-    println!("{compared} pixels compared: max |gpu − cpu| {worst}/255, {outside} channels outside the tolerance");
+    let r = common::compare_sphere(&out, &scene.camera, true, (NORMAL_TOLERANCE, MAX_DIFF), |_, dir| {
+        let sh = &sh;
+        move |n: Vec3| encode_gamma_unorm8(aces_tone_map(environment_light(env, sh, (n, -dir), m.albedo, (m.roughness, m.metallic, 1.0))))
+    });
+    let (compared, outside) = (r.compared, r.outside);
     assert!(compared > 1_800, "the sphere should cover much of the image, got {compared} pixels");
     assert_eq!(outside, 0, "channels outside the reference range ± {MAX_DIFF}/255");
 }

@@ -21,6 +21,7 @@ mod gpu_layout;
 mod light_grid;
 mod light_stats;
 mod mask_shadows;
+mod material_lobes;
 mod omni_shadows;
 mod reference;
 mod renderer_changes;

@@ -55,41 +55,21 @@ fn compare(material: Material, directional: &[DirectionalLight], orthographic: O
     // The renderer animates lights (time 0 moves them by (0, 0, 0.1)); shade what it drew.
     let mut lights = scene.lights.clone();
     animate_into(&scene.lights, 0.0, &mut lights);
-    let (mut compared, mut worst, mut sum, mut outside) = (0u32, 0u8, 0u64, 0u32);
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let (origin, dir) = cam.pixel_ray(x, y, SIZE, SIZE);
-            let Some(p) = common::hit_unit_sphere(origin, dir) else { continue };
-            let n = p.normalize();
-            if n.dot(-dir) < 0.2 {
-                continue;
-            }
-            // A directional light is the seed's point light with no falloff, from one direction:
-            // on the CPU, exactly that (a light 10⁴ m back along it whose radius never ends).
-            let mut all = lights.clone();
-            all.extend(directional.iter().map(|d| PointLight {
-                position_radius: (p - d.direction * 1e4).extend(1e30).to_array(),
-                color: d.color.extend(0.0).to_array(),
-            }));
-            // An orthographic camera looks along its axis at every point: an eye far back on the ray.
-            let eye = if orthographic.is_some() { p - dir * 1e5 } else { cam.position };
-            let shade = |n: Vec3| encode_gamma_unorm8(shade_seed(p, n, eye, &material, &all, scene.ambient));
-            let got = common::pixel(&out, x, y);
-            let (expected, off) = common::outside_reference(shade, n, NORMAL_TOLERANCE, (got, MAX_DIFF));
-            for (c, range) in off {
-                outside += 1;
-                println!("pixel ({x}, {y}) channel {c}: gpu {} outside the reference range {range:?}", got[c]);
-            }
-            for c in 0..3 {
-                let d = got[c].abs_diff(expected[c]);
-                worst = worst.max(d);
-                sum += d as u64;
-            }
-            compared += 1;
-        }
-    }
-    let mean = sum as f64 / (compared as f64 * 3.0);
-    println!("{compared} pixels compared: max |gpu − cpu| {worst}/255, mean {mean:.4}/255, {outside} channels outside the tolerance");
+    let r = common::compare_sphere(&out, cam, false, (NORMAL_TOLERANCE, MAX_DIFF), |p, dir| {
+        // A directional light is the seed's point light with no falloff, from one direction:
+        // on the CPU, exactly that (a light 10⁴ m back along it whose radius never ends).
+        let mut all = lights.clone();
+        all.extend(directional.iter().map(|d| PointLight {
+            position_radius: (p - d.direction * 1e4).extend(1e30).to_array(),
+            color: d.color.extend(0.0).to_array(),
+        }));
+        // An orthographic camera looks along its axis at every point: an eye far back on the ray.
+        let eye = if orthographic.is_some() { p - dir * 1e5 } else { cam.position };
+        let ambient = scene.ambient;
+        move |n: Vec3| encode_gamma_unorm8(shade_seed(p, n, eye, &material, &all, ambient))
+    });
+    let (compared, outside) = (r.compared, r.outside);
+    let mean = r.sum as f64 / (compared as f64 * 3.0);
     assert!(compared > 20_000, "the sphere should cover much of the image, got {compared} pixels");
     assert_eq!(outside, 0, "channels outside the reference range ± {MAX_DIFF}/255");
     assert!(mean < MAX_MEAN_DIFF, "mean difference {mean}/255");

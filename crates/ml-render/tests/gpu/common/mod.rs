@@ -99,6 +99,64 @@ pub fn outside_reference(
     (expected, outside)
 }
 
+/// How a rendered unit sphere compares with its CPU reference (`compare_sphere`): pixels
+/// compared, channels outside the reference's range, the largest and the summed difference
+/// from the reference at the exact normal.
+pub struct SphereComparison {
+    pub compared: u32,
+    pub outside: u32,
+    pub worst: u8,
+    pub sum: u64,
+}
+
+/// Compare each pixel of `out` whose camera ray hits the unit sphere at the origin with its CPU
+/// reference: every pixel, or every other one (a checkerboard) with `checker`, skipping those
+/// where the view grazes the sphere (N·V < 0.2: a pixel centre may miss the facets there).
+/// `shade(point, ray direction)` gives the reference's 8-bit colour for a normal at that point,
+/// compared by `outside_reference` with `tilt` and `margin`; the first channels outside are
+/// printed, and the summary.
+pub fn compare_sphere<F: Fn(glam::Vec3) -> [u8; 3]>(
+    out: &RenderOutput,
+    cam: &ml_cpu::camera::Camera,
+    checker: bool,
+    (tilt, margin): (f32, u8),
+    shade: impl Fn(glam::Vec3, glam::Vec3) -> F,
+) -> SphereComparison {
+    let (w, h) = (out.width, out.height);
+    let mut r = SphereComparison { compared: 0, outside: 0, worst: 0, sum: 0 };
+    for y in 0..h {
+        let step = if checker { 2 } else { 1 };
+        for x in ((if checker { y % 2 } else { 0 })..w).step_by(step) {
+            let (origin, dir) = cam.pixel_ray(x, y, w, h);
+            let Some(p) = hit_unit_sphere(origin, dir) else { continue };
+            let n = p.normalize();
+            if n.dot(-dir) < 0.2 {
+                continue;
+            }
+            let got = pixel(out, x, y);
+            let (expected, off) = outside_reference(shade(p, dir), n, tilt, (got, margin));
+            for c in 0..3 {
+                let d = got[c].abs_diff(expected[c]);
+                r.worst = r.worst.max(d);
+                r.sum += u64::from(d);
+            }
+            for (c, range) in off {
+                r.outside += 1;
+                if r.outside <= 20 {
+                    println!("pixel ({x}, {y}) channel {c}: gpu {} outside the reference range {range:?}", got[c]);
+                }
+            }
+            r.compared += 1;
+        }
+    }
+    let mean = r.sum as f64 / (f64::from(r.compared.max(1)) * 3.0);
+    println!(
+        "{} pixels compared: max |gpu − cpu| {}/255, mean {mean:.4}/255, {} channels outside the tolerance",
+        r.compared, r.worst, r.outside
+    );
+    r
+}
+
 pub fn pixel(out: &RenderOutput, x: u32, y: u32) -> [u8; 3] {
     let i = ((y * out.width + x) * 4) as usize;
     [out.rgba[i], out.rgba[i + 1], out.rgba[i + 2]]

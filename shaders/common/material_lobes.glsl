@@ -1,0 +1,149 @@
+// The pbr model with glTF's PBR extensions (lighting.glsl, under MATERIAL_LOBES): a
+// dielectric's reflectance from its index of refraction, scaled and tinted by its specular
+// factor and colour; cloth-like sheen (the Charlie distribution and visibility, Estevez and
+// Kulla 2017); a clear coat over the base; unlit surfaces. With every lobe at its default
+// the light is the pbr model's own, the same formulas rearranged.
+// ml_cpu::material_lobes is the CPU reference (keep in sync; tests compare them).
+// Needs seed_brdf.glsl and environment/environment.glsl.
+
+#ifndef MANYLIGHTS_MATERIAL_LOBES_GLSL
+#define MANYLIGHTS_MATERIAL_LOBES_GLSL
+
+
+// Pipelines of scenes with an object whose material has lobes (the others compile the pbr
+// model's plain light: its cost at a million lights stays what it was).
+layout(constant_id = 45) const bool MATERIAL_LOBES = false;
+
+// PointMaterial's lobes (ObjectData.lobes): specular: (dielectric F₀, specular factor);
+// coat: (clear coat, its roughness, unlit, 0); sheen: (colour, roughness).
+const float SHEEN_MIN_ROUGHNESS = 0.07;
+
+float d_charlie(float n_dot_h, float roughness) {
+    float r = max(roughness, SHEEN_MIN_ROUGHNESS);
+    float inv_alpha = 1.0 / (r * r);
+    float sin2 = max(1.0 - n_dot_h * n_dot_h, 0.0);
+    return (2.0 + inv_alpha) * pow(sin2, 0.5 * inv_alpha) / (2.0 * PI);
+}
+
+float lambda_sheen_fit(float x, float t) {
+    return mix(21.5473, 25.3245, t) / (1.0 + mix(3.82987, 3.32435, t) * pow(x, mix(0.19823, 0.16801, t))) + mix(-1.97760, -1.27393, t) * x +
+           mix(-4.32054, -4.85967, t);
+}
+
+float lambda_sheen(float cos_theta, float alpha) {
+    float t = (1.0 - alpha) * (1.0 - alpha);
+    return cos_theta < 0.5 ? exp(lambda_sheen_fit(cos_theta, t)) : exp(2.0 * lambda_sheen_fit(0.5, t) - lambda_sheen_fit(1.0 - cos_theta, t));
+}
+
+// G / (4 n·l n·v) of the Charlie sheen, at most 1.
+float v_charlie(float n_dot_l, float n_dot_v, float roughness) {
+    float r = max(roughness, SHEEN_MIN_ROUGHNESS);
+    float alpha = r * r;
+    return clamp(1.0 / ((1.0 + lambda_sheen(n_dot_v, alpha) + lambda_sheen(n_dot_l, alpha)) * (4.0 * n_dot_v * n_dot_l)), 0.0, 1.0);
+}
+
+// The sheen's directional albedo E(n·v, roughness): bilinear in the table of 16×16 entries
+// EnvironmentData carries (row: roughness, column: n·v, each 0 to 1 in 15 steps). A storage
+// buffer, not a constant array: lavapipe compiled a constant array indexed at run time for
+// minutes.
+const int SHEEN_TABLE_SIZE = 16;
+
+float sheen_entry(int i) {
+    return environment.sheen_albedo[i];
+}
+
+float sheen_albedo(float n_dot_v, float roughness) {
+    float top = float(SHEEN_TABLE_SIZE - 1);
+    float x = clamp(n_dot_v, 0.0, 1.0) * top, y = clamp(roughness, 0.0, 1.0) * top;
+    float x0 = min(floor(x), top - 1.0), y0 = min(floor(y), top - 1.0);
+    float fx = x - x0, fy = y - y0;
+    int i = int(y0) * SHEEN_TABLE_SIZE + int(x0);
+    float low = sheen_entry(i) + (sheen_entry(i + 1) - sheen_entry(i)) * fx;
+    float high = sheen_entry(i + SHEEN_TABLE_SIZE) + (sheen_entry(i + SHEEN_TABLE_SIZE + 1) - sheen_entry(i + SHEEN_TABLE_SIZE)) * fx;
+    return low + (high - low) * fy;
+}
+
+float max3(vec3 c) {
+    return max(max(c.r, c.g), c.b);
+}
+
+// One point light in the pbr model with lobes (zero beyond the radius and behind the
+// surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic), Lambert
+// diffuse weighted by (1 − F)(1 − metallic) plus GGX; the sheen's lobe over the base scaled by
+// 1 − max(sheen)·E at the view and the light; the clear coat's GGX lobe (F₀ 0.04) over the
+// base scaled by 1 − coat·F_coat. Its first lines are cook_torrance_point_light's (seed_brdf.glsl),
+// repeated: a shared helper returning the cosines in a struct made the seed's forward pass 1.44×
+// slower on the H100.
+vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, vec4 specular,
+                       vec4 coat, vec4 sheen) {
+    vec3 light_vec = light.position_radius.xyz - world_pos;
+    float dist = length(light_vec);
+    float radius = light.position_radius.w;
+    if (dist > radius) {
+        return vec3(0.0);
+    }
+    vec3 l = light_vec / dist;
+    vec3 h = normalize(v + l);
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    float n_dot_l = clamp(dot(n, l), 0.0, 1.0);
+    float n_dot_h = clamp(dot(n, h), 0.0, 1.0);
+    if (n_dot_l <= 0.0) {
+        return vec3(0.0);
+    }
+    float atten = clamp(1.0 - dist / radius, 0.0, 1.0);
+    float radiance = atten * atten * n_dot_l;
+    float fc = pow(1.0 - n_dot_v, 5.0);
+    vec3 f_dielectric = specular.a * (specular.rgb + (1.0 - specular.rgb) * fc);
+    vec3 f_metal = albedo + (1.0 - albedo) * fc;
+    vec3 f = mix(f_dielectric, f_metal, metallic);
+    float g = g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, roughness));
+    vec3 base = (1.0 - f) * (1.0 - metallic) * albedo / PI + d_ggx(n_dot_h, roughness) * f * g;
+    float sheen_max = max3(sheen.rgb);
+    if (sheen_max > 0.0) {
+        base *= min(1.0 - sheen_max * sheen_albedo(n_dot_v, sheen.a), 1.0 - sheen_max * sheen_albedo(n_dot_l, sheen.a));
+        base += sheen.rgb * d_charlie(n_dot_h, sheen.a) * v_charlie(n_dot_l, n_dot_v, sheen.a);
+    }
+    if (coat.x > 0.0) {
+        float f_coat = coat.x * (0.04 + 0.96 * fc);
+        base = base * (1.0 - f_coat) + vec3(f_coat * d_ggx(n_dot_h, coat.y) * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, coat.y)));
+    }
+    return base * light.color.rgb * radiance;
+}
+
+// What the clear coat lets through of what lies under it (light given off included):
+// 1 − coat·F_coat at the view.
+float coat_transmittance(vec3 n, vec3 v, vec4 coat) {
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    return 1.0 - coat.x * (0.04 + 0.96 * pow(1.0 - n_dot_v, 5.0));
+}
+
+// Environment light with lobes (environment.glsl's split sum): the specular term's F₀ and F₉₀
+// from the dielectric's F₀ and specular factor; the sheen's lobe as E(n·v)·sheen colour times
+// the radiance prefiltered at its roughness about the normal, the base scaled by
+// 1 − max(sheen)·E; the clear coat's split sum at its roughness over the base scaled by
+// 1 − coat·F_coat.
+vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion, vec4 specular, vec4 coat,
+                             vec4 sheen) {
+    mat3 to_image = mat3(environment.to_image[0].xyz, environment.to_image[1].xyz, environment.to_image[2].xyz);
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    vec3 r = normalize(2.0 * dot(n, v) * n - v);
+    vec3 diffuse = albedo * (1.0 - metallic) * environment_diffuse(to_image * n) * occlusion;
+    vec3 f0 = mix(specular.a * specular.rgb, albedo, metallic);
+    float f90 = mix(specular.a, 1.0, metallic);
+    vec2 ab = environment_brdf_at(n_dot_v, roughness);
+    vec3 prefiltered = environment_prefiltered(to_image * r, roughness);
+    vec3 base = diffuse + prefiltered * (f0 * ab.x + f90 * ab.y) * specular_occlusion(n_dot_v, occlusion, roughness);
+    float sheen_max = max3(sheen.rgb);
+    if (sheen_max > 0.0) {
+        float e = sheen_albedo(n_dot_v, sheen.a);
+        base = base * (1.0 - sheen_max * e) + sheen.rgb * e * environment_prefiltered(to_image * n, sheen.a) * occlusion;
+    }
+    if (coat.x > 0.0) {
+        vec2 coat_ab = environment_brdf_at(n_dot_v, coat.y);
+        vec3 coat_light = environment_prefiltered(to_image * r, coat.y) * (0.04 * coat_ab.x + coat_ab.y) * specular_occlusion(n_dot_v, occlusion, coat.y);
+        base = base * coat_transmittance(n, v, coat) + coat.x * coat_light;
+    }
+    return base * environment.params.x;
+}
+
+#endif
