@@ -46,7 +46,7 @@ struct FrameUniforms {
     uint light_count;
     float ambient;       // seed: colour = albedo * ambient + Lo
     float omni_texel;    // one texel of a point-light shadow cube face, in face units (2 / size)
-    uint directional_count; // lights in directional_direction/colour
+    uint directional_count; // lights in directional_lights (scene_bindings.glsl)
     uvec4 cluster_dims;  // xyz: cluster grid size
     uvec4 viewport;      // xy: image size in pixels; z: the debug view shown (DEBUG_VIEW_*)
     vec4 cluster_slices; // x, y: slice = floor(log(depth) * x + y); z: heat-map top (lights)
@@ -67,9 +67,6 @@ struct FrameUniforms {
     vec4 spot_strength;        // rgb
     vec4 ambient_light;        // rgb: ambient colour
     vec4 texture_transform;    // the 2×2 transform of texture coordinates: columns xy and zw
-    // Directional lights (glTF, scene files; every model): xyz the direction the light travels.
-    vec4 directional_direction[4];
-    vec4 directional_color[4]; // rgb
     vec4 exposure;             // x: the factor lit colour is multiplied by before tone map and gamma (2^EV)
     vec4 shadow_rays;          // x: length of the sun's shadow rays (beyond the scene's box from any point in it)
 };
@@ -87,6 +84,13 @@ struct EnvironmentData {
 // Declares the frame's values as `frame`, at binding `b` of set 0: every shader reads them
 // from a read-only storage buffer, never a uniform block (why: opaque_uniform above).
 #define FRAME_BLOCK(b) layout(std430, set = 0, binding = b) readonly buffer FrameBlock { FrameUniforms frame; }
+
+// A light infinitely far away (set 0, binding 19, std430 array; glTF and scene files, every
+// model).
+struct DirectionalLightData {
+    vec4 direction; // xyz: unit direction the light travels
+    vec4 color;     // rgb
+};
 
 // A radius-limited point light (set 0, binding 1, std430 array).
 struct PointLight {

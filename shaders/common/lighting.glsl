@@ -76,8 +76,8 @@ float spot_cone(uint i, PointLight l, vec3 world) {
 // (1 − 10⁴/10³⁰ rounds to 1) and a direction off by under 10⁻⁷ rad.
 #define SUM_DIRECTIONAL(sum, LIGHT)                                                                   \
     for (uint d_ = 0u; d_ < frame.directional_count; ++d_) {                                           \
-        PointLight far_ = PointLight(vec4(world - frame.directional_direction[d_].xyz * 1e4, 1e30),   \
-                                     vec4(frame.directional_color[d_].rgb, 0.0));                      \
+        PointLight far_ = PointLight(vec4(world - directional_lights[d_].direction.xyz * 1e4, 1e30), \
+                                     vec4(directional_lights[d_].color.rgb, 0.0));                   \
         sum += LIGHT(far_);                                                                            \
     }
 

@@ -1,4 +1,4 @@
-// Set 0 as every shading path sees it: the frame's uniforms, the lights, the objects and, with
+// Set 0 as every shading path sees it: the frame's uniforms, the lights (point and directional), the objects and, with
 // CLUSTERED defined, the cluster lists, with LIGHT_GRID the light grid's. Rust binds them by these names, reflected from the
 // SPIR-V (descriptors.rs).
 
@@ -18,6 +18,8 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer { PointLight li
 #endif
 layout(std430, set = 0, binding = 4) readonly buffer ObjectBuffer { ObjectData objects[]; };
 layout(std430, set = 0, binding = 10) readonly buffer LightConeBuffer { LightCone light_cones[]; };
+// frame.directional_count of them (a one-element stand-in where there are none).
+layout(std430, set = 0, binding = 19) readonly buffer DirectionalLightBuffer { DirectionalLightData directional_lights[]; };
 #ifdef CLUSTERED
 layout(std430, set = 0, binding = 2) readonly buffer ClusterRangeBuffer { ClusterRange cluster_ranges[]; };
 layout(std430, set = 0, binding = 3) readonly buffer LightIndexBuffer { uint light_indices[]; };

@@ -11,7 +11,7 @@
 //! problem is one line naming it. Textures (PNG, JPEG; base colour and emissive in sRGB):
 //! base colour, normal (with its scale), metallic-roughness, occlusion (with its strength)
 //! and emissive, each with its sampler's wrapping and filters; all read with TEXCOORD_0 (a
-//! texture naming another set gets a warning). Directional lights: up to
+//! texture naming another set gets a warning). Directional lights: any number up to
 //! MAX_DIRECTIONAL_LIGHTS. Cameras: perspective or orthographic.
 
 use crate::camera::Camera;

@@ -38,7 +38,7 @@ gpu_struct!(
         ambient: f32,
         /// One texel of a point-light shadow cube face in face units: 2 / size.
         omni_texel: f32,
-        /// Lights in `directional_*`.
+        /// Lights in the directional-light buffer.
         directional_count: u32,
         /// xyz: cluster grid size.
         cluster_dims: [u32; 4],
@@ -70,9 +70,6 @@ gpu_struct!(
         spot_strength: [f32; 4],
         ambient_light: [f32; 4],
         texture_transform: [f32; 4],
-        /// xyz: the direction each directional light travels.
-        directional_direction: [[f32; 4]; 4],
-        directional_color: [[f32; 4]; 4],
         /// x: the factor lit colour is multiplied by before tone map and gamma, 2^EV.
         exposure: [f32; 4],
         /// x: length of the sun's shadow rays (beyond the scene's box from any point in it).
@@ -103,6 +100,16 @@ gpu_struct!(
         to_image: [[f32; 4]; 3],
         /// x: intensity (0: no environment); y: the specular cube's last mip level.
         params: [f32; 4],
+    }
+);
+
+gpu_struct!(
+    /// A light infinitely far away (std430; see common.glsl).
+    DirectionalLightData {
+        /// xyz: unit direction the light travels.
+        direction: [f32; 4],
+        /// rgb.
+        color: [f32; 4],
     }
 );
 

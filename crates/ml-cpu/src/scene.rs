@@ -194,7 +194,7 @@ pub struct Scene {
     pub meshes: Vec<Mesh>,
     /// Textures of the scene's own (glTF), named by `Object::textures`.
     pub textures: Vec<TextureImage>,
-    /// Lights infinitely far away (glTF, scene files): at most MAX_DIRECTIONAL_LIGHTS.
+    /// Lights infinitely far away (glTF, scene files): any number up to MAX_DIRECTIONAL_LIGHTS.
     pub directional: Vec<DirectionalLight>,
     /// Spot cones, one per light (LightCone::NONE for point lights) — or none at all in a
     /// scene without spot lights.
@@ -207,8 +207,9 @@ pub struct Scene {
 /// lights get cubes 0.6 m wide beside spheres 2 m wide).
 pub const LIGHT_MARKER_SIZE: f32 = 0.02;
 
-/// Most directional lights a scene may have (FrameUniforms holds them).
-pub const MAX_DIRECTIONAL_LIGHTS: usize = 4;
+/// Most directional lights a scene may have: every point sums them all (they reach everywhere,
+/// so no culling helps), so this is a bound on absurd files, not on the buffer they lie in.
+pub const MAX_DIRECTIONAL_LIGHTS: usize = 65_536;
 
 /// A light infinitely far away: the same everywhere, from one direction.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -738,10 +738,6 @@ impl<'a> Renderer<'a> {
             spot_strength: bp.spot.strength.extend(0.0).to_array(),
             ambient_light: bp.ambient.extend(0.0).to_array(),
             texture_transform: bp.texture_transform.to_cols_array(),
-            directional_direction: std::array::from_fn(|i| {
-                self.scene.directional.get(i).map_or([0.0; 4], |d| d.direction.extend(0.0).to_array())
-            }),
-            directional_color: std::array::from_fn(|i| self.scene.directional.get(i).map_or([0.0; 4], |d| d.color.extend(0.0).to_array())),
             exposure: [exposure, 0.0, 0.0, 0.0],
             shadow_rays: [self.gpu.sun_ray_length, 0.0, 0.0, 0.0],
             ..FrameUniforms::default()

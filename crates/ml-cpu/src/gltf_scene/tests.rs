@@ -106,6 +106,11 @@ fn lights_and_cameras_come_from_their_nodes() {
     assert_eq!(s.camera.position, Vec3::new(0.0, 1.0, 4.0));
     assert!((s.camera.forward() - (-Vec3::Z)).length() < 1e-5);
     assert!((s.camera.fov_y_deg - 0.8f32.to_degrees()).abs() < 1e-4 && s.camera.near == 0.05 && s.camera.far == 80.0);
+    // Any number of directional lights: the same sun on nine more nodes.
+    for _ in 0..9 {
+        w.node(json!({ "rotation": [-half, 0.0, 0.0, half], "extensions": { "KHR_lights_punctual": { "light": sun } } }), true);
+    }
+    assert_eq!(from_bytes(&w.to_gltf(), None).unwrap().0.directional.len(), 10);
 }
 
 #[test]

@@ -26,7 +26,7 @@ use crate::scene::textures::SceneTextures;
 use crate::targets::{depth_format, Output};
 use ml_cpu::alpha_mask::AlphaMasks;
 use ml_cpu::blinn_phong::shadow_view_proj;
-use ml_cpu::gpu_types::{LightCone, ObjectData};
+use ml_cpu::gpu_types::{DirectionalLightData, LightCone, ObjectData};
 use ml_cpu::scene::Scene;
 use ml_vk::{release_on_error, vk, Buffer, Context};
 
@@ -36,6 +36,8 @@ pub struct SceneGpu {
     pub objects: Buffer,
     /// Spot cones, parallel to the lights (static: only positions animate).
     pub cones: Buffer,
+    /// The directional lights (static).
+    pub directional: Buffer,
     /// The alpha of every texture a masked object cuts with (ml_cpu::alpha_mask).
     pub alpha_masks: Buffer,
     /// The surface variants (masked, double-sided) the objects need: the mesh passes make a
@@ -82,6 +84,7 @@ impl SceneGpu {
             meshes: SceneMeshes::empty(),
             objects: Buffer::null(),
             cones: Buffer::null(),
+            directional: Buffer::null(),
             alpha_masks: Buffer::null(),
             surface_variants: SurfaceVariant::needed(&scene.objects),
             textures,
@@ -99,10 +102,24 @@ impl SceneGpu {
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
-        let made = Buffer::device_local_with(ctx, "light cones", bytemuck::cast_slice(&cones), vk::BufferUsageFlags::STORAGE_BUFFER)
-            .map_err(RenderError::from)
+        // Every directional light (frame.directional_count says how many); one stand-in if none.
+        let mut directional: Vec<DirectionalLightData> = scene
+            .directional
+            .iter()
+            .map(|d| DirectionalLightData { direction: d.direction.extend(0.0).to_array(), color: d.color.extend(0.0).to_array() })
+            .collect();
+        if directional.is_empty() {
+            directional.push(DirectionalLightData::default());
+        }
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let made = Buffer::device_local_with(ctx, "light cones", bytemuck::cast_slice(&cones), storage)
             .and_then(|cones| {
                 gpu.cones = cones;
+                Buffer::device_local_with(ctx, "directional lights", bytemuck::cast_slice(&directional), storage)
+            })
+            .map_err(RenderError::from)
+            .and_then(|directional| {
+                gpu.directional = directional;
                 gpu.upload_objects(ctx, scene)
             });
         if let Err(e) = made {
@@ -173,8 +190,12 @@ impl SceneGpu {
     /// The scene's buffers that shaders bind, under their blocks' names (a frame's table of
     /// resources holds them).
     pub fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
-        let mut named =
-            vec![("ObjectBuffer", self.objects.raw), ("LightConeBuffer", self.cones.raw), ("AlphaMaskBuffer", self.alpha_masks.raw)];
+        let mut named = vec![
+            ("ObjectBuffer", self.objects.raw),
+            ("LightConeBuffer", self.cones.raw),
+            ("DirectionalLightBuffer", self.directional.raw),
+            ("AlphaMaskBuffer", self.alpha_masks.raw),
+        ];
         named.extend(self.rays.named_buffers());
         named
     }
@@ -195,6 +216,7 @@ impl SceneGpu {
     pub fn destroy(&mut self, ctx: &Context) {
         self.release_objects(ctx);
         self.cones.destroy(ctx);
+        self.directional.destroy(ctx);
         self.textures.destroy(ctx);
         self.environment.destroy(ctx);
         self.object_textures.destroy(ctx);

@@ -94,6 +94,15 @@ fn gpu_matches_cpu_reference_on_a_rough_dielectric() {
 fn directional_lights_match_the_cpu_reference() {
     let sun = DirectionalLight { direction: Vec3::new(0.5, -1.0, -0.3).normalize(), color: Vec3::new(0.6, 0.6, 0.5) };
     let fill = DirectionalLight { direction: Vec3::new(-0.8, 0.4, -0.6).normalize(), color: Vec3::new(0.1, 0.2, 0.4) };
-    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &[sun, fill], None);
+    // Six: any number (the frame's uniforms once held four).
+    let dim = |x: f32, y: f32, z: f32, c: [f32; 3]| DirectionalLight { direction: Vec3::new(x, y, z).normalize(), color: Vec3::from(c) };
+    let more = [
+        dim(0.2, -0.3, -1.0, [0.15, 0.05, 0.0]),
+        dim(-0.5, -0.5, -0.7, [0.0, 0.12, 0.05]),
+        dim(0.9, 0.1, -0.4, [0.05, 0.0, 0.15]),
+        dim(0.0, 1.0, -0.2, [0.1, 0.1, 0.1]),
+    ];
+    let six: Vec<DirectionalLight> = [sun, fill].into_iter().chain(more).collect();
+    compare(Material { albedo: Vec3::new(0.8, 0.3, 0.2), roughness: 0.6, metallic: 0.0 }, &six, None);
     compare(Material::named("gold").unwrap(), &[sun], None);
 }
