@@ -296,9 +296,12 @@ impl<'a> Renderer<'a> {
     /// viewer's object and material combos): new meshes, object buffer, sun shadow map,
     /// passes (the GPU-driven ones hold the scene's meshlets) and frame slots. False, changing
     /// nothing, where either scene has object textures (their sets and the pipelines' texture
-    /// code depend on them).
+    /// code depend on them) or the two differ in material lobes (compiled in or not).
     pub fn set_objects(&mut self, scene: &Scene) -> Result<bool, RenderError> {
         if self.gpu.object_textures.per_object.is_empty() || !scene.textures.is_empty() || !self.scene.textures.is_empty() {
+            return Ok(false);
+        }
+        if self.settings.lighting(scene).material_lobes != self.settings.lighting(&self.scene).material_lobes {
             return Ok(false);
         }
         self.release_frames()?;

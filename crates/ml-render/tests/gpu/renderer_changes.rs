@@ -72,6 +72,14 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
         let (max, _) = common::max_difference(&changed, &old_lights);
         assert!(max > 30, "{}: the new lights changed the image by only {max}/255", technique.name());
     }
+    // Objects whose materials have lobes (pbr) need pipelines made for them: refused, nothing
+    // changed, where the renderer was made without.
+    let pbr = RenderSettings { shading: ShadingModel::Pbr, ..RenderSettings::new(Technique::Visibility, 64, 48) };
+    let mut plain = Renderer::new(&ctx, seed_scene(&LightParams::seed_default()), pbr).expect("renderer");
+    let mut coated = seed_scene(&LightParams::seed_default());
+    coated.objects[0].extras.lobes.clearcoat = 1.0;
+    assert!(!plain.set_objects(&coated).expect("asked"), "objects with lobes set on a renderer made without");
+    drop(plain);
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
 }
