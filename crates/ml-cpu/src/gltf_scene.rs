@@ -296,6 +296,8 @@ pub enum GltfError {
     UnknownVariant { name: String, known: Vec<String> },
     #[error("a material variant maps it to material {index}, but there are {materials} materials")]
     VariantMaterial { index: u64, materials: usize },
+    #[error("material {material}: ior {} must be 0 or from 1 to {}", Number(*value), Number(material_extensions::MAX_IOR))]
+    Ior { material: MaterialName, value: f32 },
     #[error("material {material}: {field} is {value}; it must be {}", describe_range(range))]
     ExtensionFactor { material: MaterialName, field: &'static str, value: String, range: std::ops::RangeInclusive<f32> },
     #[error("material {material}: emissive strength {} must be finite, not negative and at most {}", Number(*value), Number(MAX_INTENSITY))]

@@ -24,7 +24,7 @@ pub(super) fn material_lobes(m: &gltf::Material) -> Result<(MaterialLobes, Vec<&
     if let Some(ext) = m.extension_value("KHR_materials_ior") {
         lobes.ior = read.number(ext, "ior", lobes.ior, 0.0..=MAX_IOR)?;
         if lobes.ior > 0.0 && lobes.ior < 1.0 {
-            return Err(GltfError::Factor { material, factor: "ior (0, or at least 1)", value: lobes.ior });
+            return Err(GltfError::Ior { material, value: lobes.ior });
         }
     }
     if let Some(ext) = m.extension_value("KHR_materials_specular") {
