@@ -154,11 +154,12 @@ vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
 #define LOBED_LIGHT(l) shadowed(lobed_point_light(l, world, n, v, albedo, roughness, metallic, m.specular, m.coat, m.sheen), l, world, n)
             SUM_LIGHTS(lo, LOBED_LIGHT)
             SUM_DIRECTIONAL(lo, LOBED_LIGHT)
-            vec3 emitted = emission * coat_transmittance(n, v, m.coat);
+            float under_coat = coat_transmittance(n, v, m.coat);
             if (ENVIRONMENT) {
-                return lobed_environment_light(n, v, albedo, roughness, metallic, occlusion, m.specular, m.coat, m.sheen) + lo + emitted;
+                return lobed_environment_light(n, v, albedo, roughness, metallic, occlusion, m.specular, m.coat, m.sheen) + lo +
+                       emission * under_coat;
             }
-            return albedo * frame.ambient * occlusion * coat_transmittance(n, v, m.coat) + lo + emitted;
+            return albedo * frame.ambient * occlusion * under_coat + lo + emission * under_coat;
         }
 #define PBR_LIGHT(l) shadowed(pbr_point_light(l, world, n, v, albedo, roughness, metallic), l, world, n)
         SUM_LIGHTS(lo, PBR_LIGHT)

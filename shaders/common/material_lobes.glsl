@@ -63,6 +63,11 @@ float sheen_albedo(float n_dot_v, float roughness) {
     return low + (high - low) * fy;
 }
 
+// The clear coat's Fresnel reflectance at n·v (F₀ 0.04), times its strength `coat`.
+float coat_fresnel(float n_dot_v, float coat) {
+    return coat * (0.04 + 0.96 * pow(1.0 - n_dot_v, 5.0));
+}
+
 float max3(vec3 c) {
     return max(max(c.r, c.g), c.b);
 }
@@ -104,7 +109,7 @@ vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 al
         base += sheen.rgb * d_charlie(n_dot_h, sheen.a) * v_charlie(n_dot_l, n_dot_v, sheen.a);
     }
     if (coat.x > 0.0) {
-        float f_coat = coat.x * (0.04 + 0.96 * fc);
+        float f_coat = coat_fresnel(n_dot_v, coat.x);
         base = base * (1.0 - f_coat) + vec3(f_coat * d_ggx(n_dot_h, coat.y) * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, coat.y)));
     }
     return base * light.color.rgb * radiance;
@@ -113,8 +118,7 @@ vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 al
 // What the clear coat lets through of what lies under it (light given off included):
 // 1 − coat·F_coat at the view.
 float coat_transmittance(vec3 n, vec3 v, vec4 coat) {
-    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
-    return 1.0 - coat.x * (0.04 + 0.96 * pow(1.0 - n_dot_v, 5.0));
+    return 1.0 - coat_fresnel(clamp(dot(n, v), 0.0, 1.0), coat.x);
 }
 
 // Environment light with lobes (environment.glsl's split sum): the specular term's F₀ and F₉₀
@@ -141,7 +145,7 @@ vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float
     if (coat.x > 0.0) {
         vec2 coat_ab = environment_brdf_at(n_dot_v, coat.y);
         vec3 coat_light = environment_prefiltered(to_image * r, coat.y) * (0.04 * coat_ab.x + coat_ab.y) * specular_occlusion(n_dot_v, occlusion, coat.y);
-        base = base * coat_transmittance(n, v, coat) + coat.x * coat_light;
+        base = base * (1.0 - coat_fresnel(n_dot_v, coat.x)) + coat.x * coat_light;
     }
     return base * environment.params.x;
 }

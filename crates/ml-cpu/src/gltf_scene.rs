@@ -844,10 +844,10 @@ impl Builder<'_> {
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
                 let what = Part::Primitive { mesh: mesh.index(), primitive: primitive.index() };
-                let Some(parts) = self.primitive(&mesh, &primitive).map_err(|e| e.within(what))? else {
+                let m = material_variants::material_of(self.doc, &primitive, self.variant).map_err(|e| e.within(what))?;
+                let Some(parts) = self.primitive(&mesh, &primitive, m.double_sided()).map_err(|e| e.within(what))? else {
                     continue;
                 };
-                let m = material_variants::material_of(self.doc, &primitive, self.variant).map_err(|e| e.within(what))?;
                 let (material, extras, mixed, unread) = material(&m).map_err(|e| e.within(what))?;
                 let named = || match m.name() {
                     Some(name) => format!("{} '{name}'", MaterialName(m.index())),
@@ -881,9 +881,15 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// Load a primitive's triangles (once per primitive): one mesh, or with a double-sided
-    /// material and twin faces two (the twins apart); None for points and lines.
-    fn primitive(&mut self, mesh: &gltf::Mesh, primitive: &gltf::Primitive) -> Result<Option<Vec<LoadedMesh>>, GltfError> {
+    /// Load a primitive's triangles (once per primitive): one mesh, or where its material (the
+    /// one drawn: `double_sided` is that material's) is double-sided and it has twin faces, two
+    /// (the twins apart); None for points and lines.
+    fn primitive(
+        &mut self,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+        double_sided: bool,
+    ) -> Result<Option<Vec<LoadedMesh>>, GltfError> {
         use gltf::mesh::Mode;
         let key = (mesh.index(), primitive.index());
         if let Some(known) = self.by_primitive.get(&key) {
@@ -956,7 +962,6 @@ impl Builder<'_> {
             }
         }
         compute_tangents(&mut out);
-        let double_sided = material_variants::material_of(self.doc, primitive, self.variant)?.double_sided();
         let pieces = match double_sided.then(|| twin_faces::split_twin_faces(&out)).flatten() {
             Some((rest, twins)) => vec![(rest, false), (twins, true)],
             None => vec![(out, false)],

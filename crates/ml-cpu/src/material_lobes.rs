@@ -177,15 +177,20 @@ pub fn lobed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Mate
     }
     if lobes.clearcoat > 0.0 {
         let r = lobes.clearcoat_roughness;
-        let f_coat = lobes.clearcoat * (0.04 + 0.96 * fc);
+        let f_coat = coat_fresnel(n_dot_v, lobes.clearcoat);
         base = base * (1.0 - f_coat) + Vec3::splat(f_coat * d_ggx(n_dot_h, r) * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, r.max(0.05)));
     }
     base * Vec3::from_slice(&light.color[..3]) * radiance
 }
 
+/// The clear coat's Fresnel reflectance at n·v (F₀ 0.04), times its strength.
+fn coat_fresnel(n_dot_v: f32, clearcoat: f32) -> f32 {
+    clearcoat * (0.04 + 0.96 * (1.0 - n_dot_v).powf(5.0))
+}
+
 /// What the clear coat lets through of what lies under it: 1 − coat·F_coat at the view.
 pub fn coat_transmittance(n_dot_v: f32, clearcoat: f32) -> f32 {
-    1.0 - clearcoat * (0.04 + 0.96 * (1.0 - n_dot_v.clamp(0.0, 1.0)).powf(5.0))
+    1.0 - coat_fresnel(n_dot_v.clamp(0.0, 1.0), clearcoat)
 }
 
 /// Linear colour of surface point `p` with unit normal `n` seen from `eye` in the pbr model
