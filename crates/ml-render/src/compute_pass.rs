@@ -196,8 +196,7 @@ impl ComputePass {
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
             ctx.device.destroy_sampler(self.sampler, None);
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ml_vk::shader::release_pipeline(ctx, self.pipeline);
         }
         self.sets.destroy(ctx);
         self.sampler = vk::Sampler::null();

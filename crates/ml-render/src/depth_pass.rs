@@ -10,7 +10,7 @@ use crate::descriptors::{FrameSets, Resource};
 use crate::gpu_mesh::{vertex_attributes, vertex_binding};
 use glam::Mat4;
 use ml_shaders::Shader;
-use ml_vk::{shader, vk, Context, VkError, VkResultExt};
+use ml_vk::{shader, vk, Context, VkError};
 
 pub struct DepthPassDesc {
     pub format: vk::Format,
@@ -65,8 +65,7 @@ pub fn render_pass(ctx: &Context, desc: &DepthPassDesc) -> Result<vk::RenderPass
     if desc.view_mask != 0 {
         info = info.push_next(&mut multiview);
     }
-    // SAFETY: valid device and create info.
-    unsafe { ctx.device.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")
+    ml_vk::shader::render_pass(ctx, &info)
 }
 
 /// Depth-only pipeline: positions only, both faces (a shadow caster need not be closed),
@@ -229,11 +228,7 @@ impl MaskedPipeline {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: no pending work uses them; null handles are ignored.
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-        }
+        ml_vk::shader::release_pipeline(ctx, self.pipeline);
         self.pipeline = vk::Pipeline::null();
         self.layout = vk::PipelineLayout::null();
         self.sets.destroy(ctx);

@@ -92,10 +92,7 @@ impl SetLayout {
                     .stage_flags(*stages)
             })
             .collect();
-        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&raw_bindings);
-        // SAFETY: valid device and create info.
-        let raw = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }.ctx("vkCreateDescriptorSetLayout")?;
-        Ok(SetLayout { raw, bindings })
+        Ok(SetLayout { raw: ml_vk::shader::set_layout_of(ctx, &raw_bindings)?, bindings })
     }
 
     pub fn null() -> SetLayout {
@@ -117,9 +114,8 @@ impl SetLayout {
         Ok(())
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: no pending work uses it; a null handle is ignored.
-        unsafe { ctx.device.destroy_descriptor_set_layout(self.raw, None) };
+    /// Let go of the layout (the context's: shared, destroyed with it).
+    pub fn destroy(&mut self, _ctx: &Context) {
         self.raw = vk::DescriptorSetLayout::null();
     }
 }

@@ -361,7 +361,6 @@ impl RenderPassDesc {
             .collect();
         let info =
             vk::RenderPassCreateInfo::default().attachments(&self.attachments).subpasses(&subpasses).dependencies(&self.dependencies);
-        // SAFETY: valid device and create info; the referenced arrays outlive the call.
-        unsafe { ctx.device.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")
+        ml_vk::shader::render_pass(ctx, &info)
     }
 }

@@ -344,12 +344,9 @@ impl StageProbe {
         // SAFETY: nothing is pending (every submission was waited for); null handles are ignored.
         unsafe {
             d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_pipeline(self.fragment_pipeline, None);
-            d.destroy_pipeline(self.compute_pipeline, None);
-            d.destroy_pipeline_layout(self.fragment_layout, None);
-            d.destroy_pipeline_layout(self.compute_layout, None);
+            ml_vk::shader::release_pipeline(ctx, self.fragment_pipeline);
+            ml_vk::shader::release_pipeline(ctx, self.compute_pipeline);
             d.destroy_framebuffer(self.framebuffer, None);
-            d.destroy_render_pass(self.render_pass, None);
         }
         self.fragment_set_layout.destroy(ctx);
         self.compute_set_layout.destroy(ctx);
@@ -394,8 +391,7 @@ fn render_pass(ctx: &Context) -> Result<vk::RenderPass, VkError> {
             .dst_access_mask(vk::AccessFlags::TRANSFER_READ),
     ];
     let info = vk::RenderPassCreateInfo::default().attachments(&attachment).subpasses(&subpass).dependencies(&dependencies);
-    // SAFETY: valid device and create info.
-    unsafe { ctx.device.create_render_pass(&info, None) }.ctx("vkCreateRenderPass")
+    ml_vk::shader::render_pass(ctx, &info)
 }
 
 /// `--technique auto`'s quick probe: 512×512 pixels, the loop made 4× longer from 16 lights

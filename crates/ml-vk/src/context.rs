@@ -4,6 +4,7 @@
 //! the device has VK_KHR_swapchain).
 
 use crate::error::{Result, VkError, VkResultExt};
+use crate::object_cache::ObjectCache;
 use ash::{ext::debug_utils, vk};
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{c_void, CStr};
@@ -334,6 +335,8 @@ pub struct Context {
     pub pipeline_stats: bool,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) transient_pool: vk::CommandPool,
+    /// Pipelines, layouts and render passes shared by whoever asks for the same one.
+    pub(crate) objects: Mutex<ObjectCache>,
 }
 
 /// The environment variable that asks for compute pipelines' statistics (`Context::pipeline_stats`).
@@ -386,6 +389,7 @@ impl Context {
                     pipeline_stats,
                     allocator: ManuallyDrop::new(Mutex::new(allocator)),
                     transient_pool,
+                    objects: Mutex::new(ObjectCache::default()),
                 })
             }
             Err(e) => {
@@ -476,6 +480,18 @@ impl Context {
         self.parts.messages.clone()
     }
 
+    /// The shared pipelines, layouts and render passes (object_cache.rs).
+    pub(crate) fn objects(&self) -> std::sync::MutexGuard<'_, ObjectCache> {
+        // As the allocator's: a panic elsewhere leaves the maps consistent.
+        self.objects.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Pipelines the context keeps (object_cache.rs), and of those the ones someone holds
+    /// (handed out by `shader` and not yet released: none once every renderer is gone).
+    pub fn pipeline_counts(&self) -> (usize, usize) {
+        self.objects().pipeline_counts()
+    }
+
     pub fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
         // A poisoned lock only means another thread panicked mid-allocation; the allocator's
         // own state is still consistent for freeing.
@@ -542,6 +558,7 @@ impl Drop for Context {
         // an error path that left work in flight.
         unsafe {
             let _ = self.device.device_wait_idle();
+            self.objects.get_mut().unwrap_or_else(|e| e.into_inner()).destroy(&self.device);
             self.device.destroy_command_pool(self.transient_pool, None);
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);

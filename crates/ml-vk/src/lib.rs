@@ -10,6 +10,7 @@ pub mod descriptors;
 pub mod driver_env;
 pub mod error;
 pub mod image;
+pub mod object_cache;
 pub mod shader;
 pub mod swapchain;
 pub mod timing;

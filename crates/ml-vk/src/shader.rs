@@ -1,5 +1,11 @@
+//! Shader modules, pipelines and their layouts. Pipelines, pipeline layouts, set layouts and
+//! render passes made here are shared through the context (object_cache.rs): the same create
+//! info twice gives the same object. Pipelines go back with `release_pipeline`; layouts and
+//! render passes belong to the context (never destroy them).
+
 use crate::context::Context;
 use crate::error::{Result, VkResultExt};
+use crate::object_cache::Key;
 use ash::vk;
 
 /// A shader module from SPIR-V bytes (as embedded by ml-shaders).
@@ -33,6 +39,13 @@ pub fn compute_pipeline(
     layout: vk::PipelineLayout,
     constants: &[(u32, u32)],
 ) -> Result<vk::Pipeline> {
+    let stats = ctx.pipeline_stats;
+    let flags = if stats { vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR } else { vk::PipelineCreateFlags::empty() };
+    let mut key = Key::new(1);
+    key.bytes(spirv).constants(constants).handle(layout).word(flags.as_raw());
+    if let Some(pipeline) = ctx.objects().take_pipeline(&key) {
+        return Ok(pipeline);
+    }
     let module = module(ctx, spirv)?;
     let (entries, data) = specialization(constants);
     let spec = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
@@ -41,8 +54,6 @@ pub fn compute_pipeline(
         .module(module)
         .name(c"main")
         .specialization_info(&spec);
-    let stats = ctx.pipeline_stats;
-    let flags = if stats { vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR } else { vk::PipelineCreateFlags::empty() };
     let info = [vk::ComputePipelineCreateInfo::default().flags(flags).stage(stage).layout(layout)];
     // SAFETY: valid module and layout.
     let result = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
@@ -52,7 +63,29 @@ pub fn compute_pipeline(
     if stats {
         print_pipeline_stats(ctx, name, constants, pipeline);
     }
-    Ok(pipeline)
+    Ok(shared(ctx, key, pipeline))
+}
+
+/// `pipeline`, just made for `key`, handed out through the context's cache.
+fn shared(ctx: &Context, key: Key, pipeline: vk::Pipeline) -> vk::Pipeline {
+    let (pipeline, duplicate) = ctx.objects().add_pipeline(key, pipeline);
+    // SAFETY: another thread made the same pipeline meanwhile; ours was never used.
+    unsafe { ctx.device.destroy_pipeline(duplicate.unwrap_or_default(), None) };
+    pipeline
+}
+
+/// Hand back a pipeline from `compute_pipeline` or `graphics_pipeline` (null: nothing). The
+/// context keeps it a while for whoever asks for the same one (object_cache.rs) and
+/// destroys it when that is over: only while no pending work uses it, as destroying would.
+pub fn release_pipeline(ctx: &Context, pipeline: vk::Pipeline) {
+    if pipeline == vk::Pipeline::null() {
+        return;
+    }
+    let doomed = ctx.objects().release_pipeline(pipeline);
+    for p in doomed {
+        // SAFETY: no holder is left, and the last one's work is over (the caller's promise).
+        unsafe { ctx.device.destroy_pipeline(p, None) };
+    }
 }
 
 /// One line on stderr per executable of `pipeline` (`Context::pipeline_stats`): its statistics
@@ -119,6 +152,10 @@ pub struct GraphicsPipelineDesc<'a> {
 
 /// A graphics pipeline as `desc` says.
 pub fn graphics_pipeline(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<vk::Pipeline> {
+    let key = graphics_key(desc);
+    if let Some(pipeline) = ctx.objects().take_pipeline(&key) {
+        return Ok(pipeline);
+    }
     let vert = module(ctx, desc.vertex)?;
     let frag = match desc.fragment.map(|spirv| module(ctx, spirv)).transpose() {
         Ok(f) => f,
@@ -174,27 +211,222 @@ pub fn graphics_pipeline(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<v
         ctx.device.destroy_shader_module(vert, None);
         ctx.device.destroy_shader_module(frag.unwrap_or_default(), None);
     }
-    result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")
+    let pipeline = result.map(|p| p[0]).map_err(|(_, e)| e).ctx("vkCreateGraphicsPipelines")?;
+    Ok(shared(ctx, key, pipeline))
 }
 
-/// A descriptor set layout of `bindings` (binding number, type), all visible to `stages`.
+/// Every field of `desc` that reaches the create info.
+fn graphics_key(desc: &GraphicsPipelineDesc) -> Key {
+    let mut key = Key::new(2);
+    key.bytes(desc.vertex).constants(desc.vertex_constants);
+    match desc.fragment {
+        Some(fragment) => key.word(1u64).bytes(fragment).constants(desc.fragment_constants),
+        None => key.word(0u64),
+    };
+    let input = &desc.vertex_input;
+    let rasterization = &desc.rasterization;
+    let depth = &desc.depth_stencil;
+    assert!(
+        input.p_next.is_null() && rasterization.p_next.is_null() && depth.p_next.is_null(),
+        "a pipeline state with an extension struct: the cache's key does not hold it"
+    );
+    // SAFETY: the arrays the create info points at (ash sets pointer and count together).
+    let (bindings, attributes) = unsafe {
+        (
+            raw_slice(input.p_vertex_binding_descriptions, input.vertex_binding_description_count),
+            raw_slice(input.p_vertex_attribute_descriptions, input.vertex_attribute_description_count),
+        )
+    };
+    key.word(bindings.len() as u64);
+    for b in bindings {
+        key.word(b.binding).word(b.stride).word(b.input_rate.as_raw() as u32);
+    }
+    key.word(attributes.len() as u64);
+    for a in attributes {
+        key.word(a.location).word(a.binding).word(a.format.as_raw() as u32).word(a.offset);
+    }
+    key.word(rasterization.depth_clamp_enable)
+        .word(rasterization.rasterizer_discard_enable)
+        .word(rasterization.polygon_mode.as_raw() as u32)
+        .word(rasterization.cull_mode.as_raw())
+        .word(rasterization.front_face.as_raw() as u32)
+        .word(rasterization.depth_bias_enable)
+        .float(rasterization.depth_bias_constant_factor)
+        .float(rasterization.depth_bias_clamp)
+        .float(rasterization.depth_bias_slope_factor)
+        .float(rasterization.line_width);
+    key.word(depth.depth_test_enable)
+        .word(depth.depth_write_enable)
+        .word(depth.depth_compare_op.as_raw() as u32)
+        .word(depth.depth_bounds_test_enable)
+        .word(depth.stencil_test_enable)
+        .float(depth.min_depth_bounds)
+        .float(depth.max_depth_bounds);
+    for op in [depth.front, depth.back] {
+        key.word(op.fail_op.as_raw() as u32)
+            .word(op.pass_op.as_raw() as u32)
+            .word(op.depth_fail_op.as_raw() as u32)
+            .word(op.compare_op.as_raw() as u32)
+            .word(op.compare_mask)
+            .word(op.write_mask)
+            .word(op.reference);
+    }
+    key.word(desc.colour_attachments as u64).word(desc.samples.as_raw()).handle(desc.layout).handle(desc.render_pass).word(desc.subpass);
+    key
+}
+
+/// The `count` elements at `ptr` (null or 0: none).
+///
+/// # Safety
+/// `ptr` points at `count` valid elements, or `count` is 0.
+unsafe fn raw_slice<'a, T>(ptr: *const T, count: u32) -> &'a [T] {
+    if count == 0 || ptr.is_null() {
+        &[]
+    } else {
+        // SAFETY: the caller's promise.
+        unsafe { std::slice::from_raw_parts(ptr, count as usize) }
+    }
+}
+
+/// A descriptor set layout of `bindings` (binding number, type), all visible to `stages`;
+/// the context's (never destroy it).
 pub fn set_layout(ctx: &Context, bindings: &[(u32, vk::DescriptorType)], stages: vk::ShaderStageFlags) -> Result<vk::DescriptorSetLayout> {
     let bindings: Vec<vk::DescriptorSetLayoutBinding> = bindings
         .iter()
         .map(|&(b, ty)| vk::DescriptorSetLayoutBinding::default().binding(b).descriptor_type(ty).descriptor_count(1).stage_flags(stages))
         .collect();
-    // SAFETY: valid device and create info.
-    unsafe { ctx.device.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
-        .ctx("vkCreateDescriptorSetLayout")
+    set_layout_of(ctx, &bindings)
 }
 
-/// A pipeline layout of `set_layouts` and `push_constants`.
+/// The descriptor set layout of `bindings` (no immutable samplers); the context's (never
+/// destroy it).
+pub fn set_layout_of(ctx: &Context, bindings: &[vk::DescriptorSetLayoutBinding]) -> Result<vk::DescriptorSetLayout> {
+    let mut key = Key::new(3);
+    for b in bindings {
+        assert!(b.p_immutable_samplers.is_null(), "immutable samplers: the cache's key does not hold them");
+        key.word(b.binding).word(b.descriptor_type.as_raw() as u32).word(b.descriptor_count).word(b.stage_flags.as_raw());
+    }
+    if let Some(layout) = ctx.objects().set_layout(&key) {
+        return Ok(layout);
+    }
+    // SAFETY: valid device and create info.
+    let layout = unsafe { ctx.device.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(bindings), None) }
+        .ctx("vkCreateDescriptorSetLayout")?;
+    let (layout, duplicate) = ctx.objects().add_set_layout(key, layout);
+    // SAFETY: made meanwhile by another thread as well; ours was never used.
+    unsafe { ctx.device.destroy_descriptor_set_layout(duplicate.unwrap_or_default(), None) };
+    Ok(layout)
+}
+
+/// The pipeline layout of `set_layouts` (from `set_layout`: the context's, so their handles
+/// stand for their bindings) and `push_constants`; the context's (never destroy it).
 pub fn pipeline_layout(
     ctx: &Context,
     set_layouts: &[vk::DescriptorSetLayout],
     push_constants: &[vk::PushConstantRange],
 ) -> Result<vk::PipelineLayout> {
+    let mut key = Key::new(4);
+    for &l in set_layouts {
+        key.handle(l);
+    }
+    key.word(u64::MAX);
+    for r in push_constants {
+        key.word(r.stage_flags.as_raw()).word(r.offset).word(r.size);
+    }
+    if let Some(layout) = ctx.objects().pipeline_layout(&key) {
+        return Ok(layout);
+    }
     let info = vk::PipelineLayoutCreateInfo::default().set_layouts(set_layouts).push_constant_ranges(push_constants);
     // SAFETY: valid device and create info.
-    unsafe { ctx.device.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")
+    let layout = unsafe { ctx.device.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")?;
+    let (layout, duplicate) = ctx.objects().add_pipeline_layout(key, layout);
+    // SAFETY: made meanwhile by another thread as well; ours was never used.
+    unsafe { ctx.device.destroy_pipeline_layout(duplicate.unwrap_or_default(), None) };
+    Ok(layout)
+}
+
+/// The render pass `info` describes (its only extension: multiview); the context's (never
+/// destroy it).
+pub fn render_pass(ctx: &Context, info: &vk::RenderPassCreateInfo) -> Result<vk::RenderPass> {
+    let key = render_pass_key(info);
+    if let Some(pass) = ctx.objects().render_pass(&key) {
+        return Ok(pass);
+    }
+    // SAFETY: valid device and create info.
+    let pass = unsafe { ctx.device.create_render_pass(info, None) }.ctx("vkCreateRenderPass")?;
+    let (pass, duplicate) = ctx.objects().add_render_pass(key, pass);
+    // SAFETY: made meanwhile by another thread as well; ours was never used.
+    unsafe { ctx.device.destroy_render_pass(duplicate.unwrap_or_default(), None) };
+    Ok(pass)
+}
+
+/// Every field of a render pass's create info (and of its multiview struct).
+fn render_pass_key(info: &vk::RenderPassCreateInfo) -> Key {
+    let mut key = Key::new(5);
+    let references = |key: &mut Key, refs: &[vk::AttachmentReference]| {
+        key.word(refs.len() as u64);
+        for r in refs {
+            key.word(r.attachment).word(r.layout.as_raw() as u32);
+        }
+    };
+    key.word(info.flags.as_raw());
+    // SAFETY: the arrays the create info points at (ash sets pointer and count together; a
+    // subpass's resolve array has its colour array's count).
+    unsafe {
+        for a in raw_slice(info.p_attachments, info.attachment_count) {
+            key.word(a.flags.as_raw())
+                .word(a.format.as_raw() as u32)
+                .word(a.samples.as_raw())
+                .word(a.load_op.as_raw() as u32)
+                .word(a.store_op.as_raw() as u32)
+                .word(a.stencil_load_op.as_raw() as u32)
+                .word(a.stencil_store_op.as_raw() as u32)
+                .word(a.initial_layout.as_raw() as u32)
+                .word(a.final_layout.as_raw() as u32);
+        }
+        key.word(u64::MAX);
+        for s in raw_slice(info.p_subpasses, info.subpass_count) {
+            key.word(s.flags.as_raw()).word(s.pipeline_bind_point.as_raw() as u32);
+            references(&mut key, raw_slice(s.p_input_attachments, s.input_attachment_count));
+            references(&mut key, raw_slice(s.p_color_attachments, s.color_attachment_count));
+            let resolve_count = if s.p_resolve_attachments.is_null() { 0 } else { s.color_attachment_count };
+            references(&mut key, raw_slice(s.p_resolve_attachments, resolve_count));
+            references(&mut key, raw_slice(s.p_depth_stencil_attachment, u32::from(!s.p_depth_stencil_attachment.is_null())));
+            key.word(s.preserve_attachment_count as u64);
+            for &p in raw_slice(s.p_preserve_attachments, s.preserve_attachment_count) {
+                key.word(p);
+            }
+        }
+        key.word(u64::MAX);
+        for d in raw_slice(info.p_dependencies, info.dependency_count) {
+            key.word(d.src_subpass)
+                .word(d.dst_subpass)
+                .word(d.src_stage_mask.as_raw())
+                .word(d.dst_stage_mask.as_raw())
+                .word(d.src_access_mask.as_raw())
+                .word(d.dst_access_mask.as_raw())
+                .word(d.dependency_flags.as_raw());
+        }
+        let mut next = info.p_next as *const vk::BaseInStructure;
+        while !next.is_null() {
+            assert_eq!(
+                (*next).s_type,
+                vk::StructureType::RENDER_PASS_MULTIVIEW_CREATE_INFO,
+                "a render pass extension struct the cache's key does not hold"
+            );
+            let m = &*(next as *const vk::RenderPassMultiviewCreateInfo);
+            key.word(u64::MAX);
+            for masks in [raw_slice(m.p_view_masks, m.subpass_count), raw_slice(m.p_correlation_masks, m.correlation_mask_count)] {
+                key.word(masks.len() as u64);
+                for &mask in masks {
+                    key.word(mask);
+                }
+            }
+            for &offset in raw_slice(m.p_view_offsets, m.dependency_count) {
+                key.word(offset as u32);
+            }
+            next = (*next).p_next;
+        }
+    }
+    key
 }

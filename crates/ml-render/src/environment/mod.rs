@@ -413,15 +413,14 @@ impl Prefilter {
     }
 
     fn destroy(&mut self, ctx: &Context) {
+        for p in self.pipelines.drain(..) {
+            ml_vk::shader::release_pipeline(ctx, p);
+        }
+        // Layouts are the context's.
+        self.pipeline_layouts.clear();
         // SAFETY: the submission that used them has finished (or never ran); null handles are
         // ignored.
         unsafe {
-            for p in self.pipelines.drain(..) {
-                ctx.device.destroy_pipeline(p, None);
-            }
-            for l in self.pipeline_layouts.drain(..) {
-                ctx.device.destroy_pipeline_layout(l, None);
-            }
             for v in self.views.drain(..) {
                 ctx.device.destroy_image_view(v, None);
             }

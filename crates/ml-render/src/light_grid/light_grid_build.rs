@@ -296,12 +296,8 @@ impl LightGridBuild {
         for b in [&mut self.lights, &mut self.positions, &mut self.order] {
             b.destroy(ctx);
         }
-        // SAFETY: the device is idle; null handles are ignored.
-        unsafe {
-            for p in [self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan) {
-                ctx.device.destroy_pipeline(p, None);
-            }
-            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+        for p in [self.count_pipeline, self.fill_pipeline].into_iter().chain(self.mark_scan).chain(self.list_scan) {
+            ml_vk::shader::release_pipeline(ctx, p);
         }
     }
 }

@@ -126,7 +126,6 @@ impl ObjectTextureSets {
                 ctx.device.destroy_sampler(sampler, None);
             }
             ctx.device.destroy_descriptor_pool(self.pool, None);
-            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
         self.pool = vk::DescriptorPool::null();
         self.set_layout = vk::DescriptorSetLayout::null();

@@ -419,9 +419,7 @@ impl OmniShadows {
                 ctx.device.destroy_image_view(v, None);
             }
             ctx.device.destroy_image_view(self.faces_view, None);
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device.destroy_render_pass(self.render_pass, None);
+            ml_vk::shader::release_pipeline(ctx, self.pipeline);
         }
         if let Some(mut m) = self.masked.take() {
             m.destroy(ctx);

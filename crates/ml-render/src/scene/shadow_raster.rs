@@ -330,12 +330,8 @@ impl ShadowRaster {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: the device is idle; null handles are ignored.
-        unsafe {
-            for p in self.pipelines {
-                ctx.device.destroy_pipeline(p, None);
-            }
-            ctx.device.destroy_pipeline_layout(self.layout, None);
+        for p in self.pipelines {
+            ml_vk::shader::release_pipeline(ctx, p);
         }
         self.pipelines = [vk::Pipeline::null(); 4];
         self.layout = vk::PipelineLayout::null();

@@ -177,10 +177,8 @@ pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&
     }
     // SAFETY: one_shot waited for the GPU (or nothing was submitted); null handles are ignored.
     unsafe {
-        d.destroy_pipeline(pipeline, None);
-        d.destroy_pipeline_layout(layout, None);
+        ml_vk::shader::release_pipeline(ctx, pipeline);
         d.destroy_framebuffer(framebuffer, None);
-        d.destroy_render_pass(render_pass, None);
     }
     result
 }

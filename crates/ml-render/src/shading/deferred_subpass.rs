@@ -112,11 +112,7 @@ impl Pass for DeferredSubpasses {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: no pending work uses them; null handles are ignored.
-        unsafe {
-            ctx.device.destroy_pipeline(self.lighting, None);
-            ctx.device.destroy_pipeline_layout(self.lighting_layout, None);
-        }
+        ml_vk::shader::release_pipeline(ctx, self.lighting);
         self.lighting_sets.destroy(ctx);
         self.input_sets.destroy(ctx);
         self.raster.destroy(ctx);

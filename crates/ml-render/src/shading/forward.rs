@@ -108,8 +108,7 @@ impl Pass for Forward {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: no pending work uses it; a null handle is ignored.
-        unsafe { ctx.device.destroy_pipeline(self.legend, None) };
+        ml_vk::shader::release_pipeline(ctx, self.legend);
         self.raster.destroy(ctx);
     }
 }

@@ -274,10 +274,8 @@ impl MeshRaster {
                 ctx.device.destroy_framebuffer(fb, None);
             }
             for p in self.pipelines {
-                ctx.device.destroy_pipeline(p, None);
+                ml_vk::shader::release_pipeline(ctx, p);
             }
-            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
-            ctx.device.destroy_render_pass(self.render_pass, None);
         }
         self.sets.destroy(ctx);
     }

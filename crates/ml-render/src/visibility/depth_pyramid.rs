@@ -110,8 +110,7 @@ impl Pass for DepthPyramid {
     fn destroy(&mut self, ctx: &Context) {
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
+            ml_vk::shader::release_pipeline(ctx, self.pipeline);
             ctx.device.destroy_sampler(self.sampler, None);
         }
         self.pipeline = vk::Pipeline::null();

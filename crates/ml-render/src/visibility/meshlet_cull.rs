@@ -243,13 +243,9 @@ impl Pass for MeshletCull {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: the device is idle; null handles are ignored.
-        unsafe {
-            ctx.device.destroy_pipeline(self.instance_pipeline, None);
-            ctx.device.destroy_pipeline(self.meshlet_pipeline, None);
-            ctx.device.destroy_pipeline(self.triangle_pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
-        }
+        ml_vk::shader::release_pipeline(ctx, self.instance_pipeline);
+        ml_vk::shader::release_pipeline(ctx, self.meshlet_pipeline);
+        ml_vk::shader::release_pipeline(ctx, self.triangle_pipeline);
         self.instance_pipeline = vk::Pipeline::null();
         self.meshlet_pipeline = vk::Pipeline::null();
         self.triangle_pipeline = vk::Pipeline::null();

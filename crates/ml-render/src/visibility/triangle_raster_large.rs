@@ -119,11 +119,7 @@ impl Pass for TriangleRasterLarge {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: the device is idle; null handles are ignored.
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
-        }
+        ml_vk::shader::release_pipeline(ctx, self.pipeline);
         self.pipeline = vk::Pipeline::null();
         self.pipeline_layout = vk::PipelineLayout::null();
         self.sets.destroy(ctx);

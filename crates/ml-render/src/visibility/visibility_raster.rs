@@ -187,9 +187,7 @@ impl Pass for VisibilityRaster {
                 ctx.device.destroy_framebuffer(*fb, None);
                 *fb = vk::Framebuffer::null();
             }
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.pipeline_layout, None);
-            ctx.device.destroy_render_pass(self.render_pass, None);
+            ml_vk::shader::release_pipeline(ctx, self.pipeline);
         }
         self.pipeline = vk::Pipeline::null();
         self.pipeline_layout = vk::PipelineLayout::null();

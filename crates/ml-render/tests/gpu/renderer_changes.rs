@@ -61,7 +61,12 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
             }
             Renderer::new(&ctx, scene, settings(120, 80)).and_then(|mut r| r.render()).expect("fresh render")
         };
-        for (what, live, fresh) in [("resized and relit", &changed, &fresh(None)), ("moved", &moved, &fresh(Some(camera)))] {
+        let fresh_changed = fresh(None);
+        // The context's pipelines are shared: the same settings again make none.
+        let kept = ctx.pipeline_counts().0;
+        let fresh_moved = fresh(Some(camera));
+        assert_eq!(ctx.pipeline_counts().0, kept, "{}: a renderer made again made new pipelines", technique.name());
+        for (what, live, fresh) in [("resized and relit", &changed, &fresh_changed), ("moved", &moved, &fresh_moved)] {
             assert_eq!((live.width, live.height), (120, 80));
             let (max, differing) = common::max_difference(live, fresh);
             assert_eq!(max, 0, "{}: {what} differs from a fresh renderer by {max}/255 at {differing} pixels", technique.name());
@@ -80,6 +85,7 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
     coated.objects[0].extras.lobes.clearcoat = 1.0;
     assert!(!plain.set_objects(&coated).expect("asked"), "objects with lobes set on a renderer made without");
     drop(plain);
+    assert_eq!(ctx.pipeline_counts().1, 0, "every renderer is gone but pipelines are still held");
     drop(ctx);
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
 }

@@ -206,10 +206,6 @@ pub fn dispatch_probe(ctx: &Context, probe: &ml_shaders::Shader, buffers: &[(&st
         );
     })
     .expect("probe dispatch");
-    // SAFETY: the GPU is idle (one_shot waited).
-    unsafe {
-        ctx.device.destroy_pipeline(pipeline, None);
-        ctx.device.destroy_pipeline_layout(pipeline_layout, None);
-    }
+    ml_vk::shader::release_pipeline(ctx, pipeline);
     sets.destroy(ctx);
 }
