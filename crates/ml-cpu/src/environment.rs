@@ -437,6 +437,31 @@ mod tests {
     }
 
     #[test]
+    fn openexr_and_radiance_files_load_their_values() {
+        let dir = crate::files::hostile::folder("environment-valid");
+        // 8×4 texels: zero, below one, far above one (a sun), distinct per channel.
+        let values: Vec<f32> = (0..8 * 4 * 3).map(|i| if i % 7 == 0 { 0.0 } else { (i as f32 * 0.37).powi(3) / 10.0 }).collect();
+        let image = image::Rgb32FImage::from_raw(8, 4, values.clone()).expect("sized");
+        let exr = dir.join("sky.exr");
+        image::DynamicImage::ImageRgb32F(image.clone()).save_with_format(&exr, image::ImageFormat::OpenExr).expect("EXR written");
+        let loaded = EnvironmentImage::load(&exr).expect("a valid EXR");
+        assert_eq!((loaded.width, loaded.height), (8, 4));
+        assert_eq!(loaded.texels.iter().flatten().copied().collect::<Vec<f32>>(), values, "EXR keeps 32-bit floats exactly");
+        // Radiance's shared exponent keeps 8 bits of mantissa: within 1 % of the largest channel.
+        let hdr = dir.join("sky.hdr");
+        image::DynamicImage::ImageRgb32F(image).save_with_format(&hdr, image::ImageFormat::Hdr).expect("HDR written");
+        let loaded = EnvironmentImage::load(&hdr).expect("a valid .hdr");
+        assert_eq!((loaded.width, loaded.height), (8, 4));
+        for (texel, want) in loaded.texels.iter().zip(values.chunks(3)) {
+            let largest = want.iter().copied().fold(0.0f32, f32::max);
+            for (got, want) in texel.iter().zip(want) {
+                assert!((got - want).abs() <= 0.01 * largest + 1e-6, "{texel:?} against {want}");
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
     fn files_that_are_not_environments_are_refused_in_one_line() {
         let dir = crate::files::hostile::folder("environment");
         let png = dir.join("x.hdr");

@@ -261,26 +261,40 @@ struct FileMaterial {
 
 /// Read and check the scene file at `path`.
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
+    load_with(path, EnvironmentImage::Read)
+}
+
+/// Whether a scene file's `[environment]` image is read: not where another replaces it (its
+/// intensity and turn are checked either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvironmentImage {
+    Read,
+    Skip,
+}
+
+/// `load`, reading the `[environment]` image or not.
+pub fn load_with(path: &Path, image: EnvironmentImage) -> Result<SceneFile, SceneFileError> {
     let fail = |problem: Problem| SceneFileError { path: path.to_path_buf(), problem };
     let bytes = read_regular(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
-    from_bytes(&bytes, path.parent()).map_err(fail)
+    let text = std::str::from_utf8(&bytes).map_err(|e| fail(Problem::NotUtf8(e.valid_up_to())))?;
+    parse_in(text, path.parent(), image).map_err(fail)
 }
 
 /// A scene file's bytes (UTF-8 text), its `gltf` paths relative to `folder` (None: glTF
 /// objects are refused); the error is the problem, without the file's name.
 pub fn from_bytes(bytes: &[u8], folder: Option<&Path>) -> Result<SceneFile, SceneFileProblem> {
     let text = std::str::from_utf8(bytes).map_err(|e| Problem::NotUtf8(e.valid_up_to()))?;
-    parse_in(text, folder)
+    parse_in(text, folder, EnvironmentImage::Read)
 }
 
 /// Parse scene-file text (glTF objects are refused: they need the file's folder); the error
 /// is the problem, without the file's name.
 pub fn parse(text: &str) -> Result<SceneFile, SceneFileProblem> {
-    parse_in(text, None)
+    parse_in(text, None, EnvironmentImage::Read)
 }
 
 /// Parse scene-file text whose `gltf` paths are relative to `base`.
-fn parse_in(text: &str, base: Option<&Path>) -> Result<SceneFile, Problem> {
+fn parse_in(text: &str, base: Option<&Path>, image: EnvironmentImage) -> Result<SceneFile, Problem> {
     if text.len() as u64 > MAX_FILE_BYTES {
         return Err(Problem::TooLong(text.len()));
     }
@@ -288,10 +302,10 @@ fn parse_in(text: &str, base: Option<&Path>) -> Result<SceneFile, Problem> {
         line: e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1),
         message: e.message().replace('\n', " "),
     })?;
-    build(file, base)
+    build(file, base, image)
 }
 
-fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
+fn build(file: FileScene, base: Option<&Path>, image: EnvironmentImage) -> Result<SceneFile, Problem> {
     if file.objects.is_empty() {
         return Err(Problem::NoObjects);
     }
@@ -345,25 +359,27 @@ fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
     check_extent(&scene)?;
     check_draw_work(&scene)?;
     (scene.camera, scene.camera_framed) = camera(file.camera.as_ref(), &scene)?;
-    scene.environment = file.environment.as_ref().map(|e| environment(e, base)).transpose()?.flatten();
+    scene.environment = file.environment.as_ref().map(|e| environment(e, base, image)).transpose()?.flatten();
     Ok(SceneFile { scene, shading, warnings })
 }
 
-/// The file's [environment]: its image (a path relative to the scene file's folder), intensity
-/// and turn.
-fn environment(e: &FileEnvironment, base: Option<&Path>) -> Result<Option<Environment>, Problem> {
+/// The file's [environment]: its image (a path relative to the scene file's folder; not read
+/// with `EnvironmentImage::Skip`), intensity and turn.
+fn environment(e: &FileEnvironment, base: Option<&Path>, image: EnvironmentImage) -> Result<Option<Environment>, Problem> {
+    let intensity = e.intensity.map(|i| intensity("[environment] intensity", i)).transpose()?;
+    let range = -MAX_ENVIRONMENT_ROTATION_DEG..=MAX_ENVIRONMENT_ROTATION_DEG;
+    let rotation =
+        e.rotation_deg.map(|r| within("[environment] rotation_deg", finite("[environment] rotation_deg", r)?, range)).transpose()?;
     let source = match EnvironmentSource::parse(&e.file) {
         EnvironmentSource::File(path) => EnvironmentSource::File(base.ok_or(Problem::NoFolder)?.join(path)),
         other => other,
     };
+    if image == EnvironmentImage::Skip {
+        return Ok(None);
+    }
     let Some(mut env) = source.load().map_err(|err| Problem::Environment(err.to_string()))? else { return Ok(None) };
-    if let Some(i) = e.intensity {
-        env.intensity = intensity("[environment] intensity", i)?;
-    }
-    if let Some(r) = e.rotation_deg {
-        let range = -MAX_ENVIRONMENT_ROTATION_DEG..=MAX_ENVIRONMENT_ROTATION_DEG;
-        env.rotation = within("[environment] rotation_deg", finite("[environment] rotation_deg", r)?, range)?.to_radians();
-    }
+    env.intensity = intensity.unwrap_or(env.intensity);
+    env.rotation = rotation.map_or(env.rotation, f32::to_radians);
     Ok(Some(env))
 }
 

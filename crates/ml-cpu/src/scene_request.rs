@@ -213,7 +213,9 @@ impl SceneRequest {
 
     fn build_file(&self, path: &Path) -> Result<BuiltScene, SceneRequestError> {
         let is_toml = path.to_string_lossy().to_lowercase().ends_with(".toml");
-        let file = if is_toml { scene_file::load(path)? } else { gltf_scene::load(path, self.variant.as_deref())? };
+        // An environment asked for replaces the file's: its image is not read.
+        let image = if self.environment.is_some() { scene_file::EnvironmentImage::Skip } else { scene_file::EnvironmentImage::Read };
+        let file = if is_toml { scene_file::load_with(path, image)? } else { gltf_scene::load(path, self.variant.as_deref())? };
         let path = path.to_path_buf();
         let shading = match (self.shading, &file.shading) {
             (Some(model), _) => model,
@@ -337,5 +339,24 @@ mod tests {
         assert!(SceneRequest { shading: Some(ShadingModel::Pbr), ..odd }.build().is_ok());
         let e = file("empty.glb", "").build().unwrap_err().to_string();
         assert!(e.starts_with("glTF file '") && e.ends_with("empty.glb': the file is empty"), "{e}");
+    }
+
+    #[test]
+    fn an_environment_asked_for_replaces_the_files_without_reading_its_image() {
+        let dir = std::env::temp_dir().join(format!("ml-scene-request-env-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("lit.toml");
+        let text = "[environment]\nfile = \"missing.hdr\"\nintensity = 2.0\n[[objects]]\nmesh = \"sphere\"\n";
+        std::fs::write(&path, text).unwrap();
+        let own = SceneRequest::new(SceneSource::File(path.clone()));
+        let e = own.build().unwrap_err().to_string();
+        assert!(e.contains("missing.hdr"), "the file's own image is read: {e}");
+        let replaced = SceneRequest { environment: Some(EnvironmentSource::Sky), ..own.clone() }.build().unwrap();
+        let env = replaced.scene.environment.expect("the sky asked for");
+        assert_eq!(env.intensity, crate::environment::Environment::sky().intensity, "the file's intensity went with its image");
+        // The file's numbers are checked all the same.
+        std::fs::write(&path, text.replace("2.0", "-1.0")).unwrap();
+        assert!(SceneRequest { environment: Some(EnvironmentSource::Sky), ..own }.build().is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
