@@ -73,13 +73,24 @@ float spot_cone(uint i, PointLight l, vec3 world) {
 
 // Add LIGHT(light) for every directional light: each as a point light 10 km away with a
 // radius of 10³⁰ m, so every model's own point-light code applies with a falloff of exactly 1
-// (1 − 10⁴/10³⁰ rounds to 1) and a direction off by under 10⁻⁷ rad.
+// (1 − 10⁴/10³⁰ rounds to 1) and a direction off by under 10⁻⁷ rad. With shadow rays each
+// casts its shadow as a point light does: a ray 10 km long towards it.
 #define SUM_DIRECTIONAL(sum, LIGHT)                                                                   \
     for (uint d_ = 0u; d_ < frame.directional_count; ++d_) {                                           \
         PointLight far_ = PointLight(vec4(world - directional_lights[d_].direction.xyz * 1e4, 1e30), \
-                                     vec4(directional_lights[d_].color.rgb, 0.0));                   \
+                                     vec4(directional_lights[d_].color.rgb, directional_shadow_slot())); \
         sum += LIGHT(far_);                                                                            \
     }
+
+// What a directional light's PointLight carries as its shadow slot (omni_shadow.glsl): with
+// shadow rays any non-zero value casts (no slot is read); else none (no cube or atlas tile
+// can hold a light 10 km away).
+float directional_shadow_slot() {
+    if (SHADOW_RAYS) {
+        return 1.0;
+    }
+    return 0.0;
+}
 
 // What a surface point is shaded with: the object's material (ObjectData's or ObjectPush's
 // vectors) times the factors its textures give (Surface, or their copy in the G-buffer), and

@@ -34,12 +34,18 @@ fn settings(technique: Technique, rays: bool, lights: u32) -> RenderSettings {
     s
 }
 
-/// The scene with only the lights in `on` lit (the rest black), no shadows.
+/// The scene with only the lights in `on` lit (the rest black), no shadows: its point lights,
+/// then its directional lights.
 fn with_lights(scene: &Scene, on: &[bool]) -> Scene {
     let mut s = scene.clone();
     for (l, &lit) in s.lights.iter_mut().zip(on) {
         if !lit {
             l.color = [0.0; 4];
+        }
+    }
+    for (d, &lit) in s.directional.iter_mut().zip(&on[scene.lights.len()..]) {
+        if !lit {
+            d.color = Vec3::ZERO;
         }
     }
     s
@@ -75,11 +81,16 @@ fn sure_pixels(scene: &Scene, world: &WorldTriangles) -> Vec<SurePixel> {
             let offset = 1e-4 * point.abs().max_element().max(1.0);
             let origin = point + normal * offset;
             let mut seen = Vec::new();
-            for (i, l) in scene.lights.iter().enumerate() {
-                // Where the frame (time 0 of the lights' animation) has the light.
-                let light = Vec3::from_slice(&l.position_radius[..3]) + motion_offset(0.0, scene.light_motion);
+            // Where the frame (time 0 of the lights' animation) has each light; a directional
+            // one where the shaders put it, 10 km up its rays (lighting.glsl SUM_DIRECTIONAL).
+            let points = scene
+                .lights
+                .iter()
+                .map(|l| (Vec3::from_slice(&l.position_radius[..3]) + motion_offset(0.0, scene.light_motion), l.position_radius[3]));
+            let far = scene.directional.iter().map(|d| (point - d.direction * 1e4, f32::INFINITY));
+            for (i, (light, radius)) in points.chain(far).enumerate() {
                 let to_light = light - point;
-                if to_light.length() >= l.position_radius[3] || to_light.normalize().dot(normal) < -0.05 {
+                if to_light.length() >= radius || to_light.normalize().dot(normal) < -0.05 {
                     continue;
                 }
                 if !world.sure(origin, light, MARGIN, offset * 0.1) {
@@ -107,7 +118,7 @@ fn ray_test(name: &str, scene: &Scene) -> (usize, usize) {
         let r = match references.iter().position(|(states, _)| fits(states)) {
             Some(r) => r,
             None => {
-                references.push((vec![None; scene.lights.len()], Vec::new()));
+                references.push((vec![None; scene.lights.len() + scene.directional.len()], Vec::new()));
                 references.len() - 1
             }
         };
@@ -168,6 +179,25 @@ fn two_hundred_and_fifty_six_lights_shadow_where_the_triangle_caster_says() {
         scene.objects.push(Object { transform, ..Object::placed(MeshKind::Cube, Vec3::ZERO, 1.0, grey) });
     }
     let (checked, in_shadow) = ray_test("room, 256 lights", &scene);
+    assert!(checked > 2000 && in_shadow > 500, "{checked} checked, {in_shadow} in shadow");
+}
+
+/// Directional lights cast their shadows through rays too: occluders of every kind over a
+/// floor under three suns of different colours and slopes, and four point lights among them.
+#[test]
+fn directional_lights_shadow_where_the_triangle_caster_says() {
+    let mut scene = cluttered_room(4, 21);
+    // The occluders alone (the last five) over a floor: the room's walls and ceiling would
+    // shadow every sun everywhere.
+    let grey = Material { albedo: Vec3::splat(0.7), roughness: 0.7, metallic: 0.0 };
+    scene.objects = scene.objects.split_off(scene.objects.len() - 5);
+    scene.objects.push(Object::placed(MeshKind::Plane, Vec3::new(0.0, -5.0, 0.0), 7.0, grey));
+    scene.directional = [(Vec3::new(0.3, -1.0, 0.2), Vec3::new(1.0, 0.9, 0.7)), (Vec3::new(-0.8, -0.6, 0.1), Vec3::new(0.3, 0.4, 0.9))]
+        .into_iter()
+        .chain([(Vec3::new(0.1, -0.5, -0.9), Vec3::new(0.2, 0.6, 0.2))])
+        .map(|(d, color)| ml_cpu::scene::DirectionalLight { direction: d.normalize(), color })
+        .collect();
+    let (checked, in_shadow) = ray_test("floor, 3 directional and 4 point lights", &scene);
     assert!(checked > 2000 && in_shadow > 500, "{checked} checked, {in_shadow} in shadow");
 }
 
@@ -265,13 +295,17 @@ fn the_ray_cost_view_shows_where_rays_are_traced() {
 /// image of the cube array (compute raster, 128² faces) and of the atlas at that size wherever
 /// the analytic ray test is sure of each light — lit or shadowed by a margin of the cubes'
 /// texels, so that their filtered edges lie elsewhere; the pixels that differ (the maps' edges)
-/// are counted and few.
+/// are counted and few. One of the lights is a spot.
 #[test]
 fn rays_classify_as_the_cube_array_and_the_atlas_where_the_ray_test_is_sure() {
     const CUBE: u32 = 128;
     let mut scene = Scene::shadow_room();
     scene.lights.push(PointLight { position_radius: [3.0, -3.5, 1.5, 20.0], color: [1.0, 2.0, 3.0, 0.0] });
     scene.lights.push(PointLight { position_radius: [-0.5, -4.0, 0.5, 20.0], color: [3.0, 1.5, 0.5, 0.0] });
+    // The last a spot (glTF's spot lights: a cone over a point light) aimed across the floor
+    // past the pillar: its shadow is the point light's, in every mode.
+    let spot = ml_cpu::gpu_types::LightCone::spot(Vec3::new(1.0, -0.3, 0.3).normalize(), 0.5, 1.2);
+    scene.cones = vec![ml_cpu::gpu_types::LightCone::NONE, ml_cpu::gpu_types::LightCone::NONE, spot];
     let sure = common::shadow_rays::sure_pixels(&scene, SIZE, CUBE);
     let shadowed = sure.iter().filter(|(_, lit)| lit.iter().any(|&l| !l)).count();
     assert!(sure.len() > 3000 && shadowed > 300, "{} sure pixels, {shadowed} shadowed from some light", sure.len());
