@@ -388,11 +388,11 @@ vec3 encode_gamma(vec3 linear) {
 }
 
 // A pixel's samples resolved in the display's linear light — `surfaces`: their colours' sum
-// over every sample divided by the sample count; `background`: the share of samples no
-// surface holds — as the 8-bit target stores it (anti-aliasing; the background's
-// display-linear value is CLEAR_COLOR decoded).
-vec3 encode_over_background(vec3 surfaces, float background) {
-    return encode_gamma(surfaces + background * pow(CLEAR_COLOR.rgb, vec3(2.2)));
+// over every sample divided by the sample count; `share`: the share of samples no surface
+// holds, which show `background` (display-linear: background.glsl) — as the 8-bit target
+// stores it (anti-aliasing).
+vec3 encode_over_background(vec3 surfaces, float share, vec3 background) {
+    return encode_gamma(surfaces + share * background);
 }
 
 // Octahedral encoding of a unit normal into [-1, 1]² (the G-buffer keeps it in 2 floats).

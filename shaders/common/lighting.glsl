@@ -18,6 +18,7 @@
 #include "common/world_from_depth.glsl"
 #include "environment/environment.glsl"
 #include "common/material_lobes.glsl"
+#include "common/background.glsl"
 #ifdef LIGHT_GRID
 #include "light_grid/light_grid.glsl"
 #endif

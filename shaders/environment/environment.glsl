@@ -13,6 +13,8 @@
 layout(set = 1, binding = 9) uniform samplerCube environment_specular;
 layout(set = 1, binding = 10) uniform sampler2D environment_brdf;
 layout(std430, set = 1, binding = 11) readonly buffer EnvironmentBuffer { EnvironmentData environment; };
+// The image as a cube with its box mip chain (the background, common/background.glsl).
+layout(set = 1, binding = 12) uniform samplerCube environment_radiance;
 
 // Pipelines of scenes lit by an environment (the others keep their constant ambient term).
 layout(constant_id = 44) const bool ENVIRONMENT = false;

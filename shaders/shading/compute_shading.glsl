@@ -82,7 +82,7 @@ void store_background(ivec2 p) {
 #ifdef LINEAR_OUTPUT
     imageStore(out_image, p, vec4(0.0));
 #else
-    imageStore(out_image, p, CLEAR_COLOR);
+    imageStore(out_image, p, background_stored(p));
 #endif
 }
 

@@ -56,7 +56,7 @@ void main() {
     }
     gbuffer_pixel = p;
     vec4 resolved = resolve_samples(p);
-    imageStore(out_image, p, vec4(encode_over_background(resolved.rgb, 1.0 - resolved.a), 1.0));
+    imageStore(out_image, p, vec4(encode_over_background(resolved.rgb, 1.0 - resolved.a, background_linear(p)), 1.0));
 }
 #else
 void main() {

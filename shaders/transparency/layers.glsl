@@ -110,8 +110,9 @@ void light_layer(uint node) {
 
 #endif
 
-// Blending, for the resolve (which defines LAYER_BLENDING and includes shading_model.glsl
-// and clusters/cluster.glsl, for `encode_output` and `heat`).
+// Blending, for the resolve (which defines LAYER_BLENDING and includes shading_model.glsl,
+// clusters/cluster.glsl and common/background.glsl, for `encode_output`, `heat` and the
+// background).
 #ifdef LAYER_BLENDING
 
 // Whether node x lies in front of node y (nearer, or as near and of a lower object).
@@ -261,7 +262,7 @@ vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
     if (!background) {
         return vec4(encode_output(color, exposure), 1.0);
     }
-    return vec4(encode_output(color, exposure) + transmittance * CLEAR_COLOR.rgb, 1.0);
+    return vec4(encode_output(color, exposure) + transmittance * background_stored(p).rgb, 1.0);
 }
 
 #ifdef LAYER_SAMPLES
@@ -287,7 +288,7 @@ vec4 layered_samples_output(ivec2 p, float exposure) {
     if (frame.viewport.z == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
         return layer_count_color(s.count);
     }
-    vec3 background = pow(CLEAR_COLOR.rgb, vec3(2.2));
+    vec3 background = background_linear(p);
     // Each sample's opaque surface and layers, found once.
     uvec2 v[VISIBILITY_SAMPLES];
     uint over[VISIBILITY_SAMPLES];

@@ -13,6 +13,9 @@ layout(set = 0, binding = 5) uniform sampler2D hdr_image;
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 #include "common/shading_model.glsl"
 #include "clusters/cluster.glsl"
+// Set 1: the scene's textures, of which the environment (the background).
+#include "environment/environment.glsl"
+#include "common/background.glsl"
 #define LAYER_BINDING 20
 #define LAYER_BLENDING 1
 #include "transparency/layers.glsl"

@@ -12,6 +12,9 @@ FRAME_BLOCK(0);
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D out_image;
 #include "common/shading_model.glsl"
 #include "clusters/cluster.glsl"
+// Set 1: the scene's textures, of which the environment (the background).
+#include "environment/environment.glsl"
+#include "common/background.glsl"
 #define OPAQUE_DEPTH_BUFFER 1
 #include "common/opaque_depth.glsl"
 #include "visibility/surface_colours.glsl"

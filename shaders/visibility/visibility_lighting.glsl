@@ -296,7 +296,7 @@ void shade_samples(ivec2 p, bool inside) {
     }
     sum /= float(VISIBILITY_SAMPLES);
     if (first) {
-        imageStore(out_image, p, vec4(encode_over_background(sum, float(background) / float(VISIBILITY_SAMPLES)), 1.0));
+        imageStore(out_image, p, vec4(encode_over_background(sum, float(background) / float(VISIBILITY_SAMPLES), background_linear(p)), 1.0));
     } else if (shaded != 0u) {
         imageStore(out_image, p, vec4(encode_gamma(sum + pow(imageLoad(out_image, p).rgb, vec3(2.2))), 1.0));
     }

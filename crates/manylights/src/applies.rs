@@ -351,6 +351,10 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         }
         .map(|rule| rule.of_value(view)),
     );
+    // The colour background applies anywhere.
+    if let Some(shown @ "environment") = args.background.as_deref() {
+        rules.extend([pbr("background").of_value(shown), lit("background").of_value(shown)]);
+    }
     if view == DebugView::ShadowMap.name() {
         let drawn = Some(args.sun_shadow != SunShadowMode::Rays.name());
         let map = "a sun's shadow map (--sun-shadow graphics or compute)";

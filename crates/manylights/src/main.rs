@@ -215,6 +215,11 @@ struct SceneArgs {
     /// own.
     #[arg(long, allow_negative_numbers = true)]
     environment_rotation: Option<String>,
+    /// What pixels no surface covers show: colour (a dark grey) or environment (the
+    /// environment light's image, exposed and tone-mapped as the surfaces are; debug views
+    /// keep the colour). Default: a scene file's own ([environment] background), else colour.
+    #[arg(long, value_parser = ["colour", "environment"])]
+    background: Option<String>,
     /// A glTF file's material variant (KHR_materials_variants) to draw, by name. Default: the
     /// materials its primitives name.
     #[arg(long)]
@@ -601,6 +606,7 @@ fn settings_request(args: &SceneArgs, technique: Technique, frames: u32) -> Resu
     Ok(SettingsRequest {
         clusters: cluster_choice(&args.clusters)?,
         light_grid_marks: LightGridMarks::from_name(&args.light_grid_marks)?,
+        background: args.background.as_deref().map(ml_render::Background::from_name).transpose()?,
         transparency: ml_render::TransparencySettings { budget: args.transparency_budget, ..Default::default() },
         ..SettingsRequest::new(settings)
     })

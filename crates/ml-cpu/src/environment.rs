@@ -37,12 +37,15 @@ pub struct Environment {
     pub intensity: f32,
     /// Turn of the environment about +Y, in radians (counter-clockwise seen from above).
     pub rotation: f32,
+    /// Shown behind the scene where no surface is, unless the render asks otherwise (a scene
+    /// file's `[environment] background = true`).
+    pub background: bool,
 }
 
 impl Environment {
     /// The built-in sky at unit intensity, unrotated.
     pub fn sky() -> Environment {
-        Environment { image: Arc::new(EnvironmentImage::sky(SKY_WIDTH)), intensity: 1.0, rotation: 0.0 }
+        Environment { image: Arc::new(EnvironmentImage::sky(SKY_WIDTH)), intensity: 1.0, rotation: 0.0, background: false }
     }
 
     /// World direction → the image's own (the environment turned by `rotation` about +Y).
@@ -78,7 +81,7 @@ impl EnvironmentSource {
             EnvironmentSource::Off => None,
             EnvironmentSource::Sky => Some(Environment::sky()),
             EnvironmentSource::File(path) => {
-                Some(Environment { image: Arc::new(EnvironmentImage::load(path)?), intensity: 1.0, rotation: 0.0 })
+                Some(Environment { image: Arc::new(EnvironmentImage::load(path)?), intensity: 1.0, rotation: 0.0, background: false })
             }
         })
     }

@@ -214,6 +214,8 @@ struct FileEnvironment {
     file: String,
     intensity: Option<f32>,
     rotation_deg: Option<f32>,
+    /// Shown behind the scene (else the render's background colour).
+    background: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -380,6 +382,7 @@ fn environment(e: &FileEnvironment, base: Option<&Path>, image: EnvironmentImage
     let Some(mut env) = source.load().map_err(|err| Problem::Environment(err.to_string()))? else { return Ok(None) };
     env.intensity = intensity.unwrap_or(env.intensity);
     env.rotation = rotation.map_or(env.rotation, f32::to_radians);
+    env.background = e.background.unwrap_or(false);
     Ok(Some(env))
 }
 

@@ -98,7 +98,10 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
             Box::new(forward::Forward::new(ctx, a.scene, raster, (lights, heat_legend), s.technique.name())?)
         }
         PassKind::DeferredSubpasses { clustered } => Box::new(deferred_subpass::DeferredSubpasses::new(ctx, a.scene, raster, clustered)?),
-        PassKind::ToneMap { curve, display_linear } => Box::new(tone_map::ToneMap::new(ctx, (curve, display_linear))?),
+        PassKind::ToneMap { curve, display_linear } => {
+            Box::new(tone_map::ToneMap::new(ctx, a.scene, (curve, display_linear), a.shading.background)?)
+        }
+        PassKind::Backdrop => Box::new(crate::background::Backdrop::new(ctx, a.scene.textures.set_layout.raw)?),
         PassKind::GBuffer => Box::new(gbuffer::GBuffer::new(ctx, a.scene, raster)?),
         PassKind::ComputeLighting => Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?),
         PassKind::MeshletCull(phase) => {

@@ -68,6 +68,7 @@ pub enum Named {
     Raster,
     LightGridMarks,
     Antialiasing,
+    Background,
 }
 
 impl std::fmt::Display for Named {
@@ -80,6 +81,7 @@ impl std::fmt::Display for Named {
             Named::Raster => "rasteriser",
             Named::LightGridMarks => "light grid marks choice",
             Named::Antialiasing => "anti-aliasing sample count",
+            Named::Background => "background",
         })
     }
 }
@@ -120,6 +122,8 @@ pub enum SettingsError {
     /// The cluster-heat debug view is drawn by the clustered forward techniques only.
     #[error("the cluster-heat debug view needs a clustered forward technique (clustered-cpu, clustered-gpu), not {technique}")]
     HeatNeedsClusteredForward { technique: &'static str },
+    #[error("--background environment needs an environment: the pbr model (--shading pbr) with --environment FILE or sky, or a scene file's own")]
+    BackgroundNeedsEnvironment,
     #[error("the shadow-map debug view needs the blinn-phong shading model (the seed model casts no shadows)")]
     ShadowMapNeedsBlinnPhong,
     #[error("the shadow-cube debug view needs point-light shadow cubes (--omni-shadow copy|direct|multiview|layered|compute)")]

@@ -36,6 +36,7 @@ pub mod stage_probe;
 
 mod antialiasing;
 mod assembly;
+pub mod background;
 mod clusters;
 mod compute_pass;
 mod depth_pass;
@@ -61,6 +62,7 @@ mod transparency;
 mod visibility;
 
 pub use antialiasing::{auto_antialiasing, AntialiasingStats};
+pub use background::Background;
 pub use error::RenderError;
 pub use frame_resources::FRAMES_IN_FLIGHT;
 pub use light_grid::LightGridStats;

@@ -7,6 +7,7 @@
 //! passes, or a new renderer where the scene's GPU resources depend on it), the view (new
 //! frame slots: size, exposure value) and the run (nothing: frame count, clock).
 
+use crate::background::Background;
 use crate::settings::{
     Antialiasing, DebugView, Exposure, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,
     RenderSettings, ShadingModel, SunShadowMode, Technique,
@@ -47,6 +48,8 @@ pub enum PassKind {
     /// with pbr's curve or as it is; `display_linear`: the samples' mean in the display's
     /// linear light, gamma only.
     ToneMap { curve: bool, display_linear: bool },
+    /// The environment where the forward pass drew nothing (background.rs).
+    Backdrop,
     /// deferred-compute's G-buffer.
     GBuffer,
     /// deferred-compute's lighting of the G-buffer.
@@ -103,6 +106,8 @@ pub struct PipelineKey {
     pub light_grid_marks: bool,
     /// Coverage samples per pixel (`RenderSettings::antialiasing`).
     pub antialiasing: Antialiasing,
+    /// What pixels no surface covers show.
+    pub background: Background,
 }
 
 impl PipelineKey {
@@ -144,6 +149,7 @@ impl RenderSettings {
             light_stats: self.light_stats,
             light_grid_marks: self.light_grid_marks,
             antialiasing: self.antialiasing,
+            background: self.background,
         }
     }
 
@@ -221,6 +227,9 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
                 kinds.extend([build, resolve]);
             } else if antialiased {
                 kinds.push(PassKind::ToneMap { curve: false, display_linear: true });
+            } else if key.background == Background::Environment {
+                // The pass wrote the output itself: the backdrop where it drew nothing.
+                kinds.push(PassKind::Backdrop);
             }
         }
         (Geometry::Meshes, LightingStage::Subpass) => {

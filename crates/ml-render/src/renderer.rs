@@ -145,6 +145,7 @@ impl<'a> Renderer<'a> {
             settings.transparency = None;
         }
         settings.check(ctx, scene.lights.len())?;
+        settings.check_scene(&scene)?;
         let view = View::new(scene.camera, settings.width, settings.height);
         let grid = ClusterGrid::new(settings.clusters, &view);
         check_lists_fit(ctx, &settings, &grid, &scene.lights, scene.light_motion)?;
@@ -225,6 +226,7 @@ impl<'a> Renderer<'a> {
             return Ok(false);
         }
         settings.check(self.ctx, self.scene.lights.len())?;
+        settings.check_scene(&self.scene)?;
         let view = View::new(self.scene.camera, settings.width, settings.height);
         let grid = ClusterGrid::new(settings.clusters, &view);
         check_lists_fit(self.ctx, &settings, &grid, &self.scene.lights, self.scene.light_motion)?;

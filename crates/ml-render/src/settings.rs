@@ -1,6 +1,7 @@
 //! What a render is asked to do, checked against the device before anything is allocated.
 
 pub use crate::antialiasing::Antialiasing;
+use crate::background::Background;
 use crate::error::{by_name, Named, RenderError, Setting, SettingsError};
 pub use crate::exposure::{parse_exposure, Exposure, MAX_EXPOSURE_EV};
 pub use crate::scene::shadow_settings::{
@@ -192,6 +193,8 @@ pub struct RenderSettings {
     pub antialiasing: Antialiasing,
     /// Highlights under normal maps widened by the normals' spread (surface.glsl).
     pub specular_aa: bool,
+    /// What pixels no surface covers show.
+    pub background: Background,
 }
 
 /// The seed's timer runs at a quarter of real time (`timerSpeed *= 0.25`).
@@ -231,6 +234,7 @@ impl RenderSettings {
             light_grid_marks: true,
             antialiasing: Antialiasing::Off,
             specular_aa: true,
+            background: Background::Colour,
         }
     }
 
@@ -274,7 +278,18 @@ impl RenderSettings {
             specular_aa: self.specular_aa,
             environment: self.shading == ShadingModel::Pbr && scene.environment.is_some(),
             material_lobes: self.shading == ShadingModel::Pbr && scene.objects.iter().any(|o| o.extras.lobes.any()),
+            background: self.background,
         }
+    }
+
+    /// Reject what `scene` cannot give: the environment as the background where it has none
+    /// (or the model lights with none).
+    pub fn check_scene(&self, scene: &ml_cpu::scene::Scene) -> Result<(), SettingsError> {
+        let lit = self.shading == ShadingModel::Pbr && scene.environment.is_some();
+        if self.background == Background::Environment && !lit {
+            return Err(SettingsError::BackgroundNeedsEnvironment);
+        }
+        Ok(())
     }
 
     /// Reject sizes and counts the device (or common sense) cannot take, before allocating.
@@ -395,13 +410,22 @@ pub struct SettingsRequest {
     pub transparency: TransparencySettings,
     /// Whether the light grid marks the cells near the surfaces first.
     pub light_grid_marks: LightGridMarks,
+    /// What pixels without a surface show; None: the scene's environment where it asks to be
+    /// shown (and lights a pbr model), else the colour.
+    pub background: Option<Background>,
 }
 
 impl SettingsRequest {
     /// `settings` asked for as they are, the rest at its defaults: the scene's grid, its
     /// transparent objects blended within the default budget, the marks decided by its lights.
     pub fn new(settings: RenderSettings) -> SettingsRequest {
-        SettingsRequest { settings, clusters: None, transparency: TransparencySettings::default(), light_grid_marks: LightGridMarks::Auto }
+        SettingsRequest {
+            settings,
+            clusters: None,
+            transparency: TransparencySettings::default(),
+            light_grid_marks: LightGridMarks::Auto,
+            background: None,
+        }
     }
 
     /// The settings that render `scene` with `shading` (the model its request resolved to).
@@ -413,6 +437,14 @@ impl SettingsRequest {
             omni: s.omni.map(|o| OmniShadowSettings { lights: shadowed_count(&o, scene, (s.width, s.height)), ..o }),
             transparency: scene.has_blended_objects().then_some(self.transparency),
             light_grid_marks: self.light_grid_marks.resolve(scene.lights.len() as u64, s.width, s.height),
+            background: self.background.unwrap_or({
+                let shown = scene.environment.as_ref().is_some_and(|e| e.background) && shading == ShadingModel::Pbr;
+                if shown {
+                    Background::Environment
+                } else {
+                    Background::Colour
+                }
+            }),
             ..*s
         }
     }

@@ -8,8 +8,8 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource};
 use ml_render::settings::MAX_SHADOWED_LIGHTS;
 use ml_render::{
-    Antialiasing, DebugView, Exposure, Geometry, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, ShadingModel,
-    Technique,
+    Antialiasing, Background, DebugView, Exposure, Geometry, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings,
+    ShadingModel, Technique,
 };
 use std::collections::VecDeque;
 
@@ -206,6 +206,12 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         if let Some((intensity, degrees)) = &mut choices.environment {
             ui.add(Slider::new(intensity, 0.0..=16.0).text("environment"));
             ui.add(Slider::new(degrees, -180.0..=180.0).suffix("°").text("turned"));
+        }
+        // The environment behind the scene where the model is lit by one.
+        if choices.environment.is_some() && choices.settings.shading == ShadingModel::Pbr {
+            combo(ui, "Background", &mut choices.settings.background, &Background::ALL, |b| b.name());
+        } else {
+            choices.settings.background = Background::Colour;
         }
         ui.horizontal(|ui| {
             let mut auto = choices.settings.exposure == Exposure::Auto;

@@ -1,6 +1,7 @@
 //! Environment light from the command line and scene files: an equirectangular .hdr lights a
-//! pbr scene, with its intensity and turn; the table says what was prefiltered; files that are
-//! not environments and options that cannot apply are refused in one line.
+//! pbr scene, with its intensity and turn, and shows behind it where asked; the table says
+//! what was prefiltered; files that are not environments and options that cannot apply are
+//! refused in one line.
 
 use crate::common;
 
@@ -65,6 +66,20 @@ fn an_hdr_environment_lights_a_scene_turned_and_scaled() {
     let named = scene(&dir, "named.toml", "[environment]\nfile = \"sky.hdr\"\nintensity = 2.0\n");
     let (_, from_file) = render(&["--scene", named.to_str().unwrap(), "--out", out]);
     assert_eq!(rgba_difference(&from_file, &doubled), (0, 0), "the file's [environment] is the command line's");
+    // Shown behind the scene: pixels of the dark grey background change, no other does.
+    let (_, shown) = render(&["--scene", file, "--environment", env, "--background", "environment", "--out", out]);
+    let (lit_px, shown_px) = (lit.chunks(4), shown.chunks(4));
+    let changed: Vec<bool> = lit_px.clone().zip(shown_px).map(|(a, b)| a != b).collect();
+    let grey: Vec<bool> = lit_px.map(|p| p == [5, 5, 5, 255]).collect();
+    assert!(changed.iter().filter(|&&c| c).count() > 500, "the background shows the environment");
+    assert_eq!(changed, grey, "exactly the background's pixels change");
+    // A scene file asks for it with [environment] background = true; --background colour
+    // still has the last word.
+    let shown_file = scene(&dir, "shown.toml", "[environment]\nfile = \"sky.hdr\"\nbackground = true\n");
+    let (_, from_file) = render(&["--scene", shown_file.to_str().unwrap(), "--out", out]);
+    assert_eq!(rgba_difference(&from_file, &shown), (0, 0), "the file's background is the command line's");
+    let (_, overridden) = render(&["--scene", shown_file.to_str().unwrap(), "--background", "colour", "--out", out]);
+    assert_eq!(rgba_difference(&overridden, &lit), (0, 0), "--background colour over the file's");
 }
 
 #[test]
@@ -89,6 +104,8 @@ fn what_is_not_an_environment_is_refused_in_one_line() {
     assert_one_line_error(&run(&["--environment", "sky", "--environment-rotation", "nan"]), &["environment rotation 'nan'"]);
     assert_one_line_error(&run(&["--environment", "sky", "--shading", "seed"]), &["--environment", "pbr"]);
     assert_one_line_error(&run(&["--environment", "none", "--environment-intensity", "2"]), &["--environment-intensity"]);
+    assert_one_line_error(&run(&["--environment", "none", "--background", "environment"]), &["--background environment"]);
+    assert_one_line_error(&run(&["--shading", "blinn-phong", "--background", "environment"]), &["--background environment", "pbr"]);
     let bad = scene(&dir, "bad.toml", "[environment]\nfile = \"missing.exr\"\n");
     assert_one_line_error(&run_on(bad.to_str().unwrap(), &[]), &["[environment]", "missing.exr"]);
     assert!(!Path::new(out).exists(), "nothing written");

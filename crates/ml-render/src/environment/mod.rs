@@ -40,6 +40,9 @@ const FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 /// The environment's prefiltered light, or stand-ins for a scene without one.
 pub struct EnvironmentMaps {
+    /// The image as a cube with its box mip chain (the background); the specular cube where
+    /// there is no environment.
+    radiance: Image,
     specular: Image,
     brdf: Image,
     /// EnvironmentData: the coefficients (written by the prefilter), rotation and intensity.
@@ -83,6 +86,7 @@ impl EnvironmentMaps {
     /// `environment` prefiltered, or (None) the stand-ins.
     pub fn new(ctx: &Context, environment: Option<&Environment>) -> Result<EnvironmentMaps, RenderError> {
         let maps = EnvironmentMaps {
+            radiance: Image::null(),
             specular: Image::null(),
             brdf: Image::null(),
             buffer: Buffer::null(),
@@ -139,7 +143,8 @@ impl EnvironmentMaps {
         };
         let mut equirect =
             texture_with(ctx, "environment image", flat, vk::Format::R32G32B32A32_SFLOAT, &[vec![bytemuck::cast_slice(&texels)]])?;
-        let mut source = match Image::new(ctx, "environment cube", cube(size, source_levels), FORMAT, usage, vk::ImageAspectFlags::COLOR) {
+        // Kept: the background shows it.
+        self.radiance = match Image::new(ctx, "environment cube", cube(size, source_levels), FORMAT, usage, vk::ImageAspectFlags::COLOR) {
             Ok(s) => s,
             Err(e) => {
                 equirect.destroy(ctx);
@@ -147,9 +152,8 @@ impl EnvironmentMaps {
             }
         };
         let mut work = Prefilter::new();
-        let done = work.record(ctx, (&equirect, &source), (&self.specular, &self.brdf, self.buffer.raw), self.sampler);
+        let done = work.record(ctx, (&equirect, &self.radiance), (&self.specular, &self.brdf, self.buffer.raw), self.sampler);
         work.destroy(ctx);
-        source.destroy(ctx);
         equirect.destroy(ctx);
         self.stats = Some(EnvironmentStats { image: (image.width, image.height), face_size: size, prefilter_ms: done? });
         Ok(())
@@ -182,6 +186,7 @@ impl EnvironmentMaps {
         };
         match name {
             "environment_specular" => Some(image(&self.specular)),
+            "environment_radiance" => Some(image(if self.radiance.raw == vk::Image::null() { &self.specular } else { &self.radiance })),
             "environment_brdf" => Some(image(&self.brdf)),
             "EnvironmentBuffer" => Some(Resource::Buffer(self.buffer.raw)),
             _ => None,
@@ -189,6 +194,7 @@ impl EnvironmentMaps {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
+        self.radiance.destroy(ctx);
         self.specular.destroy(ctx);
         self.brdf.destroy(ctx);
         self.buffer.destroy(ctx);

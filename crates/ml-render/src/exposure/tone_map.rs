@@ -2,9 +2,11 @@
 //! that is read back, with the encoding the forward path applies in its fragment shader
 //! (tonemap.comp). A compute pass: on H100/H200 it runs on every SM.
 
+use crate::background::Background;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
+use crate::scene::SceneGpu;
 use crate::sync::Use;
 use ml_vk::{vk, Context, VkError};
 
@@ -16,9 +18,12 @@ impl ToneMap {
     /// `aces`: apply pbr's tone-mapping curve before gamma (not for debug views, whose
     /// values are shown as they are); `display_linear`: the image holds the display's linear
     /// light already (anti-aliasing's resolved samples), which only needs the gamma curve.
-    pub fn new(ctx: &Context, (aces, display_linear): (bool, bool)) -> Result<ToneMap, VkError> {
-        let constants = [("MODEL_PBR", u32::from(aces)), ("DISPLAY_LINEAR_INPUT", u32::from(display_linear))];
-        Ok(ToneMap { pass: ComputePass::new(ctx, &[], (&ml_shaders::TONEMAP_COMP, &constants))? })
+    /// Pixels without a surface get `background` (set 1: the scene's textures, of which
+    /// the environment).
+    pub fn new(ctx: &Context, scene: &SceneGpu, (aces, display_linear): (bool, bool), background: Background) -> Result<ToneMap, VkError> {
+        let constants = [("MODEL_PBR", u32::from(aces)), ("DISPLAY_LINEAR_INPUT", u32::from(display_linear)), background.constant()];
+        let textures = scene.textures.set_layout.raw;
+        Ok(ToneMap { pass: ComputePass::new(ctx, &[textures], (&ml_shaders::TONEMAP_COMP, &constants))? })
     }
 }
 
@@ -39,7 +44,7 @@ impl Pass for ToneMap {
     }
 
     fn record(&self, rec: &Recording) {
-        self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &[]), rec.targets.color.raw, rec.extent);
+        self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &[rec.scene.textures.set]), rec.targets.color.raw, rec.extent);
     }
 
     fn destroy(&mut self, ctx: &Context) {

@@ -3,6 +3,7 @@
 //! and framebuffer, and the recording of every object with its push constants. Each pass adds
 //! what is its own (the heat legend, the lighting subpass).
 
+use crate::background::Background;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
@@ -45,6 +46,9 @@ pub struct MeshRaster {
     /// Samples per pixel of subpass 0's attachments (anti-aliasing; the transparent layers'
     /// build has none).
     samples: vk::SampleCountFlags,
+    /// The background is the environment: the colour target is cleared to alpha 0 for
+    /// whoever lays it.
+    backdrop: bool,
 }
 
 impl MeshRaster {
@@ -70,6 +74,7 @@ impl MeshRaster {
                 Output::Color | Output::GBuffer | Output::Subpasses => shading.antialiasing.sample_count(),
                 Output::Visibility => vk::SampleCountFlags::TYPE_1,
             },
+            backdrop: shading.background == Background::Environment,
         };
         ml_vk::build(ctx, r, |r| {
             r.render_pass = render_pass::describe(depth_format, output, gbuffer, (shading.transparency, r.samples)).create(ctx)?;
@@ -211,7 +216,8 @@ impl MeshRaster {
         let depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
         let mut clear: Vec<vk::ClearValue> = match self.output {
             // Alpha 0: no surface at the sample (the tone map shows the background there).
-            Output::Color if self.layers || self.multisampled() => vec![zero],
+            // So too where the backdrop pass fills it (background.rs).
+            Output::Color if self.layers || self.multisampled() || self.backdrop => vec![zero],
             Output::Color | Output::Visibility => vec![colour],
             Output::GBuffer | Output::Subpasses => vec![zero; self.gbuffer.len()],
         };

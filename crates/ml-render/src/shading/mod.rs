@@ -9,6 +9,7 @@ pub mod gbuffer;
 pub mod mesh_raster;
 
 use crate::antialiasing::Antialiasing;
+use crate::background::Background;
 use ml_cpu::shading_model::ShadingModel;
 
 /// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
@@ -41,6 +42,8 @@ pub struct Shading {
     /// Some object's material has glTF's PBR extensions (`MATERIAL_LOBES`,
     /// common/material_lobes.glsl; pbr).
     pub material_lobes: bool,
+    /// What pixels no surface covers show (`BACKGROUND_ENVIRONMENT` where the pass lays it).
+    pub background: Background,
 }
 
 impl Shading {
@@ -77,11 +80,11 @@ impl Shading {
         ]
     }
 
-    /// `lighting_constants` and `COUNT_RAYS` (shading/compute_shading.glsl): the compute
-    /// lightings'.
-    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 12] {
+    /// `lighting_constants`, `COUNT_RAYS` (shading/compute_shading.glsl) and the background's:
+    /// the compute lightings' (they lay the background where no surface is).
+    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 13] {
         let [a, b, c, d, e, f, g, h, i, j, k] = self.lighting_constants();
-        [a, b, c, d, e, f, g, h, i, j, k, ("COUNT_RAYS", u32::from(self.count_rays))]
+        [a, b, c, d, e, f, g, h, i, j, k, ("COUNT_RAYS", u32::from(self.count_rays)), self.background.constant()]
     }
 
     /// `lighting_constants`, `TRANSPARENT_LAYERS` (shading/forward_frag.glsl: the forward

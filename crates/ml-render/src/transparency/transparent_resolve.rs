@@ -58,10 +58,13 @@ impl TransparentResolve {
         let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &lighting_constants))?;
         let [blinn_phong, pbr, _, _] = shading.surface_constants();
         let antialiased = shading.antialiasing != Antialiasing::Off;
+        // Set 1 (the scene's textures) for the background's environment.
+        let textures = [scene.textures.set_layout.raw];
+        let background = shading.background.constant();
         let blend = if antialiased {
-            ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_SAMPLES_COMP, &[blinn_phong, pbr, samples]))
+            ComputePass::new(ctx, &textures, (&ml_shaders::TRANSPARENT_BLEND_SAMPLES_COMP, &[blinn_phong, pbr, samples, background]))
         } else {
-            ComputePass::new(ctx, &[], (&ml_shaders::TRANSPARENT_BLEND_COMP, &[blinn_phong, pbr]))
+            ComputePass::new(ctx, &textures, (&ml_shaders::TRANSPARENT_BLEND_COMP, &[blinn_phong, pbr, background]))
         };
         match blend {
             Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute, settings, samples: antialiased }),
@@ -116,7 +119,7 @@ impl Pass for TransparentResolve {
         self.lighting.dispatch(ctx, cmd, rec.slot, (&[rec.scene.textures.set], &[]), threads);
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, vk::AccessFlags::SHADER_READ));
-        self.blend.record_into_colour_target(ctx, cmd, (rec.slot, &[]), rec.targets.color.raw, rec.extent);
+        self.blend.record_into_colour_target(ctx, cmd, (rec.slot, &[rec.scene.textures.set]), rec.targets.color.raw, rec.extent);
     }
 
     fn destroy(&mut self, ctx: &Context) {

@@ -31,7 +31,7 @@ fn sky_sphere(material: Material, rotation: f32) -> Scene {
     let far = PointLight { position_radius: [50.0, 0.0, 0.0, 1.0], color: [1.0, 1.0, 1.0, 0.0] };
     let camera = Camera::looking_at(Vec3::new(0.3, 0.6, 3.2), Vec3::ZERO, 45.0, 0.1, 100.0);
     let mut scene = Scene::new(vec![Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, material)], vec![far], camera);
-    scene.environment = Some(Environment { image: Arc::new(EnvironmentImage::sky(128)), intensity: 1.3, rotation });
+    scene.environment = Some(Environment { image: Arc::new(EnvironmentImage::sky(128)), intensity: 1.3, rotation, background: false });
     scene
 }
 
@@ -100,4 +100,85 @@ fn turning_the_environment_in_place_equals_a_renderer_made_turned() {
     assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
     assert!(common::max_difference(&before, &after).1 > 500, "the turn changed the image");
     assert_eq!(common::max_difference(&made, &after), (0, 0), "in place = made turned");
+}
+
+/// A background pixel and the range of colours the CPU sees over it (lowest, highest).
+type Seen = ((u32, u32), ([u8; 3], [u8; 3]));
+
+/// `--background environment`: where no surface is, each pixel shows the sky along its ray,
+/// exposed and tone-mapped as the surfaces are — within 2/255 of what the CPU's bilinear read
+/// of the image gives over the pixel (the GPU reads its cube) — in every technique, with anti-aliasing and with
+/// transparent layers (their resolves lay it too); debug views keep the colour.
+#[test]
+fn the_background_shows_the_environment_along_each_pixels_ray() {
+    use ml_render::{Antialiasing, Background, DebugView};
+    let mut scene = sky_sphere(Material { albedo: Vec3::new(0.9, 0.9, 0.9), roughness: 0.3, metallic: 0.5 }, 1.0);
+    // Its cube (256 texels a face) finer than the pixels (a texel 0.35°, a pixel 0.5°).
+    scene.environment.as_mut().expect("set above").image = Arc::new(EnvironmentImage::sky(1024));
+    let env = scene.environment.as_ref().expect("set above");
+    let seen = |s: RenderSettings| RenderSettings { background: Background::Environment, ..s };
+    let mut settings: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| seen(pbr(t))).collect();
+    for t in [Technique::Forward, Technique::Deferred, Technique::Visibility] {
+        settings.push(RenderSettings { antialiasing: Antialiasing::X4, ..seen(pbr(t)) });
+    }
+    let plain = Technique::ALL.len() + 3;
+    settings.push(pbr(Technique::Forward));
+    settings.push(RenderSettings { debug_view: DebugView::Depth, ..seen(pbr(Technique::Visibility)) });
+    let outs = common::render_each(&scene, &settings);
+    // Pixels whose ray passes the sphere (radius 1) by a margin: the background.
+    // Per background pixel, the range of what the CPU sees over the pixel (its centre and
+    // corners): the GPU resamples the image into its cube and reads that, which may move the
+    // horizon's steep gradient by a fraction of a pixel.
+    let mut background = Vec::new();
+    for (x, y) in (0..SIZE).flat_map(|y| (0..SIZE).map(move |x| (x, y))) {
+        let seen_at = |dx: f32, dy: f32| {
+            let (o, d) = common::shadow_rays::ray(&scene.camera, x as f32 + 0.5 + dx, y as f32 + 0.5 + dy, SIZE);
+            ((o - d * o.dot(d)).length(), encode_gamma_unorm8(aces_tone_map(env.image.radiance(env.to_image() * d) * env.intensity)))
+        };
+        let seen: Vec<(f32, [u8; 3])> =
+            [(0.0, 0.0), (-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)].map(|(dx, dy)| seen_at(dx, dy)).to_vec();
+        if seen.iter().all(|&(closest, _)| closest > 1.05) {
+            let lo: [u8; 3] = std::array::from_fn(|c| seen.iter().map(|s| s.1[c]).min().unwrap());
+            let hi: [u8; 3] = std::array::from_fn(|c| seen.iter().map(|s| s.1[c]).max().unwrap());
+            background.push(((x, y), (lo, hi)));
+        }
+    }
+    assert!(background.len() > 4_000, "{} background pixels", background.len());
+    // How far beyond its range each pixel lies, at worst.
+    let worst = |out: &ml_render::RenderOutput| {
+        let beyond = |&((x, y), (lo, hi)): &Seen| {
+            let p = common::pixel(out, x, y);
+            (0..3).map(|c| lo[c].saturating_sub(p[c]).max(p[c].saturating_sub(hi[c]))).max().unwrap()
+        };
+        background.iter().map(beyond).max()
+    };
+    let forward = &outs[0];
+    println!("forward: the background within {:?}/255 of the CPU's", worst(forward));
+    assert!(worst(forward).unwrap() <= MAX_DIFF, "forward's background is not the sky");
+    for (s, out) in settings.iter().zip(&outs).take(plain).skip(1) {
+        let (most, differing) = common::max_difference(forward, out);
+        println!("{:?} at {:?}: {differing} pixels differ from forward, by up to {most}/255", s.technique, s.antialiasing);
+        assert!(worst(out).unwrap() <= MAX_DIFF, "{:?} at {:?}: the background is not the sky", s.technique, s.antialiasing);
+        // Anti-aliasing changes the sphere's edge, not the background.
+        if s.antialiasing == Antialiasing::Off {
+            assert!(most <= 1, "{:?} differs from forward by {most}/255", s.technique);
+        }
+    }
+    // The sphere made transparent: the transparent layers' resolve lays the background (the
+    // layers blended over it, through the sphere).
+    let mut glass = scene.clone();
+    (glass.objects[0].extras.alpha_mode, glass.objects[0].extras.base_alpha) = (ml_cpu::scene::AlphaMode::Blend, 0.5);
+    let layers = |s: RenderSettings| RenderSettings { transparency: Some(Default::default()), ..s };
+    let mut through: Vec<RenderSettings> =
+        [Technique::Forward, Technique::Deferred, Technique::DeferredCompute, Technique::Visibility].map(|t| layers(seen(pbr(t)))).to_vec();
+    // (Layers over samples: the visibility technique's.)
+    through.push(RenderSettings { antialiasing: Antialiasing::X4, ..layers(seen(pbr(Technique::Visibility))) });
+    for (s, out) in through.iter().zip(common::render_each(&glass, &through)) {
+        println!("{:?} at {:?} through layers: the background within {:?}/255", s.technique, s.antialiasing, worst(&out));
+        assert!(worst(&out).unwrap() <= MAX_DIFF, "{:?} at {:?} with layers: the background is not the sky", s.technique, s.antialiasing);
+    }
+    // The colour background, and a debug view, keep the dark grey.
+    for out in &outs[plain..] {
+        assert!(background.iter().all(|&((x, y), _)| common::pixel(out, x, y) == [5, 5, 5]), "the colour background");
+    }
 }
