@@ -789,6 +789,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
+    let directional = built.scene.directional.len();
     let camera = camera_line(&built.scene);
     // A sequence renders from its first frame to write, each frame at its own clock — from
     // frame 0 under auto exposure, which carries from frame to frame.
@@ -821,6 +822,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         device: &device,
         settings: &settings,
         lights,
+        directional,
         object_textures,
         auto: auto_why.as_deref(),
         raster_auto: raster_why.as_deref(),

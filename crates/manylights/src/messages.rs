@@ -199,7 +199,10 @@ mod tests {
             describe(&e)
         );
         let e = anyhow::Error::from(SettingsError::ShadowsWithoutLights);
-        assert_eq!(describe(&e), "point-light shadows need point lights, and the scene has none (--lights N adds some)");
+        assert_eq!(
+            describe(&e),
+            "point-light shadows need point lights (shadow rays: or directional lights), and the scene has none (--lights N adds some)"
+        );
         let e = anyhow::Error::from(SettingsError::SunShadowFeature { feature: "shaderInt64", device: "gpu".into() });
         assert_eq!(describe(&e), "--sun-shadow compute needs shaderInt64, which 'gpu' lacks: use --sun-shadow graphics");
         // Errors about no flag read as the library wrote them.

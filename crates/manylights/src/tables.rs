@@ -27,6 +27,8 @@ pub struct RenderFacts<'a> {
     pub settings: &'a RenderSettings,
     /// Point lights of the scene.
     pub lights: usize,
+    /// Directional lights of the scene.
+    pub directional: usize,
     /// Whether the scene's objects have textures of their own (they widen the G-buffer).
     pub object_textures: bool,
     /// Why `auto` picked the technique; None where it was asked for by name.
@@ -142,14 +144,11 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
                     if a.cache { "on" } else { "off" }
                 ),
             )),
-            None if o.rays() => rows.push((
-                "omni shadows",
-                format!(
-                    "rays: {} light(s) ({}), a shadow ray per point and light that reaches it",
-                    o.lights,
-                    if o.all { "every light" } else { "the strongest" }
-                ),
-            )),
+            None if o.rays() => {
+                let which = if o.all { format!("every point light: {}", facts.lights) } else { format!("the strongest {}", o.lights) };
+                let suns = if facts.directional > 0 { format!(" and {} directional", facts.directional) } else { String::new() };
+                rows.push(("omni shadows", format!("rays: {which}{suns}, a shadow ray per point and light that reaches it")));
+            }
             None => rows.push((
                 "omni shadows",
                 format!("{}: {} light(s) ({which}), cubes of 6×{}² (distance / radius, D32)", o.mode.name(), o.lights, o.size),
@@ -261,6 +260,7 @@ mod tests {
             device: "gpu",
             settings: &settings,
             lights: 5,
+            directional: 0,
             object_textures: false,
             auto: None,
             raster_auto: None,

@@ -178,7 +178,7 @@ pub enum SettingsError {
     Time(f32),
     #[error("{lights} lights need {bytes} bytes of light buffer but '{device}' allows {max} bytes per storage buffer")]
     LightBuffer { lights: usize, bytes: u64, device: String, max: u32 },
-    #[error("point-light shadows need point lights, and the scene has none")]
+    #[error("point-light shadows need point lights (shadow rays: or directional lights), and the scene has none")]
     ShadowsWithoutLights,
     #[error("{value} shadowed lights is out of range: the scene has {lights} lights (use 1 to {lights})")]
     ShadowedLights { value: u32, lights: usize },

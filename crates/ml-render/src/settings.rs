@@ -283,8 +283,11 @@ impl RenderSettings {
     }
 
     /// Reject what `scene` cannot give: the environment as the background where it has none
-    /// (or the model lights with none).
+    /// (or the model lights with none), shadow rays where no light casts them.
     pub fn check_scene(&self, scene: &ml_cpu::scene::Scene) -> Result<(), SettingsError> {
+        if self.omni.is_some_and(|o| o.rays()) && scene.lights.is_empty() && scene.directional.is_empty() {
+            return Err(SettingsError::ShadowsWithoutLights);
+        }
         let lit = self.shading == ShadingModel::Pbr && scene.environment.is_some();
         if self.background == Background::Environment && !lit {
             return Err(SettingsError::BackgroundNeedsEnvironment);

@@ -137,6 +137,11 @@ impl OmniShadowSettings {
     pub(crate) fn check(&self, ctx: &Context, lights: usize) -> Result<(), SettingsError> {
         let limits = &ctx.info.limits;
         let device = || ctx.info.name.clone();
+        // Directional lights alone may cast shadow rays (`RenderSettings::check_scene` makes
+        // sure the scene has some).
+        if lights == 0 && self.rays() {
+            return Ok(());
+        }
         if lights == 0 {
             return Err(SettingsError::ShadowsWithoutLights);
         }

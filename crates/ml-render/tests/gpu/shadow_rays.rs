@@ -183,7 +183,8 @@ fn two_hundred_and_fifty_six_lights_shadow_where_the_triangle_caster_says() {
 }
 
 /// Directional lights cast their shadows through rays too: occluders of every kind over a
-/// floor under three suns of different colours and slopes, and four point lights among them.
+/// floor under three suns of different colours and slopes, with four point lights among them
+/// and alone.
 #[test]
 fn directional_lights_shadow_where_the_triangle_caster_says() {
     let mut scene = cluttered_room(4, 21);
@@ -199,6 +200,10 @@ fn directional_lights_shadow_where_the_triangle_caster_says() {
         .collect();
     let (checked, in_shadow) = ray_test("floor, 3 directional and 4 point lights", &scene);
     assert!(checked > 2000 && in_shadow > 500, "{checked} checked, {in_shadow} in shadow");
+    // Suns alone (a glTF file's usual lighting) cast theirs with no point light at all.
+    scene.lights.clear();
+    let (checked, in_shadow) = ray_test("floor, 3 directional lights alone", &scene);
+    assert!(checked > 2000 && in_shadow > 300, "{checked} checked, {in_shadow} in shadow");
 }
 
 /// The room with rotated occluders of every kind of mesh and 16 lights of random colours.
