@@ -474,6 +474,8 @@ impl<'c> Session<'c> {
                 }
                 Command::Technique(name) => self.choices.settings.technique = ml_render::Technique::from_name(&name)?,
                 Command::Antialiasing(samples) => self.choices.settings.antialiasing = ml_render::Antialiasing::from_name(&samples)?,
+                Command::Environment(source) => self.choices.load_environment(&source),
+                Command::Background(shown) => self.choices.settings.background = ml_render::Background::from_name(&shown)?,
                 Command::Lights(n) => {
                     self.choices.lights = n;
                     self.overlay.lights_edit = n;

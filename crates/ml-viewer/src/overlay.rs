@@ -2,6 +2,7 @@
 //! settings (`Choices`), pause, and a panel of per-pass GPU times with a frame-time graph.
 
 use egui::{ComboBox, DragValue, Slider};
+use ml_cpu::environment::EnvironmentSource;
 use ml_cpu::lights::{LightLayout, RadiusRange, SEED_RADIUS};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
@@ -31,6 +32,9 @@ pub struct Choices {
     pub light_grid_marks: LightGridMarks,
     /// The environment's intensity and turn in degrees (None: the scene has none).
     pub environment: Option<(f32, f32)>,
+    /// An environment loaded in the viewer: a file, sky or none, as `--environment` reads it
+    /// (None: the scene's own).
+    pub environment_source: Option<String>,
 }
 
 impl Choices {
@@ -51,8 +55,19 @@ impl Choices {
             layout: request.layout,
             radius: request.radius.map_or_else(|| built.scene.lights.first().map_or(SEED_RADIUS, |l| l.position_radius[3]), |r| r.max),
             environment: built.scene.environment.as_ref().map(|e| (e.intensity, e.rotation.to_degrees())),
+            environment_source: None,
             light_grid_marks,
         }
+    }
+
+    /// Light the scene with `source` (a file, sky or none) from the next renderer on, at the
+    /// intensity and turn chosen so far (1 and 0° where there was none).
+    pub fn load_environment(&mut self, source: &str) {
+        self.environment_source = Some(source.to_owned());
+        self.environment = match EnvironmentSource::parse(source) {
+            EnvironmentSource::Off => None,
+            _ => Some(self.environment.unwrap_or((1.0, 0.0))),
+        };
     }
 
     /// `base` (the request these choices started from, as `initial`) with what changed since:
@@ -62,6 +77,9 @@ impl Choices {
         let mut r = SceneRequest { shading: Some(self.settings.shading), ..base.clone() };
         if let SceneSource::Seed { object, material } = &mut r.source {
             (*object, *material) = (self.object, self.material);
+        }
+        if let Some(source) = &self.environment_source {
+            r.environment = Some(EnvironmentSource::parse(source));
         }
         if let Some((intensity, degrees)) = self.environment {
             (r.environment_intensity, r.environment_rotation_deg) = (Some(intensity), Some(degrees));
@@ -134,6 +152,8 @@ pub struct OverlayState {
     pub exposure_ev: f32,
     /// Whether the window had room for the open panel when last drawn (None: not yet drawn).
     pub roomy: Option<bool>,
+    /// The environment to load, as typed.
+    pub environment_edit: String,
 }
 
 impl OverlayState {
@@ -148,6 +168,7 @@ impl OverlayState {
             error: None,
             exposure_ev: 0.0,
             roomy: None,
+            environment_edit: String::new(),
         }
     }
 
@@ -206,6 +227,16 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
         if let Some((intensity, degrees)) = &mut choices.environment {
             ui.add(Slider::new(intensity, 0.0..=16.0).text("environment"));
             ui.add(Slider::new(degrees, -180.0..=180.0).suffix("°").text("turned"));
+        }
+        // Another environment (the pbr model's), loaded into a new renderer.
+        if choices.settings.shading == ShadingModel::Pbr {
+            ui.horizontal(|ui| {
+                let field = egui::TextEdit::singleline(&mut state.environment_edit).hint_text("FILE.hdr|.exr, sky, none");
+                ui.add(field.desired_width(150.0));
+                if ui.button("Load").clicked() && !state.environment_edit.trim().is_empty() {
+                    choices.load_environment(state.environment_edit.trim());
+                }
+            });
         }
         // The environment behind the scene where the model is lit by one.
         if choices.environment.is_some() && choices.settings.shading == ShadingModel::Pbr {
@@ -318,6 +349,7 @@ mod tests {
             radius: 3.0,
             light_grid_marks: LightGridMarks::Auto,
             environment: None,
+            environment_source: None,
         }
     }
 
@@ -361,5 +393,21 @@ mod tests {
         assert_eq!((turned.environment_intensity, turned.environment_rotation_deg), (Some(2.0), Some(90.0)));
         let none = initial().request(&base, &initial());
         assert_eq!((none.environment_intensity, none.environment_rotation_deg), (None, None));
+    }
+
+    #[test]
+    fn an_environment_loaded_goes_into_the_request_at_the_intensity_chosen() {
+        let base = SceneRequest::new(SceneSource::File("a.glb".into()));
+        let mut lit = Choices { environment: Some((2.0, 90.0)), ..initial() };
+        lit.load_environment("studio.hdr");
+        let r = lit.request(&base, &initial());
+        assert_eq!(r.environment, Some(EnvironmentSource::File("studio.hdr".into())));
+        assert_eq!((r.environment_intensity, r.environment_rotation_deg), (Some(2.0), Some(90.0)));
+        // A scene without one starts at 1 and 0°; none takes the sliders away.
+        let mut dark = initial();
+        dark.load_environment("sky");
+        assert_eq!((dark.environment, dark.request(&base, &initial()).environment), (Some((1.0, 0.0)), Some(EnvironmentSource::Sky)));
+        dark.load_environment("none");
+        assert_eq!((dark.environment, dark.request(&base, &initial()).environment), (None, Some(EnvironmentSource::Off)));
     }
 }

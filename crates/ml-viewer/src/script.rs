@@ -6,6 +6,8 @@
 //! technique deferred       # any --technique name
 //! lights 1000              # light count (the scene's layout)
 //! aa 4                     # anti-aliasing: off, 4, 8 or 16 (--aa)
+//! environment sky          # load an environment: FILE, sky or none (--environment)
+//! background environment   # colour or environment (--background)
 //! resize 320 240           # ask the window for this inner size
 //! minimize / restore       # ask the window system to iconify / restore the window
 //! overlay off              # hide or show the egui overlay
@@ -20,6 +22,8 @@ use std::path::PathBuf;
 pub enum Command {
     Frames(u32),
     Antialiasing(String),
+    Environment(String),
+    Background(String),
     Technique(String),
     Lights(u64),
     Resize(u32, u32),
@@ -53,6 +57,8 @@ pub fn parse(text: &str) -> Result<Vec<Command>, String> {
             ["technique", name] => Command::Technique(name.to_owned()),
             ["lights", n] => Command::Lights(number(n, u64::MAX)?),
             ["aa", samples] => Command::Antialiasing(samples.to_owned()),
+            ["environment", source] => Command::Environment(source.to_owned()),
+            ["background", shown] => Command::Background(shown.to_owned()),
             ["resize", w, h] => Command::Resize(number(w, MAX_SIDE as u64)? as u32, number(h, MAX_SIDE as u64)? as u32),
             ["minimize"] => Command::Minimize,
             ["restore"] => Command::Restore,
@@ -61,7 +67,7 @@ pub fn parse(text: &str) -> Result<Vec<Command>, String> {
             ["screenshot", path] => Command::Screenshot(PathBuf::from(path)),
             ["window-shot", path] => Command::WindowShot(PathBuf::from(path)),
             ["quit"] => Command::Quit,
-            _ => return Err(bad("unknown command (frames N, technique NAME, lights N, aa N, resize W H, minimize, restore, overlay on|off, screenshot PATH, window-shot PATH, quit)")),
+            _ => return Err(bad("unknown command (frames N, technique NAME, lights N, aa N, environment SOURCE, background NAME, resize W H, minimize, restore, overlay on|off, screenshot PATH, window-shot PATH, quit)")),
         };
         out.push(command);
     }
@@ -74,7 +80,7 @@ mod tests {
 
     #[test]
     fn commands_parse_and_mistakes_name_their_line() {
-        let script = "# a session\nframes 3\ntechnique deferred  # switch\nlights 1000\naa 4\nresize 320 240\nminimize\nrestore\noverlay off\nscreenshot a.png\nwindow-shot b.png\nquit\n";
+        let script = "# a session\nframes 3\ntechnique deferred  # switch\nlights 1000\naa 4\nenvironment sky\nbackground environment\nresize 320 240\nminimize\nrestore\noverlay off\nscreenshot a.png\nwindow-shot b.png\nquit\n";
         assert_eq!(
             parse(script).unwrap(),
             vec![
@@ -82,6 +88,8 @@ mod tests {
                 Command::Technique("deferred".into()),
                 Command::Lights(1000),
                 Command::Antialiasing("4".into()),
+                Command::Environment("sky".into()),
+                Command::Background("environment".into()),
                 Command::Resize(320, 240),
                 Command::Minimize,
                 Command::Restore,

@@ -162,19 +162,31 @@ fn auto_exposure_starts_where_render_settles() {
     resized_session_matches_render("auto-exposure", &common, (3, 2));
 }
 
+/// An environment loaded in the viewer and shown behind the scene (the panel's Load field and
+/// Background combo, scripted) gives the image `render --environment sky --background
+/// environment` gives.
+#[test]
+fn an_environment_loaded_live_shows_as_render_shows_it() {
+    let common = ["--technique", "visibility", "--shading", "pbr", "--aa", "off", "--time", "0"];
+    let session = (&["environment sky", "background environment"][..], &["--environment", "sky", "--background", "environment"][..]);
+    session_matches_render("environment", &common, session, (2, 1));
+}
+
 /// A validated viewer session with `common` arguments at 160×96: two frames, a resize to
 /// 200×120, `frames` frames, a screenshot; it ends cleanly and its screenshot is within
 /// `tolerance`/255 of `render` with the same arguments at 200×120.
-fn resized_session_matches_render(name: &str, common: &[&str], (frames, tolerance): (u32, u8)) {
+fn resized_session_matches_render(name: &str, common: &[&str], frames_tolerance: (u32, u8)) {
+    session_matches_render(name, common, (&[], &[]), frames_tolerance);
+}
+
+/// `resized_session_matches_render` with `steps` run after the first two frames, and
+/// `render_args` given to render besides `common` (what those steps change).
+fn session_matches_render(name: &str, common: &[&str], (steps, render_args): (&[&str], &[&str]), (frames, tolerance): (u32, u8)) {
     let d = dir();
     let (shot, rendered) = (d.join(format!("{name}-shot.png")), d.join(format!("{name}-render.png")));
-    let script = [
-        "frames 2".to_owned(),
-        "resize 200 120".into(),
-        format!("frames {frames}"),
-        format!("screenshot {}", shot.display()),
-        "quit".into(),
-    ];
+    let mut script = vec!["frames 2".to_owned()];
+    script.extend(steps.iter().map(|s| s.to_string()));
+    script.extend(["resize 200 120".into(), format!("frames {frames}"), format!("screenshot {}", shot.display()), "quit".into()]);
     let script_file = d.join(format!("{name}.txt"));
     std::fs::write(&script_file, script.join("\n")).unwrap();
     let mut args = vec!["--validation", "--script", script_file.to_str().unwrap(), "--width", "160", "--height", "96"];
@@ -183,7 +195,8 @@ fn resized_session_matches_render(name: &str, common: &[&str], (frames, toleranc
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "the session failed: {stdout}{stderr}");
     assert!(!stderr.contains("VALIDATION") && !stderr.contains("panicked"), "{stderr}");
-    let worst = render_difference(&shot, &[&["--validation", "--width", "200", "--height", "120"][..], common].concat(), &rendered);
+    let worst =
+        render_difference(&shot, &[&["--validation", "--width", "200", "--height", "120"][..], common, render_args].concat(), &rendered);
     println!("{name}: the viewer's screenshot and render differ by at most {worst}/255");
     assert!(worst <= tolerance, "{name}: the viewer's screenshot differs from render by {worst}/255");
 }
