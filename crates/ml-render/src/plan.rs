@@ -479,6 +479,26 @@ mod tests {
     }
 
     #[test]
+    fn the_environment_background_follows_a_forward_pass_that_writes_the_output_itself() {
+        for technique in [Technique::Forward, Technique::ClusteredCpu, Technique::ClusteredGpu] {
+            let mut k = key(technique);
+            (k.meters_exposure, k.background) = (false, Background::Environment);
+            assert_eq!(plan(&k).last(), Some(&Backdrop), "{}", technique.name());
+            // With samples the tone map lays it; with the colour nothing needs to.
+            k.antialiasing = Antialiasing::X4;
+            assert!(!plan(&k).contains(&Backdrop));
+            (k.antialiasing, k.background) = (Antialiasing::Off, Background::Colour);
+            assert!(!plan(&k).contains(&Backdrop));
+        }
+        // The other techniques' last pass writes every pixel and lays it there.
+        for technique in [Technique::Deferred, Technique::DeferredCompute, Technique::Visibility] {
+            let mut k = key(technique);
+            k.background = Background::Environment;
+            assert!(!plan(&k).contains(&Backdrop), "{}", technique.name());
+        }
+    }
+
+    #[test]
     fn the_key_leaves_out_what_does_not_make_pipelines() {
         let a = RenderSettings::new(Technique::Visibility, 64, 64);
         let b = RenderSettings { width: 128, height: 32, frames: 9, time: Some(1.0), exposure: Exposure::Ev(2.0), ..a };
