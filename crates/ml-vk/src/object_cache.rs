@@ -13,6 +13,7 @@
 //! of the create info that the helpers in `shader` set, and the SPIR-V as a 128-bit hash.
 
 use ash::vk;
+use ash::vk::Handle;
 use std::collections::hash_map::DefaultHasher;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
@@ -28,6 +29,11 @@ pub(crate) struct Key(Vec<u64>);
 impl Key {
     pub fn new(kind: u64) -> Key {
         Key(vec![kind])
+    }
+
+    /// Its first word: what kind of object it is the key of.
+    pub fn kind(&self) -> u64 {
+        self.0[0]
     }
 
     pub fn word(&mut self, w: impl Into<u64>) -> &mut Key {
@@ -74,56 +80,34 @@ struct CachedPipeline {
     released: u64,
 }
 
+/// The kinds of object a key is the key of (its first word): pipelines, counted, and the
+/// objects kept for the context's life.
+pub(crate) const COMPUTE_PIPELINE: u64 = 1;
+pub(crate) const GRAPHICS_PIPELINE: u64 = 2;
+pub(crate) const SET_LAYOUT: u64 = 3;
+pub(crate) const PIPELINE_LAYOUT: u64 = 4;
+pub(crate) const RENDER_PASS: u64 = 5;
+
 /// The context's shared objects (`Context::objects`).
 #[derive(Default)]
 pub(crate) struct ObjectCache {
-    set_layouts: HashMap<Key, vk::DescriptorSetLayout>,
-    pipeline_layouts: HashMap<Key, vk::PipelineLayout>,
-    render_passes: HashMap<Key, vk::RenderPass>,
+    /// Set layouts, pipeline layouts and render passes (raw handles; the key's first word
+    /// says which), kept until the context goes away.
+    kept: HashMap<Key, u64>,
     pipelines: HashMap<Key, CachedPipeline>,
     keys: HashMap<vk::Pipeline, Key>,
     releases: u64,
 }
 
-/// `value` under `key` unless another thread put one there first: (the one to use, the one to
-/// destroy).
-fn insert_first<T: Copy>(map: &mut HashMap<Key, T>, key: Key, value: T) -> (T, Option<T>) {
-    match map.get(&key) {
-        Some(&first) => (first, Some(value)),
-        None => {
-            map.insert(key, value);
-            (value, None)
-        }
-    }
-}
-
 impl ObjectCache {
-    pub fn set_layout(&self, key: &Key) -> Option<vk::DescriptorSetLayout> {
-        self.set_layouts.get(key).copied()
+    /// The kept object of `key` (a raw handle), if made.
+    pub fn kept(&self, key: &Key) -> Option<u64> {
+        self.kept.get(key).copied()
     }
 
-    pub fn add_set_layout(
-        &mut self,
-        key: Key,
-        layout: vk::DescriptorSetLayout,
-    ) -> (vk::DescriptorSetLayout, Option<vk::DescriptorSetLayout>) {
-        insert_first(&mut self.set_layouts, key, layout)
-    }
-
-    pub fn pipeline_layout(&self, key: &Key) -> Option<vk::PipelineLayout> {
-        self.pipeline_layouts.get(key).copied()
-    }
-
-    pub fn add_pipeline_layout(&mut self, key: Key, layout: vk::PipelineLayout) -> (vk::PipelineLayout, Option<vk::PipelineLayout>) {
-        insert_first(&mut self.pipeline_layouts, key, layout)
-    }
-
-    pub fn render_pass(&self, key: &Key) -> Option<vk::RenderPass> {
-        self.render_passes.get(key).copied()
-    }
-
-    pub fn add_render_pass(&mut self, key: Key, pass: vk::RenderPass) -> (vk::RenderPass, Option<vk::RenderPass>) {
-        insert_first(&mut self.render_passes, key, pass)
+    /// `raw`, just made for `key`, kept unless another thread kept one first: the one kept.
+    pub fn keep(&mut self, key: Key, raw: u64) -> u64 {
+        *self.kept.entry(key).or_insert(raw)
     }
 
     /// The pipeline of `key`, counted as held once more; None: not made yet.
@@ -183,15 +167,17 @@ impl ObjectCache {
             for (_, c) in self.pipelines.drain() {
                 device.destroy_pipeline(c.pipeline, None);
             }
-            for (_, l) in self.pipeline_layouts.drain() {
-                device.destroy_pipeline_layout(l, None);
+            // Pipeline layouts before the set layouts they were made of.
+            for kind in [PIPELINE_LAYOUT, SET_LAYOUT, RENDER_PASS] {
+                for (key, raw) in self.kept.iter().filter(|(key, _)| key.kind() == kind) {
+                    match key.kind() {
+                        PIPELINE_LAYOUT => device.destroy_pipeline_layout(vk::PipelineLayout::from_raw(*raw), None),
+                        SET_LAYOUT => device.destroy_descriptor_set_layout(vk::DescriptorSetLayout::from_raw(*raw), None),
+                        _ => device.destroy_render_pass(vk::RenderPass::from_raw(*raw), None),
+                    }
+                }
             }
-            for (_, l) in self.set_layouts.drain() {
-                device.destroy_descriptor_set_layout(l, None);
-            }
-            for (_, p) in self.render_passes.drain() {
-                device.destroy_render_pass(p, None);
-            }
+            self.kept.clear();
         }
         self.keys.clear();
     }

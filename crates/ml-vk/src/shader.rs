@@ -5,7 +5,7 @@
 
 use crate::context::Context;
 use crate::error::{Result, VkResultExt};
-use crate::object_cache::Key;
+use crate::object_cache::{Key, COMPUTE_PIPELINE, GRAPHICS_PIPELINE, PIPELINE_LAYOUT, RENDER_PASS, SET_LAYOUT};
 use ash::vk;
 
 /// A shader module from SPIR-V bytes (as embedded by ml-shaders).
@@ -41,7 +41,7 @@ pub fn compute_pipeline(
 ) -> Result<vk::Pipeline> {
     let stats = ctx.pipeline_stats;
     let flags = if stats { vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR } else { vk::PipelineCreateFlags::empty() };
-    let mut key = Key::new(1);
+    let mut key = Key::new(COMPUTE_PIPELINE);
     key.bytes(spirv).constants(constants).handle(layout).word(flags.as_raw());
     if let Some(pipeline) = ctx.objects().take_pipeline(&key) {
         return Ok(pipeline);
@@ -217,7 +217,7 @@ pub fn graphics_pipeline(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<v
 
 /// Every field of `desc` that reaches the create info.
 fn graphics_key(desc: &GraphicsPipelineDesc) -> Key {
-    let mut key = Key::new(2);
+    let mut key = Key::new(GRAPHICS_PIPELINE);
     key.bytes(desc.vertex).constants(desc.vertex_constants);
     match desc.fragment {
         Some(fragment) => key.word(1u64).bytes(fragment).constants(desc.fragment_constants),
@@ -301,21 +301,15 @@ pub fn set_layout(ctx: &Context, bindings: &[(u32, vk::DescriptorType)], stages:
 /// The descriptor set layout of `bindings` (no immutable samplers); the context's (never
 /// destroy it).
 pub fn set_layout_of(ctx: &Context, bindings: &[vk::DescriptorSetLayoutBinding]) -> Result<vk::DescriptorSetLayout> {
-    let mut key = Key::new(3);
+    let mut key = Key::new(SET_LAYOUT);
     for b in bindings {
         assert!(b.p_immutable_samplers.is_null(), "immutable samplers: the cache's key does not hold them");
         key.word(b.binding).word(b.descriptor_type.as_raw() as u32).word(b.descriptor_count).word(b.stage_flags.as_raw());
     }
-    if let Some(layout) = ctx.objects().set_layout(&key) {
-        return Ok(layout);
-    }
-    // SAFETY: valid device and create info.
-    let layout = unsafe { ctx.device.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(bindings), None) }
-        .ctx("vkCreateDescriptorSetLayout")?;
-    let (layout, duplicate) = ctx.objects().add_set_layout(key, layout);
-    // SAFETY: made meanwhile by another thread as well; ours was never used.
-    unsafe { ctx.device.destroy_descriptor_set_layout(duplicate.unwrap_or_default(), None) };
-    Ok(layout)
+    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(bindings);
+    // SAFETY: valid device and create info; a duplicate was never used.
+    let make = || unsafe { ctx.device.create_descriptor_set_layout(&info, None) }.ctx("vkCreateDescriptorSetLayout");
+    kept(ctx, key, make, |l| unsafe { ctx.device.destroy_descriptor_set_layout(l, None) })
 }
 
 /// The pipeline layout of `set_layouts` (from `set_layout`: the context's, so their handles
@@ -325,7 +319,7 @@ pub fn pipeline_layout(
     set_layouts: &[vk::DescriptorSetLayout],
     push_constants: &[vk::PushConstantRange],
 ) -> Result<vk::PipelineLayout> {
-    let mut key = Key::new(4);
+    let mut key = Key::new(PIPELINE_LAYOUT);
     for &l in set_layouts {
         key.handle(l);
     }
@@ -333,36 +327,37 @@ pub fn pipeline_layout(
     for r in push_constants {
         key.word(r.stage_flags.as_raw()).word(r.offset).word(r.size);
     }
-    if let Some(layout) = ctx.objects().pipeline_layout(&key) {
-        return Ok(layout);
-    }
     let info = vk::PipelineLayoutCreateInfo::default().set_layouts(set_layouts).push_constant_ranges(push_constants);
-    // SAFETY: valid device and create info.
-    let layout = unsafe { ctx.device.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")?;
-    let (layout, duplicate) = ctx.objects().add_pipeline_layout(key, layout);
-    // SAFETY: made meanwhile by another thread as well; ours was never used.
-    unsafe { ctx.device.destroy_pipeline_layout(duplicate.unwrap_or_default(), None) };
-    Ok(layout)
+    // SAFETY: valid device and create info; a duplicate was never used.
+    let make = || unsafe { ctx.device.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout");
+    kept(ctx, key, make, |l| unsafe { ctx.device.destroy_pipeline_layout(l, None) })
 }
 
 /// The render pass `info` describes (its only extension: multiview); the context's (never
 /// destroy it).
 pub fn render_pass(ctx: &Context, info: &vk::RenderPassCreateInfo) -> Result<vk::RenderPass> {
-    let key = render_pass_key(info);
-    if let Some(pass) = ctx.objects().render_pass(&key) {
-        return Ok(pass);
+    // SAFETY: valid device and create info; a duplicate was never used.
+    let make = || unsafe { ctx.device.create_render_pass(info, None) }.ctx("vkCreateRenderPass");
+    kept(ctx, render_pass_key(info), make, |p| unsafe { ctx.device.destroy_render_pass(p, None) })
+}
+
+/// The context's object of `key` (a layout or render pass, kept for the context's life), made
+/// by `make` the first time; `destroy` takes ours where another thread kept one first.
+fn kept<T: vk::Handle + Copy>(ctx: &Context, key: Key, make: impl FnOnce() -> Result<T>, destroy: impl FnOnce(T)) -> Result<T> {
+    if let Some(raw) = ctx.objects().kept(&key) {
+        return Ok(T::from_raw(raw));
     }
-    // SAFETY: valid device and create info.
-    let pass = unsafe { ctx.device.create_render_pass(info, None) }.ctx("vkCreateRenderPass")?;
-    let (pass, duplicate) = ctx.objects().add_render_pass(key, pass);
-    // SAFETY: made meanwhile by another thread as well; ours was never used.
-    unsafe { ctx.device.destroy_render_pass(duplicate.unwrap_or_default(), None) };
-    Ok(pass)
+    let made = make()?;
+    let raw = ctx.objects().keep(key, made.as_raw());
+    if raw != made.as_raw() {
+        destroy(made);
+    }
+    Ok(T::from_raw(raw))
 }
 
 /// Every field of a render pass's create info (and of its multiview struct).
 fn render_pass_key(info: &vk::RenderPassCreateInfo) -> Key {
-    let mut key = Key::new(5);
+    let mut key = Key::new(RENDER_PASS);
     let references = |key: &mut Key, refs: &[vk::AttachmentReference]| {
         key.word(refs.len() as u64);
         for r in refs {
