@@ -253,6 +253,7 @@ impl<'a> Renderer<'a> {
             return Err(RenderError::Invalid("a scene with spot lights cannot change its lights in place".into()));
         }
         self.settings.check(self.ctx, lights.len())?;
+        self.settings.check_casters(lights.len(), self.scene.directional.len())?;
         check_lists_fit(self.ctx, &self.settings, &self.grid, &lights, self.scene.light_motion)?;
         self.release_frames()?;
         self.scene.lights = lights;

@@ -282,12 +282,19 @@ impl RenderSettings {
         }
     }
 
+    /// Reject shadow rays where no light, of `lights` point and `directional` directional
+    /// ones, casts them (`check` leaves a scene without point lights to this).
+    pub fn check_casters(&self, lights: usize, directional: usize) -> Result<(), SettingsError> {
+        if self.omni.is_some_and(|o| o.rays()) && lights == 0 && directional == 0 {
+            return Err(SettingsError::ShadowsWithoutLights);
+        }
+        Ok(())
+    }
+
     /// Reject what `scene` cannot give: the environment as the background where it has none
     /// (or the model lights with none), shadow rays where no light casts them.
     pub fn check_scene(&self, scene: &ml_cpu::scene::Scene) -> Result<(), SettingsError> {
-        if self.omni.is_some_and(|o| o.rays()) && scene.lights.is_empty() && scene.directional.is_empty() {
-            return Err(SettingsError::ShadowsWithoutLights);
-        }
+        self.check_casters(scene.lights.len(), scene.directional.len())?;
         let lit = self.shading == ShadingModel::Pbr && scene.environment.is_some();
         if self.background == Background::Environment && !lit {
             return Err(SettingsError::BackgroundNeedsEnvironment);

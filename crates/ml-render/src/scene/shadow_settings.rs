@@ -137,7 +137,7 @@ impl OmniShadowSettings {
     pub(crate) fn check(&self, ctx: &Context, lights: usize) -> Result<(), SettingsError> {
         let limits = &ctx.info.limits;
         let device = || ctx.info.name.clone();
-        // Directional lights alone may cast shadow rays (`RenderSettings::check_scene` makes
+        // Directional lights alone may cast shadow rays (`RenderSettings::check_casters` makes
         // sure the scene has some).
         if lights == 0 && self.rays() {
             return Ok(());
