@@ -16,7 +16,7 @@ layout(constant_id = 46) const bool BACKGROUND_ENVIRONMENT = false;
 vec3 environment_seen(ivec2 p) {
     vec2 xy = vec2(p) + 0.5;
     vec3 d = normalize(world_from_depth(xy, 1.0) - world_from_depth(xy, 0.0));
-    mat3 to_image = mat3(environment.to_image[0].xyz, environment.to_image[1].xyz, environment.to_image[2].xyz);
+    mat3 to_image = environment_to_image();
     // A pixel spans about 2 / (proj[1][1]·height) rad at the centre, a cube texel (π/2) / face.
     float face = float(textureSize(environment_radiance, 0).x);
     float pixel = 2.0 / (frame.proj[1][1] * float(frame.viewport.y));

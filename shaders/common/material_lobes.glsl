@@ -128,7 +128,7 @@ float coat_transmittance(vec3 n, vec3 v, vec4 coat) {
 // 1 − coat·F_coat.
 vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion, vec4 specular, vec4 coat,
                              vec4 sheen) {
-    mat3 to_image = mat3(environment.to_image[0].xyz, environment.to_image[1].xyz, environment.to_image[2].xyz);
+    mat3 to_image = environment_to_image();
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 r = normalize(2.0 * dot(n, v) * n - v);
     vec3 diffuse = albedo * (1.0 - metallic) * environment_diffuse(to_image * n) * occlusion;

@@ -19,6 +19,11 @@ layout(set = 1, binding = 12) uniform samplerCube environment_radiance;
 // Pipelines of scenes lit by an environment (the others keep their constant ambient term).
 layout(constant_id = 44) const bool ENVIRONMENT = false;
 
+// World directions → the image's frame (its turn about +Y).
+mat3 environment_to_image() {
+    return mat3(environment.to_image[0].xyz, environment.to_image[1].xyz, environment.to_image[2].xyz);
+}
+
 vec3 environment_diffuse(vec3 n) {
     float y[9];
     sh9_basis(n, y);
@@ -49,7 +54,7 @@ vec3 environment_prefiltered(vec3 d, float roughness) {
 
 // `n`, `v`: unit normal and direction towards the eye, in the world.
 vec3 environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion) {
-    mat3 to_image = mat3(environment.to_image[0].xyz, environment.to_image[1].xyz, environment.to_image[2].xyz);
+    mat3 to_image = environment_to_image();
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 r = normalize(2.0 * dot(n, v) * n - v);
     vec3 diffuse = albedo * (1.0 - metallic) * environment_diffuse(to_image * n) * occlusion;
