@@ -144,9 +144,10 @@ struct ObjectData {
                            // alpha-mask buffer; z, w: that texture's width, height
     vec4 uv_transform[2];  // texture coordinates as the textures see them: uv' = M·uv + t,
                            // M's columns in [0].xy and [0].zw, t in [1].xy (transform_uv)
-    vec4 lobes[3];         // glTF's PBR extensions (material_lobes.glsl): (dielectric F₀,
-                           // specular factor), (clear coat, its roughness, unlit, 0), (sheen
-                           // colour, sheen roughness)
+    vec4 lobes[4];         // glTF's PBR extensions (material_lobes.glsl): (dielectric F₀,
+                           // specular factor), (clear coat, its roughness, unlit,
+                           // transmission), (sheen colour, sheen roughness), (the volume's
+                           // transmittance, 0)
 };
 
 // The texture coordinates an object's textures see at mesh coordinates `uv`: its
@@ -159,7 +160,7 @@ vec2 transform_uv(vec4 transform[2], vec2 uv) {
 // Bits of ObjectData.alpha_texture.x (gpu_types.rs OBJECT_*).
 const uint OBJECT_MASKED = 1u;        // alpha-tested (glTF MASK, and BLEND at one half)
 const uint OBJECT_DOUBLE_SIDED = 2u;  // drawn from both sides, the normal toward the viewer
-const uint OBJECT_BLENDED = 4u;       // BLEND in the file (the alpha debug view)
+const uint OBJECT_BLENDED = 4u;       // transparent: BLEND or transmitting (layers, alpha view)
 const uint OBJECT_ALPHA_TEXTURE = 8u; // its alpha comes from a texture too
 const uint OBJECT_ALPHA_WRAP_SHIFT = 8u; // wrap u (2 bits), then wrap v
 const uint OBJECT_ALPHA_NEAREST = 4096u;

@@ -135,6 +135,13 @@ PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive
     return m;
 }
 
+// The unit vector from `world` towards the eye; an orthographic camera looks along its axis
+// everywhere (the view matrix's third row is the eye's +Z, its back, in world space).
+vec3 toward_eye(vec3 world) {
+    vec3 back = vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
+    return frame.camera_pos.w != 0.0 ? normalize(frame.camera_pos.xyz - world) : back;
+}
+
 // Linear colour of a surface point: every light that reaches it plus what the model adds
 // (seed, pbr: ambient, times the occlusion, or pbr's environment light; blinn-phong: ambient,
 // sun, spot, reflection) plus the light it gives off (`emission`); pbr with lobes as
@@ -143,10 +150,7 @@ PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive
 vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
     vec3 albedo = m.albedo, emission = m.emission;
     float roughness = m.roughness, metallic = m.metallic, occlusion = m.occlusion;
-    // Towards the eye; an orthographic camera looks along its axis everywhere (the view
-    // matrix's third row is the eye's +Z, its back, in world space).
-    vec3 back = vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
-    vec3 v = frame.camera_pos.w != 0.0 ? normalize(frame.camera_pos.xyz - world) : back;
+    vec3 v = toward_eye(world);
     vec3 lo = vec3(0.0);
     if (MODEL_BLINN_PHONG) {
         vec3 r0 = mix(vec3(0.04), albedo, metallic);
@@ -171,7 +175,7 @@ vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
                 return lobed_environment_light(n, v, albedo, roughness, metallic, occlusion, m.specular, m.coat, m.sheen) + lo +
                        emission * under_coat;
             }
-            return albedo * frame.ambient * occlusion * under_coat + lo + emission * under_coat;
+            return albedo * frame.ambient * occlusion * (1.0 - m.coat.w) * under_coat + lo + emission * under_coat;
         }
 #define PBR_LIGHT(l) shadowed(pbr_point_light(l, world, n, v, albedo, roughness, metallic), l, world, n)
         SUM_LIGHTS(lo, PBR_LIGHT)

@@ -15,7 +15,8 @@
 layout(constant_id = 45) const bool MATERIAL_LOBES = false;
 
 // PointMaterial's lobes (ObjectData.lobes): specular: (dielectric F₀, specular factor);
-// coat: (clear coat, its roughness, unlit, 0); sheen: (colour, roughness).
+// coat: (clear coat, its roughness, unlit, transmission); sheen: (colour, roughness). The
+// fourth, the volume's transmittance, only the transparent layers read (layers.glsl).
 const float SHEEN_MIN_ROUGHNESS = 0.07;
 
 float d_charlie(float n_dot_h, float roughness) {
@@ -74,7 +75,7 @@ float max3(vec3 c) {
 
 // One point light in the pbr model with lobes (zero beyond the radius and behind the
 // surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic), Lambert
-// diffuse weighted by (1 − F)(1 − metallic) plus GGX; the sheen's lobe over the base scaled by
+// diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX; the sheen's lobe over the base scaled by
 // 1 − max(sheen)·E at the view and the light; the clear coat's GGX lobe (F₀ 0.04) over the
 // base scaled by 1 − coat·F_coat. Its first lines are cook_torrance_point_light's (seed_brdf.glsl),
 // repeated: a shared helper returning the cosines in a struct made the seed's forward pass 1.44×
@@ -102,7 +103,7 @@ vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 al
     vec3 f_metal = albedo + (1.0 - albedo) * fc;
     vec3 f = mix(f_dielectric, f_metal, metallic);
     float g = g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, roughness));
-    vec3 base = (1.0 - f) * (1.0 - metallic) * albedo / PI + d_ggx(n_dot_h, roughness) * f * g;
+    vec3 base = (1.0 - f) * (1.0 - metallic) * (1.0 - coat.w) * albedo / PI + d_ggx(n_dot_h, roughness) * f * g;
     float sheen_max = max3(sheen.rgb);
     if (sheen_max > 0.0) {
         base *= min(1.0 - sheen_max * sheen_albedo(n_dot_v, sheen.a), 1.0 - sheen_max * sheen_albedo(n_dot_l, sheen.a));
@@ -121,8 +122,18 @@ float coat_transmittance(vec3 n, vec3 v, vec4 coat) {
     return 1.0 - coat_fresnel(clamp(dot(n, v), 0.0, 1.0), coat.x);
 }
 
+// What the surface lets through of the light behind it (KHR_materials_transmission, thin
+// walled): transmission × (1 − metallic) × albedo × (1 − F) of the dielectric's Fresnel
+// term × 1 − coat·F_coat × the volume's transmittance `volume` (ml_cpu lobed_transmittance).
+vec3 lobed_transmittance(vec3 n, vec3 v, vec3 albedo, float metallic, vec4 specular, vec4 coat, vec3 volume) {
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    float fc = pow(1.0 - n_dot_v, 5.0);
+    vec3 f_dielectric = specular.a * (specular.rgb + (1.0 - specular.rgb) * fc);
+    return (1.0 - f_dielectric) * albedo * volume * (coat.w * (1.0 - metallic) * (1.0 - coat_fresnel(n_dot_v, coat.x)));
+}
+
 // Environment light with lobes (environment.glsl's split sum): the specular term's F₀ and F₉₀
-// from the dielectric's F₀ and specular factor; the sheen's lobe as E(n·v)·sheen colour times
+// from the dielectric's F₀ and specular factor, the diffuse less what is transmitted; the sheen's lobe as E(n·v)·sheen colour times
 // the radiance prefiltered at its roughness about the normal, the base scaled by
 // 1 − max(sheen)·E; the clear coat's split sum at its roughness over the base scaled by
 // 1 − coat·F_coat.
@@ -131,7 +142,7 @@ vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float
     mat3 to_image = environment_to_image();
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 r = normalize(2.0 * dot(n, v) * n - v);
-    vec3 diffuse = albedo * (1.0 - metallic) * environment_diffuse(to_image * n) * occlusion;
+    vec3 diffuse = albedo * (1.0 - metallic) * (1.0 - coat.w) * environment_diffuse(to_image * n) * occlusion;
     vec3 f0 = mix(specular.a * specular.rgb, albedo, metallic);
     float f90 = mix(specular.a, 1.0, metallic);
     vec2 ab = environment_brdf_at(n_dot_v, roughness);

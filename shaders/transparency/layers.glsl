@@ -58,7 +58,9 @@ layout(std430, set = 0, binding = LAYER_BINDING) buffer TransparentHeadBuffer { 
 // Two uvec4 a node: (depth, next, object, pixel y << 16 | x), then the surface (octahedral
 // normal snorm 2×16, albedo factor and occlusion unorm 4×8, roughness and metallic factors
 // unorm 2×8 with alpha unorm 16 above them, emissive factor and normal spread unorm 4×8),
-// which lighting replaces by (lit colour rgb, alpha) as floats.
+// which lighting replaces by its light: (lit colour rgb, alpha) as floats or, for a surface
+// that transmits light, (lit colour × alpha as floats, LAYER_TRANSMITS | what it lets
+// through of the light behind, 10 bits a channel) — layer_light reads either.
 layout(std430, set = 0, binding = LAYER_BINDING + 1) buffer TransparentNodeBuffer { uvec4 layer_nodes[]; };
 // x: nodes asked for this frame (beyond the pool's size: dropped); y: pixels that merged
 // layers; z, w: triangles the per-triangle build listed for a work group each, and for the
@@ -88,9 +90,32 @@ void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uint c
     layer_nodes[2u * node + 1u] = surface;
 }
 
+// A lit node's last word holds this bit where it transmits light (never in an alpha's float,
+// whose sign is +).
+const uint LAYER_TRANSMITS = 0x80000000u;
+
+// What a lit node does to the light behind it: `light` added, `through` of it let through
+// per channel, `weight` its share that lets nothing through (the merge's weights).
+struct LayerLight {
+    vec3 light;
+    vec3 through;
+    float weight;
+};
+
+LayerLight layer_light(uint node) {
+    uvec4 w = layer_nodes[2u * node + 1u];
+    vec3 c = uintBitsToFloat(w.xyz);
+    if ((w.w & LAYER_TRANSMITS) == 0u) {
+        float a = uintBitsToFloat(w.w);
+        return LayerLight(c * a, vec3(1.0 - a), a);
+    }
+    vec3 through = vec3(uvec3(w.w, w.w >> 10, w.w >> 20) & 1023u) / 1023.0;
+    return LayerLight(c, through, 1.0 - min(through.r, min(through.g, through.b)));
+}
+
 #ifdef MANYLIGHTS_LIGHTING_GLSL
 
-// Light node `node` where it lies and keep its colour and alpha in place of its surface.
+// Light node `node` where it lies and keep its light (layer_light) in place of its surface.
 void light_layer(uint node) {
     uvec4 a = layer_nodes[2u * node];
     uvec4 b = layer_nodes[2u * node + 1u];
@@ -105,6 +130,15 @@ void light_layer(uint node) {
                                      emissive_spread.a, object);
     vec3 color = shade_point(world, n, m, frag_xy);
     float alpha = unpackUnorm2x16(b.z).y;
+    if (MATERIAL_LOBES) {
+        if (m.coat.w > 0.0) {
+            // Transmission: its covered share lets through what lobed_transmittance says.
+            vec3 t = lobed_transmittance(n, toward_eye(world), m.albedo, m.metallic, m.specular, m.coat, o.lobes[3].rgb);
+            uvec3 q = uvec3(round(clamp(1.0 - alpha + alpha * t, 0.0, 1.0) * 1023.0));
+            layer_nodes[2u * node + 1u] = uvec4(floatBitsToUint(color * alpha), LAYER_TRANSMITS | q.r | q.g << 10 | q.b << 20);
+            return;
+        }
+    }
     layer_nodes[2u * node + 1u] = uvec4(floatBitsToUint(color), floatBitsToUint(alpha));
 }
 
@@ -121,36 +155,33 @@ bool layer_before(uvec2 x, uvec2 y) {
     return dx < dy || (dx == dy && layer_object(x.y) < layer_object(y.y));
 }
 
-// A lit node's colour and alpha.
-vec4 layer_color(uint node) {
-    return uintBitsToFloat(layer_nodes[2u * node + 1u]);
-}
-
 // A pixel's nearest LAYER_KEEP layers, sorted (sort_layers), in [lo, hi) of a double-ended
 // array that starts in its middle: (depth bits, object word) keys and node indices.
 uvec2 sorted_keys[2u * LAYER_KEEP];
 uint sorted_nodes[2u * LAYER_KEEP];
 
 // What a pixel keeps of its layers: the nearest sorted into sorted_keys/sorted_nodes
-// [lo, hi); the farther ones merged (`merged`: their α-weighted mean colour, and Π(1 − α)
-// over them all: what they leave uncovered); `count`: its layers.
+// [lo, hi); the farther ones merged (`merged`: their weighted mean colour, `merged_through`:
+// what they let through together, Π over them); `count`: its layers.
 struct SortedLayers {
     uint lo;
     uint hi;
     uint count;
-    vec4 merged;
+    vec3 merged;
+    vec3 merged_through;
 };
 
 // Pixel `p`'s layers sorted (the nearest LAYER_KEEP) and merged (the rest).
 SortedLayers sort_layers(ivec2 p) {
-    SortedLayers s = SortedLayers(LAYER_KEEP, LAYER_KEEP, 0u, vec4(0.0, 0.0, 0.0, 1.0));
+    SortedLayers s = SortedLayers(LAYER_KEEP, LAYER_KEEP, 0u, vec3(0.0), vec3(1.0));
     // A list holds its pixel's layers in the reverse of the order they were drawn, so they
     // often come nearest-first or farthest-first; either way each one goes to an end of the
     // array, without moving the others (an array filled from one end would move them all for
     // one of the two).
     uint lo = LAYER_KEEP, hi = LAYER_KEEP, count = 0u;
-    // What is merged behind them: Π(1 − α), Σα, Σα·colour.
-    float uncovered = 1.0, weight = 0.0;
+    // What is merged behind them: Π through, Σ weight, Σ light.
+    vec3 through = vec3(1.0);
+    float weight = 0.0;
     vec3 weighted = vec3(0.0);
     uint capacity = layer_capacity();
     for (uint node = layer_heads[layer_pixel(p)]; node != LAYER_END && count < capacity; count++) {
@@ -198,10 +229,10 @@ SortedLayers sort_layers(ivec2 p) {
             sorted_nodes[i] = node;
         }
         if (merged_node != LAYER_END) {
-            vec4 c = layer_color(merged_node);
-            uncovered *= 1.0 - c.a;
-            weight += c.a;
-            weighted += c.a * c.rgb;
+            LayerLight l = layer_light(merged_node);
+            through *= l.through;
+            weight += l.weight;
+            weighted += l.light;
         }
         node = a.y;
     }
@@ -210,31 +241,32 @@ SortedLayers sort_layers(ivec2 p) {
     s.count = count;
     if (count > LAYER_KEEP) {
         atomicAdd(layer_counts.y, 1u);
-        s.merged = vec4(weight > 0.0 ? weighted / weight : vec3(0.0), uncovered);
+        s.merged = weight > 0.0 ? weighted / weight : vec3(0.0);
+        s.merged_through = through;
     }
     return s;
 }
 
 // The sorted layers `s` whose bit `layers` has (bit i: sorted_nodes[s.lo + i]; all ones: every
 // one), and the merged ones, blended over `under` (linear) back to front; `transmittance`:
-// how much of `under` still shows.
-vec3 blend_sorted(SortedLayers s, uint layers, vec3 under, out float transmittance) {
-    vec3 color = mix(under, s.merged.rgb, 1.0 - s.merged.a);
-    transmittance = s.merged.a;
+// how much of `under` still shows, per channel.
+vec3 blend_sorted(SortedLayers s, uint layers, vec3 under, out vec3 transmittance) {
+    vec3 color = mix(under, s.merged, 1.0 - s.merged_through);
+    transmittance = s.merged_through;
     for (uint i = s.hi; i > s.lo; i--) {
         if ((layers & (1u << (i - 1u - s.lo))) == 0u) {
             continue;
         }
-        vec4 c = layer_color(sorted_nodes[i - 1u]);
-        color = c.rgb * c.a + color * (1.0 - c.a);
-        transmittance *= 1.0 - c.a;
+        LayerLight l = layer_light(sorted_nodes[i - 1u]);
+        color = l.light + color * l.through;
+        transmittance *= l.through;
     }
     return color;
 }
 
 // Pixel `p`'s lit layers blended over `under` (linear; black for the background) back to
 // front; `transmittance`: how much of `under` still shows, `count`: its layers.
-vec3 blend_layers(ivec2 p, vec3 under, out float transmittance, out uint count) {
+vec3 blend_layers(ivec2 p, vec3 under, out vec3 transmittance, out uint count) {
     SortedLayers s = sort_layers(p);
     count = s.count;
     return blend_sorted(s, 0xffffffffu, under, transmittance);
@@ -253,7 +285,7 @@ vec4 layer_count_color(uint count) {
 // (`background`: none; the background colour is a backdrop in the output's encoding, not
 // light in the scene, so the layers are blended over black and laid over it there).
 vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
-    float transmittance;
+    vec3 transmittance;
     uint count;
     vec3 color = blend_layers(p, background ? vec3(0.0) : under, transmittance, count);
     if (frame.viewport.z == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
@@ -323,7 +355,7 @@ vec4 layered_samples_output(ivec2 p, float exposure) {
             }
         }
         done |= members;
-        float transmittance;
+        vec3 transmittance;
         vec3 color = blend_sorted(s, layers, drawn ? surface_colour(p, leader) : vec3(0.0), transmittance);
         vec3 display = display_linear(color, exposure);
         if (!drawn) {

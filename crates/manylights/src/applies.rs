@@ -310,7 +310,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
     ];
     // Transparency needs transparent objects (a file's, or made by the two options), and
     // the shaded image or the layers' own view.
-    let transparent = built.map(|b| b.scene.has_blended_objects());
+    let transparent = built.map(|b| b.scene.has_transparent_objects());
     let needs_transparent = "transparent objects (alphaMode BLEND in a glTF file, --transparent-objects or --glass-layers)";
     rules.push(Rule::setting(
         "transparency_budget",

@@ -25,7 +25,7 @@ use crate::gpu_types::{
     OBJECT_ALPHA_BLOCK_SHIFT, OBJECT_ALPHA_NEAREST, OBJECT_ALPHA_TEXTURE, OBJECT_ALPHA_WRAP_SHIFT, OBJECT_BLENDED, OBJECT_DOUBLE_SIDED,
     OBJECT_MASKED,
 };
-use crate::scene::{AlphaMode, Object, Scene};
+use crate::scene::{Object, Scene};
 use crate::textures::{Filter, TextureImage, Wrap};
 use glam::Vec2;
 use std::collections::HashMap;
@@ -101,11 +101,12 @@ impl AlphaMasks {
         if x.double_sided {
             flags |= OBJECT_DOUBLE_SIDED;
         }
-        if x.alpha_mode == AlphaMode::Blend {
+        if x.transparent() {
             flags |= OBJECT_BLENDED;
         }
         let Some(cutoff) = x.alpha_mode.cutoff() else {
-            return ([0.0, x.base_alpha, 0.0, 0.0], [flags, 0, 0, 0]);
+            // OPAQUE: the alpha is ignored (a transmitting surface's layers cover their pixel).
+            return ([0.0, 1.0, 0.0, 0.0], [flags, 0, 0, 0]);
         };
         flags |= OBJECT_MASKED;
         let texture = o.textures.base_color.and_then(|t| Some((textures.get(t as usize)?, *self.first.get(&t)?)));
@@ -246,7 +247,7 @@ mod tests {
     use crate::camera::Camera;
     use crate::material::Material;
     use crate::mesh::MeshKind;
-    use crate::scene::{MaterialExtras, ObjectTextures};
+    use crate::scene::{AlphaMode, MaterialExtras, ObjectTextures};
     use crate::textures::TextureSampler;
 
     /// A 4×2 texture whose alpha is 0, 85, 170, 255 along each row.

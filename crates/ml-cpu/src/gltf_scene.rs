@@ -848,7 +848,10 @@ impl Builder<'_> {
                 let Some(parts) = self.primitive(&mesh, &primitive, m.double_sided()).map_err(|e| e.within(what))? else {
                     continue;
                 };
-                let (material, extras, mixed, unread) = material(&m).map_err(|e| e.within(what))?;
+                let (material, mut extras, mixed, unread) = material(&m).map_err(|e| e.within(what))?;
+                // The volume's thickness from the mesh's units to the world's: the node's mean
+                // scale (the cube root of its volume's scale).
+                extras.lobes.thickness *= glam::Mat3::from_mat4(world).determinant().abs().cbrt();
                 let named = || match m.name() {
                     Some(name) => format!("{} '{name}'", MaterialName(m.index())),
                     None => MaterialName(m.index()).to_string(),

@@ -194,15 +194,16 @@ gpu_struct!(
         /// xy of the second.
         uv_transform: [[f32; 4]; 2],
         /// glTF's PBR extensions (`MaterialLobes::vectors`).
-        lobes: [[f32; 4]; 3],
+        lobes: [[f32; 4]; 4],
     }
 );
 
 /// `ObjectData::alpha_texture.x` bits (common.glsl OBJECT_*).
 pub const OBJECT_MASKED: u32 = 1;
 pub const OBJECT_DOUBLE_SIDED: u32 = 2;
-/// BLEND in the file: blended in per-pixel layers where the render blends them (then the
-/// opaque passes skip it), else, and in every shadow, cut as a mask at one half.
+/// Transparent (`MaterialExtras::transparent`: BLEND, or transmitting): blended in per-pixel
+/// layers where the render blends them (then the opaque passes skip it); else, and in every
+/// shadow, BLEND is cut as a mask at one half and a transmitting OPAQUE surface is opaque.
 pub const OBJECT_BLENDED: u32 = 4;
 /// Its alpha comes from a texture too (else from the factor alone).
 pub const OBJECT_ALPHA_TEXTURE: u32 = 8;

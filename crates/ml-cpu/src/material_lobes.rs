@@ -2,8 +2,10 @@
 //! with them: a dielectric's reflectance from its index of refraction
 //! (KHR_materials_ior) scaled and tinted (KHR_materials_specular), a clear coat over the base
 //! (KHR_materials_clearcoat), cloth-like sheen (KHR_materials_sheen, the Charlie distribution of
-//! Estevez and Kulla 2017)) and unlit surfaces
-//! (KHR_materials_unlit). Formula for formula the CPU reference of
+//! Estevez and Kulla 2017)), unlit surfaces (KHR_materials_unlit), and light let through
+//! (KHR_materials_transmission, thin-walled, tinted by KHR_materials_volume's attenuation over
+//! its thickness: `lobed_transmittance`; the transparent layers blend what lies behind
+//! through it, straight on, without refraction). Formula for formula the CPU reference of
 //! shaders/common/material_lobes.glsl (keep in sync; tests compare them).
 //!
 //! With every extension at its default the lobed light is the pbr model's (same formulas
@@ -34,6 +36,14 @@ pub struct MaterialLobes {
     pub sheen_roughness: f32,
     /// Shown as its base colour, no light computed.
     pub unlit: bool,
+    /// How much of the light a dielectric does not reflect passes through it (tinted by its
+    /// base colour) instead of being scattered diffusely: 0 none, 1 all.
+    pub transmission: f32,
+    /// The volume's colour after `attenuation_distance` inside it (Beer's law); with
+    /// `thickness`, in world units, what the light passing through keeps.
+    pub attenuation_color: Vec3,
+    pub attenuation_distance: f32,
+    pub thickness: f32,
 }
 
 impl Default for MaterialLobes {
@@ -47,6 +57,10 @@ impl Default for MaterialLobes {
             sheen_color: Vec3::ZERO,
             sheen_roughness: 0.0,
             unlit: false,
+            transmission: 0.0,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: f32::INFINITY,
+            thickness: 0.0,
         }
     }
 }
@@ -65,13 +79,24 @@ impl MaterialLobes {
         (r * r * self.specular_color).min(Vec3::ONE)
     }
 
+    /// What light passing through keeps of each channel after crossing the volume's
+    /// thickness: attenuation colour ^ (thickness / attenuation distance); all of it for a
+    /// thin wall (thickness 0) or a clear volume.
+    pub fn volume_transmittance(&self) -> Vec3 {
+        if self.thickness <= 0.0 || !self.attenuation_distance.is_finite() {
+            return Vec3::ONE;
+        }
+        self.attenuation_color.powf(self.thickness / self.attenuation_distance)
+    }
+
     /// ObjectData::lobes: (dielectric F₀, specular factor), (clear coat, its roughness,
-    /// unlit, 0), (sheen colour, sheen roughness).
-    pub fn vectors(&self) -> [[f32; 4]; 3] {
+    /// unlit, transmission), (sheen colour, sheen roughness), (volume transmittance, 0).
+    pub fn vectors(&self) -> [[f32; 4]; 4] {
         [
             self.dielectric_f0().extend(self.specular).to_array(),
-            [self.clearcoat, self.clearcoat_roughness, f32::from(u8::from(self.unlit)), 0.0],
+            [self.clearcoat, self.clearcoat_roughness, f32::from(u8::from(self.unlit)), self.transmission],
             self.sheen_color.extend(self.sheen_roughness).to_array(),
+            self.volume_transmittance().extend(0.0).to_array(),
         ]
     }
 }
@@ -157,7 +182,7 @@ pub fn sheen_albedo(n_dot_v: f32, roughness: f32) -> f32 {
 
 /// One point light's contribution in the pbr model with `lobes` (zero beyond its radius and
 /// behind the surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic),
-/// Lambert diffuse weighted by (1 − F)(1 − metallic) plus GGX specular; the sheen's lobe with
+/// Lambert diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX specular; the sheen's lobe with
 /// the base scaled by 1 − max(sheen)·E at the view and the light; the clear coat's GGX lobe
 /// (F₀ 0.04) over the base scaled by 1 − coat·F_coat.
 pub fn lobed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material, lobes: &MaterialLobes) -> Vec3 {
@@ -168,7 +193,8 @@ pub fn lobed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Mate
     let f_metal = m.albedo + (Vec3::ONE - m.albedo) * fc;
     let f = f_dielectric.lerp(f_metal, m.metallic);
     let g = g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, m.roughness.max(0.05));
-    let mut base = (Vec3::ONE - f) * (1.0 - m.metallic) * m.albedo / PI + d_ggx(n_dot_h, m.roughness) * f * g;
+    let diffuse = (Vec3::ONE - f) * (1.0 - m.metallic) * (1.0 - lobes.transmission) * m.albedo / PI;
+    let mut base = diffuse + d_ggx(n_dot_h, m.roughness) * f * g;
     let sheen_max = lobes.sheen_color.max_element();
     if sheen_max > 0.0 {
         let r = lobes.sheen_roughness;
@@ -193,6 +219,22 @@ pub fn coat_transmittance(n_dot_v: f32, clearcoat: f32) -> f32 {
     1.0 - coat_fresnel(n_dot_v.clamp(0.0, 1.0), clearcoat)
 }
 
+/// What a surface with `lobes` lets through of the light behind it, seen at `n_dot_v`:
+/// transmission × (1 − metallic) × base colour × (1 − F) of the dielectric's Fresnel term,
+/// × 1 − coat·F_coat, × the volume's transmittance — the share its light scatters diffusely
+/// without transmission (zero for none).
+pub fn lobed_transmittance(n_dot_v: f32, m: &Material, lobes: &MaterialLobes) -> Vec3 {
+    if lobes.transmission <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let n_dot_v = n_dot_v.clamp(0.0, 1.0);
+    let fc = (1.0 - n_dot_v).powf(5.0);
+    let f0 = lobes.dielectric_f0();
+    let f_dielectric = lobes.specular * (f0 + (Vec3::ONE - f0) * fc);
+    let through = lobes.transmission * (1.0 - m.metallic) * coat_transmittance(n_dot_v, lobes.clearcoat);
+    (Vec3::ONE - f_dielectric) * m.albedo * lobes.volume_transmittance() * through
+}
+
 /// Linear colour of surface point `p` with unit normal `n` seen from `eye` in the pbr model
 /// with `lobes` and a constant ambient light (no environment): every light, the ambient term
 /// and the light it gives off (`emission`), the last two under the clear coat; an unlit
@@ -212,7 +254,7 @@ pub fn shade_lobed(
     let v = (eye - p).normalize();
     let lo: Vec3 = lights.iter().map(|l| lobed_point_light(l, p, n, v, m, lobes)).sum();
     let under_coat = coat_transmittance(n.dot(v), lobes.clearcoat);
-    m.albedo * ambient * under_coat + lo + emission * under_coat
+    m.albedo * ambient * (1.0 - lobes.transmission) * under_coat + lo + emission * under_coat
 }
 
 #[cfg(test)]
@@ -250,6 +292,29 @@ mod tests {
             let lit = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &m, &lobes);
             assert!((lit - plain).abs().max_element() > 1e-3, "{lobes:?}: {lit} vs {plain}");
         }
+    }
+
+    #[test]
+    fn transmission_takes_the_diffuse_light_and_lets_the_base_colour_through() {
+        let m = Material { albedo: Vec3::new(0.8, 0.5, 0.2), roughness: 0.4, metallic: 0.0 };
+        let v = Vec3::new(-0.4, 0.8, 0.3).normalize();
+        let glass = MaterialLobes { transmission: 1.0, ..Default::default() };
+        // All of the diffuse light goes: what is left is the specular light, as of a black base.
+        let lit = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &m, &glass);
+        let black = Material { albedo: Vec3::ZERO, ..m };
+        let specular = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &black, &MaterialLobes::default());
+        assert!((lit - specular).abs().max_element() < 1e-6, "{lit} vs {specular}");
+        assert_eq!(shade_lobed(Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 3.0, 0.0), (&m, &glass), &[], 0.5, Vec3::ZERO), Vec3::ZERO);
+        // Head on, a dielectric of F₀ 0.04 lets 96 % of the base colour through; a volume of
+        // one attenuation distance tints it once more; a metal or none lets nothing through.
+        assert!(lobed_transmittance(1.0, &m, &glass).abs_diff_eq(0.96 * m.albedo, 1e-6));
+        let tinted = MaterialLobes { attenuation_color: Vec3::new(1.0, 0.5, 0.5), attenuation_distance: 2.0, thickness: 2.0, ..glass };
+        assert!(lobed_transmittance(1.0, &m, &tinted).abs_diff_eq(0.96 * m.albedo * Vec3::new(1.0, 0.5, 0.5), 1e-6));
+        assert!(tinted.any() && glass.vectors()[1][3] == 1.0 && tinted.vectors()[3][1] == 0.5);
+        assert_eq!(lobed_transmittance(1.0, &Material { metallic: 1.0, ..m }, &glass), Vec3::ZERO);
+        assert_eq!(lobed_transmittance(1.0, &m, &MaterialLobes::default()), Vec3::ZERO);
+        // Grazing, Fresnel reflects everything: nothing passes.
+        assert!(lobed_transmittance(0.0, &m, &glass).max_element() < 1e-6);
     }
 
     #[test]

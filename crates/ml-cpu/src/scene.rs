@@ -107,6 +107,13 @@ impl MaterialExtras {
     pub fn masked(&self) -> bool {
         self.alpha_mode.cutoff().is_some()
     }
+
+    /// Whether what lies behind shows through it: BLEND, or a material that transmits light
+    /// (KHR_materials_transmission, whatever its alpha mode). Such surfaces are blended in the
+    /// transparent layers where those are on, and drawn as the other surfaces where not.
+    pub fn transparent(&self) -> bool {
+        self.alpha_mode == AlphaMode::Blend || self.lobes.transmission > 0.0
+    }
 }
 
 /// glTF's alpha modes: what a surface's alpha does to its pixels.
@@ -221,9 +228,10 @@ pub struct DirectionalLight {
 }
 
 impl Scene {
-    /// Whether some object is transparent (glTF `alphaMode: BLEND`).
-    pub fn has_blended_objects(&self) -> bool {
-        self.objects.iter().any(|o| o.extras.alpha_mode == AlphaMode::Blend)
+    /// Whether some object is transparent (`MaterialExtras::transparent`: BLEND or
+    /// transmission).
+    pub fn has_transparent_objects(&self) -> bool {
+        self.objects.iter().any(|o| o.extras.transparent())
     }
 
     /// The built-in `seed` scene (docs/DESIGN.md#the-seed-scene): a 7×7 grid of one object kind at

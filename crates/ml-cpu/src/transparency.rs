@@ -1,12 +1,15 @@
 //! Transparency's per-pixel rule (glTF `alphaMode: BLEND`), the reference every transparent
 //! path is held to: the transparent layers in front of a pixel's opaque surface are blended
-//! over it back to front in linear light, each `colour · α + under · (1 − α)`.
+//! over it back to front in linear light, each `colour · α + under · (1 − α + α · t)`, where
+//! `t` is what a transmitting surface (KHR_materials_transmission) lets through of the light
+//! behind it, per channel (zero for a plain BLEND surface).
 //!
 //! The order is the layers' depth, ties broken by their ids (object and triangle), so the
 //! result does not depend on the order in which the surfaces were listed or drawn. A pixel
 //! keeps at most `keep` layers exactly, the nearest; the farther ones are merged into one
-//! layer behind those, whose coverage is `1 − Π(1 − αᵢ)` (what they cover together) and whose
-//! colour is their α-weighted mean. The merge is order-independent too, exact where it holds
+//! layer behind those, which lets `Π(1 − αᵢ + αᵢ·tᵢ)` of what lies behind through and whose
+//! colour is their weighted mean (weights αᵢ·(1 − the least channel of tᵢ): a layer's share
+//! that does not let light through). The merge is order-independent too, exact where it holds
 //! one layer and an approximation beyond, so a renderer counts the pixels it merged.
 
 use crate::material::Material;
@@ -15,13 +18,27 @@ use crate::scene::{AlphaMode, Object, Scene};
 use glam::{Mat4, Quat, Vec3};
 
 /// One transparent surface in front of a pixel: its depth (nearer is smaller), an id that
-/// orders surfaces at the same depth, its lit colour (linear) and its coverage.
+/// orders surfaces at the same depth, its lit colour (linear), its coverage, and what its
+/// covered share lets through of the light behind (zero: nothing, as BLEND).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Layer {
     pub depth: f32,
     pub id: u32,
     pub color: Vec3,
     pub alpha: f32,
+    pub transmitted: Vec3,
+}
+
+impl Layer {
+    /// A BLEND surface: `color` covering `alpha` of the pixel, letting nothing through.
+    pub fn blended(depth: f32, id: u32, color: Vec3, alpha: f32) -> Layer {
+        Layer { depth, id, color, alpha, transmitted: Vec3::ZERO }
+    }
+
+    /// What it lets through of the light behind: 1 − α + α·t per channel.
+    pub fn transmittance(&self) -> Vec3 {
+        Vec3::splat(1.0 - self.alpha) + self.alpha * self.transmitted
+    }
 }
 
 /// A pixel's colour after its layers, and how many layers were merged (0: exact).
@@ -36,16 +53,21 @@ pub fn over(under: Vec3, color: Vec3, alpha: f32) -> Vec3 {
     color * alpha + under * (1.0 - alpha)
 }
 
-/// The farther layers merged into one (None for none): coverage `1 − Π(1 − αᵢ)`, colour the
-/// α-weighted mean (black where none covers anything).
-fn merge(layers: &[Layer]) -> Option<(Vec3, f32)> {
+/// Layer `l` over `under`.
+fn layer_over(under: Vec3, l: &Layer) -> Vec3 {
+    l.color * l.alpha + under * l.transmittance()
+}
+
+/// The farther layers merged into one (None for none): its colour, the weighted mean of
+/// theirs (black where none covers anything), and what all of them let through.
+fn merge(layers: &[Layer]) -> Option<(Vec3, Vec3)> {
     if layers.is_empty() {
         return None;
     }
-    let uncovered: f32 = layers.iter().map(|l| 1.0 - l.alpha).product();
-    let weight: f32 = layers.iter().map(|l| l.alpha).sum();
+    let through: Vec3 = layers.iter().map(Layer::transmittance).product();
+    let weight: f32 = layers.iter().map(|l| 1.0 - l.transmittance().min_element()).sum();
     let sum: Vec3 = layers.iter().map(|l| l.color * l.alpha).sum();
-    Some((if weight > 0.0 { sum / weight } else { Vec3::ZERO }, 1.0 - uncovered))
+    Some((if weight > 0.0 { sum / weight } else { Vec3::ZERO }, through))
 }
 
 /// `layers` blended over `under` (the opaque surface's colour, or the background), the
@@ -56,11 +78,11 @@ pub fn composite(under: Vec3, layers: &[Layer], keep: usize) -> Composite {
     let split = keep.min(sorted.len());
     let (near, far) = sorted.split_at(split);
     let mut color = under;
-    if let Some((c, a)) = merge(far) {
-        color = over(color, c, a);
+    if let Some((c, through)) = merge(far) {
+        color = c * (Vec3::ONE - through) + color * through;
     }
     for l in near.iter().rev() {
-        color = over(color, l.color, l.alpha);
+        color = layer_over(color, l);
     }
     Composite { color, merged: far.len() }
 }
@@ -122,7 +144,7 @@ mod tests {
     use super::*;
 
     fn layer(depth: f32, id: u32, color: [f32; 3], alpha: f32) -> Layer {
-        Layer { depth, id, color: Vec3::from(color), alpha }
+        Layer::blended(depth, id, Vec3::from(color), alpha)
     }
 
     fn glass() -> [Layer; 3] {
@@ -179,6 +201,23 @@ mod tests {
         assert_eq!(composite(under, &[layer(0.1, 0, [1.0, 1.0, 1.0], 0.0)], 4).color, under);
         let solid = composite(under, &[layer(0.1, 0, [0.9, 0.8, 0.7], 1.0)], 4);
         assert_eq!(solid.color, Vec3::new(0.9, 0.8, 0.7));
+    }
+
+    #[test]
+    fn a_transmitting_layer_tints_what_lies_behind_it() {
+        let wall = Vec3::new(0.8, 0.7, 0.6);
+        let tinted = Layer { transmitted: Vec3::new(0.9, 0.5, 0.0), ..layer(0.2, 1, [0.1, 0.2, 0.3], 1.0) };
+        let c = composite(wall, &[tinted], 4).color;
+        assert!((c - (Vec3::new(0.1, 0.2, 0.3) + wall * Vec3::new(0.9, 0.5, 0.0))).abs().max_element() < 1e-6, "{c}");
+        // Half covered: half of the wall passes untouched, the other half through the tint.
+        let half = Layer { alpha: 0.5, ..tinted };
+        let c = composite(wall, &[half], 4).color;
+        assert!((c - (Vec3::new(0.05, 0.1, 0.15) + wall * Vec3::new(0.95, 0.75, 0.5))).abs().max_element() < 1e-6, "{c}");
+        // Merged, two tints let their product through.
+        let other = Layer { depth: 0.3, id: 2, transmitted: Vec3::new(0.5, 1.0, 1.0), color: Vec3::ZERO, ..tinted };
+        let merged = composite(Vec3::ONE, &[Layer { color: Vec3::ZERO, ..tinted }, other], 0);
+        assert_eq!(merged.merged, 2);
+        assert!((merged.color - Vec3::new(0.45, 0.5, 0.0)).abs().max_element() < 1e-6, "{}", merged.color);
     }
 
     #[test]

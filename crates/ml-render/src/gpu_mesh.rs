@@ -92,7 +92,7 @@ pub const COMPUTE_LAYER_TRIANGLES: u32 = 64;
 
 /// Where `o` is a transparent object, the index of its mesh among `meshes`.
 pub fn layer_mesh(o: &Object, meshes: &SceneMeshes) -> Option<usize> {
-    if o.extras.alpha_mode != ml_cpu::scene::AlphaMode::Blend {
+    if !o.extras.transparent() {
         return None;
     }
     meshes.index_of(o.mesh)

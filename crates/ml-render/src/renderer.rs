@@ -141,7 +141,7 @@ pub trait FrameHook {
 impl<'a> Renderer<'a> {
     pub fn new(ctx: &'a Context, scene: Scene, mut settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
         // Transparency only where there is something transparent.
-        if !scene.has_blended_objects() {
+        if !scene.has_transparent_objects() {
             settings.transparency = None;
         }
         settings.check(ctx, scene.lights.len())?;

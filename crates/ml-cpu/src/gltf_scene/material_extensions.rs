@@ -1,7 +1,9 @@
 //! glTF's PBR material extensions read into `MaterialLobes`: KHR_materials_ior,
-//! KHR_materials_specular, KHR_materials_clearcoat, KHR_materials_sheen and
-//! KHR_materials_unlit — their factors, each checked against its extension's range. Their
-//! textures are not read: the factors apply alone, and the loader says so once per material.
+//! KHR_materials_specular, KHR_materials_clearcoat, KHR_materials_sheen,
+//! KHR_materials_unlit, KHR_materials_transmission and KHR_materials_volume — their factors,
+//! each checked against its extension's range. Their textures are not read: the factors apply
+//! alone, and the loader says so once per material. The volume's thickness is in the mesh's
+//! units; the loader scales it to the world's per object (`MaterialLobes::thickness`).
 
 use super::{GltfError, MaterialName};
 use crate::material_lobes::MaterialLobes;
@@ -9,8 +11,15 @@ use glam::Vec3;
 use serde_json::Value;
 
 /// The extensions this module reads.
-pub(super) const EXTENSIONS: [&str; 5] =
-    ["KHR_materials_ior", "KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit"];
+pub(super) const EXTENSIONS: [&str; 7] = [
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
+    "KHR_materials_unlit",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+];
 
 /// Largest index of refraction we take (diamond is 2.42; 0 means a mirror-like F₀ of 1).
 pub const MAX_IOR: f32 = 100.0;
@@ -48,6 +57,16 @@ pub(super) fn material_lobes(m: &gltf::Material) -> Result<(MaterialLobes, Vec<&
         lobes.sheen_color = read.color(ext, "sheenColorFactor", Vec3::ZERO, 0.0..=1.0)?;
         lobes.sheen_roughness = read.number(ext, "sheenRoughnessFactor", 0.0, 0.0..=1.0)?;
         read.textures(ext, &[("sheenColorTexture", "sheen colour"), ("sheenRoughnessTexture", "sheen roughness")]);
+    }
+    if let Some(ext) = m.extension_value("KHR_materials_transmission") {
+        lobes.transmission = read.number(ext, "transmissionFactor", 0.0, 0.0..=1.0)?;
+        read.textures(ext, &[("transmissionTexture", "transmission")]);
+    }
+    if let Some(ext) = m.extension_value("KHR_materials_volume") {
+        lobes.thickness = read.number(ext, "thicknessFactor", 0.0, 0.0..=f32::MAX)?;
+        lobes.attenuation_distance = read.number(ext, "attenuationDistance", f32::INFINITY, f32::MIN_POSITIVE..=f32::INFINITY)?;
+        lobes.attenuation_color = read.color(ext, "attenuationColor", Vec3::ONE, 0.0..=1.0)?;
+        read.textures(ext, &[("thicknessTexture", "thickness")]);
     }
     lobes.unlit = m.extension_value("KHR_materials_unlit").is_some();
     Ok((lobes, unread))

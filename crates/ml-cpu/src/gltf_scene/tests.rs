@@ -227,12 +227,12 @@ fn optional_extensions_we_do_not_read_are_named_in_a_warning() {
     let mut w = GltfWriter::new();
     let mesh = w.mesh(&[quad()]);
     w.node(json!({ "mesh": mesh }), true);
-    w.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_texture_transform"]);
+    w.json["extensionsUsed"] = json!(["KHR_materials_iridescence", "KHR_texture_transform"]);
     let (_, warnings) = from_bytes(&w.to_glb(), None).unwrap();
-    assert_eq!(warnings, ["extension KHR_materials_transmission is not supported; the file is read without it"]);
-    w.json["extensionsRequired"] = json!(["KHR_materials_transmission"]);
+    assert_eq!(warnings, ["extension KHR_materials_iridescence is not supported; the file is read without it"]);
+    w.json["extensionsRequired"] = json!(["KHR_materials_iridescence"]);
     let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
-    assert!(err.contains("KHR_materials_transmission") && err.contains("does not support"), "{err}");
+    assert!(err.contains("KHR_materials_iridescence") && err.contains("does not support"), "{err}");
 }
 
 /// KHR_texture_transform (translation · rotation · scale, one per material: the base
@@ -308,6 +308,40 @@ fn material_extensions_are_read_into_lobes() {
         ),
         ("KHR_materials_clearcoat", json!({ "clearcoatFactor": 1.5 }), "clearcoatFactor is 1.5; it must be a number in [0, 1]"),
         ("KHR_materials_sheen", json!({ "sheenColorFactor": [1.0, 1.0] }), "sheenColorFactor is [1.0,1.0]"),
+    ] {
+        w.json["materials"][m]["extensions"] = json!({ ext: body });
+        let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
+        assert!(err.contains("material 0") && err.contains(says) && !err.contains('\n'), "{err}");
+    }
+}
+
+/// KHR_materials_transmission and _volume: the factor, the attenuation and the thickness,
+/// scaled from the mesh's units to the world's by the node's scale; the object is transparent
+/// whatever its alpha mode (blended in layers); the textures are named; bad factors refused.
+#[test]
+fn transmission_and_volume_are_read_and_make_the_object_transparent() {
+    let mut w = GltfWriter::new();
+    let m = w.material([0.9, 0.6, 0.3, 1.0], 0.0, 0.2);
+    w.json["materials"][m]["extensions"] = json!({
+        "KHR_materials_transmission": { "transmissionFactor": 0.75, "transmissionTexture": { "index": 0 } },
+        "KHR_materials_volume": { "thicknessFactor": 0.3, "attenuationDistance": 0.5, "attenuationColor": [1.0, 0.5, 0.25] },
+    });
+    w.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_materials_volume"]);
+    let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
+    w.node(json!({ "mesh": mesh, "scale": [2.0, 2.0, 2.0] }), true);
+    let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
+    assert_eq!(warnings, ["material 0: its transmission texture is not read; the factors apply alone"]);
+    let o = &scene.objects[0];
+    let lobes = o.extras.lobes;
+    assert_eq!((lobes.transmission, lobes.attenuation_distance, lobes.attenuation_color), (0.75, 0.5, Vec3::new(1.0, 0.5, 0.25)));
+    assert!((lobes.thickness - 0.6).abs() < 1e-6, "{lobes:?}");
+    // 0.6 / 0.5 = 1.2 attenuation distances: colour^1.2.
+    assert!(lobes.volume_transmittance().abs_diff_eq(Vec3::new(1.0, 0.5f32.powf(1.2), 0.25f32.powf(1.2)), 1e-6));
+    assert!(o.extras.transparent() && o.extras.alpha_mode == AlphaMode::Opaque && scene.has_transparent_objects());
+    for (ext, body, says) in [
+        ("KHR_materials_transmission", json!({ "transmissionFactor": -0.1 }), "transmissionFactor is -0.1; it must be a number in [0, 1]"),
+        ("KHR_materials_volume", json!({ "attenuationDistance": 0.0 }), "attenuationDistance is 0.0"),
+        ("KHR_materials_volume", json!({ "attenuationColor": [1.0, 2.0, 0.0] }), "attenuationColor is [1.0,2.0,0.0]"),
     ] {
         w.json["materials"][m]["extensions"] = json!({ ext: body });
         let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();

@@ -113,7 +113,7 @@ impl MeshRaster {
     /// Whether this pass draws `o`: with transparent layers every opaque object (the layers'
     /// build draws the others in compute); without, every object.
     fn draws(&self, o: &ml_cpu::scene::Object) -> bool {
-        !(self.layers && o.extras.alpha_mode == ml_cpu::scene::AlphaMode::Blend)
+        !(self.layers && o.extras.transparent())
     }
 
     /// A pipeline of this pass: `draw` kind, in `subpass` with `layout`, specialised by

@@ -27,12 +27,14 @@ use ml_cpu::camera::Camera;
 use ml_cpu::gltf_writer::{png, quad as gltf_quad, GltfWriter, PrimitiveData};
 use ml_cpu::gpu_types::PointLight;
 use ml_cpu::material::Material;
+use ml_cpu::material_lobes::{lobed_transmittance, shade_lobed, MaterialLobes};
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{AlphaMode, Object, Scene};
-use ml_cpu::shading::{encode_gamma_unorm8, shade_seed};
+use ml_cpu::shading::{aces_tone_map, encode_gamma_unorm8, shade_seed};
 use ml_cpu::transparency::{composite, Layer};
 use ml_render::{
-    DebugView, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings, TransparencyStats, LAYER_KEEP,
+    Antialiasing, DebugView, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings,
+    TransparencyStats, LAYER_KEEP,
 };
 use ml_vk::{Context, ContextDesc};
 use serde_json::json;
@@ -105,26 +107,57 @@ fn met(scene: &Scene, x: u32, y: u32) -> Vec<usize> {
     (0..scene.objects.len()).filter(|&i| hit(&scene.objects[i], ray).is_some()).collect()
 }
 
-/// The CPU reference image: each surface the ray meets shaded, the glass blended over the wall.
+/// The CPU reference image: each surface the ray meets shaded in the seed model, the glass
+/// blended over the wall.
 fn reference(scene: &Scene) -> Vec<[u8; 3]> {
     let eye = scene.camera.position;
+    reference_with(scene, |o, p| (shade_seed(p, Vec3::Z, eye, &o.material, &scene.lights, scene.ambient), Vec3::ZERO), encode_gamma_unorm8)
+}
+
+/// The CPU reference image: each surface the ray meets shaded by `shade` (its light and what
+/// it lets through at a point), the layers blended over the wall (every one a layer but the
+/// first object), encoded by `encode`.
+fn reference_with(scene: &Scene, shade: impl Fn(&Object, Vec3) -> (Vec3, Vec3), encode: impl Fn(Vec3) -> [u8; 3]) -> Vec<[u8; 3]> {
     let mut out = Vec::new();
     for y in 0..H {
         for x in 0..W {
             let ray = scene.camera.pixel_ray(x, y, W, H);
-            let shade = |o: &Object, t: f32| shade_seed(ray.0 + ray.1 * t, Vec3::Z, eye, &o.material, &scene.lights, scene.ambient);
             let wall = &scene.objects[0];
-            let under = hit(wall, ray).map(|t| shade(wall, t)).expect("the wall fills the view");
+            let under = hit(wall, ray).map(|t| shade(wall, ray.0 + ray.1 * t).0).expect("the wall fills the view");
             let layers: Vec<Layer> = (1..scene.objects.len())
                 .filter_map(|i| {
                     let o = &scene.objects[i];
-                    hit(o, ray).map(|t| Layer { depth: t, id: i as u32, color: shade(o, t), alpha: o.extras.base_alpha })
+                    let alpha = if o.extras.alpha_mode == AlphaMode::Blend { o.extras.base_alpha } else { 1.0 };
+                    hit(o, ray).map(|t| {
+                        let (color, transmitted) = shade(o, ray.0 + ray.1 * t);
+                        Layer { depth: t, id: i as u32, color, alpha, transmitted }
+                    })
                 })
                 .collect();
-            out.push(encode_gamma_unorm8(composite(under, &layers, LAYER_KEEP as usize).color));
+            out.push(encode(composite(under, &layers, LAYER_KEEP as usize).color));
         }
     }
     out
+}
+
+/// How many pixels of `out` differ from `want` by more than MAX_DIFF — each must be an edge
+/// pixel — and by how much the others differ at most.
+fn edge_differences(scene: &Scene, out: &RenderOutput, want: &[[u8; 3]], s: &RenderSettings) -> (usize, u8) {
+    let (mut edges, mut worst) = (0, 0u8);
+    for y in 0..H {
+        for x in 0..W {
+            let (got, w) = (common::pixel(out, x, y), want[(y * W + x) as usize]);
+            let d = diff(got, w);
+            if d > MAX_DIFF {
+                let (technique, raster) = (s.technique.name(), s.raster.name());
+                assert!(edge(scene, x, y), "{technique} ({raster}): pixel ({x}, {y}) is {got:?}, the CPU reference {w:?}");
+                edges += 1;
+            } else {
+                worst = worst.max(d);
+            }
+        }
+    }
+    (edges, worst)
 }
 
 /// Whether pixel (x, y)'s neighbours' rays meet other surfaces than its own.
@@ -159,25 +192,7 @@ fn glass_over_a_wall_equals_the_cpu_blend_in_every_technique() {
     all.push(RenderSettings { raster: Raster::Hardware, ..settings(Technique::Visibility) });
     let outs = common::render_each(&scene, &all);
     for (s, out) in all.iter().zip(&outs) {
-        let (mut edges, mut worst) = (0, 0u8);
-        for y in 0..H {
-            for x in 0..W {
-                let got = common::pixel(out, x, y);
-                let w = want[(y * W + x) as usize];
-                let d = (0..3).map(|c| got[c].abs_diff(w[c])).max().unwrap();
-                if d > MAX_DIFF {
-                    assert!(
-                        edge(&scene, x, y),
-                        "{} ({}): pixel ({x}, {y}) is {got:?}, the CPU blend {w:?}",
-                        s.technique.name(),
-                        s.raster.name()
-                    );
-                    edges += 1;
-                } else {
-                    worst = worst.max(d);
-                }
-            }
-        }
+        let (edges, worst) = edge_differences(&scene, out, &want, s);
         assert!(edges <= MAX_EDGE_PIXELS, "{}: {edges} edge pixels differ", s.technique.name());
         let st = stats(out);
         assert!(!st.overflowed(), "{}: {st:?}", s.technique.name());
@@ -188,6 +203,76 @@ fn glass_over_a_wall_equals_the_cpu_blend_in_every_technique() {
             s.raster.name()
         );
     }
+}
+
+/// The wall and three panes in the pbr model: a transmitting one (OPAQUE, tinted by a volume),
+/// a half-covering transmitting one (BLEND) and a plain BLEND one, overlapping in the middle.
+fn transmitting_glass() -> Scene {
+    let mut scene = scene([0, 1, 2]);
+    let [a, b, c] = &mut scene.objects[1..] else { unreachable!() };
+    a.material = Material { albedo: Vec3::new(0.95, 0.6, 0.3), roughness: 0.3, metallic: 0.0 };
+    a.extras.alpha_mode = AlphaMode::Opaque;
+    a.extras.base_alpha = 0.2; // ignored: OPAQUE
+    a.extras.lobes = MaterialLobes {
+        transmission: 1.0,
+        attenuation_color: Vec3::new(0.6, 0.9, 1.0),
+        attenuation_distance: 0.4,
+        thickness: 0.2,
+        ..Default::default()
+    };
+    b.material.roughness = 0.45;
+    b.extras.lobes = MaterialLobes { transmission: 0.8, ior: 1.7, ..Default::default() };
+    c.extras.base_alpha = 0.35;
+    scene
+}
+
+#[test]
+fn transmitting_glass_tints_what_lies_behind_as_the_cpu_reference_does() {
+    // Each pane's light (its diffuse share given to transmission) and what it lets through
+    // (base colour × (1 − Fresnel) × the volume's transmittance) per pixel, as
+    // ml_cpu::material_lobes has them; blended by ml_cpu::transparency's rule.
+    let scene = transmitting_glass();
+    let eye = scene.camera.position;
+    let want = reference_with(
+        &scene,
+        |o, p| {
+            let lobes = (&o.material, &o.extras.lobes);
+            let lit = shade_lobed(p, Vec3::Z, eye, lobes, &scene.lights, scene.ambient, Vec3::ZERO);
+            (lit, lobed_transmittance((eye - p).normalize().z, &o.material, &o.extras.lobes))
+        },
+        |c| encode_gamma_unorm8(aces_tone_map(c)),
+    );
+    let pbr = |s: RenderSettings| RenderSettings { shading: ShadingModel::Pbr, ..s };
+    let mut all: Vec<RenderSettings> =
+        [Technique::Forward, Technique::ClusteredGpu, Technique::Visibility].map(|t| pbr(settings(t))).into();
+    all.push(RenderSettings { antialiasing: Antialiasing::X8, ..all[2] });
+    let outs = common::render_each(&scene, &all);
+    // Without transmission the panes hide the wall: the test sees what the tint does.
+    let mut opaque = scene.clone();
+    opaque.objects[1].extras.lobes.transmission = 0.0;
+    opaque.objects[2].extras.lobes.transmission = 0.0;
+    let hidden = common::render(opaque, all[0]);
+    let (mut tinted, mut checked) = (0, 0);
+    for (s, out) in all.iter().zip(&outs) {
+        let (edges, worst) = edge_differences(&scene, out, &want, s);
+        if s.technique == Technique::Forward {
+            for (x, y) in (0..H).flat_map(|y| (0..W).map(move |x| (x, y))).filter(|&(x, y)| met(&scene, x, y).contains(&1)) {
+                checked += 1;
+                tinted += usize::from(diff(common::pixel(out, x, y), common::pixel(&hidden, x, y)) > 8);
+            }
+        }
+        // With samples every pixel at a pane's border is a mean over its surfaces (each of them
+        // is an edge pixel, checked above); without, only some may differ.
+        assert!(s.antialiasing != Antialiasing::Off || edges <= MAX_EDGE_PIXELS, "{}: {edges} edge pixels differ", s.technique.name());
+        println!(
+            "{} ({}, {:?}): {edges} edge pixels beyond {MAX_DIFF}/255, others within {worst}/255",
+            s.technique.name(),
+            s.raster.name(),
+            s.antialiasing
+        );
+    }
+    println!("{tinted} of {checked} pixels of the volume-tinted pane differ from it with no transmission");
+    assert!(checked > 2_000 && tinted * 10 > checked * 9, "the wall shows through the transmitting pane: {tinted} of {checked}");
 }
 
 #[test]
@@ -248,17 +333,7 @@ fn a_budget_below_the_depth_complexity_is_reported() {
     let st = stats(&out);
     assert_eq!(st.dropped(), 0, "{st:?}");
     assert!(st.merged_pixels > 100, "{st:?}");
-    let want = reference(&deep);
-    let mut edges = 0;
-    for y in 0..H {
-        for x in 0..W {
-            let (got, w) = (common::pixel(&out, x, y), want[(y * W + x) as usize]);
-            if diff(got, w) > MAX_DIFF {
-                assert!(edge(&deep, x, y), "pixel ({x}, {y}) is {got:?}, the CPU blend {w:?}");
-                edges += 1;
-            }
-        }
-    }
+    let (edges, _) = edge_differences(&deep, &out, &reference(&deep), &s);
     assert!(edges <= MAX_EDGE_PIXELS, "{edges} edge pixels differ");
 }
 
@@ -372,7 +447,7 @@ fn diff(a: [u8; 3], b: [u8; 3]) -> u8 {
 #[test]
 fn foliage_shows_the_background_through_its_holes_and_blends_its_soft_edges_alike_in_every_technique() {
     let scene = foliage(Some("BLEND"));
-    assert!(scene.has_blended_objects());
+    assert!(scene.has_transparent_objects());
     let pbr = |t| RenderSettings { shading: ShadingModel::Pbr, ..settings(t) };
     let mut all: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| pbr(t)).collect();
     all.push(RenderSettings { raster: Raster::Hardware, ..pbr(Technique::Visibility) });
