@@ -169,6 +169,12 @@ def textured_spheres():
     ]
 
 
+# A Khronos glTF sample model: DamagedHelmet (CC BY 4.0, theblueturtle_; see the README beside
+# it), as three.js's glTF exporter writes it: one material with every metallic-roughness
+# texture.
+HELMET = Path(__file__).parent / "fidelity" / "DamagedHelmet.glb"
+
+
 def scenes():
     """Each scene: name, environment maker (None: no environment), objects, camera (eye, target,
     fov_y), directional lights, point and spot lights, whether the environment is the
@@ -181,6 +187,8 @@ def scenes():
     sun = [{"direction": [0.5, -0.8, -0.4], "color": [2.0, 1.9, 1.7]}]
     metal = [dict(one[0], material=material([0.95, 0.64, 0.54], 0.25, 1.0))]
     floor, spots = floor_and_spots()
+    helmet = [{"shape": "model", "file": HELMET, "position": [0.0, 0.0, 0.0], "scale": 1.0}]
+    helmet_view = ([0.6, 0.4, 3.4], [0.0, 0.0, 0.0], 40.0)
     return [
         dict(name="spheres-studio", env=studio, objects=grid, camera=wide),
         dict(name="spheres-sky", env=gradient_sky, objects=grid, camera=wide),
@@ -189,6 +197,8 @@ def scenes():
         dict(name="clearcoat-studio", env=studio, objects=lobe_row([dict(clearcoat=(1.0, 0.05)), dict(clearcoat=(1.0, 0.3)), dict(clearcoat=(0.5, 0.1))]), camera=row),
         dict(name="sheen-studio", env=studio, objects=lobe_row([dict(sheen=([0.9, 0.7, 1.0], 0.3)), dict(sheen=([1.0, 1.0, 1.0], 0.6)), dict(sheen=([0.4, 0.9, 0.5], 0.9))]), camera=row),
         dict(name="textured-spheres-sky", env=gradient_sky, objects=textured_spheres(), camera=row),
+        dict(name="damaged-helmet-studio", env=studio, objects=helmet, camera=helmet_view),
+        dict(name="damaged-helmet-sky", env=gradient_sky, objects=helmet, camera=helmet_view),
         dict(name="glass-studio", env=studio, objects=tinted_glass(), camera=row, background=True),
         dict(name="spots-points-sun", env=None, objects=floor, camera=([0.0, 3.0, 8.5], [0.0, -0.3, 0.0], 45.0), directional=[dict(sun[0], color=[0.5, 0.5, 0.55])], lights=spots),
         dict(name="sky-and-1000-lights", env=gradient_sky, objects=grid, camera=wide, lights=many_lights()),
@@ -293,6 +303,110 @@ def write_ply(path, mesh):
     path.write_bytes(header.encode() + vertices.tobytes() + faces.tobytes())
 
 
+def read_glb(path):
+    """A binary glTF of one material as the path tracer needs it: every drawn triangle in world
+    space (positions, normals, TEXCOORD_0 as one mesh) and the material's factors and images
+    (bytes, by texture name)."""
+    data = path.read_bytes()
+    json_length = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20 : 20 + json_length])
+    blob = data[20 + json_length + 8 :]
+    kinds = {5120: "i1", 5121: "u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
+    widths = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
+
+    def accessor(i):
+        a = doc["accessors"][i]
+        view = doc["bufferViews"][a["bufferView"]]
+        kind, width = np.dtype(kinds[a["componentType"]]), widths[a["type"]]
+        stride = view.get("byteStride", kind.itemsize * width)
+        start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
+        rows = np.lib.stride_tricks.as_strided(
+            np.frombuffer(blob, kind, offset=start, count=(a["count"] - 1) * stride // kind.itemsize + width),
+            (a["count"], width), (stride, kind.itemsize))
+        return np.array(rows, np.float64 if kind.kind == "f" else np.int64)
+
+    if len(doc["materials"]) != 1:
+        sys.exit(f"{path}: the harness reads models of one material")
+    pos, nrm, uv, idx = [], [], [], []
+
+    def walk(node, parent):
+        n = doc["nodes"][node]
+        local = np.array(n["matrix"], float).reshape(4, 4).T if "matrix" in n else np.eye(4)
+        world = parent @ local
+        for prim in doc["meshes"][n["mesh"]]["primitives"] if "mesh" in n else []:
+            at = prim["attributes"]
+            p = accessor(at["POSITION"])
+            base = sum(len(x) for x in pos)
+            pos.append(p @ world[:3, :3].T + world[:3, 3])
+            nrm.append(accessor(at["NORMAL"]) @ np.linalg.inv(world[:3, :3]))
+            uv.append(accessor(at["TEXCOORD_0"]))
+            idx.append(accessor(prim["indices"]).ravel() + base)
+        for child in n.get("children", []):
+            walk(child, world)
+
+    for root in doc["scenes"][doc.get("scene", 0)]["nodes"]:
+        walk(root, np.eye(4))
+    nrm = np.concatenate(nrm)
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    mesh = {"pos": np.concatenate(pos).astype(np.float32), "nrm": nrm.astype(np.float32), "uv": np.concatenate(uv).astype(np.float32),
+            "idx": np.concatenate(idx).astype(np.uint32)}
+    m = doc["materials"][0]
+    pbr = m.get("pbrMetallicRoughness", {})
+
+    def image(ref):
+        view = doc["bufferViews"][doc["images"][doc["textures"][ref["index"]]["source"]]["bufferView"]]
+        return blob[view.get("byteOffset", 0) : view.get("byteOffset", 0) + view["byteLength"]]
+
+    images = {name: image(ref) for name, ref in [("baseColor", pbr.get("baseColorTexture")), ("metallicRoughness", pbr.get("metallicRoughnessTexture")),
+                                                  ("normal", m.get("normalTexture")), ("emissive", m.get("emissiveTexture"))] if ref}
+    factors = {"baseColor": pbr.get("baseColorFactor", [1, 1, 1, 1])[:3], "roughness": pbr.get("roughnessFactor", 1.0),
+               "metallic": pbr.get("metallicFactor", 1.0), "emissive": m.get("emissiveFactor", [0, 0, 0])}
+    return mesh, images, factors
+
+
+def model_shape(path, out):
+    """The path tracer's shape for the glTF model at `path`: its triangles (a PLY file), its
+    material (the principled BSDF on its textures, under its normal map) and its emission.
+    Images go through PIL into files of `out`: roughness and metallic as grey images of their
+    channels; the normal map's green channel turned over (glTF's texture coordinates run down
+    the image, so its +y is towards −v; Mitsuba's frame takes +y along +v)."""
+    mesh, images, factors = read_glb(path)
+    ply = out / f"{path.stem}.ply"
+    write_ply(ply, mesh)
+    files = {}
+    for name, data in images.items():
+        texels = np.array(Image.open(io.BytesIO(data)).convert("RGB"))
+        if name == "metallicRoughness":
+            for channel, role in [(1, "roughness"), (2, "metallic")]:
+                files[role] = out / f"{path.stem}-{role}.png"
+                Image.fromarray(texels[..., channel]).save(files[role])
+            continue
+        if name == "normal":
+            texels[..., 1] = 255 - texels[..., 1]
+        files[name] = out / f"{path.stem}-{name}.png"
+        Image.fromarray(texels).save(files[name])
+
+    def texture(role, factor, raw):
+        bitmap = {"type": "bitmap", "filename": str(files[role]), "raw": raw}
+        return bitmap if np.allclose(factor, 1.0) else {"type": "scale", "scale": factor, "texture": bitmap} if np.isscalar(factor) else sys.exit("a coloured factor over a texture")
+
+    bsdf = {
+        "type": "principled",
+        "base_color": texture("baseColor", factors["baseColor"], False) if "baseColor" in files else {"type": "rgb", "value": factors["baseColor"]},
+        "roughness": texture("roughness", factors["roughness"], True) if "roughness" in files else factors["roughness"],
+        "metallic": texture("metallic", factors["metallic"], True) if "metallic" in files else factors["metallic"],
+        "specular": 0.5,
+    }
+    if "normal" in files:
+        bsdf = {"type": "normalmap", "normalmap": {"type": "bitmap", "filename": str(files["normal"]), "raw": True}, "bsdf": bsdf}
+    shape = {"type": "ply", "filename": str(ply), "bsdf": bsdf}
+    if "emissive" in files:
+        shape["emitter"] = {"type": "area", "radiance": texture("emissive", factors["emissive"], False)}
+    elif max(factors["emissive"]) > 0:
+        shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": factors["emissive"]}}
+    return shape
+
+
 def extended(m):
     """Whether `m` needs a glTF file of its own in manylights (extensions or textures)."""
     return any(k in m for k in ("clearcoat", "sheen", "transmission", "textures"))
@@ -318,8 +432,13 @@ def manylights_scene(path, scene, env_file):
     for d in scene.get("directional", []):
         lines += ["[[lights]]", 'kind = "directional"', f"direction = {d['direction']}", f"color = {d['color']}"]
     for i, o in enumerate(scene["objects"]):
-        m = o["material"]
         place = [f"position = {o['position']}", f"scale = {o['scale']}"]
+        if o["shape"] == "model":
+            copy = path.with_name(o["file"].name)
+            copy.write_bytes(o["file"].read_bytes())
+            lines += ["[[objects]]", f'gltf = "{copy.name}"', *place]
+            continue
+        m = o["material"]
         if o["shape"] == "sphere" and not extended(m):
             inline = f"{{ albedo = {m['albedo']}, roughness = {m['roughness']}, metallic = {m['metallic']} }}"
             lines += ["[[objects]]", 'mesh = "sphere"', *place, f"material = {inline}"]
@@ -387,6 +506,9 @@ def mitsuba_render(scene, env_file, direct, out):
     for i, d in enumerate(scene.get("directional", [])):
         desc[f"sun{i}"] = {"type": "directional", "direction": d["direction"], "irradiance": {"type": "rgb", "value": d["color"]}}
     for i, o in enumerate(scene["objects"]):
+        if o["shape"] == "model":
+            desc[f"object{i}"] = model_shape(o["file"], out)
+            continue
         m = o["material"]
         if "textures" in m:
             texture_files(m, out)

@@ -18,8 +18,8 @@ import numpy as np
 
 
 class RadiusLimitedPath(mi.SamplingIntegrator):
-    """A path tracer (emitter and BSDF sampling with multiple importance) that at every vertex
-    also sums manylights' point and spot lights, each one: colour × (1 − d/r)² × cone², with a
+    """A path tracer (emitter and BSDF sampling with multiple importance; surfaces' emission) that
+    at every vertex also sums manylights' point and spot lights, each one: colour × (1 − d/r)² × cone², with a
     shadow ray (manylights' falloff has no 1/d²; no emitter of Mitsuba's has that falloff).
 
     `direct`: only light that reaches the eye after one non-delta scattering (manylights has
@@ -58,9 +58,12 @@ class RadiusLimitedPath(mi.SamplingIntegrator):
         while active:
             si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
             valid |= (depth == 0) & si.is_valid()
-            # A sampled direction that leaves the scene meets the environment (the eye's own
-            # rays do not: the score is over surfaces).
-            if (depth > 0) & ~si.is_valid():
+            # Light given off by what the ray meets: a surface's own (glTF's emission), or the
+            # environment where a sampled direction leaves the scene (not where the eye's own
+            # rays do: the score is over surfaces).
+            if depth == 0:
+                L += si.emitter(scene).eval(si, si.is_valid())
+            else:
                 ds = mi.DirectionSample3f(scene, si, prev_si)
                 em_pdf = scene.pdf_emitter_direction(prev_si, ds, ~prev_delta)
                 mis = dr.select(prev_delta, 1.0, prev_pdf / dr.maximum(prev_pdf + em_pdf, 1e-30))
