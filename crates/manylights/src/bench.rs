@@ -14,7 +14,6 @@ use ml_cpu::cluster::ClusterDims;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::SceneRequest;
-use ml_render::report::Spread;
 use ml_render::settings::SettingsRequest;
 use ml_render::{Antialiasing, Geometry, Raster, RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
@@ -23,6 +22,7 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 mod probe;
+mod sheet;
 
 /// Each option's help ends with its default: clap's `[default: X]`, or a sentence "Default: …"
 /// where the scene decides it.
@@ -92,6 +92,16 @@ pub struct BenchArgs {
     /// probe.json), made if missing.
     #[arg(long, default_value = "bench-results")]
     out: PathBuf,
+    /// Measure only shard I of N (I from 0) of the sweep's rows (every light count × technique,
+    /// rasteriser and sample count, in the table's order): a block of them, as render's
+    /// --shard splits frames; `env`: a Slurm array task's (SLURM_ARRAY_TASK_ID less
+    /// SLURM_ARRAY_TASK_MIN, of SLURM_ARRAY_TASK_COUNT). Its sheet says which shard it is.
+    #[arg(long, allow_hyphen_values = true)]
+    shard: Option<String>,
+    /// Measure nothing: join the sheets of every shard of one run, in these folders
+    /// (comma-separated), into the sheet of the whole sweep in --out.
+    #[arg(long, allow_hyphen_values = true)]
+    merge: Option<String>,
     /// Instead of the techniques: the compute-vs-fragment probe — one BRDF loop over every
     /// pixel of --resolution as a fragment shader and as a compute shader, --warmup + --frames
     /// rounds per loop length of --probe-lights — and the ratio of their times.
@@ -137,6 +147,7 @@ impl BenchArgs {
         let probe_only = |id| Rule::setting(id, Some(self.probe), "bench without --probe", "--probe");
         let not_probe = |id| Rule::setting(id, Some(!self.probe), "bench --probe", "bench without --probe, which renders the techniques");
         let mut rules: Vec<Rule> = [
+            "shard",
             "techniques",
             "lights",
             "scene",
@@ -361,16 +372,20 @@ fn asked(a: &BenchArgs) -> Result<Asked> {
 }
 
 pub fn bench(a: &mut BenchArgs) -> Result<()> {
+    if let Some(folders) = &a.merge {
+        return merge(a, folders);
+    }
     // Every argument checked before the device is; a CPU driver then gets sizes it can finish.
     asked(a)?;
     let ctx = Context::new(&ContextDesc { validation: a.validation, device_index: a.device, window: None })?;
     let note = fit_to_a_cpu(a, &ctx.info);
     let a = &*a;
     let Asked { choices, counts, resolution, rasters, sample_counts, rules, named, auto } = asked(a)?;
+    let shard = a.shard.as_deref().map(|text| crate::output::parse_shard(text, |name| std::env::var(name).ok())).transpose()?;
     let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Box::new(Plan::new(a, resolution)?)) };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
     // What the run writes, checked before it runs (a bad path must not cost a sweep).
-    let outputs: &[&str] = if a.probe { &PROBE_RESULTS } else { &RESULTS };
+    let outputs: &[&str] = if a.probe { &PROBE_RESULTS } else { &sheet::RESULTS };
     for name in outputs {
         ml_cpu::files::check_writable(&a.out.join(name))?;
     }
@@ -424,36 +439,74 @@ pub fn bench(a: &mut BenchArgs) -> Result<()> {
             }
         }
     }
-    let mut bar = Progress::new((variants.len() * counts.len()) as u64, "");
-    let mut results: Vec<Measured> = Vec::new();
-    for &lights in &counts {
-        for &variant in &variants {
-            bar.set_message(format!("{} at {lights} lights", variant.label()));
-            // A variant the device cannot run at one count it cannot run at any (no scene of
-            // the next count built for it).
-            let refused = results.iter().find_map(|m| m.skipped.as_deref().filter(|s| m.variant == variant && s.starts_with(NOT_MEASURED)));
-            if let Some(why) = refused {
-                let skipped = Some(why.to_owned());
-                results.push(Measured { variant, lights, skipped, output: None, grid: None, ms_per_frame: 0.0 });
-                bar.inc();
-                continue;
-            }
-            // The same variant at the largest smaller count, measured or estimated.
-            let previous = results
-                .iter()
-                .filter(|m| m.variant == variant && m.lights < lights)
-                .map(|m| (m.lights, m.ms_per_frame))
-                .max_by_key(|&(n, _)| n);
-            results.push(measure(&ctx, a, &mut plan, (variant, lights), previous)?);
+    // The sweep's rows, lights outer; a shard measures its block of them.
+    let sweep: Vec<(u64, Variant)> = counts.iter().flat_map(|&lights| variants.iter().map(move |&v| (lights, v))).collect();
+    let rows = crate::output::shard_block(sweep.len() as u64, shard);
+    let mut bar = Progress::new(rows.end - rows.start, "");
+    let mut results: Vec<(usize, Measured)> = Vec::new();
+    for (row, &(lights, variant)) in sweep.iter().enumerate().filter(|(i, _)| rows.contains(&(*i as u64))) {
+        bar.set_message(format!("{} at {lights} lights", variant.label()));
+        // A variant the device cannot run at one count it cannot run at any (no scene of
+        // the next count built for it).
+        let refused =
+            results.iter().find_map(|(_, m)| m.skipped.as_deref().filter(|s| m.variant == variant && s.starts_with(NOT_MEASURED)));
+        if let Some(why) = refused {
+            let skipped = Some(why.to_owned());
+            results.push((row, Measured { variant, lights, skipped, output: None, grid: None, ms_per_frame: 0.0 }));
             bar.inc();
+            continue;
         }
+        // The same variant at the largest smaller count (of this run), measured or estimated.
+        let previous = results
+            .iter()
+            .filter(|(_, m)| m.variant == variant && m.lights < lights)
+            .map(|(_, m)| (m.lights, m.ms_per_frame))
+            .max_by_key(|&(n, _)| n);
+        results.push((row, measure(&ctx, a, &mut plan, (variant, lights), previous)?));
+        bar.inc();
     }
     bar.finish();
     let device = device_json(&ctx);
     drop(ctx);
     let auto = json!({ "technique": auto_technique.name(), "why": auto_why, "probe": probe::times_json(&quick) });
-    write_results(a, resolution, (&device, &auto), &results)?;
+    let skip = a.warmup as usize;
+    let (w, h) = resolution;
+    let mut report = json!({
+        "device": device,
+        "commit": env!("MANYLIGHTS_COMMIT"),
+        "settings": {
+            "scene": a.scene, "objects": a.objects, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
+            "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
+            "raster": a.raster, "raster_split": a.raster_split, "aa": a.aa,
+            "clusters": a.clusters,
+        },
+        "auto": auto,
+        "rows": sweep.len(),
+        "results": results.iter().map(|(row, m)| sheet::row_json(*row, m, skip)).collect::<Vec<_>>(),
+    });
+    if let Some((index, count)) = shard {
+        report["shard"] = json!({ "index": index, "count": count });
+    }
+    sheet::write(&a.out, &report)?;
     check_messages(messages.load(Ordering::SeqCst))
+}
+
+/// `--merge`: the shards' sheets joined into the whole sweep's, in --out; nothing measured, so
+/// no option of the measurement applies.
+fn merge(a: &BenchArgs, folders: &str) -> Result<()> {
+    // Every option of bench but these two is about measuring.
+    let options = <BenchArgs as clap::Args>::augment_args(clap::Command::new("bench"));
+    let measuring = options.get_arguments().map(|o| o.get_id().as_str()).filter(|id| !["merge", "out"].contains(id));
+    if let Some(other) = measuring.into_iter().find(|id| a.given.has(id)) {
+        bail!("--{} does not apply to bench --merge, which joins the shards' sheets and measures nothing", other.replace('_', "-"));
+    }
+    let folders: Vec<PathBuf> = folders.split(',').map(str::trim).filter(|f| !f.is_empty()).map(PathBuf::from).collect();
+    let report = sheet::merge(&folders)?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
+    for name in sheet::RESULTS {
+        ml_cpu::files::check_writable(&a.out.join(name))?;
+    }
+    sheet::write(&a.out, &report)
 }
 
 fn check_messages(count: u32) -> Result<()> {
@@ -556,194 +609,8 @@ fn measure(ctx: &Context, a: &BenchArgs, plan: &mut Plan, (variant, lights): (Va
     Ok(Measured { variant, lights, skipped: None, output: Some(output), grid, ms_per_frame })
 }
 
-fn spread_json(s: &Spread) -> Value {
-    json!({ "median_ms": s.median, "p95_ms": s.p95, "mean_ms": s.mean })
-}
-
-fn write_results(a: &BenchArgs, (w, h): (u32, u32), (device, auto): (&Value, &Value), results: &[Measured]) -> Result<()> {
-    let skip = a.warmup as usize;
-    let mut csv = String::from(
-        "technique,raster,aa,lights,width,height,frames,status,pass,gpu_median_ms,gpu_p95_ms,gpu_mean_ms,cpu_median_ms,cpu_p95_ms,cpu_assign_median_ms,cpu_upload_median_ms,cpu_record_median_ms,cpu_submit_median_ms,clusters,lights_per_cluster_mean,lights_per_cluster_max\n",
-    );
-    let mut rows = Vec::new();
-    for m in results {
-        let (technique, raster) = (m.variant.technique.name(), raster_name(m.variant));
-        let aa = m.variant.antialiasing.name();
-        let head = format!("{technique},{raster},{aa},{},{w},{h},{}", m.lights, a.frames);
-        let Some(out) = &m.output else {
-            let why = m.skipped.clone().unwrap_or_default();
-            csv += &format!("{head},\"{why}\",,,,,,,,,,,,,\n");
-            rows.push(json!({ "technique": technique, "raster": raster, "aa": aa, "lights": m.lights, "status": why }));
-            continue;
-        };
-        let stats = &out.stats;
-        let cpu = stats.cpu_spread(skip);
-        let grid = m.grid.map_or(String::new(), |d| format!("{}x{}x{}", d.x, d.y, d.z));
-        let clusters =
-            stats.clusters.map_or((String::new(), String::new()), |c| (format!("{:.3}", c.mean_lights), c.max_lights.to_string()));
-        let passes = stats.gpu_spread(skip).unwrap_or_default();
-        // Total median and p95, then each phase's median.
-        let cpu_cols = cpu.map_or(",,,,,".to_owned(), |(total, phases)| {
-            let medians: Vec<String> = phases.iter().map(|(_, s)| format!("{:.4}", s.median)).collect();
-            format!("{:.4},{:.4},{}", total.median, total.p95, medians.join(","))
-        });
-        if passes.is_empty() {
-            csv += &format!("{head},measured (no GPU timestamps),,,,,{cpu_cols},{grid},{},{}\n", clusters.0, clusters.1);
-        }
-        for (pass, s) in &passes {
-            csv += &format!(
-                "{head},measured,{pass},{:.4},{:.4},{:.4},{cpu_cols},{grid},{},{}\n",
-                s.median, s.p95, s.mean, clusters.0, clusters.1
-            );
-        }
-        rows.push(json!({
-            "technique": technique,
-            "raster": raster,
-            "aa": aa,
-            "lights": m.lights,
-            "status": "measured",
-            "passes": passes.iter().map(|(n, s)| json!({ "pass": n, "gpu": spread_json(s) })).collect::<Vec<_>>(),
-            "cpu": cpu.as_ref().map(|(total, phases)| {
-                let mut j = json!({ "total": spread_json(total) });
-                for (name, s) in phases {
-                    j[*name] = spread_json(s);
-                }
-                j
-            }),
-            "clusters": m.grid.map(|d| [d.x, d.y, d.z]),
-            "lights_per_cluster": stats.clusters.map(|c| json!({ "mean": c.mean_lights, "max": c.max_lights })),
-        }));
-    }
-    let report = json!({
-        "device": device,
-        "commit": env!("MANYLIGHTS_COMMIT"),
-        "settings": {
-            "scene": a.scene, "objects": a.objects, "resolution": [w, h], "frames": a.frames, "warmup": a.warmup,
-            "budget_s": a.budget_s, "shading": a.shading, "techniques": a.techniques, "lights": a.lights,
-            "raster": a.raster, "raster_split": a.raster_split, "aa": a.aa,
-            "clusters": a.clusters,
-        },
-        "auto": auto,
-        "results": rows,
-    });
-    // Always a plot, empty (and saying why) where nothing was measured.
-    let series = frame_times(results, skip);
-    let (size, rgb) = plot(&series, (w, h)).map_err(|e| anyhow::anyhow!("cannot draw results.png: {e}"))?;
-    let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
-    let [csv_path, json_path, png_path] = RESULTS.map(|name| a.out.join(name));
-    let png = ml_cpu::files::png_bytes(&png_path, &rgba, size)?;
-    let json = serde_json::to_string_pretty(&report).expect("plain JSON values");
-    // The three replace an earlier run's together, or none does.
-    ml_cpu::files::write_all_replacing(&[(csv_path, csv.as_bytes()), (json_path, json.as_bytes()), (png_path, &png)])?;
-    print!("{csv}");
-    Ok(())
-}
-
-/// What a bench run writes in its folder, and a probe run.
-const RESULTS: [&str; 3] = ["results.csv", "results.json", "results.png"];
+/// What a probe run writes in its folder.
 pub const PROBE_RESULTS: [&str; 2] = ["probe.csv", "probe.json"];
-
-/// The raster column: the visibility technique's rasteriser, empty for the others.
-fn raster_name(v: Variant) -> &'static str {
-    if v.technique.geometry() == Geometry::Meshlets {
-        v.raster.name()
-    } else {
-        ""
-    }
-}
-
-/// Per variant, (lights, GPU ms per frame: the pass medians summed) of each measured count.
-fn frame_times(results: &[Measured], skip: usize) -> Vec<(Variant, Vec<(f64, f64)>)> {
-    let mut series: Vec<(Variant, Vec<(f64, f64)>)> = Vec::new();
-    for m in results {
-        let Some(passes) = m.output.as_ref().and_then(|o| o.stats.gpu_spread(skip)) else { continue };
-        let ms: f64 = passes.iter().map(|(_, s)| s.median).sum();
-        match series.iter_mut().find(|(v, _)| *v == m.variant) {
-            Some((_, points)) => points.push((m.lights as f64, ms)),
-            None => series.push((m.variant, vec![(m.lights as f64, ms)])),
-        }
-    }
-    series
-}
-
-/// results.png: GPU ms per frame against lights, log-log, a line per technique (the text in
-/// egui's embedded Ubuntu font: no system fonts needed).
-/// The frame-time plot: its size and RGB8 pixels (written by the caller, which replaces the
-/// previous plot only with a complete one).
-type Plot = ((u32, u32), Vec<u8>);
-
-fn plot(series: &[(Variant, Vec<(f64, f64)>)], (w, h): (u32, u32)) -> Result<Plot, Box<dyn std::error::Error>> {
-    use plotters::prelude::*;
-    static FONT: std::sync::Once = std::sync::Once::new();
-    FONT.call_once(|| {
-        // Fails only for a broken font file, which egui's is not; text would then be missing.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
-    });
-    let points = series.iter().flat_map(|(_, p)| p.iter());
-    let measured = points.clone().count() > 0;
-    // Nothing measured: the axes of 1k–1M lights and 0.1–100 ms, empty.
-    let (x0, x1) = if measured { points.clone().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.0), hi.max(p.0))) } else { (1e3, 1e6) };
-    let (y0, y1) = if measured { points.fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1))) } else { (0.1, 100.0) };
-    // Whole decades, so that the log axes have labels.
-    let decades =
-        |lo: f64, hi: f64| (10f64.powf(lo.log10().floor()), 10f64.powf(hi.log10().ceil()).max(10f64.powf(lo.log10().floor() + 1.0)));
-    let ((x0, x1), (y0, y1)) = (decades(x0, x1), decades(y0, y1));
-    const SIZE: (u32, u32) = (960, 600);
-    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            if measured {
-                format!("GPU ms per frame at {w}x{h} (median)")
-            } else {
-                format!("GPU ms per frame at {w}x{h}: nothing measured (results.csv says why)")
-            },
-            ("sans-serif", 24),
-        )
-        .margin(16)
-        // Room for the last decade's label, which is centred on the right edge.
-        .margin_right(48)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc("lights")
-        .y_desc("GPU ms per frame")
-        .x_label_formatter(&|v| count_label(*v))
-        .y_label_formatter(&|v| format!("{v}"))
-        .draw()?;
-    for (variant, points) in series {
-        // A variant keeps its colour in every plot, whichever others are in it.
-        let index = Technique::ALL.iter().position(|t| *t == variant.technique).unwrap_or(0);
-        let colour = Palette99::pick(if variant.raster == Raster::Hardware { index } else { Technique::ALL.len() + index }).to_rgba();
-        chart
-            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
-            .label(variant.label())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
-        chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
-    root.present()?;
-    drop(chart);
-    drop(root);
-    Ok((SIZE, rgb))
-}
-
-/// 1000 → 1k, 1000000 → 1M (axis labels).
-fn count_label(v: f64) -> String {
-    match v {
-        v if v >= 1e6 => format!("{}M", v / 1e6),
-        v if v >= 1e3 => format!("{}k", v / 1e3),
-        v => format!("{v:.0}"),
-    }
-}
 
 #[cfg(test)]
 mod tests {
@@ -751,7 +618,7 @@ mod tests {
 
     #[test]
     fn axis_labels_are_short() {
-        assert_eq!([10.0, 1000.0, 16000.0, 1e6].map(count_label), ["10", "1k", "16k", "1M"]);
+        assert_eq!([10.0, 1000.0, 16000.0, 1e6].map(sheet::count_label), ["10", "1k", "16k", "1M"]);
     }
 
     #[test]

@@ -54,7 +54,12 @@ pub fn shard_choice(shard: Option<&str>, resume: bool, sequence: bool, env: impl
     if !sequence && (shard.is_some() || resume) {
         bail!("--shard and --resume are for an image sequence: give --out a run of # (e.g. frames/####.png)");
     }
-    let Some(text) = shard else { return Ok(None) };
+    shard.map(|text| parse_shard(text, env)).transpose()
+}
+
+/// A `--shard` value (I/N, or env: a Slurm array task's, its variables read through `env`) as
+/// (I, N), checked.
+pub fn parse_shard(text: &str, env: impl Fn(&str) -> Option<String>) -> Result<(u32, u32)> {
     let (index, count) = if text == "env" {
         let var = |name: &str| {
             env(name).map(|v| v.trim().parse::<u64>().map_err(|_| anyhow::anyhow!("--shard env: {name}='{v}' is not a whole number")))
@@ -77,7 +82,15 @@ pub fn shard_choice(shard: Option<&str>, resume: bool, sequence: bool, env: impl
     if count == 0 || count > 100_000 || index >= count {
         bail!("--shard {index}/{count}: the shard is one of 1 to 100000, numbered from 0");
     }
-    Ok(Some((index as u32, count as u32)))
+    Ok((index as u32, count as u32))
+}
+
+/// Shard (I, N)'s block of `items` in order: ⌊items·I/N⌋ up to ⌊items·(I+1)/N⌋ (all of them
+/// without a shard). The blocks of 0 to N − 1 cover every item once.
+pub fn shard_block(items: u64, shard: Option<(u32, u32)>) -> std::ops::Range<u64> {
+    let (index, count) = shard.unwrap_or((0, 1));
+    let bound = |k: u32| items * u64::from(k) / u64::from(count);
+    bound(index)..bound(index + 1)
 }
 
 /// The frames a run writes, ascending: of `frames`, shard (I, N)'s ⌊F·I/N⌋ up to
@@ -85,10 +98,8 @@ pub fn shard_choice(shard: Option<&str>, resume: bool, sequence: bool, env: impl
 /// whose files exist (`--resume`) — regular files: anything else at a frame's path stays to
 /// be written, and `prepare` refuses it.
 pub fn frames_to_write(frames: u32, shard: Option<(u32, u32)>, existing: Option<&SequencePattern>) -> Vec<u32> {
-    let (index, count) = shard.unwrap_or((0, 1));
-    let bound = |k: u32| (u64::from(frames) * u64::from(k) / u64::from(count)) as u32;
     let written = |p: &SequencePattern, i: u32| std::fs::symlink_metadata(sequence_path(p, i)).is_ok_and(|m| m.is_file());
-    (bound(index)..bound(index + 1)).filter(|&i| existing.is_none_or(|p| !written(p, i))).collect()
+    shard_block(u64::from(frames), shard).map(|i| i as u32).filter(|&i| existing.is_none_or(|p| !written(p, i))).collect()
 }
 
 /// An image as it is written: `rgba` (`size`) filtered down by `k` each axis where

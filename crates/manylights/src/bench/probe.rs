@@ -3,7 +3,8 @@
 //! their ratio — written to probe.csv and probe.json, with what `--technique auto` makes of
 //! the longest loop measured.
 
-use super::{spread_json, BenchArgs};
+use super::sheet::spread_json;
+use super::BenchArgs;
 use anyhow::{bail, Result};
 use ml_render::stage_probe::{pick_lighting_path, StageProbe, StageTimes};
 use ml_vk::Context;

@@ -2,7 +2,8 @@
 //! (visibility with both rasterisers) × 2 light counts, 64×64, 5 frames — on lavapipe with
 //! validation writes results.csv and results.json with every column and a row per pass and the
 //! results.png plot, and a combination over the time budget is skipped with its reason instead
-//! of run.
+//! of run. A sweep in shards (one through Slurm's variables) joined by `--merge` is the
+//! sheet of the whole sweep.
 
 use std::process::Command;
 
@@ -99,6 +100,72 @@ fn a_tiny_bench_writes_its_tables() {
     assert!(rows[0].contains("one frame measured") && rows[1].contains("one frame measured"), "{csv}");
     assert!(rows[2].starts_with("forward,,off,1000000,") && rows[2].contains("scaled from 64 lights"), "{csv}");
     assert!(rows[3].contains("skipped: one frame would take about") && rows[3].contains("scaled from 64 lights"), "{csv}");
+}
+
+/// Two shards of a 4-row sweep (2 counts × 2 techniques), the second as Slurm's array task 1
+/// of 2 (`--shard env`), each measuring its block; `--merge` writes the whole sweep's sheet:
+/// the rows in the sweep's order, the table the shards' tables end to end; a missing, repeated
+/// or foreign shard is refused in one line.
+#[test]
+fn shards_measure_their_block_and_merge_into_the_whole_sheet() {
+    let dir = std::env::temp_dir().join(format!("manylights-bench-shards-{}", std::process::id()));
+    let folder = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let sweep = ["bench", "--techniques", "forward,clustered-gpu", "--lights", "64,1k", "--resolution", "32x32", "--frames", "2"];
+    let run = |shard: &str, out: &str, slurm: Option<&str>| {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_manylights"));
+        command.args(sweep).args(["--warmup", "0", "--aa", "off", "--shard", shard, "--out", out]);
+        command.env_remove("SLURM_ARRAY_TASK_MIN");
+        if let Some(task) = slurm {
+            command.env("SLURM_ARRAY_TASK_ID", task).env("SLURM_ARRAY_TASK_COUNT", "2");
+        }
+        let output = command.output().unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    };
+    run("0/2", &folder("a"), None);
+    run("env", &folder("b"), Some("1"));
+    let sheet = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(name).join("results.json")).unwrap()).unwrap()
+    };
+    let rows_of = |s: &serde_json::Value| -> Vec<(u64, String, u64)> {
+        s["results"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| (r["row"].as_u64().unwrap(), r["technique"].as_str().unwrap().to_owned(), r["lights"].as_u64().unwrap()))
+            .collect()
+    };
+    let (a, b) = (sheet("a"), sheet("b"));
+    assert_eq!((a["shard"]["index"].as_u64(), b["shard"]["index"].as_u64(), a["rows"].as_u64()), (Some(0), Some(1), Some(4)), "{a}\n{b}");
+    assert_eq!(rows_of(&a), [(0, "forward".to_owned(), 64), (1, "clustered-gpu".to_owned(), 64)]);
+    assert_eq!(rows_of(&b), [(2, "forward".to_owned(), 1000), (3, "clustered-gpu".to_owned(), 1000)]);
+    let merge = |folders: &str, extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_manylights"))
+            .args(["bench", "--merge", folders, "--out", &folder("whole")])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let merged = merge(&format!("{},{}", folder("b"), folder("a")), &[]);
+    assert!(merged.status.success(), "{}", String::from_utf8_lossy(&merged.stderr));
+    let whole = sheet("whole");
+    assert!(whole.get("shard").is_none() && whole["rows"] == 4, "{whole}");
+    assert_eq!(rows_of(&whole), [rows_of(&a), rows_of(&b)].concat());
+    let table = |name: &str| std::fs::read_to_string(dir.join(name).join("results.csv")).unwrap();
+    let (ta, tb) = (table("a"), table("b"));
+    let header = ta.lines().next().unwrap();
+    assert_eq!(table("whole"), format!("{header}\n{}{}", &ta[header.len() + 1..], &tb[header.len() + 1..]));
+    assert!(image::open(dir.join("whole").join("results.png")).is_ok());
+    for (folders, extra, says) in [
+        (folder("a"), &[][..], "shard 1 of 2 is missing"),
+        (format!("{},{}", folder("a"), folder("a")), &[][..], "shard 0 of 2 is given twice"),
+        (format!("{},{}", folder("a"), folder("b")), &["--frames", "3"][..], "--frames does not apply to bench --merge"),
+        (folder("nothing"), &[][..], "--merge: cannot read"),
+    ] {
+        let refused = merge(&folders, extra);
+        let stderr = String::from_utf8_lossy(&refused.stderr);
+        assert!(!refused.status.success() && stderr.contains(says) && stderr.trim().lines().count() == 1, "{stderr}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
