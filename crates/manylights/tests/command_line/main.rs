@@ -10,4 +10,5 @@ mod environment;
 mod first_hour;
 mod import_circles;
 mod outputs;
+mod slurm;
 mod viewer;
