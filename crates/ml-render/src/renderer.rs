@@ -70,7 +70,12 @@ pub struct Renderer<'a> {
     /// The states of the named resources the frame slots share (`sync::SCENE_WIDE`), from
     /// frame to frame across the slots.
     shared_sync: sync::SyncStates,
-    readback: Option<Buffer>,
+    /// Per frame slot, host memory its colour target is copied into: by the frame's own commands
+    /// for an image sequence (`in_flight_image`), or after it (`read_back`).
+    readbacks: Vec<Buffer>,
+    /// Per slot, the sequence frame whose image its commands copy into its read-back buffer,
+    /// handed to the sink once the slot's fence has signalled.
+    in_flight_image: Vec<Option<u32>>,
     /// The scene's lights at rest as the GPU reads them: shadowed ones marked with their
     /// shadow slots (`OmniShadows::mark`).
     lights: Vec<PointLight>,
@@ -175,7 +180,8 @@ impl<'a> Renderer<'a> {
             command_pool: vk::CommandPool::null(),
             frames: Vec::new(),
             shared_sync,
-            readback: None,
+            readbacks: Vec::new(),
+            in_flight_image: vec![None; FRAMES_IN_FLIGHT],
             lights_on_gpu,
             reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
             pending: vec![false; FRAMES_IN_FLIGHT],
@@ -289,9 +295,10 @@ impl<'a> Renderer<'a> {
         self.frames.clear();
         self.pending.fill(false);
         self.reports.fill(SlotReport::default());
-        if let Some(mut b) = self.readback.take() {
+        for mut b in self.readbacks.drain(..) {
             b.destroy(ctx);
         }
+        self.in_flight_image.fill(None);
         Ok(())
     }
 
@@ -352,8 +359,10 @@ impl<'a> Renderer<'a> {
         }
         self.projection_changed()?;
         let bytes = extent.width as u64 * extent.height as u64 * 4;
-        self.readback =
-            Some(Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?);
+        for _ in 0..FRAMES_IN_FLIGHT {
+            let buffer = Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?;
+            self.readbacks.push(buffer);
+        }
         Ok(())
     }
 
@@ -425,23 +434,34 @@ impl<'a> Renderer<'a> {
         if range.is_empty() {
             return Err(RenderError::Invalid(format!("no frames to render in {range:?}")));
         }
+        let meters = self.settings.meters_exposure();
         for i in range.clone() {
             last = i as usize % FRAMES_IN_FLIGHT;
             // Exposed from the image of the slot's previous frame (two back), whether or not
-            // the frame before was waited for (an image sequence waits for each): the same
-            // EVs, so the same images, either way.
+            // the frame before was waited for: the same EVs, so the same images, either way.
             self.collect(last, &mut stats)?;
+            self.hand_over(last..last + 1, sink)?;
             self.adapt_exposure(1.0, last);
-            self.run_frame(last, self.settings.clock(i), &mut stats, None)?;
-            if i == 0 && frames > 1 && self.settings.meters_exposure() {
-                // The first frame settles its exposure as the last does: a sequence does not
-                // start dark, and later frames meter a settled image (two back). A sequence
-                // and a plain render do the same, so their last images stay equal.
+            // The first frame settles its exposure as the last does: a sequence does not start
+            // dark, and later frames meter a settled image (two back). A sequence and a plain
+            // render do the same, so their last images stay equal.
+            let settles = meters && ((i == 0 && frames > 1) || i + 1 == frames);
+            let wanted = sink.wants_images() && sink.wants_image(i);
+            // A sequence's image is copied by the frame's own commands and handed over when
+            // its slot next comes round, unless the frame settles its exposure first.
+            let mut copy = (wanted && !settles).then(|| CopyToHost { buffer: self.readbacks[last].raw, extent: self.extent });
+            self.run_frame(last, self.settings.clock(i), &mut stats, copy.as_mut().map(|c| c as &mut dyn FrameHook))?;
+            if copy.is_some() {
+                self.in_flight_image[last] = Some(i);
+            }
+            if i == 0 && frames > 1 && meters {
                 self.collect_all(&mut stats)?;
+                self.hand_over(0..FRAMES_IN_FLIGHT, sink)?;
                 last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
             }
-            if sink.wants_images() && sink.wants_image(i) {
+            if wanted && settles {
                 self.collect_all(&mut stats)?;
+                self.hand_over(0..FRAMES_IN_FLIGHT, sink)?;
                 // The last image is the one `render` returns: with its exposure settled.
                 if i + 1 == frames {
                     last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
@@ -452,6 +472,7 @@ impl<'a> Renderer<'a> {
             sink.submitted(i);
         }
         self.collect_all(&mut stats)?;
+        self.hand_over(0..FRAMES_IN_FLIGHT, sink)?;
         if !sink.wants_images() {
             // (An image sequence settled its last frame before handing it over.)
             last = self.settle_exposure(last, self.settings.clock(range.end - 1), &mut stats)?;
@@ -813,10 +834,41 @@ impl<'a> Renderer<'a> {
     fn read_back(&mut self, f: usize) -> Result<Vec<u8>, VkError> {
         let ctx = self.ctx;
         let image = self.frames[f].targets.as_ref().expect("made with the frame").color.raw;
-        let buffer = self.readback.as_ref().expect("created with the renderer");
+        let buffer = &self.readbacks[f];
         let extent = self.extent;
         commands::one_shot(ctx, |cmd| commands::copy_colour_to_host(ctx, cmd, image, extent, buffer.raw))?;
         Ok(buffer.mapped().to_vec())
+    }
+
+    /// Hand the sink the images the slots' own commands copied (in frame order), each once its
+    /// slot was collected.
+    fn hand_over(&mut self, slots: std::ops::Range<usize>, sink: &mut dyn FrameSink) -> Result<(), RenderError> {
+        let mut ready: Vec<(u32, usize)> =
+            slots.filter(|&f| !self.pending[f]).filter_map(|f| Some((self.in_flight_image[f].take()?, f))).collect();
+        ready.sort_unstable();
+        for (i, f) in ready {
+            sink.image(i, self.readbacks[f].mapped().to_vec())?;
+        }
+        Ok(())
+    }
+}
+
+/// Records the copy of a sequence frame's colour target into its slot's read-back buffer at the
+/// end of the frame's own commands: the GPU goes on with the next frame while the host takes
+/// this one's bytes.
+struct CopyToHost {
+    buffer: vk::Buffer,
+    extent: vk::Extent2D,
+}
+
+impl FrameHook for CopyToHost {
+    fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer, colour: &Image) -> Result<(), VkError> {
+        commands::copy_colour_to_host(ctx, cmd, colour.raw, self.extent, self.buffer);
+        Ok(())
+    }
+
+    fn semaphores(&self) -> (Option<(vk::Semaphore, vk::PipelineStageFlags)>, Option<vk::Semaphore>) {
+        (None, None)
     }
 }
 
@@ -834,7 +886,7 @@ impl Drop for Renderer<'_> {
         for frame in &mut self.frames {
             frame.destroy(ctx);
         }
-        if let Some(mut b) = self.readback.take() {
+        for mut b in self.readbacks.drain(..) {
             b.destroy(ctx);
         }
         for p in &mut self.passes {
