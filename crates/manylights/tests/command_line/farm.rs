@@ -1,9 +1,14 @@
-//! Sequences on a real scheduler (docs/farm.md): a single-machine Slurm cluster — Debian's
-//! slurm-wlm and munge, which `scripts/setup.sh tests` installs — started in a temporary
-//! folder as the user running the tests (its own munge key and socket, its own ports), runs
-//! docs/farm/sequence.sh as a job array of 4 tasks. Every task renders its block of the frames
-//! and the sequence equals the one a single process renders, byte for byte; the script farm.md
-//! shows is the file the test runs.
+//! Sequences on a render farm (docs/farm.md), each rendered in shards and equal, byte for byte,
+//! to the sequence one process renders:
+//! - on a real scheduler: a single-machine Slurm cluster — Debian's slurm-wlm and munge, which
+//!   `scripts/setup.sh tests` installs — started in a temporary folder as the user running the
+//!   tests (its own munge key and socket, its own ports), runs docs/farm/sequence.sh as a job
+//!   array of 4 tasks; every task renders its block of the frames;
+//! - docs/farm/indexed-job.yaml's container command, run once per completion index with the
+//!   variables Kubernetes gives each pod (no Kubernetes runs here: this checks the manifest's
+//!   command and its use of the index, not a cluster).
+//!
+//! What farm.md shows of the two is what the files hold.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -31,6 +36,35 @@ fn program(name: &str) -> PathBuf {
         .flatten()
         .or_else(|| ["/usr/sbin", "/usr/bin"].map(|d| Path::new(d).join(name)).into_iter().find(|f| f.is_file()))
         .unwrap_or_else(|| panic!("{name} is missing: the tests need slurm-wlm and munge (bash scripts/setup.sh tests installs them)"))
+}
+
+/// The sequence the tests render in shards: 8 frames, small.
+const SEQUENCE: [&str; 14] =
+    ["--scene", "seed", "--technique", "forward", "--lights", "64", "--width", "64", "--height", "36", "--frames", "8", "--exposure", "0"];
+
+fn docs(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs").join(name)
+}
+
+fn farm_md() -> String {
+    std::fs::read_to_string(docs("farm.md")).unwrap()
+}
+
+/// PATH with the manylights under test first (the scripts call `manylights`).
+fn path_with_manylights() -> std::ffi::OsString {
+    let binary = Path::new(env!("CARGO_BIN_EXE_manylights"));
+    let rest: Vec<PathBuf> = std::env::split_paths(&std::env::var_os("PATH").unwrap_or_default()).collect();
+    std::env::join_paths(std::iter::once(binary.parent().unwrap().to_path_buf()).chain(rest)).unwrap()
+}
+
+/// The frames in `sharded` are SEQUENCE's frames as one process renders them (into `whole`).
+fn assert_one_process_frames(sharded: &Path, whole: &Path) {
+    run(Command::new(env!("CARGO_BIN_EXE_manylights")).arg("render").args(SEQUENCE).arg("--out").arg(whole.join("####.png")));
+    for frame in 0..8 {
+        let name = format!("{frame:04}.png");
+        let (a, b) = (std::fs::read(sharded.join(&name)).unwrap(), std::fs::read(whole.join(&name)).unwrap());
+        assert!(a == b, "frame {frame} differs between the shards and one process");
+    }
 }
 
 fn run(command: &mut Command) -> Output {
@@ -107,58 +141,55 @@ fn a_slurm_job_array_renders_the_sequence_one_process_renders() {
         std::thread::sleep(Duration::from_millis(200));
     }
 
-    let binary = Path::new(env!("CARGO_BIN_EXE_manylights"));
-    let path = std::env::join_paths(
-        std::iter::once(binary.parent().unwrap().to_path_buf()).chain(std::env::split_paths(&std::env::var_os("PATH").unwrap_or_default())),
-    )
-    .unwrap();
-    let sequence = [
-        "--scene",
-        "seed",
-        "--technique",
-        "forward",
-        "--lights",
-        "64",
-        "--width",
-        "64",
-        "--height",
-        "36",
-        "--frames",
-        "8",
-        "--exposure",
-        "0",
-    ];
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/farm/sequence.sh");
-    let farm = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/farm.md")).unwrap();
-    let body: String = std::fs::read_to_string(&script)
-        .unwrap()
-        .lines()
-        .filter(|l| l.starts_with("#SBATCH") || l.starts_with("exec"))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    assert!(farm.contains(&body), "docs/farm.md does not show the script it names:\n{body}");
+    let script = docs("farm/sequence.sh");
+    let lines = std::fs::read_to_string(&script).unwrap();
+    let body: String = lines.lines().filter(|l| l.starts_with("#SBATCH") || l.starts_with("exec")).map(|l| format!("{l}\n")).collect();
+    assert!(farm_md().contains(&body), "docs/farm.md does not show the script it names:\n{body}");
     run(Command::new(program("sbatch"))
         .arg("--wait")
         .arg(format!("--output={}/task-%a.out", dir.display()))
         .arg(&script)
-        .args(sequence)
+        .args(SEQUENCE)
         .arg("--out")
         .arg(dir.join("frames/####.png"))
         .env("SLURM_CONF", &conf)
-        .env("PATH", &path));
+        .env("PATH", path_with_manylights()));
     // Each task rendered its block: two of the eight frames.
     for task in 0..4 {
         let log = std::fs::read_to_string(file(&format!("task-{task}.out"))).unwrap();
         assert!(log.contains("2 frames written"), "task {task}: {log}");
     }
-    // One process, the whole sequence: the same bytes, frame for frame.
-    run(Command::new(binary).arg("render").args(sequence).arg("--out").arg(dir.join("whole/####.png")));
-    for frame in 0..8 {
-        let name = format!("{frame:04}.png");
-        let (sharded, whole) =
-            (std::fs::read(dir.join("frames").join(&name)).unwrap(), std::fs::read(dir.join("whole").join(&name)).unwrap());
-        assert!(sharded == whole, "frame {frame} differs between the job array and one process");
-    }
+    assert_one_process_frames(&dir.join("frames"), &dir.join("whole"));
     drop(cluster);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_indexed_jobs_pods_render_the_sequence_one_process_renders() {
+    let manifest = std::fs::read_to_string(docs("farm/indexed-job.yaml")).unwrap();
+    // The manifest's lines this test reads: the completions, the container's command and args
+    // (YAML flow lists of JSON strings).
+    let line =
+        |key: &str| manifest.lines().map(str::trim).find_map(|l| l.strip_prefix(key)).unwrap_or_else(|| panic!("no {key} in the manifest"));
+    let completions: u32 = line("completions:").trim().parse().unwrap();
+    let command: Vec<String> = serde_json::from_str(line("command:")).unwrap();
+    let args: Vec<String> = serde_json::from_str(line("args:")).unwrap();
+    assert!(args[0].contains(&format!("--shard $SHARD/{completions}")), "the command's shard count is not the Job's completions: {args:?}");
+    let index = "fieldPath: \"metadata.annotations['batch.kubernetes.io/job-completion-index']\"";
+    for shown in [line("command:"), line("args:"), index] {
+        assert!(manifest.contains(shown) && farm_md().contains(shown), "docs/farm.md does not show the manifest's {shown}");
+    }
+    let dir = std::env::temp_dir().join(format!("manylights-indexed-job-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let render_args = format!("{} --out {}/pods/####.png", SEQUENCE.join(" "), dir.display());
+    for pod in 0..completions {
+        run(Command::new(&command[0])
+            .args(&command[1..])
+            .args(&args)
+            .env("SHARD", pod.to_string())
+            .env("RENDER_ARGS", &render_args)
+            .env("PATH", path_with_manylights()));
+    }
+    assert_one_process_frames(&dir.join("pods"), &dir.join("whole"));
     std::fs::remove_dir_all(&dir).ok();
 }
