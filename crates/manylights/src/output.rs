@@ -126,8 +126,10 @@ pub struct FrameWriter {
 struct Writing {
     pending: usize,
     written: u32,
-    /// Encoding and writing, summed over the threads.
-    busy: Duration,
+    /// Encoding (with the filtering down of a supersampled image) and writing, each summed
+    /// over the threads.
+    encoding: Duration,
+    writing: Duration,
     failure: Option<String>,
 }
 
@@ -136,8 +138,10 @@ struct Writing {
 pub struct WritingStats {
     pub frames: u32,
     pub threads: usize,
-    /// Encoding and writing a frame, mean over the frames (on one thread).
-    pub ms_per_frame: f64,
+    /// Encoding a frame (PNG, and filtering down where supersampled) and writing it, means over
+    /// the frames (on one thread).
+    pub encode_ms_per_frame: f64,
+    pub write_ms_per_frame: f64,
     /// From the first frame handed over to the last written.
     pub wall_ms: f64,
     /// What the renderer waited for a free place in all.
@@ -170,10 +174,13 @@ impl FrameWriter {
         rayon::spawn(move || {
             let begun = Instant::now();
             let (image, size) = filtered_down(rgba, size, supersample);
-            let result = files::write_png(&path, &image, size);
+            let encoded = files::png_bytes(&path, &image, size);
+            let written = Instant::now();
+            let result = encoded.and_then(|png| files::write_bytes_replacing(&path, &png));
             let (lock, freed) = &*state;
             let mut w = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-            w.busy += begun.elapsed();
+            w.encoding += written - begun;
+            w.writing += written.elapsed();
             w.pending -= 1;
             w.written += 1;
             if let Err(e) = result {
@@ -194,7 +201,8 @@ impl FrameWriter {
         Ok(WritingStats {
             frames: w.written,
             threads: rayon::current_num_threads(),
-            ms_per_frame: w.busy.as_secs_f64() * 1e3 / f64::from(w.written.max(1)),
+            encode_ms_per_frame: w.encoding.as_secs_f64() * 1e3 / f64::from(w.written.max(1)),
+            write_ms_per_frame: w.writing.as_secs_f64() * 1e3 / f64::from(w.written.max(1)),
             wall_ms: self.started.elapsed().as_secs_f64() * 1e3,
             waited_ms: self.waited.as_secs_f64() * 1e3,
         })

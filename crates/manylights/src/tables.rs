@@ -186,11 +186,17 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
     rows.push(("wall ms/frame", format!("{:.3}", stats.wall_ms_per_frame())));
     if let Some(w) = facts.sequence {
         let per_second = f64::from(w.frames) / (w.wall_ms / 1e3).max(1e-9);
+        let (taken, taken_ms) = stats.read_back;
         rows.push((
             "sequence",
             format!(
-                "{} frames written, {per_second:.1} a second; encoding and writing {:.1} ms a frame on {} threads, the renderer waited {:.0} ms for them in all",
-                w.frames, w.ms_per_frame, w.threads, w.waited_ms
+                "{} frames written, {per_second:.1} a second; a frame: read back {:.2} ms (render thread), encoded {:.1} ms and written {:.1} ms on {} threads; the renderer waited {:.0} ms for the writers in all",
+                w.frames,
+                taken_ms / f64::from(taken.max(1)),
+                w.encode_ms_per_frame,
+                w.write_ms_per_frame,
+                w.threads,
+                w.waited_ms
             ),
         ));
     }

@@ -440,7 +440,7 @@ impl<'a> Renderer<'a> {
             // Exposed from the image of the slot's previous frame (two back), whether or not
             // the frame before was waited for: the same EVs, so the same images, either way.
             self.collect(last, &mut stats)?;
-            self.hand_over(last..last + 1, sink)?;
+            self.hand_over(last..last + 1, sink, &mut stats)?;
             self.adapt_exposure(1.0, last);
             // The first frame settles its exposure as the last does: a sequence does not start
             // dark, and later frames meter a settled image (two back). A sequence and a plain
@@ -456,23 +456,26 @@ impl<'a> Renderer<'a> {
             }
             if i == 0 && frames > 1 && meters {
                 self.collect_all(&mut stats)?;
-                self.hand_over(0..FRAMES_IN_FLIGHT, sink)?;
+                self.hand_over(0..FRAMES_IN_FLIGHT, sink, &mut stats)?;
                 last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
             }
             if wanted && settles {
                 self.collect_all(&mut stats)?;
-                self.hand_over(0..FRAMES_IN_FLIGHT, sink)?;
+                self.hand_over(0..FRAMES_IN_FLIGHT, sink, &mut stats)?;
                 // The last image is the one `render` returns: with its exposure settled.
                 if i + 1 == frames {
                     last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
                 }
+                let taken = Instant::now();
                 let rgba = self.read_back(last)?;
+                stats.read_back.0 += 1;
+                stats.read_back.1 += taken.elapsed().as_secs_f64() * 1e3;
                 sink.image(i, rgba)?;
             }
             sink.submitted(i);
         }
         self.collect_all(&mut stats)?;
-        self.hand_over(0..FRAMES_IN_FLIGHT, sink)?;
+        self.hand_over(0..FRAMES_IN_FLIGHT, sink, &mut stats)?;
         if !sink.wants_images() {
             // (An image sequence settled its last frame before handing it over.)
             last = self.settle_exposure(last, self.settings.clock(range.end - 1), &mut stats)?;
@@ -842,12 +845,16 @@ impl<'a> Renderer<'a> {
 
     /// Hand the sink the images the slots' own commands copied (in frame order), each once its
     /// slot was collected.
-    fn hand_over(&mut self, slots: std::ops::Range<usize>, sink: &mut dyn FrameSink) -> Result<(), RenderError> {
+    fn hand_over(&mut self, slots: std::ops::Range<usize>, sink: &mut dyn FrameSink, stats: &mut FrameStats) -> Result<(), RenderError> {
         let mut ready: Vec<(u32, usize)> =
             slots.filter(|&f| !self.pending[f]).filter_map(|f| Some((self.in_flight_image[f].take()?, f))).collect();
         ready.sort_unstable();
         for (i, f) in ready {
-            sink.image(i, self.readbacks[f].mapped().to_vec())?;
+            let taken = Instant::now();
+            let rgba = self.readbacks[f].mapped().to_vec();
+            stats.read_back.0 += 1;
+            stats.read_back.1 += taken.elapsed().as_secs_f64() * 1e3;
+            sink.image(i, rgba)?;
         }
         Ok(())
     }

@@ -41,6 +41,9 @@ pub struct FrameStats {
     pub exposure_repeats: u32,
     /// What the renderer had allocated when the last frame finished.
     pub memory: Option<ml_vk::context::MemoryUse>,
+    /// An image sequence's frames taken out of host-visible memory for the sink: their count
+    /// and the render thread's milliseconds for it in all.
+    pub read_back: (u32, f64),
 }
 
 /// Mean GPU milliseconds per pass (None when the device has no timestamps).
@@ -62,6 +65,7 @@ impl FrameStats {
             exposure_ev: None,
             exposure_repeats: 0,
             memory: None,
+            read_back: (0, 0.0),
         }
     }
 

@@ -202,6 +202,10 @@ fn shards_and_reruns_write_the_frames_the_whole_sequence_writes() {
         for i in shards {
             let table = render(exposure, &parts, &["--shard", &format!("{i}/3")]);
             assert!(table.contains("2 frames written"), "shard {i}/3: {table}");
+            // Where a frame's time goes besides the GPU.
+            for part in ["read back", "encoded", "ms and written", "the renderer waited"] {
+                assert!(table.lines().any(|l| l.starts_with("sequence") && l.contains(part)), "shard {i}/3: no '{part}': {table}");
+            }
         }
         let (a, b) = (frames(&whole), frames(&parts));
         for i in 0..6 {
