@@ -1,6 +1,13 @@
 //! Shared harness for image tests: a validated context, render → read back, compare.
-//! Validation (with synchronization validation) is always on; any message fails the test,
-//! including those the layer reports while the device and instance are destroyed.
+//! Validation (with synchronization validation) is always on; any message fails the test.
+//!
+//! The renders of `render` and `render_each` share validated contexts (`pooled_context`):
+//! on lavapipe making a context, and every pipeline a renderer makes on it, costs time that
+//! a context kept between tests saves (its pipeline cache serves the next test). After each
+//! use the context must hold no pipeline and no memory (what a renderer leaked there fails
+//! that test); what else it may leak the layer reports when the pooled contexts are destroyed
+//! as the test binary exits, which then exits with an error. Tests that need a context of
+//! their own (a device's destruction, counts of pipelines made) make one.
 
 #![allow(dead_code)] // each test binary uses part of the harness
 
@@ -10,6 +17,7 @@ use ml_cpu::scene::Scene;
 use ml_render::{RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
+use std::sync::{Mutex, Once};
 
 pub fn settings(width: u32, height: u32) -> RenderSettings {
     RenderSettings::new(Technique::Forward, width, height)
@@ -27,9 +35,7 @@ pub fn render_each(scene: &Scene, settings: &[RenderSettings]) -> Vec<RenderOutp
 
 /// `render_each`, and the name of the driver that rendered (Vulkan's `driverName`).
 pub fn render_each_on_driver(scene: &Scene, settings: &[RenderSettings]) -> (Vec<RenderOutput>, String) {
-    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() })
-        .expect("a Vulkan device with the validation layer (CI installs lavapipe and vulkan-validationlayers)");
-    let counter = ctx.validation_counter();
+    let ctx = pooled_context();
     let outputs = settings
         .iter()
         .map(|s| {
@@ -38,9 +44,75 @@ pub fn render_each_on_driver(scene: &Scene, settings: &[RenderSettings]) -> (Vec
         })
         .collect();
     let driver = ctx.info.driver_name.clone();
-    drop(ctx);
-    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
     (outputs, driver)
+}
+
+/// Validated contexts between uses.
+static POOL: Mutex<Vec<Context>> = Mutex::new(Vec::new());
+
+/// A validated context of the pool's (made where none is free), given back when dropped after
+/// the checks above: no validation message while it was used, no pipeline held and no memory
+/// allocated any more. A test that panics drops its context instead.
+pub struct PooledContext {
+    ctx: Option<Context>,
+    messages: u32,
+}
+
+pub fn pooled_context() -> PooledContext {
+    let ctx = POOL.lock().unwrap_or_else(|e| e.into_inner()).pop().unwrap_or_else(|| {
+        Context::new(&ContextDesc { validation: true, ..Default::default() })
+            .expect("a Vulkan device with the validation layer (CI installs lavapipe and vulkan-validationlayers)")
+    });
+    // Registered once a context exists: handlers run in the reverse of their registration,
+    // so this one runs before the static destructors of the layer and driver loaded for it.
+    static EXIT_CHECK: Once = Once::new();
+    EXIT_CHECK.call_once(|| {
+        // SAFETY: registers a plain function to run at exit.
+        unsafe { libc::atexit(destroy_pool) };
+    });
+    let messages = ctx.validation_counter().load(Ordering::SeqCst);
+    PooledContext { ctx: Some(ctx), messages }
+}
+
+impl std::ops::Deref for PooledContext {
+    type Target = Context;
+    fn deref(&self) -> &Context {
+        self.ctx.as_ref().expect("held until dropped")
+    }
+}
+
+impl Drop for PooledContext {
+    fn drop(&mut self) {
+        let ctx = self.ctx.take().expect("held until dropped");
+        if std::thread::panicking() {
+            return;
+        }
+        let messages = ctx.validation_counter().load(Ordering::SeqCst) - self.messages;
+        let (_, held) = ctx.pipeline_counts();
+        let allocations = ctx.memory_use().allocations;
+        if messages > 0 || held > 0 || allocations > 0 {
+            drop(ctx);
+            panic!("{messages} validation messages (printed above); {held} pipelines still held; {allocations} allocations left");
+        }
+        POOL.lock().unwrap_or_else(|e| e.into_inner()).push(ctx);
+    }
+}
+
+/// At exit: destroy the pooled contexts, and exit with an error where the layer reported
+/// anything as they went (objects left alive on a device are reported at its destruction).
+extern "C" fn destroy_pool() {
+    let contexts = std::mem::take(&mut *POOL.lock().unwrap_or_else(|e| e.into_inner()));
+    for ctx in contexts {
+        let counter = ctx.validation_counter();
+        let before = counter.load(Ordering::SeqCst);
+        drop(ctx);
+        let reported = counter.load(Ordering::SeqCst) - before;
+        if reported > 0 {
+            eprintln!("error: the validation layer reported {reported} messages (above) as a pooled test context was destroyed");
+            // SAFETY: ends the process at once (exit's handlers are running).
+            unsafe { libc::_exit(1) };
+        }
+    }
 }
 
 /// Largest per-channel difference between two images of the same size, and how many
