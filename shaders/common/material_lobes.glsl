@@ -75,9 +75,9 @@ float max3(vec3 c) {
 
 // One point light in the pbr model with lobes (zero beyond the radius and behind the
 // surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic), Lambert
-// diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX; the sheen's lobe over the base scaled by
-// 1 − max(sheen)·E at the view and the light; the clear coat's GGX lobe (F₀ 0.04) over the
-// base scaled by 1 − coat·F_coat. Its first lines are cook_torrance_point_light's (seed_brdf.glsl),
+// diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX; the sheen's lobe over
+// the base scaled by 1 − max(sheen)·E at the view and the light; the clear coat's GGX lobe
+// (F₀ 0.04) over the base scaled by 1 − coat·F_coat. Its first lines are cook_torrance_point_light's (seed_brdf.glsl),
 // repeated: a shared helper returning the cosines in a struct made the seed's forward pass 1.44×
 // slower on the H100.
 vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, vec4 specular,
@@ -133,10 +133,10 @@ vec3 lobed_transmittance(vec3 n, vec3 v, vec3 albedo, float metallic, vec4 specu
 }
 
 // Environment light with lobes (environment.glsl's split sum): the specular term's F₀ and F₉₀
-// from the dielectric's F₀ and specular factor, the diffuse less what is transmitted; the sheen's lobe as E(n·v)·sheen colour times
-// the radiance prefiltered at its roughness about the normal, the base scaled by
-// 1 − max(sheen)·E; the clear coat's split sum at its roughness over the base scaled by
-// 1 − coat·F_coat.
+// from the dielectric's F₀ and specular factor, the diffuse less what is transmitted; the
+// sheen's lobe as E(n·v)·sheen colour times the radiance prefiltered at its roughness about
+// the normal, the base scaled by 1 − max(sheen)·E; the clear coat's split sum at its
+// roughness over the base scaled by 1 − coat·F_coat.
 vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion, vec4 specular, vec4 coat,
                              vec4 sheen) {
     mat3 to_image = environment_to_image();
