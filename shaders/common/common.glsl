@@ -139,7 +139,7 @@ struct ObjectData {
     vec4 material;         // x: metallic, y: occlusion strength, z: normal scale (glTF)
     vec4 emissive;         // rgb: emissive factor (glTF)
     vec4 alpha;            // x: the alpha below which a point is cut out (OBJECT_MASKED); y: the
-                           // base colour factor's alpha (alpha_mask.glsl)
+                           // base colour factor's alpha, 1 for OPAQUE (alpha_mask.glsl)
     uvec4 alpha_texture;   // x: OBJECT_* bits; y: its alpha texture's first byte in the
                            // alpha-mask buffer; z, w: that texture's width, height
     vec4 uv_transform[2];  // texture coordinates as the textures see them: uv' = M·uv + t,

@@ -185,7 +185,7 @@ gpu_struct!(
         /// rgb: emissive factor.
         emissive: [f32; 4],
         /// x: the alpha below which a point is dropped (`OBJECT_MASKED`); y: the base colour
-        /// factor's alpha.
+        /// factor's alpha (1 for OPAQUE, whose alpha is ignored).
         alpha: [f32; 4],
         /// x: `OBJECT_*` bits; y: where its alpha texture's texel (0, 0) is in the alpha-mask
         /// buffer (bytes); z, w: its width and height (`alpha_mask::AlphaMasks`).

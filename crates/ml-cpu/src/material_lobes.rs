@@ -182,9 +182,9 @@ pub fn sheen_albedo(n_dot_v: f32, roughness: f32) -> f32 {
 
 /// One point light's contribution in the pbr model with `lobes` (zero beyond its radius and
 /// behind the surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic),
-/// Lambert diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX specular; the sheen's lobe with
-/// the base scaled by 1 − max(sheen)·E at the view and the light; the clear coat's GGX lobe
-/// (F₀ 0.04) over the base scaled by 1 − coat·F_coat.
+/// Lambert diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX specular; the
+/// sheen's lobe with the base scaled by 1 − max(sheen)·E at the view and the light; the clear
+/// coat's GGX lobe (F₀ 0.04) over the base scaled by 1 − coat·F_coat.
 pub fn lobed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material, lobes: &MaterialLobes) -> Vec3 {
     let Some(LightAt { n_dot_v, n_dot_l, n_dot_h, radiance }) = light_at(light, p, n, v) else { return Vec3::ZERO };
     let fc = (1.0 - n_dot_v).powf(5.0);

@@ -511,7 +511,17 @@ fn gltf_object(
     let base = base.ok_or(Problem::NoFolder)?;
     let (position, scale) = placement(o)?;
     let place = glam::Mat4::from_scale_rotation_translation(Vec3::splat(scale), glam::Quat::IDENTITY, position);
-    let placed = |unplaced: &[Object]| unplaced.iter().map(|obj| Object { transform: place * obj.transform, ..*obj }).collect();
+    // A volume's thickness (world units) scales with the placement, as the geometry does.
+    let placed = |unplaced: &[Object]| {
+        unplaced
+            .iter()
+            .map(|obj| {
+                let mut extras = obj.extras;
+                extras.lobes.thickness *= scale;
+                Object { transform: place * obj.transform, extras, ..*obj }
+            })
+            .collect()
+    };
     if let Some(unplaced) = loaded.get(gltf) {
         return Ok((placed(unplaced), Vec::new()));
     }

@@ -143,6 +143,7 @@ fn gltf_objects_bring_their_meshes_placed_by_the_scene_file() {
     std::fs::create_dir_all(dir.join("models")).unwrap();
     let mut w = GltfWriter::new();
     let m = w.material([0.5, 0.25, 1.0, 1.0], 0.0, 0.5);
+    w.json["materials"][m]["extensions"] = serde_json::json!({ "KHR_materials_volume": { "thicknessFactor": 0.25 } });
     let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
     w.node(serde_json::json!({ "mesh": mesh, "translation": [0.0, 1.0, 0.0] }), true);
     std::fs::write(dir.join("models/quad.glb"), w.to_glb()).unwrap();
@@ -159,6 +160,8 @@ fn gltf_objects_bring_their_meshes_placed_by_the_scene_file() {
     // The glTF node's (0, 1, 0), scaled by 2 and moved by 10 in x.
     assert!((s.objects[1].position() - Vec3::new(10.0, 2.0, 0.0)).length() < 1e-5, "{}", s.objects[1].position());
     assert!((s.objects[2].position() - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-5);
+    // A volume's thickness scales with its placement, as its geometry does.
+    assert_eq!((s.objects[1].extras.lobes.thickness, s.objects[2].extras.lobes.thickness), (0.5, 0.25));
     // 800 placements (a 12 MB model placed so used to hold 800 copies): one mesh, 800 objects.
     let many: String = (0..800).map(|i| format!("[[objects]]\ngltf = \"models/quad.glb\"\nposition = [{i}.0, 0.0, 0.0]\n")).collect();
     std::fs::write(dir.join("many.toml"), many).unwrap();
