@@ -96,6 +96,7 @@ pub struct BenchArgs {
     /// rasteriser and sample count, in the table's order): a block of them, as render's
     /// --shard splits frames; `env`: a Slurm array task's (SLURM_ARRAY_TASK_ID less
     /// SLURM_ARRAY_TASK_MIN, of SLURM_ARRAY_TASK_COUNT). Its sheet says which shard it is.
+    /// Default: the whole sweep.
     #[arg(long, allow_hyphen_values = true)]
     shard: Option<String>,
     /// Measure nothing: join the sheets of every shard of one run, in these folders
