@@ -439,12 +439,11 @@ def manylights_scene(path, scene, env_file):
             lines += ["[[objects]]", f'gltf = "{copy.name}"', *place]
             continue
         m = o["material"]
-        if o["shape"] == "sphere" and not extended(m):
+        # Plain spheres and the floor are manylights' own meshes (sphere, plane).
+        built_in = {"sphere": "sphere", "floor": "plane"}.get(o["shape"])
+        if built_in and not extended(m):
             inline = f"{{ albedo = {m['albedo']}, roughness = {m['roughness']}, metallic = {m['metallic']} }}"
-            lines += ["[[objects]]", 'mesh = "sphere"', *place, f"material = {inline}"]
-        elif o["shape"] == "floor":
-            inline = f"{{ albedo = {m['albedo']}, roughness = {m['roughness']}, metallic = {m['metallic']} }}"
-            lines += ["[[objects]]", 'mesh = "plane"', *place, f"material = {inline}"]
+            lines += ["[[objects]]", f'mesh = "{built_in}"', *place, f"material = {inline}"]
         else:
             glb = path.with_name(f"{path.stem}-{i}.glb")
             write_glb(glb, uv_sphere() if o["shape"] == "sphere" else pane(), m)

@@ -132,9 +132,15 @@ def charlie_d(n_dot_h, roughness):
     return (2.0 + inv) * dr.power(sin2, 0.5 * inv) / (2.0 * math.pi)
 
 
-def charlie_lambda(cos_theta, alpha):
+def charlie_fit(alpha):
+    """The coefficients (a, b, c, d, e) of Estevez and Kulla's fit of the Charlie sheen's Λ,
+    a / (1 + b·x^c) + d·x + e, at α."""
     t = (1.0 - alpha) ** 2
-    a, b, c, d, e = (u + (v - u) * t for u, v in [(21.5473, 25.3245), (3.82987, 3.32435), (0.19823, 0.16801), (-1.97760, -1.27393), (-4.32054, -4.85967)])
+    return tuple(u + (v - u) * t for u, v in [(21.5473, 25.3245), (3.82987, 3.32435), (0.19823, 0.16801), (-1.97760, -1.27393), (-4.32054, -4.85967)])
+
+
+def charlie_lambda(cos_theta, alpha):
+    a, b, c, d, e = charlie_fit(alpha)
     fit = lambda x: a / (1.0 + b * dr.power(x, c)) + d * x + e
     return dr.select(cos_theta < 0.5, dr.exp(fit(cos_theta)), dr.exp(2.0 * fit(0.5) - fit(1.0 - cos_theta)))
 
@@ -149,9 +155,7 @@ def sheen_albedo_table(roughness, size=64, steps=256):
     directional albedo, integrated over the hemisphere (numpy, midpoint rule)."""
     r = max(roughness, 0.07)
     inv = 1.0 / (r * r)
-    alpha = r * r
-    t = (1.0 - alpha) ** 2
-    a, b, c, d, e = (u + (v - u) * t for u, v in [(21.5473, 25.3245), (3.82987, 3.32435), (0.19823, 0.16801), (-1.97760, -1.27393), (-4.32054, -4.85967)])
+    a, b, c, d, e = charlie_fit(r * r)
 
     def lam(x):
         fit = lambda y: a / (1.0 + b * np.power(y, c)) + d * y + e
@@ -171,6 +175,13 @@ def sheen_albedo_table(roughness, size=64, steps=256):
         vv = np.clip(1.0 / ((1.0 + lam(n_dot_v) + lam(cl)) * (4.0 * n_dot_v * cl)), 0, 1)
         table.append(min((dd * vv * cl).mean() * 2 * math.pi, 1.0))
     return table
+
+
+def ggx_d_vis(n_dot_h, n_dot_l, n_dot_v, roughness):
+    """GGX's D times Smith's height-correlated visibility V = G / (4 n·l n·v), α = roughness²."""
+    a2 = max(roughness**2, 1e-4) ** 2
+    d = a2 / (math.pi * dr.square(n_dot_h * n_dot_h * (a2 - 1.0) + 1.0))
+    return d * 0.5 / (n_dot_l * dr.sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2) + n_dot_v * dr.sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2))
 
 
 class GltfBSDF(mi.BSDF):
@@ -213,24 +224,19 @@ class GltfBSDF(mi.BSDF):
         active &= (n_dot_v > 0.0) & (n_dot_l > 0.0)
         h = dr.normalize(wi + wo)
         n_dot_h, v_dot_h = mi.Frame3f.cos_theta(h), dr.dot(wi, h)
-        a2 = max(self.roughness**2, 1e-4) ** 2
-        d = a2 / (math.pi * dr.square(n_dot_h * n_dot_h * (a2 - 1.0) + 1.0))
-        vis = 0.5 / (n_dot_l * dr.sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2) + n_dot_v * dr.sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2))
+        d_vis = ggx_d_vis(n_dot_h, n_dot_l, n_dot_v, self.roughness)
         fc = dr.power(1.0 - dr.abs(v_dot_h), 5.0)
         albedo = mi.Color3f(self.albedo)
         f_dielectric = 0.04 + 0.96 * fc
         f_metal = albedo + (1.0 - albedo) * fc
-        dielectric = (1.0 - f_dielectric) * albedo / math.pi + f_dielectric * d * vis
-        base = dr.lerp(dielectric, f_metal * d * vis, self.metallic)
+        dielectric = (1.0 - f_dielectric) * albedo / math.pi + f_dielectric * d_vis
+        base = dr.lerp(dielectric, f_metal * d_vis, self.metallic)
         if self.sheen_max > 0.0:
             scale = dr.minimum(1.0 - self.sheen_max * self.sheen_albedo(n_dot_v), 1.0 - self.sheen_max * self.sheen_albedo(n_dot_l))
             base = base * scale + mi.Color3f(self.sheen) * charlie_d(n_dot_h, self.sheen_roughness) * charlie_v(n_dot_l, n_dot_v, self.sheen_roughness)
         if self.coat > 0.0:
-            c2 = max(self.coat_roughness**2, 1e-4) ** 2
-            dc = c2 / (math.pi * dr.square(n_dot_h * n_dot_h * (c2 - 1.0) + 1.0))
-            vc = 0.5 / (n_dot_l * dr.sqrt(n_dot_v * n_dot_v * (1.0 - c2) + c2) + n_dot_v * dr.sqrt(n_dot_l * n_dot_l * (1.0 - c2) + c2))
             fr = self.coat * (0.04 + 0.96 * dr.power(1.0 - n_dot_v, 5.0))
-            base = base * (1.0 - fr) + fr * dc * vc
+            base = base * (1.0 - fr) + fr * ggx_d_vis(n_dot_h, n_dot_l, n_dot_v, self.coat_roughness)
         return dr.select(active, base * n_dot_l, 0.0)
 
     def density(self, si, wo, active):

@@ -73,6 +73,12 @@ float max3(vec3 c) {
     return max(max(c.r, c.g), c.b);
 }
 
+// A dielectric's Fresnel reflectance at Schlick's weight `fc` = (1 − n·v)⁵: its F₀ and
+// specular factor (`specular`) applied.
+vec3 dielectric_fresnel(vec4 specular, float fc) {
+    return specular.a * (specular.rgb + (1.0 - specular.rgb) * fc);
+}
+
 // One point light in the pbr model with lobes (zero beyond the radius and behind the
 // surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic), Lambert
 // diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX; the sheen's lobe over
@@ -99,7 +105,7 @@ vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 al
     float atten = clamp(1.0 - dist / radius, 0.0, 1.0);
     float radiance = atten * atten * n_dot_l;
     float fc = pow(1.0 - n_dot_v, 5.0);
-    vec3 f_dielectric = specular.a * (specular.rgb + (1.0 - specular.rgb) * fc);
+    vec3 f_dielectric = dielectric_fresnel(specular, fc);
     vec3 f_metal = albedo + (1.0 - albedo) * fc;
     vec3 f = mix(f_dielectric, f_metal, metallic);
     float g = g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, roughness));
@@ -127,8 +133,7 @@ float coat_transmittance(vec3 n, vec3 v, vec4 coat) {
 // term × 1 − coat·F_coat × the volume's transmittance `volume` (ml_cpu lobed_transmittance).
 vec3 lobed_transmittance(vec3 n, vec3 v, vec3 albedo, float metallic, vec4 specular, vec4 coat, vec3 volume) {
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
-    float fc = pow(1.0 - n_dot_v, 5.0);
-    vec3 f_dielectric = specular.a * (specular.rgb + (1.0 - specular.rgb) * fc);
+    vec3 f_dielectric = dielectric_fresnel(specular, pow(1.0 - n_dot_v, 5.0));
     return (1.0 - f_dielectric) * albedo * volume * (coat.w * (1.0 - metallic) * (1.0 - coat_fresnel(n_dot_v, coat.x)));
 }
 

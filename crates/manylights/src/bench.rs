@@ -384,12 +384,8 @@ pub fn bench(a: &mut BenchArgs) -> Result<()> {
     let Asked { choices, counts, resolution, rasters, sample_counts, rules, named, auto } = asked(a)?;
     let shard = a.shard.as_deref().map(|text| crate::output::parse_shard(text, |name| std::env::var(name).ok())).transpose()?;
     let work = if a.probe { Work::Probe(probe_lengths(&a.probe_lights)?) } else { Work::Techniques(Box::new(Plan::new(a, resolution)?)) };
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
     // What the run writes, checked before it runs (a bad path must not cost a sweep).
-    let outputs: &[&str] = if a.probe { &PROBE_RESULTS } else { &sheet::RESULTS };
-    for name in outputs {
-        ml_cpu::files::check_writable(&a.out.join(name))?;
-    }
+    prepare_folder(&a.out, if a.probe { &PROBE_RESULTS } else { &sheet::RESULTS })?;
     if let Some(note) = note {
         eprintln!("{note}");
     }
@@ -503,11 +499,14 @@ fn merge(a: &BenchArgs, folders: &str) -> Result<()> {
     }
     let folders: Vec<PathBuf> = folders.split(',').map(str::trim).filter(|f| !f.is_empty()).map(PathBuf::from).collect();
     let report = sheet::merge(&folders)?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot make folder '{}'", a.out.display()))?;
-    for name in sheet::RESULTS {
-        ml_cpu::files::check_writable(&a.out.join(name))?;
-    }
+    prepare_folder(&a.out, &sheet::RESULTS)?;
     sheet::write(&a.out, &report)
+}
+
+/// Make folder `out` if missing and check that the files `names` in it can be written.
+fn prepare_folder(out: &std::path::Path, names: &[&str]) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot make folder '{}'", out.display()))?;
+    names.iter().try_for_each(|name| Ok(ml_cpu::files::check_writable(&out.join(name))?))
 }
 
 fn check_messages(count: u32) -> Result<()> {

@@ -79,6 +79,13 @@ impl MaterialLobes {
         (r * r * self.specular_color).min(Vec3::ONE)
     }
 
+    /// A dielectric's Fresnel reflectance at Schlick's weight `fc` = (1 − n·v)⁵, scaled by the
+    /// specular factor.
+    pub fn dielectric_fresnel(&self, fc: f32) -> Vec3 {
+        let f0 = self.dielectric_f0();
+        self.specular * (f0 + (Vec3::ONE - f0) * fc)
+    }
+
     /// What light passing through keeps of each channel after crossing the volume's
     /// thickness: attenuation colour ^ (thickness / attenuation distance); all of it for a
     /// thin wall (thickness 0) or a clear volume.
@@ -188,8 +195,7 @@ pub fn sheen_albedo(n_dot_v: f32, roughness: f32) -> f32 {
 pub fn lobed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material, lobes: &MaterialLobes) -> Vec3 {
     let Some(LightAt { n_dot_v, n_dot_l, n_dot_h, radiance }) = light_at(light, p, n, v) else { return Vec3::ZERO };
     let fc = (1.0 - n_dot_v).powf(5.0);
-    let f0 = lobes.dielectric_f0();
-    let f_dielectric = lobes.specular * (f0 + (Vec3::ONE - f0) * fc);
+    let f_dielectric = lobes.dielectric_fresnel(fc);
     let f_metal = m.albedo + (Vec3::ONE - m.albedo) * fc;
     let f = f_dielectric.lerp(f_metal, m.metallic);
     let g = g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, m.roughness.max(0.05));
@@ -228,9 +234,7 @@ pub fn lobed_transmittance(n_dot_v: f32, m: &Material, lobes: &MaterialLobes) ->
         return Vec3::ZERO;
     }
     let n_dot_v = n_dot_v.clamp(0.0, 1.0);
-    let fc = (1.0 - n_dot_v).powf(5.0);
-    let f0 = lobes.dielectric_f0();
-    let f_dielectric = lobes.specular * (f0 + (Vec3::ONE - f0) * fc);
+    let f_dielectric = lobes.dielectric_fresnel((1.0 - n_dot_v).powf(5.0));
     let through = lobes.transmission * (1.0 - m.metallic) * coat_transmittance(n_dot_v, lobes.clearcoat);
     (Vec3::ONE - f_dielectric) * m.albedo * lobes.volume_transmittance() * through
 }

@@ -466,11 +466,7 @@ impl<'a> Renderer<'a> {
                 if i + 1 == frames {
                     last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
                 }
-                let taken = Instant::now();
-                let rgba = self.read_back(last)?;
-                stats.read_back.0 += 1;
-                stats.read_back.1 += taken.elapsed().as_secs_f64() * 1e3;
-                sink.image(i, rgba)?;
+                self.hand_image((i, last), true, sink, &mut stats)?;
             }
             sink.submitted(i);
         }
@@ -849,14 +845,26 @@ impl<'a> Renderer<'a> {
         let mut ready: Vec<(u32, usize)> =
             slots.filter(|&f| !self.pending[f]).filter_map(|f| Some((self.in_flight_image[f].take()?, f))).collect();
         ready.sort_unstable();
-        for (i, f) in ready {
-            let taken = Instant::now();
-            let rgba = self.readbacks[f].mapped().to_vec();
-            stats.read_back.0 += 1;
-            stats.read_back.1 += taken.elapsed().as_secs_f64() * 1e3;
-            sink.image(i, rgba)?;
+        for frame_slot in ready {
+            self.hand_image(frame_slot, false, sink, stats)?;
         }
         Ok(())
+    }
+
+    /// Hand the sink frame `i`'s image from slot `f`'s read-back buffer — copied there now where
+    /// `copy`, else by the frame's own commands — counting the time it took.
+    fn hand_image(
+        &mut self,
+        (i, f): (u32, usize),
+        copy: bool,
+        sink: &mut dyn FrameSink,
+        stats: &mut FrameStats,
+    ) -> Result<(), RenderError> {
+        let taken = Instant::now();
+        let rgba = if copy { self.read_back(f)? } else { self.readbacks[f].mapped().to_vec() };
+        stats.read_back.0 += 1;
+        stats.read_back.1 += taken.elapsed().as_secs_f64() * 1e3;
+        sink.image(i, rgba)
     }
 }
 

@@ -179,10 +179,18 @@ pub(super) fn merge(folders: &[PathBuf]) -> Result<Value> {
     }
     let Some((first_path, _, count, first)) = sheets.first() else { bail!("--merge: give the shards' folders, comma-separated") };
     for (path, index, n, sheet) in &sheets {
-        for key in ["commit", "settings", "rows"] {
-            if sheet[key] != first[key] || n != count {
-                bail!("--merge: '{}' and '{}' are shards of different runs (their {key} differ)", first_path.display(), path.display());
-            }
+        let differ = |what: &str| {
+            anyhow::anyhow!(
+                "--merge: '{}' and '{}' are shards of different runs (their {what} differ)",
+                first_path.display(),
+                path.display()
+            )
+        };
+        if n != count {
+            return Err(differ("shard counts"));
+        }
+        if let Some(key) = ["commit", "settings", "rows"].into_iter().find(|key| sheet[*key] != first[*key]) {
+            return Err(differ(key));
         }
         if sheet["device"]["name"] != first["device"]["name"] {
             bail!(
