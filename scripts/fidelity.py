@@ -15,9 +15,9 @@ an environment put objects apart so that one hides little of it from another (ma
 environment light is not shadowed by the scene). manylights' point and spot lights, whose
 (1 − d/r)² falloff no emitter of Mitsuba's has, are summed by the path tracer's integrator
 itself (fidelity_mitsuba.py), with shadow rays; manylights shadows them (and directional
-lights) by rays too. Plain materials are Mitsuba's principled BSDF; clear coat and sheen, which
-it models otherwise (Disney's), glTF's own material as its specification writes it; thin
-transmitting glass Mitsuba's thin dielectric.
+lights) by rays too. Every opaque material, textured or not, with clear coat and sheen, is
+glTF's own as its specification writes it (fidelity_mitsuba.GltfBSDF: Lambert diffuse, where
+Mitsuba's principled BSDF is Disney's); thin transmitting glass Mitsuba's thin dielectric.
 """
 
 import io
@@ -364,39 +364,36 @@ def read_glb(path):
     return mesh, images, factors
 
 
-def model_shape(path, out):
+def model_shape(path, out, name):
     """The path tracer's shape for the glTF model at `path`: its triangles (a PLY file), its
-    material (the principled BSDF on its textures, under its normal map) and its emission.
-    Images go through PIL into files of `out`: roughness and metallic as grey images of their
-    channels; the normal map's green channel turned over (glTF's texture coordinates run down
-    the image, so its +y is towards −v; Mitsuba's frame takes +y along +v)."""
+    material (glTF's on its textures, under its normal map: mitsuba_bsdf, plugin `name`) and
+    its emission. Images go through PIL into files of `out`: roughness and metallic as grey
+    images of their channels; the normal map's green channel turned over (glTF's texture
+    coordinates run down the image, so its +y is towards −v; Mitsuba's frame takes +y along
+    +v)."""
     mesh, images, factors = read_glb(path)
     ply = out / f"{path.stem}.ply"
     write_ply(ply, mesh)
     files = {}
-    for name, data in images.items():
+    for role, data in images.items():
         texels = np.array(Image.open(io.BytesIO(data)).convert("RGB"))
-        if name == "metallicRoughness":
-            for channel, role in [(1, "roughness"), (2, "metallic")]:
-                files[role] = out / f"{path.stem}-{role}.png"
-                Image.fromarray(texels[..., channel]).save(files[role])
+        if role == "metallicRoughness":
+            for channel, grey in [(1, "roughness"), (2, "metallic")]:
+                files[grey] = out / f"{path.stem}-{grey}.png"
+                Image.fromarray(texels[..., channel]).save(files[grey])
             continue
-        if name == "normal":
+        if role == "normal":
             texels[..., 1] = 255 - texels[..., 1]
-        files[name] = out / f"{path.stem}-{name}.png"
-        Image.fromarray(texels).save(files[name])
+        files[role] = out / f"{path.stem}-{role}.png"
+        Image.fromarray(texels).save(files[role])
 
     def texture(role, factor, raw):
         bitmap = {"type": "bitmap", "filename": str(files[role]), "raw": raw}
         return bitmap if np.allclose(factor, 1.0) else {"type": "scale", "scale": factor, "texture": bitmap} if np.isscalar(factor) else sys.exit("a coloured factor over a texture")
 
-    bsdf = {
-        "type": "principled",
-        "base_color": texture("baseColor", factors["baseColor"], False) if "baseColor" in files else {"type": "rgb", "value": factors["baseColor"]},
-        "roughness": texture("roughness", factors["roughness"], True) if "roughness" in files else factors["roughness"],
-        "metallic": texture("metallic", factors["metallic"], True) if "metallic" in files else factors["metallic"],
-        "specular": 0.5,
-    }
+    m = material(factors["baseColor"], factors["roughness"], factors["metallic"])
+    m["maps"] = {role: files[role] for role in ("baseColor", "roughness", "metallic") if role in files}
+    bsdf = mitsuba_bsdf(m, name)
     if "normal" in files:
         bsdf = {"type": "normalmap", "normalmap": {"type": "bitmap", "filename": str(files["normal"]), "raw": True}, "bsdf": bsdf}
     shape = {"type": "ply", "filename": str(ply), "bsdf": bsdf}
@@ -451,33 +448,28 @@ def manylights_scene(path, scene, env_file):
     path.write_text("\n".join(lines) + "\n")
 
 
-def mitsuba_bsdf(m):
-    """The path tracer's material for `m`."""
+def mitsuba_bsdf(m, name):
+    """The path tracer's material for `m`: thin glass Mitsuba's thin dielectric, the others
+    glTF's material (fidelity_mitsuba.GltfBSDF, a plugin of its own named `name`: its factors
+    are the plugin's constants; textures from m["maps"])."""
+    import mitsuba as mi
+    import fidelity_mitsuba as fm
+
     if "transmission" in m:
         return {"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0, "specular_transmittance": {"type": "rgb", "value": m["albedo"]}}
-    if "textures" in m:
-        # Factors of 1 (the scene's textured material): each texture alone.
-        return {
-            "type": "principled",
-            "base_color": {"type": "bitmap", "filename": str(m["texture_files"]["baseColor"])},
-            "roughness": {"type": "bitmap", "filename": str(m["texture_files"]["roughness"]), "raw": True},
-            "metallic": {"type": "bitmap", "filename": str(m["texture_files"]["metallic"]), "raw": True},
-            "specular": 0.5,
-        }
-    if extended(m):
-        return {"type": "gltf_material"}
-    return {"type": "principled", "base_color": {"type": "rgb", "value": m["albedo"]}, "roughness": m["roughness"], "metallic": m["metallic"], "specular": 0.5}
+    mi.register_bsdf(name, lambda props: fm.GltfBSDF(props, m))
+    return {"type": name}
 
 
 def texture_files(m, out):
     """The path tracer's images of `m`'s textures (base colour as is, roughness and metallic
-    as grey images of their channels), written into `out` once."""
-    if "texture_files" not in m:
+    as grey images of their channels), written into `out` once, named in m["maps"]."""
+    if "maps" not in m:
         files = {"baseColor": out / "base_color.png", "roughness": out / "roughness.png", "metallic": out / "metallic.png"}
         Image.fromarray(m["textures"]["baseColor"].astype(np.uint8)).save(files["baseColor"])
         for name, channel in [("roughness", 1), ("metallic", 2)]:
             Image.fromarray(m["textures"]["metallicRoughness"][..., channel].astype(np.uint8)).save(files[name])
-        m["texture_files"] = files
+        m["maps"] = files
 
 
 def mitsuba_render(scene, env_file, direct, out):
@@ -506,16 +498,12 @@ def mitsuba_render(scene, env_file, direct, out):
         desc[f"sun{i}"] = {"type": "directional", "direction": d["direction"], "irradiance": {"type": "rgb", "value": d["color"]}}
     for i, o in enumerate(scene["objects"]):
         if o["shape"] == "model":
-            desc[f"object{i}"] = model_shape(o["file"], out)
+            desc[f"object{i}"] = model_shape(o["file"], out, f"gltf_material_{i}")
             continue
         m = o["material"]
         if "textures" in m:
             texture_files(m, out)
-        bsdf = mitsuba_bsdf(m)
-        if bsdf["type"] == "gltf_material":
-            # A plugin of its own for each material (its factors are the plugin's constants).
-            bsdf = {"type": f"gltf_material_{i}"}
-            mi.register_bsdf(bsdf["type"], lambda props, m=m: fm.GltfBSDF(props, m))
+        bsdf = mitsuba_bsdf(m, f"gltf_material_{i}")
         at, s = o["position"], o["scale"]
         if o["shape"] == "sphere" and "textures" in m:
             # Textured: the same triangles and texture coordinates as manylights' glTF.

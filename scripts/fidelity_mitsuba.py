@@ -177,11 +177,20 @@ def sheen_albedo_table(roughness, size=64, steps=256):
     return table
 
 
-def ggx_d_vis(n_dot_h, n_dot_l, n_dot_v, roughness):
-    """GGX's D times Smith's height-correlated visibility V = G / (4 n·l n·v), α = roughness²."""
-    a2 = max(roughness**2, 1e-4) ** 2
-    d = a2 / (math.pi * dr.square(n_dot_h * n_dot_h * (a2 - 1.0) + 1.0))
+def ggx_d_vis(h, n_dot_l, n_dot_v, roughness):
+    """GGX's D at the half vector `h` (in the shading frame) times Smith's height-correlated
+    visibility V = G / (4 n·l n·v), α = roughness² (at least 10⁻⁴). D's denominator
+    (n·h)²(α² − 1) + 1 is written sin²θ + cos²θ·α² with sin²θ from h's tangent components:
+    in 32-bit floats the first form is 0 at n·h = 1 for a smooth surface (D infinite)."""
+    a2 = dr.square(dr.maximum(dr.square(roughness), 1e-4))
+    sin2, cos2 = dr.square(h.x) + dr.square(h.y), dr.square(h.z)
+    d = a2 / (math.pi * dr.square(sin2 + cos2 * a2))
     return d * 0.5 / (n_dot_l * dr.sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2) + n_dot_v * dr.sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2))
+
+
+def bitmap(filename, raw):
+    """A texture of Mitsuba's from an image file (raw: its values as they are, else sRGB)."""
+    return mi.load_dict({"type": "bitmap", "filename": str(filename), "raw": raw})
 
 
 class GltfBSDF(mi.BSDF):
@@ -190,13 +199,19 @@ class GltfBSDF(mi.BSDF):
     KHR_materials_sheen (Charlie distribution and visibility over the base scaled by
     1 − max(sheen)·E) and KHR_materials_clearcoat (a GGX layer of F₀ 0.04 mixed over it by
     clearcoat × Fresnel at n·v), as the specification's appendix and the extensions write it.
-    Sampled as a mixture of cosine-weighted and GGX visible-normal lobes."""
+    Base colour, roughness and metallic may come from textures (material["maps"]: image files,
+    the colour sRGB, the others grey), each times its factor. Sampled as a mixture of
+    cosine-weighted and GGX visible-normal lobes."""
 
     def __init__(self, props, material):
         mi.BSDF.__init__(self, props)
         self.albedo = material["albedo"]
         self.roughness = material["roughness"]
         self.metallic = material["metallic"]
+        maps = material.get("maps", {})
+        self.albedo_map = bitmap(maps["baseColor"], False) if "baseColor" in maps else None
+        self.roughness_map = bitmap(maps["roughness"], True) if "roughness" in maps else None
+        self.metallic_map = bitmap(maps["metallic"], True) if "metallic" in maps else None
         self.coat, self.coat_roughness = material.get("clearcoat", (0.0, 0.0))
         self.sheen, self.sheen_roughness = material.get("sheen", ([0.0, 0.0, 0.0], 0.0))
         self.sheen_max = max(self.sheen)
@@ -204,9 +219,24 @@ class GltfBSDF(mi.BSDF):
         flags = mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
         self.m_components = [flags]
         self.m_flags = flags
-        # The mixture's weights: diffuse (cosine), base specular, coat (GGX).
-        w = [max(1.0 - self.metallic, 0.0) + self.sheen_max, 1.0, self.coat]
-        self.weights = [x / sum(w) for x in w]
+
+    def at(self, si):
+        """Base colour, roughness and metallic at the surface point."""
+        albedo = mi.Color3f(self.albedo)
+        if self.albedo_map is not None:
+            albedo *= self.albedo_map.eval(si)
+        roughness, metallic = mi.Float(self.roughness), mi.Float(self.metallic)
+        if self.roughness_map is not None:
+            roughness *= self.roughness_map.eval_1(si)
+        if self.metallic_map is not None:
+            metallic *= self.metallic_map.eval_1(si)
+        return albedo, roughness, metallic
+
+    def weights(self, metallic):
+        """The sampling mixture's weights: diffuse (cosine), base specular, coat (GGX)."""
+        w = [dr.maximum(1.0 - metallic, 0.0) + self.sheen_max, mi.Float(1.0), mi.Float(self.coat)]
+        total = w[0] + w[1] + w[2]
+        return [x / total for x in w]
 
     def sheen_albedo(self, cos_theta):
         size = 64
@@ -216,45 +246,49 @@ class GltfBSDF(mi.BSDF):
         return dr.lerp(dr.gather(mi.Float, self.sheen_table, i), dr.gather(mi.Float, self.sheen_table, i + 1), f)
 
     def ggx(self, roughness):
-        return mi.MicrofacetDistribution(mi.MicrofacetType.GGX, max(roughness * roughness, 1e-4), True)
+        return mi.MicrofacetDistribution(mi.MicrofacetType.GGX, dr.maximum(roughness * roughness, 1e-4), True)
 
     def value(self, si, wo, active):
         wi = si.wi
+        albedo, roughness, metallic = self.at(si)
         n_dot_v, n_dot_l = mi.Frame3f.cos_theta(wi), mi.Frame3f.cos_theta(wo)
         active &= (n_dot_v > 0.0) & (n_dot_l > 0.0)
         h = dr.normalize(wi + wo)
         n_dot_h, v_dot_h = mi.Frame3f.cos_theta(h), dr.dot(wi, h)
-        d_vis = ggx_d_vis(n_dot_h, n_dot_l, n_dot_v, self.roughness)
+        d_vis = ggx_d_vis(h, n_dot_l, n_dot_v, roughness)
         fc = dr.power(1.0 - dr.abs(v_dot_h), 5.0)
-        albedo = mi.Color3f(self.albedo)
         f_dielectric = 0.04 + 0.96 * fc
         f_metal = albedo + (1.0 - albedo) * fc
         dielectric = (1.0 - f_dielectric) * albedo / math.pi + f_dielectric * d_vis
-        base = dr.lerp(dielectric, f_metal * d_vis, self.metallic)
+        base = dr.lerp(dielectric, f_metal * d_vis, metallic)
         if self.sheen_max > 0.0:
             scale = dr.minimum(1.0 - self.sheen_max * self.sheen_albedo(n_dot_v), 1.0 - self.sheen_max * self.sheen_albedo(n_dot_l))
             base = base * scale + mi.Color3f(self.sheen) * charlie_d(n_dot_h, self.sheen_roughness) * charlie_v(n_dot_l, n_dot_v, self.sheen_roughness)
         if self.coat > 0.0:
             fr = self.coat * (0.04 + 0.96 * dr.power(1.0 - n_dot_v, 5.0))
-            base = base * (1.0 - fr) + fr * ggx_d_vis(n_dot_h, n_dot_l, n_dot_v, self.coat_roughness)
+            base = base * (1.0 - fr) + fr * ggx_d_vis(h, n_dot_l, n_dot_v, mi.Float(self.coat_roughness))
         return dr.select(active, base * n_dot_l, 0.0)
 
     def density(self, si, wo, active):
         wi = si.wi
+        _, roughness, metallic = self.at(si)
+        weights = self.weights(metallic)
         active &= (mi.Frame3f.cos_theta(wi) > 0.0) & (mi.Frame3f.cos_theta(wo) > 0.0)
         h = dr.normalize(wi + wo)
-        pdf = self.weights[0] * mi.warp.square_to_cosine_hemisphere_pdf(wo)
-        for weight, roughness in [(self.weights[1], self.roughness), (self.weights[2], self.coat_roughness)]:
-            if weight > 0.0:
-                pdf += weight * self.ggx(roughness).pdf(wi, h) / (4.0 * dr.abs(dr.dot(wo, h)))
+        pdf = weights[0] * mi.warp.square_to_cosine_hemisphere_pdf(wo)
+        pdf += weights[1] * self.ggx(roughness).pdf(wi, h) / (4.0 * dr.abs(dr.dot(wo, h)))
+        if self.coat > 0.0:
+            pdf += weights[2] * self.ggx(mi.Float(self.coat_roughness)).pdf(wi, h) / (4.0 * dr.abs(dr.dot(wo, h)))
         return dr.select(active, pdf, 0.0)
 
     def sample(self, ctx, si, sample1, sample2, active):
         bs = dr.zeros(mi.BSDFSample3f)
-        diffuse = sample1 < self.weights[0]
-        coat = sample1 >= self.weights[0] + self.weights[1]
-        m_base, _ = self.ggx(self.roughness).sample(si.wi, sample2)
-        m_coat, _ = self.ggx(self.coat_roughness).sample(si.wi, sample2)
+        _, roughness, metallic = self.at(si)
+        weights = self.weights(metallic)
+        diffuse = sample1 < weights[0]
+        coat = sample1 >= weights[0] + weights[1]
+        m_base, _ = self.ggx(roughness).sample(si.wi, sample2)
+        m_coat, _ = self.ggx(mi.Float(self.coat_roughness)).sample(si.wi, sample2)
         m = dr.select(coat, m_coat, m_base)
         wo = dr.select(diffuse, mi.warp.square_to_cosine_hemisphere(sample2), mi.reflect(si.wi, m))
         bs.wo = wo

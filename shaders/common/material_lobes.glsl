@@ -147,11 +147,11 @@ vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float
     mat3 to_image = environment_to_image();
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 r = normalize(2.0 * dot(n, v) * n - v);
-    vec3 diffuse = albedo * (1.0 - metallic) * (1.0 - coat.w) * environment_diffuse(to_image * n) * occlusion;
+    vec3 ab = environment_brdf_at(n_dot_v, roughness);
+    vec3 diffuse = albedo * (1.0 - metallic) * (1.0 - coat.w) * (1.0 - dielectric_fresnel(specular, ab.z)) * environment_diffuse(to_image * n) * occlusion;
     vec3 f0 = mix(specular.a * specular.rgb, albedo, metallic);
     float f90 = mix(specular.a, 1.0, metallic);
-    vec2 ab = environment_brdf_at(n_dot_v, roughness);
-    vec3 prefiltered = environment_prefiltered(to_image * r, roughness);
+    vec3 prefiltered = environment_prefiltered(to_image * dominant_direction(n, r, roughness), roughness);
     vec3 base = diffuse + prefiltered * (f0 * ab.x + f90 * ab.y) * specular_occlusion(n_dot_v, occlusion, roughness);
     float sheen_max = max3(sheen.rgb);
     if (sheen_max > 0.0) {
@@ -159,8 +159,8 @@ vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float
         base = base * (1.0 - sheen_max * e) + sheen.rgb * e * environment_prefiltered(to_image * n, sheen.a) * occlusion;
     }
     if (coat.x > 0.0) {
-        vec2 coat_ab = environment_brdf_at(n_dot_v, coat.y);
-        vec3 coat_light = environment_prefiltered(to_image * r, coat.y) * (0.04 * coat_ab.x + coat_ab.y) * specular_occlusion(n_dot_v, occlusion, coat.y);
+        vec2 coat_ab = environment_brdf_at(n_dot_v, coat.y).xy;
+        vec3 coat_light = environment_prefiltered(to_image * dominant_direction(n, r, coat.y), coat.y) * (0.04 * coat_ab.x + coat_ab.y) * specular_occlusion(n_dot_v, occlusion, coat.y);
         base = base * (1.0 - coat_fresnel(n_dot_v, coat.x)) + coat.x * coat_light;
     }
     return base * environment.params.x;

@@ -3,7 +3,8 @@
 // The split sum's second factor: the BRDF's integral over the hemisphere as F₀·A + B per
 // (n·v, roughness), texel centres at both ends of each axis (GGX importance sampling with
 // Hammersley points; Smith–Schlick visibility with k = α/2). ml_cpu::environment::brdf_integral
-// is the same sum.
+// is the same sum. Third channel: what the Fresnel term takes from the diffuse layer under
+// light from every direction (diffuse_fresnel_weight), a function of n·v alone.
 #include "environment/environment_maps.glsl"
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
@@ -36,5 +37,14 @@ void main() {
             b += fc * visibility;
         }
     }
-    imageStore(brdf_table, p, vec4(a / float(SAMPLES), b / float(SAMPLES), 0.0, 1.0));
+    // Schlick's weight (1 − v·h)⁵ of cosine-distributed light directions, averaged: glTF's
+    // material weights its diffuse layer by 1 − F(v·h) for each (ml_cpu diffuse_fresnel_weight).
+    float c = 0.0;
+    for (uint i = 0u; i < SAMPLES; ++i) {
+        vec2 xi = hammersley(i, SAMPLES);
+        float phi = 2.0 * ENV_PI * xi.x, cos_theta = sqrt(1.0 - xi.y), sin_theta = sqrt(xi.y);
+        vec3 l = vec3(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+        c += pow(1.0 - clamp(dot(v, normalize(v + l)), 0.0, 1.0), 5.0);
+    }
+    imageStore(brdf_table, p, vec4(a / float(SAMPLES), b / float(SAMPLES), c / float(SAMPLES), 1.0));
 }

@@ -818,9 +818,9 @@ struct Builder<'a> {
     cones: Vec<LightCone>,
     /// Bytes the decoded textures take (with their mip chains): at most MAX_TEXTURE_BYTES.
     texture_bytes: u64,
-    /// (image, as sRGB, sampler) → index in `textures`: each image decoded once per colour
-    /// space.
-    by_texture: HashMap<(usize, bool, TextureSampler), u32>,
+    /// (image, how its texels are read, sampler) → index in `textures`: each image decoded
+    /// once per reading.
+    by_texture: HashMap<(usize, Texels, TextureSampler), u32>,
     buffers: Vec<Vec<u8>>,
     meshes: Vec<Mesh>,
     /// (mesh, primitive) → its meshes, so that instanced meshes are loaded once.
@@ -988,12 +988,12 @@ impl Builder<'_> {
         let normal = m.normal_texture().map(|t| (t.texture(), t.tex_coord()));
         let occlusion = m.occlusion_texture().map(|t| (t.texture(), t.tex_coord()));
         let emissive = m.emissive_texture().map(|t| (t.texture(), t.tex_coord()));
-        let mut slot = |what: &'static str, texture: Option<(gltf::Texture, u32)>, srgb: bool| -> Result<Option<u32>, GltfError> {
+        let mut slot = |what: &'static str, texture: Option<(gltf::Texture, u32)>, texels: Texels| -> Result<Option<u32>, GltfError> {
             let Some((texture, set)) = texture else { return Ok(None) };
             if set != 0 {
                 self.warnings.push(format!("material {name}: the {what} texture names TEXCOORD_{set}; TEXCOORD_0 is used"));
             }
-            match self.texture(&texture, srgb) {
+            match self.texture(&texture, texels) {
                 Ok(slot) => Ok(Some(slot)),
                 // Missing or unreadable: drawn without it (its factor alone), as a viewer does.
                 Err(e) => match e.left_out_because() {
@@ -1007,29 +1007,34 @@ impl Builder<'_> {
             }
         };
         Ok(ObjectTextures {
-            base_color: slot("base colour", base_color, true)?,
-            normal: slot("normal", normal, false)?,
-            metallic_roughness: slot("metallic-roughness", metallic_roughness, false)?,
-            occlusion: slot("occlusion", occlusion, false)?,
-            emissive: slot("emissive", emissive, true)?,
+            base_color: slot("base colour", base_color, Texels::Colour)?,
+            normal: slot("normal", normal, Texels::UnitNormals)?,
+            metallic_roughness: slot("metallic-roughness", metallic_roughness, Texels::Data)?,
+            occlusion: slot("occlusion", occlusion, Texels::Data)?,
+            emissive: slot("emissive", emissive, Texels::Colour)?,
         })
     }
 
-    /// A glTF texture: its image decoded to RGBA8 (once per colour space) with its sampler.
-    fn texture(&mut self, texture: &gltf::Texture, srgb: bool) -> Result<u32, GltfError> {
+    /// A glTF texture: its image decoded to RGBA8 (once per way its texels are read) with its
+    /// sampler.
+    fn texture(&mut self, texture: &gltf::Texture, texels: Texels) -> Result<u32, GltfError> {
         let sampler = sampler_of(&texture.sampler());
         let index = texture.source().index();
-        if let Some(&known) = self.by_texture.get(&(index, srgb, sampler)) {
+        if let Some(&known) = self.by_texture.get(&(index, texels, sampler)) {
             return Ok(known);
         }
-        let decoded = match self.by_texture.iter().find(|((i, s, _), _)| (*i, *s) == (index, srgb)) {
+        let decoded = match self.by_texture.iter().find(|((i, t, _), _)| (*i, *t) == (index, texels)) {
             // The same image with another sampler: decoded already, its texels shared.
             Some((_, &other)) => TextureImage { sampler, ..self.textures[other as usize].clone() },
-            None => TextureImage { sampler, ..self.image(index, srgb).map_err(|e| e.within(Part::Image(index)))? },
+            None => {
+                let image = self.image(index, texels == Texels::Colour).map_err(|e| e.within(Part::Image(index)))?;
+                let image = if texels == Texels::UnitNormals { unit_normals(image) } else { image };
+                TextureImage { sampler, ..image }
+            }
         };
         let slot = self.textures.len() as u32;
         self.textures.push(decoded);
-        self.by_texture.insert((index, srgb, sampler), slot);
+        self.by_texture.insert((index, texels, sampler), slot);
         Ok(slot)
     }
 
@@ -1135,6 +1140,23 @@ fn within_texture_budget(bytes: &[u8], taken: u64) -> Result<u64, GltfError> {
         Some(total) => Ok(total),
         None => Err(GltfError::TextureBudget { width, height, need, taken }),
     }
+}
+
+/// How a texture's texels are read: colour (sRGB-encoded), data as they are, or unit normals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Texels {
+    Colour,
+    Data,
+    UnitNormals,
+}
+
+/// A normal map's texels made unit vectors. Many stored maps are not (lossy compression,
+/// tools that write 128 for 0): a texel of length 0.98 would read, to the specular
+/// anti-aliasing, as normals spread within it (a smooth visor's highlight widened as if its
+/// roughness were 0.3), where only its mip levels' averages should be shorter than 1.
+fn unit_normals(image: TextureImage) -> TextureImage {
+    let rgba: Vec<u8> = image.rgba.chunks_exact(4).flat_map(|t| crate::textures::unit_normal_texel([t[0], t[1], t[2], t[3]])).collect();
+    TextureImage { rgba: rgba.into(), ..image }
 }
 
 /// PNG or JPEG bytes as an RGBA8 texture, its size and memory capped before decoding.

@@ -91,6 +91,13 @@ impl TextureImage {
     }
 }
 
+/// A normal-map texel (n·0.5 + 0.5 in its RGB) with its vector made unit length, to 8 bits
+/// (no 8-bit texel decodes to zero: 2c − 255 is odd); alpha kept.
+pub fn unit_normal_texel(t: [u8; 4]) -> [u8; 4] {
+    let n = (Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 255.0 * 2.0 - 1.0).normalize_or(Vec3::Z) * 0.5 + 0.5;
+    [encode(n.x), encode(n.y), encode(n.z), t[3]]
+}
+
 fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
@@ -248,6 +255,19 @@ pub fn sky_cube(size: u32) -> Vec<Vec<u8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn normal_texels_are_made_unit_length_keeping_their_direction() {
+        let decode = |t: [u8; 4]| Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 255.0 * 2.0 - 1.0;
+        // Shorter than unit (as lossy maps store them), one leaning, one flat.
+        for texel in [[128, 128, 250, 255], [90, 160, 230, 7], [128, 128, 255, 255]] {
+            let unit = unit_normal_texel(texel);
+            let (before, after) = (decode(texel), decode(unit));
+            assert!((after.length() - 1.0).abs() < 0.0068, "{texel:?} -> {unit:?}: {}", after.length());
+            assert!(after.normalize().dot(before.normalize()) > 0.9999, "{texel:?} -> {unit:?}");
+            assert_eq!(unit[3], texel[3]);
+        }
+    }
 
     #[test]
     fn mip_chains_halve_down_to_one_texel() {
