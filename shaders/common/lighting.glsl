@@ -105,6 +105,9 @@ struct PointMaterial {
     vec4 specular;
     vec4 coat;
     vec4 sheen;
+    vec3 coat_normal;
+    // Multiplies the volume's thickness (its transmittance's exponent).
+    float thickness;
 };
 
 // The roughness of a surface whose normals spread by `spread` (surface.glsl normal_spread)
@@ -118,14 +121,19 @@ float widened_roughness(float roughness, float spread) {
     return sqrt(sqrt(min(alpha * alpha + 2.0 * spread * spread, 1.0)));
 }
 
-// `object`: its index in the object buffer (whose lobes it reads).
+// `object`: its index in the object buffer (whose lobes it reads, each factor times its
+// texel in `t`; the dielectric's F₀ clamped to 1 after its colour's texel).
 PointMaterial point_material(vec4 albedo_roughness, vec4 material, vec4 emissive, vec4 albedo_occlusion, vec2 roughness_metallic,
-                             vec3 emissive_factor, float normal_spread, uint object) {
+                             vec3 emissive_factor, float normal_spread, uint object, LobeTexels t) {
     PointMaterial m;
     if (MATERIAL_LOBES) {
-        m.specular = objects[object].lobes[0];
-        m.coat = objects[object].lobes[1];
-        m.sheen = objects[object].lobes[2];
+        vec4 specular = objects[object].lobes[0];
+        vec4 coat = objects[object].lobes[1];
+        m.specular = vec4(min(specular.rgb * t.specular.rgb, vec3(1.0)), specular.a * t.specular.a);
+        m.coat = vec4(coat.xy * t.coat, coat.z, coat.w * t.transmission.x);
+        m.sheen = objects[object].lobes[2] * t.sheen;
+        m.coat_normal = t.coat_normal;
+        m.thickness = t.transmission.y;
     }
     m.albedo = albedo_roughness.rgb * albedo_occlusion.rgb;
     m.roughness = widened_roughness(albedo_roughness.a * roughness_metallic.x, normal_spread);
@@ -167,12 +175,13 @@ vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
             if (m.coat.z != 0.0) {
                 return albedo;
             }
-#define LOBED_LIGHT(l) shadowed(lobed_point_light(l, world, n, v, albedo, roughness, metallic, m.specular, m.coat, m.sheen), l, world, n)
+            vec3 coat_n = LOBE_TEXTURES ? m.coat_normal : n;
+#define LOBED_LIGHT(l) shadowed(lobed_point_light(l, world, n, v, albedo, roughness, metallic, m.specular, m.coat, coat_n, m.sheen), l, world, n)
             SUM_LIGHTS(lo, LOBED_LIGHT)
             SUM_DIRECTIONAL(lo, LOBED_LIGHT)
-            float under_coat = coat_transmittance(n, v, m.coat);
+            float under_coat = coat_transmittance(coat_n, v, m.coat);
             if (ENVIRONMENT) {
-                return lobed_environment_light(n, v, albedo, roughness, metallic, occlusion, m.specular, m.coat, m.sheen) + lo +
+                return lobed_environment_light(n, v, albedo, roughness, metallic, occlusion, m.specular, m.coat, coat_n, m.sheen) + lo +
                        emission * under_coat;
             }
             return albedo * frame.ambient * occlusion * (1.0 - m.coat.w) * under_coat + lo + emission * under_coat;

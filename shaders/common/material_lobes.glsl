@@ -83,11 +83,12 @@ vec3 dielectric_fresnel(vec4 specular, float fc) {
 // surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic), Lambert
 // diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX; the sheen's lobe over
 // the base scaled by 1 − max(sheen)·E at the view and the light; the clear coat's GGX lobe
-// (F₀ 0.04) over the base scaled by 1 − coat·F_coat. Its first lines are cook_torrance_point_light's (seed_brdf.glsl),
-// repeated: a shared helper returning the cosines in a struct made the seed's forward pass 1.44×
-// slower on the H100.
+// (F₀ 0.04) over the base scaled by 1 − coat·F_coat, its cosines about its own normal
+// `coat_n`. Its first lines are cook_torrance_point_light's (seed_brdf.glsl), repeated: a
+// shared helper returning the cosines in a struct made the seed's forward pass 1.44× slower
+// on the H100.
 vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, vec4 specular,
-                       vec4 coat, vec4 sheen) {
+                       vec4 coat, vec3 coat_n, vec4 sheen) {
     vec3 light_vec = light.position_radius.xyz - world_pos;
     float dist = length(light_vec);
     float radius = light.position_radius.w;
@@ -115,26 +116,29 @@ vec3 lobed_point_light(PointLight light, vec3 world_pos, vec3 n, vec3 v, vec3 al
         base *= min(1.0 - sheen_max * sheen_albedo(n_dot_v, sheen.a), 1.0 - sheen_max * sheen_albedo(n_dot_l, sheen.a));
         base += sheen.rgb * d_charlie(n_dot_h, sheen.a) * v_charlie(n_dot_l, n_dot_v, sheen.a);
     }
-    if (coat.x > 0.0) {
-        float f_coat = coat_fresnel(n_dot_v, coat.x);
-        base = base * (1.0 - f_coat) + vec3(f_coat * d_ggx(n_dot_h, coat.y) * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, max(0.05, coat.y)));
+    if (coat.x <= 0.0) {
+        return base * light.color.rgb * radiance;
     }
-    return base * light.color.rgb * radiance;
+    float coat_v = clamp(dot(coat_n, v), 0.0, 1.0), coat_l = clamp(dot(coat_n, l), 0.0, 1.0), coat_h = clamp(dot(coat_n, h), 0.0, 1.0);
+    float f_coat = coat_fresnel(coat_v, coat.x);
+    float coat_lobe = coat_l > 0.0 ? f_coat * d_ggx(coat_h, coat.y) * g_schlick_smith_over_4nlnv(coat_l, coat_v, max(0.05, coat.y)) : 0.0;
+    return (base * (1.0 - f_coat) * radiance + vec3(coat_lobe * atten * atten * coat_l)) * light.color.rgb;
 }
 
-// What the clear coat lets through of what lies under it (light given off included):
-// 1 − coat·F_coat at the view.
-float coat_transmittance(vec3 n, vec3 v, vec4 coat) {
-    return 1.0 - coat_fresnel(clamp(dot(n, v), 0.0, 1.0), coat.x);
+// What the clear coat (normal `coat_n`) lets through of what lies under it (light given off
+// included): 1 − coat·F_coat at the view.
+float coat_transmittance(vec3 coat_n, vec3 v, vec4 coat) {
+    return 1.0 - coat_fresnel(clamp(dot(coat_n, v), 0.0, 1.0), coat.x);
 }
 
 // What the surface lets through of the light behind it (KHR_materials_transmission, thin
 // walled): transmission × (1 − metallic) × albedo × (1 − F) of the dielectric's Fresnel
-// term × 1 − coat·F_coat × the volume's transmittance `volume` (ml_cpu lobed_transmittance).
-vec3 lobed_transmittance(vec3 n, vec3 v, vec3 albedo, float metallic, vec4 specular, vec4 coat, vec3 volume) {
+// term × 1 − coat·F_coat (about the coat's normal `coat_n`) × the volume's transmittance
+// `volume` (ml_cpu lobed_transmittance).
+vec3 lobed_transmittance(vec3 n, vec3 v, vec3 albedo, float metallic, vec4 specular, vec4 coat, vec3 coat_n, vec3 volume) {
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 f_dielectric = dielectric_fresnel(specular, pow(1.0 - n_dot_v, 5.0));
-    return (1.0 - f_dielectric) * albedo * volume * (coat.w * (1.0 - metallic) * (1.0 - coat_fresnel(n_dot_v, coat.x)));
+    return (1.0 - f_dielectric) * albedo * volume * (coat.w * (1.0 - metallic) * coat_transmittance(coat_n, v, coat));
 }
 
 // Environment light with lobes (environment.glsl's split sum): the specular term's F₀ and F₉₀
@@ -143,7 +147,7 @@ vec3 lobed_transmittance(vec3 n, vec3 v, vec3 albedo, float metallic, vec4 specu
 // the normal, the base scaled by 1 − max(sheen)·E; the clear coat's split sum at its
 // roughness over the base scaled by 1 − coat·F_coat.
 vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion, vec4 specular, vec4 coat,
-                             vec4 sheen) {
+                             vec3 coat_n, vec4 sheen) {
     mat3 to_image = environment_to_image();
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 r = normalize(2.0 * dot(n, v) * n - v);
@@ -159,9 +163,12 @@ vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float
         base = base * (1.0 - sheen_max * e) + sheen.rgb * e * environment_prefiltered(to_image * n, sheen.a) * occlusion;
     }
     if (coat.x > 0.0) {
-        vec2 coat_ab = environment_brdf_at(n_dot_v, coat.y).xy;
-        vec3 coat_light = environment_prefiltered(to_image * dominant_direction(n, r, coat.y), coat.y) * (0.04 * coat_ab.x + coat_ab.y) * specular_occlusion(n_dot_v, occlusion, coat.y);
-        base = base * (1.0 - coat_fresnel(n_dot_v, coat.x)) + coat.x * coat_light;
+        float coat_v = clamp(dot(coat_n, v), 0.0, 1.0);
+        vec3 coat_r = normalize(2.0 * dot(coat_n, v) * coat_n - v);
+        vec2 coat_ab = environment_brdf_at(coat_v, coat.y).xy;
+        vec3 coat_light = environment_prefiltered(to_image * dominant_direction(coat_n, coat_r, coat.y), coat.y) * (0.04 * coat_ab.x + coat_ab.y) *
+                          specular_occlusion(coat_v, occlusion, coat.y);
+        base = base * (1.0 - coat_fresnel(coat_v, coat.x)) + coat.x * coat_light;
     }
     return base * environment.params.x;
 }

@@ -18,6 +18,39 @@ layout(constant_id = 13) const bool OBJECT_TEXTURES = false;
 // Highlights widened by the spread of the normals a filtered normal map averages
 // (surface.glsl normal_spread; --specular-aa).
 layout(constant_id = 43) const bool SPECULAR_AA = true;
+// Whether some object's glTF PBR extensions vary over its surface: textures of theirs, or a
+// clear coat over a normal map (the coat keeps the mesh's own normal). Without, each point
+// has its object's lobes and the coat the surface's normal.
+layout(constant_id = 47) const bool LOBE_TEXTURES = false;
+
+// What an object's extension textures give at a point, each multiplying its factor (1: no
+// texture; ml_cpu::material_lobes::LobeTexels), and the clear coat's normal (world, unit).
+struct LobeTexels {
+    vec2 coat;         // strength, roughness
+    vec3 coat_normal;
+    vec4 sheen;        // colour, roughness
+    vec4 specular;     // colour, strength
+    vec2 transmission; // transmission, the volume's thickness
+};
+
+// No texture, the coat on `n`.
+LobeTexels no_lobe_texels(vec3 n) {
+    return LobeTexels(vec2(1.0), n, vec4(1.0), vec4(1.0), vec2(1.0));
+}
+
+// The texels as the G-buffer's lobes image and a transparent layer's node keep them (needs
+// common.glsl): the clear coat's octahedral normal snorm 2×16, (coat, coat roughness,
+// transmission, thickness), sheen (colour, roughness) and specular (colour, strength) unorm
+// 4×8 each.
+uvec4 pack_lobe_texels(LobeTexels t) {
+    return uvec4(packSnorm2x16(oct_encode(t.coat_normal)), packUnorm4x8(vec4(t.coat, t.transmission)), packUnorm4x8(t.sheen),
+                 packUnorm4x8(t.specular));
+}
+
+LobeTexels unpack_lobe_texels(uvec4 w) {
+    vec4 coat_transmission = unpackUnorm4x8(w.y);
+    return LobeTexels(coat_transmission.xy, oct_decode(unpackSnorm2x16(w.x)), unpackUnorm4x8(w.z), unpackUnorm4x8(w.w), coat_transmission.zw);
+}
 
 // ACES filmic curve (Narkowicz 2015's fit): HDR → [0, 1].
 vec3 aces_tone_map(vec3 x) {

@@ -32,12 +32,31 @@ layout(set = 2, binding = 1) uniform sampler2D object_normal_map;         // n·
 layout(set = 2, binding = 2) uniform sampler2D object_metallic_roughness; // g: roughness, b: metallic
 layout(set = 2, binding = 3) uniform sampler2D object_occlusion;          // r
 layout(set = 2, binding = 4) uniform sampler2D object_emissive;           // sRGB
+// glTF's PBR extensions' (LOBE_TEXTURES), each multiplying its factor.
+layout(set = 2, binding = 5) uniform sampler2D object_clearcoat;           // r
+layout(set = 2, binding = 6) uniform sampler2D object_clearcoat_roughness; // g
+layout(set = 2, binding = 7) uniform sampler2D object_clearcoat_normal;    // n·0.5 + 0.5
+layout(set = 2, binding = 8) uniform sampler2D object_sheen_color;         // sRGB
+layout(set = 2, binding = 9) uniform sampler2D object_sheen_roughness;     // a
+layout(set = 2, binding = 10) uniform sampler2D object_specular;           // a
+layout(set = 2, binding = 11) uniform sampler2D object_specular_color;     // sRGB
+layout(set = 2, binding = 12) uniform sampler2D object_transmission;       // r
+layout(set = 2, binding = 13) uniform sampler2D object_thickness;          // g
 // Bits of ObjectPush.ids.y (ObjectTextures::bits).
 const uint TEXTURE_BASE_COLOR = 1u;
 const uint TEXTURE_NORMAL = 2u;
 const uint TEXTURE_METALLIC_ROUGHNESS = 4u;
 const uint TEXTURE_OCCLUSION = 8u;
 const uint TEXTURE_EMISSIVE = 16u;
+const uint TEXTURE_CLEARCOAT = 32u;
+const uint TEXTURE_CLEARCOAT_ROUGHNESS = 64u;
+const uint TEXTURE_CLEARCOAT_NORMAL = 128u;
+const uint TEXTURE_SHEEN_COLOR = 256u;
+const uint TEXTURE_SHEEN_ROUGHNESS = 512u;
+const uint TEXTURE_SPECULAR = 1024u;
+const uint TEXTURE_SPECULAR_COLOR = 2048u;
+const uint TEXTURE_TRANSMISSION = 4096u;
+const uint TEXTURE_THICKNESS = 8192u;
 
 // What the textures make of the object's material: factors that multiply its own values.
 struct Surface {
@@ -49,6 +68,8 @@ struct Surface {
     // How far the normals a filtered normal-map texel averages spread (normal_spread),
     // in 1/255 steps as the G-buffer and the transparent layers keep it; 0 without a map.
     float normal_spread;
+    // The extensions' textures at the point and the clear coat's normal (LOBE_TEXTURES).
+    LobeTexels lobes;
 };
 
 // `n` perturbed by a tangent-space normal-map texel (n·0.5 + 0.5 encoded), its x and y
@@ -75,10 +96,27 @@ float normal_spread(vec3 texel, float scale) {
 }
 
 // `textures`: which textures the object has of its own (TEXTURE_* bits); `material`: its
-// ObjectData.material (y: occlusion strength, z: normal scale).
-Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, vec4 material) {
+// ObjectData.material (y: occlusion strength, z: normal scale); `object`: its index (whose
+// clear coat normal scale a coat normal map reads).
+Surface surface_at(vec3 geometric_normal, vec4 tangent, vec2 uv, uint textures, vec4 material, uint object) {
     Surface s;
     s.normal = normalize(geometric_normal);
+    s.lobes = no_lobe_texels(s.normal);
+    if (LOBE_TEXTURES) {
+        // The object's texture `t` where bit `bit` says it has one, else white (1: the factor
+        // as it is).
+#define LOBE_TEXEL(bit, t) ((textures & (bit)) != 0u ? SURFACE_SAMPLE(t, uv, mat2(1.0)) : vec4(1.0))
+        s.lobes.coat = vec2(LOBE_TEXEL(TEXTURE_CLEARCOAT, object_clearcoat).r, LOBE_TEXEL(TEXTURE_CLEARCOAT_ROUGHNESS, object_clearcoat_roughness).g);
+        if ((textures & TEXTURE_CLEARCOAT_NORMAL) != 0u) {
+            vec3 texel = SURFACE_SAMPLE(object_clearcoat_normal, uv, mat2(1.0)).xyz;
+            s.lobes.coat_normal = perturb_normal(s.normal, tangent, texel, objects[object].lobes[3].w);
+        }
+        s.lobes.sheen = vec4(LOBE_TEXEL(TEXTURE_SHEEN_COLOR, object_sheen_color).rgb, LOBE_TEXEL(TEXTURE_SHEEN_ROUGHNESS, object_sheen_roughness).a);
+        s.lobes.specular = vec4(LOBE_TEXEL(TEXTURE_SPECULAR_COLOR, object_specular_color).rgb, LOBE_TEXEL(TEXTURE_SPECULAR, object_specular).a);
+        s.lobes.transmission =
+            vec2(LOBE_TEXEL(TEXTURE_TRANSMISSION, object_transmission).r, LOBE_TEXEL(TEXTURE_THICKNESS, object_thickness).g);
+#undef LOBE_TEXEL
+    }
     s.albedo_factor = vec3(1.0);
     s.roughness_metallic = vec2(1.0);
     s.occlusion = 1.0;

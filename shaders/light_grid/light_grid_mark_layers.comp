@@ -16,7 +16,7 @@ layout(std430, set = 0, binding = 31) coherent buffer LightGridOccupancyBuffer {
 void main() {
     uint kept = min(layer_counts.x, layer_capacity());
     for (uint node = gl_GlobalInvocationID.x; node < kept; node += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
-        uvec4 a = layer_nodes[2u * node];
+        uvec4 a = layer_nodes[LAYER_NODE_WORDS * node];
         mark_walk(world_from_depth(layer_xy(a), uintBitsToFloat(a.x)));
     }
 }

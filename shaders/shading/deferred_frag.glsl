@@ -34,6 +34,11 @@ layout(input_attachment_index = 3, set = 2, binding = 4) uniform INPUT albedo_in
 layout(input_attachment_index = 4, set = 2, binding = 5) uniform INPUT roughness_metallic_input;
 layout(input_attachment_index = 5, set = 2, binding = 6) uniform INPUT emissive_input;
 #endif
+// GBUFFER_LOBES (the *_lobes.frag variants): where the PBR extensions vary per point, one
+// more image (a subpass reads at most 8 input attachments on lavapipe: the texels packed).
+#ifdef GBUFFER_LOBES
+layout(input_attachment_index = 6, set = 2, binding = 7) uniform UINPUT lobes_input;
+#endif
 
 #include "common/lighting.glsl"
 // For every variant (the reflection test reads includes whole): the samples' count and
@@ -51,7 +56,7 @@ vec3 shade_gbuffer(vec2 frag_xy, float z, GSample g, out bool debug) {
     vec3 world = world_from_depth(frag_xy, z);
     vec3 n = oct_decode(g.normal);
     PointMaterial m = point_material(objects[g.id].albedo_roughness, objects[g.id].material, objects[g.id].emissive, g.albedo,
-                                     g.roughness_metallic, g.emissive_factor, g.normal_spread, g.id);
+                                     g.roughness_metallic, g.emissive_factor, g.normal_spread, g.id, gsample_lobes(g));
     vec3 color;
     debug = debug_surface(world, n, m.albedo, m.roughness, m.metallic, objects[g.id].alpha_texture.x, frag_xy, color);
     if (!debug) {

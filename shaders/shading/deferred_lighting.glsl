@@ -23,6 +23,8 @@ layout(set = 0, binding = 7) uniform UIMAGE object_image;
 layout(set = 0, binding = 9) uniform IMAGE albedo_image;
 layout(set = 0, binding = 11) uniform IMAGE roughness_metallic_image;
 layout(set = 0, binding = 12) uniform IMAGE emissive_image;
+// Read where the PBR extensions vary per point (LOBE_TEXTURES; else a stand-in never read).
+layout(set = 0, binding = 36) uniform UIMAGE lobes_image;
 #include "common/textures.glsl"
 
 #include "common/lighting.glsl"
@@ -36,8 +38,10 @@ layout(set = 0, binding = 12) uniform IMAGE emissive_image;
 // This invocation's pixel, whose samples GBUFFER_LOAD reads.
 ivec2 gbuffer_pixel;
 #define GBUFFER_LOAD(name, s) texelFetch(name##_image, gbuffer_pixel, s)
-// Without OBJECT_TEXTURES the material and emissive images are stand-ins, never read.
+// Without OBJECT_TEXTURES the material and emissive images are stand-ins, never read, and
+// without LOBE_TEXTURES the lobes' images.
 #define GBUFFER_MATERIAL 1
+#define GBUFFER_LOBES 1
 #include "shading/gbuffer_samples.glsl"
 
 vec3 surface_display(vec2 xy, float z, GSample g) {
@@ -45,7 +49,7 @@ vec3 surface_display(vec2 xy, float z, GSample g) {
     vec3 emissive_factor = OBJECT_TEXTURES ? g.emissive_factor : vec3(1.0);
     float normal_spread = OBJECT_TEXTURES ? g.normal_spread : 0.0;
     PointMaterial m = point_material(objects[g.id].albedo_roughness, objects[g.id].material, objects[g.id].emissive, g.albedo,
-                                     roughness_metallic, emissive_factor, normal_spread, g.id);
+                                     roughness_metallic, emissive_factor, normal_spread, g.id, gsample_lobes(g));
     return shade_display(xy, world_from_depth(xy, z), oct_decode(g.normal), m, objects[g.id].alpha_texture.x);
 }
 
@@ -77,8 +81,9 @@ void main() {
     // binds stand-ins that are never read).
     vec2 roughness_metallic = OBJECT_TEXTURES ? texelFetch(roughness_metallic_image, p, 0).xy : vec2(1.0);
     vec4 emissive = OBJECT_TEXTURES ? texelFetch(emissive_image, p, 0) : vec4(1.0, 1.0, 1.0, 0.0);
+    LobeTexels lobes = LOBE_TEXTURES ? unpack_lobe_texels(texelFetch(lobes_image, p, 0)) : no_lobe_texels(n);
     PointMaterial m = point_material(objects[id].albedo_roughness, objects[id].material, objects[id].emissive, texelFetch(albedo_image, p, 0),
-                                     roughness_metallic, emissive.rgb, emissive.a, id);
+                                     roughness_metallic, emissive.rgb, emissive.a, id, lobes);
     shade_and_store(p, frag_xy, world, n, m, objects[id].alpha_texture.x);
 }
 #endif

@@ -34,9 +34,9 @@ void main() {
         return;
     }
 #endif
-    Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material);
+    Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material, object.ids.x);
     PointMaterial m = point_material(object.albedo_roughness, object.material, object.emissive, vec4(s.albedo_factor, s.occlusion),
-                                     s.roughness_metallic, s.emissive_factor, s.normal_spread, object.ids.x);
+                                     s.roughness_metallic, s.emissive_factor, s.normal_spread, object.ids.x, s.lobes);
     vec3 color;
     if (debug_surface(at.world, s.normal, m.albedo, m.roughness, m.metallic, objects[object.ids.x].alpha_texture.x, gl_FragCoord.xy, color)) {
         out_color = target_shown(color);

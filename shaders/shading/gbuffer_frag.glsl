@@ -4,8 +4,9 @@
 // surface's albedo factor (the base-colour or blinn-phong texture; 1 for the seed model;
 // sRGB-encoded by its image's format, so a texture's darks keep their steps) with the ambient
 // occlusion in alpha — and, in scenes whose objects have textures of their own
-// (GBUFFER_MATERIAL), 6 more: the roughness and metallic factors and the emissive factor
-// (targets.rs). Position comes from depth.
+// (GBUFFER_MATERIAL), 6 more: the roughness and metallic factors and the emissive factor;
+// where their PBR extensions vary per point (GBUFFER_LOBES), 16 more: the extensions' texels
+// and the clear coat's normal, packed (targets.rs). Position comes from depth.
 #include "common/common.glsl"
 #include "common/scene_bindings.glsl"
 #include "common/textures.glsl"
@@ -23,15 +24,21 @@ layout(location = 2) out vec4 out_albedo_occlusion;
 layout(location = 3) out vec2 out_roughness_metallic;
 layout(location = 4) out vec4 out_emissive;
 #endif
+#ifdef GBUFFER_LOBES
+layout(location = 5) out uvec4 out_lobes; // pack_lobe_texels
+#endif
 
 void main() {
     MeshPoint at = covered_point();
-    Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material);
+    Surface s = surface_at(at.normal, at.tangent, at.uv, opaque_uniform(object.ids.y), object.material, object.ids.x);
     out_normal = oct_encode(s.normal);
     out_object = object.ids.x;
     out_albedo_occlusion = vec4(s.albedo_factor, s.occlusion);
 #ifdef GBUFFER_MATERIAL
     out_roughness_metallic = s.roughness_metallic;
     out_emissive = vec4(s.emissive_factor, s.normal_spread);
+#endif
+#ifdef GBUFFER_LOBES
+    out_lobes = pack_lobe_texels(s.lobes);
 #endif
 }

@@ -4,8 +4,9 @@
 // plane's depth is affine in the image), the pixel the mean of its samples in the display's
 // linear light. The deferred lighting subpass and deferred-compute's lighting read their
 // samples differently: the includer defines `GBUFFER_LOAD(name, s)`, the G-buffer image `name`
-// (depth, normal, object, albedo, roughness_metallic, emissive) at sample `s` of the pixel, and
-// `GBUFFER_MATERIAL` where the G-buffer has the last two; and `surface_display(xy, z, g)`, the
+// (depth, normal, object, albedo, roughness_metallic, emissive, lobes) at sample `s` of the
+// pixel, `GBUFFER_MATERIAL` where the G-buffer has the roughness-metallic and emissive
+// images and `GBUFFER_LOBES` where the lobes image; and `surface_display(xy, z, g)`, the
 // display-linear colour of the surface `g` at the point `xy` (pixels) and depth `z`, after this
 // header's structs and before `resolve_samples`. Needs visibility_samples.glsl.
 
@@ -20,6 +21,7 @@ struct GSample {
     vec2 roughness_metallic;
     vec3 emissive_factor;
     float normal_spread; // in the emissive image's alpha
+    uvec4 lobes;         // pack_lobe_texels (0 without)
 };
 
 GSample gbuffer_sample(int s) {
@@ -37,12 +39,23 @@ GSample gbuffer_sample(int s) {
     g.emissive_factor = vec3(1.0);
     g.normal_spread = 0.0;
 #endif
+    g.lobes = uvec4(0u);
+#ifdef GBUFFER_LOBES
+    if (LOBE_TEXTURES) {
+        g.lobes = GBUFFER_LOAD(lobes, s);
+    }
+#endif
     return g;
 }
 
 bool same_surface(GSample a, GSample b) {
     return a.normal == b.normal && a.id == b.id && a.albedo == b.albedo && a.roughness_metallic == b.roughness_metallic
-        && a.emissive_factor == b.emissive_factor && a.normal_spread == b.normal_spread;
+        && a.emissive_factor == b.emissive_factor && a.normal_spread == b.normal_spread && a.lobes == b.lobes;
+}
+
+// The extensions' texels of `g` (no texture's where the G-buffer has none).
+LobeTexels gsample_lobes(GSample g) {
+    return LOBE_TEXTURES ? unpack_lobe_texels(g.lobes) : no_lobe_texels(oct_decode(g.normal));
 }
 
 // The display-linear colour of a surface point (the includer's; see above).

@@ -287,7 +287,7 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
 }
 
 // The surface of triangle `i` at barycentrics `w` (pixel `q`), packed for its node.
-uvec4 layer_surface(uint i, vec3 q, vec3 w, float alpha, vec2 to_ndc) {
+LayerSurface layer_surface(uint i, vec3 q, vec3 w, float alpha, vec2 to_ndc) {
     vec2 uv = w.x * tri_uv[i][0] + w.y * tri_uv[i][1] + w.z * tri_uv[i][2];
     // The texture coordinates one pixel to the right and one down.
     vec3 wx = barycentrics(i, q + vec3(to_ndc.x, 0.0, 0.0)), wy = barycentrics(i, q + vec3(0.0, to_ndc.y, 0.0));
@@ -296,9 +296,10 @@ uvec4 layer_surface(uint i, vec3 q, vec3 w, float alpha, vec2 to_ndc) {
     vec3 n = w.x * tri_normal[i][0] + w.y * tri_normal[i][1] + w.z * tri_normal[i][2];
     vec4 tangent = w.x * tri_tangent[i][0] + w.y * tri_tangent[i][1] + w.z * tri_tangent[i][2];
     bool front = (tri_object[i].y & TRIANGLE_FRONT) != 0u;
-    Surface sf = surface_at(front ? n : -n, tangent, uv, tri_object[i].z, tri_material[i]);
-    return pack_layer_surface(sf.normal, vec4(sf.albedo_factor, sf.occlusion), sf.roughness_metallic, min(alpha, 1.0),
-                              vec4(sf.emissive_factor, sf.normal_spread));
+    Surface sf = surface_at(front ? n : -n, tangent, uv, tri_object[i].z, tri_material[i], tri_object[i].x);
+    uvec4 surface = pack_layer_surface(sf.normal, vec4(sf.albedo_factor, sf.occlusion), sf.roughness_metallic, min(alpha, 1.0),
+                                       vec4(sf.emissive_factor, sf.normal_spread));
+    return LayerSurface(surface, LOBE_TEXTURES ? pack_lobe_texels(sf.lobes) : uvec4(0u));
 }
 
 // Whether triangle `slot` leaves a fragment at pixel `p` in front of the opaque depth (the

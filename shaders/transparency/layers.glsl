@@ -23,6 +23,7 @@
 #define MANYLIGHTS_LAYERS_GLSL
 
 #include "visibility/visibility_samples.glsl"
+#include "common/shading_model.glsl"
 
 const uint LAYER_END = 0xffffffffu;
 // Layers a pixel blends exactly (an array per thread); beyond, merged.
@@ -60,8 +61,19 @@ layout(std430, set = 0, binding = LAYER_BINDING) buffer TransparentHeadBuffer { 
 // unorm 2×8 with alpha unorm 16 above them, emissive factor and normal spread unorm 4×8),
 // which lighting replaces by its light: (lit colour rgb, alpha) as floats or, for a surface
 // that transmits light, (lit colour × alpha as floats, LAYER_TRANSMITS | what it lets
-// through of the light behind, 10 bits a channel) — layer_light reads either.
+// through of the light behind, 10 bits a channel) — layer_light reads either. With
+// LOBE_TEXTURES a third: the extensions' texels (pack_lobe_texels).
 layout(std430, set = 0, binding = LAYER_BINDING + 1) buffer TransparentNodeBuffer { uvec4 layer_nodes[]; };
+
+// uvec4s a node (transparency/layer_buffers.rs node_bytes). A branch, not `?:` on the
+// constant: the build's reflection evaluates no constant select.
+uint layer_node_words() {
+    if (LOBE_TEXTURES) {
+        return 3u;
+    }
+    return 2u;
+}
+#define LAYER_NODE_WORDS layer_node_words()
 // x: nodes asked for this frame (beyond the pool's size: dropped); y: pixels that merged
 // layers; z, w: triangles the per-triangle build listed for a work group each, and for the
 // tiles (transparent_build_triangles.glsl).
@@ -73,7 +85,7 @@ uint layer_pixel(ivec2 p) {
 
 // Nodes in the pool.
 uint layer_capacity() {
-    return uint(layer_nodes.length()) / 2u;
+    return uint(layer_nodes.length()) / LAYER_NODE_WORDS;
 }
 
 // The surface of a node as the build packs it (`alpha` in [0, 1]).
@@ -83,11 +95,21 @@ uvec4 pack_layer_surface(vec3 normal, vec4 albedo_occlusion, vec2 roughness_meta
                  packUnorm4x8(emissive_spread));
 }
 
+// A node's surface: pack_layer_surface's and (LOBE_TEXTURES) the extensions' texels
+// (shading_model.glsl pack_lobe_texels).
+struct LayerSurface {
+    uvec4 surface;
+    uvec4 lobes;
+};
+
 // Node `node` (of the pool) made pixel `p`'s fragment at `depth` of `object` covering the
 // samples `covered`, before `next`.
-void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uint covered, uvec4 surface) {
-    layer_nodes[2u * node] = uvec4(floatBitsToUint(depth), next, layer_object_word(object, covered), uint(p.y) << 16 | uint(p.x));
-    layer_nodes[2u * node + 1u] = surface;
+void write_layer(uint node, ivec2 p, float depth, uint next, uint object, uint covered, LayerSurface surface) {
+    layer_nodes[LAYER_NODE_WORDS * node] = uvec4(floatBitsToUint(depth), next, layer_object_word(object, covered), uint(p.y) << 16 | uint(p.x));
+    layer_nodes[LAYER_NODE_WORDS * node + 1u] = surface.surface;
+    if (LOBE_TEXTURES) {
+        layer_nodes[LAYER_NODE_WORDS * node + 2u] = surface.lobes;
+    }
 }
 
 // A lit node's last word holds this bit where it transmits light (never in an alpha's float,
@@ -103,7 +125,7 @@ struct LayerLight {
 };
 
 LayerLight layer_light(uint node) {
-    uvec4 w = layer_nodes[2u * node + 1u];
+    uvec4 w = layer_nodes[LAYER_NODE_WORDS * node + 1u];
     vec3 c = uintBitsToFloat(w.xyz);
     if ((w.w & LAYER_TRANSMITS) == 0u) {
         float a = uintBitsToFloat(w.w);
@@ -117,8 +139,8 @@ LayerLight layer_light(uint node) {
 
 // Light node `node` where it lies and keep its light (layer_light) in place of its surface.
 void light_layer(uint node) {
-    uvec4 a = layer_nodes[2u * node];
-    uvec4 b = layer_nodes[2u * node + 1u];
+    uvec4 a = layer_nodes[LAYER_NODE_WORDS * node];
+    uvec4 b = layer_nodes[LAYER_NODE_WORDS * node + 1u];
     vec2 frag_xy = layer_xy(a);
     vec3 world = world_from_depth(frag_xy, uintBitsToFloat(a.x));
     vec3 n = oct_decode(unpackSnorm2x16(b.x));
@@ -126,20 +148,25 @@ void light_layer(uint node) {
     ObjectData o = objects[object];
     vec2 roughness_metallic = OBJECT_TEXTURES ? unpackUnorm4x8(b.z).xy : vec2(1.0);
     vec4 emissive_spread = OBJECT_TEXTURES ? unpackUnorm4x8(b.w) : vec4(1.0, 1.0, 1.0, 0.0);
+    LobeTexels t = LOBE_TEXTURES ? unpack_lobe_texels(layer_nodes[LAYER_NODE_WORDS * node + 2u]) : no_lobe_texels(n);
     PointMaterial m = point_material(o.albedo_roughness, o.material, o.emissive, unpackUnorm4x8(b.y), roughness_metallic, emissive_spread.rgb,
-                                     emissive_spread.a, object);
+                                     emissive_spread.a, object, t);
     vec3 color = shade_point(world, n, m, frag_xy);
     float alpha = unpackUnorm2x16(b.z).y;
     if (MATERIAL_LOBES) {
         if (m.coat.w > 0.0) {
             // Transmission: its covered share lets through what lobed_transmittance says.
-            vec3 t = lobed_transmittance(n, toward_eye(world), m.albedo, m.metallic, m.specular, m.coat, o.lobes[3].rgb);
-            uvec3 q = uvec3(round(clamp(1.0 - alpha + alpha * t, 0.0, 1.0) * 1023.0));
-            layer_nodes[2u * node + 1u] = uvec4(floatBitsToUint(color * alpha), LAYER_TRANSMITS | q.r | q.g << 10 | q.b << 20);
+            // The volume's transmittance over the object's thickness, to the power of the
+            // thickness texel (colour^(thickness·texel / distance)).
+            vec3 volume = pow(o.lobes[3].rgb, vec3(m.thickness));
+            vec3 coat_n = LOBE_TEXTURES ? m.coat_normal : n;
+            vec3 through = lobed_transmittance(n, toward_eye(world), m.albedo, m.metallic, m.specular, m.coat, coat_n, volume);
+            uvec3 q = uvec3(round(clamp(1.0 - alpha + alpha * through, 0.0, 1.0) * 1023.0));
+            layer_nodes[LAYER_NODE_WORDS * node + 1u] = uvec4(floatBitsToUint(color * alpha), LAYER_TRANSMITS | q.r | q.g << 10 | q.b << 20);
             return;
         }
     }
-    layer_nodes[2u * node + 1u] = uvec4(floatBitsToUint(color), floatBitsToUint(alpha));
+    layer_nodes[LAYER_NODE_WORDS * node + 1u] = uvec4(floatBitsToUint(color), floatBitsToUint(alpha));
 }
 
 #endif
@@ -185,7 +212,7 @@ SortedLayers sort_layers(ivec2 p) {
     vec3 weighted = vec3(0.0);
     uint capacity = layer_capacity();
     for (uint node = layer_heads[layer_pixel(p)]; node != LAYER_END && count < capacity; count++) {
-        uvec4 a = layer_nodes[2u * node];
+        uvec4 a = layer_nodes[LAYER_NODE_WORDS * node];
         uvec2 key = a.xz;
         uint merged_node = LAYER_END;
         if (hi - lo == LAYER_KEEP) {

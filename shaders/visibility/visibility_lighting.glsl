@@ -105,8 +105,9 @@ void surface_of(ivec2 p, uint id, vec2 frag_xy, float z, out vec3 world, out vec
     }
     vec4 tangent = mat4(v[0].tangent, v[1].tangent, v[2].tangent, vec4(0.0)) * vec4(b, 0.0);
     tangent.xyz = mat3(o.model) * tangent.xyz;
-    Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material);
-    m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, s.emissive_factor, s.normal_spread, object);
+    Surface s = surface_at(normal, tangent, uv, inst.surface.x, o.material, object);
+    m = point_material(o.albedo_roughness, o.material, o.emissive, vec4(s.albedo_factor, s.occlusion), s.roughness_metallic, s.emissive_factor, s.normal_spread,
+                       object, s.lobes);
     world = world_from_depth(frag_xy, z);
     n = s.normal;
     flags = o.alpha_texture.x;

@@ -788,7 +788,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     (settings.antialiasing, aa_why) = auto::resolve_antialiasing(&ctx, &settings, aa_choice, (built.scene.lights.len(), cmd.supersample));
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
-    let (lights, object_textures) = (built.scene.lights.len(), !built.scene.textures.is_empty());
+    let (lights, gbuffer) = (built.scene.lights.len(), settings.lighting(&built.scene).gbuffer_kind());
     let directional = built.scene.directional.len();
     let camera = camera_line(&built.scene);
     // A sequence renders from its first frame to write, each frame at its own clock — from
@@ -823,7 +823,7 @@ fn render(cmd: &RenderArgs) -> Result<()> {
         settings: &settings,
         lights,
         directional,
-        object_textures,
+        gbuffer,
         auto: auto_why.as_deref(),
         raster_auto: raster_why.as_deref(),
         aa_auto: aa_why.as_deref(),

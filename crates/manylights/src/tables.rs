@@ -3,7 +3,7 @@
 
 use ml_render::report::FrameStats;
 use ml_render::settings::{DebugView, Geometry, LargeTriangles, Raster, RenderSettings};
-use ml_render::{gbuffer_bytes_per_pixel, gbuffer_images};
+use ml_render::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferKind};
 use ml_vk::DeviceInfo;
 use std::path::Path;
 
@@ -29,8 +29,9 @@ pub struct RenderFacts<'a> {
     pub lights: usize,
     /// Directional lights of the scene.
     pub directional: usize,
-    /// Whether the scene's objects have textures of their own (they widen the G-buffer).
-    pub object_textures: bool,
+    /// Which images the scene's G-buffer has (textures of objects' own and PBR extensions
+    /// varying per point widen it).
+    pub gbuffer: GBufferKind,
     /// Why `auto` picked the technique; None where it was asked for by name.
     pub auto: Option<&'a str>,
     /// Why `--raster auto` picked the rasteriser; None where it was asked for by name.
@@ -100,7 +101,7 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             rows.push(("anti-aliasing", "off (one sample a pixel, at its centre)".to_owned()));
         }
     } else if technique.lights_in_subpass() || technique.lights_in_compute() {
-        rows.push(("g-buffer", gbuffer_line(facts.object_textures, stats.gbuffer_lazily_allocated)));
+        rows.push(("g-buffer", gbuffer_line(facts.gbuffer, stats.gbuffer_lazily_allocated)));
     }
     // What the features' passes counted (the culling, the shadow raster, the atlas).
     rows.extend(stats.feature_rows());
@@ -214,14 +215,14 @@ fn peak_resident_kib() -> Option<u64> {
 
 /// The G-buffer of a scene (with object textures or not): its size, its images, and whether
 /// it got lazily allocated memory (None: it lives outside a render pass).
-fn gbuffer_line(object_textures: bool, lazily_allocated: Option<bool>) -> String {
+fn gbuffer_line(kind: GBufferKind, lazily_allocated: Option<bool>) -> String {
     let memory = match lazily_allocated {
         Some(true) => "; transient, lazily allocated",
         Some(false) => "; transient (this device has no lazily allocated memory)",
         None => "",
     };
-    let layout: Vec<&str> = gbuffer_images(object_textures).iter().map(|g| g.layout).collect();
-    format!("{} bytes/pixel + depth ({}){memory}", gbuffer_bytes_per_pixel(object_textures), layout.join(", "))
+    let layout: Vec<&str> = gbuffer_images(kind).iter().map(|g| g.layout).collect();
+    format!("{} bytes/pixel + depth ({}){memory}", gbuffer_bytes_per_pixel(kind), layout.join(", "))
 }
 
 /// The rows `info` prints for a device: what it is and the limits manylights depends on.
@@ -267,7 +268,7 @@ mod tests {
             settings: &settings,
             lights: 5,
             directional: 0,
-            object_textures: false,
+            gbuffer: GBufferKind::Base,
             auto: None,
             raster_auto: None,
             aa_auto: None,
@@ -306,7 +307,7 @@ mod tests {
             value(&rows, "g-buffer"),
             "16 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo (sRGB)-occlusion RGBA8); transient, lazily allocated"
         );
-        facts.object_textures = true;
+        facts.gbuffer = GBufferKind::Material;
         facts.auto = Some("it was faster");
         let rows = render_rows(&facts, &stats);
         assert!(value(&rows, "g-buffer").starts_with("22 bytes/pixel + depth (octahedral normal 2×f32, object index u32, albedo (sRGB)-occlusion RGBA8, roughness-metallic RG8, emissive RGBA8)"));

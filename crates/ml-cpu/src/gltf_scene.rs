@@ -21,7 +21,9 @@ use crate::gpu_types::{LightCone, PointLight};
 use crate::limits::{LENGTHS, MAX_COORDINATE, MAX_INTENSITY, MAX_OBJECTS, SCALES};
 use crate::material::Material;
 use crate::mesh::{compute_tangents, Mesh, MeshKind, Vertex};
-use crate::scene::{AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, MAX_DIRECTIONAL_LIGHTS};
+use crate::scene::{
+    AlphaMode, DirectionalLight, MaterialExtras, Object, ObjectTextures, Scene, FIRST_LOBE_SLOT, MAX_DIRECTIONAL_LIGHTS, TEXTURE_SLOTS,
+};
 use crate::scene_load::{check_draw_work, check_extent, read_reference, DrawWorkError, ExtentError, ReferenceError, SceneFile};
 use crate::textures::{Filter, TextureImage, TextureSampler, Wrap};
 use crate::twin_faces;
@@ -300,6 +302,8 @@ pub enum GltfError {
     Ior { material: MaterialName, value: f32 },
     #[error("material {material}: {field} is {value}; it must be {}", describe_range(range))]
     ExtensionFactor { material: MaterialName, field: &'static str, value: String, range: std::ops::RangeInclusive<f32> },
+    #[error("material {material}: {field} {why}")]
+    ExtensionTexture { material: MaterialName, field: &'static str, why: String },
     #[error("material {material}: emissive strength {} must be finite, not negative and at most {}", Number(*value), Number(MAX_INTENSITY))]
     EmissiveStrength { material: MaterialName, value: f32 },
     #[error("its buffer view does not exist")]
@@ -449,7 +453,6 @@ pub fn from_bytes_as(bytes: &[u8], base: Option<&Path>, variant: Option<&str>) -
         vertices: 0,
         warnings: unread.into_iter().map(|e| format!("extension {e} is not supported; the file is read without it")).collect(),
         mixed_transforms: Default::default(),
-        unread_textures: Default::default(),
     };
     builder.warnings.extend(motion_left_out(&gltf.document));
     let parents = node_parents(&gltf.document)?;
@@ -484,13 +487,7 @@ pub fn from_bytes_as(bytes: &[u8], base: Option<&Path>, variant: Option<&str>) -
     if builder.objects.is_empty() {
         return Err(GltfError::NoTriangles);
     }
-    let Builder {
-        objects, lights, camera, meshes, mut warnings, textures, directional, mut cones, mixed_transforms, unread_textures, ..
-    } = builder;
-    for (name, unread) in unread_textures {
-        let textures = if unread.len() == 1 { "texture is" } else { "textures are" };
-        warnings.push(format!("material {name}: its {} {textures} not read; the factors apply alone", unread.join(", ")));
-    }
+    let Builder { objects, lights, camera, meshes, mut warnings, textures, directional, mut cones, mixed_transforms, .. } = builder;
     if !mixed_transforms.is_empty() {
         let names: Vec<String> = mixed_transforms.into_iter().collect();
         warnings.push(format!(
@@ -834,7 +831,6 @@ struct Builder<'a> {
     /// The materials whose textures carry different texture transforms, by name.
     mixed_transforms: std::collections::BTreeSet<String>,
     /// Extension textures left out, by material name.
-    unread_textures: std::collections::BTreeMap<String, Vec<&'static str>>,
     /// The material variant drawn (KHR_materials_variants), if one was asked for.
     variant: Option<usize>,
 }
@@ -848,7 +844,7 @@ impl Builder<'_> {
                 let Some(parts) = self.primitive(&mesh, &primitive, m.double_sided()).map_err(|e| e.within(what))? else {
                     continue;
                 };
-                let (material, mut extras, mixed, unread) = material(&m).map_err(|e| e.within(what))?;
+                let (material, mut extras, mixed, lobe_textures) = material(&m, self.doc.textures().len()).map_err(|e| e.within(what))?;
                 // The volume's thickness from the mesh's units to the world's: the node's mean
                 // scale (the cube root of its volume's scale).
                 extras.lobes.thickness *= glam::Mat3::from_mat4(world).determinant().abs().cbrt();
@@ -859,10 +855,7 @@ impl Builder<'_> {
                 if mixed {
                     self.mixed_transforms.insert(named());
                 }
-                if !unread.is_empty() {
-                    self.unread_textures.insert(named(), unread);
-                }
-                let textures = self.object_textures(&m).map_err(|e| e.within(what))?;
+                let textures = self.object_textures(&m, &lobe_textures).map_err(|e| e.within(what))?;
                 for part in parts {
                     if self.objects.len() == MAX_OBJECTS {
                         return Err(GltfError::TooManyPrimitives);
@@ -979,8 +972,9 @@ impl Builder<'_> {
         Ok(Some(parts))
     }
 
-    /// The material's textures (first texture coordinates) with their samplers.
-    fn object_textures(&mut self, m: &gltf::Material) -> Result<ObjectTextures, GltfError> {
+    /// The material's textures (first texture coordinates) with their samplers, its
+    /// extensions' (`lobes`) among them.
+    fn object_textures(&mut self, m: &gltf::Material, lobes: &LobeTextureRefs) -> Result<ObjectTextures, GltfError> {
         let name = MaterialName(m.index());
         let pbr = m.pbr_metallic_roughness();
         let base_color = pbr.base_color_texture().map(|t| (t.texture(), t.tex_coord()));
@@ -988,6 +982,7 @@ impl Builder<'_> {
         let normal = m.normal_texture().map(|t| (t.texture(), t.tex_coord()));
         let occlusion = m.occlusion_texture().map(|t| (t.texture(), t.tex_coord()));
         let emissive = m.emissive_texture().map(|t| (t.texture(), t.tex_coord()));
+        let doc = self.doc;
         let mut slot = |what: &'static str, texture: Option<(gltf::Texture, u32)>, texels: Texels| -> Result<Option<u32>, GltfError> {
             let Some((texture, set)) = texture else { return Ok(None) };
             if set != 0 {
@@ -1006,13 +1001,26 @@ impl Builder<'_> {
                 },
             }
         };
-        Ok(ObjectTextures {
-            base_color: slot("base colour", base_color, Texels::Colour)?,
-            normal: slot("normal", normal, Texels::UnitNormals)?,
-            metallic_roughness: slot("metallic-roughness", metallic_roughness, Texels::Data)?,
-            occlusion: slot("occlusion", occlusion, Texels::Data)?,
-            emissive: slot("emissive", emissive, Texels::Colour)?,
-        })
+        let mut slots = [None; TEXTURE_SLOTS];
+        slots[..FIRST_LOBE_SLOT].copy_from_slice(&[
+            slot("base colour", base_color, Texels::Colour)?,
+            slot("normal", normal, Texels::UnitNormals)?,
+            slot("metallic-roughness", metallic_roughness, Texels::Data)?,
+            slot("occlusion", occlusion, Texels::Data)?,
+            slot("emissive", emissive, Texels::Colour)?,
+        ]);
+        // The extensions' textures (their indices checked against the file's textures): the
+        // colours sRGB, the clear coat's normal map unit normals.
+        for (i, (r, (_, what))) in lobes.iter().zip(LOBE_TEXTURE_FIELDS).enumerate() {
+            let texels = match what {
+                "sheen colour" | "specular colour" => Texels::Colour,
+                "clearcoat normal" => Texels::UnitNormals,
+                _ => Texels::Data,
+            };
+            let texture = r.and_then(|r| doc.textures().nth(r.index).map(|t| (t, r.tex_coord)));
+            slots[FIRST_LOBE_SLOT + i] = slot(what, texture, texels)?;
+        }
+        Ok(ObjectTextures::from_slots(slots))
     }
 
     /// A glTF texture: its image decoded to RGBA8 (once per way its texels are read) with its
@@ -1174,10 +1182,11 @@ fn decode_image(bytes: &[u8], srgb: bool) -> Result<TextureImage, GltfError> {
 }
 
 /// glTF's metallic-roughness factors, and its emissive factor (times
-/// KHR_materials_emissive_strength), normal scale, occlusion strength, alpha mode, sides and
-/// texture transform; and whether its textures carry different transforms (one is used: the
-/// base colour's, else the first textured slot's).
-fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool, Vec<&'static str>), GltfError> {
+/// KHR_materials_emissive_strength), normal scale, occlusion strength, alpha mode, sides,
+/// extensions and texture transform; whether its textures carry different transforms (one is
+/// used: the base colour's, else the first textured slot's); the textures its extensions name
+/// (in a file of `textures` textures).
+fn material(m: &gltf::Material, textures: usize) -> Result<(Material, MaterialExtras, bool, LobeTextureRefs), GltfError> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, a] = pbr.base_color_factor();
     let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
@@ -1221,17 +1230,18 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool, Vec<&
         gltf::material::AlphaMode::Blend => AlphaMode::Blend,
     };
     let pbr = m.pbr_metallic_roughness();
+    let (lobes, lobe_textures) = material_extensions::material_lobes(m, textures)?;
     let transforms: Vec<Affine2> = [pbr.base_color_texture(), pbr.metallic_roughness_texture(), m.emissive_texture()]
         .iter()
         .flatten()
         .map(texture_transform)
+        .chain(lobe_textures.iter().flatten().map(|t| t.transform))
         .collect();
     let uv_transform = transforms.first().copied().unwrap_or(Affine2::IDENTITY);
     if !uv_transform.is_finite() {
         return Err(GltfError::TextureTransform { material });
     }
     let mixed = transforms.iter().any(|t| *t != uv_transform);
-    let (lobes, unread) = material_extensions::material_lobes(m)?;
     let extras = MaterialExtras {
         uv_transform,
         emissive: Vec3::new(er, eg, eb) * emissive_strength,
@@ -1242,7 +1252,7 @@ fn material(m: &gltf::Material) -> Result<(Material, MaterialExtras, bool, Vec<&
         double_sided: m.double_sided(),
         lobes,
     };
-    Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras, mixed, unread))
+    Ok((Material { albedo: Vec3::new(r, g, b), roughness, metallic }, extras, mixed, lobe_textures))
 }
 
 /// A texture's KHR_texture_transform as the affine map of texture coordinates it is:
@@ -1514,6 +1524,7 @@ fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor, vertices: usize)
 }
 
 mod material_extensions;
+use material_extensions::{LobeTextureRefs, LOBE_TEXTURE_FIELDS};
 mod material_variants;
 
 #[cfg(test)]

@@ -44,6 +44,37 @@ pub struct MaterialLobes {
     pub attenuation_color: Vec3,
     pub attenuation_distance: f32,
     pub thickness: f32,
+    /// Scales the clear coat's normal map's tangent-space x and y.
+    pub clearcoat_normal_scale: f32,
+}
+
+/// What an object's extension textures (`ObjectTextures`) give at a point, each multiplying
+/// its factor (1: no texture).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LobeTexels {
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
+    pub sheen_color: Vec3,
+    pub sheen_roughness: f32,
+    pub specular: f32,
+    pub specular_color: Vec3,
+    pub transmission: f32,
+    pub thickness: f32,
+}
+
+impl Default for LobeTexels {
+    fn default() -> LobeTexels {
+        LobeTexels {
+            clearcoat: 1.0,
+            clearcoat_roughness: 1.0,
+            sheen_color: Vec3::ONE,
+            sheen_roughness: 1.0,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+            transmission: 1.0,
+            thickness: 1.0,
+        }
+    }
 }
 
 impl Default for MaterialLobes {
@@ -61,6 +92,7 @@ impl Default for MaterialLobes {
             attenuation_color: Vec3::ONE,
             attenuation_distance: f32::INFINITY,
             thickness: 0.0,
+            clearcoat_normal_scale: 1.0,
         }
     }
 }
@@ -75,8 +107,30 @@ impl MaterialLobes {
     /// A dielectric's reflectance at normal incidence: F₀ of the index of refraction times the
     /// specular colour, at most 1.
     pub fn dielectric_f0(&self) -> Vec3 {
+        self.dielectric_f0_unclamped().min(Vec3::ONE)
+    }
+
+    /// F₀ of the index of refraction times the specular colour, as the object buffer keeps it
+    /// (the shaders clamp it after the specular colour texture's texel multiplies it).
+    fn dielectric_f0_unclamped(&self) -> Vec3 {
         let r = (self.ior - 1.0) / (self.ior + 1.0);
-        (r * r * self.specular_color).min(Vec3::ONE)
+        r * r * self.specular_color
+    }
+
+    /// These lobes at a point where the extension textures give `t`: each factor times its
+    /// texel (the shaders' point_material does the same).
+    pub fn textured(&self, t: &LobeTexels) -> MaterialLobes {
+        MaterialLobes {
+            clearcoat: self.clearcoat * t.clearcoat,
+            clearcoat_roughness: self.clearcoat_roughness * t.clearcoat_roughness,
+            sheen_color: self.sheen_color * t.sheen_color,
+            sheen_roughness: self.sheen_roughness * t.sheen_roughness,
+            specular: self.specular * t.specular,
+            specular_color: self.specular_color * t.specular_color,
+            transmission: self.transmission * t.transmission,
+            thickness: self.thickness * t.thickness,
+            ..*self
+        }
     }
 
     /// A dielectric's Fresnel reflectance at Schlick's weight `fc` = (1 − n·v)⁵, scaled by the
@@ -96,14 +150,15 @@ impl MaterialLobes {
         self.attenuation_color.powf(self.thickness / self.attenuation_distance)
     }
 
-    /// ObjectData::lobes: (dielectric F₀, specular factor), (clear coat, its roughness,
-    /// unlit, transmission), (sheen colour, sheen roughness), (volume transmittance, 0).
+    /// ObjectData::lobes: (dielectric F₀ before its clamp to 1, specular factor), (clear coat,
+    /// its roughness, unlit, transmission), (sheen colour, sheen roughness), (volume
+    /// transmittance over the whole thickness factor, clear coat normal scale).
     pub fn vectors(&self) -> [[f32; 4]; 4] {
         [
-            self.dielectric_f0().extend(self.specular).to_array(),
+            self.dielectric_f0_unclamped().extend(self.specular).to_array(),
             [self.clearcoat, self.clearcoat_roughness, f32::from(u8::from(self.unlit)), self.transmission],
             self.sheen_color.extend(self.sheen_roughness).to_array(),
-            self.volume_transmittance().extend(0.0).to_array(),
+            self.volume_transmittance().extend(self.clearcoat_normal_scale).to_array(),
         ]
     }
 }
@@ -191,9 +246,10 @@ pub fn sheen_albedo(n_dot_v: f32, roughness: f32) -> f32 {
 /// behind the surface): F = mix(specular·Schlick(dielectric F₀), Schlick(albedo), metallic),
 /// Lambert diffuse weighted by (1 − F)(1 − metallic)(1 − transmission) plus GGX specular; the
 /// sheen's lobe with the base scaled by 1 − max(sheen)·E at the view and the light; the clear
-/// coat's GGX lobe (F₀ 0.04) over the base scaled by 1 − coat·F_coat.
-pub fn lobed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material, lobes: &MaterialLobes) -> Vec3 {
-    let Some(LightAt { n_dot_v, n_dot_l, n_dot_h, radiance }) = light_at(light, p, n, v) else { return Vec3::ZERO };
+/// coat's GGX lobe (F₀ 0.04) over the base scaled by 1 − coat·F_coat, the coat's cosines (and
+/// its Fresnel term) taken about its own normal `coat_n`.
+pub fn lobed_point_light(light: &PointLight, p: Vec3, (n, coat_n): (Vec3, Vec3), v: Vec3, m: &Material, lobes: &MaterialLobes) -> Vec3 {
+    let Some(LightAt { n_dot_v, n_dot_l, n_dot_h, radiance, l, h, falloff }) = light_at(light, p, n, v) else { return Vec3::ZERO };
     let fc = (1.0 - n_dot_v).powf(5.0);
     let f_dielectric = lobes.dielectric_fresnel(fc);
     let f_metal = m.albedo + (Vec3::ONE - m.albedo) * fc;
@@ -207,12 +263,15 @@ pub fn lobed_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Mate
         base *= (1.0 - sheen_max * sheen_albedo(n_dot_v, r)).min(1.0 - sheen_max * sheen_albedo(n_dot_l, r));
         base += lobes.sheen_color * d_charlie(n_dot_h, r) * v_charlie(n_dot_l, n_dot_v, r);
     }
-    if lobes.clearcoat > 0.0 {
-        let r = lobes.clearcoat_roughness;
-        let f_coat = coat_fresnel(n_dot_v, lobes.clearcoat);
-        base = base * (1.0 - f_coat) + Vec3::splat(f_coat * d_ggx(n_dot_h, r) * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, r.max(0.05)));
+    let color = Vec3::from_slice(&light.color[..3]);
+    if lobes.clearcoat <= 0.0 {
+        return base * color * radiance;
     }
-    base * Vec3::from_slice(&light.color[..3]) * radiance
+    let r = lobes.clearcoat_roughness;
+    let (coat_v, coat_l, coat_h) = (coat_n.dot(v).clamp(0.0, 1.0), coat_n.dot(l).clamp(0.0, 1.0), coat_n.dot(h).clamp(0.0, 1.0));
+    let f_coat = coat_fresnel(coat_v, lobes.clearcoat);
+    let coat = if coat_l > 0.0 { f_coat * d_ggx(coat_h, r) * g_schlick_smith_over_4nlnv(coat_l, coat_v, r.max(0.05)) } else { 0.0 };
+    (base * (1.0 - f_coat) * radiance + Vec3::splat(coat * falloff * coat_l)) * color
 }
 
 /// The clear coat's Fresnel reflectance at n·v (F₀ 0.04), times its strength.
@@ -225,17 +284,17 @@ pub fn coat_transmittance(n_dot_v: f32, clearcoat: f32) -> f32 {
     1.0 - coat_fresnel(n_dot_v.clamp(0.0, 1.0), clearcoat)
 }
 
-/// What a surface with `lobes` lets through of the light behind it, seen at `n_dot_v`:
-/// transmission × (1 − metallic) × base colour × (1 − F) of the dielectric's Fresnel term,
-/// × 1 − coat·F_coat, × the volume's transmittance — the share its light scatters diffusely
-/// without transmission (zero for none).
-pub fn lobed_transmittance(n_dot_v: f32, m: &Material, lobes: &MaterialLobes) -> Vec3 {
+/// What a surface with `lobes` lets through of the light behind it, seen at `n_dot_v` (and
+/// `coat_n_dot_v` about the coat's normal): transmission × (1 − metallic) × base colour ×
+/// (1 − F) of the dielectric's Fresnel term, × 1 − coat·F_coat, × the volume's transmittance
+/// — the share its light scatters diffusely without transmission (zero for none).
+pub fn lobed_transmittance((n_dot_v, coat_n_dot_v): (f32, f32), m: &Material, lobes: &MaterialLobes) -> Vec3 {
     if lobes.transmission <= 0.0 {
         return Vec3::ZERO;
     }
     let n_dot_v = n_dot_v.clamp(0.0, 1.0);
     let f_dielectric = lobes.dielectric_fresnel((1.0 - n_dot_v).powf(5.0));
-    let through = lobes.transmission * (1.0 - m.metallic) * coat_transmittance(n_dot_v, lobes.clearcoat);
+    let through = lobes.transmission * (1.0 - m.metallic) * coat_transmittance(coat_n_dot_v, lobes.clearcoat);
     (Vec3::ONE - f_dielectric) * m.albedo * lobes.volume_transmittance() * through
 }
 
@@ -245,7 +304,7 @@ pub fn lobed_transmittance(n_dot_v: f32, m: &Material, lobes: &MaterialLobes) ->
 /// surface's albedo.
 pub fn shade_lobed(
     p: Vec3,
-    n: Vec3,
+    (n, coat_n): (Vec3, Vec3),
     eye: Vec3,
     (m, lobes): (&Material, &MaterialLobes),
     lights: &[PointLight],
@@ -256,8 +315,8 @@ pub fn shade_lobed(
         return m.albedo;
     }
     let v = (eye - p).normalize();
-    let lo: Vec3 = lights.iter().map(|l| lobed_point_light(l, p, n, v, m, lobes)).sum();
-    let under_coat = coat_transmittance(n.dot(v), lobes.clearcoat);
+    let lo: Vec3 = lights.iter().map(|l| lobed_point_light(l, p, (n, coat_n), v, m, lobes)).sum();
+    let under_coat = coat_transmittance(coat_n.dot(v), lobes.clearcoat);
     m.albedo * ambient * (1.0 - lobes.transmission) * under_coat + lo + emission * under_coat
 }
 
@@ -275,7 +334,7 @@ mod tests {
         for (metallic, roughness) in [(0.0, 0.3), (1.0, 0.6), (0.4, 0.9)] {
             let m = Material { albedo: Vec3::new(0.8, 0.5, 0.2), roughness, metallic };
             let plain = crate::shading::pbr_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &m);
-            let lobed = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &m, &MaterialLobes::default());
+            let lobed = lobed_point_light(&light_above(), Vec3::ZERO, (Vec3::Y, Vec3::Y), v, &m, &MaterialLobes::default());
             assert!((plain - lobed).abs().max_element() < 1e-5 * plain.max_element().max(1.0), "{plain} vs {lobed}");
         }
         assert!(!MaterialLobes::default().any());
@@ -286,14 +345,14 @@ mod tests {
     fn each_lobe_changes_the_light() {
         let m = Material { albedo: Vec3::new(0.8, 0.5, 0.2), roughness: 0.7, metallic: 0.0 };
         let v = Vec3::new(-0.7, 0.3, 0.1).normalize();
-        let plain = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &m, &MaterialLobes::default());
+        let plain = lobed_point_light(&light_above(), Vec3::ZERO, (Vec3::Y, Vec3::Y), v, &m, &MaterialLobes::default());
         for lobes in [
             MaterialLobes { ior: 1.0, ..Default::default() },
             MaterialLobes { specular: 0.2, specular_color: Vec3::new(2.0, 0.5, 0.5), ..Default::default() },
             MaterialLobes { clearcoat: 1.0, clearcoat_roughness: 0.1, ..Default::default() },
             MaterialLobes { sheen_color: Vec3::new(0.9, 0.2, 0.6), sheen_roughness: 0.5, ..Default::default() },
         ] {
-            let lit = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &m, &lobes);
+            let lit = lobed_point_light(&light_above(), Vec3::ZERO, (Vec3::Y, Vec3::Y), v, &m, &lobes);
             assert!((lit - plain).abs().max_element() > 1e-3, "{lobes:?}: {lit} vs {plain}");
         }
     }
@@ -304,21 +363,21 @@ mod tests {
         let v = Vec3::new(-0.4, 0.8, 0.3).normalize();
         let glass = MaterialLobes { transmission: 1.0, ..Default::default() };
         // All of the diffuse light goes: what is left is the specular light, as of a black base.
-        let lit = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &m, &glass);
+        let lit = lobed_point_light(&light_above(), Vec3::ZERO, (Vec3::Y, Vec3::Y), v, &m, &glass);
         let black = Material { albedo: Vec3::ZERO, ..m };
-        let specular = lobed_point_light(&light_above(), Vec3::ZERO, Vec3::Y, v, &black, &MaterialLobes::default());
+        let specular = lobed_point_light(&light_above(), Vec3::ZERO, (Vec3::Y, Vec3::Y), v, &black, &MaterialLobes::default());
         assert!((lit - specular).abs().max_element() < 1e-6, "{lit} vs {specular}");
-        assert_eq!(shade_lobed(Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 3.0, 0.0), (&m, &glass), &[], 0.5, Vec3::ZERO), Vec3::ZERO);
+        assert_eq!(shade_lobed(Vec3::ZERO, (Vec3::Y, Vec3::Y), Vec3::new(0.0, 3.0, 0.0), (&m, &glass), &[], 0.5, Vec3::ZERO), Vec3::ZERO);
         // Head on, a dielectric of F₀ 0.04 lets 96 % of the base colour through; a volume of
         // one attenuation distance tints it once more; a metal or none lets nothing through.
-        assert!(lobed_transmittance(1.0, &m, &glass).abs_diff_eq(0.96 * m.albedo, 1e-6));
+        assert!(lobed_transmittance((1.0, 1.0), &m, &glass).abs_diff_eq(0.96 * m.albedo, 1e-6));
         let tinted = MaterialLobes { attenuation_color: Vec3::new(1.0, 0.5, 0.5), attenuation_distance: 2.0, thickness: 2.0, ..glass };
-        assert!(lobed_transmittance(1.0, &m, &tinted).abs_diff_eq(0.96 * m.albedo * Vec3::new(1.0, 0.5, 0.5), 1e-6));
+        assert!(lobed_transmittance((1.0, 1.0), &m, &tinted).abs_diff_eq(0.96 * m.albedo * Vec3::new(1.0, 0.5, 0.5), 1e-6));
         assert!(tinted.any() && glass.vectors()[1][3] == 1.0 && tinted.vectors()[3][1] == 0.5);
-        assert_eq!(lobed_transmittance(1.0, &Material { metallic: 1.0, ..m }, &glass), Vec3::ZERO);
-        assert_eq!(lobed_transmittance(1.0, &m, &MaterialLobes::default()), Vec3::ZERO);
+        assert_eq!(lobed_transmittance((1.0, 1.0), &Material { metallic: 1.0, ..m }, &glass), Vec3::ZERO);
+        assert_eq!(lobed_transmittance((1.0, 1.0), &m, &MaterialLobes::default()), Vec3::ZERO);
         // Grazing, Fresnel reflects everything: nothing passes.
-        assert!(lobed_transmittance(0.0, &m, &glass).max_element() < 1e-6);
+        assert!(lobed_transmittance((0.0, 0.0), &m, &glass).max_element() < 1e-6);
     }
 
     #[test]

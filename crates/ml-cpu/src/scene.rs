@@ -40,16 +40,56 @@ pub struct ObjectTextures {
     pub occlusion: Option<u32>,
     /// Multiplies `MaterialExtras::emissive` (sRGB).
     pub emissive: Option<u32>,
+    /// The extensions' textures (`MaterialLobes`), each multiplying its factor (linear but
+    /// where said): the clear coat's strength (red) and roughness (green) and its own normal
+    /// map (without one the coat follows the mesh's normal, not the base's map).
+    pub clearcoat: Option<u32>,
+    pub clearcoat_roughness: Option<u32>,
+    pub clearcoat_normal: Option<u32>,
+    /// The sheen's colour (sRGB) and roughness (alpha).
+    pub sheen_color: Option<u32>,
+    pub sheen_roughness: Option<u32>,
+    /// The dielectric's specular strength (alpha) and colour (sRGB).
+    pub specular: Option<u32>,
+    pub specular_color: Option<u32>,
+    /// Transmission (red) and the volume's thickness (green).
+    pub transmission: Option<u32>,
+    pub thickness: Option<u32>,
 }
 
 /// Number of texture slots of an object (`ObjectTextures::slots`).
-pub const TEXTURE_SLOTS: usize = 5;
+pub const TEXTURE_SLOTS: usize = 14;
+
+/// The slots of the extensions' textures, from the clear coat's on (`ObjectTextures::slots`).
+pub const FIRST_LOBE_SLOT: usize = 5;
 
 impl ObjectTextures {
     /// The slots in binding order (object_textures.rs, surface.glsl): base colour, normal,
-    /// metallic-roughness, occlusion, emissive.
+    /// metallic-roughness, occlusion, emissive, then the extensions' (FIRST_LOBE_SLOT on):
+    /// clear coat, its roughness, its normal, sheen colour, sheen roughness, specular,
+    /// specular colour, transmission, thickness.
     pub fn slots(&self) -> [Option<u32>; TEXTURE_SLOTS] {
-        [self.base_color, self.normal, self.metallic_roughness, self.occlusion, self.emissive]
+        [
+            self.base_color,
+            self.normal,
+            self.metallic_roughness,
+            self.occlusion,
+            self.emissive,
+            self.clearcoat,
+            self.clearcoat_roughness,
+            self.clearcoat_normal,
+            self.sheen_color,
+            self.sheen_roughness,
+            self.specular,
+            self.specular_color,
+            self.transmission,
+            self.thickness,
+        ]
+    }
+
+    /// Whether any of the extensions' textures is there.
+    pub fn any_lobe_texture(&self) -> bool {
+        self.slots()[FIRST_LOBE_SLOT..].iter().any(Option::is_some)
     }
 
     /// Bit i set where slot i holds a texture (what the shaders test).
@@ -59,8 +99,29 @@ impl ObjectTextures {
 
     /// Every texture index changed by `f`.
     pub fn map(self, f: impl Fn(u32) -> u32) -> ObjectTextures {
-        let [base_color, normal, metallic_roughness, occlusion, emissive] = self.slots().map(|s| s.map(&f));
-        ObjectTextures { base_color, normal, metallic_roughness, occlusion, emissive }
+        ObjectTextures::from_slots(self.slots().map(|s| s.map(&f)))
+    }
+
+    /// The textures of `slots`, in `slots`' order.
+    pub fn from_slots(slots: [Option<u32>; TEXTURE_SLOTS]) -> ObjectTextures {
+        let [base_color, normal, metallic_roughness, occlusion, emissive, clearcoat, clearcoat_roughness, clearcoat_normal, sheen_color, sheen_roughness, specular, specular_color, transmission, thickness] =
+            slots;
+        ObjectTextures {
+            base_color,
+            normal,
+            metallic_roughness,
+            occlusion,
+            emissive,
+            clearcoat,
+            clearcoat_roughness,
+            clearcoat_normal,
+            sheen_color,
+            sheen_roughness,
+            specular,
+            specular_color,
+            transmission,
+            thickness,
+        }
     }
 }
 
@@ -232,6 +293,13 @@ impl Scene {
     /// transmission).
     pub fn has_transparent_objects(&self) -> bool {
         self.objects.iter().any(|o| o.extras.transparent())
+    }
+
+    /// Whether some object's PBR extensions vary over its surface: textures of theirs, or a
+    /// clear coat over a normal map (the coat keeps the mesh's normal, the base takes the
+    /// map's), so the lighting needs them per point, not per object.
+    pub fn has_lobe_textures(&self) -> bool {
+        self.objects.iter().any(|o| o.textures.any_lobe_texture() || (o.extras.lobes.clearcoat > 0.0 && o.textures.normal.is_some()))
     }
 
     /// The built-in `seed` scene (docs/DESIGN.md#the-seed-scene): a 7×7 grid of one object kind at

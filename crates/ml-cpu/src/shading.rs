@@ -33,6 +33,10 @@ pub(crate) struct LightAt {
     pub n_dot_l: f32,
     pub n_dot_h: f32,
     pub radiance: f32,
+    /// Towards the light, the half vector, and the falloff (1 − d/r)² alone.
+    pub l: Vec3,
+    pub h: Vec3,
+    pub falloff: f32,
 }
 
 /// Light `light` at point `p` (unit normal `n`, towards the eye `v`); None beyond its radius or
@@ -51,14 +55,23 @@ pub(crate) fn light_at(light: &PointLight, p: Vec3, n: Vec3, v: Vec3) -> Option<
         return None;
     }
     let atten = (1.0 - dist / radius).clamp(0.0, 1.0);
-    Some(LightAt { n_dot_v: n.dot(v).clamp(0.0, 1.0), n_dot_l, n_dot_h: n.dot(h).clamp(0.0, 1.0), radiance: atten * atten * n_dot_l })
+    let falloff = atten * atten;
+    Some(LightAt {
+        n_dot_v: n.dot(v).clamp(0.0, 1.0),
+        n_dot_l,
+        n_dot_h: n.dot(h).clamp(0.0, 1.0),
+        radiance: falloff * n_dot_l,
+        l,
+        h,
+        falloff,
+    })
 }
 
 /// One light's contribution under the seed's Cook–Torrance terms (exactly zero beyond its
 /// radius): the `seed` model (specular only, N·L twice) or, with `pbr`, the `pbr` model
 /// (Lambert diffuse weighted by (1 − F)(1 − metallic), N·L once) — cook_torrance_point_light.
 fn cook_torrance_point_light(light: &PointLight, p: Vec3, n: Vec3, v: Vec3, m: &Material, pbr: bool) -> Vec3 {
-    let Some(LightAt { n_dot_v, n_dot_l, n_dot_h, radiance }) = light_at(light, p, n, v) else { return Vec3::ZERO };
+    let Some(LightAt { n_dot_v, n_dot_l, n_dot_h, radiance, .. }) = light_at(light, p, n, v) else { return Vec3::ZERO };
     let f = f_schlick(n_dot_v, m.albedo, m.metallic);
     let spec = d_ggx(n_dot_h, m.roughness) * f * g_schlick_smith_over_4nlnv(n_dot_l, n_dot_v, m.roughness.max(0.05));
     let color = Vec3::from_slice(&light.color[..3]);

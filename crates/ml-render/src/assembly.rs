@@ -93,7 +93,10 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         }
         PassKind::ClusterAssignCpu => Box::<cluster_assign_cpu::CpuClusterAssign>::default(),
         PassKind::LightGridBuild { marked } => Box::new(LightGridBuild::new(ctx, a.lights, marked)?),
-        PassKind::LightGridMark { depth_buffer, layers } => Box::new(LightGridMark::new(ctx, (depth_buffer, aa), layers)?),
+        PassKind::LightGridMark { depth_buffer, layers } => {
+            let layers = layers.then(|| transparency().lobe_textures);
+            Box::new(LightGridMark::new(ctx, (depth_buffer, aa), layers)?)
+        }
         PassKind::Forward { lights, heat_legend } => {
             Box::new(forward::Forward::new(ctx, a.scene, raster, (lights, heat_legend), s.technique.name())?)
         }

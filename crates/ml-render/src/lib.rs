@@ -76,7 +76,7 @@ pub use settings::{
     TIMER_SPEED,
 };
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
-pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage};
+pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage, GBufferKind};
 pub use transparency::{
     TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,
     MAX_BUDGET as MAX_TRANSPARENCY_BUDGET,

@@ -149,6 +149,11 @@ impl<'a> Renderer<'a> {
         if !scene.has_transparent_objects() {
             settings.transparency = None;
         }
+        // Nodes that keep the PBR extensions' texels where they vary per point.
+        let lobe_textures = settings.lighting(&scene).lobe_textures;
+        if let Some(t) = &mut settings.transparency {
+            t.lobe_textures = lobe_textures;
+        }
         settings.check(ctx, scene.lights.len())?;
         settings.check_scene(&scene)?;
         let view = View::new(scene.camera, settings.width, settings.height);
@@ -331,7 +336,7 @@ impl<'a> Renderer<'a> {
         let ctx = self.ctx;
         let (extent, depth) = (self.extent, self.depth_format);
         let technique = self.settings.technique;
-        let gbuffer = crate::targets::gbuffer_images(!self.scene.textures.is_empty());
+        let gbuffer = crate::targets::gbuffer_images(self.settings.lighting(&self.scene).gbuffer_kind());
         let raster = self.settings.raster;
         let layers = self.settings.blends_layers();
         let cpu_lists = technique.has_cluster_grid();

@@ -278,6 +278,9 @@ impl RenderSettings {
             specular_aa: self.specular_aa,
             environment: self.shading == ShadingModel::Pbr && scene.environment.is_some(),
             material_lobes: self.shading == ShadingModel::Pbr && scene.objects.iter().any(|o| o.extras.lobes.any()),
+            lobe_textures: self.shading == ShadingModel::Pbr
+                && scene.objects.iter().any(|o| o.extras.lobes.any())
+                && scene.has_lobe_textures(),
             background: self.background,
         }
     }

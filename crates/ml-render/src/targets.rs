@@ -22,8 +22,12 @@ pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// base colours keep the 8-bit steps they have in the texture; stored linear, a dark texel of
 /// a model exposed several EV up moved the image by up to 6/255) — 16 B/pixel besides depth —
 /// then, only in scenes whose objects have textures of their own (`gbuffer_images`), the
-/// roughness and metallic factors (2 B) and the emissive factor (4 B, sRGB like its texture).
-pub const GBUFFER: [GBufferImage; 5] = [
+/// roughness and metallic factors (2 B) and the emissive factor (4 B, sRGB like its texture);
+/// then, only where the PBR extensions vary per point (`GBufferKind::Lobes`), their texels in
+/// one image (16 B; a subpass reads at most 8 input attachments on lavapipe): the clear coat's
+/// octahedral normal (snorm 2×16), its strength and roughness, transmission and thickness,
+/// the sheen's colour and roughness, the specular's colour and strength (unorm 4×8 each).
+pub const GBUFFER: [GBufferImage; 6] = [
     GBufferImage {
         key: "normal", name: "g-buffer normal", format: vk::Format::R32G32_SFLOAT, bytes: 8, layout: "octahedral normal 2×f32"
     },
@@ -43,7 +47,23 @@ pub const GBUFFER: [GBufferImage; 5] = [
         layout: "roughness-metallic RG8",
     },
     GBufferImage { key: "emissive", name: "g-buffer emissive", format: vk::Format::R8G8B8A8_SRGB, bytes: 4, layout: "emissive RGBA8" },
+    GBufferImage {
+        key: "lobes",
+        name: "g-buffer material lobes",
+        format: vk::Format::R32G32B32A32_UINT,
+        bytes: 16,
+        layout: "extensions' texels RGBA32UI",
+    },
 ];
+
+/// Which of GBUFFER's images a scene's G-buffer has: the first three; five, where objects
+/// have textures of their own; all, where their PBR extensions vary per point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GBufferKind {
+    Base,
+    Material,
+    Lobes,
+}
 
 pub struct GBufferImage {
     /// What the shaders call it (`normal_image`, `normal_input`: `normal`).
@@ -55,12 +75,15 @@ pub struct GBufferImage {
     /// What it holds and how, in a few words (the table `render` prints).
     pub layout: &'static str,
 }
-/// The G-buffer images of a scene: GBUFFER's first three, or all five where objects have
-/// textures of their own. The two more images cost scenes without textures even when left
-/// unwritten (write mask 0): the seed scene's G-buffer pass took 1.85 ms instead of 1.55 on
-/// the H100 (measured).
-pub fn gbuffer_images(object_textures: bool) -> &'static [GBufferImage] {
-    &GBUFFER[..if object_textures { GBUFFER.len() } else { GBUFFER.len() - 2 }]
+/// The G-buffer images of a scene of `kind`. Images a scene does not use cost it even when
+/// left unwritten (write mask 0): the seed scene's G-buffer pass took 1.85 ms instead of 1.55
+/// on the H100 with the material and emissive images (measured).
+pub fn gbuffer_images(kind: GBufferKind) -> &'static [GBufferImage] {
+    &GBUFFER[..match kind {
+        GBufferKind::Base => 3,
+        GBufferKind::Material => 5,
+        GBufferKind::Lobes => GBUFFER.len(),
+    }]
 }
 
 /// What the raster pass writes.
@@ -98,8 +121,8 @@ impl Output {
 }
 
 /// Bytes per pixel of a scene's G-buffer, depth excluded (the figure `render` prints).
-pub fn gbuffer_bytes_per_pixel(object_textures: bool) -> u32 {
-    gbuffer_images(object_textures).iter().map(|g| g.bytes).sum()
+pub fn gbuffer_bytes_per_pixel(kind: GBufferKind) -> u32 {
+    gbuffer_images(kind).iter().map(|g| g.bytes).sum()
 }
 
 /// The first depth format the device can render to (and, for a G-buffer, sample).

@@ -177,7 +177,7 @@ fn every_material_texture_and_factor_and_sampler_is_read() {
     assert_eq!(t.metallic_roughness, t.occlusion);
     assert_eq!(t.bits(), 0b11111);
     assert_eq!(s.textures.len(), 4, "base, normal, ORM once, emissive");
-    let srgb: Vec<bool> = t.slots().iter().map(|i| s.textures[i.unwrap() as usize].srgb).collect();
+    let srgb: Vec<bool> = t.slots().iter().flatten().map(|&i| s.textures[i as usize].srgb).collect();
     assert_eq!(srgb, [true, false, false, false, true]);
     let sampler = |i: Option<u32>| s.textures[i.unwrap() as usize].sampler;
     let nearest = TextureSampler {
@@ -269,24 +269,35 @@ fn texture_transforms_and_emissive_strength_are_read() {
 }
 
 /// The PBR extensions' factors (ior, specular, clearcoat, sheen, unlit) become the object's
-/// lobes; their textures are named in one warning per material; a factor outside its range
-/// is refused in one line.
+/// lobes and their textures its texture slots (colours sRGB, normals made unit); a factor
+/// outside its range or a texture that is not there is refused in one line.
 #[test]
 fn material_extensions_are_read_into_lobes() {
     let mut w = GltfWriter::new();
+    let image = w.texture(png(1, 1, &[200, 100, 50, 255]), "image/png");
     let m = w.material([0.8, 0.2, 0.1, 1.0], 0.0, 0.6);
     w.json["materials"][m]["extensions"] = json!({
         "KHR_materials_ior": { "ior": 2.0 },
-        "KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [2.0, 1.0, 0.5], "specularTexture": { "index": 0 } },
-        "KHR_materials_clearcoat": { "clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.1, "clearcoatNormalTexture": { "index": 0 } },
-        "KHR_materials_sheen": { "sheenColorFactor": [0.5, 0.4, 0.3], "sheenRoughnessFactor": 0.25 },
+        "KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [2.0, 1.0, 0.5], "specularTexture": { "index": image } },
+        "KHR_materials_clearcoat": {
+            "clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.1, "clearcoatNormalTexture": { "index": image, "scale": 0.5 }
+        },
+        "KHR_materials_sheen": { "sheenColorFactor": [0.5, 0.4, 0.3], "sheenRoughnessFactor": 0.25, "sheenColorTexture": { "index": image } },
     });
     let names = ["KHR_materials_ior", "KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit"];
     w.json["extensionsUsed"] = json!(names);
     let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
     w.node(json!({ "mesh": mesh }), true);
     let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
-    assert_eq!(warnings, ["material 0: its specular, clearcoat normal textures are not read; the factors apply alone"]);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let t = scene.objects[0].textures;
+    assert!(t.any_lobe_texture() && t.clearcoat.is_none() && t.specular_color.is_none());
+    let texels = |slot: Option<u32>| &scene.textures[slot.unwrap() as usize];
+    assert!(!texels(t.specular).srgb && texels(t.sheen_color).srgb && !texels(t.clearcoat_normal).srgb);
+    assert_eq!(texels(t.specular).rgba[..], [200, 100, 50, 255], "data as stored");
+    let unit = crate::textures::unit_normal_texel([200, 100, 50, 255]);
+    assert_eq!(texels(t.clearcoat_normal).rgba[..], unit, "a normal made unit");
+    assert_eq!(scene.objects[0].extras.lobes.clearcoat_normal_scale, 0.5);
     let lobes = scene.objects[0].extras.lobes;
     let f0 = 1.0f32 / 9.0;
     assert!(lobes.dielectric_f0().abs_diff_eq(Vec3::new(2.0 * f0, f0, 0.5 * f0), 1e-6), "{lobes:?}");
@@ -308,6 +319,17 @@ fn material_extensions_are_read_into_lobes() {
         ),
         ("KHR_materials_clearcoat", json!({ "clearcoatFactor": 1.5 }), "clearcoatFactor is 1.5; it must be a number in [0, 1]"),
         ("KHR_materials_sheen", json!({ "sheenColorFactor": [1.0, 1.0] }), "sheenColorFactor is [1.0,1.0]"),
+        (
+            "KHR_materials_sheen",
+            json!({ "sheenColorTexture": { "index": 3 } }),
+            "sheenColorTexture names texture 3, but there are 1 textures",
+        ),
+        ("KHR_materials_clearcoat", json!({ "clearcoatTexture": {} }), "clearcoatTexture names no texture (no index)"),
+        (
+            "KHR_materials_clearcoat",
+            json!({ "clearcoatNormalTexture": { "index": 0, "scale": "x" } }),
+            "clearcoatNormalTexture has scale \"x\"",
+        ),
     ] {
         w.json["materials"][m]["extensions"] = json!({ ext: body });
         let err = from_bytes(&w.to_glb(), None).unwrap_err().to_string();
@@ -317,10 +339,11 @@ fn material_extensions_are_read_into_lobes() {
 
 /// KHR_materials_transmission and _volume: the factor, the attenuation and the thickness,
 /// scaled from the mesh's units to the world's by the node's scale; the object is transparent
-/// whatever its alpha mode (blended in layers); the textures are named; bad factors refused.
+/// whatever its alpha mode (blended in layers); the textures are read; bad factors refused.
 #[test]
 fn transmission_and_volume_are_read_and_make_the_object_transparent() {
     let mut w = GltfWriter::new();
+    w.texture(png(1, 1, &[255; 4]), "image/png");
     let m = w.material([0.9, 0.6, 0.3, 1.0], 0.0, 0.2);
     w.json["materials"][m]["extensions"] = json!({
         "KHR_materials_transmission": { "transmissionFactor": 0.75, "transmissionTexture": { "index": 0 } },
@@ -330,8 +353,9 @@ fn transmission_and_volume_are_read_and_make_the_object_transparent() {
     let mesh = w.mesh(&[PrimitiveData { material: Some(m), ..quad() }]);
     w.node(json!({ "mesh": mesh, "scale": [2.0, 2.0, 2.0] }), true);
     let (scene, warnings) = from_bytes(&w.to_glb(), None).unwrap();
-    assert_eq!(warnings, ["material 0: its transmission texture is not read; the factors apply alone"]);
+    assert!(warnings.is_empty(), "{warnings:?}");
     let o = &scene.objects[0];
+    assert!(o.textures.transmission.is_some() && o.textures.thickness.is_none());
     let lobes = o.extras.lobes;
     assert_eq!((lobes.transmission, lobes.attenuation_distance, lobes.attenuation_color), (0.75, 0.5, Vec3::new(1.0, 0.5, 0.25)));
     assert!((lobes.thickness - 0.6).abs() < 1e-6, "{lobes:?}");

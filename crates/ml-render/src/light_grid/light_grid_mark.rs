@@ -30,8 +30,9 @@ pub struct LightGridMark {
 impl LightGridMark {
     /// The marks from the opaque depth (`depth_buffer`: the compute raster's buffer, else the
     /// depth target; its samples: `antialiasing`), and with `layers` from the transparent
-    /// layers' nodes.
-    pub fn new(ctx: &Context, (depth_buffer, antialiasing): (bool, Antialiasing), layers: bool) -> Result<LightGridMark, VkError> {
+    /// layers' nodes (`Some(lobe_textures)`: whether a node keeps the PBR extensions' texels,
+    /// a word more).
+    pub fn new(ctx: &Context, (depth_buffer, antialiasing): (bool, Antialiasing), layers: Option<bool>) -> Result<LightGridMark, VkError> {
         let (shader, constants) = if depth_buffer {
             (&ml_shaders::LIGHT_GRID_MARK_BUFFER_COMP, vec![antialiasing.constant()])
         } else {
@@ -39,8 +40,9 @@ impl LightGridMark {
         };
         let pass = ComputePass::new(ctx, &[], (shader, &constants))?;
         let mut mark = LightGridMark { pass, layers: None, occupancy: vec![vk::Buffer::null(); FRAMES_IN_FLIGHT], depth_buffer };
-        if layers {
-            match ComputePass::new(ctx, &[], (&ml_shaders::LIGHT_GRID_MARK_LAYERS_COMP, &[antialiasing.constant()])) {
+        if let Some(lobe_textures) = layers {
+            let constants = [antialiasing.constant(), ("LOBE_TEXTURES", u32::from(lobe_textures))];
+            match ComputePass::new(ctx, &[], (&ml_shaders::LIGHT_GRID_MARK_LAYERS_COMP, &constants)) {
                 Ok(p) => mark.layers = Some(p),
                 Err(e) => {
                     mark.pass.destroy(ctx);

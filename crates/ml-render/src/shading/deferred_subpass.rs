@@ -10,10 +10,11 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
+use crate::shading::gbuffer::gbuffer_shader;
 use crate::shading::mesh_raster::{Draw, MeshRaster};
 use crate::shading::Shading;
 use crate::sync::{shading_reads, Use};
-use crate::targets::{gbuffer_images, Output};
+use crate::targets::{gbuffer_images, GBufferKind, Output};
 use ml_vk::{shader, vk, Context, VkError};
 
 pub struct DeferredSubpasses {
@@ -33,22 +34,29 @@ impl DeferredSubpasses {
         (depth_format, shading): (vk::Format, Shading),
         clustered: bool,
     ) -> Result<DeferredSubpasses, VkError> {
-        let gbuffer = if shading.object_textures { &ml_shaders::GBUFFER_TEXTURED_FRAG } else { &ml_shaders::GBUFFER_FRAG };
+        let kind = shading.gbuffer_kind();
+        let gbuffer = gbuffer_shader(kind);
         // With anti-aliasing, the variant that reads the G-buffer's samples (a subpass input's
-        // type says whether it is multisampled).
+        // type says whether it is multisampled); a subpass may not name inputs it lacks, so
+        // each kind of G-buffer has its own.
         let samples = shading.antialiasing != Antialiasing::Off;
-        let lighting = match (clustered, shading.object_textures, samples) {
-            (false, false, false) => &ml_shaders::DEFERRED_FRAG,
-            (true, false, false) => &ml_shaders::DEFERRED_CLUSTERED_FRAG,
-            (false, true, false) => &ml_shaders::DEFERRED_TEXTURED_FRAG,
-            (true, true, false) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_FRAG,
-            (false, false, true) => &ml_shaders::DEFERRED_SAMPLES_FRAG,
-            (true, false, true) => &ml_shaders::DEFERRED_CLUSTERED_SAMPLES_FRAG,
-            (false, true, true) => &ml_shaders::DEFERRED_TEXTURED_SAMPLES_FRAG,
-            (true, true, true) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_SAMPLES_FRAG,
+        use GBufferKind::{Base, Lobes, Material};
+        let lighting = match (clustered, kind, samples) {
+            (false, Base, false) => &ml_shaders::DEFERRED_FRAG,
+            (true, Base, false) => &ml_shaders::DEFERRED_CLUSTERED_FRAG,
+            (false, Material, false) => &ml_shaders::DEFERRED_TEXTURED_FRAG,
+            (true, Material, false) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_FRAG,
+            (false, Lobes, false) => &ml_shaders::DEFERRED_LOBES_FRAG,
+            (true, Lobes, false) => &ml_shaders::DEFERRED_CLUSTERED_LOBES_FRAG,
+            (false, Base, true) => &ml_shaders::DEFERRED_SAMPLES_FRAG,
+            (true, Base, true) => &ml_shaders::DEFERRED_CLUSTERED_SAMPLES_FRAG,
+            (false, Material, true) => &ml_shaders::DEFERRED_TEXTURED_SAMPLES_FRAG,
+            (true, Material, true) => &ml_shaders::DEFERRED_CLUSTERED_TEXTURED_SAMPLES_FRAG,
+            (false, Lobes, true) => &ml_shaders::DEFERRED_LOBES_SAMPLES_FRAG,
+            (true, Lobes, true) => &ml_shaders::DEFERRED_CLUSTERED_LOBES_SAMPLES_FRAG,
         };
         let textures = scene.textures.set_layout.raw;
-        let attachments = (depth_format, Output::Subpasses, gbuffer_images(shading.object_textures));
+        let attachments = (depth_format, Output::Subpasses, gbuffer_images(kind));
         let raster =
             MeshRaster::new(ctx, attachments, (gbuffer, shading, &scene.surface_variants), (textures, scene.object_textures.set_layout))?;
         let stages = [(&ml_shaders::FULLSCREEN_VERT, vk::ShaderStageFlags::VERTEX), (lighting, vk::ShaderStageFlags::FRAGMENT)];

@@ -8,7 +8,7 @@ use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::mesh_raster::MeshRaster;
 use crate::shading::Shading;
-use crate::targets::{gbuffer_images, Output};
+use crate::targets::{gbuffer_images, GBufferKind, Output};
 use ml_vk::{vk, Context, VkError};
 
 pub struct GBuffer {
@@ -17,10 +17,19 @@ pub struct GBuffer {
 
 impl GBuffer {
     pub fn new(ctx: &Context, scene: &SceneGpu, (depth_format, shading): (vk::Format, Shading)) -> Result<GBuffer, VkError> {
-        let fragment = if shading.object_textures { &ml_shaders::GBUFFER_TEXTURED_FRAG } else { &ml_shaders::GBUFFER_FRAG };
         let layouts = (scene.textures.set_layout.raw, scene.object_textures.set_layout);
-        let attachments = (depth_format, Output::GBuffer, gbuffer_images(shading.object_textures));
+        let attachments = (depth_format, Output::GBuffer, gbuffer_images(shading.gbuffer_kind()));
+        let fragment = gbuffer_shader(shading.gbuffer_kind());
         Ok(GBuffer { raster: MeshRaster::new(ctx, attachments, (fragment, shading, &scene.surface_variants), layouts)? })
+    }
+}
+
+/// The G-buffer pass's fragment shader for a G-buffer of `kind` (one output per image).
+pub fn gbuffer_shader(kind: GBufferKind) -> &'static ml_shaders::Shader {
+    match kind {
+        GBufferKind::Base => &ml_shaders::GBUFFER_FRAG,
+        GBufferKind::Material => &ml_shaders::GBUFFER_TEXTURED_FRAG,
+        GBufferKind::Lobes => &ml_shaders::GBUFFER_LOBES_FRAG,
     }
 }
 

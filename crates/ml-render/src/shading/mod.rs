@@ -10,6 +10,7 @@ pub mod mesh_raster;
 
 use crate::antialiasing::Antialiasing;
 use crate::background::Background;
+use crate::targets::GBufferKind;
 use ml_cpu::shading_model::ShadingModel;
 
 /// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
@@ -42,34 +43,50 @@ pub struct Shading {
     /// Some object's material has glTF's PBR extensions (`MATERIAL_LOBES`,
     /// common/material_lobes.glsl; pbr).
     pub material_lobes: bool,
+    /// Some object's extensions vary over its surface (`LOBE_TEXTURES`, Scene::has_lobe_textures;
+    /// with `material_lobes`): read per point, kept per point by the G-buffer and the layers.
+    pub lobe_textures: bool,
     /// What pixels no surface covers show (`BACKGROUND_ENVIRONMENT` where the pass lays it).
     pub background: Background,
 }
 
 impl Shading {
     /// The specialization constants (name, value) of a pipeline that reads surfaces without
-    /// lighting them (the G-buffer's): `MODEL_BLINN_PHONG`, `MODEL_PBR`, `OBJECT_TEXTURES` and
-    /// `SPECULAR_AA` (common/shading_model.glsl).
-    pub fn surface_constants(self) -> [(&'static str, u32); 4] {
+    /// lighting them (the G-buffer's): `MODEL_BLINN_PHONG`, `MODEL_PBR`, `OBJECT_TEXTURES`,
+    /// `SPECULAR_AA` and `LOBE_TEXTURES` (common/shading_model.glsl).
+    pub fn surface_constants(self) -> [(&'static str, u32); 5] {
         [
             ("MODEL_BLINN_PHONG", u32::from(self.model == ShadingModel::BlinnPhong)),
             ("MODEL_PBR", u32::from(self.model == ShadingModel::Pbr)),
             ("OBJECT_TEXTURES", u32::from(self.object_textures)),
             ("SPECULAR_AA", u32::from(self.specular_aa)),
+            ("LOBE_TEXTURES", u32::from(self.lobe_textures)),
         ]
+    }
+
+    /// Which images the scene's G-buffer has.
+    pub fn gbuffer_kind(self) -> GBufferKind {
+        if self.lobe_textures {
+            GBufferKind::Lobes
+        } else if self.object_textures {
+            GBufferKind::Material
+        } else {
+            GBufferKind::Base
+        }
     }
 
     /// The specialization constants (name, value) of a lighting pipeline: the surface's,
     /// `OMNI_SHADOWS`, `SHADOW_ATLAS` and `SHADOW_RAYS` (shadows/omni_shadow.glsl),
     /// `SUN_RAYS` (common/blinn_phong.glsl), `SPOT_LIGHTS` (common/lighting.glsl) and
     /// `ENVIRONMENT` (environment/environment.glsl) and `MATERIAL_LOBES`.
-    pub fn lighting_constants(self) -> [(&'static str, u32); 11] {
-        let [model_a, model_b, textures, specular] = self.surface_constants();
+    pub fn lighting_constants(self) -> [(&'static str, u32); 12] {
+        let [model_a, model_b, textures, specular, lobe_textures] = self.surface_constants();
         [
             model_a,
             model_b,
             textures,
             specular,
+            lobe_textures,
             ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
             ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
             ("SHADOW_RAYS", u32::from(self.shadow_rays)),
@@ -82,18 +99,18 @@ impl Shading {
 
     /// `lighting_constants`, `COUNT_RAYS` (shading/compute_shading.glsl) and the background's:
     /// the compute lightings' (they lay the background where no surface is).
-    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 13] {
-        let [a, b, c, d, e, f, g, h, i, j, k] = self.lighting_constants();
-        [a, b, c, d, e, f, g, h, i, j, k, ("COUNT_RAYS", u32::from(self.count_rays)), self.background.constant()]
+    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 14] {
+        let [a, b, c, d, e, f, g, h, i, j, k, l] = self.lighting_constants();
+        [a, b, c, d, e, f, g, h, i, j, k, l, ("COUNT_RAYS", u32::from(self.count_rays)), self.background.constant()]
     }
 
     /// `lighting_constants`, `TRANSPARENT_LAYERS` (shading/forward_frag.glsl: the forward
     /// pass of a scene with transparent layers writes linear HDR for their resolve), the
     /// samples per pixel its masks are tested at and `display_constant`: the forward pass's.
-    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 14] {
-        let [a, b, c, d, e, f, g, h, i, j, k] = self.lighting_constants();
+    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 15] {
+        let [a, b, c, d, e, f, g, h, i, j, k, l] = self.lighting_constants();
         let layers = ("TRANSPARENT_LAYERS", u32::from(self.transparency));
-        [a, b, c, d, e, f, g, h, i, j, k, layers, self.antialiasing.constant(), self.display_constant()]
+        [a, b, c, d, e, f, g, h, i, j, k, l, layers, self.antialiasing.constant(), self.display_constant()]
     }
 
     /// `DISPLAY_LINEAR_OUTPUT` (shading/display_output.glsl): with anti-aliasing, the forward

@@ -7,8 +7,15 @@ use ml_vk::{vk, Buffer, Context, VkError};
 /// (transparency/layers.glsl).
 pub const LAYER_BUFFERS: [&str; 3] = ["TransparentHeadBuffer", "TransparentNodeBuffer", "TransparentCountBuffer"];
 
-/// Bytes of a transparent layer's node: two uvec4 (transparency/layers.glsl).
-pub const NODE_BYTES: u64 = 32;
+/// Bytes of a transparent layer's node: two uvec4, three where the scene's PBR extensions
+/// vary per point (`LOBE_TEXTURES`: their texels, transparency/layers.glsl).
+pub fn node_bytes(lobe_textures: bool) -> u64 {
+    if lobe_textures {
+        48
+    } else {
+        32
+    }
+}
 
 /// A frame slot's transparent layers: heads, node pool, counters (host-visible: the build pass
 /// reads them when the frame is done). The build owns them; the frame's table names them.
@@ -16,16 +23,18 @@ pub struct LayerBuffers {
     pub heads: Buffer,
     pub nodes: Buffer,
     pub counts: Buffer,
+    /// Bytes a node (`node_bytes`).
+    pub node_bytes: u64,
 }
 
 impl LayerBuffers {
-    /// `nodes`: the pool's size.
-    pub fn new(ctx: &Context, extent: vk::Extent2D, nodes: u64) -> Result<LayerBuffers, VkError> {
-        let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null() };
+    /// `nodes`: the pool's size, of `node_bytes` each.
+    pub fn new(ctx: &Context, extent: vk::Extent2D, (nodes, node_bytes): (u64, u64)) -> Result<LayerBuffers, VkError> {
+        let b = LayerBuffers { heads: Buffer::null(), nodes: Buffer::null(), counts: Buffer::null(), node_bytes };
         ml_vk::build(ctx, b, |b| {
             use gpu_allocator::MemoryLocation as M;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-            let (heads, nodes) = (extent.width as u64 * extent.height as u64 * 4, nodes * NODE_BYTES);
+            let (heads, nodes) = (extent.width as u64 * extent.height as u64 * 4, nodes * node_bytes);
             b.heads = Buffer::new(ctx, "transparent heads", heads, usage, M::GpuOnly)?;
             b.nodes = Buffer::new(ctx, "transparent nodes", nodes, usage, M::GpuOnly)?;
             b.counts = Buffer::new(ctx, "transparent counters", 16, usage, M::GpuToCpu)?;
@@ -45,7 +54,7 @@ impl LayerBuffers {
 
     /// Nodes in the pool.
     pub fn capacity(&self) -> u64 {
-        self.nodes.size / NODE_BYTES
+        self.nodes.size / self.node_bytes
     }
 
     /// The counters as the slot's last frame left them: nodes asked for, pixels that merged,

@@ -16,7 +16,7 @@ pub mod transparent_resolve;
 use crate::error::{RenderError, Setting, SettingsError};
 use crate::report::FeatureStats;
 use crate::sync::Use;
-pub use layer_buffers::{LayerBuffers, LAYER_BUFFERS, NODE_BYTES};
+pub use layer_buffers::{node_bytes, LayerBuffers, LAYER_BUFFERS};
 use ml_vk::{vk, Context};
 
 /// A list's end (layers.glsl LAYER_END): what the heads are cleared to.
@@ -40,11 +40,14 @@ pub struct TransparencySettings {
     /// triangle (`transparent_build`; the same fragments either way, which tests check by
     /// moving this bound).
     pub tiled_up_to: u32,
+    /// The scene's PBR extensions vary per point, so nodes keep their texels too
+    /// (`node_bytes`; settled by the renderer from the scene).
+    pub lobe_textures: bool,
 }
 
 impl Default for TransparencySettings {
     fn default() -> Self {
-        TransparencySettings { budget: DEFAULT_BUDGET, tiled_up_to: crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES }
+        TransparencySettings { budget: DEFAULT_BUDGET, tiled_up_to: crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES, lobe_textures: false }
     }
 }
 
@@ -59,7 +62,7 @@ impl TransparencySettings {
         if self.budget == 0 || self.budget > MAX_BUDGET {
             return Err(SettingsError::OutOfRange { what: Setting::TransparencyBudget, value: self.budget, max: MAX_BUDGET }.into());
         }
-        let bytes = self.nodes(width, height) * NODE_BYTES;
+        let bytes = self.nodes(width, height) * node_bytes(self.lobe_textures);
         let max = ctx.info.limits.max_storage_buffer_range;
         if bytes > max as u64 {
             let budget = self.budget;
@@ -87,8 +90,9 @@ pub fn counts_to_host() -> Use {
 pub struct TransparencyStats {
     /// Transparent fragments in front of the opaque surfaces (kept or dropped).
     pub fragments: u64,
-    /// Nodes the pool holds.
+    /// Nodes the pool holds, of `node_bytes` each.
     pub capacity: u64,
+    pub node_bytes: u64,
     /// Pixels of the image.
     pub pixels: u64,
     /// Pixels with more than `LAYER_KEEP` layers, whose farthest ones were merged.
@@ -107,7 +111,7 @@ impl TransparencyStats {
 
     /// Bytes per pixel of the lists (heads and the pool).
     pub fn bytes_per_pixel(&self) -> f64 {
-        4.0 + (self.capacity * NODE_BYTES) as f64 / self.pixels.max(1) as f64
+        4.0 + (self.capacity * self.node_bytes) as f64 / self.pixels.max(1) as f64
     }
 
     /// Whether something was dropped or merged (the frame is not exact).

@@ -7,7 +7,7 @@
 //! for the tiles' build. Runs after the opaque raster, before the resolve; clears the slot's
 //! lists first.
 
-use super::{counts_to_host, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
+use super::{counts_to_host, node_bytes, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
@@ -401,7 +401,11 @@ impl Pass for TransparentBuild {
         if let Some(mut old) = self.layers[slot].take() {
             old.destroy(ctx);
         }
-        self.layers[slot] = Some(LayerBuffers::new(ctx, extent, self.settings.nodes(extent.width, extent.height))?);
+        self.layers[slot] = Some(LayerBuffers::new(
+            ctx,
+            extent,
+            (self.settings.nodes(extent.width, extent.height), node_bytes(self.settings.lobe_textures)),
+        )?);
         Ok(())
     }
 
@@ -461,6 +465,7 @@ impl Pass for TransparentBuild {
         stats.set_feature(TransparencyStats {
             fragments: fragments as u64,
             capacity: layers.capacity(),
+            node_bytes: layers.node_bytes,
             pixels: layers.pixels(),
             merged_pixels: merged as u64,
             group_triangles: group_triangles as u64,

@@ -56,15 +56,20 @@ impl TransparentResolve {
         let samples = shading.antialiasing.constant();
         let lighting_constants = [&shading.lighting_constants()[..], &[samples]].concat();
         let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &lighting_constants))?;
-        let [blinn_phong, pbr, _, _] = shading.surface_constants();
+        // The nodes' size (with the PBR extensions' texels where they vary per point).
+        let [blinn_phong, pbr, _, _, lobe_textures] = shading.surface_constants();
         let antialiased = shading.antialiasing != Antialiasing::Off;
         // Set 1 (the scene's textures) for the background's environment.
         let textures = [scene.textures.set_layout.raw];
         let background = shading.background.constant();
         let blend = if antialiased {
-            ComputePass::new(ctx, &textures, (&ml_shaders::TRANSPARENT_BLEND_SAMPLES_COMP, &[blinn_phong, pbr, samples, background]))
+            ComputePass::new(
+                ctx,
+                &textures,
+                (&ml_shaders::TRANSPARENT_BLEND_SAMPLES_COMP, &[blinn_phong, pbr, samples, background, lobe_textures]),
+            )
         } else {
-            ComputePass::new(ctx, &textures, (&ml_shaders::TRANSPARENT_BLEND_COMP, &[blinn_phong, pbr, background]))
+            ComputePass::new(ctx, &textures, (&ml_shaders::TRANSPARENT_BLEND_COMP, &[blinn_phong, pbr, background, lobe_textures]))
         };
         match blend {
             Ok(blend) => Ok(TransparentResolve { lighting, blend, after_compute, settings, samples: antialiased }),

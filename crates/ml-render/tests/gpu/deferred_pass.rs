@@ -13,7 +13,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::internals::describe;
 use ml_render::internals::{Output, HDR_FORMAT};
-use ml_render::{gbuffer_bytes_per_pixel, gbuffer_images};
+use ml_render::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferKind};
 use ml_render::{RenderSettings, Technique};
 use ml_vk::vk;
 use spirq::prelude::*;
@@ -21,18 +21,20 @@ use spirq::ty::DescriptorType;
 
 #[test]
 fn deferred_pass_has_two_subpasses_joined_by_input_attachments() {
-    for object_textures in [false, true] {
-        check_two_subpasses(object_textures);
+    for kind in [GBufferKind::Base, GBufferKind::Material, GBufferKind::Lobes] {
+        check_two_subpasses(kind);
     }
     // The G-buffer is compact: target ≤ 16 bytes per pixel besides depth (the seed's: 68),
-    // 22 where objects have textures of their own.
-    assert_eq!(gbuffer_bytes_per_pixel(false), 16);
-    assert_eq!(gbuffer_bytes_per_pixel(true), 22);
+    // 22 where objects have textures of their own, 38 where their PBR extensions vary per
+    // point.
+    assert_eq!(gbuffer_bytes_per_pixel(GBufferKind::Base), 16);
+    assert_eq!(gbuffer_bytes_per_pixel(GBufferKind::Material), 22);
+    assert_eq!(gbuffer_bytes_per_pixel(GBufferKind::Lobes), 38);
 }
 
-fn check_two_subpasses(object_textures: bool) {
-    let images = gbuffer_images(object_textures);
-    assert_eq!(images.len(), if object_textures { 5 } else { 3 });
+fn check_two_subpasses(kind: GBufferKind) {
+    let images = gbuffer_images(kind);
+    assert_eq!(images.len(), [3, 5, 6][kind as usize]);
     let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, images, (false, vk::SampleCountFlags::TYPE_1));
     assert_eq!(d.subpasses.len(), 2);
     let (gbuffer, lighting) = (&d.subpasses[0], &d.subpasses[1]);
@@ -69,17 +71,22 @@ fn check_two_subpasses(object_textures: bool) {
 #[test]
 fn lighting_shaders_load_the_gbuffer_as_input_attachments() {
     use ml_shaders::*;
-    for (name, spirv, object_textures) in [
-        ("deferred.frag", DEFERRED_FRAG, false),
-        ("deferred_clustered.frag", DEFERRED_CLUSTERED_FRAG, false),
-        ("deferred_textured.frag", DEFERRED_TEXTURED_FRAG, true),
-        ("deferred_clustered_textured.frag", DEFERRED_CLUSTERED_TEXTURED_FRAG, true),
-        ("deferred_samples.frag", DEFERRED_SAMPLES_FRAG, false),
-        ("deferred_clustered_samples.frag", DEFERRED_CLUSTERED_SAMPLES_FRAG, false),
-        ("deferred_textured_samples.frag", DEFERRED_TEXTURED_SAMPLES_FRAG, true),
-        ("deferred_clustered_textured_samples.frag", DEFERRED_CLUSTERED_TEXTURED_SAMPLES_FRAG, true),
+    use GBufferKind::{Base, Lobes, Material};
+    for (name, spirv, kind) in [
+        ("deferred.frag", DEFERRED_FRAG, Base),
+        ("deferred_clustered.frag", DEFERRED_CLUSTERED_FRAG, Base),
+        ("deferred_textured.frag", DEFERRED_TEXTURED_FRAG, Material),
+        ("deferred_clustered_textured.frag", DEFERRED_CLUSTERED_TEXTURED_FRAG, Material),
+        ("deferred_lobes.frag", DEFERRED_LOBES_FRAG, Lobes),
+        ("deferred_clustered_lobes.frag", DEFERRED_CLUSTERED_LOBES_FRAG, Lobes),
+        ("deferred_samples.frag", DEFERRED_SAMPLES_FRAG, Base),
+        ("deferred_clustered_samples.frag", DEFERRED_CLUSTERED_SAMPLES_FRAG, Base),
+        ("deferred_textured_samples.frag", DEFERRED_TEXTURED_SAMPLES_FRAG, Material),
+        ("deferred_clustered_textured_samples.frag", DEFERRED_CLUSTERED_TEXTURED_SAMPLES_FRAG, Material),
+        ("deferred_lobes_samples.frag", DEFERRED_LOBES_SAMPLES_FRAG, Lobes),
+        ("deferred_clustered_lobes_samples.frag", DEFERRED_CLUSTERED_LOBES_SAMPLES_FRAG, Lobes),
     ] {
-        let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(object_textures), (false, vk::SampleCountFlags::TYPE_1));
+        let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(kind), (false, vk::SampleCountFlags::TYPE_1));
         let inputs = d.subpasses[1].inputs.len() as u32;
         let words: Vec<u32> = spirv.spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         let entries = ReflectConfig::new().spv(words).ref_all_rscs(true).reflect().expect("reflect");
@@ -102,7 +109,7 @@ fn lighting_shaders_load_the_gbuffer_as_input_attachments() {
 #[test]
 fn multisampled_passes_keep_samples_inside_and_one_value_a_pixel_out() {
     let four = vk::SampleCountFlags::TYPE_4;
-    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(true), (false, four));
+    let d = describe(vk::Format::D32_SFLOAT, Output::Subpasses, gbuffer_images(GBufferKind::Lobes), (false, four));
     let hdr = d.subpasses[1].colour[0].attachment as usize;
     for (i, a) in d.attachments.iter().enumerate() {
         assert_eq!(a.samples, if i == hdr { vk::SampleCountFlags::TYPE_1 } else { four }, "attachment {i}");

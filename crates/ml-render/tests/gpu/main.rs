@@ -20,6 +20,7 @@ mod golden;
 mod gpu_layout;
 mod light_grid;
 mod light_stats;
+mod lobe_textures;
 mod mask_shadows;
 mod material_lobes;
 mod omni_shadows;

@@ -73,7 +73,7 @@ fn compare(material: Material, lobes: MaterialLobes) {
     let (eye, ambient) = (scene.camera.position, scene.ambient);
     let r = common::compare_sphere(&out, &scene.camera, false, (NORMAL_TOLERANCE, MAX_DIFF), |p, _| {
         let lights = &lights;
-        move |n: Vec3| encode_gamma_unorm8(aces_tone_map(shade_lobed(p, n, eye, (&material, &lobes), lights, ambient, Vec3::ZERO)))
+        move |n: Vec3| encode_gamma_unorm8(aces_tone_map(shade_lobed(p, (n, n), eye, (&material, &lobes), lights, ambient, Vec3::ZERO)))
     });
     let (compared, outside) = (r.compared, r.outside);
     assert!(compared > 3_000, "the sphere should cover much of the image, got {compared} pixels");

@@ -237,8 +237,9 @@ fn transmitting_glass_tints_what_lies_behind_as_the_cpu_reference_does() {
         &scene,
         |o, p| {
             let lobes = (&o.material, &o.extras.lobes);
-            let lit = shade_lobed(p, Vec3::Z, eye, lobes, &scene.lights, scene.ambient, Vec3::ZERO);
-            (lit, lobed_transmittance((eye - p).normalize().z, &o.material, &o.extras.lobes))
+            let lit = shade_lobed(p, (Vec3::Z, Vec3::Z), eye, lobes, &scene.lights, scene.ambient, Vec3::ZERO);
+            let n_dot_v = (eye - p).normalize().z;
+            (lit, lobed_transmittance((n_dot_v, n_dot_v), &o.material, &o.extras.lobes))
         },
         |c| encode_gamma_unorm8(aces_tone_map(c)),
     );
