@@ -84,11 +84,14 @@ float spot_cone(uint i, PointLight l, vec3 world) {
     }
 
 // What a directional light's PointLight carries as its shadow slot (omni_shadow.glsl): with
-// shadow rays any non-zero value casts (no slot is read); else none (no cube or atlas tile
-// can hold a light 10 km away).
+// shadow rays any non-zero value casts (no slot is read); with maps, whose cubes and tiles
+// cannot hold a light 10 km away, a ray's (DIRECTIONAL_RAYS); without shadows none.
 float directional_shadow_slot() {
     if (SHADOW_RAYS) {
         return 1.0;
+    }
+    if (DIRECTIONAL_RAYS) {
+        return DIRECTIONAL_RAY_SLOT;
     }
     return 0.0;
 }

@@ -14,6 +14,11 @@ layout(constant_id = 12) const bool OMNI_SHADOWS = false;
 layout(constant_id = 15) const bool SHADOW_ATLAS = false;
 // Shadowed lights are tested by a shadow ray each (no cubes).
 layout(constant_id = 21) const bool SHADOW_RAYS = false;
+// The point lights' shadows are maps (cubes or the atlas) and directional lights cast theirs
+// by a shadow ray each: no map can hold a light 10 km away (lighting.glsl SUM_DIRECTIONAL).
+layout(constant_id = 48) const bool DIRECTIONAL_RAYS = false;
+// The shadow slot such a directional light carries (no cube or tile's).
+const float DIRECTIONAL_RAY_SLOT = -1.0;
 
 // Shadow rays read masked objects' alpha (the shading shaders that cut fragments themselves
 // have included it with their binding already).
@@ -103,6 +108,11 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
         }
         if (SHADOW_RAYS) {
             return ray_occluded(ray_origin(world, n), l.position_radius.xyz) ? 0.0 : 1.0;
+        }
+        if (DIRECTIONAL_RAYS) {
+            if (l.color.w == DIRECTIONAL_RAY_SLOT) {
+                return ray_occluded(ray_origin(world, n), l.position_radius.xyz) ? 0.0 : 1.0;
+            }
         }
         // One texel of a face in face units: the cube array's, or in the atlas the light's own.
         uint slot = uint(l.color.w) - 1u;

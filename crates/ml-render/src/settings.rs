@@ -263,17 +263,19 @@ impl RenderSettings {
     /// What the lighting pipelines are compiled for, for `scene`.
     pub fn lighting(&self, scene: &ml_cpu::scene::Scene) -> Shading {
         let shadow_rays = self.omni.is_some_and(|o| o.rays());
+        let directional_rays = self.omni.is_some_and(|o| !o.rays()) && !scene.directional.is_empty();
         let sun_rays = self.shading == ShadingModel::BlinnPhong && self.sun_shadow == SunShadowMode::Rays;
         Shading {
             model: self.shading,
             omni_shadows: self.omni.is_some(),
             shadow_atlas: self.omni.is_some_and(|o| o.atlas().is_some()),
             shadow_rays,
+            directional_rays,
             sun_rays,
             object_textures: !scene.textures.is_empty(),
             spot_lights: !scene.cones.is_empty(),
             transparency: self.blends_layers(),
-            count_rays: self.light_stats && (shadow_rays || sun_rays),
+            count_rays: self.light_stats && (shadow_rays || directional_rays || sun_rays),
             antialiasing: self.antialiasing,
             specular_aa: self.specular_aa,
             environment: self.shading == ShadingModel::Pbr && scene.environment.is_some(),

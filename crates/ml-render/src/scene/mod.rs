@@ -98,7 +98,8 @@ impl SceneGpu {
             meshlets: None,
             wants_meshlets: config.meshlets,
             rays: RayGeometry::null(),
-            wants_rays: config.omni.is_some_and(|o| o.rays()) || config.sun == Some(SunShadowMode::Rays),
+            // Directional lights cast their shadows by rays in every point-light shadow mode.
+            wants_rays: config.omni.is_some_and(|o| o.rays() || !scene.directional.is_empty()) || config.sun == Some(SunShadowMode::Rays),
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };

@@ -24,6 +24,9 @@ pub struct Shading {
     pub shadow_atlas: bool,
     /// The point lights' shadows are shadow rays (no cubes).
     pub shadow_rays: bool,
+    /// The point lights' shadows are maps and the scene has directional lights, which cast
+    /// theirs by rays (`DIRECTIONAL_RAYS`).
+    pub directional_rays: bool,
     /// The sun's shadow is a shadow ray (no map; blinn-phong).
     pub sun_rays: bool,
     pub object_textures: bool,
@@ -76,10 +79,10 @@ impl Shading {
     }
 
     /// The specialization constants (name, value) of a lighting pipeline: the surface's,
-    /// `OMNI_SHADOWS`, `SHADOW_ATLAS` and `SHADOW_RAYS` (shadows/omni_shadow.glsl),
+    /// `OMNI_SHADOWS`, `SHADOW_ATLAS`, `SHADOW_RAYS` and `DIRECTIONAL_RAYS` (shadows/omni_shadow.glsl),
     /// `SUN_RAYS` (common/blinn_phong.glsl), `SPOT_LIGHTS` (common/lighting.glsl) and
     /// `ENVIRONMENT` (environment/environment.glsl) and `MATERIAL_LOBES`.
-    pub fn lighting_constants(self) -> [(&'static str, u32); 12] {
+    pub fn lighting_constants(self) -> [(&'static str, u32); 13] {
         let [model_a, model_b, textures, specular, lobe_textures] = self.surface_constants();
         [
             model_a,
@@ -90,6 +93,7 @@ impl Shading {
             ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
             ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
             ("SHADOW_RAYS", u32::from(self.shadow_rays)),
+            ("DIRECTIONAL_RAYS", u32::from(self.directional_rays)),
             ("SUN_RAYS", u32::from(self.sun_rays)),
             ("SPOT_LIGHTS", u32::from(self.spot_lights)),
             ("ENVIRONMENT", u32::from(self.environment)),
@@ -99,18 +103,18 @@ impl Shading {
 
     /// `lighting_constants`, `COUNT_RAYS` (shading/compute_shading.glsl) and the background's:
     /// the compute lightings' (they lay the background where no surface is).
-    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 14] {
-        let [a, b, c, d, e, f, g, h, i, j, k, l] = self.lighting_constants();
-        [a, b, c, d, e, f, g, h, i, j, k, l, ("COUNT_RAYS", u32::from(self.count_rays)), self.background.constant()]
+    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 15] {
+        let [a, b, c, d, e, f, g, h, i, j, k, l, m] = self.lighting_constants();
+        [a, b, c, d, e, f, g, h, i, j, k, l, m, ("COUNT_RAYS", u32::from(self.count_rays)), self.background.constant()]
     }
 
     /// `lighting_constants`, `TRANSPARENT_LAYERS` (shading/forward_frag.glsl: the forward
     /// pass of a scene with transparent layers writes linear HDR for their resolve), the
     /// samples per pixel its masks are tested at and `display_constant`: the forward pass's.
-    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 15] {
-        let [a, b, c, d, e, f, g, h, i, j, k, l] = self.lighting_constants();
+    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 16] {
+        let [a, b, c, d, e, f, g, h, i, j, k, l, m] = self.lighting_constants();
         let layers = ("TRANSPARENT_LAYERS", u32::from(self.transparency));
-        [a, b, c, d, e, f, g, h, i, j, k, l, layers, self.antialiasing.constant(), self.display_constant()]
+        [a, b, c, d, e, f, g, h, i, j, k, l, m, layers, self.antialiasing.constant(), self.display_constant()]
     }
 
     /// `DISPLAY_LINEAR_OUTPUT` (shading/display_output.glsl): with anti-aliasing, the forward

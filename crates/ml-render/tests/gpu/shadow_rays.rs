@@ -187,6 +187,18 @@ fn two_hundred_and_fifty_six_lights_shadow_where_the_triangle_caster_says() {
 /// and alone.
 #[test]
 fn directional_lights_shadow_where_the_triangle_caster_says() {
+    let mut scene = suns_over_a_floor();
+    let (checked, in_shadow) = ray_test("floor, 3 directional and 4 point lights", &scene);
+    assert!(checked > 2000 && in_shadow > 500, "{checked} checked, {in_shadow} in shadow");
+    // Suns alone (a glTF file's usual lighting) cast theirs with no point light at all.
+    scene.lights.clear();
+    let (checked, in_shadow) = ray_test("floor, 3 directional lights alone", &scene);
+    assert!(checked > 2000 && in_shadow > 300, "{checked} checked, {in_shadow} in shadow");
+}
+
+/// Occluders of every kind over a floor under three suns of different colours and slopes,
+/// with four point lights among them.
+fn suns_over_a_floor() -> Scene {
     let mut scene = cluttered_room(4, 21);
     // The occluders alone (the last five) over a floor: the room's walls and ceiling would
     // shadow every sun everywhere.
@@ -198,12 +210,37 @@ fn directional_lights_shadow_where_the_triangle_caster_says() {
         .chain([(Vec3::new(0.1, -0.5, -0.9), Vec3::new(0.2, 0.6, 0.2))])
         .map(|(d, color)| ml_cpu::scene::DirectionalLight { direction: d.normalize(), color })
         .collect();
-    let (checked, in_shadow) = ray_test("floor, 3 directional and 4 point lights", &scene);
-    assert!(checked > 2000 && in_shadow > 500, "{checked} checked, {in_shadow} in shadow");
-    // Suns alone (a glTF file's usual lighting) cast theirs with no point light at all.
-    scene.lights.clear();
-    let (checked, in_shadow) = ray_test("floor, 3 directional lights alone", &scene);
-    assert!(checked > 2000 && in_shadow > 300, "{checked} checked, {in_shadow} in shadow");
+    scene
+}
+
+/// Under the point-light shadow maps (the cube array, the atlas), whose cubes and tiles cannot
+/// hold a light 10 km away, directional lights cast their shadows by rays: with the point
+/// lights dark, the maps' images are the rays' image (which the test above holds to the
+/// triangle caster), and differ from the image without shadows.
+#[test]
+fn directional_lights_cast_their_shadows_in_every_shadow_mode() {
+    let scene = suns_over_a_floor();
+    let mut on = vec![false; scene.lights.len()];
+    on.extend(vec![true; scene.directional.len()]);
+    let suns = with_lights(&scene, &on);
+    let n = scene.lights.len() as u32;
+    let maps = |mode: OmniShadowMode| {
+        let mut s = settings(Technique::Forward, false, n);
+        s.omni = Some(OmniShadowSettings { mode, lights: n, all: false, size: 64 });
+        s
+    };
+    let atlas = OmniShadowMode::Atlas(ml_render::settings::AtlasSettings { budget_mib: 64, cache: true, fixed_size: Some(64) });
+    let modes = [settings(Technique::Forward, true, n), maps(OmniShadowMode::COMPUTE), maps(OmniShadowMode::Direct), maps(atlas)];
+    let outputs = common::render_each(&suns, &modes);
+    let unshadowed = common::render(suns.clone(), settings(Technique::Forward, false, n));
+    let shadowed = common::pixels_beyond(&outputs[0], &unshadowed, 8);
+    println!("the suns' shadows: {shadowed} pixels");
+    assert!(shadowed > 300, "the suns cast shadows on {shadowed} pixels only");
+    for (name, other) in ["cube array (compute)", "cube array (direct)", "atlas"].iter().zip(&outputs[1..]) {
+        let (worst, differing) = common::max_difference(&outputs[0], other);
+        println!("rays against the {name}: {differing} pixels differ, by up to {worst}/255");
+        assert!(worst <= 1, "{name}: the suns' shadows differ from the rays' by {worst}/255");
+    }
 }
 
 /// The room with rotated occluders of every kind of mesh and 16 lights of random colours.
