@@ -142,10 +142,11 @@ vec3 lobed_transmittance(vec3 n, vec3 v, vec3 albedo, float metallic, vec4 specu
 }
 
 // Environment light with lobes (environment.glsl's split sum): the specular term's F₀ and F₉₀
-// from the dielectric's F₀ and specular factor, the diffuse less what is transmitted; the
-// sheen's lobe as E(n·v)·sheen colour times the radiance prefiltered at its roughness about
-// the normal, the base scaled by 1 − max(sheen)·E; the clear coat's split sum at its
-// roughness over the base scaled by 1 − coat·F_coat.
+// from the dielectric's F₀ and specular factor, the diffuse less what is transmitted and what
+// the dielectric's Fresnel term reflects; the sheen's lobe as E(n·v)·sheen colour times the
+// radiance prefiltered at its roughness about the normal, the base scaled by
+// 1 − max(sheen)·E; the clear coat's split sum at its roughness about its own normal
+// `coat_n` over the base scaled by 1 − coat·F_coat.
 vec3 lobed_environment_light(vec3 n, vec3 v, vec3 albedo, float roughness, float metallic, float occlusion, vec4 specular, vec4 coat,
                              vec3 coat_n, vec4 sheen) {
     mat3 to_image = environment_to_image();

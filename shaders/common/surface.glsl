@@ -1,8 +1,9 @@
 // What the rasterised surface contributes before lighting (forward fragment shaders and the
 // G-buffer pass alike): an object's own base-colour texture and normal map (glTF), and
 // blinn-phong's albedo texture and normal map; normal maps perturb the normal through the
-// tangent frame (TBN); glTF's metallic-roughness, occlusion and emissive textures. The seed
-// model's built-in objects use none.
+// tangent frame (TBN); glTF's metallic-roughness, occlusion and emissive textures, and its PBR
+// extensions' (LOBE_TEXTURES: the clear coat's own normal map among them). The seed model's
+// built-in objects use none.
 // Needs common.glsl, scene_bindings.glsl and textures.glsl. In a fragment shader textures
 // are sampled with the implicit derivatives; a compute shader defines SURFACE_GRADIENTS and
 // sets surface_uv_dx and surface_uv_dy (∂uv/∂x, ∂uv/∂y at the pixel) before surface_at.

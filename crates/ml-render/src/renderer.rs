@@ -143,17 +143,21 @@ pub trait FrameHook {
     fn semaphores(&self) -> (Option<(vk::Semaphore, vk::PipelineStageFlags)>, Option<vk::Semaphore>);
 }
 
+/// What `scene` settles of `settings`: transparency only where there is something
+/// transparent, and nodes that keep the PBR extensions' texels where they vary per point.
+fn settle_for_scene(settings: &mut RenderSettings, scene: &Scene) {
+    if !scene.has_transparent_objects() {
+        settings.transparency = None;
+    }
+    let lobe_textures = settings.lighting(scene).lobe_textures;
+    if let Some(t) = &mut settings.transparency {
+        t.lobe_textures = lobe_textures;
+    }
+}
+
 impl<'a> Renderer<'a> {
     pub fn new(ctx: &'a Context, scene: Scene, mut settings: RenderSettings) -> Result<Renderer<'a>, RenderError> {
-        // Transparency only where there is something transparent.
-        if !scene.has_transparent_objects() {
-            settings.transparency = None;
-        }
-        // Nodes that keep the PBR extensions' texels where they vary per point.
-        let lobe_textures = settings.lighting(&scene).lobe_textures;
-        if let Some(t) = &mut settings.transparency {
-            t.lobe_textures = lobe_textures;
-        }
+        settle_for_scene(&mut settings, &scene);
         settings.check(ctx, scene.lights.len())?;
         settings.check_scene(&scene)?;
         let view = View::new(scene.camera, settings.width, settings.height);
@@ -231,7 +235,8 @@ impl<'a> Renderer<'a> {
     /// renderer). New frame slots (targets, per-frame buffers, the passes' sets) and cluster
     /// grid, and new passes where the key changed (grid, debug view, exposure meter); meshes,
     /// textures and the scene's buffers stay (the viewer's resizes and overlay).
-    pub fn reconfigure(&mut self, settings: RenderSettings) -> Result<bool, RenderError> {
+    pub fn reconfigure(&mut self, mut settings: RenderSettings) -> Result<bool, RenderError> {
+        settle_for_scene(&mut settings, &self.scene);
         let (key, new_key) = (self.settings.pipeline_key(), settings.pipeline_key());
         if key.renderer_part() != new_key.renderer_part() {
             return Ok(false);

@@ -3,7 +3,8 @@
 //! volume's thickness. Each multiplies its factor at every point: a quad textured with one
 //! texel renders as the quad whose factor is multiplied by that texel, in every technique
 //! (the deferred ones carry the texels through the G-buffer, the transparent layers in their
-//! nodes), and differs from the quad whose texture is ignored.
+//! nodes), and differs from the quad whose texture is ignored (the clear coat's normal map,
+//! which no factor stands for, by the techniques' agreement).
 
 use crate::common;
 
@@ -207,13 +208,15 @@ fn each_extension_texture_multiplies_its_factor_in_every_technique() {
             println!("{what}: textured against forward: {differing} pixels differ, by up to {worst}/255");
             assert!(worst <= 2, "{what}: differs from forward by {worst}/255");
         }
-        let without = common::render_each(&ignored, std::slice::from_ref(s)).remove(0);
-        for (i, case) in cases.iter().enumerate() {
-            let changed = changed_in_column(&with_texture, &without, i, cases.len());
-            println!("{what} {}: {changed} pixels change without the texture", case.field);
-            assert!(changed > 100, "{what}: ignoring the {} changes only {changed} pixels", case.field);
-        }
         if textured_forward.is_none() {
+            // Each texture matters: ignored, its quad changes (once, in forward: a technique
+            // that ignored one would already differ from the multiplied factors above).
+            let without = common::render_each(&ignored, std::slice::from_ref(s)).remove(0);
+            for (i, case) in cases.iter().enumerate() {
+                let changed = changed_in_column(&with_texture, &without, i, cases.len());
+                println!("{what} {}: {changed} pixels change without the texture", case.field);
+                assert!(changed > 100, "{what}: ignoring the {} changes only {changed} pixels", case.field);
+            }
             textured_forward = Some(with_texture);
         }
     }
