@@ -106,13 +106,13 @@ float omni_visibility(PointLight l, vec3 world, vec3 n) {
         if (dist >= radius) {
             return 1.0;
         }
-        if (SHADOW_RAYS) {
-            return ray_occluded(ray_origin(world, n), l.position_radius.xyz) ? 0.0 : 1.0;
-        }
+        // Every shadowed light by a ray, or (under maps) the directional ones.
+        bool by_ray = SHADOW_RAYS;
         if (DIRECTIONAL_RAYS) {
-            if (l.color.w == DIRECTIONAL_RAY_SLOT) {
-                return ray_occluded(ray_origin(world, n), l.position_radius.xyz) ? 0.0 : 1.0;
-            }
+            by_ray = l.color.w == DIRECTIONAL_RAY_SLOT;
+        }
+        if (by_ray) {
+            return ray_occluded(ray_origin(world, n), l.position_radius.xyz) ? 0.0 : 1.0;
         }
         // One texel of a face in face units: the cube array's, or in the atlas the light's own.
         uint slot = uint(l.color.w) - 1u;

@@ -1009,14 +1009,8 @@ impl Builder<'_> {
             slot("occlusion", occlusion, Texels::Data)?,
             slot("emissive", emissive, Texels::Colour)?,
         ]);
-        // The extensions' textures (their indices checked against the file's textures): the
-        // colours sRGB, the clear coat's normal map unit normals.
-        for (i, (r, (_, what))) in lobes.iter().zip(LOBE_TEXTURE_FIELDS).enumerate() {
-            let texels = match what {
-                "sheen colour" | "specular colour" => Texels::Colour,
-                "clearcoat normal" => Texels::UnitNormals,
-                _ => Texels::Data,
-            };
+        // The extensions' textures (their indices checked against the file's textures).
+        for (i, (r, (_, what, texels))) in lobes.iter().zip(LOBE_TEXTURE_FIELDS).enumerate() {
             let texture = r.and_then(|r| doc.textures().nth(r.index).map(|t| (t, r.tex_coord)));
             slots[FIRST_LOBE_SLOT + i] = slot(what, texture, texels)?;
         }
@@ -1259,10 +1253,14 @@ fn material(m: &gltf::Material, textures: usize) -> Result<(Material, MaterialEx
 /// translation · rotation · scale, the rotation's columns (cos, sin) and (−sin, cos).
 fn texture_transform(info: &gltf::texture::Info) -> Affine2 {
     let Some(t) = info.texture_transform() else { return Affine2::IDENTITY };
-    let (sin, cos) = t.rotation().sin_cos();
-    let [sx, sy] = t.scale();
-    let columns = glam::Mat2::from_cols(glam::Vec2::new(cos, sin) * sx, glam::Vec2::new(-sin, cos) * sy);
-    Affine2::from_mat2_translation(columns, glam::Vec2::from(t.offset()))
+    uv_affine(t.offset().into(), t.rotation(), t.scale().into())
+}
+
+/// KHR_texture_transform's parts as the affine map they make: translation · rotation · scale.
+fn uv_affine(offset: glam::Vec2, rotation: f32, scale: glam::Vec2) -> Affine2 {
+    let (sin, cos) = rotation.sin_cos();
+    let columns = glam::Mat2::from_cols(glam::Vec2::new(cos, sin) * scale.x, glam::Vec2::new(-sin, cos) * scale.y);
+    Affine2::from_mat2_translation(columns, offset)
 }
 
 /// A glTF sampler (filters glTF leaves open: linear, trilinear between mips).

@@ -264,6 +264,7 @@ impl RenderSettings {
     pub fn lighting(&self, scene: &ml_cpu::scene::Scene) -> Shading {
         let shadow_rays = self.omni.is_some_and(|o| o.rays());
         let directional_rays = self.omni.is_some_and(|o| !o.rays()) && !scene.directional.is_empty();
+        let material_lobes = self.shading == ShadingModel::Pbr && scene.objects.iter().any(|o| o.extras.lobes.any());
         let sun_rays = self.shading == ShadingModel::BlinnPhong && self.sun_shadow == SunShadowMode::Rays;
         Shading {
             model: self.shading,
@@ -279,10 +280,8 @@ impl RenderSettings {
             antialiasing: self.antialiasing,
             specular_aa: self.specular_aa,
             environment: self.shading == ShadingModel::Pbr && scene.environment.is_some(),
-            material_lobes: self.shading == ShadingModel::Pbr && scene.objects.iter().any(|o| o.extras.lobes.any()),
-            lobe_textures: self.shading == ShadingModel::Pbr
-                && scene.objects.iter().any(|o| o.extras.lobes.any())
-                && scene.has_lobe_textures(),
+            material_lobes,
+            lobe_textures: material_lobes && scene.has_lobe_textures(),
             background: self.background,
         }
     }

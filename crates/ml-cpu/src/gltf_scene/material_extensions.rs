@@ -5,9 +5,9 @@
 //! which the loader reads into the object's texture slots). The volume's thickness is in the
 //! mesh's units; the loader scales it to the world's per object (`MaterialLobes::thickness`).
 
-use super::{GltfError, MaterialName};
+use super::{uv_affine, GltfError, MaterialName, Texels};
 use crate::material_lobes::MaterialLobes;
-use glam::{Affine2, Mat2, Vec2, Vec3};
+use glam::{Affine2, Vec2, Vec3};
 use serde_json::Value;
 
 /// The extensions this module reads.
@@ -35,18 +35,22 @@ pub(super) struct TextureRef {
 }
 
 /// The extensions' textures in the object's slot order (`ObjectTextures::slots` from
-/// FIRST_LOBE_SLOT): the field that names each in its extension, and what the loader calls it.
-pub(super) const LOBE_TEXTURE_FIELDS: [(&str, &str); 9] = [
-    ("clearcoatTexture", "clearcoat"),
-    ("clearcoatRoughnessTexture", "clearcoat roughness"),
-    ("clearcoatNormalTexture", "clearcoat normal"),
-    ("sheenColorTexture", "sheen colour"),
-    ("sheenRoughnessTexture", "sheen roughness"),
-    ("specularTexture", "specular"),
-    ("specularColorTexture", "specular colour"),
-    ("transmissionTexture", "transmission"),
-    ("thicknessTexture", "thickness"),
+/// FIRST_LOBE_SLOT): the field that names each in its extension, what the loader calls it,
+/// and how its texels are read (colours sRGB, the clear coat's normal map unit normals).
+pub(super) const LOBE_TEXTURE_FIELDS: [(&str, &str, Texels); 9] = [
+    ("clearcoatTexture", "clearcoat", Texels::Data),
+    ("clearcoatRoughnessTexture", "clearcoat roughness", Texels::Data),
+    (CLEARCOAT_NORMAL_FIELD, "clearcoat normal", Texels::UnitNormals),
+    ("sheenColorTexture", "sheen colour", Texels::Colour),
+    ("sheenRoughnessTexture", "sheen roughness", Texels::Data),
+    ("specularTexture", "specular", Texels::Data),
+    ("specularColorTexture", "specular colour", Texels::Colour),
+    ("transmissionTexture", "transmission", Texels::Data),
+    ("thicknessTexture", "thickness", Texels::Data),
 ];
+
+/// The clear coat's normal map, whose scale its lobes keep.
+const CLEARCOAT_NORMAL_FIELD: &str = "clearcoatNormalTexture";
 
 /// The textures a material's extensions name, in LOBE_TEXTURE_FIELDS' order.
 pub(super) type LobeTextureRefs = [Option<TextureRef>; LOBE_TEXTURE_FIELDS.len()];
@@ -73,7 +77,8 @@ pub(super) fn material_lobes(m: &gltf::Material, textures: usize) -> Result<(Mat
         lobes.clearcoat = read.number(ext, "clearcoatFactor", 0.0, 0.0..=1.0)?;
         lobes.clearcoat_roughness = read.number(ext, "clearcoatRoughnessFactor", 0.0, 0.0..=1.0)?;
         read.textures(ext, &mut refs)?;
-        lobes.clearcoat_normal_scale = refs[2].map_or(1.0, |t| t.scale);
+        let normal = LOBE_TEXTURE_FIELDS.iter().position(|(field, ..)| *field == CLEARCOAT_NORMAL_FIELD);
+        lobes.clearcoat_normal_scale = normal.and_then(|i| refs[i]).map_or(1.0, |t| t.scale);
     }
     if let Some(ext) = m.extension_value("KHR_materials_sheen") {
         lobes.sheen_color = read.color(ext, "sheenColorFactor", Vec3::ZERO, 0.0..=1.0)?;
@@ -124,7 +129,7 @@ impl Reader {
 
     /// Each texture of LOBE_TEXTURE_FIELDS that `ext` names, into its place in `refs`.
     fn textures(&self, ext: &Value, refs: &mut LobeTextureRefs) -> Result<(), GltfError> {
-        for (slot, (field, _)) in refs.iter_mut().zip(LOBE_TEXTURE_FIELDS) {
+        for (slot, (field, ..)) in refs.iter_mut().zip(LOBE_TEXTURE_FIELDS) {
             if let Some(t) = self.texture(ext, field)? {
                 *slot = Some(t);
             }
@@ -157,8 +162,9 @@ impl Reader {
     }
 }
 
-/// A KHR_texture_transform object as the affine map of texture coordinates it is (as the
-/// loader's own texture_transform builds it); None where a part is not finite numbers.
+/// A KHR_texture_transform object as the affine map of texture coordinates it is
+/// (`uv_affine`, as the loader's own texture_transform builds it); None where a part is not
+/// finite numbers.
 fn texture_transform(t: &Value) -> Option<Affine2> {
     let pair = |name: &str, default: Vec2| match t.get(name) {
         None => Some(default),
@@ -171,8 +177,6 @@ fn texture_transform(t: &Value) -> Option<Affine2> {
         None => 0.0,
         Some(v) => v.as_f64()? as f32,
     };
-    let (offset, scale) = (pair("offset", Vec2::ZERO)?, pair("scale", Vec2::ONE)?);
-    let (sin, cos) = rotation.sin_cos();
-    let affine = Affine2::from_mat2_translation(Mat2::from_cols(Vec2::new(cos, sin) * scale.x, Vec2::new(-sin, cos) * scale.y), offset);
+    let affine = uv_affine(pair("offset", Vec2::ZERO)?, rotation, pair("scale", Vec2::ONE)?);
     affine.is_finite().then_some(affine)
 }
