@@ -49,6 +49,7 @@ mod gpu_mesh;
 mod light_grid;
 mod light_stats;
 mod pass;
+mod read_back;
 mod render_pass;
 mod renderer;
 mod scene;

@@ -5,6 +5,7 @@
 
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
+use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::sync::Use;
@@ -108,9 +109,10 @@ pub trait Pass {
         Vec::new()
     }
 
-    /// What the host reads of the pass's resources once the frame is done (in `collect`),
-    /// declared as uses at the frame's end: after every pass, the renderer orders them.
-    fn host_reads(&self) -> Vec<Use> {
+    /// What the host reads of slot `slot`'s resources once its frame is done (in `collect`):
+    /// after every pass the renderer orders them, copies those in device memory into their
+    /// `ReadBack` and makes them visible to the host (`read_back`).
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
         Vec::new()
     }
 

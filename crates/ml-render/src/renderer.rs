@@ -12,6 +12,7 @@ use crate::exposure::auto_exposure::{self, AutoExposure};
 use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
+use crate::read_back::{self, HostRead};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
 use crate::settings::{Geometry, LightAssignment, RenderSettings};
@@ -815,9 +816,11 @@ impl<'a> Renderer<'a> {
             }
         }
         // The colour target as the read-back and a window's blit take it; what the passes'
-        // `collect` reads, as the host reads it.
-        let frame_end: Vec<sync::Use> = std::iter::once(sync::frame_end()).chain(self.passes.iter().flat_map(|p| p.host_reads())).collect();
+        // `collect` reads, as the host reads it or copied for it.
+        let reads: Vec<HostRead> = self.passes.iter().flat_map(|p| p.host_reads(f)).collect();
+        let frame_end: Vec<sync::Use> = std::iter::once(sync::frame_end()).chain(reads.iter().map(HostRead::at_frame_end)).collect();
         frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &frame_end, &image);
+        read_back::record_copies(ctx, cmd, &reads);
         if let Some(hook) = hook {
             hook.record(ctx, cmd, &targets.color)?;
         }

@@ -258,6 +258,11 @@ pub const SHADOW_CUBES: &str = "shadow cubes";
 /// them): written by the atlas's pass, read by the shading passes.
 pub const SHADOW_ATLAS: [&str; 2] = ["ShadowAtlasBuffer", "ShadowAtlasTileBuffer"];
 
+/// The compute shadow raster's counters of the point lights' pass (its shader block's name;
+/// one buffer for every slot): written and dispatched from by the pass, read back at the
+/// frame's end.
+pub const SHADOW_RASTER_COUNTERS: &str = "OmniRasterCounterBuffer";
+
 /// How a pass that shades reads the point-light shadows (cubes and atlas): in `stages`.
 pub fn shadow_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let read = (stages, vk::AccessFlags::SHADER_READ);
@@ -269,10 +274,10 @@ pub fn shadow_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
 /// name): added to by the lighting's subgroups, read by the host after the frame.
 pub const RAY_COUNT: &str = "RayCountBuffer";
 
-/// How a compute lighting adds to the ray count, and how the host then reads it.
-pub fn ray_count_uses() -> (Use, Use) {
+/// How a compute lighting adds to the ray count (the host reads it in place after the frame).
+pub fn ray_count_use() -> Use {
     let add = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-    (Use::at(RAY_COUNT, add, None), Use::at(RAY_COUNT, (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ), None))
+    Use::at(RAY_COUNT, add, None)
 }
 
 /// How a pass that shades reads what the frame lit it with: the lights and their lists, and
@@ -286,7 +291,7 @@ pub fn shading_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
 /// The resources the frame slots share (the scene's): their states are the renderer's, not a
 /// slot's. Frames are recorded in the order they are submitted, so a frame's first use of one
 /// follows the last frame's, whichever slot that frame ran in.
-pub const SCENE_WIDE: [&str; 4] = [MESHLET_VISIBILITY, SHADOW_CUBES, SHADOW_ATLAS[0], SHADOW_ATLAS[1]];
+pub const SCENE_WIDE: [&str; 5] = [MESHLET_VISIBILITY, SHADOW_CUBES, SHADOW_ATLAS[0], SHADOW_ATLAS[1], SHADOW_RASTER_COUNTERS];
 
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.

@@ -59,15 +59,6 @@ pub fn memory_barrier(
     unsafe { ctx.device.cmd_pipeline_barrier(cmd, src.0, dst.0, vk::DependencyFlags::empty(), &b, &[], &[]) };
 }
 
-/// Copy the first `bytes` of `src` into `dst` (host-visible) and make the copy visible to the
-/// host (counters read back after a frame).
-pub fn copy_buffer_to_host(ctx: &Context, cmd: vk::CommandBuffer, (src, dst): (vk::Buffer, vk::Buffer), bytes: vk::DeviceSize) {
-    // SAFETY: recording state outside a render pass; the caller's buffers are alive and hold
-    // `bytes`, and the writes to `src` were made visible to transfers.
-    unsafe { ctx.device.cmd_copy_buffer(cmd, src, dst, &[vk::BufferCopy::default().size(bytes)]) };
-    transfer_to_host_barrier(ctx, cmd);
-}
-
 /// The most bytes one vkCmdUpdateBuffer writes.
 const UPDATE_LIMIT: usize = 65536;
 

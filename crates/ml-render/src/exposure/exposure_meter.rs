@@ -1,6 +1,6 @@
 //! Auto exposure's meter (`--exposure auto`; docs/DESIGN.md#exposure): the last pass of a
 //! frame reads the finished 8-bit image back into linear luminance and sums log2 luminance per
-//! 8×8 work group (exposure_meter.comp); the sums are copied to the host with the frame, and
+//! 8×8 work group (exposure_meter.comp); the sums are copied to the host at the frame's end, and
 //! `collect` adds them up into the frame's log-average luminance, which the renderer turns into
 //! the next frame's EV.
 
@@ -9,18 +9,21 @@ use crate::descriptors::Resource;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
+use crate::read_back::{HostRead, ReadBack};
 use crate::report::FrameStats;
 use crate::sync::{Use, COLOUR_TARGET};
 use gpu_allocator::MemoryLocation;
-use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{vk, Buffer, Context, VkError};
+
+/// The sums' shader block.
+const SUMS: &str = "ExposureMeterBuffer";
 
 pub struct ExposureMeter {
     pass: ComputePass,
     /// Per frame slot: the work groups' sums on the GPU, their copy for the host, and the
     /// groups they hold (made for the slot's image size when the slot is bound).
     sums: Vec<Buffer>,
-    readback: Vec<Buffer>,
+    readback: ReadBack,
     groups: Vec<u32>,
 }
 
@@ -31,7 +34,7 @@ impl ExposureMeter {
         Ok(ExposureMeter {
             pass: ComputePass::new(ctx, &[], (&ml_shaders::EXPOSURE_METER_COMP, &curve))?,
             sums: (0..FRAMES_IN_FLIGHT).map(|_| Buffer::null()).collect(),
-            readback: (0..FRAMES_IN_FLIGHT).map(|_| Buffer::null()).collect(),
+            readback: ReadBack::new("exposure meter read-back"),
             groups: vec![0; FRAMES_IN_FLIGHT],
         })
     }
@@ -51,38 +54,36 @@ impl Pass for ExposureMeter {
         if groups != self.groups[slot] {
             // A new size (no frame of this slot in flight while it is bound).
             self.sums[slot].destroy(ctx);
-            self.readback[slot].destroy(ctx);
             self.groups[slot] = 0;
             let bytes = groups as u64 * 8;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC;
             self.sums[slot] = Buffer::new(ctx, "exposure meter sums", bytes, usage, MemoryLocation::GpuOnly)?;
-            let host = vk::BufferUsageFlags::TRANSFER_DST;
-            self.readback[slot] = Buffer::new(ctx, "exposure meter read-back", bytes, host, MemoryLocation::GpuToCpu)?;
+            self.readback.make(ctx, slot, bytes)?;
             self.groups[slot] = groups;
         }
         let sums = Resource::Buffer(self.sums[slot].raw);
-        self.pass.bind_frame(ctx, frame, &|name| if name == "ExposureMeterBuffer" { Some(sums) } else { frame.buffer(name) })
+        self.pass.bind_frame(ctx, frame, &|name| if name == SUMS { Some(sums) } else { frame.buffer(name) })
     }
 
-    /// After every pass that writes the colour target: it reads the finished image.
+    /// After every pass that writes the colour target: it reads the finished image. It
+    /// writes the sums after the slot's last copy of them.
     fn uses(&self) -> Vec<Use> {
-        let read = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
-        vec![Use::at(COLOUR_TARGET, read, Some(vk::ImageLayout::GENERAL))]
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let read = (compute, vk::AccessFlags::SHADER_READ);
+        vec![Use::at(COLOUR_TARGET, read, Some(vk::ImageLayout::GENERAL)), Use::at(SUMS, (compute, vk::AccessFlags::SHADER_WRITE), None)]
+    }
+
+    fn host_reads(&self, slot: usize) -> Vec<HostRead> {
+        vec![self.readback.of(slot, SUMS, self.sums[slot].raw)]
     }
 
     fn record(&self, rec: &Recording) {
-        let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let (compute, transfer) = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::PipelineStageFlags::TRANSFER);
-        // The sums' last copy, two frames ago, read them (same queue).
-        memory_barrier(ctx, cmd, (transfer, vk::AccessFlags::TRANSFER_READ), (compute, vk::AccessFlags::SHADER_WRITE));
-        self.pass.dispatch(ctx, cmd, rec.slot, (&[], &[]), rec.extent);
-        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
-        copy_buffer_to_host(ctx, cmd, (self.sums[rec.slot].raw, self.readback[rec.slot].raw), self.groups[rec.slot] as u64 * 8);
+        self.pass.dispatch(rec.ctx, rec.cmd, rec.slot, (&[], &[]), rec.extent);
     }
 
     fn collect(&self, slot: usize, report: &mut SlotReport, _: &mut FrameStats) {
         let bytes = self.groups[slot] as usize * 8;
-        let sums: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&self.readback[slot].mapped()[..bytes]);
+        let sums: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&self.readback.bytes(slot)[..bytes]);
         let (log2_sum, pixels) = sums.iter().fold((0.0f64, 0.0f64), |(s, n), g| (s + g[0] as f64, n + g[1] as f64));
         // A frame with no metered pixel (all background) keeps the exposure it had.
         report.log2_luminance = (pixels > 0.0).then_some((log2_sum / pixels) as f32);
@@ -90,9 +91,10 @@ impl Pass for ExposureMeter {
 
     fn destroy(&mut self, ctx: &Context) {
         self.pass.destroy(ctx);
-        for b in self.sums.iter_mut().chain(&mut self.readback) {
+        for b in &mut self.sums {
             b.destroy(ctx);
         }
+        self.readback.destroy(ctx);
         self.groups.fill(0);
     }
 }

@@ -24,6 +24,7 @@ use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
+use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::specialization::compute_pipeline;
 use crate::sync::{Use, LIGHT_GRID_LISTS, LIGHT_GRID_OCCUPANCY};
@@ -92,6 +93,9 @@ struct GridSlot {
     dispatch: Buffer,
     feedback: Buffer,
 }
+
+/// The feedback's shader block (light_grid_scan.comp).
+const FEEDBACK: &str = "LightGridFeedbackBuffer";
 
 impl GridSlot {
     fn new(ctx: &Context, lights: u64, cells: u64) -> Result<GridSlot, VkError> {
@@ -232,7 +236,7 @@ impl LightGridBuild {
     }
 
     /// Record the frame's build: the lists (ordered with their readers by the barriers its
-    /// `uses` give) and its own buffers; afterwards the feedback is visible to the host.
+    /// `uses` give) and its own buffers.
     fn record_build(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
         let (own, set) = (&self.slots[slot], self.sets.sets[slot]);
         let d = &ctx.device;
@@ -285,7 +289,6 @@ impl LightGridBuild {
                 }
             }
         }
-        memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ));
     }
 
     fn release_all(&mut self, ctx: &Context) {
@@ -335,7 +338,7 @@ impl Pass for LightGridBuild {
                 "LightGridKeptBuffer" => own.kept.raw,
                 "LightGridKeptCountBuffer" => own.kept_count.raw,
                 "LightGridDispatchBuffer" => own.dispatch.raw,
-                "LightGridFeedbackBuffer" => own.feedback.raw,
+                FEEDBACK => own.feedback.raw,
                 _ => return frame.buffer(name),
             };
             Some(Resource::Buffer(buffer))
@@ -353,7 +356,13 @@ impl Pass for LightGridBuild {
             (stages, rw.1 | vk::AccessFlags::TRANSFER_WRITE)
         };
         uses.push(Use::at(LIGHT_GRID_OCCUPANCY, marks, None));
+        uses.push(Use::at(FEEDBACK, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), None));
         uses
+    }
+
+    /// The feedback, where the scan wrote it (host-visible).
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(FEEDBACK)]
     }
 
     fn frame_uniforms(&self, uniforms: &mut FrameUniforms, light_offset: glam::Vec3) {

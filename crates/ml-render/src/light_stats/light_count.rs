@@ -10,6 +10,7 @@ use crate::compute_pass::ComputePass;
 use crate::descriptors::Resource;
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
 use crate::pass::{Pass, Recording, SlotReport};
+use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
@@ -85,8 +86,8 @@ impl Pass for LightCount {
         uses
     }
 
-    fn host_reads(&self) -> Vec<Use> {
-        vec![Use::at(LIGHT_COUNTS, (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ), None)]
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(LIGHT_COUNTS)]
     }
 
     fn record(&self, rec: &Recording) {

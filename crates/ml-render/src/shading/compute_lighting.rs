@@ -8,9 +8,10 @@ use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
+use crate::read_back::HostRead;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{ray_count_uses, shading_reads, Use};
+use crate::sync::{ray_count_use, shading_reads, Use, RAY_COUNT};
 use crate::targets::GBUFFER;
 use ml_vk::{vk, Context, VkError};
 
@@ -69,12 +70,12 @@ impl Pass for ComputeLighting {
     fn uses(&self) -> Vec<Use> {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::output_use(self.layers));
-        uses.push(ray_count_uses().0);
+        uses.push(ray_count_use());
         uses
     }
 
-    fn host_reads(&self) -> Vec<Use> {
-        vec![ray_count_uses().1]
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(RAY_COUNT)]
     }
 
     fn record(&self, rec: &Recording) {

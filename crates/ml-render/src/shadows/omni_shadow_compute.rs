@@ -9,25 +9,27 @@ use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
+use crate::read_back::{HostRead, ReadBack};
 use crate::report::{FeatureStats, FrameStats};
 use crate::scene::meshlets::MeshletGeometryView;
 use crate::scene::omni_shadow::NEAR_FRACTION;
 use crate::scene::shadow_atlas::tile_table;
 use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
-use crate::sync::{Use, SHADOW_ATLAS, SHADOW_CUBES};
-use gpu_allocator::MemoryLocation;
+use crate::sync::{Use, SHADOW_ATLAS, SHADOW_CUBES, SHADOW_RASTER_COUNTERS};
 use ml_cpu::gpu_types::OmniRasterCounters;
 use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
-use ml_vk::commands::copy_buffer_to_host;
-use ml_vk::{vk, Buffer, Context, VkError};
+use ml_vk::{vk, Context, VkError};
 
 pub struct OmniShadowCompute {
     views: ShadowViews,
     raster: ShadowRaster,
-    /// The counters, copied out at the end of the pass, per frame slot.
-    readback: Vec<Buffer>,
+    /// The counters, copied at the end of the frame, per frame slot.
+    readback: ReadBack,
     /// The shadow atlas's plan for the frame being recorded (the atlas views).
     plan: Option<AtlasPlan>,
+    /// Whether the frame being recorded draws (some light placed; the atlas: a plan), and so
+    /// has counters to read back.
+    draws: bool,
 }
 
 impl OmniShadowCompute {
@@ -37,21 +39,9 @@ impl OmniShadowCompute {
         (views, size, large_capacity): (ShadowViews, u32, u32),
     ) -> Result<OmniShadowCompute, RenderError> {
         let raster = ShadowRaster::new(ctx, geometry, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
-        let pass = OmniShadowCompute { views, raster, readback: Vec::new(), plan: None };
-        ml_vk::build(ctx, pass, |p| {
-            for _ in 0..FRAMES_IN_FLIGHT {
-                let bytes = size_of::<OmniRasterCounters>() as u64;
-                let readback = Buffer::new(
-                    ctx,
-                    "shadow raster counters read-back",
-                    bytes,
-                    vk::BufferUsageFlags::TRANSFER_DST,
-                    MemoryLocation::GpuToCpu,
-                )?;
-                p.readback.push(readback);
-            }
-            Ok(())
-        })
+        let pass =
+            OmniShadowCompute { views, raster, readback: ReadBack::new("shadow raster counters read-back"), plan: None, draws: false };
+        ml_vk::build(ctx, pass, |p| Ok(p.readback.make_all(ctx, size_of::<OmniRasterCounters>() as u64)?))
     }
 }
 
@@ -66,24 +56,41 @@ impl Pass for OmniShadowCompute {
     }
 
     /// The cubes, overwritten by a copy (left TRANSFER_DST_OPTIMAL); or the atlas's table,
-    /// written by transfers, and the atlas, cleared and drawn by compute shaders.
+    /// written by transfers, and the atlas, cleared and drawn by compute shaders. The
+    /// raster's counters: written by transfers and shaders, dispatched from.
     fn uses(&self) -> Vec<Use> {
-        let transfer = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE);
-        match self.views {
+        use vk::AccessFlags as A;
+        use vk::PipelineStageFlags as S;
+        let transfer = (S::TRANSFER, A::TRANSFER_WRITE);
+        let rw = A::SHADER_READ | A::SHADER_WRITE;
+        let counters = (S::TRANSFER | S::COMPUTE_SHADER | S::DRAW_INDIRECT, A::TRANSFER_WRITE | rw | A::INDIRECT_COMMAND_READ);
+        let mut uses = match self.views {
             ShadowViews::Atlas { .. } => {
                 let [atlas, table] = SHADOW_ATLAS;
-                let compute = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-                vec![Use::at(table, transfer, None), Use::at(atlas, compute, None)]
+                vec![Use::at(table, transfer, None), Use::at(atlas, (S::COMPUTE_SHADER, rw), None)]
             }
             _ => vec![Use::overwriting(SHADOW_CUBES, transfer, vk::ImageLayout::TRANSFER_DST_OPTIMAL)],
+        };
+        uses.push(Use::at(SHADOW_RASTER_COUNTERS, counters, None));
+        uses
+    }
+
+    /// The raster's counters, where the frame drew (the slot's copy keeps what it had
+    /// otherwise).
+    fn host_reads(&self, slot: usize) -> Vec<HostRead> {
+        if !self.draws {
+            return Vec::new();
         }
+        vec![self.readback.of(slot, SHADOW_RASTER_COUNTERS, self.raster.counters.raw)]
     }
 
     fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
         p.scene.omni.place(p.rest_lights, p.light_offset);
-        if let ShadowViews::Atlas { .. } = self.views {
+        let atlas = matches!(self.views, ShadowViews::Atlas { .. });
+        if atlas {
             self.plan = plan_atlas(p)?;
         }
+        self.draws = self.views.lights() > 0 && !p.scene.omni.placed().is_empty() && (!atlas || self.plan.is_some());
         Ok(())
     }
 
@@ -101,18 +108,16 @@ impl Pass for OmniShadowCompute {
                 self.raster.record_atlas(rec.ctx, rec.cmd, rec.slot, (&lights, &tiles), projection);
             }
             // No plan, no face to draw (the atlas keeps what it holds).
-            (ShadowViews::Atlas { .. }, None) => return,
+            (ShadowViews::Atlas { .. }, None) => {}
             _ => {
                 let target = ShadowTarget { image: rec.scene.omni.cubes.raw, readers: None };
                 self.raster.record(rec.ctx, rec.cmd, rec.slot, &lights, projection, &target);
             }
         }
-        let counter_bytes = size_of::<OmniRasterCounters>() as u64;
-        copy_buffer_to_host(rec.ctx, rec.cmd, (self.raster.counters.raw, self.readback[rec.slot].raw), counter_bytes);
     }
 
     fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
-        let c: OmniRasterCounters = bytemuck::pod_read_unaligned(&self.readback[slot].mapped()[..size_of::<OmniRasterCounters>()]);
+        let c: OmniRasterCounters = self.readback.read(slot);
         stats.set_feature(OmniRasterStats {
             pairs: c.pairs[3],
             small: c.drawn[0].saturating_sub(c.drawn[1]),
@@ -125,10 +130,7 @@ impl Pass for OmniShadowCompute {
 
     fn destroy(&mut self, ctx: &Context) {
         self.raster.destroy(ctx);
-        for b in &mut self.readback {
-            b.destroy(ctx);
-        }
-        self.readback.clear();
+        self.readback.destroy(ctx);
     }
 }
 

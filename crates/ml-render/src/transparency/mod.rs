@@ -80,11 +80,6 @@ pub fn layer_uses(stages: vk::PipelineStageFlags) -> Vec<Use> {
     vec![Use::at(LAYER_BUFFERS[0], read, None), Use::at(LAYER_BUFFERS[1], read_write, None), Use::at(LAYER_BUFFERS[2], read_write, None)]
 }
 
-/// The counters as the host reads them once the frame is done (after every pass).
-pub fn counts_to_host() -> Use {
-    Use::at(LAYER_BUFFERS[2], (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ), None)
-}
-
 /// The transparent layers of the last frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TransparencyStats {

@@ -7,12 +7,13 @@
 //! for the tiles' build. Runs after the opaque raster, before the resolve; clears the slot's
 //! lists first.
 
-use super::{counts_to_host, node_bytes, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
+use super::{node_bytes, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::{layer_mesh, SceneMeshes};
 use crate::pass::{Pass, Recording, SlotReport};
+use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
@@ -413,8 +414,8 @@ impl Pass for TransparentBuild {
         self.layers[slot].as_ref().map_or_else(Vec::new, |l| l.named().to_vec())
     }
 
-    fn host_reads(&self) -> Vec<Use> {
-        vec![counts_to_host()]
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(LAYER_BUFFERS[2])]
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {

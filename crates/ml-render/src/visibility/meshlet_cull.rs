@@ -18,6 +18,7 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording, SlotReport};
 use crate::plan::Phase;
+use crate::read_back::HostRead;
 use crate::report::{FeatureStats, FrameStats};
 use crate::specialization::compute_pipeline;
 use crate::sync::{Use, DEPTH_PYRAMID, MESHLET_VISIBILITY, VISIBILITY_DEPTH};
@@ -28,7 +29,7 @@ use crate::visibility::meshlet_scene::{
     VISIBLE_INSTANCES,
 };
 use ml_cpu::gpu_types::{CullCounters, CullPush};
-use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
+use ml_vk::commands::memory_barrier;
 use ml_vk::{shader, vk, Context, VkError};
 
 pub struct MeshletCull {
@@ -94,12 +95,6 @@ impl MeshletCull {
             Ok(())
         })
     }
-
-    /// Whether this pass reads the counters back: the late phase's, unless the compute
-    /// raster's large-triangle pass comes after it (that one does then).
-    fn reads_back(&self) -> bool {
-        self.phase == Phase::Late && self.raster.bin_list().is_none()
-    }
 }
 
 /// The culling passes' push constants (the large-triangle pass reads the same).
@@ -141,9 +136,6 @@ impl Pass for MeshletCull {
         let mut counters = (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ);
         if early {
             counters = (counters.0 | S::TRANSFER, counters.1 | A::TRANSFER_WRITE);
-        }
-        if self.reads_back() {
-            counters = (counters.0 | S::TRANSFER, counters.1 | A::TRANSFER_READ);
         }
         // The early phase reads which meshlets the last frame saw, the late one writes it.
         let visibility = if early { (S::COMPUTE_SHADER, A::SHADER_READ) } else { compute };
@@ -206,11 +198,16 @@ impl Pass for MeshletCull {
             let meshlets = (std::mem::offset_of!(CullCounters, meshlets) + phase * 16) as u64;
             d.cmd_dispatch_indirect(cmd, f.counters.raw, meshlets);
         }
-        // The passes after it are ordered by their declared uses; the read-back is this pass's.
-        if self.reads_back() {
-            memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (transfer, vk::AccessFlags::TRANSFER_READ));
-            copy_buffer_to_host(ctx, cmd, (f.counters.raw, f.readback.raw), std::mem::size_of::<CullCounters>() as u64);
+    }
+
+    /// The late phase's counters, copied once the frame's every pass has added to them (the
+    /// large triangles' pass adds the pixels it covered).
+    fn host_reads(&self, slot: usize) -> Vec<HostRead> {
+        if self.phase != Phase::Late {
+            return Vec::new();
         }
+        let scene = self.scene.borrow();
+        vec![scene.readback.of(slot, CULL_COUNTERS, scene.frames[slot].counters.raw)]
     }
 
     fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {

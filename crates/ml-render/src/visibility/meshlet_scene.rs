@@ -1,7 +1,7 @@
 //! The scene as the GPU-driven passes draw it (technique visibility; docs/DESIGN.md#gpu-culling):
 //! the scene's meshlet geometry (scene::meshlets, borrowed) and, per frame slot, the culling's buffers (counters with
 //! the indirect dispatches and draws, the visible-instance list, the draw slots, the
-//! compacted indices and triangle ids, a read-back of the counters); and, shared by the
+//! compacted indices and triangle ids) and a read-back of the counters; and, shared by the
 //! slots, each meshlet instance's visibility at the end of the last frame (frames run in
 //! submission order, so the next frame reads what the last one wrote). The culling, raster
 //! and lighting passes share it and bind its buffers by the names the shaders give them.
@@ -12,6 +12,7 @@
 use crate::descriptors::Resource;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
+use crate::read_back::ReadBack;
 use crate::scene::meshlets::{storage_bytes, MeshletGeometryView};
 use crate::sync::MESHLET_VISIBILITY;
 use gpu_allocator::MemoryLocation;
@@ -35,8 +36,6 @@ pub const LARGE_TRIANGLES: &str = "LargeTriangleBuffer";
 pub struct CullFrame {
     /// CullCounters: counts, the indirect dispatches and the two phases' draws.
     pub counters: Buffer,
-    /// The counters, copied after the late phase for the CPU.
-    pub readback: Buffer,
     pub visible_instances: Buffer,
     /// The meshlets to draw (uvec4 each): early from 0, late from `capacity` on.
     pub draw_slots: Buffer,
@@ -55,6 +54,9 @@ pub struct MeshletScene {
     /// Per meshlet instance: 1 where it was visible at the end of the last frame.
     pub visibility: Buffer,
     pub frames: Vec<CullFrame>,
+    /// The counters, copied at the end of each frame for the CPU (the late culling's
+    /// `host_reads`).
+    pub readback: ReadBack,
     /// Draws one phase may write: every meshlet instance (each is drawn at most once a frame).
     pub capacity: u32,
 }
@@ -66,7 +68,13 @@ impl MeshletScene {
     /// The scene's meshlets `geometry` with per-frame culling buffers; `bin_list`: large
     /// triangles, and bins, the compute raster's lists hold per phase (0 where it has none).
     pub fn new(ctx: &Context, geometry: MeshletGeometryView, bin_list: u32) -> Result<SharedMeshletScene, VkError> {
-        let s = MeshletScene { geometry, visibility: Buffer::null(), frames: Vec::new(), capacity: geometry.meshlet_instance_count.max(1) };
+        let s = MeshletScene {
+            geometry,
+            visibility: Buffer::null(),
+            frames: Vec::new(),
+            readback: ReadBack::new("cull counters read-back"),
+            capacity: geometry.meshlet_instance_count.max(1),
+        };
         let made = ml_vk::build(ctx, s, |s| s.create(ctx, bin_list))?;
         Ok(Rc::new(RefCell::new(made)))
     }
@@ -88,7 +96,6 @@ impl MeshletScene {
             let counter_bytes = std::mem::size_of::<CullCounters>() as u64;
             let mut f = CullFrame {
                 counters: Buffer::null(),
-                readback: Buffer::null(),
                 visible_instances: Buffer::null(),
                 draw_slots: Buffer::null(),
                 indices: Buffer::null(),
@@ -104,7 +111,6 @@ impl MeshletScene {
                     storage | U::INDIRECT_BUFFER | U::TRANSFER_DST | U::TRANSFER_SRC,
                     MemoryLocation::GpuOnly,
                 )?;
-                f.readback = Buffer::new(ctx, "cull counters read-back", counter_bytes, U::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
                 f.visible_instances = Buffer::new(
                     ctx,
                     "visible instances",
@@ -125,7 +131,7 @@ impl MeshletScene {
             }
             self.frames.push(f);
         }
-        Ok(())
+        self.readback.make_all(ctx, size_of::<CullCounters>() as u64)
     }
 
     /// The buffer a culling, raster or lighting shader calls `name`, of `frame`'s slot: the
@@ -151,7 +157,7 @@ impl MeshletScene {
 
     /// Slot `slot`'s counters as its last finished frame left them.
     pub fn counters(&self, slot: usize) -> CullCounters {
-        bytemuck::pod_read_unaligned(&self.frames[slot].readback.mapped()[..std::mem::size_of::<CullCounters>()])
+        self.readback.read(slot)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -160,6 +166,7 @@ impl MeshletScene {
             f.destroy(ctx);
         }
         self.frames.clear();
+        self.readback.destroy(ctx);
     }
 }
 
@@ -167,7 +174,6 @@ impl CullFrame {
     fn destroy(&mut self, ctx: &Context) {
         for b in [
             &mut self.counters,
-            &mut self.readback,
             &mut self.visible_instances,
             &mut self.draw_slots,
             &mut self.indices,

@@ -16,7 +16,6 @@ use crate::technique::Raster;
 use crate::visibility::meshlet_cull::cull_push;
 use crate::visibility::meshlet_scene::{SharedMeshletScene, CULL_COUNTERS, LARGE_BINS, LARGE_TRIANGLES};
 use ml_cpu::gpu_types::{CullCounters, CullPush};
-use ml_vk::commands::{copy_buffer_to_host, memory_barrier};
 use ml_vk::{shader, vk, Context, VkError};
 
 pub struct TriangleRasterLarge {
@@ -75,10 +74,7 @@ impl Pass for TriangleRasterLarge {
         use vk::AccessFlags as A;
         use vk::PipelineStageFlags as S;
         let rw = A::SHADER_READ | A::SHADER_WRITE;
-        let mut counters = (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ);
-        if self.phase == Phase::Late {
-            counters = (counters.0 | S::TRANSFER, counters.1 | A::TRANSFER_READ);
-        }
+        let counters = (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ);
         vec![
             Use::at(CULL_COUNTERS, counters, None),
             Use::at(LARGE_BINS, (S::COMPUTE_SHADER, A::SHADER_READ), None),
@@ -95,7 +91,6 @@ impl Pass for TriangleRasterLarge {
         let push = cull_push(self.phase, true, self.raster, &scene, rec.extent);
         let phase = usize::from(self.phase == Phase::Late);
         let dispatch = (std::mem::offset_of!(CullCounters, large) + phase * 16) as u64;
-        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         // SAFETY: recording state outside a render pass; everything bound is alive until the
         // frame's fence signals.
         unsafe {
@@ -103,18 +98,6 @@ impl Pass for TriangleRasterLarge {
             d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             d.cmd_dispatch_indirect(cmd, scene.frames[slot].counters.raw, dispatch);
-        }
-        // The late phase reads the counters back (this pass adds the pixels it covered); the
-        // passes after it are ordered by their declared uses.
-        if self.phase == Phase::Late {
-            memory_barrier(
-                ctx,
-                cmd,
-                (compute, vk::AccessFlags::SHADER_WRITE),
-                (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
-            );
-            let f = &scene.frames[slot];
-            copy_buffer_to_host(ctx, cmd, (f.counters.raw, f.readback.raw), std::mem::size_of::<CullCounters>() as u64);
         }
     }
 
