@@ -7,6 +7,7 @@ use crate::descriptors::Resource;
 use crate::sync::{DEPTH_PYRAMID, SURFACE_COLOURS, VISIBILITY_DEPTH};
 use crate::targets::Targets;
 use ml_vk::vk;
+use std::cell::RefCell;
 
 /// Frames recorded while the GPU works on the previous one (docs/DESIGN.md#frames-in-flight).
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -16,6 +17,9 @@ pub struct FrameResources<'a> {
     pub slot: usize,
     buffers: Vec<(&'static str, vk::Buffer)>,
     pub targets: &'a Targets,
+    /// The names found since `take_found`: what a pass's shaders bound from the table (the
+    /// renderer checks them against the pass's declared uses).
+    found: RefCell<Vec<&'static str>>,
 }
 
 impl<'a> FrameResources<'a> {
@@ -28,14 +32,14 @@ impl<'a> FrameResources<'a> {
             (VISIBILITY_DEPTH, targets.visibility_depth.raw),
             (SURFACE_COLOURS, targets.surface_colours.raw),
         ];
-        FrameResources { slot, buffers, targets }
+        FrameResources { slot, buffers, targets, found: RefCell::new(Vec::new()) }
     }
 
     /// The table with `named` buffers added (a name given twice is a bug: the first would
     /// shadow the second).
     pub fn with(mut self, named: &[(&'static str, vk::Buffer)]) -> FrameResources<'a> {
         for &(name, buffer) in named {
-            debug_assert!(self.raw_buffer(name).is_none(), "{name} added twice");
+            debug_assert!(self.buffers.iter().all(|(n, _)| *n != name), "{name} added twice");
             self.buffers.push((name, buffer));
         }
         self
@@ -48,6 +52,16 @@ impl<'a> FrameResources<'a> {
 
     /// The buffer called `name` itself (for passes that hand it on).
     pub fn raw_buffer(&self, name: &str) -> Option<vk::Buffer> {
-        self.buffers.iter().find(|(n, _)| *n == name).map(|&(_, b)| b)
+        let &(found, buffer) = self.buffers.iter().find(|(n, _)| *n == name)?;
+        self.found.borrow_mut().push(found);
+        Some(buffer)
+    }
+
+    /// The names looked up and found since the last call, each once.
+    pub fn take_found(&self) -> Vec<&'static str> {
+        let mut names = std::mem::take(&mut *self.found.borrow_mut());
+        names.sort_unstable();
+        names.dedup();
+        names
     }
 }

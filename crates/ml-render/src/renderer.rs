@@ -150,7 +150,7 @@ fn settle_for_scene(settings: &mut RenderSettings, scene: &Scene) {
     if !scene.has_transparent_objects() {
         settings.transparency = None;
     }
-    let lobe_textures = settings.lighting(scene).lobe_textures;
+    let lobe_textures = settings.lighting(scene).lobe_textures();
     if let Some(t) = &mut settings.transparency {
         t.lobe_textures = lobe_textures;
     }
@@ -322,7 +322,8 @@ impl<'a> Renderer<'a> {
         if self.gpu.object_textures.per_object.is_empty() || !scene.textures.is_empty() || !self.scene.textures.is_empty() {
             return Ok(false);
         }
-        if self.settings.lighting(scene).material_lobes != self.settings.lighting(&self.scene).material_lobes {
+        let lobes = |scene: &Scene| self.settings.lighting(scene).constant("MATERIAL_LOBES");
+        if lobes(scene) != lobes(&self.scene) {
             return Ok(false);
         }
         self.release_frames()?;
@@ -378,11 +379,22 @@ impl<'a> Renderer<'a> {
     }
 
     /// Point every pass's sets of slot `f` at its buffers and targets, the scene's and the
-    /// passes' own (the slot is idle).
+    /// passes' own (the slot is idle). In debug builds, every resource a pass's shaders bind
+    /// that the frame orders by declared uses must be among the pass's (`sync::undeclared`).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
         let owned: Vec<(&'static str, vk::Buffer)> = self.passes.iter().flat_map(|p| p.slot_buffers(f)).collect();
         let resources = self.frames[f].resources(f, &self.gpu.named_buffers()).with(&owned);
-        self.passes.iter_mut().try_for_each(|p| p.bind_frame(self.ctx, &resources))
+        let ordered: Vec<&'static str> = self.passes.iter().flat_map(|p| p.uses()).map(|u| u.name).collect();
+        for p in &mut self.passes {
+            resources.take_found();
+            p.bind_frame(self.ctx, &resources)?;
+            if cfg!(debug_assertions) {
+                let missing = sync::undeclared(&resources.take_found(), &p.uses(), &ordered);
+                let pass = p.timer_name().unwrap_or("an untimed pass");
+                assert!(missing.is_empty(), "{pass} binds {missing:?}, which the frame orders by declared uses, without declaring them");
+            }
+        }
+        Ok(())
     }
 
     /// Tell the passes the projection (or size) changed, with slot 0's uniforms holding it (no

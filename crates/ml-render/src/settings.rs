@@ -2,13 +2,16 @@
 
 pub use crate::antialiasing::Antialiasing;
 use crate::background::Background;
+use crate::environment;
 use crate::error::{by_name, Named, RenderError, Setting, SettingsError};
 pub use crate::exposure::{parse_exposure, Exposure, MAX_EXPOSURE_EV};
 pub use crate::scene::shadow_settings::{
     multiview_depth_is_broken, AtlasSettings, OmniShadowMode, OmniShadowSettings, SunShadowMode, MAX_OMNI_BYTES, MAX_SHADOWED_LIGHTS,
 };
-use crate::scene::SceneConfig;
+use crate::scene::{shadow_settings, SceneConfig};
 pub use crate::shading::Shading;
+use crate::shading::{light_constants, material_lobes, surface_constants};
+use crate::specialization::Constants;
 pub use crate::targets::MAX_DIMENSION;
 use crate::targets::{multisampled_images, Output};
 pub use crate::technique::{
@@ -260,28 +263,20 @@ impl RenderSettings {
         self.time.unwrap_or(i as f32 * FRAME_SECONDS * TIMER_SPEED)
     }
 
-    /// What the lighting pipelines are compiled for, for `scene`.
+    /// What the lighting pipelines are compiled for, for `scene`: each feature's constants,
+    /// from its module — a feature that compiles into the lighting adds its line here.
     pub fn lighting(&self, scene: &ml_cpu::scene::Scene) -> Shading {
-        let shadow_rays = self.omni.is_some_and(|o| o.rays());
-        let directional_rays = self.omni.is_some_and(|o| !o.rays()) && !scene.directional.is_empty();
-        let material_lobes = self.shading == ShadingModel::Pbr && scene.objects.iter().any(|o| o.extras.lobes.any());
-        let sun_rays = self.shading == ShadingModel::BlinnPhong && self.sun_shadow == SunShadowMode::Rays;
+        let model = self.shading;
+        let lobe_textures = material_lobes(model, scene) && scene.has_lobe_textures();
+        let surface = surface_constants(model, !scene.textures.is_empty(), self.specular_aa, lobe_textures);
+        let sun = (model == ShadingModel::BlinnPhong).then_some(self.sun_shadow);
+        let shadows = shadow_settings::lighting_constants(self.omni, sun, !scene.directional.is_empty());
         Shading {
-            model: self.shading,
-            omni_shadows: self.omni.is_some(),
-            shadow_atlas: self.omni.is_some_and(|o| o.atlas().is_some()),
-            shadow_rays,
-            directional_rays,
-            sun_rays,
-            object_textures: !scene.textures.is_empty(),
-            spot_lights: !scene.cones.is_empty(),
+            surface: Constants::of(&[&surface]),
+            lighting: Constants::of(&[&shadows, &light_constants(model, scene), &environment::lighting_constants(model, scene)]),
             transparency: self.blends_layers(),
-            count_rays: self.light_stats && (shadow_rays || directional_rays || sun_rays),
+            count_rays: self.light_stats && shadow_settings::traces_rays(&shadows),
             antialiasing: self.antialiasing,
-            specular_aa: self.specular_aa,
-            environment: self.shading == ShadingModel::Pbr && scene.environment.is_some(),
-            material_lobes,
-            lobe_textures: material_lobes && scene.has_lobe_textures(),
             background: self.background,
         }
     }
@@ -299,8 +294,7 @@ impl RenderSettings {
     /// (or the model lights with none), shadow rays where no light casts them.
     pub fn check_scene(&self, scene: &ml_cpu::scene::Scene) -> Result<(), SettingsError> {
         self.check_casters(scene.lights.len(), scene.directional.len())?;
-        let lit = self.shading == ShadingModel::Pbr && scene.environment.is_some();
-        if self.background == Background::Environment && !lit {
+        if self.background == Background::Environment && !environment::lights_scene(self.shading, scene) {
             return Err(SettingsError::BackgroundNeedsEnvironment);
         }
         Ok(())

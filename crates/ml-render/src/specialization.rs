@@ -29,6 +29,40 @@ pub fn resolve<const N: usize>(stages: [&Shader; N], constants: &[(&str, u32)]) 
     Ok(stages.map(|s| constants.iter().filter_map(|&(name, value)| Some((s.spec_id(name)?, value))).collect()))
 }
 
+/// Specialization constants by name as the features contribute them, each from its own
+/// module (a value, so the settings holding them stay `Copy` and comparable).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Constants {
+    entries: [(&'static str, u32); Constants::CAPACITY],
+    len: usize,
+}
+
+impl Constants {
+    /// More than every feature's constants of one kind of pipeline together.
+    pub const CAPACITY: usize = 24;
+
+    /// The features' `groups` one after another (more than `CAPACITY` is a bug: raise it).
+    pub fn of(groups: &[&[(&'static str, u32)]]) -> Constants {
+        let mut c = Constants { entries: [("", 0); Constants::CAPACITY], len: 0 };
+        for &(name, value) in groups.iter().copied().flatten() {
+            assert!(c.len < Constants::CAPACITY, "more than {} specialization constants", Constants::CAPACITY);
+            debug_assert!(c.get(name).is_none(), "{name} contributed twice");
+            c.entries[c.len] = (name, value);
+            c.len += 1;
+        }
+        c
+    }
+
+    pub fn as_slice(&self) -> &[(&'static str, u32)] {
+        &self.entries[..self.len]
+    }
+
+    /// The value of the constant `name`, where a feature contributed it.
+    pub fn get(&self, name: &str) -> Option<u32> {
+        self.as_slice().iter().find(|(n, _)| *n == name).map(|&(_, v)| v)
+    }
+}
+
 /// Reported as the other shader-interface mismatches are (descriptors.rs).
 impl From<UnknownConstant> for VkError {
     fn from(e: UnknownConstant) -> VkError {
@@ -73,6 +107,13 @@ mod tests {
         let e = resolve([&VERT, &FRAG], &[("MODEL_PBR", 1), ("MODEL_PRB", 1)]).unwrap_err();
         assert_eq!(e, UnknownConstant { name: "MODEL_PRB".into(), stages: vec!["a.vert", "a.frag"] });
         assert!(resolve([&VERT], &[("MODEL_PBR", 1)]).is_err());
+    }
+
+    #[test]
+    fn constants_keep_the_features_order_and_find_by_name() {
+        let c = Constants::of(&[&[("MODEL_PBR", 1), ("OBJECT_TEXTURES", 0)], &[], &[("ENVIRONMENT", 1)]]);
+        assert_eq!(c.as_slice(), &[("MODEL_PBR", 1), ("OBJECT_TEXTURES", 0), ("ENVIRONMENT", 1)]);
+        assert_eq!((c.get("ENVIRONMENT"), c.get("OBJECT_TEXTURES"), c.get("SHADOW_RAYS")), (Some(1), Some(0), None));
     }
 
     #[test]

@@ -293,6 +293,14 @@ pub fn shading_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
 /// follows the last frame's, whichever slot that frame ran in.
 pub const SCENE_WIDE: [&str; 5] = [MESHLET_VISIBILITY, SHADOW_CUBES, SHADOW_ATLAS[0], SHADOW_ATLAS[1], SHADOW_RASTER_COUNTERS];
 
+/// Of the frame's resources a pass's shaders bind (`bound`), those that other passes order by
+/// their declared uses (`ordered`) but the pass does not declare (`declared`): the state knows
+/// nothing of such a use, so no barrier would order it — a pass declares every ordered
+/// resource it touches, or none is ordered.
+pub fn undeclared(bound: &[&'static str], declared: &[Use], ordered: &[&'static str]) -> Vec<&'static str> {
+    bound.iter().copied().filter(|name| ordered.contains(name) && !declared.iter().any(|u| u.name == *name)).collect()
+}
+
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.
 pub fn frame_end() -> Use {
@@ -382,6 +390,17 @@ mod tests {
                 d
             })
             .collect()
+    }
+
+    #[test]
+    fn a_pass_that_binds_an_ordered_resource_must_declare_it() {
+        let read = (S::COMPUTE_SHADER, A::SHADER_READ);
+        let declared = [Use::at("LightIndexBuffer", read, None)];
+        let ordered = ["LightIndexBuffer", "ClusterRangeBuffer", "LightBuffer"];
+        // FrameBlock is ordered by nobody (the host writes it before the frame).
+        let bound = ["ClusterRangeBuffer", "FrameBlock", "LightIndexBuffer"];
+        assert_eq!(undeclared(&bound, &declared, &ordered), vec!["ClusterRangeBuffer"]);
+        assert!(undeclared(&["FrameBlock", "LightIndexBuffer"], &declared, &ordered).is_empty());
     }
 
     #[test]

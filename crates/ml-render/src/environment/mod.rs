@@ -13,9 +13,22 @@ use crate::error::RenderError;
 use crate::report::FeatureStats;
 use ml_cpu::environment::Environment;
 use ml_cpu::gpu_types::EnvironmentData;
+use ml_cpu::scene::Scene;
+use ml_cpu::shading_model::ShadingModel;
 use ml_shaders::Shader;
 use ml_vk::image::{image_transition, sampler, texture_with, ImageShape};
 use ml_vk::{shader, vk, Buffer, Context, GpuTimer, Image, VkError, VkResultExt};
+
+/// Whether the scene's environment lights it: the pbr model and a scene with one (else the
+/// constant ambient).
+pub fn lights_scene(model: ShadingModel, scene: &Scene) -> bool {
+    model == ShadingModel::Pbr && scene.environment.is_some()
+}
+
+/// The environment's lighting constant, `ENVIRONMENT` (environment/environment.glsl).
+pub fn lighting_constants(model: ShadingModel, scene: &Scene) -> [(&'static str, u32); 1] {
+    [("ENVIRONMENT", u32::from(lights_scene(model, scene)))]
+}
 
 /// Mip levels of the specular cube: roughness level / (levels − 1), 0 (a mirror) to 1.
 pub const SPECULAR_LEVELS: u32 = 6;

@@ -84,8 +84,9 @@ impl Pass for LightGridMark {
             uses.push(Use::at(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ), None));
         }
         if self.layers.is_some() {
-            // The nodes and their count, as the transparent build left them.
-            uses.extend(LAYER_BUFFERS[1..].iter().map(|&name| Use::at(name, (compute, vk::AccessFlags::SHADER_READ), None)));
+            // The nodes and their count, as the transparent build left them, and the heads its
+            // shader binds with them.
+            uses.extend(LAYER_BUFFERS.iter().map(|&name| Use::at(name, (compute, vk::AccessFlags::SHADER_READ), None)));
         }
         uses
     }

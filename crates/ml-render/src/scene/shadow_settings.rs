@@ -225,6 +225,31 @@ impl SunShadowMode {
     }
 }
 
+/// What the shadow settings compile into the lighting pipelines, for a scene with or without
+/// directional lights: `OMNI_SHADOWS`, `SHADOW_ATLAS`, `SHADOW_RAYS`, `DIRECTIONAL_RAYS`
+/// (shadows/omni_shadow.glsl: the point lights' shadows are maps and the scene has
+/// directional lights, which cast theirs by rays) and `SUN_RAYS` (common/blinn_phong.glsl:
+/// the sun's shadow is a ray, no map).
+pub fn lighting_constants(
+    omni: Option<OmniShadowSettings>,
+    sun: Option<SunShadowMode>,
+    directional_lights: bool,
+) -> [(&'static str, u32); 5] {
+    let rays = omni.is_some_and(|o| o.rays());
+    [
+        ("OMNI_SHADOWS", u32::from(omni.is_some())),
+        ("SHADOW_ATLAS", u32::from(omni.is_some_and(|o| o.atlas().is_some()))),
+        ("SHADOW_RAYS", u32::from(rays)),
+        ("DIRECTIONAL_RAYS", u32::from(omni.is_some() && !rays && directional_lights)),
+        ("SUN_RAYS", u32::from(sun == Some(SunShadowMode::Rays))),
+    ]
+}
+
+/// Whether the lighting traces shadow rays with those constants.
+pub fn traces_rays(constants: &[(&'static str, u32)]) -> bool {
+    constants.iter().any(|&(name, on)| on != 0 && matches!(name, "SHADOW_RAYS" | "DIRECTIONAL_RAYS" | "SUN_RAYS"))
+}
+
 /// Most memory the shadow cubes may take, whatever the device has: 16 lights at 2048² are 1.5 GiB.
 pub const MAX_OMNI_BYTES: u64 = 4 << 30;
 

@@ -8,6 +8,7 @@ use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::shading::mesh_raster::MeshRaster;
 use crate::shading::Shading;
+use crate::sync::{Use, LIGHT_LISTS};
 use crate::targets::{gbuffer_images, GBufferKind, Output};
 use ml_vk::{vk, Context, VkError};
 
@@ -40,6 +41,13 @@ impl Pass for GBuffer {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         self.raster.bind_frame(ctx, frame)
+    }
+
+    /// Its render pass orders the attachments; its shaders bind the frame's lights with the
+    /// rest of set 0 (the surface code reads none), a read like every shading pass's.
+    fn uses(&self) -> Vec<Use> {
+        let stages = vk::PipelineStageFlags::VERTEX_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
+        vec![Use::at(LIGHT_LISTS[0], (stages, vk::AccessFlags::SHADER_READ), None)]
     }
 
     fn record(&self, rec: &Recording) {

@@ -87,7 +87,7 @@ impl MeshRaster {
             // their samples.
             let constants = match output {
                 Output::Color => shading.forward_lighting_constants().to_vec(),
-                _ => [&shading.surface_constants()[..], &[shading.antialiasing.constant()]].concat(),
+                _ => [shading.surface_constants(), &[shading.antialiasing.constant()]].concat(),
             };
             for &v in variants.iter().chain([&SurfaceVariant::OPAQUE]) {
                 if r.pipelines[v.index()] == vk::Pipeline::null() {

@@ -10,27 +10,21 @@ pub mod mesh_raster;
 
 use crate::antialiasing::Antialiasing;
 use crate::background::Background;
+use crate::specialization::Constants;
 use crate::targets::GBufferKind;
+use ml_cpu::scene::Scene;
 use ml_cpu::shading_model::ShadingModel;
 
-/// What a lighting pipeline is compiled for: the model, whether point lights cast shadows,
-/// whether objects have textures of their own and whether there are spot lights
-/// (specialization constants, so each pipeline carries only what it runs).
+/// What a lighting pipeline is compiled for: each feature's specialization constants (so each
+/// pipeline carries only what it runs), contributed from the feature's module by
+/// `RenderSettings::lighting`, and what the passes themselves choose by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shading {
-    pub model: ShadingModel,
-    pub omni_shadows: bool,
-    /// The point lights' shadows are in the shadow atlas (else in the cube array).
-    pub shadow_atlas: bool,
-    /// The point lights' shadows are shadow rays (no cubes).
-    pub shadow_rays: bool,
-    /// The point lights' shadows are maps and the scene has directional lights, which cast
-    /// theirs by rays (`DIRECTIONAL_RAYS`).
-    pub directional_rays: bool,
-    /// The sun's shadow is a shadow ray (no map; blinn-phong).
-    pub sun_rays: bool,
-    pub object_textures: bool,
-    pub spot_lights: bool,
+    /// The constants of pipelines that read surfaces (the G-buffer's too): `surface_constants`.
+    pub surface: Constants,
+    /// What lighting them adds: the shadows', the lights', the environment's, the material
+    /// extensions'.
+    pub lighting: Constants,
     /// Transparent objects are blended in per-pixel layers (the opaque passes skip them).
     pub transparency: bool,
     /// The compute lightings count the shadow rays they trace (`--light-stats` with rays).
@@ -38,89 +32,96 @@ pub struct Shading {
     /// Coverage samples per pixel: the mesh techniques draw into multisampled attachments and
     /// light in the display's linear light (`display_constant`).
     pub antialiasing: Antialiasing,
-    /// Highlights under normal maps widened by the normals' spread (`SPECULAR_AA`).
-    pub specular_aa: bool,
-    /// The pbr model lit by the scene's environment instead of its constant ambient
-    /// (`ENVIRONMENT`, environment/environment.glsl).
-    pub environment: bool,
-    /// Some object's material has glTF's PBR extensions (`MATERIAL_LOBES`,
-    /// common/material_lobes.glsl; pbr).
-    pub material_lobes: bool,
-    /// Some object's extensions vary over its surface (`LOBE_TEXTURES`, Scene::has_lobe_textures;
-    /// with `material_lobes`): read per point, kept per point by the G-buffer and the layers.
-    pub lobe_textures: bool,
     /// What pixels no surface covers show (`BACKGROUND_ENVIRONMENT` where the pass lays it).
     pub background: Background,
 }
 
+/// The surface's constants (common/shading_model.glsl): the model, whether objects have
+/// textures of their own, whether highlights under normal maps widen by the normals' spread
+/// (`SPECULAR_AA`), whether the PBR extensions vary over a surface (`LOBE_TEXTURES`,
+/// Scene::has_lobe_textures: read per point, kept per point by the G-buffer and the layers).
+pub fn surface_constants(model: ShadingModel, object_textures: bool, specular_aa: bool, lobe_textures: bool) -> [(&'static str, u32); 5] {
+    [
+        ("MODEL_BLINN_PHONG", u32::from(model == ShadingModel::BlinnPhong)),
+        ("MODEL_PBR", u32::from(model == ShadingModel::Pbr)),
+        ("OBJECT_TEXTURES", u32::from(object_textures)),
+        ("SPECULAR_AA", u32::from(specular_aa)),
+        ("LOBE_TEXTURES", u32::from(lobe_textures)),
+    ]
+}
+
+/// Whether the scene's materials use glTF's PBR extensions (`MATERIAL_LOBES`,
+/// common/material_lobes.glsl; pbr).
+pub fn material_lobes(model: ShadingModel, scene: &Scene) -> bool {
+    model == ShadingModel::Pbr && scene.objects.iter().any(|o| o.extras.lobes.any())
+}
+
+/// The lights' and the materials' lighting constants: `SPOT_LIGHTS` (common/lighting.glsl)
+/// and `MATERIAL_LOBES`.
+pub fn light_constants(model: ShadingModel, scene: &Scene) -> [(&'static str, u32); 2] {
+    [("SPOT_LIGHTS", u32::from(!scene.cones.is_empty())), ("MATERIAL_LOBES", u32::from(material_lobes(model, scene)))]
+}
+
 impl Shading {
     /// The specialization constants (name, value) of a pipeline that reads surfaces without
-    /// lighting them (the G-buffer's): `MODEL_BLINN_PHONG`, `MODEL_PBR`, `OBJECT_TEXTURES`,
-    /// `SPECULAR_AA` and `LOBE_TEXTURES` (common/shading_model.glsl).
-    pub fn surface_constants(self) -> [(&'static str, u32); 5] {
-        [
-            ("MODEL_BLINN_PHONG", u32::from(self.model == ShadingModel::BlinnPhong)),
-            ("MODEL_PBR", u32::from(self.model == ShadingModel::Pbr)),
-            ("OBJECT_TEXTURES", u32::from(self.object_textures)),
-            ("SPECULAR_AA", u32::from(self.specular_aa)),
-            ("LOBE_TEXTURES", u32::from(self.lobe_textures)),
-        ]
+    /// lighting them (the G-buffer's).
+    pub fn surface_constants(&self) -> &[(&'static str, u32)] {
+        self.surface.as_slice()
+    }
+
+    /// The value of constant `name` for these settings, where a feature sets it.
+    pub fn constant(&self, name: &str) -> Option<u32> {
+        self.surface.get(name).or_else(|| self.lighting.get(name))
+    }
+
+    /// Whether constant `name` is set and on.
+    fn on(&self, name: &str) -> bool {
+        self.constant(name).is_some_and(|v| v != 0)
     }
 
     /// Which images the scene's G-buffer has.
-    pub fn gbuffer_kind(self) -> GBufferKind {
-        if self.lobe_textures {
+    pub fn gbuffer_kind(&self) -> GBufferKind {
+        if self.on("LOBE_TEXTURES") {
             GBufferKind::Lobes
-        } else if self.object_textures {
+        } else if self.on("OBJECT_TEXTURES") {
             GBufferKind::Material
         } else {
             GBufferKind::Base
         }
     }
 
-    /// The specialization constants (name, value) of a lighting pipeline: the surface's,
-    /// `OMNI_SHADOWS`, `SHADOW_ATLAS`, `SHADOW_RAYS` and `DIRECTIONAL_RAYS` (shadows/omni_shadow.glsl),
-    /// `SUN_RAYS` (common/blinn_phong.glsl), `SPOT_LIGHTS` (common/lighting.glsl) and
-    /// `ENVIRONMENT` (environment/environment.glsl) and `MATERIAL_LOBES`.
-    pub fn lighting_constants(self) -> [(&'static str, u32); 13] {
-        let [model_a, model_b, textures, specular, lobe_textures] = self.surface_constants();
-        [
-            model_a,
-            model_b,
-            textures,
-            specular,
-            lobe_textures,
-            ("OMNI_SHADOWS", u32::from(self.omni_shadows)),
-            ("SHADOW_ATLAS", u32::from(self.shadow_atlas)),
-            ("SHADOW_RAYS", u32::from(self.shadow_rays)),
-            ("DIRECTIONAL_RAYS", u32::from(self.directional_rays)),
-            ("SUN_RAYS", u32::from(self.sun_rays)),
-            ("SPOT_LIGHTS", u32::from(self.spot_lights)),
-            ("ENVIRONMENT", u32::from(self.environment)),
-            ("MATERIAL_LOBES", u32::from(self.material_lobes)),
-        ]
+    /// Whether surfaces' PBR extensions vary per point (their texels kept per point).
+    pub fn lobe_textures(&self) -> bool {
+        self.on("LOBE_TEXTURES")
+    }
+
+    /// The specialization constants (name, value) of a lighting pipeline: the surface's and
+    /// every lighting feature's.
+    pub fn lighting_constants(&self) -> Vec<(&'static str, u32)> {
+        [self.surface.as_slice(), self.lighting.as_slice()].concat()
     }
 
     /// `lighting_constants`, `COUNT_RAYS` (shading/compute_shading.glsl) and the background's:
     /// the compute lightings' (they lay the background where no surface is).
-    pub fn compute_lighting_constants(self) -> [(&'static str, u32); 15] {
-        let [a, b, c, d, e, f, g, h, i, j, k, l, m] = self.lighting_constants();
-        [a, b, c, d, e, f, g, h, i, j, k, l, m, ("COUNT_RAYS", u32::from(self.count_rays)), self.background.constant()]
+    pub fn compute_lighting_constants(&self) -> Vec<(&'static str, u32)> {
+        let mut c = self.lighting_constants();
+        c.extend([("COUNT_RAYS", u32::from(self.count_rays)), self.background.constant()]);
+        c
     }
 
     /// `lighting_constants`, `TRANSPARENT_LAYERS` (shading/forward_frag.glsl: the forward
     /// pass of a scene with transparent layers writes linear HDR for their resolve), the
     /// samples per pixel its masks are tested at and `display_constant`: the forward pass's.
-    pub fn forward_lighting_constants(self) -> [(&'static str, u32); 16] {
-        let [a, b, c, d, e, f, g, h, i, j, k, l, m] = self.lighting_constants();
-        let layers = ("TRANSPARENT_LAYERS", u32::from(self.transparency));
-        [a, b, c, d, e, f, g, h, i, j, k, l, m, layers, self.antialiasing.constant(), self.display_constant()]
+    pub fn forward_lighting_constants(&self) -> Vec<(&'static str, u32)> {
+        let mut c = self.lighting_constants();
+        c.extend([("TRANSPARENT_LAYERS", u32::from(self.transparency)), self.antialiasing.constant(), self.display_constant()]);
+        c
     }
 
     /// `DISPLAY_LINEAR_OUTPUT` (shading/display_output.glsl): with anti-aliasing, the forward
     /// pass writes the display's linear light, in which its samples are averaged and which the
     /// tone map only gamma-encodes.
-    pub fn display_constant(self) -> (&'static str, u32) {
+    pub fn display_constant(&self) -> (&'static str, u32) {
         ("DISPLAY_LINEAR_OUTPUT", u32::from(self.antialiasing != Antialiasing::Off))
     }
 }

@@ -17,7 +17,7 @@ use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{Use, VISIBILITY_DEPTH};
+use crate::sync::{Use, LIGHT_LISTS, VISIBILITY_DEPTH};
 use ml_cpu::gpu_types::LayerObject;
 use ml_cpu::scene::Object;
 use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
@@ -440,6 +440,8 @@ impl Pass for TransparentBuild {
         if self.depth_buffer {
             uses.push(Use::at(VISIBILITY_DEPTH, (shaders, vk::AccessFlags::SHADER_READ), None));
         }
+        // Bound with the rest of set 0 (the surface code reads no light).
+        uses.push(Use::at(LIGHT_LISTS[0], (shaders, vk::AccessFlags::SHADER_READ), None));
         uses
     }
 

@@ -57,7 +57,8 @@ impl TransparentResolve {
         let lighting_constants = [&shading.lighting_constants()[..], &[samples]].concat();
         let lighting = ComputePass::new(ctx, &[scene.textures.set_layout.raw], (shader, &lighting_constants))?;
         // The nodes' size (with the PBR extensions' texels where they vary per point).
-        let [blinn_phong, pbr, _, _, lobe_textures] = shading.surface_constants();
+        let surface = |name| (name, shading.constant(name).expect("every surface constant is set"));
+        let [blinn_phong, pbr, lobe_textures] = ["MODEL_BLINN_PHONG", "MODEL_PBR", "LOBE_TEXTURES"].map(surface);
         let antialiased = shading.antialiasing != Antialiasing::Off;
         // Set 1 (the scene's textures) for the background's environment.
         let textures = [scene.textures.set_layout.raw];
