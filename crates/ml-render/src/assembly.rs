@@ -11,10 +11,12 @@ use crate::light_grid::light_grid_mark::LightGridMark;
 use crate::light_stats::light_count::LightCount;
 use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
-use crate::scene::shadow_raster::ShadowViews;
 use crate::scene::SceneGpu;
-use crate::settings::{OmniShadowMode, Raster, RenderSettings, Shading};
+use crate::settings::{DebugView, OmniShadowMode, Raster, RenderSettings, Shading};
 use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
+use crate::shadows::shadow_map_view::ShownStore;
+use crate::shadows::shadow_raster::ShadowViews;
+use crate::shadows::stores::SharedShadows;
 use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
 use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
@@ -29,6 +31,8 @@ pub struct Assembly<'a> {
     /// The scene's lights at rest (the GPU build animates them).
     pub lights: &'a [PointLight],
     pub scene: &'a SceneGpu,
+    /// The shadow stores (the shadow passes share them).
+    pub shadows: &'a SharedShadows,
     /// The scene's objects (what the transparent layers' build makes room for).
     pub objects: &'a [ml_cpu::scene::Object],
     /// Depth format of the technique's raster pass.
@@ -77,19 +81,25 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
     };
     let transparency = || s.transparency.expect("planned with transparency");
     Ok(match kind {
-        PassKind::OmniShadows => Box::new(omni_shadow_pass::OmniShadowPass::new(&a.scene.omni)),
+        PassKind::OmniShadows => Box::new(omni_shadow_pass::OmniShadowPass::new(a.shadows.clone())),
         PassKind::OmniShadowsCompute => {
             let omni = s.omni.expect("planned with point-light shadows");
             let OmniShadowMode::Compute { large_list } = omni.mode else { unreachable!("planned for the compute mode") };
             let views = ShadowViews::Cubes { lights: omni.lights };
-            Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.scene.meshlets()?, (views, omni.size, large_list))?)
+            Box::new(omni_shadow_compute::OmniShadowCompute::new(
+                ctx,
+                (a.scene.meshlets()?, a.shadows.clone()),
+                (views, omni.size, large_list),
+            )?)
         }
         PassKind::ShadowAtlas => {
             let omni = s.omni.expect("planned with point-light shadows");
-            let atlas = &a.scene.omni.atlas;
-            let views =
-                ShadowViews::Atlas { lights: omni.lights, pairs: atlas.lists.pairs, depths: atlas.depths.raw, tiles: atlas.tiles.raw };
-            Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, a.scene.meshlets()?, (views, 0, atlas.lists.large))?)
+            let (views, large) = {
+                let atlas = &a.shadows.borrow().omni.atlas;
+                let (pairs, depths, tiles) = (atlas.lists.pairs, atlas.depths.raw, atlas.tiles.raw);
+                (ShadowViews::Atlas { lights: omni.lights, pairs, depths, tiles }, atlas.lists.large)
+            };
+            Box::new(omni_shadow_compute::OmniShadowCompute::new(ctx, (a.scene.meshlets()?, a.shadows.clone()), (views, 0, large))?)
         }
         PassKind::ClusterAssignCpu => Box::<cluster_assign_cpu::CpuClusterAssign>::default(),
         PassKind::LightGridBuild { marked } => Box::new(LightGridBuild::new(ctx, a.lights, marked)?),
@@ -121,7 +131,14 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::VisibilityLighting => {
             Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, (shared()?, compute), (a.shading, aa))?)
         }
-        PassKind::ShadowMapView => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, s.debug_view)?),
+        PassKind::ShadowMapView => {
+            let shown = match s.debug_view {
+                DebugView::ShadowCube => ShownStore::Cube,
+                DebugView::ShadowAtlas => ShownStore::Atlas,
+                _ => ShownStore::SunMap,
+            };
+            Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, &a.shadows.borrow(), shown)?)
+        }
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
         PassKind::TransparentBuild { depth_buffer } => {
             Box::new(TransparentBuild::new(ctx, (a.scene, a.objects), (a.shading, transparency()), depth_buffer)?)

@@ -69,14 +69,14 @@ pub use frame_resources::FRAMES_IN_FLIGHT;
 pub use light_grid::LightGridStats;
 pub use light_stats::LightStats;
 pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
-pub use scene::ray_geometry::RayStats;
-pub use scene::textures::SHADOW_MAP_SIZE;
 pub use settings::{
     layers_take, Antialiasing, DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightGridMarks, LightingStage,
     OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS,
     TIMER_SPEED,
 };
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};
+pub use shadows::ray_geometry::RayStats;
+pub use shadows::stores::SHADOW_MAP_SIZE;
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage, GBufferKind};
 pub use transparency::{
     TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,

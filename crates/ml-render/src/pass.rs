@@ -42,7 +42,8 @@ pub struct SlotReport {
 
 /// The CPU side of a frame, before it is recorded (`Pass::prepare`): what a pass's CPU step
 /// reads (the frame's view, lights and grid) and may change (the slot's light lists, the
-/// scene's GPU state such as the shadow atlas's cache, the frame's statistics).
+/// frame's statistics); state a feature keeps across frames (the shadow atlas's cache) is
+/// its own.
 pub struct Prepare<'a> {
     pub ctx: &'a Context,
     pub grid: &'a ClusterGrid,
@@ -56,7 +57,6 @@ pub struct Prepare<'a> {
     pub lights: &'a [PointLight],
     /// The slot's lists (written, grown by the renderer where they are too short).
     pub lists: &'a mut dyn ListUpload,
-    pub scene: &'a mut SceneGpu,
     pub stats: &'a mut FrameStats,
     /// A CPU light assignment's milliseconds and what it built (the renderer reports the
     /// time as its own CPU phase and scales the cluster heat map by the fullest cluster).

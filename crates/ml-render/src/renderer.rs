@@ -16,6 +16,8 @@ use crate::read_back::{self, HostRead};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
 use crate::settings::{Geometry, LightAssignment, RenderSettings};
+use crate::shadows::omni_shadow::OmniShadows;
+use crate::shadows::stores::{ShadowStores, SharedShadows};
 use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
 use ml_cpu::camera::{Camera, View};
@@ -23,7 +25,9 @@ use ml_cpu::cluster::{count_entries, ClusterGrid};
 use ml_cpu::gpu_types::{FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
 use ml_cpu::scene::Scene;
-use ml_vk::{commands, vk, Buffer, Context, Image, VkError, VkResultExt};
+use ml_vk::{commands, release_on_error, vk, Buffer, Context, Image, VkError, VkResultExt};
+use std::cell::RefCell;
+use std::rc::Rc;
 use std::time::Instant;
 
 /// A rendered image (tightly packed RGBA8, row 0 at the top) and its measurements.
@@ -64,6 +68,8 @@ pub struct Renderer<'a> {
     extent: vk::Extent2D,
     /// The scene's meshes, buffers and textures on the GPU.
     gpu: SceneGpu,
+    /// The shadow stores (the shadow passes share them).
+    shadows: SharedShadows,
     /// The technique's passes, in recording order.
     passes: Vec<Box<dyn Pass>>,
     command_pool: vk::CommandPool,
@@ -169,11 +175,16 @@ impl<'a> Renderer<'a> {
         }
         let depth = depth_format(ctx, Output::of(settings.technique))?;
         let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
-        let mut gpu = SceneGpu::new(ctx, &scene, settings.scene_config())?;
-        gpu.omni.choose(&scene, settings.aspect());
-        let lights = gpu_lights(&scene, &gpu);
+        // The sun's map in the G-buffer's depth format (sampleable).
+        let mut shadows = ShadowStores::new(ctx, &scene, settings.shadow_config(), depth_format(ctx, Output::GBuffer)?)?;
+        let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| shadows.resource(name));
+        let mut gpu = release_on_error(ctx, made, &mut [&mut shadows])?;
+        let drawn = shadows.draw_casters(ctx, &scene, &gpu);
+        release_on_error(ctx, drawn, &mut [&mut shadows, &mut gpu])?;
+        shadows.omni.choose(&scene, settings.aspect());
+        let lights = gpu_lights(&scene, &shadows.omni);
         let mut shared_sync = sync::SyncStates::default();
-        if let Some(layout) = gpu.omni.initial_cube_layout() {
+        if let Some(layout) = shadows.omni.initial_cube_layout() {
             shared_sync.know(sync::SHADOW_CUBES, layout);
         }
         let mut r = Renderer {
@@ -186,6 +197,7 @@ impl<'a> Renderer<'a> {
             scene,
             settings,
             gpu,
+            shadows: Rc::new(RefCell::new(shadows)),
             passes: Vec::new(),
             command_pool: vk::CommandPool::null(),
             frames: Vec::new(),
@@ -223,6 +235,7 @@ impl<'a> Renderer<'a> {
             shading: self.settings.lighting(&self.scene),
             lights: &self.lights,
             scene: &self.gpu,
+            shadows: &self.shadows,
             objects: &self.scene.objects,
             depth_format: self.depth_format,
         };
@@ -274,8 +287,8 @@ impl<'a> Renderer<'a> {
         check_lists_fit(self.ctx, &self.settings, &self.grid, &lights, self.scene.light_motion)?;
         self.release_frames()?;
         self.scene.lights = lights;
-        self.gpu.omni.choose(&self.scene, self.settings.aspect());
-        self.lights = gpu_lights(&self.scene, &self.gpu);
+        self.shadows.borrow_mut().omni.choose(&self.scene, self.settings.aspect());
+        self.lights = gpu_lights(&self.scene, &self.shadows.borrow().omni);
         // The atlas keeps its faces: a face is drawn again when the light of its key (the
         // scene index) is not where it was or has another radius, which covers lights that
         // changed, came or went.
@@ -330,8 +343,11 @@ impl<'a> Renderer<'a> {
         self.scene.objects = scene.objects.clone();
         self.scene.meshes = scene.meshes.clone();
         self.gpu.replace_objects(self.ctx, &self.scene)?;
+        let mut shadows = self.shadows.borrow_mut();
+        shadows.draw_casters(self.ctx, &self.scene, &self.gpu)?;
         // Other casters: every atlas face is drawn again.
-        self.gpu.omni.atlas.forget();
+        shadows.omni.atlas.forget();
+        drop(shadows);
         self.make_passes()?;
         self.create_frames()?;
         Ok(true)
@@ -383,7 +399,8 @@ impl<'a> Renderer<'a> {
     /// that the frame orders by declared uses must be among the pass's (`sync::undeclared`).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
         let owned: Vec<(&'static str, vk::Buffer)> = self.passes.iter().flat_map(|p| p.slot_buffers(f)).collect();
-        let resources = self.frames[f].resources(f, &self.gpu.named_buffers()).with(&owned);
+        let scene = [self.gpu.named_buffers(), self.shadows.borrow().named_buffers()].concat();
+        let resources = self.frames[f].resources(f, &scene).with(&owned);
         let ordered: Vec<&'static str> = self.passes.iter().flat_map(|p| p.uses()).map(|u| u.name).collect();
         for p in &mut self.passes {
             resources.take_found();
@@ -505,8 +522,8 @@ impl<'a> Renderer<'a> {
             stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
         }
         stats.frames = range.len() as u32;
-        stats.sun_shadow_ms = self.gpu.sun_shadow_ms;
-        if let Some(mut rays) = self.gpu.rays.stats {
+        stats.sun_shadow_ms = self.shadows.borrow().sun_ms;
+        if let Some(mut rays) = self.shadows.borrow().rays.stats {
             // Counted with the light statistics (compute lightings only).
             rays.traced = self.settings.light_stats.then_some(self.rays_traced[last].0);
             stats.set_feature(rays);
@@ -731,7 +748,6 @@ impl<'a> Renderer<'a> {
             light_offset: motion_offset(t, self.scene.light_motion),
             lights: &self.animated,
             lists: &mut lists,
-            scene: &mut self.gpu,
             stats,
             assigned: None,
         };
@@ -759,7 +775,8 @@ impl<'a> Renderer<'a> {
         let bp = &self.scene.blinn_phong;
         // World size of a shadow-map texel: the orthographic projection's first row is the
         // sun's x axis over the half-width it covers.
-        let shadow_texel_world = 2.0 / self.gpu.shadow_view_proj.row(0).truncate().length() / self.gpu.textures.shadow_size as f32;
+        let shadows = self.shadows.borrow();
+        let shadow_texel_world = 2.0 / shadows.sun_view_proj.row(0).truncate().length() / shadows.sun_map_size as f32;
         let exposure = self.exposure.expose(f);
         let frame = &mut self.frames[f];
         let light_offset = motion_offset(t, self.scene.light_motion);
@@ -771,7 +788,7 @@ impl<'a> Renderer<'a> {
             camera_pos: cam.position.extend(cam.w_of_depth().0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
-            omni_texel: self.gpu.omni.texel(),
+            omni_texel: shadows.omni.texel(),
             directional_count: self.scene.directional.len() as u32,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, 0],
             viewport: [v.width, v.height, debug_view, 0],
@@ -779,8 +796,8 @@ impl<'a> Renderer<'a> {
             cluster_frustum: [g.near, g.far, v.projection.x_axis.x, v.projection.y_axis.y],
             light_animation: light_offset.extend(0.0).to_array(),
             cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
-            shadow_view_proj: self.gpu.shadow_view_proj.to_cols_array_2d(),
-            sun_direction: bp.sun_direction.extend(1.0 / self.gpu.textures.shadow_size as f32).to_array(),
+            shadow_view_proj: shadows.sun_view_proj.to_cols_array_2d(),
+            sun_direction: bp.sun_direction.extend(1.0 / shadows.sun_map_size as f32).to_array(),
             sun_strength: bp.sun_strength.extend(shadow_texel_world).to_array(),
             spot_position_range: bp.spot.position.extend(bp.spot.range).to_array(),
             spot_direction_power: bp.spot.direction.extend(bp.spot.power).to_array(),
@@ -788,7 +805,7 @@ impl<'a> Renderer<'a> {
             ambient_light: bp.ambient.extend(0.0).to_array(),
             texture_transform: bp.texture_transform.to_cols_array(),
             exposure: [exposure, 0.0, 0.0, 0.0],
-            shadow_rays: [self.gpu.sun_ray_length, 0.0, 0.0, 0.0],
+            shadow_rays: [shadows.sun_ray_length, 0.0, 0.0, 0.0],
             ..FrameUniforms::default()
         };
         for p in &self.passes {
@@ -812,7 +829,8 @@ impl<'a> Renderer<'a> {
         let view_proj = self.view.view_proj();
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
-        let image = |name: &str| targets.named_image(name).or_else(|| self.gpu.named_image(name));
+        let shadows = self.shadows.borrow();
+        let image = |name: &str| targets.named_image(name).or_else(|| shadows.named_image(name));
         for pass in &self.passes {
             // The barrier that orders the pass's declared uses is part of its time, as the
             // barriers it records itself are.
@@ -843,13 +861,13 @@ impl<'a> Renderer<'a> {
     /// The point-light shadow cubes' texels (distance / radius) as the last frame left them,
     /// layer after layer (cube i: layers 6i … 6i + 5), row by row; for tests and tools.
     pub fn shadow_cube_depths(&self) -> Result<Vec<f32>, VkError> {
-        self.gpu.omni.read_depths(self.ctx)
+        self.shadows.borrow().omni.read_depths(self.ctx)
     }
 
     /// The sun's shadow map's texels (depth, row by row; blinn-phong, else one texel at the far
     /// plane); for tests and tools.
     pub fn sun_shadow_depths(&self) -> Result<Vec<f32>, VkError> {
-        self.gpu.textures.read_shadow_map(self.ctx)
+        self.shadows.borrow().read_sun_map(self.ctx)
     }
 
     /// Copy frame `f`'s colour target (left in TRANSFER_SRC_OPTIMAL by the frame's last
@@ -912,10 +930,10 @@ impl FrameHook for CopyToHost {
     }
 }
 
-/// `scene`'s lights as the GPU reads them: marked with the shadow slots `gpu` chose.
-fn gpu_lights(scene: &Scene, gpu: &SceneGpu) -> Vec<PointLight> {
+/// `scene`'s lights as the GPU reads them: marked with the shadow slots `omni` chose.
+fn gpu_lights(scene: &Scene, omni: &OmniShadows) -> Vec<PointLight> {
     let mut lights = scene.lights.clone();
-    gpu.omni.mark(&mut lights);
+    omni.mark(&mut lights);
     lights
 }
 
@@ -935,5 +953,6 @@ impl Drop for Renderer<'_> {
         // SAFETY: the device is idle; a null handle is ignored.
         unsafe { ctx.device.destroy_command_pool(self.command_pool, None) };
         self.gpu.destroy(ctx);
+        self.shadows.borrow_mut().destroy(ctx);
     }
 }

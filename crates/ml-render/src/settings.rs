@@ -5,12 +5,14 @@ use crate::background::Background;
 use crate::environment;
 use crate::error::{by_name, Named, RenderError, Setting, SettingsError};
 pub use crate::exposure::{parse_exposure, Exposure, MAX_EXPOSURE_EV};
-pub use crate::scene::shadow_settings::{
-    multiview_depth_is_broken, AtlasSettings, OmniShadowMode, OmniShadowSettings, SunShadowMode, MAX_OMNI_BYTES, MAX_SHADOWED_LIGHTS,
-};
-use crate::scene::{shadow_settings, SceneConfig};
+use crate::scene::SceneConfig;
 pub use crate::shading::Shading;
 use crate::shading::{light_constants, material_lobes, surface_constants};
+use crate::shadows::shadow_settings;
+pub use crate::shadows::shadow_settings::{
+    multiview_depth_is_broken, AtlasSettings, OmniShadowMode, OmniShadowSettings, SunShadowMode, MAX_OMNI_BYTES, MAX_SHADOWED_LIGHTS,
+};
+use crate::shadows::stores::ShadowConfig;
 use crate::specialization::Constants;
 pub use crate::targets::MAX_DIMENSION;
 use crate::targets::{multisampled_images, Output};
@@ -205,14 +207,19 @@ pub const TIMER_SPEED: f32 = 0.25;
 pub const FRAME_SECONDS: f32 = 1.0 / 60.0;
 
 impl RenderSettings {
-    /// What the scene's GPU resources are made for: the sun's map (blinn-phong), the point
-    /// lights' store, and whether some pass draws the scene's meshlets (the visibility
-    /// technique, the compute shadow rasters).
+    /// What the scene's GPU resources are made for: the blinn-phong model's maps, and whether
+    /// some pass draws the scene's meshlets (the visibility technique, the compute shadow
+    /// rasters).
     pub fn scene_config(&self) -> SceneConfig {
-        let sun = (self.shading == ShadingModel::BlinnPhong).then_some(self.sun_shadow);
-        let omni_compute = self.omni.is_some_and(|o| matches!(o.mode, OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_)));
+        let ShadowConfig { sun, omni } = self.shadow_config();
+        let omni_compute = omni.is_some_and(|o| matches!(o.mode, OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_)));
         let meshlets = self.technique.geometry() == Geometry::Meshlets || omni_compute || sun == Some(SunShadowMode::Compute);
-        SceneConfig { sun, omni: self.omni, meshlets }
+        SceneConfig { material_maps: self.shading == ShadingModel::BlinnPhong, meshlets }
+    }
+
+    /// What the shadow stores are made for: the sun's map (blinn-phong), the point lights'.
+    pub fn shadow_config(&self) -> ShadowConfig {
+        ShadowConfig { sun: (self.shading == ShadingModel::BlinnPhong).then_some(self.sun_shadow), omni: self.omni }
     }
 
     /// Defaults for everything but technique and size: the seed model, 16×9×24 clusters, one
@@ -269,8 +276,7 @@ impl RenderSettings {
         let model = self.shading;
         let lobe_textures = material_lobes(model, scene) && scene.has_lobe_textures();
         let surface = surface_constants(model, !scene.textures.is_empty(), self.specular_aa, lobe_textures);
-        let sun = (model == ShadingModel::BlinnPhong).then_some(self.sun_shadow);
-        let shadows = shadow_settings::lighting_constants(self.omni, sun, !scene.directional.is_empty());
+        let shadows = shadow_settings::lighting_constants(self.omni, self.shadow_config().sun, !scene.directional.is_empty());
         Shading {
             surface: Constants::of(&[&surface]),
             lighting: Constants::of(&[&shadows, &light_constants(model, scene), &environment::lighting_constants(model, scene)]),

@@ -1,31 +1,22 @@
-//! The scene on the GPU, shared by every pass and frame: meshes, the object and spot-cone
-//! buffers, the scene's textures (set 1 of every shading pipeline: the sun's shadow map, the
-//! sky, material maps, the point-light shadow cubes) and each object's own textures (set 2).
+//! The scene on the GPU, shared by every pass and frame: meshes, meshlets, the object,
+//! spot-cone and directional-light buffers, the scene's textures (set 1 of every shading
+//! pipeline: the sky, material maps, the environment, and what the shadow stores bind there)
+//! and each object's own textures (set 2).
 
 pub mod meshlets;
 pub mod object_data;
 pub mod object_textures;
-pub mod omni_shadow;
-pub mod ray_geometry;
-pub mod shadow_atlas;
-pub mod shadow_raster;
-pub mod shadow_settings;
-pub mod sun_shadow;
 pub mod textures;
 
+use crate::descriptors::Resource;
 use crate::environment::EnvironmentMaps;
 use crate::error::RenderError;
 use crate::gpu_mesh::SceneMeshes;
 use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
 use crate::scene::object_data::{object_data, SurfaceVariant};
 use crate::scene::object_textures::ObjectTextureSets;
-use crate::scene::omni_shadow::OmniShadows;
-use crate::scene::ray_geometry::RayGeometry;
-use crate::scene::shadow_settings::{OmniShadowSettings, SunShadowMode};
 use crate::scene::textures::SceneTextures;
-use crate::targets::{depth_format, Output};
 use ml_cpu::alpha_mask::AlphaMasks;
-use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::gpu_types::{DirectionalLightData, LightCone, ObjectData};
 use ml_cpu::scene::Scene;
 use ml_vk::{release_on_error, vk, Buffer, Context};
@@ -47,39 +38,28 @@ pub struct SceneGpu {
     /// The environment light, prefiltered (stand-ins without one): part of the texture set.
     pub environment: EnvironmentMaps,
     pub object_textures: ObjectTextureSets,
-    /// Point-light shadow cubes (a stand-in without shadowed lights): part of the scene's
-    /// texture set, rendered each frame by the omni-shadow pass.
-    pub omni: OmniShadows,
-    /// The sun's shadow-map view-projection (blinn-phong).
-    pub shadow_view_proj: glam::Mat4,
-    /// How long the sun's shadow rays are: from any point of the scene's box beyond it.
-    pub sun_ray_length: f32,
-    /// Whether the sun's shadow map is drawn (blinn-phong), and by whom.
-    sun: Option<SunShadowMode>,
-    /// GPU milliseconds the sun's shadow map took to draw (None: not drawn, or no timestamps).
-    pub sun_shadow_ms: Option<f64>,
     /// The scene's meshlets, built once for every pass that draws them (the visibility
     /// technique, the compute shadow rasters of the point lights and the sun); None where
     /// the settings have no such pass.
     meshlets: Option<MeshletGeometry>,
     wants_meshlets: bool,
-    /// The shadow rays' hierarchy of the objects (stand-ins where no light casts rays).
-    pub rays: RayGeometry,
-    wants_rays: bool,
 }
 
 impl SceneGpu {
-    pub fn new(ctx: &Context, scene: &Scene, config: SceneConfig) -> Result<SceneGpu, RenderError> {
-        let sun = config.sun;
+    /// The scene's GPU resources as `config` asks; set 1 binds, besides the scene's own
+    /// textures and environment, what `set_one` names (the shadow stores').
+    pub fn new(
+        ctx: &Context,
+        scene: &Scene,
+        config: SceneConfig,
+        set_one: &dyn Fn(&str) -> Option<Resource>,
+    ) -> Result<SceneGpu, RenderError> {
         // Each of these needs the ones before it; a failure releases those.
-        let gbuffer_depth = depth_format(ctx, Output::GBuffer)?;
-        let has_masked = scene.objects.iter().any(|o| o.extras.masked());
-        let mut omni = OmniShadows::new(ctx, config.omni, has_masked)?;
-        let mut environment = release_on_error(ctx, EnvironmentMaps::new(ctx, scene.environment.as_ref()), &mut [&mut omni])?;
-        let made = SceneTextures::new(ctx, sun.is_some(), gbuffer_depth, (&omni, &environment));
-        let mut textures = release_on_error(ctx, made.map_err(RenderError::from), &mut [&mut omni, &mut environment])?;
+        let mut environment = EnvironmentMaps::new(ctx, scene.environment.as_ref())?;
+        let made = SceneTextures::new(ctx, config.material_maps, &|name| set_one(name).or_else(|| environment.resource(name)));
+        let mut textures = release_on_error(ctx, made.map_err(RenderError::from), &mut [&mut environment])?;
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
-        let object_textures = release_on_error(ctx, made, &mut [&mut omni, &mut environment, &mut textures])?;
+        let object_textures = release_on_error(ctx, made, &mut [&mut environment, &mut textures])?;
         let mut gpu = SceneGpu {
             meshes: SceneMeshes::empty(),
             objects: Buffer::null(),
@@ -90,16 +70,8 @@ impl SceneGpu {
             textures,
             environment,
             object_textures,
-            omni,
-            shadow_view_proj: glam::Mat4::IDENTITY,
-            sun_ray_length: 1.0,
-            sun,
-            sun_shadow_ms: None,
             meshlets: None,
             wants_meshlets: config.meshlets,
-            rays: RayGeometry::null(),
-            // Directional lights cast their shadows by rays in every point-light shadow mode.
-            wants_rays: config.omni.is_some_and(|o| o.rays() || !scene.directional.is_empty()) || config.sun == Some(SunShadowMode::Rays),
         };
         // One cone per light where the scene has spots; else one the shaders never read.
         let cones = if scene.cones.is_empty() { vec![LightCone::NONE] } else { scene.cones.clone() };
@@ -130,40 +102,22 @@ impl SceneGpu {
         Ok(gpu)
     }
 
-    /// The scene's objects on the GPU: its meshes, the object buffer, and (blinn-phong) the
-    /// sun's shadow map of them.
+    /// The scene's objects on the GPU: its meshes, the object buffer and its meshlets (the
+    /// shadow stores draw their casters from them: `ShadowStores::draw_casters`).
     fn upload_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), RenderError> {
         self.meshes = SceneMeshes::upload(ctx, scene)?;
         let masks = AlphaMasks::pack(scene).map_err(|e| RenderError::Invalid(e.to_string()))?;
         self.alpha_masks = storage_buffer_with(ctx, "alpha masks", bytemuck::cast_slice(&masks.words))?;
         let objects: Vec<ObjectData> = scene.objects.iter().map(|o| object_data(o, &masks, &scene.textures)).collect();
         self.objects = Buffer::device_local_with(ctx, "objects", bytemuck::cast_slice(&objects), vk::BufferUsageFlags::STORAGE_BUFFER)?;
-        self.omni.bind_casters(ctx, (self.objects.raw, self.alpha_masks.raw))?;
         if self.wants_meshlets {
             self.meshlets = Some(MeshletGeometry::build(ctx, scene, &self.object_textures.set_index)?);
-        }
-        self.rays = RayGeometry::new(ctx, scene, self.wants_rays)?;
-        let (lo, hi) = scene.bounds();
-        self.shadow_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
-        self.sun_ray_length = (hi - lo).length() + 1.0;
-        if let Some(mode) = self.sun {
-            let view_proj = self.shadow_view_proj;
-            let inputs = sun_shadow::ShadowInputs {
-                scene,
-                meshes: &self.meshes,
-                objects: self.objects.raw,
-                alpha_masks: self.alpha_masks.raw,
-                view_proj,
-                mode,
-                meshlets: self.meshlets.as_ref().map(MeshletGeometry::view),
-            };
-            self.sun_shadow_ms = self.textures.render_shadow_map(ctx, &inputs)?;
         }
         Ok(())
     }
 
     /// Draw `scene`'s objects from now on (no frame in flight): new meshes, object buffer and
-    /// sun shadow map. Only for scenes without object textures (every object binds the one
+    /// meshlets (the shadow stores then draw their casters again). Only for scenes without object textures (every object binds the one
     /// set of stand-ins).
     pub fn replace_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), RenderError> {
         // The passes were made for the surface variants (and the masked shadow pipeline) of the
@@ -185,25 +139,17 @@ impl SceneGpu {
         if let Some(mut meshlets) = self.meshlets.take() {
             meshlets.destroy(ctx);
         }
-        self.rays.destroy(ctx);
     }
 
     /// The scene's buffers that shaders bind, under their blocks' names (a frame's table of
     /// resources holds them).
     pub fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
-        let mut named = vec![
+        vec![
             ("ObjectBuffer", self.objects.raw),
             ("LightConeBuffer", self.cones.raw),
             ("DirectionalLightBuffer", self.directional.raw),
             ("AlphaMaskBuffer", self.alpha_masks.raw),
-        ];
-        named.extend(self.rays.named_buffers());
-        named
-    }
-
-    /// The scene's images that passes declare (`sync`), under their names: the shadow cubes.
-    pub fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
-        (name == crate::sync::SHADOW_CUBES).then_some((self.omni.cubes.raw, vk::ImageAspectFlags::DEPTH))
+        ]
     }
 
     /// The scene's meshlets, for a pass that draws them.
@@ -221,18 +167,20 @@ impl SceneGpu {
         self.textures.destroy(ctx);
         self.environment.destroy(ctx);
         self.object_textures.destroy(ctx);
-        self.omni.destroy(ctx);
     }
 }
 
-/// What the scene's GPU resources are made for (the render settings' `scene_config`): which
-/// shadow stores, and whether some pass draws the scene's meshlets.
+/// What the scene's GPU resources are made for (the render settings' `scene_config`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneConfig {
-    /// Whether the sun's shadow map is drawn (blinn-phong), and by whom.
-    pub sun: Option<SunShadowMode>,
-    /// Point-light shadows (None: the stand-in).
-    pub omni: Option<OmniShadowSettings>,
+    /// The blinn-phong model's albedo and normal maps and sky (else 1×1 stand-ins).
+    pub material_maps: bool,
     /// Whether a pass draws the scene's meshlets.
     pub meshlets: bool,
+}
+
+impl ml_vk::Release for SceneGpu {
+    fn release(&mut self, ctx: &Context) {
+        self.destroy(ctx);
+    }
 }

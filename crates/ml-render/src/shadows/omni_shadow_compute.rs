@@ -12,15 +12,17 @@ use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::read_back::{HostRead, ReadBack};
 use crate::report::{FeatureStats, FrameStats};
 use crate::scene::meshlets::MeshletGeometryView;
-use crate::scene::omni_shadow::NEAR_FRACTION;
-use crate::scene::shadow_atlas::tile_table;
-use crate::scene::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
+use crate::shadows::omni_shadow::{OmniShadows, NEAR_FRACTION};
+use crate::shadows::shadow_atlas::tile_table;
+use crate::shadows::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
+use crate::shadows::stores::SharedShadows;
 use crate::sync::{Use, SHADOW_ATLAS, SHADOW_CUBES, SHADOW_RASTER_COUNTERS};
 use ml_cpu::gpu_types::OmniRasterCounters;
 use ml_cpu::shadow_atlas::{AtlasPlan, PlannedLight};
 use ml_vk::{vk, Context, VkError};
 
 pub struct OmniShadowCompute {
+    shadows: SharedShadows,
     views: ShadowViews,
     raster: ShadowRaster,
     /// The counters, copied at the end of the frame, per frame slot.
@@ -35,12 +37,12 @@ pub struct OmniShadowCompute {
 impl OmniShadowCompute {
     pub fn new(
         ctx: &Context,
-        geometry: MeshletGeometryView,
+        (geometry, shadows): (MeshletGeometryView, SharedShadows),
         (views, size, large_capacity): (ShadowViews, u32, u32),
     ) -> Result<OmniShadowCompute, RenderError> {
         let raster = ShadowRaster::new(ctx, geometry, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
-        let pass =
-            OmniShadowCompute { views, raster, readback: ReadBack::new("shadow raster counters read-back"), plan: None, draws: false };
+        let readback = ReadBack::new("shadow raster counters read-back");
+        let pass = OmniShadowCompute { shadows, views, raster, readback, plan: None, draws: false };
         ml_vk::build(ctx, pass, |p| Ok(p.readback.make_all(ctx, size_of::<OmniRasterCounters>() as u64)?))
     }
 }
@@ -85,18 +87,21 @@ impl Pass for OmniShadowCompute {
     }
 
     fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
-        p.scene.omni.place(p.rest_lights, p.light_offset);
+        let mut shadows = self.shadows.borrow_mut();
+        let omni = &mut shadows.omni;
+        omni.place(p.rest_lights, p.light_offset);
         let atlas = matches!(self.views, ShadowViews::Atlas { .. });
         if atlas {
-            self.plan = plan_atlas(p)?;
+            self.plan = plan_atlas(omni, p)?;
         }
-        self.draws = self.views.lights() > 0 && !p.scene.omni.placed().is_empty() && (!atlas || self.plan.is_some());
+        self.draws = self.views.lights() > 0 && !omni.placed().is_empty() && (!atlas || self.plan.is_some());
         Ok(())
     }
 
     fn record(&self, rec: &Recording) {
+        let shadows = self.shadows.borrow();
         let lights: Vec<[f32; 4]> =
-            rec.scene.omni.placed().iter().take(self.views.lights() as usize).map(|l| l.position.extend(l.radius).to_array()).collect();
+            shadows.omni.placed().iter().take(self.views.lights() as usize).map(|l| l.position.extend(l.radius).to_array()).collect();
         if lights.is_empty() {
             return;
         }
@@ -110,7 +115,7 @@ impl Pass for OmniShadowCompute {
             // No plan, no face to draw (the atlas keeps what it holds).
             (ShadowViews::Atlas { .. }, None) => {}
             _ => {
-                let target = ShadowTarget { image: rec.scene.omni.cubes.raw, readers: None };
+                let target = ShadowTarget { image: shadows.omni.cubes.raw, readers: None };
                 self.raster.record(rec.ctx, rec.cmd, rec.slot, &lights, projection, &target);
             }
         }
@@ -136,8 +141,7 @@ impl Pass for OmniShadowCompute {
 
 /// The shadow atlas's plan for the frame's placed lights (keys: their scene indices), its
 /// figures reported in the frame's statistics; None without an atlas.
-fn plan_atlas(p: &mut Prepare) -> Result<Option<AtlasPlan>, RenderError> {
-    let omni = &mut p.scene.omni;
+fn plan_atlas(omni: &mut OmniShadows, p: &mut Prepare) -> Result<Option<AtlasPlan>, RenderError> {
     let Some(atlas) = omni.settings.and_then(|o| o.atlas()) else { return Ok(None) };
     let lights: Vec<(u32, PlannedLight)> =
         omni.chosen().iter().zip(omni.placed()).map(|(&i, l)| (i, PlannedLight { position: l.position, radius: l.radius })).collect();

@@ -1,23 +1,25 @@
 //! Point-light shadows (docs/DESIGN.md#point-light-shadows): every frame, before shading, the
-//! shadowed lights' cubes are rendered where the lights are now. The cube array is a scene
-//! resource (the shading passes sample it through the scene's texture set); this pass records
+//! shadowed lights' cubes are rendered where the lights are now. The cube array is a shadow
+//! store (the shading passes sample it through the scene's texture set); this pass records
 //! its rendering in the mode the settings chose (omni_shadow.rs).
 
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Prepare, Recording};
-use crate::scene::omni_shadow::OmniShadows;
+use crate::shadows::stores::SharedShadows;
 use crate::sync::Use;
 use ml_vk::{Context, VkError};
 
 pub struct OmniShadowPass {
+    shadows: SharedShadows,
     /// What its drawing does to the cube array (OmniShadows::cube_use).
     cubes: Option<Use>,
 }
 
 impl OmniShadowPass {
-    pub fn new(omni: &OmniShadows) -> OmniShadowPass {
-        OmniShadowPass { cubes: omni.cube_use() }
+    pub fn new(shadows: SharedShadows) -> OmniShadowPass {
+        let cubes = shadows.borrow().omni.cube_use();
+        OmniShadowPass { shadows, cubes }
     }
 }
 
@@ -35,12 +37,12 @@ impl Pass for OmniShadowPass {
     }
 
     fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
-        p.scene.omni.place(p.rest_lights, p.light_offset);
+        self.shadows.borrow_mut().omni.place(p.rest_lights, p.light_offset);
         Ok(())
     }
 
     fn record(&self, rec: &Recording) {
-        let omni = &rec.scene.omni;
+        let omni = &self.shadows.borrow().omni;
         omni.record(rec.ctx, rec.cmd, omni.placed(), (&rec.scene.meshes, rec.objects));
     }
 

@@ -6,7 +6,7 @@ use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
-use crate::settings::DebugView;
+use crate::shadows::stores::ShadowStores;
 use crate::sync::{shadow_reads, Use};
 use ml_vk::{vk, Context, VkError};
 
@@ -14,13 +14,21 @@ pub struct ShadowMapView {
     pass: ComputePass,
 }
 
+/// Which store the view paints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShownStore {
+    SunMap,
+    Cube,
+    Atlas,
+}
+
 impl ShadowMapView {
-    /// `view`: the sun's map, the point-light cube (constant CUBE) or the shadow atlas
+    /// `shown`: the sun's map, the point-light cube (constant CUBE) or the shadow atlas
     /// (ATLAS, and its blocks: ATLAS_BLOCKS, ATLAS_SIDE, ATLAS_COLUMNS, ATLAS_ROWS).
-    pub fn new(ctx: &Context, scene: &SceneGpu, view: DebugView) -> Result<ShadowMapView, VkError> {
-        let blocks = scene.omni.atlas.blocks().filter(|_| view == DebugView::ShadowAtlas);
+    pub fn new(ctx: &Context, scene: &SceneGpu, shadows: &ShadowStores, shown: ShownStore) -> Result<ShadowMapView, VkError> {
+        let blocks = shadows.omni.atlas.blocks().filter(|_| shown == ShownStore::Atlas);
         let constants = [
-            ("CUBE", u32::from(view == DebugView::ShadowCube)),
+            ("CUBE", u32::from(shown == ShownStore::Cube)),
             ("ATLAS", u32::from(blocks.is_some())),
             ("ATLAS_BLOCKS", blocks.map_or(1, |b| b.count)),
             ("ATLAS_SIDE", blocks.map_or(1, |b| b.side)),

@@ -8,7 +8,7 @@
 //! are small stand-ins the shaders never read.
 
 use crate::error::RenderError;
-use crate::scene::shadow_settings::{AtlasSettings, OmniShadowSettings};
+use crate::shadows::shadow_settings::{AtlasSettings, OmniShadowSettings};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::camera::Camera;
 use ml_cpu::gpu_types::{OmniRasterCounters, ShadowCubeTiles};

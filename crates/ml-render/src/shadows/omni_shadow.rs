@@ -21,8 +21,8 @@
 use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
 use crate::error::RenderError;
 use crate::gpu_mesh::{record_draws, SceneMeshes};
-use crate::scene::shadow_atlas::ShadowAtlasGpu;
-use crate::scene::shadow_settings::{OmniShadowMode, OmniShadowSettings};
+use crate::shadows::shadow_atlas::ShadowAtlasGpu;
+use crate::shadows::shadow_settings::{OmniShadowMode, OmniShadowSettings};
 use crate::sync::{Entry, Exit, Use, SHADOW_CUBES};
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
