@@ -156,17 +156,16 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             )),
         }
     }
+    if settings.shading == ml_render::ShadingModel::BlinnPhong && settings.sun_shadow != ml_render::SunShadowMode::Rays {
+        let (by, size) = (settings.sun_shadow.name(), ml_render::SHADOW_MAP_SIZE);
+        rows.push(("sun shadow", format!("the sun's {size}² shadow map by {by}, drawn in the first frame (its pass's time above)")));
+    }
     if let Some(ev) = stats.exposure_ev {
         let repeats = stats.exposure_repeats;
         rows.push((
             "exposure",
             format!("auto: {ev:+.2} EV (metered on the GPU; the last frame rendered {repeats} more time(s) to settle)"),
         ));
-    }
-    if let Some(ms) = stats.sun_shadow_ms {
-        let by = settings.sun_shadow.name();
-        let size = ml_render::SHADOW_MAP_SIZE;
-        rows.push(("sun shadow ms", format!("{ms:.3}  (the sun's {size}² shadow map by {by}, once at load)")));
     }
     if let Some(m) = stats.memory {
         let mib = |b: u64| b as f64 / (1 << 20) as f64;

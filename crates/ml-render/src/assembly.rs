@@ -17,6 +17,7 @@ use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
 use crate::shadows::shadow_map_view::ShownStore;
 use crate::shadows::shadow_raster::ShadowViews;
 use crate::shadows::stores::SharedShadows;
+use crate::shadows::sun_shadow::SunShadowPass;
 use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
 use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
@@ -81,6 +82,10 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
     };
     let transparency = || s.transparency.expect("planned with transparency");
     Ok(match kind {
+        PassKind::SunShadow => {
+            let masked = a.objects.iter().any(|o| o.extras.masked());
+            Box::new(SunShadowPass::new(ctx, a.shadows.clone(), s.sun_shadow, (masked, a.scene.meshlets().ok()))?)
+        }
         PassKind::OmniShadows => Box::new(omni_shadow_pass::OmniShadowPass::new(a.shadows.clone())),
         PassKind::OmniShadowsCompute => {
             let omni = s.omni.expect("planned with point-light shadows");

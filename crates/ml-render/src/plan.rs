@@ -24,6 +24,8 @@ pub enum Phase {
 /// A pass of a frame, as data.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
 pub enum PassKind {
+    /// The sun's shadow map (blinn-phong), in the first frame after its casters changed.
+    SunShadow,
     /// Point-light shadow cubes by a graphics mode (copy, direct, multiview, layered).
     OmniShadows,
     /// Point-light shadow cubes by the compute shadow raster.
@@ -162,12 +164,16 @@ impl RenderSettings {
     }
 }
 
-/// The passes of a frame in recording order: point-light shadows, light assignment, the
-/// raster pass and lighting after it, then debug views and the exposure meter over the
-/// result.
+/// The passes of a frame in recording order: the sun's and the point lights' shadows, light
+/// assignment, the raster pass and lighting after it, then debug views and the exposure meter
+/// over the result.
 pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     let mut kinds = Vec::new();
     let technique = key.technique;
+    // Shadow rays toward the sun read no map.
+    if key.shading == ShadingModel::BlinnPhong && key.sun_shadow != SunShadowMode::Rays {
+        kinds.push(PassKind::SunShadow);
+    }
     match key.omni.map(|o| o.mode) {
         Some(OmniShadowMode::Compute { .. }) => kinds.push(PassKind::OmniShadowsCompute),
         Some(OmniShadowMode::Atlas(_)) => kinds.push(PassKind::ShadowAtlas),
@@ -361,6 +367,11 @@ mod tests {
         let mut k = shadowed(key(Technique::Forward), OmniShadowMode::Rays);
         k.meters_exposure = false;
         assert_eq!(plan(&k), [forward]);
+        // The sun's map (blinn-phong) before the point lights' shadows; none for its rays.
+        k.shading = ShadingModel::BlinnPhong;
+        let k = shadowed(k, OmniShadowMode::Layered);
+        assert_eq!(plan(&k), [SunShadow, OmniShadows, forward]);
+        assert_eq!(plan(&PipelineKey { sun_shadow: SunShadowMode::Rays, ..k }), [OmniShadows, forward]);
         let mut k = key(Technique::ClusteredGpu);
         k.debug_view = DebugView::ClusterHeat;
         k.meters_exposure = false;
@@ -458,7 +469,7 @@ mod tests {
         assert_eq!(plan(&k)[1], ToneMap { curve: false, display_linear: false });
         k.debug_view = DebugView::None;
         k.shading = ShadingModel::BlinnPhong;
-        assert_eq!(plan(&k)[1], ToneMap { curve: false, display_linear: false });
+        assert_eq!(plan(&k)[2], ToneMap { curve: false, display_linear: false });
     }
 
     #[test]

@@ -187,6 +187,8 @@ impl<'a> Renderer<'a> {
         if let Some(layout) = shadows.omni.initial_cube_layout() {
             shared_sync.know(sync::SHADOW_CUBES, layout);
         }
+        // Cleared when it was made (its pass draws it where the sun casts a map).
+        shared_sync.know(sync::SUN_MAP, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
         let mut r = Renderer {
             ctx,
             extent: vk::Extent2D { width: settings.width, height: settings.height },
@@ -522,7 +524,6 @@ impl<'a> Renderer<'a> {
             stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
         }
         stats.frames = range.len() as u32;
-        stats.sun_shadow_ms = self.shadows.borrow().sun_ms;
         if let Some(mut rays) = self.shadows.borrow().rays.stats {
             // Counted with the light statistics (compute lightings only).
             rays.traced = self.settings.light_stats.then_some(self.rays_traced[last].0);
@@ -829,8 +830,7 @@ impl<'a> Renderer<'a> {
         let view_proj = self.view.view_proj();
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
-        let shadows = self.shadows.borrow();
-        let image = |name: &str| targets.named_image(name).or_else(|| shadows.named_image(name));
+        let image = |name: &str| targets.named_image(name).or_else(|| self.shadows.borrow().named_image(name));
         for pass in &self.passes {
             // The barrier that orders the pass's declared uses is part of its time, as the
             // barriers it records itself are.

@@ -33,8 +33,6 @@ pub struct FrameStats {
     /// raster, the atlas's plan), each as its feature defines it: `feature` reads one back,
     /// `feature_rows` gives them all as rows of a table. One of each type.
     features: Vec<Arc<dyn FeatureStats>>,
-    /// blinn-phong: GPU ms of the sun's shadow map, drawn once when the scene was loaded.
-    pub sun_shadow_ms: Option<f64>,
     /// Auto exposure: the EV the returned image was exposed with, and how often its frame was
     /// rendered again for the exposure to settle.
     pub exposure_ev: Option<f32>,
@@ -61,7 +59,6 @@ impl FrameStats {
             index_growths: 0,
             gbuffer_lazily_allocated: None,
             features: Vec::new(),
-            sun_shadow_ms: None,
             exposure_ev: None,
             exposure_repeats: 0,
             memory: None,

@@ -16,8 +16,7 @@
 //! for undefined. A resource the frame slots share keeps one state for all of them
 //! (`SCENE_WIDE`); one that work outside the frames left in a layout starts from it
 //! (`SyncStates::know`). Declared by none of their passes, and ordered by hand: the hardware
-//! visibility raster's images (its render pass orders them) and the sun's shadow map (drawn
-//! once, outside the frames, when the scene is loaded).
+//! visibility raster's images (its render pass orders them).
 
 use ml_vk::vk;
 
@@ -263,11 +262,18 @@ pub const SHADOW_ATLAS: [&str; 2] = ["ShadowAtlasBuffer", "ShadowAtlasTileBuffer
 /// frame's end.
 pub const SHADOW_RASTER_COUNTERS: &str = "OmniRasterCounterBuffer";
 
-/// How a pass that shades reads the point-light shadows (cubes and atlas): in `stages`.
+/// The sun's shadow map (blinn-phong; the scene's, a stand-in otherwise): drawn by the sun's
+/// shadow pass in the first frame after its casters changed, sampled by the shading passes in
+/// DEPTH_STENCIL_READ_ONLY_OPTIMAL.
+pub const SUN_MAP: &str = "sun shadow map";
+
+/// How a pass that shades reads the shadow stores (the sun's map, the point lights' cubes and
+/// atlas): in `stages`.
 pub fn shadow_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let read = (stages, vk::AccessFlags::SHADER_READ);
-    let cubes = Use::at(SHADOW_CUBES, read, Some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL));
-    std::iter::once(cubes).chain(SHADOW_ATLAS.iter().map(|&name| Use::at(name, read, None))).collect()
+    let sampled = Some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+    let maps = [Use::at(SUN_MAP, read, sampled), Use::at(SHADOW_CUBES, read, sampled)];
+    maps.into_iter().chain(SHADOW_ATLAS.iter().map(|&name| Use::at(name, read, None))).collect()
 }
 
 /// The frame slot's count of the shadow rays its compute lighting traced (its shader block's
@@ -291,7 +297,7 @@ pub fn shading_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
 /// The resources the frame slots share (the scene's): their states are the renderer's, not a
 /// slot's. Frames are recorded in the order they are submitted, so a frame's first use of one
 /// follows the last frame's, whichever slot that frame ran in.
-pub const SCENE_WIDE: [&str; 5] = [MESHLET_VISIBILITY, SHADOW_CUBES, SHADOW_ATLAS[0], SHADOW_ATLAS[1], SHADOW_RASTER_COUNTERS];
+pub const SCENE_WIDE: [&str; 6] = [MESHLET_VISIBILITY, SUN_MAP, SHADOW_CUBES, SHADOW_ATLAS[0], SHADOW_ATLAS[1], SHADOW_RASTER_COUNTERS];
 
 /// Of the frame's resources a pass's shaders bind (`bound`), those that other passes order by
 /// their declared uses (`ordered`) but the pass does not declare (`declared`): the state knows

@@ -13,4 +13,5 @@ pub mod shadow_map_view;
 pub mod shadow_raster;
 pub mod shadow_settings;
 pub mod stores;
+pub mod sun_map;
 pub mod sun_shadow;

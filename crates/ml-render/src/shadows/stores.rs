@@ -11,7 +11,8 @@ use crate::scene::SceneGpu;
 use crate::shadows::omni_shadow::{self, OmniShadows};
 use crate::shadows::ray_geometry::RayGeometry;
 use crate::shadows::shadow_settings::{OmniShadowSettings, SunShadowMode};
-use crate::shadows::sun_shadow::{draw_shadow_map, render_shadow_map, ShadowInputs};
+use crate::shadows::sun_map::clear_shadow_map;
+use crate::sync::{SHADOW_CUBES, SUN_MAP};
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::scene::Scene;
 use ml_vk::image::sampler;
@@ -35,8 +36,8 @@ pub struct ShadowStores {
     /// Point-light shadow cubes or the atlas (a stand-in without shadowed lights), rendered
     /// each frame by the point-light shadow passes.
     pub omni: OmniShadows,
-    /// The sun's shadow map (blinn-phong; a 1×1 texel at the far plane otherwise), drawn when
-    /// the casters change.
+    /// The sun's shadow map (blinn-phong; a 1×1 texel at the far plane otherwise), drawn by
+    /// the sun's shadow pass when the casters change.
     sun_map: Image,
     /// Texels per side of the sun's map.
     pub sun_map_size: u32,
@@ -49,8 +50,9 @@ pub struct ShadowStores {
     pub sun_ray_length: f32,
     /// Whether the sun's shadow map is drawn, and by whom.
     sun: Option<SunShadowMode>,
-    /// GPU milliseconds the sun's shadow map took to draw (None: not drawn, or no timestamps).
-    pub sun_ms: Option<f64>,
+    /// The casters changed since the sun's map was drawn: the next frame's sun shadow pass
+    /// draws it.
+    pub sun_due: bool,
     /// The shadow rays' hierarchy of the objects (stand-ins where no light casts rays).
     pub rays: RayGeometry,
     wants_rays: bool,
@@ -72,7 +74,7 @@ impl ShadowStores {
             sun_view_proj: glam::Mat4::IDENTITY,
             sun_ray_length: 1.0,
             sun: config.sun,
-            sun_ms: None,
+            sun_due: false,
             rays: RayGeometry::null(),
             // Directional lights cast their shadows by rays in every point-light shadow mode.
             wants_rays: config.omni.is_some_and(|o| o.rays() || !scene.directional.is_empty()) || config.sun == Some(SunShadowMode::Rays),
@@ -89,7 +91,7 @@ impl ShadowStores {
             | vk::ImageUsageFlags::TRANSFER_SRC;
         self.sun_map = Image::new_2d(ctx, "shadow map", extent, format, usage, vk::ImageAspectFlags::DEPTH)?;
         // Cleared to the far plane ("lit everywhere") until the objects are drawn into it.
-        render_shadow_map(ctx, &self.sun_map, None)?;
+        clear_shadow_map(ctx, &self.sun_map)?;
         // Outside the map is lit: the border is the far plane (1.0) and the test is ≤. Each
         // tap filters four comparisons bilinearly (as the seed's DX12-book sampler does), so
         // the lit fraction changes continuously with the position: a position rebuilt from
@@ -106,7 +108,8 @@ impl ShadowStores {
     }
 
     /// The casters changed (the scene's objects reached the GPU, or were replaced; no frame in
-    /// flight): the compute rasters' object buffers, the rays' hierarchy, the sun's map.
+    /// flight): the compute rasters' object buffers, the rays' hierarchy, the sun's view (its
+    /// map is due: the next frame draws it, where the sun casts a map).
     pub fn draw_casters(&mut self, ctx: &Context, scene: &Scene, gpu: &SceneGpu) -> Result<(), RenderError> {
         self.omni.bind_casters(ctx, (gpu.objects.raw, gpu.alpha_masks.raw))?;
         self.rays.destroy(ctx);
@@ -114,18 +117,7 @@ impl ShadowStores {
         let (lo, hi) = scene.bounds();
         self.sun_view_proj = shadow_view_proj(lo, hi, scene.blinn_phong.sun_direction);
         self.sun_ray_length = (hi - lo).length() + 1.0;
-        if let Some(mode) = self.sun {
-            let inputs = ShadowInputs {
-                scene,
-                meshes: &gpu.meshes,
-                objects: gpu.objects.raw,
-                alpha_masks: gpu.alpha_masks.raw,
-                view_proj: self.sun_view_proj,
-                mode,
-                meshlets: gpu.meshlets().ok(),
-            };
-            self.sun_ms = draw_shadow_map(ctx, &self.sun_map, &inputs)?;
-        }
+        self.sun_due = self.sun.is_some_and(|mode| mode != SunShadowMode::Rays);
         Ok(())
     }
 
@@ -152,9 +144,20 @@ impl ShadowStores {
         self.rays.named_buffers().to_vec()
     }
 
-    /// The stores' images that passes declare (`sync`), under their names: the shadow cubes.
+    /// The stores' images that passes declare (`sync`), under their names: the sun's map and
+    /// the shadow cubes.
     pub fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
-        (name == crate::sync::SHADOW_CUBES).then_some((self.omni.cubes.raw, vk::ImageAspectFlags::DEPTH))
+        let image = match name {
+            SUN_MAP => &self.sun_map,
+            SHADOW_CUBES => &self.omni.cubes,
+            _ => return None,
+        };
+        Some((image.raw, vk::ImageAspectFlags::DEPTH))
+    }
+
+    /// The sun's map (the sun's shadow pass draws into it).
+    pub fn sun_map(&self) -> &Image {
+        &self.sun_map
     }
 
     /// The sun's shadow map's texels (row by row), copied to the host; for tests and tools.

@@ -1,184 +1,221 @@
-//! The sun's shadow map (blinn-phong; docs/DESIGN.md#sun-shadow-map): rendered once, when the
-//! renderer is made — the sun and the objects do not move (only the point lights do). Depth
-//! only, every object, an orthographic view along the sun fitted to the scene
+//! The sun's shadow map (blinn-phong; docs/DESIGN.md#sun-shadow-map): drawn by a pass of the
+//! first frame after the casters reached the GPU (`ShadowStores::draw_casters` marks it due) —
+//! the sun and the objects do not move (only the point lights do), so later frames record
+//! nothing. Depth only, every object, an orthographic view along the sun fitted to the scene
 //! (ml_cpu::blinn_phong), by a render pass or by the compute shadow raster (shadow_raster.rs);
-//! 3×3 PCF taps read it through a comparison sampler (scene_textures.rs). In the render pass,
-//! alpha-masked objects are drawn after the others by a pipeline of their own whose fragment
-//! shader drops what their masks cut out (depth_pass.rs MaskedPipeline; made only for scenes
-//! with masked objects).
+//! the map is a declared resource (`sync::SUN_MAP`) the shading passes read, so the frame's
+//! barriers order the drawing before them. 3×3 PCF taps read it through a comparison sampler
+//! (stores.rs). In the render pass, alpha-masked objects are drawn after the others by a
+//! pipeline of their own whose fragment shader drops what their masks cut out (depth_pass.rs
+//! MaskedPipeline; made only for scenes with masked objects).
 
-use crate::depth_pass::{self, DepthPassDesc, MaskedPipeline, ShadowMaskPush};
+use crate::depth_pass::{self, MaskedPipeline, ShadowMaskPush};
 use crate::error::RenderError;
-use crate::gpu_mesh::{record_draws, SceneMeshes};
+use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
+use crate::gpu_mesh::record_draws;
+use crate::pass::{Pass, Recording};
 use crate::scene::meshlets::MeshletGeometryView;
 use crate::shadows::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use crate::shadows::shadow_settings::SunShadowMode;
+use crate::shadows::stores::SharedShadows;
+use crate::shadows::sun_map::{self, begin_info, map_render_pass, READERS};
+use crate::sync::{Entry, Exit, Use, SUN_MAP};
 use ml_cpu::gpu_types::ShadowPush;
-use ml_cpu::scene::Scene;
-use ml_vk::{shader, vk, Context, GpuTimer, Image, VkError, VkResultExt};
-
-/// What the sun's shadow pass draws.
-pub struct ShadowInputs<'a> {
-    pub scene: &'a Scene,
-    pub meshes: &'a SceneMeshes,
-    /// The scene's object buffer (the compute raster reads the transforms there).
-    pub objects: vk::Buffer,
-    /// The scene's alpha masks (masked objects' shadows have their shape).
-    pub alpha_masks: vk::Buffer,
-    pub view_proj: glam::Mat4,
-    pub mode: SunShadowMode,
-    /// The scene's meshlets (the compute raster draws them; SceneGpu builds them for it).
-    pub meshlets: Option<MeshletGeometryView>,
-}
-
-/// Who reads the map once it is drawn.
-const READERS: vk::PipelineStageFlags =
-    vk::PipelineStageFlags::from_raw(vk::PipelineStageFlags::FRAGMENT_SHADER.as_raw() | vk::PipelineStageFlags::COMPUTE_SHADER.as_raw());
+use ml_vk::{shader, vk, Context, Image, VkError};
 
 /// Large triangles the compute raster lists for a work group each (the scene's floor is one);
 /// past it, the thread that found one draws it alone.
 const LARGE_LIST: u32 = 1 << 16;
 
-/// Draw every object of `inputs` into `target` from the sun as `inputs.mode` says (`target`
-/// holds the far plane until then); leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL. Returns the
-/// drawing's GPU milliseconds (None without timestamps).
-pub(crate) fn draw_shadow_map(ctx: &Context, target: &Image, inputs: &ShadowInputs) -> Result<Option<f64>, RenderError> {
-    if inputs.mode == SunShadowMode::Rays {
-        // No map is read: the shading traces rays. It is only cleared, for its layout.
-        render_shadow_map(ctx, target, None)?;
-        return Ok(None);
-    }
-    let mut timer = GpuTimer::new(ctx, 1)?;
-    let drawn = match inputs.mode {
-        SunShadowMode::Graphics => render_shadow_map(ctx, target, Some((inputs, &mut timer))).map_err(RenderError::from),
-        SunShadowMode::Rays => Ok(()),
-        SunShadowMode::Compute => {
-            // One orthographic view; its "light" at the origin with radius 1 leaves world
-            // positions as they are (omni_raster.glsl).
-            let views = (ShadowViews::Ortho, target.extent.width, LARGE_LIST);
-            let meshlets =
-                inputs.meshlets.ok_or_else(|| RenderError::Internal("the sun's compute shadow raster has no meshlets".into()))?;
-            ShadowRaster::new(ctx, meshlets, views, 1).and_then(|mut raster| {
-                let shadow_target = ShadowTarget { image: target.raw, readers: Some(READERS) };
-                let result = raster.bind(ctx, 0, (inputs.objects, inputs.alpha_masks)).and_then(|()| {
-                    ml_vk::commands::one_shot(ctx, |cmd| {
-                        timer.reset(ctx, cmd);
-                        timer.begin(ctx, cmd, 0);
-                        // It ends with a barrier (the map's layout transition), which the
-                        // timestamp after it needs on lavapipe (GpuTimer::end).
-                        raster.record(ctx, cmd, 0, &[[0.0, 0.0, 0.0, 1.0]], inputs.view_proj, &shadow_target);
-                        timer.end(ctx, cmd, 0);
-                    })
-                });
-                raster.destroy(ctx);
-                Ok(result?)
-            })
-        }
-    };
-    let ms = drawn.and_then(|()| Ok(timer.read_ms(ctx)?));
-    timer.destroy(ctx);
-    Ok(ms?.map(|passes| passes[0]))
+/// Who draws the map.
+enum Drawer {
+    /// A depth-only render pass (and the masked objects' pipeline where there are any).
+    Graphics {
+        render_pass: vk::RenderPass,
+        framebuffer: vk::Framebuffer,
+        layout: vk::PipelineLayout,
+        pipeline: vk::Pipeline,
+        masked: Option<MaskedPipeline>,
+    },
+    /// The compute shadow raster in one orthographic view.
+    Compute(Box<ShadowRaster>),
 }
 
-/// Clear `target` to the far plane and, given inputs, draw every object into it from the sun
-/// (timed by the timer given with them); leave it DEPTH_STENCIL_READ_ONLY_OPTIMAL for the
-/// shading passes.
-pub(crate) fn render_shadow_map(ctx: &Context, target: &Image, inputs: Option<(&ShadowInputs, &mut GpuTimer)>) -> Result<(), VkError> {
-    let d = &ctx.device;
-    // The depth writes before every later shader read of the map (frames come after this
-    // submission in queue order).
-    let render_pass = depth_pass::render_pass(
-        ctx,
-        &DepthPassDesc {
-            format: target.format,
-            final_layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
-            after: vk::PipelineStageFlags::empty(),
-            readers: (READERS, vk::AccessFlags::SHADER_READ),
-            view_mask: 0,
-        },
-    )?;
-    let views = [target.view];
-    let fb_info = vk::FramebufferCreateInfo::default()
-        .render_pass(render_pass)
-        .attachments(&views)
-        .width(target.extent.width)
-        .height(target.extent.height)
-        .layers(1);
-    let push_size = std::mem::size_of::<ShadowPush>() as u32;
-    let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::VERTEX).size(push_size)];
-    let mut framebuffer = vk::Framebuffer::null();
-    let mut layout = vk::PipelineLayout::null();
-    let mut pipeline = vk::Pipeline::null();
-    let mut masked_pipeline: Option<MaskedPipeline> = None;
-    let result = (|| {
-        // SAFETY: as above.
-        framebuffer = unsafe { d.create_framebuffer(&fb_info, None) }.ctx("vkCreateFramebuffer")?;
-        // Only a pass that draws needs the pipeline (a clear does not), and only one that
-        // draws masked objects the masked pipeline.
-        if let Some((s, _)) = &inputs {
-            layout = shader::pipeline_layout(ctx, &[], &push)?;
-            pipeline = depth_pass::pipeline(ctx, render_pass, layout, (ml_shaders::SHADOW_VERT.spirv, None))?;
-            if s.scene.objects.iter().any(|o| o.extras.masked()) {
-                let shaders = (&ml_shaders::SHADOW_MASKED_VERT, &ml_shaders::SHADOW_MASKED_FRAG);
-                let m = masked_pipeline.insert(MaskedPipeline::new(ctx, render_pass, shaders, 1)?);
-                m.bind(ctx, 0, (s.objects, s.alpha_masks))?;
+/// The pass that draws the sun's map where it is due.
+pub struct SunShadowPass {
+    shadows: SharedShadows,
+    drawer: Drawer,
+}
+
+impl SunShadowPass {
+    /// The pass for `mode` (graphics or compute): `masked`, whether some object is alpha
+    /// masked; `meshlets`, the scene's (the compute raster draws them).
+    pub fn new(
+        ctx: &Context,
+        shadows: SharedShadows,
+        mode: SunShadowMode,
+        (masked, meshlets): (bool, Option<MeshletGeometryView>),
+    ) -> Result<SunShadowPass, RenderError> {
+        let (format, size) = {
+            let s = shadows.borrow();
+            (s.sun_map().format, s.sun_map_size)
+        };
+        let drawer = match mode {
+            SunShadowMode::Compute => {
+                let meshlets = meshlets.ok_or_else(|| RenderError::Internal("the sun's compute shadow raster has no meshlets".into()))?;
+                Drawer::Compute(Box::new(ShadowRaster::new(ctx, meshlets, (ShadowViews::Ortho, size, LARGE_LIST), FRAMES_IN_FLIGHT)?))
             }
+            SunShadowMode::Graphics | SunShadowMode::Rays => {
+                let empty = vk::RenderPass::null();
+                let mut d = Drawer::Graphics {
+                    render_pass: empty,
+                    framebuffer: vk::Framebuffer::null(),
+                    layout: vk::PipelineLayout::null(),
+                    pipeline: vk::Pipeline::null(),
+                    masked: None,
+                };
+                let made = make_graphics(ctx, &mut d, (format, masked), shadows.borrow().sun_map());
+                if let Err(e) = made {
+                    d.destroy(ctx);
+                    return Err(e.into());
+                }
+                d
+            }
+        };
+        Ok(SunShadowPass { shadows, drawer })
+    }
+}
+
+/// The graphics drawer's render pass (after the map's last readers), framebuffer and
+/// pipelines.
+fn make_graphics(ctx: &Context, d: &mut Drawer, (format, masked_objects): (vk::Format, bool), target: &Image) -> Result<(), VkError> {
+    let Drawer::Graphics { render_pass, framebuffer, layout, pipeline, masked } = d else { return Ok(()) };
+    *render_pass = map_render_pass(ctx, format, READERS)?;
+    *framebuffer = sun_map::framebuffer(ctx, *render_pass, target)?;
+    let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::VERTEX).size(size_of::<ShadowPush>() as u32)];
+    *layout = shader::pipeline_layout(ctx, &[], &push)?;
+    *pipeline = depth_pass::pipeline(ctx, *render_pass, *layout, (ml_shaders::SHADOW_VERT.spirv, None))?;
+    if masked_objects {
+        let shaders = (&ml_shaders::SHADOW_MASKED_VERT, &ml_shaders::SHADOW_MASKED_FRAG);
+        *masked = Some(MaskedPipeline::new(ctx, *render_pass, shaders, FRAMES_IN_FLIGHT)?);
+    }
+    Ok(())
+}
+
+impl Drawer {
+    fn destroy(&mut self, ctx: &Context) {
+        match self {
+            Drawer::Graphics { framebuffer, pipeline, masked, .. } => {
+                if let Some(m) = masked {
+                    m.destroy(ctx);
+                }
+                // SAFETY: no pending work uses them; null handles are ignored. The render
+                // pass and layout are the context cache's.
+                unsafe {
+                    ml_vk::shader::release_pipeline(ctx, *pipeline);
+                    ctx.device.destroy_framebuffer(*framebuffer, None);
+                }
+                *framebuffer = vk::Framebuffer::null();
+                *pipeline = vk::Pipeline::null();
+            }
+            Drawer::Compute(raster) => raster.destroy(ctx),
         }
-        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: target.extent };
-        ml_vk::commands::one_shot(ctx, |cmd| {
-            let begin = vk::RenderPassBeginInfo::default()
-                .render_pass(render_pass)
-                .framebuffer(framebuffer)
-                .render_area(area)
-                .clear_values(&depth_pass::CLEAR_FAR);
-            let mut inputs = inputs;
-            if let Some((_, timer)) = inputs.as_mut() {
-                timer.reset(ctx, cmd);
-                timer.begin(ctx, cmd, 0);
+    }
+}
+
+impl Pass for SunShadowPass {
+    fn timer_name(&self) -> Option<&'static str> {
+        Some("sun shadow map")
+    }
+
+    fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        let named = |name| frame.raw_buffer(name).expect("the scene's buffers are in every frame's table");
+        let casters = (named("ObjectBuffer"), named("AlphaMaskBuffer"));
+        match &mut self.drawer {
+            Drawer::Graphics { masked, .. } => masked.as_ref().map_or(Ok(()), |m| m.bind(ctx, frame.slot, casters)),
+            Drawer::Compute(raster) => raster.bind(ctx, frame.slot, casters),
+        }
+    }
+
+    /// Where the map is due: the render pass orders itself after the shaders that read the
+    /// map last and leaves it for them (its external dependencies); the compute raster
+    /// overwrites it by a copy (left TRANSFER_DST_OPTIMAL). Nothing in the frames after.
+    fn uses(&self) -> Vec<Use> {
+        if !self.shadows.borrow().sun_due {
+            return Vec::new();
+        }
+        vec![match self.drawer {
+            Drawer::Graphics { .. } => Use {
+                name: SUN_MAP,
+                entry: Entry::Chained { stages: READERS },
+                exit: Exit {
+                    stages: READERS,
+                    writes: vk::AccessFlags::empty(),
+                    wrote: true,
+                    visible: vk::AccessFlags::SHADER_READ,
+                    layout: Some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+                },
+            },
+            Drawer::Compute(_) => {
+                let transfer = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE);
+                Use::overwriting(SUN_MAP, transfer, vk::ImageLayout::TRANSFER_DST_OPTIMAL)
             }
-            // SAFETY: recording state; everything used is alive until the wait in one_shot.
-            unsafe {
-                d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-                if let Some((s, _)) = &inputs {
-                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                    depth_pass::set_square_viewport(ctx, cmd, target.extent.width);
-                    let objects = &s.scene.objects;
+        }]
+    }
+
+    fn record(&self, rec: &Recording) {
+        let (view_proj, map) = {
+            let mut shadows = self.shadows.borrow_mut();
+            if !shadows.sun_due {
+                return;
+            }
+            shadows.sun_due = false;
+            (shadows.sun_view_proj, (shadows.sun_map().raw, shadows.sun_map().extent))
+        };
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        match &self.drawer {
+            Drawer::Compute(raster) => {
+                // One view; its "light" at the origin with radius 1 leaves world positions as
+                // they are (omni_raster.glsl).
+                raster.record(ctx, cmd, rec.slot, &[[0.0, 0.0, 0.0, 1.0]], view_proj, &ShadowTarget { image: map.0, readers: None });
+            }
+            Drawer::Graphics { render_pass, framebuffer, layout, pipeline, masked } => {
+                let d = &ctx.device;
+                let (meshes, objects) = (&rec.scene.meshes, rec.objects);
+                // SAFETY: recording state outside a render pass; everything bound lives until
+                // the frame's fence signals.
+                unsafe {
+                    d.cmd_begin_render_pass(cmd, &begin_info(*render_pass, *framebuffer, map.1), vk::SubpassContents::INLINE);
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, *pipeline);
+                    depth_pass::set_square_viewport(ctx, cmd, map.1.width);
                     record_draws(
                         ctx,
                         cmd,
-                        (s.meshes, objects),
+                        (meshes, objects),
                         |i| u32::from(!objects[i as usize].extras.masked()),
                         |_, object| {
                             let push =
-                                ShadowPush { model: object.transform.to_cols_array_2d(), light_view_proj: s.view_proj.to_cols_array_2d() };
-                            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
+                                ShadowPush { model: object.transform.to_cols_array_2d(), light_view_proj: view_proj.to_cols_array_2d() };
+                            d.cmd_push_constants(cmd, *layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&push));
                         },
                     );
-                    if let Some(m) = &masked_pipeline {
-                        m.record_bind(ctx, cmd, 0);
+                    if let Some(m) = masked {
+                        m.record_bind(ctx, cmd, rec.slot);
                         record_draws(
                             ctx,
                             cmd,
-                            (s.meshes, objects),
+                            (meshes, objects),
                             |i| u32::from(objects[i as usize].extras.masked()),
-                            |i, object| m.push(ctx, cmd, &ShadowMaskPush::new(s.view_proj, object.transform, i)),
+                            |i, object| m.push(ctx, cmd, &ShadowMaskPush::new(view_proj, object.transform, i)),
                         );
                     }
+                    d.cmd_end_render_pass(cmd);
                 }
-                d.cmd_end_render_pass(cmd);
             }
-            if let Some((_, timer)) = &inputs {
-                timer.end(ctx, cmd, 0);
-            }
-        })
-    })();
-    if let Some(m) = &mut masked_pipeline {
-        m.destroy(ctx);
+        }
     }
-    // SAFETY: one_shot waited for the GPU (or nothing was submitted); null handles are ignored.
-    unsafe {
-        ml_vk::shader::release_pipeline(ctx, pipeline);
-        d.destroy_framebuffer(framebuffer, None);
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.drawer.destroy(ctx);
     }
-    result
 }
