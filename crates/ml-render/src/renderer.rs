@@ -774,10 +774,6 @@ impl<'a> Renderer<'a> {
         let debug_view = self.settings.debug_view.code();
         let cam = &v.camera;
         let bp = &self.scene.blinn_phong;
-        // World size of a shadow-map texel: the orthographic projection's first row is the
-        // sun's x axis over the half-width it covers.
-        let shadows = self.shadows.borrow();
-        let shadow_texel_world = 2.0 / shadows.sun_view_proj.row(0).truncate().length() / shadows.sun_map_size as f32;
         let exposure = self.exposure.expose(f);
         let frame = &mut self.frames[f];
         let light_offset = motion_offset(t, self.scene.light_motion);
@@ -789,7 +785,6 @@ impl<'a> Renderer<'a> {
             camera_pos: cam.position.extend(cam.w_of_depth().0).to_array(),
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
-            omni_texel: shadows.omni.texel(),
             directional_count: self.scene.directional.len() as u32,
             cluster_dims: [g.dims.x, g.dims.y, g.dims.z, 0],
             viewport: [v.width, v.height, debug_view, 0],
@@ -797,18 +792,17 @@ impl<'a> Renderer<'a> {
             cluster_frustum: [g.near, g.far, v.projection.x_axis.x, v.projection.y_axis.y],
             light_animation: light_offset.extend(0.0).to_array(),
             cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
-            shadow_view_proj: shadows.sun_view_proj.to_cols_array_2d(),
-            sun_direction: bp.sun_direction.extend(1.0 / shadows.sun_map_size as f32).to_array(),
-            sun_strength: bp.sun_strength.extend(shadow_texel_world).to_array(),
+            sun_direction: bp.sun_direction.extend(0.0).to_array(),
+            sun_strength: bp.sun_strength.extend(0.0).to_array(),
             spot_position_range: bp.spot.position.extend(bp.spot.range).to_array(),
             spot_direction_power: bp.spot.direction.extend(bp.spot.power).to_array(),
             spot_strength: bp.spot.strength.extend(0.0).to_array(),
             ambient_light: bp.ambient.extend(0.0).to_array(),
             texture_transform: bp.texture_transform.to_cols_array(),
             exposure: [exposure, 0.0, 0.0, 0.0],
-            shadow_rays: [shadows.sun_ray_length, 0.0, 0.0, 0.0],
             ..FrameUniforms::default()
         };
+        self.shadows.borrow().frame_uniforms(&mut uniforms);
         for p in &self.passes {
             p.frame_uniforms(&mut uniforms, light_offset);
         }

@@ -14,6 +14,7 @@ use crate::shadows::shadow_settings::{OmniShadowSettings, SunShadowMode};
 use crate::shadows::sun_map::clear_shadow_map;
 use crate::sync::{SHADOW_CUBES, SUN_MAP};
 use ml_cpu::blinn_phong::shadow_view_proj;
+use ml_cpu::gpu_types::FrameUniforms;
 use ml_cpu::scene::Scene;
 use ml_vk::image::sampler;
 use ml_vk::{vk, Context, Image, VkError};
@@ -119,6 +120,19 @@ impl ShadowStores {
         self.sun_ray_length = (hi - lo).length() + 1.0;
         self.sun_due = self.sun.is_some_and(|mode| mode != SunShadowMode::Rays);
         Ok(())
+    }
+
+    /// Fill the frame's uniforms the stores own: the sun's view-projection, its map's texel
+    /// (`sun_direction.w`: in map units; `sun_strength.w`: in the world — the orthographic
+    /// projection's first row is the sun's x axis over the half-width it covers), its rays'
+    /// length, and a point-light cube texel.
+    pub fn frame_uniforms(&self, u: &mut FrameUniforms) {
+        let size = self.sun_map_size as f32;
+        u.shadow_view_proj = self.sun_view_proj.to_cols_array_2d();
+        u.sun_direction[3] = 1.0 / size;
+        u.sun_strength[3] = 2.0 / self.sun_view_proj.row(0).truncate().length() / size;
+        u.shadow_rays[0] = self.sun_ray_length;
+        u.omni_texel = self.omni.texel();
     }
 
     /// What the stores bind in the scene's set 1 (common/textures.glsl), by name.
