@@ -53,6 +53,7 @@ mod read_back;
 mod render_pass;
 mod renderer;
 mod scene;
+mod scene_part;
 mod shading;
 mod shadows;
 mod specialization;

@@ -7,6 +7,7 @@
 
 use crate::antialiasing::{Antialiasing, AntialiasingStats};
 use crate::assembly::{assemble, Assembly};
+use crate::environment::EnvironmentMaps;
 use crate::error::RenderError;
 use crate::exposure::auto_exposure::{self, AutoExposure};
 use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
@@ -15,6 +16,7 @@ use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::read_back::{self, HostRead};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
+use crate::scene_part::{self, ScenePart};
 use crate::settings::{Geometry, LightAssignment, RenderSettings};
 use crate::shadows::omni_shadow::OmniShadows;
 use crate::shadows::stores::{ShadowStores, SharedShadows};
@@ -68,6 +70,8 @@ pub struct Renderer<'a> {
     extent: vk::Extent2D,
     /// The scene's meshes, buffers and textures on the GPU.
     gpu: SceneGpu,
+    /// The environment light, prefiltered (stand-ins without one).
+    environment: EnvironmentMaps,
     /// The shadow stores (the shadow passes share them).
     shadows: SharedShadows,
     /// The technique's passes, in recording order.
@@ -175,12 +179,19 @@ impl<'a> Renderer<'a> {
         }
         let depth = depth_format(ctx, Output::of(settings.technique))?;
         let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
+        // The scene's parts, then its geometry and textures (set 1 binds what the parts name),
+        // then the shadow stores' casters; a failure releases what was made before it.
+        let mut environment = EnvironmentMaps::new(ctx, scene.environment.as_ref())?;
         // The sun's map in the G-buffer's depth format (sampleable).
-        let mut shadows = ShadowStores::new(ctx, &scene, settings.shadow_config(), depth_format(ctx, Output::GBuffer)?)?;
-        let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| shadows.resource(name));
-        let mut gpu = release_on_error(ctx, made, &mut [&mut shadows])?;
+        let made = depth_format(ctx, Output::GBuffer)
+            .map_err(RenderError::from)
+            .and_then(|format| ShadowStores::new(ctx, &scene, settings.shadow_config(), format));
+        let mut shadows = release_on_error(ctx, made, &mut [&mut environment])?;
+        let parts = scene_parts(&shadows, &environment);
+        let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| scene_part::resource(&parts, name));
+        let mut gpu = release_on_error(ctx, made, &mut [&mut environment, &mut shadows])?;
         let drawn = shadows.draw_casters(ctx, &scene, &gpu);
-        release_on_error(ctx, drawn, &mut [&mut shadows, &mut gpu])?;
+        release_on_error(ctx, drawn, &mut [&mut environment, &mut shadows, &mut gpu])?;
         shadows.omni.choose(&scene, settings.aspect());
         let lights = gpu_lights(&scene, &shadows.omni);
         let mut shared_sync = sync::SyncStates::default();
@@ -199,6 +210,7 @@ impl<'a> Renderer<'a> {
             scene,
             settings,
             gpu,
+            environment,
             shadows: Rc::new(RefCell::new(shadows)),
             passes: Vec::new(),
             command_pool: vk::CommandPool::null(),
@@ -308,7 +320,7 @@ impl<'a> Renderer<'a> {
         let Some(env) = &mut self.scene.environment else { return Ok(false) };
         (env.intensity, env.rotation) = (intensity, rotation);
         self.ctx.wait_idle()?;
-        self.gpu.environment.set_view(self.ctx, env)?;
+        self.environment.set_view(self.ctx, env)?;
         Ok(true)
     }
 
@@ -401,7 +413,10 @@ impl<'a> Renderer<'a> {
     /// that the frame orders by declared uses must be among the pass's (`sync::undeclared`).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
         let owned: Vec<(&'static str, vk::Buffer)> = self.passes.iter().flat_map(|p| p.slot_buffers(f)).collect();
-        let scene = [self.gpu.named_buffers(), self.shadows.borrow().named_buffers()].concat();
+        let shadows = self.shadows.borrow();
+        let parts = scene_parts(&shadows, &self.environment);
+        let scene: Vec<_> = self.gpu.named_buffers().into_iter().chain(parts.iter().flat_map(|p| p.named_buffers())).collect();
+        drop(shadows);
         let resources = self.frames[f].resources(f, &scene).with(&owned);
         let ordered: Vec<&'static str> = self.passes.iter().flat_map(|p| p.uses()).map(|u| u.name).collect();
         for p in &mut self.passes {
@@ -529,7 +544,7 @@ impl<'a> Renderer<'a> {
             rays.traced = self.settings.light_stats.then_some(self.rays_traced[last].0);
             stats.set_feature(rays);
         }
-        if let Some(environment) = self.gpu.environment.stats {
+        if let Some(environment) = self.environment.stats {
             stats.set_feature(environment);
         }
         let antialiasing = self.settings.antialiasing;
@@ -802,7 +817,9 @@ impl<'a> Renderer<'a> {
             exposure: [exposure, 0.0, 0.0, 0.0],
             ..FrameUniforms::default()
         };
-        self.shadows.borrow().frame_uniforms(&mut uniforms);
+        for part in scene_parts(&self.shadows.borrow(), &self.environment) {
+            part.frame_uniforms(&mut uniforms);
+        }
         for p in &self.passes {
             p.frame_uniforms(&mut uniforms, light_offset);
         }
@@ -824,7 +841,9 @@ impl<'a> Renderer<'a> {
         let view_proj = self.view.view_proj();
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
-        let image = |name: &str| targets.named_image(name).or_else(|| self.shadows.borrow().named_image(name));
+        let image = |name: &str| {
+            targets.named_image(name).or_else(|| scene_part::named_image(&scene_parts(&self.shadows.borrow(), &self.environment), name))
+        };
         for pass in &self.passes {
             // The barrier that orders the pass's declared uses is part of its time, as the
             // barriers it records itself are.
@@ -924,6 +943,12 @@ impl FrameHook for CopyToHost {
     }
 }
 
+/// The scene's parts beside its geometry and textures (`scene_part`): a new part is its line
+/// here and where `Renderer::new` makes it.
+fn scene_parts<'s>(shadows: &'s ShadowStores, environment: &'s EnvironmentMaps) -> [&'s dyn ScenePart; 2] {
+    [shadows, environment]
+}
+
 /// `scene`'s lights as the GPU reads them: marked with the shadow slots `omni` chose.
 fn gpu_lights(scene: &Scene, omni: &OmniShadows) -> Vec<PointLight> {
     let mut lights = scene.lights.clone();
@@ -948,5 +973,6 @@ impl Drop for Renderer<'_> {
         unsafe { ctx.device.destroy_command_pool(self.command_pool, None) };
         self.gpu.destroy(ctx);
         self.shadows.borrow_mut().destroy(ctx);
+        self.environment.destroy(ctx);
     }
 }

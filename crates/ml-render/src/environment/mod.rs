@@ -11,6 +11,7 @@
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::error::RenderError;
 use crate::report::FeatureStats;
+use crate::scene_part::ScenePart;
 use ml_cpu::environment::Environment;
 use ml_cpu::gpu_types::EnvironmentData;
 use ml_cpu::scene::Scene;
@@ -191,8 +192,20 @@ impl EnvironmentMaps {
         })
     }
 
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.radiance.destroy(ctx);
+        self.specular.destroy(ctx);
+        self.brdf.destroy(ctx);
+        self.buffer.destroy(ctx);
+        // SAFETY: no pending work uses it; a null handle is ignored.
+        unsafe { ctx.device.destroy_sampler(self.sampler, None) };
+        self.sampler = vk::Sampler::null();
+    }
+}
+
+impl ScenePart for EnvironmentMaps {
     /// What set 1's environment bindings point at, by the names environment.glsl gives them.
-    pub fn resource(&self, name: &str) -> Option<Resource> {
+    fn resource(&self, name: &str) -> Option<Resource> {
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         let image = |i: &Image| {
             Resource::Image(vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(i.view).image_layout(read_only))
@@ -204,16 +217,6 @@ impl EnvironmentMaps {
             "EnvironmentBuffer" => Some(Resource::Buffer(self.buffer.raw)),
             _ => None,
         }
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        self.radiance.destroy(ctx);
-        self.specular.destroy(ctx);
-        self.brdf.destroy(ctx);
-        self.buffer.destroy(ctx);
-        // SAFETY: no pending work uses it; a null handle is ignored.
-        unsafe { ctx.device.destroy_sampler(self.sampler, None) };
-        self.sampler = vk::Sampler::null();
     }
 }
 

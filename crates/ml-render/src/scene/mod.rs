@@ -1,6 +1,7 @@
 //! The scene on the GPU, shared by every pass and frame: meshes, meshlets, the object,
 //! spot-cone and directional-light buffers, the scene's textures (set 1 of every shading
-//! pipeline: the sky, material maps, the environment, and what the shadow stores bind there)
+//! pipeline: the sky and material maps, and what the scene's other parts bind there: the
+//! environment's maps, the shadow stores')
 //! and each object's own textures (set 2).
 
 pub mod meshlets;
@@ -9,7 +10,6 @@ pub mod object_textures;
 pub mod textures;
 
 use crate::descriptors::Resource;
-use crate::environment::EnvironmentMaps;
 use crate::error::RenderError;
 use crate::gpu_mesh::SceneMeshes;
 use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeometryView};
@@ -35,8 +35,6 @@ pub struct SceneGpu {
     /// pipeline for each.
     pub surface_variants: Vec<SurfaceVariant>,
     pub textures: SceneTextures,
-    /// The environment light, prefiltered (stand-ins without one): part of the texture set.
-    pub environment: EnvironmentMaps,
     pub object_textures: ObjectTextureSets,
     /// The scene's meshlets, built once for every pass that draws them (the visibility
     /// technique, the compute shadow rasters of the point lights and the sun); None where
@@ -47,7 +45,7 @@ pub struct SceneGpu {
 
 impl SceneGpu {
     /// The scene's GPU resources as `config` asks; set 1 binds, besides the scene's own
-    /// textures and environment, what `set_one` names (the shadow stores').
+    /// textures, what `set_one` names (the scene's parts: `scene_part`).
     pub fn new(
         ctx: &Context,
         scene: &Scene,
@@ -55,11 +53,9 @@ impl SceneGpu {
         set_one: &dyn Fn(&str) -> Option<Resource>,
     ) -> Result<SceneGpu, RenderError> {
         // Each of these needs the ones before it; a failure releases those.
-        let mut environment = EnvironmentMaps::new(ctx, scene.environment.as_ref())?;
-        let made = SceneTextures::new(ctx, config.material_maps, &|name| set_one(name).or_else(|| environment.resource(name)));
-        let mut textures = release_on_error(ctx, made.map_err(RenderError::from), &mut [&mut environment])?;
+        let mut textures = SceneTextures::new(ctx, config.material_maps, set_one)?;
         let made = ObjectTextureSets::new(ctx, &scene.textures, &scene.objects);
-        let object_textures = release_on_error(ctx, made, &mut [&mut environment, &mut textures])?;
+        let object_textures = release_on_error(ctx, made, &mut [&mut textures])?;
         let mut gpu = SceneGpu {
             meshes: SceneMeshes::empty(),
             objects: Buffer::null(),
@@ -68,7 +64,6 @@ impl SceneGpu {
             alpha_masks: Buffer::null(),
             surface_variants: SurfaceVariant::needed(&scene.objects),
             textures,
-            environment,
             object_textures,
             meshlets: None,
             wants_meshlets: config.meshlets,
@@ -165,7 +160,6 @@ impl SceneGpu {
         self.cones.destroy(ctx);
         self.directional.destroy(ctx);
         self.textures.destroy(ctx);
-        self.environment.destroy(ctx);
         self.object_textures.destroy(ctx);
     }
 }

@@ -8,6 +8,7 @@
 use crate::descriptors::Resource;
 use crate::error::RenderError;
 use crate::scene::SceneGpu;
+use crate::scene_part::ScenePart;
 use crate::shadows::omni_shadow::{self, OmniShadows};
 use crate::shadows::ray_geometry::RayGeometry;
 use crate::shadows::shadow_settings::{OmniShadowSettings, SunShadowMode};
@@ -122,53 +123,6 @@ impl ShadowStores {
         Ok(())
     }
 
-    /// Fill the frame's uniforms the stores own: the sun's view-projection, its map's texel
-    /// (`sun_direction.w`: in map units; `sun_strength.w`: in the world — the orthographic
-    /// projection's first row is the sun's x axis over the half-width it covers), its rays'
-    /// length, and a point-light cube texel.
-    pub fn frame_uniforms(&self, u: &mut FrameUniforms) {
-        let size = self.sun_map_size as f32;
-        u.shadow_view_proj = self.sun_view_proj.to_cols_array_2d();
-        u.sun_direction[3] = 1.0 / size;
-        u.sun_strength[3] = 2.0 / self.sun_view_proj.row(0).truncate().length() / size;
-        u.shadow_rays[0] = self.sun_ray_length;
-        u.omni_texel = self.omni.texel();
-    }
-
-    /// What the stores bind in the scene's set 1 (common/textures.glsl), by name.
-    pub fn resource(&self, name: &str) -> Option<Resource> {
-        let [sun_compare, omni_compare, plain] = self.samplers[..] else { return None };
-        let depth_read = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
-        let info = |sampler: vk::Sampler, view: vk::ImageView| {
-            Resource::Image(vk::DescriptorImageInfo::default().sampler(sampler).image_view(view).image_layout(depth_read))
-        };
-        Some(match name {
-            "shadow_map" => info(sun_compare, self.sun_map.view),
-            "shadow_depth" => info(plain, self.sun_map.view),
-            "omni_shadows" => info(omni_compare, self.omni.cubes.view),
-            "omni_faces" => info(plain, self.omni.faces_view),
-            "ShadowAtlasBuffer" => Resource::Buffer(self.omni.atlas.depths.raw),
-            "ShadowAtlasTileBuffer" => Resource::Buffer(self.omni.atlas.tiles.raw),
-            _ => return None,
-        })
-    }
-
-    /// The stores' buffers shaders bind from the frame's table (the rays' hierarchy).
-    pub fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
-        self.rays.named_buffers().to_vec()
-    }
-
-    /// The stores' images that passes declare (`sync`), under their names: the sun's map and
-    /// the shadow cubes.
-    pub fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
-        let image = match name {
-            SUN_MAP => &self.sun_map,
-            SHADOW_CUBES => &self.omni.cubes,
-            _ => return None,
-        };
-        Some((image.raw, vk::ImageAspectFlags::DEPTH))
-    }
-
     /// The sun's map (the sun's shadow pass draws into it).
     pub fn sun_map(&self) -> &Image {
         &self.sun_map
@@ -189,6 +143,55 @@ impl ShadowStores {
                 ctx.device.destroy_sampler(s, None);
             }
         }
+    }
+}
+
+impl ScenePart for ShadowStores {
+    /// Fill the frame's uniforms the stores own: the sun's view-projection, its map's texel
+    /// (`sun_direction.w`: in map units; `sun_strength.w`: in the world — the orthographic
+    /// projection's first row is the sun's x axis over the half-width it covers), its rays'
+    /// length, and a point-light cube texel.
+    fn frame_uniforms(&self, u: &mut FrameUniforms) {
+        let size = self.sun_map_size as f32;
+        u.shadow_view_proj = self.sun_view_proj.to_cols_array_2d();
+        u.sun_direction[3] = 1.0 / size;
+        u.sun_strength[3] = 2.0 / self.sun_view_proj.row(0).truncate().length() / size;
+        u.shadow_rays[0] = self.sun_ray_length;
+        u.omni_texel = self.omni.texel();
+    }
+
+    /// What the stores bind in the scene's set 1 (common/textures.glsl), by name.
+    fn resource(&self, name: &str) -> Option<Resource> {
+        let [sun_compare, omni_compare, plain] = self.samplers[..] else { return None };
+        let depth_read = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+        let info = |sampler: vk::Sampler, view: vk::ImageView| {
+            Resource::Image(vk::DescriptorImageInfo::default().sampler(sampler).image_view(view).image_layout(depth_read))
+        };
+        Some(match name {
+            "shadow_map" => info(sun_compare, self.sun_map.view),
+            "shadow_depth" => info(plain, self.sun_map.view),
+            "omni_shadows" => info(omni_compare, self.omni.cubes.view),
+            "omni_faces" => info(plain, self.omni.faces_view),
+            "ShadowAtlasBuffer" => Resource::Buffer(self.omni.atlas.depths.raw),
+            "ShadowAtlasTileBuffer" => Resource::Buffer(self.omni.atlas.tiles.raw),
+            _ => return None,
+        })
+    }
+
+    /// The stores' buffers shaders bind from the frame's table (the rays' hierarchy).
+    fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
+        self.rays.named_buffers().to_vec()
+    }
+
+    /// The stores' images that passes declare (`sync`), under their names: the sun's map and
+    /// the shadow cubes.
+    fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+        let image = match name {
+            SUN_MAP => &self.sun_map,
+            SHADOW_CUBES => &self.omni.cubes,
+            _ => return None,
+        };
+        Some((image.raw, vk::ImageAspectFlags::DEPTH))
     }
 }
 
