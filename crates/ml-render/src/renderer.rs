@@ -190,7 +190,7 @@ impl<'a> Renderer<'a> {
         let parts = scene_parts(&shadows, &environment);
         let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| scene_part::resource(&parts, name));
         let mut gpu = release_on_error(ctx, made, &mut [&mut environment, &mut shadows])?;
-        let drawn = shadows.draw_casters(ctx, &scene, &gpu);
+        let drawn = shadows.casters_changed(ctx, &scene, &gpu);
         release_on_error(ctx, drawn, &mut [&mut environment, &mut shadows, &mut gpu])?;
         shadows.omni.choose(&scene, settings.aspect());
         let lights = gpu_lights(&scene, &shadows.omni);
@@ -358,7 +358,7 @@ impl<'a> Renderer<'a> {
         self.scene.meshes = scene.meshes.clone();
         self.gpu.replace_objects(self.ctx, &self.scene)?;
         let mut shadows = self.shadows.borrow_mut();
-        shadows.draw_casters(self.ctx, &self.scene, &self.gpu)?;
+        shadows.casters_changed(self.ctx, &self.scene, &self.gpu)?;
         // Other casters: every atlas face is drawn again.
         shadows.omni.atlas.forget();
         drop(shadows);

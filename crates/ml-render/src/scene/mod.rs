@@ -98,7 +98,7 @@ impl SceneGpu {
     }
 
     /// The scene's objects on the GPU: its meshes, the object buffer and its meshlets (the
-    /// shadow stores draw their casters from them: `ShadowStores::draw_casters`).
+    /// shadow stores take their casters from them: `ShadowStores::casters_changed`).
     fn upload_objects(&mut self, ctx: &Context, scene: &Scene) -> Result<(), RenderError> {
         self.meshes = SceneMeshes::upload(ctx, scene)?;
         let masks = AlphaMasks::pack(scene).map_err(|e| RenderError::Invalid(e.to_string()))?;

@@ -65,7 +65,7 @@ pub type SharedShadows = Rc<RefCell<ShadowStores>>;
 
 impl ShadowStores {
     /// The stores for `scene` as `config` asks, the sun's map in `sun_format` (which must be
-    /// sampleable), cleared; `draw_casters` once the scene's objects are on the GPU.
+    /// sampleable), cleared; `casters_changed` once the scene's objects are on the GPU.
     pub fn new(ctx: &Context, scene: &Scene, config: ShadowConfig, sun_format: vk::Format) -> Result<ShadowStores, RenderError> {
         let has_masked = scene.objects.iter().any(|o| o.extras.masked());
         let stores = ShadowStores {
@@ -112,7 +112,7 @@ impl ShadowStores {
     /// The casters changed (the scene's objects reached the GPU, or were replaced; no frame in
     /// flight): the compute rasters' object buffers, the rays' hierarchy, the sun's view (its
     /// map is due: the next frame draws it, where the sun casts a map).
-    pub fn draw_casters(&mut self, ctx: &Context, scene: &Scene, gpu: &SceneGpu) -> Result<(), RenderError> {
+    pub fn casters_changed(&mut self, ctx: &Context, scene: &Scene, gpu: &SceneGpu) -> Result<(), RenderError> {
         self.omni.bind_casters(ctx, (gpu.objects.raw, gpu.alpha_masks.raw))?;
         self.rays.destroy(ctx);
         self.rays = RayGeometry::new(ctx, scene, self.wants_rays)?;

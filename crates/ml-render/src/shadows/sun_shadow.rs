@@ -1,5 +1,5 @@
 //! The sun's shadow map (blinn-phong; docs/DESIGN.md#sun-shadow-map): drawn by a pass of the
-//! first frame after the casters reached the GPU (`ShadowStores::draw_casters` marks it due) —
+//! first frame after the casters reached the GPU (`ShadowStores::casters_changed` marks it due) —
 //! the sun and the objects do not move (only the point lights do), so later frames record
 //! nothing. Depth only, every object, an orthographic view along the sun fitted to the scene
 //! (ml_cpu::blinn_phong), by a render pass or by the compute shadow raster (shadow_raster.rs);
@@ -65,10 +65,10 @@ impl SunShadowPass {
                 let meshlets = meshlets.ok_or_else(|| RenderError::Internal("the sun's compute shadow raster has no meshlets".into()))?;
                 Drawer::Compute(Box::new(ShadowRaster::new(ctx, meshlets, (ShadowViews::Ortho, size, LARGE_LIST), FRAMES_IN_FLIGHT)?))
             }
+            // (The sun's rays read no map: `plan` makes no such pass for them.)
             SunShadowMode::Graphics | SunShadowMode::Rays => {
-                let empty = vk::RenderPass::null();
                 let mut d = Drawer::Graphics {
-                    render_pass: empty,
+                    render_pass: vk::RenderPass::null(),
                     framebuffer: vk::Framebuffer::null(),
                     layout: vk::PipelineLayout::null(),
                     pipeline: vk::Pipeline::null(),
