@@ -54,7 +54,7 @@ pub fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, reads: &[HostRead]) 
     }
 }
 
-/// The host-visible copies of one device buffer, a buffer per frame slot.
+/// The host-visible copies of one device buffer (or image), a buffer per frame slot.
 pub struct ReadBack {
     label: &'static str,
     host: Vec<Buffer>,
@@ -83,6 +83,11 @@ impl ReadBack {
     pub fn of(&self, slot: usize, name: &'static str, from: vk::Buffer) -> HostRead {
         let host = &self.host[slot];
         HostRead { name, copy: Some((from, host.raw, host.size)) }
+    }
+
+    /// Slot `slot`'s host buffer (for a copy recorded elsewhere: the colour target's).
+    pub fn raw(&self, slot: usize) -> vk::Buffer {
+        self.host[slot].raw
     }
 
     /// Slot `slot`'s copy as its finished frame left it.

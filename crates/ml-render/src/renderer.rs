@@ -13,7 +13,7 @@ use crate::exposure::auto_exposure::{self, AutoExposure};
 use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Prepare, Recording, SlotReport};
-use crate::read_back::{self, HostRead};
+use crate::read_back::{self, HostRead, ReadBack};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
 use crate::scene_part::{self, ScenePart};
@@ -27,7 +27,7 @@ use ml_cpu::cluster::{count_entries, ClusterGrid};
 use ml_cpu::gpu_types::{FrameUniforms, PointLight};
 use ml_cpu::lights::{motion_offset, move_into};
 use ml_cpu::scene::Scene;
-use ml_vk::{commands, release_on_error, vk, Buffer, Context, Image, VkError, VkResultExt};
+use ml_vk::{commands, release_on_error, vk, Context, Image, VkError, VkResultExt};
 use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Instant;
@@ -83,7 +83,7 @@ pub struct Renderer<'a> {
     shared_sync: sync::SyncStates,
     /// Per frame slot, host memory its colour target is copied into: by the frame's own commands
     /// for an image sequence (`in_flight_image`), or after it (`read_back`).
-    readbacks: Vec<Buffer>,
+    readbacks: ReadBack,
     /// Per slot, the sequence frame whose image its commands copy into its read-back buffer,
     /// handed to the sink once the slot's fence has signalled.
     in_flight_image: Vec<Option<u32>>,
@@ -216,7 +216,7 @@ impl<'a> Renderer<'a> {
             command_pool: vk::CommandPool::null(),
             frames: Vec::new(),
             shared_sync,
-            readbacks: Vec::new(),
+            readbacks: ReadBack::new("read-back"),
             in_flight_image: vec![None; FRAMES_IN_FLIGHT],
             lights_on_gpu,
             reports: vec![SlotReport::default(); FRAMES_IN_FLIGHT],
@@ -333,9 +333,7 @@ impl<'a> Renderer<'a> {
         self.frames.clear();
         self.pending.fill(false);
         self.reports.fill(SlotReport::default());
-        for mut b in self.readbacks.drain(..) {
-            b.destroy(ctx);
-        }
+        self.readbacks.destroy(ctx);
         self.in_flight_image.fill(None);
         Ok(())
     }
@@ -400,12 +398,7 @@ impl<'a> Renderer<'a> {
             self.bind_passes(f)?;
         }
         self.projection_changed()?;
-        let bytes = extent.width as u64 * extent.height as u64 * 4;
-        for _ in 0..FRAMES_IN_FLIGHT {
-            let buffer = Buffer::new(ctx, "read-back", bytes, vk::BufferUsageFlags::TRANSFER_DST, gpu_allocator::MemoryLocation::GpuToCpu)?;
-            self.readbacks.push(buffer);
-        }
-        Ok(())
+        self.readbacks.make_all(ctx, extent.width as u64 * extent.height as u64 * 4)
     }
 
     /// Point every pass's sets of slot `f` at its buffers and targets, the scene's and the
@@ -418,11 +411,13 @@ impl<'a> Renderer<'a> {
         let scene: Vec<_> = self.gpu.named_buffers().into_iter().chain(parts.iter().flat_map(|p| p.named_buffers())).collect();
         drop(shadows);
         let resources = self.frames[f].resources(f, &scene).with(&owned);
-        let ordered: Vec<&'static str> = self.passes.iter().flat_map(|p| p.uses()).map(|u| u.name).collect();
+        let checked = cfg!(debug_assertions);
+        let ordered: Vec<&'static str> =
+            if checked { self.passes.iter().flat_map(|p| p.uses()).map(|u| u.name).collect() } else { Vec::new() };
         for p in &mut self.passes {
             resources.take_found();
             p.bind_frame(self.ctx, &resources)?;
-            if cfg!(debug_assertions) {
+            if checked {
                 let missing = sync::undeclared(&resources.take_found(), &p.uses(), &ordered);
                 let pass = p.timer_name().unwrap_or("an untimed pass");
                 assert!(missing.is_empty(), "{pass} binds {missing:?}, which the frame orders by declared uses, without declaring them");
@@ -506,7 +501,7 @@ impl<'a> Renderer<'a> {
             let wanted = sink.wants_images() && sink.wants_image(i);
             // A sequence's image is copied by the frame's own commands and handed over when
             // its slot next comes round, unless the frame settles its exposure first.
-            let mut copy = (wanted && !settles).then(|| CopyToHost { buffer: self.readbacks[last].raw, extent: self.extent });
+            let mut copy = (wanted && !settles).then(|| CopyToHost { buffer: self.readbacks.raw(last), extent: self.extent });
             self.run_frame(last, self.settings.clock(i), &mut stats, copy.as_mut().map(|c| c as &mut dyn FrameHook))?;
             if copy.is_some() {
                 self.in_flight_image[last] = Some(i);
@@ -889,10 +884,9 @@ impl<'a> Renderer<'a> {
     fn read_back(&mut self, f: usize) -> Result<Vec<u8>, VkError> {
         let ctx = self.ctx;
         let image = self.frames[f].targets.as_ref().expect("made with the frame").color.raw;
-        let buffer = &self.readbacks[f];
-        let extent = self.extent;
-        commands::one_shot(ctx, |cmd| commands::copy_colour_to_host(ctx, cmd, image, extent, buffer.raw))?;
-        Ok(buffer.mapped().to_vec())
+        let (buffer, extent) = (self.readbacks.raw(f), self.extent);
+        commands::one_shot(ctx, |cmd| commands::copy_colour_to_host(ctx, cmd, image, extent, buffer))?;
+        Ok(self.readbacks.bytes(f).to_vec())
     }
 
     /// Hand the sink the images the slots' own commands copied (in frame order), each once its
@@ -917,7 +911,7 @@ impl<'a> Renderer<'a> {
         stats: &mut FrameStats,
     ) -> Result<(), RenderError> {
         let taken = Instant::now();
-        let rgba = if copy { self.read_back(f)? } else { self.readbacks[f].mapped().to_vec() };
+        let rgba = if copy { self.read_back(f)? } else { self.readbacks.bytes(f).to_vec() };
         stats.read_back.0 += 1;
         stats.read_back.1 += taken.elapsed().as_secs_f64() * 1e3;
         sink.image(i, rgba)
@@ -963,9 +957,7 @@ impl Drop for Renderer<'_> {
         for frame in &mut self.frames {
             frame.destroy(ctx);
         }
-        for mut b in self.readbacks.drain(..) {
-            b.destroy(ctx);
-        }
+        self.readbacks.destroy(ctx);
         for p in &mut self.passes {
             p.destroy(ctx);
         }

@@ -81,6 +81,23 @@ impl Use {
         }
         u
     }
+
+    /// A depth image a render pass draws again for shaders that sample it (at `readers`):
+    /// its external dependencies order it after their last reads and make its writes visible
+    /// to them, leaving it DEPTH_STENCIL_READ_ONLY_OPTIMAL (shadow maps).
+    pub fn redrawn_for_readers(name: &'static str, readers: vk::PipelineStageFlags) -> Use {
+        Use {
+            name,
+            entry: Entry::Chained { stages: readers },
+            exit: Exit {
+                stages: readers,
+                writes: vk::AccessFlags::empty(),
+                wrote: true,
+                visible: vk::AccessFlags::SHADER_READ,
+                layout: Some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+            },
+        }
+    }
 }
 
 /// A resource's state between passes.

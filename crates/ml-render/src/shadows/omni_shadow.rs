@@ -23,7 +23,7 @@ use crate::error::RenderError;
 use crate::gpu_mesh::{record_draws, SceneMeshes};
 use crate::shadows::shadow_atlas::ShadowAtlasGpu;
 use crate::shadows::shadow_settings::{OmniShadowMode, OmniShadowSettings};
-use crate::sync::{Entry, Exit, Use, SHADOW_CUBES};
+use crate::sync::{Use, SHADOW_CUBES};
 use glam::{Mat4, Vec3};
 use ml_cpu::gpu_types::OmniShadowPush;
 use ml_cpu::gpu_types::PointLight;
@@ -261,21 +261,12 @@ impl OmniShadows {
     /// DEPTH_STENCIL_READ_ONLY_OPTIMAL). None where no graphics mode draws it.
     pub fn cube_use(&self) -> Option<Use> {
         let settings = self.cube_settings()?;
-        let read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
         match settings.mode {
             OmniShadowMode::Compute { .. } | OmniShadowMode::Atlas(_) | OmniShadowMode::Rays => None,
             OmniShadowMode::Copy => Some(Use::overwriting(SHADOW_CUBES, (TRANSFER_DST.0, TRANSFER_DST.1), TRANSFER_DST.2)),
-            OmniShadowMode::Direct | OmniShadowMode::Multiview | OmniShadowMode::Layered => Some(Use {
-                name: SHADOW_CUBES,
-                entry: Entry::Chained { stages: SHADER_READERS },
-                exit: Exit {
-                    stages: SHADER_READERS,
-                    writes: vk::AccessFlags::empty(),
-                    wrote: true,
-                    visible: vk::AccessFlags::SHADER_READ,
-                    layout: Some(read_only),
-                },
-            }),
+            OmniShadowMode::Direct | OmniShadowMode::Multiview | OmniShadowMode::Layered => {
+                Some(Use::redrawn_for_readers(SHADOW_CUBES, SHADER_READERS))
+            }
         }
     }
 

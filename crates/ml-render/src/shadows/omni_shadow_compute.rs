@@ -29,9 +29,6 @@ pub struct OmniShadowCompute {
     readback: ReadBack,
     /// The shadow atlas's plan for the frame being recorded (the atlas views).
     plan: Option<AtlasPlan>,
-    /// Whether the frame being recorded draws (some light placed; the atlas: a plan), and so
-    /// has counters to read back.
-    draws: bool,
 }
 
 impl OmniShadowCompute {
@@ -42,8 +39,17 @@ impl OmniShadowCompute {
     ) -> Result<OmniShadowCompute, RenderError> {
         let raster = ShadowRaster::new(ctx, geometry, (views, size, large_capacity), FRAMES_IN_FLIGHT)?;
         let readback = ReadBack::new("shadow raster counters read-back");
-        let pass = OmniShadowCompute { shadows, views, raster, readback, plan: None, draws: false };
+        let pass = OmniShadowCompute { shadows, views, raster, readback, plan: None };
         ml_vk::build(ctx, pass, |p| Ok(p.readback.make_all(ctx, size_of::<OmniRasterCounters>() as u64)?))
+    }
+
+    /// The lights the frame draws (position and radius each): the placed ones the views
+    /// hold, none where an atlas frame has no plan (the atlas keeps what it holds).
+    fn drawn_lights(&self, omni: &OmniShadows) -> Vec<[f32; 4]> {
+        if matches!(self.views, ShadowViews::Atlas { .. }) && self.plan.is_none() {
+            return Vec::new();
+        }
+        omni.placed().iter().take(self.views.lights() as usize).map(|l| l.position.extend(l.radius).to_array()).collect()
     }
 }
 
@@ -80,7 +86,7 @@ impl Pass for OmniShadowCompute {
     /// The raster's counters, where the frame drew (the slot's copy keeps what it had
     /// otherwise).
     fn host_reads(&self, slot: usize) -> Vec<HostRead> {
-        if !self.draws {
+        if self.drawn_lights(&self.shadows.borrow().omni).is_empty() {
             return Vec::new();
         }
         vec![self.readback.of(slot, SHADOW_RASTER_COUNTERS, self.raster.counters.raw)]
@@ -90,31 +96,27 @@ impl Pass for OmniShadowCompute {
         let mut shadows = self.shadows.borrow_mut();
         let omni = &mut shadows.omni;
         omni.place(p.rest_lights, p.light_offset);
-        let atlas = matches!(self.views, ShadowViews::Atlas { .. });
-        if atlas {
+        if let ShadowViews::Atlas { .. } = self.views {
             self.plan = plan_atlas(omni, p)?;
         }
-        self.draws = self.views.lights() > 0 && !omni.placed().is_empty() && (!atlas || self.plan.is_some());
         Ok(())
     }
 
     fn record(&self, rec: &Recording) {
         let shadows = self.shadows.borrow();
-        let lights: Vec<[f32; 4]> =
-            shadows.omni.placed().iter().take(self.views.lights() as usize).map(|l| l.position.extend(l.radius).to_array()).collect();
+        let lights = self.drawn_lights(&shadows.omni);
         if lights.is_empty() {
             return;
         }
         // Every face's projection: 90°, in the light's frame in radii.
         let projection = glam::Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, NEAR_FRACTION, 1.0);
-        match (self.views, &self.plan) {
-            (ShadowViews::Atlas { .. }, Some(plan)) => {
+        // Only atlas frames have a plan (an atlas frame without one draws nothing).
+        match &self.plan {
+            Some(plan) => {
                 let tiles = tile_table(plan, lights.len());
                 self.raster.record_atlas(rec.ctx, rec.cmd, rec.slot, (&lights, &tiles), projection);
             }
-            // No plan, no face to draw (the atlas keeps what it holds).
-            (ShadowViews::Atlas { .. }, None) => {}
-            _ => {
+            None => {
                 let target = ShadowTarget { image: shadows.omni.cubes.raw, readers: None };
                 self.raster.record(rec.ctx, rec.cmd, rec.slot, &lights, projection, &target);
             }

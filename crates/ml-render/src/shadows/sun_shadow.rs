@@ -19,7 +19,7 @@ use crate::shadows::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use crate::shadows::shadow_settings::SunShadowMode;
 use crate::shadows::stores::SharedShadows;
 use crate::shadows::sun_map::{self, begin_info, map_render_pass, READERS};
-use crate::sync::{Entry, Exit, Use, SUN_MAP};
+use crate::sync::{Use, SUN_MAP};
 use ml_cpu::gpu_types::ShadowPush;
 use ml_vk::{shader, vk, Context, Image, VkError};
 
@@ -145,17 +145,7 @@ impl Pass for SunShadowPass {
             return Vec::new();
         }
         vec![match self.drawer {
-            Drawer::Graphics { .. } => Use {
-                name: SUN_MAP,
-                entry: Entry::Chained { stages: READERS },
-                exit: Exit {
-                    stages: READERS,
-                    writes: vk::AccessFlags::empty(),
-                    wrote: true,
-                    visible: vk::AccessFlags::SHADER_READ,
-                    layout: Some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-                },
-            },
+            Drawer::Graphics { .. } => Use::redrawn_for_readers(SUN_MAP, READERS),
             Drawer::Compute(_) => {
                 let transfer = (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE);
                 Use::overwriting(SUN_MAP, transfer, vk::ImageLayout::TRANSFER_DST_OPTIMAL)
