@@ -90,12 +90,31 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces) {
         // Front faces come swapped: corners b and c.
         z = z.xzy;
     }
+    // The edge functions at the first pixel's centre, stepped from pixel to pixel and out to
+    // each sample (exact: integers), not evaluated afresh at every sample.
+    ivec3 unit_x = -ivec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
+    ivec3 unit_y = ivec3(t.c.x - t.b.x, t.a.x - t.c.x, t.b.x - t.a.x);
+    ivec3 row;
+    small_covers_at(t, t.first, ivec2(128), row);
+    // A pixel where an edge function stays below its bias even with the most any sample adds
+    // to the centre's value has no sample covered: its samples are not tested.
+    ivec3 reach = ivec3(-0x7fffffff);
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        ivec2 o = sample_offset(k) - 128;
+        reach = max(reach, o.x * unit_x + o.y * unit_y);
+    }
+    ivec3 least = t.bias - reach;
     uint covered = 0u;
-    for (int y = t.first.y; y <= t.last.y; y++) {
-        for (int x = t.first.x; x <= t.last.x; x++) {
+    for (int y = t.first.y; y <= t.last.y; y++, row += 256 * unit_y) {
+        ivec3 centre = row;
+        for (int x = t.first.x; x <= t.last.x; x++, centre += 256 * unit_x) {
+            if (any(lessThan(centre, least))) {
+                continue;
+            }
             [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-                ivec3 w;
-                if (!small_covers_at(t, ivec2(x, y), sample_offset(k), w)) {
+                ivec2 o = sample_offset(k) - 128;
+                ivec3 w = centre + o.x * unit_x + o.y * unit_y;
+                if (any(lessThan(w - t.bias, ivec3(0)))) {
                     continue;
                 }
                 covered++;

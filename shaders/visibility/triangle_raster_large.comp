@@ -4,8 +4,8 @@
 #extension GL_EXT_shader_atomic_int64 : require
 // The compute raster's large triangles (visibility_polygon.glsl): a work group per listed
 // 64×64-pixel bin of a triangle's box, so a triangle covering the screen is spread over the
-// whole GPU. The triangle was clipped and snapped once, when it was found; here each thread
-// takes an 8×8-pixel block of the bin and draws it for every fan triangle that reaches it.
+// whole GPU. The triangle was clipped and snapped once, when it was found; here the work group
+// draws the bin's pixels for every fan triangle that reaches them, a sample a thread.
 #include "common/common.glsl"
 
 layout(local_size_x = 64) in;
@@ -22,8 +22,6 @@ layout(push_constant) uniform CullPushBlock { CullPush cull; };
 #include "common/alpha_mask.glsl"
 #include "visibility/visibility_polygon.glsl"
 
-const int BLOCK = 8;
-
 shared uint group_pixels;
 
 void main() {
@@ -34,6 +32,13 @@ void main() {
     if (lid == 0u) {
         group_pixels = 0u;
     }
+    // Thread lid takes sample `own` of every lanes-th pixel of each row, so the atomics a
+    // subgroup issues together fall on neighbouring pixels' samples, side by side in the
+    // buffer: on the H200 the cost of 64-bit atomics follows the places in memory one
+    // instruction touches (a thread per 8×8 block of pixels, each its own samples, took twice
+    // as long). Every thread has as many points of a triangle's box to test.
+    uint own = lid % VISIBILITY_SAMPLES;
+    int lanes = int(gl_WorkGroupSize.x / VISIBILITY_SAMPLES), lane = int(lid / VISIBILITY_SAMPLES);
     uint covered = 0u;
     for (uint e = gl_WorkGroupID.x; e < count; e += gl_NumWorkGroups.x) {
         uvec2 listed = large_bins[e];
@@ -45,8 +50,7 @@ void main() {
         SurfaceTest surface = MASK_TESTS ? large_surface(at, head.z) : no_surface_test();
         bool both_faces = SURFACE_TESTS && (head.w & INSTANCE_DOUBLE_SIDED) != 0u;
         ivec2 bin = ivec2(listed.y & 0xffffu, listed.y >> 16u);
-        ivec2 lo = bin * BIN + ivec2(lid % uint(BIN / BLOCK), lid / uint(BIN / BLOCK)) * BLOCK;
-        ivec2 hi = lo + BLOCK - 1;
+        ivec2 lo = bin * BIN, hi = lo + BIN - 1;
         i64vec2 s0 = large_corner(at, 0);
         vec4 q0 = large_depth(at, 0);
         for (int k = 1; k + 1 < int(head.x); k++) {
@@ -58,7 +62,11 @@ void main() {
             if (any(greaterThan(from, to)) || !fan_reaches(t, from, to)) {
                 continue;
             }
-            covered += fan_block(t, from, to, head.y, surface);
+            // From the first pixel of the row that is this thread's.
+            from.x += ((lane - from.x % lanes) + lanes) % lanes;
+            if (from.x <= to.x) {
+                covered += fan_samples(t, from, to, lanes, own, head.y, surface);
+            }
         }
     }
     barrier();

@@ -76,37 +76,36 @@ vec4 large_depth(uint at, int k) {
     return vec4(large_triangles[at].depths[k >> 2][k & 3], 0.0, 0.0, 0.0);
 }
 
-// The pixels of [from, to] the fan triangle covers (and `s` keeps) drawn with visibility id
-// `id`, sample by sample, the edge functions stepped from pixel to pixel (exact: integers);
-// returns the samples covered.
-uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id, SurfaceTest s) {
+// Sample k of every `step`-th pixel of each row of [from, to] (from from.x on) that the fan
+// triangle covers (and `s` keeps) drawn with visibility id `id`, the edge functions stepped
+// from pixel to pixel (exact: integers); returns the samples covered.
+uint fan_samples(FanTriangle t, ivec2 from, ivec2 to, int step, uint k, uint id, SurfaceTest s) {
     // Per sub-pixel to the right and down, each edge function changes by −d.y and d.x.
     i64vec3 unit_x = -i64vec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
     i64vec3 unit_y = i64vec3(t.c.x - t.b.x, t.a.x - t.c.x, t.b.x - t.a.x);
-    i64vec3 step_x = 256l * unit_x, step_y = 256l * unit_y;
+    i64vec3 step_x = int64_t(256 * step) * unit_x, step_y = 256l * unit_y;
+    // From the first pixel's centre to its sample k.
     i64vec3 row;
     fan_covers(t, from, row);
+    ivec2 offset = sample_offset(k) - 128;
+    row += int64_t(offset.x) * unit_x + int64_t(offset.y) * unit_y;
+    i64vec3 bias = i64vec3(t.bias);
     vec3 z = vec3(t.qa.x, t.qb.x, t.qc.x);
     vec2 size = vec2(frame.viewport.xy);
     uint covered = 0u;
     for (int y = from.y; y <= to.y; y++, row += step_y) {
-        i64vec3 centre = row;
-        for (int x = from.x; x <= to.x; x++, centre += step_x) {
-            for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-                // From the pixel centre (where `centre` is) to the sample.
-                ivec2 offset = sample_offset(k) - 128;
-                i64vec3 w = centre + int64_t(offset.x) * unit_x + int64_t(offset.y) * unit_y;
-                if (any(lessThan(w - i64vec3(t.bias), i64vec3(0)))) {
-                    continue;
-                }
-                vec3 weights = vec3(w);
-                float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
-                if (!surface_kept_at(s, vec2(x, y) + vec2(sample_offset(k)) / SUBPIXEL, size)) {
-                    continue;
-                }
-                covered++;
-                keep_nearest_id(ivec2(x, y), k, depth, id);
+        i64vec3 w = row;
+        for (int x = from.x; x <= to.x; x += step, w += step_x) {
+            if (any(lessThan(w - bias, i64vec3(0)))) {
+                continue;
             }
+            vec3 weights = vec3(w);
+            float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
+            if (!surface_kept_at(s, vec2(x, y) + vec2(sample_offset(k)) / SUBPIXEL, size)) {
+                continue;
+            }
+            covered++;
+            keep_nearest_id(ivec2(x, y), k, depth, id);
         }
     }
     return covered;
@@ -116,10 +115,12 @@ uint fan_block(FanTriangle t, ivec2 from, ivec2 to, uint id, SurfaceTest s) {
 // `both_faces`); returns the pixels covered.
 uint raster_polygon_alone(Polygon p, uint id, bool both_faces, SurfaceTest s) {
     uint covered = 0u;
-    for (int k = 1; k + 1 < p.count; k++) {
+    for (int f = 1; f + 1 < p.count; f++) {
         FanTriangle t;
-        if (fan_triangle(p.s[0], p.s[k], p.s[k + 1], p.q[0], p.q[k], p.q[k + 1], ivec2(frame.viewport.xy), both_faces, t)) {
-            covered += fan_block(t, t.first, t.last, id, s);
+        if (fan_triangle(p.s[0], p.s[f], p.s[f + 1], p.q[0], p.q[f], p.q[f + 1], ivec2(frame.viewport.xy), both_faces, t)) {
+            for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+                covered += fan_samples(t, t.first, t.last, 1, k, id, s);
+            }
         }
     }
     return covered;
