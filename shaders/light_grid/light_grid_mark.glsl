@@ -137,13 +137,13 @@ void main() {
 #else
 #define WALK(l) centre
 #endif
-    // Not unrolled: each walk's code is large, and lavapipe builds a frame of every value live
-    // across the barriers below (LLVM coroutines): 16 copies took it minutes.
-    for (uint l = leaders; l != 0u; l &= l - 1u) {
-        GridWalk w = WALK(l);
+    // The box is the first surfaces' walks: a pixel's further surfaces (edge pixels') mostly
+    // walk the same cells; each is walked once, below, into the box where it lies inside and
+    // into the grid's marks where not.
+    if (leaders != 0u) {
         for (uint a = 0u; a < 3u; ++a) {
-            atomicMin(box_lo[a], w.lo[a]);
-            atomicMax(box_hi[a], w.hi[a]);
+            atomicMin(box_lo[a], centre.lo[a]);
+            atomicMax(box_hi[a], centre.hi[a]);
         }
     }
     barrier();
@@ -151,9 +151,11 @@ void main() {
     uvec3 hi = uvec3(box_hi[0], box_hi[1], box_hi[2]);
     uvec3 n = lo.x > hi.x ? uvec3(0u) : hi - lo + 1u;
     bool in_box = n.x * n.y * n.z <= BOX_CELLS;
+    // Not unrolled: each walk's code is large, and lavapipe builds a frame of every value live
+    // across the barrier below (LLVM coroutines): 16 copies took it minutes.
     for (uint l = leaders; l != 0u; l &= l - 1u) {
         GridWalk w = WALK(l);
-        if (!in_box) {
+        if (!in_box || any(lessThan(w.lo, lo)) || any(greaterThan(w.hi, hi))) {
             mark_rows(w);
             continue;
         }
