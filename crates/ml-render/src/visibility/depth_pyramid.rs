@@ -1,9 +1,9 @@
 //! The depth pyramid of the late culling phase (depth_pyramid_pass.glsl): level 0 the early
 //! raster's depth — the hardware raster's depth image, or the compute raster's 64-bit buffer
 //! read where it lies — reduced 2×2 to the farthest value, each level the one below it reduced
-//! again, a dispatch per level, into one storage buffer (a frame target, made again with the
-//! others). A buffer rather than a mipmapped image: plain loads, no per-level views, and the
-//! same answers on every driver.
+//! again (up to six levels a dispatch, depth_pyramid_levels.comp), into one storage buffer (a
+//! frame target, made again with the others). A buffer rather than a mipmapped image: plain
+//! loads, no per-level views, and the same answers on every driver.
 
 use crate::antialiasing::Antialiasing;
 use crate::descriptors::{FrameSets, Resource};
@@ -18,11 +18,20 @@ use ml_vk::commands::memory_barrier;
 use ml_vk::image::fetch_sampler;
 use ml_vk::{shader, vk, Context, VkError};
 
+/// The levels above the first: a work group's 32×32 texels of the first level it makes, and
+/// on to one texel.
+const LEVELS: &Shader = &ml_shaders::DEPTH_PYRAMID_LEVELS_COMP;
+const LEVELS_A_DISPATCH: u32 = 6;
+
 pub struct DepthPyramid {
     sets: FrameSets,
     sampler: vk::Sampler,
     pipeline_layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
+    /// The levels above the first, from the one below each (depth_pyramid_levels.comp).
+    level_sets: FrameSets,
+    level_layout: vk::PipelineLayout,
+    level_pipeline: vk::Pipeline,
     /// Its dispatches cover a level by the shader's work groups.
     shader: &'static Shader,
     /// It reads the compute raster's 64-bit buffer (else the depth image).
@@ -39,6 +48,9 @@ impl DepthPyramid {
             sampler: vk::Sampler::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            level_sets: FrameSets::new(ctx, &[(LEVELS, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
+            level_layout: vk::PipelineLayout::null(),
+            level_pipeline: vk::Pipeline::null(),
             shader,
             from_buffer,
         };
@@ -47,6 +59,8 @@ impl DepthPyramid {
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             let constants = if from_buffer { vec![antialiasing.constant()] } else { Vec::new() };
             p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &constants)?;
+            p.level_layout = shader::pipeline_layout(ctx, &[p.level_sets.layout.raw], &push)?;
+            p.level_pipeline = compute_pipeline(ctx, LEVELS, p.level_layout, &[])?;
             p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })
@@ -67,7 +81,8 @@ impl Pass for DepthPyramid {
         self.sets.write(ctx, frame.slot, &|name| match name {
             "depth_image" => Some(Resource::Image(depth)),
             _ => frame.buffer(name),
-        })
+        })?;
+        self.level_sets.write(ctx, frame.slot, &|name| frame.buffer(name))
     }
 
     /// Its levels, written (and read, each from the one before) in compute; the culling reads
@@ -94,14 +109,24 @@ impl Pass for DepthPyramid {
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline_layout, 0, &[self.sets.sets[rec.slot]], &[]);
-            for level in 0..levels {
-                if level > 0 {
-                    memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
-                }
-                let push = [level, rec.extent.width, rec.extent.height, 0];
-                d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::cast_slice(&push));
-                let size = depth_pyramid_level(rec.extent, level);
-                let [x, y, _] = self.shader.groups([size.width, size.height, 1]);
+            let push = [rec.extent.width, rec.extent.height, 0, 0];
+            d.cmd_push_constants(cmd, self.pipeline_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::cast_slice(&push));
+            let size = depth_pyramid_level(rec.extent, 0);
+            let [x, y, _] = self.shader.groups([size.width, size.height, 1]);
+            d.cmd_dispatch(cmd, x, y, 1);
+            if levels > 1 {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.level_pipeline);
+                let set = [self.level_sets.sets[rec.slot]];
+                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.level_layout, 0, &set, &[]);
+            }
+            for first in (1..levels).step_by(LEVELS_A_DISPATCH as usize) {
+                memory_barrier(ctx, cmd, (compute, vk::AccessFlags::SHADER_WRITE), (compute, rw));
+                let end = (first + LEVELS_A_DISPATCH).min(levels);
+                let push = [first, rec.extent.width, rec.extent.height, end];
+                d.cmd_push_constants(cmd, self.level_layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::cast_slice(&push));
+                // A work group makes 2×2 texels a thread of the first level.
+                let size = depth_pyramid_level(rec.extent, first);
+                let [x, y, _] = LEVELS.groups([size.width.div_ceil(2), size.height.div_ceil(2), 1]);
                 d.cmd_dispatch(cmd, x, y, 1);
             }
         }
@@ -111,12 +136,16 @@ impl Pass for DepthPyramid {
         // SAFETY: the device is idle; null handles are ignored.
         unsafe {
             ml_vk::shader::release_pipeline(ctx, self.pipeline);
+            ml_vk::shader::release_pipeline(ctx, self.level_pipeline);
             ctx.device.destroy_sampler(self.sampler, None);
         }
         self.pipeline = vk::Pipeline::null();
         self.pipeline_layout = vk::PipelineLayout::null();
+        self.level_pipeline = vk::Pipeline::null();
+        self.level_layout = vk::PipelineLayout::null();
         self.sampler = vk::Sampler::null();
         self.sets.destroy(ctx);
+        self.level_sets.destroy(ctx);
     }
 }
 
