@@ -95,7 +95,7 @@ uint rasterize(vec2 pa, vec2 pb, vec2 pc, vec3 z, uint id, bool both_faces) {
     ivec3 unit_x = -ivec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
     ivec3 unit_y = ivec3(t.c.x - t.b.x, t.a.x - t.c.x, t.b.x - t.a.x);
     ivec3 row;
-    small_covers_at(t, t.first, ivec2(128), row);
+    small_covers(t, t.first, row);
     // A pixel where an edge function stays below its bias even with the most any sample adds
     // to the centre's value has no sample covered: its samples are not tested.
     ivec3 reach = ivec3(-0x7fffffff);
