@@ -10,8 +10,12 @@
 // which scans them at every tile of the image: few triangles are that large. Both run after
 // this dispatch, with the work groups it counts.
 //
-// A thread first marks the pixels of its box its triangle leaves a fragment at, then takes
-// room for all of them (take_nodes: one atomic on the pool a work group), then writes them.
+// A thread's walk only notes where its triangle may leave a fragment (an edge test in
+// registers); the tests that read memory (the opaque depth, the alpha texture) and the
+// writes are dealt over the work group, a listed pixel a thread, in rounds (see main). A
+// thread that tested its own box's pixels kept its subgroup waiting on the largest box and
+// on each of its reads in turn: on the H200, 3.8 ms for a forest of a million leaves at
+// 1080p, where the rounds take 2.3.
 //
 // The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer.
 #include "common/common.glsl"
@@ -20,10 +24,18 @@ layout(local_size_x = 64) in;
 
 #include "transparency/layer_triangles.glsl"
 
-// The largest box, in pixels a side, a thread walks (a work group: GROUP_BOX); the words of
-// a thread's box's bits.
+// The largest box, in pixels a side, a thread walks (a work group: GROUP_BOX).
 const int THREAD_BOX = 16;
-const uint BOX_WORDS = uint(THREAD_BOX * THREAD_BOX) / 32u;
+
+// A round's list: the pixels (y << 16 | x) where the work group's triangles (their places,
+// round_slot) may leave a fragment, up to ROUND_TAKE from each thread's walk; how many; and
+// whether some thread's walk goes on. 16 a round measured best on the H200 (8: 2.6 ms for
+// the forest above; 32: 3.9).
+const uint ROUND_TAKE = 16u;
+shared uint round_pixel[64u * ROUND_TAKE];
+shared uint round_slot[64u * ROUND_TAKE];
+shared uint round_count;
+shared uint round_more;
 
 // The entry among the dispatch's `entries` from `first` whose triangles hold triangle `t`
 // (entries list their first triangle, counted over the dispatch, in place.w).
@@ -78,28 +90,63 @@ void main() {
             box = ivec4(0, 0, -1, -1);
         }
     }
-    // The box's pixels a fragment is left at, a bit each (THREAD_BOX² at most), then room
-    // for all of them and their nodes.
-    int width = max(box.z - box.x + 1, 1);
-    int pixels = max(box.z - box.x + 1, 0) * max(box.w - box.y + 1, 0);
+    // Rounds, the same for every thread: each walks on through its box, listing the pixels
+    // whose centre (with anti-aliasing: some sample) its triangle may cover, up to
+    // ROUND_TAKE; then the work group tests the listed pixels a thread each (the same
+    // pixel_fragment as before: the filter only skips pixels it would refuse), takes room
+    // for the fragments found and writes them.
     vec2 to_ndc = 2.0 / vec2(frame.viewport.xy);
-    uint hits[BOX_WORDS];
-    for (uint k = 0u; k < BOX_WORDS; k++) {
-        hits[k] = 0u;
-    }
-    uint mine = 0u;
-    for (int i = 0; i < pixels; i++) {
-        if (pixel_fragment(lid, box.xy + ivec2(i % width, i / width), to_ndc)) {
-            hits[i >> 5] |= 1u << (i & 31);
-            mine++;
-        }
-    }
-    uint node = take_nodes(mine);
+    vec3 r0 = tri_edges[lid][0], r1 = tri_edges[lid][1], r2 = tri_edges[lid][2];
+    // How much each edge function may grow from the centre to a sample (samples_outside's
+    // reach, with its margin); 0 without anti-aliasing.
+    vec3 reach = VISIBILITY_SAMPLES == 1u ? vec3(0.0)
+                                          : 1.01 * 0.5 * vec3(dot(abs(r0.xy), to_ndc), dot(abs(r1.xy), to_ndc), dot(abs(r2.xy), to_ndc));
+    ivec2 at = box.xy;
+    bool walking = box.x <= box.z && box.y <= box.w;
     uint capacity = layer_capacity();
-    for (uint k = 0u; k < BOX_WORDS && mine > 0u; k++) {
-        for (uint bits = hits[k]; bits != 0u; bits &= bits - 1u) {
-            int i = int(32u * k) + findLSB(bits);
-            keep_fragment(lid, box.xy + ivec2(i % width, i / width), node++, capacity, to_ndc);
+    while (true) {
+        if (lid == 0u) {
+            round_count = 0u;
+            round_more = 0u;
+        }
+        barrier();
+        for (uint taken = 0u; walking && taken < ROUND_TAKE;) {
+            vec3 q = vec3((vec2(at) + 0.5) * to_ndc - 1.0, 1.0);
+            if (all(greaterThanEqual(vec3(dot(r0, q), dot(r1, q), dot(r2, q)) + reach, vec3(0.0)))) {
+                uint e = atomicAdd(round_count, 1u);
+                round_pixel[e] = uint(at.y) << 16 | uint(at.x);
+                round_slot[e] = lid;
+                taken++;
+            }
+            at.x++;
+            if (at.x > box.z) {
+                at = ivec2(box.x, at.y + 1);
+                walking = at.y <= box.w;
+            }
+        }
+        if (walking) {
+            round_more = 1u;
+        }
+        barrier();
+        uint listed = round_count;
+        bool more = round_more != 0u;
+        // This thread's share of the list: entries lid, lid + 64, … (ROUND_TAKE at most),
+        // a bit each where a fragment is left.
+        uint found = 0u, mine = 0u;
+        for (uint j = lid, r = 0u; j < listed; j += 64u, r++) {
+            uint word = round_pixel[j];
+            if (pixel_fragment(round_slot[j], ivec2(word & 0xffffu, word >> 16), to_ndc)) {
+                found |= 1u << r;
+                mine++;
+            }
+        }
+        uint node = take_nodes(mine);
+        for (uint bits = found; bits != 0u; bits &= bits - 1u) {
+            uint j = lid + 64u * uint(findLSB(bits)), word = round_pixel[j];
+            keep_fragment(round_slot[j], ivec2(word & 0xffffu, word >> 16), node++, capacity, to_ndc);
+        }
+        if (!more) {
+            break;
         }
     }
 }
