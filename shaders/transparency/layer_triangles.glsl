@@ -70,7 +70,8 @@ const uint LAYER_TILE = 16u;
 const int GROUP_BOX = 256;
 const uint GROUP_BLOCK_WORDS = uint((GROUP_BOX / 16) * (GROUP_BOX / 16)) / 32u;
 
-// Triangles set up at once (the tiles' build: 64; a work group's own triangle: 1).
+// Triangles set up at once (the tiles' build: 64; the per-triangle build: a place a thread;
+// a work group's own triangle: 1).
 #ifndef LAYER_SLOTS
 #define LAYER_SLOTS 64u
 #endif

@@ -15,12 +15,17 @@
 // writes are dealt over the work group, a listed pixel a thread, in rounds (see main). A
 // thread that tested its own box's pixels kept its subgroup waiting on the largest box and
 // on each of its reads in turn: on the H200, 3.8 ms for a forest of a million leaves at
-// 1080p, where the rounds take 2.3.
+// 1080p, where the rounds take 2.15.
 //
 // The includer defines OPAQUE_DEPTH_BUFFER for the compute raster's 64-bit buffer.
 #include "common/common.glsl"
 
-layout(local_size_x = 64) in;
+// A work group's threads, and the triangles it sets up at once (a place each). On the H200
+// the build slows sharply once a work group's shared memory passes about 24 KB (64 threads
+// and 16 a round: 2.27 ms for the forest above, 20 a round: 4.1); 32 threads: 2.15.
+const uint BUILD_THREADS = 32u;
+#define LAYER_SLOTS BUILD_THREADS
+layout(local_size_x = BUILD_THREADS) in;
 
 #include "transparency/layer_triangles.glsl"
 
@@ -29,11 +34,11 @@ const int THREAD_BOX = 16;
 
 // A round's list: the pixels (y << 16 | x) where the work group's triangles (their places,
 // round_slot) may leave a fragment, up to ROUND_TAKE from each thread's walk; how many; and
-// whether some thread's walk goes on. 16 a round measured best on the H200 (8: 2.6 ms for
-// the forest above; 32: 3.9).
+// whether some thread's walk goes on. 16 a round measured best on the H200 (12: 2.27 ms
+// for the forest above).
 const uint ROUND_TAKE = 16u;
-shared uint round_pixel[64u * ROUND_TAKE];
-shared uint round_slot[64u * ROUND_TAKE];
+shared uint round_pixel[BUILD_THREADS * ROUND_TAKE];
+shared uint round_slot[BUILD_THREADS * ROUND_TAKE];
 shared uint round_count;
 shared uint round_more;
 
@@ -130,10 +135,10 @@ void main() {
         barrier();
         uint listed = round_count;
         bool more = round_more != 0u;
-        // This thread's share of the list: entries lid, lid + 64, … (ROUND_TAKE at most),
-        // a bit each where a fragment is left.
+        // This thread's share of the list: entries lid, lid + BUILD_THREADS, … (ROUND_TAKE
+        // at most), a bit each where a fragment is left.
         uint found = 0u, mine = 0u;
-        for (uint j = lid, r = 0u; j < listed; j += 64u, r++) {
+        for (uint j = lid, r = 0u; j < listed; j += BUILD_THREADS, r++) {
             uint word = round_pixel[j];
             if (pixel_fragment(round_slot[j], ivec2(word & 0xffffu, word >> 16), to_ndc)) {
                 found |= 1u << r;
@@ -142,7 +147,7 @@ void main() {
         }
         uint node = take_nodes(mine);
         for (uint bits = found; bits != 0u; bits &= bits - 1u) {
-            uint j = lid + 64u * uint(findLSB(bits)), word = round_pixel[j];
+            uint j = lid + BUILD_THREADS * uint(findLSB(bits)), word = round_pixel[j];
             keep_fragment(round_slot[j], ivec2(word & 0xffffu, word >> 16), node++, capacity, to_ndc);
         }
         if (!more) {
