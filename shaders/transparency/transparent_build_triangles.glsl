@@ -97,9 +97,9 @@ void main() {
     }
     // Rounds, the same for every thread: each walks on through its box, listing the pixels
     // whose centre (with anti-aliasing: some sample) its triangle may cover, up to
-    // ROUND_TAKE; then the work group tests the listed pixels a thread each (the same
-    // pixel_fragment as before: the filter only skips pixels it would refuse), takes room
-    // for the fragments found and writes them.
+    // ROUND_TAKE; then the work group tests the listed pixels a thread each (pixel_fragment
+    // decides, as in the other builds: the walk's filter only skips pixels it would refuse),
+    // takes room for the fragments found and writes them.
     vec2 to_ndc = 2.0 / vec2(frame.viewport.xy);
     vec3 r0 = tri_edges[lid][0], r1 = tri_edges[lid][1], r2 = tri_edges[lid][2];
     // How much each edge function may grow from the centre to a sample (samples_outside's
