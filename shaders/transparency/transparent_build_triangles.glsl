@@ -23,9 +23,9 @@
 // A work group's threads, and the triangles it sets up at once (a place each). On the H200
 // the build slows sharply once a work group's shared memory passes about 24 KB (64 threads
 // and 16 a round: 2.27 ms for the forest above, 20 a round: 4.1); 32 threads: 2.15.
-const uint BUILD_THREADS = 32u;
+layout(local_size_x = 32) in;
+const uint BUILD_THREADS = gl_WorkGroupSize.x;
 #define LAYER_SLOTS BUILD_THREADS
-layout(local_size_x = BUILD_THREADS) in;
 
 #include "transparency/layer_triangles.glsl"
 
