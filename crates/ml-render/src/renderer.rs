@@ -16,7 +16,7 @@ use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::read_back::{self, HostRead, ReadBack};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
-use crate::scene_part::{self, ScenePart};
+use crate::scene_part::{self, FrameCounts, ScenePart};
 use crate::settings::{Geometry, LightAssignment, RenderSettings};
 use crate::shadows::omni_shadow::OmniShadows;
 use crate::shadows::stores::{ShadowStores, SharedShadows};
@@ -534,13 +534,10 @@ impl<'a> Renderer<'a> {
             stats.gbuffer_lazily_allocated = Some(targets.gbuffer.iter().all(|i| i.is_lazily_allocated()));
         }
         stats.frames = range.len() as u32;
-        if let Some(mut rays) = self.shadows.borrow().rays.stats {
-            // Counted with the light statistics (compute lightings only).
-            rays.traced = self.settings.light_stats.then_some(self.rays_traced[last].0);
-            stats.set_feature(rays);
-        }
-        if let Some(environment) = self.environment.stats {
-            stats.set_feature(environment);
+        // Rays are counted with the light statistics (compute lightings only).
+        let counts = FrameCounts { rays_traced: self.settings.light_stats.then_some(self.rays_traced[last].0) };
+        for part in scene_parts(&self.shadows.borrow(), &self.environment) {
+            part.report(&counts, &mut stats);
         }
         let antialiasing = self.settings.antialiasing;
         if antialiasing != Antialiasing::Off {

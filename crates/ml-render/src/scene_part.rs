@@ -1,10 +1,12 @@
 //! A part of the scene's GPU state beside its geometry and textures — the environment light's
 //! maps, the shadow stores — as the frames see it: what it binds in the scene's set 1, the
-//! buffers shaders bind from a frame's table, the images passes declare (`sync`) and the frame
-//! uniforms it owns, each by name. The renderer holds the parts and asks each in turn, so a new
-//! one is its module and its line in the renderer's list (`Renderer::parts`).
+//! buffers shaders bind from a frame's table, the images passes declare (`sync`), the frame
+//! uniforms it owns, each by name, and its rows of the run's table. The renderer holds the
+//! parts and asks each in turn, so a new one is its module and its line in the renderer's list
+//! (`scene_parts` in renderer.rs).
 
 use crate::descriptors::Resource;
+use crate::report::FrameStats;
 use ml_cpu::gpu_types::FrameUniforms;
 use ml_vk::vk;
 
@@ -25,6 +27,17 @@ pub trait ScenePart {
 
     /// Fill the frame's uniforms it owns.
     fn frame_uniforms(&self, _uniforms: &mut FrameUniforms) {}
+
+    /// Its figures for the run's table (`stats.set_feature`), with what the last frame counted.
+    fn report(&self, _counts: &FrameCounts, _stats: &mut FrameStats) {}
+}
+
+/// What the last frame counted on the GPU that a part reports with its own figures.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameCounts {
+    /// The shadow rays the compute lighting traced from the opaque surfaces (None where they
+    /// are not counted: without `--light-stats`).
+    pub rays_traced: Option<u64>,
 }
 
 /// The first of `parts` that binds `name` in set 1.

@@ -10,8 +10,8 @@
 
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::error::RenderError;
-use crate::report::FeatureStats;
-use crate::scene_part::ScenePart;
+use crate::report::{FeatureStats, FrameStats};
+use crate::scene_part::{FrameCounts, ScenePart};
 use ml_cpu::environment::Environment;
 use ml_cpu::gpu_types::EnvironmentData;
 use ml_cpu::scene::Scene;
@@ -216,6 +216,13 @@ impl ScenePart for EnvironmentMaps {
             "environment_brdf" => Some(image(&self.brdf)),
             "EnvironmentBuffer" => Some(Resource::Buffer(self.buffer.raw)),
             _ => None,
+        }
+    }
+
+    /// The environment's row: its image and prefiltering (none for the stand-ins).
+    fn report(&self, _counts: &FrameCounts, stats: &mut FrameStats) {
+        if let Some(environment) = self.stats {
+            stats.set_feature(environment);
         }
     }
 }

@@ -7,8 +7,9 @@
 
 use crate::descriptors::Resource;
 use crate::error::RenderError;
+use crate::report::FrameStats;
 use crate::scene::SceneGpu;
-use crate::scene_part::ScenePart;
+use crate::scene_part::{FrameCounts, ScenePart};
 use crate::shadows::omni_shadow::{self, OmniShadows};
 use crate::shadows::ray_geometry::RayGeometry;
 use crate::shadows::shadow_settings::{OmniShadowSettings, SunShadowMode};
@@ -181,6 +182,14 @@ impl ScenePart for ShadowStores {
     /// The stores' buffers shaders bind from the frame's table (the rays' hierarchy).
     fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
         self.rays.named_buffers().to_vec()
+    }
+
+    /// The rays' hierarchy's row, with the rays the last frame traced where they were counted.
+    fn report(&self, counts: &FrameCounts, stats: &mut FrameStats) {
+        if let Some(mut rays) = self.rays.stats {
+            rays.traced = counts.rays_traced;
+            stats.set_feature(rays);
+        }
     }
 
     /// The stores' images that passes declare (`sync`), under their names: the sun's map and
