@@ -235,14 +235,18 @@ uint samples_in_front(uint i, ivec2 p, vec2 to_ndc) {
     return covered;
 }
 
+// How much the edge function of coefficients `r` may change from a pixel's centre to any of
+// its samples: over half a pixel each way, with a margin for rounding.
+float edge_reach(vec3 r, vec2 to_ndc) {
+    return 1.01 * (0.5 * (abs(r.x) * to_ndc.x + abs(r.y) * to_ndc.y));
+}
+
 // Whether no sample of the pixel centred at `q` can lie inside triangle `i`: an edge function
-// below zero by more than it changes over half a pixel each way (with a margin for rounding:
-// this only skips work, layer_point decides).
+// below zero by more than its reach (this only skips work, layer_point decides).
 bool samples_outside(uint i, vec3 q, vec2 to_ndc) {
     for (uint j = 0u; j < 3u; j++) {
         vec3 r = tri_edges[i][j];
-        float reach = 0.5 * (abs(r.x) * to_ndc.x + abs(r.y) * to_ndc.y);
-        if (dot(r, q) + 1.01 * reach < 0.0) {
+        if (dot(r, q) + edge_reach(r, to_ndc) < 0.0) {
             return true;
         }
     }

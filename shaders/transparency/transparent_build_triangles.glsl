@@ -103,9 +103,8 @@ void main() {
     vec2 to_ndc = 2.0 / vec2(frame.viewport.xy);
     vec3 r0 = tri_edges[lid][0], r1 = tri_edges[lid][1], r2 = tri_edges[lid][2];
     // How much each edge function may grow from the centre to a sample (samples_outside's
-    // reach, with its margin); 0 without anti-aliasing.
-    vec3 reach = VISIBILITY_SAMPLES == 1u ? vec3(0.0)
-                                          : 1.01 * 0.5 * vec3(dot(abs(r0.xy), to_ndc), dot(abs(r1.xy), to_ndc), dot(abs(r2.xy), to_ndc));
+    // bound); 0 without anti-aliasing, where the centre alone counts.
+    vec3 reach = VISIBILITY_SAMPLES == 1u ? vec3(0.0) : vec3(edge_reach(r0, to_ndc), edge_reach(r1, to_ndc), edge_reach(r2, to_ndc));
     ivec2 at = box.xy;
     bool walking = box.x <= box.z && box.y <= box.w;
     uint capacity = layer_capacity();
