@@ -10,7 +10,8 @@ use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::ArgMatches;
 use ml_cpu::scene_request::{BuiltScene, SceneSource, SceneWarning};
-use ml_render::{DebugView, OmniShadowMode, RenderSettings, ShadingModel, SunShadowMode, Technique};
+use ml_render::error::or_list;
+use ml_render::{DebugView, OmniShadowMode, RenderSettings, ShadingModel, SunShadowMode, Technique, ViewNeed};
 
 /// The options of a command given on the command line, by clap's id (the field's name): the
 /// others keep their defaults, which never make an option refused as not applying.
@@ -94,10 +95,6 @@ pub(crate) const CLUSTER_GRID: &str = "the techniques with a cluster grid";
 /// … and the technique whose visibility buffer the rasterisers draw.
 pub(crate) const VISIBILITY_BUFFER: &str = "the technique with a visibility buffer";
 
-pub(crate) fn draws_meshlets(t: Technique) -> bool {
-    t.geometry() == ml_render::Geometry::Meshlets
-}
-
 /// The techniques a command renders with, as far as they are known: those named and, with
 /// auto, its pick on this device; before the probe, any technique auto may pick.
 pub(crate) struct Techniques {
@@ -152,15 +149,6 @@ impl Techniques {
     }
 }
 
-/// `a`, `a or b`, `a, b or c`.
-fn or_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
-    let names: Vec<&str> = names.collect();
-    match names.split_last() {
-        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
-        _ => names.join(""),
-    }
-}
-
 /// Refuse the first of `rules` whose option was given and does not apply to `techniques` (as
 /// far as they are known) or to the settings and scene asked for (as far as they are known).
 pub(crate) fn check_rules(rules: &[Rule], given: &Given, techniques: &Techniques) -> Result<Unused, NotApplying> {
@@ -201,7 +189,7 @@ impl Unused {
     pub(crate) fn take_effect(&self, settings: &mut RenderSettings) {
         self.warn();
         if self.has("debug_view") {
-            settings.debug_view = DebugView::None;
+            settings.debug_view = DebugView::NONE;
         }
     }
 
@@ -238,9 +226,6 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         Rule::setting(id, own_lights.map(|own| !own), format!("the lights of '{}'", args.scene), "--lights N, whose lights replace them")
     };
     let omni = args.omni_shadow.as_str();
-    let cube_modes =
-        OmniShadowMode::ALL.into_iter().filter(|m| !matches!(m, OmniShadowMode::Atlas(_) | OmniShadowMode::Rays)).map(OmniShadowMode::name);
-    let cubes = format!("point-light shadow cubes (--omni-shadow {})", or_list(cube_modes));
     let map_modes = OmniShadowMode::ALL.into_iter().filter(|m| *m != OmniShadowMode::Rays).map(OmniShadowMode::name);
     let shadow_maps = format!("point-light shadow maps (--omni-shadow {})", or_list(map_modes));
     let shadows = format!("point-light shadows (--omni-shadow {})", or_list(OmniShadowMode::ALL.into_iter().map(OmniShadowMode::name)));
@@ -297,10 +282,10 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
             "the shaded image (--debug-view none; debug views show their values as they are)",
         ),
         Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
-        Rule::technique("culling", "the technique that culls meshlets on the GPU", draws_meshlets),
+        Rule::technique("culling", "the technique that culls meshlets on the GPU", Technique::draws_meshlets),
         Rule::technique("light_grid_marks", "the techniques that know their surfaces before their lighting", Technique::marks_light_grid),
-        Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
-        Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
+        Rule::technique("raster", VISIBILITY_BUFFER, Technique::draws_meshlets),
+        Rule::technique("raster_split", VISIBILITY_BUFFER, Technique::draws_meshlets),
         Rule::setting(
             "raster_split",
             Some(args.raster != "hardware"),
@@ -320,45 +305,35 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
     ));
     rules.push(Rule::setting(
         "transparency_budget",
-        Some(matches!(args.debug_view.as_str(), "none" | "transparency-layers")),
+        Some(DebugView::from_name(&args.debug_view).is_ok_and(DebugView::shows_layers)),
         format!("--debug-view {}", args.debug_view),
         "the shaded image or --debug-view transparency-layers (surface views show the opaque surfaces only)",
     ));
-    let view = args.debug_view.as_str();
-    rules.extend(
-        match DebugView::from_name(view).unwrap_or(DebugView::None) {
-            DebugView::ClusterHeat => {
-                Some(Rule::technique("debug_view", "the clustered forward techniques", Technique::draws_cluster_heat))
-            }
-            DebugView::Meshlets | DebugView::Triangles | DebugView::Aa => {
-                Some(Rule::technique("debug_view", "the technique drawn in meshlets", draws_meshlets))
-            }
-            DebugView::ShadowMap => Some(sun("debug_view")),
-            DebugView::ShadowCube => {
-                Some(Rule::setting("debug_view", Some(!matches!(omni, "off" | "atlas" | "rays")), format!("--omni-shadow {omni}"), cubes))
-            }
-            DebugView::ShadowAtlas => Some(Rule::setting("debug_view", Some(omni == "atlas"), format!("--omni-shadow {omni}"), atlas)),
-            DebugView::RayCost => {
-                Some(Rule::setting("debug_view", Some(omni == "rays"), format!("--omni-shadow {omni}"), "shadow rays (--omni-shadow rays)"))
-            }
-            DebugView::TransparencyLayers => Some(Rule::setting(
-                "debug_view",
-                transparent,
-                format!("'{}', which has no transparent objects", args.scene),
-                needs_transparent,
-            )),
-            _ => None,
-        }
-        .map(|rule| rule.of_value(view)),
-    );
     // The colour background applies anywhere.
     if let Some(shown @ "environment") = args.background.as_deref() {
         rules.extend([pbr("background").of_value(shown), lit("background").of_value(shown)]);
     }
-    if view == DebugView::ShadowMap.name() {
-        let drawn = Some(args.sun_shadow != SunShadowMode::Rays.name());
-        let map = "a sun's shadow map (--sun-shadow graphics or compute)";
-        rules.push(Rule::setting("debug_view", drawn, format!("--sun-shadow {}", args.sun_shadow), map).of_value(view));
+    // The debug view's needs, as its feature declares them.
+    let view = DebugView::from_name(&args.debug_view).unwrap_or(DebugView::NONE);
+    for need in view.needs() {
+        let rule = |holds, instead| Rule::setting("debug_view", holds, instead, need.needs());
+        rules.extend(
+            match *need {
+                ViewNeed::Technique { what, holds } => Some(Rule::technique("debug_view", what, holds)),
+                ViewNeed::OmniShadow { modes, .. } => Some(rule(Some(modes.contains(&omni)), format!("--omni-shadow {omni}"))),
+                ViewNeed::Shading { model: wanted, .. } => {
+                    Some(rule(model.map(|m| m == wanted), format!("the {} shading model", model.map_or("", ShadingModel::name))))
+                }
+                ViewNeed::SunMap => {
+                    let drawn = SunShadowMode::from_name(&args.sun_shadow).ok().map(ViewNeed::sun_map);
+                    Some(rule(drawn, format!("--sun-shadow {}", args.sun_shadow)))
+                }
+                ViewNeed::TransparentObjects => Some(rule(transparent, format!("'{}', which has no transparent objects", args.scene))),
+                // Known once the raster and samples are: the settings' check says.
+                ViewNeed::SampleBuffer => None,
+            }
+            .map(|rule| rule.of_value(view.name())),
+        );
     }
     rules
 }
@@ -391,7 +366,7 @@ mod tests {
     /// A rule whose id names no option would never hold.
     #[test]
     fn every_rule_names_an_option() {
-        for view in DebugView::ALL {
+        for view in DebugView::all() {
             let Command::Render(args) = Cli::parse_from(["manylights", "render", "--debug-view", view.name(), "--out", "a.png"]).command
             else {
                 unreachable!()

@@ -4,7 +4,7 @@
 //! would take longer than the budget is skipped and says so: brute force estimated from a smaller
 //! count (linear), clustered techniques from one frame (see `Previous`).
 
-use crate::applies::{check_rules, draws_meshlets, objects_rule, Auto, Given, Rule, Techniques, CLUSTER_GRID, VISIBILITY_BUFFER};
+use crate::applies::{check_rules, objects_rule, Auto, Given, Rule, Techniques, CLUSTER_GRID, VISIBILITY_BUFFER};
 use crate::auto::{self, technique_choice};
 use crate::{cluster_choice, print_warnings, scene_source, shading_choice, Progress, Whole};
 use anyhow::{bail, Context as _, Result};
@@ -177,8 +177,8 @@ impl BenchArgs {
                 "transparent objects (alphaMode BLEND in a glTF file, --transparent-objects or --glass-layers)",
             ),
             Rule::technique("clusters", CLUSTER_GRID, Technique::has_cluster_grid),
-            Rule::technique("raster", VISIBILITY_BUFFER, draws_meshlets),
-            Rule::technique("raster_split", VISIBILITY_BUFFER, draws_meshlets),
+            Rule::technique("raster", VISIBILITY_BUFFER, Technique::draws_meshlets),
+            Rule::technique("raster_split", VISIBILITY_BUFFER, Technique::draws_meshlets),
             Rule::setting(
                 "raster_split",
                 Some(rasters.iter().any(|r| *r != Raster::Hardware)),

@@ -114,13 +114,7 @@ fn flag(s: Setting) -> &'static str {
 fn settings(e: &SettingsError) -> String {
     match e {
         SettingsError::OutOfRange { what, value, max } => format!("{} {value} is out of range: use 1 to {max}", flag(*what)),
-        SettingsError::HeatNeedsClusteredForward { technique } => format!(
-            "--debug-view cluster-heat needs a clustered forward technique (clustered-cpu, clustered-gpu), not {technique}"
-        ),
-        SettingsError::ShadowMapNeedsBlinnPhong => {
-            "--debug-view shadow-map needs --shading blinn-phong (the seed model casts no shadows)".into()
-        }
-        SettingsError::ShadowCubeNeedsShadows => "--debug-view shadow-cube needs point-light shadows (--omni-shadow)".into(),
+        SettingsError::ViewNeeds { view, needs, instead } => format!("--debug-view {view} needs {needs}, not {instead}"),
         SettingsError::NoFrames => "--frames must be at least 1".into(),
         SettingsError::Time(t) => format!("--time {t} is not a finite number"),
         SettingsError::ShadowsWithoutLights => format!("{e} (--lights N adds some)"),

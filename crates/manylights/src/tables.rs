@@ -2,7 +2,7 @@
 //! (`render_rows`), a device's facts (`device_rows`), as rows of a two-column table.
 
 use ml_render::report::FrameStats;
-use ml_render::settings::{DebugView, Geometry, LargeTriangles, Raster, RenderSettings};
+use ml_render::settings::{Geometry, LargeTriangles, Raster, RenderSettings};
 use ml_render::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferKind};
 use ml_vk::DeviceInfo;
 use std::path::Path;
@@ -117,20 +117,8 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         rows.push(("lights/cluster", format!("mean {:.2}, max {}", c.mean_lights, c.max_lights)));
         rows.push(("index list", format!("{} entries ({} buffer growths)", c.index_len, stats.index_growths)));
     }
-    if settings.debug_view == DebugView::RayCost {
-        rows.push((
-            "heat legend",
-            "log scale: black 0, blue 1, cyan, green, yellow, red 1024 traversal steps (nodes and triangles) of a point's shadow rays"
-                .into(),
-        ));
-    }
-    if settings.debug_view == DebugView::Aa {
-        rows.push(("heat legend", "surfaces shaded per pixel: blue 1, cyan 2, green 3, yellow 4, red 5 or more".into()));
-    }
-    if settings.debug_view == DebugView::ClusterHeat {
-        let grid = stats.feature::<ml_render::LightGridStats>().map(|g| g.heat_top());
-        let top = stats.clusters.map(|c| c.max_lights).or(grid).unwrap_or(1).max(1);
-        rows.push(("heat legend", format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights tested")));
+    if let Some(legend) = settings.debug_view.legend(stats) {
+        rows.push(("heat legend", legend));
     }
     if let Some(o) = settings.omni {
         let which = if o.all { "every light reaching the view" } else { "the strongest" };

@@ -1,10 +1,12 @@
 //! `assemble`: the passes of a frame made from its plan (`plan::plan`, the ordered pass kinds
 //! as data) — each kind's pass constructed for the scene and settings. A new pass is a file
 //! in its feature's folder, a `PassKind` with its place in `plan`, and its line here
-//! (docs/architecture.md has the checklist).
+//! (docs/architecture.md has the checklist). `FEATURES` gathers the features' debug views
+//! the same way, a line each.
 
 use crate::clusters::cluster_assign_cpu;
-use crate::error::RenderError;
+use crate::debug_view::DebugView;
+use crate::error::{by_name, Named, RenderError};
 use crate::exposure::{exposure_meter, tone_map};
 use crate::light_grid::light_grid_build::LightGridBuild;
 use crate::light_grid::light_grid_mark::LightGridMark;
@@ -12,9 +14,8 @@ use crate::light_stats::light_count::LightCount;
 use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
 use crate::scene::SceneGpu;
-use crate::settings::{DebugView, OmniShadowMode, Raster, RenderSettings, Shading};
+use crate::settings::{OmniShadowMode, Raster, RenderSettings, Shading};
 use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
-use crate::shadows::shadow_map_view::ShownStore;
 use crate::shadows::shadow_raster::ShadowViews;
 use crate::shadows::stores::SharedShadows;
 use crate::shadows::sun_shadow::SunShadowPass;
@@ -24,6 +25,27 @@ use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_gather, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context};
+
+/// The debug views of every feature, in the order lists and menus show them.
+const FEATURES: [&[DebugView]; 6] = [
+    &[DebugView::NONE],
+    crate::clusters::VIEWS,
+    crate::shading::VIEWS,
+    crate::shadows::VIEWS,
+    crate::visibility::VIEWS,
+    crate::transparency::VIEWS,
+];
+
+impl DebugView {
+    /// Every feature's views, `NONE` first.
+    pub fn all() -> impl Iterator<Item = DebugView> {
+        FEATURES.into_iter().flatten().copied()
+    }
+
+    pub fn from_name(name: &str) -> Result<DebugView, RenderError> {
+        by_name(&DebugView::all().collect::<Vec<_>>(), DebugView::name, Named::DebugView, name)
+    }
+}
 
 /// What the passes of a technique are made for.
 pub struct Assembly<'a> {
@@ -136,14 +158,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::VisibilityLighting => {
             Box::new(visibility_lighting::VisibilityLighting::new(ctx, a.scene, (shared()?, compute), (a.shading, aa))?)
         }
-        PassKind::ShadowMapView => {
-            let shown = match s.debug_view {
-                DebugView::ShadowCube => ShownStore::Cube,
-                DebugView::ShadowAtlas => ShownStore::Atlas,
-                _ => ShownStore::SunMap,
-            };
-            Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, &a.shadows.borrow(), shown)?)
-        }
+        PassKind::ShadowMapView(shown) => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, &a.shadows.borrow(), shown)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
         PassKind::TransparentBuild { depth_buffer } => {
             Box::new(TransparentBuild::new(ctx, (a.scene, a.objects), (a.shading, transparency()), depth_buffer)?)
@@ -153,4 +168,28 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         }
         PassKind::LightCount { depth_buffer } => Box::new(LightCount::new(ctx, a.scene, a.shading, (depth_buffer, aa))?),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Names and codes unique, and every view the shaders know declared by one feature.
+    #[test]
+    fn every_shader_view_is_declared_once() {
+        let views: Vec<DebugView> = DebugView::all().collect();
+        let mut names: Vec<&str> = views.iter().map(|v| v.name()).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), views.len(), "a name declared twice");
+        let mut codes: Vec<u32> = views.iter().map(|v| v.code()).collect();
+        codes.sort_unstable();
+        let mut shader: Vec<u32> = ml_shaders::debug_view::ALL.iter().map(|&(_, code)| code).collect();
+        shader.sort_unstable();
+        assert_eq!(codes, shader, "the views declared and the shaders' DEBUG_VIEW_* differ");
+        assert_eq!(views[0], DebugView::NONE);
+        for view in views {
+            assert_eq!(DebugView::from_name(view.name()).ok(), Some(view));
+        }
+    }
 }

@@ -119,23 +119,13 @@ pub enum SettingsError {
     NoCubeArrays { device: String },
     #[error("{what} {value} is out of range: use 1 to {max}")]
     OutOfRange { what: Setting, value: u32, max: u32 },
-    /// The cluster-heat debug view is drawn by the clustered forward techniques only.
-    #[error("the cluster-heat debug view needs a clustered forward technique (clustered-cpu, clustered-gpu), not {technique}")]
-    HeatNeedsClusteredForward { technique: &'static str },
+    /// A debug view whose feature is not in the settings (what it needs: `ViewNeed`).
+    #[error("the {view} debug view needs {needs}, not {instead}")]
+    ViewNeeds { view: &'static str, needs: String, instead: String },
     #[error("--background environment needs an environment: the pbr model (--shading pbr) with --environment FILE or sky, or a scene file's own")]
     BackgroundNeedsEnvironment,
-    #[error("the shadow-map debug view needs the blinn-phong shading model (the seed model casts no shadows)")]
-    ShadowMapNeedsBlinnPhong,
-    #[error("the shadow-cube debug view needs point-light shadow cubes (--omni-shadow copy|direct|multiview|layered|compute)")]
-    ShadowCubeNeedsShadows,
-    #[error("the transparency-layers debug view needs transparent objects (a scene with alphaMode BLEND materials)")]
-    LayerViewNeedsTransparency,
-    #[error("the shadow-atlas debug view needs the shadow atlas (--omni-shadow atlas)")]
-    ShadowAtlasViewNeedsAtlas,
     #[error("--light-stats counts the light loop of the compute-lit techniques (deferred-compute, visibility), not {technique}'s")]
     LightStatsNeedCompute { technique: &'static str },
-    #[error("the {view} debug view shows the meshlets of the visibility technique, not {technique}")]
-    ViewNeedsMeshlets { view: &'static str, technique: &'static str },
     #[error("the {technique} technique needs {feature}, which '{device}' lacks: use deferred-compute")]
     TechniqueFeature { technique: &'static str, feature: &'static str, device: String },
     #[error("the compute raster draws the visibility buffer of the visibility technique, not {technique}'s (use --raster hardware)")]
@@ -158,8 +148,6 @@ pub enum SettingsError {
     AntialiasingSamples { samples: &'static str, what: String, device: String, offered: String },
     #[error("the scene has transparent (BLEND) materials, whose layers are anti-aliased by the visibility technique at up to {max} samples a pixel, not by {technique} at {samples}: use --technique visibility with --aa 4 or 8, or --aa off")]
     AntialiasingWithLayers { samples: &'static str, technique: &'static str, max: u32 },
-    #[error("the aa debug view shows the surfaces the visibility technique shades in its 64-bit buffer (with --aa, or the compute and hybrid rasters), not {technique}'s")]
-    AaViewNeedsComputeRaster { technique: &'static str },
     #[error(
         "a transparency budget of {budget} nodes per pixel at {width}x{height} takes {bytes} bytes but '{device}' allows {max} bytes per storage buffer: lower --transparency-budget"
     )]
@@ -204,6 +192,15 @@ pub enum SettingsError {
 }
 
 /// The one of `all` whose name (`name_of`) is `name`; else the error that lists the names.
+/// `a`, `a or b`, `a, b or c`.
+pub fn or_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let names: Vec<&str> = names.collect();
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => names.join(""),
+    }
+}
+
 pub(crate) fn by_name<T: Copy>(all: &[T], name_of: fn(T) -> &'static str, kind: Named, name: &str) -> Result<T, RenderError> {
     all.iter().copied().find(|&v| name_of(v) == name).ok_or_else(|| {
         let expected = all.iter().map(|&v| name_of(v)).collect::<Vec<_>>().join(", ");

@@ -39,6 +39,7 @@ mod assembly;
 pub mod background;
 mod clusters;
 mod compute_pass;
+mod debug_view;
 mod depth_pass;
 mod descriptors;
 mod environment;
@@ -72,7 +73,7 @@ pub use light_stats::LightStats;
 pub use renderer::{FrameHook, FrameSink, RenderOutput, Renderer};
 pub use settings::{
     layers_take, Antialiasing, DebugView, Exposure, Geometry, LargeTriangles, LightAssignment, LightGridMarks, LightingStage,
-    OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, FRAME_SECONDS,
+    OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Shading, ShadingModel, SunShadowMode, Technique, ViewNeed, FRAME_SECONDS,
     TIMER_SPEED,
 };
 pub use shadows::omni_shadow_compute::{AtlasStats, OmniRasterStats};

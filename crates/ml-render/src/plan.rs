@@ -12,6 +12,7 @@ use crate::settings::{
     Antialiasing, DebugView, Exposure, Geometry, LightAssignment, LightingStage, OmniShadowMode, OmniShadowSettings, Raster,
     RenderSettings, ShadingModel, SunShadowMode, Technique,
 };
+use crate::shadows::shadow_map_view::ShownStore;
 use ml_cpu::cluster::ClusterDims;
 
 /// The early or the late phase of the visibility technique's culling and raster.
@@ -69,8 +70,8 @@ pub enum PassKind {
     DepthPyramid,
     /// Lighting from the visibility buffer.
     VisibilityLighting,
-    /// The shadow-map, shadow-cube and shadow-atlas debug views.
-    ShadowMapView,
+    /// The debug views that paint a shadow store (the sun's map, a cube, the atlas).
+    ShadowMapView(ShownStore),
     /// Auto exposure's meter, reading the finished image (with pbr's curve or without).
     ExposureMeter { curve: bool },
     /// The transparent objects' fragments into per-pixel lists, tested against the opaque
@@ -228,7 +229,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
             kinds.extend(key.layers.then_some(resolve));
         }
         (Geometry::Meshes, LightingStage::Forward) => {
-            kinds.push(PassKind::Forward { lights, heat_legend: key.debug_view == DebugView::ClusterHeat });
+            kinds.push(PassKind::Forward { lights, heat_legend: key.debug_view == crate::clusters::HEAT_VIEW });
             if key.layers {
                 kinds.extend([build, resolve]);
             } else if antialiased {
@@ -244,8 +245,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
                 kinds.extend([build, resolve]);
             } else {
                 // pbr's curve, not for surface views (their values are shown as they are).
-                let surface_view = !matches!(key.debug_view, DebugView::None | DebugView::ClusterHeat);
-                let curve = key.shading == ShadingModel::Pbr && !surface_view && !antialiased;
+                let curve = key.shading == ShadingModel::Pbr && key.debug_view.toned() && !antialiased;
                 kinds.push(PassKind::ToneMap { curve, display_linear: antialiased });
             }
         }
@@ -260,9 +260,7 @@ pub fn plan(key: &PipelineKey) -> Vec<PassKind> {
     if key.light_stats {
         kinds.push(PassKind::LightCount { depth_buffer: opaque_depth_buffer });
     }
-    if matches!(key.debug_view, DebugView::ShadowMap | DebugView::ShadowCube | DebugView::ShadowAtlas) {
-        kinds.push(PassKind::ShadowMapView);
-    }
+    kinds.extend(key.debug_view.shown_store().map(PassKind::ShadowMapView));
     if key.meters_exposure {
         kinds.push(PassKind::ExposureMeter { curve: key.shading == ShadingModel::Pbr });
     }
@@ -359,9 +357,9 @@ mod tests {
             (OmniShadowMode::Atlas(AtlasSettings::DEFAULT), ShadowAtlas),
         ] {
             let mut k = shadowed(key(Technique::Forward), mode);
-            k.debug_view = DebugView::ShadowCube;
+            k.debug_view = crate::shadows::CUBE_VIEW;
             k.meters_exposure = false;
-            assert_eq!(plan(&k), [first, forward, ShadowMapView], "{}", mode.name());
+            assert_eq!(plan(&k), [first, forward, ShadowMapView(ShownStore::Cube)], "{}", mode.name());
         }
         // Shadow rays are traced in the lighting: no pass of their own.
         let mut k = shadowed(key(Technique::Forward), OmniShadowMode::Rays);
@@ -373,7 +371,7 @@ mod tests {
         assert_eq!(plan(&k), [SunShadow, OmniShadows, forward]);
         assert_eq!(plan(&PipelineKey { sun_shadow: SunShadowMode::Rays, ..k }), [OmniShadows, forward]);
         let mut k = key(Technique::ClusteredGpu);
-        k.debug_view = DebugView::ClusterHeat;
+        k.debug_view = crate::clusters::HEAT_VIEW;
         k.meters_exposure = false;
         assert_eq!(plan(&k), [LightGridBuild { marked: false }, Forward { lights: LightAssignment::Gpu, heat_legend: true }]);
     }
@@ -433,9 +431,9 @@ mod tests {
         );
         // A surface view shows the opaque surfaces only; the layers' own view keeps them.
         let mut s = RenderSettings { transparency: Some(Default::default()), ..RenderSettings::new(Technique::Forward, 64, 64) };
-        s.debug_view = DebugView::GBufferAlbedo;
+        s.debug_view = DebugView::from_name("gbuffer-albedo").unwrap();
         assert!(!s.pipeline_key().layers);
-        s.debug_view = DebugView::TransparencyLayers;
+        s.debug_view = crate::transparency::LAYERS_VIEW;
         assert!(s.pipeline_key().layers);
     }
 
@@ -465,9 +463,9 @@ mod tests {
     fn surface_views_skip_the_tone_curve_and_blinn_phong_has_none() {
         let mut k = key(Technique::Deferred);
         k.meters_exposure = false;
-        k.debug_view = DebugView::GBufferNormal;
+        k.debug_view = DebugView::from_name("gbuffer-normal").unwrap();
         assert_eq!(plan(&k)[1], ToneMap { curve: false, display_linear: false });
-        k.debug_view = DebugView::None;
+        k.debug_view = DebugView::NONE;
         k.shading = ShadingModel::BlinnPhong;
         assert_eq!(plan(&k)[2], ToneMap { curve: false, display_linear: false });
     }

@@ -2,8 +2,9 @@
 
 pub use crate::antialiasing::Antialiasing;
 use crate::background::Background;
+pub use crate::debug_view::{DebugView, ViewNeed};
 use crate::environment;
-use crate::error::{by_name, Named, RenderError, Setting, SettingsError};
+use crate::error::{by_name, or_list, Named, RenderError, Setting, SettingsError};
 pub use crate::exposure::{parse_exposure, Exposure, MAX_EXPOSURE_EV};
 use crate::scene::SceneConfig;
 pub use crate::shading::Shading;
@@ -24,105 +25,52 @@ use ml_cpu::cluster::ClusterDims;
 pub use ml_cpu::shading_model::ShadingModel;
 use ml_vk::{vk, Context};
 
-/// What the image shows instead of the shaded scene.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum DebugView {
-    None,
-    /// Lights per cluster as a heat map (clustered forward techniques).
-    ClusterHeat,
-    /// The G-buffer's channels (any technique: the values it shades with): albedo (texture
-    /// included), normal·0.5 + 0.5, (roughness, metallic, 0).
-    GBufferAlbedo,
-    GBufferNormal,
-    GBufferMaterial,
-    /// View depth, ln(depth/near)/ln(far/near) in grey.
-    Depth,
-    /// The sun's shadow map over the whole image (blinn-phong).
-    ShadowMap,
-    /// The six faces of the first shadowed point light's cube, unfolded as a cross.
-    ShadowCube,
-    /// The shadow atlas, every block of it, fitted to the image (--omni-shadow atlas).
-    ShadowAtlas,
-    /// A colour per meshlet instance (visibility).
-    Meshlets,
-    /// A colour per triangle (visibility).
-    Triangles,
-    /// Which surfaces alpha masks cut: opaque grey, masked green, blended orange (drawn as
-    /// masks); double-sided ones brighter. Cut-out points show what lies behind them.
-    Alpha,
-    /// Transparent layers per pixel as a heat map up to the 32 a pixel blends exactly; white
-    /// where more were merged (scenes with transparent objects).
-    TransparencyLayers,
-    /// The traversal steps (nodes visited, triangles tested) of each point's shadow rays as a
-    /// heat map on a log scale (--omni-shadow rays).
-    RayCost,
-    /// Surfaces shaded per pixel with anti-aliasing (visibility, compute raster): one blue,
-    /// two cyan, three green, four yellow, five and more red; the background as it is.
-    Aa,
-}
+impl ViewNeed {
+    /// Whether the sun's shadow mode draws a map.
+    pub fn sun_map(mode: SunShadowMode) -> bool {
+        mode != SunShadowMode::Rays
+    }
 
-impl DebugView {
-    pub const ALL: [DebugView; 15] = [
-        DebugView::None,
-        DebugView::ClusterHeat,
-        DebugView::GBufferAlbedo,
-        DebugView::GBufferNormal,
-        DebugView::GBufferMaterial,
-        DebugView::Depth,
-        DebugView::ShadowMap,
-        DebugView::ShadowCube,
-        DebugView::ShadowAtlas,
-        DebugView::Meshlets,
-        DebugView::Triangles,
-        DebugView::Alpha,
-        DebugView::TransparencyLayers,
-        DebugView::RayCost,
-        DebugView::Aa,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            DebugView::None => "none",
-            DebugView::ClusterHeat => "cluster-heat",
-            DebugView::GBufferAlbedo => "gbuffer-albedo",
-            DebugView::GBufferNormal => "gbuffer-normal",
-            DebugView::GBufferMaterial => "gbuffer-material",
-            DebugView::Depth => "depth",
-            DebugView::ShadowMap => "shadow-map",
-            DebugView::ShadowCube => "shadow-cube",
-            DebugView::ShadowAtlas => "shadow-atlas",
-            DebugView::Meshlets => "meshlets",
-            DebugView::Triangles => "triangles",
-            DebugView::Alpha => "alpha",
-            DebugView::TransparencyLayers => "transparency-layers",
-            DebugView::RayCost => "ray-cost",
-            DebugView::Aa => "aa",
+    /// Whether `settings` have it.
+    pub fn holds(&self, s: &RenderSettings) -> bool {
+        match *self {
+            ViewNeed::Technique { holds, .. } => holds(s.technique),
+            ViewNeed::OmniShadow { modes, .. } => s.omni.is_some_and(|o| modes.contains(&o.mode.name())),
+            ViewNeed::Shading { model, .. } => s.shading == model,
+            ViewNeed::SunMap => ViewNeed::sun_map(s.sun_shadow),
+            ViewNeed::TransparentObjects => s.transparency.is_some(),
+            ViewNeed::SampleBuffer => s.raster.fills_buffer(s.antialiasing),
         }
     }
 
-    pub fn from_name(name: &str) -> Result<DebugView, RenderError> {
-        by_name(&DebugView::ALL, DebugView::name, Named::DebugView, name)
+    /// What it needs, in the options that give it.
+    pub fn needs(&self) -> String {
+        match *self {
+            ViewNeed::Technique { what, holds } => {
+                format!("--technique {} ({what})", or_list(Technique::ALL.into_iter().filter(|&t| holds(t)).map(Technique::name)))
+            }
+            ViewNeed::OmniShadow { what, modes } => format!("{what} (--omni-shadow {})", or_list(modes.iter().copied())),
+            ViewNeed::Shading { model, what } => format!("{what} (--shading {})", model.name()),
+            ViewNeed::SunMap => {
+                let modes = SunShadowMode::ALL.into_iter().filter(|&m| ViewNeed::sun_map(m)).map(SunShadowMode::name);
+                format!("a sun's shadow map (--sun-shadow {})", or_list(modes))
+            }
+            ViewNeed::TransparentObjects => {
+                "transparent objects (alphaMode BLEND in a glTF file, --transparent-objects or --glass-layers)".into()
+            }
+            ViewNeed::SampleBuffer => "the 64-bit depth-and-id buffer (--raster compute or hybrid, or --aa)".into(),
+        }
     }
 
-    /// The value shaders see: `DEBUG_VIEW_*` in common/common.glsl, generated from there.
-    pub fn code(self) -> u32 {
-        use ml_shaders::debug_view as v;
+    /// What `settings` have instead, where it does not hold.
+    fn instead(&self, s: &RenderSettings) -> String {
         match self {
-            DebugView::None => v::NONE,
-            DebugView::ClusterHeat => v::CLUSTER_HEAT,
-            DebugView::GBufferAlbedo => v::GBUFFER_ALBEDO,
-            DebugView::GBufferNormal => v::GBUFFER_NORMAL,
-            DebugView::GBufferMaterial => v::GBUFFER_MATERIAL,
-            DebugView::Depth => v::DEPTH,
-            DebugView::ShadowMap => v::SHADOW_MAP,
-            DebugView::ShadowCube => v::SHADOW_CUBE,
-            DebugView::ShadowAtlas => v::SHADOW_ATLAS,
-            DebugView::Meshlets => v::MESHLETS,
-            DebugView::Triangles => v::TRIANGLES,
-            DebugView::Alpha => v::ALPHA,
-            DebugView::TransparencyLayers => v::TRANSPARENCY_LAYERS,
-            DebugView::RayCost => v::RAY_COST,
-            DebugView::Aa => v::AA,
+            ViewNeed::Technique { .. } => s.technique.name().to_owned(),
+            ViewNeed::OmniShadow { .. } => format!("--omni-shadow {}", s.omni.map_or("off", |o| o.mode.name())),
+            ViewNeed::Shading { .. } => format!("the {} shading model", s.shading.name()),
+            ViewNeed::SunMap => format!("--sun-shadow {}", s.sun_shadow.name()),
+            ViewNeed::TransparentObjects => "a scene without transparent objects".into(),
+            ViewNeed::SampleBuffer => "--raster hardware with --aa off".into(),
         }
     }
 }
@@ -229,7 +177,7 @@ impl RenderSettings {
             technique,
             shading: ShadingModel::Seed,
             clusters: ClusterDims::DEFAULT,
-            debug_view: DebugView::None,
+            debug_view: DebugView::NONE,
             omni: None,
             sun_shadow: SunShadowMode::Graphics,
             width,
@@ -253,16 +201,24 @@ impl RenderSettings {
         self.width as f32 / self.height as f32
     }
 
+    /// The debug view's first need the settings lack.
+    fn check_view(&self) -> Result<(), SettingsError> {
+        match self.debug_view.needs().iter().find(|need| !need.holds(self)) {
+            Some(need) => Err(SettingsError::ViewNeeds { view: self.debug_view.name(), needs: need.needs(), instead: need.instead(self) }),
+            None => Ok(()),
+        }
+    }
+
     /// Whether the exposure-meter pass runs: auto exposure, on the shaded image (a debug view
     /// shows its values as they are).
     pub fn meters_exposure(&self) -> bool {
-        self.exposure == Exposure::Auto && self.debug_view == DebugView::None
+        self.exposure == Exposure::Auto && self.debug_view.is_none()
     }
 
     /// Whether the transparent layers are built and blended: transparency on, and the image
     /// shaded (or the layer view); a surface debug view shows the opaque surfaces only.
     pub fn blends_layers(&self) -> bool {
-        self.transparency.is_some() && matches!(self.debug_view, DebugView::None | DebugView::TransparencyLayers)
+        self.transparency.is_some() && self.debug_view.shows_layers()
     }
 
     /// Animation clock of frame `i`.
@@ -320,21 +276,11 @@ impl RenderSettings {
                 return Err(SettingsError::OutOfRange { what, value, max }.into());
             }
         }
-        if self.debug_view == DebugView::ClusterHeat && !self.technique.draws_cluster_heat() {
-            return Err(SettingsError::HeatNeedsClusteredForward { technique: self.technique.name() }.into());
-        }
+        self.check_view()?;
         if self.light_stats && self.technique.lighting_stage() != LightingStage::Compute {
             return Err(SettingsError::LightStatsNeedCompute { technique: self.technique.name() }.into());
         }
-        if matches!(self.debug_view, DebugView::Meshlets | DebugView::Triangles) && self.technique.geometry() != Geometry::Meshlets {
-            return Err(SettingsError::ViewNeedsMeshlets { view: self.debug_view.name(), technique: self.technique.name() }.into());
-        }
         check_antialiasing(self, ctx)?;
-        // The lighting that reads the 64-bit buffer counts the surfaces.
-        let buffer = self.raster.fills_buffer(self.antialiasing);
-        if self.debug_view == DebugView::Aa && (self.technique != Technique::Visibility || !buffer) {
-            return Err(SettingsError::AaViewNeedsComputeRaster { technique: self.technique.name() }.into());
-        }
         if self.technique.geometry() == Geometry::Meshlets {
             if let Some(feature) = missing_meshlet_feature(&ctx.info.features) {
                 return Err(SettingsError::TechniqueFeature { technique: self.technique.name(), feature, device: device() }.into());
@@ -365,20 +311,8 @@ impl RenderSettings {
                 }
             }
         }
-        if self.debug_view == DebugView::ShadowMap && self.shading != ShadingModel::BlinnPhong {
-            return Err(SettingsError::ShadowMapNeedsBlinnPhong.into());
-        }
-        if self.debug_view == DebugView::ShadowCube && self.omni.is_none_or(|o| o.atlas().is_some()) {
-            return Err(SettingsError::ShadowCubeNeedsShadows.into());
-        }
-        if self.debug_view == DebugView::ShadowAtlas && self.omni.is_none_or(|o| o.atlas().is_none()) {
-            return Err(SettingsError::ShadowAtlasViewNeedsAtlas.into());
-        }
         if let Some(omni) = &self.omni {
             omni.check(ctx, lights)?;
-        }
-        if self.debug_view == DebugView::TransparencyLayers && self.transparency.is_none() {
-            return Err(SettingsError::LayerViewNeedsTransparency.into());
         }
         if let Some(t) = &self.transparency {
             t.check(ctx, self.width, self.height)?;

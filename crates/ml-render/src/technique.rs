@@ -95,6 +95,11 @@ impl Technique {
         self.assignment() == LightAssignment::Cpu
     }
 
+    /// Whether it draws meshlets, culled on the GPU, into a visibility buffer.
+    pub fn draws_meshlets(self) -> bool {
+        self.geometry() == Geometry::Meshlets
+    }
+
     /// Whether it draws the cluster-heat debug view: the clustered forward fragment shader
     /// does.
     pub fn draws_cluster_heat(self) -> bool {

@@ -261,7 +261,7 @@ pub fn draw(ctx: &egui::Context, choices: &mut Choices, state: &mut OverlayState
             ui.add(DragValue::new(&mut choices.settings.clusters.y).range(1..=128));
             ui.add(DragValue::new(&mut choices.settings.clusters.z).range(1..=64));
         });
-        combo(ui, "Debug view", &mut choices.settings.debug_view, &DebugView::ALL, |v| v.name());
+        combo(ui, "Debug view", &mut choices.settings.debug_view, &DebugView::all().collect::<Vec<_>>(), |v| v.name());
         let mut mode = choices.settings.omni.map(|o| o.mode);
         ComboBox::from_label("Point-light shadows").selected_text(mode.map_or("off", |m| m.name())).show_ui(ui, |ui| {
             ui.selectable_value(&mut mode, None, "off");

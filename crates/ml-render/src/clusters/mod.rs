@@ -3,3 +3,29 @@
 //! the light grid (`crate::light_grid`).
 
 pub mod cluster_assign_cpu;
+
+use crate::debug_view::{DebugView, Drawn, Legend, ViewNeed, ViewSpec};
+use crate::report::FrameStats;
+use crate::technique::Technique;
+
+/// Lights per cluster as a heat map, drawn by the clustered forward fragment shader (the light
+/// grid's cells near each point where the grid assigns them): through the tone curve, over
+/// the opaque surfaces.
+pub const HEAT_VIEW: DebugView = DebugView {
+    spec: &ViewSpec {
+        name: "cluster-heat",
+        code: ml_shaders::debug_view::CLUSTER_HEAT,
+        needs: &[ViewNeed::Technique { what: "the clustered forward techniques", holds: Technique::draws_cluster_heat }],
+        drawn: Drawn::InShading { toned: true, layers: false },
+        legend: Legend::Counted(heat_legend),
+    },
+};
+
+pub(crate) const VIEWS: &[DebugView] = &[HEAT_VIEW];
+
+/// The heat map's scale: its red is the most lights a cluster (or grid cell) listed.
+fn heat_legend(stats: &FrameStats) -> String {
+    let grid = stats.feature::<crate::LightGridStats>().map(|g| g.heat_top());
+    let top = stats.clusters.map(|c| c.max_lights).or(grid).unwrap_or(1).max(1);
+    format!("log scale: black 0, blue 1, cyan, green, yellow, red {top} lights tested")
+}

@@ -10,10 +10,33 @@ pub mod mesh_raster;
 
 use crate::antialiasing::Antialiasing;
 use crate::background::Background;
+use crate::debug_view::{DebugView, Drawn, Legend, ViewSpec};
 use crate::specialization::Constants;
 use crate::targets::GBufferKind;
 use ml_cpu::scene::Scene;
 use ml_cpu::shading_model::ShadingModel;
+
+/// A surface view: the values a technique shades with, shown as they are over the opaque
+/// surfaces, in any technique.
+const fn surface_view(name: &'static str, code: u32) -> ViewSpec {
+    ViewSpec { name, code, needs: &[], drawn: Drawn::InShading { toned: false, layers: false }, legend: Legend::None }
+}
+
+/// The G-buffer's channels (any technique: the values it shades with): albedo (texture
+/// included), normal·0.5 + 0.5, (roughness, metallic, 0); view depth, ln(depth/near) /
+/// ln(far/near) in grey; which surfaces alpha masks cut: opaque grey, masked green, blended
+/// orange (drawn as masks), double-sided ones brighter, cut-out points showing what lies
+/// behind them.
+pub(crate) const VIEWS: &[DebugView] = {
+    use ml_shaders::debug_view as code;
+    &[
+        DebugView { spec: &surface_view("gbuffer-albedo", code::GBUFFER_ALBEDO) },
+        DebugView { spec: &surface_view("gbuffer-normal", code::GBUFFER_NORMAL) },
+        DebugView { spec: &surface_view("gbuffer-material", code::GBUFFER_MATERIAL) },
+        DebugView { spec: &surface_view("depth", code::DEPTH) },
+        DebugView { spec: &surface_view("alpha", code::ALPHA) },
+    ]
+};
 
 /// What a lighting pipeline is compiled for: each feature's specialization constants (so each
 /// pipeline carries only what it runs), contributed from the feature's module by

@@ -3,6 +3,7 @@
 //! technique drew. Untimed.
 
 use crate::compute_pass::ComputePass;
+pub(crate) use crate::debug_view::ShownStore;
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
@@ -12,14 +13,6 @@ use ml_vk::{vk, Context, VkError};
 
 pub struct ShadowMapView {
     pass: ComputePass,
-}
-
-/// Which store the view paints.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ShownStore {
-    SunMap,
-    Cube,
-    Atlas,
 }
 
 impl ShadowMapView {

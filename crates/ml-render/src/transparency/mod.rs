@@ -13,11 +13,26 @@ mod layer_buffers;
 pub mod transparent_build;
 pub mod transparent_resolve;
 
+use crate::debug_view::{DebugView, Drawn, Legend, ViewNeed, ViewSpec};
 use crate::error::{RenderError, Setting, SettingsError};
 use crate::report::FeatureStats;
 use crate::sync::Use;
 pub use layer_buffers::{node_bytes, LayerBuffers, LAYER_BUFFERS};
 use ml_vk::{vk, Context};
+
+/// Transparent layers per pixel as a heat map up to the `LAYER_KEEP` a pixel blends exactly;
+/// white where more were merged.
+pub const LAYERS_VIEW: DebugView = DebugView {
+    spec: &ViewSpec {
+        name: "transparency-layers",
+        code: ml_shaders::debug_view::TRANSPARENCY_LAYERS,
+        needs: &[ViewNeed::TransparentObjects],
+        drawn: Drawn::InShading { toned: false, layers: true },
+        legend: Legend::None,
+    },
+};
+
+pub(crate) const VIEWS: &[DebugView] = &[LAYERS_VIEW];
 
 /// A list's end (layers.glsl LAYER_END): what the heads are cleared to.
 pub const LAYER_END: u32 = 0xffff_ffff;

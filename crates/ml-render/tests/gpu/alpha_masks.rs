@@ -23,6 +23,7 @@
 //!   the side the camera sees, exactly as the same quad turned to face the camera.
 
 use crate::common;
+use crate::common::view;
 
 use glam::{Quat, Vec2, Vec3, Vec4};
 use ml_cpu::alpha_mask::kept;
@@ -416,7 +417,7 @@ fn a_masked_grid_is_the_same_in_every_technique_and_shading_model() {
     let edges = cpu.pixels().filter(|&(x, y)| !cpu.sure(x, y)).count();
     println!("grid: {edges} of {} pixels are edge pixels", GRID_W * GRID_H);
     for model in [ShadingModel::Seed, ShadingModel::BlinnPhong, ShadingModel::Pbr] {
-        let settings: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| with(t, model, DebugView::None, (GRID_W, GRID_H))).collect();
+        let settings: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| with(t, model, DebugView::NONE, (GRID_W, GRID_H))).collect();
         let out = common::render_each(&scene, &settings);
         let lit = out[0].rgba.chunks_exact(4).filter(|p| p[0].max(p[1]).max(p[2]) > 40).count();
         let saturated = out[0].rgba.chunks_exact(4).filter(|p| p[0].max(p[1]).max(p[2]) == 255).count();
@@ -443,7 +444,7 @@ fn a_masked_grid_is_the_same_through_every_raster_and_without_culling() {
     let tracer = Tracer::new(&scene);
     let cpu = CpuView::new(&tracer, (GRID_W, GRID_H), true, false);
     for model in [ShadingModel::Seed, ShadingModel::Pbr] {
-        let base = with(Technique::Visibility, model, DebugView::None, (GRID_W, GRID_H));
+        let base = with(Technique::Visibility, model, DebugView::NONE, (GRID_W, GRID_H));
         let variants = [
             ("hardware, culling off", RenderSettings { culling: false, ..base }),
             ("hybrid", RenderSettings { raster: Raster::hybrid(Raster::DEFAULT_SPLIT), ..base }),
@@ -483,7 +484,7 @@ fn b_every_sure_pixel_shows_what_the_cpu_sees() {
     assert!(through > 300, "only {through} pixels see through holes");
     assert!(cube_seen >= 4 && cube_in_plain_sight == 0, "the cube should show through a hole only: {cube_seen}, {cube_in_plain_sight}");
     let mut settings: Vec<RenderSettings> =
-        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Pbr, DebugView::GBufferAlbedo, (GRID_W, GRID_H))).collect();
+        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Pbr, view("gbuffer-albedo"), (GRID_W, GRID_H))).collect();
     let vis = *settings.last().unwrap();
     settings.push(RenderSettings { raster: Raster::hybrid(Raster::DEFAULT_SPLIT), ..vis });
     settings.push(RenderSettings { raster: Raster::compute(Raster::DEFAULT_SPLIT), ..vis });
@@ -515,7 +516,7 @@ fn the_alpha_view_shows_each_surfaces_mode() {
     let kinds: std::collections::BTreeSet<String> = scene.objects.iter().map(|o| format!("{:?}", o.extras.alpha_mode)).collect();
     assert!(kinds.len() >= 3, "the grid should hold opaque, masked and blended surfaces: {kinds:?}");
     let mut settings: Vec<RenderSettings> =
-        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Pbr, DebugView::Alpha, (GRID_W, GRID_H))).collect();
+        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Pbr, view("alpha"), (GRID_W, GRID_H))).collect();
     let vis = *settings.last().unwrap();
     settings.push(RenderSettings { raster: Raster::compute(Raster::DEFAULT_SPLIT), ..vis });
     for (o, s) in common::render_each(&scene, &settings).iter().zip(&settings) {
@@ -600,9 +601,9 @@ fn b_holes_show_what_is_behind_and_factors_and_modes_cut_as_the_file_says() {
         assert_eq!(hidden[i] > 100, !drawn, "{name}");
     }
     let settings: Vec<RenderSettings> =
-        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Seed, DebugView::None, (ROW_W, ROW_H))).collect();
+        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Seed, DebugView::NONE, (ROW_W, ROW_H))).collect();
     let albedo: Vec<RenderSettings> =
-        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Pbr, DebugView::GBufferAlbedo, (ROW_W, ROW_H))).collect();
+        Technique::ALL.iter().map(|&t| with(t, ShadingModel::Pbr, view("gbuffer-albedo"), (ROW_W, ROW_H))).collect();
     let out = common::render_each(&scene, &[settings.clone(), albedo].concat());
     let without = common::render_each(&bare, &settings);
     for (i, t) in Technique::ALL.into_iter().enumerate() {
@@ -765,7 +766,7 @@ fn c_the_sun_shines_through_the_holes() {
         .iter()
         .map(|&(mode, t)| RenderSettings {
             sun_shadow: mode,
-            ..with(t, ShadingModel::BlinnPhong, DebugView::None, (SHADOW_SIZE, SHADOW_SIZE))
+            ..with(t, ShadingModel::BlinnPhong, DebugView::NONE, (SHADOW_SIZE, SHADOW_SIZE))
         })
         .collect();
     let renders: Vec<Vec<RenderOutput>> = scenes.iter().map(|s| common::render_each(s, &ctx_settings)).collect();
@@ -814,7 +815,7 @@ fn c_point_lights_shine_through_the_holes_in_every_shadow_mode() {
         .iter()
         .map(|&(mode, t)| RenderSettings {
             omni: Some(OmniShadowSettings { mode, lights: 1, all: false, size: CUBE }),
-            ..with(t, ShadingModel::Pbr, DebugView::None, (SHADOW_SIZE, SHADOW_SIZE))
+            ..with(t, ShadingModel::Pbr, DebugView::NONE, (SHADOW_SIZE, SHADOW_SIZE))
         })
         .collect();
     let plain: Vec<RenderSettings> = shadowed.iter().map(|s| RenderSettings { omni: None, ..*s }).collect();
@@ -908,8 +909,8 @@ fn d_back_faces_vanish_unless_double_sided_and_then_are_lit_from_the_camera_side
     // (specular only, its highlights cover little of the quads) is held to the same
     // double-sided rule by the masked grid's twin-faced plates (CI's time).
     for model in [ShadingModel::Pbr] {
-        let settings: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| with(t, model, DebugView::None, (SIDE_W, SIDE_H))).collect();
-        let normals: Vec<RenderSettings> = settings.iter().map(|s| RenderSettings { debug_view: DebugView::GBufferNormal, ..*s }).collect();
+        let settings: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| with(t, model, DebugView::NONE, (SIDE_W, SIDE_H))).collect();
+        let normals: Vec<RenderSettings> = settings.iter().map(|s| RenderSettings { debug_view: view("gbuffer-normal"), ..*s }).collect();
         let r: Vec<Vec<RenderOutput>> = scenes.iter().map(|s| common::render_each(s, &settings)).collect();
         let n = if model == ShadingModel::Pbr { common::render_each(&away_front, &normals) } else { Vec::new() };
         for (i, t) in Technique::ALL.into_iter().enumerate() {

@@ -21,6 +21,7 @@
 //! Validation (with synchronization validation) stays silent.
 
 use crate::common;
+use crate::common::view;
 
 use glam::{Quat, Vec3};
 use ml_cpu::camera::Camera;
@@ -288,7 +289,7 @@ fn transparent_layers_are_anti_aliased_over_and_under_opaque_edges() {
     let outputs = common::render_each(&scene, &[eight, eight]);
     assert_eq!(common::max_difference(&outputs[0], &outputs[1]), (0, 0), "two renders with layers differ");
     let bare = common::render(glass_over_edges(false), RenderSettings { transparency: None, ..eight });
-    let with_layers = ml_render::DebugView::TransparencyLayers;
+    let with_layers = view("transparency-layers");
     let counts = common::render(scene.clone(), RenderSettings { debug_view: with_layers, ..eight });
     let (mut outside, mut differ) = (0, 0);
     for (i, c) in counts.rgba.chunks(4).enumerate() {

@@ -11,6 +11,7 @@
 //! validation) stays silent.
 
 use crate::common;
+use crate::common::view;
 
 use glam::{Mat4, Quat, Vec3};
 use ml_cpu::camera::Camera;
@@ -40,9 +41,9 @@ struct Drawn<'a> {
 /// One renderer for both: the debug view changes passes, not the scene's resources.
 fn draw(ctx: &Context, scene: &Scene, base: RenderSettings, raster: Raster) -> [RenderOutput; 2] {
     let settings = |debug_view| RenderSettings { raster, debug_view, ..base };
-    let mut renderer = Renderer::new(ctx, scene.clone(), settings(DebugView::Triangles)).expect("renderer");
+    let mut renderer = Renderer::new(ctx, scene.clone(), settings(view("triangles"))).expect("renderer");
     let ids = renderer.render().expect("render");
-    assert!(renderer.reconfigure(settings(DebugView::None)).expect("reconfigure"), "a debug view needs a new renderer");
+    assert!(renderer.reconfigure(settings(DebugView::NONE)).expect("reconfigure"), "a debug view needs a new renderer");
     [ids, renderer.render().expect("render")]
 }
 
@@ -88,7 +89,7 @@ fn validated() -> Context {
 /// The colour of pixels no triangle covers, in the triangles view.
 fn background(ctx: &Context) -> [u8; 3] {
     let empty = Scene::new(Vec::new(), Vec::new(), Camera::seed());
-    let s = RenderSettings { debug_view: DebugView::Triangles, ..RenderSettings::new(Technique::Visibility, 8, 8) };
+    let s = RenderSettings { debug_view: view("triangles"), ..RenderSettings::new(Technique::Visibility, 8, 8) };
     let out = Renderer::new(ctx, empty, s).unwrap().render().unwrap();
     common::pixel(&out, 4, 4)
 }
@@ -228,7 +229,7 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
         scene.meshes.push(screen_mesh(&camera, cells, seed));
         let white = Material::named("white").unwrap();
         scene.objects.push(Object { transform: Mat4::IDENTITY, ..Object::placed(MeshKind::Loaded(0), Vec3::ZERO, 1.0, white) });
-        let base = RenderSettings { debug_view: DebugView::Triangles, ..RenderSettings::new(Technique::Visibility, W, H) };
+        let base = RenderSettings { debug_view: view("triangles"), ..RenderSettings::new(Technique::Visibility, W, H) };
         // Every triangle in compute: each pixel counted once, none left empty.
         // About a cell: the jittered triangles fall on both sides of it.
         let split = ((W + 16) as f32 / cells.0 as f32).max((H + 16) as f32 / cells.1 as f32).ceil() as u32;

@@ -9,6 +9,7 @@
 //! so each of those steps stays below a step of 8 bits. Every technique draws the same image.
 
 use crate::common;
+use crate::common::view;
 
 use glam::Vec3;
 use ml_cpu::camera::Camera;
@@ -111,7 +112,7 @@ type Seen = ((u32, u32), ([u8; 3], [u8; 3]));
 /// transparent layers (their resolves lay it too); debug views keep the colour.
 #[test]
 fn the_background_shows_the_environment_along_each_pixels_ray() {
-    use ml_render::{Antialiasing, Background, DebugView};
+    use ml_render::{Antialiasing, Background};
     let mut scene = sky_sphere(Material { albedo: Vec3::new(0.9, 0.9, 0.9), roughness: 0.3, metallic: 0.5 }, 1.0);
     // Its cube (256 texels a face) finer than the pixels (a texel 0.35°, a pixel 0.5°).
     scene.environment.as_mut().expect("set above").image = Arc::new(EnvironmentImage::sky(1024));
@@ -123,7 +124,7 @@ fn the_background_shows_the_environment_along_each_pixels_ray() {
     }
     let plain = Technique::ALL.len() + 3;
     settings.push(pbr(Technique::Forward));
-    settings.push(RenderSettings { debug_view: DebugView::Depth, ..seen(pbr(Technique::Visibility)) });
+    settings.push(RenderSettings { debug_view: view("depth"), ..seen(pbr(Technique::Visibility)) });
     let outs = common::render_each(&scene, &settings);
     // Pixels whose ray passes the sphere (radius 1) by a margin: the background.
     // Per background pixel, the range of what the CPU sees over the pixel (its centre and

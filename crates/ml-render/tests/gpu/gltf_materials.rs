@@ -5,6 +5,7 @@
 //! values through the G-buffer).
 
 use crate::common;
+use crate::common::view;
 
 use glam::{Quat, Vec3};
 use ml_cpu::gltf_writer::{png, quad, quarters, GltfWriter, PrimitiveData};
@@ -70,7 +71,7 @@ fn metallic_roughness_texture_sets_roughness_and_metallic() {
     let m = w.material([0.8, 0.8, 0.8, 1.0], 1.0, 0.6);
     w.json["materials"][m]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = json!({ "index": texture });
     let scene = row_of_quads(&mut w, &[(m, 0.0)], 1.2, 1.0);
-    let outputs = common::render_each(&scene, &every_technique(ShadingModel::Pbr, DebugView::GBufferMaterial, (SIZE, SIZE)));
+    let outputs = common::render_each(&scene, &every_technique(ShadingModel::Pbr, view("gbuffer-material"), (SIZE, SIZE)));
     // Quarters red, green, blue, white: (g, b) = (0, 0), (1, 0), (0, 1), (1, 1) × (0.6, 1).
     let rough = (0.6f32 * 255.0).round() as u8;
     for (centre, want) in QUARTER_CENTRES.into_iter().zip([[0, 0, 0], [rough, 0, 0], [0, 255, 0], [rough, 255, 0]]) {
@@ -96,7 +97,7 @@ fn occlusion_darkens_ambient_light_and_emission_adds_light() {
     let mut scene = row_of_quads(&mut w, &[(occluded, -1.1), (glowing, 1.1)], 1.2, 2.0);
     scene.ambient = 1.0;
     let size = (2 * SIZE, SIZE);
-    let outputs = common::render_each(&scene, &every_technique(ShadingModel::Seed, DebugView::None, size));
+    let outputs = common::render_each(&scene, &every_technique(ShadingModel::Seed, DebugView::NONE, size));
     let gamma = |linear: f32| (linear.powf(1.0 / 2.2) * 255.0).round() as u8;
     // Occlusion texel red: 1 in the red and white quarters, 0 in the others → 1 or 0.5.
     let half = gamma(0.5);
@@ -147,7 +148,7 @@ fn samplers_wrap_and_filter_as_the_file_says() {
     assert_eq!(scene.textures.len(), 4, "one image, four samplers");
     let size = (4 * SIZE, SIZE);
     let techniques = [Technique::Forward, Technique::Deferred, Technique::DeferredCompute];
-    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, DebugView::GBufferAlbedo, size)
+    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, view("gbuffer-albedo"), size)
         .into_iter()
         .filter(|s| techniques.contains(&s.technique))
         .collect();
@@ -201,7 +202,7 @@ fn orthographic_cameras_keep_sizes_and_every_technique_agrees() {
     // znear 0 cannot start logarithmic depth slices: it is moved and said so.
     assert!(warnings.len() == 1 && warnings[0].contains("znear 0"), "{warnings:?}");
     assert_eq!(ortho.camera.orthographic, Some(3.0));
-    let albedo = every_technique(ShadingModel::Pbr, DebugView::GBufferAlbedo, (SIZE, SIZE)).remove(0);
+    let albedo = every_technique(ShadingModel::Pbr, view("gbuffer-albedo"), (SIZE, SIZE)).remove(0);
     let covered = |scene: &Scene| {
         let out = common::render(scene.clone(), albedo);
         // Left half: the near quad; right half: the far one.
@@ -214,7 +215,7 @@ fn orthographic_cameras_keep_sizes_and_every_technique_agrees() {
     assert!(near > 500 && near.abs_diff(far) <= SIZE as usize, "orthographic: near quad {near} pixels, far quad {far}");
     let (near, far) = covered(&perspective);
     assert!(far * 2 < near, "perspective: near quad {near} pixels, far quad {far}");
-    let outputs = common::render_each(&ortho, &every_technique(ShadingModel::Pbr, DebugView::None, (SIZE, SIZE)));
+    let outputs = common::render_each(&ortho, &every_technique(ShadingModel::Pbr, DebugView::NONE, (SIZE, SIZE)));
     let lit = outputs[0].rgba.chunks_exact(4).filter(|p| p[0] > 80).count();
     assert!(lit > 500, "the lights light the quads: {lit} bright pixels");
     for (out, t) in outputs.iter().zip(Technique::ALL).skip(1) {
@@ -234,7 +235,7 @@ fn a_minified_texture_is_read_from_its_mipmaps() {
     let texture = w.texture(png(64, 64, &checker), "image/png");
     let m = w.textured_material(Some(texture), None);
     let scene = row_of_quads(&mut w, &[(m, 0.0)], 8.0, 1.0);
-    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, DebugView::GBufferAlbedo, (SIZE, SIZE))
+    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, view("gbuffer-albedo"), (SIZE, SIZE))
         .into_iter()
         .filter(|s| [Technique::Forward, Technique::DeferredCompute].contains(&s.technique))
         .collect();
@@ -270,7 +271,7 @@ fn dark_textures_keep_their_steps_through_the_gbuffer() {
     let material = w.textured_material(Some(texture), None);
     let mut scene = row_of_quads(&mut w, &[(material, 0.0)], 1.2, 1.0);
     scene.lights = vec![ml_cpu::gpu_types::PointLight { position_radius: [0.3, -0.2, 1.5, 6.0], color: [1.0, 1.0, 1.0, 0.0] }];
-    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, DebugView::None, (SIZE, SIZE))
+    let settings: Vec<RenderSettings> = every_technique(ShadingModel::Pbr, DebugView::NONE, (SIZE, SIZE))
         .into_iter()
         .map(|s| RenderSettings { exposure: ml_render::Exposure::Ev(5.0), ..s })
         .collect();

@@ -19,6 +19,7 @@
 //! culling on against off) stay exact where they were: they live in the other tests.
 
 use crate::common;
+use crate::common::view;
 
 use ml_cpu::bench_scene::bench_scene;
 use ml_cpu::gltf_writer::{png, quad, quarters, GltfWriter, PrimitiveData};
@@ -78,7 +79,7 @@ struct Case {
 
 impl Case {
     fn new(name: &str, scene: Scene, shading: ShadingModel) -> Case {
-        Case { name: name.into(), scene, shading, omni: None, view: DebugView::None, techniques: Technique::ALL.to_vec() }
+        Case { name: name.into(), scene, shading, omni: None, view: DebugView::NONE, techniques: Technique::ALL.to_vec() }
     }
 }
 
@@ -127,19 +128,19 @@ fn cases() -> Vec<Case> {
         Case::new("gltf-textured-pbr", textured_gltf(), ShadingModel::Pbr),
     ];
     // Debug views: what every technique shows of its surfaces, and the views of one kind of pass.
-    for view in [DebugView::GBufferNormal, DebugView::GBufferMaterial, DebugView::Depth] {
+    for view in [view("gbuffer-normal"), view("gbuffer-material"), view("depth")] {
         cases.push(Case { view, ..Case::new(&format!("view-{}", view.name()), seed.clone(), ShadingModel::Seed) });
     }
-    cases.push(Case { view: DebugView::GBufferAlbedo, ..Case::new("view-gbuffer-albedo-gltf", textured_gltf(), ShadingModel::Pbr) });
+    cases.push(Case { view: view("gbuffer-albedo"), ..Case::new("view-gbuffer-albedo-gltf", textured_gltf(), ShadingModel::Pbr) });
     let clustered_forward = vec![Technique::ClusteredCpu, Technique::ClusteredGpu];
     cases.push(Case {
-        view: DebugView::ClusterHeat,
+        view: view("cluster-heat"),
         techniques: clustered_forward,
         ..Case::new("view-cluster-heat", seed, ShadingModel::Seed)
     });
     let shadow_map = Case::new("view-shadow-map", teapots.with_floor(), ShadingModel::BlinnPhong);
-    cases.push(Case { view: DebugView::ShadowMap, ..shadow_map });
-    cases.push(Case { view: DebugView::ShadowCube, omni, ..Case::new("view-shadow-cube", Scene::shadow_room(), ShadingModel::Pbr) });
+    cases.push(Case { view: view("shadow-map"), ..shadow_map });
+    cases.push(Case { view: view("shadow-cube"), omni, ..Case::new("view-shadow-cube", Scene::shadow_room(), ShadingModel::Pbr) });
     cases
 }
 

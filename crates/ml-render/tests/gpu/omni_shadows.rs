@@ -6,6 +6,7 @@
 //! edge (or on an object's silhouette) are left out.
 
 use crate::common;
+use crate::common::view;
 
 use glam::Vec3;
 use ml_cpu::camera::Camera;
@@ -16,7 +17,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
 use ml_cpu::textures::cube_direction;
 use ml_render::settings::multiview_depth_is_broken;
-use ml_render::{DebugView, OmniShadowMode, OmniShadowSettings, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
+use ml_render::{OmniShadowMode, OmniShadowSettings, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::collections::HashMap;
 
@@ -206,7 +207,7 @@ fn shadow_cube_view_shows_each_face_in_its_cell() {
     let (width, height) = (4 * SIZE, 3 * SIZE);
     let mut s = RenderSettings::new(Technique::Forward, width, height);
     s.omni = Some(OmniShadowSettings { mode: OmniShadowMode::Layered, lights: 1, all: false, size: SIZE });
-    s.debug_view = DebugView::ShadowCube;
+    s.debug_view = view("shadow-cube");
     let out = common::render(scene, s);
     let cells = [(2, 1), (0, 1), (1, 0), (1, 2), (1, 1), (3, 1)];
     let grey_at = |face: usize, tx: u32, ty: u32| {

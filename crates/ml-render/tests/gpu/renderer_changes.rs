@@ -5,6 +5,7 @@
 //! with validation on — and moving the camera must match a renderer made at that camera.
 
 use crate::common;
+use crate::common::view;
 
 use glam::Vec3;
 use ml_cpu::camera::Camera;
@@ -13,7 +14,7 @@ use ml_cpu::lights::{LightLayout, LightParams, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
-use ml_render::{DebugView, RenderSettings, Renderer, ShadingModel, Technique};
+use ml_render::{RenderSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 
@@ -40,7 +41,7 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
             "a new model needs new pipelines"
         );
         // A debug view and back (the subpass techniques swap their tone map).
-        let depth_view = RenderSettings { debug_view: DebugView::Depth, ..resized };
+        let depth_view = RenderSettings { debug_view: view("depth"), ..resized };
         assert!(live.reconfigure(depth_view).expect("a debug view"));
         let depth = live.render().expect("render the depth view");
         let fresh_depth = Renderer::new(&ctx, seed_scene(&LightParams::seed_default()), depth_view).and_then(|mut r| r.render()).unwrap();

@@ -3,6 +3,7 @@
 //! (≤ 1/255; measured: identical).
 
 use crate::common;
+use crate::common::view;
 
 use ml_cpu::lights::LightParams;
 use ml_cpu::material::Material;
@@ -58,8 +59,8 @@ fn gltf_nodes_place_their_coloured_quads() {
     const SIZE: u32 = 128;
     let mut albedo = RenderSettings::new(Technique::Forward, SIZE, SIZE);
     albedo.shading = ShadingModel::Pbr;
-    albedo.debug_view = DebugView::GBufferAlbedo;
-    let shaded = RenderSettings { debug_view: DebugView::None, technique: Technique::DeferredCompute, ..albedo };
+    albedo.debug_view = view("gbuffer-albedo");
+    let shaded = RenderSettings { debug_view: DebugView::NONE, technique: Technique::DeferredCompute, ..albedo };
     let outputs = common::render_each(&scene, &[albedo, shaded]);
     let view_proj = scene.camera.projection(1.0) * scene.camera.view();
     // The blue quad's node is the green node's child: its +z offset turns with the parent to −y.
@@ -119,7 +120,7 @@ fn gltf_textures_colour_and_bend_their_quads() {
     };
     let outputs = common::render_each(
         &scene,
-        &[settings(DebugView::GBufferAlbedo, Technique::Forward), settings(DebugView::GBufferNormal, Technique::Deferred)],
+        &[settings(view("gbuffer-albedo"), Technique::Forward), settings(view("gbuffer-normal"), Technique::Deferred)],
     );
     let view_proj = scene.camera.projection(1.0) * scene.camera.view();
     let pixel_at = |x: f32, object_point: Vec3| {
@@ -147,7 +148,7 @@ fn gltf_textures_colour_and_bend_their_quads() {
     // plain quad (lit symmetrically) sets the scale.
     let brightness = |light_x: f32, quad_x: f32| {
         let s = build(light_x);
-        let out = common::render(s, settings(DebugView::None, Technique::Forward));
+        let out = common::render(s, settings(DebugView::NONE, Technique::Forward));
         let (px, py) = pixel_at(quad_x, Vec3::ZERO);
         common::pixel(&out, px, py).iter().map(|&c| c as u32).sum::<u32>()
     };

@@ -6,6 +6,7 @@
 //! the memory stays within the budget at 4,096 shadowed lights; absurd budgets are refused.
 
 use crate::common;
+use crate::common::view;
 
 use common::shadow_rays::sure_pixels;
 use glam::Vec3;
@@ -17,7 +18,7 @@ use ml_cpu::scene::{Object, Scene};
 use ml_render::settings::AtlasSettings;
 use ml_render::AtlasStats;
 use ml_render::{
-    DebugView, FrameSink, OmniShadowMode, OmniShadowSettings, RenderError, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique,
+    FrameSink, OmniShadowMode, OmniShadowSettings, RenderError, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique,
 };
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
@@ -319,7 +320,7 @@ fn absurd_budgets_are_refused() {
 #[test]
 fn the_atlas_view_shows_the_faces() {
     let mut s = settings(Technique::Forward, ShadingModel::Pbr, Some((atlas(256, true, Some(CUBE)), 2)));
-    s.debug_view = DebugView::ShadowAtlas;
+    s.debug_view = view("shadow-atlas");
     let out = common::render(two_light_room(), s);
     let black = out.rgba.chunks_exact(4).filter(|p| p[..3] == [0, 0, 0]).count();
     let total = (SIZE * SIZE) as usize;

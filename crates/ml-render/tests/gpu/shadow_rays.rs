@@ -11,6 +11,7 @@
 //! the cubes' texels.
 
 use crate::common;
+use crate::common::view;
 
 use glam::Vec3;
 use ml_cpu::gpu_types::PointLight;
@@ -316,7 +317,7 @@ fn alpha_masked_surfaces_cast_the_shadows_their_masks_cut() {
 #[test]
 fn the_ray_cost_view_shows_where_rays_are_traced() {
     let scene = Scene::shadow_room();
-    let view = |technique| RenderSettings { debug_view: ml_render::DebugView::RayCost, ..settings(technique, true, 1) };
+    let view = |technique| RenderSettings { debug_view: view("ray-cost"), ..settings(technique, true, 1) };
     let outputs = common::render_each(&scene, &[view(Technique::Forward), view(Technique::Visibility), view(Technique::DeferredCompute)]);
     let lit = |out: &RenderOutput| out.rgba.chunks_exact(4).filter(|p| p[..3] != [0, 0, 0]).count();
     let traced = lit(&outputs[0]);

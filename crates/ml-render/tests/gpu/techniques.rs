@@ -13,6 +13,7 @@
 //! arithmetic differently.
 
 use crate::common;
+use crate::common::view;
 
 use ml_cpu::cluster::ClusterDims;
 use ml_cpu::lights::LightParams;
@@ -147,7 +148,7 @@ fn every_technique_equals_forward_with_blinn_phong_and_pbr() {
 fn cluster_heat_view_paints_counts_and_a_legend() {
     let scene = Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), &LightParams::seed_default()).unwrap();
     let mut settings = RenderSettings::new(Technique::ClusteredCpu, 320, 180);
-    settings.debug_view = ml_render::DebugView::ClusterHeat;
+    settings.debug_view = view("cluster-heat");
     let heat = common::render(scene.clone(), settings);
     // The legend's ramp spans x ∈ [2%, 35%] of the width near the bottom: black → red.
     let y = (180.0 * 0.915) as u32;

@@ -4,6 +4,7 @@
 //! through the inverse transpose; a model-matrix normal would tilt visibly).
 
 use crate::common;
+use crate::common::view;
 
 use glam::{Mat3, Mat4, Quat, Vec3};
 use ml_cpu::camera::Camera;
@@ -11,7 +12,7 @@ use ml_cpu::gpu_types::PointLight;
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::{DebugView, RenderSettings, Technique};
+use ml_render::{RenderSettings, Technique};
 
 const SIZE: u32 = 96;
 
@@ -59,7 +60,7 @@ fn a_turned_uneven_ellipsoid_has_the_analytic_normals() {
         .iter()
         .map(|&t| {
             let mut s = RenderSettings::new(t, SIZE, SIZE);
-            s.debug_view = DebugView::GBufferNormal;
+            s.debug_view = view("gbuffer-normal");
             s
         })
         .collect();

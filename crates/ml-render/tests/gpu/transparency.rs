@@ -21,6 +21,7 @@
 //!   the benchmarks render (`ml_cpu::forest`, BLEND leaves), small.
 
 use crate::common;
+use crate::common::view;
 
 use glam::{Mat4, Quat, Vec3, Vec4};
 use ml_cpu::camera::Camera;
@@ -33,8 +34,8 @@ use ml_cpu::scene::{AlphaMode, Object, Scene};
 use ml_cpu::shading::{aces_tone_map, encode_gamma_unorm8, shade_seed};
 use ml_cpu::transparency::{composite, Layer};
 use ml_render::{
-    Antialiasing, DebugView, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings,
-    TransparencyStats, LAYER_KEEP,
+    Antialiasing, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings, TransparencyStats,
+    LAYER_KEEP,
 };
 use ml_vk::{Context, ContextDesc};
 use serde_json::json;
@@ -492,7 +493,7 @@ fn foliage_shows_the_background_through_its_holes_and_blends_its_soft_edges_alik
 #[test]
 fn the_layer_view_counts_each_pixels_layers() {
     let mut s = settings(Technique::Visibility);
-    s.debug_view = DebugView::TransparencyLayers;
+    s.debug_view = view("transparency-layers");
     let scene = scene([0, 1, 2]);
     let out = common::render(scene.clone(), s);
     // No layer: black; more layers: hotter colours, never black.

@@ -281,3 +281,8 @@ pub fn dispatch_probe(ctx: &Context, probe: &ml_shaders::Shader, buffers: &[(&st
     ml_vk::shader::release_pipeline(ctx, pipeline);
     sets.destroy(ctx);
 }
+
+/// The debug view of that name.
+pub fn view(name: &str) -> ml_render::DebugView {
+    ml_render::DebugView::from_name(name).expect("a debug view")
+}
