@@ -70,6 +70,9 @@ pub trait ListUpload {
     fn max_entries(&self, ctx: &Context) -> usize;
 }
 
+/// What a pass is to the frame's recording: its pipelines and sets, what it reads and writes,
+/// its commands. What it does around the recording — a CPU step, buffers per frame slot,
+/// read-backs, figures, uniforms — is its `FrameWork`, where it has any.
 pub trait Pass {
     /// Name in the timing table; None: untimed (debug views, CPU work).
     fn timer_name(&self) -> Option<&'static str>;
@@ -90,6 +93,17 @@ pub trait Pass {
     /// Record the pass into a frame's command buffer.
     fn record(&self, rec: &Recording);
 
+    fn destroy(&mut self, ctx: &Context);
+
+    /// Its work around the recording (`Some(self)` where it implements `FrameWork`).
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        None
+    }
+}
+
+/// What a pass does around the frame's recording, each step called by the renderer at its
+/// time in the frame (docs/architecture.md, "Adding a feature"): most passes do none of it.
+pub trait FrameWork {
     /// The pass's CPU step for a frame, before the frame is recorded (lights assigned on the
     /// CPU, the shadowed lights placed and the shadow atlas planned): what `record` then
     /// draws from.
@@ -123,12 +137,4 @@ pub trait Pass {
     /// Fill the frame's uniforms that the pass owns (the light grid's placement), the lights
     /// moved by `light_offset` this frame.
     fn frame_uniforms(&self, _uniforms: &mut ml_cpu::gpu_types::FrameUniforms, _light_offset: glam::Vec3) {}
-
-    /// The projection or image size changed; slot 0's uniforms hold the new ones and no frame
-    /// is in flight.
-    fn projection_changed(&mut self, _ctx: &Context) -> Result<(), VkError> {
-        Ok(())
-    }
-
-    fn destroy(&mut self, ctx: &Context);
 }

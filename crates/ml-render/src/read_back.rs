@@ -1,5 +1,5 @@
 //! What the host reads of a frame once its slot's fence has signalled (statistics, the
-//! exposure meter's sums), declared by the passes (`Pass::host_reads`) and carried out by the
+//! exposure meter's sums), declared by the passes (`FrameWork::host_reads`) and carried out by the
 //! renderer at the frame's end: one barrier the sync model derives from every declared read
 //! orders each buffer after its last use in the frame, then the copies of the buffers that
 //! live in device memory, then one barrier that makes the copies visible to the host. No pass

@@ -390,14 +390,14 @@ impl<'a> Renderer<'a> {
         };
         for f in 0..FRAMES_IN_FLIGHT {
             self.frames.push(FrameInFlight::new(ctx, &setup)?);
-            for p in &mut self.passes {
-                p.create_slot(ctx, f, extent)?;
+            for work in self.passes.iter_mut().filter_map(|p| p.frame_work()) {
+                work.create_slot(ctx, f, extent)?;
             }
         }
         for f in 0..FRAMES_IN_FLIGHT {
             self.bind_passes(f)?;
         }
-        self.projection_changed()?;
+        self.projection_changed();
         self.readbacks.make_all(ctx, extent.width as u64 * extent.height as u64 * 4)
     }
 
@@ -405,7 +405,8 @@ impl<'a> Renderer<'a> {
     /// passes' own (the slot is idle). In debug builds, every resource a pass's shaders bind
     /// that the frame orders by declared uses must be among the pass's (`sync::undeclared`).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
-        let owned: Vec<(&'static str, vk::Buffer)> = self.passes.iter().flat_map(|p| p.slot_buffers(f)).collect();
+        let owned: Vec<(&'static str, vk::Buffer)> =
+            self.passes.iter_mut().filter_map(|p| p.frame_work()).flat_map(|w| w.slot_buffers(f)).collect();
         let shadows = self.shadows.borrow();
         let parts = scene_parts(&shadows, &self.environment);
         let scene: Vec<_> = self.gpu.named_buffers().into_iter().chain(parts.iter().flat_map(|p| p.named_buffers())).collect();
@@ -426,11 +427,9 @@ impl<'a> Renderer<'a> {
         Ok(())
     }
 
-    /// Tell the passes the projection (or size) changed, with slot 0's uniforms holding it (no
-    /// frame in flight).
-    fn projection_changed(&mut self) -> Result<(), VkError> {
+    /// Slot 0's uniforms with the new projection (or size), no frame in flight.
+    fn projection_changed(&mut self) {
         self.write_uniforms(0, 0.0);
-        self.passes.iter_mut().try_for_each(|p| p.projection_changed(self.ctx))
     }
 
     /// The passes the timer reports, in order.
@@ -628,7 +627,7 @@ impl<'a> Renderer<'a> {
         if self.view.projection != projection {
             // Frame 0's uniforms carry the projection to the passes: wait for its frame.
             self.ctx.wait_idle()?;
-            self.projection_changed()?;
+            self.projection_changed();
         }
         Ok(())
     }
@@ -718,8 +717,8 @@ impl<'a> Renderer<'a> {
             stats.add_gpu(&ms);
         }
         let mut report = SlotReport::default();
-        for p in &self.passes {
-            p.collect(f, &mut report, stats);
+        for work in self.passes.iter_mut().filter_map(|p| p.frame_work()) {
+            work.collect(f, &mut report, stats);
         }
         self.rays_traced[f] = self.frames[f].take_ray_count();
         self.reports[f] = report;
@@ -759,8 +758,8 @@ impl<'a> Renderer<'a> {
             stats,
             assigned: None,
         };
-        for p in &mut self.passes {
-            p.prepare(&mut prepare)?;
+        for work in self.passes.iter_mut().filter_map(|p| p.frame_work()) {
+            work.prepare(&mut prepare)?;
         }
         let assigned = prepare.assigned;
         let assign_ms = assigned.map(|(ms, _)| ms);
@@ -812,8 +811,8 @@ impl<'a> Renderer<'a> {
         for part in scene_parts(&self.shadows.borrow(), &self.environment) {
             part.frame_uniforms(&mut uniforms);
         }
-        for p in &self.passes {
-            p.frame_uniforms(&mut uniforms, light_offset);
+        for work in self.passes.iter_mut().filter_map(|p| p.frame_work()) {
+            work.frame_uniforms(&mut uniforms, light_offset);
         }
         frame.uniforms.write(0, &[uniforms]);
     }
@@ -852,7 +851,7 @@ impl<'a> Renderer<'a> {
         }
         // The colour target as the read-back and a window's blit take it; what the passes'
         // `collect` reads, as the host reads it or copied for it.
-        let reads: Vec<HostRead> = self.passes.iter().flat_map(|p| p.host_reads(f)).collect();
+        let reads: Vec<HostRead> = self.passes.iter_mut().filter_map(|p| p.frame_work()).flat_map(|w| w.host_reads(f)).collect();
         let frame_end: Vec<sync::Use> = std::iter::once(sync::frame_end()).chain(reads.iter().map(HostRead::at_frame_end)).collect();
         frame.sync.barrier(&mut self.shared_sync, (ctx, cmd), &frame_end, &image);
         read_back::record_copies(ctx, cmd, &reads);

@@ -6,7 +6,7 @@
 use crate::error::RenderError;
 use crate::frame::lists_too_long;
 use crate::frame_resources::FrameResources;
-use crate::pass::{Pass, Prepare, Recording};
+use crate::pass::{FrameWork, Pass, Prepare, Recording};
 use ml_cpu::cluster::{ClusterAssigner, ClusterLists};
 use ml_vk::{Context, VkError};
 use std::time::Instant;
@@ -32,6 +32,14 @@ impl Pass for CpuClusterAssign {
 
     fn record(&self, _: &Recording) {}
 
+    fn destroy(&mut self, _: &Context) {}
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for CpuClusterAssign {
     fn prepare(&mut self, up: &mut Prepare) -> Result<(), RenderError> {
         let start = Instant::now();
         // The CPU also holds the lists (and their pairs) in memory: cap what it builds.
@@ -44,6 +52,4 @@ impl Pass for CpuClusterAssign {
         up.assigned = Some((ms, self.lists.stats()));
         Ok(())
     }
-
-    fn destroy(&mut self, _: &Context) {}
 }

@@ -8,7 +8,7 @@ use crate::compute_pass::ComputePass;
 use crate::descriptors::Resource;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::pass::{Pass, Recording, SlotReport};
+use crate::pass::{FrameWork, Pass, Recording, SlotReport};
 use crate::read_back::{HostRead, ReadBack};
 use crate::report::FrameStats;
 use crate::sync::{Use, COLOUR_TARGET};
@@ -73,20 +73,8 @@ impl Pass for ExposureMeter {
         vec![Use::at(COLOUR_TARGET, read, Some(vk::ImageLayout::GENERAL)), Use::at(SUMS, (compute, vk::AccessFlags::SHADER_WRITE), None)]
     }
 
-    fn host_reads(&self, slot: usize) -> Vec<HostRead> {
-        vec![self.readback.of(slot, SUMS, self.sums[slot].raw)]
-    }
-
     fn record(&self, rec: &Recording) {
         self.pass.dispatch(rec.ctx, rec.cmd, rec.slot, (&[], &[]), rec.extent);
-    }
-
-    fn collect(&self, slot: usize, report: &mut SlotReport, _: &mut FrameStats) {
-        let bytes = self.groups[slot] as usize * 8;
-        let sums: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&self.readback.bytes(slot)[..bytes]);
-        let (log2_sum, pixels) = sums.iter().fold((0.0f64, 0.0f64), |(s, n), g| (s + g[0] as f64, n + g[1] as f64));
-        // A frame with no metered pixel (all background) keeps the exposure it had.
-        report.log2_luminance = (pixels > 0.0).then_some((log2_sum / pixels) as f32);
     }
 
     fn destroy(&mut self, ctx: &Context) {
@@ -96,5 +84,23 @@ impl Pass for ExposureMeter {
         }
         self.readback.destroy(ctx);
         self.groups.fill(0);
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for ExposureMeter {
+    fn host_reads(&self, slot: usize) -> Vec<HostRead> {
+        vec![self.readback.of(slot, SUMS, self.sums[slot].raw)]
+    }
+
+    fn collect(&self, slot: usize, report: &mut SlotReport, _: &mut FrameStats) {
+        let bytes = self.groups[slot] as usize * 8;
+        let sums: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&self.readback.bytes(slot)[..bytes]);
+        let (log2_sum, pixels) = sums.iter().fold((0.0f64, 0.0f64), |(s, n), g| (s + g[0] as f64, n + g[1] as f64));
+        // A frame with no metered pixel (all background) keeps the exposure it had.
+        report.log2_luminance = (pixels > 0.0).then_some((log2_sum / pixels) as f32);
     }
 }

@@ -23,7 +23,7 @@ use super::LightGridStats;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::pass::{Pass, Recording, SlotReport};
+use crate::pass::{FrameWork, Pass, Recording, SlotReport};
 use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::specialization::compute_pipeline;
@@ -316,17 +316,6 @@ impl Pass for LightGridBuild {
         Some("light grid build")
     }
 
-    fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
-        let s = &self.slots[slot];
-        vec![
-            (LIST_ENDS, s.lists.raw),
-            (POSITIONS, s.positions.raw),
-            (COLORS, s.colors.raw),
-            (INDICES, s.indices.raw),
-            (LIGHT_GRID_OCCUPANCY, s.occupancy.raw),
-        ]
-    }
-
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let own = &self.slots[frame.slot];
         self.sets.write(ctx, frame.slot, &|name| {
@@ -360,6 +349,31 @@ impl Pass for LightGridBuild {
         uses
     }
 
+    fn record(&self, rec: &Recording) {
+        self.record_build(rec.ctx, rec.cmd, rec.slot);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.release_all(ctx);
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for LightGridBuild {
+    fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
+        let s = &self.slots[slot];
+        vec![
+            (LIST_ENDS, s.lists.raw),
+            (POSITIONS, s.positions.raw),
+            (COLORS, s.colors.raw),
+            (INDICES, s.indices.raw),
+            (LIGHT_GRID_OCCUPANCY, s.occupancy.raw),
+        ]
+    }
+
     /// The feedback, where the scan wrote it (host-visible).
     fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
         vec![HostRead::in_place(FEEDBACK)]
@@ -370,10 +384,6 @@ impl Pass for LightGridBuild {
         uniforms.light_grid_origin = s.origin_at(light_offset).extend(1.0 / s.cell).to_array();
         uniforms.light_grid_dims = s.dims.extend(s.cells()).to_array();
         uniforms.light_grid_reach = [s.reach, s.wide as f32, 0.0, 0.0];
-    }
-
-    fn record(&self, rec: &Recording) {
-        self.record_build(rec.ctx, rec.cmd, rec.slot);
     }
 
     fn collect(&self, slot: usize, report: &mut SlotReport, stats: &mut FrameStats) {
@@ -389,10 +399,6 @@ impl Pass for LightGridBuild {
         };
         report.max_lights = Some(grid.heat_top());
         stats.set_feature(grid);
-    }
-
-    fn destroy(&mut self, ctx: &Context) {
-        self.release_all(ctx);
     }
 }
 

@@ -9,7 +9,7 @@ use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::descriptors::Resource;
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
-use crate::pass::{Pass, Recording, SlotReport};
+use crate::pass::{FrameWork, Pass, Recording, SlotReport};
 use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
@@ -55,14 +55,6 @@ impl Pass for LightCount {
         None
     }
 
-    fn create_slot(&mut self, ctx: &Context, slot: usize, extent: vk::Extent2D) -> Result<(), VkError> {
-        self.counts[slot].destroy(ctx);
-        let (x, y) = self.pass.groups(extent);
-        let bytes = x as u64 * y as u64 * 16;
-        self.counts[slot] = Buffer::new(ctx, "light counts", bytes, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu)?;
-        Ok(())
-    }
-
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let counts = Resource::Buffer(self.counts[frame.slot].raw);
         let depth = self.pass.sampled(&frame.targets.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
@@ -86,12 +78,33 @@ impl Pass for LightCount {
         uses
     }
 
-    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
-        vec![HostRead::in_place(LIGHT_COUNTS)]
-    }
-
     fn record(&self, rec: &Recording) {
         self.pass.dispatch(rec.ctx, rec.cmd, rec.slot, (&[rec.scene.textures.set], &[]), rec.extent);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pass.destroy(ctx);
+        for b in &mut self.counts {
+            b.destroy(ctx);
+        }
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for LightCount {
+    fn create_slot(&mut self, ctx: &Context, slot: usize, extent: vk::Extent2D) -> Result<(), VkError> {
+        self.counts[slot].destroy(ctx);
+        let (x, y) = self.pass.groups(extent);
+        let bytes = x as u64 * y as u64 * 16;
+        self.counts[slot] = Buffer::new(ctx, "light counts", bytes, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu)?;
+        Ok(())
+    }
+
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(LIGHT_COUNTS)]
     }
 
     fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
@@ -103,12 +116,5 @@ impl Pass for LightCount {
             sum.reached += u64::from(reached);
         }
         stats.set_feature(sum);
-    }
-
-    fn destroy(&mut self, ctx: &Context) {
-        self.pass.destroy(ctx);
-        for b in &mut self.counts {
-            b.destroy(ctx);
-        }
     }
 }

@@ -7,7 +7,7 @@
 use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
-use crate::pass::{Pass, Recording};
+use crate::pass::{FrameWork, Pass, Recording};
 use crate::read_back::HostRead;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
@@ -74,10 +74,6 @@ impl Pass for ComputeLighting {
         uses
     }
 
-    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
-        vec![HostRead::in_place(RAY_COUNT)]
-    }
-
     fn record(&self, rec: &Recording) {
         let sets = [rec.scene.textures.set];
         self.pass.record_into_colour_target(rec.ctx, rec.cmd, (rec.slot, &sets), rec.targets.color.raw, rec.extent);
@@ -85,5 +81,15 @@ impl Pass for ComputeLighting {
 
     fn destroy(&mut self, ctx: &Context) {
         self.pass.destroy(ctx);
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for ComputeLighting {
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(RAY_COUNT)]
     }
 }

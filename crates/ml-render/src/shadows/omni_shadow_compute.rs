@@ -8,7 +8,7 @@
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::pass::{Pass, Prepare, Recording, SlotReport};
+use crate::pass::{FrameWork, Pass, Prepare, Recording, SlotReport};
 use crate::read_back::{HostRead, ReadBack};
 use crate::report::{FeatureStats, FrameStats};
 use crate::scene::meshlets::MeshletGeometryView;
@@ -83,25 +83,6 @@ impl Pass for OmniShadowCompute {
         uses
     }
 
-    /// The raster's counters, where the frame drew (the slot's copy keeps what it had
-    /// otherwise).
-    fn host_reads(&self, slot: usize) -> Vec<HostRead> {
-        if self.drawn_lights(&self.shadows.borrow().omni).is_empty() {
-            return Vec::new();
-        }
-        vec![self.readback.of(slot, SHADOW_RASTER_COUNTERS, self.raster.counters.raw)]
-    }
-
-    fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
-        let mut shadows = self.shadows.borrow_mut();
-        let omni = &mut shadows.omni;
-        omni.place(p.rest_lights, p.light_offset);
-        if let ShadowViews::Atlas { .. } = self.views {
-            self.plan = plan_atlas(omni, p)?;
-        }
-        Ok(())
-    }
-
     fn record(&self, rec: &Recording) {
         let shadows = self.shadows.borrow();
         let lights = self.drawn_lights(&shadows.omni);
@@ -123,6 +104,36 @@ impl Pass for OmniShadowCompute {
         }
     }
 
+    fn destroy(&mut self, ctx: &Context) {
+        self.raster.destroy(ctx);
+        self.readback.destroy(ctx);
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for OmniShadowCompute {
+    /// The raster's counters, where the frame drew (the slot's copy keeps what it had
+    /// otherwise).
+    fn host_reads(&self, slot: usize) -> Vec<HostRead> {
+        if self.drawn_lights(&self.shadows.borrow().omni).is_empty() {
+            return Vec::new();
+        }
+        vec![self.readback.of(slot, SHADOW_RASTER_COUNTERS, self.raster.counters.raw)]
+    }
+
+    fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
+        let mut shadows = self.shadows.borrow_mut();
+        let omni = &mut shadows.omni;
+        omni.place(p.rest_lights, p.light_offset);
+        if let ShadowViews::Atlas { .. } = self.views {
+            self.plan = plan_atlas(omni, p)?;
+        }
+        Ok(())
+    }
+
     fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
         let c: OmniRasterCounters = self.readback.read(slot);
         stats.set_feature(OmniRasterStats {
@@ -133,11 +144,6 @@ impl Pass for OmniShadowCompute {
             texels: c.drawn[2],
             pairs_in_place: c.drawn[3],
         });
-    }
-
-    fn destroy(&mut self, ctx: &Context) {
-        self.raster.destroy(ctx);
-        self.readback.destroy(ctx);
     }
 }
 

@@ -5,7 +5,7 @@
 
 use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
-use crate::pass::{Pass, Prepare, Recording};
+use crate::pass::{FrameWork, Pass, Prepare, Recording};
 use crate::shadows::stores::SharedShadows;
 use crate::sync::Use;
 use ml_vk::{Context, VkError};
@@ -36,15 +36,21 @@ impl Pass for OmniShadowPass {
         Ok(())
     }
 
-    fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
-        self.shadows.borrow_mut().omni.place(p.rest_lights, p.light_offset);
-        Ok(())
-    }
-
     fn record(&self, rec: &Recording) {
         let omni = &self.shadows.borrow().omni;
         omni.record(rec.ctx, rec.cmd, omni.placed(), (&rec.scene.meshes, rec.objects));
     }
 
     fn destroy(&mut self, _: &Context) {}
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for OmniShadowPass {
+    fn prepare(&mut self, p: &mut Prepare) -> Result<(), RenderError> {
+        self.shadows.borrow_mut().omni.place(p.rest_lights, p.light_offset);
+        Ok(())
+    }
 }

@@ -12,7 +12,7 @@ use crate::compute_pass::ComputePass;
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::{layer_mesh, SceneMeshes};
-use crate::pass::{Pass, Recording, SlotReport};
+use crate::pass::{FrameWork, Pass, Recording, SlotReport};
 use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
@@ -398,26 +398,6 @@ impl Pass for TransparentBuild {
         Some("transparent layers")
     }
 
-    fn create_slot(&mut self, ctx: &Context, slot: usize, extent: vk::Extent2D) -> Result<(), VkError> {
-        if let Some(mut old) = self.layers[slot].take() {
-            old.destroy(ctx);
-        }
-        self.layers[slot] = Some(LayerBuffers::new(
-            ctx,
-            extent,
-            (self.settings.nodes(extent.width, extent.height), node_bytes(self.settings.lobe_textures)),
-        )?);
-        Ok(())
-    }
-
-    fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
-        self.layers[slot].as_ref().map_or_else(Vec::new, |l| l.named().to_vec())
-    }
-
-    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
-        vec![HostRead::in_place(LAYER_BUFFERS[2])]
-    }
-
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let depth = vk::DescriptorImageInfo::default()
             .sampler(self.sampler)
@@ -462,20 +442,6 @@ impl Pass for TransparentBuild {
         self.record_compute(rec);
     }
 
-    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
-        let Some(layers) = self.layers[slot].as_ref() else { return };
-        let [fragments, merged, group_triangles, tiled_triangles] = layers.counts();
-        stats.set_feature(TransparencyStats {
-            fragments: fragments as u64,
-            capacity: layers.capacity(),
-            node_bytes: layers.node_bytes,
-            pixels: layers.pixels(),
-            merged_pixels: merged as u64,
-            group_triangles: group_triangles as u64,
-            tiled_triangles: tiled_triangles as u64,
-        });
-    }
-
     fn destroy(&mut self, ctx: &Context) {
         // SAFETY: no pending work uses it; a null handle is ignored.
         unsafe { ctx.device.destroy_sampler(self.sampler, None) };
@@ -493,6 +459,46 @@ impl Pass for TransparentBuild {
         for mut layers in self.layers.iter_mut().filter_map(Option::take) {
             layers.destroy(ctx);
         }
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for TransparentBuild {
+    fn create_slot(&mut self, ctx: &Context, slot: usize, extent: vk::Extent2D) -> Result<(), VkError> {
+        if let Some(mut old) = self.layers[slot].take() {
+            old.destroy(ctx);
+        }
+        self.layers[slot] = Some(LayerBuffers::new(
+            ctx,
+            extent,
+            (self.settings.nodes(extent.width, extent.height), node_bytes(self.settings.lobe_textures)),
+        )?);
+        Ok(())
+    }
+
+    fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
+        self.layers[slot].as_ref().map_or_else(Vec::new, |l| l.named().to_vec())
+    }
+
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(LAYER_BUFFERS[2])]
+    }
+
+    fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
+        let Some(layers) = self.layers[slot].as_ref() else { return };
+        let [fragments, merged, group_triangles, tiled_triangles] = layers.counts();
+        stats.set_feature(TransparencyStats {
+            fragments: fragments as u64,
+            capacity: layers.capacity(),
+            node_bytes: layers.node_bytes,
+            pixels: layers.pixels(),
+            merged_pixels: merged as u64,
+            group_triangles: group_triangles as u64,
+            tiled_triangles: tiled_triangles as u64,
+        });
     }
 }
 

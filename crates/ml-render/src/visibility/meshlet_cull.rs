@@ -16,7 +16,7 @@ use crate::antialiasing::Antialiasing;
 use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::pass::{Pass, Recording, SlotReport};
+use crate::pass::{FrameWork, Pass, Recording, SlotReport};
 use crate::plan::Phase;
 use crate::read_back::HostRead;
 use crate::report::{FeatureStats, FrameStats};
@@ -200,6 +200,24 @@ impl Pass for MeshletCull {
         }
     }
 
+    fn destroy(&mut self, ctx: &Context) {
+        ml_vk::shader::release_pipeline(ctx, self.instance_pipeline);
+        ml_vk::shader::release_pipeline(ctx, self.meshlet_pipeline);
+        ml_vk::shader::release_pipeline(ctx, self.triangle_pipeline);
+        self.instance_pipeline = vk::Pipeline::null();
+        self.meshlet_pipeline = vk::Pipeline::null();
+        self.triangle_pipeline = vk::Pipeline::null();
+        self.pipeline_layout = vk::PipelineLayout::null();
+        self.sets.destroy(ctx);
+        self.scene.borrow_mut().destroy(ctx);
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for MeshletCull {
     /// The late phase's counters, copied once the frame's every pass has added to them (the
     /// large triangles' pass adds the pixels it covered).
     fn host_reads(&self, slot: usize) -> Vec<HostRead> {
@@ -237,18 +255,6 @@ impl Pass for MeshletCull {
             in_place: c.rasterized[3] as u64,
             scene_triangles: scene.geometry.triangles,
         });
-    }
-
-    fn destroy(&mut self, ctx: &Context) {
-        ml_vk::shader::release_pipeline(ctx, self.instance_pipeline);
-        ml_vk::shader::release_pipeline(ctx, self.meshlet_pipeline);
-        ml_vk::shader::release_pipeline(ctx, self.triangle_pipeline);
-        self.instance_pipeline = vk::Pipeline::null();
-        self.meshlet_pipeline = vk::Pipeline::null();
-        self.triangle_pipeline = vk::Pipeline::null();
-        self.pipeline_layout = vk::PipelineLayout::null();
-        self.sets.destroy(ctx);
-        self.scene.borrow_mut().destroy(ctx);
     }
 }
 

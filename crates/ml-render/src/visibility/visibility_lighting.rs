@@ -7,7 +7,7 @@
 use crate::antialiasing::Antialiasing;
 use crate::compute_pass::ComputePass;
 use crate::frame_resources::FrameResources;
-use crate::pass::{Pass, Recording};
+use crate::pass::{FrameWork, Pass, Recording};
 use crate::read_back::HostRead;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
@@ -87,10 +87,6 @@ impl Pass for VisibilityLighting {
         uses
     }
 
-    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
-        vec![HostRead::in_place(RAY_COUNT)]
-    }
-
     fn record(&self, rec: &Recording) {
         let sets = &rec.scene.object_textures.sets;
         let runs: Vec<(Vec<vk::DescriptorSet>, Vec<u8>)> = (0u32..)
@@ -103,5 +99,15 @@ impl Pass for VisibilityLighting {
     fn destroy(&mut self, ctx: &Context) {
         self.pass.destroy(ctx);
         self.scene.borrow_mut().destroy(ctx);
+    }
+
+    fn frame_work(&mut self) -> Option<&mut dyn FrameWork> {
+        Some(self)
+    }
+}
+
+impl FrameWork for VisibilityLighting {
+    fn host_reads(&self, _slot: usize) -> Vec<HostRead> {
+        vec![HostRead::in_place(RAY_COUNT)]
     }
 }
