@@ -7,6 +7,7 @@
 
 use crate::antialiasing::{Antialiasing, AntialiasingStats};
 use crate::assembly::{assemble, Assembly};
+use crate::clusters;
 use crate::environment::EnvironmentMaps;
 use crate::error::RenderError;
 use crate::exposure::auto_exposure::{self, AutoExposure};
@@ -22,6 +23,7 @@ use crate::shadows::omni_shadow::OmniShadows;
 use crate::shadows::stores::{ShadowStores, SharedShadows};
 use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
+use ml_cpu::blinn_phong::BlinnPhongLights;
 use ml_cpu::camera::{Camera, View};
 use ml_cpu::cluster::{count_entries, ClusterGrid};
 use ml_cpu::gpu_types::{FrameUniforms, PointLight};
@@ -187,7 +189,7 @@ impl<'a> Renderer<'a> {
             .map_err(RenderError::from)
             .and_then(|format| ShadowStores::new(ctx, &scene, settings.shadow_config(), format));
         let mut shadows = release_on_error(ctx, made, &mut [&mut environment])?;
-        let parts = scene_parts(&shadows, &environment);
+        let parts = scene_parts(&shadows, &environment, &scene.blinn_phong);
         let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| scene_part::resource(&parts, name));
         let mut gpu = release_on_error(ctx, made, &mut [&mut environment, &mut shadows])?;
         let drawn = shadows.casters_changed(ctx, &scene, &gpu);
@@ -408,7 +410,7 @@ impl<'a> Renderer<'a> {
         let owned: Vec<(&'static str, vk::Buffer)> =
             self.passes.iter_mut().filter_map(|p| p.frame_work()).flat_map(|w| w.slot_buffers(f)).collect();
         let shadows = self.shadows.borrow();
-        let parts = scene_parts(&shadows, &self.environment);
+        let parts = scene_parts(&shadows, &self.environment, &self.scene.blinn_phong);
         let scene: Vec<_> = self.gpu.named_buffers().into_iter().chain(parts.iter().flat_map(|p| p.named_buffers())).collect();
         drop(shadows);
         let resources = self.frames[f].resources(f, &scene).with(&owned);
@@ -535,7 +537,7 @@ impl<'a> Renderer<'a> {
         stats.frames = range.len() as u32;
         // Rays are counted with the light statistics (compute lightings only).
         let counts = FrameCounts { rays_traced: self.settings.light_stats.then_some(self.rays_traced[last].0) };
-        for part in scene_parts(&self.shadows.borrow(), &self.environment) {
+        for part in scene_parts(&self.shadows.borrow(), &self.environment, &self.scene.blinn_phong) {
             part.report(&counts, &mut stats);
         }
         let antialiasing = self.settings.antialiasing;
@@ -779,7 +781,6 @@ impl<'a> Renderer<'a> {
         let (g, v) = (&self.grid, &self.view);
         let debug_view = self.settings.debug_view.code();
         let cam = &v.camera;
-        let bp = &self.scene.blinn_phong;
         let exposure = self.exposure.expose(f);
         let frame = &mut self.frames[f];
         let light_offset = motion_offset(t, self.scene.light_motion);
@@ -792,23 +793,13 @@ impl<'a> Renderer<'a> {
             light_count: self.scene.lights.len() as u32,
             ambient: self.scene.ambient,
             directional_count: self.scene.directional.len() as u32,
-            cluster_dims: [g.dims.x, g.dims.y, g.dims.z, 0],
             viewport: [v.width, v.height, debug_view, 0],
-            cluster_slices: [g.log_scale, g.log_bias, self.heat_top, 0.0],
-            cluster_frustum: [g.near, g.far, v.projection.x_axis.x, v.projection.y_axis.y],
             light_animation: light_offset.extend(0.0).to_array(),
-            cluster_build: [frame.index_capacity() as u32, 0, 0, 0],
-            sun_direction: bp.sun_direction.extend(0.0).to_array(),
-            sun_strength: bp.sun_strength.extend(0.0).to_array(),
-            spot_position_range: bp.spot.position.extend(bp.spot.range).to_array(),
-            spot_direction_power: bp.spot.direction.extend(bp.spot.power).to_array(),
-            spot_strength: bp.spot.strength.extend(0.0).to_array(),
-            ambient_light: bp.ambient.extend(0.0).to_array(),
-            texture_transform: bp.texture_transform.to_cols_array(),
             exposure: [exposure, 0.0, 0.0, 0.0],
             ..FrameUniforms::default()
         };
-        for part in scene_parts(&self.shadows.borrow(), &self.environment) {
+        clusters::grid_uniforms(g, (self.heat_top, frame.index_capacity() as u32), &mut uniforms);
+        for part in scene_parts(&self.shadows.borrow(), &self.environment, &self.scene.blinn_phong) {
             part.frame_uniforms(&mut uniforms);
         }
         for work in self.passes.iter_mut().filter_map(|p| p.frame_work()) {
@@ -833,7 +824,9 @@ impl<'a> Renderer<'a> {
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
         let image = |name: &str| {
-            targets.named_image(name).or_else(|| scene_part::named_image(&scene_parts(&self.shadows.borrow(), &self.environment), name))
+            targets
+                .named_image(name)
+                .or_else(|| scene_part::named_image(&scene_parts(&self.shadows.borrow(), &self.environment, &self.scene.blinn_phong), name))
         };
         for pass in &self.passes {
             // The barrier that orders the pass's declared uses is part of its time, as the
@@ -935,8 +928,12 @@ impl FrameHook for CopyToHost {
 
 /// The scene's parts beside its geometry and textures (`scene_part`): a new part is its line
 /// here and where `Renderer::new` makes it.
-fn scene_parts<'s>(shadows: &'s ShadowStores, environment: &'s EnvironmentMaps) -> [&'s dyn ScenePart; 2] {
-    [shadows, environment]
+fn scene_parts<'s>(
+    shadows: &'s ShadowStores,
+    environment: &'s EnvironmentMaps,
+    blinn_phong: &'s BlinnPhongLights,
+) -> [&'s dyn ScenePart; 3] {
+    [shadows, environment, blinn_phong]
 }
 
 /// `scene`'s lights as the GPU reads them: marked with the shadow slots `omni` chose.

@@ -2,6 +2,7 @@
 //! subpasses, the G-buffer and its compute lighting, and the render pass and mesh pipelines
 //! they share.
 
+pub mod blinn_phong;
 pub mod compute_lighting;
 pub mod deferred_subpass;
 pub mod forward;
