@@ -176,19 +176,25 @@ void light_layer(uint node) {
 // background).
 #ifdef LAYER_BLENDING
 
-// Whether node x lies in front of node y (nearer, or as near and of a lower object).
+// The object word of node `node`.
+uint layer_object_of(uint node) {
+    return layer_nodes[LAYER_NODE_WORDS * node].z;
+}
+
+// Whether layer x lies in front of layer y, each (depth bits, node): nearer, or as near and of
+// a lower object (read from the nodes: ties are rare).
 bool layer_before(uvec2 x, uvec2 y) {
     float dx = uintBitsToFloat(x.x), dy = uintBitsToFloat(y.x);
-    return dx < dy || (dx == dy && layer_object(x.y) < layer_object(y.y));
+    return dx < dy || (dx == dy && layer_object(layer_object_of(x.y)) < layer_object(layer_object_of(y.y)));
 }
 
 // A pixel's nearest LAYER_KEEP layers, sorted (sort_layers), in [lo, hi) of a double-ended
-// array that starts in its middle: (depth bits, object word) keys and node indices.
-uvec2 sorted_keys[2u * LAYER_KEEP];
-uint sorted_nodes[2u * LAYER_KEEP];
+// array that starts in its middle: (depth bits, node) each, eight bytes a layer to move (the
+// sort's cost is its moves through per-thread memory; the object word, for ties and
+// coverage, is read from the node where needed).
+uvec2 sorted_layers[2u * LAYER_KEEP];
 
-// What a pixel keeps of its layers: the nearest sorted into sorted_keys/sorted_nodes
-// [lo, hi); the farther ones merged (`merged`: their weighted mean colour, `merged_through`:
+// What a pixel keeps of its layers: the nearest sorted into sorted_layers [lo, hi); the farther ones merged (`merged`: their weighted mean colour, `merged_through`:
 // what they let through together, Π over them); `count`: its layers.
 struct SortedLayers {
     uint lo;
@@ -213,12 +219,12 @@ SortedLayers sort_layers(ivec2 p) {
     uint capacity = layer_capacity();
     for (uint node = layer_heads[layer_pixel(p)]; node != LAYER_END && count < capacity; count++) {
         uvec4 a = layer_nodes[LAYER_NODE_WORDS * node];
-        uvec2 key = a.xz;
+        uvec2 key = uvec2(a.x, node);
         uint merged_node = LAYER_END;
         if (hi - lo == LAYER_KEEP) {
-            if (layer_before(key, sorted_keys[hi - 1u])) {
+            if (layer_before(key, sorted_layers[hi - 1u])) {
                 hi--;
-                merged_node = sorted_nodes[hi];
+                merged_node = sorted_layers[hi].y;
             } else {
                 merged_node = node;
             }
@@ -226,12 +232,12 @@ SortedLayers sort_layers(ivec2 p) {
         if (merged_node != node) {
             // Its place i: keys[lo, i) before it, keys[i, hi) not. The ends first.
             uint i = hi;
-            if (lo != hi && layer_before(key, sorted_keys[hi - 1u])) {
-                if (layer_before(key, sorted_keys[lo])) {
+            if (lo != hi && layer_before(key, sorted_layers[hi - 1u])) {
+                if (layer_before(key, sorted_layers[lo])) {
                     i = lo;
                 } else {
                     i = hi - 1u;
-                    while (layer_before(key, sorted_keys[i - 1u])) {
+                    while (layer_before(key, sorted_layers[i - 1u])) {
                         i--;
                     }
                 }
@@ -240,20 +246,17 @@ SortedLayers sort_layers(ivec2 p) {
             // LAYER_KEEP - 1 layers are kept here, and lo never passes the middle).
             if (hi < 2u * LAYER_KEEP && (lo == 0u || hi - i <= i - lo)) {
                 for (uint k = hi; k > i; k--) {
-                    sorted_keys[k] = sorted_keys[k - 1u];
-                    sorted_nodes[k] = sorted_nodes[k - 1u];
+                    sorted_layers[k] = sorted_layers[k - 1u];
                 }
                 hi++;
             } else {
                 for (uint k = lo; k < i; k++) {
-                    sorted_keys[k - 1u] = sorted_keys[k];
-                    sorted_nodes[k - 1u] = sorted_nodes[k];
+                    sorted_layers[k - 1u] = sorted_layers[k];
                 }
                 lo--;
                 i--;
             }
-            sorted_keys[i] = key;
-            sorted_nodes[i] = node;
+            sorted_layers[i] = key;
         }
         if (merged_node != LAYER_END) {
             LayerLight l = layer_light(merged_node);
@@ -274,7 +277,7 @@ SortedLayers sort_layers(ivec2 p) {
     return s;
 }
 
-// The sorted layers `s` whose bit `layers` has (bit i: sorted_nodes[s.lo + i]; all ones: every
+// The sorted layers `s` whose bit `layers` has (bit i: sorted_layers[s.lo + i]; all ones: every
 // one), and the merged ones, blended over `under` (linear) back to front; `transmittance`:
 // how much of `under` still shows, per channel.
 vec3 blend_sorted(SortedLayers s, uint layers, vec3 under, out vec3 transmittance) {
@@ -284,7 +287,7 @@ vec3 blend_sorted(SortedLayers s, uint layers, vec3 under, out vec3 transmittanc
         if ((layers & (1u << (i - 1u - s.lo))) == 0u) {
             continue;
         }
-        LayerLight l = layer_light(sorted_nodes[i - 1u]);
+        LayerLight l = layer_light(sorted_layers[i - 1u].y);
         color = l.light + color * l.through;
         transmittance *= l.through;
     }
@@ -333,14 +336,6 @@ vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
 // in the display's linear light, as without layers. Samples with the same surface and the
 // same layers are blended once.
 
-// Which sorted layers of `s` cover sample k (bit i: sorted_nodes[s.lo + i]).
-uint layers_over_sample(SortedLayers s, uint k) {
-    uint bits = 0u;
-    for (uint i = s.lo; i < s.hi; i++) {
-        bits |= ((layer_covered(sorted_keys[i].y) >> k) & 1u) << (i - s.lo);
-    }
-    return bits;
-}
 
 vec4 layered_samples_output(ivec2 p, float exposure) {
     SortedLayers s = sort_layers(p);
@@ -349,11 +344,19 @@ vec4 layered_samples_output(ivec2 p, float exposure) {
     }
     vec3 background = background_linear(p);
     // Each sample's opaque surface and layers, found once.
+    // over[k]: which sorted layers cover sample k (bit i: sorted_layers[s.lo + i]), each
+    // layer's coverage read from its node once.
     uvec2 v[VISIBILITY_SAMPLES];
     uint over[VISIBILITY_SAMPLES];
     for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         v[k] = opaque_sample(p, k);
-        over[k] = layers_over_sample(s, k);
+        over[k] = 0u;
+    }
+    for (uint i = s.lo; i < s.hi; i++) {
+        uint covered = layer_covered(layer_object_of(sorted_layers[i].y));
+        for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+            over[k] |= ((covered >> k) & 1u) << (i - s.lo);
+        }
     }
     vec3 sum = vec3(0.0);
     uint done = 0u;
