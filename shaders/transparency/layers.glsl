@@ -194,8 +194,9 @@ bool layer_before(uvec2 x, uvec2 y) {
 // coverage, is read from the node where needed).
 uvec2 sorted_layers[2u * LAYER_KEEP];
 
-// What a pixel keeps of its layers: the nearest sorted into sorted_layers [lo, hi); the farther ones merged (`merged`: their weighted mean colour, `merged_through`:
-// what they let through together, Π over them); `count`: its layers.
+// What a pixel keeps of its layers: the nearest sorted into sorted_layers [lo, hi); the
+// farther ones merged (`merged`: their weighted mean colour, `merged_through`: what they let
+// through together, Π over them); `count`: its layers.
 struct SortedLayers {
     uint lo;
     uint hi;
@@ -230,15 +231,19 @@ SortedLayers sort_layers(ivec2 p) {
             }
         }
         if (merged_node != node) {
-            // Its place i: keys[lo, i) before it, keys[i, hi) not. The ends first.
+            // Its place i: layers [lo, i) not after it, [i, hi) after it. The ends first (lists
+            // often come farthest- or nearest-first), then a binary search: reads are the
+            // sort's cost.
             uint i = hi;
             if (lo != hi && layer_before(key, sorted_layers[hi - 1u])) {
-                if (layer_before(key, sorted_layers[lo])) {
-                    i = lo;
-                } else {
-                    i = hi - 1u;
-                    while (layer_before(key, sorted_layers[i - 1u])) {
-                        i--;
+                uint below = lo + 1u;
+                i = layer_before(key, sorted_layers[lo]) ? lo : hi - 1u;
+                while (below < i) {
+                    uint middle = (below + i) >> 1u;
+                    if (layer_before(key, sorted_layers[middle])) {
+                        i = middle;
+                    } else {
+                        below = middle + 1u;
                     }
                 }
             }
