@@ -341,7 +341,6 @@ vec4 layered_output(ivec2 p, vec3 under, bool background, float exposure) {
 // in the display's linear light, as without layers. Samples with the same surface and the
 // same layers are blended once.
 
-
 vec4 layered_samples_output(ivec2 p, float exposure) {
     SortedLayers s = sort_layers(p);
     if (frame.viewport.z == DEBUG_VIEW_TRANSPARENCY_LAYERS) {
