@@ -226,6 +226,8 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         Rule::setting(id, own_lights.map(|own| !own), format!("the lights of '{}'", args.scene), "--lights N, whose lights replace them")
     };
     let omni = args.omni_shadow.as_str();
+    // The debug view asked for (an unknown name is refused where the settings are made).
+    let asked_view = DebugView::from_name(&args.debug_view).ok();
     let map_modes = OmniShadowMode::ALL.into_iter().filter(|m| *m != OmniShadowMode::Rays).map(OmniShadowMode::name);
     let shadow_maps = format!("point-light shadow maps (--omni-shadow {})", or_list(map_modes));
     let shadows = format!("point-light shadows (--omni-shadow {})", or_list(OmniShadowMode::ALL.into_iter().map(OmniShadowMode::name)));
@@ -305,7 +307,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
     ));
     rules.push(Rule::setting(
         "transparency_budget",
-        Some(DebugView::from_name(&args.debug_view).is_ok_and(DebugView::shows_layers)),
+        Some(asked_view.is_some_and(DebugView::shows_layers)),
         format!("--debug-view {}", args.debug_view),
         "the shaded image or --debug-view transparency-layers (surface views show the opaque surfaces only)",
     ));
@@ -314,7 +316,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
         rules.extend([pbr("background").of_value(shown), lit("background").of_value(shown)]);
     }
     // The debug view's needs, as its feature declares them.
-    let view = DebugView::from_name(&args.debug_view).unwrap_or(DebugView::NONE);
+    let view = asked_view.unwrap_or(DebugView::NONE);
     for need in view.needs() {
         let rule = |holds, instead| Rule::setting("debug_view", holds, instead, need.needs());
         rules.extend(

@@ -30,6 +30,13 @@ pub(crate) struct ViewSpec {
     pub(crate) legend: Legend,
 }
 
+impl ViewSpec {
+    /// A view without a legend: what most views are.
+    pub(crate) const fn plain(name: &'static str, code: u32, needs: &'static [ViewNeed], drawn: Drawn) -> ViewSpec {
+        ViewSpec { name, code, needs, drawn, legend: Legend::None }
+    }
+}
+
 /// How a view is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Drawn {
@@ -78,15 +85,8 @@ pub enum ViewNeed {
 
 impl DebugView {
     /// The shaded image itself.
-    pub const NONE: DebugView = DebugView {
-        spec: &ViewSpec {
-            name: "none",
-            code: ml_shaders::debug_view::NONE,
-            needs: &[],
-            drawn: Drawn::InShading { toned: true, layers: true },
-            legend: Legend::None,
-        },
-    };
+    pub const NONE: DebugView =
+        DebugView { spec: &ViewSpec::plain("none", ml_shaders::debug_view::NONE, &[], Drawn::InShading { toned: true, layers: true }) };
 
     pub fn name(self) -> &'static str {
         self.spec.name

@@ -2,9 +2,8 @@
 //! maps, the shadow stores, the blinn-phong model's other lights — as the frames see it: what
 //! it binds in the scene's set 1, the buffers shaders bind from a frame's table, the images
 //! passes declare (`sync`), the frame uniforms it owns, each by name, and its rows of the
-//! run's table. The renderer holds the
-//! parts and asks each in turn, so a new one is its module and its line in the renderer's list
-//! (`scene_parts` in renderer.rs).
+//! run's table. The renderer holds the parts and asks each in turn, so a new one is its module
+//! and its line in the renderer's list (`scene_parts` in renderer.rs).
 
 use crate::descriptors::Resource;
 use crate::report::FrameStats;

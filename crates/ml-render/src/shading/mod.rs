@@ -11,7 +11,7 @@ pub mod mesh_raster;
 
 use crate::antialiasing::Antialiasing;
 use crate::background::Background;
-use crate::debug_view::{DebugView, Drawn, Legend, ViewSpec};
+use crate::debug_view::{DebugView, Drawn, ViewSpec};
 use crate::specialization::Constants;
 use crate::targets::GBufferKind;
 use ml_cpu::scene::Scene;
@@ -20,7 +20,7 @@ use ml_cpu::shading_model::ShadingModel;
 /// A surface view: the values a technique shades with, shown as they are over the opaque
 /// surfaces, in any technique.
 const fn surface_view(name: &'static str, code: u32) -> ViewSpec {
-    ViewSpec { name, code, needs: &[], drawn: Drawn::InShading { toned: false, layers: false }, legend: Legend::None }
+    ViewSpec::plain(name, code, &[], Drawn::InShading { toned: false, layers: false })
 }
 
 /// The G-buffer's channels (any technique: the values it shades with): albedo (texture

@@ -24,35 +24,32 @@ const CUBE_MODES: &[&str] = &["copy", "direct", "multiview", "layered", "compute
 
 /// The sun's shadow map over the whole image (blinn-phong, whose sun casts shadows).
 pub const SUN_MAP_VIEW: DebugView = DebugView {
-    spec: &ViewSpec {
-        name: "shadow-map",
-        code: ml_shaders::debug_view::SHADOW_MAP,
-        needs: &[ViewNeed::Shading { model: ShadingModel::BlinnPhong, what: "the blinn-phong model's sun" }, ViewNeed::SunMap],
-        drawn: Drawn::Store(ShownStore::SunMap),
-        legend: Legend::None,
-    },
+    spec: &ViewSpec::plain(
+        "shadow-map",
+        ml_shaders::debug_view::SHADOW_MAP,
+        &[ViewNeed::Shading { model: ShadingModel::BlinnPhong, what: "the blinn-phong model's sun" }, ViewNeed::SunMap],
+        Drawn::Store(ShownStore::SunMap),
+    ),
 };
 
 /// The six faces of the first shadowed point light's cube, unfolded as a cross.
 pub const CUBE_VIEW: DebugView = DebugView {
-    spec: &ViewSpec {
-        name: "shadow-cube",
-        code: ml_shaders::debug_view::SHADOW_CUBE,
-        needs: &[ViewNeed::OmniShadow { what: "point-light shadow cubes", modes: CUBE_MODES }],
-        drawn: Drawn::Store(ShownStore::Cube),
-        legend: Legend::None,
-    },
+    spec: &ViewSpec::plain(
+        "shadow-cube",
+        ml_shaders::debug_view::SHADOW_CUBE,
+        &[ViewNeed::OmniShadow { what: "point-light shadow cubes", modes: CUBE_MODES }],
+        Drawn::Store(ShownStore::Cube),
+    ),
 };
 
 /// The shadow atlas, every block of it, fitted to the image.
 pub const ATLAS_VIEW: DebugView = DebugView {
-    spec: &ViewSpec {
-        name: "shadow-atlas",
-        code: ml_shaders::debug_view::SHADOW_ATLAS,
-        needs: &[ViewNeed::OmniShadow { what: "the shadow atlas", modes: &["atlas"] }],
-        drawn: Drawn::Store(ShownStore::Atlas),
-        legend: Legend::None,
-    },
+    spec: &ViewSpec::plain(
+        "shadow-atlas",
+        ml_shaders::debug_view::SHADOW_ATLAS,
+        &[ViewNeed::OmniShadow { what: "the shadow atlas", modes: &["atlas"] }],
+        Drawn::Store(ShownStore::Atlas),
+    ),
 };
 
 /// The traversal steps (nodes visited, triangles tested) of each point's shadow rays as a

@@ -13,7 +13,7 @@ mod layer_buffers;
 pub mod transparent_build;
 pub mod transparent_resolve;
 
-use crate::debug_view::{DebugView, Drawn, Legend, ViewNeed, ViewSpec};
+use crate::debug_view::{DebugView, Drawn, ViewNeed, ViewSpec};
 use crate::error::{RenderError, Setting, SettingsError};
 use crate::report::FeatureStats;
 use crate::sync::Use;
@@ -23,13 +23,12 @@ use ml_vk::{vk, Context};
 /// Transparent layers per pixel as a heat map up to the `LAYER_KEEP` a pixel blends exactly;
 /// white where more were merged.
 pub const LAYERS_VIEW: DebugView = DebugView {
-    spec: &ViewSpec {
-        name: "transparency-layers",
-        code: ml_shaders::debug_view::TRANSPARENCY_LAYERS,
-        needs: &[ViewNeed::TransparentObjects],
-        drawn: Drawn::InShading { toned: false, layers: true },
-        legend: Legend::None,
-    },
+    spec: &ViewSpec::plain(
+        "transparency-layers",
+        ml_shaders::debug_view::TRANSPARENCY_LAYERS,
+        &[ViewNeed::TransparentObjects],
+        Drawn::InShading { toned: false, layers: true },
+    ),
 };
 
 pub(crate) const VIEWS: &[DebugView] = &[LAYERS_VIEW];

@@ -32,7 +32,7 @@ pub const SURFACES_VIEW: DebugView = DebugView {
 pub(crate) const VIEWS: &[DebugView] = {
     use ml_shaders::debug_view as code;
     const fn colours(name: &'static str, code: u32) -> ViewSpec {
-        ViewSpec { name, code, needs: &[DRAWS_MESHLETS], drawn: Drawn::InShading { toned: false, layers: false }, legend: Legend::None }
+        ViewSpec::plain(name, code, &[DRAWS_MESHLETS], Drawn::InShading { toned: false, layers: false })
     }
     &[DebugView { spec: &colours("meshlets", code::MESHLETS) }, DebugView { spec: &colours("triangles", code::TRIANGLES) }, SURFACES_VIEW]
 };
