@@ -25,6 +25,18 @@ layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D out_image;
 layout(set = 0, binding = 8, rgba8) uniform image2D out_image;
 #endif
 
+// With COUNT_RAYS, the rays this invocation traced since the last count added to the frame's
+// (a subgroup's at a time; every lane that shaded calls it).
+void count_rays() {
+    if (COUNT_RAYS) {
+        uint traced = subgroupAdd(rays_traced);
+        rays_traced = 0u;
+        if (subgroupElect() && traced != 0u) {
+            atomicAdd(ray_count.x, traced);
+        }
+    }
+}
+
 // `object_flags`: the object's OBJECT_* bits (the alpha debug view).
 void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object_flags) {
     vec3 color;
@@ -33,12 +45,7 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m,
         return;
     }
     color = shade_point(world, n, m, frag_xy);
-    if (COUNT_RAYS) {
-        uint traced = subgroupAdd(rays_traced);
-        if (subgroupElect() && traced != 0u) {
-            atomicAdd(ray_count.x, traced);
-        }
-    }
+    count_rays();
 #ifdef LINEAR_OUTPUT
     imageStore(out_image, p, vec4(color, 1.0));
 #else
@@ -55,12 +62,7 @@ vec3 shade_linear(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object
         return clamp(color, 0.0, 1.0);
     }
     color = shade_point(world, n, m, frag_xy);
-    if (COUNT_RAYS) {
-        uint traced = subgroupAdd(rays_traced);
-        if (subgroupElect() && traced != 0u) {
-            atomicAdd(ray_count.x, traced);
-        }
-    }
+    count_rays();
     return color;
 }
 

@@ -20,7 +20,9 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::ray_bvh::WorldTriangles;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::{OmniShadowMode, OmniShadowSettings, RenderOutput, RenderSettings, ShadingModel, Technique};
+use ml_render::{
+    Antialiasing, AntialiasingStats, OmniShadowMode, OmniShadowSettings, RenderOutput, RenderSettings, ShadingModel, Technique,
+};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
@@ -409,4 +411,13 @@ fn the_rays_traced_are_counted() {
         .count() as u64;
     println!("rays traced: {once} (CPU: {expected} pixels facing the light); deferred-compute {deferred}");
     assert!(expected > 5000 && once.abs_diff(expected) * 100 <= expected, "GPU {once}, CPU {expected}");
+    // Anti-aliased, a pixel shades each surface its samples hold, at most a ray each from the
+    // room's one light: a lane that shades several surfaces (an edge pixel's, dealt out)
+    // counts each surface's rays once, not again with the next surface's.
+    let s = RenderSettings { light_stats: true, antialiasing: Antialiasing::X4, ..settings(Technique::Visibility, true, 1) };
+    let out = common::render_each(&room, &[s]);
+    let rays = out[0].stats.feature::<ml_render::RayStats>().and_then(|r| r.traced).expect("visibility counts");
+    let surfaces = out[0].stats.feature::<AntialiasingStats>().and_then(|a| a.surfaces).expect("the surfaces shaded");
+    println!("anti-aliased: {rays} rays traced, {surfaces} surfaces shaded");
+    assert!(surfaces > SIZE as u64 * SIZE as u64 / 2 && rays <= surfaces && rays * 10 >= surfaces * 5, "{rays} rays, {surfaces} surfaces");
 }
