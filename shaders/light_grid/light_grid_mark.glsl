@@ -29,10 +29,15 @@ shared uint box_lo[3];
 shared uint box_hi[3];
 shared uint box_marks[BOX_CELLS / 32u];
 
-// Mark cells u0..u1 of the box (one row along x).
+// Mark cells u0..u1 of the box (one row along x). The group's points mostly mark the same
+// cells: an atomic only where a bit is missing (bits are only set before the barrier that
+// ends the marking, so an outdated read costs at most a needless atomic).
 void mark_box_run(uint u0, uint u1) {
     for (uint word = u0 >> 5u; word <= u1 >> 5u; ++word) {
-        atomicOr(box_marks[word], bits_between(max(u0, word << 5u) - (word << 5u), min(u1, (word << 5u) + 31u) - (word << 5u)));
+        uint bits = bits_between(max(u0, word << 5u) - (word << 5u), min(u1, (word << 5u) + 31u) - (word << 5u));
+        if ((box_marks[word] & bits) != bits) {
+            atomicOr(box_marks[word], bits);
+        }
     }
 }
 
@@ -155,6 +160,11 @@ void main() {
     // across the barrier below (LLVM coroutines): 16 copies took it minutes.
     for (uint l = leaders; l != 0u; l &= l - 1u) {
         GridWalk w = WALK(l);
+        // A walk's marks are its box of cells: a further surface's within the first's (the
+        // pixel's surfaces lie within a pixel of each other) adds none.
+        if (l != leaders && all(greaterThanEqual(w.lo, centre.lo)) && all(lessThanEqual(w.hi, centre.hi))) {
+            continue;
+        }
         if (!in_box || any(lessThan(w.lo, lo)) || any(greaterThan(w.hi, hi))) {
             mark_rows(w);
             continue;
