@@ -2,7 +2,7 @@
 //! as data) — each kind's pass constructed for the scene and settings. A new pass is a file
 //! in its feature's folder, a `PassKind` with its place in `plan`, and its line here
 //! (docs/architecture.md has the checklist). `FEATURES` gathers the features' debug views
-//! the same way, a line each.
+//! the same way, a line each, and `SCENE_PARTS` the scene parts they make.
 
 use crate::clusters::cluster_assign_cpu;
 use crate::debug_view::DebugView;
@@ -14,6 +14,7 @@ use crate::light_stats::light_count::LightCount;
 use crate::pass::Pass;
 use crate::plan::{plan, PassKind};
 use crate::scene::SceneGpu;
+use crate::scene_part::MakePart;
 use crate::settings::{OmniShadowMode, Raster, RenderSettings, Shading};
 use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
 use crate::shadows::shadow_raster::ShadowViews;
@@ -25,6 +26,10 @@ use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_gather, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
 use ml_vk::{vk, Context};
+
+/// The scene's parts beside the shadow stores (`scene_part`), each made by its feature, in
+/// the order the frames ask them.
+pub const SCENE_PARTS: [MakePart; 2] = [crate::environment::make_part, crate::shading::blinn_phong::make_part];
 
 /// The debug views of every feature, in the order lists and menus show them.
 const FEATURES: [&[DebugView]; 6] = [

@@ -66,6 +66,7 @@ mod visibility;
 
 pub use antialiasing::{auto_antialiasing, AntialiasingStats};
 pub use background::Background;
+pub use environment::EnvironmentView;
 pub use error::RenderError;
 pub use frame_resources::FRAMES_IN_FLIGHT;
 pub use light_grid::LightGridStats;

@@ -6,9 +6,8 @@
 //! uses need (`sync`), times and collects from.
 
 use crate::antialiasing::{Antialiasing, AntialiasingStats};
-use crate::assembly::{assemble, Assembly};
+use crate::assembly::{assemble, Assembly, SCENE_PARTS};
 use crate::clusters;
-use crate::environment::EnvironmentMaps;
 use crate::error::RenderError;
 use crate::exposure::auto_exposure::{self, AutoExposure};
 use crate::frame::{lists_too_long, max_index_entries, FrameInFlight, FrameSetup, SlotLists};
@@ -17,13 +16,12 @@ use crate::pass::{Pass, Prepare, Recording, SlotReport};
 use crate::read_back::{self, HostRead, ReadBack};
 use crate::report::{CpuPhases, FrameStats};
 use crate::scene::SceneGpu;
-use crate::scene_part::{self, FrameCounts, ScenePart};
+use crate::scene_part::{self, FrameCounts, OwnedParts, PartAccess, PartHost};
 use crate::settings::{Geometry, LightAssignment, RenderSettings};
 use crate::shadows::omni_shadow::OmniShadows;
 use crate::shadows::stores::{ShadowStores, SharedShadows};
 use crate::sync;
 use crate::targets::{depth_format, Output, Targets};
-use ml_cpu::blinn_phong::BlinnPhongLights;
 use ml_cpu::camera::{Camera, View};
 use ml_cpu::cluster::{count_entries, ClusterGrid};
 use ml_cpu::gpu_types::{FrameUniforms, PointLight};
@@ -72,8 +70,9 @@ pub struct Renderer<'a> {
     extent: vk::Extent2D,
     /// The scene's meshes, buffers and textures on the GPU.
     gpu: SceneGpu,
-    /// The environment light, prefiltered (stand-ins without one).
-    environment: EnvironmentMaps,
+    /// The scene's parts beside the shadow stores (the assembly's SCENE_PARTS: the environment
+    /// light's maps, the blinn-phong lights).
+    parts: OwnedParts,
     /// The shadow stores (the shadow passes share them).
     shadows: SharedShadows,
     /// The technique's passes, in recording order.
@@ -183,17 +182,17 @@ impl<'a> Renderer<'a> {
         let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
         // The scene's parts, then its geometry and textures (set 1 binds what the parts name),
         // then the shadow stores' casters; a failure releases what was made before it.
-        let mut environment = EnvironmentMaps::new(ctx, scene.environment.as_ref())?;
+        let mut parts = OwnedParts::make(ctx, &scene, &SCENE_PARTS)?;
         // The sun's map in the G-buffer's depth format (sampleable).
         let made = depth_format(ctx, Output::GBuffer)
             .map_err(RenderError::from)
             .and_then(|format| ShadowStores::new(ctx, &scene, settings.shadow_config(), format));
-        let mut shadows = release_on_error(ctx, made, &mut [&mut environment])?;
-        let parts = scene_parts(&shadows, &environment, &scene.blinn_phong);
-        let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| scene_part::resource(&parts, name));
-        let mut gpu = release_on_error(ctx, made, &mut [&mut environment, &mut shadows])?;
+        let mut shadows = release_on_error(ctx, made, &mut [&mut parts])?;
+        let every = scene_part::all(&shadows, &parts);
+        let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| scene_part::resource(&every, name));
+        let mut gpu = release_on_error(ctx, made, &mut [&mut parts, &mut shadows])?;
         let drawn = shadows.casters_changed(ctx, &scene, &gpu);
-        release_on_error(ctx, drawn, &mut [&mut environment, &mut shadows, &mut gpu])?;
+        release_on_error(ctx, drawn, &mut [&mut parts, &mut shadows, &mut gpu])?;
         shadows.omni.choose(&scene, settings.aspect());
         let lights = gpu_lights(&scene, &shadows.omni);
         let mut shared_sync = sync::SyncStates::default();
@@ -212,7 +211,7 @@ impl<'a> Renderer<'a> {
             scene,
             settings,
             gpu,
-            environment,
+            parts,
             shadows: Rc::new(RefCell::new(shadows)),
             passes: Vec::new(),
             command_pool: vk::CommandPool::null(),
@@ -315,17 +314,6 @@ impl<'a> Renderer<'a> {
     }
 
     /// Destroy the frame slots and what points at them (for `resize` and `set_lights`).
-    /// Light the scene with its environment at `intensity`, turned by `rotation` radians about
-    /// +Y, from the next frame on (no new prefiltering: the turn and scale apply as it is
-    /// read). False where the scene has no environment.
-    pub fn set_environment_view(&mut self, intensity: f32, rotation: f32) -> Result<bool, RenderError> {
-        let Some(env) = &mut self.scene.environment else { return Ok(false) };
-        (env.intensity, env.rotation) = (intensity, rotation);
-        self.ctx.wait_idle()?;
-        self.environment.set_view(self.ctx, env)?;
-        Ok(true)
-    }
-
     fn release_frames(&mut self) -> Result<(), VkError> {
         let ctx = self.ctx;
         ctx.wait_idle()?;
@@ -410,8 +398,9 @@ impl<'a> Renderer<'a> {
         let owned: Vec<(&'static str, vk::Buffer)> =
             self.passes.iter_mut().filter_map(|p| p.frame_work()).flat_map(|w| w.slot_buffers(f)).collect();
         let shadows = self.shadows.borrow();
-        let parts = scene_parts(&shadows, &self.environment, &self.scene.blinn_phong);
+        let parts = scene_part::all(&*shadows, &self.parts);
         let scene: Vec<_> = self.gpu.named_buffers().into_iter().chain(parts.iter().flat_map(|p| p.named_buffers())).collect();
+        drop(parts);
         drop(shadows);
         let resources = self.frames[f].resources(f, &scene).with(&owned);
         let checked = cfg!(debug_assertions);
@@ -537,7 +526,7 @@ impl<'a> Renderer<'a> {
         stats.frames = range.len() as u32;
         // Rays are counted with the light statistics (compute lightings only).
         let counts = FrameCounts { rays_traced: self.settings.light_stats.then_some(self.rays_traced[last].0) };
-        for part in scene_parts(&self.shadows.borrow(), &self.environment, &self.scene.blinn_phong) {
+        for part in scene_part::all(&*self.shadows.borrow(), &self.parts) {
             part.report(&counts, &mut stats);
         }
         let antialiasing = self.settings.antialiasing;
@@ -799,7 +788,7 @@ impl<'a> Renderer<'a> {
             ..FrameUniforms::default()
         };
         clusters::grid_uniforms(g, (self.heat_top, frame.index_capacity() as u32), &mut uniforms);
-        for part in scene_parts(&self.shadows.borrow(), &self.environment, &self.scene.blinn_phong) {
+        for part in scene_part::all(&*self.shadows.borrow(), &self.parts) {
             part.frame_uniforms(&mut uniforms);
         }
         for work in self.passes.iter_mut().filter_map(|p| p.frame_work()) {
@@ -824,9 +813,7 @@ impl<'a> Renderer<'a> {
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
         let image = |name: &str| {
-            targets
-                .named_image(name)
-                .or_else(|| scene_part::named_image(&scene_parts(&self.shadows.borrow(), &self.environment, &self.scene.blinn_phong), name))
+            targets.named_image(name).or_else(|| scene_part::named_image(&scene_part::all(&*self.shadows.borrow(), &self.parts), name))
         };
         for pass in &self.passes {
             // The barrier that orders the pass's declared uses is part of its time, as the
@@ -926,14 +913,10 @@ impl FrameHook for CopyToHost {
     }
 }
 
-/// The scene's parts beside its geometry and textures (`scene_part`): a new part is its line
-/// here and where `Renderer::new` makes it.
-fn scene_parts<'s>(
-    shadows: &'s ShadowStores,
-    environment: &'s EnvironmentMaps,
-    blinn_phong: &'s BlinnPhongLights,
-) -> [&'s dyn ScenePart; 3] {
-    [shadows, environment, blinn_phong]
+impl PartHost for Renderer<'_> {
+    fn part_access(&mut self) -> PartAccess<'_> {
+        PartAccess { ctx: self.ctx, scene: &mut self.scene, parts: &mut self.parts }
+    }
 }
 
 /// `scene`'s lights as the GPU reads them: marked with the shadow slots `omni` chose.
@@ -958,6 +941,6 @@ impl Drop for Renderer<'_> {
         unsafe { ctx.device.destroy_command_pool(self.command_pool, None) };
         self.gpu.destroy(ctx);
         self.shadows.borrow_mut().destroy(ctx);
-        self.environment.destroy(ctx);
+        ml_vk::Release::release(&mut self.parts, ctx);
     }
 }

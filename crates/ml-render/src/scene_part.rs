@@ -2,13 +2,18 @@
 //! maps, the shadow stores, the blinn-phong model's other lights — as the frames see it: what
 //! it binds in the scene's set 1, the buffers shaders bind from a frame's table, the images
 //! passes declare (`sync`), the frame uniforms it owns, each by name, and its rows of the
-//! run's table. The renderer holds the parts and asks each in turn, so a new one is its module
-//! and its line in the renderer's list (`scene_parts` in renderer.rs).
+//! run's table. The renderer holds the parts and asks each in turn: the shadow stores (which
+//! the shadow passes share) and the parts the assembly's `SCENE_PARTS` makes, a line each, so
+//! a new part is its module and that line. A part's module reaches its part again through
+//! `PartHost` (the environment's view).
 
 use crate::descriptors::Resource;
+use crate::error::RenderError;
 use crate::report::FrameStats;
 use ml_cpu::gpu_types::FrameUniforms;
-use ml_vk::vk;
+use ml_cpu::scene::Scene;
+use ml_vk::{vk, Context};
+use std::any::Any;
 
 pub trait ScenePart {
     /// What it binds in the scene's set 1 under `name` (common/textures.glsl and the
@@ -30,6 +35,63 @@ pub trait ScenePart {
 
     /// Its figures for the run's table (`stats.set_feature`), with what the last frame counted.
     fn report(&self, _counts: &FrameCounts, _stats: &mut FrameStats) {}
+}
+
+/// A scene part the renderer owns: made for its scene by a `MakePart`, released with it.
+pub trait OwnedPart: ScenePart + Any {
+    fn destroy(&mut self, _ctx: &Context) {}
+}
+
+/// How a part is made for a scene (the assembly's `SCENE_PARTS`).
+pub type MakePart = fn(&Context, &Scene) -> Result<Box<dyn OwnedPart>, RenderError>;
+
+/// The parts `SCENE_PARTS` made, in its order.
+#[derive(Default)]
+pub struct OwnedParts(pub Vec<Box<dyn OwnedPart>>);
+
+impl OwnedParts {
+    /// Each of `makers` for `scene`; where one fails, those made before it are released.
+    pub fn make(ctx: &Context, scene: &Scene, makers: &[MakePart]) -> Result<OwnedParts, RenderError> {
+        let mut parts = OwnedParts::default();
+        for make in makers {
+            let made = make(ctx, scene);
+            let part = ml_vk::release_on_error(ctx, made, &mut [&mut parts])?;
+            parts.0.push(part);
+        }
+        Ok(parts)
+    }
+
+    /// The part of type `T`, if one was made.
+    pub fn get_mut<T: OwnedPart>(&mut self) -> Option<&mut T> {
+        self.0.iter_mut().find_map(|p| (p.as_mut() as &mut dyn Any).downcast_mut::<T>())
+    }
+}
+
+impl ml_vk::Release for OwnedParts {
+    fn release(&mut self, ctx: &Context) {
+        for p in &mut self.0 {
+            p.destroy(ctx);
+        }
+        self.0.clear();
+    }
+}
+
+/// What a scene part's module may reach of the renderer that holds its part, to change it
+/// and the scene together (the environment's view): its fields are the crate's own.
+pub struct PartAccess<'r> {
+    pub(crate) ctx: &'r Context,
+    pub(crate) scene: &'r mut Scene,
+    pub(crate) parts: &'r mut OwnedParts,
+}
+
+/// The renderer, as the scene parts' modules see it (they cannot name it: it assembles them).
+pub trait PartHost {
+    fn part_access(&mut self) -> PartAccess<'_>;
+}
+
+/// `first` (the shadow stores) and then the owned parts: every part, as the frames ask them.
+pub fn all<'s>(first: &'s dyn ScenePart, owned: &'s OwnedParts) -> Vec<&'s dyn ScenePart> {
+    std::iter::once(first).chain(owned.0.iter().map(|p| p.as_ref() as &dyn ScenePart)).collect()
 }
 
 /// What the last frame counted on the GPU that a part reports with its own figures.

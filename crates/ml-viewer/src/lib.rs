@@ -14,7 +14,7 @@ use camera_control::FirstPerson;
 use ml_cpu::scene::Scene;
 use ml_cpu::scene_request::SceneRequest;
 use ml_render::report::FrameStats;
-use ml_render::{RenderSettings, Renderer, TIMER_SPEED};
+use ml_render::{EnvironmentView, RenderSettings, Renderer, TIMER_SPEED};
 use ml_vk::swapchain::Acquired;
 use ml_vk::{vk, Context, ContextDesc, WindowHandles};
 pub use overlay::Choices;

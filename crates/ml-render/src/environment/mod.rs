@@ -11,7 +11,7 @@
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::error::RenderError;
 use crate::report::{FeatureStats, FrameStats};
-use crate::scene_part::{FrameCounts, ScenePart};
+use crate::scene_part::{FrameCounts, OwnedPart, PartHost, ScenePart};
 use ml_cpu::environment::Environment;
 use ml_cpu::gpu_types::EnvironmentData;
 use ml_cpu::scene::Scene;
@@ -224,6 +224,36 @@ impl ScenePart for EnvironmentMaps {
         if let Some(environment) = self.stats {
             stats.set_feature(environment);
         }
+    }
+}
+
+impl OwnedPart for EnvironmentMaps {
+    fn destroy(&mut self, ctx: &Context) {
+        EnvironmentMaps::destroy(self, ctx);
+    }
+}
+
+/// The scene's environment prefiltered (or the stand-ins), as a scene part.
+pub fn make_part(ctx: &Context, scene: &Scene) -> Result<Box<dyn OwnedPart>, RenderError> {
+    Ok(Box::new(EnvironmentMaps::new(ctx, scene.environment.as_ref())?))
+}
+
+/// The environment's view on the renderer (`use ml_render::EnvironmentView`).
+pub trait EnvironmentView {
+    /// Light the scene with its environment at `intensity`, turned by `rotation` radians about
+    /// +Y, from the next frame on (no new prefiltering: the turn and scale apply as it is
+    /// read). False where the scene has no environment.
+    fn set_environment_view(&mut self, intensity: f32, rotation: f32) -> Result<bool, RenderError>;
+}
+
+impl<H: PartHost> EnvironmentView for H {
+    fn set_environment_view(&mut self, intensity: f32, rotation: f32) -> Result<bool, RenderError> {
+        let access = self.part_access();
+        let (Some(env), Some(maps)) = (&mut access.scene.environment, access.parts.get_mut::<EnvironmentMaps>()) else { return Ok(false) };
+        (env.intensity, env.rotation) = (intensity, rotation);
+        access.ctx.wait_idle()?;
+        maps.set_view(access.ctx, env)?;
+        Ok(true)
     }
 }
 

@@ -2,9 +2,12 @@
 //! colour — and its texture transform, as a scene part: the frame uniforms they fill.
 
 use crate::descriptors::Resource;
-use crate::scene_part::ScenePart;
+use crate::error::RenderError;
+use crate::scene_part::{OwnedPart, ScenePart};
 use ml_cpu::blinn_phong::BlinnPhongLights;
 use ml_cpu::gpu_types::FrameUniforms;
+use ml_cpu::scene::Scene;
+use ml_vk::Context;
 
 impl ScenePart for BlinnPhongLights {
     fn resource(&self, _name: &str) -> Option<Resource> {
@@ -21,4 +24,11 @@ impl ScenePart for BlinnPhongLights {
         uniforms.ambient_light = self.ambient.extend(0.0).to_array();
         uniforms.texture_transform = self.texture_transform.to_cols_array();
     }
+}
+
+impl OwnedPart for BlinnPhongLights {}
+
+/// The scene's blinn-phong lights (a copy: the renderer never changes them), as a scene part.
+pub fn make_part(_ctx: &Context, scene: &Scene) -> Result<Box<dyn OwnedPart>, RenderError> {
+    Ok(Box::new(scene.blinn_phong))
 }

@@ -20,7 +20,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
 use ml_cpu::shading::{aces_tone_map, encode_gamma_unorm8};
 use ml_cpu::shading_model::ShadingModel;
-use ml_render::{RenderSettings, Technique};
+use ml_render::{EnvironmentView, RenderSettings, Technique};
 use std::sync::Arc;
 
 const SIZE: u32 = 96;
