@@ -3,7 +3,8 @@
 // hide anything); depth_pyramid_levels.comp makes the levels above. The includer says where
 // the raster's depth is: `float raster_depth(uvec2 pixel, uint width)` (depth_pyramid.comp:
 // the hardware raster's depth image; depth_pyramid_buffer.comp: the compute raster's 64-bit
-// buffer).
+// buffer), or with GROUP_FARTHEST `float group_farthest(uvec2 texel, uvec2 image)`, which the
+// whole work group calls (depth_pyramid_samples.comp: the buffer's samples).
 
 #ifndef MANYLIGHTS_DEPTH_PYRAMID_PASS_GLSL
 #define MANYLIGHTS_DEPTH_PYRAMID_PASS_GLSL
@@ -20,6 +21,13 @@ void main() {
     uvec2 image = image_size.xy;
     uvec2 size = pyramid_level_size(image, 0);
     uvec2 p = gl_GlobalInvocationID.xy;
+#ifdef GROUP_FARTHEST
+    // The whole work group reads its pixels together (barriers): every thread takes part.
+    float farthest = group_farthest(p, image);
+    if (any(greaterThanEqual(p, size))) {
+        return;
+    }
+#else
     if (any(greaterThanEqual(p, size))) {
         return;
     }
@@ -30,6 +38,7 @@ void main() {
             farthest = max(farthest, raster_depth(q, image.x));
         }
     }
+#endif
     depth_pyramid[p.y * size.x + p.x] = farthest;
 }
 

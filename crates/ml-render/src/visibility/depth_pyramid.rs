@@ -42,7 +42,12 @@ impl DepthPyramid {
     /// The pyramid of the depth image, or with `from_buffer` of the compute raster's buffer
     /// (its samples: `antialiasing`).
     pub fn new(ctx: &Context, from_buffer: bool, antialiasing: Antialiasing) -> Result<DepthPyramid, VkError> {
-        let shader = if from_buffer { &ml_shaders::DEPTH_PYRAMID_BUFFER_COMP } else { &ml_shaders::DEPTH_PYRAMID_COMP };
+        let shader = match (from_buffer, antialiasing) {
+            (false, _) => &ml_shaders::DEPTH_PYRAMID_COMP,
+            (true, Antialiasing::Off) => &ml_shaders::DEPTH_PYRAMID_BUFFER_COMP,
+            // Several samples a pixel: read as pairs, a work group's pixels together.
+            (true, _) => &ml_shaders::DEPTH_PYRAMID_SAMPLES_COMP,
+        };
         let p = DepthPyramid {
             sets: FrameSets::new(ctx, &[(shader, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
             sampler: vk::Sampler::null(),

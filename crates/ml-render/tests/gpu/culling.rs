@@ -4,8 +4,9 @@
 //! `on_an_edge`), along 20 random camera paths of 30 frames — low cameras among the objects and behind walls, so that meshlets are occluded and
 //! come out from behind occluders, back faces turn away, objects leave and enter the frustum —
 //! each path with a camera cut halfway (the early phase then draws last frame's visible set
-//! from a different place: the late phase must find everything else). Validation (with
-//! synchronization validation) stays silent throughout.
+//! from a different place: the late phase must find everything else); then 5 of the paths
+//! with anti-aliasing's samples. Validation (with synchronization validation) stays silent
+//! throughout.
 
 use crate::common;
 
@@ -15,7 +16,7 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::random_scene::random_scene;
 use ml_cpu::scene::{Object, Scene};
-use ml_render::{CullStats, RenderOutput, RenderSettings, Renderer, Technique};
+use ml_render::{Antialiasing, CullStats, RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
@@ -117,12 +118,28 @@ fn culling_on_and_off_give_the_same_frames() {
     let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a Vulkan device with validation");
     let counter = ctx.validation_counter();
     let scene = walled_scene();
+    // Without anti-aliasing, and with samples (the pyramid's first level is read from them
+    // otherwise: depth_pyramid_samples.comp) on fewer paths.
+    for (antialiasing, paths) in [(Antialiasing::Off, PATHS), (Antialiasing::X4, PATHS / 4)] {
+        let (occluded, late_drawn) = compare_culling(&ctx, &scene, antialiasing, paths);
+        // The paths must exercise both phases, or the test proves nothing.
+        assert!(occluded > 0 && late_drawn > 0, "{antialiasing:?}");
+    }
+    drop(ctx);
+    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
+}
+
+/// `paths` camera paths rendered with culling on and off at `antialiasing`: the frames equal
+/// but for a few edge pixels; returns the meshlet tests culled and the meshlets the late phase
+/// drew.
+fn compare_culling(ctx: &Context, scene: &Scene, antialiasing: Antialiasing, paths: u64) -> (u64, u64) {
     let mut on = RenderSettings::new(Technique::Visibility, W, H);
     on.frames = 1;
+    on.antialiasing = antialiasing;
     let off = RenderSettings { culling: false, ..on };
-    let mut renderers = [Renderer::new(&ctx, scene.clone(), on).unwrap(), Renderer::new(&ctx, scene, off).unwrap()];
+    let mut renderers = [Renderer::new(ctx, scene.clone(), on).unwrap(), Renderer::new(ctx, scene.clone(), off).unwrap()];
     let (mut occluded, mut late_drawn, mut frames, mut edge_pixels) = (0u64, 0u64, 0, 0);
-    for p in 0..PATHS {
+    for p in 0..paths {
         for (i, camera) in path(p).into_iter().enumerate() {
             let mut images = Vec::new();
             for r in &mut renderers {
@@ -149,12 +166,8 @@ fn culling_on_and_off_give_the_same_frames() {
         }
     }
     println!(
-        "{frames} frames: {occluded} meshlet tests culled, {late_drawn} meshlets drawn by the late phase; {edge_pixels} edge pixels differ"
+        "{antialiasing:?}: {frames} frames: {occluded} meshlet tests culled, {late_drawn} meshlets drawn by the late phase; {edge_pixels} edge pixels differ"
     );
-    assert!(edge_pixels <= 3, "{edge_pixels} edge pixels differ in {frames} frames");
-    // The paths must exercise both phases, or the test proves nothing.
-    assert!(occluded > 0 && late_drawn > 0);
-    drop(renderers);
-    drop(ctx);
-    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
+    assert!(edge_pixels <= 3, "{antialiasing:?}: {edge_pixels} edge pixels differ in {frames} frames");
+    (occluded, late_drawn)
 }
