@@ -41,6 +41,11 @@ void mark_box_run(uint u0, uint u1) {
     }
 }
 
+// Whether walk w's cells lie within the box of cells [lo, hi].
+bool cells_within(GridWalk w, uvec3 lo, uvec3 hi) {
+    return all(greaterThanEqual(w.lo, lo)) && all(lessThanEqual(w.hi, hi));
+}
+
 #ifdef OPAQUE_DEPTH_BUFFER
 // Anti-aliased: each surface of a pixel marks the walk from the point where the lighting
 // shades it — the mean of its samples' positions (visibility_samples.glsl shading_xy) at the
@@ -162,10 +167,10 @@ void main() {
         GridWalk w = WALK(l);
         // A walk's marks are its box of cells: a further surface's within the first's (the
         // pixel's surfaces lie within a pixel of each other) adds none.
-        if (l != leaders && all(greaterThanEqual(w.lo, centre.lo)) && all(lessThanEqual(w.hi, centre.hi))) {
+        if (l != leaders && cells_within(w, centre.lo, centre.hi)) {
             continue;
         }
-        if (!in_box || any(lessThan(w.lo, lo)) || any(greaterThan(w.hi, hi))) {
+        if (!in_box || !cells_within(w, lo, hi)) {
             mark_rows(w);
             continue;
         }

@@ -188,8 +188,8 @@ impl<'a> Renderer<'a> {
             .map_err(RenderError::from)
             .and_then(|format| ShadowStores::new(ctx, &scene, settings.shadow_config(), format));
         let mut shadows = release_on_error(ctx, made, &mut [&mut parts])?;
-        let every = scene_part::all(&shadows, &parts);
-        let made = SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| scene_part::resource(&every, name));
+        let made =
+            SceneGpu::new(ctx, &scene, settings.scene_config(), &|name| scene_part::resource(scene_part::all(&shadows, &parts), name));
         let mut gpu = release_on_error(ctx, made, &mut [&mut parts, &mut shadows])?;
         let drawn = shadows.casters_changed(ctx, &scene, &gpu);
         release_on_error(ctx, drawn, &mut [&mut parts, &mut shadows, &mut gpu])?;
@@ -399,8 +399,7 @@ impl<'a> Renderer<'a> {
             self.passes.iter_mut().filter_map(|p| p.frame_work()).flat_map(|w| w.slot_buffers(f)).collect();
         let shadows = self.shadows.borrow();
         let parts = scene_part::all(&*shadows, &self.parts);
-        let scene: Vec<_> = self.gpu.named_buffers().into_iter().chain(parts.iter().flat_map(|p| p.named_buffers())).collect();
-        drop(parts);
+        let scene: Vec<_> = self.gpu.named_buffers().into_iter().chain(parts.flat_map(|p| p.named_buffers())).collect();
         drop(shadows);
         let resources = self.frames[f].resources(f, &scene).with(&owned);
         let checked = cfg!(debug_assertions);
@@ -813,7 +812,7 @@ impl<'a> Renderer<'a> {
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
         let image = |name: &str| {
-            targets.named_image(name).or_else(|| scene_part::named_image(&scene_part::all(&*self.shadows.borrow(), &self.parts), name))
+            targets.named_image(name).or_else(|| scene_part::named_image(scene_part::all(&*self.shadows.borrow(), &self.parts), name))
         };
         for pass in &self.passes {
             // The barrier that orders the pass's declared uses is part of its time, as the

@@ -89,9 +89,10 @@ pub trait PartHost {
     fn part_access(&mut self) -> PartAccess<'_>;
 }
 
-/// `first` (the shadow stores) and then the owned parts: every part, as the frames ask them.
-pub fn all<'s>(first: &'s dyn ScenePart, owned: &'s OwnedParts) -> Vec<&'s dyn ScenePart> {
-    std::iter::once(first).chain(owned.0.iter().map(|p| p.as_ref() as &dyn ScenePart)).collect()
+/// `first` (the shadow stores) and then the owned parts: every part, as the frames ask them
+/// (each frame, for its uniforms and images: no list is built).
+pub fn all<'s>(first: &'s dyn ScenePart, owned: &'s OwnedParts) -> impl Iterator<Item = &'s dyn ScenePart> {
+    std::iter::once(first).chain(owned.0.iter().map(|p| p.as_ref() as &dyn ScenePart))
 }
 
 /// What the last frame counted on the GPU that a part reports with its own figures.
@@ -103,11 +104,11 @@ pub struct FrameCounts {
 }
 
 /// The first of `parts` that binds `name` in set 1.
-pub fn resource(parts: &[&dyn ScenePart], name: &str) -> Option<Resource> {
-    parts.iter().find_map(|p| p.resource(name))
+pub fn resource<'s>(mut parts: impl Iterator<Item = &'s dyn ScenePart>, name: &str) -> Option<Resource> {
+    parts.find_map(|p| p.resource(name))
 }
 
 /// The first of `parts` that has the image `name`.
-pub fn named_image(parts: &[&dyn ScenePart], name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
-    parts.iter().find_map(|p| p.named_image(name))
+pub fn named_image<'s>(mut parts: impl Iterator<Item = &'s dyn ScenePart>, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+    parts.find_map(|p| p.named_image(name))
 }
