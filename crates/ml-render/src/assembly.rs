@@ -2,11 +2,14 @@
 //! as data) — each kind's pass constructed for the scene and settings. A new pass is a file
 //! in its feature's folder, a `PassKind` with its place in `plan`, and its line here
 //! (docs/architecture.md has the checklist). `FEATURES` gathers the features' debug views
-//! the same way, a line each, and `SCENE_PARTS` the scene parts they make.
+//! the same way, a line each, `SCENE_PARTS` the scene parts they make, and
+//! `RenderSettings::lighting` and `check_scene` what they compile into the lighting and ask
+//! of a scene.
 
 use crate::clusters::cluster_assign_cpu;
 use crate::debug_view::DebugView;
-use crate::error::{by_name, Named, RenderError};
+use crate::environment;
+use crate::error::{by_name, Named, RenderError, SettingsError};
 use crate::exposure::{exposure_meter, tone_map};
 use crate::light_grid::light_grid_build::LightGridBuild;
 use crate::light_grid::light_grid_mark::LightGridMark;
@@ -16,15 +19,17 @@ use crate::plan::{plan, PassKind};
 use crate::scene::SceneGpu;
 use crate::scene_part::MakePart;
 use crate::settings::{OmniShadowMode, Raster, RenderSettings, Shading};
-use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer};
+use crate::shading::{compute_lighting, deferred_subpass, forward, gbuffer, light_constants, material_lobes, surface_constants};
 use crate::shadows::shadow_raster::ShadowViews;
 use crate::shadows::stores::SharedShadows;
 use crate::shadows::sun_shadow::SunShadowPass;
-use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view};
+use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view, shadow_settings};
+use crate::specialization::Constants;
 use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_gather, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
+use ml_cpu::scene::Scene;
 use ml_vk::{vk, Context};
 
 /// The scene's parts beside the shadow stores (`scene_part`), each made by its feature, in
@@ -40,6 +45,32 @@ const FEATURES: [&[DebugView]; 6] = [
     crate::visibility::VIEWS,
     crate::transparency::VIEWS,
 ];
+
+impl RenderSettings {
+    /// What the lighting pipelines are compiled for, for `scene`: each feature's constants,
+    /// from its module — a feature that compiles into the lighting adds its part here.
+    pub fn lighting(&self, scene: &Scene) -> Shading {
+        let model = self.shading;
+        let lobe_textures = material_lobes(model, scene) && scene.has_lobe_textures();
+        let surface = surface_constants(model, !scene.textures.is_empty(), self.specular_aa, lobe_textures);
+        let shadows = shadow_settings::lighting_constants(self.omni, self.shadow_config().sun, !scene.directional.is_empty());
+        Shading {
+            surface: Constants::of(&[&surface]),
+            lighting: Constants::of(&[&shadows, &light_constants(model, scene), &environment::lighting_constants(model, scene)]),
+            transparency: self.blends_layers(),
+            count_rays: self.light_stats && shadow_settings::traces_rays(&shadows),
+            antialiasing: self.antialiasing,
+            background: self.background,
+        }
+    }
+
+    /// Reject what `scene` cannot give, each feature's checks in turn: shadow rays where no
+    /// light casts them, the environment as the background where it does not light the scene.
+    pub fn check_scene(&self, scene: &Scene) -> Result<(), SettingsError> {
+        self.check_casters(scene.lights.len(), scene.directional.len())?;
+        environment::check_background(self.background, self.shading, scene)
+    }
+}
 
 impl DebugView {
     /// Every feature's views, `NONE` first.

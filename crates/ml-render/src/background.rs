@@ -61,13 +61,13 @@ impl Pass for Backdrop {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        self.pass.bind_frame(ctx, frame, &|name| frame.buffer(name))
+        self.pass.bind_frame(ctx, frame)
     }
 
     /// Reads what the forward pass wrote and writes the rest.
     fn uses(&self) -> Vec<Use> {
         let access = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
-        vec![Use::at(COLOUR_TARGET, (vk::PipelineStageFlags::COMPUTE_SHADER, access), Some(vk::ImageLayout::GENERAL))]
+        vec![Use::image(COLOUR_TARGET, (vk::PipelineStageFlags::COMPUTE_SHADER, access), vk::ImageLayout::GENERAL)]
     }
 
     fn record(&self, rec: &Recording) {

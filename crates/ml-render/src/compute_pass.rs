@@ -1,6 +1,6 @@
 //! A compute pass over the image that writes the colour target (the compute lighting, the tone
 //! map, the shadow-map view): one pipeline, its set 0 per frame slot (laid out as the shader
-//! declares it), a fetch sampler for its inputs.
+//! declares it; the frame's table fills it).
 
 use crate::descriptors::{FrameSets, Resource};
 use crate::frame_resources::FrameResources;
@@ -9,12 +9,10 @@ use crate::specialization;
 use crate::sync::{Use, COLOUR_TARGET, HDR_TARGET};
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
-use ml_vk::image::fetch_sampler;
 use ml_vk::{shader, vk, Context, Image, VkError};
 
 pub struct ComputePass {
     sets: FrameSets,
-    pub sampler: vk::Sampler,
     pipeline_layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
     /// The shader's work-group size, a thread per pixel: a dispatch over an image divides
@@ -27,7 +25,6 @@ impl ComputePass {
     pub fn empty() -> ComputePass {
         ComputePass {
             sets: FrameSets::empty(),
-            sampler: vk::Sampler::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             workgroup_size: [1; 3],
@@ -53,7 +50,6 @@ impl ComputePass {
     ) -> Result<ComputePass, VkError> {
         let p = ComputePass {
             sets: FrameSets::new(ctx, &[(shader, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
-            sampler: vk::Sampler::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             workgroup_size: shader.workgroup_size,
@@ -63,7 +59,6 @@ impl ComputePass {
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(push_bytes)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &layouts, if push_bytes > 0 { &push } else { &[] })?;
             p.pipeline = specialization::compute_pipeline(ctx, shader, p.pipeline_layout, constants)?;
-            p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })
     }
@@ -79,26 +74,25 @@ impl ComputePass {
     }
 
     /// Point slot `frame.slot`'s set 0 at the colour target (`out_image`, which every such
-    /// pass writes) and at what `lookup` names.
-    pub fn bind_frame(&self, ctx: &Context, frame: &FrameResources, lookup: &dyn Fn(&str) -> Option<Resource>) -> Result<(), VkError> {
-        self.bind_frame_to(ctx, frame, &frame.targets.color, lookup)
+    /// pass writes) and at what the frame's table holds under the shader's names.
+    pub fn bind_frame(&self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
+        self.bind_frame_to(ctx, frame, &frame.targets.color, &|_| None)
     }
 
-    /// `bind_frame` with `out` as `out_image` (the compute lighting's linear HDR image).
+    /// `bind_frame` with `out` as `out_image` (the compute lighting's linear HDR image), and
+    /// what `own` names (the pass's own resources) in place of the frame's.
     pub fn bind_frame_to(
         &self,
         ctx: &Context,
         frame: &FrameResources,
         out: &Image,
-        lookup: &dyn Fn(&str) -> Option<Resource>,
+        own: &dyn Fn(&str) -> Option<Resource>,
     ) -> Result<(), VkError> {
         let out = vk::DescriptorImageInfo::default().image_view(out.view).image_layout(vk::ImageLayout::GENERAL);
-        self.sets.write(ctx, frame.slot, &|name| if name == "out_image" { Some(Resource::Image(out)) } else { lookup(name) })
-    }
-
-    /// `image` in `layout`, read through this pass's fetch sampler.
-    pub fn sampled(&self, image: &Image, layout: vk::ImageLayout) -> Option<Resource> {
-        Some(Resource::Image(vk::DescriptorImageInfo::default().sampler(self.sampler).image_view(image.view).image_layout(layout)))
+        self.sets.write(ctx, frame.slot, &|name| match name {
+            "out_image" => Some(Resource::Image(out)),
+            _ => own(name).or_else(|| frame.resource(name)),
+        })
     }
 
     /// How a pass that writes the colour target through this pass uses it (`Pass::uses`): as
@@ -193,13 +187,8 @@ impl ComputePass {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: the device is idle; null handles are ignored.
-        unsafe {
-            ctx.device.destroy_sampler(self.sampler, None);
-            ml_vk::shader::release_pipeline(ctx, self.pipeline);
-        }
+        ml_vk::shader::release_pipeline(ctx, self.pipeline);
         self.sets.destroy(ctx);
-        self.sampler = vk::Sampler::null();
         self.pipeline_layout = vk::PipelineLayout::null();
         self.pipeline = vk::Pipeline::null();
     }

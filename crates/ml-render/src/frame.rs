@@ -7,11 +7,12 @@
 use crate::error::{ListsTooLong, RenderError};
 use crate::frame_resources::FrameResources;
 use crate::pass::ListUpload;
-use crate::sync::{SyncStates, RAY_COUNT};
+use crate::sync::{BufferName, SyncStates, FRAME_BLOCK, LIGHT_LISTS, RAY_COUNT};
 use crate::targets::Targets;
 use gpu_allocator::MemoryLocation;
 use ml_cpu::cluster::ClusterLists;
 use ml_cpu::gpu_types::{ClusterRange, FrameUniforms, PointLight};
+use ml_vk::image::fetch_sampler;
 use ml_vk::{vk, Buffer, Context, GpuTimer, VkError, VkResultExt};
 
 pub struct FrameInFlight {
@@ -27,6 +28,8 @@ pub struct FrameInFlight {
     pub targets: Option<Targets>,
     /// Its named resources' states between passes, from frame to frame (`sync`).
     pub sync: SyncStates,
+    /// How its passes' shaders read the targets they sample.
+    fetch: vk::Sampler,
 }
 
 /// Everything `FrameInFlight::new` needs from the renderer.
@@ -58,6 +61,7 @@ impl FrameInFlight {
             timer: GpuTimer::null(),
             targets: None,
             sync: SyncStates::default(),
+            fetch: vk::Sampler::null(),
         };
         // On failure everything made so far is released (null parts are skipped).
         ml_vk::build(ctx, frame, |f| f.create(ctx, setup))
@@ -80,19 +84,20 @@ impl FrameInFlight {
         self.ray_count.write(0, &[0u32; 4]);
         self.timer = GpuTimer::new(ctx, setup.passes)?;
         self.targets = Some((setup.make_targets)()?);
+        self.fetch = fetch_sampler(ctx)?;
         Ok(())
     }
 
     /// What slot `slot`'s passes bind: this frame's buffers and targets under their shader
     /// names, with the scene's `scene` added.
-    pub fn resources(&self, slot: usize, scene: &[(&'static str, vk::Buffer)]) -> FrameResources<'_> {
+    pub fn resources(&self, slot: usize, scene: &[(BufferName, vk::Buffer)]) -> FrameResources<'_> {
         let targets = self.targets.as_ref().expect("made with the frame");
-        FrameResources::new(slot, targets)
+        FrameResources::new(slot, targets, self.fetch)
             .with(&[
-                ("FrameBlock", self.uniforms.raw),
-                ("LightBuffer", self.lights.raw),
-                ("ClusterRangeBuffer", self.cluster_ranges.raw),
-                ("LightIndexBuffer", self.light_indices.raw),
+                (FRAME_BLOCK, self.uniforms.raw),
+                (LIGHT_LISTS[0], self.lights.raw),
+                (LIGHT_LISTS[1], self.cluster_ranges.raw),
+                (LIGHT_LISTS[2], self.light_indices.raw),
                 (RAY_COUNT, self.ray_count.raw),
             ])
             .with(scene)
@@ -140,9 +145,13 @@ impl FrameInFlight {
         for b in [&mut self.uniforms, &mut self.lights, &mut self.cluster_ranges, &mut self.light_indices, &mut self.ray_count] {
             b.destroy(ctx);
         }
-        // SAFETY: the caller waited for the device to be idle; a null fence is ignored.
-        unsafe { ctx.device.destroy_fence(self.fence, None) };
+        // SAFETY: the caller waited for the device to be idle; null handles are ignored.
+        unsafe {
+            ctx.device.destroy_fence(self.fence, None);
+            ctx.device.destroy_sampler(self.fetch, None);
+        }
         self.fence = vk::Fence::null();
+        self.fetch = vk::Sampler::null();
     }
 }
 

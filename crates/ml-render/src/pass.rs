@@ -8,7 +8,7 @@ use crate::frame_resources::FrameResources;
 use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
-use crate::sync::Use;
+use crate::sync::{BufferName, Use};
 use crate::targets::Targets;
 use ml_cpu::camera::View;
 use ml_cpu::cluster::{ClusterGrid, ClusterLists, ClusterStats};
@@ -119,7 +119,7 @@ pub trait FrameWork {
 
     /// The pass's own buffers of slot `slot` under the names the shaders give them: the slot's
     /// table of resources holds them for every pass (`FrameResources`).
-    fn slot_buffers(&self, _slot: usize) -> Vec<(&'static str, vk::Buffer)> {
+    fn slot_buffers(&self, _slot: usize) -> Vec<(BufferName, vk::Buffer)> {
         Vec::new()
     }
 

@@ -8,7 +8,7 @@
 //! use).
 
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::sync::Use;
+use crate::sync::{BufferName, Use};
 use gpu_allocator::MemoryLocation;
 use ml_vk::commands::transfer_to_host_barrier;
 use ml_vk::{vk, Buffer, Context, VkError};
@@ -18,14 +18,14 @@ use ml_vk::{vk, Buffer, Context, VkError};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HostRead {
     /// The buffer's name in the frame (its shader block's).
-    pub name: &'static str,
+    pub name: BufferName,
     /// (device buffer, host buffer, bytes) where the frame's end copies it.
     copy: Option<(vk::Buffer, vk::Buffer, vk::DeviceSize)>,
 }
 
 impl HostRead {
     /// The host reads the host-visible buffer `name` where the shaders wrote it.
-    pub fn in_place(name: &'static str) -> HostRead {
+    pub fn in_place(name: BufferName) -> HostRead {
         HostRead { name, copy: None }
     }
 
@@ -36,7 +36,7 @@ impl HostRead {
             Some(_) => (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ),
             None => (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
         };
-        Use::at(self.name, end, None)
+        Use::buffer(self.name, end)
     }
 }
 
@@ -80,7 +80,7 @@ impl ReadBack {
     }
 
     /// The read of `name` (the device buffer `from`) into slot `slot`'s copy, as long as it.
-    pub fn of(&self, slot: usize, name: &'static str, from: vk::Buffer) -> HostRead {
+    pub fn of(&self, slot: usize, name: BufferName, from: vk::Buffer) -> HostRead {
         let host = &self.host[slot];
         HostRead { name, copy: Some((from, host.raw, host.size)) }
     }

@@ -395,7 +395,7 @@ impl<'a> Renderer<'a> {
     /// passes' own (the slot is idle). In debug builds, every resource a pass's shaders bind
     /// that the frame orders by declared uses must be among the pass's (`sync::undeclared`).
     fn bind_passes(&mut self, f: usize) -> Result<(), VkError> {
-        let owned: Vec<(&'static str, vk::Buffer)> =
+        let owned: Vec<(sync::BufferName, vk::Buffer)> =
             self.passes.iter_mut().filter_map(|p| p.frame_work()).flat_map(|w| w.slot_buffers(f)).collect();
         let shadows = self.shadows.borrow();
         let parts = scene_part::all(&*shadows, &self.parts);
@@ -811,7 +811,7 @@ impl<'a> Renderer<'a> {
         let view_proj = self.view.view_proj();
         let rec = Recording { ctx, cmd, slot: f, extent: self.extent, targets, scene: &self.gpu, objects: &self.scene.objects, view_proj };
         let mut timed = 0;
-        let image = |name: &str| {
+        let image = |name: sync::ImageName| {
             targets.named_image(name).or_else(|| scene_part::named_image(scene_part::all(&*self.shadows.borrow(), &self.parts), name))
         };
         for pass in &self.passes {

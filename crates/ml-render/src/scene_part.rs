@@ -10,6 +10,7 @@
 use crate::descriptors::Resource;
 use crate::error::RenderError;
 use crate::report::FrameStats;
+use crate::sync::{BufferName, ImageName};
 use ml_cpu::gpu_types::FrameUniforms;
 use ml_cpu::scene::Scene;
 use ml_vk::{vk, Context};
@@ -21,12 +22,12 @@ pub trait ScenePart {
     fn resource(&self, name: &str) -> Option<Resource>;
 
     /// Its buffers shaders bind from a frame's table, under their blocks' names.
-    fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
+    fn named_buffers(&self) -> Vec<(BufferName, vk::Buffer)> {
         Vec::new()
     }
 
     /// Its images that passes declare, under their names (`sync`).
-    fn named_image(&self, _name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+    fn named_image(&self, _name: ImageName) -> Option<(vk::Image, vk::ImageAspectFlags)> {
         None
     }
 
@@ -109,6 +110,6 @@ pub fn resource<'s>(mut parts: impl Iterator<Item = &'s dyn ScenePart>, name: &s
 }
 
 /// The first of `parts` that has the image `name`.
-pub fn named_image<'s>(mut parts: impl Iterator<Item = &'s dyn ScenePart>, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+pub fn named_image<'s>(mut parts: impl Iterator<Item = &'s dyn ScenePart>, name: ImageName) -> Option<(vk::Image, vk::ImageAspectFlags)> {
     parts.find_map(|p| p.named_image(name))
 }

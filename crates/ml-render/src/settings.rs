@@ -3,18 +3,14 @@
 pub use crate::antialiasing::Antialiasing;
 use crate::background::Background;
 pub use crate::debug_view::{DebugView, ViewNeed};
-use crate::environment;
 use crate::error::{by_name, or_list, Named, RenderError, Setting, SettingsError};
 pub use crate::exposure::{parse_exposure, Exposure, MAX_EXPOSURE_EV};
 use crate::scene::SceneConfig;
 pub use crate::shading::Shading;
-use crate::shading::{light_constants, material_lobes, surface_constants};
-use crate::shadows::shadow_settings;
 pub use crate::shadows::shadow_settings::{
     multiview_depth_is_broken, AtlasSettings, OmniShadowMode, OmniShadowSettings, SunShadowMode, MAX_OMNI_BYTES, MAX_SHADOWED_LIGHTS,
 };
 use crate::shadows::stores::ShadowConfig;
-use crate::specialization::Constants;
 pub use crate::targets::MAX_DIMENSION;
 use crate::targets::{multisampled_images, Output};
 pub use crate::technique::{
@@ -226,38 +222,11 @@ impl RenderSettings {
         self.time.unwrap_or(i as f32 * FRAME_SECONDS * TIMER_SPEED)
     }
 
-    /// What the lighting pipelines are compiled for, for `scene`: each feature's constants,
-    /// from its module — a feature that compiles into the lighting adds its line here.
-    pub fn lighting(&self, scene: &ml_cpu::scene::Scene) -> Shading {
-        let model = self.shading;
-        let lobe_textures = material_lobes(model, scene) && scene.has_lobe_textures();
-        let surface = surface_constants(model, !scene.textures.is_empty(), self.specular_aa, lobe_textures);
-        let shadows = shadow_settings::lighting_constants(self.omni, self.shadow_config().sun, !scene.directional.is_empty());
-        Shading {
-            surface: Constants::of(&[&surface]),
-            lighting: Constants::of(&[&shadows, &light_constants(model, scene), &environment::lighting_constants(model, scene)]),
-            transparency: self.blends_layers(),
-            count_rays: self.light_stats && shadow_settings::traces_rays(&shadows),
-            antialiasing: self.antialiasing,
-            background: self.background,
-        }
-    }
-
     /// Reject shadow rays where no light, of `lights` point and `directional` directional
     /// ones, casts them (`check` leaves a scene without point lights to this).
     pub fn check_casters(&self, lights: usize, directional: usize) -> Result<(), SettingsError> {
         if self.omni.is_some_and(|o| o.rays()) && lights == 0 && directional == 0 {
             return Err(SettingsError::ShadowsWithoutLights);
-        }
-        Ok(())
-    }
-
-    /// Reject what `scene` cannot give: the environment as the background where it has none
-    /// (or the model lights with none), shadow rays where no light casts them.
-    pub fn check_scene(&self, scene: &ml_cpu::scene::Scene) -> Result<(), SettingsError> {
-        self.check_casters(scene.lights.len(), scene.directional.len())?;
-        if self.background == Background::Environment && !environment::lights_scene(self.shading, scene) {
-            return Err(SettingsError::BackgroundNeedsEnvironment);
         }
         Ok(())
     }

@@ -47,6 +47,15 @@ pub struct Exit {
     pub layout: Option<vk::ImageLayout>,
 }
 
+/// A buffer of the frame's resources (`FrameResources`), by the name the shader blocks that
+/// bind it give it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BufferName(pub &'static str);
+
+/// An image of the frame's resources: the name its state between passes goes by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageName(pub &'static str);
+
 /// A pass's use of one of the frame's named resources.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Use {
@@ -65,17 +74,26 @@ const WRITES: vk::AccessFlags = vk::AccessFlags::from_raw(
 );
 
 impl Use {
-    /// A use in `stages` with `access` (reads, writes or both), a buffer's or, with
-    /// `layout`, an image's; what it writes is left to the next use to make visible.
-    pub fn at(name: &'static str, (stages, access): (vk::PipelineStageFlags, vk::AccessFlags), layout: Option<vk::ImageLayout>) -> Use {
+    /// A use of buffer `name` in `stages` with `access` (reads, writes or both); what it
+    /// writes is left to the next use to make visible.
+    pub fn buffer(name: BufferName, reach: (vk::PipelineStageFlags, vk::AccessFlags)) -> Use {
+        Use::at(name.0, reach, None)
+    }
+
+    /// `buffer`, for image `name`, which the pass uses in `layout`.
+    pub fn image(name: ImageName, reach: (vk::PipelineStageFlags, vk::AccessFlags), layout: vk::ImageLayout) -> Use {
+        Use::at(name.0, reach, Some(layout))
+    }
+
+    fn at(name: &'static str, (stages, access): (vk::PipelineStageFlags, vk::AccessFlags), layout: Option<vk::ImageLayout>) -> Use {
         let writes = access & WRITES;
         let entry = Entry::Barrier { stages, access, layout, discard: false };
         Use { name, entry, exit: Exit { stages, writes, wrote: !writes.is_empty(), visible: vk::AccessFlags::empty(), layout } }
     }
 
-    /// `at`, for an image whose texels the pass all writes before reading any.
-    pub fn overwriting(name: &'static str, (stages, access): (vk::PipelineStageFlags, vk::AccessFlags), layout: vk::ImageLayout) -> Use {
-        let mut u = Use::at(name, (stages, access), Some(layout));
+    /// `image`, for an image whose texels the pass all writes before reading any.
+    pub fn overwriting(name: ImageName, reach: (vk::PipelineStageFlags, vk::AccessFlags), layout: vk::ImageLayout) -> Use {
+        let mut u = Use::image(name, reach, layout);
         if let Entry::Barrier { discard, .. } = &mut u.entry {
             *discard = true;
         }
@@ -85,9 +103,9 @@ impl Use {
     /// A depth image a render pass draws again for shaders that sample it (at `readers`):
     /// its external dependencies order it after their last reads and make its writes visible
     /// to them, leaving it DEPTH_STENCIL_READ_ONLY_OPTIMAL (shadow maps).
-    pub fn redrawn_for_readers(name: &'static str, readers: vk::PipelineStageFlags) -> Use {
+    pub fn redrawn_for_readers(name: ImageName, readers: vk::PipelineStageFlags) -> Use {
         Use {
-            name,
+            name: name.0,
             entry: Entry::Chained { stages: readers },
             exit: Exit {
                 stages: readers,
@@ -219,88 +237,97 @@ impl State {
 
 /// The name of a frame slot's colour target (the image `render` reads back and a window
 /// presents) in the frame's resources.
-pub const COLOUR_TARGET: &str = "colour target";
+pub const COLOUR_TARGET: ImageName = ImageName("colour target");
 
 /// The HDR target where a compute pass writes it (the compute lighting's linear output, read
 /// by the transparent resolve); the render passes that write it order it themselves.
-pub const HDR_TARGET: &str = "hdr target";
+pub const HDR_TARGET: ImageName = ImageName("hdr target");
+
+/// The frame slot's uniforms (FrameUniforms; its shader block's name): written by the host
+/// before the frame.
+pub const FRAME_BLOCK: BufferName = BufferName("FrameBlock");
 
 /// The frame slot's lights and cluster lists, as their shader blocks name them: written by
 /// the host (the CPU assignment), read by every shading pass.
-pub const LIGHT_LISTS: [&str; 3] = ["LightBuffer", "ClusterRangeBuffer", "LightIndexBuffer"];
+pub const LIGHT_LISTS: [BufferName; 3] = [BufferName("LightBuffer"), BufferName("ClusterRangeBuffer"), BufferName("LightIndexBuffer")];
 
 /// The frame slot's light-grid lists (where each ends, the lights in them — positions,
 /// colours — and their scene indices): written by the light grid's build, read by every
 /// shading pass.
-pub const LIGHT_GRID_LISTS: [&str; 4] = ["LightGridListBuffer", "LightGridPositionBuffer", "LightGridColorBuffer", "LightGridIndexBuffer"];
+pub const LIGHT_GRID_LISTS: [BufferName; 4] = [
+    BufferName("LightGridListBuffer"),
+    BufferName("LightGridPositionBuffer"),
+    BufferName("LightGridColorBuffer"),
+    BufferName("LightGridIndexBuffer"),
+];
 
 /// The frame slot's light-grid marks (a bit per cell a surface point walks, and per 32 cells
 /// the list of the first marked one): written by the marks pass (or the build), read by the
 /// build and by every shading pass (a marked cell's list is its rank among them).
-pub const LIGHT_GRID_OCCUPANCY: &str = "LightGridOccupancyBuffer";
+pub const LIGHT_GRID_OCCUPANCY: BufferName = BufferName("LightGridOccupancyBuffer");
 
 /// How a shading pass reads the lights and lists (whichever the technique has): in `stages`.
 pub fn light_list_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let mut names = LIGHT_LISTS.to_vec();
     names.extend(&LIGHT_GRID_LISTS);
     names.push(LIGHT_GRID_OCCUPANCY);
-    names.into_iter().map(|name| Use::at(name, (stages, vk::AccessFlags::SHADER_READ), None)).collect()
+    names.into_iter().map(|name| Use::buffer(name, (stages, vk::AccessFlags::SHADER_READ))).collect()
 }
 
 /// The frame slot's depth pyramid (its shader block's name): written by the depth pyramid
 /// pass, read by the culling.
-pub const DEPTH_PYRAMID: &str = "DepthPyramidBuffer";
+pub const DEPTH_PYRAMID: BufferName = BufferName("DepthPyramidBuffer");
 
 /// The frame slot's 64-bit visibility-depth buffer (the compute and hybrid rasters'; its
 /// shader block's name): cleared and written by the culling passes, the large triangles and
 /// the hybrid's fragments, read by the depth pyramid and the lighting.
-pub const VISIBILITY_DEPTH: &str = "VisibilityDepthBuffer";
+pub const VISIBILITY_DEPTH: BufferName = BufferName("VisibilityDepthBuffer");
 
 /// The frame slot's opaque surface colours at their first samples (visibility with
 /// anti-aliasing and transparent layers; its shader block's name): written by the lighting,
 /// read by the transparent layers' blend.
-pub const SURFACE_COLOURS: &str = "SurfaceColourBuffer";
+pub const SURFACE_COLOURS: BufferName = BufferName("SurfaceColourBuffer");
 
 /// Each meshlet instance's visibility at the end of the last frame (its shader block's name):
 /// read by the early culling, written by the late one. The frame slots share it.
-pub const MESHLET_VISIBILITY: &str = "MeshletVisibilityBuffer";
+pub const MESHLET_VISIBILITY: BufferName = BufferName("MeshletVisibilityBuffer");
 
 /// The point-light shadow cubes (the scene's depth cube array): written by the point-light
 /// shadow pass in every mode but the atlas, sampled by the shading passes in
 /// DEPTH_STENCIL_READ_ONLY_OPTIMAL (where there are no cubes, by its stand-in).
-pub const SHADOW_CUBES: &str = "shadow cubes";
+pub const SHADOW_CUBES: ImageName = ImageName("shadow cubes");
 
 /// The shadow atlas and its tile table (the scene's buffers, as the shading shaders name
 /// them): written by the atlas's pass, read by the shading passes.
-pub const SHADOW_ATLAS: [&str; 2] = ["ShadowAtlasBuffer", "ShadowAtlasTileBuffer"];
+pub const SHADOW_ATLAS: [BufferName; 2] = [BufferName("ShadowAtlasBuffer"), BufferName("ShadowAtlasTileBuffer")];
 
 /// The compute shadow raster's counters of the point lights' pass (its shader block's name;
 /// one buffer for every slot): written and dispatched from by the pass, read back at the
 /// frame's end.
-pub const SHADOW_RASTER_COUNTERS: &str = "OmniRasterCounterBuffer";
+pub const SHADOW_RASTER_COUNTERS: BufferName = BufferName("OmniRasterCounterBuffer");
 
 /// The sun's shadow map (blinn-phong; the scene's, a stand-in otherwise): drawn by the sun's
 /// shadow pass in the first frame after its casters changed, sampled by the shading passes in
 /// DEPTH_STENCIL_READ_ONLY_OPTIMAL.
-pub const SUN_MAP: &str = "sun shadow map";
+pub const SUN_MAP: ImageName = ImageName("sun shadow map");
 
 /// How a pass that shades reads the shadow stores (the sun's map, the point lights' cubes and
 /// atlas): in `stages`.
 pub fn shadow_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let read = (stages, vk::AccessFlags::SHADER_READ);
-    let sampled = Some(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-    let maps = [Use::at(SUN_MAP, read, sampled), Use::at(SHADOW_CUBES, read, sampled)];
-    maps.into_iter().chain(SHADOW_ATLAS.iter().map(|&name| Use::at(name, read, None))).collect()
+    let sampled = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+    let maps = [Use::image(SUN_MAP, read, sampled), Use::image(SHADOW_CUBES, read, sampled)];
+    maps.into_iter().chain(SHADOW_ATLAS.iter().map(|&name| Use::buffer(name, read))).collect()
 }
 
 /// The frame slot's count of the shadow rays its compute lighting traced (its shader block's
 /// name): added to by the lighting's subgroups, read by the host after the frame.
-pub const RAY_COUNT: &str = "RayCountBuffer";
+pub const RAY_COUNT: BufferName = BufferName("RayCountBuffer");
 
 /// How a compute lighting adds to the ray count (the host reads it in place after the frame).
 pub fn ray_count_use() -> Use {
     let add = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-    Use::at(RAY_COUNT, add, None)
+    Use::buffer(RAY_COUNT, add)
 }
 
 /// How a pass that shades reads what the frame lit it with: the lights and their lists, and
@@ -314,7 +341,8 @@ pub fn shading_reads(stages: vk::PipelineStageFlags) -> Vec<Use> {
 /// The resources the frame slots share (the scene's): their states are the renderer's, not a
 /// slot's. Frames are recorded in the order they are submitted, so a frame's first use of one
 /// follows the last frame's, whichever slot that frame ran in.
-pub const SCENE_WIDE: [&str; 6] = [MESHLET_VISIBILITY, SUN_MAP, SHADOW_CUBES, SHADOW_ATLAS[0], SHADOW_ATLAS[1], SHADOW_RASTER_COUNTERS];
+pub const SCENE_WIDE: [&str; 6] =
+    [MESHLET_VISIBILITY.0, SUN_MAP.0, SHADOW_CUBES.0, SHADOW_ATLAS[0].0, SHADOW_ATLAS[1].0, SHADOW_RASTER_COUNTERS.0];
 
 /// Of the frame's resources a pass's shaders bind (`bound`), those that other passes order by
 /// their declared uses (`ordered`) but the pass does not declare (`declared`): the state knows
@@ -327,7 +355,7 @@ pub fn undeclared(bound: &[&'static str], declared: &[Use], ordered: &[&'static 
 /// How the frame leaves its colour target: read by transfers (the read-back, a window's
 /// blit) in TRANSFER_SRC_OPTIMAL.
 pub fn frame_end() -> Use {
-    Use::at(COLOUR_TARGET, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ), Some(vk::ImageLayout::TRANSFER_SRC_OPTIMAL))
+    Use::image(COLOUR_TARGET, (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_READ), vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
 }
 
 /// The state of every named resource of a frame slot (buffers and images the slot holds) or,
@@ -339,8 +367,8 @@ pub struct SyncStates(std::collections::HashMap<&'static str, State>);
 impl SyncStates {
     /// Start image `name` from `layout`, where work outside the frames left it (finished, its
     /// writes visible to every later use), instead of undefined.
-    pub fn know(&mut self, name: &'static str, layout: vk::ImageLayout) {
-        self.0.insert(name, State { layout: Some(layout), ..State::default() });
+    pub fn know(&mut self, name: ImageName, layout: vk::ImageLayout) {
+        self.0.insert(name.0, State { layout: Some(layout), ..State::default() });
     }
 
     /// Record one barrier ordering `uses` after every earlier use of their resources, and
@@ -352,7 +380,7 @@ impl SyncStates {
         scene: &mut SyncStates,
         (ctx, cmd): (&ml_vk::Context, vk::CommandBuffer),
         uses: &[Use],
-        image: &dyn Fn(&str) -> Option<(vk::Image, vk::ImageAspectFlags)>,
+        image: &dyn Fn(ImageName) -> Option<(vk::Image, vk::ImageAspectFlags)>,
     ) {
         let (mut src, mut dst) = (vk::PipelineStageFlags::empty(), vk::PipelineStageFlags::empty());
         let mut global = vk::MemoryBarrier::default();
@@ -363,7 +391,7 @@ impl SyncStates {
             if let Some(d) = state.before(u) {
                 src |= d.src_stages;
                 dst |= d.dst_stages;
-                match (d.layout, image(u.name)) {
+                match (d.layout, image(ImageName(u.name))) {
                     (Some((old, new)), Some((raw, aspect))) => images.push(
                         vk::ImageMemoryBarrier::default()
                             .src_access_mask(d.src_access)
@@ -402,7 +430,7 @@ mod tests {
     use vk::ImageLayout as L;
     use vk::PipelineStageFlags as S;
 
-    const COLOUR: &str = COLOUR_TARGET;
+    const COLOUR: ImageName = COLOUR_TARGET;
 
     fn run(uses: &[Use]) -> Vec<Option<Dependency>> {
         let mut state = State::default();
@@ -418,7 +446,7 @@ mod tests {
     #[test]
     fn a_pass_that_binds_an_ordered_resource_must_declare_it() {
         let read = (S::COMPUTE_SHADER, A::SHADER_READ);
-        let declared = [Use::at("LightIndexBuffer", read, None)];
+        let declared = [Use::buffer(BufferName("LightIndexBuffer"), read)];
         let ordered = ["LightIndexBuffer", "ClusterRangeBuffer", "LightBuffer"];
         // FrameBlock is ordered by nobody (the host writes it before the frame).
         let bound = ["ClusterRangeBuffer", "FrameBlock", "LightIndexBuffer"];
@@ -429,8 +457,8 @@ mod tests {
     #[test]
     fn a_compute_write_then_a_compute_read_then_the_read_back() {
         let write = Use::overwriting(COLOUR, (S::COMPUTE_SHADER, A::SHADER_WRITE), L::GENERAL);
-        let meter = Use::at(COLOUR, (S::COMPUTE_SHADER, A::SHADER_READ), Some(L::GENERAL));
-        let copy = Use::at(COLOUR, (S::TRANSFER, A::TRANSFER_READ), Some(L::TRANSFER_SRC_OPTIMAL));
+        let meter = Use::image(COLOUR, (S::COMPUTE_SHADER, A::SHADER_READ), L::GENERAL);
+        let copy = Use::image(COLOUR, (S::TRANSFER, A::TRANSFER_READ), L::TRANSFER_SRC_OPTIMAL);
         let d = run(&[write, meter, copy, write]);
         // First use: only the layout, from undefined.
         assert_eq!(d[0].unwrap().layout, Some((L::UNDEFINED, L::GENERAL)));
@@ -476,8 +504,8 @@ mod tests {
 
     #[test]
     fn two_reads_of_one_write_in_the_same_stages_need_one_barrier() {
-        let write = Use::at("lists", (S::COMPUTE_SHADER, A::SHADER_WRITE), None);
-        let read = Use::at("lists", (S::COMPUTE_SHADER | S::FRAGMENT_SHADER, A::SHADER_READ), None);
+        let write = Use::buffer(BufferName("lists"), (S::COMPUTE_SHADER, A::SHADER_WRITE));
+        let read = Use::buffer(BufferName("lists"), (S::COMPUTE_SHADER | S::FRAGMENT_SHADER, A::SHADER_READ));
         let d = run(&[write, read, read]);
         assert!(d[1].is_some());
         assert_eq!(d[2], None, "already visible to these readers");
@@ -489,9 +517,9 @@ mod tests {
 
     #[test]
     fn a_render_pass_chains_itself_and_leaves_its_writes_visible_to_transfers() {
-        let copy = Use::at(COLOUR, (S::TRANSFER, A::TRANSFER_READ), Some(L::TRANSFER_SRC_OPTIMAL));
+        let copy = Use::image(COLOUR, (S::TRANSFER, A::TRANSFER_READ), L::TRANSFER_SRC_OPTIMAL);
         let forward = Use {
-            name: COLOUR,
+            name: COLOUR.0,
             entry: Entry::Chained { stages: S::COLOR_ATTACHMENT_OUTPUT | S::TRANSFER },
             exit: Exit {
                 stages: S::TRANSFER,
@@ -501,7 +529,7 @@ mod tests {
                 layout: Some(L::TRANSFER_SRC_OPTIMAL),
             },
         };
-        let meter = Use::at(COLOUR, (S::COMPUTE_SHADER, A::SHADER_READ), Some(L::GENERAL));
+        let meter = Use::image(COLOUR, (S::COMPUTE_SHADER, A::SHADER_READ), L::GENERAL);
         let d = run(&[copy, forward, copy]);
         assert_eq!(d[1], None, "the copy ends where the render pass's dependency begins");
         assert_eq!(d[2], None, "the render pass's outgoing dependency made it visible to the copy");

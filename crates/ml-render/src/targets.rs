@@ -230,7 +230,7 @@ pub fn depth_pyramid_len(extent: vk::Extent2D) -> u64 {
 impl Targets {
     /// The target called `name` and its aspect, for the barriers between passes (`sync`):
     /// the colour target.
-    pub fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+    pub fn named_image(&self, name: crate::sync::ImageName) -> Option<(vk::Image, vk::ImageAspectFlags)> {
         match name {
             crate::sync::COLOUR_TARGET => Some((self.color.raw, vk::ImageAspectFlags::COLOR)),
             crate::sync::HDR_TARGET => Some((self.hdr.raw, vk::ImageAspectFlags::COLOR)),

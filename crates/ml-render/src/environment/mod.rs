@@ -8,8 +8,9 @@
 //! (docs/DESIGN.md#environment-light). A scene without an environment binds stand-ins its
 //! shaders never read (their ENVIRONMENT constant is off).
 
+use crate::background::Background;
 use crate::descriptors::{self, Resource, SetLayout};
-use crate::error::RenderError;
+use crate::error::{RenderError, SettingsError};
 use crate::report::{FeatureStats, FrameStats};
 use crate::scene_part::{FrameCounts, OwnedPart, PartHost, ScenePart};
 use ml_cpu::environment::Environment;
@@ -24,6 +25,15 @@ use ml_vk::{shader, vk, Buffer, Context, GpuTimer, Image, VkError, VkResultExt};
 /// constant ambient).
 pub fn lights_scene(model: ShadingModel, scene: &Scene) -> bool {
     model == ShadingModel::Pbr && scene.environment.is_some()
+}
+
+/// Reject the environment as the `background` where it does not light the scene (the model
+/// lights with none, or the model is not pbr).
+pub fn check_background(background: Background, model: ShadingModel, scene: &Scene) -> Result<(), SettingsError> {
+    if background == Background::Environment && !lights_scene(model, scene) {
+        return Err(SettingsError::BackgroundNeedsEnvironment);
+    }
+    Ok(())
 }
 
 /// The environment's lighting constant, `ENVIRONMENT` (environment/environment.glsl).

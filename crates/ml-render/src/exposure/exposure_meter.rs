@@ -11,12 +11,12 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{FrameWork, Pass, Recording, SlotReport};
 use crate::read_back::{HostRead, ReadBack};
 use crate::report::FrameStats;
-use crate::sync::{Use, COLOUR_TARGET};
+use crate::sync::{BufferName, Use, COLOUR_TARGET};
 use gpu_allocator::MemoryLocation;
 use ml_vk::{vk, Buffer, Context, VkError};
 
 /// The sums' shader block.
-const SUMS: &str = "ExposureMeterBuffer";
+const SUMS: BufferName = BufferName("ExposureMeterBuffer");
 
 pub struct ExposureMeter {
     pass: ComputePass,
@@ -62,7 +62,7 @@ impl Pass for ExposureMeter {
             self.groups[slot] = groups;
         }
         let sums = Resource::Buffer(self.sums[slot].raw);
-        self.pass.bind_frame(ctx, frame, &|name| if name == SUMS { Some(sums) } else { frame.buffer(name) })
+        self.pass.bind_frame_to(ctx, frame, &frame.targets.color, &|name| (name == SUMS.0).then_some(sums))
     }
 
     /// After every pass that writes the colour target: it reads the finished image. It
@@ -70,7 +70,7 @@ impl Pass for ExposureMeter {
     fn uses(&self) -> Vec<Use> {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let read = (compute, vk::AccessFlags::SHADER_READ);
-        vec![Use::at(COLOUR_TARGET, read, Some(vk::ImageLayout::GENERAL)), Use::at(SUMS, (compute, vk::AccessFlags::SHADER_WRITE), None)]
+        vec![Use::image(COLOUR_TARGET, read, vk::ImageLayout::GENERAL), Use::buffer(SUMS, (compute, vk::AccessFlags::SHADER_WRITE))]
     }
 
     fn record(&self, rec: &Recording) {

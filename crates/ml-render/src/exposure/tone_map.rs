@@ -8,7 +8,7 @@ use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::scene::SceneGpu;
 use crate::sync::Use;
-use ml_vk::{vk, Context, VkError};
+use ml_vk::{Context, VkError};
 
 pub struct ToneMap {
     pass: ComputePass,
@@ -33,8 +33,7 @@ impl Pass for ToneMap {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        let hdr = self.pass.sampled(&frame.targets.hdr, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
-        self.pass.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { frame.buffer(name) })
+        self.pass.bind_frame(ctx, frame)
     }
 
     /// After the render pass, whose outgoing dependency orders the HDR writes before this

@@ -27,7 +27,7 @@ use crate::pass::{FrameWork, Pass, Recording, SlotReport};
 use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::specialization::compute_pipeline;
-use crate::sync::{Use, LIGHT_GRID_LISTS, LIGHT_GRID_OCCUPANCY};
+use crate::sync::{BufferName, Use, LIGHT_GRID_LISTS, LIGHT_GRID_OCCUPANCY};
 use bytemuck::Zeroable;
 use ml_cpu::gpu_types::{FrameUniforms, LightGridDispatch, LightGridFeedback, PointLight};
 use ml_cpu::light_grid::{bindable_cells, cell_budget, grid_order, LightGridShape};
@@ -41,12 +41,6 @@ const SCAN_BLOCK: u32 = 1024;
 const GROUPS_PER_ROW: u32 = 32_768;
 /// Cells per word of marks.
 const CELLS_PER_WORD: u64 = 32;
-
-/// The grid's names of its lists in the shaders (what the shading passes bind).
-const LIST_ENDS: &str = "LightGridListBuffer";
-const POSITIONS: &str = "LightGridPositionBuffer";
-const COLORS: &str = "LightGridColorBuffer";
-const INDICES: &str = "LightGridIndexBuffer";
 
 pub struct LightGridBuild {
     /// The build's set per frame slot (one layout for every step: the union of the shaders').
@@ -95,7 +89,7 @@ struct GridSlot {
 }
 
 /// The feedback's shader block (light_grid_scan.comp).
-const FEEDBACK: &str = "LightGridFeedbackBuffer";
+const FEEDBACK: BufferName = BufferName("LightGridFeedbackBuffer");
 
 impl GridSlot {
     fn new(ctx: &Context, lights: u64, cells: u64) -> Result<GridSlot, VkError> {
@@ -327,8 +321,8 @@ impl Pass for LightGridBuild {
                 "LightGridKeptBuffer" => own.kept.raw,
                 "LightGridKeptCountBuffer" => own.kept_count.raw,
                 "LightGridDispatchBuffer" => own.dispatch.raw,
-                FEEDBACK => own.feedback.raw,
-                _ => return frame.buffer(name),
+                n if n == FEEDBACK.0 => own.feedback.raw,
+                _ => return frame.resource(name),
             };
             Some(Resource::Buffer(buffer))
         })
@@ -336,7 +330,7 @@ impl Pass for LightGridBuild {
 
     fn uses(&self) -> Vec<Use> {
         let rw = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-        let mut uses: Vec<Use> = LIGHT_GRID_LISTS.iter().map(|&name| Use::at(name, rw, None)).collect();
+        let mut uses: Vec<Use> = LIGHT_GRID_LISTS.iter().map(|&name| Use::buffer(name, rw)).collect();
         // The marks: read (and their words' lists written) after the marks pass, or all set here.
         let marks = if self.marked {
             rw
@@ -344,8 +338,8 @@ impl Pass for LightGridBuild {
             let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
             (stages, rw.1 | vk::AccessFlags::TRANSFER_WRITE)
         };
-        uses.push(Use::at(LIGHT_GRID_OCCUPANCY, marks, None));
-        uses.push(Use::at(FEEDBACK, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), None));
+        uses.push(Use::buffer(LIGHT_GRID_OCCUPANCY, marks));
+        uses.push(Use::buffer(FEEDBACK, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE)));
         uses
     }
 
@@ -363,13 +357,14 @@ impl Pass for LightGridBuild {
 }
 
 impl FrameWork for LightGridBuild {
-    fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
+    fn slot_buffers(&self, slot: usize) -> Vec<(BufferName, vk::Buffer)> {
         let s = &self.slots[slot];
+        let [ends, positions, colors, indices] = LIGHT_GRID_LISTS;
         vec![
-            (LIST_ENDS, s.lists.raw),
-            (POSITIONS, s.positions.raw),
-            (COLORS, s.colors.raw),
-            (INDICES, s.indices.raw),
+            (ends, s.lists.raw),
+            (positions, s.positions.raw),
+            (colors, s.colors.raw),
+            (indices, s.indices.raw),
             (LIGHT_GRID_OCCUPANCY, s.occupancy.raw),
         ]
     }

@@ -61,13 +61,9 @@ impl Pass for LightGridMark {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         self.occupancy[frame.slot] = frame.raw_buffer(LIGHT_GRID_OCCUPANCY).unwrap_or_default();
-        let depth = self.pass.sampled(&frame.targets.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-        self.pass.bind_frame(ctx, frame, &|name| match name {
-            "opaque_depth" => depth,
-            _ => frame.buffer(name),
-        })?;
+        self.pass.bind_frame(ctx, frame)?;
         match &self.layers {
-            Some(layers) => layers.bind_frame(ctx, frame, &|name| frame.buffer(name)),
+            Some(layers) => layers.bind_frame(ctx, frame),
             None => Ok(()),
         }
     }
@@ -79,14 +75,14 @@ impl Pass for LightGridMark {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         let marks = (compute | vk::PipelineStageFlags::TRANSFER, rw | vk::AccessFlags::TRANSFER_WRITE);
-        let mut uses = vec![Use::at(LIGHT_GRID_OCCUPANCY, marks, None)];
+        let mut uses = vec![Use::buffer(LIGHT_GRID_OCCUPANCY, marks)];
         if self.depth_buffer {
-            uses.push(Use::at(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ), None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ)));
         }
         if self.layers.is_some() {
             // The nodes and their count, as the transparent build left them, and the heads its
             // shader binds with them.
-            uses.extend(LAYER_BUFFERS.iter().map(|&name| Use::at(name, (compute, vk::AccessFlags::SHADER_READ), None)));
+            uses.extend(LAYER_BUFFERS.iter().map(|&name| Use::buffer(name, (compute, vk::AccessFlags::SHADER_READ))));
         }
         uses
     }

@@ -14,12 +14,12 @@ use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{light_list_reads, Use, VISIBILITY_DEPTH};
+use crate::sync::{light_list_reads, BufferName, Use, VISIBILITY_DEPTH};
 use gpu_allocator::MemoryLocation;
 use ml_vk::{vk, Buffer, Context, VkError};
 
 /// The per-group sums' name in the shaders (and in the frame's declared uses).
-const LIGHT_COUNTS: &str = "LightCountBuffer";
+const LIGHT_COUNTS: BufferName = BufferName("LightCountBuffer");
 
 pub struct LightCount {
     pass: ComputePass,
@@ -57,12 +57,7 @@ impl Pass for LightCount {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let counts = Resource::Buffer(self.counts[frame.slot].raw);
-        let depth = self.pass.sampled(&frame.targets.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-        self.pass.bind_frame(ctx, frame, &|name| match name {
-            LIGHT_COUNTS => Some(counts),
-            "opaque_depth" => depth,
-            _ => frame.buffer(name),
-        })
+        self.pass.bind_frame_to(ctx, frame, &frame.targets.color, &|name| (name == LIGHT_COUNTS.0).then_some(counts))
     }
 
     /// Reads the lights and lists as the lighting did, and the opaque depth (the compute
@@ -72,9 +67,9 @@ impl Pass for LightCount {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let mut uses = light_list_reads(compute);
         if self.depth_buffer {
-            uses.push(Use::at(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ), None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, (compute, vk::AccessFlags::SHADER_READ)));
         }
-        uses.push(Use::at(LIGHT_COUNTS, (compute, vk::AccessFlags::SHADER_WRITE), None));
+        uses.push(Use::buffer(LIGHT_COUNTS, (compute, vk::AccessFlags::SHADER_WRITE)));
         uses
     }
 

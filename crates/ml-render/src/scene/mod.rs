@@ -16,10 +16,16 @@ use crate::scene::meshlets::{storage_buffer_with, MeshletGeometry, MeshletGeomet
 use crate::scene::object_data::{object_data, SurfaceVariant};
 use crate::scene::object_textures::ObjectTextureSets;
 use crate::scene::textures::SceneTextures;
+use crate::sync::BufferName;
 use ml_cpu::alpha_mask::AlphaMasks;
 use ml_cpu::gpu_types::{DirectionalLightData, LightCone, ObjectData};
 use ml_cpu::scene::Scene;
 use ml_vk::{release_on_error, vk, Buffer, Context};
+
+/// The scene's objects (ObjectData), under their shader block's name.
+pub const OBJECTS: BufferName = BufferName("ObjectBuffer");
+/// The scene's alpha masks' block bounds (common/alpha_mask.glsl), under their block's name.
+pub const ALPHA_MASKS: BufferName = BufferName("AlphaMaskBuffer");
 
 pub struct SceneGpu {
     pub meshes: SceneMeshes,
@@ -138,12 +144,12 @@ impl SceneGpu {
 
     /// The scene's buffers that shaders bind, under their blocks' names (a frame's table of
     /// resources holds them).
-    pub fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
+    pub fn named_buffers(&self) -> Vec<(BufferName, vk::Buffer)> {
         vec![
-            ("ObjectBuffer", self.objects.raw),
-            ("LightConeBuffer", self.cones.raw),
-            ("DirectionalLightBuffer", self.directional.raw),
-            ("AlphaMaskBuffer", self.alpha_masks.raw),
+            (OBJECTS, self.objects.raw),
+            (BufferName("LightConeBuffer"), self.cones.raw),
+            (BufferName("DirectionalLightBuffer"), self.directional.raw),
+            (ALPHA_MASKS, self.alpha_masks.raw),
         ]
     }
 

@@ -46,23 +46,17 @@ impl Pass for ComputeLighting {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let t = frame.targets;
-        let sampled = |image, layout| self.pass.sampled(image, layout);
         let out = if self.layers { &t.hdr } else { &t.color };
-        self.pass.bind_frame_to(ctx, frame, out, &|name| match name {
-            "depth_image" => sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
+        self.pass.bind_frame_to(ctx, frame, out, &|name| {
             // A G-buffer without the material, emissive and lobes images (a scene without object
             // textures, or whose PBR extensions do not vary per point) binds a base image in
             // their place — the object index where the shader reads unsigned integers, else the
             // albedo: the shader, specialised for such scenes, never reads them, but Vulkan
             // wants every binding it names written with a view of its numeric type.
             // Only G-buffer images fall back; any other name nobody provides stays an error.
-            _ => match name.strip_suffix("_image").filter(|key| GBUFFER.iter().any(|g| g.key == *key)) {
-                Some(key) => t
-                    .gbuffer_image(key)
-                    .or_else(|| t.gbuffer_image(if key == "lobes" { "object" } else { "albedo" }))
-                    .and_then(|g| sampled(g, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)),
-                None => frame.buffer(name),
-            },
+            let key = name.strip_suffix("_image").filter(|key| GBUFFER.iter().any(|g| g.key == *key))?;
+            let g = t.gbuffer_image(key).or_else(|| t.gbuffer_image(if key == "lobes" { "object" } else { "albedo" }))?;
+            frame.sampled(g, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
         })
     }
 

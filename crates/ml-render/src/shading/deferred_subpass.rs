@@ -90,7 +90,7 @@ impl Pass for DeferredSubpasses {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         self.raster.bind_frame(ctx, frame)?;
-        self.lighting_sets.write(ctx, frame.slot, &|name| frame.buffer(name))?;
+        self.lighting_sets.write(ctx, frame.slot, &|name| frame.resource(name))?;
         let t = frame.targets;
         let input =
             |view: vk::ImageView, layout| Some(Resource::Image(vk::DescriptorImageInfo::default().image_view(view).image_layout(layout)));

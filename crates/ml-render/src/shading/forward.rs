@@ -81,7 +81,7 @@ impl Pass for Forward {
             return uses;
         }
         uses.push(Use {
-            name: COLOUR_TARGET,
+            name: COLOUR_TARGET.0,
             entry: Entry::Chained { stages: attachments | transfer },
             exit: Exit {
                 stages: transfer,

@@ -47,7 +47,7 @@ impl Pass for GBuffer {
     /// rest of set 0 (the surface code reads none), a read like every shading pass's.
     fn uses(&self) -> Vec<Use> {
         let stages = vk::PipelineStageFlags::VERTEX_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
-        vec![Use::at(LIGHT_LISTS[0], (stages, vk::AccessFlags::SHADER_READ), None)]
+        vec![Use::buffer(LIGHT_LISTS[0], (stages, vk::AccessFlags::SHADER_READ))]
     }
 
     fn record(&self, rec: &Recording) {

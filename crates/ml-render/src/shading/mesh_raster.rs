@@ -190,7 +190,7 @@ impl MeshRaster {
         frame: &FrameResources,
         extra: &dyn Fn(&str) -> Option<Resource>,
     ) -> Result<(), VkError> {
-        self.sets.write(ctx, frame.slot, &|name| extra(name).or_else(|| frame.buffer(name)))?;
+        self.sets.write(ctx, frame.slot, &|name| extra(name).or_else(|| frame.resource(name)))?;
         let t = frame.targets;
         let mut views: Vec<vk::ImageView> = match self.output {
             Output::Color if self.layers => vec![t.hdr.view],

@@ -12,6 +12,7 @@ use crate::pass::{FrameWork, Pass, Prepare, Recording, SlotReport};
 use crate::read_back::{HostRead, ReadBack};
 use crate::report::{FeatureStats, FrameStats};
 use crate::scene::meshlets::MeshletGeometryView;
+use crate::scene::{ALPHA_MASKS, OBJECTS};
 use crate::shadows::omni_shadow::{OmniShadows, NEAR_FRACTION};
 use crate::shadows::shadow_atlas::tile_table;
 use crate::shadows::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
@@ -60,7 +61,7 @@ impl Pass for OmniShadowCompute {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let named = |name| frame.raw_buffer(name).expect("the scene's buffers are in every frame's table");
-        self.raster.bind(ctx, frame.slot, (named("ObjectBuffer"), named("AlphaMaskBuffer")))
+        self.raster.bind(ctx, frame.slot, (named(OBJECTS), named(ALPHA_MASKS)))
     }
 
     /// The cubes, overwritten by a copy (left TRANSFER_DST_OPTIMAL); or the atlas's table,
@@ -75,11 +76,11 @@ impl Pass for OmniShadowCompute {
         let mut uses = match self.views {
             ShadowViews::Atlas { .. } => {
                 let [atlas, table] = SHADOW_ATLAS;
-                vec![Use::at(table, transfer, None), Use::at(atlas, (S::COMPUTE_SHADER, rw), None)]
+                vec![Use::buffer(table, transfer), Use::buffer(atlas, (S::COMPUTE_SHADER, rw))]
             }
             _ => vec![Use::overwriting(SHADOW_CUBES, transfer, vk::ImageLayout::TRANSFER_DST_OPTIMAL)],
         };
-        uses.push(Use::at(SHADOW_RASTER_COUNTERS, counters, None));
+        uses.push(Use::buffer(SHADOW_RASTER_COUNTERS, counters));
         uses
     }
 

@@ -5,6 +5,7 @@
 
 use crate::error::RenderError;
 use crate::report::FeatureStats;
+use crate::sync::BufferName;
 use ml_cpu::gpu_types::{RayInstance, RayNode, RayTriangle};
 use ml_cpu::ray_bvh::{RayScene, RAY_STACK};
 use ml_cpu::scene::Scene;
@@ -109,13 +110,13 @@ impl RayGeometry {
     }
 
     /// The buffers under the shaders' block names (common/scene_bindings.glsl).
-    pub fn named_buffers(&self) -> [(&'static str, vk::Buffer); 5] {
+    pub fn named_buffers(&self) -> [(BufferName, vk::Buffer); 5] {
         [
-            ("RayTopBuffer", self.top.raw),
-            ("RayNodeBuffer", self.nodes.raw),
-            ("RayTriangleBuffer", self.triangles.raw),
-            ("RayInstanceBuffer", self.instances.raw),
-            ("RayUvBuffer", self.uvs.raw),
+            (BufferName("RayTopBuffer"), self.top.raw),
+            (BufferName("RayNodeBuffer"), self.nodes.raw),
+            (BufferName("RayTriangleBuffer"), self.triangles.raw),
+            (BufferName("RayInstanceBuffer"), self.instances.raw),
+            (BufferName("RayUvBuffer"), self.uvs.raw),
         ]
     }
 

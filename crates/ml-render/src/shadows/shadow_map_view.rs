@@ -39,7 +39,7 @@ impl Pass for ShadowMapView {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        self.pass.bind_frame(ctx, frame, &|_| None)
+        self.pass.bind_frame(ctx, frame)
     }
 
     fn uses(&self) -> Vec<Use> {

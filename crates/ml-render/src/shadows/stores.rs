@@ -14,7 +14,7 @@ use crate::shadows::omni_shadow::{self, OmniShadows};
 use crate::shadows::ray_geometry::RayGeometry;
 use crate::shadows::shadow_settings::{OmniShadowSettings, SunShadowMode};
 use crate::shadows::sun_map::clear_shadow_map;
-use crate::sync::{SHADOW_CUBES, SUN_MAP};
+use crate::sync::{BufferName, ImageName, SHADOW_CUBES, SUN_MAP};
 use ml_cpu::blinn_phong::shadow_view_proj;
 use ml_cpu::gpu_types::FrameUniforms;
 use ml_cpu::scene::Scene;
@@ -180,7 +180,7 @@ impl ScenePart for ShadowStores {
     }
 
     /// The stores' buffers shaders bind from the frame's table (the rays' hierarchy).
-    fn named_buffers(&self) -> Vec<(&'static str, vk::Buffer)> {
+    fn named_buffers(&self) -> Vec<(BufferName, vk::Buffer)> {
         self.rays.named_buffers().to_vec()
     }
 
@@ -194,7 +194,7 @@ impl ScenePart for ShadowStores {
 
     /// The stores' images that passes declare (`sync`), under their names: the sun's map and
     /// the shadow cubes.
-    fn named_image(&self, name: &str) -> Option<(vk::Image, vk::ImageAspectFlags)> {
+    fn named_image(&self, name: ImageName) -> Option<(vk::Image, vk::ImageAspectFlags)> {
         let image = match name {
             SUN_MAP => &self.sun_map,
             SHADOW_CUBES => &self.omni.cubes,

@@ -15,6 +15,7 @@ use crate::frame_resources::{FrameResources, FRAMES_IN_FLIGHT};
 use crate::gpu_mesh::record_draws;
 use crate::pass::{Pass, Recording};
 use crate::scene::meshlets::MeshletGeometryView;
+use crate::scene::{ALPHA_MASKS, OBJECTS};
 use crate::shadows::shadow_raster::{ShadowRaster, ShadowTarget, ShadowViews};
 use crate::shadows::shadow_settings::SunShadowMode;
 use crate::shadows::stores::SharedShadows;
@@ -130,7 +131,7 @@ impl Pass for SunShadowPass {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let named = |name| frame.raw_buffer(name).expect("the scene's buffers are in every frame's table");
-        let casters = (named("ObjectBuffer"), named("AlphaMaskBuffer"));
+        let casters = (named(OBJECTS), named(ALPHA_MASKS));
         match &mut self.drawer {
             Drawer::Graphics { masked, .. } => masked.as_ref().map_or(Ok(()), |m| m.bind(ctx, frame.slot, casters)),
             Drawer::Compute(raster) => raster.bind(ctx, frame.slot, casters),

@@ -1,11 +1,13 @@
 //! The transparent layers' buffers of a frame slot (layers.glsl), owned by the build pass and
 //! named to the frame's table of resources, where the resolve finds them.
 
+use crate::sync::BufferName;
 use ml_vk::{vk, Buffer, Context, VkError};
 
 /// The transparent layers' per-frame buffers, by their shader names: heads, nodes, counters
 /// (transparency/layers.glsl).
-pub const LAYER_BUFFERS: [&str; 3] = ["TransparentHeadBuffer", "TransparentNodeBuffer", "TransparentCountBuffer"];
+pub const LAYER_BUFFERS: [BufferName; 3] =
+    [BufferName("TransparentHeadBuffer"), BufferName("TransparentNodeBuffer"), BufferName("TransparentCountBuffer")];
 
 /// Bytes of a transparent layer's node: two uvec4, three where the scene's PBR extensions
 /// vary per point (`LOBE_TEXTURES`: their texels, transparency/layers.glsl).
@@ -43,7 +45,7 @@ impl LayerBuffers {
     }
 
     /// The buffers under their shader names.
-    pub fn named(&self) -> [(&'static str, vk::Buffer); 3] {
+    pub fn named(&self) -> [(BufferName, vk::Buffer); 3] {
         [(LAYER_BUFFERS[0], self.heads.raw), (LAYER_BUFFERS[1], self.nodes.raw), (LAYER_BUFFERS[2], self.counts.raw)]
     }
 

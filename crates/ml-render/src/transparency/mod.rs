@@ -91,7 +91,7 @@ impl TransparencySettings {
 pub fn layer_uses(stages: vk::PipelineStageFlags) -> Vec<Use> {
     let read = (stages, vk::AccessFlags::SHADER_READ);
     let read_write = (stages, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-    vec![Use::at(LAYER_BUFFERS[0], read, None), Use::at(LAYER_BUFFERS[1], read_write, None), Use::at(LAYER_BUFFERS[2], read_write, None)]
+    vec![Use::buffer(LAYER_BUFFERS[0], read), Use::buffer(LAYER_BUFFERS[1], read_write), Use::buffer(LAYER_BUFFERS[2], read_write)]
 }
 
 /// The transparent layers of the last frame.

@@ -17,11 +17,10 @@ use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{Use, LIGHT_LISTS, VISIBILITY_DEPTH};
+use crate::sync::{BufferName, Use, LIGHT_LISTS, VISIBILITY_DEPTH};
 use ml_cpu::gpu_types::LayerObject;
 use ml_cpu::scene::Object;
 use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
-use ml_vk::image::fetch_sampler;
 use ml_vk::{vk, Buffer, Context, MemoryLocation, VkError};
 
 /// Work groups of one dispatch along x (Vulkan's least maxComputeWorkGroupCount): the
@@ -64,8 +63,6 @@ pub struct TransparentBuild {
     /// Per frame slot, the lists (made with the slot, for its image size), which the frame's
     /// table names for the resolve.
     layers: Vec<Option<LayerBuffers>>,
-    /// Reads the opaque depth image.
-    sampler: vk::Sampler,
     /// The opaque depth is the compute raster's 64-bit buffer (else the depth target).
     depth_buffer: bool,
 }
@@ -114,7 +111,6 @@ impl TransparentBuild {
             large_counts: Vec::new(),
             settings,
             layers: (0..FRAMES_IN_FLIGHT).map(|_| None).collect(),
-            sampler: vk::Sampler::null(),
             depth_buffer,
         };
         ml_vk::build(ctx, pass, |pass| {
@@ -153,7 +149,6 @@ impl TransparentBuild {
                     _ => None,
                 })?;
             }
-            pass.sampler = fetch_sampler(ctx)?;
             Ok(())
         })
     }
@@ -399,14 +394,9 @@ impl Pass for TransparentBuild {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        let depth = vk::DescriptorImageInfo::default()
-            .sampler(self.sampler)
-            .image_view(frame.targets.depth.view)
-            .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-        let lookup = |name: &str| (name == "opaque_depth").then_some(Resource::Image(depth)).or_else(|| frame.buffer(name));
-        self.tiles.bind_frame(ctx, frame, &lookup)?;
-        self.triangles.bind_frame(ctx, frame, &lookup)?;
-        self.large.bind_frame(ctx, frame, &lookup)
+        self.tiles.bind_frame(ctx, frame)?;
+        self.triangles.bind_frame(ctx, frame)?;
+        self.large.bind_frame(ctx, frame)
     }
 
     /// Clears and appends to the lists (after the earlier frame's readers of this slot's); reads
@@ -416,12 +406,12 @@ impl Pass for TransparentBuild {
         let shaders = vk::PipelineStageFlags::COMPUTE_SHADER;
         let stages = vk::PipelineStageFlags::TRANSFER | shaders;
         let access = vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
-        let mut uses: Vec<Use> = LAYER_BUFFERS.iter().map(|&name| Use::at(name, (stages, access), None)).collect();
+        let mut uses: Vec<Use> = LAYER_BUFFERS.iter().map(|&name| Use::buffer(name, (stages, access))).collect();
         if self.depth_buffer {
-            uses.push(Use::at(VISIBILITY_DEPTH, (shaders, vk::AccessFlags::SHADER_READ), None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, (shaders, vk::AccessFlags::SHADER_READ)));
         }
         // Bound with the rest of set 0 (the surface code reads no light).
-        uses.push(Use::at(LIGHT_LISTS[0], (shaders, vk::AccessFlags::SHADER_READ), None));
+        uses.push(Use::buffer(LIGHT_LISTS[0], (shaders, vk::AccessFlags::SHADER_READ)));
         uses
     }
 
@@ -443,9 +433,6 @@ impl Pass for TransparentBuild {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: no pending work uses it; a null handle is ignored.
-        unsafe { ctx.device.destroy_sampler(self.sampler, None) };
-        self.sampler = vk::Sampler::null();
         self.tiles.destroy(ctx);
         self.triangles.destroy(ctx);
         self.large.destroy(ctx);
@@ -479,7 +466,7 @@ impl FrameWork for TransparentBuild {
         Ok(())
     }
 
-    fn slot_buffers(&self, slot: usize) -> Vec<(&'static str, vk::Buffer)> {
+    fn slot_buffers(&self, slot: usize) -> Vec<(BufferName, vk::Buffer)> {
         self.layers[slot].as_ref().map_or_else(Vec::new, |l| l.named().to_vec())
     }
 

@@ -89,10 +89,9 @@ impl Pass for TransparentResolve {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        self.lighting.bind_frame(ctx, frame, &|name| frame.buffer(name))?;
+        self.lighting.bind_frame(ctx, frame)?;
         // (Anti-aliased, the blend reads no HDR image: none is asked for.)
-        let hdr = self.blend.sampled(&frame.targets.hdr, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
-        self.blend.bind_frame(ctx, frame, &|name| if name == "hdr_image" { hdr } else { frame.buffer(name) })
+        self.blend.bind_frame(ctx, frame)
     }
 
     /// After the layers' build and the opaque pass that wrote the HDR image.
@@ -102,16 +101,16 @@ impl Pass for TransparentResolve {
         uses.extend(layer_uses(compute));
         if self.samples {
             let read = (compute, vk::AccessFlags::SHADER_READ);
-            uses.push(Use::at(VISIBILITY_DEPTH, read, None));
-            uses.push(Use::at(SURFACE_COLOURS, read, None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, read));
+            uses.push(Use::buffer(SURFACE_COLOURS, read));
             // The pixels without layers keep the lighting's colour.
             let write = (compute, vk::AccessFlags::SHADER_WRITE);
-            uses.push(Use::at(COLOUR_TARGET, write, Some(vk::ImageLayout::GENERAL)));
+            uses.push(Use::image(COLOUR_TARGET, write, vk::ImageLayout::GENERAL));
             return uses;
         }
         if self.after_compute {
             let layout = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-            uses.push(Use::at(HDR_TARGET, (compute, vk::AccessFlags::SHADER_READ), Some(layout)));
+            uses.push(Use::image(HDR_TARGET, (compute, vk::AccessFlags::SHADER_READ), layout));
         }
         uses.push(ComputePass::colour_use());
         uses

@@ -6,7 +6,7 @@
 //! loads, no per-level views, and the same answers on every driver.
 
 use crate::antialiasing::Antialiasing;
-use crate::descriptors::{FrameSets, Resource};
+use crate::descriptors::FrameSets;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
@@ -15,7 +15,6 @@ use crate::sync::{Use, DEPTH_PYRAMID, VISIBILITY_DEPTH};
 use crate::targets::{depth_pyramid_level, depth_pyramid_shape};
 use ml_shaders::Shader;
 use ml_vk::commands::memory_barrier;
-use ml_vk::image::fetch_sampler;
 use ml_vk::{shader, vk, Context, VkError};
 
 /// The levels above the first: a work group's 32×32 texels of the first level it makes, and
@@ -25,7 +24,6 @@ const LEVELS_A_DISPATCH: u32 = 6;
 
 pub struct DepthPyramid {
     sets: FrameSets,
-    sampler: vk::Sampler,
     pipeline_layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
     /// The levels above the first, from the one below each (depth_pyramid_levels.comp).
@@ -50,7 +48,6 @@ impl DepthPyramid {
         };
         let p = DepthPyramid {
             sets: FrameSets::new(ctx, &[(shader, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
-            sampler: vk::Sampler::null(),
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             level_sets: FrameSets::new(ctx, &[(LEVELS, vk::ShaderStageFlags::COMPUTE)], 0, FRAMES_IN_FLIGHT)?,
@@ -66,7 +63,6 @@ impl DepthPyramid {
             p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &constants)?;
             p.level_layout = shader::pipeline_layout(ctx, &[p.level_sets.layout.raw], &push)?;
             p.level_pipeline = compute_pipeline(ctx, LEVELS, p.level_layout, &[])?;
-            p.sampler = fetch_sampler(ctx)?;
             Ok(())
         })
     }
@@ -78,16 +74,8 @@ impl Pass for DepthPyramid {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        let t = frame.targets;
-        let depth = vk::DescriptorImageInfo::default()
-            .sampler(self.sampler)
-            .image_view(t.depth.view)
-            .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-        self.sets.write(ctx, frame.slot, &|name| match name {
-            "depth_image" => Some(Resource::Image(depth)),
-            _ => frame.buffer(name),
-        })?;
-        self.level_sets.write(ctx, frame.slot, &|name| frame.buffer(name))
+        self.sets.write(ctx, frame.slot, &|name| frame.resource(name))?;
+        self.level_sets.write(ctx, frame.slot, &|name| frame.resource(name))
     }
 
     /// Its levels, written (and read, each from the one before) in compute; the culling reads
@@ -95,9 +83,9 @@ impl Pass for DepthPyramid {
     /// compute raster's 64-bit buffer it reads.
     fn uses(&self) -> Vec<Use> {
         let rw = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-        let mut uses = vec![Use::at(DEPTH_PYRAMID, rw, None)];
+        let mut uses = vec![Use::buffer(DEPTH_PYRAMID, rw)];
         if self.from_buffer {
-            uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ)));
         }
         uses
     }
@@ -138,17 +126,12 @@ impl Pass for DepthPyramid {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        // SAFETY: the device is idle; null handles are ignored.
-        unsafe {
-            ml_vk::shader::release_pipeline(ctx, self.pipeline);
-            ml_vk::shader::release_pipeline(ctx, self.level_pipeline);
-            ctx.device.destroy_sampler(self.sampler, None);
-        }
+        ml_vk::shader::release_pipeline(ctx, self.pipeline);
+        ml_vk::shader::release_pipeline(ctx, self.level_pipeline);
         self.pipeline = vk::Pipeline::null();
         self.pipeline_layout = vk::PipelineLayout::null();
         self.level_pipeline = vk::Pipeline::null();
         self.level_layout = vk::PipelineLayout::null();
-        self.sampler = vk::Sampler::null();
         self.sets.destroy(ctx);
         self.level_sets.destroy(ctx);
     }

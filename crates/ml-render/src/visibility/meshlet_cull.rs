@@ -140,21 +140,21 @@ impl Pass for MeshletCull {
         // The early phase reads which meshlets the last frame saw, the late one writes it.
         let visibility = if early { (S::COMPUTE_SHADER, A::SHADER_READ) } else { compute };
         let mut uses = vec![
-            Use::at(DEPTH_PYRAMID, (S::COMPUTE_SHADER, A::SHADER_READ), None),
-            Use::at(MESHLET_VISIBILITY, visibility, None),
-            Use::at(CULL_COUNTERS, counters, None),
-            Use::at(VISIBLE_INSTANCES, compute, None),
-            Use::at(DRAW_SLOTS, compute, None),
-            Use::at(COMPACTED_INDICES, compute, None),
-            Use::at(TRIANGLE_IDS, compute, None),
+            Use::buffer(DEPTH_PYRAMID, (S::COMPUTE_SHADER, A::SHADER_READ)),
+            Use::buffer(MESHLET_VISIBILITY, visibility),
+            Use::buffer(CULL_COUNTERS, counters),
+            Use::buffer(VISIBLE_INSTANCES, compute),
+            Use::buffer(DRAW_SLOTS, compute),
+            Use::buffer(COMPACTED_INDICES, compute),
+            Use::buffer(TRIANGLE_IDS, compute),
         ];
         if self.raster != Raster::Hardware {
             // Cleared by a transfer in the early phase.
             let depth = if early { (S::COMPUTE_SHADER | S::TRANSFER, rw | A::TRANSFER_WRITE) } else { compute };
-            uses.push(Use::at(VISIBILITY_DEPTH, depth, None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, depth));
         }
         if self.raster.bin_list().is_some() {
-            uses.extend([Use::at(LARGE_BINS, compute, None), Use::at(LARGE_TRIANGLES, compute, None)]);
+            uses.extend([Use::buffer(LARGE_BINS, compute), Use::buffer(LARGE_TRIANGLES, compute)]);
         }
         uses
     }

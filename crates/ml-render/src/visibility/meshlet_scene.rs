@@ -14,7 +14,7 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::read_back::ReadBack;
 use crate::scene::meshlets::{storage_bytes, MeshletGeometryView};
-use crate::sync::MESHLET_VISIBILITY;
+use crate::sync::{BufferName, MESHLET_VISIBILITY};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{CullCounters, LargeTriangle};
 use ml_vk::{vk, Buffer, Context, VkError};
@@ -24,13 +24,13 @@ use std::rc::Rc;
 /// The culling's per-slot buffers, by their shader blocks' names: every pass that touches one
 /// declares it (`Pass::uses`), and the barriers between those passes are derived (`sync`);
 /// so is the meshlet visibility the slots share (`sync::MESHLET_VISIBILITY`).
-pub const CULL_COUNTERS: &str = "CullCounterBuffer";
-pub const VISIBLE_INSTANCES: &str = "VisibleInstanceBuffer";
-pub const DRAW_SLOTS: &str = "DrawSlotBuffer";
-pub const COMPACTED_INDICES: &str = "CompactedIndexBuffer";
-pub const TRIANGLE_IDS: &str = "TriangleIdBuffer";
-pub const LARGE_BINS: &str = "LargeBinBuffer";
-pub const LARGE_TRIANGLES: &str = "LargeTriangleBuffer";
+pub const CULL_COUNTERS: BufferName = BufferName("CullCounterBuffer");
+pub const VISIBLE_INSTANCES: BufferName = BufferName("VisibleInstanceBuffer");
+pub const DRAW_SLOTS: BufferName = BufferName("DrawSlotBuffer");
+pub const COMPACTED_INDICES: BufferName = BufferName("CompactedIndexBuffer");
+pub const TRIANGLE_IDS: BufferName = BufferName("TriangleIdBuffer");
+pub const LARGE_BINS: BufferName = BufferName("LargeBinBuffer");
+pub const LARGE_TRIANGLES: BufferName = BufferName("LargeTriangleBuffer");
 
 /// The culling's buffers of one frame slot.
 pub struct CullFrame {
@@ -141,18 +141,20 @@ impl MeshletScene {
         if let Some(found) = self.geometry.buffer(name) {
             return Some(found);
         }
-        let buffer = match name {
-            MESHLET_VISIBILITY => &self.visibility,
-            VISIBLE_INSTANCES => &f.visible_instances,
-            CULL_COUNTERS => &f.counters,
-            DRAW_SLOTS => &f.draw_slots,
-            COMPACTED_INDICES => &f.indices,
-            TRIANGLE_IDS => &f.triangle_ids,
-            LARGE_BINS => &f.large_bins,
-            LARGE_TRIANGLES => &f.large_triangles,
-            _ => return frame.buffer(name),
-        };
-        Some(Resource::Buffer(buffer.raw))
+        let own = [
+            (MESHLET_VISIBILITY, &self.visibility),
+            (VISIBLE_INSTANCES, &f.visible_instances),
+            (CULL_COUNTERS, &f.counters),
+            (DRAW_SLOTS, &f.draw_slots),
+            (COMPACTED_INDICES, &f.indices),
+            (TRIANGLE_IDS, &f.triangle_ids),
+            (LARGE_BINS, &f.large_bins),
+            (LARGE_TRIANGLES, &f.large_triangles),
+        ];
+        match own.iter().find(|(n, _)| n.0 == name) {
+            Some((_, buffer)) => Some(Resource::Buffer(buffer.raw)),
+            None => frame.resource(name),
+        }
     }
 
     /// Slot `slot`'s counters as its last finished frame left them.

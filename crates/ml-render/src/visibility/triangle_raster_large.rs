@@ -76,10 +76,10 @@ impl Pass for TriangleRasterLarge {
         let rw = A::SHADER_READ | A::SHADER_WRITE;
         let counters = (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ);
         vec![
-            Use::at(CULL_COUNTERS, counters, None),
-            Use::at(LARGE_BINS, (S::COMPUTE_SHADER, A::SHADER_READ), None),
-            Use::at(LARGE_TRIANGLES, (S::COMPUTE_SHADER, rw), None),
-            Use::at(VISIBILITY_DEPTH, (S::COMPUTE_SHADER, rw), None),
+            Use::buffer(CULL_COUNTERS, counters),
+            Use::buffer(LARGE_BINS, (S::COMPUTE_SHADER, A::SHADER_READ)),
+            Use::buffer(LARGE_TRIANGLES, (S::COMPUTE_SHADER, rw)),
+            Use::buffer(VISIBILITY_DEPTH, (S::COMPUTE_SHADER, rw)),
         ]
     }
 

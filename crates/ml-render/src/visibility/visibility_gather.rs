@@ -33,20 +33,13 @@ impl Pass for VisibilityGather {
     }
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        let t = frame.targets;
-        let ids = self.pass.sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
-        let depth = self.pass.sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
-        self.pass.bind_frame(ctx, frame, &|name| match name {
-            "visibility_image" => ids,
-            "depth_image" => depth,
-            _ => frame.buffer(name),
-        })
+        self.pass.bind_frame(ctx, frame)
     }
 
     /// The images, after the raster's render pass (whose outgoing dependency makes them
     /// visible to compute); every sample of the buffer written.
     fn uses(&self) -> Vec<Use> {
-        vec![Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), None)]
+        vec![Use::buffer(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE))]
     }
 
     fn record(&self, rec: &Recording) {

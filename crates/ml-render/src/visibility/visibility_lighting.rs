@@ -66,11 +66,7 @@ impl Pass for VisibilityLighting {
         let t = frame.targets;
         let scene = self.scene.borrow();
         let out = if self.layers { &t.hdr } else { &t.color };
-        self.pass.bind_frame_to(ctx, frame, out, &|name| match name {
-            "depth_image" => self.pass.sampled(&t.depth, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL),
-            "visibility_image" => self.pass.sampled(&t.visibility, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
-            _ => scene.buffer(frame, name),
-        })
+        self.pass.bind_frame_to(ctx, frame, out, &|name| scene.buffer(frame, name))
     }
 
     /// After the late raster, the light grid build and the point-light shadows.
@@ -78,10 +74,10 @@ impl Pass for VisibilityLighting {
         let mut uses = shading_reads(vk::PipelineStageFlags::COMPUTE_SHADER);
         uses.push(ComputePass::output_use(self.layers));
         if self.from_buffer {
-            uses.push(Use::at(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ), None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ)));
         }
         if self.surface_colours {
-            uses.push(Use::at(SURFACE_COLOURS, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE), None));
+            uses.push(Use::buffer(SURFACE_COLOURS, (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE)));
         }
         uses.push(ray_count_use());
         uses

@@ -123,13 +123,13 @@ impl Pass for VisibilityRaster {
         use vk::AccessFlags as A;
         use vk::PipelineStageFlags as S;
         let mut uses = vec![
-            Use::at(CULL_COUNTERS, (S::DRAW_INDIRECT, A::INDIRECT_COMMAND_READ), None),
-            Use::at(COMPACTED_INDICES, (S::VERTEX_INPUT, A::INDEX_READ), None),
-            Use::at(DRAW_SLOTS, (S::VERTEX_SHADER, A::SHADER_READ), None),
-            Use::at(TRIANGLE_IDS, (S::FRAGMENT_SHADER, A::SHADER_READ), None),
+            Use::buffer(CULL_COUNTERS, (S::DRAW_INDIRECT, A::INDIRECT_COMMAND_READ)),
+            Use::buffer(COMPACTED_INDICES, (S::VERTEX_INPUT, A::INDEX_READ)),
+            Use::buffer(DRAW_SLOTS, (S::VERTEX_SHADER, A::SHADER_READ)),
+            Use::buffer(TRIANGLE_IDS, (S::FRAGMENT_SHADER, A::SHADER_READ)),
         ];
         if self.atomic {
-            uses.push(Use::at(VISIBILITY_DEPTH, (S::FRAGMENT_SHADER, A::SHADER_READ | A::SHADER_WRITE), None));
+            uses.push(Use::buffer(VISIBILITY_DEPTH, (S::FRAGMENT_SHADER, A::SHADER_READ | A::SHADER_WRITE)));
         }
         uses
     }
