@@ -76,7 +76,12 @@ impl ComputePass {
     /// Point slot `frame.slot`'s set 0 at the colour target (`out_image`, which every such
     /// pass writes) and at what the frame's table holds under the shader's names.
     pub fn bind_frame(&self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
-        self.bind_frame_to(ctx, frame, &frame.targets.color, &|_| None)
+        self.bind_frame_with(ctx, frame, &|_| None)
+    }
+
+    /// `bind_frame`, with what `own` names (the pass's own resources) in place of the frame's.
+    pub fn bind_frame_with(&self, ctx: &Context, frame: &FrameResources, own: &dyn Fn(&str) -> Option<Resource>) -> Result<(), VkError> {
+        self.bind_frame_to(ctx, frame, &frame.targets.color, own)
     }
 
     /// `bind_frame` with `out` as `out_image` (the compute lighting's linear HDR image), and

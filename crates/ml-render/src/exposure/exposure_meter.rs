@@ -62,7 +62,7 @@ impl Pass for ExposureMeter {
             self.groups[slot] = groups;
         }
         let sums = Resource::Buffer(self.sums[slot].raw);
-        self.pass.bind_frame_to(ctx, frame, &frame.targets.color, &|name| (name == SUMS.0).then_some(sums))
+        self.pass.bind_frame_with(ctx, frame, &|name| (name == SUMS.0).then_some(sums))
     }
 
     /// After every pass that writes the colour target: it reads the finished image. It

@@ -57,7 +57,7 @@ impl Pass for LightCount {
 
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         let counts = Resource::Buffer(self.counts[frame.slot].raw);
-        self.pass.bind_frame_to(ctx, frame, &frame.targets.color, &|name| (name == LIGHT_COUNTS.0).then_some(counts))
+        self.pass.bind_frame_with(ctx, frame, &|name| (name == LIGHT_COUNTS.0).then_some(counts))
     }
 
     /// Reads the lights and lists as the lighting did, and the opaque depth (the compute
