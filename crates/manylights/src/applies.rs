@@ -9,6 +9,7 @@ use crate::{auto, SceneArgs};
 use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::ArgMatches;
+use ml_cpu::environment::Environment;
 use ml_cpu::scene_request::{BuiltScene, SceneSource, SceneWarning};
 use ml_render::error::or_list;
 use ml_render::{DebugView, OmniShadowMode, RenderSettings, ShadingModel, SunShadowMode, Technique, ViewNeed};
@@ -242,7 +243,7 @@ fn scene_rules(args: &SceneArgs, source: &SceneSource, built: Option<&BuiltScene
     let lit = |id| {
         Rule::setting(
             id,
-            built.map(|b| b.scene.environment.is_some()),
+            built.map(|b| b.scene.sections.get::<Environment>().is_some()),
             "a scene without an environment",
             "an environment (--environment FILE or sky)",
         )

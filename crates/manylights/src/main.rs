@@ -10,11 +10,12 @@ use clap::error::ErrorKind;
 use clap::{Args, CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 use ml_cpu::camera::CameraSpec;
 use ml_cpu::cluster::ClusterDims;
-use ml_cpu::environment::{parse_intensity, parse_rotation_deg, EnvironmentSource};
+use ml_cpu::environment::{parse_intensity, parse_rotation_deg, Environment, EnvironmentAsk, EnvironmentSource};
 use ml_cpu::lights::{LightColors, LightLayout, RadiusRange};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene_request::{BuiltScene, SceneRequest, SceneSource, SceneWarning};
+use ml_cpu::scene_section::Sections;
 use ml_render::settings::{AtlasSettings, SettingsRequest, MAX_SHADOWED_LIGHTS};
 use ml_render::{
     Antialiasing, DebugView, Exposure, LightGridMarks, OmniShadowMode, OmniShadowSettings, Raster, RenderSettings, Renderer, ShadingModel,
@@ -538,6 +539,11 @@ fn cluster_choice(text: &str) -> Result<Option<ClusterDims>> {
 /// The scene the arguments ask for.
 fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
     let source = scene_source(&args.scene, MeshKind::from_name(&args.object)?, Material::named(&args.material)?, args.objects)?;
+    let environment = EnvironmentAsk {
+        source: args.environment.as_deref().map(EnvironmentSource::parse),
+        intensity: args.environment_intensity.as_deref().map(parse_intensity).transpose().map_err(anyhow::Error::msg)?,
+        rotation_deg: args.environment_rotation.as_deref().map(parse_rotation_deg).transpose().map_err(anyhow::Error::msg)?,
+    };
     Ok(SceneRequest {
         source,
         lights: args.lights,
@@ -551,11 +557,10 @@ fn scene_request(args: &SceneArgs) -> Result<SceneRequest> {
         transparent_percent: args.transparent_objects,
         glass_layers: args.glass_layers,
         light_colors: args.light_colors.as_deref().map(LightColors::from_name).transpose()?,
-        environment: args.environment.as_deref().map(EnvironmentSource::parse),
-        environment_intensity: args.environment_intensity.as_deref().map(parse_intensity).transpose().map_err(anyhow::Error::msg)?,
-        environment_rotation_deg: args.environment_rotation.as_deref().map(parse_rotation_deg).transpose().map_err(anyhow::Error::msg)?,
+        sections: Sections::default(),
         variant: args.variant.clone(),
-    })
+    }
+    .asking(environment))
 }
 
 /// The settings the arguments ask for, with `technique` (`--technique` itself may say auto).
@@ -628,7 +633,7 @@ fn exposure_choice(args: &SceneArgs) -> Result<Exposure> {
 fn viewer_exposure(args: &SceneArgs, built: &BuiltScene, settings: &mut RenderSettings) {
     let default_rig = built.warnings.iter().any(|w| matches!(w, SceneWarning::DefaultRig { .. }));
     let sky = args.environment.as_deref().is_none_or(|e| e == "sky");
-    let lit = built.shading == ShadingModel::Pbr && built.scene.environment.is_some();
+    let lit = built.shading == ShadingModel::Pbr && built.scene.sections.get::<Environment>().is_some();
     if args.exposure.is_none() && default_rig && lit && sky {
         settings.exposure = Exposure::Ev(0.0);
     }

@@ -5,8 +5,13 @@
 //! (`brdf_integral`). The GPU prefilters the image once (ml-render's environment module); this
 //! module is the CPU reference the image tests compare it with, and makes the built-in sky.
 
+use crate::file_fields;
 use crate::files::read_regular;
+use crate::scene::Scene;
+use crate::scene_section::{Section, Sections};
+use crate::section_kind::{AskError, FileSite, RequestSite, SectionError, SectionKind};
 use crate::shading::d_ggx;
+use crate::shading_model::ShadingModel;
 use glam::{Mat3, Vec2, Vec3};
 use std::f32::consts::PI;
 use std::path::Path;
@@ -85,6 +90,84 @@ impl EnvironmentSource {
             }
         })
     }
+}
+
+/// The environment as a scene's section (`section_kind`): a scene file's `[environment]`
+/// table, the request's `EnvironmentAsk`.
+pub const SECTION: SectionKind =
+    SectionKind { table: "environment", read: read_table, replaces_file, unlit_file: sky_for_unlit_file, apply: apply_ask };
+
+/// What a request asks of the environment (the command line's `--environment`,
+/// `--environment-intensity` and `--environment-rotation`; the window's panel).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EnvironmentAsk {
+    /// The environment light: None: a file's own, else the built-in sky for a file without
+    /// lights of its own (the default rig lights it too), else none.
+    pub source: Option<EnvironmentSource>,
+    /// Its intensity and turn about +Y in degrees, where given (else its own: 1 and 0 unless
+    /// a scene file says).
+    pub intensity: Option<f32>,
+    pub rotation_deg: Option<f32>,
+}
+
+/// A scene file's `[environment]` table.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileEnvironment {
+    /// An equirectangular .hdr or .exr file (relative to the scene file's folder), "sky" or
+    /// "none".
+    file: String,
+    intensity: Option<f32>,
+    rotation_deg: Option<f32>,
+    /// Shown behind the scene (else the render's background colour).
+    background: Option<bool>,
+}
+
+/// The file's `[environment]`: its image (a path relative to the scene file's folder; not
+/// read where the request replaces it), intensity and turn.
+fn read_table(table: toml::de::ValueDeserializer<'_>, site: &FileSite) -> Result<Option<Box<dyn Section>>, SectionError> {
+    let e = <FileEnvironment as serde::Deserialize>::deserialize(table)?;
+    let intensity = e.intensity.map(|i| file_fields::intensity("[environment] intensity", i)).transpose()?;
+    let what = "[environment] rotation_deg";
+    let range = -MAX_ENVIRONMENT_ROTATION_DEG..=MAX_ENVIRONMENT_ROTATION_DEG;
+    let rotation = e.rotation_deg.map(|r| file_fields::within(what, file_fields::finite(what, r)?, range)).transpose()?;
+    let source = match EnvironmentSource::parse(&e.file) {
+        EnvironmentSource::File(path) => EnvironmentSource::File(site.folder.ok_or(SectionError::NoFolder)?.join(path)),
+        other => other,
+    };
+    if site.replaced {
+        return Ok(None);
+    }
+    let Some(mut env) = source.load().map_err(|err| SectionError::Unusable(err.to_string()))? else { return Ok(None) };
+    env.intensity = intensity.unwrap_or(env.intensity);
+    env.rotation = rotation.map_or(env.rotation, f32::to_radians);
+    env.background = e.background.unwrap_or(false);
+    Ok(Some(Box::new(env)))
+}
+
+/// An environment asked for replaces the file's: its image is not read.
+fn replaces_file(asks: &Sections) -> bool {
+    asks.get::<EnvironmentAsk>().is_some_and(|a| a.source.is_some())
+}
+
+/// A pbr model without lights of its own looks as it does in a glTF viewer: under a sky.
+fn sky_for_unlit_file(asks: &Sections, scene: &mut Scene, site: &RequestSite) {
+    if site.shading == ShadingModel::Pbr && !replaces_file(asks) && scene.sections.get::<Environment>().is_none() {
+        scene.sections.set(Some(Environment::sky()));
+    }
+}
+
+/// The environment asked for, at the intensity and turn asked for.
+fn apply_ask(asks: &Sections, scene: &mut Scene, _site: &RequestSite) -> Result<(), AskError> {
+    let Some(ask) = asks.get::<EnvironmentAsk>() else { return Ok(()) };
+    if let Some(source) = &ask.source {
+        scene.sections.set(source.load()?);
+    }
+    if let Some(env) = scene.sections.get_mut::<Environment>() {
+        env.intensity = ask.intensity.unwrap_or(env.intensity);
+        env.rotation = ask.rotation_deg.map_or(env.rotation, f32::to_radians);
+    }
+    Ok(())
 }
 
 /// Largest environment intensity (the lights' own cap).

@@ -267,8 +267,9 @@ pub struct Scene {
     /// Spot cones, one per light (LightCone::NONE for point lights) — or none at all in a
     /// scene without spot lights.
     pub cones: Vec<LightCone>,
-    /// Light from every direction at infinity (the pbr model; None: the constant ambient).
-    pub environment: Option<crate::environment::Environment>,
+    /// What the features add to the scene, by type (`scene_section`): the environment light
+    /// (the pbr model; none: the constant ambient).
+    pub sections: crate::scene_section::Sections,
 }
 
 /// A light marker's half-width as a fraction of its light's radius (the seed's radius-15
@@ -338,7 +339,7 @@ impl Scene {
             textures: Vec::new(),
             directional: Vec::new(),
             cones: Vec::new(),
-            environment: None,
+            sections: Default::default(),
         }
     }
 

@@ -1,29 +1,31 @@
-//! Scene files (`--scene FILE.toml`): camera, shading, point lights and objects made
-//! of the built-in meshes. Every field is optional but `objects`; unknown fields are errors
-//! (a typo must not be silently ignored). Everything read is checked — finite numbers, sane
-//! ranges, counts and file size limited before anything is allocated — and every problem is
-//! one error naming the file and, where the parser knows it, the line.
+//! Scene files (`--scene FILE.toml`): camera, shading, point lights and objects made of the
+//! built-in meshes, and the tables of the features with a scene section (`[environment]`,
+//! `sections::SECTIONS`), each read by its feature. Every field is optional but `objects`;
+//! unknown fields are errors (a typo must not be silently ignored). Everything read is
+//! checked — finite numbers, sane ranges, counts and file size limited before anything is
+//! allocated — and every problem is one error naming the file and, where the parser knows it,
+//! the line.
 
 use crate::camera::{clip_planes_for, Camera, DEFAULT_FOV_Y_DEG};
-use crate::environment::{Environment, EnvironmentSource, MAX_ENVIRONMENT_ROTATION_DEG};
-use crate::error::Number;
+use crate::file_fields::{finite, intensity, non_negative, positive, unit, within, FieldProblem};
 use crate::files::{read_regular, ReadError};
 use crate::framing::{frame_scene, framing_distance, DEFAULT_ASPECT};
 use crate::gltf_scene::GltfError;
 use crate::gpu_types::{LightCone, PointLight};
 use crate::lights::SEED_RADIUS;
 pub use crate::limits::MAX_OBJECTS;
-use crate::limits::{LENGTHS, MAX_COORDINATE, MAX_INTENSITY, MAX_LIGHTS, SCALES};
+use crate::limits::{LENGTHS, MAX_COORDINATE, MAX_LIGHTS, SCALES};
 use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::{DirectionalLight, Object, Scene, MAX_DIRECTIONAL_LIGHTS, SEED_AMBIENT};
 pub use crate::scene_load::SceneFile;
 use crate::scene_load::{check_draw_work, check_extent, read_reference, DrawWorkError, ExtentError, ReferenceError};
+use crate::section_kind::{FileSite, SectionError};
+use crate::sections::SECTIONS;
 use crate::SceneError;
 use glam::Vec3;
 use serde::{de, Deserialize, Deserializer};
 use std::collections::HashMap;
-use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -77,16 +79,8 @@ pub enum SceneFileProblem {
     TooManyLights(usize),
     #[error("{entry}: {problem}")]
     In { entry: Entry, problem: Box<SceneFileProblem> },
-    #[error("{what} {value} is not a finite number")]
-    NotFinite { what: &'static str, value: f32 },
-    #[error("{what} {value} must be greater than 0")]
-    NotPositive { what: &'static str, value: f32 },
-    #[error("{what} {value} must not be negative")]
-    Negative { what: &'static str, value: f32 },
-    #[error("{what} {value} must lie in [0, 1]")]
-    NotUnit { what: &'static str, value: f32 },
-    #[error("{what} {} is out of range: use {} to {}", Number(*value), Number(*range.start()), Number(*range.end()))]
-    OutOfRange { what: &'static str, value: f32, range: RangeInclusive<f32> },
+    #[error(transparent)]
+    Field(#[from] FieldProblem),
     #[error(transparent)]
     Extent(#[from] ExtentError),
     #[error(transparent)]
@@ -133,8 +127,9 @@ pub enum SceneFileProblem {
     NearFar { near: f32, far: f32 },
     #[error("[camera] looks straight up or down, where its yaw is undefined: move target or position sideways")]
     CameraVertical,
-    #[error("[environment] {0}")]
-    Environment(String),
+    /// A feature's table (`[environment]`) that its feature cannot use.
+    #[error("[{table}] {problem}")]
+    Section { table: &'static str, problem: Box<SectionError> },
 }
 
 impl SceneFileProblem {
@@ -181,7 +176,6 @@ impl<'de> Deserialize<'de> for Triple {
 struct FileScene {
     camera: Option<FileCamera>,
     shading: Option<FileShading>,
-    environment: Option<FileEnvironment>,
     #[serde(default)]
     lights: Vec<FileLight>,
     objects: Vec<FileObject>,
@@ -204,18 +198,6 @@ struct FileCamera {
 struct FileShading {
     model: Option<String>,
     ambient: Option<f32>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct FileEnvironment {
-    /// An equirectangular .hdr or .exr file (relative to the scene file's folder), "sky" or
-    /// "none".
-    file: String,
-    intensity: Option<f32>,
-    rotation_deg: Option<f32>,
-    /// Shown behind the scene (else the render's background colour).
-    background: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -263,51 +245,71 @@ struct FileMaterial {
 
 /// Read and check the scene file at `path`.
 pub fn load(path: &Path) -> Result<SceneFile, SceneFileError> {
-    load_with(path, EnvironmentImage::Read)
+    load_with(path, &[])
 }
 
-/// Whether a scene file's `[environment]` image is read: not where another replaces it (its
-/// intensity and turn are checked either way).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum EnvironmentImage {
-    Read,
-    Skip,
-}
-
-/// `load`, reading the `[environment]` image or not.
-pub fn load_with(path: &Path, image: EnvironmentImage) -> Result<SceneFile, SceneFileError> {
+/// `load`, the features' tables named in `replaced` checked but not loaded (the request
+/// replaces their sections: `SectionKind::replaces_file`).
+pub fn load_with(path: &Path, replaced: &[&str]) -> Result<SceneFile, SceneFileError> {
     let fail = |problem: Problem| SceneFileError { path: path.to_path_buf(), problem };
     let bytes = read_regular(path, MAX_FILE_BYTES).map_err(|e| fail(e.into()))?;
     let text = std::str::from_utf8(&bytes).map_err(|e| fail(Problem::NotUtf8(e.valid_up_to())))?;
-    parse_in(text, path.parent(), image).map_err(fail)
+    parse_in(text, path.parent(), replaced).map_err(fail)
 }
 
 /// A scene file's bytes (UTF-8 text), its `gltf` paths relative to `folder` (None: glTF
 /// objects are refused); the error is the problem, without the file's name.
 pub fn from_bytes(bytes: &[u8], folder: Option<&Path>) -> Result<SceneFile, SceneFileProblem> {
     let text = std::str::from_utf8(bytes).map_err(|e| Problem::NotUtf8(e.valid_up_to()))?;
-    parse_in(text, folder, EnvironmentImage::Read)
+    parse_in(text, folder, &[])
 }
 
 /// Parse scene-file text (glTF objects are refused: they need the file's folder); the error
 /// is the problem, without the file's name.
 pub fn parse(text: &str) -> Result<SceneFile, SceneFileProblem> {
-    parse_in(text, None, EnvironmentImage::Read)
+    parse_in(text, None, &[])
 }
 
-/// Parse scene-file text whose `gltf` paths are relative to `base`.
-fn parse_in(text: &str, base: Option<&Path>, image: EnvironmentImage) -> Result<SceneFile, Problem> {
+/// Parse scene-file text whose `gltf` paths are relative to `base`. The features' tables
+/// (`sections::SECTIONS`) are taken out of the document and read by their features, the rest
+/// is the format's own; either way the TOML reader's errors know their line.
+fn parse_in(text: &str, base: Option<&Path>, replaced: &[&str]) -> Result<SceneFile, Problem> {
     if text.len() as u64 > MAX_FILE_BYTES {
         return Err(Problem::TooLong(text.len()));
     }
-    let file: FileScene = toml::from_str(text).map_err(|e| Problem::Syntax {
+    let syntax = |e: toml::de::Error| Problem::Syntax {
         line: e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1),
         message: e.message().replace('\n', " "),
+    };
+    let mut document = toml::de::DeTable::parse(text).map_err(syntax)?;
+    let tables: Vec<_> = SECTIONS.iter().filter_map(|kind| Some((kind, document.get_mut().remove(kind.table)?))).collect();
+    let file = FileScene::deserialize(toml::de::Deserializer::from(document)).map_err(|e| {
+        // The fields the format knows, then the features' tables.
+        let unknown = e.message().starts_with("unknown field");
+        let mut problem = syntax(e);
+        if let (true, Problem::Syntax { message, .. }) = (unknown, &mut problem) {
+            let tables: Vec<String> = SECTIONS.iter().map(|kind| format!("`{}`", kind.table)).collect();
+            message.push_str(&format!(", or a feature's table: {}", tables.join(", ")));
+        }
+        problem
     })?;
-    build(file, base, image)
+    let mut built = build(file, base)?;
+    for (kind, table) in tables {
+        let site = FileSite { folder: base, replaced: replaced.contains(&kind.table) };
+        let read = (kind.read)(toml::de::ValueDeserializer::from(table), &site).map_err(|problem| match problem {
+            SectionError::Format(e) => syntax(e),
+            // The field's name says the table.
+            SectionError::Field(field) => Problem::Field(field),
+            problem => Problem::Section { table: kind.table, problem: Box::new(problem) },
+        })?;
+        if let Some(section) = read {
+            built.scene.sections.insert(section);
+        }
+    }
+    Ok(built)
 }
 
-fn build(file: FileScene, base: Option<&Path>, image: EnvironmentImage) -> Result<SceneFile, Problem> {
+fn build(file: FileScene, base: Option<&Path>) -> Result<SceneFile, Problem> {
     if file.objects.is_empty() {
         return Err(Problem::NoObjects);
     }
@@ -361,37 +363,7 @@ fn build(file: FileScene, base: Option<&Path>, image: EnvironmentImage) -> Resul
     check_extent(&scene)?;
     check_draw_work(&scene)?;
     (scene.camera, scene.camera_framed) = camera(file.camera.as_ref(), &scene)?;
-    scene.environment = file.environment.as_ref().map(|e| environment(e, base, image)).transpose()?.flatten();
     Ok(SceneFile { scene, shading, warnings })
-}
-
-/// The file's [environment]: its image (a path relative to the scene file's folder; not read
-/// with `EnvironmentImage::Skip`), intensity and turn.
-fn environment(e: &FileEnvironment, base: Option<&Path>, image: EnvironmentImage) -> Result<Option<Environment>, Problem> {
-    let intensity = e.intensity.map(|i| intensity("[environment] intensity", i)).transpose()?;
-    let range = -MAX_ENVIRONMENT_ROTATION_DEG..=MAX_ENVIRONMENT_ROTATION_DEG;
-    let rotation =
-        e.rotation_deg.map(|r| within("[environment] rotation_deg", finite("[environment] rotation_deg", r)?, range)).transpose()?;
-    let source = match EnvironmentSource::parse(&e.file) {
-        EnvironmentSource::File(path) => EnvironmentSource::File(base.ok_or(Problem::NoFolder)?.join(path)),
-        other => other,
-    };
-    if image == EnvironmentImage::Skip {
-        return Ok(None);
-    }
-    let Some(mut env) = source.load().map_err(|err| Problem::Environment(err.to_string()))? else { return Ok(None) };
-    env.intensity = intensity.unwrap_or(env.intensity);
-    env.rotation = rotation.map_or(env.rotation, f32::to_radians);
-    env.background = e.background.unwrap_or(false);
-    Ok(Some(env))
-}
-
-fn finite(what: &'static str, value: f32) -> Result<f32, Problem> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(Problem::NotFinite { what, value })
-    }
 }
 
 /// Three finite numbers.
@@ -400,15 +372,6 @@ fn vec3(what: &'static str, Triple(v): Triple) -> Result<Vec3, Problem> {
         finite(what, x)?;
     }
     Ok(Vec3::from(v))
-}
-
-/// `value`, refused outside `range` (finite already).
-fn within(what: &'static str, value: f32, range: RangeInclusive<f32>) -> Result<f32, Problem> {
-    if range.contains(&value) {
-        Ok(value)
-    } else {
-        Err(Problem::OutOfRange { what, value, range })
-    }
 }
 
 /// A place or a direction: each coordinate within ±MAX_COORDINATE.
@@ -422,41 +385,12 @@ fn coordinates(what: &'static str, v: Triple) -> Result<Vec3, Problem> {
 
 /// A radius, a clip plane, a half-height: positive, in LENGTHS.
 fn length(what: &'static str, value: f32) -> Result<f32, Problem> {
-    within(what, positive(what, value)?, LENGTHS)
+    Ok(within(what, positive(what, value)?, LENGTHS)?)
 }
 
 /// An object's scale: positive, in SCALES.
 fn scale(value: f32) -> Result<f32, Problem> {
-    within("scale", positive("scale", value)?, SCALES)
-}
-
-/// A light's colour or the ambient term: not negative, at most MAX_INTENSITY.
-fn intensity(what: &'static str, value: f32) -> Result<f32, Problem> {
-    within(what, non_negative(what, value)?, 0.0..=MAX_INTENSITY)
-}
-
-fn positive(what: &'static str, value: f32) -> Result<f32, Problem> {
-    if finite(what, value)? > 0.0 {
-        Ok(value)
-    } else {
-        Err(Problem::NotPositive { what, value })
-    }
-}
-
-fn non_negative(what: &'static str, value: f32) -> Result<f32, Problem> {
-    if finite(what, value)? >= 0.0 {
-        Ok(value)
-    } else {
-        Err(Problem::Negative { what, value })
-    }
-}
-
-fn unit(what: &'static str, value: f32) -> Result<f32, Problem> {
-    if (0.0..=1.0).contains(&finite(what, value)?) {
-        Ok(value)
-    } else {
-        Err(Problem::NotUnit { what, value })
-    }
+    Ok(within("scale", positive("scale", value)?, SCALES)?)
 }
 
 fn object(o: &FileObject) -> Result<Object, Problem> {

@@ -4,7 +4,6 @@
 
 use crate::bench_scene::bench_scene;
 use crate::camera::CameraSpec;
-use crate::environment::{EnvironmentError, EnvironmentSource};
 use crate::framing::{frame_scene, DEFAULT_ASPECT};
 use crate::gltf_scene::{self, GltfFileError};
 use crate::lights::{LightColors, LightFrame, LightLayout, LightParams, RadiusRange, DEFAULT_RIG_LIGHTS, SEED_LIGHT_COUNT, SEED_RADIUS};
@@ -12,6 +11,9 @@ use crate::material::Material;
 use crate::mesh::MeshKind;
 use crate::scene::Scene;
 use crate::scene_file::{self, SceneFileError};
+use crate::scene_section::{Section, Sections};
+use crate::section_kind::{AskError, RequestSite};
+use crate::sections::SECTIONS;
 use crate::shading_model::ShadingModel;
 use crate::surface_sampler::SurfaceSampler;
 use crate::SceneError;
@@ -69,13 +71,9 @@ pub struct SceneRequest {
     /// Colours of the lights placed by layout; None: the seed scene's palette, near-white in
     /// a file (`LightColors`).
     pub light_colors: Option<LightColors>,
-    /// The environment light: None: a file's own, else the built-in sky for a file without
-    /// lights of its own (the default rig lights it too), else none.
-    pub environment: Option<EnvironmentSource>,
-    /// The environment's intensity and turn about +Y in degrees, where given (else its own:
-    /// 1 and 0 unless a scene file says).
-    pub environment_intensity: Option<f32>,
-    pub environment_rotation_deg: Option<f32>,
+    /// What it asks of the features' sections of the scene, each in its feature's type
+    /// (`section_kind`; the environment light's `EnvironmentAsk`).
+    pub sections: Sections,
     /// A glTF file's material variant to draw (KHR_materials_variants), by name.
     pub variant: Option<String>,
 }
@@ -116,8 +114,10 @@ pub enum SceneRequestError {
     /// A file whose box fits its lights no radius.
     #[error("'{}': {problem}", path.display())]
     FileLights { path: PathBuf, problem: SceneError },
-    #[error(transparent)]
-    Environment(#[from] EnvironmentError),
+    /// What a feature's section was asked for and cannot be (an environment file that does
+    /// not load).
+    #[error("{0}")]
+    Section(AskError),
 }
 
 impl SceneRequest {
@@ -137,11 +137,16 @@ impl SceneRequest {
             transparent_percent: 0,
             glass_layers: 0,
             light_colors: None,
-            environment: None,
-            environment_intensity: None,
-            environment_rotation_deg: None,
+            sections: Sections::default(),
             variant: None,
         }
+    }
+
+    /// The request with `ask` as what it asks of its feature's section (replacing an earlier
+    /// ask of that feature).
+    pub fn asking<T: Section>(mut self, ask: T) -> SceneRequest {
+        self.sections.set(Some(ask));
+        self
     }
 
     /// Whether the scene is the seed's grid (its object and material may change).
@@ -170,12 +175,9 @@ impl SceneRequest {
         }
         crate::transparency::make_transparent(&mut built.scene, self.transparent_percent);
         crate::transparency::add_glass_layers(&mut built.scene, self.glass_layers, self.aspect);
-        if let Some(source) = &self.environment {
-            built.scene.environment = source.load()?;
-        }
-        if let Some(env) = &mut built.scene.environment {
-            env.intensity = self.environment_intensity.unwrap_or(env.intensity);
-            env.rotation = self.environment_rotation_deg.map_or(env.rotation, f32::to_radians);
+        let site = RequestSite { shading: built.shading };
+        for kind in SECTIONS {
+            (kind.apply)(&self.sections, &mut built.scene, &site).map_err(SceneRequestError::Section)?;
         }
         Ok(built)
     }
@@ -213,9 +215,9 @@ impl SceneRequest {
 
     fn build_file(&self, path: &Path) -> Result<BuiltScene, SceneRequestError> {
         let is_toml = path.to_string_lossy().to_lowercase().ends_with(".toml");
-        // An environment asked for replaces the file's: its image is not read.
-        let image = if self.environment.is_some() { scene_file::EnvironmentImage::Skip } else { scene_file::EnvironmentImage::Read };
-        let file = if is_toml { scene_file::load_with(path, image)? } else { gltf_scene::load(path, self.variant.as_deref())? };
+        // A section the request replaces is the request's: the file's table is only checked.
+        let replaced: Vec<&str> = SECTIONS.iter().filter(|kind| (kind.replaces_file)(&self.sections)).map(|kind| kind.table).collect();
+        let file = if is_toml { scene_file::load_with(path, &replaced)? } else { gltf_scene::load(path, self.variant.as_deref())? };
         let path = path.to_path_buf();
         let shading = match (self.shading, &file.shading) {
             (Some(model), _) => model,
@@ -233,9 +235,11 @@ impl SceneRequest {
             scene.camera = frame_scene(&scene, self.aspect, scene.camera.fov_y_deg);
         }
         let unlit = scene.lights.is_empty() && scene.directional.is_empty();
-        // A pbr model without lights of its own looks as it does in a glTF viewer: under a sky.
-        if unlit && shading == ShadingModel::Pbr && self.environment.is_none() && scene.environment.is_none() {
-            scene.environment = Some(crate::environment::Environment::sky());
+        if unlit {
+            let site = RequestSite { shading };
+            for kind in SECTIONS {
+                (kind.unlit_file)(&self.sections, &mut scene, &site);
+            }
         }
         if self.lights.is_some() || unlit {
             let count = self.lights.unwrap_or(DEFAULT_RIG_LIGHTS as u64);
@@ -343,6 +347,7 @@ mod tests {
 
     #[test]
     fn an_environment_asked_for_replaces_the_files_without_reading_its_image() {
+        use crate::environment::{Environment, EnvironmentAsk, EnvironmentSource};
         let dir = std::env::temp_dir().join(format!("ml-scene-request-env-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("lit.toml");
@@ -351,12 +356,14 @@ mod tests {
         let own = SceneRequest::new(SceneSource::File(path.clone()));
         let e = own.build().unwrap_err().to_string();
         assert!(e.contains("missing.hdr"), "the file's own image is read: {e}");
-        let replaced = SceneRequest { environment: Some(EnvironmentSource::Sky), ..own.clone() }.build().unwrap();
-        let env = replaced.scene.environment.expect("the sky asked for");
-        assert_eq!(env.intensity, crate::environment::Environment::sky().intensity, "the file's intensity went with its image");
+        let sky =
+            |request: &SceneRequest| request.clone().asking(EnvironmentAsk { source: Some(EnvironmentSource::Sky), ..Default::default() });
+        let replaced = sky(&own).build().unwrap();
+        let env = replaced.scene.sections.get::<Environment>().expect("the sky asked for");
+        assert_eq!(env.intensity, Environment::sky().intensity, "the file's intensity went with its image");
         // The file's numbers are checked all the same.
         std::fs::write(&path, text.replace("2.0", "-1.0")).unwrap();
-        assert!(SceneRequest { environment: Some(EnvironmentSource::Sky), ..own }.build().is_err());
+        assert!(sky(&own).build().is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,16 +1,15 @@
 //! `assemble`: the passes of a frame made from its plan (`plan::plan`, the ordered pass kinds
 //! as data) — each kind's pass constructed for the scene and settings. A new pass is a file
 //! in its feature's folder, a `PassKind` with its place in `plan`, and its line here
-//! (docs/architecture.md has the checklist). `FEATURES` gathers the features' debug views
-//! the same way, a line each, `SCENE_PARTS` the scene parts they make, and
-//! `RenderSettings::lighting` and `check_scene` what they compile into the lighting and ask
-//! of a scene.
+//! (docs/architecture.md has the checklist). `FEATURES` gathers the rest of every feature
+//! (`feature::Feature`: debug views, scene part, lighting constants, scene checks) the same
+//! way, a line each.
 
 use crate::clusters::cluster_assign_cpu;
 use crate::debug_view::DebugView;
-use crate::environment;
 use crate::error::{by_name, Named, RenderError, SettingsError};
 use crate::exposure::{exposure_meter, tone_map};
+use crate::feature::Feature;
 use crate::light_grid::light_grid_build::LightGridBuild;
 use crate::light_grid::light_grid_mark::LightGridMark;
 use crate::light_stats::light_count::LightCount;
@@ -32,50 +31,74 @@ use ml_cpu::gpu_types::PointLight;
 use ml_cpu::scene::Scene;
 use ml_vk::{vk, Context};
 
-/// The scene's parts beside the shadow stores (`scene_part`), each made by its feature, in
-/// the order the frames ask them.
-pub const SCENE_PARTS: [MakePart; 2] = [crate::environment::make_part, crate::shading::blinn_phong::make_part];
-
-/// The debug views of every feature, in the order lists and menus show them.
-const FEATURES: [&[DebugView]; 6] = [
-    &[DebugView::NONE],
-    crate::clusters::VIEWS,
-    crate::shading::VIEWS,
-    crate::shadows::VIEWS,
-    crate::visibility::VIEWS,
-    crate::transparency::VIEWS,
+/// Every feature's hooks (`feature`), a line each: its debug views in the order lists and
+/// menus show them, its scene part (made in this order), its lighting constants, its checks
+/// of a scene.
+const FEATURES: [Feature; 7] = [
+    Feature::views(&[DebugView::NONE]),
+    crate::environment::FEATURE,
+    crate::clusters::FEATURE,
+    SHADING,
+    SHADOWS,
+    crate::visibility::FEATURE,
+    Feature::views(crate::transparency::VIEWS),
 ];
 
+/// The shading models as a feature: their views, the blinn-phong model's other lights, the
+/// lights' and materials' constants (the surfaces' own constants are `lighting`'s first
+/// group). Built here: the settings are made of its types (`feature`).
+const SHADING: Feature = Feature {
+    views: crate::shading::VIEWS,
+    part: Some(crate::shading::blinn_phong::make_part),
+    lighting: |s, scene| Constants::of(&[&light_constants(s.shading, scene)]),
+    ..Feature::NONE
+};
+
+/// The shadows as a feature: their views, their constants, and no shadow rays without a light
+/// to cast them. Their stores are not a part the list makes: the shadow passes share them.
+const SHADOWS: Feature = Feature {
+    views: crate::shadows::VIEWS,
+    lighting: |s, scene| {
+        Constants::of(&[&shadow_settings::lighting_constants(s.omni, s.shadow_config().sun, !scene.directional.is_empty())])
+    },
+    check_scene: |s, scene| s.check_casters(scene.lights.len(), scene.directional.len()),
+    ..Feature::NONE
+};
+
+/// How the scene's parts beside the shadow stores are made, in the order the frames ask them.
+pub fn scene_parts() -> impl Iterator<Item = MakePart> {
+    FEATURES.into_iter().filter_map(|f| f.part)
+}
+
 impl RenderSettings {
-    /// What the lighting pipelines are compiled for, for `scene`: each feature's constants,
-    /// from its module — a feature that compiles into the lighting adds its part here.
+    /// What the lighting pipelines are compiled for, for `scene`: the surfaces' constants,
+    /// then each feature's.
     pub fn lighting(&self, scene: &Scene) -> Shading {
         let model = self.shading;
         let lobe_textures = material_lobes(model, scene) && scene.has_lobe_textures();
         let surface = surface_constants(model, !scene.textures.is_empty(), self.specular_aa, lobe_textures);
-        let shadows = shadow_settings::lighting_constants(self.omni, self.shadow_config().sun, !scene.directional.is_empty());
+        let features = FEATURES.map(|f| (f.lighting)(self, scene));
+        let lighting = Constants::of(&features.each_ref().map(Constants::as_slice));
         Shading {
             surface: Constants::of(&[&surface]),
-            lighting: Constants::of(&[&shadows, &light_constants(model, scene), &environment::lighting_constants(model, scene)]),
+            count_rays: self.light_stats && shadow_settings::traces_rays(lighting.as_slice()),
+            lighting,
             transparency: self.blends_layers(),
-            count_rays: self.light_stats && shadow_settings::traces_rays(&shadows),
             antialiasing: self.antialiasing,
             background: self.background,
         }
     }
 
-    /// Reject what `scene` cannot give, each feature's checks in turn: shadow rays where no
-    /// light casts them, the environment as the background where it does not light the scene.
+    /// Reject what `scene` cannot give, each feature's checks in turn.
     pub fn check_scene(&self, scene: &Scene) -> Result<(), SettingsError> {
-        self.check_casters(scene.lights.len(), scene.directional.len())?;
-        environment::check_background(self.background, self.shading, scene)
+        FEATURES.iter().try_for_each(|f| (f.check_scene)(self, scene))
     }
 }
 
 impl DebugView {
     /// Every feature's views, `NONE` first.
     pub fn all() -> impl Iterator<Item = DebugView> {
-        FEATURES.into_iter().flatten().copied()
+        FEATURES.into_iter().flat_map(|f| f.views.iter().copied())
     }
 
     pub fn from_name(name: &str) -> Result<DebugView, RenderError> {

@@ -10,6 +10,9 @@ use crate::error::{by_name, Named, RenderError};
 use crate::frame_resources::FrameResources;
 use crate::pass::{Pass, Recording};
 use crate::sync::{Use, COLOUR_TARGET};
+use ml_cpu::environment::Environment;
+use ml_cpu::scene::Scene;
+use ml_cpu::shading_model::ShadingModel;
 use ml_vk::{vk, Context, VkError};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -33,6 +36,17 @@ impl Background {
 
     pub fn from_name(name: &str) -> Result<Background, RenderError> {
         by_name(&Background::ALL, Background::name, Named::Background, name)
+    }
+
+    /// What `scene` asks to show with `model`: its environment where it asks to be shown and
+    /// lights the model (pbr), else the colour.
+    pub fn asked_by(scene: &Scene, model: ShadingModel) -> Background {
+        let shown = scene.sections.get::<Environment>().is_some_and(|e| e.background) && model == ShadingModel::Pbr;
+        if shown {
+            Background::Environment
+        } else {
+            Background::Colour
+        }
     }
 
     /// `BACKGROUND_ENVIRONMENT` (common/background.glsl) of the pipelines that lay it.

@@ -44,6 +44,7 @@ mod depth_pass;
 mod descriptors;
 mod environment;
 mod exposure;
+mod feature;
 mod frame;
 mod frame_resources;
 mod gpu_mesh;

@@ -6,7 +6,7 @@
 //! uses need (`sync`), times and collects from.
 
 use crate::antialiasing::{Antialiasing, AntialiasingStats};
-use crate::assembly::{assemble, Assembly, SCENE_PARTS};
+use crate::assembly::{assemble, scene_parts, Assembly};
 use crate::clusters;
 use crate::error::RenderError;
 use crate::exposure::auto_exposure::{self, AutoExposure};
@@ -70,7 +70,7 @@ pub struct Renderer<'a> {
     extent: vk::Extent2D,
     /// The scene's meshes, buffers and textures on the GPU.
     gpu: SceneGpu,
-    /// The scene's parts beside the shadow stores (the assembly's SCENE_PARTS: the environment
+    /// The scene's parts beside the shadow stores (the features' parts, the assembly's list: the environment
     /// light's maps, the blinn-phong lights).
     parts: OwnedParts,
     /// The shadow stores (the shadow passes share them).
@@ -182,7 +182,7 @@ impl<'a> Renderer<'a> {
         let lights_on_gpu = settings.technique.assignment() == LightAssignment::Gpu;
         // The scene's parts, then its geometry and textures (set 1 binds what the parts name),
         // then the shadow stores' casters; a failure releases what was made before it.
-        let mut parts = OwnedParts::make(ctx, &scene, &SCENE_PARTS)?;
+        let mut parts = OwnedParts::make(ctx, &scene, scene_parts())?;
         // The sun's map in the G-buffer's depth format (sampleable).
         let made = depth_format(ctx, Output::GBuffer)
             .map_err(RenderError::from)

@@ -3,8 +3,8 @@
 //! it binds in the scene's set 1, the buffers shaders bind from a frame's table, the images
 //! passes declare (`sync`), the frame uniforms it owns, each by name, and its rows of the
 //! run's table. The renderer holds the parts and asks each in turn: the shadow stores (which
-//! the shadow passes share) and the parts the assembly's `SCENE_PARTS` makes, a line each, so
-//! a new part is its module and that line. A part's module reaches its part again through
+//! the shadow passes share) and the parts the features make (a feature's `part`, listed in the
+//! assembly's `FEATURES`), so a new part is its module and its feature's line. A part's module reaches its part again through
 //! `PartHost` (the environment's view).
 
 use crate::descriptors::Resource;
@@ -43,16 +43,16 @@ pub trait OwnedPart: ScenePart + Any {
     fn destroy(&mut self, _ctx: &Context) {}
 }
 
-/// How a part is made for a scene (the assembly's `SCENE_PARTS`).
+/// How a part is made for a scene (a feature's `part`, `feature::Feature`).
 pub type MakePart = fn(&Context, &Scene) -> Result<Box<dyn OwnedPart>, RenderError>;
 
-/// The parts `SCENE_PARTS` made, in its order.
+/// The parts the features made, in the assembly's order.
 #[derive(Default)]
 pub struct OwnedParts(pub Vec<Box<dyn OwnedPart>>);
 
 impl OwnedParts {
     /// Each of `makers` for `scene`; where one fails, those made before it are released.
-    pub fn make(ctx: &Context, scene: &Scene, makers: &[MakePart]) -> Result<OwnedParts, RenderError> {
+    pub fn make(ctx: &Context, scene: &Scene, makers: impl IntoIterator<Item = MakePart>) -> Result<OwnedParts, RenderError> {
         let mut parts = OwnedParts::default();
         for make in makers {
             let made = make(ctx, scene);

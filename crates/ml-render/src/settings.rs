@@ -354,14 +354,7 @@ impl SettingsRequest {
             omni: s.omni.map(|o| OmniShadowSettings { lights: shadowed_count(&o, scene, (s.width, s.height)), ..o }),
             transparency: scene.has_transparent_objects().then_some(self.transparency),
             light_grid_marks: self.light_grid_marks.resolve(scene.lights.len() as u64, s.width, s.height),
-            background: self.background.unwrap_or({
-                let shown = scene.environment.as_ref().is_some_and(|e| e.background) && shading == ShadingModel::Pbr;
-                if shown {
-                    Background::Environment
-                } else {
-                    Background::Colour
-                }
-            }),
+            background: self.background.unwrap_or(Background::asked_by(scene, shading)),
             ..*s
         }
     }

@@ -2,7 +2,7 @@
 //! settings (`Choices`), pause, and a panel of per-pass GPU times with a frame-time graph.
 
 use egui::{ComboBox, DragValue, Slider};
-use ml_cpu::environment::EnvironmentSource;
+use ml_cpu::environment::{Environment, EnvironmentAsk, EnvironmentSource};
 use ml_cpu::lights::{LightLayout, RadiusRange, SEED_RADIUS};
 use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
@@ -54,7 +54,7 @@ impl Choices {
             lights: built.scene.lights.len() as u64,
             layout: request.layout,
             radius: request.radius.map_or_else(|| built.scene.lights.first().map_or(SEED_RADIUS, |l| l.position_radius[3]), |r| r.max),
-            environment: built.scene.environment.as_ref().map(|e| (e.intensity, e.rotation.to_degrees())),
+            environment: built.scene.sections.get::<Environment>().map(|e| (e.intensity, e.rotation.to_degrees())),
             environment_source: None,
             light_grid_marks,
         }
@@ -78,11 +78,15 @@ impl Choices {
         if let SceneSource::Seed { object, material } = &mut r.source {
             (*object, *material) = (self.object, self.material);
         }
-        if let Some(source) = &self.environment_source {
-            r.environment = Some(EnvironmentSource::parse(source));
-        }
-        if let Some((intensity, degrees)) = self.environment {
-            (r.environment_intensity, r.environment_rotation_deg) = (Some(intensity), Some(degrees));
+        if self.environment_source.is_some() || self.environment.is_some() {
+            let mut ask = r.sections.get::<EnvironmentAsk>().cloned().unwrap_or_default();
+            if let Some(source) = &self.environment_source {
+                ask.source = Some(EnvironmentSource::parse(source));
+            }
+            if let Some((intensity, degrees)) = self.environment {
+                (ask.intensity, ask.rotation_deg) = (Some(intensity), Some(degrees));
+            }
+            r.sections.set(Some(ask));
         }
         if (self.lights, self.layout, self.radius) != (initial.lights, initial.layout, initial.radius) {
             (r.lights, r.layout) = (Some(self.lights), self.layout);
@@ -385,14 +389,19 @@ mod tests {
         assert_eq!(teapot.lights, None);
     }
 
+    /// What `r` asks of the environment (nothing: the default ask).
+    fn ask(r: &SceneRequest) -> EnvironmentAsk {
+        r.sections.get::<EnvironmentAsk>().cloned().unwrap_or_default()
+    }
+
     #[test]
     fn an_environments_intensity_and_turn_go_into_the_request() {
         let base = SceneRequest::new(SceneSource::File("a.glb".into()));
         let start = Choices { environment: Some((1.0, 0.0)), ..initial() };
         let turned = Choices { environment: Some((2.0, 90.0)), ..start.clone() }.request(&base, &start);
-        assert_eq!((turned.environment_intensity, turned.environment_rotation_deg), (Some(2.0), Some(90.0)));
+        assert_eq!((ask(&turned).intensity, ask(&turned).rotation_deg), (Some(2.0), Some(90.0)));
         let none = initial().request(&base, &initial());
-        assert_eq!((none.environment_intensity, none.environment_rotation_deg), (None, None));
+        assert_eq!((ask(&none).intensity, ask(&none).rotation_deg), (None, None));
     }
 
     #[test]
@@ -401,13 +410,13 @@ mod tests {
         let mut lit = Choices { environment: Some((2.0, 90.0)), ..initial() };
         lit.load_environment("studio.hdr");
         let r = lit.request(&base, &initial());
-        assert_eq!(r.environment, Some(EnvironmentSource::File("studio.hdr".into())));
-        assert_eq!((r.environment_intensity, r.environment_rotation_deg), (Some(2.0), Some(90.0)));
+        assert_eq!(ask(&r).source, Some(EnvironmentSource::File("studio.hdr".into())));
+        assert_eq!((ask(&r).intensity, ask(&r).rotation_deg), (Some(2.0), Some(90.0)));
         // A scene without one starts at 1 and 0°; none takes the sliders away.
         let mut dark = initial();
         dark.load_environment("sky");
-        assert_eq!((dark.environment, dark.request(&base, &initial()).environment), (Some((1.0, 0.0)), Some(EnvironmentSource::Sky)));
+        assert_eq!((dark.environment, ask(&dark.request(&base, &initial())).source), (Some((1.0, 0.0)), Some(EnvironmentSource::Sky)));
         dark.load_environment("none");
-        assert_eq!((dark.environment, dark.request(&base, &initial()).environment), (None, Some(EnvironmentSource::Off)));
+        assert_eq!((dark.environment, ask(&dark.request(&base, &initial())).source), (None, Some(EnvironmentSource::Off)));
     }
 }

@@ -306,3 +306,20 @@ fn a_huge_array_is_refused_at_its_fourth_number() {
     assert!(e.contains("line 3: more than 3 numbers"), "{}", &e[..e.len().min(200)]);
     assert!(start.elapsed().as_secs_f32() < 5.0, "{:?}", start.elapsed());
 }
+
+#[test]
+fn a_features_table_is_read_by_its_feature_and_its_errors_keep_their_lines() {
+    use crate::environment::Environment;
+    let base = "[[objects]]\nmesh = \"sphere\"\n\n[environment]\n";
+    let refused = |body: &str| parse(&format!("{base}{body}")).map(drop).expect_err("refused").to_string();
+    assert_eq!(refused("file = \"sky\"\nintensity = \"x\"\n"), "line 6: invalid type: string \"x\", expected f32");
+    assert_eq!(refused("file = \"sky\"\nintensity = -1.0\n"), "[environment] intensity -1 must not be negative");
+    assert!(refused("file = \"sky\"\nbogus = 1\n").starts_with("line 6: unknown field `bogus`"));
+    assert!(refused("file = \"studio.hdr\"\n").contains("no folder"));
+    let top = parse("[[objects]]\nmesh = \"sphere\"\n[bogus]\nx = 1\n").map(drop).expect_err("refused").to_string();
+    assert!(top.starts_with("line 3: unknown field `bogus`") && top.ends_with("or a feature's table: `environment`"), "{top}");
+    let lit = parse(&format!("{base}file = \"sky\"\nintensity = 2.0\nrotation_deg = 90.0\n")).expect("a sky").scene;
+    let env = lit.sections.get::<Environment>().expect("the file's sky");
+    assert_eq!((env.intensity, env.rotation, env.background), (2.0, 90f32.to_radians(), false));
+    assert!(parse(&format!("{base}file = \"none\"\n")).expect("none").scene.sections.get::<Environment>().is_none());
+}

@@ -5,6 +5,7 @@
 pub mod cluster_assign_cpu;
 
 use crate::debug_view::{DebugView, Drawn, Legend, ViewNeed, ViewSpec};
+use crate::feature::Feature;
 use crate::report::FrameStats;
 use crate::technique::Technique;
 use ml_cpu::cluster::ClusterGrid;
@@ -24,6 +25,9 @@ pub const HEAT_VIEW: DebugView = DebugView {
 };
 
 pub(crate) const VIEWS: &[DebugView] = &[HEAT_VIEW];
+
+/// The clusters as a feature (the assembly's list): their view.
+pub const FEATURE: Feature = Feature::views(VIEWS);
 
 /// The heat map's scale: its red is the most lights a cluster (or grid cell) listed.
 fn heat_legend(stats: &FrameStats) -> String {

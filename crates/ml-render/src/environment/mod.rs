@@ -11,8 +11,11 @@
 use crate::background::Background;
 use crate::descriptors::{self, Resource, SetLayout};
 use crate::error::{RenderError, SettingsError};
+use crate::feature::Feature;
 use crate::report::{FeatureStats, FrameStats};
 use crate::scene_part::{FrameCounts, OwnedPart, PartHost, ScenePart};
+use crate::settings::RenderSettings;
+use crate::specialization::Constants;
 use ml_cpu::environment::Environment;
 use ml_cpu::gpu_types::EnvironmentData;
 use ml_cpu::scene::Scene;
@@ -21,24 +24,27 @@ use ml_shaders::Shader;
 use ml_vk::image::{image_transition, sampler, texture_with, ImageShape};
 use ml_vk::{shader, vk, Buffer, Context, GpuTimer, Image, VkError, VkResultExt};
 
+/// The environment light as the assembly lists it (`feature`): its maps, made with each scene;
+/// its constant, `ENVIRONMENT` (environment/environment.glsl); the background it may show.
+pub const FEATURE: Feature = Feature { part: Some(make_part), lighting, check_scene, ..Feature::NONE };
+
 /// Whether the scene's environment lights it: the pbr model and a scene with one (else the
 /// constant ambient).
-pub fn lights_scene(model: ShadingModel, scene: &Scene) -> bool {
-    model == ShadingModel::Pbr && scene.environment.is_some()
+fn lights_scene(model: ShadingModel, scene: &Scene) -> bool {
+    model == ShadingModel::Pbr && scene.sections.get::<Environment>().is_some()
 }
 
-/// Reject the environment as the `background` where it does not light the scene (the model
+/// Reject the environment as the background where it does not light the scene (the model
 /// lights with none, or the model is not pbr).
-pub fn check_background(background: Background, model: ShadingModel, scene: &Scene) -> Result<(), SettingsError> {
-    if background == Background::Environment && !lights_scene(model, scene) {
+fn check_scene(settings: &RenderSettings, scene: &Scene) -> Result<(), SettingsError> {
+    if settings.background == Background::Environment && !lights_scene(settings.shading, scene) {
         return Err(SettingsError::BackgroundNeedsEnvironment);
     }
     Ok(())
 }
 
-/// The environment's lighting constant, `ENVIRONMENT` (environment/environment.glsl).
-pub fn lighting_constants(model: ShadingModel, scene: &Scene) -> [(&'static str, u32); 1] {
-    [("ENVIRONMENT", u32::from(lights_scene(model, scene)))]
+fn lighting(settings: &RenderSettings, scene: &Scene) -> Constants {
+    Constants::of(&[&[("ENVIRONMENT", u32::from(lights_scene(settings.shading, scene)))]])
 }
 
 /// Mip levels of the specular cube: roughness level / (levels − 1), 0 (a mirror) to 1.
@@ -244,8 +250,8 @@ impl OwnedPart for EnvironmentMaps {
 }
 
 /// The scene's environment prefiltered (or the stand-ins), as a scene part.
-pub fn make_part(ctx: &Context, scene: &Scene) -> Result<Box<dyn OwnedPart>, RenderError> {
-    Ok(Box::new(EnvironmentMaps::new(ctx, scene.environment.as_ref())?))
+fn make_part(ctx: &Context, scene: &Scene) -> Result<Box<dyn OwnedPart>, RenderError> {
+    Ok(Box::new(EnvironmentMaps::new(ctx, scene.sections.get::<Environment>())?))
 }
 
 /// The environment's view on the renderer (`use ml_render::EnvironmentView`).
@@ -259,7 +265,9 @@ pub trait EnvironmentView {
 impl<H: PartHost> EnvironmentView for H {
     fn set_environment_view(&mut self, intensity: f32, rotation: f32) -> Result<bool, RenderError> {
         let access = self.part_access();
-        let (Some(env), Some(maps)) = (&mut access.scene.environment, access.parts.get_mut::<EnvironmentMaps>()) else { return Ok(false) };
+        let (Some(env), Some(maps)) = (access.scene.sections.get_mut::<Environment>(), access.parts.get_mut::<EnvironmentMaps>()) else {
+            return Ok(false);
+        };
         (env.intensity, env.rotation) = (intensity, rotation);
         access.ctx.wait_idle()?;
         maps.set_view(access.ctx, env)?;

@@ -11,6 +11,7 @@ pub mod visibility_lighting;
 pub mod visibility_raster;
 
 use crate::debug_view::{DebugView, Drawn, Legend, ViewNeed, ViewSpec};
+use crate::feature::Feature;
 use crate::technique::Technique;
 
 const DRAWS_MESHLETS: ViewNeed = ViewNeed::Technique { what: "the technique drawn in meshlets", holds: Technique::draws_meshlets };
@@ -36,3 +37,6 @@ pub(crate) const VIEWS: &[DebugView] = {
     }
     &[DebugView { spec: &colours("meshlets", code::MESHLETS) }, DebugView { spec: &colours("triangles", code::TRIANGLES) }, SURFACES_VIEW]
 };
+
+/// The visibility technique as a feature (the assembly's list): its views.
+pub const FEATURE: Feature = Feature::views(VIEWS);

@@ -32,7 +32,7 @@ fn sky_sphere(material: Material, rotation: f32) -> Scene {
     let far = PointLight { position_radius: [50.0, 0.0, 0.0, 1.0], color: [1.0, 1.0, 1.0, 0.0] };
     let camera = Camera::looking_at(Vec3::new(0.3, 0.6, 3.2), Vec3::ZERO, 45.0, 0.1, 100.0);
     let mut scene = Scene::new(vec![Object::placed(MeshKind::Sphere, Vec3::ZERO, 1.0, material)], vec![far], camera);
-    scene.environment = Some(Environment { image: Arc::new(EnvironmentImage::sky(128)), intensity: 1.3, rotation, background: false });
+    scene.sections.set(Some(Environment { image: Arc::new(EnvironmentImage::sky(128)), intensity: 1.3, rotation, background: false }));
     scene
 }
 
@@ -43,7 +43,7 @@ fn pbr(technique: Technique) -> RenderSettings {
 fn compare(material: Material, rotation: f32) {
     let scene = sky_sphere(material, rotation);
     let out = common::render(scene.clone(), pbr(Technique::Forward));
-    let env = scene.environment.as_ref().expect("set above");
+    let env = scene.sections.get::<Environment>().expect("set above");
     let sh = diffuse_sh9(&env.image);
     let m = material;
     // Every other pixel, a checkerboard: the reference sums the whole image per point.
@@ -86,7 +86,7 @@ fn turning_the_environment_in_place_equals_a_renderer_made_turned() {
     use std::sync::atomic::Ordering;
     let scene = sky_sphere(Material { albedo: Vec3::new(0.9, 0.9, 0.9), roughness: 0.3, metallic: 0.5 }, 0.0);
     let mut turned = scene.clone();
-    let env = turned.environment.as_mut().expect("set");
+    let env = turned.sections.get_mut::<Environment>().expect("set");
     (env.intensity, env.rotation) = (2.0, 1.0);
     let settings = RenderSettings { width: 64, height: 64, ..pbr(Technique::Visibility) };
     let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a validated device");
@@ -115,8 +115,8 @@ fn the_background_shows_the_environment_along_each_pixels_ray() {
     use ml_render::{Antialiasing, Background};
     let mut scene = sky_sphere(Material { albedo: Vec3::new(0.9, 0.9, 0.9), roughness: 0.3, metallic: 0.5 }, 1.0);
     // Its cube (256 texels a face) finer than the pixels (a texel 0.35°, a pixel 0.5°).
-    scene.environment.as_mut().expect("set above").image = Arc::new(EnvironmentImage::sky(1024));
-    let env = scene.environment.as_ref().expect("set above");
+    scene.sections.get_mut::<Environment>().expect("set above").image = Arc::new(EnvironmentImage::sky(1024));
+    let env = scene.sections.get::<Environment>().expect("set above");
     let seen = |s: RenderSettings| RenderSettings { background: Background::Environment, ..s };
     let mut settings: Vec<RenderSettings> = Technique::ALL.iter().map(|&t| seen(pbr(t))).collect();
     for t in [Technique::Forward, Technique::Deferred, Technique::Visibility] {

@@ -7,7 +7,7 @@
 
 use crate::common;
 
-use ml_cpu::environment::EnvironmentSource;
+use ml_cpu::environment::{EnvironmentAsk, EnvironmentSource};
 use ml_cpu::gltf_writer::{mesh_primitive, GltfWriter};
 use ml_cpu::lights::{LightLayout, RadiusRange};
 use ml_cpu::mesh::MeshKind;
@@ -63,7 +63,7 @@ fn every_kind_at_every_size_is_lit_inside_one_band() {
     let mut outside = Vec::new();
     // The point lights alone: without the built-in sky a pbr file without lights gets.
     let render = |request: SceneRequest| {
-        let built = SceneRequest { environment: Some(EnvironmentSource::Off), ..request }.build().expect("the file builds");
+        let built = request.asking(no_sky()).build().expect("the file builds");
         let settings = RenderSettings { shading: built.shading, ..RenderSettings::new(Technique::Forward, 96, 64) };
         let lights = built.scene.lights.len();
         (Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render()).expect("render"), lights)
@@ -139,11 +139,7 @@ fn a_file_without_a_camera_is_framed_to_fill_the_image() {
             for (width, height) in [(160u32, 90u32), (90, 160)] {
                 // Framing alone: without the sky (prefiltered anew for each of the 42 renders).
                 let aspect = width as f32 / height as f32;
-                let request = SceneRequest {
-                    aspect,
-                    environment: Some(EnvironmentSource::Off),
-                    ..SceneRequest::new(SceneSource::File(path.clone()))
-                };
+                let request = SceneRequest { aspect, ..SceneRequest::new(SceneSource::File(path.clone())) }.asking(no_sky());
                 let built = request.build().expect("the file builds");
                 let settings = RenderSettings { shading: built.shading, ..RenderSettings::new(Technique::Forward, width, height) };
                 let out = Renderer::new(&ctx, built.scene, settings).and_then(|mut r| r.render()).expect("render");
@@ -210,4 +206,9 @@ fn shown_lights_are_blobs_of_their_colour_in_every_technique() {
     }
     println!("{seen} of 64 lights in view, each a blob of its colour in {} techniques", techniques.len());
     assert_eq!(seen, 64, "lights out of view");
+}
+
+/// No environment: the point lights alone, where a pbr file without lights gets the sky.
+fn no_sky() -> EnvironmentAsk {
+    EnvironmentAsk { source: Some(EnvironmentSource::Off), ..Default::default() }
 }

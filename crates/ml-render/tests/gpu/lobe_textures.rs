@@ -167,7 +167,7 @@ fn scene(variant: Variant) -> Scene {
     assert!(warnings.is_empty(), "{warnings:?}");
     let light = |x: f32, color: [f32; 3]| PointLight { position_radius: [x, 1.2, 2.0, 9.0], color: [color[0], color[1], color[2], 0.0] };
     scene.lights = vec![light(-6.0, [3.0, 2.0, 1.5]), light(0.0, [1.5, 2.5, 3.0]), light(6.0, [2.5, 2.5, 2.0])];
-    scene.environment = Some(Environment { image: Arc::new(EnvironmentImage::sky(64)), intensity: 0.6, rotation: 0.0, background: false });
+    scene.sections.set(Some(Environment { image: Arc::new(EnvironmentImage::sky(64)), intensity: 0.6, rotation: 0.0, background: false }));
     scene
 }
 

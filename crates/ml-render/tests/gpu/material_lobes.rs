@@ -102,7 +102,7 @@ fn four_lobes(lobes: [MaterialLobes; 4]) -> Scene {
         lobes.iter().enumerate().map(|(i, l)| with_lobes(rough_red(), *l, Vec3::new(i as f32 * 2.2 - 3.3, 0.0, 0.0), 1.0)).collect();
     let camera = Camera::looking_at(Vec3::new(0.0, 1.5, 7.5), Vec3::ZERO, 55.0, 0.1, 100.0);
     let mut scene = Scene::new(objects, lights(), camera);
-    scene.environment = Some(Environment { image: Arc::new(EnvironmentImage::sky(64)), intensity: 0.8, rotation: 0.5, background: false });
+    scene.sections.set(Some(Environment { image: Arc::new(EnvironmentImage::sky(64)), intensity: 0.8, rotation: 0.5, background: false }));
     scene
 }
 
