@@ -4,6 +4,8 @@
 //! its radiance prefiltered by the GGX lobe times the BRDF's integral over the hemisphere
 //! (`brdf_integral`). The GPU prefilters the image once (ml-render's environment module); this
 //! module is the CPU reference the image tests compare it with, and makes the built-in sky.
+//! It is also the environment's scene section (`SECTION`): a scene file's `[environment]`
+//! table and what a request asks of it (`EnvironmentAsk`).
 
 use crate::file_fields;
 use crate::files::read_regular;

@@ -122,8 +122,10 @@ pub enum SettingsError {
     /// A debug view whose feature is not in the settings (what it needs: `ViewNeed`).
     #[error("the {view} debug view needs {needs}, not {instead}")]
     ViewNeeds { view: &'static str, needs: String, instead: String },
-    #[error("--background environment needs an environment: the pbr model (--shading pbr) with --environment FILE or sky, or a scene file's own")]
-    BackgroundNeedsEnvironment,
+    /// What a feature refuses of a scene under the settings (`Feature::check_scene`), in its
+    /// own words.
+    #[error("{0}")]
+    SceneRefused(&'static str),
     #[error("--light-stats counts the light loop of the compute-lit techniques (deferred-compute, visibility), not {technique}'s")]
     LightStatsNeedCompute { technique: &'static str },
     #[error("the {technique} technique needs {feature}, which '{device}' lacks: use deferred-compute")]

@@ -38,7 +38,9 @@ fn lights_scene(model: ShadingModel, scene: &Scene) -> bool {
 /// lights with none, or the model is not pbr).
 fn check_scene(settings: &RenderSettings, scene: &Scene) -> Result<(), SettingsError> {
     if settings.background == Background::Environment && !lights_scene(settings.shading, scene) {
-        return Err(SettingsError::BackgroundNeedsEnvironment);
+        return Err(SettingsError::SceneRefused(
+            "--background environment needs an environment: the pbr model (--shading pbr) with --environment FILE or sky, or a scene file's own",
+        ));
     }
     Ok(())
 }
