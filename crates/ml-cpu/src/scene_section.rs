@@ -48,9 +48,9 @@ impl Sections {
 
     /// Keep `value` as the section of its type (None: remove it).
     pub fn set<T: Section>(&mut self, value: Option<T>) {
-        self.0.retain(|s| !s.as_any().is::<T>());
-        if let Some(value) = value {
-            self.0.push(Box::new(value));
+        match value {
+            Some(value) => self.insert(Box::new(value)),
+            None => self.0.retain(|s| !s.as_any().is::<T>()),
         }
     }
 
