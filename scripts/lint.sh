@@ -13,7 +13,8 @@ echo "lint: cargo fmt --check" >&2
 cargo fmt --all -- --check
 # Both with the test profile, the one `cargo test` builds with: the dependencies' build scripts
 # (glslang's C++ above all) then run once for the gates and the tests, not once per profile.
+# ml-cpu's criterion feature: its benchmark is a target too (the test build leaves criterion out).
 echo "lint: cargo clippy -D warnings" >&2
-cargo clippy --profile test --workspace --all-targets --locked -q -- -D warnings
+cargo clippy --profile test --workspace --all-targets --features ml-cpu/criterion --locked -q -- -D warnings
 echo "lint: cargo doc -D warnings" >&2
 RUSTDOCFLAGS=-Dwarnings cargo doc --profile test --no-deps --workspace --locked -q

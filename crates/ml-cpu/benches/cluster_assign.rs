@@ -1,6 +1,6 @@
 //! CPU light assignment alone: 16×9×24 grid, 1920×1080, the seed camera, random lights of
 //! radius 1–3 in the benchmark box (x,z ∈ [−20, 20], y ∈ [−2, 12]).
-//! Run: `cargo bench -p ml-cpu --bench cluster_assign`.
+//! Run: `cargo bench -p ml-cpu --features criterion --bench cluster_assign`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use ml_cpu::camera::{Camera, View};
