@@ -15,8 +15,6 @@ use ml_cpu::material::Material;
 use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::Scene;
 use ml_render::{RenderSettings, Renderer, ShadingModel, Technique};
-use ml_vk::{Context, ContextDesc};
-use std::sync::atomic::Ordering;
 
 fn seed_scene(lights: &LightParams) -> Scene {
     Scene::seed(MeshKind::Sphere, Material::named("gold").unwrap(), lights).unwrap()
@@ -24,8 +22,7 @@ fn seed_scene(lights: &LightParams) -> Scene {
 
 #[test]
 fn resized_relit_and_moved_renderers_equal_fresh_ones() {
-    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a Vulkan device with validation");
-    let counter = ctx.validation_counter();
+    let ctx = common::pooled_context();
     let many = LightParams { count: 700, layout: LightLayout::Random, seed: 5, radius: RadiusRange { min: 1.0, max: 6.0 } };
     let camera = Camera::looking_at(Vec3::new(-6.0, 9.0, 12.0), Vec3::ZERO, 50.0, 0.1, 200.0);
     for technique in Technique::ALL {
@@ -88,5 +85,4 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
     drop(plain);
     assert_eq!(ctx.pipeline_counts().1, 0, "every renderer is gone but pipelines are still held");
     drop(ctx);
-    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
 }

@@ -37,9 +37,7 @@ use ml_render::{
     Antialiasing, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings, TransparencyStats,
     LAYER_KEEP,
 };
-use ml_vk::{Context, ContextDesc};
 use serde_json::json;
-use std::sync::atomic::Ordering;
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -292,8 +290,7 @@ fn the_order_the_quads_are_listed_in_changes_nothing() {
 fn a_resized_renderer_draws_the_layers_as_a_fresh_one_does() {
     // The lists are the build pass's own buffers of each frame slot, made again for the new
     // size when the viewer resizes.
-    let ctx = Context::new(&ContextDesc { validation: true, ..Default::default() }).expect("a Vulkan device with validation");
-    let counter = ctx.validation_counter();
+    let ctx = common::pooled_context();
     for technique in [Technique::Forward, Technique::Visibility] {
         let small = RenderSettings { frames: 2, ..settings(technique) };
         let large = RenderSettings { width: W + 24, height: H + 16, ..small };
@@ -308,7 +305,6 @@ fn a_resized_renderer_draws_the_layers_as_a_fresh_one_does() {
         assert_eq!(stats(&resized), stats(&fresh), "{}", technique.name());
     }
     drop(ctx);
-    assert_eq!(counter.load(Ordering::SeqCst), 0, "validation messages (printed above)");
 }
 
 #[test]
