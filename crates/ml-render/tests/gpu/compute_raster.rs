@@ -81,10 +81,6 @@ fn compare(what: &str, d: &Drawn, background: [u8; 3]) -> (usize, usize) {
     (covered, differing)
 }
 
-fn validated() -> common::PooledContext {
-    common::pooled_context()
-}
-
 /// The colour of pixels no triangle covers, in the triangles view.
 fn background(ctx: &Context) -> [u8; 3] {
     let empty = Scene::new(Vec::new(), Vec::new(), Camera::seed());
@@ -125,7 +121,7 @@ fn textured_gltf_scene() -> Scene {
 
 #[test]
 fn the_compute_raster_draws_the_hardwares_triangles() {
-    let ctx = validated();
+    let ctx = common::pooled_context();
     let bg = background(&ctx);
     let base = RenderSettings::new(Technique::Visibility, W, H);
     let split = Raster::DEFAULT_SPLIT;
@@ -163,7 +159,6 @@ fn the_compute_raster_draws_the_hardwares_triangles() {
     }
     // The random scenes' floors and the bench scene's are large and cross the near plane.
     assert!(large > 0, "no large triangle was drawn in compute");
-    drop(ctx);
 }
 
 /// A plane of `cols` × `rows` cells in front of `camera`, reaching 8 pixels past every side of
@@ -217,7 +212,7 @@ fn screen_mesh(camera: &Camera, (cols, rows): (u32, u32), seed: u64) -> Mesh {
 
 #[test]
 fn a_screen_of_shared_edges_is_drawn_watertight() {
-    let ctx = validated();
+    let ctx = common::pooled_context();
     let bg = background(&ctx);
     let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 0.8), Vec3::ZERO, 60.0, 0.1, 10.0);
     for (seed, cells) in [(1, (40, 24)), (2, (97, 61)), (3, (23, 11))] {
@@ -269,5 +264,4 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
         let holes = (0..W * H).filter(|i| common::pixel(&mixed, i % W, i / W) == bg).count();
         assert_eq!(holes, 0, "{cells:?} cells: pixels neither rasteriser covered");
     }
-    drop(ctx);
 }

@@ -123,7 +123,6 @@ fn culling_on_and_off_give_the_same_frames() {
         // The paths must exercise both phases, or the test proves nothing.
         assert!(occluded > 0 && late_drawn > 0, "{antialiasing:?}");
     }
-    drop(ctx);
 }
 
 /// `paths` camera paths rendered with culling on and off at `antialiasing`: the frames equal

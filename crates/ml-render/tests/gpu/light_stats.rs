@@ -91,5 +91,4 @@ fn the_counts_equal_the_lists_and_a_cpu_count_of_the_lights_reaching() {
             println!("{name}: {got:?} (CPU: {want:?})");
         }
     }
-    drop(ctx);
 }

@@ -84,5 +84,4 @@ fn resized_relit_and_moved_renderers_equal_fresh_ones() {
     assert!(!plain.set_objects(&coated).expect("asked"), "objects with lobes set on a renderer made without");
     drop(plain);
     assert_eq!(ctx.pipeline_counts().1, 0, "every renderer is gone but pipelines are still held");
-    drop(ctx);
 }

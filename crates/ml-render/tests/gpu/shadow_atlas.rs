@@ -103,7 +103,6 @@ fn with_pair(scene: &Scene, mut base: RenderSettings, budget_mib: u32, f: impl F
         let mut uncached = Renderer::new(&ctx, scene.clone(), base).expect("renderer");
         f(&mut cached, &mut uncached);
     }
-    drop(ctx);
 }
 
 fn atlas_stats(out: &RenderOutput) -> AtlasStats {

@@ -304,7 +304,6 @@ fn a_resized_renderer_draws_the_layers_as_a_fresh_one_does() {
         assert!(resized.rgba == fresh.rgba, "{}: the resized renderer's layers differ from a fresh one's", technique.name());
         assert_eq!(stats(&resized), stats(&fresh), "{}", technique.name());
     }
-    drop(ctx);
 }
 
 #[test]
