@@ -25,7 +25,7 @@
 
 // Sum LIGHT(light) over every light that may reach the point: the cluster's lights in
 // ascending index order, the light grid's near the point, or all of them. A macro, so that
-// LIGHT (a model's light with its shadow, or a debug view's) is written into the loop itself.
+// LIGHT (a model's light with its shadow) is written into the loop itself.
 #ifdef CLUSTERED
 #define SUM_LIGHTS(sum, LIGHT)                                                   \
     {                                                                            \
@@ -178,6 +178,7 @@ vec3 model_point_light(PointLight l, vec3 world, vec3 n, vec3 v, PointMaterial m
 // material_lobes.glsl has it (an unlit surface: its albedo). `frag_xy` is the pixel centre
 // (gl_FragCoord.xy), which picks the cluster.
 vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
+    ray_steps = 0u; // the ray-cost view's count is this point's (a lane may shade several)
     vec3 albedo = m.albedo, emission = m.emission;
     float roughness = m.roughness, metallic = m.metallic, occlusion = m.occlusion;
     vec3 v = toward_eye(world);
@@ -223,16 +224,6 @@ vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
 // Steps the ray-cost view's heat scale ends at (tables.rs says so in its legend).
 const float RAY_COST_TOP = 1024.0;
 
-// Traces the shadow ray of light `l` at `world` where the light loop would (it reaches the
-// point from in front, and casts a shadow), for its steps alone.
-vec3 ray_cost_light(PointLight l, vec3 world, vec3 n) {
-    vec3 to_light = l.position_radius.xyz - world;
-    if (OMNI_SHADOWS && l.color.w != 0.0 && dot(n, to_light) > 0.0 && length(to_light) <= l.position_radius.w) {
-        omni_visibility(l, world, n);
-    }
-    return vec3(0.0);
-}
-
 // The surface debug views (G-buffer channels, depth): what the view shows at a surface point
 // as linear colour, which encode_gamma turns into the promised display values — albedo as
 // it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
@@ -253,13 +244,6 @@ bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metal
         display = n * 0.5 + 0.5;
     } else if (view == DEBUG_VIEW_GBUFFER_MATERIAL) {
         display = vec3(roughness, metallic, 0.0);
-    } else if (view == DEBUG_VIEW_RAY_COST) {
-        // The point's shadow rays' traversal steps on a log scale up to RAY_COST_TOP.
-        ray_steps = 0u;
-        vec3 none = vec3(0.0);
-#define RAY_COST_LIGHT(l) ray_cost_light(l, world, n)
-        SUM_LIGHTS(none, RAY_COST_LIGHT)
-        display = heat(log2(1.0 + float(ray_steps)) / log2(1.0 + RAY_COST_TOP));
     } else if (view == DEBUG_VIEW_DEPTH) {
         float depth = -(frame.view * vec4(world, 1.0)).z;
         display = vec3(log(depth / frame.cluster_frustum.x) / log(frame.cluster_frustum.y / frame.cluster_frustum.x));
@@ -267,6 +251,20 @@ bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metal
         return false;
     }
     color = pow(clamp(display, 0.0, 1.0), vec3(2.2));
+    return true;
+}
+
+// The ray-cost view, which the shading path shows in place of the colour of a point it has just
+// shaded (shade_point): the traversal steps of the point's shadow rays on a log scale up to
+// RAY_COST_TOP, as display-linear colour (what debug_surface gives). Shading traces the rays,
+// so the view shows what the frame traces, and no loop over the lights is written for it
+// alone (on lavapipe, every copy of the light loop and its shadow code costs time to make the
+// pipeline). False, leaving `color`, for any other view.
+bool ray_cost_shown(inout vec3 color) {
+    if (frame.viewport.z != DEBUG_VIEW_RAY_COST) {
+        return false;
+    }
+    color = pow(clamp(heat(log2(1.0 + float(ray_steps)) / log2(1.0 + RAY_COST_TOP)), 0.0, 1.0), vec3(2.2));
     return true;
 }
 

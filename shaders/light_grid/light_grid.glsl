@@ -42,20 +42,29 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
 // Run BODY for each place `k_` of the lists (the light's position and radius
 // grid_light_positions[k_], its colour grid_light_colors[k_], its scene index
 // grid_scene_index[k_]) that a point at `world` tests: the wide lights, then the rows of
-// cells within reach.
+// cells within reach (z outer, y inner). One loop over runs of the lists, the wide lights'
+// the first, so that BODY — a light with its shadow code — is written once: lavapipe inlines
+// every copy before it folds the constants, and each costs time to make the pipeline.
 #define GRID_FOR_LIGHTS(BODY)                                                   \
     {                                                                           \
-        uint wide_ = grid_lists[0];                                             \
-        for (uint k_ = 0u; k_ < wide_; ++k_) {                                  \
-            BODY                                                                \
-        }                                                                       \
         GridWalk w_ = grid_walk(world);                                         \
-        for (uint z_ = w_.lo.z; z_ <= w_.hi.z; ++z_) {                          \
-            for (uint y_ = w_.lo.y; y_ <= w_.hi.y; ++y_) {                      \
-                uvec2 run_ = grid_row(w_, y_, z_);                              \
-                for (uint k_ = run_.x; k_ < run_.y; ++k_) {                     \
-                    BODY                                                        \
-                }                                                               \
+        uint k_ = 0u, end_ = grid_lists[0];                                     \
+        uint y_ = w_.lo.y, z_ = w_.lo.z;                                        \
+        for (;;) {                                                              \
+            for (; k_ < end_; ++k_) {                                           \
+                BODY                                                            \
+            }                                                                   \
+            if (z_ > w_.hi.z) {                                                 \
+                break;                                                          \
+            }                                                                   \
+            uvec2 run_ = grid_row(w_, y_, z_);                                  \
+            k_ = run_.x;                                                        \
+            end_ = run_.y;                                                      \
+            if (y_ == w_.hi.y) {                                                \
+                y_ = w_.lo.y;                                                   \
+                ++z_;                                                           \
+            } else {                                                            \
+                ++y_;                                                           \
             }                                                                   \
         }                                                                       \
     }

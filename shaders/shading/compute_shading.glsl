@@ -46,6 +46,10 @@ void shade_and_store(ivec2 p, vec2 frag_xy, vec3 world, vec3 n, PointMaterial m,
     }
     color = shade_point(world, n, m, frag_xy);
     count_rays();
+    if (ray_cost_shown(color)) {
+        imageStore(out_image, p, vec4(encode_gamma(color), 1.0));
+        return;
+    }
 #ifdef LINEAR_OUTPUT
     imageStore(out_image, p, vec4(color, 1.0));
 #else
@@ -63,7 +67,8 @@ vec3 shade_linear(vec2 frag_xy, vec3 world, vec3 n, PointMaterial m, uint object
     }
     color = shade_point(world, n, m, frag_xy);
     count_rays();
-    return color;
+    debug = ray_cost_shown(color);
+    return debug ? clamp(color, 0.0, 1.0) : color;
 }
 
 // shade_linear's colour as the display's linear light (display_linear), for the anti-aliased

@@ -61,6 +61,7 @@ vec3 shade_gbuffer(vec2 frag_xy, float z, GSample g, out bool debug) {
     debug = debug_surface(world, n, m.albedo, m.roughness, m.metallic, objects[g.id].alpha_texture.x, frag_xy, color);
     if (!debug) {
         color = shade_point(world, n, m, frag_xy);
+        debug = ray_cost_shown(color);
     }
     return color;
 }

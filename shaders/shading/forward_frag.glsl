@@ -43,6 +43,10 @@ void main() {
         return;
     }
     color = shade_point(at.world, s.normal, m, gl_FragCoord.xy);
+    if (ray_cost_shown(color)) {
+        out_color = target_shown(color);
+        return;
+    }
     // The target is UNORM: the seed writes gamma-encoded values itself (or, anti-aliased, the
     // display's linear light, display_output.glsl).
     out_color = TRANSPARENT_LAYERS ? vec4(color, 1.0) : target_lit(color, frame.exposure.x);
