@@ -319,16 +319,30 @@ fn shader_failures(shader: &crate::Shader) -> Vec<String> {
 
 #[test]
 fn no_branch_rests_on_uniforms_alone() {
-    let shaders: Vec<&crate::Shader> = ALL.iter().filter(|s| s.file != PROBE.file).collect();
-    // spirv-opt runs about a hundred times a set of constants: on every core.
+    let mut shaders: Vec<&crate::Shader> = ALL.iter().filter(|s| s.file != PROBE.file).collect();
+    // spirv-opt runs about a hundred times a set of constants, its time growing with the
+    // shader: on every core, each taking the largest shader left, so that no core is left
+    // with the lighting shaders at the end.
+    shaders.sort_by_key(|s| std::cmp::Reverse(s.spirv.len()));
+    let next = std::sync::atomic::AtomicUsize::new(0);
     let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
-    let failures: Vec<String> = std::thread::scope(|scope| {
-        let workers: Vec<_> = shaders
-            .chunks(shaders.len().div_ceil(threads))
-            .map(|chunk| scope.spawn(move || chunk.iter().flat_map(|s| shader_failures(s)).collect::<Vec<_>>()))
+    let mut failures: Vec<(usize, Vec<String>)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut found = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(shader) = shaders.get(i) else { break found };
+                        found.push((i, shader_failures(shader)));
+                    }
+                })
+            })
             .collect();
         workers.into_iter().flat_map(|w| w.join().unwrap()).collect()
     });
+    failures.sort_by_key(|(i, _)| *i);
+    let failures: Vec<String> = failures.into_iter().flat_map(|(_, f)| f).collect();
     assert!(failures.is_empty(), "read these through opaque_uniform (common.glsl):\n{}", failures.join("\n"));
 }
 
