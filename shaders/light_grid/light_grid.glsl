@@ -50,21 +50,24 @@ uvec2 grid_row(GridWalk w, uint y, uint z) {
         GridWalk w_ = grid_walk(world);                                         \
         uint k_ = 0u, end_ = grid_lists[0];                                     \
         uint y_ = w_.lo.y, z_ = w_.lo.z;                                        \
+        bool rows_ = w_.lo.y <= w_.hi.y && w_.lo.z <= w_.hi.z;                  \
         for (;;) {                                                              \
             for (; k_ < end_; ++k_) {                                           \
                 BODY                                                            \
             }                                                                   \
-            if (z_ > w_.hi.z) {                                                 \
+            if (!rows_) {                                                       \
                 break;                                                          \
             }                                                                   \
             uvec2 run_ = grid_row(w_, y_, z_);                                  \
             k_ = run_.x;                                                        \
             end_ = run_.y;                                                      \
-            if (y_ == w_.hi.y) {                                                \
+            if (y_ < w_.hi.y) {                                                 \
+                ++y_;                                                           \
+            } else if (z_ < w_.hi.z) {                                          \
                 y_ = w_.lo.y;                                                   \
                 ++z_;                                                           \
             } else {                                                            \
-                ++y_;                                                           \
+                rows_ = false;                                                  \
             }                                                                   \
         }                                                                       \
     }
