@@ -224,6 +224,11 @@ vec3 shade_point(vec3 world, vec3 n, PointMaterial m, vec2 frag_xy) {
 // Steps the ray-cost view's heat scale ends at (tables.rs says so in its legend).
 const float RAY_COST_TOP = 1024.0;
 
+// A debug view's display value (0 to 1) as the linear colour encode_gamma turns back into it.
+vec3 debug_shown(vec3 display) {
+    return pow(clamp(display, 0.0, 1.0), vec3(2.2));
+}
+
 // The surface debug views (G-buffer channels, depth): what the view shows at a surface point
 // as linear colour, which encode_gamma turns into the promised display values — albedo as
 // it is, normal·0.5 + 0.5, (roughness, metallic, 0), and ln(depth/near)/ln(far/near) in grey.
@@ -250,7 +255,7 @@ bool debug_surface(vec3 world, vec3 n, vec3 albedo, float roughness, float metal
     } else {
         return false;
     }
-    color = pow(clamp(display, 0.0, 1.0), vec3(2.2));
+    color = debug_shown(display);
     return true;
 }
 
@@ -264,7 +269,7 @@ bool ray_cost_shown(inout vec3 color) {
     if (frame.viewport.z != DEBUG_VIEW_RAY_COST) {
         return false;
     }
-    color = pow(clamp(heat(log2(1.0 + float(ray_steps)) / log2(1.0 + RAY_COST_TOP)), 0.0, 1.0), vec3(2.2));
+    color = debug_shown(heat(log2(1.0 + float(ray_steps)) / log2(1.0 + RAY_COST_TOP)));
     return true;
 }
 
