@@ -55,8 +55,8 @@ pub fn raster_line(raster: Raster) -> String {
         Raster::Compute { split, large: LargeTriangles::Hardware } => format!(
             "hybrid (triangles up to {split} px a side in compute; larger ones and those crossing the near plane by the hardware; 64-bit atomic min)"
         ),
-        Raster::Compute { split, large: LargeTriangles::Bins { bin_list } } => format!(
-            "compute (triangles up to {split} px a side a thread each; larger ones and those crossing the near plane clipped, a work group per 64x64 bin, list of {bin_list}; 64-bit atomic min)"
+        Raster::Compute { split, large: LargeTriangles::Bins { bin_list, .. } } => format!(
+            "compute (triangles up to {split} px a side a thread each; larger ones and those crossing the near plane clipped, a work group per 64x64 bin, lists of {bin_list} to start, grown when a frame overflows them; 64-bit atomic min)"
         ),
     }
 }
@@ -154,6 +154,9 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
             "exposure",
             format!("auto: {ev:+.2} EV (metered on the GPU; the last frame rendered {repeats} more time(s) to settle)"),
         ));
+    }
+    if stats.redraws > 0 {
+        rows.push(("redrawn", format!("the last frame, {} more time(s): it overflowed lists that have grown since", stats.redraws)));
     }
     if let Some(m) = stats.memory {
         let mib = |b: u64| b as f64 / (1 << 20) as f64;

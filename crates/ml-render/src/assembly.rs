@@ -157,7 +157,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
     let aa = s.antialiasing;
     let mut shared = || -> Result<SharedMeshletScene, RenderError> {
         if meshlets.is_none() {
-            *meshlets = Some(MeshletScene::new(ctx, a.scene.meshlets()?, s.raster.bin_list().unwrap_or(0))?);
+            *meshlets = Some(MeshletScene::new(ctx, a.scene.meshlets()?, (s.raster.bin_list().unwrap_or(0), s.raster.lists_grow()))?);
         }
         Ok(meshlets.clone().expect("made above"))
     };

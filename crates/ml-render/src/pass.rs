@@ -46,6 +46,8 @@ pub struct SlotReport {
 /// its own.
 pub struct Prepare<'a> {
     pub ctx: &'a Context,
+    /// The frame slot the frame is recorded into.
+    pub slot: usize,
     pub grid: &'a ClusterGrid,
     /// The camera and image size the frame is seen through.
     pub view: &'a View,
@@ -61,6 +63,9 @@ pub struct Prepare<'a> {
     /// A CPU light assignment's milliseconds and what it built (the renderer reports the
     /// time as its own CPU phase and scales the cluster heat map by the fullest cluster).
     pub assigned: Option<(f64, ClusterStats)>,
+    /// Set by a pass that replaced a buffer of the slot (grew it): the renderer binds every
+    /// pass to the slot's buffers again before recording.
+    pub rebind: bool,
 }
 
 /// Where a CPU assignment's lists go: the frame slot's buffers.
@@ -133,6 +138,13 @@ pub trait FrameWork {
     /// Read what slot `slot`'s finished frame reports (its fence has signalled): feedback for
     /// the frame loop into `report`, the pass's own figures into `stats`.
     fn collect(&self, _slot: usize, _report: &mut SlotReport, _stats: &mut FrameStats) {}
+
+    /// Whether slot `slot`'s finished frame did some of its work the slow way, which the
+    /// slot's next frame will not (a list it overflowed grows in `prepare`): a render's last
+    /// frame is then drawn again.
+    fn redraws(&self, _ctx: &Context, _slot: usize) -> bool {
+        false
+    }
 
     /// Fill the frame's uniforms that the pass owns (the light grid's placement), the lights
     /// moved by `light_offset` this frame.

@@ -67,10 +67,12 @@ impl ReadBack {
     }
 
     /// Slot `slot`'s copy, `bytes` long, replacing the one it had (no frame of the slot in
-    /// flight).
+    /// flight); zeros until a frame of the slot has copied into it, so that a reader before
+    /// the first frame (a list growing by what the last frame asked for) reads nothing asked.
     pub fn make(&mut self, ctx: &Context, slot: usize, bytes: vk::DeviceSize) -> Result<(), VkError> {
         self.host[slot].destroy(ctx);
         self.host[slot] = Buffer::new(ctx, self.label, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        self.host[slot].write(0, &vec![0u8; bytes as usize]);
         Ok(())
     }
 

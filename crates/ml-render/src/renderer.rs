@@ -492,6 +492,13 @@ impl<'a> Renderer<'a> {
             // its slot next comes round, unless the frame settles its exposure first.
             let mut copy = (wanted && !settles).then(|| CopyToHost { buffer: self.readbacks.raw(last), extent: self.extent });
             self.run_frame(last, self.settings.clock(i), &mut stats, copy.as_mut().map(|c| c as &mut dyn FrameHook))?;
+            if i + 1 == frames && self.redraws(last, &mut stats)? {
+                // The last image drawn again where the frame overflowed a list that has grown
+                // since: what the frames after it would draw (drawn in place, a large triangle
+                // is slow, and a CPU driver may cut its long loop short).
+                stats.redraws += 1;
+                self.run_frame(last, self.settings.clock(i), &mut stats, copy.as_mut().map(|c| c as &mut dyn FrameHook))?;
+            }
             if copy.is_some() {
                 self.in_flight_image[last] = Some(i);
             }
@@ -718,6 +725,14 @@ impl<'a> Renderer<'a> {
         Ok(())
     }
 
+    /// Wait for slot `slot`'s frame and collect it: whether a pass asks for it to be drawn
+    /// again (`FrameWork::redraws`).
+    fn redraws(&mut self, slot: usize, stats: &mut FrameStats) -> Result<bool, VkError> {
+        self.collect(slot, stats)?;
+        let ctx = self.ctx;
+        Ok(self.passes.iter_mut().filter_map(|p| p.frame_work()).any(|w| w.redraws(ctx, slot)))
+    }
+
     fn collect_all(&mut self, stats: &mut FrameStats) -> Result<(), VkError> {
         (0..FRAMES_IN_FLIGHT).try_for_each(|f| self.collect(f, stats))
     }
@@ -739,6 +754,7 @@ impl<'a> Renderer<'a> {
         let mut lists = SlotLists { frame: &mut self.frames[f], grew: false };
         let mut prepare = Prepare {
             ctx,
+            slot: f,
             grid: &self.grid,
             view: &self.view,
             rest_lights: &self.lights,
@@ -747,11 +763,12 @@ impl<'a> Renderer<'a> {
             lists: &mut lists,
             stats,
             assigned: None,
+            rebind: false,
         };
         for work in self.passes.iter_mut().filter_map(|p| p.frame_work()) {
             work.prepare(&mut prepare)?;
         }
-        let assigned = prepare.assigned;
+        let (assigned, rebind) = (prepare.assigned, prepare.rebind);
         let assign_ms = assigned.map(|(ms, _)| ms);
         if let Some((_, cluster_stats)) = assigned {
             self.heat_top = cluster_stats.max_lights.max(1) as f32;
@@ -759,6 +776,8 @@ impl<'a> Renderer<'a> {
         }
         if lists.grew {
             stats.index_growths += 1;
+        }
+        if lists.grew || rebind {
             self.bind_passes(f)?;
         }
         self.write_uniforms(f, t);

@@ -37,6 +37,9 @@ pub struct FrameStats {
     /// rendered again for the exposure to settle.
     pub exposure_ev: Option<f32>,
     pub exposure_repeats: u32,
+    /// How often the last frame was drawn again because it overflowed a list that grew
+    /// (`FrameWork::redraws`).
+    pub redraws: u32,
     /// What the renderer had allocated when the last frame finished.
     pub memory: Option<ml_vk::context::MemoryUse>,
     /// An image sequence's frames taken out of host-visible memory for the sink: their count
@@ -61,6 +64,7 @@ impl FrameStats {
             features: Vec::new(),
             exposure_ev: None,
             exposure_repeats: 0,
+            redraws: 0,
             memory: None,
             read_back: (0, 0.0),
         }

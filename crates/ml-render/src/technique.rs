@@ -170,8 +170,11 @@ pub enum LargeTriangles {
     Hardware,
     /// Compute too (`--raster compute`): clipped once, and drawn by a work group per
     /// 64×64-pixel bin of their box. `bin_list`: large triangles, and bins, the lists hold per
-    /// culling phase; past them the thread that found a triangle draws it alone.
-    Bins { bin_list: u32 },
+    /// culling phase at first; past them the thread that found a triangle draws it alone
+    /// (slow; and a CPU driver may cut a long loop short). `grows`: a frame slot's lists grow
+    /// after a frame that overflowed them, and a render's last frame is drawn again with
+    /// them grown (false: fixed lists, which tests of drawing in place ask for).
+    Bins { bin_list: u32, grows: bool },
 }
 
 impl Raster {
@@ -186,7 +189,7 @@ impl Raster {
 
     /// The compute raster (large triangles too) with `split`.
     pub fn compute(split: u32) -> Raster {
-        Raster::Compute { split, large: LargeTriangles::Bins { bin_list: Raster::DEFAULT_BIN_LIST } }
+        Raster::Compute { split, large: LargeTriangles::Bins { bin_list: Raster::DEFAULT_BIN_LIST, grows: true } }
     }
 
     /// The hybrid raster (large triangles by the hardware) with `split`.
@@ -227,9 +230,14 @@ impl Raster {
     /// The large triangles' bin list's size, where they are drawn in compute.
     pub fn bin_list(self) -> Option<u32> {
         match self {
-            Raster::Compute { large: LargeTriangles::Bins { bin_list }, .. } => Some(bin_list),
+            Raster::Compute { large: LargeTriangles::Bins { bin_list, .. }, .. } => Some(bin_list),
             _ => None,
         }
+    }
+
+    /// Whether the large triangles' lists grow when a frame overflows them.
+    pub fn lists_grow(self) -> bool {
+        matches!(self, Raster::Compute { large: LargeTriangles::Bins { grows: true, .. }, .. })
     }
 }
 

@@ -14,9 +14,10 @@
 
 use crate::antialiasing::Antialiasing;
 use crate::descriptors::FrameSets;
+use crate::error::RenderError;
 use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
-use crate::pass::{FrameWork, Pass, Recording, SlotReport};
+use crate::pass::{FrameWork, Pass, Prepare, Recording, SlotReport};
 use crate::plan::Phase;
 use crate::read_back::HostRead;
 use crate::report::{FeatureStats, FrameStats};
@@ -97,13 +98,14 @@ impl MeshletCull {
     }
 }
 
-/// The culling passes' push constants (the large-triangle pass reads the same).
-pub fn cull_push(phase: Phase, culling: bool, raster: Raster, scene: &MeshletScene, extent: vk::Extent2D) -> CullPush {
+/// The culling passes' push constants for frame slot `slot` (the large-triangle pass reads
+/// the same).
+pub fn cull_push(phase: Phase, culling: bool, raster: Raster, (scene, slot): (&MeshletScene, usize), extent: vk::Extent2D) -> CullPush {
     let (_, levels) = depth_pyramid_shape(extent);
-    let bins = raster.bin_list();
+    let bins = raster.bin_list().is_some();
     CullPush {
         mode: [u32::from(phase == Phase::Late), u32::from(culling), levels, scene.capacity],
-        triangles: [scene.geometry.triangles as u32, raster.split(), bins.unwrap_or(0), u32::from(bins.is_some())],
+        triangles: [scene.geometry.triangles as u32, raster.split(), scene.frames[slot].large_capacity, u32::from(bins)],
     }
 }
 
@@ -169,7 +171,7 @@ impl Pass for MeshletCull {
         let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
         let rw = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE;
         let indirect_read = vk::AccessFlags::INDIRECT_COMMAND_READ;
-        let push = cull_push(self.phase, self.culling, self.raster, &scene, rec.extent);
+        let push = cull_push(self.phase, self.culling, self.raster, (&scene, slot), rec.extent);
         let set = [self.sets.sets[slot]];
         // SAFETY: recording state outside a render pass; everything bound is alive until the
         // frame's fence signals.
@@ -218,6 +220,15 @@ impl Pass for MeshletCull {
 }
 
 impl FrameWork for MeshletCull {
+    /// The late phase (whose counters are read back): the slot's large-triangle lists grown
+    /// where its last frame overflowed them.
+    fn prepare(&mut self, prepare: &mut Prepare) -> Result<(), RenderError> {
+        if self.phase == Phase::Late && self.scene.borrow_mut().grow_large_lists(prepare.ctx, prepare.slot)? {
+            prepare.rebind = true;
+        }
+        Ok(())
+    }
+
     /// The late phase's counters, copied once the frame's every pass has added to them (the
     /// large triangles' pass adds the pixels it covered).
     fn host_reads(&self, slot: usize) -> Vec<HostRead> {
@@ -226,6 +237,11 @@ impl FrameWork for MeshletCull {
         }
         let scene = self.scene.borrow();
         vec![scene.readback.of(slot, CULL_COUNTERS, scene.frames[slot].counters.raw)]
+    }
+
+    /// Large triangles drawn in place where the lists will grow.
+    fn redraws(&self, ctx: &Context, slot: usize) -> bool {
+        self.phase == Phase::Late && self.scene.borrow().drew_in_place_for_want_of_room(ctx, slot)
     }
 
     fn collect(&self, slot: usize, _: &mut SlotReport, stats: &mut FrameStats) {
@@ -253,6 +269,7 @@ impl FrameWork for MeshletCull {
             large_triangles: c.binned[2] as u64 + c.binned[3] as u64,
             bins: c.binned[0] as u64 + c.binned[1] as u64,
             in_place: c.rasterized[3] as u64,
+            large_list: scene.frames[slot].large_capacity,
             scene_triangles: scene.geometry.triangles,
         });
     }
@@ -294,6 +311,9 @@ pub struct CullStats {
     pub large_triangles: u64,
     pub bins: u64,
     pub in_place: u64,
+    /// The lists' size in that frame (bins and large triangles each; they grow after a
+    /// frame that overflowed them).
+    pub large_list: u32,
 }
 
 impl FeatureStats for CullStats {
@@ -327,14 +347,17 @@ impl FeatureStats for CullStats {
             )),
             Raster::Compute { large: LargeTriangles::Bins { .. }, .. } => {
                 // Said only where it happened: a triangle is drawn in place when the bins'
-                // lists are full.
-                let in_place =
-                    if c.in_place > 0 { format!(" ({} drawn in place: the bins' lists were full)", c.in_place) } else { String::new() };
+                // lists are full (they grow for the slot's next frame).
+                let in_place = if c.in_place > 0 {
+                    format!(" ({} drawn in place: the bins' lists were full; they grow)", c.in_place)
+                } else {
+                    String::new()
+                };
                 rows.push((
                     "compute raster",
                     format!(
-                        "{} small triangles a thread each, {} large ones in {} bins{in_place}; {} pixels covered",
-                        c.compute_triangles, c.large_triangles, c.bins, c.compute_pixels
+                        "{} small triangles a thread each, {} large ones in {} bins (lists of {}){in_place}; {} pixels covered",
+                        c.compute_triangles, c.large_triangles, c.bins, c.large_list, c.compute_pixels
                     ),
                 ))
             }

@@ -7,7 +7,9 @@
 //! and lighting passes share it and bind its buffers by the names the shaders give them.
 //!
 //! The compacted buffers hold every triangle of the scene once: a meshlet instance is drawn
-//! at most once a frame (early or late), so that is their worst case — culling off.
+//! at most once a frame (early or late), so that is their worst case — culling off. The
+//! compute raster's large-triangle lists have no such bound (a near view of foliage lists
+//! hundreds of thousands): a slot's lists grow when its last frame asked for more.
 
 use crate::descriptors::Resource;
 use crate::frame_resources::FrameResources;
@@ -43,9 +45,11 @@ pub struct CullFrame {
     pub indices: Buffer,
     /// A visibility id per kept triangle: early from 0, late from `triangles` on.
     pub triangle_ids: Buffer,
-    /// The compute raster's large triangles, clipped, and the bins they are listed by.
+    /// The compute raster's large triangles, clipped, and the bins they are listed by:
+    /// `large_capacity` of each (0: no lists, the large triangles go to the hardware).
     pub large_triangles: Buffer,
     pub large_bins: Buffer,
+    pub large_capacity: u32,
 }
 
 pub struct MeshletScene {
@@ -59,6 +63,11 @@ pub struct MeshletScene {
     pub readback: ReadBack,
     /// Draws one phase may write: every meshlet instance (each is drawn at most once a frame).
     pub capacity: u32,
+    /// Whether the large-triangle lists grow (`grow_large_lists`), and the size the longest
+    /// a finished frame asked for gave them: every slot's grow to it (auto exposure draws a
+    /// frame again in the other slot).
+    lists_grow: bool,
+    grown: u32,
 }
 
 /// Shared by the passes of one technique; destroyed by whichever is destroyed first.
@@ -66,9 +75,12 @@ pub type SharedMeshletScene = Rc<RefCell<MeshletScene>>;
 
 impl MeshletScene {
     /// The scene's meshlets `geometry` with per-frame culling buffers; `bin_list`: large
-    /// triangles, and bins, the compute raster's lists hold per phase (0 where it has none).
-    pub fn new(ctx: &Context, geometry: MeshletGeometryView, bin_list: u32) -> Result<SharedMeshletScene, VkError> {
+    /// triangles, and bins, the compute raster's lists hold per phase at first (0 where it
+    /// has none), and whether they grow.
+    pub fn new(ctx: &Context, geometry: MeshletGeometryView, (bin_list, lists_grow): (u32, bool)) -> Result<SharedMeshletScene, VkError> {
         let s = MeshletScene {
+            lists_grow,
+            grown: 0,
             geometry,
             visibility: Buffer::null(),
             frames: Vec::new(),
@@ -90,8 +102,6 @@ impl MeshletScene {
         let triangles = self.geometry.triangles.max(1);
         let index_bytes = checked("compacted indices", 3 * triangles * 4)?;
         let id_bytes = checked("triangle ids", 2 * triangles * 4)?;
-        let bin_bytes = checked("large-triangle bins", bin_list.max(1) as u64 * 8)?;
-        let large_bytes = checked("large triangles", bin_list.max(1) as u64 * std::mem::size_of::<LargeTriangle>() as u64)?;
         for _ in 0..FRAMES_IN_FLIGHT {
             let counter_bytes = std::mem::size_of::<CullCounters>() as u64;
             let mut f = CullFrame {
@@ -102,6 +112,7 @@ impl MeshletScene {
                 triangle_ids: Buffer::null(),
                 large_triangles: Buffer::null(),
                 large_bins: Buffer::null(),
+                large_capacity: bin_list,
             };
             let made = (|| {
                 f.counters = Buffer::new(
@@ -121,8 +132,7 @@ impl MeshletScene {
                 f.draw_slots = Buffer::new(ctx, "draw slots", slot_bytes, storage, MemoryLocation::GpuOnly)?;
                 f.indices = Buffer::new(ctx, "compacted indices", index_bytes, storage | U::INDEX_BUFFER, MemoryLocation::GpuOnly)?;
                 f.triangle_ids = Buffer::new(ctx, "triangle ids", id_bytes, storage, MemoryLocation::GpuOnly)?;
-                f.large_bins = Buffer::new(ctx, "large-triangle bins", bin_bytes, storage, MemoryLocation::GpuOnly)?;
-                f.large_triangles = Buffer::new(ctx, "large triangles", large_bytes, storage, MemoryLocation::GpuOnly)?;
+                (f.large_triangles, f.large_bins) = large_lists(ctx, bin_list)?;
                 Ok(())
             })();
             if let Err(e) = made {
@@ -157,6 +167,45 @@ impl MeshletScene {
         }
     }
 
+    /// Grow slot `slot`'s large-triangle lists where its last finished frame asked for more
+    /// than they hold — the triangles past them were drawn in place, each by one thread
+    /// (right, but a near view of foliage took 100 ms a frame so) — to 1.5× what it asked,
+    /// at most what the device binds as one storage buffer (past that, in place it stays),
+    /// or where another slot's have grown longer. Returns whether they grew (the passes must
+    /// then be bound to them again). Call only after the slot's fence has signalled.
+    pub fn grow_large_lists(&mut self, ctx: &Context, slot: usize) -> Result<bool, VkError> {
+        let Some(capacity) = self.grown_capacity(ctx, slot) else {
+            return Ok(false);
+        };
+        self.grown = capacity;
+        let (triangles, bins) = large_lists(ctx, capacity)?;
+        let f = &mut self.frames[slot];
+        std::mem::replace(&mut f.large_triangles, triangles).destroy(ctx);
+        std::mem::replace(&mut f.large_bins, bins).destroy(ctx);
+        f.large_capacity = capacity;
+        Ok(true)
+    }
+
+    /// The size `grow_large_lists` would give slot `slot`'s lists; None where they stay.
+    pub fn grown_capacity(&self, ctx: &Context, slot: usize) -> Option<u32> {
+        let held = self.frames[slot].large_capacity;
+        if !self.lists_grow || held == 0 {
+            return None;
+        }
+        // Bins and large triangles asked for, per phase: the shader counts past the lists.
+        let asked = self.counters(slot).binned.into_iter().max().unwrap_or(0);
+        let limit = ctx.info.limits.max_storage_buffer_range as u64 / size_of::<LargeTriangle>() as u64;
+        let wanted = if asked > held { (u64::from(asked) * 3 / 2).min(limit) as u32 } else { 0 };
+        let capacity = wanted.max(self.grown);
+        (capacity > held).then_some(capacity)
+    }
+
+    /// Whether slot `slot`'s finished frame drew large triangles in place, which its lists,
+    /// grown, would have held.
+    pub fn drew_in_place_for_want_of_room(&self, ctx: &Context, slot: usize) -> bool {
+        self.counters(slot).rasterized[3] > 0 && self.grown_capacity(ctx, slot).is_some()
+    }
+
     /// Slot `slot`'s counters as its last finished frame left them.
     pub fn counters(&self, slot: usize) -> CullCounters {
         self.readback.read(slot)
@@ -169,6 +218,24 @@ impl MeshletScene {
         }
         self.frames.clear();
         self.readback.destroy(ctx);
+    }
+}
+
+/// The compute raster's lists for `capacity` large triangles and as many bins (1 of each where
+/// there are none: a binding needs a buffer).
+fn large_lists(ctx: &Context, capacity: u32) -> Result<(Buffer, Buffer), VkError> {
+    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+    let entries = u64::from(capacity.max(1));
+    let triangle_bytes = storage_bytes(ctx, "large triangles", entries * size_of::<LargeTriangle>() as u64)?;
+    let bin_bytes = storage_bytes(ctx, "large-triangle bins", entries * 8)?;
+    let triangles = Buffer::new(ctx, "large triangles", triangle_bytes, storage, MemoryLocation::GpuOnly)?;
+    match Buffer::new(ctx, "large-triangle bins", bin_bytes, storage, MemoryLocation::GpuOnly) {
+        Ok(bins) => Ok((triangles, bins)),
+        Err(e) => {
+            let mut triangles = triangles;
+            triangles.destroy(ctx);
+            Err(e)
+        }
     }
 }
 

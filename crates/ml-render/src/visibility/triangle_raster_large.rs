@@ -88,7 +88,7 @@ impl Pass for TriangleRasterLarge {
         let d = &ctx.device;
         let scene = self.scene.borrow();
         // The shader reads the phase and the lists' capacity of the culling's push constants.
-        let push = cull_push(self.phase, true, self.raster, &scene, rec.extent);
+        let push = cull_push(self.phase, true, self.raster, (&scene, slot), rec.extent);
         let phase = usize::from(self.phase == Phase::Late);
         let dispatch = (std::mem::offset_of!(CullCounters, large) + phase * 16) as u64;
         // SAFETY: recording state outside a render pass; everything bound is alive until the

@@ -224,7 +224,7 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
         // Every triangle in compute: each pixel counted once, none left empty.
         // About a cell: the jittered triangles fall on both sides of it.
         let split = ((W + 16) as f32 / cells.0 as f32).max((H + 16) as f32 / cells.1 as f32).ceil() as u32;
-        let bins = |bin_list| Raster::Compute { split, large: LargeTriangles::Bins { bin_list } };
+        let bins = |bin_list| Raster::Compute { split, large: LargeTriangles::Bins { bin_list, grows: false } };
         // Every triangle in compute — a thread each; split between threads and bins; nearly
         // all by bins (a split of 1 pixel); nearly all in place (a list of 3 bins): each
         // pixel counted once, none left empty.
@@ -264,4 +264,55 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
         let holes = (0..W * H).filter(|i| common::pixel(&mixed, i % W, i / W) == bg).count();
         assert_eq!(holes, 0, "{cells:?} cells: pixels neither rasteriser covered");
     }
+}
+
+/// Large-triangle lists too short for a frame grow for the slot's next frames, and a render's
+/// last frame is drawn again with them grown: the image is the one lists long enough from the
+/// start give, byte for byte (drawn in place, a triangle is one thread's loop, which a CPU
+/// driver may cut short: a near view of a forest lost part of its ground so).
+#[test]
+fn lists_too_short_grow_and_the_last_frame_is_drawn_again() {
+    let ctx = common::pooled_context();
+    let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 0.8), Vec3::ZERO, 60.0, 0.1, 10.0);
+    let mut scene = Scene::new(Vec::new(), Vec::new(), camera);
+    scene.meshes.push(screen_mesh(&camera, (40, 24), 1));
+    let white = Material::named("white").unwrap();
+    scene.objects.push(Object { transform: Mat4::IDENTITY, ..Object::placed(MeshKind::Loaded(0), Vec3::ZERO, 1.0, white) });
+    let base = RenderSettings { debug_view: view("triangles"), ..RenderSettings::new(Technique::Visibility, W, H) };
+    // A split of 1 pixel: every triangle large, listed by the bins of its box.
+    let lists = |bin_list, grows| Raster::Compute { split: 1, large: LargeTriangles::Bins { bin_list, grows } };
+    let render = |raster, frames| Renderer::new(&ctx, scene.clone(), RenderSettings { raster, frames, ..base }).unwrap().render().unwrap();
+    let long_enough = render(Raster::compute(1), 1);
+    let c = *long_enough.stats.feature::<CullStats>().unwrap();
+    assert!(c.large_triangles > 100 && c.in_place == 0 && long_enough.stats.redraws == 0, "{c:?}");
+    // One frame, or two (one a slot): the last frame drawn again. Three: the last is the
+    // first slot's second, drawn with the lists its first frame grew.
+    for (frames, redraws) in [(1, 1), (2, 1), (3, 0)] {
+        let grown = render(lists(16, true), frames);
+        let g = *grown.stats.feature::<CullStats>().unwrap();
+        println!(
+            "{frames} frame(s): {} large triangles in {} bins, lists of {}, {} redrawn",
+            g.large_triangles, g.bins, g.large_list, grown.stats.redraws
+        );
+        if redraws > 0 {
+            // The statistics are the redrawn frame's.
+            assert!(g.in_place == 0 && g.large_list as u64 >= g.bins.max(g.large_triangles), "{frames} frame(s): the lists grew: {g:?}");
+        }
+        assert_eq!(grown.stats.redraws, redraws, "{frames} frame(s): the last frame drawn again where it overflowed");
+        assert_eq!(common::max_difference(&grown, &long_enough), (0, 0), "{frames} frame(s): the image of lists long enough");
+    }
+    // Fixed lists stay as they are: drawn in place, not again.
+    let fixed = render(lists(16, false), 3);
+    let f = *fixed.stats.feature::<CullStats>().unwrap();
+    assert!(f.in_place > 0 && f.large_list == 16 && fixed.stats.redraws == 0, "{f:?}");
+    assert_eq!(common::max_difference(&fixed, &long_enough), (0, 0), "drawn in place: the same image");
+    // Two triangles over a larger image: a box of 245,760 pixels is more than lavapipe lets one
+    // invocation loop (65,535 iterations in all), so drawn in place it loses its last rows.
+    let mut two = scene.clone();
+    two.meshes[0] = screen_mesh(&camera, (1, 1), 1);
+    let large = RenderSettings { debug_view: view("triangles"), ..RenderSettings::new(Technique::Visibility, 4 * W, 4 * H) };
+    let render = |raster| Renderer::new(&ctx, two.clone(), RenderSettings { raster, ..large }).unwrap().render().unwrap();
+    let (grown, long_enough) = (render(lists(1, true)), render(Raster::compute(1)));
+    assert_eq!(grown.stats.redraws, 1);
+    assert_eq!(common::max_difference(&grown, &long_enough), (0, 0), "two triangles: the image of lists long enough");
 }
