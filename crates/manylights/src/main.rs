@@ -306,8 +306,8 @@ struct SceneArgs {
     culling: String,
     /// Whether the light grid lists only the lights near the frame's surfaces, after a pass
     /// that marks the cells their points walk (deferred-compute, visibility): auto (where the
-    /// lights are more than a third of the pixels, where the pass costs less than listing every
-    /// light), on, or off. The same lights light every pixel either way.
+    /// lights are more than a third of the pixels, a pixel of N coverage samples counted N/2
+    /// times, where the pass costs less than listing every light), on, or off. The same lights light every pixel either way.
     #[arg(long, default_value = "auto", value_parser = LightGridMarks::NAMES)]
     light_grid_marks: String,
     /// Who draws the visibility technique's visibility buffer: hardware (the graphics
@@ -791,6 +791,8 @@ fn render(cmd: &RenderArgs) -> Result<()> {
     let aa_choice = (auto::antialiasing_choice(&args.aa)?, (raster_choice(args)?, args.raster_split));
     let aa_why;
     (settings.antialiasing, aa_why) = auto::resolve_antialiasing(&ctx, &settings, aa_choice, (built.scene.lights.len(), cmd.supersample));
+    // Samples weigh on whether the light grid's marks pay.
+    settings.light_grid_marks = wanted.marks_light_grid(built.scene.lights.len(), &settings);
     let raster_why;
     (settings.raster, raster_why) = auto::resolve_raster(&ctx, &built.scene, &settings, (raster_choice(args)?, args.raster_split))?;
     let (lights, gbuffer) = (built.scene.lights.len(), settings.lighting(&built.scene).gbuffer_kind());

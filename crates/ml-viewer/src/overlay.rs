@@ -110,6 +110,13 @@ impl Choices {
     /// The settings of these choices at a size, the clock fixed at `time` if given.
     pub fn settings(&self, (width, height): (u32, u32), time: Option<f32>) -> RenderSettings {
         let s = &self.settings;
+        // Transparent layers take samples in the visibility technique (the overlay offers
+        // what the settings take).
+        let antialiasing = if s.transparency.is_none() || ml_render::layers_take(s.technique, s.antialiasing) {
+            s.antialiasing
+        } else {
+            Antialiasing::Off
+        };
         RenderSettings {
             width,
             height,
@@ -119,14 +126,8 @@ impl Choices {
             raster: self.drawn_raster(),
             // The viewer's overlay shows times, not light counts.
             light_stats: false,
-            light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height),
-            // Transparent layers take samples in the visibility technique (the overlay offers
-            // what the settings take).
-            antialiasing: if s.transparency.is_none() || ml_render::layers_take(s.technique, s.antialiasing) {
-                s.antialiasing
-            } else {
-                Antialiasing::Off
-            },
+            light_grid_marks: self.light_grid_marks.resolve(self.lights, width, height, antialiasing),
+            antialiasing,
             ..*s
         }
     }
