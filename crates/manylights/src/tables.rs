@@ -156,7 +156,10 @@ pub fn render_rows(facts: &RenderFacts, stats: &FrameStats) -> Vec<(&'static str
         ));
     }
     if stats.redraws > 0 {
-        rows.push(("redrawn", format!("the last frame, {} more time(s): it overflowed lists that have grown since", stats.redraws)));
+        rows.push((
+            "redrawn",
+            format!("{} time(s): a frame overflowed lists that have grown since, drawn again (a sequence: from it on)", stats.redraws),
+        ));
     }
     if let Some(m) = stats.memory {
         let mib = |b: u64| b as f64 / (1 << 20) as f64;

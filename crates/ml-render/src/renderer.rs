@@ -476,11 +476,24 @@ impl<'a> Renderer<'a> {
             return Err(RenderError::Invalid(format!("no frames to render in {range:?}")));
         }
         let meters = self.settings.meters_exposure();
-        for i in range.clone() {
+        // Frames submitted so far (a frame drawn again is not told to the sink twice).
+        let mut told = range.start;
+        let mut i = range.start;
+        loop {
+            if i == range.end {
+                match self.hand_over_all(sink, &mut stats)? {
+                    Some(first) => i = first,
+                    None => break,
+                }
+            }
             last = i as usize % FRAMES_IN_FLIGHT;
             // Exposed from the image of the slot's previous frame (two back), whether or not
             // the frame before was waited for: the same EVs, so the same images, either way.
             self.collect(last, &mut stats)?;
+            if let Some(first) = self.overflowed_image(last..last + 1, &mut stats)? {
+                i = first;
+                continue;
+            }
             self.hand_over(last..last + 1, sink, &mut stats)?;
             self.adapt_exposure(1.0, last);
             // The first frame settles its exposure as the last does: a sequence does not start
@@ -503,23 +516,29 @@ impl<'a> Renderer<'a> {
                 self.in_flight_image[last] = Some(i);
             }
             if i == 0 && frames > 1 && meters {
-                self.collect_all(&mut stats)?;
-                self.hand_over(0..FRAMES_IN_FLIGHT, sink, &mut stats)?;
+                if let Some(first) = self.hand_over_all(sink, &mut stats)? {
+                    i = first;
+                    continue;
+                }
                 last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
             }
             if wanted && settles {
-                self.collect_all(&mut stats)?;
-                self.hand_over(0..FRAMES_IN_FLIGHT, sink, &mut stats)?;
+                if let Some(first) = self.hand_over_all(sink, &mut stats)? {
+                    i = first;
+                    continue;
+                }
                 // The last image is the one `render` returns: with its exposure settled.
                 if i + 1 == frames {
                     last = self.settle_exposure(last, self.settings.clock(i), &mut stats)?;
                 }
                 self.hand_image((i, last), true, sink, &mut stats)?;
             }
-            sink.submitted(i);
+            if i == told {
+                sink.submitted(i);
+                told += 1;
+            }
+            i += 1;
         }
-        self.collect_all(&mut stats)?;
-        self.hand_over(0..FRAMES_IN_FLIGHT, sink, &mut stats)?;
         if !sink.wants_images() {
             // (An image sequence settled its last frame before handing it over.)
             last = self.settle_exposure(last, self.settings.clock(range.end - 1), &mut stats)?;
@@ -731,6 +750,39 @@ impl<'a> Renderer<'a> {
         self.collect(slot, stats)?;
         let ctx = self.ctx;
         Ok(self.passes.iter_mut().filter_map(|p| p.frame_work()).any(|w| w.redraws(ctx, slot)))
+    }
+
+    /// Of the images of `slots` (collected) not yet handed over, the first frame that
+    /// overflowed a list that has grown since, if any (`FrameWork::redraws`): its image may
+    /// lack what it drew in place (a CPU driver cuts a long loop short). Then the frames from
+    /// it on are drawn again, in order, with the grown lists: the images in flight are dropped
+    /// and that frame returned. Each time some list has grown, so it ends.
+    fn overflowed_image(&mut self, slots: std::ops::Range<usize>, stats: &mut FrameStats) -> Result<Option<u32>, VkError> {
+        let mut first = None;
+        for f in slots {
+            if let Some(i) = self.in_flight_image[f] {
+                if self.redraws(f, stats)? {
+                    first = Some(first.map_or(i, |j: u32| j.min(i)));
+                }
+            }
+        }
+        if first.is_some() {
+            self.collect_all(stats)?;
+            self.in_flight_image.fill(None);
+            stats.redraws += 1;
+        }
+        Ok(first)
+    }
+
+    /// Wait for every slot and hand the sink their images, unless one overflowed
+    /// (`overflowed_image`): then the frame to draw again from.
+    fn hand_over_all(&mut self, sink: &mut dyn FrameSink, stats: &mut FrameStats) -> Result<Option<u32>, RenderError> {
+        self.collect_all(stats)?;
+        if let Some(first) = self.overflowed_image(0..FRAMES_IN_FLIGHT, stats)? {
+            return Ok(Some(first));
+        }
+        self.hand_over(0..FRAMES_IN_FLIGHT, sink, stats)?;
+        Ok(None)
     }
 
     fn collect_all(&mut self, stats: &mut FrameStats) -> Result<(), VkError> {

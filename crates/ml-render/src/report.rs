@@ -37,8 +37,8 @@ pub struct FrameStats {
     /// rendered again for the exposure to settle.
     pub exposure_ev: Option<f32>,
     pub exposure_repeats: u32,
-    /// How often the last frame was drawn again because it overflowed a list that grew
-    /// (`FrameWork::redraws`).
+    /// How often frames were drawn again because one overflowed a list that grew since
+    /// (`FrameWork::redraws`): the last frame, or an image sequence's from the first such.
     pub redraws: u32,
     /// What the renderer had allocated when the last frame finished.
     pub memory: Option<ml_vk::context::MemoryUse>,

@@ -267,11 +267,11 @@ fn a_screen_of_shared_edges_is_drawn_watertight() {
 }
 
 /// Large-triangle lists too short for a frame grow for the slot's next frames, and a render's
-/// last frame is drawn again with them grown: the image is the one lists long enough from the
-/// start give, byte for byte (drawn in place, a triangle is one thread's loop, which a CPU
+/// last frame, or an image sequence's frames from the first that overflowed, are drawn again
+/// with them grown: each image is the one lists long enough from the start give, byte for byte (drawn in place, a triangle is one thread's loop, which a CPU
 /// driver may cut short: a near view of a forest lost part of its ground so).
 #[test]
-fn lists_too_short_grow_and_the_last_frame_is_drawn_again() {
+fn lists_too_short_grow_and_frames_that_overflowed_are_drawn_again() {
     let ctx = common::pooled_context();
     let camera = Camera::looking_at(Vec3::new(0.0, 0.0, 0.8), Vec3::ZERO, 60.0, 0.1, 10.0);
     let mut scene = Scene::new(Vec::new(), Vec::new(), camera);
@@ -315,4 +315,15 @@ fn lists_too_short_grow_and_the_last_frame_is_drawn_again() {
     let (grown, long_enough) = (render(lists(1, true)), render(Raster::compute(1)));
     assert_eq!(grown.stats.redraws, 1);
     assert_eq!(common::max_difference(&grown, &long_enough), (0, 0), "two triangles: the image of lists long enough");
+    // An image sequence: the first frame of each slot overflows its lists. Found when the
+    // first slot comes round, the frames from its first on are drawn again with lists grown
+    // (every slot's), so no image handed over is one drawn in place.
+    let mut sequence = common::Frames::default();
+    let settings = RenderSettings { raster: lists(1, true), frames: 3, ..large };
+    let output = Renderer::new(&ctx, two.clone(), settings).unwrap().render_into(&mut sequence).unwrap();
+    assert_eq!(sequence.0.len(), 3, "each frame's image, once");
+    for (i, image) in sequence.0.iter().enumerate() {
+        assert_eq!(common::rgba_difference(image, &long_enough.rgba), (0, 0), "frame {i}: the image of lists long enough");
+    }
+    assert_eq!(output.stats.redraws, 1, "drawn again from the first frame, once");
 }

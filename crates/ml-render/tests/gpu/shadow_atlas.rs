@@ -17,9 +17,7 @@ use ml_cpu::mesh::MeshKind;
 use ml_cpu::scene::{Object, Scene};
 use ml_render::settings::AtlasSettings;
 use ml_render::AtlasStats;
-use ml_render::{
-    FrameSink, OmniShadowMode, OmniShadowSettings, RenderError, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique,
-};
+use ml_render::{OmniShadowMode, OmniShadowSettings, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique};
 use ml_vk::{Context, ContextDesc};
 
 /// The image side and the cube array's face side the atlas is compared with.
@@ -141,20 +139,6 @@ fn the_cache_changes_no_pixel_while_the_camera_moves() {
     });
 }
 
-/// Collects every frame's image.
-#[derive(Default)]
-struct Frames(Vec<Vec<u8>>);
-
-impl FrameSink for Frames {
-    fn wants_images(&self) -> bool {
-        true
-    }
-    fn image(&mut self, _i: u32, rgba: Vec<u8>) -> Result<(), RenderError> {
-        self.0.push(rgba);
-        Ok(())
-    }
-}
-
 /// The seed's animation (every light moving, every face drawn every frame) over 10 frames,
 /// then one light moved by hand: only its faces are drawn again, and the images never differ.
 #[test]
@@ -164,7 +148,7 @@ fn the_cache_changes_no_pixel_while_lights_move() {
     base.frames = 10;
     base.time = None;
     with_pair(&scene, base, 64, |cached, uncached| {
-        let (mut on, mut off) = (Frames::default(), Frames::default());
+        let (mut on, mut off) = (common::Frames::default(), common::Frames::default());
         let last_on = cached.render_into(&mut on).expect("render");
         uncached.render_into(&mut off).expect("render");
         assert_eq!(on.0.len(), 10);

@@ -14,7 +14,7 @@
 pub mod shadow_rays;
 
 use ml_cpu::scene::Scene;
-use ml_render::{RenderOutput, RenderSettings, Renderer, Technique};
+use ml_render::{FrameSink, RenderError, RenderOutput, RenderSettings, Renderer, Technique};
 use ml_vk::{Context, ContextDesc};
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, Once};
@@ -120,6 +120,20 @@ extern "C" fn destroy_pool() {
 pub fn max_difference(a: &RenderOutput, b: &RenderOutput) -> (u8, usize) {
     assert_eq!((a.width, a.height), (b.width, b.height));
     rgba_difference(&a.rgba, &b.rgba)
+}
+
+/// Collects every frame's image (an image sequence), in the order handed over.
+#[derive(Default)]
+pub struct Frames(pub Vec<Vec<u8>>);
+
+impl FrameSink for Frames {
+    fn wants_images(&self) -> bool {
+        true
+    }
+    fn image(&mut self, _i: u32, rgba: Vec<u8>) -> Result<(), RenderError> {
+        self.0.push(rgba);
+        Ok(())
+    }
 }
 
 /// `max_difference` of two RGBA byte arrays of one size.
