@@ -169,10 +169,18 @@ void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
             }
         }
     }
-    // Centres p + 0.5 within [lo, hi], a pixel of margin for the projection's rounding;
-    // clamped before the conversion (a crossing's projection may be far outside).
-    lo = clamp(floor(lo - 0.5) - 1.0, vec2(0.0), size);
-    hi = clamp(ceil(hi - 0.5) + 1.0, vec2(-1.0), size - 1.0);
+    // The pixels whose centre p + 0.5 lies within [lo, hi] — with anti-aliasing, some
+    // sample of theirs: within half a pixel of the centre — widened by an eighth of a pixel for
+    // the projection's rounding (a thousand times its error at the image's coordinates; a
+    // corner far outside, where the error grows, lies beyond the clamp). Clamped before the
+    // conversion (a crossing's projection may be far outside). A box a pixel wider each way
+    // than this walked four times the pixels of a small triangle's.
+    float margin = 0.125;
+    if (VISIBILITY_SAMPLES != 1u) {
+        margin += 0.5;
+    }
+    lo = clamp(ceil(lo - 0.5 - margin), vec2(0.0), size);
+    hi = clamp(floor(hi - 0.5 + margin), vec2(-1.0), size - 1.0);
     box = ivec4(ivec2(lo), ivec2(hi));
 }
 

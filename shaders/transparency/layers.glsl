@@ -7,9 +7,9 @@
 //
 // Memory is a fixed budget: a pool of nodes (`--transparency-budget` per pixel on average)
 // and a head per pixel. A fragment that finds the pool full is dropped and counted. A pixel
-// blends its LAYER_KEEP nearest layers exactly, in order of depth (ties by object); farther
-// ones are merged into one layer behind them (coverage 1 − Π(1 − α), α-weighted colour) and
-// the pixel is counted. ml-cpu transparency.rs is the same rule on the CPU.
+// blends its LAYER_KEEP nearest layers exactly, in order of depth (ties by object, then by
+// their light); farther ones are merged into one layer behind them (coverage 1 − Π(1 − α),
+// α-weighted colour) and the pixel is counted. ml-cpu transparency.rs is the same rule on the CPU.
 //
 // With anti-aliasing (VISIBILITY_SAMPLES > 1) a node also keeps the samples of its pixel its
 // fragment covers in front of the opaque surface there; it is shaded where the opaque
@@ -181,11 +181,28 @@ uint layer_object_of(uint node) {
     return layer_nodes[LAYER_NODE_WORDS * node].z;
 }
 
-// Whether layer x lies in front of layer y, each (depth bits, node): nearer, or as near and of
-// a lower object (read from the nodes: ties are rare).
+// Whether layer x lies in front of layer y, each (depth bits, node) of a lit node: nearer; as
+// near, of a lower object; of the same object too, of the lower light (its words in order) —
+// two triangles of one mesh meeting at a pixel's point are ordered by what they are, not by
+// the order their fragments happened to be listed in, which varies with the build and the
+// run; layers equal in all of that blend the same either way. Read from the nodes: ties are
+// rare.
 bool layer_before(uvec2 x, uvec2 y) {
     float dx = uintBitsToFloat(x.x), dy = uintBitsToFloat(y.x);
-    return dx < dy || (dx == dy && layer_object(layer_object_of(x.y)) < layer_object(layer_object_of(y.y)));
+    if (dx != dy) {
+        return dx < dy;
+    }
+    uint ox = layer_object(layer_object_of(x.y)), oy = layer_object(layer_object_of(y.y));
+    if (ox != oy) {
+        return ox < oy;
+    }
+    uvec4 lx = layer_nodes[LAYER_NODE_WORDS * x.y + 1u], ly = layer_nodes[LAYER_NODE_WORDS * y.y + 1u];
+    for (uint i = 0u; i < 4u; i++) {
+        if (lx[i] != ly[i]) {
+            return lx[i] < ly[i];
+        }
+    }
+    return false;
 }
 
 // A pixel's nearest LAYER_KEEP layers, sorted (sort_layers), in [lo, hi) of a double-ended

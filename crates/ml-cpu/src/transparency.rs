@@ -4,8 +4,10 @@
 //! `t` is what a transmitting surface (KHR_materials_transmission) lets through of the light
 //! behind it, per channel (zero for a plain BLEND surface).
 //!
-//! The order is the layers' depth, ties broken by their ids (object and triangle), so the
-//! result does not depend on the order in which the surfaces were listed or drawn. A pixel
+//! The order is the layers' depth, ties broken by their ids (the object), then by the layers
+//! themselves (colour, coverage, what they let through), so the result does not depend on the
+//! order in which the surfaces were listed or drawn: layers equal in all of that blend the same
+//! either way. A pixel
 //! keeps at most `keep` layers exactly, the nearest; the farther ones are merged into one
 //! layer behind those, which lets `Π(1 − αᵢ + αᵢ·tᵢ)` of what lies behind through and whose
 //! colour is their weighted mean (weights αᵢ·(1 − the least channel of tᵢ): a layer's share
@@ -33,6 +35,13 @@ impl Layer {
     /// A BLEND surface: `color` covering `alpha` of the pixel, letting nothing through.
     pub fn blended(depth: f32, id: u32, color: Vec3, alpha: f32) -> Layer {
         Layer { depth, id, color, alpha, transmitted: Vec3::ZERO }
+    }
+
+    /// Its colour, coverage and what it lets through, as bits: what orders layers as deep and
+    /// of the same id.
+    fn bits(&self) -> [u32; 7] {
+        let (c, t) = (self.color, self.transmitted);
+        [c.x, c.y, c.z, self.alpha, t.x, t.y, t.z].map(f32::to_bits)
     }
 
     /// What it lets through of the light behind: 1 − α + α·t per channel.
@@ -74,7 +83,7 @@ fn merge(layers: &[Layer]) -> Option<(Vec3, Vec3)> {
 /// `keep` nearest exactly and the rest merged behind them.
 pub fn composite(under: Vec3, layers: &[Layer], keep: usize) -> Composite {
     let mut sorted = layers.to_vec();
-    sorted.sort_by(|a, b| a.depth.total_cmp(&b.depth).then(a.id.cmp(&b.id)));
+    sorted.sort_by(|a, b| a.depth.total_cmp(&b.depth).then(a.id.cmp(&b.id)).then_with(|| a.bits().cmp(&b.bits())));
     let split = keep.min(sorted.len());
     let (near, far) = sorted.split_at(split);
     let mut color = under;
@@ -192,6 +201,12 @@ mod tests {
         assert_eq!(ab, composite(under, &[b, a], 4).color);
         // The smaller id is in front.
         assert_eq!(ab, over(over(under, b.color, b.alpha), a.color, a.alpha));
+        // Of one id too, in an order of their own: the green one, whose colour's bits are the
+        // smaller, in front.
+        let b = layer(0.5, 1, [0.0, 1.0, 0.0], 0.5);
+        let ab = composite(under, &[a, b], 4).color;
+        assert_eq!(ab, composite(under, &[b, a], 4).color);
+        assert_eq!(ab, over(over(under, a.color, a.alpha), b.color, b.alpha));
     }
 
     #[test]
