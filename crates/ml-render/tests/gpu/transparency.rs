@@ -555,7 +555,9 @@ fn the_tiles_build_and_the_per_triangle_build_agree() {
 /// The BLEND forest the benchmarks render (`ml_cpu::forest`), small: 4 trees of 512 leaf cards
 /// (4,096 leaf triangles, each tree one object), framed by the loader's camera, 64 lights.
 /// Built over tiles or a thread per triangle, every byte and fragment the same, in the
-/// visibility technique and the forward pass.
+/// visibility technique (also at 8 samples) and the forward pass. The tiles' build tests
+/// every pixel of a tile, the other only its triangle's box: the boxes hold every pixel
+/// whose centre (or, at 8 samples, some sample) a leaf covers.
 #[test]
 fn the_forest_is_the_same_from_either_build() {
     let (mut forest, _) = ml_cpu::gltf_scene::from_bytes(&ml_cpu::forest::forest_glb(4, 512, "BLEND"), None).expect("a good file");
@@ -570,23 +572,22 @@ fn the_forest_is_the_same_from_either_build() {
         .collect();
     forest.cones.clear();
     forest.light_motion = 0.0;
-    let with = |technique, tiled_up_to| RenderSettings {
+    let with = |(technique, antialiasing), tiled_up_to| RenderSettings {
         shading: ShadingModel::Pbr,
         transparency: Some(TransparencySettings { tiled_up_to, ..TransparencySettings::default() }),
+        antialiasing,
         ..settings(technique)
     };
-    for technique in [Technique::Visibility, Technique::Forward] {
-        let out = common::render_each(&forest, &[with(technique, 0), with(technique, u32::MAX)]);
+    let runs =
+        [(Technique::Visibility, Antialiasing::Off), (Technique::Visibility, Antialiasing::X8), (Technique::Forward, Antialiasing::Off)];
+    for run in runs {
+        let out = common::render_each(&forest, &[with(run, 0), with(run, u32::MAX)]);
         let (threads, tiles) = (stats(&out[0]), stats(&out[1]));
-        println!(
-            "{} forest: {} fragments, {} pixels differ",
-            technique.name(),
-            threads.fragments,
-            common::pixels_beyond(&out[0], &out[1], 0)
-        );
-        assert!(threads.fragments > u64::from(W * H) / 4, "{}: {threads:?}", technique.name());
-        assert_eq!(threads.fragments, tiles.fragments, "{}", technique.name());
-        assert!(out[0].rgba == out[1].rgba, "{}: the builds' images differ", technique.name());
+        let name = format!("{} at {} samples", run.0.name(), run.1.samples());
+        println!("{name} forest: {} fragments, {} pixels differ", threads.fragments, common::pixels_beyond(&out[0], &out[1], 0));
+        assert!(threads.fragments > u64::from(W * H) / 4, "{name}: {threads:?}");
+        assert_eq!(threads.fragments, tiles.fragments, "{name}");
+        assert!(out[0].rgba == out[1].rgba, "{name}: the builds' images differ");
     }
 }
 
