@@ -171,10 +171,10 @@ void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
     }
     // The pixels whose centre p + 0.5 lies within [lo, hi] — with anti-aliasing, some
     // sample of theirs: within half a pixel of the centre — widened by an eighth of a pixel for
-    // the projection's rounding (a thousand times its error at the image's coordinates; a
-    // corner far outside, where the error grows, lies beyond the clamp). Clamped before the
-    // conversion (a crossing's projection may be far outside). A box a pixel wider each way
-    // than this walked four times the pixels of a small triangle's.
+    // the projection's rounding (float rounding at coordinates up to 16,384 pixels is under a
+    // five-hundredth of one; a corner far outside, where it grows, lies beyond the clamp).
+    // Clamped before the conversion (a crossing's projection may be far outside). A box a
+    // pixel wider each way than this walked four times the pixels of a small triangle's.
     float margin = 0.125;
     if (VISIBILITY_SAMPLES != 1u) {
         margin += 0.5;

@@ -9,7 +9,8 @@
 // and a head per pixel. A fragment that finds the pool full is dropped and counted. A pixel
 // blends its LAYER_KEEP nearest layers exactly, in order of depth (ties by object, then by
 // their light); farther ones are merged into one layer behind them (coverage 1 − Π(1 − α),
-// α-weighted colour) and the pixel is counted. ml-cpu transparency.rs is the same rule on the CPU.
+// α-weighted colour) and the pixel is counted. ml-cpu transparency.rs is the same rule on
+// the CPU.
 //
 // With anti-aliasing (VISIBILITY_SAMPLES > 1) a node also keeps the samples of its pixel its
 // fragment covers in front of the opaque surface there; it is shaded where the opaque

@@ -7,12 +7,12 @@
 //! The order is the layers' depth, ties broken by their ids (the object), then by the layers
 //! themselves (colour, coverage, what they let through), so the result does not depend on the
 //! order in which the surfaces were listed or drawn: layers equal in all of that blend the same
-//! either way. A pixel
-//! keeps at most `keep` layers exactly, the nearest; the farther ones are merged into one
-//! layer behind those, which lets `Π(1 − αᵢ + αᵢ·tᵢ)` of what lies behind through and whose
-//! colour is their weighted mean (weights αᵢ·(1 − the least channel of tᵢ): a layer's share
-//! that does not let light through). The merge is order-independent too, exact where it holds
-//! one layer and an approximation beyond, so a renderer counts the pixels it merged.
+//! either way. A pixel keeps at most `keep` layers exactly, the nearest; the farther ones are
+//! merged into one layer behind those, which lets `Π(1 − αᵢ + αᵢ·tᵢ)` of what lies behind
+//! through and whose colour is their weighted mean (weights αᵢ·(1 − the least channel of tᵢ): a
+//! layer's share that does not let light through). The merge is order-independent too, exact
+//! where it holds one layer and an approximation beyond, so a renderer counts the pixels it
+//! merged.
 
 use crate::material::Material;
 use crate::mesh::MeshKind;
