@@ -31,6 +31,12 @@
 #define LAYER_BINDING 14
 #include "transparency/layers.glsl"
 #include "common/opaque_depth.glsl"
+#ifdef OPAQUE_DEPTH_BUFFER
+// The visibility raster's depth pyramid, made after its early phase: no nearer than the
+// opaque depth the build tests against (the late phase only brings surfaces nearer).
+layout(std430, set = 0, binding = 17) readonly buffer DepthPyramidBuffer { float depth_pyramid[]; };
+#include "visibility/depth_pyramid_test.glsl"
+#endif
 
 // The transparent objects' meshes one after another (gpu_mesh.rs: 12 floats a vertex, position, normal, uv,
 // tangent; three indices a triangle, each from its mesh's first vertex), and this frame's
@@ -182,6 +188,20 @@ void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
     lo = clamp(ceil(lo - 0.5 - margin), vec2(0.0), size);
     hi = clamp(floor(hi - 0.5 + margin), vec2(-1.0), size - 1.0);
     box = ivec4(ivec2(lo), ivec2(hi));
+#ifdef OPAQUE_DEPTH_BUFFER
+    // A triangle wholly in front of the eye whose nearest corner lies behind the farthest
+    // opaque depth over its box leaves no fragment: its box is emptied, and no build walks
+    // it (a dense crown's cores hide most of its leaves). Its fragments' depths lie between
+    // its corners' up to their rounding, which the margin of 2^-20 covers.
+    if (all(greaterThanEqual(vec3(clip[0].z, clip[1].z, clip[2].z), vec3(0.0))) && all(greaterThan(tri_w[slot], vec3(0.0)))
+        && all(lessThanEqual(box.xy, box.zw))) {
+        float nearest = min(clip[0].z / clip[0].w, min(clip[1].z / clip[1].w, clip[2].z / clip[2].w));
+        uvec2 image = frame.viewport.xy;
+        if (nearest - 1.0 / 1048576.0 > pyramid_farthest(image, pyramid_levels(image), box.xy, box.zw)) {
+            box = ivec4(0, 0, -1, -1);
+        }
+    }
+#endif
 }
 
 // Whether the points where an edge function (coefficients `c`) is 0 belong to this triangle:
@@ -261,6 +281,19 @@ bool samples_outside(uint i, vec3 q, vec2 to_ndc) {
     return false;
 }
 
+// Whether a fragment of alpha 1 at `depth` lies on the opaque surface at depth `opaque`: the
+// visibility raster drew this point as the triangle's core (common.glsl BLENDED_CORES), at
+// the depth its snapped corners give, which may lie a little behind this one. Within a
+// thousandth of the distance (depth's 1 − d is about near / distance), far more than the
+// snapping moves a surface even at a grazing angle. Leaving such a fragment out only
+// matters where the core was not drawn — where the two filters' rounding of the alpha
+// texture's coordinates disagree on an alpha of exactly 1, and then only in front of an
+// opaque surface that close behind; keeping one costs a layer that blends the core's own
+// colour over it.
+bool on_core(float depth, float opaque) {
+    return depth >= opaque - (1.0 - opaque) * (1.0 / 1024.0);
+}
+
 // Whether triangle `i` leaves a fragment at pixel `p`: the samples it covers in front of the
 // opaque surface there (`covered`, a bit each; without anti-aliasing, bit 0: the centre, in
 // front of `opaque`), and at the point the pixel shades it (`q`: the centre, or with
@@ -295,6 +328,12 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
     alpha = tri_alpha[i];
     if ((tri_alpha_texture[i].x & OBJECT_ALPHA_TEXTURE) != 0u) {
         alpha *= texture_alpha(tri_alpha_texture[i], w.x * tri_uv[i][0] + w.y * tri_uv[i][1] + w.z * tri_uv[i][2]);
+    }
+    // (Nested: the build's reflection evaluates no `&&` of two constants.)
+    if (BLENDED_CORES) {
+        if (VISIBILITY_SAMPLES == 1u && alpha >= 1.0 && (tri_alpha_texture[i].x & OBJECT_CORE) != 0u && on_core(depth, opaque)) {
+            return false;
+        }
     }
     return alpha > 0.0;
 }

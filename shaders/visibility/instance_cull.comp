@@ -7,7 +7,8 @@
 
 layout(local_size_x = 64) in;
 
-// Transparent objects are blended in layers (transparency/layers.glsl), not drawn here.
+// Transparent objects are blended in layers (transparency/layers.glsl), not drawn here —
+// but for their cores (BLENDED_CORES).
 layout(constant_id = 20) const bool SKIP_BLENDED = false;
 
 #include "visibility/meshlet_cull.glsl"
@@ -27,7 +28,8 @@ void main() {
         return;
     }
     atomicAdd(counters.tested.z, 1u);
-    if (SKIP_BLENDED && (objects[i].alpha_texture.x & OBJECT_BLENDED) != 0u) {
+    uint flags = objects[i].alpha_texture.x;
+    if (SKIP_BLENDED && (flags & OBJECT_BLENDED) != 0u && !(BLENDED_CORES && (flags & OBJECT_CORE) != 0u)) {
         return;
     }
     vec4 b = instances[i].bounds;

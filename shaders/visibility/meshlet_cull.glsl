@@ -6,7 +6,6 @@
 #ifndef MANYLIGHTS_MESHLET_CULL_GLSL
 #define MANYLIGHTS_MESHLET_CULL_GLSL
 
-#include "visibility/depth_pyramid.glsl"
 
 FRAME_BLOCK(0);
 layout(std430, set = 0, binding = 1) readonly buffer InstanceBuffer { Instance instances[]; };
@@ -24,6 +23,7 @@ layout(std430, set = 0, binding = 6) buffer DrawSlotBuffer { uvec4 draw_slots[];
 layout(std430, set = 0, binding = 7) buffer MeshletVisibilityBuffer { uint meshlet_visible[]; };
 // Farthest depth over 2^(level+1) pixels a side (depth_pyramid.glsl); the late phase's test.
 layout(std430, set = 0, binding = 8) readonly buffer DepthPyramidBuffer { float depth_pyramid[]; };
+#include "visibility/depth_pyramid_test.glsl"
 layout(std430, set = 0, binding = 9) readonly buffer MeshletVertexBuffer { uint meshlet_vertices[]; };
 layout(std430, set = 0, binding = 10) readonly buffer MeshletTriangleBuffer { uint meshlet_triangles[]; };
 layout(std430, set = 0, binding = 11) readonly buffer VertexBuffer { float vertex_data[]; };
@@ -92,21 +92,7 @@ bool sphere_occluded(vec3 c, float r) {
     vec2 size = vec2(frame.viewport.xy);
     ivec2 p0 = clamp(ivec2(floor((lo * 0.5 + 0.5) * size)), ivec2(0), ivec2(size) - 1);
     ivec2 p1 = clamp(ivec2(floor((hi * 0.5 + 0.5) * size)), ivec2(0), ivec2(size) - 1);
-    // Level L's texels cover 2^(L+1) pixels a side: at the level where the rectangle spans
-    // at most 2 texels each way.
-    ivec2 span = p1 - p0;
-    int level = clamp(findMSB(max(span.x, span.y)), 0, int(opaque_uniform(cull.mode.z)) - 1);
-    uvec2 image = frame.viewport.xy;
-    uvec2 texels = pyramid_level_size(image, level);
-    uint base = pyramid_level_offset(image, level);
-    uvec2 t0 = uvec2(p0) >> uint(level + 1), t1 = min(uvec2(p1) >> uint(level + 1), texels - 1u);
-    float farthest = 0.0;
-    for (uint y = t0.y; y <= t1.y; y++) {
-        for (uint x = t0.x; x <= t1.x; x++) {
-            farthest = max(farthest, depth_pyramid[base + y * texels.x + x]);
-        }
-    }
-    return depth > farthest;
+    return depth > pyramid_farthest(frame.viewport.xy, int(opaque_uniform(cull.mode.z)), p0, p1);
 }
 
 #endif

@@ -456,8 +456,8 @@ void main() {
         load_corner_uvs(m, d.y);
         SurfaceTest s = no_surface_test();
         s.masked = true;
-        s.alpha = objects[d.y].alpha;
         s.alpha_texture = objects[d.y].alpha_texture;
+        s.alpha = raster_alpha(objects[d.y].alpha, s.alpha_texture.x);
         draw_masked_meshlet(m, d, culling, flags, s, triangles, pixels);
     } else
 #endif

@@ -131,7 +131,8 @@ SurfaceTest large_surface(uint at, uint object) {
     SurfaceTest s = no_surface_test();
     if (object != NOT_MASKED) {
         vec4 uv = large_triangles[at].surface_uv[0];
-        s = masked_surface(objects[object].alpha, objects[object].alpha_texture, large_triangles[at].surface_clip[0],
+        uvec4 alpha_texture = objects[object].alpha_texture;
+        s = masked_surface(raster_alpha(objects[object].alpha, alpha_texture.x), alpha_texture, large_triangles[at].surface_clip[0],
                            large_triangles[at].surface_clip[1], large_triangles[at].surface_clip[2], uv.xy, uv.zw,
                            large_triangles[at].surface_uv[1].xy);
     }

@@ -24,7 +24,8 @@ bool side_drawn() {
 
 // Whether the point at texture coordinates `uv` is there (its alpha mask keeps it).
 bool point_there(vec2 uv) {
-    return alpha_kept(objects[in_object].alpha, objects[in_object].alpha_texture, uv);
+    uvec4 alpha_texture = objects[in_object].alpha_texture;
+    return alpha_kept(raster_alpha(objects[in_object].alpha, alpha_texture.x), alpha_texture, uv);
 }
 
 bool surface_there() {

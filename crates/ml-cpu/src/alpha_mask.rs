@@ -22,8 +22,8 @@
 //! only points near the shape's edge are filtered.
 
 use crate::gpu_types::{
-    OBJECT_ALPHA_BLOCK_SHIFT, OBJECT_ALPHA_NEAREST, OBJECT_ALPHA_TEXTURE, OBJECT_ALPHA_WRAP_SHIFT, OBJECT_BLENDED, OBJECT_DOUBLE_SIDED,
-    OBJECT_MASKED,
+    OBJECT_ALPHA_BLOCK_SHIFT, OBJECT_ALPHA_NEAREST, OBJECT_ALPHA_TEXTURE, OBJECT_ALPHA_WRAP_SHIFT, OBJECT_BLENDED, OBJECT_CORE,
+    OBJECT_DOUBLE_SIDED, OBJECT_MASKED,
 };
 use crate::scene::{Object, Scene};
 use crate::textures::{Filter, TextureImage, Wrap};
@@ -103,6 +103,9 @@ impl AlphaMasks {
         }
         if x.transparent() {
             flags |= OBJECT_BLENDED;
+        }
+        if x.has_core() {
+            flags |= OBJECT_CORE;
         }
         let Some(cutoff) = x.alpha_mode.cutoff() else {
             // OPAQUE: the alpha is ignored (a transmitting surface's layers cover their pixel).
@@ -371,6 +374,15 @@ mod tests {
             OBJECT_BLENDED | OBJECT_MASKED
         );
         assert_eq!(masks.object_fields(&scene.objects[3], &scene.textures), ([0.5, 0.8, 0.0, 0.0], [OBJECT_MASKED, 0, 0, 0]));
+        // A core (points of alpha 1 drawn as opaque) only where its alpha can reach 1 and it
+        // transmits nothing.
+        let core = |o: &Object| masks.object_fields(o, &scene.textures).1[0] & OBJECT_CORE != 0;
+        let mut blended = scene.objects[2];
+        assert!(!core(&blended), "alpha factor 0.8");
+        blended.extras.base_alpha = 1.0;
+        assert!(core(&blended));
+        blended.extras.lobes.transmission = 0.5;
+        assert!(!core(&blended), "transmitting");
         // Nothing masked: one word the shaders never read.
         scene.objects.truncate(2);
         scene.objects.remove(0);

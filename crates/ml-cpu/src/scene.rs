@@ -175,6 +175,14 @@ impl MaterialExtras {
     pub fn transparent(&self) -> bool {
         self.alpha_mode == AlphaMode::Blend || self.lobes.transmission > 0.0
     }
+
+    /// Whether its points of alpha 1 let nothing through: BLEND transmitting nothing, its
+    /// alpha factor 1 (a point's alpha is the factor times its texture's).
+    /// Blending such a point hides what lies behind it, so a renderer may draw those points as
+    /// opaque (its "core") and blend only the rest.
+    pub fn has_core(&self) -> bool {
+        self.alpha_mode == AlphaMode::Blend && self.lobes.transmission == 0.0 && self.base_alpha >= 1.0
+    }
 }
 
 /// glTF's alpha modes: what a surface's alpha does to its pixels.

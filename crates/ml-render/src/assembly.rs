@@ -24,6 +24,7 @@ use crate::shadows::stores::SharedShadows;
 use crate::shadows::sun_shadow::SunShadowPass;
 use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view, shadow_settings};
 use crate::specialization::Constants;
+use crate::technique::Geometry;
 use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_gather, visibility_lighting, visibility_raster};
@@ -84,6 +85,7 @@ impl RenderSettings {
             count_rays: self.light_stats && shadow_settings::traces_rays(lighting.as_slice()),
             lighting,
             transparency: self.blends_layers(),
+            blended_cores: self.blends_layers() && self.technique.geometry() == Geometry::Meshlets && self.antialiasing.samples() == 1,
             antialiasing: self.antialiasing,
             background: self.background,
         }
@@ -204,13 +206,16 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::GBuffer => Box::new(gbuffer::GBuffer::new(ctx, a.scene, raster)?),
         PassKind::ComputeLighting => Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?),
         PassKind::MeshletCull(phase) => {
-            Box::new(meshlet_cull::MeshletCull::new(ctx, shared()?, phase, (s.culling, s.raster, a.shading.transparency, aa))?)
+            let layers = (a.shading.transparency, a.shading.cores_constant());
+            Box::new(meshlet_cull::MeshletCull::new(ctx, shared()?, phase, (s.culling, s.raster, layers, aa))?)
         }
         PassKind::TriangleRasterLarge(phase) => {
-            Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, (s.raster, aa))?)
+            let cores = a.shading.cores_constant();
+            Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, (s.raster, aa, cores))?)
         }
         PassKind::VisibilityRaster(phase) => {
-            Box::new(visibility_raster::VisibilityRaster::new(ctx, shared()?, (phase, atomic, aa), a.depth_format)?)
+            let cores = a.shading.cores_constant();
+            Box::new(visibility_raster::VisibilityRaster::new(ctx, shared()?, (phase, atomic, aa, cores), a.depth_format)?)
         }
         PassKind::VisibilityGather(phase) => Box::new(visibility_gather::VisibilityGather::new(ctx, phase, aa)?),
         PassKind::DepthPyramid => Box::new(depth_pyramid::DepthPyramid::new(ctx, compute, aa)?),

@@ -20,6 +20,9 @@ pub struct UnknownConstant {
     pub stages: Vec<&'static str>,
 }
 
+/// A specialization constant by name, and its value.
+pub type Constant = (&'static str, u32);
+
 /// Per stage of one pipeline, the (id, value) pairs of the `constants` (name, value) that it
 /// declares; a name none declares is an error.
 pub fn resolve<const N: usize>(stages: [&Shader; N], constants: &[(&str, u32)]) -> Result<[Vec<(u32, u32)>; N], UnknownConstant> {

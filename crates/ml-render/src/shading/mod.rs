@@ -12,7 +12,7 @@ pub mod mesh_raster;
 use crate::antialiasing::Antialiasing;
 use crate::background::Background;
 use crate::debug_view::{DebugView, Drawn, ViewSpec};
-use crate::specialization::Constants;
+use crate::specialization::{Constant, Constants};
 use crate::targets::GBufferKind;
 use ml_cpu::scene::Scene;
 use ml_cpu::shading_model::ShadingModel;
@@ -51,6 +51,9 @@ pub struct Shading {
     pub lighting: Constants,
     /// Transparent objects are blended in per-pixel layers (the opaque passes skip them).
     pub transparency: bool,
+    /// The visibility rasters draw transparent objects' points of alpha 1 as opaque and the
+    /// layers hold the rest (common.glsl BLENDED_CORES): layers, meshlets, one sample a pixel.
+    pub blended_cores: bool,
     /// The compute lightings count the shadow rays they trace (`--light-stats` with rays).
     pub count_rays: bool,
     /// Coverage samples per pixel: the mesh techniques draw into multisampled attachments and
@@ -91,6 +94,12 @@ impl Shading {
     /// lighting them (the G-buffer's).
     pub fn surface_constants(&self) -> &[(&'static str, u32)] {
         self.surface.as_slice()
+    }
+
+    /// `BLENDED_CORES` for the passes that draw or leave out transparent objects' cores,
+    /// where they are drawn (else nothing: the constant's default is off).
+    pub fn cores_constant(&self) -> Option<Constant> {
+        self.blended_cores.then_some(("BLENDED_CORES", 1))
     }
 
     /// The value of constant `name` for these settings, where a feature sets it.

@@ -17,7 +17,7 @@ use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{BufferName, Use, LIGHT_LISTS, VISIBILITY_DEPTH};
+use crate::sync::{BufferName, Use, DEPTH_PYRAMID, LIGHT_LISTS, VISIBILITY_DEPTH};
 use ml_cpu::gpu_types::LayerObject;
 use ml_cpu::scene::Object;
 use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
@@ -97,6 +97,7 @@ impl TransparentBuild {
         let layouts = [scene.textures.set_layout.raw, scene.object_textures.set_layout, mesh_sets.layout.raw];
         // From the compute raster's buffer, the fragments keep the samples they cover.
         let mut constants = shading.surface_constants().to_vec();
+        constants.extend(shading.cores_constant());
         if depth_buffer {
             constants.push(shading.antialiasing.constant());
         }
@@ -409,6 +410,7 @@ impl Pass for TransparentBuild {
         let mut uses: Vec<Use> = LAYER_BUFFERS.iter().map(|&name| Use::buffer(name, (stages, access))).collect();
         if self.depth_buffer {
             uses.push(Use::buffer(VISIBILITY_DEPTH, (shaders, vk::AccessFlags::SHADER_READ)));
+            uses.push(Use::buffer(DEPTH_PYRAMID, (shaders, vk::AccessFlags::SHADER_READ)));
         }
         // Bound with the rest of set 0 (the surface code reads no light).
         uses.push(Use::buffer(LIGHT_LISTS[0], (shaders, vk::AccessFlags::SHADER_READ)));

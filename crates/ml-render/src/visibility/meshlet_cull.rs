@@ -21,7 +21,7 @@ use crate::pass::{FrameWork, Pass, Prepare, Recording, SlotReport};
 use crate::plan::Phase;
 use crate::read_back::HostRead;
 use crate::report::{FeatureStats, FrameStats};
-use crate::specialization::compute_pipeline;
+use crate::specialization::{compute_pipeline, Constant};
 use crate::sync::{Use, DEPTH_PYRAMID, MESHLET_VISIBILITY, VISIBILITY_DEPTH};
 use crate::targets::depth_pyramid_shape;
 use crate::technique::{LargeTriangles, Raster};
@@ -47,12 +47,13 @@ pub struct MeshletCull {
 }
 
 impl MeshletCull {
-    /// `layers`: the transparent objects are blended in layers, not drawn into the buffer.
+    /// `layers`: the transparent objects are blended in layers, not drawn into the buffer —
+    /// but for their cores where `cores` (Shading::cores_constant) says so.
     pub fn new(
         ctx: &Context,
         scene: SharedMeshletScene,
         phase: Phase,
-        (culling, raster, layers, antialiasing): (bool, Raster, bool, Antialiasing),
+        (culling, raster, (layers, cores), antialiasing): (bool, Raster, (bool, Option<Constant>), Antialiasing),
     ) -> Result<MeshletCull, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
         // Scenes with masked objects get the compute raster that draws their pixels from
@@ -78,7 +79,7 @@ impl MeshletCull {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             if phase == Phase::Early {
-                let skip = [("SKIP_BLENDED", u32::from(layers))];
+                let skip: Vec<_> = [("SKIP_BLENDED", u32::from(layers))].into_iter().chain(cores).collect();
                 p.instance_pipeline = compute_pipeline(ctx, &ml_shaders::INSTANCE_CULL_COMP, p.pipeline_layout, &skip)?;
             }
             p.meshlet_pipeline = compute_pipeline(ctx, &ml_shaders::MESHLET_CULL_COMP, p.pipeline_layout, &[])?;
@@ -89,7 +90,7 @@ impl MeshletCull {
                 Raster::Hardware => vec![antialiasing.constant()],
                 Raster::Compute { .. } => {
                     let [tests, masks] = p.scene.borrow().geometry.surface_constants();
-                    vec![tests, masks, antialiasing.constant()]
+                    [tests, masks, antialiasing.constant()].into_iter().chain(cores).collect()
                 }
             };
             p.triangle_pipeline = compute_pipeline(ctx, triangles, p.pipeline_layout, &constants)?;

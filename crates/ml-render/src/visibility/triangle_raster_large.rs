@@ -10,7 +10,7 @@ use crate::frame_resources::FrameResources;
 use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::plan::Phase;
-use crate::specialization::compute_pipeline;
+use crate::specialization::{compute_pipeline, Constant};
 use crate::sync::{Use, VISIBILITY_DEPTH};
 use crate::technique::Raster;
 use crate::visibility::meshlet_cull::cull_push;
@@ -28,11 +28,12 @@ pub struct TriangleRasterLarge {
 }
 
 impl TriangleRasterLarge {
+    /// `cores`: Shading::cores_constant.
     pub fn new(
         ctx: &Context,
         scene: SharedMeshletScene,
         phase: Phase,
-        (raster, antialiasing): (Raster, Antialiasing),
+        (raster, antialiasing, cores): (Raster, Antialiasing, Option<Constant>),
     ) -> Result<TriangleRasterLarge, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
         let shader = &ml_shaders::TRIANGLE_RASTER_LARGE_COMP;
@@ -48,7 +49,8 @@ impl TriangleRasterLarge {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             let [tests, masks] = p.scene.borrow().geometry.surface_constants();
-            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &[tests, masks, antialiasing.constant()])?;
+            let constants: Vec<_> = [tests, masks, antialiasing.constant()].into_iter().chain(cores).collect();
+            p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &constants)?;
             Ok(())
         })
     }

@@ -14,7 +14,7 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::pass::{Pass, Recording};
 use crate::plan::Phase;
 use crate::render_pass;
-use crate::specialization;
+use crate::specialization::{self, Constant};
 use crate::sync::{Use, VISIBILITY_DEPTH};
 use crate::visibility::meshlet_scene::{SharedMeshletScene, COMPACTED_INDICES, CULL_COUNTERS, DRAW_SLOTS, TRIANGLE_IDS};
 use ml_cpu::gpu_types::{CullCounters, DrawIndexedCommand};
@@ -34,11 +34,12 @@ pub struct VisibilityRaster {
 
 impl VisibilityRaster {
     /// The pass of `phase`; `atomic`: the compute raster's hardware half; either draws
-    /// `antialiasing`'s samples.
+    /// `antialiasing`'s samples, and transparent objects' cores where `cores`
+    /// (Shading::cores_constant) says so.
     pub fn new(
         ctx: &Context,
         scene: SharedMeshletScene,
-        (phase, atomic, antialiasing): (Phase, bool, Antialiasing),
+        (phase, atomic, antialiasing, cores): (Phase, bool, Antialiasing, Option<Constant>),
         depth_format: vk::Format,
     ) -> Result<VisibilityRaster, VkError> {
         // Masked or double-sided objects: both sides drawn, the fragment tests its surface.
@@ -70,7 +71,9 @@ impl VisibilityRaster {
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::FRAGMENT).size(16)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             let samples = antialiasing.sample_count();
-            let [vertex_constants, fragment_constants] = specialization::resolve([vert, frag], &[antialiasing.constant()])?;
+            // Cores are tested where surfaces are (transparent objects are masked).
+            let constants: Vec<_> = [antialiasing.constant()].into_iter().chain(cores.filter(|_| surface_tests)).collect();
+            let [vertex_constants, fragment_constants] = specialization::resolve([vert, frag], &constants)?;
             // The G-buffer pass's state: back faces culled (counter-clockwise fronts) — or, with
             // surface tests, by the fragment shader —, depth LESS (the atomic min is the test
             // of the compute raster's half).
