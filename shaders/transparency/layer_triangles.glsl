@@ -239,6 +239,22 @@ bool layer_point(uint i, vec3 q, out vec3 w, out float depth) {
     return depth >= 0.0 && depth <= 1.0;
 }
 
+// Where a core's layers end in front of the opaque depth `opaque` (common.glsl
+// BLENDED_CORES): a fragment of alpha 1 at or behind it lies on the opaque surface — the
+// visibility raster drew the point as its triangle's core, at the depth its snapped corners
+// give, which may lie a little behind the layer's. A thousandth of the distance (depth's
+// 1 − d is about near / distance) is far more than the snapping moves a surface even at a
+// grazing angle. Leaving such a fragment out only matters where the core was not drawn —
+// where the two filters' rounding of the alpha texture's coordinates disagree on an alpha
+// of exactly 1, and then only in front of an opaque surface that close behind; keeping one
+// costs a layer that blends the core's own colour over it. With samples, whose layers take
+// their alpha at the pixel and the raster per sample, a core's sample is left out whatever
+// the pixel's alpha: the samples where the raster found alpha 1 are opaque, the layer holds
+// the others.
+float core_depth(float opaque) {
+    return opaque - (1.0 - opaque) * (1.0 / 1024.0);
+}
+
 // Which samples of pixel `p` (centre `q`, x and y in NDC) triangle `i` covers in front of the
 // opaque samples there (a bit each): layer_point's test, the triangle read from shared memory
 // once for all of them, each edge's tie rule decided once, and the depth a/b of the edge
@@ -249,6 +265,7 @@ uint samples_in_front(uint i, ivec2 p, vec2 to_ndc) {
     vec3 z = tri_z[i], w = tri_w[i];
     // edge_owns' rule where an edge function is 0, per edge.
     bvec3 ties = bvec3(edge_owns_ties(r0.xy), edge_owns_ties(r1.xy), edge_owns_ties(r2.xy));
+    bool core = BLENDED_CORES && (tri_alpha_texture[i].x & OBJECT_CORE) != 0u;
     uint covered = 0u;
     for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         vec3 q = vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0);
@@ -256,7 +273,11 @@ uint samples_in_front(uint i, ivec2 p, vec2 to_ndc) {
         bvec3 pos = greaterThan(e, vec3(0.0)), zero = equal(e, vec3(0.0));
         bool inside = (pos.x || (zero.x && ties.x)) && (pos.y || (zero.y && ties.y)) && (pos.z || (zero.z && ties.z));
         float a = dot(e, z), b = dot(e, w);
-        if (inside && b > 0.0 && a >= 0.0 && a <= b && a < opaque_depth_of_sample(p, k) * b) {
+        float opaque = opaque_depth_of_sample(p, k);
+        if (core) {
+            opaque = core_depth(opaque);
+        }
+        if (inside && b > 0.0 && a >= 0.0 && a <= b && a < opaque * b) {
             covered |= 1u << k;
         }
     }
@@ -279,19 +300,6 @@ bool samples_outside(uint i, vec3 q, vec2 to_ndc) {
         }
     }
     return false;
-}
-
-// Whether a fragment of alpha 1 at `depth` lies on the opaque surface at depth `opaque`: the
-// visibility raster drew this point as the triangle's core (common.glsl BLENDED_CORES), at
-// the depth its snapped corners give, which may lie a little behind this one. Within a
-// thousandth of the distance (depth's 1 − d is about near / distance), far more than the
-// snapping moves a surface even at a grazing angle. Leaving such a fragment out only
-// matters where the core was not drawn — where the two filters' rounding of the alpha
-// texture's coordinates disagree on an alpha of exactly 1, and then only in front of an
-// opaque surface that close behind; keeping one costs a layer that blends the core's own
-// colour over it.
-bool on_core(float depth, float opaque) {
-    return depth >= opaque - (1.0 - opaque) * (1.0 / 1024.0);
 }
 
 // Whether triangle `i` leaves a fragment at pixel `p`: the samples it covers in front of the
@@ -331,7 +339,7 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
     }
     // (Nested: the build's reflection evaluates no `&&` of two constants.)
     if (BLENDED_CORES) {
-        if (VISIBILITY_SAMPLES == 1u && alpha >= 1.0 && (tri_alpha_texture[i].x & OBJECT_CORE) != 0u && on_core(depth, opaque)) {
+        if (VISIBILITY_SAMPLES == 1u && alpha >= 1.0 && (tri_alpha_texture[i].x & OBJECT_CORE) != 0u && depth >= core_depth(opaque)) {
             return false;
         }
     }

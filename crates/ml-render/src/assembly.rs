@@ -85,7 +85,7 @@ impl RenderSettings {
             count_rays: self.light_stats && shadow_settings::traces_rays(lighting.as_slice()),
             lighting,
             transparency: self.blends_layers(),
-            blended_cores: self.blends_layers() && self.technique.geometry() == Geometry::Meshlets && self.antialiasing.samples() == 1,
+            blended_cores: self.blends_layers() && self.technique.geometry() == Geometry::Meshlets,
             antialiasing: self.antialiasing,
             background: self.background,
         }

@@ -168,6 +168,21 @@ fn samples_cut_the_error_against_the_supersampled_reference() {
     }
 }
 
+/// Soft-edged foliage (the BLEND forest, its leaves' alpha 0 or 1 but at the texels' edges):
+/// the raster draws each sample where the alpha is 1 as opaque (the leaves' cores) and the
+/// layers only the rest, as a supersampled render, where each sample has its own alpha, does.
+/// Measured on lavapipe, 8 samples leave 0.34 of the error without them; taking the layers'
+/// alpha once a pixel for all its samples left 0.59.
+#[test]
+fn blended_foliage_s_samples_take_their_own_alpha() {
+    let forest = crate::transparency::blend_forest();
+    // One node a pixel: the 8×8 reference's pool fits a storage buffer lavapipe binds.
+    let budget = Some(TransparencySettings { budget: 1, ..TransparencySettings::default() });
+    let base = RenderSettings { shading: ShadingModel::Pbr, transparency: budget, ..visibility(160, 120, Antialiasing::Off) };
+    let (off, aa, _) = errors("BLEND forest", &forest, base, &[RenderSettings { antialiasing: Antialiasing::X8, ..base }]);
+    assert!(aa[0] <= 0.45 * off, "BLEND forest: {:.3} with 8 samples against {off:.3} without", aa[0]);
+}
+
 #[test]
 fn samples_change_no_pixel_they_must_not() {
     // The marks' pass runs where the settings leave it on (their default).

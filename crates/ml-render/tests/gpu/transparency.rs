@@ -554,14 +554,7 @@ fn the_tiles_build_and_the_per_triangle_build_agree() {
 
 /// The BLEND forest the benchmarks render (`ml_cpu::forest`), small: 4 trees of 512 leaf cards
 /// (4,096 leaf triangles, each tree one object), framed by the loader's camera, 64 lights.
-/// Built over tiles or a thread per triangle, every byte and fragment the same, in the
-/// visibility technique (also at 8 samples) and the forward pass. The tiles' build tests
-/// every pixel of a tile, the other only its triangle's box: the boxes hold every pixel
-/// whose centre (or, at 8 samples, some sample) a leaf covers. Without samples the
-/// visibility raster draws the leaves' cores (their alpha is 0 or 1 but at the texels'
-/// edges), so few fragments are left to its layers; its image is the forward pass's.
-#[test]
-fn the_forest_is_the_same_from_either_build() {
+pub fn blend_forest() -> Scene {
     let (mut forest, _) = ml_cpu::gltf_scene::from_bytes(&ml_cpu::forest::forest_glb(4, 512, "BLEND"), None).expect("a good file");
     // 4×4×4 lights through the forest's box, each reaching a quarter of its diagonal.
     let (lo, hi) = forest.bounds();
@@ -574,6 +567,18 @@ fn the_forest_is_the_same_from_either_build() {
         .collect();
     forest.cones.clear();
     forest.light_motion = 0.0;
+    forest
+}
+
+/// The forest of `blend_forest`: built over tiles or a thread per triangle, every byte and fragment the same, in the
+/// visibility technique (also at 8 samples) and the forward pass. The tiles' build tests
+/// every pixel of a tile, the other only its triangle's box: the boxes hold every pixel
+/// whose centre (or, at 8 samples, some sample) a leaf covers. The visibility raster draws
+/// the leaves' cores (their alpha is 0 or 1 but at the texels' edges), so few fragments are
+/// left to its layers; without samples its image is the forward pass's.
+#[test]
+fn the_forest_is_the_same_from_either_build() {
+    let forest = blend_forest();
     let with = |(technique, antialiasing), tiled_up_to| RenderSettings {
         shading: ShadingModel::Pbr,
         transparency: Some(TransparencySettings { tiled_up_to, ..TransparencySettings::default() }),
@@ -589,11 +594,11 @@ fn the_forest_is_the_same_from_either_build() {
         let name = format!("{} at {} samples", run.0.name(), run.1.samples());
         println!("{name} forest: {} fragments, {} pixels differ", threads.fragments, common::pixels_beyond(&out[0], &out[1], 0));
         // The cores leave the layers a leaf's edges alone: still fragments to compare.
-        let cores = run == (Technique::Visibility, Antialiasing::Off);
+        let cores = run.0 == Technique::Visibility;
         assert!(threads.fragments > u64::from(W * H) / if cores { 400 } else { 4 }, "{name}: {threads:?}");
         assert_eq!(threads.fragments, tiles.fragments, "{name}");
         assert!(out[0].rgba == out[1].rgba, "{name}: the builds' images differ");
-        if cores {
+        if run == (Technique::Visibility, Antialiasing::Off) {
             let forward = &first[0];
             let beyond = common::pixels_beyond(forward, &out[0], 1);
             println!("{name}: {beyond} pixels beyond 1/255 of forward ({} fragments there)", stats(forward).fragments);
