@@ -259,7 +259,10 @@ float core_depth(float opaque) {
 // opaque samples there (a bit each): layer_point's test, the triangle read from shared memory
 // once for all of them, each edge's tie rule decided once, and the depth a/b of the edge
 // functions' weights compared as a against b (b > 0: in front of the eye) — the anti-aliased
-// build runs it for every pixel its triangles' boxes hold.
+// build runs it for every pixel its triangles' boxes hold. Unrolled (the per-sample values
+// stay in registers): on the H200 the BLEND forest's build at 8 samples took 2.60 ms, 2.70
+// as a loop. Splitting it, to read the opaque samples only where a sample lies in front of
+// the depth pyramid's farthest over the pixel, made it 3.59.
 uint samples_in_front(uint i, ivec2 p, vec2 to_ndc) {
     vec3 r0 = tri_edges[i][0], r1 = tri_edges[i][1], r2 = tri_edges[i][2];
     vec3 z = tri_z[i], w = tri_w[i];
@@ -267,7 +270,7 @@ uint samples_in_front(uint i, ivec2 p, vec2 to_ndc) {
     bvec3 ties = bvec3(edge_owns_ties(r0.xy), edge_owns_ties(r1.xy), edge_owns_ties(r2.xy));
     bool core = BLENDED_CORES && (tri_alpha_texture[i].x & OBJECT_CORE) != 0u;
     uint covered = 0u;
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+    [[unroll]] for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
         vec3 q = vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0);
         vec3 e = vec3(dot(r0, q), dot(r1, q), dot(r2, q));
         bvec3 pos = greaterThan(e, vec3(0.0)), zero = equal(e, vec3(0.0));
