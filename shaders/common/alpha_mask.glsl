@@ -120,16 +120,6 @@ bool alpha_filtered_kept(vec4 alpha, uvec4 alpha_texture, vec2 uv) {
     return alpha.y * texture_alpha(alpha_texture, uv) >= alpha.x;
 }
 
-// The ObjectData `alpha` the camera's visibility rasters test an object with (`flags`: its
-// alpha_texture.x): a transparent object's core is its points of alpha 1 (common.glsl
-// BLENDED_CORES), so its cutoff there is 1.
-vec4 raster_alpha(vec4 alpha, uint flags) {
-    if (BLENDED_CORES && (flags & OBJECT_CORE) != 0u) {
-        alpha.x = 1.0;
-    }
-    return alpha;
-}
-
 // Whether the point at `uv` of the object with ObjectData `alpha` and `alpha_texture` is there.
 bool alpha_kept(vec4 alpha, uvec4 alpha_texture, vec2 uv) {
     uint verdict = alpha_verdict(alpha, alpha_texture, uv);

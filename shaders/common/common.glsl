@@ -162,18 +162,10 @@ const uint OBJECT_MASKED = 1u;        // alpha-tested (glTF MASK, and BLEND at o
 const uint OBJECT_DOUBLE_SIDED = 2u;  // drawn from both sides, the normal toward the viewer
 const uint OBJECT_BLENDED = 4u;       // transparent: BLEND or transmitting (layers, alpha view)
 const uint OBJECT_ALPHA_TEXTURE = 8u; // its alpha comes from a texture too
-const uint OBJECT_CORE = 16u;         // transparent where its alpha is below 1 only (BLENDED_CORES)
+const uint OBJECT_CORE = 16u;         // transparent where its alpha is below 1 only (blended_cores.glsl)
 const uint OBJECT_ALPHA_WRAP_SHIFT = 8u; // wrap u (2 bits), then wrap v
 const uint OBJECT_ALPHA_NEAREST = 4096u;
 const uint OBJECT_ALPHA_BLOCK_SHIFT = 13u; // log2 of the alpha blocks' side, 4 bits
-
-// Whether the camera's visibility rasters draw the cores of transparent objects (layers on,
-// the meshlet technique): an OBJECT_CORE object's points (or samples) of alpha 1 are drawn as
-// opaque (alpha_mask.glsl raster_alpha) and the layers' builds leave them out
-// (layer_triangles.glsl core_depth). A layer of alpha 1 shows its own colour and hides all
-// behind it, so the picture is the one blending gives; most of a leaf's pixels move from the
-// layers, whose cost follows fragments, to the opaque raster.
-layout(constant_id = 25) const bool BLENDED_CORES = false;
 
 // Per draw, by push constants: the object's index and, again, its material — the forward
 // fragment shaders read it here (reading it from the object buffer made the seed forward

@@ -28,6 +28,7 @@
 #include "common/surface.glsl"
 #define ALPHA_MASK_BINDING 11
 #include "common/alpha_mask.glsl"
+#include "common/blended_cores.glsl"
 #define LAYER_BINDING 14
 #include "transparency/layers.glsl"
 #include "common/opaque_depth.glsl"
@@ -239,10 +240,10 @@ bool layer_point(uint i, vec3 q, out vec3 w, out float depth) {
     return depth >= 0.0 && depth <= 1.0;
 }
 
-// Where a core's layers end in front of the opaque depth `opaque` (common.glsl
-// BLENDED_CORES): a fragment of alpha 1 at or behind it lies on the opaque surface — the
-// visibility raster drew the point as its triangle's core, at the depth its snapped corners
-// give, which may lie a little behind the layer's. A thousandth of the distance (depth's
+// Where a core's layers end in front of the opaque depth `opaque` (blended_cores.glsl): a
+// fragment of alpha 1 at or behind it lies on the opaque surface — the visibility raster
+// drew the point as its triangle's core, at the depth its snapped corners give, which may
+// lie a little behind the layer's. A thousandth of the distance (depth's
 // 1 − d is about near / distance) is far more than the snapping moves a surface even at a
 // grazing angle. Leaving such a fragment out only matters where the core was not drawn —
 // where the two filters' rounding of the alpha texture's coordinates disagree on an alpha

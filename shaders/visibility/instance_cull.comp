@@ -12,6 +12,7 @@ layout(local_size_x = 64) in;
 layout(constant_id = 20) const bool SKIP_BLENDED = false;
 
 #include "visibility/meshlet_cull.glsl"
+#include "common/blended_cores.glsl"
 
 void main() {
     uint i = gl_GlobalInvocationID.x;

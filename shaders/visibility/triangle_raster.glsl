@@ -33,6 +33,7 @@ layout(std430, set = 0, binding = 16) buffer LargeTriangleBuffer { LargeTriangle
 
 #define ALPHA_MASK_BINDING 17
 #include "common/alpha_mask.glsl"
+#include "common/blended_cores.glsl"
 #include "visibility/visibility_polygon.glsl"
 
 const uint ROUTE_NONE = 0u;    // no pixel to draw

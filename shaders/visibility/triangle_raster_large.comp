@@ -20,6 +20,7 @@ layout(push_constant) uniform CullPushBlock { CullPush cull; };
 
 #define ALPHA_MASK_BINDING 6
 #include "common/alpha_mask.glsl"
+#include "common/blended_cores.glsl"
 #include "visibility/visibility_polygon.glsl"
 
 shared uint group_pixels;

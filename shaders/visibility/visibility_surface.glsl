@@ -8,6 +8,9 @@
 #ifndef MANYLIGHTS_VISIBILITY_SURFACE_GLSL
 #define MANYLIGHTS_VISIBILITY_SURFACE_GLSL
 
+// (Declared by both variants: the build's reflection reads no #ifdef.)
+#include "common/blended_cores.glsl"
+
 #ifdef SURFACE_TESTS
 layout(std430, set = 0, binding = 1) readonly buffer ObjectBuffer { ObjectData objects[]; };
 #define ALPHA_MASK_BINDING 7

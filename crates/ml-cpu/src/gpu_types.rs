@@ -208,7 +208,7 @@ pub const OBJECT_BLENDED: u32 = 4;
 /// Its alpha comes from a texture too (else from the factor alone).
 pub const OBJECT_ALPHA_TEXTURE: u32 = 8;
 /// Transparent only where its alpha is below 1 (BLEND, transmitting nothing, factor 1): the
-/// visibility rasters may draw its points of alpha 1 as opaque (common.glsl BLENDED_CORES).
+/// visibility rasters may draw its points of alpha 1 as opaque (blended_cores.glsl).
 pub const OBJECT_CORE: u32 = 16;
 /// The alpha texture's wrap modes (`Wrap` as 0 repeat, 1 mirrored repeat, 2 clamp): u at this
 /// bit, v two bits above; and nearest filtering at `OBJECT_ALPHA_NEAREST`.

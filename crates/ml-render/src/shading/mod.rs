@@ -52,7 +52,7 @@ pub struct Shading {
     /// Transparent objects are blended in per-pixel layers (the opaque passes skip them).
     pub transparency: bool,
     /// The visibility rasters draw transparent objects' points of alpha 1 as opaque and the
-    /// layers hold the rest (common.glsl BLENDED_CORES): layers on, the meshlet technique.
+    /// layers hold the rest (blended_cores.glsl): layers on, the meshlet technique.
     pub blended_cores: bool,
     /// The compute lightings count the shadow rays they trace (`--light-stats` with rays).
     pub count_rays: bool,

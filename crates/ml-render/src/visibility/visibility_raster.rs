@@ -71,8 +71,7 @@ impl VisibilityRaster {
             let push = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::FRAGMENT).size(16)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             let samples = antialiasing.sample_count();
-            // Cores are tested where surfaces are (transparent objects are masked).
-            let constants: Vec<_> = [antialiasing.constant()].into_iter().chain(cores.filter(|_| surface_tests)).collect();
+            let constants: Vec<_> = [antialiasing.constant()].into_iter().chain(cores).collect();
             let [vertex_constants, fragment_constants] = specialization::resolve([vert, frag], &constants)?;
             // The G-buffer pass's state: back faces culled (counter-clockwise fronts) — or, with
             // surface tests, by the fragment shader —, depth LESS (the atomic min is the test
