@@ -243,15 +243,14 @@ bool layer_point(uint i, vec3 q, out vec3 w, out float depth) {
 // Where a core's layers end in front of the opaque depth `opaque` (blended_cores.glsl): a
 // fragment of alpha 1 at or behind it lies on the opaque surface — the visibility raster
 // drew the point as its triangle's core, at the depth its snapped corners give, which may
-// lie a little behind the layer's. A thousandth of the distance (depth's
-// 1 − d is about near / distance) is far more than the snapping moves a surface even at a
-// grazing angle. Leaving such a fragment out only matters where the core was not drawn —
-// where the two filters' rounding of the alpha texture's coordinates disagree on an alpha
-// of exactly 1, and then only in front of an opaque surface that close behind; keeping one
-// costs a layer that blends the core's own colour over it. With samples, whose layers take
-// their alpha at the pixel and the raster per sample, a core's sample is left out whatever
-// the pixel's alpha: the samples where the raster found alpha 1 are opaque, the layer holds
-// the others.
+// lie a little behind the layer's. A thousandth of the distance (depth's 1 − d is about
+// near / distance) is far more than the snapping moves a surface even at a grazing angle.
+// Leaving such a fragment out only matters where the core was not drawn — where the two
+// filters' rounding of the alpha texture's coordinates disagree on an alpha of exactly 1,
+// and then only in front of an opaque surface that close behind; keeping one costs a layer
+// that blends the core's own colour over it. With samples, whose layers take their alpha at
+// the pixel and the raster per sample, a core's sample is left out whatever the pixel's
+// alpha: the samples where the raster found alpha 1 are opaque, the layer holds the others.
 float core_depth(float opaque) {
     return opaque - (1.0 - opaque) * (1.0 / 1024.0);
 }
