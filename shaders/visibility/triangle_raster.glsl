@@ -231,8 +231,8 @@ uint set_up_masked(uint lid, vec2 pa, vec2 pb, vec2 pc, vec3 z, bool both_faces,
 }
 
 // Points whose block bounds do not decide (near a cut-out's edge) are filtered after the
-// others, together: (triangle << 16 | pixel number in its box) of each, up to the capacity;
-// past it, where they are found.
+// others, together: (sample << 24 | triangle << 16 | pixel number in its box) of each, up to
+// the capacity; past it, where they are found.
 const uint MASK_FILTER_CAPACITY = 256u;
 shared uint mask_filter[MASK_FILTER_CAPACITY];
 shared uint mask_filtered;
@@ -276,36 +276,30 @@ bool masked_covers_any(uint i, uint n) {
     return false;
 }
 
-// Pixel `n` of triangle i's box, which the triangle covers, drawn into each sample it covers
-// where its alpha keeps the sample's point; returns the samples drawn, or MASK_PIXEL_FILTER
-// where the texture must be filtered to tell and `filter_now` is false (samples drawn before
-// are drawn again then: the atomic min makes that harmless).
-uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) {
+// Sample k of pixel `n` of triangle i's box drawn where the triangle covers it and its alpha
+// keeps the sample's point; returns 1 where drawn, else 0, or MASK_PIXEL_FILTER where the
+// texture must be filtered to tell and `filter_now` is false.
+uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool filter_now) {
     ivec2 cell = masked_cell(i, n);
+    ivec3 w;
+    if (!masked_covers(i, cell, k, w)) {
+        return 0u;
+    }
     ivec2 box = mask_box[i];
-    ivec2 pixel = ivec2(box.x & 0xffff, box.x >> 16) + cell;
     vec4 z_inv_w = mask_z_inv_w[i], uv_w = mask_uv_w[i], uv_w_rest = mask_uv_w_rest[i];
     vec3 inv_w = vec3(z_inv_w.w, uv_w.xy), u_w = vec3(uv_w.zw, uv_w_rest.x), v_w = uv_w_rest.yzw;
-    uint drawn = 0u;
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-        ivec3 w;
-        if (!masked_covers(i, cell, k, w)) {
-            continue;
-        }
-        vec3 weights = vec3(w);
-        float depth = dot(weights, z_inv_w.xyz) / float(box.y);
-        vec2 uv = vec2(dot(weights, u_w), dot(weights, v_w)) / dot(weights, inv_w);
-        uint verdict = alpha_verdict(s.alpha, s.alpha_texture, uv);
-        if (verdict == ALPHA_FILTER && !filter_now) {
-            return MASK_PIXEL_FILTER;
-        }
-        if (verdict == ALPHA_DROPPED || (verdict == ALPHA_FILTER && !alpha_filtered_kept(s.alpha, s.alpha_texture, uv))) {
-            continue;
-        }
-        keep_nearest_id(pixel, k, depth, id);
-        drawn++;
+    vec3 weights = vec3(w);
+    float depth = dot(weights, z_inv_w.xyz) / float(box.y);
+    vec2 uv = vec2(dot(weights, u_w), dot(weights, v_w)) / dot(weights, inv_w);
+    uint verdict = alpha_verdict(s.alpha, s.alpha_texture, uv);
+    if (verdict == ALPHA_FILTER && !filter_now) {
+        return MASK_PIXEL_FILTER;
     }
-    return drawn;
+    if (verdict == ALPHA_DROPPED || (verdict == ALPHA_FILTER && !alpha_filtered_kept(s.alpha, s.alpha_texture, uv))) {
+        return 0u;
+    }
+    keep_nearest_id(ivec2(box.x & 0xffff, box.x >> 16) + cell, k, depth, id);
+    return 1u;
 }
 
 // Covered pixels (triangle << 16 | pixel number in its box) queued per subgroup, two
@@ -315,20 +309,30 @@ uint draw_masked_pixel(uint i, uint n, uint id, SurfaceTest s, bool filter_now) 
 // to it, queues the covered ones, and tests the alpha a full subgroup of them at a time.
 shared uint mask_queue[2u * gl_WorkGroupSize.x];
 
-// Queue entry `e` of the meshlet's batch from triangle `first` drawn (draw_masked_pixel), or
+// The first `count` pixels of the subgroup's queue (from `queue`; the meshlet's batch from
+// triangle `first`) drawn, their samples dealt a lane each, a pixel's samples to neighbouring
+// lanes: the atomics one instruction issues fall side by side in the buffer, where a lane
+// drawing its pixel's samples one after another touched as many places as lanes (the cost
+// of 64-bit atomics on the H200 follows the places). A sample the bounds leave open is
 // listed to be filtered later; returns the samples drawn.
-uint draw_queued(uint e, uint first, uvec4 d, SurfaceTest s) {
-    uint i = e >> 16u, n = e & 0xffffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
-    uint drawn = draw_masked_pixel(i, n, id, s, false);
-    if (drawn != MASK_PIXEL_FILTER) {
-        return drawn;
+uint draw_queued(uint queue, uint count, uint first, uvec4 d, SurfaceTest s) {
+    uint drawn = 0u;
+    for (uint item = gl_SubgroupInvocationID; item < count * VISIBILITY_SAMPLES; item += gl_SubgroupSize) {
+        uint e = mask_queue[queue + item / VISIBILITY_SAMPLES], k = item % VISIBILITY_SAMPLES;
+        uint i = e >> 16u, n = e & 0xffffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
+        uint got = draw_masked_sample(i, n, k, id, s, false);
+        if (got != MASK_PIXEL_FILTER) {
+            drawn += got;
+            continue;
+        }
+        uint at = atomicAdd(mask_filtered, 1u);
+        if (at < MASK_FILTER_CAPACITY) {
+            mask_filter[at] = e | (k << 24u);
+        } else {
+            drawn += draw_masked_sample(i, n, k, id, s, true);
+        }
     }
-    uint at = atomicAdd(mask_filtered, 1u);
-    if (at < MASK_FILTER_CAPACITY) {
-        mask_filter[at] = e;
-        return 0u;
-    }
-    return draw_masked_pixel(i, n, id, s, true);
+    return drawn;
 }
 
 // The meshlet's triangles, its object masked (`flags`: its instance's), by the whole work
@@ -409,7 +413,7 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
             if (queued >= gl_SubgroupSize) {
                 subgroupMemoryBarrierShared();
                 subgroupBarrier();
-                pixels += draw_queued(mask_queue[queue + lane], first, d, s);
+                pixels += draw_queued(queue, gl_SubgroupSize, first, d, s);
                 uint rest = mask_queue[queue + gl_SubgroupSize + lane];
                 subgroupBarrier();
                 mask_queue[queue + lane] = rest;
@@ -420,14 +424,12 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
         }
         subgroupMemoryBarrierShared();
         subgroupBarrier();
-        if (lane < queued) {
-            pixels += draw_queued(mask_queue[queue + lane], first, d, s);
-        }
+        pixels += draw_queued(queue, queued, first, d, s);
         barrier();
         uint filtered = min(mask_filtered, MASK_FILTER_CAPACITY);
         for (uint k = lid; k < filtered; k += gl_WorkGroupSize.x) {
-            uint e = mask_filter[k], i = e >> 16u;
-            pixels += draw_masked_pixel(i, e & 0xffffu, (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i), s, true);
+            uint e = mask_filter[k], i = (e >> 16u) & 0xffu;
+            pixels += draw_masked_sample(i, e & 0xffffu, e >> 24u, (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i), s, true);
         }
         barrier();
         if (lid == 0u) {
