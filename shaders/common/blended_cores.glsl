@@ -8,7 +8,7 @@
 // Whether the camera's visibility rasters draw the cores of transparent objects (layers on,
 // the meshlet technique): an OBJECT_CORE object's points (or samples) of alpha 1 are drawn as
 // opaque (alpha_mask.glsl raster_alpha) and the layers' builds leave them out
-// (layer_triangles.glsl core_depth). A layer of alpha 1 shows its own colour and hides all
+// (layer_triangles.glsl core_slack). A layer of alpha 1 shows its own colour and hides all
 // behind it, so the picture is the one blending gives; most of a leaf's pixels move from the
 // layers, whose cost follows fragments, to the opaque raster.
 layout(constant_id = 25) const bool BLENDED_CORES = false;

@@ -346,7 +346,7 @@ fn leaf_alpha(r: f32) -> f32 {
     ((r - 9.0) / 4.0).clamp(0.0, 1.0) * ((31.0 - r) / 7.0).clamp(0.0, 1.0)
 }
 
-fn leaf_png() -> Vec<u8> {
+pub fn leaf_png() -> Vec<u8> {
     let n = LEAF_TEXELS;
     let rgba: Vec<u8> = (0..n * n)
         .flat_map(|i| {
