@@ -216,9 +216,14 @@ bool edge_owns(float e, vec2 c) {
     return e > 0.0 || (e == 0.0 && edge_owns_ties(c));
 }
 
+// Triangle `i`'s three edge functions at the point `q` (x, y in NDC, 1).
+vec3 edge_values(uint i, vec3 q) {
+    return vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
+}
+
 // The barycentrics of point `q` (x, y in NDC, 1) on triangle `i`'s plane.
 vec3 barycentrics(uint i, vec3 q) {
-    vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
+    vec3 e = edge_values(i, q);
     return e / (e.x + e.y + e.z);
 }
 
@@ -227,7 +232,7 @@ vec3 barycentrics(uint i, vec3 q) {
 bool layer_point(uint i, vec3 q, out vec3 w, out float depth) {
     w = vec3(0.0);
     depth = 0.0;
-    vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
+    vec3 e = edge_values(i, q);
     if (!(edge_owns(e.x, tri_edges[i][0].xy) && edge_owns(e.y, tri_edges[i][1].xy) && edge_owns(e.z, tri_edges[i][2].xy))) {
         return false;
     }
@@ -253,7 +258,7 @@ bool layer_point(uint i, vec3 q, out vec3 w, out float depth) {
 // once a pixel, the H200's forest build took 1.36 ms against 1.04, 3.93 against 3.04 at 8
 // samples.)
 float core_slack(uint i, vec3 q, vec2 to_ndc) {
-    vec3 e = vec3(dot(tri_edges[i][0], q), dot(tri_edges[i][1], q), dot(tri_edges[i][2], q));
+    vec3 e = edge_values(i, q);
     vec3 ex = vec3(tri_edges[i][0].x, tri_edges[i][1].x, tri_edges[i][2].x);
     vec3 ey = vec3(tri_edges[i][0].y, tri_edges[i][1].y, tri_edges[i][2].y);
     float a = dot(e, tri_z[i]), b = dot(e, tri_w[i]);
@@ -386,7 +391,7 @@ bool pixel_fragment(uint slot, ivec2 p, vec2 to_ndc) {
     vec3 q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0), w;
     float depth, alpha;
     uint covered;
-    vec3 e = vec3(dot(tri_edges[slot][0], q), dot(tri_edges[slot][1], q), dot(tri_edges[slot][2], q));
+    vec3 e = edge_values(slot, q);
     // With anti-aliasing a triangle may cover samples and not the centre.
     bool may = VISIBILITY_SAMPLES != 1u || all(greaterThanEqual(e, vec3(0.0)));
     return may && layer_fragment(slot, p, to_ndc, opaque_depth_at(p), q, covered, w, depth, alpha);

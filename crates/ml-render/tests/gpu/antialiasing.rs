@@ -168,6 +168,16 @@ fn samples_cut_the_error_against_the_supersampled_reference() {
     }
 }
 
+/// `errors` of `scene`, its transparent objects blended in layers (pbr), at `size` without
+/// samples and with 8: (without, with). One node a pixel, so that the 8×8 reference's pool
+/// fits a storage buffer lavapipe binds.
+fn layered_errors(what: &str, scene: &Scene, (width, height): (u32, u32)) -> (f64, f64) {
+    let layers = Some(TransparencySettings { budget: 1, ..TransparencySettings::default() });
+    let base = RenderSettings { shading: ShadingModel::Pbr, transparency: layers, ..visibility(width, height, Antialiasing::Off) };
+    let (off, aa, _) = errors(what, scene, base, &[RenderSettings { antialiasing: Antialiasing::X8, ..base }]);
+    (off, aa[0])
+}
+
 /// Soft-edged foliage (the BLEND forest, its leaves' alpha 0 or 1 but at the texels' edges):
 /// the raster draws each sample where the alpha is 1 as opaque (the leaves' cores) and the
 /// layers only the rest, as a supersampled render, where each sample has its own alpha, does.
@@ -175,12 +185,8 @@ fn samples_cut_the_error_against_the_supersampled_reference() {
 /// alpha once a pixel for all its samples left 0.59.
 #[test]
 fn blended_foliage_s_samples_take_their_own_alpha() {
-    let forest = crate::transparency::blend_forest();
-    // One node a pixel: the 8×8 reference's pool fits a storage buffer lavapipe binds.
-    let budget = Some(TransparencySettings { budget: 1, ..TransparencySettings::default() });
-    let base = RenderSettings { shading: ShadingModel::Pbr, transparency: budget, ..visibility(160, 120, Antialiasing::Off) };
-    let (off, aa, _) = errors("BLEND forest", &forest, base, &[RenderSettings { antialiasing: Antialiasing::X8, ..base }]);
-    assert!(aa[0] <= 0.45 * off, "BLEND forest: {:.3} with 8 samples against {off:.3} without", aa[0]);
+    let (off, aa) = layered_errors("BLEND forest", &crate::transparency::blend_forest(), (160, 120));
+    assert!(aa <= 0.45 * off, "BLEND forest: {aa:.3} with 8 samples against {off:.3} without");
 }
 
 /// A soft-edged BLEND decal (a ring of alpha 1 fading to 0 both ways) 2 mm in front of a lit
@@ -205,10 +211,8 @@ fn a_soft_decal_just_in_front_of_a_wall_keeps_its_soft_edges() {
     scene.camera = Camera::looking_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 45.0, 0.1, 20.0);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     let scene = lit(scene, &mut rng, 8, (Vec3::new(-1.5, -1.5, 0.5), Vec3::new(1.5, 1.5, 2.0)), 0.5..1.0, 2.5..4.0);
-    let layers = Some(TransparencySettings { budget: 1, ..TransparencySettings::default() });
-    let base = RenderSettings { shading: ShadingModel::Pbr, transparency: layers, ..visibility(128, 96, Antialiasing::Off) };
-    let (off, aa, _) = errors("decal", &scene, base, &[RenderSettings { antialiasing: Antialiasing::X8, ..base }]);
-    assert!(aa[0] <= 2.0 * off, "decal: {:.3} with 8 samples against {off:.3} without", aa[0]);
+    let (off, aa) = layered_errors("decal", &scene, (128, 96));
+    assert!(aa <= 2.0 * off, "decal: {aa:.3} with 8 samples against {off:.3} without");
 }
 
 #[test]
