@@ -76,6 +76,18 @@ uint alpha_bounds_pair(uint at) {
     return alpha_bytes[at >> 2u] >> ((at & 3u) * 8u);
 }
 
+// The bounds of the block the first tap of `uv` is in (the pair: least alpha in the low byte,
+// greatest above; they hold every tap the filter takes there).
+uint texture_bounds_at(uvec4 texture_fields, vec2 uv) {
+    uint flags = texture_fields.x;
+    int w = int(texture_fields.z), h = int(texture_fields.w);
+    vec2 p = uv * vec2(w, h) - 0.5;
+    uvec2 f = uvec2(wrap_texels(texture_fields, ivec2((flags & OBJECT_ALPHA_NEAREST) != 0u ? floor(p + 0.5) : floor(p))));
+    uint shift = (flags >> OBJECT_ALPHA_BLOCK_SHIFT) & 15u;
+    uint row = (uint(w) + (1u << shift) - 1u) >> shift;
+    return alpha_bounds_pair(alpha_bounds_start(texture_fields) + 2u * ((f.y >> shift) * row + (f.x >> shift)));
+}
+
 // What a point's block bounds say of it: dropped, kept, or filter it (alpha_verdict).
 const uint ALPHA_DROPPED = 0u;
 const uint ALPHA_KEPT = 1u;
@@ -86,14 +98,7 @@ const uint ALPHA_FILTER = 2u;
 // sides of the cutoff, which happens only near the cut-out's edge. With alpha_filtered_kept,
 // keep in sync with alpha_mask.rs texture_kept.
 uint texture_bounds_verdict(uvec4 texture_fields, vec2 uv, float factor, float cutoff) {
-    uint flags = texture_fields.x;
-    int w = int(texture_fields.z), h = int(texture_fields.w);
-    vec2 p = uv * vec2(w, h) - 0.5;
-    uvec2 f = uvec2(wrap_texels(texture_fields, ivec2((flags & OBJECT_ALPHA_NEAREST) != 0u ? floor(p + 0.5) : floor(p))));
-    uint x = f.x, y = f.y;
-    uint shift = (flags >> OBJECT_ALPHA_BLOCK_SHIFT) & 15u;
-    uint row = (uint(w) + (1u << shift) - 1u) >> shift;
-    uint pair = alpha_bounds_pair(alpha_bounds_start(texture_fields) + 2u * ((y >> shift) * row + (x >> shift)));
+    uint pair = texture_bounds_at(texture_fields, uv);
     if (factor * (float(pair & 0xffu) / 255.0) >= cutoff) {
         return ALPHA_KEPT;
     }

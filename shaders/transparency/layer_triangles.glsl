@@ -63,11 +63,34 @@ const uint LIST_HUGE_GROUPS = 8u;     // x, y, z: the tiles' (x: the image's til
 // texture set's slot in large_triangles (per triangle: where it lists; the others: whose
 // list they draw, its count and place replacing x and y). large_list: x: the first entry of
 // the texture set's room for listed triangles, y: its size; z: per triangle: the first
-// triangle of this dispatch's piece.
+// triangle of this dispatch's piece; w: per triangle: 1 where the piece's triangles are
+// cores, which the compute raster lists as candidates (built here only where it left them
+// to this build: CullCounters.candidates.y). The candidates' build: dispatch_objects.x: the
+// texture set it builds.
 layout(push_constant) uniform LayerDispatchBlock {
     uvec4 dispatch_objects;
     uvec4 large_list;
 };
+
+#ifdef OPAQUE_DEPTH_BUFFER
+// The culling's counters: CullCounters.candidates, whether the compute raster listed the
+// candidates of transparent objects' cores (transparent_build_candidates.glsl) or left the
+// cores to the per-triangle build, and how many.
+layout(std430, set = 3, binding = 9) readonly buffer CullCounterBuffer { CullCounters counters; };
+#endif
+#ifdef LAYER_CANDIDATE_BUILD
+// The candidates' build: the scene's meshlets, to set up the triangle a visibility id names;
+// the raster's candidates; the objects' instances (Instance.surface: their textures and
+// texture set).
+layout(std430, set = 3, binding = 4) readonly buffer MeshletBuffer { Meshlet meshlets[]; };
+layout(std430, set = 3, binding = 5) readonly buffer MeshletVertexBuffer { uint meshlet_vertices[]; };
+layout(std430, set = 3, binding = 6) readonly buffer MeshletTriangleBuffer { uint meshlet_triangles[]; };
+layout(std430, set = 3, binding = 7) readonly buffer VertexBuffer { float vertex_data[]; };
+layout(std430, set = 3, binding = 8) readonly buffer MeshletInstanceBuffer { uvec2 meshlet_instances[]; };
+layout(std430, set = 3, binding = 10) readonly buffer LayerCandidateBuffer { uvec4 layer_candidates[]; };
+layout(std430, set = 3, binding = 11) readonly buffer InstanceBuffer { Instance instances[]; };
+#include "visibility/meshlet_geometry.glsl"
+#endif
 
 // The side of the tiles' build's square tiles, in pixels.
 const uint LAYER_TILE = 16u;
@@ -108,29 +131,32 @@ struct Vtx {
     vec4 tangent;
 };
 
-Vtx mesh_vertex(uint i) {
-    uint b = 12u * i;
-    Vtx v;
-    v.position = vec3(mesh_vertices[b], mesh_vertices[b + 1u], mesh_vertices[b + 2u]);
-    v.normal = vec3(mesh_vertices[b + 3u], mesh_vertices[b + 4u], mesh_vertices[b + 5u]);
-    v.uv = vec2(mesh_vertices[b + 6u], mesh_vertices[b + 7u]);
-    v.tangent = vec4(mesh_vertices[b + 8u], mesh_vertices[b + 9u], mesh_vertices[b + 10u], mesh_vertices[b + 11u]);
-    return v;
-}
+// A function `name` reading vertex i of the float array `data` (VERTEX_FLOATS a vertex, as
+// gpu_mesh.rs lays them out): the transparent meshes' and the meshlets' alike.
+#define VERTEX_READER(name, data)                                                                            \
+    Vtx name(uint i) {                                                                                       \
+        uint b = VERTEX_FLOATS * i;                                                                          \
+        Vtx v;                                                                                               \
+        v.position = vec3(data[b], data[b + 1u], data[b + 2u]);                                              \
+        v.normal = vec3(data[b + 3u], data[b + 4u], data[b + 5u]);                                           \
+        v.uv = vec2(data[b + 6u], data[b + 7u]);                                                             \
+        v.tangent = vec4(data[b + 8u], data[b + 9u], data[b + 10u], data[b + 11u]);                          \
+        return v;                                                                                            \
+    }
+VERTEX_READER(mesh_vertex, mesh_vertices)
 
-// Set up triangle `k` of entry `entry` (of layer_objects) in place `slot`; `box` gets the
-// pixels whose centres it may cover (first, last; inclusive, within the image: empty where
-// none).
-void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
-    uint o = entry.ids.x;
+// Set up in place `slot` the triangle of `corners` of object `object.x` (its own textures:
+// `object.y`); `box` gets the pixels whose centres it may cover (first, last; inclusive,
+// within the image: empty where none).
+void set_up_corners(uint slot, uvec2 object, Vtx corners[3], out ivec4 box) {
+    uint o = object.x;
     mat4 model = objects[o].model;
     mat3 normal_matrix = mat3(objects[o].normal_matrix);
     vec4 uv_transform[2] = objects[o].uv_transform;
     mat4 view_proj = frame.proj * frame.view;
-    uint first = entry.ids.z + 3u * k;
     vec4 clip[3];
     for (uint v = 0u; v < 3u; v++) {
-        Vtx x = mesh_vertex(entry.place.x + mesh_indices[first + v]);
+        Vtx x = corners[v];
         vec3 world = (model * vec4(x.position, 1.0)).xyz;
         clip[v] = view_proj * vec4(world, 1.0);
         tri_normal[slot][v] = normal_matrix * x.normal;
@@ -151,7 +177,7 @@ void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
     tri_edges[slot][2] = r2 * s;
     tri_z[slot] = vec3(clip[0].z, clip[1].z, clip[2].z);
     tri_w[slot] = vec3(clip[0].w, clip[1].w, clip[2].w);
-    tri_object[slot] = uvec3(o, (drawn ? TRIANGLE_DRAWN : 0u) | (front ? TRIANGLE_FRONT : 0u), entry.ids.y);
+    tri_object[slot] = uvec3(o, (drawn ? TRIANGLE_DRAWN : 0u) | (front ? TRIANGLE_FRONT : 0u), object.y);
     tri_alpha[slot] = objects[o].alpha.y;
     tri_alpha_texture[slot] = alpha_texture;
     tri_material[slot] = objects[o].material;
@@ -203,6 +229,17 @@ void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
         }
     }
 #endif
+}
+
+// Set up triangle `k` of entry `entry` (of layer_objects) in place `slot`, as set_up_corners
+// says.
+void set_up_triangle(uint slot, LayerObject entry, uint k, out ivec4 box) {
+    uint first = entry.ids.z + 3u * k;
+    Vtx corners[3];
+    for (uint v = 0u; v < 3u; v++) {
+        corners[v] = mesh_vertex(entry.place.x + mesh_indices[first + v]);
+    }
+    set_up_corners(slot, entry.ids.xy, corners, box);
 }
 
 // Whether the points where an edge function (coefficients `c`) is 0 belong to this triangle:
@@ -323,12 +360,35 @@ bool samples_outside(uint i, vec3 q, vec2 to_ndc) {
     return false;
 }
 
+// Which of the samples `listed` (a bit each) of pixel `p` triangle `i`'s plane lies in front
+// of the opaque samples at: the compute raster's candidates (transparent_build_candidates.glsl)
+// say which samples it covers, its own set-up only how deep it lies there.
+uint listed_in_front(uint i, ivec2 p, uint listed, vec2 to_ndc) {
+    vec3 r0 = tri_edges[i][0], r1 = tri_edges[i][1], r2 = tri_edges[i][2];
+    vec3 z = tri_z[i], w = tri_w[i];
+    uint covered = 0u;
+    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
+        if ((listed & (1u << k)) == 0u) {
+            continue;
+        }
+        vec3 q = vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0);
+        vec3 e = vec3(dot(r0, q), dot(r1, q), dot(r2, q));
+        float a = dot(e, z), b = dot(e, w);
+        if (b > 0.0 && a >= 0.0 && a <= b && a < opaque_depth_of_sample(p, k) * b) {
+            covered |= 1u << k;
+        }
+    }
+    return covered;
+}
+
 // Whether triangle `i` leaves a fragment at pixel `p`: the samples it covers in front of the
 // opaque surface there (`covered`, a bit each; without anti-aliasing, bit 0: the centre, in
 // front of `opaque`), and at the point the pixel shades it (`q`: the centre, or with
 // anti-aliasing visibility_samples.glsl shading_xy of its samples — inside the triangle, as
-// they are) its barycentrics, depth and coverage.
-bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out uint covered, out vec3 w, out float depth, out float alpha) {
+// they are) its barycentrics, depth and coverage. `listed`: 0, or the samples the compute
+// raster found it covers there, none of them opaque (listed_in_front).
+bool layer_fragment_of(uint i, ivec2 p, vec2 to_ndc, float opaque, uint listed, out vec3 q, out uint covered, out vec3 w, out float depth,
+                       out float alpha) {
     q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0);
     covered = 0u;
     w = vec3(0.0);
@@ -337,7 +397,15 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
     if ((tri_object[i].y & TRIANGLE_DRAWN) == 0u) {
         return false;
     }
-    if (VISIBILITY_SAMPLES == 1u) {
+    if (listed != 0u) {
+        covered = listed_in_front(i, p, listed, to_ndc);
+        if (covered == 0u) {
+            return false;
+        }
+        q = vec3(shading_xy(p, covered) * to_ndc - 1.0, 1.0);
+        w = barycentrics(i, q);
+        depth = dot(w, tri_z[i]) / dot(w, tri_w[i]);
+    } else if (VISIBILITY_SAMPLES == 1u) {
         if (!layer_point(i, q, w, depth) || depth >= opaque) {
             return false;
         }
@@ -360,12 +428,17 @@ bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out 
     }
     // (Nested: the build's reflection evaluates no `&&` of two constants.)
     if (BLENDED_CORES) {
-        if (VISIBILITY_SAMPLES == 1u && alpha >= 1.0 && (tri_alpha_texture[i].x & OBJECT_CORE) != 0u
+        if (VISIBILITY_SAMPLES == 1u && listed == 0u && alpha >= 1.0 && (tri_alpha_texture[i].x & OBJECT_CORE) != 0u
             && depth >= opaque - core_slack(i, q, to_ndc)) {
             return false;
         }
     }
     return alpha > 0.0;
+}
+
+// layer_fragment_of for the builds that test their triangles' coverage themselves.
+bool layer_fragment(uint i, ivec2 p, vec2 to_ndc, float opaque, out vec3 q, out uint covered, out vec3 w, out float depth, out float alpha) {
+    return layer_fragment_of(i, p, to_ndc, opaque, 0u, q, covered, w, depth, alpha);
 }
 
 // The surface of triangle `i` at barycentrics `w` (pixel `q`), packed for its node.
@@ -397,20 +470,24 @@ bool pixel_fragment(uint slot, ivec2 p, vec2 to_ndc) {
     return may && layer_fragment(slot, p, to_ndc, opaque_depth_at(p), q, covered, w, depth, alpha);
 }
 
-// Keep pixel `p`'s fragment of triangle `slot`, which pixel_fragment found, in node `node`
-// (dropped where the pool is full), linked in front of its pixel's list by an atomic
-// exchange of the head. Its barycentrics, depth and coverage found again (not kept from the
-// test: registers), its existence not: the writes follow the test's bits, so they take
-// exactly the room counted.
-void keep_fragment(uint slot, ivec2 p, uint node, uint capacity, vec2 to_ndc) {
+// Keep pixel `p`'s fragment of triangle `slot`, which pixel_fragment (or with `listed`,
+// layer_fragment_of) found, in node `node` (dropped where the pool is full), linked in front
+// of its pixel's list by an atomic exchange of the head. Its barycentrics, depth and
+// coverage found again (not kept from the test: registers), its existence not: the writes
+// follow the test's bits, so they take exactly the room counted.
+void keep_fragment_of(uint slot, ivec2 p, uint node, uint capacity, vec2 to_ndc, uint listed) {
     vec3 q, w;
     float depth, alpha;
     uint covered;
-    layer_fragment(slot, p, to_ndc, opaque_depth_at(p), q, covered, w, depth, alpha);
+    layer_fragment_of(slot, p, to_ndc, opaque_depth_at(p), listed, q, covered, w, depth, alpha);
     if (node < capacity) {
         uint next = atomicExchange(layer_heads[layer_pixel(p)], node);
         write_layer(node, p, depth, next, tri_object[slot].x, covered, layer_surface(slot, q, w, alpha, to_ndc));
     }
+}
+
+void keep_fragment(uint slot, ivec2 p, uint node, uint capacity, vec2 to_ndc) {
+    keep_fragment_of(slot, p, node, capacity, to_ndc, 0u);
 }
 
 // The work group's room in the pool: `mine` nodes for this thread, the first returned. One

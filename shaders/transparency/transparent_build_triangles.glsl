@@ -58,6 +58,12 @@ uint entry_of(uint t, uint first, uint entries) {
 }
 
 void main() {
+#ifdef OPAQUE_DEPTH_BUFFER
+    // Cores the compute raster listed as candidates are the candidates' build's.
+    if (opaque_uniform(large_list.w) != 0u && opaque_uniform(counters.candidates.y) == 0u) {
+        return;
+    }
+#endif
     uint lid = gl_LocalInvocationIndex;
     uint first = opaque_uniform(dispatch_objects.x), entries = opaque_uniform(dispatch_objects.y);
     uint triangles = opaque_uniform(dispatch_objects.z), list_slot = opaque_uniform(dispatch_objects.w) - 1u;

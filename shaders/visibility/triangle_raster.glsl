@@ -34,6 +34,9 @@ layout(std430, set = 0, binding = 16) buffer LargeTriangleBuffer { LargeTriangle
 #define ALPHA_MASK_BINDING 17
 #include "common/alpha_mask.glsl"
 #include "common/blended_cores.glsl"
+// The transparent layers' candidates (cores' soft samples: the masked raster lists them).
+#define LAYER_CANDIDATE_BINDING 18
+#include "visibility/layer_candidates.glsl"
 #include "visibility/visibility_polygon.glsl"
 
 const uint ROUTE_NONE = 0u;    // no pixel to draw
@@ -163,6 +166,9 @@ uint list_large(vec4 a, vec4 b, vec4 c, uint id, uint flags, uint object, Surfac
         return 0u;
     }
     atomicAdd(counters.rasterized.w, 1u);
+    if (lists_candidates(s.alpha_texture.x)) {
+        leave_cores_to_the_triangles();
+    }
     return raster_polygon_alone(p, id, (flags & INSTANCE_DOUBLE_SIDED) != 0u, s);
 }
 
@@ -278,8 +284,10 @@ bool masked_covers_any(uint i, uint n) {
 
 // Sample k of pixel `n` of triangle i's box drawn where the triangle covers it and its alpha
 // keeps the sample's point; returns 1 where drawn, else 0, or MASK_PIXEL_FILTER where the
-// texture must be filtered to tell and `filter_now` is false.
-uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool filter_now) {
+// texture must be filtered to tell and `filter_now` is false. `soft`: a core's sample for
+// the layers (layer_candidates.glsl): drawn where its alpha is 1, soft where between.
+uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool filter_now, out bool soft) {
+    soft = false;
     ivec2 cell = masked_cell(i, n);
     ivec3 w;
     if (!masked_covers(i, cell, k, w)) {
@@ -291,15 +299,39 @@ uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool fil
     vec3 weights = vec3(w);
     float depth = dot(weights, z_inv_w.xyz) / float(box.y);
     vec2 uv = vec2(dot(weights, u_w), dot(weights, v_w)) / dot(weights, inv_w);
-    uint verdict = alpha_verdict(s.alpha, s.alpha_texture, uv);
-    if (verdict == ALPHA_FILTER && !filter_now) {
-        return MASK_PIXEL_FILTER;
+    ivec2 pixel = ivec2(box.x & 0xffff, box.x >> 16) + cell;
+    if (lists_candidates(s.alpha_texture.x)) {
+        uint verdict = core_sample_verdict(s.alpha, s.alpha_texture, uv);
+        if (verdict == FILTER_SAMPLE && !filter_now) {
+            return MASK_PIXEL_FILTER;
+        }
+        float alpha = verdict == CORE_SAMPLE ? 1.0 : verdict == CLEAR_SAMPLE ? 0.0 : 0.5;
+        if (verdict == FILTER_SAMPLE) {
+            alpha = s.alpha.y * texture_alpha(s.alpha_texture, uv);
+        }
+        if (alpha < 1.0) {
+            soft = soft_in_front(alpha, pixel, k, depth);
+            return 0u;
+        }
+    } else {
+        uint verdict = alpha_verdict(s.alpha, s.alpha_texture, uv);
+        if (verdict == ALPHA_FILTER && !filter_now) {
+            return MASK_PIXEL_FILTER;
+        }
+        if (verdict == ALPHA_DROPPED || (verdict == ALPHA_FILTER && !alpha_filtered_kept(s.alpha, s.alpha_texture, uv))) {
+            return 0u;
+        }
     }
-    if (verdict == ALPHA_DROPPED || (verdict == ALPHA_FILTER && !alpha_filtered_kept(s.alpha, s.alpha_texture, uv))) {
-        return 0u;
-    }
-    keep_nearest_id(ivec2(box.x & 0xffff, box.x >> 16) + cell, k, depth, id);
+    keep_nearest_id(pixel, k, depth, id);
     return 1u;
+}
+
+// Sample k of pixel `n` of triangle i's box (visibility id `id`) listed for the layers where
+// `soft` (every active lane calls it together).
+void list_masked_soft_sample(bool soft, uint i, uint n, uint k, uint id) {
+    vec3 z = mask_z_inv_w[i].xyz;
+    ivec2 pixel = ivec2(mask_box[i].x & 0xffff, mask_box[i].x >> 16) + masked_cell(i, n);
+    list_soft_sample(soft, k, pixel, id, min(z.x, min(z.y, z.z)));
 }
 
 // Covered pixels (triangle << 16 | pixel number in its box) queued per subgroup, two
@@ -317,19 +349,24 @@ shared uint mask_queue[2u * gl_WorkGroupSize.x];
 // listed to be filtered later; returns the samples drawn.
 uint draw_queued(uint queue, uint count, uint first, uvec4 d, SurfaceTest s) {
     uint drawn = 0u;
+    bool core = lists_candidates(s.alpha_texture.x);
     for (uint item = gl_SubgroupInvocationID; item < count * VISIBILITY_SAMPLES; item += gl_SubgroupSize) {
         uint e = mask_queue[queue + item / VISIBILITY_SAMPLES], k = item % VISIBILITY_SAMPLES;
         uint i = e >> 16u, n = e & 0xffffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
-        uint got = draw_masked_sample(i, n, k, id, s, false);
+        bool soft;
+        uint got = draw_masked_sample(i, n, k, id, s, false, soft);
         if (got != MASK_PIXEL_FILTER) {
             drawn += got;
-            continue;
-        }
-        uint at = atomicAdd(mask_filtered, 1u);
-        if (at < MASK_FILTER_CAPACITY) {
-            mask_filter[at] = e | (k << 24u);
         } else {
-            drawn += draw_masked_sample(i, n, k, id, s, true);
+            uint at = atomicAdd(mask_filtered, 1u);
+            if (at < MASK_FILTER_CAPACITY) {
+                mask_filter[at] = e | (k << 24u);
+            } else {
+                drawn += draw_masked_sample(i, n, k, id, s, true, soft);
+            }
+        }
+        if (core) {
+            list_masked_soft_sample(soft, i, n, k, id);
         }
     }
     return drawn;
@@ -344,6 +381,8 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
     if (lid == 0u) {
         mask_filtered = 0u;
     }
+    // A transparent object's core: its large triangles' soft samples are listed where drawn.
+    bool core = lists_candidates(s.alpha_texture.x);
     for (uint first = 0u; first < m.triangles.y; first += gl_WorkGroupSize.x) {
         uint box_pixels = 0u;
         uint t = first + lid;
@@ -360,12 +399,17 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
                 s.uv[2] = corner_uv[v.z];
                 vec2 pa, pb, pc;
                 uint r = route_triangle(a, b, c, pa, pb, pc);
+                if (core && r == ROUTE_LARGE && (opaque_uniform(cull.triangles.w) == 0u || crosses_near_plane(a, b, c))) {
+                    // The hardware draws it, or it is clipped: not listed.
+                    leave_cores_to_the_triangles();
+                }
                 if (r == ROUTE_LARGE && cull.triangles.w == 0u) {
                     keep_triangle(t);
                 } else if (r == ROUTE_LARGE) {
                     pixels += list_large(a, b, c, id, flags, d.y, s);
                 } else if (r == ROUTE_COMPUTE) {
-                    box_pixels = set_up_masked(lid, pa, pb, pc, vec3(a.z / a.w, b.z / b.w, c.z / c.w), both_faces, s);
+                    vec3 z = vec3(a.z / a.w, b.z / b.w, c.z / c.w);
+                    box_pixels = set_up_masked(lid, pa, pb, pc, z, both_faces, s);
                     triangles++;
                 }
             }
@@ -428,8 +472,12 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
         barrier();
         uint filtered = min(mask_filtered, MASK_FILTER_CAPACITY);
         for (uint k = lid; k < filtered; k += gl_WorkGroupSize.x) {
-            uint e = mask_filter[k], i = (e >> 16u) & 0xffu;
-            pixels += draw_masked_sample(i, e & 0xffffu, e >> 24u, (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i), s, true);
+            uint e = mask_filter[k], i = (e >> 16u) & 0xffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
+            bool soft;
+            pixels += draw_masked_sample(i, e & 0xffffu, e >> 24u, id, s, true, soft);
+            if (core) {
+                list_masked_soft_sample(soft, i, e & 0xffffu, e >> 24u, id);
+            }
         }
         barrier();
         if (lid == 0u) {

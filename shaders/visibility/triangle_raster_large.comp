@@ -21,6 +21,9 @@ layout(push_constant) uniform CullPushBlock { CullPush cull; };
 #define ALPHA_MASK_BINDING 6
 #include "common/alpha_mask.glsl"
 #include "common/blended_cores.glsl"
+// The transparent layers' candidates (cores' soft samples).
+#define LAYER_CANDIDATE_BINDING 7
+#include "visibility/layer_candidates.glsl"
 #include "visibility/visibility_polygon.glsl"
 
 shared uint group_pixels;
@@ -54,6 +57,15 @@ void main() {
         ivec2 lo = bin * BIN, hi = lo + BIN - 1;
         i64vec2 s0 = large_corner(at, 0);
         vec4 q0 = large_depth(at, 0);
+        // A core's soft samples listed: a pixel once, its triangle whole (unclipped, one fan
+        // triangle), else the cores are left to the per-triangle build.
+        bool listing = MASK_TESTS && head.z != NOT_MASKED && lists_candidates(objects[head.z].alpha_texture.x);
+        if (listing && head.x != 3u) {
+            if (lid == 0u) {
+                leave_cores_to_the_triangles();
+            }
+            listing = false;
+        }
         for (int k = 1; k + 1 < int(head.x); k++) {
             FanTriangle t;
             if (!fan_triangle(s0, large_corner(at, k), large_corner(at, k + 1), q0, large_depth(at, k), large_depth(at, k + 1), size, both_faces, t)) {
@@ -66,7 +78,7 @@ void main() {
             // From the first pixel of the row that is this thread's.
             from.x += ((lane - from.x % lanes) + lanes) % lanes;
             if (from.x <= to.x) {
-                covered += fan_samples(t, from, to, lanes, own, head.y, surface);
+                covered += fan_samples(t, from, to, lanes, own, head.y, surface, listing);
             }
         }
     }

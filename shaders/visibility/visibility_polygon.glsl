@@ -79,7 +79,7 @@ vec4 large_depth(uint at, int k) {
 // Sample k of every `step`-th pixel of each row of [from, to] (from from.x on) that the fan
 // triangle covers (and `s` keeps) drawn with visibility id `id`, the edge functions stepped
 // from pixel to pixel (exact: integers); returns the samples covered.
-uint fan_samples(FanTriangle t, ivec2 from, ivec2 to, int step, uint k, uint id, SurfaceTest s) {
+uint fan_samples(FanTriangle t, ivec2 from, ivec2 to, int step, uint k, uint id, SurfaceTest s, bool listing) {
     // Per sub-pixel to the right and down, each edge function changes by −d.y and d.x.
     i64vec3 unit_x = -i64vec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
     i64vec3 unit_y = i64vec3(t.c.x - t.b.x, t.a.x - t.c.x, t.b.x - t.a.x);
@@ -96,16 +96,26 @@ uint fan_samples(FanTriangle t, ivec2 from, ivec2 to, int step, uint k, uint id,
     for (int y = from.y; y <= to.y; y++, row += step_y) {
         i64vec3 w = row;
         for (int x = from.x; x <= to.x; x += step, w += step_x) {
-            if (any(lessThan(w - bias, i64vec3(0)))) {
-                continue;
+            bool soft = false;
+            if (all(greaterThanEqual(w - bias, i64vec3(0)))) {
+                vec3 weights = vec3(w);
+                float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
+                vec2 xy = vec2(x, y) + vec2(sample_offset(k)) / SUBPIXEL;
+                if (surface_kept_at(s, xy, size)) {
+                    covered++;
+                    keep_nearest_id(ivec2(x, y), k, depth, id);
+                } else if (listing) {
+#ifdef MANYLIGHTS_LAYER_CANDIDATES_GLSL
+                    vec3 l = clip_barycentrics(s.clip[0], s.clip[1], s.clip[2], xy / size * 2.0 - 1.0);
+                    soft = soft_sample(s.alpha, s.alpha_texture, l.x * s.uv[0] + l.y * s.uv[1] + l.z * s.uv[2], ivec2(x, y), k, depth);
+#endif
+                }
             }
-            vec3 weights = vec3(w);
-            float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
-            if (!surface_kept_at(s, vec2(x, y) + vec2(sample_offset(k)) / SUBPIXEL, size)) {
-                continue;
+#ifdef MANYLIGHTS_LAYER_CANDIDATES_GLSL
+            if (listing) {
+                list_soft_sample(soft, k, ivec2(x, y), id, min(z.x, min(z.y, z.z)));
             }
-            covered++;
-            keep_nearest_id(ivec2(x, y), k, depth, id);
+#endif
         }
     }
     return covered;
@@ -119,7 +129,7 @@ uint raster_polygon_alone(Polygon p, uint id, bool both_faces, SurfaceTest s) {
         FanTriangle t;
         if (fan_triangle(p.s[0], p.s[f], p.s[f + 1], p.q[0], p.q[f], p.q[f + 1], ivec2(frame.viewport.xy), both_faces, t)) {
             for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-                covered += fan_samples(t, t.first, t.last, 1, k, id, s);
+                covered += fan_samples(t, t.first, t.last, 1, k, id, s, false);
             }
         }
     }

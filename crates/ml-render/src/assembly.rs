@@ -147,6 +147,10 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     Ok(())
 }
 
+/// Layer candidates the compute raster's list holds at first (16 MiB; it grows after a frame
+/// that listed more).
+const INITIAL_CANDIDATES: u32 = 1 << 20;
+
 /// The pass of `kind` for the assembly's scene and settings.
 fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<SharedMeshletScene>) -> Result<Box<dyn Pass>, RenderError> {
     let s = a.settings;
@@ -157,9 +161,16 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
     let atomic = s.raster != Raster::Hardware;
     // Samples per pixel of that buffer.
     let aa = s.antialiasing;
+    // The compute raster lists the pixels of transparent objects' cores for the layers' build.
+    let listing_candidates = a.shading.blended_cores
+        && s.raster.bin_list().is_some()
+        && s.transparency.is_some_and(|t| t.candidates)
+        && a.objects.iter().any(|o| o.extras.has_core());
     let mut shared = || -> Result<SharedMeshletScene, RenderError> {
         if meshlets.is_none() {
-            *meshlets = Some(MeshletScene::new(ctx, a.scene.meshlets()?, (s.raster.bin_list().unwrap_or(0), s.raster.lists_grow()))?);
+            let candidates = if listing_candidates { INITIAL_CANDIDATES } else { 0 };
+            let lists = (s.raster.bin_list().unwrap_or(0), s.raster.lists_grow(), candidates);
+            *meshlets = Some(MeshletScene::new(ctx, a.scene.meshlets()?, lists)?);
         }
         Ok(meshlets.clone().expect("made above"))
     };
@@ -206,12 +217,13 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::GBuffer => Box::new(gbuffer::GBuffer::new(ctx, a.scene, raster)?),
         PassKind::ComputeLighting => Box::new(compute_lighting::ComputeLighting::new(ctx, a.scene, a.shading)?),
         PassKind::MeshletCull(phase) => {
-            let layers = (a.shading.transparency, a.shading.cores_constant());
+            let layers = (a.shading.transparency, a.shading.cores_constant(), listing_candidates);
             Box::new(meshlet_cull::MeshletCull::new(ctx, shared()?, phase, (s.culling, s.raster, layers, aa))?)
         }
         PassKind::TriangleRasterLarge(phase) => {
             let cores = a.shading.cores_constant();
-            Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, (s.raster, aa, cores))?)
+            let listing = (cores, listing_candidates);
+            Box::new(triangle_raster_large::TriangleRasterLarge::new(ctx, shared()?, phase, (s.raster, aa, listing))?)
         }
         PassKind::VisibilityRaster(phase) => {
             let cores = a.shading.cores_constant();
@@ -225,7 +237,13 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::ShadowMapView(shown) => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, &a.shadows.borrow(), shown)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
         PassKind::TransparentBuild { depth_buffer } => {
-            Box::new(TransparentBuild::new(ctx, (a.scene, a.objects), (a.shading, transparency()), depth_buffer)?)
+            let meshlets = if depth_buffer { Some(shared()?) } else { None };
+            Box::new(TransparentBuild::new(
+                ctx,
+                (a.scene, a.objects, meshlets),
+                (a.shading, transparency()),
+                (depth_buffer, listing_candidates),
+            )?)
         }
         PassKind::TransparentResolve { lights, after_compute } => {
             Box::new(TransparentResolve::new(ctx, a.scene, (a.shading, transparency()), (lights, after_compute))?)

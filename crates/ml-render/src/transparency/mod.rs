@@ -57,11 +57,20 @@ pub struct TransparencySettings {
     /// The scene's PBR extensions vary per point, so nodes keep their texels too
     /// (`node_bytes`; settled by the renderer from the scene).
     pub lobe_textures: bool,
+    /// The compute raster lists the pixels of transparent objects' cores for the layers
+    /// (transparent_build_candidates.glsl; else the per-triangle build takes them: the same
+    /// fragments, which tests check by switching this off).
+    pub candidates: bool,
 }
 
 impl Default for TransparencySettings {
     fn default() -> Self {
-        TransparencySettings { budget: DEFAULT_BUDGET, tiled_up_to: crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES, lobe_textures: false }
+        TransparencySettings {
+            budget: DEFAULT_BUDGET,
+            tiled_up_to: crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES,
+            lobe_textures: false,
+            candidates: true,
+        }
     }
 }
 

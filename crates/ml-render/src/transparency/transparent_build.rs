@@ -5,7 +5,10 @@
 //! thread per triangle (transparent_build_triangles.glsl), which lists its triangles too
 //! large for a thread for a work group each (transparent_build_large.glsl) and the huge ones
 //! for the tiles' build. Runs after the opaque raster, before the resolve; clears the slot's
-//! lists first.
+//! lists first. Where the compute raster lists the pixels of transparent objects' cores as
+//! candidates (`TransparencySettings::candidates`), a fourth build tests those
+//! (transparent_build_candidates.glsl), and the per-triangle build takes the cores only in a
+//! frame whose raster could not list them all.
 
 use super::{node_bytes, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;
@@ -18,7 +21,8 @@ use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
 use crate::sync::{BufferName, Use, DEPTH_PYRAMID, LIGHT_LISTS, VISIBILITY_DEPTH};
-use ml_cpu::gpu_types::LayerObject;
+use crate::visibility::meshlet_scene::{SharedMeshletScene, CULL_COUNTERS, LAYER_CANDIDATES};
+use ml_cpu::gpu_types::{CullCounters, LayerObject};
 use ml_cpu::scene::Object;
 use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
 use ml_vk::{vk, Buffer, Context, MemoryLocation, VkError};
@@ -46,6 +50,12 @@ pub struct TransparentBuild {
     triangles: ComputePass,
     /// Their triangles too large for a thread, a work group each.
     large: ComputePass,
+    /// The cores' candidates the compute raster listed (`candidates`).
+    listed: ComputePass,
+    /// The meshlets the compute raster draws, its counters and candidates (with its buffer).
+    meshlet_scene: Option<SharedMeshletScene>,
+    /// The raster lists the cores' candidates.
+    candidates: bool,
     /// Set 3 of the builds, per frame slot: the meshes, the slot's entries and the listed
     /// triangles' counts.
     mesh_sets: FrameSets,
@@ -76,11 +86,14 @@ struct DispatchPush {
 }
 
 impl TransparentBuild {
+    /// The build over the compute raster's buffer where `depth_buffer` (its meshlets in
+    /// `meshlet_scene`, which lists the cores' candidates where `candidates`), else over the
+    /// depth target.
     pub fn new(
         ctx: &Context,
-        (scene, objects): (&SceneGpu, &[Object]),
+        (scene, objects, meshlet_scene): (&SceneGpu, &[Object], Option<SharedMeshletScene>),
         (shading, settings): (Shading, TransparencySettings),
-        depth_buffer: bool,
+        (depth_buffer, candidates): (bool, bool),
     ) -> Result<TransparentBuild, VkError> {
         use ml_shaders as s;
         let (tiles, triangles, large) = if depth_buffer {
@@ -92,8 +105,13 @@ impl TransparentBuild {
         } else {
             (&s::TRANSPARENT_BUILD_COMPUTE_COMP, &s::TRANSPARENT_BUILD_TRIANGLES_COMP, &s::TRANSPARENT_BUILD_LARGE_COMP)
         };
+        let listed = &s::TRANSPARENT_BUILD_CANDIDATES_COMP;
         let compute = vk::ShaderStageFlags::COMPUTE;
-        let mesh_sets = FrameSets::new(ctx, &[(tiles, compute), (triangles, compute), (large, compute)], 3, FRAMES_IN_FLIGHT)?;
+        let mut stages = vec![(tiles, compute), (triangles, compute), (large, compute)];
+        if depth_buffer {
+            stages.push((listed, compute));
+        }
+        let mesh_sets = FrameSets::new(ctx, &stages, 3, FRAMES_IN_FLIGHT)?;
         let layouts = [scene.textures.set_layout.raw, scene.object_textures.set_layout, mesh_sets.layout.raw];
         // From the compute raster's buffer, the fragments keep the samples they cover.
         let mut constants = shading.surface_constants().to_vec();
@@ -106,6 +124,9 @@ impl TransparentBuild {
             tiles: ComputePass::empty(),
             triangles: ComputePass::empty(),
             large: ComputePass::empty(),
+            listed: ComputePass::empty(),
+            meshlet_scene,
+            candidates: candidates && depth_buffer,
             mesh_sets,
             meshes: LayerMeshes { vertices: Buffer::null(), indices: Buffer::null(), places: Vec::new() },
             object_lists: Vec::new(),
@@ -118,6 +139,9 @@ impl TransparentBuild {
             pass.tiles = ComputePass::with_push(ctx, &layouts, (tiles, &constants), push)?;
             pass.triangles = ComputePass::with_push(ctx, &layouts, (triangles, &constants), push)?;
             pass.large = ComputePass::with_push(ctx, &layouts, (large, &constants), push)?;
+            if pass.candidates {
+                pass.listed = ComputePass::with_push(ctx, &layouts, (listed, &constants), push)?;
+            }
             pass.meshes = LayerMeshes::new(ctx, &scene.meshes, objects)?;
             // Room for every transparent object and every triangle the per-triangle build may
             // list: a list never overflows.
@@ -135,20 +159,11 @@ impl TransparentBuild {
             }
             let sets = scene.object_textures.sets.len().max(1) as u64;
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-            for slot in 0..FRAMES_IN_FLIGHT {
+            for _ in 0..FRAMES_IN_FLIGHT {
                 pass.object_lists.push(Buffer::new(ctx, "transparent objects", bytes, usage, MemoryLocation::GpuOnly)?);
                 let bytes = sets * (LIST_WORDS * 4) as u64;
                 let usage = usage | vk::BufferUsageFlags::INDIRECT_BUFFER;
                 pass.large_counts.push(Buffer::new(ctx, "listed transparent triangles", bytes, usage, MemoryLocation::GpuOnly)?);
-                let (vertices, indices) = (pass.meshes.vertices.raw, pass.meshes.indices.raw);
-                let (entries, large) = (pass.object_lists[slot].raw, pass.large_counts[slot].raw);
-                pass.mesh_sets.write(ctx, slot, &|name| match name {
-                    "MeshVertexBuffer" => Some(Resource::Buffer(vertices)),
-                    "MeshIndexBuffer" => Some(Resource::Buffer(indices)),
-                    "LayerObjectBuffer" => Some(Resource::Buffer(entries)),
-                    "LargeTriangleCountBuffer" => Some(Resource::Buffer(large)),
-                    _ => None,
-                })?;
             }
             Ok(())
         })
@@ -160,7 +175,7 @@ impl TransparentBuild {
     /// where its entries lie.
     fn object_list(&self, rec: &Recording) -> (Vec<LayerObject>, Vec<ObjectGroup>) {
         let scene = rec.scene;
-        let mut listed: Vec<(u32, bool, LayerObject)> = Vec::new();
+        let mut listed: Vec<(u32, Build, LayerObject)> = Vec::new();
         for (index, o) in rec.objects.iter().enumerate() {
             let Some(m) = layer_mesh(o, &scene.meshes) else { continue };
             let Some(((x, y), size)) = screen_rect(o.bounds(), rec.view_proj, rec.extent) else { continue };
@@ -169,9 +184,16 @@ impl TransparentBuild {
             let triangles = scene.meshes.meshes[m].index_count / 3;
             let ids = [index as u32, o.textures.bits(), first_index, triangles];
             let entry = LayerObject { ids, place: [first_vertex, y << 16 | x, end, 0] };
-            listed.push((scene.object_textures.set_index[index], triangles > self.settings.tiled_up_to, entry));
+            let build = if self.candidates && o.extras.has_core() {
+                Build::Cores
+            } else if triangles > self.settings.tiled_up_to {
+                Build::PerTriangle
+            } else {
+                Build::Tiles
+            };
+            listed.push((scene.object_textures.set_index[index], build, entry));
         }
-        listed.sort_by_key(|(set, per_triangle, _)| (*set, *per_triangle));
+        listed.sort_by_key(|(set, build, _)| (*set, *build));
         object_groups(listed)
     }
 
@@ -219,14 +241,27 @@ impl TransparentBuild {
             let large = g.set + 1;
             let large_list = [g.large_first, g.triangles, 0, 0];
             let piece = MAX_GROUPS_X * per_group;
-            for base in (0..g.triangles).step_by(piece as usize) {
+            // The others' triangles, then the cores' (which return at once where the raster
+            // listed their candidates).
+            let core_first = g.triangles - g.core_triangles;
+            for (range, cores) in [(0..core_first, 0), (core_first..g.triangles, 1)] {
+                for base in range.clone().step_by(piece as usize) {
+                    after_earlier();
+                    let count = (range.end - base).min(piece);
+                    let push = DispatchPush {
+                        objects: [g.first + g.tiled, g.per_triangle, g.triangles, large],
+                        large_list: [large_list[0], large_list[1], base, cores],
+                    };
+                    let push = (&sets[..], bytemuck::bytes_of(&push));
+                    self.triangles.dispatch(ctx, cmd, rec.slot, push, vk::Extent2D { width: count, height: 1 });
+                }
+            }
+            if let Some(meshlets) = self.meshlet_scene.as_ref().filter(|_| g.core_triangles > 0) {
                 after_earlier();
-                let count = (g.triangles - base).min(piece);
-                let push = DispatchPush {
-                    objects: [g.first + g.tiled, g.per_triangle, g.triangles, large],
-                    large_list: [large_list[0], large_list[1], base, 0],
-                };
-                self.triangles.dispatch(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), vk::Extent2D { width: count, height: 1 });
+                let counters = meshlets.borrow().frames[rec.slot].counters.raw;
+                let push = DispatchPush { objects: [g.set, 0, 0, 0], large_list: [0; 4] };
+                let groups = std::mem::offset_of!(CullCounters, candidate_groups) as u64;
+                self.listed.dispatch_indirect(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), (counters, groups));
             }
             // The lists and their work groups, as the per-triangle build left them.
             let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
@@ -241,9 +276,21 @@ impl TransparentBuild {
     }
 }
 
+/// Which build takes an object's triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Build {
+    /// The tiles' (few triangles).
+    Tiles,
+    /// A thread a triangle.
+    PerTriangle,
+    /// The candidates' (a core the compute raster lists), else a thread a triangle.
+    Cores,
+}
+
 /// One texture set's transparent objects in the frame's entries: `tiled` built over tiles
 /// from `first` on (the rectangle they span, if any), then `per_triangle` built a thread per
-/// triangle (`triangles` in all), and the room for their large triangles from `large_first`.
+/// triangle (`triangles` in all, of which the last `core_triangles` are cores), and the room
+/// for their large triangles from `large_first`.
 #[derive(Debug, PartialEq)]
 struct ObjectGroup {
     set: u32,
@@ -252,26 +299,39 @@ struct ObjectGroup {
     tiled_rect: Option<((u32, u32), (u32, u32))>,
     per_triangle: u32,
     triangles: u32,
+    core_triangles: u32,
     large_first: u32,
 }
 
-/// `listed` (texture set, built per triangle, entry), sorted by set then per-triangle, as
-/// the frame's entries (the per-triangle ones numbering their first triangle in `place.w`,
+/// `listed` (texture set, build, entry), sorted by set then build, as the frame's entries
+/// (the per-triangle ones, cores among them, numbering their first triangle in `place.w`,
 /// room for their large triangles after all of them) and its groups.
-fn object_groups(listed: Vec<(u32, bool, LayerObject)>) -> (Vec<LayerObject>, Vec<ObjectGroup>) {
+fn object_groups(listed: Vec<(u32, Build, LayerObject)>) -> (Vec<LayerObject>, Vec<ObjectGroup>) {
     let corner = |packed: u32| (packed & 0xffff, packed >> 16);
     let mut groups: Vec<ObjectGroup> = Vec::new();
     let mut entries = Vec::with_capacity(listed.len());
-    for (set, per_triangle, mut entry) in listed {
+    for (set, build, mut entry) in listed {
         if groups.last().is_none_or(|g| g.set != set) {
             let first = entries.len() as u32;
-            groups.push(ObjectGroup { set, first, tiled: 0, tiled_rect: None, per_triangle: 0, triangles: 0, large_first: 0 });
+            groups.push(ObjectGroup {
+                set,
+                first,
+                tiled: 0,
+                tiled_rect: None,
+                per_triangle: 0,
+                triangles: 0,
+                core_triangles: 0,
+                large_first: 0,
+            });
         }
         let g = groups.last_mut().expect("just pushed");
-        if per_triangle {
+        if build != Build::Tiles {
             entry.place[3] = g.triangles;
             g.per_triangle += 1;
             g.triangles += entry.ids[3];
+            if build == Build::Cores {
+                g.core_triangles += entry.ids[3];
+            }
         } else {
             let (lo, end) = (corner(entry.place[1]), corner(entry.place[2]));
             g.tiled += 1;
@@ -394,10 +454,25 @@ impl Pass for TransparentBuild {
         Some("transparent layers")
     }
 
+    /// Set 0 from the frame's table; set 3: the meshes, the slot's entries and lists and,
+    /// over the compute raster's buffer, its meshlets, counters and candidates.
     fn bind_frame(&mut self, ctx: &Context, frame: &FrameResources) -> Result<(), VkError> {
         self.tiles.bind_frame(ctx, frame)?;
         self.triangles.bind_frame(ctx, frame)?;
-        self.large.bind_frame(ctx, frame)
+        self.large.bind_frame(ctx, frame)?;
+        if self.candidates {
+            self.listed.bind_frame(ctx, frame)?;
+        }
+        let (vertices, indices) = (self.meshes.vertices.raw, self.meshes.indices.raw);
+        let (entries, large) = (self.object_lists[frame.slot].raw, self.large_counts[frame.slot].raw);
+        let meshlets = self.meshlet_scene.as_ref().map(|m| m.borrow());
+        self.mesh_sets.write(ctx, frame.slot, &|name| match name {
+            "MeshVertexBuffer" => Some(Resource::Buffer(vertices)),
+            "MeshIndexBuffer" => Some(Resource::Buffer(indices)),
+            "LayerObjectBuffer" => Some(Resource::Buffer(entries)),
+            "LargeTriangleCountBuffer" => Some(Resource::Buffer(large)),
+            _ => meshlets.as_ref().and_then(|m| m.buffer(frame, name)),
+        })
     }
 
     /// Clears and appends to the lists (after the earlier frame's readers of this slot's); reads
@@ -411,6 +486,12 @@ impl Pass for TransparentBuild {
         if self.depth_buffer {
             uses.push(Use::buffer(VISIBILITY_DEPTH, (shaders, vk::AccessFlags::SHADER_READ)));
             uses.push(Use::buffer(DEPTH_PYRAMID, (shaders, vk::AccessFlags::SHADER_READ)));
+            // The raster's counters (whether it listed the cores' candidates; their work
+            // groups) and candidates.
+            let indirect = vk::PipelineStageFlags::DRAW_INDIRECT;
+            let counters = vk::AccessFlags::SHADER_READ | vk::AccessFlags::INDIRECT_COMMAND_READ;
+            uses.push(Use::buffer(CULL_COUNTERS, (shaders | indirect, counters)));
+            uses.push(Use::buffer(LAYER_CANDIDATES, (shaders, vk::AccessFlags::SHADER_READ)));
         }
         // Bound with the rest of set 0 (the surface code reads no light).
         uses.push(Use::buffer(LIGHT_LISTS[0], (shaders, vk::AccessFlags::SHADER_READ)));
@@ -438,7 +519,11 @@ impl Pass for TransparentBuild {
         self.tiles.destroy(ctx);
         self.triangles.destroy(ctx);
         self.large.destroy(ctx);
+        self.listed.destroy(ctx);
         self.mesh_sets.destroy(ctx);
+        if let Some(scene) = self.meshlet_scene.take() {
+            scene.borrow_mut().destroy(ctx);
+        }
         ml_vk::Release::release(&mut self.meshes, ctx);
         for list in self.object_lists.iter_mut().chain(&mut self.large_counts) {
             list.destroy(ctx);
@@ -509,11 +594,11 @@ mod tests {
             place: [0, lo.1 << 16 | lo.0, end.1 << 16 | end.0, 0],
         };
         let listed = vec![
-            (0, false, entry((10, 20), (30, 40), 2)),
-            (0, false, entry((5, 30), (20, 50), 2)),
-            (0, true, entry((0, 0), (90, 90), 100)),
-            (0, true, entry((0, 0), (90, 90), 300)),
-            (2, true, entry((100, 0), (120, 16), 70)),
+            (0, Build::Tiles, entry((10, 20), (30, 40), 2)),
+            (0, Build::Tiles, entry((5, 30), (20, 50), 2)),
+            (0, Build::PerTriangle, entry((0, 0), (90, 90), 100)),
+            (0, Build::Cores, entry((0, 0), (90, 90), 300)),
+            (2, Build::PerTriangle, entry((100, 0), (120, 16), 70)),
         ];
         let (entries, groups) = object_groups(listed);
         assert_eq!(
@@ -526,9 +611,19 @@ mod tests {
                     tiled_rect: Some(((5, 20), (30, 50))),
                     per_triangle: 2,
                     triangles: 400,
+                    core_triangles: 300,
                     large_first: 5
                 },
-                ObjectGroup { set: 2, first: 4, tiled: 0, tiled_rect: None, per_triangle: 1, triangles: 70, large_first: 405 }
+                ObjectGroup {
+                    set: 2,
+                    first: 4,
+                    tiled: 0,
+                    tiled_rect: None,
+                    per_triangle: 1,
+                    triangles: 70,
+                    core_triangles: 0,
+                    large_first: 405
+                }
             ]
         );
         // The per-triangle entries number their first triangle within their set's.

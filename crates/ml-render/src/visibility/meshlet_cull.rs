@@ -26,8 +26,8 @@ use crate::sync::{Use, DEPTH_PYRAMID, MESHLET_VISIBILITY, VISIBILITY_DEPTH};
 use crate::targets::depth_pyramid_shape;
 use crate::technique::{LargeTriangles, Raster};
 use crate::visibility::meshlet_scene::{
-    MeshletScene, SharedMeshletScene, COMPACTED_INDICES, CULL_COUNTERS, DRAW_SLOTS, LARGE_BINS, LARGE_TRIANGLES, TRIANGLE_IDS,
-    VISIBLE_INSTANCES,
+    MeshletScene, SharedMeshletScene, COMPACTED_INDICES, CULL_COUNTERS, DRAW_SLOTS, LARGE_BINS, LARGE_TRIANGLES, LAYER_CANDIDATES,
+    TRIANGLE_IDS, VISIBLE_INSTANCES,
 };
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::commands::memory_barrier;
@@ -48,12 +48,13 @@ pub struct MeshletCull {
 
 impl MeshletCull {
     /// `layers`: the transparent objects are blended in layers, not drawn into the buffer —
-    /// but for their cores where `cores` (Shading::cores_constant) says so.
+    /// but for their cores where `cores` (Shading::cores_constant) says so, whose pixels the
+    /// compute raster lists for the layers' build where `candidates`.
     pub fn new(
         ctx: &Context,
         scene: SharedMeshletScene,
         phase: Phase,
-        (culling, raster, (layers, cores), antialiasing): (bool, Raster, (bool, Option<Constant>), Antialiasing),
+        (culling, raster, (layers, cores, candidates), antialiasing): (bool, Raster, (bool, Option<Constant>, bool), Antialiasing),
     ) -> Result<MeshletCull, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
         // Scenes with masked objects get the compute raster that draws their pixels from
@@ -90,7 +91,8 @@ impl MeshletCull {
                 Raster::Hardware => vec![antialiasing.constant()],
                 Raster::Compute { .. } => {
                     let [tests, masks] = p.scene.borrow().geometry.surface_constants();
-                    [tests, masks, antialiasing.constant()].into_iter().chain(cores).collect()
+                    let listing = candidates.then_some(("LAYER_CANDIDATES", 1));
+                    [tests, masks, antialiasing.constant()].into_iter().chain(cores).chain(listing).collect()
                 }
             };
             p.triangle_pipeline = compute_pipeline(ctx, triangles, p.pipeline_layout, &constants)?;
@@ -159,6 +161,10 @@ impl Pass for MeshletCull {
         if self.raster.bin_list().is_some() {
             uses.extend([Use::buffer(LARGE_BINS, compute), Use::buffer(LARGE_TRIANGLES, compute)]);
         }
+        if self.raster != Raster::Hardware {
+            // The compute raster binds the layer candidates' list (writing it where it lists).
+            uses.push(Use::buffer(LAYER_CANDIDATES, compute));
+        }
         uses
     }
 
@@ -224,8 +230,12 @@ impl FrameWork for MeshletCull {
     /// The late phase (whose counters are read back): the slot's large-triangle lists grown
     /// where its last frame overflowed them.
     fn prepare(&mut self, prepare: &mut Prepare) -> Result<(), RenderError> {
-        if self.phase == Phase::Late && self.scene.borrow_mut().grow_large_lists(prepare.ctx, prepare.slot)? {
-            prepare.rebind = true;
+        if self.phase == Phase::Late {
+            let mut scene = self.scene.borrow_mut();
+            let large = scene.grow_large_lists(prepare.ctx, prepare.slot)?;
+            if large | scene.grow_candidates(prepare.ctx, prepare.slot)? {
+                prepare.rebind = true;
+            }
         }
         Ok(())
     }
@@ -272,6 +282,9 @@ impl FrameWork for MeshletCull {
             in_place: c.rasterized[3] as u64,
             large_list: scene.frames[slot].large_capacity,
             scene_triangles: scene.geometry.triangles,
+            layer_candidates: c.candidates[0] as u64,
+            candidate_room: scene.frames[slot].candidate_capacity,
+            cores_per_triangle: c.candidates[1] != 0,
         });
     }
 }
@@ -315,6 +328,13 @@ pub struct CullStats {
     /// The lists' size in that frame (bins and large triangles each; they grow after a
     /// frame that overflowed them).
     pub large_list: u32,
+    /// Compute raster with transparent objects' cores: the soft samples it listed for the
+    /// layers (0: none listed), its list's room, and whether it left the cores to the
+    /// per-triangle build (a core triangle it clipped or drew in place, or the list full: it
+    /// grows).
+    pub layer_candidates: u64,
+    pub candidate_room: u32,
+    pub cores_per_triangle: bool,
 }
 
 impl FeatureStats for CullStats {
@@ -362,6 +382,24 @@ impl FeatureStats for CullStats {
                     ),
                 ))
             }
+        }
+        if c.layer_candidates > 0 || c.cores_per_triangle {
+            let built = if c.cores_per_triangle {
+                if c.layer_candidates > u64::from(c.candidate_room) {
+                    "; the list was full (it grows): the cores built a thread per triangle"
+                } else {
+                    "; a core triangle it clipped (or drew in place): the cores built a thread per triangle"
+                }
+            } else {
+                ""
+            };
+            rows.push((
+                "layer candidates",
+                format!(
+                    "{} soft samples of transparent cores listed for the layers (room for {}){built}",
+                    c.layer_candidates, c.candidate_room
+                ),
+            ));
         }
         rows
     }

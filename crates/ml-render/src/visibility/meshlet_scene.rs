@@ -33,6 +33,10 @@ pub const COMPACTED_INDICES: BufferName = BufferName("CompactedIndexBuffer");
 pub const TRIANGLE_IDS: BufferName = BufferName("TriangleIdBuffer");
 pub const LARGE_BINS: BufferName = BufferName("LargeBinBuffer");
 pub const LARGE_TRIANGLES: BufferName = BufferName("LargeTriangleBuffer");
+pub const LAYER_CANDIDATES: BufferName = BufferName("LayerCandidateBuffer");
+
+/// Bytes of a layer candidate (triangle_raster.glsl: a uvec4).
+const CANDIDATE_BYTES: u64 = 16;
 
 /// The culling's buffers of one frame slot.
 pub struct CullFrame {
@@ -50,6 +54,10 @@ pub struct CullFrame {
     pub large_triangles: Buffer,
     pub large_bins: Buffer,
     pub large_capacity: u32,
+    /// The compute raster's candidates for the transparent layers (cores of transparent
+    /// objects: triangle_raster.glsl), `candidate_capacity` of them (1 where it lists none).
+    pub layer_candidates: Buffer,
+    pub candidate_capacity: u32,
 }
 
 pub struct MeshletScene {
@@ -68,6 +76,8 @@ pub struct MeshletScene {
     /// frame again in the other slot).
     lists_grow: bool,
     grown: u32,
+    /// The candidates' list's size, grown like the large-triangle lists (0: none listed).
+    candidates_grown: u32,
 }
 
 /// Shared by the passes of one technique; destroyed by whichever is destroyed first.
@@ -76,11 +86,17 @@ pub type SharedMeshletScene = Rc<RefCell<MeshletScene>>;
 impl MeshletScene {
     /// The scene's meshlets `geometry` with per-frame culling buffers; `bin_list`: large
     /// triangles, and bins, the compute raster's lists hold per phase at first (0 where it
-    /// has none), and whether they grow.
-    pub fn new(ctx: &Context, geometry: MeshletGeometryView, (bin_list, lists_grow): (u32, bool)) -> Result<SharedMeshletScene, VkError> {
+    /// has none), and whether they grow; `candidates`: the layer candidates its list holds at
+    /// first (0 where the raster lists none; it grows).
+    pub fn new(
+        ctx: &Context,
+        geometry: MeshletGeometryView,
+        (bin_list, lists_grow, candidates): (u32, bool, u32),
+    ) -> Result<SharedMeshletScene, VkError> {
         let s = MeshletScene {
             lists_grow,
             grown: 0,
+            candidates_grown: candidates,
             geometry,
             visibility: Buffer::null(),
             frames: Vec::new(),
@@ -113,6 +129,8 @@ impl MeshletScene {
                 large_triangles: Buffer::null(),
                 large_bins: Buffer::null(),
                 large_capacity: bin_list,
+                layer_candidates: Buffer::null(),
+                candidate_capacity: self.candidates_grown.max(1),
             };
             let made = (|| {
                 f.counters = Buffer::new(
@@ -133,6 +151,7 @@ impl MeshletScene {
                 f.indices = Buffer::new(ctx, "compacted indices", index_bytes, storage | U::INDEX_BUFFER, MemoryLocation::GpuOnly)?;
                 f.triangle_ids = Buffer::new(ctx, "triangle ids", id_bytes, storage, MemoryLocation::GpuOnly)?;
                 (f.large_triangles, f.large_bins) = large_lists(ctx, bin_list)?;
+                f.layer_candidates = candidate_list(ctx, f.candidate_capacity)?;
                 Ok(())
             })();
             if let Err(e) = made {
@@ -160,6 +179,7 @@ impl MeshletScene {
             (TRIANGLE_IDS, &f.triangle_ids),
             (LARGE_BINS, &f.large_bins),
             (LARGE_TRIANGLES, &f.large_triangles),
+            (LAYER_CANDIDATES, &f.layer_candidates),
         ];
         match own.iter().find(|(n, _)| n.0 == name) {
             Some((_, buffer)) => Some(Resource::Buffer(buffer.raw)),
@@ -183,6 +203,31 @@ impl MeshletScene {
         std::mem::replace(&mut f.large_triangles, triangles).destroy(ctx);
         std::mem::replace(&mut f.large_bins, bins).destroy(ctx);
         f.large_capacity = capacity;
+        Ok(true)
+    }
+
+    /// Grow slot `slot`'s layer candidates' list where its last finished frame listed more
+    /// than it holds (that frame's cores were built by the per-triangle build instead: the
+    /// same image, slower), to 1.5× what it listed, at most what the device binds as one
+    /// storage buffer, or where another slot's has grown longer. Returns whether it grew (the
+    /// passes must then be bound to it again). Call only after the slot's fence has signalled.
+    pub fn grow_candidates(&mut self, ctx: &Context, slot: usize) -> Result<bool, VkError> {
+        let held = self.frames[slot].candidate_capacity;
+        if self.candidates_grown == 0 {
+            return Ok(false);
+        }
+        let asked = self.counters(slot).candidates[0];
+        let limit = ctx.info.limits.max_storage_buffer_range as u64 / CANDIDATE_BYTES;
+        let wanted = if asked > held { (u64::from(asked) * 3 / 2).min(limit) as u32 } else { 0 };
+        let capacity = wanted.max(self.candidates_grown);
+        if capacity <= held {
+            return Ok(false);
+        }
+        self.candidates_grown = capacity;
+        let list = candidate_list(ctx, capacity)?;
+        let f = &mut self.frames[slot];
+        std::mem::replace(&mut f.layer_candidates, list).destroy(ctx);
+        f.candidate_capacity = capacity;
         Ok(true)
     }
 
@@ -221,6 +266,12 @@ impl MeshletScene {
     }
 }
 
+/// The compute raster's list of `capacity` layer candidates.
+fn candidate_list(ctx: &Context, capacity: u32) -> Result<Buffer, VkError> {
+    let bytes = storage_bytes(ctx, "layer candidates", u64::from(capacity.max(1)) * CANDIDATE_BYTES)?;
+    Buffer::new(ctx, "layer candidates", bytes, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuOnly)
+}
+
 /// The compute raster's lists for `capacity` large triangles and as many bins (1 of each where
 /// there are none: a binding needs a buffer).
 fn large_lists(ctx: &Context, capacity: u32) -> Result<(Buffer, Buffer), VkError> {
@@ -249,6 +300,7 @@ impl CullFrame {
             &mut self.triangle_ids,
             &mut self.large_bins,
             &mut self.large_triangles,
+            &mut self.layer_candidates,
         ] {
             b.destroy(ctx);
         }

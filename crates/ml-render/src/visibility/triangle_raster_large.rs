@@ -14,7 +14,7 @@ use crate::specialization::{compute_pipeline, Constant};
 use crate::sync::{Use, VISIBILITY_DEPTH};
 use crate::technique::Raster;
 use crate::visibility::meshlet_cull::cull_push;
-use crate::visibility::meshlet_scene::{SharedMeshletScene, CULL_COUNTERS, LARGE_BINS, LARGE_TRIANGLES};
+use crate::visibility::meshlet_scene::{SharedMeshletScene, CULL_COUNTERS, LARGE_BINS, LARGE_TRIANGLES, LAYER_CANDIDATES};
 use ml_cpu::gpu_types::{CullCounters, CullPush};
 use ml_vk::{shader, vk, Context, VkError};
 
@@ -28,12 +28,13 @@ pub struct TriangleRasterLarge {
 }
 
 impl TriangleRasterLarge {
-    /// `cores`: Shading::cores_constant.
+    /// `cores`: Shading::cores_constant; `candidates`: it lists the cores' soft samples for
+    /// the layers.
     pub fn new(
         ctx: &Context,
         scene: SharedMeshletScene,
         phase: Phase,
-        (raster, antialiasing, cores): (Raster, Antialiasing, Option<Constant>),
+        (raster, antialiasing, (cores, candidates)): (Raster, Antialiasing, (Option<Constant>, bool)),
     ) -> Result<TriangleRasterLarge, VkError> {
         let compute = vk::ShaderStageFlags::COMPUTE;
         let shader = &ml_shaders::TRIANGLE_RASTER_LARGE_COMP;
@@ -49,7 +50,8 @@ impl TriangleRasterLarge {
             let push = [vk::PushConstantRange::default().stage_flags(compute).size(std::mem::size_of::<CullPush>() as u32)];
             p.pipeline_layout = shader::pipeline_layout(ctx, &[p.sets.layout.raw], &push)?;
             let [tests, masks] = p.scene.borrow().geometry.surface_constants();
-            let constants: Vec<_> = [tests, masks, antialiasing.constant()].into_iter().chain(cores).collect();
+            let listing = candidates.then_some(("LAYER_CANDIDATES", 1));
+            let constants: Vec<_> = [tests, masks, antialiasing.constant()].into_iter().chain(cores).chain(listing).collect();
             p.pipeline = compute_pipeline(ctx, shader, p.pipeline_layout, &constants)?;
             Ok(())
         })
@@ -82,6 +84,7 @@ impl Pass for TriangleRasterLarge {
             Use::buffer(LARGE_BINS, (S::COMPUTE_SHADER, A::SHADER_READ)),
             Use::buffer(LARGE_TRIANGLES, (S::COMPUTE_SHADER, rw)),
             Use::buffer(VISIBILITY_DEPTH, (S::COMPUTE_SHADER, rw)),
+            Use::buffer(LAYER_CANDIDATES, (S::COMPUTE_SHADER, rw)),
         ]
     }
 

@@ -34,8 +34,8 @@ use ml_cpu::scene::{AlphaMode, Object, Scene};
 use ml_cpu::shading::{aces_tone_map, encode_gamma_unorm8, shade_seed};
 use ml_cpu::transparency::{composite, Layer};
 use ml_render::{
-    Antialiasing, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings, TransparencyStats,
-    LAYER_KEEP,
+    Antialiasing, CullStats, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings,
+    TransparencyStats, LAYER_KEEP,
 };
 use serde_json::json;
 
@@ -570,18 +570,24 @@ pub fn blend_forest() -> Scene {
     forest
 }
 
-/// The forest of `blend_forest`: built over tiles or a thread per triangle, every byte and fragment the same, in the
-/// visibility technique (also at 8 samples) and the forward pass. The tiles' build tests
-/// every pixel of a tile, the other only its triangle's box: the boxes hold every pixel
-/// whose centre (or, at 8 samples, some sample) a leaf covers. The visibility raster draws
-/// the leaves' cores (their alpha is 0 or 1 but at the texels' edges), so few fragments are
-/// left to its layers; without samples its image is the forward pass's.
+/// The forest of `blend_forest` with its layers built three ways. Over tiles or a thread per
+/// triangle: every byte and fragment the same, in the visibility technique (also at 8
+/// samples) and the forward pass. The tiles' build tests every pixel of a tile, the other only
+/// its triangle's box: the boxes hold every pixel whose centre (or, at 8 samples, some
+/// sample) a leaf covers. The visibility raster draws the leaves' cores (their alpha is 0 or
+/// 1 but at the texels' edges), so few fragments are left to its layers; without samples its
+/// image is the forward pass's. And from the compute raster's candidates (the visibility
+/// technique's own way): the soft samples the raster found, by its coverage and alpha — a
+/// leaf's edge is cut where the raster cuts its core, not where the unsnapped triangle and
+/// the pixel's alpha put it — so a few edge pixels differ from the other builds (at 8
+/// samples more: each sample takes its own alpha, as the supersampled reference does; the
+/// anti-aliasing tests measure that against it).
 #[test]
 fn the_forest_is_the_same_from_either_build() {
     let forest = blend_forest();
-    let with = |(technique, antialiasing), tiled_up_to| RenderSettings {
+    let with = |(technique, antialiasing), tiled_up_to, candidates| RenderSettings {
         shading: ShadingModel::Pbr,
-        transparency: Some(TransparencySettings { tiled_up_to, ..TransparencySettings::default() }),
+        transparency: Some(TransparencySettings { tiled_up_to, candidates, ..TransparencySettings::default() }),
         antialiasing,
         ..settings(technique)
     };
@@ -589,8 +595,8 @@ fn the_forest_is_the_same_from_either_build() {
         [(Technique::Forward, Antialiasing::Off), (Technique::Visibility, Antialiasing::Off), (Technique::Visibility, Antialiasing::X8)];
     let mut first = Vec::new();
     for run in runs {
-        let out = common::render_each(&forest, &[with(run, 0), with(run, u32::MAX)]);
-        let (threads, tiles) = (stats(&out[0]), stats(&out[1]));
+        let out = common::render_each(&forest, &[with(run, 0, false), with(run, u32::MAX, false), with(run, 0, true)]);
+        let (threads, tiles, listed) = (stats(&out[0]), stats(&out[1]), stats(&out[2]));
         let name = format!("{} at {} samples", run.0.name(), run.1.samples());
         println!("{name} forest: {} fragments, {} pixels differ", threads.fragments, common::pixels_beyond(&out[0], &out[1], 0));
         // The cores leave the layers a leaf's edges alone: still fragments to compare.
@@ -598,14 +604,57 @@ fn the_forest_is_the_same_from_either_build() {
         assert!(threads.fragments > u64::from(W * H) / if cores { 400 } else { 4 }, "{name}: {threads:?}");
         assert_eq!(threads.fragments, tiles.fragments, "{name}");
         assert!(out[0].rgba == out[1].rgba, "{name}: the builds' images differ");
+        if cores {
+            let cull = *out[2].stats.feature::<CullStats>().expect("culling stats");
+            assert!(cull.layer_candidates > 0 && !cull.cores_per_triangle, "{name}: {cull:?}");
+            let (beyond, far) = (common::pixels_beyond(&out[0], &out[2], 2), common::pixels_beyond(&out[0], &out[2], 32));
+            println!(
+                "{name}: from the candidates {} fragments ({} listed); {beyond} pixels beyond 2/255 of the per-triangle build's, {far} beyond 32/255",
+                listed.fragments, cull.layer_candidates
+            );
+            let limit = if run.1 == Antialiasing::Off { W * H / 400 } else { W * H / 40 };
+            assert!(listed.fragments > 0 && beyond <= limit as usize && far <= (W * H / 400) as usize, "{name}: {beyond}, {far}");
+        } else {
+            assert_eq!(out[2].rgba, out[0].rgba, "{name}: candidates are the compute raster's");
+        }
         if run == (Technique::Visibility, Antialiasing::Off) {
             let forward = &first[0];
-            let beyond = common::pixels_beyond(forward, &out[0], 1);
-            println!("{name}: {beyond} pixels beyond 1/255 of forward ({} fragments there)", stats(forward).fragments);
-            assert!(threads.fragments < stats(forward).fragments / 4, "the cores left {threads:?}");
-            assert!(beyond <= (W * H / 100) as usize, "{name}: {beyond} pixels beyond 1/255 of forward");
+            for (build, out) in [("per-triangle", &out[0]), ("candidates", &out[2])] {
+                let beyond = common::pixels_beyond(forward, out, 1);
+                println!("{name}, {build}: {beyond} pixels beyond 1/255 of forward ({} fragments there)", stats(forward).fragments);
+                assert!(stats(out).fragments < stats(forward).fragments / 4, "the cores left {:?}", stats(out));
+                assert!(beyond <= (W * H / 100) as usize, "{name}, {build}: {beyond} pixels beyond 1/255 of forward");
+            }
         }
         first.extend(out.into_iter().take(1));
+    }
+}
+
+/// Inside a crown of the forest leaves cross the near plane, which the compute raster clips:
+/// it cannot list their soft samples, and leaves the frame's cores to the per-triangle build
+/// (the table says so) — every byte the image the per-triangle build gives without
+/// candidates, at one sample and at eight.
+#[test]
+fn a_frame_whose_raster_cannot_list_a_core_builds_the_cores_a_thread_per_triangle() {
+    let mut forest = blend_forest();
+    let crown = forest.objects.iter().find(|o| o.extras.has_core()).expect("a crown with cores");
+    let (lo, hi) = crown.bounds();
+    let eye = (lo + hi) * 0.5;
+    forest.camera = Camera::looking_at(eye, eye + Vec3::new(1.0, -0.2, 0.3), 70.0, 0.05, 100.0);
+    for antialiasing in [Antialiasing::Off, Antialiasing::X8] {
+        let with = |candidates| RenderSettings {
+            shading: ShadingModel::Pbr,
+            transparency: Some(TransparencySettings { candidates, ..TransparencySettings::default() }),
+            antialiasing,
+            ..settings(Technique::Visibility)
+        };
+        let out = common::render_each(&forest, &[with(true), with(false)]);
+        let cull = *out[0].stats.feature::<CullStats>().expect("culling stats");
+        assert!(cull.cores_per_triangle, "{cull:?}");
+        assert!(stats(&out[0]).fragments > 0);
+        assert!(out[0].rgba == out[1].rgba, "at {} samples", antialiasing.samples());
+        let row = out[0].stats.feature_rows().into_iter().find(|(name, _)| *name == "layer candidates").expect("a row of its own").1;
+        assert!(row.contains("built a thread per triangle"), "{row}");
     }
 }
 
