@@ -25,7 +25,8 @@ use crate::shadows::sun_shadow::SunShadowPass;
 use crate::shadows::{omni_shadow_compute, omni_shadow_pass, shadow_map_view, shadow_settings};
 use crate::specialization::Constants;
 use crate::technique::Geometry;
-use crate::transparency::{transparent_build::TransparentBuild, transparent_resolve::TransparentResolve};
+use crate::transparency::transparent_build::{RasterBuffers, TransparentBuild};
+use crate::transparency::transparent_resolve::TransparentResolve;
 use crate::visibility::meshlet_scene::{MeshletScene, SharedMeshletScene};
 use crate::visibility::{depth_pyramid, meshlet_cull, triangle_raster_large, visibility_gather, visibility_lighting, visibility_raster};
 use ml_cpu::gpu_types::PointLight;
@@ -147,6 +148,11 @@ fn add_passes(ctx: &Context, a: &Assembly, passes: &mut Vec<Box<dyn Pass>>) -> R
     Ok(())
 }
 
+/// The meshlet scene's buffers of a frame slot by name, for the transparent layers' build.
+fn raster_buffers(scene: SharedMeshletScene) -> RasterBuffers {
+    Box::new(move |slot, name| scene.borrow().slot_buffer(slot, name))
+}
+
 /// Layer candidates the compute raster's list holds at first (16 MiB; it grows after a frame
 /// that listed more).
 const INITIAL_CANDIDATES: u32 = 1 << 20;
@@ -237,7 +243,7 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
         PassKind::ShadowMapView(shown) => Box::new(shadow_map_view::ShadowMapView::new(ctx, a.scene, &a.shadows.borrow(), shown)?),
         PassKind::ExposureMeter { curve } => Box::new(exposure_meter::ExposureMeter::new(ctx, curve)?),
         PassKind::TransparentBuild { depth_buffer } => {
-            let meshlets = if depth_buffer { Some(shared()?) } else { None };
+            let meshlets = if depth_buffer { Some(raster_buffers(shared()?)) } else { None };
             Box::new(TransparentBuild::new(
                 ctx,
                 (a.scene, a.objects, meshlets),

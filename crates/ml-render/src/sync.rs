@@ -283,6 +283,15 @@ pub const DEPTH_PYRAMID: BufferName = BufferName("DepthPyramidBuffer");
 /// the hybrid's fragments, read by the depth pyramid and the lighting.
 pub const VISIBILITY_DEPTH: BufferName = BufferName("VisibilityDepthBuffer");
 
+/// The culling's counters of the frame slot (its shader block's name; `CullCounters`):
+/// cleared and written by the culling and the compute raster, read as indirect commands and by
+/// the transparent layers' build.
+pub const CULL_COUNTERS: BufferName = BufferName("CullCounterBuffer");
+
+/// The compute raster's candidates for the transparent layers (its shader block's name):
+/// written by the rasters, read by the layers' build.
+pub const LAYER_CANDIDATES: BufferName = BufferName("LayerCandidateBuffer");
+
 /// The frame slot's opaque surface colours at their first samples (visibility with
 /// anti-aliasing and transparent layers; its shader block's name): written by the lighting,
 /// read by the transparent layers' blend.

@@ -20,12 +20,15 @@ use crate::read_back::HostRead;
 use crate::report::FrameStats;
 use crate::scene::SceneGpu;
 use crate::shading::Shading;
-use crate::sync::{BufferName, Use, DEPTH_PYRAMID, LIGHT_LISTS, VISIBILITY_DEPTH};
-use crate::visibility::meshlet_scene::{SharedMeshletScene, CULL_COUNTERS, LAYER_CANDIDATES};
+use crate::sync::{BufferName, Use, CULL_COUNTERS, DEPTH_PYRAMID, LAYER_CANDIDATES, LIGHT_LISTS, VISIBILITY_DEPTH};
 use ml_cpu::gpu_types::{CullCounters, LayerObject};
 use ml_cpu::scene::Object;
 use ml_vk::commands::{memory_barrier, one_shot, update_buffer};
 use ml_vk::{vk, Buffer, Context, MemoryLocation, VkError};
+
+/// The compute raster's buffers a frame slot's build binds, by their shader blocks' names
+/// (its meshlets, counters and candidates; the visibility passes own them).
+pub type RasterBuffers = Box<dyn Fn(usize, &str) -> Option<Resource>>;
 
 /// Work groups of one dispatch along x (Vulkan's least maxComputeWorkGroupCount): the
 /// per-triangle build dispatches a texture set's triangles in pieces of this many groups.
@@ -52,8 +55,8 @@ pub struct TransparentBuild {
     large: ComputePass,
     /// The cores' candidates the compute raster listed (`candidates`).
     listed: ComputePass,
-    /// The meshlets the compute raster draws, its counters and candidates (with its buffer).
-    meshlet_scene: Option<SharedMeshletScene>,
+    /// The compute raster's meshlets, counters and candidates (with its buffer).
+    raster_buffers: Option<RasterBuffers>,
     /// The raster lists the cores' candidates.
     candidates: bool,
     /// Set 3 of the builds, per frame slot: the meshes, the slot's entries and the listed
@@ -86,12 +89,12 @@ struct DispatchPush {
 }
 
 impl TransparentBuild {
-    /// The build over the compute raster's buffer where `depth_buffer` (its meshlets in
-    /// `meshlet_scene`, which lists the cores' candidates where `candidates`), else over the
-    /// depth target.
+    /// The build over the compute raster's buffer where `depth_buffer` (its meshlets, counters
+    /// and candidates in `raster_buffers`; it lists the cores' candidates where
+    /// `candidates`), else over the depth target.
     pub fn new(
         ctx: &Context,
-        (scene, objects, meshlet_scene): (&SceneGpu, &[Object], Option<SharedMeshletScene>),
+        (scene, objects, raster_buffers): (&SceneGpu, &[Object], Option<RasterBuffers>),
         (shading, settings): (Shading, TransparencySettings),
         (depth_buffer, candidates): (bool, bool),
     ) -> Result<TransparentBuild, VkError> {
@@ -125,7 +128,7 @@ impl TransparentBuild {
             triangles: ComputePass::empty(),
             large: ComputePass::empty(),
             listed: ComputePass::empty(),
-            meshlet_scene,
+            raster_buffers,
             candidates: candidates && depth_buffer,
             mesh_sets,
             meshes: LayerMeshes { vertices: Buffer::null(), indices: Buffer::null(), places: Vec::new() },
@@ -256,9 +259,9 @@ impl TransparentBuild {
                     self.triangles.dispatch(ctx, cmd, rec.slot, push, vk::Extent2D { width: count, height: 1 });
                 }
             }
-            if let Some(meshlets) = self.meshlet_scene.as_ref().filter(|_| g.core_triangles > 0) {
+            let counters = self.raster_buffers.as_ref().and_then(|find| find(rec.slot, CULL_COUNTERS.0));
+            if let Some(Resource::Buffer(counters)) = counters.filter(|_| g.core_triangles > 0) {
                 after_earlier();
-                let counters = meshlets.borrow().frames[rec.slot].counters.raw;
                 let push = DispatchPush { objects: [g.set, 0, 0, 0], large_list: [0; 4] };
                 let groups = std::mem::offset_of!(CullCounters, candidate_groups) as u64;
                 self.listed.dispatch_indirect(ctx, cmd, rec.slot, (&sets, bytemuck::bytes_of(&push)), (counters, groups));
@@ -465,13 +468,13 @@ impl Pass for TransparentBuild {
         }
         let (vertices, indices) = (self.meshes.vertices.raw, self.meshes.indices.raw);
         let (entries, large) = (self.object_lists[frame.slot].raw, self.large_counts[frame.slot].raw);
-        let meshlets = self.meshlet_scene.as_ref().map(|m| m.borrow());
+        let raster = self.raster_buffers.as_ref();
         self.mesh_sets.write(ctx, frame.slot, &|name| match name {
             "MeshVertexBuffer" => Some(Resource::Buffer(vertices)),
             "MeshIndexBuffer" => Some(Resource::Buffer(indices)),
             "LayerObjectBuffer" => Some(Resource::Buffer(entries)),
             "LargeTriangleCountBuffer" => Some(Resource::Buffer(large)),
-            _ => meshlets.as_ref().and_then(|m| m.buffer(frame, name)),
+            _ => raster.and_then(|find| find(frame.slot, name)),
         })
     }
 
@@ -521,9 +524,6 @@ impl Pass for TransparentBuild {
         self.large.destroy(ctx);
         self.listed.destroy(ctx);
         self.mesh_sets.destroy(ctx);
-        if let Some(scene) = self.meshlet_scene.take() {
-            scene.borrow_mut().destroy(ctx);
-        }
         ml_vk::Release::release(&mut self.meshes, ctx);
         for list in self.object_lists.iter_mut().chain(&mut self.large_counts) {
             list.destroy(ctx);

@@ -17,6 +17,7 @@ use crate::frame_resources::FRAMES_IN_FLIGHT;
 use crate::read_back::ReadBack;
 use crate::scene::meshlets::{storage_bytes, MeshletGeometryView};
 use crate::sync::{BufferName, MESHLET_VISIBILITY};
+pub use crate::sync::{CULL_COUNTERS, LAYER_CANDIDATES};
 use gpu_allocator::MemoryLocation;
 use ml_cpu::gpu_types::{CullCounters, LargeTriangle};
 use ml_vk::{vk, Buffer, Context, VkError};
@@ -26,14 +27,12 @@ use std::rc::Rc;
 /// The culling's per-slot buffers, by their shader blocks' names: every pass that touches one
 /// declares it (`Pass::uses`), and the barriers between those passes are derived (`sync`);
 /// so is the meshlet visibility the slots share (`sync::MESHLET_VISIBILITY`).
-pub const CULL_COUNTERS: BufferName = BufferName("CullCounterBuffer");
 pub const VISIBLE_INSTANCES: BufferName = BufferName("VisibleInstanceBuffer");
 pub const DRAW_SLOTS: BufferName = BufferName("DrawSlotBuffer");
 pub const COMPACTED_INDICES: BufferName = BufferName("CompactedIndexBuffer");
 pub const TRIANGLE_IDS: BufferName = BufferName("TriangleIdBuffer");
 pub const LARGE_BINS: BufferName = BufferName("LargeBinBuffer");
 pub const LARGE_TRIANGLES: BufferName = BufferName("LargeTriangleBuffer");
-pub const LAYER_CANDIDATES: BufferName = BufferName("LayerCandidateBuffer");
 
 /// Bytes of a layer candidate (triangle_raster.glsl: a uvec4).
 const CANDIDATE_BYTES: u64 = 16;
@@ -166,7 +165,12 @@ impl MeshletScene {
     /// The buffer a culling, raster or lighting shader calls `name`, of `frame`'s slot: the
     /// scene's own, else the frame's (its uniforms, targets and scene buffers).
     pub fn buffer(&self, frame: &FrameResources, name: &str) -> Option<Resource> {
-        let f = &self.frames[frame.slot];
+        self.slot_buffer(frame.slot, name).or_else(|| frame.resource(name))
+    }
+
+    /// The scene's own buffer called `name`, of slot `slot` where it has one per slot.
+    pub fn slot_buffer(&self, slot: usize, name: &str) -> Option<Resource> {
+        let f = &self.frames[slot];
         if let Some(found) = self.geometry.buffer(name) {
             return Some(found);
         }
@@ -181,10 +185,7 @@ impl MeshletScene {
             (LARGE_TRIANGLES, &f.large_triangles),
             (LAYER_CANDIDATES, &f.layer_candidates),
         ];
-        match own.iter().find(|(n, _)| n.0 == name) {
-            Some((_, buffer)) => Some(Resource::Buffer(buffer.raw)),
-            None => frame.resource(name),
-        }
+        own.iter().find(|(n, _)| n.0 == name).map(|(_, buffer)| Resource::Buffer(buffer.raw))
     }
 
     /// Grow slot `slot`'s large-triangle lists where its last finished frame asked for more
