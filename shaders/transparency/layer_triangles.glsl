@@ -360,33 +360,12 @@ bool samples_outside(uint i, vec3 q, vec2 to_ndc) {
     return false;
 }
 
-// Which of the samples `listed` (a bit each) of pixel `p` triangle `i`'s plane lies in front
-// of the opaque samples at: the compute raster's candidates (transparent_build_candidates.glsl)
-// say which samples it covers, its own set-up only how deep it lies there.
-uint listed_in_front(uint i, ivec2 p, uint listed, vec2 to_ndc) {
-    vec3 r0 = tri_edges[i][0], r1 = tri_edges[i][1], r2 = tri_edges[i][2];
-    vec3 z = tri_z[i], w = tri_w[i];
-    uint covered = 0u;
-    for (uint k = 0u; k < VISIBILITY_SAMPLES; k++) {
-        if ((listed & (1u << k)) == 0u) {
-            continue;
-        }
-        vec3 q = vec3(sample_xy(p, k) * to_ndc - 1.0, 1.0);
-        vec3 e = vec3(dot(r0, q), dot(r1, q), dot(r2, q));
-        float a = dot(e, z), b = dot(e, w);
-        if (b > 0.0 && a >= 0.0 && a <= b && a < opaque_depth_of_sample(p, k) * b) {
-            covered |= 1u << k;
-        }
-    }
-    return covered;
-}
-
 // Whether triangle `i` leaves a fragment at pixel `p`: the samples it covers in front of the
 // opaque surface there (`covered`, a bit each; without anti-aliasing, bit 0: the centre, in
 // front of `opaque`), and at the point the pixel shades it (`q`: the centre, or with
 // anti-aliasing visibility_samples.glsl shading_xy of its samples — inside the triangle, as
 // they are) its barycentrics, depth and coverage. `listed`: 0, or the samples the compute
-// raster found it covers there, none of them opaque (listed_in_front).
+// raster found it covers there in front of the opaque ones, which it takes as they are.
 bool layer_fragment_of(uint i, ivec2 p, vec2 to_ndc, float opaque, uint listed, out vec3 q, out uint covered, out vec3 w, out float depth,
                        out float alpha) {
     q = vec3((vec2(p) + 0.5) * to_ndc - 1.0, 1.0);
@@ -398,10 +377,7 @@ bool layer_fragment_of(uint i, ivec2 p, vec2 to_ndc, float opaque, uint listed, 
         return false;
     }
     if (listed != 0u) {
-        covered = listed_in_front(i, p, listed, to_ndc);
-        if (covered == 0u) {
-            return false;
-        }
+        covered = listed;
         q = vec3(shading_xy(p, covered) * to_ndc - 1.0, 1.0);
         w = barycentrics(i, q);
         depth = dot(w, tri_z[i]) / dot(w, tri_w[i]);

@@ -284,10 +284,11 @@ bool masked_covers_any(uint i, uint n) {
 
 // Sample k of pixel `n` of triangle i's box drawn where the triangle covers it and its alpha
 // keeps the sample's point; returns 1 where drawn, else 0, or MASK_PIXEL_FILTER where the
-// texture must be filtered to tell and `filter_now` is false. `soft`: a core's sample for
-// the layers (layer_candidates.glsl): drawn where its alpha is 1, soft where between.
-uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool filter_now, out bool soft) {
-    soft = false;
+// texture must be filtered to tell and `filter_now` is false. `soft`: a core's sample's depth
+// where it is for the layers (layer_candidates.glsl: drawn where its alpha is 1, soft where
+// between), else -1.
+uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool filter_now, out float soft) {
+    soft = -1.0;
     ivec2 cell = masked_cell(i, n);
     ivec3 w;
     if (!masked_covers(i, cell, k, w)) {
@@ -305,12 +306,9 @@ uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool fil
         if (verdict == FILTER_SAMPLE && !filter_now) {
             return MASK_PIXEL_FILTER;
         }
-        float alpha = verdict == CORE_SAMPLE ? 1.0 : verdict == CLEAR_SAMPLE ? 0.0 : 0.5;
-        if (verdict == FILTER_SAMPLE) {
-            alpha = s.alpha.y * texture_alpha(s.alpha_texture, uv);
-        }
+        float alpha = core_sample_alpha(s.alpha, s.alpha_texture, uv, verdict);
         if (alpha < 1.0) {
-            soft = soft_in_front(alpha, pixel, k, depth);
+            soft = soft_in_front(alpha, pixel, k, depth) ? depth : -1.0;
             return 0u;
         }
     } else {
@@ -327,11 +325,13 @@ uint draw_masked_sample(uint i, uint n, uint k, uint id, SurfaceTest s, bool fil
 }
 
 // Sample k of pixel `n` of triangle i's box (visibility id `id`) listed for the layers where
-// `soft` (every active lane calls it together).
-void list_masked_soft_sample(bool soft, uint i, uint n, uint k, uint id) {
-    vec3 z = mask_z_inv_w[i].xyz;
-    ivec2 pixel = ivec2(mask_box[i].x & 0xffff, mask_box[i].x >> 16) + masked_cell(i, n);
-    list_soft_sample(soft, k, pixel, id, min(z.x, min(z.y, z.z)));
+// soft (`soft`: its depth, else negative; every active lane calls it together).
+void list_masked_soft_sample(float soft, uint i, uint n, uint k, uint id) {
+    uvec4 c = uvec4(0u);
+    if (soft >= 0.0) {
+        c = layer_candidate(k, ivec2(mask_box[i].x & 0xffff, mask_box[i].x >> 16) + masked_cell(i, n), id, soft);
+    }
+    list_soft_sample(soft >= 0.0, c);
 }
 
 // Covered pixels (triangle << 16 | pixel number in its box) queued per subgroup, two
@@ -353,7 +353,7 @@ uint draw_queued(uint queue, uint count, uint first, uvec4 d, SurfaceTest s) {
     for (uint item = gl_SubgroupInvocationID; item < count * VISIBILITY_SAMPLES; item += gl_SubgroupSize) {
         uint e = mask_queue[queue + item / VISIBILITY_SAMPLES], k = item % VISIBILITY_SAMPLES;
         uint i = e >> 16u, n = e & 0xffffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
-        bool soft;
+        float soft;
         uint got = draw_masked_sample(i, n, k, id, s, false, soft);
         if (got != MASK_PIXEL_FILTER) {
             drawn += got;
@@ -473,7 +473,7 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
         uint filtered = min(mask_filtered, MASK_FILTER_CAPACITY);
         for (uint k = lid; k < filtered; k += gl_WorkGroupSize.x) {
             uint e = mask_filter[k], i = (e >> 16u) & 0xffu, id = (d.x << VISIBILITY_TRIANGLE_BITS) | (first + i);
-            bool soft;
+            float soft;
             pixels += draw_masked_sample(i, e & 0xffffu, e >> 24u, id, s, true, soft);
             if (core) {
                 list_masked_soft_sample(soft, i, e & 0xffffu, e >> 24u, id);

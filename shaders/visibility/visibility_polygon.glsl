@@ -79,6 +79,16 @@ vec4 large_depth(uint at, int k) {
 // Sample k of every `step`-th pixel of each row of [from, to] (from from.x on) that the fan
 // triangle covers (and `s` keeps) drawn with visibility id `id`, the edge functions stepped
 // from pixel to pixel (exact: integers); returns the samples covered.
+#ifdef MANYLIGHTS_LAYER_CANDIDATES_GLSL
+// A transparent core's alpha at the point `xy` (in pixels) as the raster needs it
+// (core_sample_alpha).
+float core_alpha_at(SurfaceTest s, vec2 xy, vec2 size) {
+    vec3 l = clip_barycentrics(s.clip[0], s.clip[1], s.clip[2], xy / size * 2.0 - 1.0);
+    vec2 uv = l.x * s.uv[0] + l.y * s.uv[1] + l.z * s.uv[2];
+    return core_sample_alpha(s.alpha, s.alpha_texture, uv, core_sample_verdict(s.alpha, s.alpha_texture, uv));
+}
+#endif
+
 uint fan_samples(FanTriangle t, ivec2 from, ivec2 to, int step, uint k, uint id, SurfaceTest s, bool listing) {
     // Per sub-pixel to the right and down, each edge function changes by −d.y and d.x.
     i64vec3 unit_x = -i64vec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);
@@ -96,26 +106,31 @@ uint fan_samples(FanTriangle t, ivec2 from, ivec2 to, int step, uint k, uint id,
     for (int y = from.y; y <= to.y; y++, row += step_y) {
         i64vec3 w = row;
         for (int x = from.x; x <= to.x; x += step, w += step_x) {
-            bool soft = false;
-            if (all(greaterThanEqual(w - bias, i64vec3(0)))) {
-                vec3 weights = vec3(w);
-                float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
-                vec2 xy = vec2(x, y) + vec2(sample_offset(k)) / SUBPIXEL;
-                if (surface_kept_at(s, xy, size)) {
-                    covered++;
-                    keep_nearest_id(ivec2(x, y), k, depth, id);
-                } else if (listing) {
-#ifdef MANYLIGHTS_LAYER_CANDIDATES_GLSL
-                    vec3 l = clip_barycentrics(s.clip[0], s.clip[1], s.clip[2], xy / size * 2.0 - 1.0);
-                    soft = soft_sample(s.alpha, s.alpha_texture, l.x * s.uv[0] + l.y * s.uv[1] + l.z * s.uv[2], ivec2(x, y), k, depth);
-#endif
-                }
+            if (any(lessThan(w - bias, i64vec3(0)))) {
+                continue;
             }
+            vec3 weights = vec3(w);
+            float depth = dot(weights, z) / (weights.x + weights.y + weights.z);
+            vec2 xy = vec2(x, y) + vec2(sample_offset(k)) / SUBPIXEL;
+            bool kept;
 #ifdef MANYLIGHTS_LAYER_CANDIDATES_GLSL
             if (listing) {
-                list_soft_sample(soft, k, ivec2(x, y), id, min(z.x, min(z.y, z.z)));
-            }
+                // A transparent core's sample: drawn where its alpha is 1; where between,
+                // listed for the layers (by the soft lanes alone).
+                float alpha = core_alpha_at(s, xy, size);
+                kept = alpha >= 1.0;
+                if (!kept && soft_in_front(alpha, ivec2(x, y), k, depth)) {
+                    list_soft_sample(true, layer_candidate(k, ivec2(x, y), id, depth));
+                }
+            } else
 #endif
+            {
+                kept = surface_kept_at(s, xy, size);
+            }
+            if (kept) {
+                covered++;
+                keep_nearest_id(ivec2(x, y), k, depth, id);
+            }
         }
     }
     return covered;

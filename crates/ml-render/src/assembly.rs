@@ -167,8 +167,12 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
     let atomic = s.raster != Raster::Hardware;
     // Samples per pixel of that buffer.
     let aa = s.antialiasing;
-    // The compute raster lists the pixels of transparent objects' cores for the layers' build.
+    // The compute raster lists the soft samples of transparent objects' cores for the layers'
+    // build, one sample a pixel (with more, a node a sample swamped the pool where whole
+    // pixels are soft, and joining a pixel's samples as the list happened to order them made
+    // renders differ).
     let listing_candidates = a.shading.blended_cores
+        && aa.samples() == 1
         && s.raster.bin_list().is_some()
         && s.transparency.is_some_and(|t| t.candidates)
         && a.objects.iter().any(|o| o.extras.has_core());

@@ -577,11 +577,10 @@ pub fn blend_forest() -> Scene {
 /// sample) a leaf covers. The visibility raster draws the leaves' cores (their alpha is 0 or
 /// 1 but at the texels' edges), so few fragments are left to its layers; without samples its
 /// image is the forward pass's. And from the compute raster's candidates (the visibility
-/// technique's own way): the soft samples the raster found, by its coverage and alpha — a
-/// leaf's edge is cut where the raster cuts its core, not where the unsnapped triangle and
-/// the pixel's alpha put it — so a few edge pixels differ from the other builds (at 8
-/// samples more: each sample takes its own alpha, as the supersampled reference does; the
-/// anti-aliasing tests measure that against it).
+/// technique's own way without anti-aliasing): the soft samples the raster found, by its
+/// coverage and alpha — a leaf's edge is cut where the raster cuts its core, not where the
+/// unsnapped triangle puts it — so a few edge pixels differ from the other builds. With
+/// samples the raster lists none: the per-triangle build's bytes.
 #[test]
 fn the_forest_is_the_same_from_either_build() {
     let forest = blend_forest();
@@ -604,7 +603,7 @@ fn the_forest_is_the_same_from_either_build() {
         assert!(threads.fragments > u64::from(W * H) / if cores { 400 } else { 4 }, "{name}: {threads:?}");
         assert_eq!(threads.fragments, tiles.fragments, "{name}");
         assert!(out[0].rgba == out[1].rgba, "{name}: the builds' images differ");
-        if cores {
+        if cores && run.1 == Antialiasing::Off {
             let cull = *out[2].stats.feature::<CullStats>().expect("culling stats");
             assert!(cull.layer_candidates > 0 && !cull.cores_per_triangle, "{name}: {cull:?}");
             let (beyond, far) = (common::pixels_beyond(&out[0], &out[2], 2), common::pixels_beyond(&out[0], &out[2], 32));
@@ -612,10 +611,9 @@ fn the_forest_is_the_same_from_either_build() {
                 "{name}: from the candidates {} fragments ({} listed); {beyond} pixels beyond 2/255 of the per-triangle build's, {far} beyond 32/255",
                 listed.fragments, cull.layer_candidates
             );
-            let limit = if run.1 == Antialiasing::Off { W * H / 400 } else { W * H / 40 };
-            assert!(listed.fragments > 0 && beyond <= limit as usize && far <= (W * H / 400) as usize, "{name}: {beyond}, {far}");
+            assert!(listed.fragments > 0 && beyond <= (W * H / 400) as usize && far <= (W * H / 1000) as usize, "{name}: {beyond}, {far}");
         } else {
-            assert_eq!(out[2].rgba, out[0].rgba, "{name}: candidates are the compute raster's");
+            assert!(out[2].rgba == out[0].rgba, "{name}: the compute raster listed candidates");
         }
         if run == (Technique::Visibility, Antialiasing::Off) {
             let forward = &first[0];
@@ -633,7 +631,7 @@ fn the_forest_is_the_same_from_either_build() {
 /// Inside a crown of the forest leaves cross the near plane, which the compute raster clips:
 /// it cannot list their soft samples, and leaves the frame's cores to the per-triangle build
 /// (the table says so) — every byte the image the per-triangle build gives without
-/// candidates, at one sample and at eight.
+/// candidates.
 #[test]
 fn a_frame_whose_raster_cannot_list_a_core_builds_the_cores_a_thread_per_triangle() {
     let mut forest = blend_forest();
@@ -641,21 +639,18 @@ fn a_frame_whose_raster_cannot_list_a_core_builds_the_cores_a_thread_per_triangl
     let (lo, hi) = crown.bounds();
     let eye = (lo + hi) * 0.5;
     forest.camera = Camera::looking_at(eye, eye + Vec3::new(1.0, -0.2, 0.3), 70.0, 0.05, 100.0);
-    for antialiasing in [Antialiasing::Off, Antialiasing::X8] {
-        let with = |candidates| RenderSettings {
-            shading: ShadingModel::Pbr,
-            transparency: Some(TransparencySettings { candidates, ..TransparencySettings::default() }),
-            antialiasing,
-            ..settings(Technique::Visibility)
-        };
-        let out = common::render_each(&forest, &[with(true), with(false)]);
-        let cull = *out[0].stats.feature::<CullStats>().expect("culling stats");
-        assert!(cull.cores_per_triangle, "{cull:?}");
-        assert!(stats(&out[0]).fragments > 0);
-        assert!(out[0].rgba == out[1].rgba, "at {} samples", antialiasing.samples());
-        let row = out[0].stats.feature_rows().into_iter().find(|(name, _)| *name == "layer candidates").expect("a row of its own").1;
-        assert!(row.contains("built a thread per triangle"), "{row}");
-    }
+    let with = |candidates| RenderSettings {
+        shading: ShadingModel::Pbr,
+        transparency: Some(TransparencySettings { candidates, ..TransparencySettings::default() }),
+        ..settings(Technique::Visibility)
+    };
+    let out = common::render_each(&forest, &[with(true), with(false)]);
+    let cull = *out[0].stats.feature::<CullStats>().expect("culling stats");
+    assert!(cull.cores_per_triangle, "{cull:?}");
+    assert!(stats(&out[0]).fragments > 0);
+    assert!(out[0].rgba == out[1].rgba);
+    let row = out[0].stats.feature_rows().into_iter().find(|(name, _)| *name == "layer candidates").expect("a row of its own").1;
+    assert!(row.contains("built a thread per triangle"), "{row}");
 }
 
 /// A mesh of one object whose two triangles meet at every point of a pixel (the same square
