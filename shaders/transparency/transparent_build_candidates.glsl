@@ -8,9 +8,10 @@
 // depth against the finished buffer: the test the listing made against the buffer so far,
 // so what is kept does not depend on the order the raster drew in); the others set their
 // triangle up from the meshlets — as the per-triangle build sets up its triangles — and keep
-// a node of their sample, shaded there. (A node for each soft sample, not each pixel: joining
-// the samples a pixel lists side by side made renders at 8 samples differ, as the list's
-// order does; and cost about as much.)
+// a node of their sample, shaded there. The renderer has the raster list candidates only
+// without anti-aliasing: with samples a node each swamped the pool where whole pixels are
+// soft (a decal), and joining the samples a pixel listed side by side made renders differ,
+// as the list's order does.
 //
 // Where the raster could not list them all (CullCounters.candidates.y: a core triangle it
 // clipped, or the list full) the cores are the per-triangle build's, and this does nothing.
