@@ -1,9 +1,10 @@
 // The compute raster's candidates for the transparent layers (transparent_build_candidates.glsl):
 // where it tests a sample of a transparent object with a core (blended_cores.glsl) and finds
 // its alpha between 0 and 1 — not the core's, not cut out — in front of what the buffer
-// holds so far, it lists the sample: its pixel, its bit, the visibility id and its depth. Both compute rasters include it (the small triangles' and the large ones'); the includer declares `counters`
-// (CullCounterBuffer), `visibility_depth` (uint64_t) and LAYER_CANDIDATE_BINDING, and
-// includes alpha_mask.glsl and blended_cores.glsl first.
+// holds so far, it lists the sample: its pixel, its bit, the visibility id and its depth.
+// Both compute rasters include it (the small triangles' and the large ones'); the includer
+// declares `counters` (CullCounterBuffer), `visibility_depth` (uint64_t) and
+// LAYER_CANDIDATE_BINDING, and includes alpha_mask.glsl and blended_cores.glsl first.
 
 #ifndef MANYLIGHTS_LAYER_CANDIDATES_GLSL
 #define MANYLIGHTS_LAYER_CANDIDATES_GLSL
@@ -33,6 +34,8 @@ bool soft_in_front(float alpha, ivec2 pixel, uint k, float depth) {
     if (alpha <= 0.0) {
         return false;
     }
+    // (Read while other threads' atomics may lower it: any value it held this frame is no
+    // nearer than the finished buffer's, against which the candidates' build decides.)
     uvec2 there = unpack32(visibility_depth[sample_slot(pixel, k, frame.viewport.x)]);
     return depth < visibility_buffer_depth(there);
 }

@@ -57,9 +57,9 @@ pub struct TransparencySettings {
     /// The scene's PBR extensions vary per point, so nodes keep their texels too
     /// (`node_bytes`; settled by the renderer from the scene).
     pub lobe_textures: bool,
-    /// The compute raster lists the pixels of transparent objects' cores for the layers
-    /// (transparent_build_candidates.glsl; else the per-triangle build takes them: the same
-    /// fragments, which tests check by switching this off).
+    /// Without anti-aliasing, the compute raster lists the soft samples of transparent
+    /// objects' cores for the layers (transparent_build_candidates.glsl); else the
+    /// per-triangle build takes the cores (tests compare the two by switching this off).
     pub candidates: bool,
 }
 
