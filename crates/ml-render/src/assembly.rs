@@ -153,10 +153,6 @@ fn raster_buffers(scene: SharedMeshletScene) -> RasterBuffers {
     Box::new(move |slot, name| scene.borrow().slot_buffer(slot, name))
 }
 
-/// Layer candidates the compute raster's list holds at first (16 MiB; it grows after a frame
-/// that listed more).
-const INITIAL_CANDIDATES: u32 = 1 << 20;
-
 /// The pass of `kind` for the assembly's scene and settings.
 fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<SharedMeshletScene>) -> Result<Box<dyn Pass>, RenderError> {
     let s = a.settings;
@@ -174,11 +170,11 @@ fn make_pass(ctx: &Context, a: &Assembly, kind: PassKind, meshlets: &mut Option<
     let listing_candidates = a.shading.blended_cores
         && aa.samples() == 1
         && s.raster.bin_list().is_some()
-        && s.transparency.is_some_and(|t| t.candidates)
+        && s.transparency.is_some_and(|t| t.candidate_list > 0)
         && a.objects.iter().any(|o| o.extras.has_core());
     let mut shared = || -> Result<SharedMeshletScene, RenderError> {
         if meshlets.is_none() {
-            let candidates = if listing_candidates { INITIAL_CANDIDATES } else { 0 };
+            let candidates = if listing_candidates { s.transparency.map_or(0, |t| t.candidate_list) } else { 0 };
             let lists = (s.raster.bin_list().unwrap_or(0), s.raster.lists_grow(), candidates);
             *meshlets = Some(MeshletScene::new(ctx, a.scene.meshlets()?, lists)?);
         }

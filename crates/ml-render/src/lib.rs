@@ -83,7 +83,7 @@ pub use shadows::ray_geometry::RayStats;
 pub use shadows::stores::SHADOW_MAP_SIZE;
 pub use targets::{gbuffer_bytes_per_pixel, gbuffer_images, GBufferImage, GBufferKind};
 pub use transparency::{
-    TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, LAYER_KEEP,
+    TransparencySettings, TransparencyStats, DEFAULT_BUDGET as DEFAULT_TRANSPARENCY_BUDGET, DEFAULT_CANDIDATE_LIST, LAYER_KEEP,
     MAX_BUDGET as MAX_TRANSPARENCY_BUDGET,
 };
 pub use visibility::meshlet_cull::CullStats;

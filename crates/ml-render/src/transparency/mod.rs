@@ -58,10 +58,14 @@ pub struct TransparencySettings {
     /// (`node_bytes`; settled by the renderer from the scene).
     pub lobe_textures: bool,
     /// Without anti-aliasing, the compute raster lists the soft samples of transparent
-    /// objects' cores for the layers (transparent_build_candidates.glsl); else the
-    /// per-triangle build takes the cores (tests compare the two by switching this off).
-    pub candidates: bool,
+    /// objects' cores for the layers (transparent_build_candidates.glsl), its list holding
+    /// this many at first (it grows after a frame that listed more; 0: it lists none, and the
+    /// per-triangle build takes the cores, as with samples).
+    pub candidate_list: u32,
 }
+
+/// Layer candidates the compute raster's list holds at first (16 MiB).
+pub const DEFAULT_CANDIDATE_LIST: u32 = 1 << 20;
 
 impl Default for TransparencySettings {
     fn default() -> Self {
@@ -69,7 +73,7 @@ impl Default for TransparencySettings {
             budget: DEFAULT_BUDGET,
             tiled_up_to: crate::gpu_mesh::COMPUTE_LAYER_TRIANGLES,
             lobe_textures: false,
-            candidates: true,
+            candidate_list: DEFAULT_CANDIDATE_LIST,
         }
     }
 }

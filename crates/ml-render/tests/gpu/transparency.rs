@@ -35,7 +35,7 @@ use ml_cpu::shading::{aces_tone_map, encode_gamma_unorm8, shade_seed};
 use ml_cpu::transparency::{composite, Layer};
 use ml_render::{
     Antialiasing, CullStats, Raster, RenderOutput, RenderSettings, Renderer, ShadingModel, Technique, TransparencySettings,
-    TransparencyStats, LAYER_KEEP,
+    TransparencyStats, DEFAULT_CANDIDATE_LIST, LAYER_KEEP,
 };
 use serde_json::json;
 
@@ -586,7 +586,11 @@ fn the_forest_is_the_same_from_either_build() {
     let forest = blend_forest();
     let with = |(technique, antialiasing), tiled_up_to, candidates| RenderSettings {
         shading: ShadingModel::Pbr,
-        transparency: Some(TransparencySettings { tiled_up_to, candidates, ..TransparencySettings::default() }),
+        transparency: Some(TransparencySettings {
+            tiled_up_to,
+            candidate_list: if candidates { DEFAULT_CANDIDATE_LIST } else { 0 },
+            ..TransparencySettings::default()
+        }),
         antialiasing,
         ..settings(technique)
     };
@@ -639,18 +643,40 @@ fn a_frame_whose_raster_cannot_list_a_core_builds_the_cores_a_thread_per_triangl
     let (lo, hi) = crown.bounds();
     let eye = (lo + hi) * 0.5;
     forest.camera = Camera::looking_at(eye, eye + Vec3::new(1.0, -0.2, 0.3), 70.0, 0.05, 100.0);
-    let with = |candidates| RenderSettings {
+    let with = |candidate_list| RenderSettings {
         shading: ShadingModel::Pbr,
-        transparency: Some(TransparencySettings { candidates, ..TransparencySettings::default() }),
+        transparency: Some(TransparencySettings { candidate_list, ..TransparencySettings::default() }),
         ..settings(Technique::Visibility)
     };
-    let out = common::render_each(&forest, &[with(true), with(false)]);
+    let out = common::render_each(&forest, &[with(DEFAULT_CANDIDATE_LIST), with(0)]);
     let cull = *out[0].stats.feature::<CullStats>().expect("culling stats");
     assert!(cull.cores_per_triangle, "{cull:?}");
     assert!(stats(&out[0]).fragments > 0);
     assert!(out[0].rgba == out[1].rgba);
     let row = out[0].stats.feature_rows().into_iter().find(|(name, _)| *name == "layer candidates").expect("a row of its own").1;
     assert!(row.contains("built a thread per triangle"), "{row}");
+}
+
+/// A candidates' list too short for the forest's soft samples: the frame's cores are left to
+/// the per-triangle build (its bytes; the table says the list was full), the list grows, and
+/// a later frame lists them all — the image a list long enough from the start gives.
+#[test]
+fn a_full_list_of_candidates_builds_the_cores_a_thread_per_triangle_and_grows() {
+    let forest = blend_forest();
+    let with = |candidate_list, frames| RenderSettings {
+        shading: ShadingModel::Pbr,
+        transparency: Some(TransparencySettings { candidate_list, ..TransparencySettings::default() }),
+        frames,
+        ..settings(Technique::Visibility)
+    };
+    let out = common::render_each(&forest, &[with(16, 1), with(0, 1), with(16, 4), with(DEFAULT_CANDIDATE_LIST, 1)]);
+    let (full, grown) = (*out[0].stats.feature::<CullStats>().unwrap(), *out[2].stats.feature::<CullStats>().unwrap());
+    assert!(full.cores_per_triangle && full.layer_candidates > 16 && full.candidate_room == 16, "{full:?}");
+    let row = out[0].stats.feature_rows().into_iter().find(|(name, _)| *name == "layer candidates").expect("a row of its own").1;
+    assert!(row.contains("the list was full"), "{row}");
+    assert!(out[0].rgba == out[1].rgba, "the full list's frame is not the per-triangle build's");
+    assert!(!grown.cores_per_triangle && grown.candidate_room >= grown.layer_candidates as u32, "{grown:?}");
+    assert!(out[2].rgba == out[3].rgba, "the grown list's frame is not the long list's");
 }
 
 /// A mesh of one object whose two triangles meet at every point of a pixel (the same square
