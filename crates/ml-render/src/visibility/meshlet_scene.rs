@@ -34,7 +34,7 @@ pub const TRIANGLE_IDS: BufferName = BufferName("TriangleIdBuffer");
 pub const LARGE_BINS: BufferName = BufferName("LargeBinBuffer");
 pub const LARGE_TRIANGLES: BufferName = BufferName("LargeTriangleBuffer");
 
-/// Bytes of a layer candidate (triangle_raster.glsl: a uvec4).
+/// Bytes of a layer candidate (layer_candidates.glsl: a uvec4).
 const CANDIDATE_BYTES: u64 = 16;
 
 /// The culling's buffers of one frame slot.
@@ -54,7 +54,7 @@ pub struct CullFrame {
     pub large_bins: Buffer,
     pub large_capacity: u32,
     /// The compute raster's candidates for the transparent layers (cores of transparent
-    /// objects: triangle_raster.glsl), `candidate_capacity` of them (1 where it lists none).
+    /// objects: layer_candidates.glsl), `candidate_capacity` of them (1 where it lists none).
     pub layer_candidates: Buffer,
     pub candidate_capacity: u32,
 }
