@@ -270,9 +270,9 @@ struct CullCounters {
                                  // groups (bins listed, at most MAX_GROUPS), 1, 1
     uvec4 binned;                // x, y: bins listed early, late; z, w: large triangles found early,
                                  // late (past the lists' capacity too)
-    uvec4 candidates;            // compute raster, transparent cores: x: (pixel, triangle) candidates
-                                 // listed for the layers (past the list's room too); y: 1 where
-                                 // the per-triangle build must build the cores instead
+    uvec4 candidates;            // compute raster, transparent cores: x: soft samples listed for
+                                 // the layers (past the list's room too); y: 1 where the
+                                 // per-triangle build must build the cores instead
     uvec4 candidate_groups;      // the candidates' build's work groups (at most 65535), 1, 1
 };
 

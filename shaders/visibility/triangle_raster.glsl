@@ -408,8 +408,7 @@ void draw_masked_meshlet(Meshlet m, uvec4 d, bool culling, uint flags, SurfaceTe
                 } else if (r == ROUTE_LARGE) {
                     pixels += list_large(a, b, c, id, flags, d.y, s);
                 } else if (r == ROUTE_COMPUTE) {
-                    vec3 z = vec3(a.z / a.w, b.z / b.w, c.z / c.w);
-                    box_pixels = set_up_masked(lid, pa, pb, pc, z, both_faces, s);
+                    box_pixels = set_up_masked(lid, pa, pb, pc, vec3(a.z / a.w, b.z / b.w, c.z / c.w), both_faces, s);
                     triangles++;
                 }
             }

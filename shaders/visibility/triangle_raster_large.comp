@@ -57,8 +57,8 @@ void main() {
         ivec2 lo = bin * BIN, hi = lo + BIN - 1;
         i64vec2 s0 = large_corner(at, 0);
         vec4 q0 = large_depth(at, 0);
-        // A core's soft samples listed: a pixel once, its triangle whole (unclipped, one fan
-        // triangle), else the cores are left to the per-triangle build.
+        // A core's soft samples listed where its triangle is whole (unclipped), else the cores
+        // are left to the per-triangle build.
         bool listing = MASK_TESTS && head.z != NOT_MASKED && lists_candidates(objects[head.z].alpha_texture.x);
         if (listing && head.x != 3u) {
             if (lid == 0u) {

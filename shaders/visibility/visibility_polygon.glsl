@@ -76,9 +76,6 @@ vec4 large_depth(uint at, int k) {
     return vec4(large_triangles[at].depths[k >> 2][k & 3], 0.0, 0.0, 0.0);
 }
 
-// Sample k of every `step`-th pixel of each row of [from, to] (from from.x on) that the fan
-// triangle covers (and `s` keeps) drawn with visibility id `id`, the edge functions stepped
-// from pixel to pixel (exact: integers); returns the samples covered.
 #ifdef MANYLIGHTS_LAYER_CANDIDATES_GLSL
 // A transparent core's alpha at the point `xy` (in pixels) as the raster needs it
 // (core_sample_alpha).
@@ -89,6 +86,10 @@ float core_alpha_at(SurfaceTest s, vec2 xy, vec2 size) {
 }
 #endif
 
+// Sample k of every `step`-th pixel of each row of [from, to] (from from.x on) that the fan
+// triangle covers (and `s` keeps) drawn with visibility id `id`, the edge functions stepped
+// from pixel to pixel (exact: integers); returns the samples covered. Where `listing`, a
+// transparent core's: its soft samples listed for the layers (layer_candidates.glsl).
 uint fan_samples(FanTriangle t, ivec2 from, ivec2 to, int step, uint k, uint id, SurfaceTest s, bool listing) {
     // Per sub-pixel to the right and down, each edge function changes by −d.y and d.x.
     i64vec3 unit_x = -i64vec3(t.c.y - t.b.y, t.a.y - t.c.y, t.b.y - t.a.y);

@@ -384,8 +384,8 @@ gpu_struct!(
         /// x, y: bins listed early, late; z, w: large triangles found early, late (past the
         /// lists' capacity too).
         binned: [u32; 4],
-        /// The compute raster, transparent objects' cores: x: (pixel, triangle) candidates
-        /// listed for the layers' build (past the list's room too); y: 1 where the
+        /// The compute raster, transparent objects' cores: x: soft samples listed for the
+        /// layers' build (past the list's room too); y: 1 where the
         /// per-triangle build must build the cores instead (a core triangle too large for
         /// the list, or the list full).
         candidates: [u32; 4],

@@ -5,10 +5,10 @@
 //! thread per triangle (transparent_build_triangles.glsl), which lists its triangles too
 //! large for a thread for a work group each (transparent_build_large.glsl) and the huge ones
 //! for the tiles' build. Runs after the opaque raster, before the resolve; clears the slot's
-//! lists first. Where the compute raster lists the pixels of transparent objects' cores as
-//! candidates (`TransparencySettings::candidates`), a fourth build tests those
-//! (transparent_build_candidates.glsl), and the per-triangle build takes the cores only in a
-//! frame whose raster could not list them all.
+//! lists first. Where the compute raster lists the soft samples of transparent objects' cores
+//! as candidates (no anti-aliasing; `TransparencySettings::candidate_list`), a fourth build
+//! makes their nodes (transparent_build_candidates.glsl), and the per-triangle build takes the
+//! cores only in a frame whose raster could not list them all.
 
 use super::{node_bytes, LayerBuffers, TransparencySettings, TransparencyStats, LAYER_BUFFERS};
 use crate::compute_pass::ComputePass;

@@ -219,11 +219,9 @@ impl MeshletScene {
         }
         let asked = self.counters(slot).candidates[0];
         let limit = ctx.info.limits.max_storage_buffer_range as u64 / CANDIDATE_BYTES;
-        let wanted = if asked > held { (u64::from(asked) * 3 / 2).min(limit) as u32 } else { 0 };
-        let capacity = wanted.max(self.candidates_grown);
-        if capacity <= held {
+        let Some(capacity) = grown_size(held, asked, limit, self.candidates_grown) else {
             return Ok(false);
-        }
+        };
         self.candidates_grown = capacity;
         let list = candidate_list(ctx, capacity)?;
         let f = &mut self.frames[slot];
@@ -241,9 +239,7 @@ impl MeshletScene {
         // Bins and large triangles asked for, per phase: the shader counts past the lists.
         let asked = self.counters(slot).binned.into_iter().max().unwrap_or(0);
         let limit = ctx.info.limits.max_storage_buffer_range as u64 / size_of::<LargeTriangle>() as u64;
-        let wanted = if asked > held { (u64::from(asked) * 3 / 2).min(limit) as u32 } else { 0 };
-        let capacity = wanted.max(self.grown);
-        (capacity > held).then_some(capacity)
+        grown_size(held, asked, limit, self.grown)
     }
 
     /// Whether slot `slot`'s finished frame drew large triangles in place, which its lists,
@@ -265,6 +261,14 @@ impl MeshletScene {
         self.frames.clear();
         self.readback.destroy(ctx);
     }
+}
+
+/// The size a list holding `held` entries grows to after a frame that asked for `asked`: 1.5×
+/// that, at most `limit`, or what another slot's list grew to (`grown`); None where it stays.
+fn grown_size(held: u32, asked: u32, limit: u64, grown: u32) -> Option<u32> {
+    let wanted = if asked > held { (u64::from(asked) * 3 / 2).min(limit) as u32 } else { 0 };
+    let capacity = wanted.max(grown);
+    (capacity > held).then_some(capacity)
 }
 
 /// The compute raster's list of `capacity` layer candidates.
